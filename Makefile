@@ -1,0 +1,124 @@
+# robin_contact: two-body frictionless contact by Robin domain decomposition.
+# Plain Makefile, explicit module dependencies. `make -j2` works.
+#   make            build bin/robin_contact (installs missing Debian packages first)
+#   make run        build and solve inputs/default.nml
+#   make check      build and run every test (last line: N passed, M failed)
+#   make DEBUG=1    checked build (-fcheck=all, FP traps, backtrace) in build/debug
+
+FC      ?= gfortran
+CC      ?= gcc
+PYTHON  ?= /usr/bin/python3
+DEBUG   ?= 0
+ifeq ($(origin FC),default)
+FC := gfortran
+endif
+
+ifeq ($(DEBUG),1)
+BUILD   := build/debug
+FOPT    := -g -O0 -fcheck=all -ffpe-trap=invalid,zero,overflow -fbacktrace
+COPT    := -g -O0
+else
+BUILD   := build/release
+FOPT    := -O2 -g
+COPT    := -O2 -g
+endif
+
+HDF5_INC := /usr/include/hdf5/serial
+HDF5_LIB := /usr/lib/x86_64-linux-gnu/hdf5/serial
+FFLAGS  := $(FOPT) -fopenmp -ffree-line-length-none -Wall -Wno-maybe-uninitialized -Wno-compare-reals \
+           -J$(BUILD) -I$(BUILD) -I$(HDF5_INC) $(EXTRA_FFLAGS)
+CFLAGS  := $(COPT) -fopenmp -Wall -Iinclude -I/usr/include/suitesparse $(EXTRA_CFLAGS)
+LDLIBS  := -L$(HDF5_LIB) -lhdf5_fortran -lhdf5 -lcholmod -lsuitesparseconfig -lmetis -llapack -lopenblas -lm
+
+BIN     := bin
+PROG    := $(BIN)/robin_contact
+
+# Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
+# condensation -> contact iteration -> output).
+MODS := kinds errors config sysinfo deck mesh assembly linop mprgp cholmod_iface banded cholesky \
+        condense contact results
+OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o
+
+TESTS_F := test_deck test_mprgp test_cholesky test_fem test_equilibrium test_contact
+BENCH_F := bench_mprgp
+TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
+BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
+
+DEPS_STAMP := build/.deps-ok
+
+.PHONY: all run check bench-mprgp table1 bench hard plots clean deps FORCE
+all: $(PROG)
+
+# ---- system packages: install what is missing (Debian 12) --------------------
+$(DEPS_STAMP): tools/install-deps.sh
+	@if command -v $(FC) >/dev/null 2>&1 && command -v $(CC) >/dev/null 2>&1 \
+	   && [ -f /usr/include/suitesparse/cholmod.h ] && [ -f $(HDF5_INC)/hdf5.mod ] \
+	   && [ -f /usr/include/metis.h ] && [ -e /usr/lib/x86_64-linux-gnu/libopenblas.so ] \
+	   && [ -e /usr/lib/x86_64-linux-gnu/liblapack.so ] \
+	   && [ -x $(PYTHON) ] && $(PYTHON) -c 'import numpy, h5py, meshio, matplotlib' 2>/dev/null; then :; \
+	 else bash tools/install-deps.sh; fi
+	@mkdir -p build && touch $@
+deps: $(DEPS_STAMP)
+
+# ---- compile -------------------------------------------------------------------
+$(BUILD)/%.o: src/%.f90 | $(DEPS_STAMP)
+	@mkdir -p $(BUILD)
+	$(FC) $(FFLAGS) -c $< -o $@
+
+$(BUILD)/%.o: src/%.c include/cholmod_shim.h | $(DEPS_STAMP)
+	@mkdir -p $(BUILD)
+	$(CC) $(CFLAGS) -c $< -o $@
+
+# Explicit module dependencies.
+$(BUILD)/errors.o:
+$(BUILD)/config.o:        $(BUILD)/kinds.o
+$(BUILD)/sysinfo.o:       $(BUILD)/kinds.o
+$(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o
+$(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o
+$(BUILD)/linop.o:         $(BUILD)/kinds.o
+$(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/linop.o
+$(BUILD)/cholmod_iface.o: $(BUILD)/kinds.o
+$(BUILD)/banded.o:        $(BUILD)/kinds.o
+$(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
+                          $(BUILD)/assembly.o $(BUILD)/cholesky.o
+$(BUILD)/contact.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/linop.o \
+                          $(BUILD)/mprgp.o $(BUILD)/condense.o
+$(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
+                          $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact.o
+$(BUILD)/robin_contact.o: $(OBJS)
+
+# ---- link ----------------------------------------------------------------------
+$(BUILD)/robin_contact: $(BUILD)/robin_contact.o $(OBJS)
+	$(FC) $(FFLAGS) -o $@ $^ $(LDLIBS)
+
+$(PROG): $(BUILD)/robin_contact FORCE
+	@mkdir -p $(BIN)
+	@cmp -s $< $@ || cp $< $@
+
+$(BUILD)/tests/%.o: tests/%.f90 $(OBJS)
+	@mkdir -p $(BUILD)/tests
+	$(FC) $(FFLAGS) -c $< -o $@
+
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(OBJS)
+	$(FC) $(FFLAGS) -o $@ $< $(OBJS) $(LDLIBS)
+
+# ---- user targets ----------------------------------------------------------------
+run: $(PROG)
+	@mkdir -p results
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PROG) inputs/default.nml
+
+check: $(PROG) $(TEST_BINS)
+	@BUILD=$(BUILD) PYTHON=$(PYTHON) bash tests/run_tests.sh
+
+bench-mprgp: $(BENCH_BINS)
+	$(BUILD)/tests/bench_mprgp
+
+table1: $(PROG)
+	$(PYTHON) tools/table1.py --bin $(PROG) --csv results/table1.csv
+
+clean:
+	rm -rf build bin
+
+.SECONDARY:

@@ -1,0 +1,82 @@
+/* cholmod_shim.h: a thin C layer over CHOLMOD (int API, supernodal LL').
+ *
+ * One opaque handle per matrix/factor.  Each handle owns its own
+ * cholmod_common, so two threads may work on two different handles at the
+ * same time; one handle must not be used by two threads at once.
+ *
+ * Every function returns one of the CHSH_* codes and, on failure, writes one
+ * NUL-terminated sentence into msg (at most msglen bytes, msglen >= 1).
+ * All index arrays are 0-based C int; dense arrays are column-major.
+ */
+#ifndef CHOLMOD_SHIM_H
+#define CHOLMOD_SHIM_H
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* status codes (match module cholesky's info values) */
+#define CHSH_OK             0
+#define CHSH_NOT_POSDEF     1
+#define CHSH_OUT_OF_MEMORY  2
+#define CHSH_FAILURE        3
+
+/* fill-reducing orderings (match module cholesky's ORD_* values) */
+#define CHSH_ORD_METIS      1
+#define CHSH_ORD_AMD        2
+#define CHSH_ORD_NATURAL    3
+
+typedef struct chsh_factor chsh_factor;   /* opaque */
+
+/* Statistics of the last analysis/factorization of a handle. */
+typedef struct chsh_stats {
+    double t_analyze;     /* wall time of ordering + symbolic analysis [s] */
+    double t_factor;      /* wall time of numeric factorization [s] */
+    double lnz;           /* nnz(L), fundamental (no supernodal padding) */
+    double lsize;         /* entries stored in the supernodal L (with padding) */
+    double flops;         /* LL' flop count (Common->fl) */
+    double mem_peak;      /* peak CHOLMOD memory of this handle [bytes] */
+    double mem_inuse;     /* CHOLMOD memory in use now [bytes] */
+    int    n;             /* matrix order */
+    int    nlast;         /* number of DOFs requested last */
+    int    last_ok;       /* 1 if L->Perm ends with exactly those DOFs, in order */
+    int    is_super;      /* 1 if L is supernodal */
+} chsh_stats;
+
+/* Create an empty handle (also holds OpenBLAS to one thread, once). */
+int chsh_create(chsh_factor **h, char *msg, int msglen);
+
+/* Analyze + factorize a symmetric positive definite matrix given in full
+ * symmetric CSC (both triangles; only the upper triangle is read).
+ * colptr[n+1], rowind[colptr[n]], val[colptr[n]]; rows sorted per column.
+ * ordering: CHSH_ORD_*.  last[nlast] (may be NULL when nlast == 0): DOFs to be
+ * ordered last, in this order (the interface).  A previous factor in the
+ * handle is released first. */
+int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
+                   const double *val, int ordering, int nlast, const int *last,
+                   char *msg, int msglen);
+
+/* Solve K X = B in place: b is n x nrhs with leading dimension ldb >= n. */
+int chsh_solve(chsh_factor *h, int nrhs, double *b, int ldb,
+               char *msg, int msglen);
+
+/* Release the solve workspace kept between solves (it is kept to make
+ * repeated solves with the same nrhs cheap). */
+void chsh_release_workspace(chsh_factor *h);
+
+/* Copy the trailing m x m diagonal block of L (lower triangle, zeros above)
+ * into lg (column-major, leading dimension ldlg >= m).  Row/column i of the
+ * block is DOF last[i] when stats.last_ok is 1. */
+int chsh_trailing_block(chsh_factor *h, int m, double *lg, int ldlg,
+                        char *msg, int msglen);
+
+/* Fill *st with the statistics of the handle. */
+int chsh_get_stats(const chsh_factor *h, chsh_stats *st);
+
+/* Free everything owned by the handle and set *h to NULL (NULL is fine). */
+void chsh_free(chsh_factor **h);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* CHOLMOD_SHIM_H */

@@ -1,0 +1,447 @@
+!> Sparse Cholesky factorization of one symmetric positive definite matrix, behind one
+!! type: CHOLMOD (supernodal, through cholmod_iface) or a banded LAPACK factorization
+!! (module banded). Also forms the interface flexibility F = E (K^-1)_GG E.
+!!
+!! With FACT_CHOLMOD and the interface DOFs G ordered last, P K P' = L L' has a
+!! trailing block L_G with L_G L_G' = S (Schur complement of K on G), so
+!! (K^-1)_GG = S^-1 comes from one LAPACK `dpotri` on L_G: the condensation costs
+!! about one factorization instead of m solves. Otherwise F is formed by blocked
+!! solves with unit right-hand sides.
+!!
+!! One chol_t owns one factorization; two chol_t may be used from two threads at
+!! once, one chol_t must not. Do not copy a chol_t (it owns a C handle): pass it
+!! by reference and release it with `free`.
+module cholesky
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int
+  use kinds, only: wp, ip, i8
+  use cholmod_iface, only: cm_stats_t, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
+                           cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
+                           CM_ORD_AMD, CM_ORD_NATURAL
+  use banded, only: band_t
+  implicit none
+  private
+
+  integer, parameter, public :: FACT_CHOLMOD = 1   !< CHOLMOD supernodal LL'
+  integer, parameter, public :: FACT_BANDED = 2    !< RCM + LAPACK band Cholesky
+
+  integer, parameter, public :: ORD_METIS = 1      !< METIS nested dissection (CHOLMOD)
+  integer, parameter, public :: ORD_AMD = 2        !< AMD, or CAMD when an interface is given
+  integer, parameter, public :: ORD_NATURAL = 3    !< natural order (interface last if given)
+
+  integer, parameter, public :: CHOL_OK = 0          !< info: success
+  integer, parameter, public :: CHOL_NOT_POSDEF = 1  !< info: matrix not positive definite
+  integer, parameter, public :: CHOL_NO_MEMORY = 2   !< info: out of memory / too large
+  integer, parameter, public :: CHOL_FAILURE = 3     !< info: any other failure
+
+  !> One factorization of one symmetric positive definite matrix K (n x n).
+  type, public :: chol_t
+    integer :: method = 0                 !< FACT_CHOLMOD, FACT_BANDED, or 0 when empty/failed
+    integer :: ordering = 0               !< ORD_* requested (FACT_CHOLMOD)
+    integer :: n = 0                      !< matrix order
+    integer :: m_last = 0                 !< number of DOFs ordered last (interface)
+    integer, allocatable :: last(:)       !< those DOFs, 1-based, in the order given
+    real(wp) :: t_analyze = 0.0_wp        !< ordering + symbolic analysis wall time [s]
+    real(wp) :: t_factor = 0.0_wp         !< numeric factorization wall time [s]
+    integer(i8) :: nnz_factor = 0         !< nonzeros in L (CHOLMOD: without supernodal padding)
+    real(wp) :: flops = 0.0_wp            !< factorization flop count
+    integer(i8) :: mem_bytes = 0          !< peak memory of the factorization [bytes]
+    integer :: bandwidth = -1             !< half-bandwidth (FACT_BANDED), else -1
+    logical :: interface_last_ok = .false.  !< true if L's permutation ends with `last`, in order
+    type(c_ptr), private :: handle = c_null_ptr
+    type(band_t), private :: band
+  contains
+    procedure :: factor => chol_factor
+    procedure, private :: chol_solve_vec
+    procedure, private :: chol_solve_mat
+    generic :: solve => chol_solve_vec, chol_solve_mat
+    procedure :: flexibility => chol_flexibility
+    procedure :: summary => chol_summary
+    procedure :: free => chol_free
+  end type chol_t
+
+  interface
+    subroutine dpotri(uplo, n, a, lda, info)
+      import :: wp
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, lda
+      real(wp), intent(inout) :: a(lda, *)
+      integer, intent(out) :: info
+    end subroutine dpotri
+  end interface
+
+contains
+
+  !> Factorize K, given in full symmetric CSC (both triangles, 0-based, rows sorted
+  !! increasingly in each column, K symmetric).
+  !! info: 0 ok; 1 not positive definite; 2 out of memory; 3 other failure (msg says which).
+  subroutine chol_factor(self, n, colptr, rowind, val, method, ordering, info, msg, last)
+    class(chol_t), intent(inout) :: self
+    integer, intent(in) :: n                    !< matrix order
+    integer(ip), intent(in) :: colptr(:)        !< column pointers, size n+1, 0-based
+    integer(ip), intent(in) :: rowind(:)        !< row indices, 0-based, size >= colptr(n+1)
+    real(wp), intent(in) :: val(:)              !< values, size >= colptr(n+1)
+    integer, intent(in) :: method               !< FACT_CHOLMOD or FACT_BANDED
+    integer, intent(in) :: ordering             !< ORD_METIS, ORD_AMD or ORD_NATURAL (CHOLMOD)
+    integer, intent(out) :: info                !< status code (see above)
+    character(len=*), intent(out) :: msg        !< one sentence on failure, else blank
+    integer, intent(in), optional :: last(:)    !< 1-based DOFs to order last (interface), CHOLMOD
+    integer :: j, p, nnz, k
+    logical, allocatable :: seen(:)
+    integer(c_int), allocatable :: last0(:)
+    type(cm_stats_t) :: st
+    character(len=200) :: emsg
+
+    call self%free()
+    info = CHOL_OK
+    msg = ''
+
+    ! ---- check arguments ----
+    if (n < 1) then
+      write (emsg, '(a,i0,a)') 'Cholesky: matrix order n = ', n, ' must be positive.'
+      call fail(CHOL_FAILURE, emsg)
+      return
+    end if
+    if (size(colptr) < n + 1) then
+      call fail(CHOL_FAILURE, 'Cholesky: colptr is shorter than n+1.')
+      return
+    end if
+    if (colptr(1) /= 0) then
+      call fail(CHOL_FAILURE, 'Cholesky: colptr(1) must be 0 (0-based CSC).')
+      return
+    end if
+    nnz = colptr(n + 1)
+    if (size(rowind) < nnz .or. size(val) < nnz) then
+      call fail(CHOL_FAILURE, 'Cholesky: rowind or val is shorter than colptr(n+1).')
+      return
+    end if
+    do j = 1, n
+      if (colptr(j + 1) < colptr(j)) then
+        write (emsg, '(a,i0,a)') 'Cholesky: colptr decreases at column ', j, '.'
+        call fail(CHOL_FAILURE, emsg)
+        return
+      end if
+      do p = colptr(j) + 1, colptr(j + 1)
+        if (rowind(p) < 0 .or. rowind(p) >= n) then
+          write (emsg, '(a,i0,a,i0,a)') 'Cholesky: row index ', rowind(p), ' out of range in column ', j, '.'
+          call fail(CHOL_FAILURE, emsg)
+          return
+        end if
+        if (p > colptr(j) + 1) then
+          if (rowind(p) <= rowind(p - 1)) then
+            write (emsg, '(a,i0,a)') 'Cholesky: row indices not strictly increasing in column ', j, '.'
+            call fail(CHOL_FAILURE, emsg)
+            return
+          end if
+        end if
+      end do
+    end do
+    if (method /= FACT_CHOLMOD .and. method /= FACT_BANDED) then
+      write (emsg, '(a,i0,a)') 'Cholesky: unknown factorization method ', method, '.'
+      call fail(CHOL_FAILURE, emsg)
+      return
+    end if
+    if (method == FACT_CHOLMOD .and. (ordering < ORD_METIS .or. ordering > ORD_NATURAL)) then
+      write (emsg, '(a,i0,a)') 'Cholesky: unknown ordering ', ordering, '.'
+      call fail(CHOL_FAILURE, emsg)
+      return
+    end if
+    if (present(last)) then
+      allocate (seen(n))
+      seen = .false.
+      do k = 1, size(last)
+        if (last(k) < 1 .or. last(k) > n) then
+          write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
+          call fail(CHOL_FAILURE, emsg)
+          return
+        end if
+        if (seen(last(k))) then
+          write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
+          call fail(CHOL_FAILURE, emsg)
+          return
+        end if
+        seen(last(k)) = .true.
+      end do
+      self%last = last
+    else
+      allocate (self%last(0))
+    end if
+    self%m_last = size(self%last)
+    self%n = n
+    self%ordering = ordering
+
+    ! ---- factorize ----
+    select case (method)
+    case (FACT_CHOLMOD)
+      call cm_create(self%handle, info, msg)
+      if (info /= CHOL_OK) return
+      allocate (last0(self%m_last))
+      last0 = int(self%last - 1, c_int)
+      call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, info, msg)
+      st = cm_get_stats(self%handle)
+      self%t_analyze = st%t_analyze
+      self%t_factor = st%t_factor
+      self%nnz_factor = int(st%lnz, i8)
+      self%flops = st%flops
+      self%mem_bytes = int(st%mem_peak, i8)
+      self%interface_last_ok = (st%last_ok == 1 .and. self%m_last > 0)
+      if (info /= CHOL_OK) then
+        call cm_free(self%handle)
+        return
+      end if
+    case (FACT_BANDED)
+      call self%band%factor(n, colptr, rowind, val, info, msg)
+      self%t_analyze = self%band%t_order
+      self%t_factor = self%band%t_factor
+      self%bandwidth = self%band%kd
+      if (info /= CHOL_OK) return
+      self%nnz_factor = int(n, i8) * int(self%band%kd + 1, i8) &
+                        - int(self%band%kd, i8) * int(self%band%kd + 1, i8) / 2
+      self%flops = real(n, wp) * real(self%band%kd, wp) * real(self%band%kd + 3, wp)
+      self%mem_bytes = int(size(self%band%ab, kind=i8) * 8_i8, i8)
+    end select
+    self%method = method
+
+  contains
+
+    subroutine fail(code, text)
+      integer, intent(in) :: code
+      character(len=*), intent(in) :: text
+      info = code
+      msg = text
+    end subroutine fail
+
+  end subroutine chol_factor
+
+  !> Map ORD_* to the shim's codes.
+  pure integer function cm_ordering(ordering)
+    integer, intent(in) :: ordering
+    select case (ordering)
+    case (ORD_METIS)
+      cm_ordering = CM_ORD_METIS
+    case (ORD_AMD)
+      cm_ordering = CM_ORD_AMD
+    case default
+      cm_ordering = CM_ORD_NATURAL
+    end select
+  end function cm_ordering
+
+  !> Solve K x = b in place (one right-hand side). info: 0 ok, 2 out of memory, 3 failure.
+  subroutine chol_solve_vec(self, b, info, msg)
+    class(chol_t), intent(in) :: self
+    real(wp), intent(inout), target, contiguous :: b(:)   !< right-hand side in, solution out
+    integer, intent(out) :: info                          !< status code
+    character(len=*), intent(out), optional :: msg        !< one sentence on failure
+    real(wp), pointer, contiguous :: b2(:, :)
+    b2(1:size(b), 1:1) => b
+    call chol_solve_mat(self, b2, info, msg)
+  end subroutine chol_solve_vec
+
+  !> Solve K X = B in place (columns of b). info: 0 ok, 2 out of memory, 3 failure.
+  subroutine chol_solve_mat(self, b, info, msg)
+    class(chol_t), intent(in) :: self
+    real(wp), intent(inout), contiguous :: b(:, :)   !< right-hand sides in, solutions out (n x nrhs)
+    integer, intent(out) :: info                     !< status code
+    character(len=*), intent(out), optional :: msg   !< one sentence on failure
+    character(len=512) :: emsg
+    emsg = ''
+    info = CHOL_OK
+    if (self%method == 0) then
+      info = CHOL_FAILURE
+      emsg = 'Cholesky: solve called without a valid factorization.'
+    else if (size(b, 1) /= self%n) then
+      info = CHOL_FAILURE
+      write (emsg, '(a,i0,a,i0,a)') 'Cholesky: right-hand side length ', size(b, 1), &
+        ' differs from the matrix order ', self%n, '.'
+    else if (self%method == FACT_CHOLMOD) then
+      call cm_solve(self%handle, b, info, emsg)
+    else
+      call self%band%solve(b, info, emsg)
+    end if
+    if (present(msg)) msg = emsg
+  end subroutine chol_solve_mat
+
+  !> Interface flexibility F(i,j) = sgn(i) sgn(j) (K^-1)(idx(i), idx(j)), m = size(idx),
+  !! symmetric, full storage. Uses the trailing block of L when the factorization
+  !! is CHOLMOD with every idx(i) among the DOFs ordered last and the ordering check
+  !! passed; otherwise blocked solves with unit right-hand sides.
+  !! info: 0 ok; 1 Schur complement not positive definite; 2 out of memory; 3 failure.
+  subroutine chol_flexibility(self, idx, sgn, F, info, msg, use_solves, used_block)
+    class(chol_t), intent(in) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based DOFs of the interface rows
+    real(wp), intent(in) :: sgn(:)                !< row scaling (the +-1 signs of E), size(idx)
+    real(wp), intent(out) :: F(:, :)              !< m x m flexibility [K^-1 units]
+    integer, intent(out) :: info                  !< status code
+    character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
+    logical, intent(in), optional :: use_solves   !< force the solve-based path (default false)
+    logical, intent(out), optional :: used_block  !< true if the trailing-block path was used
+    integer :: m, i, j, k, st
+    integer, allocatable :: pos(:)
+    logical :: try_block
+    character(len=200) :: emsg
+
+    info = CHOL_OK
+    msg = ''
+    if (present(used_block)) used_block = .false.
+    m = size(idx)
+    if (self%method == 0) then
+      info = CHOL_FAILURE
+      msg = 'Cholesky: flexibility requested without a valid factorization.'
+      return
+    end if
+    if (size(sgn) /= m .or. size(F, 1) /= m .or. size(F, 2) /= m) then
+      info = CHOL_FAILURE
+      write (emsg, '(a,i0,a)') 'Cholesky: flexibility needs sgn(', m, ') and F(m,m) for m = size(idx).'
+      msg = emsg
+      return
+    end if
+    if (m == 0) return
+    do i = 1, m
+      if (idx(i) < 1 .or. idx(i) > self%n) then
+        info = CHOL_FAILURE
+        write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', idx(i), ' (entry ', i, ') is out of range.'
+        msg = emsg
+        return
+      end if
+    end do
+
+    try_block = self%method == FACT_CHOLMOD .and. self%interface_last_ok .and. self%m_last > 0
+    if (present(use_solves)) try_block = try_block .and. .not. use_solves
+    if (try_block) then
+      allocate (pos(self%n), stat=st)
+      if (st /= 0) then
+        try_block = .false.
+      else
+        pos = 0
+        do k = 1, self%m_last
+          pos(self%last(k)) = k
+        end do
+        try_block = all(pos(idx) > 0)
+      end if
+    end if
+
+    if (try_block) then
+      call flex_block()
+      if (present(used_block)) used_block = (info == CHOL_OK)
+    else
+      call flex_solves()
+    end if
+
+  contains
+
+    !> F from the trailing block L_G: (K^-1)_GG = (L_G L_G')^-1 via dpotri.
+    subroutine flex_block()
+      real(wp), allocatable :: lg(:, :)
+      integer :: ml, lapinfo, a, b
+      ml = self%m_last
+      allocate (lg(ml, ml), stat=st)
+      if (st /= 0) then
+        info = CHOL_NO_MEMORY
+        msg = 'Cholesky: out of memory for the trailing block of L.'
+        return
+      end if
+      call cm_trailing_block(self%handle, lg, info, msg)
+      if (info /= CHOL_OK) return
+      call dpotri('L', ml, lg, ml, lapinfo)
+      if (lapinfo > 0) then
+        info = CHOL_NOT_POSDEF
+        write (emsg, '(a,i0,a)') 'Cholesky: trailing block of L is singular (dpotri info ', lapinfo, ').'
+        msg = emsg
+        return
+      else if (lapinfo < 0) then
+        info = CHOL_FAILURE
+        msg = 'Cholesky: dpotri rejected its arguments.'
+        return
+      end if
+      do j = 1, m
+        do i = 1, m
+          a = max(pos(idx(i)), pos(idx(j)))
+          b = min(pos(idx(i)), pos(idx(j)))
+          F(i, j) = sgn(i) * sgn(j) * lg(a, b)
+        end do
+      end do
+    end subroutine flex_block
+
+    !> F from blocked solves with unit right-hand sides (at most 64 columns at once,
+    !! fewer for large n to bound the workspace), then symmetrized.
+    subroutine flex_solves()
+      real(wp), allocatable :: w(:, :)
+      integer :: nb, j0, nc, jj
+      nb = int(max(1_i8, min(64_i8, 2_i8**24 / int(self%n, i8))))
+      nb = min(nb, m)
+      allocate (w(self%n, nb), stat=st)
+      if (st /= 0) then
+        info = CHOL_NO_MEMORY
+        msg = 'Cholesky: out of memory for the flexibility solve block.'
+        return
+      end if
+      do j0 = 1, m, nb
+        nc = min(nb, m - j0 + 1)
+        w(:, 1:nc) = 0.0_wp
+        do jj = 1, nc
+          w(idx(j0 + jj - 1), jj) = 1.0_wp
+        end do
+        call chol_solve_mat(self, w(:, 1:nc), info, msg)
+        if (info /= CHOL_OK) exit
+        do jj = 1, nc
+          j = j0 + jj - 1
+          do i = 1, m
+            F(i, j) = sgn(i) * sgn(j) * w(idx(i), jj)
+          end do
+        end do
+      end do
+      if (self%method == FACT_CHOLMOD) call cm_release_workspace(self%handle)
+      if (info /= CHOL_OK) return
+      do j = 1, m
+        do i = j + 1, m
+          F(i, j) = 0.5_wp * (F(i, j) + F(j, i))
+          F(j, i) = F(i, j)
+        end do
+      end do
+    end subroutine flex_solves
+
+  end subroutine chol_flexibility
+
+  !> One line describing the factorization (method, sizes, times, memory).
+  function chol_summary(self) result(line)
+    class(chol_t), intent(in) :: self
+    character(len=:), allocatable :: line
+    character(len=400) :: buf
+    character(len=*), parameter :: ordname(3) = [character(len=7) :: 'metis', 'amd', 'natural']
+    select case (self%method)
+    case (FACT_CHOLMOD)
+      write (buf, '(a,a,a,i0,a,i0,a,es10.3,a,es10.3,a,f0.3,a,f0.3,a,f0.1,a,l1)') &
+        'cholmod/', trim(ordname(self%ordering)), ' n=', self%n, ' m_last=', self%m_last, &
+        ' nnz(L)=', real(self%nnz_factor, wp), ' flops=', self%flops, &
+        ' t_analyze=', self%t_analyze, 's t_factor=', self%t_factor, 's mem=', &
+        real(self%mem_bytes, wp) / 2.0_wp**20, 'MiB interface_last=', self%interface_last_ok
+    case (FACT_BANDED)
+      write (buf, '(a,i0,a,i0,a,es10.3,a,es10.3,a,f0.3,a,f0.3,a,f0.1,a)') &
+        'banded n=', self%n, ' bandwidth=', self%bandwidth, ' nnz(L)=', real(self%nnz_factor, wp), &
+        ' flops=', self%flops, ' t_order=', self%t_analyze, 's t_factor=', self%t_factor, &
+        's mem=', real(self%mem_bytes, wp) / 2.0_wp**20, 'MiB'
+    case default
+      buf = 'no factorization'
+    end select
+    line = trim(buf)
+  end function chol_summary
+
+  !> Release the factorization and reset the statistics.
+  subroutine chol_free(self)
+    class(chol_t), intent(inout) :: self
+    call cm_free(self%handle)
+    call self%band%free()
+    if (allocated(self%last)) deallocate (self%last)
+    self%method = 0
+    self%ordering = 0
+    self%n = 0
+    self%m_last = 0
+    self%t_analyze = 0.0_wp
+    self%t_factor = 0.0_wp
+    self%nnz_factor = 0
+    self%flops = 0.0_wp
+    self%mem_bytes = 0
+    self%bandwidth = -1
+    self%interface_last_ok = .false.
+  end subroutine chol_free
+
+end module cholesky

@@ -1,0 +1,93 @@
+!> The data model of an input deck: scene, bodies, loads, contact, solver and output
+!! settings, with their defaults. `deck` fills it from namelists; every later stage
+!! (mesh, assembly, solvers, output) reads it and never writes it.
+module config
+  use kinds, only: wp
+  implicit none
+  private
+
+  integer, parameter, public :: SIDE_LEFT = 1    !< x = x0
+  integer, parameter, public :: SIDE_RIGHT = 2   !< x = x0 + width
+  integer, parameter, public :: SIDE_BOTTOM = 3  !< y = y0
+  integer, parameter, public :: SIDE_TOP = 4     !< y = y0 + height
+  character(len=6), parameter, public :: side_names(4) = ['left  ', 'right ', 'bottom', 'top   ']
+
+  integer, parameter, public :: BC_FREE = 0          !< traction-free (unless a &traction says otherwise)
+  integer, parameter, public :: BC_CLAMPED = 1       !< u = 0
+  integer, parameter, public :: BC_ROLLER = 2        !< normal displacement 0, tangential free
+  integer, parameter, public :: BC_CONTACT = 3       !< contact side (Signorini with the other body)
+  integer, parameter, public :: BC_DISPLACEMENT = 4  !< prescribed displacement vector (&displacement)
+  character(len=12), parameter, public :: bc_names(0:4) = &
+    ['free        ', 'clamped     ', 'roller      ', 'contact     ', 'displacement']
+
+  integer, parameter, public :: ELEM_Q1 = 1  !< bilinear quadrilateral, 2x2 Gauss
+  integer, parameter, public :: ELEM_P1 = 2  !< linear triangle, each cell split in two
+  character(len=2), parameter, public :: element_names(2) = ['Q1', 'P1']
+
+  !> One elastic body: a rectangle meshed by nx x ny cells.
+  type, public :: body_cfg_t
+    integer :: id = 0                 !< 1 or 2
+    real(wp) :: x0 = 0.0_wp           !< lower-left corner x [length]
+    real(wp) :: y0 = 0.0_wp           !< lower-left corner y [length]
+    real(wp) :: width = 1.0_wp        !< extent in x [length]
+    real(wp) :: height = 1.0_wp       !< extent in y [length]
+    integer :: nx = 8                 !< cells along x
+    integer :: ny = 8                 !< cells along y
+    integer :: element = ELEM_Q1      !< ELEM_Q1 or ELEM_P1
+    real(wp) :: young = 2.1e11_wp     !< Young's modulus [stress]
+    real(wp) :: poisson = 0.3_wp      !< Poisson's ratio [-], in (-1, 0.5)
+    integer :: bc(4) = BC_FREE        !< condition per side (SIDE_* order)
+    real(wp) :: u_side(2, 4) = 0.0_wp !< prescribed displacement per side when bc = BC_DISPLACEMENT [length]
+  end type body_cfg_t
+
+  !> A linear traction t(s) = t0 + t1*s on one side of one body; s is the global
+  !! coordinate along the side (x on top/bottom, y on left/right).
+  type, public :: traction_cfg_t
+    integer :: body = 0               !< body id
+    integer :: side = 0               !< SIDE_*
+    real(wp) :: t0(2) = 0.0_wp        !< [stress]
+    real(wp) :: t1(2) = 0.0_wp        !< [stress/length]
+  end type traction_cfg_t
+
+  !> Outer and inner solver settings.
+  type, public :: solver_cfg_t
+    character(len=16) :: method = 'robin'             !< 'robin' | 'monolithic'
+    character(len=16) :: robin_operator = 'steklov'   !< 'steklov' | 'constant'
+    real(wp) :: alpha = 0.0_wp                        !< constant Robin parameter [length/stress]
+    real(wp) :: delta = 0.95_wp                       !< relaxation, 0 < delta <= 1
+    real(wp) :: tol = 1.0e-8_wp                       !< outer tolerance
+    character(len=16) :: stop = 'increment'           !< 'increment' | 'residual'
+    integer :: max_outer = 800                        !< outer iteration limit
+    character(len=16) :: factorization = 'cholmod'    !< 'cholmod' | 'banded'
+    character(len=16) :: ordering = 'metis'           !< 'metis' | 'amd' | 'natural' (cholmod only)
+    character(len=16) :: acceleration = 'none'        !< outer acceleration: 'none' | 'aitken' | 'anderson'
+    real(wp) :: inner_factor = 0.1_wp                 !< inner rtol = inner_factor * outer criterion (clamped)
+    real(wp) :: inner_rtol_min = 1.0e-12_wp           !< floor of the adaptive inner tolerance
+    real(wp) :: inner_rtol_max = 1.0e-2_wp            !< ceiling of the adaptive inner tolerance
+    integer :: inner_max_it = 100000                  !< MPRGP iteration limit per subproblem
+    real(wp) :: monolithic_rtol = 1.0e-12_wp          !< MPRGP tolerance for method='monolithic'
+  end type solver_cfg_t
+
+  !> Output settings.
+  type, public :: output_cfg_t
+    character(len=512) :: file = ''                   !< result file ('' -> results/<deck name>.h5)
+    integer :: checkpoint_every = 0                   !< outer iterations between checkpoints (0: none)
+    integer :: progress_lines = 30                    !< at most about this many progress lines
+  end type output_cfg_t
+
+  !> A whole input deck, defaults included.
+  type, public :: deck_t
+    character(len=512) :: source = ''                 !< deck path as given
+    character(len=256) :: title = ''                  !< free text
+    logical :: plane_strain = .true.                  !< .true.: plane strain, .false.: plane stress
+    type(body_cfg_t) :: body(2)                       !< indexed by id
+    integer :: ntraction = 0                          !< number of tractions in use
+    type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)
+    real(wp) :: gap_radius = 0.0_wp                   !< R of the parabolic initial gap, 0: none [length]
+    real(wp) :: gap_center = 0.0_wp                   !< xc of the parabolic gap [length]
+    type(solver_cfg_t) :: solver
+    type(output_cfg_t) :: output
+    character(len=:), allocatable :: effective        !< effective deck as namelist text
+  end type deck_t
+
+end module config

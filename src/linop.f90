@@ -1,0 +1,149 @@
+!> Linear operators y = A x behind one abstract type, so that an iterative solver
+!! (MPRGP) does not know whether it multiplies by a dense matrix, a sparse one or
+!! a sequence of Cholesky solves.
+!!
+!! Thread safety: `apply` of the types below touches only the operator itself and
+!! its arguments (no module state). Two threads may apply two different operators
+!! concurrently; one operator must not be applied by two threads at once (the
+!! binding takes `intent(inout)` so that extensions may keep work space).
+module linop
+  use kinds, only: wp
+  implicit none
+  private
+
+  public :: linop_t, dense_op_t, csc_op_t, dense_op_init, csc_op_init
+
+  !> An abstract symmetric linear operator of size `n`.
+  type, abstract :: linop_t
+    integer :: n = 0  !< number of rows = number of columns
+  contains
+    procedure(linop_apply_iface), deferred :: apply  !< y = A x
+  end type linop_t
+
+  abstract interface
+    !> Compute y = A x. `x` and `y` have size `self%n` and must not alias.
+    subroutine linop_apply_iface(self, x, y)
+      import :: linop_t, wp
+      class(linop_t), intent(inout) :: self  !< the operator
+      real(wp), intent(in) :: x(:)           !< input vector (size n)
+      real(wp), intent(out) :: y(:)          !< output vector A x (size n)
+    end subroutine linop_apply_iface
+  end interface
+
+  !> Dense symmetric n x n matrix in full storage; applied by BLAS dsymv
+  !! (upper triangle used, so the operator is exactly symmetric even if the
+  !! stored matrix is symmetric only up to rounding).
+  type, extends(linop_t) :: dense_op_t
+    real(wp), allocatable :: a(:,:)  !< the matrix (n x n, both triangles stored)
+  contains
+    procedure :: apply => dense_apply
+  end type dense_op_t
+
+  !> Sparse symmetric matrix in compressed sparse column form, both triangles
+  !! stored, 0-based indices (CHOLMOD/SciPy convention).
+  type, extends(linop_t) :: csc_op_t
+    integer, allocatable :: colptr(:)  !< column starts, size n+1, 0-based
+    integer, allocatable :: rowind(:)  !< row indices, size nnz, 0-based
+    real(wp), allocatable :: val(:)    !< values, size nnz
+  contains
+    procedure :: apply => csc_apply
+  end type csc_op_t
+
+  interface
+    !> BLAS: y := alpha A x + beta y, A symmetric (reference BLAS signature).
+    subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
+      import :: wp
+      character(len=1), intent(in) :: uplo
+      integer, intent(in) :: n, lda, incx, incy
+      real(wp), intent(in) :: alpha, beta
+      real(wp), intent(in) :: a(lda, *), x(*)
+      real(wp), intent(inout) :: y(*)
+    end subroutine dsymv
+  end interface
+
+contains
+
+  !> Make `op` a dense operator holding a copy of the square matrix `a`.
+  !! `info` (optional): 0 on success, 1 if `a` is not square (op%n is then 0).
+  subroutine dense_op_init(op, a, info)
+    type(dense_op_t), intent(out) :: op      !< the operator to set up
+    real(wp), intent(in) :: a(:,:)           !< symmetric matrix, full storage
+    integer, intent(out), optional :: info   !< 0 ok, 1 not square
+    if (present(info)) info = 0
+    if (size(a, 1) /= size(a, 2)) then
+      if (present(info)) info = 1
+      op%n = 0
+      allocate (op%a(0, 0))
+      return
+    end if
+    op%n = size(a, 1)
+    allocate (op%a(op%n, op%n), source=a)
+  end subroutine dense_op_init
+
+  !> y = A x for a dense operator (BLAS dsymv).
+  subroutine dense_apply(self, x, y)
+    class(dense_op_t), intent(inout) :: self  !< the operator
+    real(wp), intent(in) :: x(:)              !< input vector (size n)
+    real(wp), intent(out) :: y(:)             !< output A x (size n)
+    if (self%n == 0) return
+    call dsymv('U', self%n, 1.0_wp, self%a, self%n, x, 1, 0.0_wp, y, 1)
+  end subroutine dense_apply
+
+  !> Make `op` a CSC operator holding copies of the arrays (0-based indices).
+  !! `info` (optional): 0 on success, 1 bad n or colptr, 2 row index out of range
+  !! (op%n is then 0 and the operator is empty).
+  subroutine csc_op_init(op, n, colptr, rowind, val, info)
+    type(csc_op_t), intent(out) :: op       !< the operator to set up
+    integer, intent(in) :: n                !< matrix size
+    integer, intent(in) :: colptr(:)        !< size n+1, 0-based, nondecreasing
+    integer, intent(in) :: rowind(:)        !< 0-based row indices
+    real(wp), intent(in) :: val(:)          !< values
+    integer, intent(out), optional :: info  !< 0 ok, 1 bad structure, 2 index out of range
+    integer :: j, nnz, ierr
+    ierr = 0
+    if (n < 0 .or. size(colptr) /= n + 1) then
+      ierr = 1
+    else if (colptr(1) /= 0) then
+      ierr = 1
+    else
+      nnz = colptr(n + 1)
+      if (size(rowind) < nnz .or. size(val) < nnz) ierr = 1
+      do j = 1, n
+        if (colptr(j + 1) < colptr(j)) ierr = 1
+      end do
+      if (ierr == 0) then
+        if (nnz > 0) then
+          if (minval(rowind(1:nnz)) < 0 .or. maxval(rowind(1:nnz)) >= n) ierr = 2
+        end if
+      end if
+    end if
+    if (present(info)) info = ierr
+    if (ierr /= 0) then
+      op%n = 0
+      allocate (op%colptr(1), op%rowind(0), op%val(0))
+      op%colptr = 0
+      return
+    end if
+    op%n = n
+    allocate (op%colptr(n + 1), source=colptr)
+    allocate (op%rowind(nnz), source=rowind(1:nnz))
+    allocate (op%val(nnz), source=val(1:nnz))
+  end subroutine csc_op_init
+
+  !> y = A x for a CSC operator (both triangles stored).
+  subroutine csc_apply(self, x, y)
+    class(csc_op_t), intent(inout) :: self  !< the operator
+    real(wp), intent(in) :: x(:)            !< input vector (size n)
+    real(wp), intent(out) :: y(:)           !< output A x (size n)
+    integer :: j, k
+    real(wp) :: xj
+    y(1:self%n) = 0.0_wp
+    do j = 1, self%n
+      xj = x(j)
+      do k = self%colptr(j) + 1, self%colptr(j + 1)
+        y(self%rowind(k) + 1) = y(self%rowind(k) + 1) + self%val(k) * xj
+      end do
+    end do
+  end subroutine csc_apply
+
+end module linop

@@ -1,0 +1,132 @@
+!> Benchmark of mprgp_solve (prints, asserts nothing).
+!!
+!! 1. The 1D obstacle problem -u'' = -15 on (0,1), u(0) = u(1) = 0, u >= -1, by
+!!    finite differences: A = tridiag(-1,2,-1)*(n+1)^2 (scaled form, sparse CSC),
+!!    b = -15, l = -1, start x = 0. Same solution as the unscaled form
+!!    tridiag(-1,2,-1), b = -15 h^2, and the same iteration counts up to rounding
+!!    (MPRGP and its stopping test |gP| <= rtol |b| are invariant under A, b -> cA, cb).
+!! 2. A dense contact-like problem: A = inverse of tridiag(-1,2,-1)*(m+1)^2 (the
+!!    discrete Green's function, a smooth dense "flexibility" like the condensed
+!!    F_a of the contact solver), b_i = sin(3 pi x_i), l = 0 (about a third active).
+!!
+!! Columns: size, rtol, products with A (power iterations included), CG /
+!! expansion / proportioning steps, wall time per solve (system_clock, averaged
+!! over repeated solves), final |gP|/|b| (at the true gradient), status.
+program bench_mprgp
+  use kinds, only: wp
+  use linop, only: csc_op_t, dense_op_t, csc_op_init, dense_op_init, linop_t
+  use mprgp
+  implicit none
+
+  integer :: ns(3) = [100, 1000, 5000], ms(3) = [500, 1000, 2000]
+  real(wp) :: rtols(2) = [1.0e-4_wp, 1.0e-8_wp]
+  integer :: i, j
+
+  write (*, '(a)') 'MPRGP benchmark (Gamma = 1, alpha_bar = 1.9/lambda_max from 20 power iterations)'
+  write (*, '(a)') '1D obstacle: -u'''' = -15, u >= -1, A = tridiag(-1,2,-1)*(n+1)^2 (CSC), x0 = 0'
+  call header()
+  do j = 1, size(rtols)
+    do i = 1, size(ns)
+      call run_obstacle(ns(i), rtols(j))
+    end do
+  end do
+  write (*, '(a)') ''
+  write (*, '(a)') 'dense Green''s function (inverse FD Laplacian), b = sin(3 pi x), l = 0, dsymv, x0 = 0'
+  call header()
+  do j = 1, size(rtols)
+    do i = 1, size(ms)
+      call run_dense(ms(i), rtols(j))
+    end do
+  end do
+
+contains
+
+  subroutine header()
+    write (*, '(a)') '     n      rtol   A-products      cg     exp    prop    time/solve [s]   |gP|/|b|   status'
+  end subroutine header
+
+  subroutine run_obstacle(n, rtol)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: rtol
+    type(csc_op_t) :: op
+    integer, allocatable :: cp(:), ri(:)
+    real(wp), allocatable :: v(:), b(:), l(:)
+    integer :: j, k, info
+    real(wp) :: h2
+    h2 = real(n + 1, wp)**2
+    allocate (cp(n + 1), ri(3 * n), v(3 * n))
+    k = 0
+    cp(1) = 0
+    do j = 1, n
+      if (j > 1) then
+        k = k + 1; ri(k) = j - 2; v(k) = -h2
+      end if
+      k = k + 1; ri(k) = j - 1; v(k) = 2.0_wp * h2
+      if (j < n) then
+        k = k + 1; ri(k) = j; v(k) = -h2
+      end if
+      cp(j + 1) = k
+    end do
+    call csc_op_init(op, n, cp, ri, v, info)
+    if (info /= 0) error stop 'csc_op_init failed'
+    allocate (b(n), l(n))
+    b = -15.0_wp
+    l = -1.0_wp
+    call timed(op, b, l, n, rtol)
+  end subroutine run_obstacle
+
+  subroutine run_dense(m, rtol)
+    integer, intent(in) :: m
+    real(wp), intent(in) :: rtol
+    type(dense_op_t) :: op
+    real(wp), allocatable :: a(:,:), b(:), l(:)
+    real(wp) :: h, xi, xj
+    integer :: i, j
+    allocate (a(m, m), b(m), l(m))
+    h = 1.0_wp / (m + 1)
+    ! (tridiag(-1,2,-1)/h^2)^-1 = h * G, G_ij = x_min (1 - x_max)
+    do j = 1, m
+      xj = j * h
+      do i = 1, m
+        xi = i * h
+        a(i, j) = h * min(xi, xj) * (1.0_wp - max(xi, xj))
+      end do
+      b(j) = sin(3.0_wp * acos(-1.0_wp) * xj)
+    end do
+    l = 0.0_wp
+    call dense_op_init(op, a)
+    deallocate (a)
+    call timed(op, b, l, m, rtol)
+  end subroutine run_dense
+
+  subroutine timed(op, b, l, n, rtol)
+    class(linop_t), intent(inout) :: op
+    real(wp), intent(in) :: b(:), l(:)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: rtol
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st
+    real(wp), allocatable :: x(:)
+    integer(kind=8) :: t0, t1, rate
+    integer :: reps
+    real(wp) :: elapsed
+    allocate (x(n))
+    opts%rtol = rtol
+    opts%max_it = 1000000
+    x = 0.0_wp
+    call mprgp_solve(op, b, l, x, opts, st)   ! warm-up, not timed
+    reps = 0
+    call system_clock(t0, rate)
+    do
+      x = 0.0_wp
+      call mprgp_solve(op, b, l, x, opts, st)
+      reps = reps + 1
+      call system_clock(t1)
+      elapsed = real(t1 - t0, wp) / real(rate, wp)
+      if (elapsed >= 0.5_wp .or. reps >= 1000) exit
+    end do
+    write (*, '(i6,es10.1,i13,3i8,es18.3,es11.2,3x,a)') n, rtol, st%n_matvec, st%n_cg, st%n_exp, &
+      st%n_prop, elapsed / reps, st%gp_norm / st%b_norm, mprgp_status_name(st%status)
+  end subroutine timed
+
+end program bench_mprgp

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# Runs every test of `make check`: the Fortran test programs in $BUILD/tests, the
+# shell tests tests/test_*.sh and the Python tests tests/test_*.py. Each is one test;
+# it passes when it exits 0. Logs go to $BUILD/test-logs. Last line: N passed, M failed.
+set -u
+BUILD=${BUILD:-build/release}
+PYTHON=${PYTHON:-/usr/bin/python3}
+export BIN=${BIN:-bin/robin_contact}
+export PYTHON BUILD
+logs=$BUILD/test-logs
+mkdir -p "$logs"
+pass=0; fail=0; failed=""
+run_one() {   # name, command...
+  local name=$1; shift
+  local t0=$(date +%s%N)
+  if timeout 900 "$@" >"$logs/$name.log" 2>&1; then
+    status=PASS; pass=$((pass+1))
+  else
+    status=FAIL; fail=$((fail+1)); failed="$failed $name"
+  fi
+  local t1=$(date +%s%N)
+  local checks=$(grep -c '^PASS' "$logs/$name.log" || true)
+  local bad=$(grep -c '^FAIL' "$logs/$name.log" || true)
+  local ms=$(( (t1 - t0) / 1000000 ))
+  printf '%-4s %-28s %4s checks passed, %s failed  (%d.%03d s)\n' "$status" "$name" "$checks" "$bad" \
+    $((ms / 1000)) $((ms % 1000))
+  if [ $status = FAIL ]; then
+    echo "---- last lines of $logs/$name.log"; tail -n 25 "$logs/$name.log"; echo "----"
+  fi
+}
+for t in "$BUILD"/tests/test_*; do
+  case "$t" in *.o|*.log) continue;; esac
+  [ -x "$t" ] || continue
+  run_one "$(basename "$t")" "$t"
+done
+for t in tests/test_*.sh; do
+  [ -f "$t" ] || continue
+  run_one "$(basename "$t" .sh)" bash "$t"
+done
+for t in tests/test_*.py; do
+  [ -f "$t" ] || continue
+  run_one "$(basename "$t" .py)" "$PYTHON" "$t"
+done
+[ -n "$failed" ] && echo "failed:$failed"
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

@@ -1,0 +1,733 @@
+!> Unit test of module cholesky (CHOLMOD + banded factorizations, interface flexibility).
+!! Test matrices are built here, independently of the FE code: a shifted 2D 5-point
+!! Laplacian, a 2D bar-and-diagonal spring lattice (2 DOF per node, clamped on one
+!! side: an elasticity-like SPD matrix), and a random diagonally dominant SPD matrix.
+!! Every result is checked against dense LAPACK. One line per check; exits non-zero
+!! if any check fails.
+program test_cholesky
+  use, intrinsic :: iso_fortran_env, only: int64, output_unit
+  use omp_lib, only: omp_get_max_threads
+  use kinds, only: wp
+  use cholesky
+  use banded, only: rcm_order, band_width
+  implicit none
+
+  !> A sparse symmetric matrix in full 0-based CSC.
+  type :: csc_t
+    integer :: n = 0
+    integer, allocatable :: colptr(:), rowind(:)
+    real(wp), allocatable :: val(:)
+  end type csc_t
+
+  interface
+    subroutine dpotrf(uplo, n, a, lda, info)
+      import :: wp
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, lda
+      real(wp), intent(inout) :: a(lda, *)
+      integer, intent(out) :: info
+    end subroutine dpotrf
+    subroutine dpotri(uplo, n, a, lda, info)
+      import :: wp
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, lda
+      real(wp), intent(inout) :: a(lda, *)
+      integer, intent(out) :: info
+    end subroutine dpotri
+    subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
+      import :: wp
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, nrhs, lda, ldb
+      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+      integer, intent(out) :: info
+    end subroutine dposv
+    subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
+      import :: wp
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, lda
+      real(wp), intent(in) :: a(lda, *), anorm
+      real(wp), intent(out) :: rcond, work(*)
+      integer, intent(out) :: iwork(*), info
+    end subroutine dpocon
+  end interface
+
+  real(wp), parameter :: eps = epsilon(1.0_wp)
+  real(wp), parameter :: RES_TOL = 10.0_wp     ! scaled residual threshold
+  integer :: nfail = 0, npass = 0
+  integer :: seed_size
+  integer, allocatable :: seed(:)
+  type(csc_t) :: A
+  integer, allocatable :: iface(:)
+  integer :: k, nx
+
+  call random_seed(size=seed_size)
+  allocate (seed(seed_size))
+  seed = 20240611
+  call random_seed(put=seed)
+  write (output_unit, '(a,i0)') 'test_cholesky: OpenMP threads available = ', omp_get_max_threads()
+
+  ! ---- 1. shifted 2D Laplacian, interface = last grid row ----
+  k = 14
+  call laplace2d(k, 1.0_wp, A)
+  iface = [(k * (k - 1) + nx, nx = 1, k)]
+  call check_matrix('laplace14', A, iface)
+
+  ! ---- 2. 2D spring lattice (2 DOF/node), interface = y-DOFs of the bottom edge ----
+  nx = 9
+  call lattice2d(nx, 8, A)
+  iface = [(2 * (nx - 1 - k) + 2, k = 0, nx - 1)]      ! bottom edge, given right to left
+  call check_matrix('lattice9x8', A, iface)
+
+  ! ---- 3. random sparse SPD (diagonally dominant), interface = random unsorted subset ----
+  call random_spd(180, 5, A)
+  iface = random_subset(180, 23)
+  call check_matrix('random180', A, iface)
+
+  ! ---- 4. RCM on a randomly numbered grid ----
+  call check_rcm()
+
+  ! ---- 5. not positive definite ----
+  call check_not_posdef()
+
+  ! ---- 6. bad input ----
+  call check_bad_input()
+
+  ! ---- 7. two factorizations at once (OpenMP sections) ----
+  call check_concurrent(ORD_METIS)
+  call check_concurrent(ORD_AMD)
+
+  ! ---- 8. larger problem: timings ----
+  call timing_run()
+
+  write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
+  if (nfail > 0) error stop 1
+
+contains
+
+  ! ======================================================================
+  ! reporting
+  ! ======================================================================
+
+  subroutine report(ok, what, value, tol)
+    logical, intent(in) :: ok
+    character(len=*), intent(in) :: what
+    real(wp), intent(in), optional :: value, tol
+    character(len=64) :: extra
+    extra = ''
+    if (present(value) .and. present(tol)) write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
+    if (ok) then
+      npass = npass + 1
+      write (output_unit, '(a)') 'PASS  '//what//trim(extra)
+    else
+      nfail = nfail + 1
+      write (output_unit, '(a)') 'FAIL  '//what//trim(extra)
+    end if
+  end subroutine report
+
+  subroutine report_le(value, tol, what)
+    real(wp), intent(in) :: value, tol
+    character(len=*), intent(in) :: what
+    call report(value <= tol, what, value, tol)   ! NaN fails
+  end subroutine report_le
+
+  function wtime() result(t)
+    real(wp) :: t
+    integer(int64) :: cnt, rate
+    call system_clock(cnt, rate)
+    t = real(cnt, wp) / real(rate, wp)
+  end function wtime
+
+  ! ======================================================================
+  ! matrix builders
+  ! ======================================================================
+
+  !> Full symmetric CSC from triplets (duplicates summed, rows sorted).
+  subroutine csc_from_triplets(n, ti, tj, tv, nt, M)
+    integer, intent(in) :: n, nt
+    integer, intent(in) :: ti(:), tj(:)       ! 1-based
+    real(wp), intent(in) :: tv(:)
+    type(csc_t), intent(out) :: M
+    integer, allocatable :: cnt(:), ri(:), pos(:)
+    real(wp), allocatable :: rv(:)
+    integer :: t, j, p, q, i, nnz, pstart
+    real(wp) :: v
+    allocate (cnt(n + 1), pos(n))
+    cnt = 0
+    do t = 1, nt
+      cnt(tj(t) + 1) = cnt(tj(t) + 1) + 1
+    end do
+    cnt(1) = 0
+    do j = 1, n
+      cnt(j + 1) = cnt(j + 1) + cnt(j)
+    end do
+    allocate (ri(nt), rv(nt))
+    pos = cnt(1:n)
+    do t = 1, nt
+      pos(tj(t)) = pos(tj(t)) + 1
+      ri(pos(tj(t))) = ti(t)
+      rv(pos(tj(t))) = tv(t)
+    end do
+    ! sort each column (insertion sort) and merge duplicates
+    M%n = n
+    allocate (M%colptr(n + 1), M%rowind(nt), M%val(nt))
+    nnz = 0
+    M%colptr(1) = 0
+    do j = 1, n
+      do p = cnt(j) + 2, cnt(j + 1)
+        i = ri(p)
+        v = rv(p)
+        q = p - 1
+        do while (q > cnt(j))
+          if (ri(q) <= i) exit
+          ri(q + 1) = ri(q)
+          rv(q + 1) = rv(q)
+          q = q - 1
+        end do
+        ri(q + 1) = i
+        rv(q + 1) = v
+      end do
+      pstart = nnz
+      do p = cnt(j) + 1, cnt(j + 1)
+        if (nnz > pstart) then
+          if (M%rowind(nnz) == ri(p) - 1) then
+            M%val(nnz) = M%val(nnz) + rv(p)
+            cycle
+          end if
+        end if
+        nnz = nnz + 1
+        M%rowind(nnz) = ri(p) - 1
+        M%val(nnz) = rv(p)
+      end do
+      M%colptr(j + 1) = nnz
+    end do
+    M%rowind = M%rowind(1:nnz)
+    M%val = M%val(1:nnz)
+  end subroutine csc_from_triplets
+
+  !> 5-point Laplacian on a k x k grid (Dirichlet boundary) plus shift*I.
+  subroutine laplace2d(k, shift, M)
+    integer, intent(in) :: k
+    real(wp), intent(in) :: shift
+    type(csc_t), intent(out) :: M
+    integer, allocatable :: ti(:), tj(:)
+    real(wp), allocatable :: tv(:)
+    integer :: i, j, nt, id
+    allocate (ti(5 * k * k), tj(5 * k * k), tv(5 * k * k))
+    nt = 0
+    do j = 1, k
+      do i = 1, k
+        id = (j - 1) * k + i
+        call add_trip(ti, tj, tv, nt, id, id, 4.0_wp + shift)
+        if (i > 1) call add_trip(ti, tj, tv, nt, id, id - 1, -1.0_wp)
+        if (i < k) call add_trip(ti, tj, tv, nt, id, id + 1, -1.0_wp)
+        if (j > 1) call add_trip(ti, tj, tv, nt, id, id - k, -1.0_wp)
+        if (j < k) call add_trip(ti, tj, tv, nt, id, id + k, -1.0_wp)
+      end do
+    end do
+    call csc_from_triplets(k * k, ti, tj, tv, nt, M)
+  end subroutine laplace2d
+
+  subroutine add_trip(ti, tj, tv, nt, a, b, v)
+    integer, intent(inout) :: ti(:), tj(:), nt
+    real(wp), intent(inout) :: tv(:)
+    integer, intent(in) :: a, b
+    real(wp), intent(in) :: v
+    nt = nt + 1
+    ti(nt) = a
+    tj(nt) = b
+    tv(nt) = v
+  end subroutine add_trip
+
+  !> Spring lattice on nx x ny cells, nodes (i,j), i = 0..nx, j = 0..ny, bars along
+  !! the edges and both diagonals of every cell (axial stiffness EA/L with EA = 1),
+  !! nodes i = 0 clamped. Free node (i,j) has DOFs 2*((j*nx)+i-1)+1 (x) and +2 (y).
+  subroutine lattice2d(nx, ny, M)
+    integer, intent(in) :: nx, ny
+    type(csc_t), intent(out) :: M
+    integer, allocatable :: ti(:), tj(:)
+    real(wp), allocatable :: tv(:)
+    integer :: i, j, nt, cap
+    cap = 4 * 16 * (nx + 1) * (ny + 1)
+    allocate (ti(cap), tj(cap), tv(cap))
+    nt = 0
+    do j = 0, ny
+      do i = 0, nx
+        if (i < nx) call lattice_bar(nx, ti, tj, tv, nt, i, j, i + 1, j)
+        if (j < ny) call lattice_bar(nx, ti, tj, tv, nt, i, j, i, j + 1)
+        if (i < nx .and. j < ny) then
+          call lattice_bar(nx, ti, tj, tv, nt, i, j, i + 1, j + 1)
+          call lattice_bar(nx, ti, tj, tv, nt, i + 1, j, i, j + 1)
+        end if
+      end do
+    end do
+    call csc_from_triplets(2 * nx * (ny + 1), ti, tj, tv, nt, M)
+  end subroutine lattice2d
+
+  !> Add one bar (axial stiffness 1/length) between lattice nodes (i1,j1) and (i2,j2).
+  subroutine lattice_bar(nx, ti, tj, tv, nt, i1, j1, i2, j2)
+      integer, intent(in) :: nx
+      integer, intent(inout) :: ti(:), tj(:), nt
+      real(wp), intent(inout) :: tv(:)
+      integer, intent(in) :: i1, j1, i2, j2
+      real(wp) :: d(2), len, ke
+      integer :: a, b, da(4)
+      real(wp) :: s(4)
+      d = [real(i2 - i1, wp), real(j2 - j1, wp)]
+      len = norm2(d)
+      d = d / len
+      ke = 1.0_wp / len
+      da = [lattice_dof(nx, i1, j1, 1), lattice_dof(nx, i1, j1, 2), &
+            lattice_dof(nx, i2, j2, 1), lattice_dof(nx, i2, j2, 2)]
+      s = [d(1), d(2), -d(1), -d(2)]
+      do b = 1, 4
+        do a = 1, 4
+          if (da(a) > 0 .and. da(b) > 0) call add_trip(ti, tj, tv, nt, da(a), da(b), ke * s(a) * s(b))
+        end do
+      end do
+  end subroutine lattice_bar
+
+  !> DOF number of component c of lattice node (i,j); 0 for clamped nodes (i = 0).
+  integer function lattice_dof(nx, i, j, c)
+    integer, intent(in) :: nx, i, j, c
+    if (i == 0) then
+      lattice_dof = 0
+    else
+      lattice_dof = 2 * (j * nx + i - 1) + c
+    end if
+  end function lattice_dof
+
+  !> Random symmetric pattern with about nb off-diagonals per column, values in
+  !! [-1,1], diagonal = sum of |off-diagonals| + 1 (strictly diagonally dominant).
+  subroutine random_spd(n, nb, M)
+    integer, intent(in) :: n, nb
+    type(csc_t), intent(out) :: M
+    integer, allocatable :: ti(:), tj(:)
+    real(wp), allocatable :: tv(:), dsum(:)
+    integer :: j, q, i, nt
+    real(wp) :: r, v
+    allocate (ti(2 * n * nb + n), tj(2 * n * nb + n), tv(2 * n * nb + n), dsum(n))
+    dsum = 0.0_wp
+    nt = 0
+    do j = 1, n
+      do q = 1, nb / 2 + 1
+        call random_number(r)
+        i = 1 + int(r * n)
+        i = min(max(i, 1), n)
+        if (i == j) cycle
+        call random_number(v)
+        v = 2.0_wp * v - 1.0_wp
+        nt = nt + 1; ti(nt) = i; tj(nt) = j; tv(nt) = v
+        nt = nt + 1; ti(nt) = j; tj(nt) = i; tv(nt) = v
+        dsum(i) = dsum(i) + abs(v)
+        dsum(j) = dsum(j) + abs(v)
+      end do
+    end do
+    do j = 1, n
+      nt = nt + 1; ti(nt) = j; tj(nt) = j; tv(nt) = dsum(j) + 1.0_wp
+    end do
+    call csc_from_triplets(n, ti, tj, tv, nt, M)
+  end subroutine random_spd
+
+  !> m distinct random indices in 1..n, in random order.
+  function random_subset(n, m) result(s)
+    integer, intent(in) :: n, m
+    integer :: s(m)
+    integer :: p(n), i, j, t
+    real(wp) :: r
+    p = [(i, i = 1, n)]
+    do i = n, 2, -1
+      call random_number(r)
+      j = 1 + int(r * i)
+      j = min(j, i)
+      t = p(i); p(i) = p(j); p(j) = t
+    end do
+    s = p(1:m)
+  end function random_subset
+
+  subroutine to_dense(M, D)
+    type(csc_t), intent(in) :: M
+    real(wp), allocatable, intent(out) :: D(:, :)
+    integer :: j, p
+    allocate (D(M%n, M%n))
+    D = 0.0_wp
+    do j = 1, M%n
+      do p = M%colptr(j) + 1, M%colptr(j + 1)
+        D(M%rowind(p) + 1, j) = M%val(p)
+      end do
+    end do
+  end subroutine to_dense
+
+  !> y = K x with K in CSC.
+  function csc_matvec(M, x) result(y)
+    type(csc_t), intent(in) :: M
+    real(wp), intent(in) :: x(:)
+    real(wp) :: y(M%n)
+    integer :: j, p
+    y = 0.0_wp
+    do j = 1, M%n
+      do p = M%colptr(j) + 1, M%colptr(j + 1)
+        y(M%rowind(p) + 1) = y(M%rowind(p) + 1) + M%val(p) * x(j)
+      end do
+    end do
+  end function csc_matvec
+
+  !> Infinity norm of K (= 1-norm, symmetric).
+  function csc_norm_inf(M) result(a)
+    type(csc_t), intent(in) :: M
+    real(wp) :: a
+    real(wp) :: rs(M%n)
+    integer :: j, p
+    rs = 0.0_wp
+    do j = 1, M%n
+      do p = M%colptr(j) + 1, M%colptr(j + 1)
+        rs(M%rowind(p) + 1) = rs(M%rowind(p) + 1) + abs(M%val(p))
+      end do
+    end do
+    a = maxval(rs)
+  end function csc_norm_inf
+
+  !> Scaled residual |K u - f|_inf / (n |K|_inf |u|_inf eps).
+  function scaled_residual(M, u, f) result(r)
+    type(csc_t), intent(in) :: M
+    real(wp), intent(in) :: u(:), f(:)
+    real(wp) :: r
+    r = maxval(abs(csc_matvec(M, u) - f)) / (real(M%n, wp) * csc_norm_inf(M) * maxval(abs(u)) * eps)
+  end function scaled_residual
+
+  function rel_diff(a, b) result(r)
+    real(wp), intent(in) :: a(:), b(:)
+    real(wp) :: r
+    r = norm2(a - b) / max(norm2(b), tiny(1.0_wp))
+  end function rel_diff
+
+  function rel_diff2(a, b) result(r)
+    real(wp), intent(in) :: a(:, :), b(:, :)
+    real(wp) :: r
+    r = norm2(a - b) / max(norm2(b), tiny(1.0_wp))
+  end function rel_diff2
+
+  ! ======================================================================
+  ! checks
+  ! ======================================================================
+
+  !> All solvers against dense LAPACK on one matrix; flexibility on `iface`.
+  subroutine check_matrix(name, M, iface)
+    character(len=*), intent(in) :: name
+    type(csc_t), intent(in) :: M
+    integer, intent(in) :: iface(:)
+    real(wp), allocatable :: D(:, :), Dc(:, :), f(:), ud(:), u(:), F3(:, :), U3(:, :), sgn(:)
+    real(wp), allocatable :: Fd(:, :), Fb(:, :), Fs(:, :), work(:), Fsub(:, :)
+    integer, allocatable :: sub(:)
+    integer :: ms
+    integer, allocatable :: iwork(:)
+    real(wp) :: anorm, rcond, kappa, tol_sol, tol_flex, t
+    integer :: n, mi, info, i, j, o, meth
+    logical :: used
+    character(len=256) :: msg
+    character(len=80) :: tag
+    type(chol_t) :: ch
+    character(len=*), parameter :: onames(3) = [character(len=7) :: 'metis', 'amd', 'natural']
+
+    n = M%n
+    mi = size(iface)
+    call to_dense(M, D)
+    allocate (f(n), sgn(mi))
+    call random_number(f)
+    f = f - 0.5_wp
+    do i = 1, mi
+      sgn(i) = merge(1.0_wp, -1.0_wp, mod(i, 3) /= 0)
+    end do
+
+    ! dense reference: solution, condition number, inverse block
+    Dc = D
+    anorm = maxval(sum(abs(D), dim=1))
+    call dpotrf('L', n, Dc, n, info)
+    call report(info == 0, name//': dense LAPACK dpotrf succeeds')
+    allocate (work(3 * n), iwork(n))
+    call dpocon('L', n, Dc, n, anorm, rcond, work, iwork, info)
+    kappa = 1.0_wp / rcond
+    write (output_unit, '(a,i0,a,i0,a,es9.2)') '      '//name//': n = ', n, ', nnz = ', M%colptr(n + 1), &
+      ', kappa_1 estimate = ', kappa
+    call dpotri('L', n, Dc, n, info)
+    allocate (Fd(mi, mi))
+    do j = 1, mi
+      do i = 1, mi
+        Fd(i, j) = sgn(i) * sgn(j) * Dc(max(iface(i), iface(j)), min(iface(i), iface(j)))
+      end do
+    end do
+    Dc = D
+    ud = f
+    call dposv('L', n, 1, Dc, n, ud, n, info)
+    call report_le(scaled_residual(M, ud, f), RES_TOL, name//': dense dposv scaled residual')
+
+    ! solution differences are bounded by ~ kappa * eps (times a modest constant)
+    tol_sol = 100.0_wp * kappa * eps
+    tol_flex = max(1.0e-12_wp, 100.0_wp * kappa * eps)
+    allocate (Fb(mi, mi), Fs(mi, mi))
+
+    do meth = 1, 4
+      if (meth <= 3) then
+        o = meth
+        tag = name//' cholmod/'//trim(onames(o))
+        t = wtime()
+        call ch%factor(n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg, last=iface)
+      else
+        tag = name//' banded'
+        call ch%factor(n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, info, msg)
+      end if
+      call report(info == 0, trim(tag)//': factor info = 0 '//trim(msg))
+      if (info /= 0) cycle
+      write (output_unit, '(a)') '      '//ch%summary()
+      if (meth <= 3) call report(ch%interface_last_ok, trim(tag)//': interface DOFs ordered last, in the given order')
+      u = f
+      call ch%solve(u, info, msg)
+      call report(info == 0, trim(tag)//': solve info = 0')
+      call report_le(scaled_residual(M, u, f), RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)')
+      call report_le(rel_diff(u, ud), tol_sol, trim(tag)//': |u - u_dposv|/|u_dposv|')
+
+      ! several right-hand sides at once = one at a time
+      allocate (F3(n, 3), U3(n, 3))
+      call random_number(F3)
+      U3 = F3
+      call ch%solve(U3, info, msg)
+      do j = 1, 3
+        u = F3(:, j)
+        call ch%solve(u, info, msg)
+        F3(:, j) = u
+      end do
+      call report_le(rel_diff2(U3, F3), tol_sol, trim(tag)//': 3 right-hand sides at once = one by one')
+      deallocate (F3, U3)
+
+      ! flexibility
+      if (meth <= 3) then
+        call ch%flexibility(iface, sgn, Fb, info, msg, used_block=used)
+        call report(info == 0 .and. used, trim(tag)//': flexibility via trailing block of L used')
+        call report_le(rel_diff2(Fb, Fd), tol_flex, trim(tag)//': F (trailing block) vs dense inverse block')
+        call ch%flexibility(iface, sgn, Fs, info, msg, use_solves=.true., used_block=used)
+        call report(info == 0 .and. .not. used, trim(tag)//': flexibility via solves ran')
+        call report_le(rel_diff2(Fs, Fd), tol_flex, trim(tag)//': F (solves) vs dense inverse block')
+        call report_le(rel_diff2(Fb, Fs), tol_flex, trim(tag)//': F (trailing block) vs F (solves)')
+        call report(all(Fb == transpose(Fb)), trim(tag)//': F symmetric in full storage')
+        ! a subset of the interface, in another order, still uses the block
+        ms = max(1, mi / 2)
+        sub = [(mi + 1 - 2 * i, i = 1, ms)]          ! positions mi-1, mi-3, ... (reversed)
+        if (allocated(Fsub)) deallocate (Fsub)
+        allocate (Fsub(ms, ms))
+        call ch%flexibility(iface(sub), sgn(sub), Fsub, info, msg, used_block=used)
+        call report(info == 0 .and. used .and. rel_diff2(Fsub, Fd(sub, sub)) <= tol_flex, &
+                    trim(tag)//': F of a reordered interface subset (trailing block)')
+      else
+        call ch%flexibility(iface, sgn, Fs, info, msg, used_block=used)
+        call report(info == 0 .and. .not. used, trim(tag)//': flexibility via solves ran')
+        call report_le(rel_diff2(Fs, Fd), tol_flex, trim(tag)//': F (solves) vs dense inverse block')
+      end if
+      call ch%free()
+    end do
+  end subroutine check_matrix
+
+  !> RCM gives a permutation and a small bandwidth on a randomly numbered grid.
+  subroutine check_rcm()
+    type(csc_t) :: M, P
+    integer, allocatable :: perm(:), q(:), ti(:), tj(:)
+    real(wp), allocatable :: tv(:)
+    integer :: k, n, j, p2, nt, kd_rand, kd_rcm
+    logical, allocatable :: seen(:)
+    k = 30
+    call laplace2d(k, 0.0_wp, M)
+    n = M%n
+    q = random_subset(n, n)               ! random renumbering old -> new
+    allocate (ti(M%colptr(n + 1)), tj(M%colptr(n + 1)), tv(M%colptr(n + 1)))
+    nt = 0
+    do j = 1, n
+      do p2 = M%colptr(j) + 1, M%colptr(j + 1)
+        nt = nt + 1
+        ti(nt) = q(M%rowind(p2) + 1)
+        tj(nt) = q(j)
+        tv(nt) = M%val(p2)
+      end do
+    end do
+    call csc_from_triplets(n, ti, tj, tv, nt, P)
+    allocate (perm(n), seen(n))
+    kd_rand = band_width(n, P%colptr, P%rowind, [(j, j = 1, n)])
+    call rcm_order(n, P%colptr, P%rowind, perm)
+    seen = .false.
+    seen(perm) = .true.
+    call report(all(seen) .and. minval(perm) >= 1 .and. maxval(perm) <= n, 'RCM returns a permutation')
+    kd_rcm = band_width(n, P%colptr, P%rowind, perm)
+    write (output_unit, '(a,i0,a,i0,a,i0)') '      RCM on a randomly numbered ', k, '^2 grid: bandwidth ', &
+      kd_rand, ' -> ', kd_rcm
+    call report_le(real(kd_rcm, wp), real(2 * k, wp), 'RCM bandwidth of a k x k grid <= 2k')
+  end subroutine check_rcm
+
+  !> Indefinite matrices give info = 1 and a message, for every method; no crash after.
+  subroutine check_not_posdef()
+    type(csc_t) :: M
+    type(chol_t) :: ch
+    real(wp) :: lmin, u(144), F(3, 3)
+    integer :: info, o, j, p
+    character(len=256) :: msg
+    character(len=*), parameter :: onames(3) = [character(len=7) :: 'metis', 'amd', 'natural']
+    ! (a) one diagonal entry made strongly negative
+    call laplace2d(12, 0.0_wp, M)
+    do j = 1, M%n
+      do p = M%colptr(j) + 1, M%colptr(j + 1)
+        if (j == 50 .and. M%rowind(p) == 49) M%val(p) = -10.0_wp
+      end do
+    end do
+    do o = 1, 3
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg, last=[1, 2, 3])
+      call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, &
+                  'negative diagonal: cholmod/'//trim(onames(o))//' info = 1: '//trim(msg))
+    end do
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, info, msg)
+    call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, 'negative diagonal: banded info = 1: '//trim(msg))
+    ! (b) shift just below the smallest eigenvalue: one slightly negative eigenvalue
+    lmin = 8.0_wp * sin(acos(-1.0_wp) / 26.0_wp)**2
+    call laplace2d(12, -1.05_wp * lmin, M)
+    do o = 1, 3
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg)
+      call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, &
+                  'lambda_min = -0.05 lambda_1: cholmod/'//trim(onames(o))//' info = 1: '//trim(msg))
+    end do
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, info, msg)
+    call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, &
+                'lambda_min = -0.05 lambda_1: banded info = 1: '//trim(msg))
+    ! using the failed factorization is an error, not a crash
+    u = 1.0_wp
+    call ch%solve(u, info, msg)
+    call report(info == CHOL_FAILURE, 'solve after a failed factorization returns info = 3')
+    call ch%flexibility([1, 2, 3], [1.0_wp, 1.0_wp, 1.0_wp], F, info, msg)
+    call report(info == CHOL_FAILURE, 'flexibility after a failed factorization returns info = 3')
+    ! and the same object factorizes a good matrix afterwards
+    call laplace2d(12, 1.0_wp, M)
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_AMD, info, msg)
+    u = 1.0_wp
+    call ch%solve(u, info, msg)
+    call report(info == 0 .and. scaled_residual(M, u, [(1.0_wp, j = 1, 144)]) <= RES_TOL, &
+                'the same chol_t is reusable after a failure')
+    call ch%free()
+  end subroutine check_not_posdef
+
+  !> Invalid arguments give info = 3 with a message.
+  subroutine check_bad_input()
+    type(csc_t) :: M
+    type(chol_t) :: ch
+    integer :: info, tmp
+    character(len=256) :: msg
+    call laplace2d(6, 1.0_wp, M)
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=[3, 5, 3])
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'repeated interface DOF: info = 3: '//trim(msg))
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=[0])
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interface DOF 0: info = 3: '//trim(msg))
+    tmp = M%rowind(1)
+    M%rowind(1) = M%rowind(2)
+    M%rowind(2) = tmp
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_METIS, info, msg)
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'unsorted row indices: info = 3: '//trim(msg))
+    call ch%free()
+  end subroutine check_bad_input
+
+  !> Two factorizations + flexibilities + solves inside `omp parallel sections`
+  !! equal the same computed sequentially.
+  subroutine check_concurrent(ord)
+    integer, intent(in) :: ord
+    type(csc_t) :: M1, M2
+    type(chol_t) :: c1, c2
+    integer, allocatable :: g1(:), g2(:)
+    real(wp), allocatable :: F1(:, :), F2(:, :), P1(:, :), P2(:, :), u1(:), u2(:), v1(:), v2(:)
+    real(wp), allocatable :: s1(:), s2(:)
+    integer :: i1, i2, j1, j2, i
+    character(len=256) :: m1s, m2s, tmsg
+    character(len=16) :: oname
+    real(wp) :: d
+    oname = merge('metis', 'amd  ', ord == ORD_METIS)
+    call lattice2d(40, 30, M1)
+    call laplace2d(70, 0.5_wp, M2)
+    g1 = [(2 * i, i = 1, 40)]
+    g2 = [(70 * 69 + i, i = 1, 70)]
+    s1 = [(merge(1.0_wp, -1.0_wp, mod(i, 2) == 0), i = 1, size(g1))]
+    s2 = [(1.0_wp, i = 1, size(g2))]
+    allocate (F1(size(g1), size(g1)), F2(size(g2), size(g2)), P1(size(g1), size(g1)), P2(size(g2), size(g2)))
+    allocate (u1(M1%n), u2(M2%n), v1(M1%n), v2(M2%n))
+    ! sequential reference
+    call conc_work(ord, c1, M1, g1, s1, P1, v1, i1, m1s)
+    call conc_work(ord, c2, M2, g2, s2, P2, v2, i2, m2s)
+    call report(i1 == 0 .and. i2 == 0, 'sequential reference runs ('//trim(oname)//')')
+    ! concurrent
+    !$omp parallel sections default(shared)
+    !$omp section
+    call conc_work(ord, c1, M1, g1, s1, F1, u1, j1, m1s)
+    !$omp section
+    call conc_work(ord, c2, M2, g2, s2, F2, u2, j2, m2s)
+    !$omp end parallel sections
+    d = max(rel_diff2(F1, P1), rel_diff2(F2, P2), rel_diff(u1, v1), rel_diff(u2, v2))
+    write (tmsg, '(a)') 'two chol_t in omp parallel sections = sequential ('//trim(oname)//')'
+    call report(j1 == 0 .and. j2 == 0 .and. d <= 4.0_wp * eps, trim(tmsg), d, 4.0_wp * eps)
+    call c1%free()
+    call c2%free()
+  end subroutine check_concurrent
+
+  !> Factor, flexibility and one solve for check_concurrent.
+  subroutine conc_work(ord, c, M, g, s, F, u, info, msg)
+      integer, intent(in) :: ord
+      type(chol_t), intent(inout) :: c
+      type(csc_t), intent(in) :: M
+      integer, intent(in) :: g(:)
+      real(wp), intent(in) :: s(:)
+      real(wp), intent(out) :: F(:, :)
+      real(wp), intent(out), contiguous :: u(:)
+      integer, intent(out) :: info
+      character(len=*), intent(out) :: msg
+      call c%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ord, info, msg, last=g)
+      if (info /= 0) return
+      call c%flexibility(g, s, F, info, msg)
+      if (info /= 0) return
+      u = 1.0_wp
+      call c%solve(u, info, msg)
+  end subroutine conc_work
+
+  !> A larger lattice (200 x 200 cells, ~80k DOFs, 200 interface DOFs): print timings.
+  subroutine timing_run()
+    type(csc_t) :: M
+    type(chol_t) :: ch
+    integer, allocatable :: g(:)
+    real(wp), allocatable :: Fb(:, :), Fs(:, :), s(:), u(:), f(:)
+    integer :: info, o, i, nc
+    real(wp) :: t0, tb, ts
+    logical :: used
+    character(len=256) :: msg
+    character(len=*), parameter :: onames(3) = [character(len=7) :: 'metis', 'amd', 'natural']
+    nc = 200
+    t0 = wtime()
+    call lattice2d(nc, nc, M)
+    write (output_unit, '(a,i0,a,i0,a,i0,a,f0.3,a)') '      timing problem: lattice ', nc, 'x', nc, ', n = ', M%n, &
+      ' (assembled in ', wtime() - t0, ' s)'
+    g = [(2 * i, i = 1, nc)]
+    s = [(1.0_wp, i = 1, nc)]
+    allocate (Fb(nc, nc), Fs(nc, nc), f(M%n))
+    call random_number(f)
+    do o = 1, 2
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg, last=g)
+      call report(info == 0 .and. ch%interface_last_ok, &
+                  'timing lattice cholmod/'//trim(onames(o))//': factor ok, interface last')
+      if (info /= 0) cycle
+      write (output_unit, '(a)') '      '//ch%summary()
+      t0 = wtime()
+      call ch%flexibility(g, s, Fb, info, msg, used_block=used)
+      tb = wtime() - t0
+      t0 = wtime()
+      call ch%flexibility(g, s, Fs, info, msg, use_solves=.true.)
+      ts = wtime() - t0
+      write (output_unit, '(a,f0.4,a,f0.4,a)') '      flexibility (m = 200): trailing block + dpotri ', tb, &
+        ' s, blocked solves ', ts, ' s'
+      call report_le(rel_diff2(Fb, Fs), 1.0e-10_wp, 'timing lattice cholmod/'//trim(onames(o))// &
+                     ': F (trailing block) vs F (solves)')
+      u = f
+      call ch%solve(u, info, msg)
+      call report_le(scaled_residual(M, u, f), RES_TOL, 'timing lattice cholmod/'//trim(onames(o))// &
+                     ': scaled residual')
+    end do
+    call ch%free()
+  end subroutine timing_run
+
+end program test_cholesky

@@ -1,0 +1,144 @@
+!> Contact solver tests: the monolithic solution satisfies the KKT conditions of
+!! METHOD.md and the equilibrium of each body (reactions + loads + contact forces);
+!! the Robin iterate equals the monolithic solution on the paper's scene, on a
+!! partial-contact scene (parabolic gap) and on a scene whose load lifts part of the
+!! interface; the recovered displacements reproduce the condensed ones.
+program test_contact
+  use kinds, only: wp
+  use config, only: deck_t
+  use deck, only: read_deck
+  use mesh, only: mesh_t, mesh_build
+  use assembly, only: body_system_t, assemble_body, expand, residual_full
+  use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
+                      recover_displacement
+  use contact, only: contact_result_t, solve_robin, solve_monolithic
+  implicit none
+  integer :: nfail = 0
+  character(len=4096) :: none(0)
+
+  call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.95, tol=1e-10 /"], .false.)
+  call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.5, tol=1e-10 /"], .false.)
+  call scene('tests/decks/gap.nml', none, .true.)
+  call scene('tests/decks/lift.nml', none, .true.)
+  call scene('tests/decks/lift.nml', [character(len=80) :: &
+    "&solver robin_operator='constant', alpha=3e-12, delta=0.5 /"], .true.)
+
+  if (nfail > 0) then
+    write (*, '(i0,a)') nfail, ' check(s) failed'
+    stop 1
+  end if
+
+contains
+
+  subroutine check(ok, what, val, tol)
+    logical, intent(in) :: ok
+    character(len=*), intent(in) :: what
+    real(wp), intent(in) :: val, tol
+    if (ok) then
+      write (*, '(a,a,a,es10.3,a,es9.2,a)') 'PASS  ', what, ' (', val, ' <= ', tol, ')'
+    else
+      write (*, '(a,a,a,es10.3,a,es9.2,a)') 'FAIL  ', what, ' (', val, ' > ', tol, ')'
+      nfail = nfail + 1
+    end if
+  end subroutine check
+
+  subroutine scene(path, over, expect_partial)
+    character(len=*), intent(in) :: path, over(:)
+    logical, intent(in) :: expect_partial
+    type(deck_t) :: d
+    type(mesh_t) :: msh(2)
+    type(body_system_t) :: sys(2)
+    type(interface_t) :: itf
+    type(body_condensed_t) :: bc(2)
+    type(contact_result_t) :: mono, rob
+    integer :: a, info, i, k, c
+    character(len=512) :: msg
+    real(wp), allocatable :: ufree(:), ufull(:), r(:)
+    real(wp) :: fscale, uscale, lnorm, e, load(2), react(2), cont(2), bu
+    character(len=160) :: tag
+    character(len=4096), allocatable :: ov(:)
+
+    allocate (ov(size(over)))
+    ov = over
+    call read_deck(path, ov, d)
+    tag = trim(path)
+    if (size(over) > 0) tag = trim(tag)//' '//trim(over(1))
+    write (*, '(a)') '--- '//trim(tag)
+    do a = 1, 2
+      call mesh_build(msh(a), d%body(a))
+      call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info, msg)
+      if (info /= 0) error stop 'assembly failed'
+    end do
+    call build_interface(d, msh, sys, itf, info, msg)
+    if (info /= 0) error stop 'interface failed'
+    do a = 1, 2
+      call factor_body(d, itf, a, sys(a), bc(a), info, msg)
+      if (info /= 0) error stop 'factor failed'
+      call condense_body(sys(a), bc(a), info, msg)
+      if (info /= 0) error stop 'condense failed'
+    end do
+
+    ! ---- monolithic: KKT of METHOD.md -------------------------------------------------
+    call solve_monolithic(d, itf, bc, mono)
+    call check(mono%status == 'converged', 'monolithic converged', 0.0_wp, 0.0_wp)
+    lnorm = maxval(abs(mono%lam))
+    uscale = max(maxval(abs(bc(1)%b)), maxval(abs(bc(2)%b)), maxval(abs(itf%g0)))
+    call check(minval(mono%lam) >= 0.0_wp, 'lam >= 0', -minval(mono%lam), 0.0_wp)
+    call check(maxval(mono%gap) <= 1.0e-9_wp*uscale, 'no penetration', maxval(mono%gap)/uscale, 1.0e-9_wp)
+    e = maxval(mono%lam*abs(mono%gap))/(lnorm*uscale)
+    call check(e <= 1.0e-9_wp, 'complementarity lam*|gap|', e, 1.0e-9_wp)
+    call check(lnorm > 0.0_wp, 'some contact force', 0.0_wp, 0.0_wp)
+    if (expect_partial) then
+      k = count(mono%lam > 1.0e-8_wp*lnorm)
+      call check(k > 0 .and. k < itf%m, 'partial contact (some nodes separate)', real(itf%m - k, wp), &
+                 real(itf%m, wp))
+      e = maxval(mono%gap, mask=mono%lam <= 1.0e-8_wp*lnorm)
+      call check(e < 0.0_wp, 'separated nodes have a negative gap', e/uscale, 0.0_wp)
+    end if
+
+    ! ---- equilibrium of each body: reactions + applied loads + contact forces = 0 ------
+    fscale = 0.0_wp
+    do a = 1, 2
+      allocate (ufree(sys(a)%n), ufull(sys(a)%ndof), r(sys(a)%ndof))
+      call recover_displacement(sys(a), bc(a), mono%lam, ufree)
+      call expand(sys(a), ufree, ufull)
+      ! recovered B_a u_a equals the condensed b_a - F_a lam
+      e = 0.0_wp
+      do i = 1, itf%m
+        bu = bc(a)%sgn(i)*ufree(bc(a)%idx(i))
+        e = max(e, abs(bu - mono%w(i, a)))
+      end do
+      call check(e <= 1.0e-10_wp*uscale, 'body '//achar(48 + a)//': recovered B u = b - F lam', e/uscale, 1.0e-10_wp)
+      call residual_full(msh(a), d%body(a), d%plane_strain, ufull, sys(a)%f_applied, r)
+      ! r = K u - f: at free DOFs it must be -B' lam, at prescribed DOFs it is the support force
+      load = [sum(sys(a)%f_applied(1::2)), sum(sys(a)%f_applied(2::2))]
+      react = 0.0_wp
+      do i = 1, sys(a)%ndof
+        c = 2 - mod(i, 2)
+        if (sys(a)%free_of(i) == 0) react(c) = react(c) + r(i)
+      end do
+      ! force exerted on body a by the contact: -lam n_a
+      cont = -sum(mono%lam)*bc(a)%normal
+      fscale = max(sum(abs(sys(a)%f_applied)), sum(mono%lam), maxval(abs(react)), tiny(1.0_wp))
+      ! K u = f + support + contact, so at prescribed DOFs r = support force; balance:
+      ! applied load + contact force + support forces = 0
+      e = maxval(abs(load + cont + react))/fscale
+      call check(e <= 1.0e-9_wp, 'body '//achar(48 + a)//': reactions + loads + contact balance', e, 1.0e-9_wp)
+      deallocate (ufree, ufull, r)
+    end do
+    write (*, '(a,es14.6,a,i0,a,i0)') '      total contact force ', sum(mono%lam), ' active ', mono%active, ' of ', itf%m
+
+    ! ---- Robin equals monolithic --------------------------------------------------------
+    call solve_robin(d, itf, bc, rob)
+    call check(rob%status == 'converged', 'robin converged ('//trim(rob%status)//')', real(rob%outer, wp), &
+               real(d%solver%max_outer, wp))
+    e = norm2(rob%lam - mono%lam)/norm2(mono%lam)
+    call check(e <= 1.0e-6_wp, 'robin lam = monolithic lam', e, 1.0e-6_wp)
+    e = norm2(rob%lam_body(:, 1) - rob%lam_body(:, 2))/norm2(mono%lam)
+    call check(e <= 1.0e-6_wp, 'robin bodies agree on lam', e, 1.0e-6_wp)
+    e = maxval(abs(rob%gap - mono%gap))/uscale
+    call check(e <= 1.0e-6_wp, 'robin gap = monolithic gap', e, 1.0e-6_wp)
+    write (*, '(a,i0,a,i0)') '      robin outer ', rob%outer, ' inner ', rob%inner
+  end subroutine scene
+
+end program test_contact

@@ -1,0 +1,743 @@
+!> The manufactured solution of test_fem, in a module so that its body force can be
+!! passed to assemble_body as a procedure argument (no internal-procedure trampoline).
+module test_fem_manufactured
+  use kinds, only: wp
+  implicit none
+  private
+  public :: ms_u, ms_force, ms_lam, ms_mu
+  real(wp), parameter :: pi = acos(-1.0_wp)
+  real(wp), parameter :: ka = pi, kb = 0.5_wp*pi, kc = 0.75_wp*pi, kd_ = pi
+  real(wp) :: ms_lam = 0.0_wp   !< Lame lambda of the manufactured problem
+  real(wp) :: ms_mu = 0.0_wp    !< shear modulus of the manufactured problem
+
+contains
+
+  !> Manufactured solution u = (sin(ka x) cos(kb y), cos(kc x) sin(kd y)).
+  pure subroutine ms_u(x, y, u, g)
+    real(wp), intent(in) :: x, y
+    real(wp), intent(out) :: u(2), g(2, 2)   ! g(i,j) = d u_i / d x_j
+    u(1) = sin(ka*x)*cos(kb*y)
+    u(2) = cos(kc*x)*sin(kd_*y)
+    g(1, 1) = ka*cos(ka*x)*cos(kb*y)
+    g(1, 2) = -kb*sin(ka*x)*sin(kb*y)
+    g(2, 1) = -kc*sin(kc*x)*sin(kd_*y)
+    g(2, 2) = kd_*cos(kc*x)*cos(kd_*y)
+  end subroutine ms_u
+
+  !> f = -div sigma = -(lam + mu) grad div u - mu lap u.
+  subroutine ms_force(x, y, f)
+    real(wp), intent(in) :: x, y
+    real(wp), intent(out) :: f(2)
+    real(wp) :: u1xx, u1yy, u1xy, u2xx, u2yy, u2xy
+    u1xx = -ka**2*sin(ka*x)*cos(kb*y)
+    u1yy = -kb**2*sin(ka*x)*cos(kb*y)
+    u1xy = -ka*kb*cos(ka*x)*sin(kb*y)
+    u2xx = -kc**2*cos(kc*x)*sin(kd_*y)
+    u2yy = -kd_**2*cos(kc*x)*sin(kd_*y)
+    u2xy = -kc*kd_*sin(kc*x)*cos(kd_*y)
+    f(1) = -(ms_lam + ms_mu)*(u1xx + u2xy) - ms_mu*(u1xx + u1yy)
+    f(2) = -(ms_lam + ms_mu)*(u1xy + u2yy) - ms_mu*(u2xx + u2yy)
+  end subroutine ms_force
+
+end module test_fem_manufactured
+
+!> Unit tests of modules mesh and assembly: sparse structure, patch test on a distorted
+!! mesh, convergence rates against a manufactured solution, traction loads, unit scaling
+!! and error reporting. Solves use LAPACK's banded Cholesky (dpbsv) directly.
+program test_fem
+  use kinds, only: wp
+  use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
+                    SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, &
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
+  use mesh, only: mesh_t, mesh_build, side_nodes
+  use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec
+  use test_fem_manufactured, only: ms_u, ms_force, ms_lam, ms_mu
+  implicit none
+
+  interface
+    subroutine dpbsv(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+      import :: wp
+      character, intent(in) :: uplo
+      integer, intent(in) :: n, kd, nrhs, ldab, ldb
+      real(wp), intent(inout) :: ab(ldab, *), b(ldb, *)
+      integer, intent(out) :: info
+    end subroutine dpbsv
+  end interface
+
+  real(wp), parameter :: eps = epsilon(1.0_wp)
+  integer :: nfail = 0, npass = 0
+
+  call test_structure(ELEM_Q1)
+  call test_structure(ELEM_P1)
+  call test_patch(ELEM_Q1, .true.)
+  call test_patch(ELEM_Q1, .false.)
+  call test_patch(ELEM_P1, .true.)
+  call test_patch(ELEM_P1, .false.)
+  call test_manufactured(ELEM_Q1)
+  call test_manufactured(ELEM_P1)
+  call test_tractions(ELEM_Q1)
+  call test_tractions(ELEM_P1)
+  call test_units(ELEM_Q1, .true.)
+  call test_units(ELEM_P1, .false.)
+  call test_errors()
+
+  write (*, '(i0,a,i0,a)') npass, ' passed, ', nfail, ' failed'
+  if (nfail > 0) error stop 1
+
+contains
+
+  subroutine check(what, ok, value, tol)
+    character(len=*), intent(in) :: what
+    logical, intent(in) :: ok
+    real(wp), intent(in) :: value, tol
+    if (ok) then
+      npass = npass + 1
+      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'PASS  ', what, ' (', value, ', tol ', tol, ')'
+    else
+      nfail = nfail + 1
+      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'FAIL  ', what, ' (', value, ', tol ', tol, ')'
+    end if
+  end subroutine check
+
+  !> Solve K u = f on the free DOFs with LAPACK's banded Cholesky (natural order).
+  subroutine band_solve(sys, x)
+    type(body_system_t), intent(in) :: sys
+    real(wp), intent(out) :: x(:)
+    real(wp), allocatable :: ab(:, :)
+    integer :: kd, i, j, p, info
+    kd = 0
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        i = sys%rowind(p) + 1
+        kd = max(kd, j - i)
+      end do
+    end do
+    allocate (ab(kd + 1, sys%n))
+    ab = 0.0_wp
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        i = sys%rowind(p) + 1
+        if (i <= j) ab(kd + 1 + i - j, j) = sys%val(p)
+      end do
+    end do
+    x(1:sys%n) = sys%f
+    call dpbsv('U', sys%n, kd, 1, ab, kd + 1, x, sys%n, info)
+    if (info /= 0) then
+      write (*, '(a,i0)') 'FAIL  dpbsv info = ', info
+      error stop 1
+    end if
+  end subroutine band_solve
+
+  !> Mesh, assemble and solve one body; stops the test on an assembly error.
+  subroutine solve_body(body, plane_strain, tr, ntr, m, sys, u_full, u_prescribed, distort)
+    type(body_cfg_t), intent(in) :: body
+    logical, intent(in) :: plane_strain
+    type(traction_cfg_t), intent(in) :: tr(:)
+    integer, intent(in) :: ntr
+    type(mesh_t), intent(out) :: m
+    type(body_system_t), intent(out) :: sys
+    real(wp), allocatable, intent(out) :: u_full(:)
+    real(wp), intent(in), optional :: u_prescribed(:)
+    real(wp), intent(in), optional :: distort
+    integer :: info
+    character(len=256) :: msg
+    real(wp), allocatable :: u(:)
+    call mesh_build(m, body)
+    if (present(distort)) call distort_interior(m, distort)
+    if (present(u_prescribed)) then
+      call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed)
+    else
+      call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg)
+    end if
+    if (info /= 0) then
+      write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
+      error stop 1
+    end if
+    allocate (u(sys%n), u_full(sys%ndof))
+    call band_solve(sys, u)
+    call expand(sys, u, u_full)
+  end subroutine solve_body
+
+  !> Deterministic pseudo-random number in [-0.5, 0.5) for integer pair (i, j).
+  pure real(wp) function hash01(i, j)
+    integer, intent(in) :: i, j
+    real(wp) :: v
+    v = sin(12.9898_wp*real(i, wp) + 78.233_wp*real(j, wp) + 0.5_wp)*43758.5453_wp
+    hash01 = v - floor(v) - 0.5_wp
+  end function hash01
+
+  !> Move every interior node by up to +-frac/2 of a cell size in x and y.
+  subroutine distort_interior(m, frac)
+    type(mesh_t), intent(inout) :: m
+    real(wp), intent(in) :: frac
+    integer :: i, j, k
+    real(wp) :: hx, hy
+    hx = m%width/m%nx
+    hy = m%height/m%ny
+    do j = 1, m%ny - 1
+      do i = 1, m%nx - 1
+        k = 1 + i + j*(m%nx + 1)
+        m%xy(1, k) = m%xy(1, k) + frac*hx*hash01(i, j)
+        m%xy(2, k) = m%xy(2, k) + frac*hy*hash01(j + 17, i + 5)
+      end do
+    end do
+  end subroutine distort_interior
+
+  ! ---------------------------------------------------------------------------------
+  !> CSC structure: counts, sorted rows, symmetry, matvec against the element loop,
+  !! the lifting of prescribed values, rigid-body modes.
+  subroutine test_structure(element)
+    integer, intent(in) :: element
+    type(body_cfg_t) :: body
+    type(mesh_t) :: m
+    type(body_system_t) :: sys
+    type(traction_cfg_t) :: tr(1)
+    integer :: info, i, j, p, q, nnz_expect, k
+    character(len=256) :: msg
+    character(len=2) :: en
+    logical :: sorted, found
+    real(wp) :: asym, diff, scale, x(200), y(200), lam, mu, x0, x1, y0, y1, ix2, iy2, ixy, energy
+    real(wp), allocatable :: uf(:), r(:), u(:)
+
+    en = element_names(element)
+    body%id = 1
+    body%x0 = -0.4_wp
+    body%y0 = 0.3_wp
+    body%width = 2.5_wp
+    body%height = 1.2_wp
+    body%nx = 5
+    body%ny = 3
+    body%element = element
+    body%young = 70.0_wp
+    body%poisson = 0.33_wp
+    body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
+    body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
+    tr(1)%body = 1
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [0.3_wp, -1.0_wp]
+    tr(1)%t1 = [0.0_wp, 0.5_wp]
+    call mesh_build(m, body)
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call check(en//' assemble_body info = 0 on a valid body', info == 0, real(info, wp), 0.0_wp)
+
+    ! 6 x 4 nodes = 48 dofs; left clamped 8, bottom roller 5 more y's, right both 8
+    ! minus the bottom-right y already prescribed: 7; free 48 - 20 = 28.
+    call check(en//' free dof count (expect 28)', sys%n == 28, real(sys%n, wp), 0.0_wp)
+    call check(en//' corner rule: bottom-right y takes the later side (roller, 0)', &
+               sys%u_fixed(2*6) == 0.0_wp .and. sys%u_fixed(2*6 - 1) == 0.01_wp, sys%u_fixed(2*6), 0.0_wp)
+
+    ! nnz from first principles: count couplings between free dofs through cells.
+    nnz_expect = count_couplings(m, sys)
+    call check(en//' nnz equals the free-free couplings through cells', &
+               sys%colptr(sys%n + 1) == nnz_expect, real(sys%colptr(sys%n + 1), wp), real(nnz_expect, wp))
+
+    sorted = .true.
+    asym = 0.0_wp
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        if (p > sys%colptr(j) + 1) then
+          if (sys%rowind(p) <= sys%rowind(p - 1)) sorted = .false.
+        end if
+        i = sys%rowind(p) + 1
+        found = .false.
+        do q = sys%colptr(i) + 1, sys%colptr(i + 1)
+          if (sys%rowind(q) + 1 == j) then
+            found = .true.
+            asym = max(asym, abs(sys%val(q) - sys%val(p)))
+          end if
+        end do
+        if (.not. found) asym = huge(1.0_wp)
+      end do
+    end do
+    call check(en//' rows strictly increasing in every column', sorted, 0.0_wp, 0.0_wp)
+    call check(en//' pattern and values symmetric (max |Kij-Kji|/|K|)', &
+               asym <= 10*eps*sys%k_norm, asym/sys%k_norm, 10*eps)
+
+    ! Matvec on free dofs + lifting against the element loop on all dofs:
+    ! (K_full u_full - f_applied)_free = K_ff u_f - f.
+    do k = 1, sys%n
+      x(k) = hash01(k, 3)
+    end do
+    allocate (uf(sys%ndof), r(sys%ndof))
+    call expand(sys, x(1:sys%n), uf)
+    call residual_full(m, body, .true., uf, sys%f_applied, r)
+    call csc_matvec(sys, x(1:sys%n), y(1:sys%n))
+    diff = 0.0_wp
+    do k = 1, sys%n
+      diff = max(diff, abs(r(sys%dof_of(k)) - (y(k) - sys%f(k))))
+    end do
+    scale = sys%k_norm*maxval(abs(uf)) + maxval(abs(sys%f_applied))
+    call check(en//' csc_matvec and lifting agree with the element loop', diff <= 100*eps*scale, &
+               diff/scale, 100*eps)
+
+    ! k_norm is the infinity norm: at least every |K_jj|, at most the sum of all entries.
+    call check(en//' k_norm between max |K_jj| and sum |K_ij|', &
+               sys%k_norm >= maxval(abs(sys%val))*(1 - eps) .and. sys%k_norm <= sum(abs(sys%val)), &
+               sys%k_norm, 0.0_wp)
+
+    ! Rigid-body modes produce no force.
+    allocate (u(sys%ndof))
+    uf = 0.0_wp
+    do k = 1, m%nnode
+      u(2*k - 1) = 0.3_wp - 0.7_wp*m%xy(2, k)
+      u(2*k) = -1.1_wp + 0.7_wp*m%xy(1, k)
+    end do
+    call residual_full(m, body, .true., u, uf, r)
+    call check(en//' rigid-body motion gives zero nodal forces', &
+               maxval(abs(r)) <= 100*eps*sys%k_norm*maxval(abs(u)), &
+               maxval(abs(r))/(sys%k_norm*maxval(abs(u))), 100*eps)
+
+    ! Q1: the bilinear field u = (xy, xy) is in the element space; its strain energy
+    ! u'Ku must equal the exact integral of lam (tr eps)^2 + 2 mu eps:eps (this checks the
+    ! quadrature of the element stiffness, which the patch test cannot see).
+    if (element == ELEM_Q1) then
+      do k = 1, m%nnode
+        u(2*k - 1) = m%xy(1, k)*m%xy(2, k)
+        u(2*k) = m%xy(1, k)*m%xy(2, k)
+      end do
+      call residual_full(m, body, .true., u, uf, r)
+      mu = body%young/(2*(1 + body%poisson))
+      lam = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
+      x0 = body%x0
+      x1 = body%x0 + body%width
+      y0 = body%y0
+      y1 = body%y0 + body%height
+      ix2 = (y1 - y0)*(x1**3 - x0**3)/3
+      iy2 = (x1 - x0)*(y1**3 - y0**3)/3
+      ixy = (x1**2 - x0**2)*(y1**2 - y0**2)/4
+      energy = (lam + mu)*(ix2 + iy2 + 2*ixy) + 2*mu*(ix2 + iy2)
+      diff = abs(dot_product(u, r) - energy)
+      call check(en//' strain energy of a bilinear field is exact (rel err)', diff <= 1.0e-13_wp*energy, &
+                 diff/energy, 1.0e-13_wp)
+    end if
+  end subroutine test_structure
+
+  !> Number of (free row, free column) pairs of dofs sharing at least one cell.
+  integer function count_couplings(m, sys) result(cnt)
+    type(mesh_t), intent(in) :: m
+    type(body_system_t), intent(in) :: sys
+    logical, allocatable :: adj(:, :)
+    integer :: c, a, b
+    allocate (adj(m%nnode, m%nnode))
+    adj = .false.
+    do c = 1, m%ncell
+      do a = 1, m%nvert
+        do b = 1, m%nvert
+          adj(m%cells(a, c), m%cells(b, c)) = .true.
+        end do
+      end do
+    end do
+    cnt = 0
+    do b = 1, sys%ndof
+      if (sys%free_of(b) == 0) cycle
+      do a = 1, sys%ndof
+        if (sys%free_of(a) == 0) cycle
+        if (adj((a - 1)/2 + 1, (b - 1)/2 + 1)) cnt = cnt + 1
+      end do
+    end do
+  end function count_couplings
+
+  ! ---------------------------------------------------------------------------------
+  !> Patch test: a linear field prescribed on the boundary of a distorted mesh is
+  !! reproduced inside, and its stress is the constant D eps.
+  subroutine test_patch(element, plane_strain)
+    integer, intent(in) :: element
+    logical, intent(in) :: plane_strain
+    type(body_cfg_t) :: body
+    type(mesh_t) :: m
+    type(body_system_t) :: sys
+    type(traction_cfg_t) :: tr(1)
+    real(wp), allocatable :: u_ex(:), u(:), sigma(:, :), vm(:)
+    real(wp) :: a(0:2), b(0:2), e, nu, lam, mu, exx, eyy, gxy, s_ex(4), vm_ex, err, umax
+    integer :: k, i, j
+    character(len=32) :: what
+
+    write (what, '(a,a,a)') element_names(element), ' ', merge('plane strain', 'plane stress', plane_strain)
+    a = [1.0e-3_wp, 2.0e-3_wp, -1.0e-3_wp]
+    b = [-5.0e-4_wp, 1.5e-3_wp, 3.0e-3_wp]
+    body%id = 1
+    body%x0 = 0.2_wp
+    body%y0 = -0.3_wp
+    body%width = 1.2_wp
+    body%height = 1.0_wp
+    body%nx = 6
+    body%ny = 5
+    body%element = element
+    body%young = 200.0_wp
+    body%poisson = 0.3_wp
+    body%bc = BC_CLAMPED
+    e = body%young
+    nu = body%poisson
+
+    ! The mesh is built twice (here and in solve_body) with the same distortion.
+    call mesh_build(m, body)
+    call distort_interior(m, 0.3_wp)
+    allocate (u_ex(2*m%nnode))
+    do k = 1, m%nnode
+      u_ex(2*k - 1) = a(0) + a(1)*m%xy(1, k) + a(2)*m%xy(2, k)
+      u_ex(2*k) = b(0) + b(1)*m%xy(1, k) + b(2)*m%xy(2, k)
+    end do
+    call solve_body(body, plane_strain, tr, 0, m, sys, u, u_prescribed=u_ex, distort=0.3_wp)
+
+    err = 0.0_wp
+    do j = 1, m%ny - 1
+      do i = 1, m%nx - 1
+        k = 1 + i + j*(m%nx + 1)
+        err = max(err, abs(u(2*k - 1) - u_ex(2*k - 1)), abs(u(2*k) - u_ex(2*k)))
+      end do
+    end do
+    umax = maxval(abs(u_ex))
+    call check('patch '//trim(what)//': interior displacements (max rel err)', err <= 1.0e-12_wp*umax, &
+               err/umax, 1.0e-12_wp)
+
+    ! Stress of the linear field, from the textbook moduli (independent of module assembly).
+    mu = e/(2*(1 + nu))
+    if (plane_strain) then
+      lam = e*nu/((1 + nu)*(1 - 2*nu))
+    else
+      lam = e*nu/(1 - nu**2)
+    end if
+    exx = a(1)
+    eyy = b(2)
+    gxy = a(2) + b(1)
+    s_ex(1) = (lam + 2*mu)*exx + lam*eyy
+    s_ex(2) = lam*exx + (lam + 2*mu)*eyy
+    s_ex(3) = mu*gxy
+    s_ex(4) = merge(nu*(s_ex(1) + s_ex(2)), 0.0_wp, plane_strain)
+    vm_ex = sqrt(0.5_wp*((s_ex(1) - s_ex(2))**2 + (s_ex(2) - s_ex(4))**2 + (s_ex(4) - s_ex(1))**2) &
+                 + 3*s_ex(3)**2)
+    allocate (sigma(4, m%nnode), vm(m%nnode))
+    call nodal_stress(m, body, plane_strain, u, sigma, vm)
+    err = 0.0_wp
+    do k = 1, m%nnode
+      err = max(err, maxval(abs(sigma(:, k) - s_ex)))
+    end do
+    call check('patch '//trim(what)//': nodal stress = D eps (max rel err)', &
+               err <= 1.0e-11_wp*maxval(abs(s_ex)), err/maxval(abs(s_ex)), 1.0e-11_wp)
+    err = maxval(abs(vm - vm_ex))
+    call check('patch '//trim(what)//': von Mises (max rel err)', err <= 1.0e-11_wp*vm_ex, err/vm_ex, 1.0e-11_wp)
+  end subroutine test_patch
+
+  ! ---------------------------------------------------------------------------------
+  !> Shape functions, x-y gradients, position and Jacobian of cell c at reference
+  !! point (r, s): Q1 on [-1,1]^2, P1 on the unit triangle (own implementation).
+  subroutine eval_cell(m, c, r, s, nf, g, xq, det)
+    type(mesh_t), intent(in) :: m
+    integer, intent(in) :: c
+    real(wp), intent(in) :: r, s
+    real(wp), intent(out) :: nf(4), g(2, 4), xq(2), det
+    real(wp) :: dr(4), ds(4), jac(2, 2), xe(2, 4)
+    integer :: a, nv
+    nv = m%nvert
+    do a = 1, nv
+      xe(:, a) = m%xy(:, m%cells(a, c))
+    end do
+    if (nv == 4) then
+      nf = 0.25_wp*[(1 - r)*(1 - s), (1 + r)*(1 - s), (1 + r)*(1 + s), (1 - r)*(1 + s)]
+      dr = 0.25_wp*[-(1 - s), (1 - s), (1 + s), -(1 + s)]
+      ds = 0.25_wp*[-(1 - r), -(1 + r), (1 + r), (1 - r)]
+    else
+      nf = [1 - r - s, r, s, 0.0_wp]
+      dr = [-1.0_wp, 1.0_wp, 0.0_wp, 0.0_wp]
+      ds = [-1.0_wp, 0.0_wp, 1.0_wp, 0.0_wp]
+    end if
+    jac(1, 1) = sum(dr(1:nv)*xe(1, 1:nv))
+    jac(1, 2) = sum(dr(1:nv)*xe(2, 1:nv))
+    jac(2, 1) = sum(ds(1:nv)*xe(1, 1:nv))
+    jac(2, 2) = sum(ds(1:nv)*xe(2, 1:nv))
+    det = jac(1, 1)*jac(2, 2) - jac(1, 2)*jac(2, 1)
+    g = 0.0_wp
+    do a = 1, nv
+      g(1, a) = (jac(2, 2)*dr(a) - jac(1, 2)*ds(a))/det
+      g(2, a) = (-jac(2, 1)*dr(a) + jac(1, 1)*ds(a))/det
+    end do
+    xq = matmul(xe(:, 1:nv), nf(1:nv))
+  end subroutine eval_cell
+
+  !> L2 and H1-seminorm errors against the manufactured u, 5x5 Gauss on Q1 cells and
+  !! a collapsed (Duffy) 5x5 Gauss rule on P1 cells (exact to degree 9 and 8).
+  subroutine ms_errors(m, u, el2, eh1)
+    type(mesh_t), intent(in) :: m
+    real(wp), intent(in) :: u(:)
+    real(wp), intent(out) :: el2, eh1
+    real(wp), parameter :: gx(5) = [-0.906179845938663992797626878299_wp, -0.538469310105683091036314420700_wp, &
+                                    0.0_wp, 0.538469310105683091036314420700_wp, 0.906179845938663992797626878299_wp]
+    real(wp), parameter :: gw(5) = [0.236926885056189087514264040720_wp, 0.478628670499366468041291514836_wp, &
+                                    0.568888888888888888888888888889_wp, 0.478628670499366468041291514836_wp, &
+                                    0.236926885056189087514264040720_wp]
+    integer :: c, ig, jg, a, k
+    real(wp) :: r, s, w, nf(4), g(2, 4), xq(2), det, ue(2), ge(2, 2), uh(2), gh(2, 2)
+    el2 = 0.0_wp
+    eh1 = 0.0_wp
+    do c = 1, m%ncell
+      do jg = 1, 5
+        do ig = 1, 5
+          if (m%nvert == 4) then
+            r = gx(ig)
+            s = gx(jg)
+            w = gw(ig)*gw(jg)
+          else
+            r = 0.5_wp*(1 + gx(ig))
+            s = 0.5_wp*(1 + gx(jg))*(1 - r)
+            w = 0.25_wp*gw(ig)*gw(jg)*(1 - r)
+          end if
+          call eval_cell(m, c, r, s, nf, g, xq, det)
+          call ms_u(xq(1), xq(2), ue, ge)
+          uh = 0.0_wp
+          gh = 0.0_wp
+          do a = 1, m%nvert
+            k = m%cells(a, c)
+            uh = uh + nf(a)*u(2*k - 1:2*k)
+            gh(:, 1) = gh(:, 1) + g(1, a)*u(2*k - 1:2*k)
+            gh(:, 2) = gh(:, 2) + g(2, a)*u(2*k - 1:2*k)
+          end do
+          el2 = el2 + w*det*sum((uh - ue)**2)
+          eh1 = eh1 + w*det*sum((gh - ge)**2)
+        end do
+      end do
+    end do
+    el2 = sqrt(el2)
+    eh1 = sqrt(eh1)
+  end subroutine ms_errors
+
+  !> Observed convergence rates against the manufactured solution (Dirichlet on the
+  !! whole boundary, body force from the optional callback of assemble_body).
+  subroutine test_manufactured(element)
+    integer, intent(in) :: element
+    integer, parameter :: nlev = 5
+    type(body_cfg_t) :: body
+    type(mesh_t) :: m
+    type(body_system_t) :: sys
+    type(traction_cfg_t) :: tr(1)
+    real(wp) :: el2(nlev), eh1(nlev), rl2, rh1, ue(2), ge(2, 2)
+    real(wp), allocatable :: up(:), x(:), u(:)
+    integer :: lev, info, k
+    character(len=256) :: msg
+    character(len=80) :: what
+
+    body%id = 1
+    body%x0 = 0.5_wp
+    body%y0 = -0.25_wp
+    body%width = 1.5_wp
+    body%height = 1.0_wp
+    body%element = element
+    body%young = 1.0_wp
+    body%poisson = 0.3_wp
+    body%bc = BC_CLAMPED
+    ms_mu = body%young/(2*(1 + body%poisson))
+    ms_lam = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
+    do lev = 1, nlev
+      body%nx = 2**(lev + 1)
+      body%ny = 2**(lev + 1)
+      call mesh_build(m, body)
+      allocate (up(2*m%nnode))
+      do k = 1, m%nnode
+        call ms_u(m%xy(1, k), m%xy(2, k), ue, ge)
+        up(2*k - 1:2*k) = ue
+      end do
+      call assemble_body(m, body, .true., tr, 0, sys, info, msg, u_prescribed=up, body_force=ms_force)
+      if (info /= 0) then
+        write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
+        error stop 1
+      end if
+      allocate (x(sys%n), u(sys%ndof))
+      call band_solve(sys, x)
+      call expand(sys, x, u)
+      call ms_errors(m, u, el2(lev), eh1(lev))
+      write (*, '(a,a,1x,i3,a,i3,a,es11.4,a,es11.4)') '      manufactured ', element_names(element), &
+        body%nx, ' x', body%ny, ': L2 error ', el2(lev), '  H1-seminorm error ', eh1(lev)
+      deallocate (up, x, u)
+    end do
+    do lev = 2, nlev
+      rl2 = log(el2(lev - 1)/el2(lev))/log(2.0_wp)
+      rh1 = log(eh1(lev - 1)/eh1(lev))/log(2.0_wp)
+      write (what, '(a,a,a,i0,a,i0)') 'manufactured ', element_names(element), ' L2 rate ', &
+        2**lev, ' -> ', 2**(lev + 1)
+      call check(trim(what)//' (>= 1.8)', rl2 >= 1.8_wp, rl2, 1.8_wp)
+      write (what, '(a,a,a,i0,a,i0)') 'manufactured ', element_names(element), ' H1 rate ', &
+        2**lev, ' -> ', 2**(lev + 1)
+      call check(trim(what)//' (>= 0.9)', rh1 >= 0.9_wp, rh1, 0.9_wp)
+    end do
+  end subroutine test_manufactured
+
+  ! ---------------------------------------------------------------------------------
+  !> Consistent traction loads: resultant and first moment are exact, only side nodes
+  !! are loaded.
+  subroutine test_tractions(element)
+    integer, intent(in) :: element
+    type(body_cfg_t) :: body
+    type(mesh_t) :: m
+    type(body_system_t) :: sys
+    type(traction_cfg_t) :: tr(2)
+    integer, allocatable :: nodes(:)
+    integer :: side, info, k, coord, kase
+    character(len=256) :: msg
+    character(len=80) :: what
+    real(wp) :: sa, sb, fsum(2), fmom(2), fex(2), mex(2), err, scale, other
+    real(wp), allocatable :: s_of(:)
+    logical, allocatable :: onside(:)
+
+    body%id = 2
+    body%x0 = 0.5_wp
+    body%y0 = 1.0_wp
+    body%width = 2.0_wp
+    body%height = 1.2_wp
+    body%nx = 7
+    body%ny = 5
+    body%element = element
+    body%bc = BC_FREE
+    call mesh_build(m, body)
+    allocate (onside(m%nnode))
+    do kase = 1, 2
+      do side = 1, 4
+        tr(1)%body = 2
+        tr(1)%side = side
+        if (kase == 1) then
+          tr(1)%t0 = [1.3_wp, -0.7_wp]
+          tr(1)%t1 = 0.0_wp
+        else
+          tr(1)%t0 = [0.4_wp, -1.1_wp]
+          tr(1)%t1 = [2.5_wp, 0.8_wp]
+        end if
+        ! A traction on the other body must be ignored.
+        tr(2)%body = 1
+        tr(2)%side = SIDE_TOP
+        tr(2)%t0 = [100.0_wp, 100.0_wp]
+        call assemble_body(m, body, .false., tr, 2, sys, info, msg)
+        if (info /= 0) then
+          write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
+          error stop 1
+        end if
+        call side_nodes(m, side, nodes)
+        coord = merge(2, 1, side == SIDE_LEFT .or. side == SIDE_RIGHT)
+        s_of = m%xy(coord, nodes)
+        sa = s_of(1)
+        sb = s_of(size(s_of))
+        fsum = 0.0_wp
+        fmom = 0.0_wp
+        do k = 1, size(nodes)
+          fsum = fsum + sys%f_applied(2*nodes(k) - 1:2*nodes(k))
+          fmom = fmom + s_of(k)*sys%f_applied(2*nodes(k) - 1:2*nodes(k))
+        end do
+        onside = .false.
+        onside(nodes) = .true.
+        other = 0.0_wp
+        do k = 1, m%nnode
+          if (.not. onside(k)) other = max(other, maxval(abs(sys%f_applied(2*k - 1:2*k))))
+        end do
+        fex = tr(1)%t0*(sb - sa) + tr(1)%t1*(sb**2 - sa**2)/2
+        mex = tr(1)%t0*(sb**2 - sa**2)/2 + tr(1)%t1*(sb**3 - sa**3)/3
+        scale = (maxval(abs(tr(1)%t0)) + maxval(abs(tr(1)%t1))*max(abs(sa), abs(sb)))*(sb - sa)
+        write (what, '(a,a,1x,a,1x,a)') 'traction ', element_names(element), &
+          trim(merge('uniform', 'linear ', kase == 1)), trim(side_names(side))
+        err = maxval(abs(fsum - fex))
+        call check(trim(what)//': resultant exact', err <= 20*eps*scale, err/scale, 20*eps)
+        err = maxval(abs(fmom - mex))
+        call check(trim(what)//': first moment exact', err <= 20*eps*scale*max(abs(sa), abs(sb)), &
+                   err/(scale*max(abs(sa), abs(sb))), 20*eps)
+        call check(trim(what)//': no load off the side', other == 0.0_wp, other, 0.0_wp)
+      end do
+    end do
+  end subroutine test_tractions
+
+  ! ---------------------------------------------------------------------------------
+  !> The same problem in SI (m, Pa) and in mm, N, MPa gives u_mm = 1e3 u_SI.
+  subroutine test_units(element, plane_strain)
+    integer, intent(in) :: element
+    logical, intent(in) :: plane_strain
+    type(body_cfg_t) :: b_si, b_mm
+    type(mesh_t) :: m
+    type(body_system_t) :: sys
+    type(traction_cfg_t) :: t_si(2), t_mm(2)
+    real(wp), allocatable :: u_si(:), u_mm(:)
+    real(wp) :: err, scale
+
+    b_si%id = 1
+    b_si%x0 = 0.1_wp
+    b_si%y0 = 0.2_wp
+    b_si%width = 0.5_wp
+    b_si%height = 0.3_wp
+    b_si%nx = 10
+    b_si%ny = 6
+    b_si%element = element
+    b_si%young = 7.0e10_wp
+    b_si%poisson = 0.33_wp
+    b_si%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
+    b_si%u_side(:, SIDE_RIGHT) = [1.0e-4_wp, -2.0e-4_wp]
+    t_si(1)%body = 1
+    t_si(1)%side = SIDE_TOP
+    t_si(1)%t0 = [1.0e6_wp, -2.0e7_wp]
+    t_si(1)%t1 = [0.0_wp, 3.0e7_wp]
+    t_si(2)%body = 1
+    t_si(2)%side = SIDE_RIGHT
+    t_si(2)%t0 = [5.0e6_wp, 0.0_wp]      ! on a prescribed side: reaches f_applied only
+
+    b_mm = b_si
+    b_mm%x0 = b_si%x0*1.0e3_wp
+    b_mm%y0 = b_si%y0*1.0e3_wp
+    b_mm%width = b_si%width*1.0e3_wp
+    b_mm%height = b_si%height*1.0e3_wp
+    b_mm%young = b_si%young*1.0e-6_wp
+    b_mm%u_side = b_si%u_side*1.0e3_wp
+    t_mm = t_si
+    t_mm(1)%t0 = t_si(1)%t0*1.0e-6_wp
+    t_mm(1)%t1 = t_si(1)%t1*1.0e-9_wp
+    t_mm(2)%t0 = t_si(2)%t0*1.0e-6_wp
+
+    call solve_body(b_si, plane_strain, t_si, 2, m, sys, u_si)
+    call solve_body(b_mm, plane_strain, t_mm, 2, m, sys, u_mm)
+    scale = maxval(abs(u_mm))
+    err = maxval(abs(u_mm - 1.0e3_wp*u_si))
+    call check('units '//element_names(element)//' '//merge('strain', 'stress', plane_strain)// &
+               ': u[mm] = 1e3 u[m] (max rel err)', err <= 1.0e-12_wp*scale, err/scale, 1.0e-12_wp)
+  end subroutine test_units
+
+  ! ---------------------------------------------------------------------------------
+  !> Impossible inputs are reported through info/msg, not by stopping.
+  subroutine test_errors()
+    type(body_cfg_t) :: body
+    type(mesh_t) :: m
+    type(body_system_t) :: sys
+    type(traction_cfg_t) :: tr(1)
+    integer :: info
+    character(len=256) :: msg
+    real(wp) :: up(3)
+
+    body%id = 1
+    body%nx = 3
+    body%ny = 2
+    body%bc(SIDE_LEFT) = BC_CLAMPED
+    call mesh_build(m, body)
+    tr(1)%body = 1
+    tr(1)%side = 7
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    write (*, '(a,a)') '      message: ', trim(msg)
+    call check('errors: traction side 7 gives info /= 0 and a message', info /= 0 .and. len_trim(msg) > 0, &
+               real(info, wp), 0.0_wp)
+    call assemble_body(m, body, .true., tr, 2, sys, info, msg)
+    call check('errors: ntraction > size(tractions) gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    tr(1)%side = SIDE_TOP
+    body%poisson = 0.5_wp
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call check('errors: Poisson ratio 0.5 gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    body%poisson = 0.3_wp
+    body%bc(SIDE_TOP) = 9
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call check('errors: unknown side condition gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    body%bc(SIDE_TOP) = BC_FREE
+    up = 0.0_wp
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg, u_prescribed=up)
+    call check('errors: u_prescribed of the wrong size gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    m%xy(1, 2) = m%xy(1, 2) + 2*body%width    ! fold a cell over
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    write (*, '(a,a)') '      message: ', trim(msg)
+    call check('errors: an inverted cell gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    body%nx = 0
+    call mesh_build(m, body, info, msg)
+    call check('errors: mesh_build with nx = 0 gives info /= 0', info /= 0 .and. m%nnode == 0, &
+               real(info, wp), 0.0_wp)
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call check('errors: assemble_body on an empty mesh gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+  end subroutine test_errors
+
+end program test_fem

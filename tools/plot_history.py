@@ -1,0 +1,109 @@
+#!/usr/bin/python3
+"""Convergence history of robin_contact runs: the stopping criterion and the true
+residual against the outer iteration, log scale, one curve pair per result file
+(solid: criterion, dashed: residual, same colour; label from the file name and the
+method/delta attributes).
+
+Usage: tools/plot_history.py FILE.h5 [FILE.h5 ...] [-o history.png] [--title TEXT]
+
+Reads /history/criterion and /history/residual of each file (results.f90 layout).
+Non-positive values (e.g. a residual that is exactly zero) cannot be drawn on a log
+axis and are left out. A run without history (method='monolithic') is listed in the
+legend with a note and no curve. Exit 0 on success, 1 on a missing or unreadable file.
+Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def text_attr(obj, name, default=""):
+    """A string attribute as str: fixed-length HDF5 strings come back as bytes or numpy
+    bytes (possibly blank-padded by Fortran), sometimes inside a 1-element array."""
+    if name not in obj.attrs:
+        return default
+    v = obj.attrs[name]
+    if isinstance(v, np.ndarray):
+        v = v.reshape(-1)[0] if v.size else b""
+    if isinstance(v, (bytes, np.bytes_)):
+        v = v.decode("utf-8", "replace")
+    return str(v).strip().strip("\x00").strip()
+
+
+def num_attr(obj, name, default=float("nan")):
+    if name not in obj.attrs:
+        return default
+    v = np.asarray(obj.attrs[name]).reshape(-1)
+    return float(v[0]) if v.size else default
+
+
+def positive(v):
+    v = np.asarray(v, dtype=float).copy()
+    v[~(v > 0.0)] = np.nan
+    return v
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("files", nargs="+", metavar="FILE.h5", help="robin_contact result files")
+    ap.add_argument("-o", "--output", default="history.png", help="output image (default history.png)")
+    ap.add_argument("--title", default=None, help="figure title")
+    a = ap.parse_args(argv)
+
+    fig, ax = plt.subplots(figsize=(8.0, 5.5), dpi=120)
+    colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
+    drawn = 0
+    for k, path in enumerate(a.files):
+        try:
+            with h5py.File(path, "r") as f:
+                method = text_attr(f, "method", "?")
+                status = text_attr(f, "status", "?")
+                delta = num_attr(f, "delta")
+                crit = np.array(f["/history/criterion"]) if "/history/criterion" in f else np.zeros(0)
+                res = np.array(f["/history/residual"]) if "/history/residual" in f else np.zeros(0)
+        except (OSError, KeyError) as e:
+            print(f"plot_history: cannot read {path}: {e}", file=sys.stderr)
+            return 1
+        name = os.path.basename(path)
+        if name.endswith(".h5"):
+            name = name[:-3]
+        label = f"{name} ({method}"
+        if method != "monolithic" and np.isfinite(delta):
+            label += f", δ={delta:g}"
+        label += f", {status})"
+        c = colours[k % len(colours)]
+        if crit.size == 0 and res.size == 0:
+            ax.plot([], [], color=c, label=label + ": no outer history")
+            continue
+        if crit.size:
+            ax.semilogy(np.arange(1, crit.size + 1), positive(crit), "-", color=c, lw=1.5,
+                        label=label + ": criterion")
+        if res.size:
+            ax.semilogy(np.arange(1, res.size + 1), positive(res), "--", color=c, lw=1.2,
+                        label=label + ": residual")
+        drawn += 1
+    ax.set_yscale("log")
+    ax.set_xlabel("outer iteration")
+    ax.set_ylabel("criterion (solid), residual (dashed)")
+    ax.set_title(a.title or "robin_contact convergence history")
+    ax.grid(True, which="major", alpha=0.4)
+    ax.grid(True, which="minor", alpha=0.15)
+    ax.legend(fontsize=7, loc="best")
+    fig.tight_layout()
+    out_dir = os.path.dirname(a.output)
+    if out_dir:
+        os.makedirs(out_dir, exist_ok=True)
+    fig.savefig(a.output)
+    print(f"plot_history: wrote {a.output} ({drawn} of {len(a.files)} runs with history)")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
