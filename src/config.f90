@@ -61,7 +61,7 @@ module config
     character(len=16) :: factorization = 'cholmod'    !< 'cholmod' | 'banded'
     character(len=16) :: ordering = 'metis'           !< 'metis' | 'amd' | 'natural' (cholmod only)
     character(len=16) :: acceleration = 'none'        !< outer acceleration: 'none' | 'aitken' | 'anderson'
-    real(wp) :: inner_factor = 0.1_wp                 !< inner rtol = inner_factor * outer criterion (clamped)
+    real(wp) :: inner_factor = 1.0e-3_wp              !< inner rtol = inner_factor * outer progress (clamped)
     real(wp) :: inner_rtol_min = 1.0e-12_wp           !< floor of the adaptive inner tolerance
     real(wp) :: inner_rtol_max = 1.0e-2_wp            !< ceiling of the adaptive inner tolerance
     integer :: inner_max_it = 100000                  !< MPRGP iteration limit per subproblem
