@@ -43,7 +43,12 @@ typedef struct chsh_stats {
     int    is_super;      /* 1 if L is supernodal */
 } chsh_stats;
 
-/* Create an empty handle (also holds OpenBLAS to one thread, once). */
+/* Hold OpenBLAS to one thread (done once per process; parallelism is over
+ * the bodies with OpenMP).  Called by chsh_create; call it before any other
+ * BLAS/LAPACK work that may run in two threads at once. */
+void chsh_init(void);
+
+/* Create an empty handle (calls chsh_init). */
 int chsh_create(chsh_factor **h, char *msg, int msglen);
 
 /* Analyze + factorize a symmetric positive definite matrix given in full

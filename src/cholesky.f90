@@ -14,7 +14,7 @@
 module cholesky
   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int
   use kinds, only: wp, ip, i8
-  use cholmod_iface, only: cm_stats_t, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
+  use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
                            CM_ORD_AMD, CM_ORD_NATURAL
   use banded, only: band_t
@@ -170,6 +170,7 @@ contains
     self%ordering = ordering
 
     ! ---- factorize ----
+    call cm_init()    ! BLAS single-threaded, for the banded path too
     select case (method)
     case (FACT_CHOLMOD)
       call cm_create(self%handle, info, msg)

@@ -36,7 +36,7 @@ module cholmod_iface
     integer(c_int) :: is_super = 0    !< 1 if the factor is supernodal
   end type cm_stats_t
 
-  public :: cm_create, cm_factorize, cm_solve, cm_trailing_block, cm_get_stats, &
+  public :: cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, cm_get_stats, &
             cm_release_workspace, cm_free
 
   interface
@@ -97,6 +97,9 @@ module cholmod_iface
       integer(c_int) :: code
     end function chsh_get_stats
 
+    subroutine chsh_init() bind(c, name='chsh_init')
+    end subroutine chsh_init
+
     subroutine chsh_free(h) bind(c, name='chsh_free')
       import :: c_ptr
       type(c_ptr), intent(inout) :: h
@@ -120,6 +123,12 @@ contains
       s(k:k) = buf(k)
     end do
   end function c_to_f
+
+  !> Hold OpenBLAS to one thread (once per process; safe to call repeatedly and
+  !! from several threads). Parallelism is over the bodies, with OpenMP.
+  subroutine cm_init()
+    call chsh_init()
+  end subroutine cm_init
 
   !> Create an empty handle (idempotent: an existing handle is kept).
   subroutine cm_create(h, info, msg)

@@ -56,6 +56,11 @@ static pthread_once_t blas_once = PTHREAD_ONCE_INIT;
 static pthread_mutex_t metis_lock = PTHREAD_MUTEX_INITIALIZER;
 static void blas_one_thread(void) { openblas_set_num_threads(1); }
 
+void chsh_init(void)
+{
+    pthread_once(&blas_once, blas_one_thread);
+}
+
 static void set_msg(char *msg, int msglen, const char *fmt, ...)
 {
     va_list ap;
@@ -119,7 +124,7 @@ int chsh_create(chsh_factor **h, char *msg, int msglen)
         return CHSH_FAILURE;
     }
     *h = NULL;
-    pthread_once(&blas_once, blas_one_thread);
+    chsh_init();
     f = (chsh_factor *) calloc(1, sizeof(chsh_factor));
     if (f == NULL) {
         set_msg(msg, msglen, "chsh_create: out of memory for the handle.");

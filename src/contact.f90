@@ -41,7 +41,40 @@ module contact
     integer, allocatable :: h_active(:)        !< active contact nodes
   end type contact_result_t
 
-  public :: solve_robin, solve_monolithic, interface_residual
+  integer, parameter, public :: ANDERSON_DEPTH = 5   !< history depth of Anderson acceleration
+
+  !> Everything the outer iteration carries from one iteration to the next: with it a
+  !! run resumes bitwise identically from a checkpoint.
+  type, public :: robin_state_t
+    integer :: it = 0                          !< completed outer iterations
+    integer :: inner = 0                       !< cumulative Hessian multiplications
+    integer :: nacc = 0                        !< acceleration steps taken
+    real(wp) :: crit = huge(1.0_wp)            !< last criterion
+    real(wp) :: progress = huge(1.0_wp)        !< min(increment, residual) of the last iteration
+    real(wp) :: best = huge(1.0_wp)            !< best criterion so far
+    real(wp) :: omega = 0.0_wp                 !< Aitken relaxation
+    real(wp) :: wall = 0.0_wp                  !< wall time spent in the iteration so far [s]
+    real(wp) :: flam(2) = 0.0_wp               !< |F_a lam_a| of the last iterate [length]
+    real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
+    real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
+    real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
+    real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
+    real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
+  end type robin_state_t
+
+  abstract interface
+    !> Writes a checkpoint of the outer state and the history so far.
+    subroutine checkpoint_iface(st, res)
+      import :: robin_state_t, contact_result_t
+      type(robin_state_t), intent(in) :: st
+      type(contact_result_t), intent(in) :: res
+    end subroutine checkpoint_iface
+    !> True when the run must stop at the end of this outer iteration.
+    logical function stop_iface()
+    end function stop_iface
+  end interface
+
+  public :: solve_robin, solve_monolithic, interface_residual, state_init, checkpoint_iface, stop_iface
 
 contains
 
@@ -102,37 +135,52 @@ contains
     end if
   end subroutine solve_monolithic
 
-  !> The Robin iteration of METHOD.md with relaxation delta, Steklov-Poincare or
-  !! constant Robin operator, stopping on the increment or the residual.
-  subroutine solve_robin(d, itf, bc, res, progress_unit)
+  !> The Robin iteration of METHOD.md: each body's contact problem against its
+  !! obstacle (MPRGP, in parallel), the force imbalance d = lam_1 - lam_2, its
+  !! correction S d, and the relaxed (or accelerated) update of the obstacles.
+  !! Robin operators S: 'steklov' (the paper's: F_2 for body 1's obstacle, F_1 for
+  !! body 2's), 'constant' (alpha M^-1) and 'harmonic' (S = 2 F_1 (F_1+F_2)^-1 F_2
+  !! for both, which makes the linearised iteration independent of the contrast of
+  !! the bodies: see the README). Acceleration of the obstacle fixed point: 'none',
+  !! 'aitken' (dynamic relaxation) or 'anderson' (depth 5).
+  !! With `state` the iteration resumes from a checkpoint; `checkpoint` is called
+  !! every output%checkpoint_every iterations and when `stop_requested` turns true.
+  subroutine solve_robin(d, itf, bc, res, progress_unit, state, checkpoint, stop_requested)
     type(deck_t), intent(in) :: d                      !< deck (solver settings)
     type(interface_t), intent(in) :: itf               !< contact line
     type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
-    type(contact_result_t), intent(out) :: res         !< solution, status and history
+    type(contact_result_t), intent(inout) :: res       !< solution, status and history (in: history of a restart)
     integer, intent(in), optional :: progress_unit     !< unit for progress lines (none if absent)
+    type(robin_state_t), intent(inout), optional :: state   !< in: state to resume from (state%it > 0)
+    procedure(checkpoint_iface), optional :: checkpoint     !< writes a checkpoint of (state, res)
+    procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
+    type(robin_state_t) :: st_
     type(dense_op_t) :: op(2)
     type(mprgp_opts_t) :: opts(2)
     type(mprgp_stats_t) :: st(2)
-    real(wp), allocatable :: G(:, :), Gnew(:, :), lam(:, :), grad(:, :), rhs(:, :), lb(:)
-    real(wp), allocatable :: dlam(:), corr(:, :), w(:, :)
-    real(wp) :: delta, crit, best, rtol_in, t0, denom(2), ref, lmax(2), incr, progress, uref
-    integer :: m, a, it, every, nmv(2), maxout, nthr
-    logical :: steklov, done, printed
+    real(wp), allocatable :: Gnew(:, :), grad(:, :), rhs(:, :), lb(:), dlam(:), corr(:, :), w(:, :), S(:, :)
+    real(wp) :: delta, rtol_in, t0, denom(2), ref, lmax(2), incr, uref
+    integer :: m, a, it, every, nmv(2), maxout, nthr, it0, info
+    logical :: printed, resumed
 
     m = itf%m
     t0 = wtime()
     nthr = body_threads()
-    res%method = 'robin'
     maxout = d%solver%max_outer
-    call alloc_result(res, m, maxout)
-    allocate (G(m, 2), Gnew(m, 2), lam(m, 2), grad(m, 2), rhs(m, 2), lb(m), dlam(m), corr(m, 2), w(m, 2))
+    resumed = .false.
+    if (present(state)) resumed = state%it > 0
+    if (resumed) then
+      st_ = state
+      if (size(res%h_criterion) < maxout) call grow_history(res, maxout)
+      t0 = t0 - st_%wall
+    else
+      call alloc_result(res, m, maxout)
+      call state_init(st_, m, itf%g0)
+    end if
+    res%method = 'robin'
+    allocate (Gnew(m, 2), grad(m, 2), rhs(m, 2), lb(m), dlam(m), corr(m, 2), w(m, 2))
     delta = d%solver%delta
-    steklov = d%solver%robin_operator /= 'constant'
     lb = 0.0_wp
-    lam = 0.0_wp
-    do a = 1, 2
-      G(:, a) = itf%g0
-    end do
     ref = tiny(1.0_wp) + 1.0e-14_wp*(maxabs(bc(1)%b) + maxabs(bc(2)%b) + maxabs(itf%g0))
     uref = max(maxabs(bc(1)%b), maxabs(bc(2)%b), maxabs(itf%g0), tiny(1.0_wp))
 
@@ -145,38 +193,62 @@ contains
       if (m > 0) lmax(a) = lambda_max_estimate(op(a), 30, nmv(a))
     end do
     !$omp end parallel do
-    res%inner = sum(nmv)
+    if (.not. resumed) st_%inner = sum(nmv)
+    if (d%solver%robin_operator == 'harmonic' .and. m > 0) then
+      call harmonic_operator(bc(1)%flex, bc(2)%flex, S, info)
+      if (info /= 0) then
+        res%status = 'failed'
+        write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
+        return
+      end if
+    end if
     every = max(1, maxout/max(1, d%output%progress_lines))
-    best = huge(1.0_wp)
-    crit = huge(1.0_wp)
-    progress = huge(1.0_wp)
-    done = .false.
     res%status = 'max_outer'
-    if (present(progress_unit)) write (progress_unit, '(a)') &
-      '  outer   criterion    residual  active       inner'
+    printed = .false.
+    if (present(progress_unit)) then
+      if (resumed) write (progress_unit, '(a,i0)') 'resuming after outer iteration ', st_%it
+      write (progress_unit, '(a)') '  outer   criterion    residual  active       inner'
+    end if
+    it0 = st_%it + 1
 
-    do it = 1, maxout
-      if (it == 1) then
+    do it = it0, maxout
+      if (d%solver%robin_operator == 'harmonic') then
+        ! the harmonic operator makes the linearised outer map nilpotent at delta = 0.5:
+        ! the outer iteration is as exact as its subproblems, so solve them tightly
+        rtol_in = max(d%solver%inner_rtol_min, d%solver%inner_factor*d%solver%tol)
+      else if (it == 1) then
         rtol_in = d%solver%inner_rtol_max
       else
-        rtol_in = min(d%solver%inner_rtol_max, max(d%solver%inner_rtol_min, d%solver%inner_factor*progress))
+        rtol_in = min(d%solver%inner_rtol_max, max(d%solver%inner_rtol_min, d%solver%inner_factor*st_%progress))
       end if
       ! 1. each body against its obstacle, in parallel
       !$omp parallel do num_threads(nthr) schedule(static, 1) if (m > 64)
       do a = 1, 2
-        rhs(:, a) = bc(a)%b - G(:, a)
-        opts(a)%rtol = rtol_in
+        rhs(:, a) = bc(a)%b - st_%G(:, a)
+        ! The tolerance is measured against the body's own contact displacement
+        ! |F_a lam_a| (previous iterate), not against |b_a - G_a|: with a large
+        ! material contrast the stiff body's b_a - G_a is a small difference of the
+        ! soft body's large displacements, and a tolerance relative to it would leave
+        ! the stiff body's force inaccurate by the contrast ratio.
+        if (st_%flam(a) > 0.0_wp) then
+          opts(a)%rtol = 0.0_wp
+          opts(a)%atol = max(rtol_in*st_%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs(:, a)))
+        else
+          opts(a)%rtol = rtol_in
+          opts(a)%atol = 0.0_wp
+        end if
         opts(a)%max_it = d%solver%inner_max_it
         opts(a)%lambda_max = lmax(a)
-        if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, lam(:, a), opts(a), st(a), grad(:, a))
+        if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st_%lam(:, a), opts(a), st(a), grad(:, a))
       end do
       !$omp end parallel do
       if (m == 0) then
-        res%status = 'converged'; res%outer = it; done = .true.
+        res%status = 'converged'
+        res%outer = it
         exit
       end if
       do a = 1, 2
-        res%inner = res%inner + st(a)%n_matvec
+        st_%inner = st_%inner + st(a)%n_matvec
         if (st(a)%status == MPRGP_MAX_IT) then
           res%inner_maxit_hits = res%inner_maxit_hits + 1
         else if (st(a)%status /= MPRGP_CONVERGED) then
@@ -186,98 +258,242 @@ contains
           exit
         end if
         ! B_a u_a = b_a - F_a lam_a = G_a - grad_a
-        w(:, a) = G(:, a) - grad(:, a)
+        w(:, a) = st_%G(:, a) - grad(:, a)
+        st_%flam(a) = norm2(grad(:, a) + rhs(:, a))
       end do
       if (res%status == 'failed') then
         res%outer = it
         exit
       end if
-      ! 2. force imbalance and its Steklov-Poincare (or constant Robin) correction
-      dlam = lam(:, 1) - lam(:, 2)
-      if (steklov) then
-        call op(2)%apply(dlam, corr(:, 1))   ! F_2 d, for body 1's obstacle
-        call op(1)%apply(dlam, corr(:, 2))   ! F_1 d, for body 2's obstacle
-        res%inner = res%inner + 2
-      else
+      ! 2. force imbalance and its Robin correction
+      dlam = st_%lam(:, 1) - st_%lam(:, 2)
+      select case (trim(d%solver%robin_operator))
+      case ('constant')
         corr(:, 1) = d%solver%alpha*dlam/itf%trib
         corr(:, 2) = corr(:, 1)
-      end if
-      ! 3. relaxed update of the obstacles
-      Gnew(:, 1) = (1.0_wp - delta)*G(:, 1) + delta*(itf%g0 - w(:, 2) + corr(:, 1))
-      Gnew(:, 2) = (1.0_wp - delta)*G(:, 2) + delta*(itf%g0 - w(:, 1) - corr(:, 2))
+      case ('harmonic')
+        call dsymv('U', m, 1.0_wp, S, m, dlam, 1, 0.0_wp, corr(:, 1), 1)
+        corr(:, 2) = corr(:, 1)
+        st_%inner = st_%inner + 1
+      case default
+        call op(2)%apply(dlam, corr(:, 1))   ! F_2 d, for body 1's obstacle
+        call op(1)%apply(dlam, corr(:, 2))   ! F_1 d, for body 2's obstacle
+        st_%inner = st_%inner + 2
+      end select
+      ! 3. the fixed-point map T(G) and the relaxed or accelerated update
+      Gnew(:, 1) = itf%g0 - w(:, 2) + corr(:, 1)
+      Gnew(:, 2) = itf%g0 - w(:, 1) - corr(:, 2)
+      call accelerate(d%solver%acceleration, delta, st_, Gnew)
 
       ! a non-finite iterate is not kept: the result holds the last finite one
-      if (.not. (all_finite(Gnew) .and. all_finite(lam) .and. all_finite(w))) then
+      if (.not. (all_finite(Gnew) .and. all_finite(st_%lam) .and. all_finite(w))) then
         res%status = 'diverged'
         write (res%message, '(a,i0)') 'non-finite values in the outer iteration at iteration ', it
         exit
       end if
       ! true residual of the current iterate
-      res%lam_body = lam
-      res%lam = 0.5_wp*(lam(:, 1) + lam(:, 2))
+      res%lam_body = st_%lam
       res%w = w
       call interface_residual(itf, bc, res)
       ! increment of the obstacles (the paper's criterion) and the stopping criterion
       do a = 1, 2
         denom(a) = max(norm2(Gnew(:, a)), ref)
       end do
-      incr = norm2(Gnew(:, 1) - G(:, 1))/denom(1) + norm2(Gnew(:, 2) - G(:, 2))/denom(2)
+      incr = norm2(Gnew(:, 1) - st_%G(:, 1))/denom(1) + norm2(Gnew(:, 2) - st_%G(:, 2))/denom(2)
       if (d%solver%stop == 'residual') then
-        crit = res%residual
+        st_%crit = res%residual
       else
-        crit = incr
+        st_%crit = incr
       end if
       ! the inner tolerance follows the outer progress: both the increment and the
       ! residual must shrink before the subproblems are solved tightly (a tolerance
       ! tied to the residual alone can freeze the obstacles and stall the iteration)
-      progress = min(incr, res%residual)
-      G = Gnew
-      res%obstacle = G
+      st_%progress = min(incr, res%residual)
+      st_%G = Gnew
+      st_%it = it
+      st_%wall = wtime() - t0
+      res%obstacle = st_%G
       res%outer = it
-      res%criterion = crit
+      res%inner = st_%inner
+      res%criterion = st_%crit
       res%nhist = it
-      res%h_criterion(it) = crit
+      res%h_criterion(it) = st_%crit
       res%h_residual(it) = res%residual
-      res%h_inner(it) = res%inner
+      res%h_inner(it) = st_%inner
       res%h_active(it) = res%active
-      res%h_wall(it) = wtime() - t0
+      res%h_wall(it) = st_%wall
       printed = .false.
       if (present(progress_unit) .and. (it <= 5 .or. mod(it, every) == 0)) then
-        write (progress_unit, '(i7,2es12.3,i8,i12)') it, crit, res%residual, res%active, res%inner
+        write (progress_unit, '(i7,2es12.3,i8,i12)') it, st_%crit, res%residual, res%active, st_%inner
         printed = .true.
       end if
-      if (.not. ieee_is_finite(crit)) then
+      if (.not. ieee_is_finite(st_%crit)) then
         res%status = 'diverged'
         write (res%message, '(a,i0)') 'non-finite criterion at iteration ', it
         exit
       end if
-      best = min(best, crit)
-      if (it > 10 .and. crit > 1.0e4_wp*best .and. crit > 1.0_wp) then
+      st_%best = min(st_%best, st_%crit)
+      if (it > 10 .and. st_%crit > 1.0e4_wp*st_%best .and. st_%crit > 1.0_wp) then
         res%status = 'diverged'
-        write (res%message, '(a,es10.3,a,es10.3)') 'criterion grew to ', crit, ' from its best ', best
+        write (res%message, '(a,es10.3,a,es10.3)') 'criterion grew to ', st_%crit, ' from its best ', st_%best
         exit
       end if
       ! a relative increment stays bounded while the iterates blow up geometrically:
       ! watch the size of the obstacles against the displacements the loads cause
-      if (maxval(abs(G)) > 1.0e6_wp*uref) then
+      if (maxval(abs(st_%G)) > 1.0e6_wp*uref) then
         res%status = 'diverged'
-        write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(G)), &
+        write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(st_%G)), &
           ' (1e6 times the load displacement scale ', uref, ')'
         exit
       end if
-      if (crit <= d%solver%tol) then
-        res%status = 'converged'
-        done = .true.
+      if (st_%crit <= d%solver%tol) then
+        if (d%solver%stop /= 'residual' .and. res%residual > max(sqrt(d%solver%tol), 1.0e3_wp*d%solver%tol)) then
+          ! the obstacles stopped moving but the bodies do not agree: a stagnated
+          ! iteration, not a solution
+          res%status = 'diverged'
+          write (res%message, '(a,es10.3,a,es10.3,a)') 'stagnated: increment ', st_%crit, &
+            ' below tol but residual ', res%residual, ' (the bodies do not agree)'
+        else
+          res%status = 'converged'
+        end if
         exit
       end if
+      if (present(stop_requested)) then
+        if (stop_requested()) then
+          res%status = 'interrupted'
+          write (res%message, '(a,i0)') 'stopped by a signal after outer iteration ', it
+          if (present(checkpoint)) call checkpoint(st_, res)
+          exit
+        end if
+      end if
+      if (present(checkpoint) .and. d%output%checkpoint_every > 0) then
+        if (mod(it, d%output%checkpoint_every) == 0) call checkpoint(st_, res)
+      end if
     end do
-    if (present(progress_unit) .and. res%outer > 0) then
-      if (.not. printed) write (progress_unit, '(i7,2es12.3,i8,i12)') res%outer, res%criterion, &
-        res%residual, res%active, res%inner
-    end if
+    if (present(progress_unit) .and. res%outer > 0 .and. .not. printed) &
+      write (progress_unit, '(i7,2es12.3,i8,i12)') res%outer, res%criterion, res%residual, res%active, res%inner
     if (res%status == 'max_outer') write (res%message, '(a,i0,a,es10.3)') 'max_outer = ', maxout, &
       ' reached; last criterion ', res%criterion
+    if (present(state)) state = st_
   end subroutine solve_robin
+
+  !> Fresh outer state: obstacles at the initial gap, no contact force.
+  subroutine state_init(st, m, g0)
+    type(robin_state_t), intent(out) :: st   !< state to initialise
+    integer, intent(in) :: m                 !< interface size
+    real(wp), intent(in) :: g0(:)            !< initial gap
+    allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
+    allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
+    st%G(:, 1) = g0
+    st%G(:, 2) = g0
+    st%lam = 0.0_wp
+    st%r_prev = 0.0_wp
+    st%x_prev = 0.0_wp
+    st%dX = 0.0_wp
+    st%dR = 0.0_wp
+  end subroutine state_init
+
+  !> Relaxed or accelerated fixed-point update: on entry Gnew = T(G), on exit the
+  !! next obstacles. The residual of the fixed point is r = T(G) - G.
+  subroutine accelerate(kind, delta, st, Gnew)
+    character(len=*), intent(in) :: kind
+    real(wp), intent(in) :: delta
+    type(robin_state_t), intent(inout) :: st
+    real(wp), intent(inout) :: Gnew(:, :)
+    real(wp), allocatable :: x(:), r(:), dr(:), gam(:), qr(:, :), rhs(:), work(:)
+    integer :: n2, k, j, info, lwork
+    real(wp) :: den
+    n2 = 2*size(Gnew, 1)
+    allocate (x(n2), r(n2))
+    x = reshape(st%G, [n2])
+    r = reshape(Gnew, [n2]) - x
+    select case (trim(kind))
+    case ('aitken')
+      ! Irons-Tuck dynamic relaxation: omega_k = -omega_{k-1} r_{k-1}'(r_k - r_{k-1}) / |r_k - r_{k-1}|^2
+      if (st%nacc == 0) then
+        st%omega = delta
+      else
+        allocate (dr(n2))
+        dr = r - st%r_prev
+        den = dot_product(dr, dr)
+        if (den > 0.0_wp) then
+          st%omega = -st%omega*dot_product(st%r_prev, dr)/den
+          ! keep the relaxation in a safe band
+          st%omega = max(-2.0_wp, min(2.0_wp, st%omega))
+          if (abs(st%omega) < 1.0e-3_wp) st%omega = sign(1.0e-3_wp, st%omega)
+        end if
+      end if
+      st%r_prev = r
+      st%nacc = st%nacc + 1
+      x = x + st%omega*r
+    case ('anderson')
+      ! Anderson mixing of depth ANDERSON_DEPTH with mixing parameter delta:
+      ! x+ = x + delta r - (dX + delta dR) gamma, gamma = argmin |r - dR gamma|
+      if (st%nacc > 0) then
+        j = mod(st%nacc - 1, ANDERSON_DEPTH) + 1
+        st%dX(:, j) = x - st%x_prev
+        st%dR(:, j) = r - st%r_prev
+      end if
+      st%x_prev = x
+      st%r_prev = r
+      k = min(st%nacc, ANDERSON_DEPTH)
+      st%nacc = st%nacc + 1
+      if (k > 0) then
+        allocate (qr(n2, k), rhs(n2), gam(k))
+        qr = st%dR(:, 1:k)
+        rhs = r
+        lwork = -1
+        allocate (work(1))
+        call dgels('N', n2, k, 1, qr, n2, rhs, n2, work, lwork, info)
+        lwork = max(1, int(work(1)))
+        deallocate (work)
+        allocate (work(lwork))
+        call dgels('N', n2, k, 1, qr, n2, rhs, n2, work, lwork, info)
+        if (info == 0 .and. all_finite(rhs(1:k))) then
+          gam = rhs(1:k)
+          x = x + delta*r - matmul(st%dX(:, 1:k) + delta*st%dR(:, 1:k), gam)
+        else
+          x = x + delta*r
+        end if
+      else
+        x = x + delta*r
+      end if
+    case default
+      x = x + delta*r
+    end select
+    Gnew = reshape(x, shape(Gnew))
+  end subroutine accelerate
+
+  !> S = 2 F_1 (F_1 + F_2)^-1 F_2 = 2 (F_1^-1 + F_2^-1)^-1 (symmetric positive definite).
+  subroutine harmonic_operator(F1, F2, S, info)
+    real(wp), intent(in) :: F1(:, :), F2(:, :)
+    real(wp), allocatable, intent(out) :: S(:, :)
+    integer, intent(out) :: info
+    real(wp), allocatable :: A(:, :), X(:, :)
+    integer :: m
+    m = size(F1, 1)
+    allocate (A(m, m), X(m, m), S(m, m))
+    A = F1 + F2
+    X = F2
+    call dposv('U', m, m, A, m, X, m, info)
+    if (info /= 0) return
+    call dgemm('N', 'N', m, m, m, 2.0_wp, F1, m, X, m, 0.0_wp, S, m)
+    S = 0.5_wp*(S + transpose(S))
+  end subroutine harmonic_operator
+
+  subroutine grow_history(res, nh)
+    type(contact_result_t), intent(inout) :: res
+    integer, intent(in) :: nh
+    real(wp), allocatable :: r(:)
+    integer, allocatable :: i(:)
+    integer :: n
+    n = res%nhist
+    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_criterion(1:n); call move_alloc(r, res%h_criterion)
+    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_residual(1:n); call move_alloc(r, res%h_residual)
+    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_wall(1:n); call move_alloc(r, res%h_wall)
+    allocate (i(nh)); i = 0; i(1:n) = res%h_inner(1:n); call move_alloc(i, res%h_inner)
+    allocate (i(nh)); i = 0; i(1:n) = res%h_active(1:n); call move_alloc(i, res%h_active)
+  end subroutine grow_history
 
   !> Gap, imbalance, penetration and complementarity of res%lam_body, res%w.
   subroutine interface_residual(itf, bc, res)
@@ -316,6 +532,8 @@ contains
   subroutine alloc_result(res, m, nh)
     type(contact_result_t), intent(inout) :: res
     integer, intent(in) :: m, nh
+    if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
+    if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, res%h_active)
     allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
     allocate (res%h_criterion(nh), res%h_residual(nh), res%h_wall(nh), res%h_inner(nh), res%h_active(nh))
     res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = 0.0_wp

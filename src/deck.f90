@@ -63,7 +63,7 @@ module deck
   character(len=*), parameter :: E_COND = 'free clamped roller contact displacement'
   character(len=*), parameter :: E_SIDE = 'left right bottom top'
   character(len=*), parameter :: E_METHOD = 'robin monolithic'
-  character(len=*), parameter :: E_OPERATOR = 'steklov constant'
+  character(len=*), parameter :: E_OPERATOR = 'steklov constant harmonic'
   character(len=*), parameter :: E_STOP = 'increment residual'
   character(len=*), parameter :: E_FACT = 'cholmod banded'
   character(len=*), parameter :: E_ORDERING = 'metis amd natural'

@@ -21,7 +21,7 @@ program test_contact
   call scene('tests/decks/gap.nml', none, .true.)
   call scene('tests/decks/lift.nml', none, .true.)
   call scene('tests/decks/lift.nml', [character(len=80) :: &
-    "&solver robin_operator='constant', alpha=3e-12, delta=0.5 /"], .true.)
+    "&solver robin_operator='constant', alpha=2e-12, delta=0.5, max_outer=2000 /"], .true.)
 
   if (nfail > 0) then
     write (*, '(i0,a)') nfail, ' check(s) failed'
