@@ -35,9 +35,9 @@ PROG    := $(BIN)/robin_contact
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors config sysinfo deck mesh assembly linop mprgp cholmod_iface banded cholesky \
-        condense contact results
-OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o
+MODS := kinds errors config sysinfo signals deck mesh assembly linop mprgp cholmod_iface banded cholesky \
+        condense contact h5io results checkpoint
+OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
 
 TESTS_F := test_deck test_mprgp test_cholesky test_fem test_equilibrium test_contact
 BENCH_F := bench_mprgp
@@ -65,7 +65,7 @@ $(BUILD)/%.o: src/%.f90 | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(FC) $(FFLAGS) -c $< -o $@
 
-$(BUILD)/%.o: src/%.c include/cholmod_shim.h | $(DEPS_STAMP)
+$(BUILD)/%.o: src/%.c include/cholmod_shim.h include/sighdl.h | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) -c $< -o $@
 
@@ -85,8 +85,11 @@ $(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $
                           $(BUILD)/assembly.o $(BUILD)/cholesky.o
 $(BUILD)/contact.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/linop.o \
                           $(BUILD)/mprgp.o $(BUILD)/condense.o
-$(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                          $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact.o
+$(BUILD)/h5io.o:          $(BUILD)/kinds.o
+$(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
+                          $(BUILD)/condense.o $(BUILD)/contact.o $(BUILD)/h5io.o
+$(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact.o $(BUILD)/results.o
+$(BUILD)/signals.o:
 $(BUILD)/robin_contact.o: $(OBJS)
 
 # ---- link ----------------------------------------------------------------------
@@ -117,6 +120,16 @@ bench-mprgp: $(BENCH_BINS)
 
 table1: $(PROG)
 	$(PYTHON) tools/table1.py --bin $(PROG) --csv results/table1.csv
+
+hard: $(PROG)
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/hard.py --bin $(PROG)
+
+bench: $(PROG)
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/bench.py --bin $(PROG)
+	$(PYTHON) tools/plot_bench.py results/bench.csv
+
+plots: $(PROG)
+	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh
 
 clean:
 	rm -rf build bin

@@ -4,7 +4,8 @@
 module results
   use kinds, only: wp
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
-  use hdf5
+  use hdf5, only: hid_t, h5open_f, h5fcreate_f, h5fclose_f, h5gcreate_f, h5gclose_f, H5F_ACC_TRUNC_F
+  use h5io, only: dset_r1, dset_r2, dset_i1, dset_i2, dset_str, attr_str, attr_int, attr_real
   use config, only: deck_t, ELEM_Q1, element_names
   use mesh, only: mesh_t
   use assembly, only: body_system_t, expand, nodal_stress
@@ -348,135 +349,5 @@ contains
       'Format="HDF">'//path//'</DataItem>'
     write (u, '(a)') '        </Attribute>'
   end subroutine xattr
-
-  ! ---- small HDF5 helpers ------------------------------------------------------
-
-  subroutine dset_r1(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), intent(in) :: v(:)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = size(v)
-    call h5screate_simple_f(1, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_r1
-
-  subroutine dset_r2(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), intent(in), contiguous :: v(:, :)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(2)
-    integer :: err
-    dims = shape(v)
-    call h5screate_simple_f(2, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_r2
-
-  subroutine dset_i1(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: v(:)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = size(v)
-    call h5screate_simple_f(1, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_i1
-
-  subroutine dset_i2(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in), contiguous :: v(:, :)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(2)
-    integer :: err
-    dims = shape(v)
-    call h5screate_simple_f(2, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_i2
-
-  subroutine dset_str(loc, name, s)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name, s
-    integer(hid_t) :: sp, ds, ty
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5tcopy_f(H5T_FORTRAN_S1, ty, err)
-    call h5tset_size_f(ty, int(max(1, len(s)), size_t), err)
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5dcreate_f(loc, name, ty, sp, ds, err)
-    call h5dwrite_f(ds, ty, s, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-    call h5tclose_f(ty, err)
-  end subroutine dset_str
-
-  subroutine attr_str(loc, name, s)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name, s
-    integer(hid_t) :: sp, at, ty
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5tcopy_f(H5T_FORTRAN_S1, ty, err)
-    call h5tset_size_f(ty, int(max(1, len(s)), size_t), err)
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5acreate_f(loc, name, ty, sp, at, err)
-    if (len(s) > 0) then
-      call h5awrite_f(at, ty, s, dims, err)
-    else
-      call h5awrite_f(at, ty, ' ', dims, err)
-    end if
-    call h5aclose_f(at, err)
-    call h5sclose_f(sp, err)
-    call h5tclose_f(ty, err)
-  end subroutine attr_str
-
-  subroutine attr_int(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: v
-    integer(hid_t) :: sp, at
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, sp, at, err)
-    call h5awrite_f(at, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5aclose_f(at, err)
-    call h5sclose_f(sp, err)
-  end subroutine attr_int
-
-  subroutine attr_real(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), intent(in) :: v
-    integer(hid_t) :: sp, at
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, sp, at, err)
-    call h5awrite_f(at, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5aclose_f(at, err)
-    call h5sclose_f(sp, err)
-  end subroutine attr_real
 
 end module results

@@ -7,15 +7,18 @@
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-  use errors, only: fatal, terminate, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL
-  use config, only: deck_t
-  use deck, only: read_deck, print_deck, deck_usage
+  use errors, only: fatal, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
+                    EXIT_INTERRUPTED
+  use config, only: deck_t, output_cfg_t
+  use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
-  use contact, only: contact_result_t, solve_robin, solve_monolithic
+  use contact, only: contact_result_t, robin_state_t, solve_robin, solve_monolithic
   use results, only: timing_t, write_results, program_version
+  use checkpoint, only: checkpoint_setup, checkpoint_write, checkpoint_read, checkpoint_file, checkpoint_failed
+  use signals, only: signals_install, stop_requested
   use sysinfo, only: peak_rss_mb
   use omp_lib, only: omp_get_wtime, omp_get_max_threads
   implicit none
@@ -27,8 +30,9 @@ program robin_contact
   type(body_condensed_t) :: bc(2)
   type(contact_result_t) :: res
   type(timing_t) :: tm
-  character(len=:), allocatable :: deck_path
+  character(len=:), allocatable :: deck_path, restart_file, key
   character(len=4096), allocatable :: overrides(:)
+  type(robin_state_t) :: state
   character(len=512) :: msg(2), msg1
   integer :: info(2), info1, a, nthr, code, maxndof
   real(wp) :: t_start, t0
@@ -36,8 +40,12 @@ program robin_contact
   logical :: ok
 
   t_start = omp_get_wtime()
-  call parse_arguments(deck_path, overrides)
+  call parse_arguments(deck_path, overrides, restart_file)
   call read_deck(deck_path, overrides, d)
+  if (len(restart_file) > 0 .and. d%solver%method /= 'robin') &
+    call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': --restart applies to method=''robin'' only')
+  if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
+  key = physics_key(d)
   write (output_unit, '(a)') 'robin_contact '//program_version//': effective input'
   call print_deck(d, output_unit)
   nthr = max(1, min(2, omp_get_max_threads()))
@@ -87,7 +95,13 @@ program robin_contact
   if (d%solver%method == 'monolithic') then
     call solve_monolithic(d, itf, bc, res)
   else
-    call solve_robin(d, itf, bc, res, output_unit)
+    if (len(restart_file) > 0) then
+      call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
+      if (.not. ok) call fatal(EXIT_INPUT, trim(msg1))
+    end if
+    call checkpoint_setup(checkpoint_file(d%output%file), key)
+    call solve_robin(d, itf, bc, res, output_unit, state, checkpoint_write, stop_requested)
+    if (checkpoint_failed()) call warn('a checkpoint could not be written to '//checkpoint_file(d%output%file))
   end if
   ! displacements of both bodies under their own contact forces
   maxndof = max(sys(1)%ndof, sys(2)%ndof)
@@ -110,6 +124,8 @@ program robin_contact
     code = EXIT_OK
   case ('failed')
     code = EXIT_NUMERICAL
+  case ('interrupted')
+    code = EXIT_INTERRUPTED
   case default
     code = EXIT_NOT_CONVERGED
   end select
@@ -122,6 +138,8 @@ program robin_contact
     tm%total = omp_get_wtime() - t_start
     call write_results(d%output%file, d, msh, sys, itf, res, u, tm, ok, msg1)
     if (.not. ok) call fatal(EXIT_NUMERICAL, 'output: '//trim(msg1))
+    ! a converged run has no use for its checkpoint; a run that stopped keeps it
+    if (code == EXIT_OK) call remove_file(checkpoint_file(d%output%file))
   end if
   tm%output = omp_get_wtime() - t0
   tm%total = omp_get_wtime() - t_start
@@ -165,10 +183,36 @@ contains
     if (s(1:1) == '.') s = '0'//s
   end function fmt_real
 
-  subroutine parse_arguments(path, extra)
+  !> The effective deck without the settings that may change between a run and its
+  !! restart (output, max_outer): a checkpoint is only accepted under the same key.
+  function physics_key(d0) result(k)
+    type(deck_t), intent(in) :: d0
+    character(len=:), allocatable :: k
+    type(deck_t) :: d1
+    type(output_cfg_t) :: o
+    d1 = d0
+    d1%output = o
+    d1%source = ''
+    d1%title = ''
+    d1%solver%max_outer = 1
+    call deck_text(d1, k)
+  end function physics_key
+
+  subroutine remove_file(path)
+    character(len=*), intent(in) :: path
+    integer :: u, ios
+    logical :: ex
+    inquire (file=path, exist=ex)
+    if (.not. ex) return
+    open (newunit=u, file=path, status='old', iostat=ios)
+    if (ios == 0) close (u, status='delete', iostat=ios)
+  end subroutine remove_file
+
+  subroutine parse_arguments(path, extra, restart)
     character(len=:), allocatable, intent(out) :: path
     character(len=4096), allocatable, intent(out) :: extra(:)
-    integer :: n, i, l
+    character(len=:), allocatable, intent(out) :: restart
+    integer :: n, i, l, k
     character(len=4096) :: arg
     n = command_argument_count()
     if (n < 1) call fatal(EXIT_INPUT, 'no deck file given'//achar(10)//deck_usage)
@@ -178,11 +222,25 @@ contains
       call terminate(EXIT_OK)
     end if
     path = trim(arg)
+    restart = ''
     allocate (extra(n - 1))
-    do i = 2, n
-      call get_command_argument(i, extra(i - 1), l)
-      if (l > len(extra(i - 1))) call fatal(EXIT_INPUT, 'command-line argument too long')
+    k = 0
+    i = 2
+    do while (i <= n)
+      call get_command_argument(i, arg, l)
+      if (l > len(arg)) call fatal(EXIT_INPUT, 'command-line argument too long')
+      if (trim(arg) == '--restart') then
+        if (i == n) call fatal(EXIT_INPUT, '--restart needs a checkpoint file (FILE.ckpt.h5)')
+        call get_command_argument(i + 1, arg, l)
+        restart = trim(arg)
+        i = i + 2
+        cycle
+      end if
+      k = k + 1
+      extra(k) = arg
+      i = i + 1
     end do
+    extra = extra(1:k)
   end subroutine parse_arguments
 
 end program robin_contact

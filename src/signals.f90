@@ -1,0 +1,36 @@
+!> SIGTERM/SIGINT from a batch scheduler: the C handler (src/sighdl.c) sets a flag
+!! that the outer iteration polls through `stop_requested`.
+module signals
+  use, intrinsic :: iso_c_binding, only: c_int
+  implicit none
+  private
+
+  interface
+    integer(c_int) function rc_signals_install() bind(c, name='rc_signals_install')
+      import :: c_int
+    end function rc_signals_install
+    integer(c_int) function rc_signals_pending() bind(c, name='rc_signals_pending')
+      import :: c_int
+    end function rc_signals_pending
+  end interface
+
+  public :: signals_install, stop_requested, pending_signal
+
+contains
+
+  !> Install the handlers; .false. if the system refused.
+  logical function signals_install()
+    signals_install = rc_signals_install() == 0
+  end function signals_install
+
+  !> True once SIGTERM or SIGINT has been received.
+  logical function stop_requested()
+    stop_requested = rc_signals_pending() /= 0
+  end function stop_requested
+
+  !> The signal number received, 0 if none.
+  integer function pending_signal()
+    pending_signal = int(rc_signals_pending())
+  end function pending_signal
+
+end module signals

@@ -1,0 +1,417 @@
+#!/usr/bin/env python3
+"""Speed against error: benchmark of robin_contact on the paper's scene.
+
+Runs (each a separate process of bin/robin_contact, OMP_NUM_THREADS=2 unless said):
+  ladder   meshes 16x8 ... 1024x512 per body (level k: 16*2^k x 8*2^k), for
+           monolithic, robin/steklov delta=0.5 and robin/harmonic delta=0.5
+           (CHOLMOD + METIS);
+  ordering the same meshes with robin/steklov and CHOLMOD + AMD, and with the
+           banded Cholesky while its predicted time stays below --banded-limit s;
+  threads  robin/steklov at 512x256 and 1024x512 with OMP_NUM_THREADS=1 and 2,
+           METIS and AMD orderings, run back to back;
+  sweep    256x128, tol 1e-2 ... 1e-10, stop='residual' and 'increment', both Robin
+           operators, plus monolithic with monolithic_rtol 1e-2 ... 1e-10.
+
+Error columns:
+  alg_err   |lam - lam_mono| / |lam_mono| against the monolithic run of the same mesh
+            (ladder/ordering/threads rows against the ladder's monolithic run; sweep rows
+            against it too, the monolithic sweep rows included);
+  p_err     discretisation error: relative L2 error of the contact pressure along the line
+            against the finest mesh of the ladder (its monolithic run), the fine pressure
+            taken at the coarse nodes (meshes double, nodes nest), weights = the coarse
+            tributary lengths;
+  force_err |F - F_fine| / |F_fine| of the total contact force F = sum(lam);
+  p_order, force_order   log2(err(previous mesh) / err(this mesh)) within one series;
+  force_order3           log2(|F(k-2) - F(k-1)| / |F(k-1) - F(k)|), no reference needed.
+
+Timing hygiene: the machine may be shared. busy_before = cores kept busy (by anything)
+during the second before the run; runs at >= 512x256 and the thread comparison wait up
+to --quiet-wait s for < 0.5 busy core. load1 = the 1-minute load average at the start.
+
+Writes results/bench.csv (one row per run, all columns) and prints markdown tables.
+
+Usage: tools/bench.py [--max-level N] [--quick] [--bin bin/robin_contact]
+                      [--deck inputs/default.nml] [--csv results/bench.csv]
+Levels: 0 = 16x8, 1 = 32x16, 2 = 64x32, 3 = 128x64, 4 = 256x128, 5 = 512x256, 6 = 1024x512.
+--max-level N (default 6) is the finest level; --quick caps it at 4 (256x128).
+"""
+import argparse
+import csv
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+RESULT_RE = re.compile(r"^result: (.*)$", re.M)
+TIME_RE = re.compile(r"^time: (.*)$", re.M)
+FORCE_RE = re.compile(r"^contact: total normal force=\s*(\S+)", re.M)
+
+COLUMNS = [
+    "group", "level", "nx", "ny", "label", "method", "operator", "delta", "factorization",
+    "ordering", "threads", "tol", "stop", "mono_rtol", "exit", "status", "n1", "n2", "m",
+    "outer", "inner", "residual", "assemble_s", "factor_s", "condense_s", "iterate_s",
+    "output_s", "total_s", "solve_s", "solve_over_factor", "peak_mb", "factor_mb",
+    "process_wall_s", "load1", "busy_before", "force", "alg_err", "p_err", "force_err", "p_order",
+    "force_order", "force_order3", "cmdline",
+]
+
+
+def mesh_of(level):
+    return 16 * 2 ** level, 8 * 2 ** level
+
+
+def fnum(x):
+    try:
+        return float(x)
+    except (TypeError, ValueError):
+        return float("nan")
+
+
+def cpu_times():
+    with open("/proc/stat") as f:
+        v = [int(x) for x in f.readline().split()[1:]]
+    return sum(v), v[3] + v[4]
+
+
+def busy_cores(dt):
+    """Average number of busy cores over dt seconds (whole machine)."""
+    t0, i0 = cpu_times()
+    time.sleep(dt)
+    t1, i1 = cpu_times()
+    return (1.0 - (i1 - i0) / max(t1 - t0, 1)) * (os.cpu_count() or 1)
+
+
+class Runner:
+    def __init__(self, binary, deck, workdir, keep):
+        self.binary = binary
+        self.deck = deck
+        self.workdir = workdir
+        self.keep = keep
+        self.count = 0
+        self.contact = {}     # row id -> dict of contact arrays
+        self.quiet_wait = 0.0
+
+    def run(self, row, overrides, threads=2):
+        """Run one case; fill row with the parsed result and keep the contact arrays."""
+        self.count += 1
+        stem = f"run{self.count:03d}"
+        h5 = os.path.join(self.workdir, stem + ".h5")
+        args = [self.binary, self.deck] + overrides + [f"&output file='{h5}', progress_lines=0 /"]
+        env = dict(os.environ)
+        env["OMP_NUM_THREADS"] = str(threads)
+        row["threads"] = threads
+        row["load1"] = round(os.getloadavg()[0], 2)
+        row["busy_before"] = self.wait_quiet(row)
+        row["cmdline"] = "OMP_NUM_THREADS=%d %s" % (threads, " ".join(
+            a if re.fullmatch(r"[\w./=-]+", a) else "'" + a.replace("'", '"') + "'" for a in args[:-1]))
+        t0 = time.monotonic()
+        p = subprocess.run(args, capture_output=True, text=True, env=env)
+        row["process_wall_s"] = round(time.monotonic() - t0, 3)
+        row["exit"] = p.returncode
+        res = RESULT_RE.findall(p.stdout)
+        tim = TIME_RE.findall(p.stdout)
+        if not res or not tim:
+            sys.stderr.write(f"bench: no result/time line from: {row['cmdline']} (exit {p.returncode})\n")
+            sys.stderr.write(p.stdout[-1500:] + p.stderr[-1500:] + "\n")
+            row["status"] = "error"
+            self._clean(stem)
+            return row
+        r = dict(kv.split("=", 1) for kv in res[-1].split())
+        t = dict(kv.split("=", 1) for kv in tim[-1].split())
+        row["status"] = r.get("status")
+        for k in ("n1", "n2", "m", "outer", "inner"):
+            row[k] = int(r[k])
+        row["residual"] = fnum(r.get("residual"))
+        for k in ("assemble", "factor", "condense", "iterate", "output", "total"):
+            row[k + "_s"] = fnum(t.get(k))
+        row["peak_mb"] = fnum(t.get("peak_mb"))
+        row["factor_mb"] = fnum(t.get("factor_mb"))
+        row["solve_s"] = row["factor_s"] + row["condense_s"] + row["iterate_s"]
+        row["solve_over_factor"] = row["solve_s"] / row["factor_s"] if row["factor_s"] > 0 else float("nan")
+        fm = FORCE_RE.findall(p.stdout)
+        if os.path.exists(h5):
+            with h5py.File(h5, "r") as f:
+                c = {k: np.array(f["/contact/" + k]) for k in ("normal_force", "pressure", "x", "tributary_length")}
+            self.contact[id(row)] = c
+            row["force"] = float(np.sum(c["normal_force"]))
+        elif fm:
+            row["force"] = fnum(fm[-1])
+        self._clean(stem)
+        sys.stderr.write(f"  {row['group']:8s} {row['nx']}x{row['ny']:<4} {row['label']:16s} "
+                         f"{row['factorization']}/{row['ordering']} thr={threads} tol={row['tol']} "
+                         f"{row['stop']}: {row['status']} outer={row['outer']} inner={row['inner']} "
+                         f"total={row['total_s']} s (load {row['load1']})\n")
+        return row
+
+    def wait_quiet(self, row):
+        """Cores kept busy by other processes over the last second; for the big runs
+        (level >= 5 and the thread comparison) wait up to quiet_wait s for < 0.5."""
+        big = row["level"] >= 5 or row["group"] == "threads"
+        deadline = time.monotonic() + (self.quiet_wait if big else 0.0)
+        while True:
+            b = busy_cores(1.0 if big else 0.2)
+            if b < 0.5 or time.monotonic() >= deadline:
+                return round(b, 2)
+            sys.stderr.write(f"  (machine busy: {b:.2f} cores; waiting)\n")
+            time.sleep(4.0)
+
+    def _clean(self, stem):
+        if self.keep:
+            return
+        for fn in os.listdir(self.workdir):
+            if fn.startswith(stem):
+                os.remove(os.path.join(self.workdir, fn))
+
+
+def new_row(group, level, label, method, operator, factorization="cholmod", ordering="metis",
+            tol=1e-8, stop="increment", mono_rtol=1e-12, delta=0.5):
+    nx, ny = mesh_of(level)
+    row = {k: "" for k in COLUMNS}
+    row.update(group=group, level=level, nx=nx, ny=ny, label=label, method=method,
+               operator=operator if method == "robin" else "", delta=delta if method == "robin" else "",
+               factorization=factorization, ordering=ordering if factorization == "cholmod" else "rcm",
+               tol=tol if method == "robin" else "", stop=stop if method == "robin" else "",
+               mono_rtol=mono_rtol if method == "monolithic" else "")
+    return row
+
+
+def overrides_of(row):
+    nx, ny = row["nx"], row["ny"]
+    ov = [f"&body id=1, nx={nx}, ny={ny} /", f"&body id=2, nx={nx}, ny={ny} /"]
+    s = f"&solver method='{row['method']}', factorization='{row['factorization']}'"
+    if row["factorization"] == "cholmod":
+        s += f", ordering='{row['ordering']}'"
+    if row["method"] == "robin":
+        s += (f", robin_operator='{row['operator']}', delta={row['delta']}, tol={row['tol']:.0e}"
+              f", stop='{row['stop']}'")
+    else:
+        s += f", monolithic_rtol={row['mono_rtol']:.0e}"
+    return ov + [s + " /"]
+
+
+def rel(a, b):
+    nb = np.linalg.norm(b)
+    return float(np.linalg.norm(a - b) / nb) if nb > 0 else float("nan")
+
+
+def pressure_error(coarse, fine):
+    xc, xf = coarse["x"], fine["x"]
+    hf = np.min(np.diff(xf)) if xf.size > 1 else 1.0
+    pos = np.interp(xc, xf, np.arange(xf.size))
+    if np.max(np.abs(pos - np.rint(pos))) > 1e-6:
+        raise SystemExit("bench: coarse contact nodes do not nest in the fine mesh")
+    pf = fine["pressure"][np.rint(pos).astype(int)]
+    w = coarse["tributary_length"]
+    return float(np.sqrt(np.sum(w * (coarse["pressure"] - pf) ** 2) / np.sum(w * pf ** 2)))
+
+
+def order(e_prev, e):
+    if not (e_prev > 0 and e > 0) or math.isnan(e_prev) or math.isnan(e):
+        return ""
+    return round(math.log2(e_prev / e), 3)
+
+
+def fmt(x, spec):
+    if x == "" or x is None:
+        return ""
+    if isinstance(x, float) and math.isnan(x):
+        return "nan"
+    return format(x, spec)
+
+
+def table(head, rows):
+    out = ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
+    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
+    return "\n".join(out)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--max-level", type=int, default=6)
+    ap.add_argument("--quick", action="store_true", help="cap the ladder at 256x128 (level 4)")
+    ap.add_argument("--bin", default="bin/robin_contact")
+    ap.add_argument("--deck", default="inputs/default.nml")
+    ap.add_argument("--csv", default="results/bench.csv")
+    ap.add_argument("--sweep-level", type=int, default=4, help="mesh level of the tolerance sweep (4 = 256x128)")
+    ap.add_argument("--banded-limit", type=float, default=60.0,
+                    help="skip the banded run when 16x the previous level's banded time exceeds this [s]")
+    ap.add_argument("--skip", default="", help="comma list of groups to skip: ordering,threads,sweep")
+    ap.add_argument("--quiet-wait", type=float, default=180.0,
+                    help="before each run at >= 512x256 and each thread-comparison run, wait up to this "
+                         "many s until other processes keep < 0.5 core busy")
+    ap.add_argument("--keep-h5", action="store_true", help="keep the result files (in --workdir)")
+    ap.add_argument("--workdir", default=None, help="folder for the run files (default: a temporary folder)")
+    a = ap.parse_args()
+    top = min(a.max_level, 4) if a.quick else a.max_level
+    top = max(0, min(top, 6))
+    sweep_level = min(a.sweep_level, top)
+    skip = set(s for s in a.skip.split(",") if s)
+    if not os.access(a.bin, os.X_OK):
+        raise SystemExit(f"bench: no executable {a.bin} (run make first)")
+    workdir = a.workdir or tempfile.mkdtemp(prefix="bench_", dir=os.environ.get("TMPDIR", "/tmp"))
+    os.makedirs(workdir, exist_ok=True)
+    R = Runner(a.bin, a.deck, workdir, a.keep_h5)
+    R.quiet_wait = a.quiet_wait
+    rows = []
+
+    def go(row, threads=2):
+        R.run(row, overrides_of(row), threads)
+        rows.append(row)
+        return row
+
+    sys.stderr.write(f"bench: levels 0..{top}, work folder {workdir}\n")
+    mono = {}
+    banded_prev = None
+    for lv in range(top + 1):
+        mono[lv] = go(new_row("ladder", lv, "monolithic", "monolithic", ""))
+        go(new_row("ladder", lv, "robin-steklov", "robin", "steklov"))
+        go(new_row("ladder", lv, "robin-harmonic", "robin", "harmonic"))
+        if "ordering" not in skip:
+            go(new_row("ordering", lv, "robin-steklov", "robin", "steklov", ordering="amd"))
+            if banded_prev is None or banded_prev * 16.0 < a.banded_limit:
+                r = go(new_row("ordering", lv, "robin-steklov", "robin", "steklov", factorization="banded"))
+                banded_prev = r["total_s"] if r["status"] != "error" else 1e30
+    if "threads" not in skip:
+        tlevels = [lv for lv in (5, 6) if lv <= top] or [top]
+        for lv in tlevels:
+            for ordering in ("metis", "amd"):
+                for thr in (1, 2):
+                    go(new_row("threads", lv, "robin-steklov", "robin", "steklov", ordering=ordering), threads=thr)
+    if "sweep" not in skip:
+        tols = [10.0 ** -k for k in range(2, 11)]
+        for op in ("steklov", "harmonic"):
+            for stop in ("residual", "increment"):
+                for tol in tols:
+                    go(new_row("sweep", sweep_level, "robin-" + op, "robin", op, tol=tol, stop=stop))
+        for tol in tols:
+            go(new_row("sweep", sweep_level, "monolithic", "monolithic", "", mono_rtol=tol))
+
+    # ---- errors ---------------------------------------------------------------------
+    C = R.contact
+    fine = C.get(id(mono[top]))
+    for r in rows:
+        c = C.get(id(r))
+        if c is None:
+            continue
+        m = C.get(id(mono[r["level"]]))
+        if m is not None and r is not mono[r["level"]]:
+            r["alg_err"] = rel(c["normal_force"], m["normal_force"])
+        if fine is not None and r["level"] < top:
+            r["p_err"] = pressure_error(c, fine)
+            F = float(np.sum(fine["normal_force"]))
+            r["force_err"] = abs(r["force"] - F) / abs(F)
+    series = {}
+    for r in rows:
+        if r["group"] in ("ladder", "ordering") and r["status"] != "error":
+            key = (r["label"], r["factorization"], r["ordering"])
+            series.setdefault(key, []).append(r)
+    for ser in series.values():
+        ser.sort(key=lambda r: r["level"])
+        for i, r in enumerate(ser):
+            if i >= 1 and ser[i - 1]["level"] == r["level"] - 1:
+                p = ser[i - 1]
+                if r["p_err"] != "":
+                    r["p_order"] = order(p["p_err"], r["p_err"])
+                    r["force_order"] = order(p["force_err"], r["force_err"])
+                if i >= 2 and ser[i - 2]["level"] == r["level"] - 2:
+                    q = ser[i - 2]
+                    r["force_order3"] = order(abs(q["force"] - p["force"]), abs(p["force"] - r["force"]))
+
+    os.makedirs(os.path.dirname(a.csv) or ".", exist_ok=True)
+    with open(a.csv, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=COLUMNS)
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    if not a.workdir and not a.keep_h5:
+        shutil.rmtree(workdir, ignore_errors=True)
+
+    # ---- tables -----------------------------------------------------------------------
+    def oi(r):
+        return f"{r['outer']}/{r['inner']}" if r["status"] != "error" else "error"
+
+    def st(r):
+        return "" if r["status"] == "converged" else f" ({r['status']})"
+
+    print(f"# robin_contact bench ({a.deck}, Q1 plane strain, OMP_NUM_THREADS=2 unless said)\n")
+    print("## Ladder: CHOLMOD + METIS, time per phase [s], memory [MB]\n")
+    lr = [r for r in rows if r["group"] == "ladder"]
+    print(table(["mesh", "DOFs/body", "m", "method", "outer/inner", "assemble", "factor", "condense",
+                 "iterate", "output", "total", "(f+c+i)/f", "peak MB", "factor MB", "alg. err", "busy"],
+                [[f"{r['nx']}x{r['ny']}", r["n1"], r["m"], r["label"] + st(r), oi(r), fmt(r["assemble_s"], ".3f"),
+                  fmt(r["factor_s"], ".3f"), fmt(r["condense_s"], ".3f"), fmt(r["iterate_s"], ".3f"),
+                  fmt(r["output_s"], ".3f"), fmt(r["total_s"], ".3f"), fmt(r["solve_over_factor"], ".2f"),
+                  fmt(r["peak_mb"], ".0f"), fmt(r["factor_mb"], ".0f"), fmt(r["alg_err"], ".1e"), r["busy_before"]]
+                 for r in lr]))
+    print("\n## Discretisation error against the finest mesh "
+          f"({mesh_of(top)[0]}x{mesh_of(top)[1]}, monolithic)\n")
+    print(table(["mesh", "method", "total force [N/m]", "force err", "order", "3-mesh force order",
+                 "pressure L2 err", "order"],
+                [[f"{r['nx']}x{r['ny']}", r["label"], fmt(r["force"], ".6e"), fmt(r["force_err"], ".2e"),
+                  r["force_order"], r["force_order3"], fmt(r["p_err"], ".2e"), r["p_order"]]
+                 for r in lr if r["label"] != "robin-harmonic"]))
+    if "ordering" not in skip:
+        print("\n## Factorizations side by side (robin/steklov, delta 0.5): factor / condense / total [s], "
+              "factor MB\n")
+        out = []
+        for lv in range(top + 1):
+            cells = [f"{mesh_of(lv)[0]}x{mesh_of(lv)[1]}"]
+            for fac, ordn in (("cholmod", "metis"), ("cholmod", "amd"), ("banded", "rcm")):
+                grp = "ladder" if ordn == "metis" else "ordering"
+                rr = [r for r in rows if r["group"] == grp and r["level"] == lv and r["label"] == "robin-steklov"
+                      and r["factorization"] == fac and r["ordering"] == ordn]
+                if rr and rr[0]["status"] != "error":
+                    r = rr[0]
+                    cells.append(f"{r['factor_s']:.3f} / {r['condense_s']:.3f} / {r['total_s']:.3f}")
+                    cells.append(fmt(r["factor_mb"], ".0f"))
+                    cells.append(fmt(r["alg_err"], ".1e"))
+                else:
+                    cells += ["—", "", ""]
+            out.append(cells)
+        print(table(["mesh", "METIS f/c/total", "MB", "err", "AMD f/c/total", "MB", "err",
+                     "banded f/c/total", "MB", "err"], out))
+    if "threads" not in skip:
+        print("\n## Threads: robin/steklov, OMP_NUM_THREADS 1 vs 2 (back to back)\n")
+        out = []
+        tr = [r for r in rows if r["group"] == "threads"]
+        for lv in sorted(set(r["level"] for r in tr)):
+            for ordn in ("metis", "amd"):
+                one = [r for r in tr if r["level"] == lv and r["ordering"] == ordn and r["threads"] == 1]
+                two = [r for r in tr if r["level"] == lv and r["ordering"] == ordn and r["threads"] == 2]
+                if not one or not two or "error" in (one[0]["status"], two[0]["status"]):
+                    continue
+                o, t = one[0], two[0]
+                fc1, fc2 = o["factor_s"] + o["condense_s"], t["factor_s"] + t["condense_s"]
+                out.append([f"{o['nx']}x{o['ny']}", ordn, f"{fc1:.2f}", f"{fc2:.2f}", f"{fc1 / fc2:.2f}",
+                            f"{o['total_s']:.2f}", f"{t['total_s']:.2f}", f"{o['total_s'] / t['total_s']:.2f}",
+                            f"{o['busy_before']}/{t['busy_before']}"])
+        print(table(["mesh", "ordering", "factor+condense 1 thr", "2 thr", "speed-up", "total 1 thr",
+                     "2 thr", "speed-up", "busy"], out))
+    if "sweep" not in skip:
+        nx, ny = mesh_of(sweep_level)
+        print(f"\n## Tolerance sweep at {nx}x{ny}: error of lam against the monolithic solution "
+              "(monolithic_rtol 1e-12)\n")
+        sr = [r for r in rows if r["group"] == "sweep"]
+        print(table(["method", "stop", "tol", "status", "outer/inner", "iterate [s]", "f+c+i [s]", "residual",
+                     "alg. err"],
+                    [[r["label"], r["stop"] or "(mono rtol)", fmt(r["tol"] if r["tol"] != "" else r["mono_rtol"], ".0e"),
+                      r["status"], oi(r), fmt(r["iterate_s"], ".3f"), fmt(r["solve_s"], ".3f"),
+                      fmt(r["residual"], ".1e"), fmt(r["alg_err"], ".1e")] for r in sr]))
+    fin = [r for r in rows if r["group"] == "ladder" and r["level"] == top and r["label"] == "robin-steklov"]
+    if fin and fin[0]["status"] != "error":
+        r = fin[0]
+        print(f"\nAt {r['nx']}x{r['ny']} ({r['n1']} DOFs per body, m={r['m']}), robin/steklov: "
+              f"(factor+condense+iterate)/factor = {r['solve_s']:.2f} / {r['factor_s']:.2f} = "
+              f"{r['solve_over_factor']:.2f} (target <= 1.5); total {r['total_s']:.2f} s")
+    print(f"\nwrote {a.csv} ({len(rows)} runs)")
+
+
+if __name__ == "__main__":
+    main()
