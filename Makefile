@@ -3,7 +3,8 @@
 #   make            build bin/robin_contact (installs missing Debian packages first)
 #   make run        build and solve inputs/default.nml
 #   make check      build and run every test (last line: N passed, M failed)
-#   make DEBUG=1    checked build (-fcheck=all, FP traps, backtrace) in build/debug
+#   make DEBUG=1    checked build (-fcheck=all, FP traps, backtrace) in build/debug,
+#                   bin/robin_contact_debug; `make check DEBUG=1` tests that one
 
 FC      ?= gfortran
 CC      ?= gcc
@@ -31,7 +32,11 @@ CFLAGS  := $(COPT) -fopenmp -Wall -Iinclude -I/usr/include/suitesparse $(EXTRA_C
 LDLIBS  := -L$(HDF5_LIB) -lhdf5_fortran -lhdf5 -lcholmod -lsuitesparseconfig -lmetis -llapack -lopenblas -lm
 
 BIN     := bin
+ifeq ($(DEBUG),1)
+PROG    := $(BIN)/robin_contact_debug
+else
 PROG    := $(BIN)/robin_contact
+endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
@@ -113,7 +118,7 @@ run: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PROG) inputs/default.nml
 
 check: $(PROG) $(TEST_BINS)
-	@BUILD=$(BUILD) PYTHON=$(PYTHON) bash tests/run_tests.sh
+	@BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
 
 bench-mprgp: $(BENCH_BINS)
 	$(BUILD)/tests/bench_mprgp

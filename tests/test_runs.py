@@ -134,7 +134,10 @@ for mesh in ["3x1", "6x2", "16x8"]:
         got = (m.group(1), int(m.group(3)), int(m.group(4)))
         # counts: exact match expected on the same build; allow +-1 outer and 3% inner for
         # other BLAS kernels / CPUs (summation order changes the last bits)
-        ok = got[0] == st and abs(got[1] - outer) <= 1 and abs(got[2] - inner) <= max(3, 0.03 * inner)
+        if st == "converged":
+            ok = got[0] == st and abs(got[1] - outer) <= 1 and abs(got[2] - inner) <= max(3, 0.03 * inner)
+        else:  # an oscillating, non-converged run: its counts carry no information
+            ok = got[0] in ("max_outer", "diverged")
         check(ok, f"table1 {mesh} delta={delta}: {got[0]} {got[1]}/{got[2]} vs reference {st} {outer}/{inner}")
         if got[0] == "converged":
             e = np.linalg.norm(lam(out) - lref) / np.linalg.norm(lref)
