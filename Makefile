@@ -103,7 +103,7 @@ $(BUILD)/robin_contact: $(BUILD)/robin_contact.o $(OBJS)
 
 $(PROG): $(BUILD)/robin_contact FORCE
 	@mkdir -p $(BIN)
-	@cmp -s $< $@ || cp $< $@
+	@cmp -s $< $@ || { cp $< $@.tmp && mv -f $@.tmp $@; }
 
 $(BUILD)/tests/%.o: tests/%.f90 $(OBJS)
 	@mkdir -p $(BUILD)/tests

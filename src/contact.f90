@@ -42,6 +42,7 @@ module contact
   end type contact_result_t
 
   integer, parameter, public :: ANDERSON_DEPTH = 5   !< history depth of Anderson acceleration
+  integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
 
   !> Everything the outer iteration carries from one iteration to the next: with it a
   !! run resumes bitwise identically from a checkpoint.
@@ -49,6 +50,7 @@ module contact
     integer :: it = 0                          !< completed outer iterations
     integer :: inner = 0                       !< cumulative Hessian multiplications
     integer :: nacc = 0                        !< acceleration steps taken
+    integer :: stalled = 0                     !< consecutive iterations with a small increment but a large residual
     real(wp) :: crit = huge(1.0_wp)            !< last criterion
     real(wp) :: progress = huge(1.0_wp)        !< min(increment, residual) of the last iteration
     real(wp) :: best = huge(1.0_wp)            !< best criterion so far
@@ -215,7 +217,10 @@ contains
       if (d%solver%robin_operator == 'harmonic') then
         ! the harmonic operator makes the linearised outer map nilpotent at delta = 0.5:
         ! the outer iteration is as exact as its subproblems, so solve them tightly
-        rtol_in = max(d%solver%inner_rtol_min, d%solver%inner_factor*d%solver%tol)
+        ! (scaled by the contrast of the bodies: the stiff body's obstacle is built from
+        ! the soft body's displacement, whose error the contrast amplifies)
+        rtol_in = max(4.0_wp*epsilon(1.0_wp), &
+                      d%solver%inner_factor*d%solver%tol*minval(lmax)/max(maxval(lmax), tiny(1.0_wp)))
       else if (it == 1) then
         rtol_in = d%solver%inner_rtol_max
       else
@@ -347,16 +352,24 @@ contains
         exit
       end if
       if (st_%crit <= d%solver%tol) then
-        if (d%solver%stop /= 'residual' .and. res%residual > max(sqrt(d%solver%tol), 1.0e3_wp*d%solver%tol)) then
-          ! the obstacles stopped moving but the bodies do not agree: a stagnated
-          ! iteration, not a solution
-          res%status = 'diverged'
-          write (res%message, '(a,es10.3,a,es10.3,a)') 'stagnated: increment ', st_%crit, &
-            ' below tol but residual ', res%residual, ' (the bodies do not agree)'
+        if (d%solver%stop /= 'residual' .and. res%residual > 1.0e2_wp*d%solver%tol) then
+          ! the obstacles stopped moving but the bodies do not agree yet: a small
+          ! increment is not a small error. Go on (the inner tolerance follows the
+          ! smaller increment); if it persists, the iteration has stagnated.
+          st_%stalled = st_%stalled + 1
+          if (st_%stalled >= STALL_LIMIT) then
+            res%status = 'diverged'
+            write (res%message, '(a,es10.3,a,es10.3,a,i0,a)') 'stagnated: increment ', st_%crit, &
+              ' below tol but residual ', res%residual, ' above 100 tol for ', STALL_LIMIT, &
+              ' iterations (the bodies do not agree)'
+            exit
+          end if
         else
           res%status = 'converged'
+          exit
         end if
-        exit
+      else
+        st_%stalled = 0
       end if
       if (present(stop_requested)) then
         if (stop_requested()) then

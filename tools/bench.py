@@ -55,7 +55,7 @@ FORCE_RE = re.compile(r"^contact: total normal force=\s*(\S+)", re.M)
 
 COLUMNS = [
     "group", "level", "nx", "ny", "label", "method", "operator", "delta", "factorization",
-    "ordering", "threads", "tol", "stop", "mono_rtol", "exit", "status", "n1", "n2", "m",
+    "ordering", "threads", "omp_env", "tol", "stop", "mono_rtol", "exit", "status", "n1", "n2", "m",
     "outer", "inner", "residual", "assemble_s", "factor_s", "condense_s", "iterate_s",
     "output_s", "total_s", "solve_s", "solve_over_factor", "peak_mb", "factor_mb",
     "process_wall_s", "load1", "busy_before", "force", "alg_err", "p_err", "force_err", "p_order",
@@ -98,7 +98,7 @@ class Runner:
         self.contact = {}     # row id -> dict of contact arrays
         self.quiet_wait = 0.0
 
-    def run(self, row, overrides, threads=2):
+    def run(self, row, overrides, threads=2, extra_env=None):
         """Run one case; fill row with the parsed result and keep the contact arrays."""
         self.count += 1
         stem = f"run{self.count:03d}"
@@ -106,11 +106,14 @@ class Runner:
         args = [self.binary, self.deck] + overrides + [f"&output file='{h5}', progress_lines=0 /"]
         env = dict(os.environ)
         env["OMP_NUM_THREADS"] = str(threads)
+        env.pop("OMP_THREAD_LIMIT", None)
+        env.update(extra_env or {})
         row["threads"] = threads
+        row["omp_env"] = " ".join(f"{k}={v}" for k, v in sorted((extra_env or {}).items()))
         row["load1"] = round(os.getloadavg()[0], 2)
         row["busy_before"] = self.wait_quiet(row)
-        row["cmdline"] = "OMP_NUM_THREADS=%d %s" % (threads, " ".join(
-            a if re.fullmatch(r"[\w./=-]+", a) else "'" + a.replace("'", '"') + "'" for a in args[:-1]))
+        row["cmdline"] = "OMP_NUM_THREADS=%d %s%s" % (threads, row["omp_env"] + " " if row["omp_env"] else "", " ".join(
+            a if re.fullmatch(r"[\w./=-]+", a) else '"' + a + '"' for a in args[:-1]))
         t0 = time.monotonic()
         p = subprocess.run(args, capture_output=True, text=True, env=env)
         row["process_wall_s"] = round(time.monotonic() - t0, 3)
@@ -243,7 +246,7 @@ def main():
     ap.add_argument("--banded-limit", type=float, default=60.0,
                     help="skip the banded run when 16x the previous level's banded time exceeds this [s]")
     ap.add_argument("--skip", default="", help="comma list of groups to skip: ordering,threads,sweep")
-    ap.add_argument("--quiet-wait", type=float, default=180.0,
+    ap.add_argument("--quiet-wait", type=float, default=120.0,
                     help="before each run at >= 512x256 and each thread-comparison run, wait up to this "
                          "many s until other processes keep < 0.5 core busy")
     ap.add_argument("--keep-h5", action="store_true", help="keep the result files (in --workdir)")
@@ -261,8 +264,8 @@ def main():
     R.quiet_wait = a.quiet_wait
     rows = []
 
-    def go(row, threads=2):
-        R.run(row, overrides_of(row), threads)
+    def go(row, threads=2, extra_env=None):
+        R.run(row, overrides_of(row), threads, extra_env)
         rows.append(row)
         return row
 
@@ -282,8 +285,11 @@ def main():
         tlevels = [lv for lv in (5, 6) if lv <= top] or [top]
         for lv in tlevels:
             for ordering in ("metis", "amd"):
-                for thr in (1, 2):
-                    go(new_row("threads", lv, "robin-steklov", "robin", "steklov", ordering=ordering), threads=thr)
+                # OMP_NUM_THREADS=1 as a user would set it, the same with OMP_THREAD_LIMIT=1
+                # (truly one thread: see the note on CHOLMOD's own OpenMP loops), then 2
+                for thr, env in ((1, None), (1, {"OMP_THREAD_LIMIT": "1"}), (2, None)):
+                    go(new_row("threads", lv, "robin-steklov", "robin", "steklov", ordering=ordering),
+                       threads=thr, extra_env=env)
     if "sweep" not in skip:
         tols = [10.0 ** -k for k in range(2, 11)]
         for op in ("steklov", "harmonic"):
@@ -378,22 +384,26 @@ def main():
         print(table(["mesh", "METIS f/c/total", "MB", "err", "AMD f/c/total", "MB", "err",
                      "banded f/c/total", "MB", "err"], out))
     if "threads" not in skip:
-        print("\n## Threads: robin/steklov, OMP_NUM_THREADS 1 vs 2 (back to back)\n")
+        print("\n## Threads: robin/steklov, back to back: OMP_NUM_THREADS=1, OMP_NUM_THREADS=1 with "
+              "OMP_THREAD_LIMIT=1, OMP_NUM_THREADS=2; factor+condense [s] (total [s])\n")
         out = []
-        tr = [r for r in rows if r["group"] == "threads"]
+        tr = [r for r in rows if r["group"] == "threads" and r["status"] != "error"]
         for lv in sorted(set(r["level"] for r in tr)):
             for ordn in ("metis", "amd"):
-                one = [r for r in tr if r["level"] == lv and r["ordering"] == ordn and r["threads"] == 1]
-                two = [r for r in tr if r["level"] == lv and r["ordering"] == ordn and r["threads"] == 2]
-                if not one or not two or "error" in (one[0]["status"], two[0]["status"]):
+                sel = [r for r in tr if r["level"] == lv and r["ordering"] == ordn]
+                one = [r for r in sel if r["threads"] == 1 and not r["omp_env"]]
+                lim = [r for r in sel if r["threads"] == 1 and r["omp_env"]]
+                two = [r for r in sel if r["threads"] == 2]
+                if not (one and lim and two):
                     continue
-                o, t = one[0], two[0]
-                fc1, fc2 = o["factor_s"] + o["condense_s"], t["factor_s"] + t["condense_s"]
-                out.append([f"{o['nx']}x{o['ny']}", ordn, f"{fc1:.2f}", f"{fc2:.2f}", f"{fc1 / fc2:.2f}",
-                            f"{o['total_s']:.2f}", f"{t['total_s']:.2f}", f"{o['total_s'] / t['total_s']:.2f}",
-                            f"{o['busy_before']}/{t['busy_before']}"])
-        print(table(["mesh", "ordering", "factor+condense 1 thr", "2 thr", "speed-up", "total 1 thr",
-                     "2 thr", "speed-up", "busy"], out))
+                o, l1, t = one[0], lim[0], two[0]
+                fc = [x["factor_s"] + x["condense_s"] for x in (o, l1, t)]
+                out.append([f"{o['nx']}x{o['ny']}", ordn] +
+                           [f"{f:.2f} ({x['total_s']:.2f})" for f, x in zip(fc, (o, l1, t))] +
+                           [f"{fc[1] / fc[2]:.2f}", f"{l1['total_s'] / t['total_s']:.2f}",
+                            f"{o['busy_before']}/{l1['busy_before']}/{t['busy_before']}"])
+        print(table(["mesh", "ordering", "OMP=1", "OMP=1, limit 1", "OMP=2", "speed-up f+c (limit 1 -> 2)",
+                     "speed-up total", "busy before"], out))
     if "sweep" not in skip:
         nx, ny = mesh_of(sweep_level)
         print(f"\n## Tolerance sweep at {nx}x{ny}: error of lam against the monolithic solution "
