@@ -32,6 +32,8 @@ module contact
     real(wp) :: imbalance = 0.0_wp             !< |lam_1 - lam_2| / |lam|
     real(wp) :: penetration = 0.0_wp           !< max(gap, 0) / displacement scale
     real(wp) :: complementarity = 0.0_wp       !< max lam_i |gap_i| / (max lam * displacement scale)
+    real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
+    real(wp) :: kappa = 0.0_wp                 !< condition number estimate of F_1 + F_2
     integer :: active = 0                      !< nodes with lam > 0
     integer :: nhist = 0                       !< entries in the history
     real(wp), allocatable :: h_criterion(:)    !< per outer iteration
@@ -77,6 +79,7 @@ module contact
   end interface
 
   public :: solve_robin, solve_monolithic, interface_residual, state_init, checkpoint_iface, stop_iface
+  public :: error_bound
 
 contains
 
@@ -389,6 +392,69 @@ contains
       ' reached; last criterion ', res%criterion
     if (present(state)) state = st_
   end subroutine solve_robin
+
+  !> A posteriori bound of the error of res%lam against the monolithic solution lam*
+  !! of the same discrete problem: for the strongly convex QP min 1/2 l'Hl - c'l, l >= 0
+  !! (H = F_1 + F_2, c = b_1 + b_2 - g0) and the natural residual
+  !! r = l - max(0, l - (Hl - c)/L), |l - lam*| <= 2 (L/mu) |r| with L, mu the extreme
+  !! eigenvalues of H (estimated by power and inverse iteration, kappa enlarged by 10%).
+  !! Sets res%error_bound (relative to |lam|) and res%kappa.
+  subroutine error_bound(itf, bc, res)
+    type(interface_t), intent(in) :: itf               !< contact line
+    type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
+    type(contact_result_t), intent(inout) :: res       !< lam in; error_bound, kappa out
+    real(wp), allocatable :: H(:, :), A(:, :), g(:), r(:), x(:), y(:)
+    real(wp) :: lmax, lmin, nl
+    integer :: m, i, k, info
+    m = itf%m
+    res%error_bound = 0.0_wp
+    res%kappa = 1.0_wp
+    if (m == 0) return
+    allocate (H(m, m), A(m, m), g(m), r(m), x(m), y(m))
+    H = bc(1)%flex + bc(2)%flex
+    ! largest eigenvalue: power iteration (a lower estimate, enlarged below)
+    do i = 1, m
+      x(i) = 1.0_wp + 0.5_wp*sin(real(i, wp))
+    end do
+    x = x/norm2(x)
+    lmax = 0.0_wp
+    do k = 1, 60
+      call dsymv('U', m, 1.0_wp, H, m, x, 1, 0.0_wp, y, 1)
+      lmax = norm2(y)
+      if (.not. lmax > 0.0_wp) exit
+      x = y/lmax
+    end do
+    ! smallest eigenvalue: inverse iteration on the Cholesky factor of H
+    A = H
+    call dpotrf('U', m, A, m, info)
+    if (info /= 0 .or. .not. lmax > 0.0_wp) then
+      res%error_bound = huge(1.0_wp)
+      return
+    end if
+    do i = 1, m
+      x(i) = 1.0_wp + 0.5_wp*cos(real(3*i, wp))
+    end do
+    x = x/norm2(x)
+    do k = 1, 60
+      y = x
+      call dpotrs('U', m, 1, A, m, y, m, info)
+      x = y/norm2(y)
+    end do
+    call dsymv('U', m, 1.0_wp, H, m, x, 1, 0.0_wp, y, 1)
+    lmin = dot_product(x, y)
+    res%kappa = 1.1_wp*lmax/max(lmin, tiny(1.0_wp))
+    ! natural residual of the mean contact force
+    call dsymv('U', m, 1.0_wp, H, m, res%lam, 1, 0.0_wp, g, 1)
+    g = g - (bc(1)%b + bc(2)%b - itf%g0)
+    r = res%lam - max(0.0_wp, res%lam - g/lmax)
+    nl = norm2(res%lam)
+    ! the residual itself is computed in floating point: add its rounding level
+    if (nl > 0.0_wp) then
+      res%error_bound = 2.0_wp*res%kappa*(norm2(r)/nl + 10.0_wp*real(m, wp)*epsilon(1.0_wp))
+    else
+      res%error_bound = merge(0.0_wp, huge(1.0_wp), norm2(r) == 0.0_wp)
+    end if
+  end subroutine error_bound
 
   !> Fresh outer state: obstacles at the initial gap, no contact force.
   subroutine state_init(st, m, g0)

@@ -115,6 +115,8 @@ contains
     call attr_real(fid, 'imbalance', res%imbalance)
     call attr_real(fid, 'penetration', res%penetration)
     call attr_real(fid, 'complementarity', res%complementarity)
+    call attr_real(fid, 'error_bound', res%error_bound)
+    call attr_real(fid, 'kappa', res%kappa)
     call attr_real(fid, 'delta', d%solver%delta)
     call attr_real(fid, 'tol', d%solver%tol)
     if (allocated(d%effective)) call dset_str(fid, 'input_deck', d%effective)

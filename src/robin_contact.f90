@@ -15,7 +15,7 @@ program robin_contact
   use assembly, only: body_system_t, assemble_body, expand
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
-  use contact, only: contact_result_t, robin_state_t, solve_robin, solve_monolithic
+  use contact, only: contact_result_t, robin_state_t, solve_robin, solve_monolithic, error_bound
   use results, only: timing_t, write_results, program_version
   use checkpoint, only: checkpoint_setup, checkpoint_write, checkpoint_read, checkpoint_file, checkpoint_failed
   use signals, only: signals_install, stop_requested
@@ -103,6 +103,7 @@ program robin_contact
     call solve_robin(d, itf, bc, res, output_unit, state, checkpoint_write, stop_requested)
     if (checkpoint_failed()) call warn('a checkpoint could not be written to '//checkpoint_file(d%output%file))
   end if
+  if (res%status /= 'failed') call error_bound(itf, bc, res)
   ! displacements of both bodies under their own contact forces
   maxndof = max(sys(1)%ndof, sys(2)%ndof)
   allocate (u(maxndof, 2))
@@ -156,6 +157,8 @@ contains
     write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
+    write (output_unit, '(a,es10.3,a,es10.3,a)') 'accuracy: |lam - lam_monolithic|/|lam| <= ', res%error_bound, &
+      ' (a posteriori bound, cond(F1+F2) ~ ', res%kappa, ')'
     if (code /= EXIT_NUMERICAL) write (output_unit, '(a)') 'output: '//trim(d%output%file)
     write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
