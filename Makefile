@@ -105,12 +105,19 @@ $(PROG): $(BUILD)/robin_contact FORCE
 	@mkdir -p $(BIN)
 	@cmp -s $< $@ || { cp $< $@.tmp && mv -f $@.tmp $@; }
 
-$(BUILD)/tests/%.o: tests/%.f90 $(OBJS)
+# Test programs; tests/fe_testing.f90 is a module shared by the FE tests.
+TEST_SUPPORT := $(BUILD)/tests/fe_testing.o
+
+$(TEST_SUPPORT): tests/fe_testing.f90 $(OBJS)
 	@mkdir -p $(BUILD)/tests
 	$(FC) $(FFLAGS) -c $< -o $@
 
-$(BUILD)/tests/%: $(BUILD)/tests/%.o $(OBJS)
-	$(FC) $(FFLAGS) -o $@ $< $(OBJS) $(LDLIBS)
+$(BUILD)/tests/%.o: tests/%.f90 $(OBJS) $(TEST_SUPPORT)
+	@mkdir -p $(BUILD)/tests
+	$(FC) $(FFLAGS) -c $< -o $@
+
+$(BUILD)/tests/%: $(BUILD)/tests/%.o $(OBJS) $(TEST_SUPPORT)
+	$(FC) $(FFLAGS) -o $@ $< $(OBJS) $(TEST_SUPPORT) $(LDLIBS)
 
 # ---- user targets ----------------------------------------------------------------
 run: $(PROG)

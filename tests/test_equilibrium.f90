@@ -9,6 +9,7 @@ program test_equilibrium
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, BC_CLAMPED, BC_CONTACT
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand, residual_full
+  use fe_testing, only: band_solve
   implicit none
 
   interface
@@ -49,34 +50,6 @@ contains
     end if
   end subroutine check
 
-  !> Solve K u = f on the free DOFs with LAPACK's banded Cholesky (natural order).
-  subroutine band_solve(sys, x)
-    type(body_system_t), intent(in) :: sys
-    real(wp), intent(out) :: x(:)
-    real(wp), allocatable :: ab(:, :)
-    integer :: kd, i, j, p, info
-    kd = 0
-    do j = 1, sys%n
-      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
-        i = sys%rowind(p) + 1
-        kd = max(kd, j - i)
-      end do
-    end do
-    allocate (ab(kd + 1, sys%n))
-    ab = 0.0_wp
-    do j = 1, sys%n
-      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
-        i = sys%rowind(p) + 1
-        if (i <= j) ab(kd + 1 + i - j, j) = sys%val(p)
-      end do
-    end do
-    x(1:sys%n) = sys%f
-    call dpbsv('U', sys%n, kd, 1, ab, kd + 1, x, sys%n, info)
-    if (info /= 0) then
-      write (*, '(a,i0)') 'FAIL  dpbsv info = ', info
-      error stop 1
-    end if
-  end subroutine band_solve
 
   !> The seed's body 1 in SI units (scale = 1) or in mm, N, MPa (scale = 1e3 mm per m).
   subroutine seed_body(element, nx, ny, to_mm, body, tr)
