@@ -7,8 +7,9 @@ Writes (next to the csv unless --out-dir):
       left:  tolerance sweep (one mesh): error of lam against the monolithic solution vs
              the time of the contact iteration (iterate phase) and, dashed, vs the whole
              solve (factor + condense + iterate);
-      right: mesh ladder: discretisation error of the contact pressure (solid) and of the
-             total contact force (dotted) against the finest mesh vs total run time.
+      right: mesh ladder: discretisation error against the finest mesh of the contact
+             pressure away from the contact-zone edge (solid) and of the total contact force
+             (dotted) vs total run time; CHOLMOD with METIS, and robin/steklov with AMD.
   bench_phases.png  stacked bars of the time per phase, one panel per mesh, one bar per
       method / factorization (ladder and ordering rows, 2 threads).
 """
@@ -69,22 +70,30 @@ def work_precision(rows, out):
             ax1.axhline(min(solve), color="k", lw=0.8, ls=":")
             ax1.text(ax1.get_xlim()[0] * 1.5, min(solve) * 1.08, "fastest factor+condense+iterate", fontsize=8)
         ax1.set_title(f"tolerance sweep at {r0['nx']}x{r0['ny']} per body (red x: not converged)")
-    ax1.set_xlabel("relative L2 error of lam against monolithic (rtol 1e-12)")
+    ref = [r for r in rows if r["group"] == "ladder" and r["label"] == "monolithic" and r["mono_rtol"]]
+    ax1.set_xlabel("relative L2 error of lam against monolithic"
+                   + (f" (monolithic_rtol {ref[0]['mono_rtol']})" if ref else ""))
     ax1.set_ylabel("iterate phase [s] (floored at 1 ms)")
     ax1.grid(True, which="both", alpha=0.3)
     ax1.legend(fontsize=7)
 
-    ladder = [r for r in rows if r["group"] == "ladder" and r["status"] != "error"]
-    for label in ("monolithic", "robin-steklov", "robin-harmonic"):
-        rr = sorted([r for r in ladder if r["label"] == label and num(r["p_err"])], key=lambda r: r["level"])
+    ladder = [r for r in rows if r["group"] in ("ladder", "ordering") and r["status"] != "error"]
+    series = [("monolithic", "metis", "tab:gray"), ("robin-steklov", "metis", "tab:blue"),
+              ("robin-harmonic", "metis", "tab:orange"), ("robin-steklov", "amd", "tab:green")]
+    for label, ordering, c in series:
+        rr = sorted([r for r in ladder if r["label"] == label and r["factorization"] == "cholmod"
+                     and r["ordering"] == ordering and num(r["p_err"])], key=lambda r: r["level"])
         if not rr:
             continue
         t = [num(r["total_s"]) for r in rr]
-        ax2.loglog([num(r["p_err"]) for r in rr], t, "-o", color=COLORS[label], label=label + ": pressure L2")
-        ax2.loglog([num(r["force_err"]) for r in rr], t, ":s", color=COLORS[label], label=label + ": total force")
-        if label == "robin-steklov":
+        name = f"{label} ({ordering})"
+        if num(rr[0].get("p_err_away")):
+            ax2.loglog([num(r["p_err_away"]) for r in rr], t, "-o", color=c,
+                       label=name + ": pressure L2 away from the zone edge")
+        ax2.loglog([num(r["force_err"]) for r in rr], t, ":s", color=c, label=name + ": total force")
+        if label == "robin-steklov" and ordering == "metis":
             for r, ti in zip(rr, t):
-                ax2.annotate(f"{r['nx']}x{r['ny']}", (num(r["p_err"]), ti), fontsize=7,
+                ax2.annotate(f"{r['nx']}x{r['ny']}", (num(r["force_err"]), ti), fontsize=7,
                              textcoords="offset points", xytext=(4, -10))
     fin = [r for r in ladder if r["p_err"] == ""]
     ttl = "mesh ladder, error against the finest mesh"
