@@ -45,6 +45,7 @@ module contact
 
   integer, parameter, public :: ANDERSON_DEPTH = 5   !< history depth of Anderson acceleration
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
+  integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
   !> Everything the outer iteration carries from one iteration to the next: with it a
   !! run resumes bitwise identically from a checkpoint.
@@ -53,6 +54,8 @@ module contact
     integer :: inner = 0                       !< cumulative Hessian multiplications
     integer :: nacc = 0                        !< acceleration steps taken
     integer :: stalled = 0                     !< consecutive iterations with a small increment but a large residual
+    integer :: it_best = 0                     !< iteration of the last 1% improvement of the residual
+    real(wp) :: res_best = huge(1.0_wp)        !< residual at it_best
     real(wp) :: crit = huge(1.0_wp)            !< last criterion
     real(wp) :: progress = huge(1.0_wp)        !< min(increment, residual) of the last iteration
     real(wp) :: best = huge(1.0_wp)            !< best criterion so far
@@ -352,6 +355,18 @@ contains
         res%status = 'diverged'
         write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(st_%G)), &
           ' (1e6 times the load displacement scale ', uref, ')'
+        exit
+      end if
+      ! the residual stop: a residual that has not improved by 1% in FLAT_LIMIT iterations
+      ! has reached the floor that rounding and conditioning allow; tol is out of reach
+      if (res%residual < 0.99_wp*st_%res_best) then
+        st_%res_best = res%residual
+        st_%it_best = it
+      end if
+      if (d%solver%stop == 'residual' .and. st_%crit > d%solver%tol .and. it - st_%it_best >= FLAT_LIMIT) then
+        res%status = 'diverged'
+        write (res%message, '(a,es10.3,a,i0,a,es10.3,a)') 'stagnated: the residual has stayed near ', &
+          st_%res_best, ' for ', FLAT_LIMIT, ' iterations; tol = ', d%solver%tol, ' is out of reach'
         exit
       end if
       if (st_%crit <= d%solver%tol) then
