@@ -285,6 +285,9 @@ def main():
     ap.add_argument("--sweep-level", type=int, default=4, help="mesh level of the tolerance sweep (4 = 256x128)")
     ap.add_argument("--banded-limit", type=float, default=60.0,
                     help="skip the banded run when 16x the previous level's banded time exceeds this [s]")
+    ap.add_argument("--orderings", default="amd",
+                    help="comma list of CHOLMOD orderings compared with metis (ordering and threads "
+                         "groups), e.g. amd,nd (default amd)")
     ap.add_argument("--skip", default="", help="comma list of groups to skip: ordering,threads,sweep")
     ap.add_argument("--quiet-wait", type=float, default=120.0,
                     help="before each run at >= 512x256 and each thread-comparison run, wait up to this "
@@ -308,6 +311,7 @@ def main():
     top = max(0, min(top, 6))
     sweep_level = min(a.sweep_level, top)
     skip = set(s for s in a.skip.split(",") if s)
+    orderings = [o for o in a.orderings.split(",") if o and o != "metis"]
     if not os.access(a.bin, os.X_OK):
         raise SystemExit(f"bench: no executable {a.bin} (run make first)")
     workdir = a.workdir or tempfile.mkdtemp(prefix="bench_", dir=os.environ.get("TMPDIR", "/tmp"))
@@ -331,14 +335,15 @@ def main():
         go(new_row("ladder", lv, "robin-steklov", "robin", "steklov"))
         go(new_row("ladder", lv, "robin-harmonic", "robin", "harmonic"))
         if "ordering" not in skip:
-            go(new_row("ordering", lv, "robin-steklov", "robin", "steklov", ordering="amd"))
+            for ordn in orderings:
+                go(new_row("ordering", lv, "robin-steklov", "robin", "steklov", ordering=ordn))
             if banded_prev is None or banded_prev * 16.0 < a.banded_limit:
                 r = go(new_row("ordering", lv, "robin-steklov", "robin", "steklov", factorization="banded"))
                 banded_prev = r["total_s"] if r["status"] != "error" else 1e30
     if "threads" not in skip:
         tlevels = [lv for lv in (5, 6) if lv <= top] or [top]
         for lv in tlevels:
-            for ordering in ("metis", "amd"):
+            for ordering in ["metis"] + orderings:
                 # OMP_NUM_THREADS=1 as a user would set it, the same with OMP_THREAD_LIMIT=1
                 # (truly one thread: see the note on CHOLMOD's own OpenMP loops), then 2
                 for thr, env in ((1, None), (1, {"OMP_THREAD_LIMIT": "1"}), (2, None)):
@@ -391,7 +396,7 @@ def main():
         w = csv.DictWriter(fh, fieldnames=COLUMNS)
         w.writeheader()
         for r in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+            w.writerow({k: (f"{v:.10g}" if isinstance(v, float) else v) for k, v in r.items()})
     if not a.workdir and not a.keep_h5:
         shutil.rmtree(workdir, ignore_errors=True)
 
@@ -435,7 +440,7 @@ def main():
         out = []
         for lv in range(top + 1):
             cells = [f"{mesh_of(lv)[0]}x{mesh_of(lv)[1]}"]
-            for fac, ordn in (("cholmod", "metis"), ("cholmod", "amd"), ("banded", "rcm")):
+            for fac, ordn in [("cholmod", "metis")] + [("cholmod", o) for o in orderings] + [("banded", "rcm")]:
                 grp = "ladder" if ordn == "metis" else "ordering"
                 rr = [r for r in rows if r["group"] == grp and r["level"] == lv and r["label"] == "robin-steklov"
                       and r["factorization"] == fac and r["ordering"] == ordn]
@@ -447,15 +452,17 @@ def main():
                 else:
                     cells += ["—", "", ""]
             out.append(cells)
-        print(table(["mesh", "METIS f/c/total", "MB", "err", "AMD f/c/total", "MB", "err",
-                     "banded f/c/total", "MB", "err"], out))
+        head = ["mesh"]
+        for name in ["METIS"] + [o.upper() for o in orderings] + ["banded"]:
+            head += [f"{name} f/c/total", "MB", "err"]
+        print(table(head, out))
     if "threads" not in skip:
         print("\n## Threads: robin/steklov, back to back: OMP_NUM_THREADS=1, OMP_NUM_THREADS=1 with "
               "OMP_THREAD_LIMIT=1, OMP_NUM_THREADS=2; factor+condense [s] (total [s])\n")
         out = []
         tr = [r for r in rows if r["group"] == "threads" and r["status"] != "error"]
         for lv in sorted(set(r["level"] for r in tr)):
-            for ordn in ("metis", "amd"):
+            for ordn in ["metis"] + orderings:
                 sel = [r for r in tr if r["level"] == lv and r["ordering"] == ordn]
                 one = [r for r in sel if r["threads"] == 1 and not r["omp_env"]]
                 lim = [r for r in sel if r["threads"] == 1 and r["omp_env"]]
