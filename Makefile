@@ -40,11 +40,11 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors config sysinfo signals deck mesh assembly linop mprgp cholmod_iface banded cholesky \
+MODS := kinds errors config sysinfo signals deck mesh assembly ordering linop mprgp cholmod_iface banded cholesky \
         condense contact h5io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
 
-TESTS_F := test_deck test_mprgp test_cholesky test_fem test_equilibrium test_contact
+TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact
 BENCH_F := bench_mprgp
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
@@ -81,13 +81,14 @@ $(BUILD)/sysinfo.o:       $(BUILD)/kinds.o
 $(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o
 $(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o
+$(BUILD)/ordering.o:      $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
 $(BUILD)/linop.o:         $(BUILD)/kinds.o
 $(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/linop.o
 $(BUILD)/cholmod_iface.o: $(BUILD)/kinds.o
 $(BUILD)/banded.o:        $(BUILD)/kinds.o
 $(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                          $(BUILD)/assembly.o $(BUILD)/cholesky.o
+                          $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
 $(BUILD)/contact.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/linop.o \
                           $(BUILD)/mprgp.o $(BUILD)/condense.o
 $(BUILD)/h5io.o:          $(BUILD)/kinds.o

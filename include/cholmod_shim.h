@@ -25,6 +25,7 @@ extern "C" {
 #define CHSH_ORD_METIS      1
 #define CHSH_ORD_AMD        2
 #define CHSH_ORD_NATURAL    3
+#define CHSH_ORD_GIVEN      4   /* interior order given by the caller */
 
 typedef struct chsh_factor chsh_factor;   /* opaque */
 
@@ -55,11 +56,13 @@ int chsh_create(chsh_factor **h, char *msg, int msglen);
  * symmetric CSC (both triangles; only the upper triangle is read).
  * colptr[n+1], rowind[colptr[n]], val[colptr[n]]; rows sorted per column.
  * ordering: CHSH_ORD_*.  last[nlast] (may be NULL when nlast == 0): DOFs to be
- * ordered last, in this order (the interface).  A previous factor in the
- * handle is released first. */
+ * ordered last, in this order (the interface).  interior[n - nlast]: with
+ * CHSH_ORD_GIVEN, the order of all the other DOFs (a permutation of the DOFs
+ * not in `last`), followed by `last`; ignored (may be NULL) otherwise.  A
+ * previous factor in the handle is released first. */
 int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
                    const double *val, int ordering, int nlast, const int *last,
-                   char *msg, int msglen);
+                   const int *interior, char *msg, int msglen);
 
 /* Solve K X = B in place: b is n x nrhs with leading dimension ldb >= n. */
 int chsh_solve(chsh_factor *h, int nrhs, double *b, int ldb,

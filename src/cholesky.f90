@@ -16,7 +16,7 @@ module cholesky
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
-                           CM_ORD_AMD, CM_ORD_NATURAL
+                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN
   use banded, only: band_t
   implicit none
   private
@@ -27,6 +27,7 @@ module cholesky
   integer, parameter, public :: ORD_METIS = 1      !< METIS nested dissection (CHOLMOD)
   integer, parameter, public :: ORD_AMD = 2        !< AMD, or CAMD when an interface is given
   integer, parameter, public :: ORD_NATURAL = 3    !< natural order (interface last if given)
+  integer, parameter, public :: ORD_GIVEN = 4      !< caller's interior order (interior_perm), interface last
 
   integer, parameter, public :: CHOL_OK = 0          !< info: success
   integer, parameter, public :: CHOL_NOT_POSDEF = 1  !< info: matrix not positive definite
@@ -73,21 +74,24 @@ contains
 
   !> Factorize K, given in full symmetric CSC (both triangles, 0-based, rows sorted
   !! increasingly in each column, K symmetric).
+  !! With ORD_GIVEN (CHOLMOD), interior_perm is the elimination order of every DOF not in
+  !! `last` (e.g. module ordering's nested dissection), followed by `last`.
   !! info: 0 ok; 1 not positive definite; 2 out of memory; 3 other failure (msg says which).
-  subroutine chol_factor(self, n, colptr, rowind, val, method, ordering, info, msg, last)
+  subroutine chol_factor(self, n, colptr, rowind, val, method, ordering, info, msg, last, interior_perm)
     class(chol_t), intent(inout) :: self
     integer, intent(in) :: n                    !< matrix order
     integer(ip), intent(in) :: colptr(:)        !< column pointers, size n+1, 0-based
     integer(ip), intent(in) :: rowind(:)        !< row indices, 0-based, size >= colptr(n+1)
     real(wp), intent(in) :: val(:)              !< values, size >= colptr(n+1)
     integer, intent(in) :: method               !< FACT_CHOLMOD or FACT_BANDED
-    integer, intent(in) :: ordering             !< ORD_METIS, ORD_AMD or ORD_NATURAL (CHOLMOD)
+    integer, intent(in) :: ordering             !< ORD_METIS, ORD_AMD, ORD_NATURAL or ORD_GIVEN (CHOLMOD)
     integer, intent(out) :: info                !< status code (see above)
     character(len=*), intent(out) :: msg        !< one sentence on failure, else blank
     integer, intent(in), optional :: last(:)    !< 1-based DOFs to order last (interface), CHOLMOD
+    integer, intent(in), optional :: interior_perm(:)  !< ORD_GIVEN: 1-based order of the DOFs not in `last`
     integer :: j, p, nnz, k
     logical, allocatable :: seen(:)
-    integer(c_int), allocatable :: last0(:)
+    integer(c_int), allocatable :: last0(:), inter0(:)
     type(cm_stats_t) :: st
     character(len=200) :: emsg
 
@@ -140,14 +144,14 @@ contains
       call fail(CHOL_FAILURE, emsg)
       return
     end if
-    if (method == FACT_CHOLMOD .and. (ordering < ORD_METIS .or. ordering > ORD_NATURAL)) then
+    if (method == FACT_CHOLMOD .and. (ordering < ORD_METIS .or. ordering > ORD_GIVEN)) then
       write (emsg, '(a,i0,a)') 'Cholesky: unknown ordering ', ordering, '.'
       call fail(CHOL_FAILURE, emsg)
       return
     end if
+    allocate (seen(n))
+    seen = .false.
     if (present(last)) then
-      allocate (seen(n))
-      seen = .false.
       do k = 1, size(last)
         if (last(k) < 1 .or. last(k) > n) then
           write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
@@ -165,6 +169,35 @@ contains
     else
       allocate (self%last(0))
     end if
+    if (method == FACT_CHOLMOD .and. ordering == ORD_GIVEN) then
+      ! interior_perm: every DOF not in `last`, once (seen marks `last` so far)
+      if (.not. present(interior_perm)) then
+        call fail(CHOL_FAILURE, 'Cholesky: ordering GIVEN needs interior_perm.')
+        return
+      end if
+      if (size(interior_perm) /= n - size(self%last)) then
+        write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interior_perm has ', size(interior_perm), &
+          ' entries, expected n - size(last) = ', n - size(self%last), '.'
+        call fail(CHOL_FAILURE, emsg)
+        return
+      end if
+      do k = 1, size(interior_perm)
+        if (interior_perm(k) < 1 .or. interior_perm(k) > n) then
+          write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interior_perm entry ', k, ' = ', interior_perm(k), &
+            ' is out of range.'
+          call fail(CHOL_FAILURE, emsg)
+          return
+        end if
+        if (seen(interior_perm(k))) then
+          write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interior_perm entry ', k, ' = ', interior_perm(k), &
+            ' is repeated or an interface DOF.'
+          call fail(CHOL_FAILURE, emsg)
+          return
+        end if
+        seen(interior_perm(k)) = .true.
+      end do
+    end if
+    deallocate (seen)
     self%m_last = size(self%last)
     self%n = n
     self%ordering = ordering
@@ -177,7 +210,15 @@ contains
       if (info /= CHOL_OK) return
       allocate (last0(self%m_last))
       last0 = int(self%last - 1, c_int)
-      call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, info, msg)
+      if (ordering == ORD_GIVEN) then
+        allocate (inter0(size(interior_perm)))
+        inter0 = int(interior_perm - 1, c_int)
+        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, info, msg, &
+                          interior0=inter0)
+        deallocate (inter0)
+      else
+        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, info, msg)
+      end if
       st = cm_get_stats(self%handle)
       self%t_analyze = st%t_analyze
       self%t_factor = st%t_factor
@@ -221,6 +262,8 @@ contains
       cm_ordering = CM_ORD_METIS
     case (ORD_AMD)
       cm_ordering = CM_ORD_AMD
+    case (ORD_GIVEN)
+      cm_ordering = CM_ORD_GIVEN
     case default
       cm_ordering = CM_ORD_NATURAL
     end select
@@ -407,7 +450,7 @@ contains
     class(chol_t), intent(in) :: self
     character(len=:), allocatable :: line
     character(len=400) :: buf
-    character(len=*), parameter :: ordname(3) = [character(len=7) :: 'metis', 'amd', 'natural']
+    character(len=*), parameter :: ordname(4) = [character(len=7) :: 'metis', 'amd', 'natural', 'given']
     select case (self%method)
     case (FACT_CHOLMOD)
       write (buf, '(a,a,a,i0,a,i0,a,es10.3,a,es10.3,a,f0.3,a,f0.3,a,f0.1,a,l1)') &

@@ -18,6 +18,7 @@ module cholmod_iface
   integer, parameter, public :: CM_ORD_METIS = 1      !< METIS nested dissection
   integer, parameter, public :: CM_ORD_AMD = 2        !< (constrained) approximate minimum degree
   integer, parameter, public :: CM_ORD_NATURAL = 3    !< natural order (interface last if given)
+  integer, parameter, public :: CM_ORD_GIVEN = 4      !< interior order given by the caller, interface last
 
   integer, parameter :: MSG_LEN = 512
 
@@ -48,7 +49,7 @@ module cholmod_iface
       integer(c_int) :: code
     end function chsh_create
 
-    function chsh_factorize(h, n, colptr, rowind, val, ordering, nlast, last, msg, msglen) &
+    function chsh_factorize(h, n, colptr, rowind, val, ordering, nlast, last, interior, msg, msglen) &
         bind(c, name='chsh_factorize') result(code)
       import :: c_ptr, c_int, c_double, c_char
       type(c_ptr), value :: h
@@ -57,6 +58,7 @@ module cholmod_iface
       real(c_double), intent(in) :: val(*)
       integer(c_int), value :: ordering, nlast
       integer(c_int), intent(in) :: last(*)
+      integer(c_int), intent(in) :: interior(*)
       character(kind=c_char), intent(out) :: msg(*)
       integer(c_int), value :: msglen
       integer(c_int) :: code
@@ -145,7 +147,9 @@ contains
 
   !> Analyze and factorize a symmetric positive definite matrix (full symmetric CSC,
   !! 0-based, rows sorted). `last0` (0-based, may be empty) lists DOFs to order last.
-  subroutine cm_factorize(h, n, colptr, rowind, val, ordering, last0, info, msg)
+  !! With CM_ORD_GIVEN, `interior0` (0-based, size n - size(last0)) is the order of
+  !! all the other DOFs; it is required then and ignored otherwise.
+  subroutine cm_factorize(h, n, colptr, rowind, val, ordering, last0, info, msg, interior0)
     type(c_ptr), intent(in) :: h                  !< handle from cm_create
     integer, intent(in) :: n                      !< matrix order
     integer(c_int), intent(in) :: colptr(:)       !< column pointers, size n+1, 0-based
@@ -155,10 +159,30 @@ contains
     integer(c_int), intent(in) :: last0(:)        !< DOFs to order last, 0-based, in order
     integer, intent(out) :: info                  !< CM_* code
     character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
+    integer(c_int), intent(in), optional :: interior0(:)  !< interior order, 0-based (CM_ORD_GIVEN)
     character(kind=c_char) :: buf(MSG_LEN)
+    integer(c_int) :: none(1)
     msg = ''
-    info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
-                          int(size(last0), c_int), last0, buf, MSG_LEN)
+    if (ordering == CM_ORD_GIVEN) then
+      if (.not. present(interior0)) then
+        info = CM_FAILURE
+        msg = 'cm_factorize: ordering GIVEN needs the interior order.'
+        return
+      end if
+      if (size(interior0) /= n - size(last0)) then
+        info = CM_FAILURE
+        msg = 'cm_factorize: the interior order must have n - size(last) entries.'
+        return
+      end if
+    end if
+    none = 0
+    if (present(interior0) .and. ordering == CM_ORD_GIVEN .and. n > size(last0)) then
+      info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
+                            int(size(last0), c_int), last0, interior0, buf, MSG_LEN)
+    else
+      info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
+                            int(size(last0), c_int), last0, none, buf, MSG_LEN)
+    end if
     if (info /= CM_OK) msg = c_to_f(buf)
   end subroutine cm_factorize
 

@@ -14,7 +14,9 @@
  *   AMD     - cholmod_camd on the whole matrix with constraint sets
  *             0 = interior, 1 = interface, interface entries then re-listed
  *             in the given order;
- *   NATURAL - interior in increasing index order.
+ *   NATURAL - interior in increasing index order;
+ *   GIVEN   - interior in the caller's order (e.g. geometric nested
+ *             dissection; checked to be a permutation of the interior).
  * The permutation is handed to cholmod_analyze_p as CHOLMOD_GIVEN with the
  * etree postorder switched off (a postorder could move interior columns
  * behind interface ones).  After the analysis the tail of L->Perm is
@@ -171,8 +173,8 @@ static void wrap_sparse(cholmod_sparse *A, int n, const int *colptr,
 /* Build the interface-last permutation perm[n] (see the file header). */
 static int build_last_perm(chsh_factor *h, cholmod_sparse *A, int n,
                            const int *colptr, const int *rowind, int ordering,
-                           int nlast, const int *last, int *perm,
-                           char *msg, int msglen)
+                           int nlast, const int *last, const int *interior,
+                           int *perm, char *msg, int msglen)
 {
     cholmod_common *c = &h->c;
     int ni = n - nlast, k, j, p, code = CHSH_OK;
@@ -192,6 +194,21 @@ static int build_last_perm(chsh_factor *h, cholmod_sparse *A, int n,
 
     if (ni > 0 && ordering == CHSH_ORD_NATURAL) {
         for (k = 0; k < ni; k++) perm[k] = inter[k];
+    } else if (ni > 0 && ordering == CHSH_ORD_GIVEN) {
+        /* the caller's interior order: in range, not in `last`, no repeats
+         * (is_last marks `last` with 1, the given entries seen so far with 2) */
+        for (k = 0; k < ni; k++) {
+            j = interior[k];
+            if (j < 0 || j >= n || is_last[j]) {
+                set_msg(msg, msglen,
+                        "CHOLMOD ordering: given interior DOF %d (entry %d) is out of range, an interface DOF or repeated.",
+                        j + 1, k + 1);
+                code = CHSH_FAILURE;
+                goto done;
+            }
+            is_last[j] = 2;
+            perm[k] = j;
+        }
     } else if (ni > 0 && ordering == CHSH_ORD_METIS) {
         /* interior submatrix, upper triangle, pattern only */
         size_t nz = 0;
@@ -271,7 +288,7 @@ done:
 
 int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
                    const double *val, int ordering, int nlast, const int *last,
-                   char *msg, int msglen)
+                   const int *interior, char *msg, int msglen)
 {
     cholmod_common *c;
     cholmod_sparse A;
@@ -291,12 +308,16 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
         return CHSH_FAILURE;
     }
     if (ordering != CHSH_ORD_METIS && ordering != CHSH_ORD_AMD
-        && ordering != CHSH_ORD_NATURAL) {
+        && ordering != CHSH_ORD_NATURAL && ordering != CHSH_ORD_GIVEN) {
         set_msg(msg, msglen, "chsh_factorize: unknown ordering code %d.", ordering);
         return CHSH_FAILURE;
     }
     if (nlast < 0 || nlast > n || (nlast > 0 && last == NULL)) {
         set_msg(msg, msglen, "chsh_factorize: invalid interface size %d for n = %d.", nlast, n);
+        return CHSH_FAILURE;
+    }
+    if (ordering == CHSH_ORD_GIVEN && nlast < n && interior == NULL) {
+        set_msg(msg, msglen, "chsh_factorize: ordering GIVEN needs the interior order.");
         return CHSH_FAILURE;
     }
     h->st.n = n;
@@ -306,7 +327,7 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
     /* ---- analysis ---- */
     t0 = SuiteSparse_time();
     c->nmethods = 1;
-    if (nlast > 0) {
+    if (nlast > 0 || ordering == CHSH_ORD_GIVEN) {
         /* validate the interface list: in range, no repeats */
         char *seen = (char *) calloc((size_t) n, 1);
         perm = (int *) malloc((size_t) n * sizeof(int));
@@ -328,7 +349,7 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
         }
         free(seen);
         code = build_last_perm(h, &A, n, colptr, rowind, ordering, nlast, last,
-                               perm, msg, msglen);
+                               interior, perm, msg, msglen);
         if (code != CHSH_OK) {
             free(perm);
             return code;

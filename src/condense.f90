@@ -9,7 +9,8 @@ module condense
   use config, only: deck_t, BC_CONTACT, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
   use mesh, only: mesh_t, side_nodes
   use assembly, only: body_system_t
-  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
+  use ordering, only: nested_dissection
   implicit none
   private
 
@@ -162,16 +163,20 @@ contains
     end do
   end subroutine interface_dofs
 
-  !> Factorize K_a with the interface DOFs ordered last.
-  subroutine factor_body(d, itf, a, sys, bc, info, msg)
+  !> Factorize K_a with the interface DOFs ordered last. ordering='nd' orders the
+  !! other DOFs by geometric nested dissection of the body's grid (module ordering);
+  !! its time is part of t_factor.
+  subroutine factor_body(d, itf, a, msh, sys, bc, info, msg)
     type(deck_t), intent(in) :: d                    !< the deck (factorization, ordering)
     type(interface_t), intent(in) :: itf             !< the contact line
     integer, intent(in) :: a                         !< body number
+    type(mesh_t), intent(in) :: msh                  !< mesh of body a
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
     type(body_condensed_t), intent(inout) :: bc      !< receives the factorization
     integer, intent(out) :: info                     !< 0 ok, else failure (see chol_factor)
     character(len=*), intent(out) :: msg             !< description of a failure
-    integer :: method, ordering
+    integer :: method, iord
+    integer, allocatable :: perm(:)
     real(wp) :: t0
 
     t0 = wtime()
@@ -180,13 +185,25 @@ contains
     if (d%solver%factorization == 'banded') method = FACT_BANDED
     select case (d%solver%ordering)
     case ('amd')
-      ordering = ORD_AMD
+      iord = ORD_AMD
     case ('natural')
-      ordering = ORD_NATURAL
+      iord = ORD_NATURAL
+    case ('nd')
+      iord = ORD_GIVEN
     case default
-      ordering = ORD_METIS
+      iord = ORD_METIS
     end select
-    call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, ordering, info, msg, last=bc%idx)
+    if (iord == ORD_GIVEN .and. method == FACT_CHOLMOD) then
+      call nested_dissection(msh, sys, bc%idx, perm, info, msg)
+      if (info /= 0) then
+        bc%t_factor = wtime() - t0
+        return
+      end if
+      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, info, msg, last=bc%idx, &
+                          interior_perm=perm)
+    else
+      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, info, msg, last=bc%idx)
+    end if
     bc%t_factor = wtime() - t0
   end subroutine factor_body
 

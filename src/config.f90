@@ -59,7 +59,7 @@ module config
     character(len=16) :: stop = 'increment'           !< 'increment' | 'residual'
     integer :: max_outer = 800                        !< outer iteration limit
     character(len=16) :: factorization = 'cholmod'    !< 'cholmod' | 'banded'
-    character(len=16) :: ordering = 'metis'           !< 'metis' | 'amd' | 'natural' (cholmod only)
+    character(len=16) :: ordering = 'metis'           !< 'metis' | 'amd' | 'natural' | 'nd' (cholmod only)
     character(len=16) :: acceleration = 'none'        !< outer acceleration: 'none' | 'aitken' | 'anderson'
     real(wp) :: inner_factor = 1.0e-3_wp              !< inner rtol = inner_factor * outer progress (clamped)
     real(wp) :: inner_rtol_min = 1.0e-12_wp           !< floor of the adaptive inner tolerance

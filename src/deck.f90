@@ -66,7 +66,7 @@ module deck
   character(len=*), parameter :: E_OPERATOR = 'steklov constant harmonic'
   character(len=*), parameter :: E_STOP = 'increment residual'
   character(len=*), parameter :: E_FACT = 'cholmod banded'
-  character(len=*), parameter :: E_ORDERING = 'metis amd natural'
+  character(len=*), parameter :: E_ORDERING = 'metis amd natural nd'
   character(len=*), parameter :: E_ACCEL = 'none aitken anderson'
 
   integer, parameter :: T_INT = 1, T_REAL = 2, T_STR = 3

@@ -80,7 +80,7 @@ program robin_contact
   t0 = omp_get_wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
-    call factor_body(d, itf, a, sys(a), bc(a), info(a), msg(a))
+    call factor_body(d, itf, a, msh(a), sys(a), bc(a), info(a), msg(a))
   end do
   !$omp end parallel do
   do a = 1, 2

@@ -85,7 +85,7 @@ contains
     call build_interface(d, msh, sys, itf, info, msg)
     if (info /= 0) error stop 'interface failed'
     do a = 1, 2
-      call factor_body(d, itf, a, sys(a), bc(a), info, msg)
+      call factor_body(d, itf, a, msh(a), sys(a), bc(a), info, msg)
       if (info /= 0) error stop 'factor failed'
       call condense_body(sys(a), bc(a), info, msg)
       if (info /= 0) error stop 'condense failed'

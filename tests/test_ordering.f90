@@ -1,0 +1,439 @@
+!> Unit test of module ordering (geometric nested dissection of a body's node grid) and
+!! of its use as a given interior order in module cholesky (ORD_GIVEN) and in
+!! condense's factor_body (ordering = 'nd').
+!! Checks: the permutation is exactly the free DOFs not in `last`; both DOFs of a node
+!! are adjacent; the top-level separator (the middle grid line across the longer side)
+!! comes last; a real FE body factored with nd, METIS and AMD gives the same solution
+!! (scaled residual) and the same interface flexibility from the trailing block;
+!! invalid inputs are reported; two bodies condensed with 'nd' equal 'metis'.
+!! One line per check; exits non-zero if any check fails.
+program test_ordering
+  use, intrinsic :: iso_fortran_env, only: int64, output_unit
+  use kinds, only: wp
+  use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, &
+                    SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT
+  use mesh, only: mesh_t, mesh_build, side_nodes, node_id
+  use assembly, only: body_system_t, assemble_body, csc_matvec
+  use ordering, only: nested_dissection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
+  use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
+  implicit none
+
+  real(wp), parameter :: eps = epsilon(1.0_wp)
+  real(wp), parameter :: RES_TOL = 10.0_wp        ! scaled residual threshold
+  real(wp), parameter :: FLEX_TOL = 1.0e-10_wp    ! relative flexibility agreement between orderings
+  integer :: nfail = 0, npass = 0
+
+  ! ---- permutation properties on assorted grids ----
+  call check_perm('Q1 40x20, left clamped, bottom normal last', 40, 20, ELEM_Q1, &
+                  [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE], SIDE_BOTTOM, 2)
+  call check_perm('P1 1x1, all free, no last', 1, 1, ELEM_P1, [BC_FREE, BC_FREE, BC_FREE, BC_FREE], 0, 0)
+  call check_perm('P1 1x7, bottom clamped, right x last', 1, 7, ELEM_P1, &
+                  [BC_FREE, BC_CONTACT, BC_CLAMPED, BC_FREE], SIDE_RIGHT, 1)
+  call check_perm('Q1 7x1, left clamped, top normal last', 7, 1, ELEM_Q1, &
+                  [BC_CLAMPED, BC_FREE, BC_FREE, BC_CONTACT], SIDE_TOP, 2)
+  call check_perm('P1 13x3, bottom roller, top normal last', 13, 3, ELEM_P1, &
+                  [BC_FREE, BC_FREE, BC_ROLLER, BC_CONTACT], SIDE_TOP, 2)
+  call check_perm('Q1 33x65, left clamped, right x last', 33, 65, ELEM_Q1, &
+                  [BC_CLAMPED, BC_CONTACT, BC_FREE, BC_FREE], SIDE_RIGHT, 1)
+  call check_perm('P1 64x64, top clamped, no last', 64, 64, ELEM_P1, &
+                  [BC_FREE, BC_FREE, BC_FREE, BC_CLAMPED], 0, 0)
+
+  ! ---- factor a real FE body with nd, METIS and AMD ----
+  call check_factor('Q1 40x20', 40, 20, ELEM_Q1)
+  call check_factor('P1 37x23', 37, 23, ELEM_P1)
+
+  ! ---- invalid inputs ----
+  call check_bad_input()
+
+  ! ---- condense two bodies with ordering 'nd' vs 'metis' ----
+  call check_condense()
+
+  ! ---- a large grid: ordering time at 1024 x 512 cells (printed, not asserted) ----
+  call check_large()
+
+  write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
+  if (nfail > 0) error stop 1
+
+contains
+
+  subroutine report(ok, what, value, tol)
+    logical, intent(in) :: ok
+    character(len=*), intent(in) :: what
+    real(wp), intent(in), optional :: value, tol
+    character(len=64) :: extra
+    extra = ''
+    if (present(value) .and. present(tol)) write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
+    if (ok) then
+      npass = npass + 1
+      write (output_unit, '(a)') 'PASS  '//what//trim(extra)
+    else
+      nfail = nfail + 1
+      write (output_unit, '(a)') 'FAIL  '//what//trim(extra)
+    end if
+  end subroutine report
+
+  subroutine report_le(value, tol, what)
+    real(wp), intent(in) :: value, tol
+    character(len=*), intent(in) :: what
+    call report(value <= tol, what, value, tol)   ! NaN fails
+  end subroutine report_le
+
+  function wtime() result(t)
+    real(wp) :: t
+    integer(int64) :: cnt, rate
+    call system_clock(cnt, rate)
+    t = real(cnt, wp)/real(rate, wp)
+  end function wtime
+
+  !> A unit-square-ish body with the given grid, element and side conditions.
+  function make_body(nx, ny, elem, bcs) result(b)
+    integer, intent(in) :: nx, ny, elem, bcs(4)
+    type(body_cfg_t) :: b
+    b%id = 1
+    b%x0 = 0.0_wp
+    b%y0 = 0.0_wp
+    b%width = 2.0_wp
+    b%height = 1.0_wp
+    b%nx = nx
+    b%ny = ny
+    b%element = elem
+    b%young = 2.1e11_wp
+    b%poisson = 0.3_wp
+    b%bc = bcs
+  end function make_body
+
+  !> Mesh + assembly of a body (top loaded downwards); stops on failure.
+  subroutine build(b, msh, sys)
+    type(body_cfg_t), intent(in) :: b
+    type(mesh_t), intent(out) :: msh
+    type(body_system_t), intent(out) :: sys
+    type(traction_cfg_t) :: tr(1)
+    integer :: info
+    character(len=256) :: msg
+    tr(1)%body = 1
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
+    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
+    call mesh_build(msh, b, info, msg)
+    if (info /= 0) error stop 'mesh_build failed'
+    call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
+    if (info /= 0) error stop 'assemble_body failed'
+  end subroutine build
+
+  !> Free DOFs of component c of the nodes on `side` (skipping prescribed ones).
+  function side_free_dofs(msh, sys, side, c) result(idx)
+    type(mesh_t), intent(in) :: msh
+    type(body_system_t), intent(in) :: sys
+    integer, intent(in) :: side, c
+    integer, allocatable :: idx(:)
+    integer, allocatable :: nodes(:)
+    integer :: k, f
+    allocate (idx(0))
+    if (side == 0) return
+    call side_nodes(msh, side, nodes)
+    do k = 1, size(nodes)
+      f = sys%free_of(2*(nodes(k) - 1) + c)
+      if (f > 0) idx = [idx, f]
+    end do
+  end function side_free_dofs
+
+  !> The ND permutation is exactly the free DOFs not in `last`, node DOFs adjacent,
+  !! and the top-level separator line comes last.
+  subroutine check_perm(name, nx, ny, elem, bcs, last_side, last_comp)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: nx, ny, elem, bcs(4), last_side, last_comp
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    integer, allocatable :: last(:), perm(:), cnt(:)
+    logical, allocatable :: is_last(:)
+    integer :: info, k, f, g, node, nsep, mid, i, j
+    logical :: ok
+    character(len=256) :: msg
+
+    call build(make_body(nx, ny, elem, bcs), msh, sys)
+    last = side_free_dofs(msh, sys, last_side, last_comp)
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    call report(info == ND_OK, name//': nested_dissection info = 0 '//trim(msg))
+    if (info /= ND_OK) return
+    call report(size(perm) == sys%n - size(last), name//': size = n - size(last)')
+    allocate (cnt(sys%n), is_last(sys%n))
+    cnt = 0
+    is_last = .false.
+    is_last(last) = .true.
+    ok = all(perm >= 1 .and. perm <= sys%n)
+    if (ok) then
+      do k = 1, size(perm)
+        cnt(perm(k)) = cnt(perm(k)) + 1
+      end do
+      ok = all(merge(cnt == 0, cnt == 1, is_last))
+    end if
+    call report(ok, name//': a permutation of exactly the free non-interface DOFs')
+    if (.not. ok) return
+
+    ! both DOFs of a node consecutive (x then y) when both are in the permutation
+    ok = .true.
+    do k = 1, size(perm)
+      g = sys%dof_of(perm(k))
+      if (mod(g, 2) == 1) then            ! an x DOF: its y DOF, if ordered, comes next
+        f = sys%free_of(g + 1)
+        if (f > 0) then
+          if (.not. is_last(f)) then
+            if (k == size(perm)) then
+              ok = .false.
+            else
+              ok = ok .and. perm(k + 1) == f
+            end if
+          end if
+        end if
+      else                                ! a y DOF: its x DOF, if ordered, comes just before
+        f = sys%free_of(g - 1)
+        if (f > 0) then
+          if (.not. is_last(f)) then
+            if (k == 1) then
+              ok = .false.
+            else
+              ok = ok .and. perm(k - 1) == f
+            end if
+          end if
+        end if
+      end if
+    end do
+    call report(ok, name//': the two DOFs of a node are adjacent, x first')
+
+    ! the top-level separator: the middle grid line across the longer side, last
+    if ((nx + 1)*(ny + 1) >= ND_LEAF_NODES) then
+      nsep = 0
+      do k = 1, sys%n
+        if (is_last(k)) cycle
+        node = (sys%dof_of(k) + 1)/2
+        i = mod(node - 1, nx + 1)
+        j = (node - 1)/(nx + 1)
+        if (nx >= ny) then
+          if (i == nx/2) nsep = nsep + 1
+        else
+          if (j == ny/2) nsep = nsep + 1
+        end if
+      end do
+      ok = nsep > 0
+      do k = size(perm) - nsep + 1, size(perm)
+        node = (sys%dof_of(perm(k)) + 1)/2
+        if (nx >= ny) then
+          mid = mod(node - 1, nx + 1)
+          ok = ok .and. mid == nx/2
+        else
+          mid = (node - 1)/(nx + 1)
+          ok = ok .and. mid == ny/2
+        end if
+      end do
+      call report(ok, name//': the last DOFs are the middle grid line (top-level separator)')
+    end if
+  end subroutine check_perm
+
+  !> Factor one body with METIS, AMD and nd, interface (bottom normal DOFs) last.
+  subroutine check_factor(name, nx, ny, elem)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: nx, ny, elem
+    character(len=*), parameter :: onames(3) = [character(len=5) :: 'metis', 'amd', 'nd']
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    type(chol_t) :: ch
+    integer, allocatable :: last(:), perm(:)
+    real(wp), allocatable :: u(:), r(:), sgn(:), flex(:, :, :)
+    real(wp) :: res, d, nnz(3)
+    integer :: o, info, m
+    logical :: used
+    character(len=256) :: msg
+    character(len=64) :: tag
+
+    call build(make_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys)
+    last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
+    m = size(last)
+    allocate (u(sys%n), r(sys%n), sgn(m), flex(m, m, 3))
+    sgn = -1.0_wp
+    nnz = 0.0_wp
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    call report(info == ND_OK, name//': nested_dissection ok '//trim(msg))
+    if (info /= ND_OK) return
+    write (output_unit, '(a,i0,a,i0)') '      '//name//': n = ', sys%n, ', interface m = ', m
+    do o = 1, 3
+      tag = name//' '//trim(onames(o))
+      select case (o)
+      case (1)
+        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
+      case (2)
+        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
+      case default
+        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                       interior_perm=perm)
+      end select
+      call report(info == 0, trim(tag)//': factor info = 0 '//trim(msg))
+      if (info /= 0) cycle
+      write (output_unit, '(a)') '      '//ch%summary()
+      nnz(o) = real(ch%nnz_factor, wp)
+      call report(ch%interface_last_ok, trim(tag)//': interface DOFs ordered last, in the given order')
+      u = sys%f
+      call ch%solve(u, info, msg)
+      call csc_matvec(sys, u, r)
+      res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u))*eps)
+      call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
+      call ch%flexibility(last, sgn, flex(:, :, o), info, msg, used_block=used)
+      call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
+      call ch%free()
+    end do
+    do o = 2, 3
+      d = norm2(flex(:, :, o) - flex(:, :, 1))/norm2(flex(:, :, 1))
+      call report_le(d, FLEX_TOL, name//' '//trim(onames(o))//': flexibility = METIS''s (relative)')
+    end do
+    write (output_unit, '(a,3(a,es10.3))') '      '//name//' nnz(L):', ' metis=', nnz(1), ' amd=', nnz(2), &
+      ' nd=', nnz(3)
+    call report(nnz(3) > 0.0_wp .and. nnz(3) <= 1.5_wp*nnz(1), name//': nnz(L) nd <= 1.5 x METIS', &
+                nnz(3)/max(nnz(1), 1.0_wp), 1.5_wp)
+  end subroutine check_factor
+
+  !> Bad `last` and bad interior orders are reported, not crashed on.
+  subroutine check_bad_input()
+    type(mesh_t) :: msh, other
+    type(body_system_t) :: sys
+    type(chol_t) :: ch
+    integer, allocatable :: last(:), perm(:), bad(:)
+    integer :: info, n
+    character(len=256) :: msg
+
+    call build(make_body(10, 6, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys)
+    n = sys%n
+    last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
+    call nested_dissection(msh, sys, [last, 0], perm, info, msg)
+    call report(info == ND_BAD_LAST .and. size(perm) == 0 .and. len_trim(msg) > 0, &
+                'nested_dissection: interface DOF 0 rejected: '//trim(msg))
+    call nested_dissection(msh, sys, [last, last(1)], perm, info, msg)
+    call report(info == ND_BAD_LAST .and. len_trim(msg) > 0, &
+                'nested_dissection: repeated interface DOF rejected: '//trim(msg))
+    other%nx = 11
+    other%ny = 6
+    call nested_dissection(other, sys, last, perm, info, msg)
+    call report(info /= ND_OK .and. len_trim(msg) > 0, &
+                'nested_dissection: mesh of another size rejected: '//trim(msg))
+
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last)
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'ORD_GIVEN without interior_perm: info = 3: '//trim(msg))
+    bad = perm(1:size(perm) - 1)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                   interior_perm=bad)
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interior_perm too short: info = 3: '//trim(msg))
+    bad = perm
+    bad(2) = bad(1)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                   interior_perm=bad)
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interior_perm repeated entry: info = 3: '//trim(msg))
+    bad = perm
+    bad(1) = last(1)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                   interior_perm=bad)
+    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interior_perm holds an interface DOF: info = 3: '//trim(msg))
+    ! the banded factorization ignores the ordering
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_BANDED, ORD_GIVEN, info, msg)
+    call report(info == 0, 'banded with ORD_GIVEN (ordering ignored): info = 0')
+    ! ORD_GIVEN without an interface: the whole order is given
+    call nested_dissection(msh, sys, [integer ::], perm, info, msg)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, interior_perm=perm)
+    call report(info == 0, 'ORD_GIVEN with no interface DOFs: info = 0 '//trim(msg))
+    call ch%free()
+  end subroutine check_bad_input
+
+  !> Two bodies (the default scene's geometry, coarse) condensed with 'nd' and 'metis'.
+  subroutine check_condense()
+    type(deck_t) :: d
+    type(mesh_t) :: msh(2)
+    type(body_system_t) :: sys(2)
+    type(interface_t) :: itf
+    type(body_condensed_t) :: bc(2, 2)
+    type(traction_cfg_t) :: tr(2)
+    character(len=5), parameter :: ords(2) = ['metis', 'nd   ']
+    integer :: a, o, info
+    character(len=256) :: msg
+    real(wp) :: dflex, db
+
+    d%body(1) = make_body(30, 12, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE])
+    d%body(1)%y0 = 1.0_wp
+    d%body(2) = make_body(30, 10, ELEM_P1, [BC_CLAMPED, BC_FREE, BC_FREE, BC_CONTACT])
+    d%body(2)%id = 2
+    tr(1)%body = 1
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [0.0_wp, -3.0e6_wp]
+    tr(2)%body = 2
+    tr(2)%side = SIDE_BOTTOM
+    tr(2)%t0 = [5.0e5_wp, 1.0e6_wp]
+    do a = 1, 2
+      call mesh_build(msh(a), d%body(a))
+      call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), info, msg)
+      if (info /= 0) error stop 'assembly failed'
+    end do
+    call build_interface(d, msh, sys, itf, info, msg)
+    call report(info == 0 .and. itf%m > 0, 'two-body scene: interface built '//trim(msg))
+    if (info /= 0) return
+    do o = 1, 2
+      d%solver%ordering = ords(o)
+      do a = 1, 2
+        call factor_body(d, itf, a, msh(a), sys(a), bc(a, o), info, msg)
+        call report(info == 0 .and. bc(a, o)%chol%interface_last_ok, &
+                    'factor_body ordering='''//trim(ords(o))//''', body '//achar(48 + a)//': ok, interface last '//trim(msg))
+        if (info /= 0) return
+        call condense_body(sys(a), bc(a, o), info, msg)
+        if (info /= 0) error stop 'condense_body failed'
+      end do
+    end do
+    do a = 1, 2
+      dflex = norm2(bc(a, 2)%flex - bc(a, 1)%flex)/max(norm2(bc(a, 1)%flex), tiny(1.0_wp))
+      db = norm2(bc(a, 2)%b - bc(a, 1)%b)/max(norm2(bc(a, 1)%b), tiny(1.0_wp))
+      call report_le(max(dflex, db), FLEX_TOL, 'body '//achar(48 + a)//': F_a and b_a with ''nd'' = with ''metis''')
+      call bc(a, 1)%chol%free()
+      call bc(a, 2)%chol%free()
+    end do
+  end subroutine check_condense
+
+  !> Ordering a 1024 x 512 cell grid (about 1M DOFs; only free_of is needed): time printed.
+  subroutine check_large()
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    integer, allocatable :: last(:), perm(:)
+    logical, allocatable :: seen(:)
+    integer :: k, info, n
+    real(wp) :: t0, t
+    character(len=256) :: msg
+
+    msh%nx = 1024
+    msh%ny = 512
+    msh%nnode = (msh%nx + 1)*(msh%ny + 1)
+    sys%ndof = 2*msh%nnode
+    allocate (sys%free_of(sys%ndof))
+    ! left side clamped: the nodes with i = 0 have no free DOFs
+    n = 0
+    do k = 1, sys%ndof
+      if (mod((k - 1)/2, msh%nx + 1) == 0) then
+        sys%free_of(k) = 0
+      else
+        n = n + 1
+        sys%free_of(k) = n
+      end if
+    end do
+    sys%n = n
+    last = [(sys%free_of(2*(node_id(msh, k, 0) - 1) + 2), k=1, msh%nx)]
+    t0 = wtime()
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    t = wtime() - t0
+    write (output_unit, '(a,i0,a,f0.3,a)') '      nested dissection of 1024x512 cells (n = ', n, '): ', t, ' s'
+    allocate (seen(n))
+    seen = .false.
+    seen(last) = .true.
+    do k = 1, size(perm)
+      if (seen(perm(k))) exit
+      seen(perm(k)) = .true.
+    end do
+    call report(info == ND_OK .and. size(perm) == n - size(last) .and. all(seen), &
+                '1024x512 cells: a permutation of the free non-interface DOFs')
+  end subroutine check_large
+
+end program test_ordering
