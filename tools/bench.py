@@ -285,7 +285,7 @@ def main():
     ap.add_argument("--sweep-level", type=int, default=4, help="mesh level of the tolerance sweep (4 = 256x128)")
     ap.add_argument("--banded-limit", type=float, default=60.0,
                     help="skip the banded run when 16x the previous level's banded time exceeds this [s]")
-    ap.add_argument("--orderings", default="amd",
+    ap.add_argument("--orderings", default="amd,nd",
                     help="comma list of CHOLMOD orderings compared with metis (ordering and threads "
                          "groups), e.g. amd,nd (default amd)")
     ap.add_argument("--skip", default="", help="comma list of groups to skip: ordering,threads,sweep")
