@@ -106,10 +106,10 @@ $(PROG): $(BUILD)/robin_contact FORCE
 	@mkdir -p $(BIN)
 	@cmp -s $< $@ || { cp $< $@.tmp && mv -f $@.tmp $@; }
 
-# Test programs; tests/fe_testing.f90 is a module shared by the FE tests.
-TEST_SUPPORT := $(BUILD)/tests/fe_testing.o
+# Test programs; tests/testing.f90 is a module of helpers shared by them.
+TEST_SUPPORT := $(BUILD)/tests/testing.o
 
-$(TEST_SUPPORT): tests/fe_testing.f90 $(OBJS)
+$(TEST_SUPPORT): tests/testing.f90 $(OBJS)
 	@mkdir -p $(BUILD)/tests
 	$(FC) $(FFLAGS) -c $< -o $@
 

@@ -10,6 +10,7 @@ program test_cholesky
   use kinds, only: wp
   use cholesky
   use banded, only: rcm_order, band_width
+  use testing, only: report, report_le, wtime, test_summary
   implicit none
 
   !> A sparse symmetric matrix in full 0-based CSC.
@@ -53,7 +54,6 @@ program test_cholesky
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: RES_TOL = 10.0_wp     ! scaled residual threshold
-  integer :: nfail = 0, npass = 0
   integer :: seed_size
   integer, allocatable :: seed(:)
   type(csc_t) :: A
@@ -99,8 +99,7 @@ program test_cholesky
   ! ---- 8. larger problem: timings ----
   call timing_run()
 
-  write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
-  if (nfail > 0) error stop 1
+  call test_summary()
 
 contains
 
@@ -108,34 +107,8 @@ contains
   ! reporting
   ! ======================================================================
 
-  subroutine report(ok, what, value, tol)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    real(wp), intent(in), optional :: value, tol
-    character(len=64) :: extra
-    extra = ''
-    if (present(value) .and. present(tol)) write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
-    if (ok) then
-      npass = npass + 1
-      write (output_unit, '(a)') 'PASS  '//what//trim(extra)
-    else
-      nfail = nfail + 1
-      write (output_unit, '(a)') 'FAIL  '//what//trim(extra)
-    end if
-  end subroutine report
 
-  subroutine report_le(value, tol, what)
-    real(wp), intent(in) :: value, tol
-    character(len=*), intent(in) :: what
-    call report(value <= tol, what, value, tol)   ! NaN fails
-  end subroutine report_le
 
-  function wtime() result(t)
-    real(wp) :: t
-    integer(int64) :: cnt, rate
-    call system_clock(cnt, rate)
-    t = real(cnt, wp) / real(rate, wp)
-  end function wtime
 
   ! ======================================================================
   ! matrix builders

@@ -9,7 +9,7 @@ program test_equilibrium
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, BC_CLAMPED, BC_CONTACT
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand, residual_full
-  use fe_testing, only: band_solve
+  use testing, only: band_solve
   implicit none
 
   interface

@@ -52,7 +52,7 @@ program test_fem
   use mesh, only: mesh_t, mesh_build, side_nodes
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec
   use test_fem_manufactured, only: ms_u, ms_force, ms_lam, ms_mu
-  use fe_testing, only: band_solve
+  use testing, only: band_solve
   implicit none
 
   interface

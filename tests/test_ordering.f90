@@ -18,12 +18,12 @@ program test_ordering
   use ordering, only: nested_dissection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
+  use testing, only: report, report_le, wtime, test_summary
   implicit none
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: RES_TOL = 10.0_wp        ! scaled residual threshold
   real(wp), parameter :: FLEX_TOL = 1.0e-10_wp    ! relative flexibility agreement between orderings
-  integer :: nfail = 0, npass = 0
 
   ! ---- permutation properties on assorted grids ----
   call check_perm('Q1 40x20, left clamped, bottom normal last', 40, 20, ELEM_Q1, &
@@ -53,39 +53,12 @@ program test_ordering
   ! ---- a large grid: ordering time at 1024 x 512 cells (printed, not asserted) ----
   call check_large()
 
-  write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
-  if (nfail > 0) error stop 1
+  call test_summary()
 
 contains
 
-  subroutine report(ok, what, value, tol)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    real(wp), intent(in), optional :: value, tol
-    character(len=64) :: extra
-    extra = ''
-    if (present(value) .and. present(tol)) write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
-    if (ok) then
-      npass = npass + 1
-      write (output_unit, '(a)') 'PASS  '//what//trim(extra)
-    else
-      nfail = nfail + 1
-      write (output_unit, '(a)') 'FAIL  '//what//trim(extra)
-    end if
-  end subroutine report
 
-  subroutine report_le(value, tol, what)
-    real(wp), intent(in) :: value, tol
-    character(len=*), intent(in) :: what
-    call report(value <= tol, what, value, tol)   ! NaN fails
-  end subroutine report_le
 
-  function wtime() result(t)
-    real(wp) :: t
-    integer(int64) :: cnt, rate
-    call system_clock(cnt, rate)
-    t = real(cnt, wp)/real(rate, wp)
-  end function wtime
 
   !> A unit-square-ish body with the given grid, element and side conditions.
   function make_body(nx, ny, elem, bcs) result(b)

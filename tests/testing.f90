@@ -1,0 +1,87 @@
+!> Helpers shared by the Fortran test programs: PASS/FAIL reporting with counters and
+!! the closing line, a wall clock, and an independent direct solve of an assembled body
+!! (LAPACK band Cholesky in the natural order) so the FE tests do not depend on the
+!! Cholesky module that other tests check.
+module testing
+  use, intrinsic :: iso_fortran_env, only: output_unit, int64
+  use kinds, only: wp
+  use assembly, only: body_system_t
+  implicit none
+  private
+
+  integer, public, protected :: npass = 0   !< checks passed so far
+  integer, public, protected :: nfail = 0   !< checks failed so far
+
+  public :: report, report_le, wtime, test_summary, band_solve
+
+contains
+
+  !> Print one check as `PASS  what (value, tol)` or `FAIL  ...` and count it.
+  subroutine report(ok, what, value, tol)
+    logical, intent(in) :: ok                         !< outcome
+    character(len=*), intent(in) :: what              !< what was checked
+    real(wp), intent(in), optional :: value, tol      !< measured value and its tolerance
+    character(len=64) :: extra
+    extra = ''
+    if (present(value) .and. present(tol)) write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
+    if (ok) then
+      npass = npass + 1
+      write (output_unit, '(a)') 'PASS  '//what//trim(extra)
+    else
+      nfail = nfail + 1
+      write (output_unit, '(a)') 'FAIL  '//what//trim(extra)
+    end if
+  end subroutine report
+
+  !> A check that value <= tol (a NaN fails).
+  subroutine report_le(value, tol, what)
+    real(wp), intent(in) :: value, tol  !< measured value, tolerance
+    character(len=*), intent(in) :: what  !< what was checked
+    call report(value <= tol, what, value, tol)
+  end subroutine report_le
+
+  !> Wall clock [s].
+  function wtime() result(t)
+    real(wp) :: t
+    integer(int64) :: cnt, rate
+    call system_clock(cnt, rate)
+    t = real(cnt, wp)/real(rate, wp)
+  end function wtime
+
+  !> Print `N checks passed, M failed` and stop with status 1 if anything failed.
+  subroutine test_summary()
+    write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
+    if (nfail > 0) error stop 1
+  end subroutine test_summary
+
+  !> Solve K u = f on the free DOFs with LAPACK's banded Cholesky (natural order);
+  !! stops the test program if the matrix is not positive definite.
+  subroutine band_solve(sys, x)
+    type(body_system_t), intent(in) :: sys  !< assembled body
+    real(wp), intent(out) :: x(:)           !< solution at the free DOFs
+    real(wp), allocatable :: ab(:, :)
+    integer :: kd, i, j, p, info
+    kd = 0
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        i = sys%rowind(p) + 1
+        kd = max(kd, j - i)
+      end do
+    end do
+    allocate (ab(kd + 1, sys%n))
+    ab = 0.0_wp
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        i = sys%rowind(p) + 1
+        if (i <= j) ab(kd + 1 + i - j, j) = sys%val(p)
+      end do
+    end do
+    x(1:sys%n) = sys%f
+    call dpbsv('U', sys%n, kd, 1, ab, kd + 1, x, sys%n, info)
+    if (info /= 0) then
+      write (*, '(a,i0)') 'FAIL  dpbsv info = ', info
+      error stop 1
+    end if
+  end subroutine band_solve
+
+end module testing
