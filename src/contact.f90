@@ -225,7 +225,10 @@ contains
         ! the outer iteration is as exact as its subproblems, so solve them tightly
         ! (scaled by the contrast of the bodies: the stiff body's obstacle is built from
         ! the soft body's displacement, whose error the contrast amplifies)
-        rtol_in = max(4.0_wp*epsilon(1.0_wp), &
+        ! The floor is what rounding lets the projected gradient reach (a product with
+        ! an m x m matrix carries ~ sqrt(m) eps of relative error): asking for less
+        ! only spins MPRGP up to inner_max_it.
+        rtol_in = max(sqrt(real(max(m, 1), wp))*epsilon(1.0_wp), &
                       d%solver%inner_factor*d%solver%tol*minval(lmax)/max(maxval(lmax), tiny(1.0_wp)))
       else if (it == 1) then
         rtol_in = d%solver%inner_rtol_max
