@@ -447,6 +447,7 @@ contains
     call dpotrf('U', m, A, m, info)
     if (info /= 0 .or. .not. lmax > 0.0_wp) then
       res%error_bound = huge(1.0_wp)
+      res%kappa = huge(1.0_wp)
       return
     end if
     do i = 1, m
@@ -461,6 +462,12 @@ contains
     call dsymv('U', m, 1.0_wp, H, m, x, 1, 0.0_wp, y, 1)
     lmin = dot_product(x, y)
     res%kappa = 1.1_wp*lmax/max(lmin, tiny(1.0_wp))
+    if (.not. (ieee_is_finite(res%kappa) .and. ieee_is_finite(lmax) .and. lmax > 0.0_wp)) then
+      ! out of the range of double precision: no bound can be given
+      res%kappa = huge(1.0_wp)
+      res%error_bound = huge(1.0_wp)
+      return
+    end if
     ! natural residual of the mean contact force
     call dsymv('U', m, 1.0_wp, H, m, res%lam, 1, 0.0_wp, g, 1)
     g = g - (bc(1)%b + bc(2)%b - itf%g0)

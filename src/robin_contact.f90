@@ -7,6 +7,7 @@
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: fatal, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
                     EXIT_INTERRUPTED
   use config, only: deck_t, output_cfg_t
@@ -59,6 +60,10 @@ program robin_contact
     call omp_set_max_active_levels(1)
   end if
 
+  ! A result file left at this path by an earlier run must not pass for this run's if
+  ! this one fails: remove it (and its XDMF files) now that the input is valid.
+  call remove_stale_results(d%output%file)
+
   ! ---- assemble both bodies --------------------------------------------------------
   t0 = omp_get_wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
@@ -95,6 +100,11 @@ program robin_contact
   !$omp end parallel do
   do a = 1, 2
     if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': condensation failed: '//trim(msg(a)))
+    if (.not. (all(ieee_is_finite(bc(a)%flex)) .and. all(ieee_is_finite(bc(a)%b)))) then
+      write (msg1, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
+        d%body(a)%young, '): the stiffness is out of the range of double precision; rescale the units'
+      call fatal(EXIT_NUMERICAL, trim(msg1))
+    end if
   end do
   tm%condense = omp_get_wtime() - t0
   tm%factor_mb = (bc(1)%chol%mem_bytes + bc(2)%chol%mem_bytes)/1048576.0_wp
@@ -166,7 +176,7 @@ contains
     write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
-    write (output_unit, '(a,es10.3,a,es10.3,a)') 'accuracy: |lam - lam_monolithic|/|lam| <= ', res%error_bound, &
+    write (output_unit, '(a,es10.3e3,a,es10.3e3,a)') 'accuracy: |lam - lam_monolithic|/|lam| <= ', res%error_bound, &
       ' (a posteriori bound, cond(F1+F2) ~ ', res%kappa, ')'
     if (code /= EXIT_NUMERICAL) write (output_unit, '(a)') 'output: '//trim(d%output%file)
     write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
@@ -209,6 +219,21 @@ contains
     d1%solver%max_outer = 1
     call deck_text(d1, k)
   end function physics_key
+
+  subroutine remove_stale_results(file)
+    character(len=*), intent(in) :: file
+    character(len=:), allocatable :: stem
+    integer :: l
+    l = len_trim(file)
+    stem = trim(file)
+    if (l > 3) then
+      if (file(l - 2:l) == '.h5') stem = file(1:l - 3)
+    end if
+    call remove_file(trim(file))
+    call remove_file(stem//'.xdmf')
+    call remove_file(stem//'_body1.xdmf')
+    call remove_file(stem//'_body2.xdmf')
+  end subroutine remove_stale_results
 
   subroutine remove_file(path)
     character(len=*), intent(in) :: path
