@@ -176,8 +176,8 @@ contains
     write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
-    write (output_unit, '(a,es10.3e3,a,es10.3e3,a)') 'accuracy: |lam - lam_monolithic|/|lam| <= ', res%error_bound, &
-      ' (a posteriori bound, cond(F1+F2) ~ ', res%kappa, ')'
+    write (output_unit, '(a)') 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
+      ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
     if (code /= EXIT_NUMERICAL) write (output_unit, '(a)') 'output: '//trim(d%output%file)
     write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
@@ -187,6 +187,19 @@ contains
       ' n2=', sys(2)%n, ' m=', itf%m, ' delta=', fmt_real(d%solver%delta, '(f0.6)'), ' residual=', res%residual, &
       ' wall_s=', fmt_real(tm%total, '(f0.3)')
   end subroutine summary
+
+  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308).
+  function sci(x) result(t)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: t
+    character(len=24) :: buf
+    if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
+      write (buf, '(es11.3e3)') x
+    else
+      write (buf, '(es10.3)') x
+    end if
+    t = trim(adjustl(buf))
+  end function sci
 
   !> A fixed-point number without trailing zeros and with a leading 0 (0.95, 1, 0.012).
   function fmt_real(x, fmt) result(s)
