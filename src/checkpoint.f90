@@ -6,10 +6,10 @@ module checkpoint
   use kinds, only: wp
   use hdf5, only: hid_t, h5open_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5gcreate_f, h5gopen_f, &
                   h5gclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F
-  use h5io, only: dset_r1, dset_r2, dset_i1, dset_str, attr_int, attr_real, attr_str, &
+  use h5io, only: dset_r1, dset_r2, dset_str, attr_int, attr_real, attr_str, &
                   read_r1, read_r2, read_i1, read_str, read_attr_int, read_attr_real
   use contact, only: robin_state_t, contact_result_t
-  use results, only: ensure_parent_dir, atomic_rename
+  use results, only: ensure_parent_dir, atomic_rename, write_history
   implicit none
   private
 
@@ -81,13 +81,7 @@ contains
     call dset_r2(gid, 'dX', st%dX)
     call dset_r2(gid, 'dR', st%dR)
     call h5gclose_f(gid, err)
-    call h5gcreate_f(fid, 'history', gid, err)
-    call dset_r1(gid, 'criterion', res%h_criterion(1:res%nhist))
-    call dset_r1(gid, 'residual', res%h_residual(1:res%nhist))
-    call dset_r1(gid, 'wall_s', res%h_wall(1:res%nhist))
-    call dset_i1(gid, 'inner', res%h_inner(1:res%nhist))
-    call dset_i1(gid, 'active', res%h_active(1:res%nhist))
-    call h5gclose_f(gid, err)
+    call write_history(fid, res)
     call h5fclose_f(fid, err)
     call atomic_rename(tmp, target_file, ok)
     if (.not. ok .or. err /= 0) write_failed = .true.

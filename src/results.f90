@@ -28,7 +28,7 @@ module results
     real(wp) :: factor_mb = 0.0_wp            !< memory of the two Cholesky factors [MiB]
   end type timing_t
 
-  public :: write_results, ensure_parent_dir, atomic_rename
+  public :: write_results, write_history, ensure_parent_dir, atomic_rename
 
   interface
     integer(c_int) function c_rename(old, new) bind(c, name='rename')
@@ -157,14 +157,7 @@ contains
     call dset_r1(gid, 'obstacle_body1', res%obstacle(:, 1))
     call dset_r1(gid, 'obstacle_body2', res%obstacle(:, 2))
     call h5gclose_f(gid, err)
-    ! history
-    call h5gcreate_f(fid, 'history', gid, err)
-    call dset_r1(gid, 'criterion', res%h_criterion(1:res%nhist))
-    call dset_r1(gid, 'residual', res%h_residual(1:res%nhist))
-    call dset_i1(gid, 'inner', res%h_inner(1:res%nhist))
-    call dset_i1(gid, 'active', res%h_active(1:res%nhist))
-    call dset_r1(gid, 'wall_s', res%h_wall(1:res%nhist))
-    call h5gclose_f(gid, err)
+    call write_history(fid, res)
     ! bodies
     do a = 1, 2
       write (bname, '(a,i0)') 'body', a
@@ -242,6 +235,21 @@ contains
     end subroutine remove_files
 
   end subroutine write_results
+
+  !> The group /history of an open HDF5 file: one entry per outer iteration.
+  subroutine write_history(fid, res)
+    integer(hid_t), intent(in) :: fid              !< open file
+    type(contact_result_t), intent(in) :: res      !< history source
+    integer(hid_t) :: gid
+    integer :: err
+    call h5gcreate_f(fid, 'history', gid, err)
+    call dset_r1(gid, 'criterion', res%h_criterion(1:res%nhist))
+    call dset_r1(gid, 'residual', res%h_residual(1:res%nhist))
+    call dset_i1(gid, 'inner', res%h_inner(1:res%nhist))
+    call dset_i1(gid, 'active', res%h_active(1:res%nhist))
+    call dset_r1(gid, 'wall_s', res%h_wall(1:res%nhist))
+    call h5gclose_f(gid, err)
+  end subroutine write_history
 
   function pad3(v) result(p)
     real(wp), intent(in) :: v(:, :)
