@@ -66,11 +66,17 @@ $(DEPS_STAMP): tools/install-deps.sh
 deps: $(DEPS_STAMP)
 
 # ---- compile -------------------------------------------------------------------
-$(BUILD)/%.o: src/%.f90 | $(DEPS_STAMP)
+# Sources are grouped by stage (src/base, input, fem, linalg, contact, io; the driver at
+# the top); objects and modules go flat into $(BUILD).
+SRC_DIRS := src src/base src/input src/fem src/linalg src/contact src/io
+vpath %.f90 $(SRC_DIRS)
+vpath %.c $(SRC_DIRS)
+
+$(BUILD)/%.o: %.f90 | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(FC) $(FFLAGS) -c $< -o $@
 
-$(BUILD)/%.o: src/%.c include/cholmod_shim.h include/sighdl.h | $(DEPS_STAMP)
+$(BUILD)/%.o: %.c include/cholmod_shim.h include/sighdl.h | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) -c $< -o $@
 
