@@ -40,8 +40,8 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors config sysinfo signals deck mesh assembly ordering linop mprgp cholmod_iface banded cholesky \
-        condense contact h5io results checkpoint
+MODS := kinds errors clock strings config sysinfo signals deck mesh assembly ordering linop mprgp cholmod_iface banded cholesky \
+        condense contact_types contact h5io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
 
 TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact
@@ -84,23 +84,26 @@ $(BUILD)/%.o: %.c include/cholmod_shim.h include/sighdl.h | $(DEPS_STAMP)
 $(BUILD)/errors.o:
 $(BUILD)/config.o:        $(BUILD)/kinds.o
 $(BUILD)/sysinfo.o:       $(BUILD)/kinds.o
-$(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o
+$(BUILD)/clock.o:         $(BUILD)/kinds.o
+$(BUILD)/strings.o:       $(BUILD)/kinds.o
+$(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o
 $(BUILD)/ordering.o:      $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
 $(BUILD)/linop.o:         $(BUILD)/kinds.o
-$(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/linop.o
+$(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
 $(BUILD)/cholmod_iface.o: $(BUILD)/kinds.o
 $(BUILD)/banded.o:        $(BUILD)/kinds.o
 $(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
+$(BUILD)/contact_types.o: $(BUILD)/kinds.o
 $(BUILD)/contact.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/linop.o \
-                          $(BUILD)/mprgp.o $(BUILD)/condense.o
+                          $(BUILD)/mprgp.o $(BUILD)/condense.o $(BUILD)/contact_types.o
 $(BUILD)/h5io.o:          $(BUILD)/kinds.o
 $(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
-                          $(BUILD)/condense.o $(BUILD)/contact.o $(BUILD)/h5io.o
-$(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact.o $(BUILD)/results.o
+                          $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
+$(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o $(BUILD)/results.o
 $(BUILD)/signals.o:
 $(BUILD)/robin_contact.o: $(OBJS)
 

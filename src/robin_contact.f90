@@ -16,11 +16,13 @@ program robin_contact
   use assembly, only: body_system_t, assemble_body, expand
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
-  use contact, only: contact_result_t, robin_state_t, solve_robin, solve_monolithic, error_bound
+  use contact_types, only: contact_result_t, robin_state_t
+  use contact, only: solve_robin, solve_monolithic, error_bound
   use results, only: timing_t, write_results, program_version
-  use checkpoint, only: checkpoint_setup, checkpoint_write, checkpoint_read, checkpoint_file, checkpoint_failed
+  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
   use signals, only: signals_install, stop_requested
   use sysinfo, only: peak_rss_mb
+  use strings, only: sci, fmt_real
   use omp_lib, only: omp_get_wtime, omp_get_max_threads, omp_set_max_active_levels
   implicit none
 
@@ -34,6 +36,7 @@ program robin_contact
   character(len=:), allocatable :: deck_path, restart_file, key
   character(len=4096), allocatable :: overrides(:)
   type(robin_state_t) :: state
+  type(h5_checkpointer_t) :: ckpt
   character(len=512) :: msg(2), msg1
   integer :: info(2), info1, a, nthr, code, maxndof
   real(wp) :: t_start, t0
@@ -118,9 +121,11 @@ program robin_contact
       call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
       if (.not. ok) call fatal(EXIT_INPUT, trim(msg1))
     end if
-    call checkpoint_setup(checkpoint_file(d%output%file), key)
-    call solve_robin(d, itf, bc, res, output_unit, state, checkpoint_write, stop_requested)
-    if (checkpoint_failed()) call warn('a checkpoint could not be written to '//checkpoint_file(d%output%file))
+    ckpt%file = checkpoint_file(d%output%file)
+    ckpt%key = key
+    ckpt%every = d%output%checkpoint_every
+    call solve_robin(d, itf, bc, res, output_unit, state, ckpt, stop_requested)
+    if (ckpt%failed) call warn('a checkpoint could not be written to '//checkpoint_file(d%output%file))
   end if
   if (res%status /= 'failed') call error_bound(itf, bc, res)
   ! displacements of both bodies under their own contact forces
@@ -187,36 +192,6 @@ contains
       ' n2=', sys(2)%n, ' m=', itf%m, ' delta=', fmt_real(d%solver%delta, '(f0.6)'), ' residual=', res%residual, &
       ' wall_s=', fmt_real(tm%total, '(f0.3)')
   end subroutine summary
-
-  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308).
-  function sci(x) result(t)
-    real(wp), intent(in) :: x
-    character(len=:), allocatable :: t
-    character(len=24) :: buf
-    if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
-      write (buf, '(es11.3e3)') x
-    else
-      write (buf, '(es10.3)') x
-    end if
-    t = trim(adjustl(buf))
-  end function sci
-
-  !> A fixed-point number without trailing zeros and with a leading 0 (0.95, 1, 0.012).
-  function fmt_real(x, fmt) result(s)
-    real(wp), intent(in) :: x
-    character(len=*), intent(in) :: fmt
-    character(len=:), allocatable :: s
-    character(len=40) :: buf
-    write (buf, fmt) x
-    s = trim(adjustl(buf))
-    if (index(s, '.') > 0 .and. fmt /= '(f0.3)') then
-      do while (s(len(s):len(s)) == '0')
-        s = s(1:len(s) - 1)
-      end do
-      if (s(len(s):len(s)) == '.') s = s(1:len(s) - 1)
-    end if
-    if (s(1:1) == '.') s = '0'//s
-  end function fmt_real
 
   !> The effective deck without the settings that may change between a run and its
   !! restart (output, max_outer): a checkpoint is only accepted under the same key.

@@ -11,7 +11,8 @@ program test_contact
   use assembly, only: body_system_t, assemble_body, expand, residual_full
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
-  use contact, only: contact_result_t, solve_robin, solve_monolithic, error_bound
+  use contact_types, only: contact_result_t
+  use contact, only: solve_robin, solve_monolithic, error_bound
   implicit none
   integer :: nfail = 0
   character(len=4096) :: none(0)

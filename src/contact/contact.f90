@@ -11,77 +11,18 @@ module contact
   use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, lambda_max_estimate, &
                    MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
   use condense, only: interface_t, body_condensed_t
+  use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, ANDERSON_DEPTH, &
+                           state_init, alloc_result, grow_history
   implicit none
   private
 
-  !> Outcome of a contact solve, with the outer history.
-  type, public :: contact_result_t
-    character(len=16) :: status = 'none'       !< converged | max_outer | diverged | failed | interrupted
-    character(len=16) :: method = ''           !< robin | monolithic
-    character(len=256) :: message = ''         !< why it failed, if it did
-    integer :: outer = 0                       !< outer iterations (1 for monolithic)
-    integer :: inner = 0                       !< Hessian multiplications, all subproblems (IT_inner)
-    integer :: inner_maxit_hits = 0            !< subproblems that stopped on inner_max_it
-    real(wp), allocatable :: lam(:)            !< (m) normal contact force, mean of the bodies' [force]
-    real(wp), allocatable :: lam_body(:, :)    !< (m,2) each body's contact force [force]
-    real(wp), allocatable :: w(:, :)           !< (m,2) B_a u_a, normal interface displacement [length]
-    real(wp), allocatable :: gap(:)            !< (m) B_1u_1 + B_2u_2 - g0 [length]
-    real(wp), allocatable :: obstacle(:, :)    !< (m,2) final obstacles G_a [length]
-    real(wp) :: criterion = 0.0_wp             !< last value of the stopping criterion
-    real(wp) :: residual = 0.0_wp              !< max(imbalance, penetration, complementarity)
-    real(wp) :: imbalance = 0.0_wp             !< |lam_1 - lam_2| / |lam|
-    real(wp) :: penetration = 0.0_wp           !< max(gap, 0) / displacement scale
-    real(wp) :: complementarity = 0.0_wp       !< max lam_i |gap_i| / (max lam * displacement scale)
-    real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
-    real(wp) :: kappa = 0.0_wp                 !< condition number estimate of F_1 + F_2
-    integer :: active = 0                      !< nodes with lam > 0
-    integer :: nhist = 0                       !< entries in the history
-    real(wp), allocatable :: h_criterion(:)    !< per outer iteration
-    real(wp), allocatable :: h_residual(:)     !< per outer iteration
-    real(wp), allocatable :: h_wall(:)         !< wall time since the start of the iteration [s]
-    integer, allocatable :: h_inner(:)         !< cumulative inner multiplications
-    integer, allocatable :: h_active(:)        !< active contact nodes
-  end type contact_result_t
 
-  integer, parameter, public :: ANDERSON_DEPTH = 5   !< history depth of Anderson acceleration
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
-  !> Everything the outer iteration carries from one iteration to the next: with it a
-  !! run resumes bitwise identically from a checkpoint.
-  type, public :: robin_state_t
-    integer :: it = 0                          !< completed outer iterations
-    integer :: inner = 0                       !< cumulative Hessian multiplications
-    integer :: nacc = 0                        !< acceleration steps taken
-    integer :: stalled = 0                     !< consecutive iterations with a small increment but a large residual
-    integer :: it_best = 0                     !< iteration of the last 1% improvement of the residual
-    real(wp) :: res_best = huge(1.0_wp)        !< residual at it_best
-    real(wp) :: crit = huge(1.0_wp)            !< last criterion
-    real(wp) :: progress = huge(1.0_wp)        !< min(increment, residual) of the last iteration
-    real(wp) :: best = huge(1.0_wp)            !< best criterion so far
-    real(wp) :: omega = 0.0_wp                 !< Aitken relaxation
-    real(wp) :: wall = 0.0_wp                  !< wall time spent in the iteration so far [s]
-    real(wp) :: flam(2) = 0.0_wp               !< |F_a lam_a| of the last iterate [length]
-    real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
-    real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
-    real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
-    real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
-    real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
-  end type robin_state_t
 
-  abstract interface
-    !> Writes a checkpoint of the outer state and the history so far.
-    subroutine checkpoint_iface(st, res)
-      import :: robin_state_t, contact_result_t
-      type(robin_state_t), intent(in) :: st
-      type(contact_result_t), intent(in) :: res
-    end subroutine checkpoint_iface
-    !> True when the run must stop at the end of this outer iteration.
-    logical function stop_iface()
-    end function stop_iface
-  end interface
 
-  public :: solve_robin, solve_monolithic, interface_residual, state_init, checkpoint_iface, stop_iface
+  public :: solve_robin, solve_monolithic, interface_residual
   public :: error_bound
 
 contains
@@ -151,16 +92,16 @@ contains
   !! for both, which makes the linearised iteration independent of the contrast of
   !! the bodies: see the README). Acceleration of the obstacle fixed point: 'none',
   !! 'aitken' (dynamic relaxation) or 'anderson' (depth 5).
-  !! With `state` the iteration resumes from a checkpoint; `checkpoint` is called
-  !! every output%checkpoint_every iterations and when `stop_requested` turns true.
-  subroutine solve_robin(d, itf, bc, res, progress_unit, state, checkpoint, stop_requested)
+  !! With `state` the iteration resumes from a checkpoint; `ckpt%save` is called
+  !! every ckpt%every iterations and when `stop_requested` turns true.
+  subroutine solve_robin(d, itf, bc, res, progress_unit, state, ckpt, stop_requested)
     type(deck_t), intent(in) :: d                      !< deck (solver settings)
     type(interface_t), intent(in) :: itf               !< contact line
     type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
     type(contact_result_t), intent(inout) :: res       !< solution, status and history (in: history of a restart)
     integer, intent(in), optional :: progress_unit     !< unit for progress lines (none if absent)
     type(robin_state_t), intent(inout), optional :: state   !< in: state to resume from (state%it > 0)
-    procedure(checkpoint_iface), optional :: checkpoint     !< writes a checkpoint of (state, res)
+    class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     type(robin_state_t) :: st_
     type(dense_op_t) :: op(2)
@@ -396,12 +337,14 @@ contains
         if (stop_requested()) then
           res%status = 'interrupted'
           write (res%message, '(a,i0)') 'stopped by a signal after outer iteration ', it
-          if (present(checkpoint)) call checkpoint(st_, res)
+          if (present(ckpt)) call ckpt%save(st_, res)
           exit
         end if
       end if
-      if (present(checkpoint) .and. d%output%checkpoint_every > 0) then
-        if (mod(it, d%output%checkpoint_every) == 0) call checkpoint(st_, res)
+      if (present(ckpt)) then
+        if (ckpt%every > 0) then
+          if (mod(it, ckpt%every) == 0) call ckpt%save(st_, res)
+        end if
       end if
     end do
     if (present(progress_unit) .and. res%outer > 0 .and. .not. printed) &
@@ -481,21 +424,6 @@ contains
     end if
   end subroutine error_bound
 
-  !> Fresh outer state: obstacles at the initial gap, no contact force.
-  subroutine state_init(st, m, g0)
-    type(robin_state_t), intent(out) :: st   !< state to initialise
-    integer, intent(in) :: m                 !< interface size
-    real(wp), intent(in) :: g0(:)            !< initial gap
-    allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
-    allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
-    st%G(:, 1) = g0
-    st%G(:, 2) = g0
-    st%lam = 0.0_wp
-    st%r_prev = 0.0_wp
-    st%x_prev = 0.0_wp
-    st%dX = 0.0_wp
-    st%dR = 0.0_wp
-  end subroutine state_init
 
   !> Relaxed or accelerated fixed-point update: on entry Gnew = T(G), on exit the
   !! next obstacles. The residual of the fixed point is r = T(G) - G.
@@ -585,19 +513,6 @@ contains
     S = 0.5_wp*(S + transpose(S))
   end subroutine harmonic_operator
 
-  subroutine grow_history(res, nh)
-    type(contact_result_t), intent(inout) :: res
-    integer, intent(in) :: nh
-    real(wp), allocatable :: r(:)
-    integer, allocatable :: i(:)
-    integer :: n
-    n = res%nhist
-    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_criterion(1:n); call move_alloc(r, res%h_criterion)
-    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_residual(1:n); call move_alloc(r, res%h_residual)
-    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_wall(1:n); call move_alloc(r, res%h_wall)
-    allocate (i(nh)); i = 0; i(1:n) = res%h_inner(1:n); call move_alloc(i, res%h_inner)
-    allocate (i(nh)); i = 0; i(1:n) = res%h_active(1:n); call move_alloc(i, res%h_active)
-  end subroutine grow_history
 
   !> Gap, imbalance, penetration and complementarity of res%lam_body, res%w.
   subroutine interface_residual(itf, bc, res)
@@ -633,16 +548,6 @@ contains
     res%active = count(res%lam > 0.0_wp)
   end subroutine interface_residual
 
-  subroutine alloc_result(res, m, nh)
-    type(contact_result_t), intent(inout) :: res
-    integer, intent(in) :: m, nh
-    if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
-    if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, res%h_active)
-    allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
-    allocate (res%h_criterion(nh), res%h_residual(nh), res%h_wall(nh), res%h_inner(nh), res%h_active(nh))
-    res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = 0.0_wp
-    res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
-  end subroutine alloc_result
 
   function matmul_sym(a, x) result(y)
     real(wp), intent(in) :: a(:, :), x(:)

@@ -28,6 +28,7 @@ module mprgp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use linop, only: linop_t
+  use strings, only: itoa, rtoa
   implicit none
   private
 
@@ -212,14 +213,14 @@ contains
       call fail(MPRGP_BAD_ARG, 'opts%rtol is not finite')
       return
     else if (opts%rtol < 0.0_wp) then
-      call fail(MPRGP_BAD_ARG, 'opts%rtol is negative: '//trim(num2str(opts%rtol)))
+      call fail(MPRGP_BAD_ARG, 'opts%rtol is negative: '//trim(rtoa(opts%rtol)))
       return
     end if
     if (.not. ieee_is_finite(opts%atol)) then
       call fail(MPRGP_BAD_ARG, 'opts%atol is not finite')
       return
     else if (opts%atol < 0.0_wp) then
-      call fail(MPRGP_BAD_ARG, 'opts%atol is negative: '//trim(num2str(opts%atol)))
+      call fail(MPRGP_BAD_ARG, 'opts%atol is negative: '//trim(rtoa(opts%atol)))
       return
     end if
     if (opts%max_it < 0) then
@@ -230,7 +231,7 @@ contains
       call fail(MPRGP_BAD_ARG, 'opts%gamma is not finite')
       return
     else if (opts%gamma <= 0.0_wp) then
-      call fail(MPRGP_BAD_ARG, 'opts%gamma must be positive: '//trim(num2str(opts%gamma)))
+      call fail(MPRGP_BAD_ARG, 'opts%gamma must be positive: '//trim(rtoa(opts%gamma)))
       return
     end if
     if (.not. (ieee_is_finite(opts%alpha_bar) .and. ieee_is_finite(opts%lambda_max))) then
@@ -243,15 +244,15 @@ contains
     end if
     do i = 1, n
       if (.not. ieee_is_finite(b(i))) then
-        call fail(MPRGP_NONFINITE, 'b('//trim(int2str(i))//') is not finite')
+        call fail(MPRGP_NONFINITE, 'b('//trim(itoa(i))//') is not finite')
         return
       end if
       if (.not. ieee_is_finite(lb(i))) then
-        call fail(MPRGP_NONFINITE, 'lb('//trim(int2str(i))//') is not finite (use -huge(1.0_wp) for no bound)')
+        call fail(MPRGP_NONFINITE, 'lb('//trim(itoa(i))//') is not finite (use -huge(1.0_wp) for no bound)')
         return
       end if
       if (.not. ieee_is_finite(x(i))) then
-        call fail(MPRGP_NONFINITE, 'initial x('//trim(int2str(i))//') is not finite')
+        call fail(MPRGP_NONFINITE, 'initial x('//trim(itoa(i))//') is not finite')
         return
       end if
     end do
@@ -305,7 +306,7 @@ contains
       stats%gp_norm = sqrt(gp2)
       if (.not. ieee_is_finite(gp2)) then
         call fail(MPRGP_NONFINITE, 'the projected gradient became non-finite after '// &
-                  trim(int2str(it))//' steps')
+                  trim(itoa(it))//' steps')
         exit main
       end if
 
@@ -322,7 +323,7 @@ contains
           write (s1, '(es10.3)') stats%gp_norm
           write (s2, '(es10.3)') tol_now
           stats%message = 'converged: |gP| = '//trim(adjustl(s1))//' <= '//trim(adjustl(s2))// &
-                          ' after '//trim(int2str(it))//' steps, '//trim(int2str(stats%n_matvec))//' products with A'
+                          ' after '//trim(itoa(it))//' steps, '//trim(itoa(stats%n_matvec))//' products with A'
           exit main
         end if
         call true_gradient()
@@ -334,7 +335,7 @@ contains
         write (s1, '(es10.3)') stats%gp_norm
         write (s2, '(es10.3)') tol_now
         stats%message = 'not converged: |gP| = '//trim(adjustl(s1))//' > '//trim(adjustl(s2))// &
-                        ' after max_it = '//trim(int2str(opts%max_it))//' steps'
+                        ' after max_it = '//trim(itoa(opts%max_it))//' steps'
         exit main
       end if
       it = it + 1
@@ -568,13 +569,13 @@ contains
       ok = .false.
       if (.not. (ieee_is_finite(dad_) .and. ieee_is_finite(dd_))) then
         call fail(MPRGP_NONFINITE, 'non-finite curvature along the '//what//' after '// &
-                  trim(int2str(it))//' steps')
+                  trim(itoa(it))//' steps')
         return
       end if
       if (dad_ <= 0.0_wp) then
         write (s1, '(es10.3)') dad_
         call fail(MPRGP_NOT_SPD, 'p''Ap = '//trim(adjustl(s1))//' <= 0 along the '//what// &
-                  ' at step '//trim(int2str(it))//': A is not SPD')
+                  ' at step '//trim(itoa(it))//': A is not SPD')
         return
       end if
       ok = .true.
@@ -584,23 +585,5 @@ contains
     end function check_curvature
 
   end subroutine mprgp_solve
-
-  !> Integer to text.
-  ! Fixed-length results (used with trim): deferred-length character results built
-  ! into concatenations were seen to corrupt memory when two threads ran the same
-  ! statement (gfortran 12, AddressSanitizer), and MPRGP runs on two threads.
-  function int2str(k) result(s)
-    integer, intent(in) :: k
-    character(len=24) :: s
-    write (s, '(i0)') k
-  end function int2str
-
-  !> Real to text.
-  function num2str(v) result(s)
-    real(wp), intent(in) :: v
-    character(len=24) :: s
-    write (s, '(es12.4)') v
-    s = adjustl(s)
-  end function num2str
 
 end module mprgp

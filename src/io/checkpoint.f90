@@ -8,16 +8,21 @@ module checkpoint
                   h5gclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F
   use h5io, only: dset_r1, dset_r2, dset_str, attr_int, attr_real, attr_str, &
                   read_r1, read_r2, read_i1, read_str, read_attr_int, read_attr_real
-  use contact, only: robin_state_t, contact_result_t
+  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t
   use results, only: ensure_parent_dir, atomic_rename, write_history
   implicit none
   private
 
-  character(len=:), allocatable :: target_file   ! where checkpoints go
-  character(len=:), allocatable :: target_key    ! fingerprint of the deck and mesh
-  logical :: write_failed = .false.
+  !> Checkpoints of the Robin iteration in an HDF5 file, replaced atomically.
+  type, extends(checkpointer_t), public :: h5_checkpointer_t
+    character(len=:), allocatable :: file   !< where checkpoints go
+    character(len=:), allocatable :: key    !< fingerprint of the deck and mesh
+    logical :: failed = .false.             !< a checkpoint could not be written
+  contains
+    procedure :: save => checkpoint_write
+  end type h5_checkpointer_t
 
-  public :: checkpoint_setup, checkpoint_write, checkpoint_read, checkpoint_file, checkpoint_failed
+  public :: checkpoint_read, checkpoint_file
 
 contains
 
@@ -28,37 +33,25 @@ contains
     p = trim(result_file)//'.ckpt.h5'
   end function checkpoint_file
 
-  !> Set where `checkpoint_write` writes and the fingerprint it records.
-  subroutine checkpoint_setup(file, key)
-    character(len=*), intent(in) :: file  !< checkpoint path
-    character(len=*), intent(in) :: key   !< fingerprint (effective deck without output settings)
-    target_file = trim(file)
-    target_key = key
-  end subroutine checkpoint_setup
-
-  !> True if a checkpoint could not be written.
-  logical function checkpoint_failed()
-    checkpoint_failed = write_failed
-  end function checkpoint_failed
-
-  !> Write the outer state and history (matches contact's checkpoint_iface).
-  subroutine checkpoint_write(st, res)
+  !> Write the outer state and history.
+  subroutine checkpoint_write(self, st, res)
+    class(h5_checkpointer_t), intent(inout) :: self  !< target file and key
     type(robin_state_t), intent(in) :: st       !< outer state after iteration st%it
     type(contact_result_t), intent(in) :: res   !< history so far
     integer(hid_t) :: fid, gid
     integer :: err
     character(len=:), allocatable :: tmp
     logical :: ok
-    if (.not. allocated(target_file)) return
-    call ensure_parent_dir(target_file)
-    tmp = target_file//'.tmp'
+    if (.not. allocated(self%file)) return
+    call ensure_parent_dir(self%file)
+    tmp = self%file//'.tmp'
     call h5open_f(err)
     call h5fcreate_f(tmp, H5F_ACC_TRUNC_F, fid, err)
     if (err /= 0) then
-      write_failed = .true.
+      self%failed = .true.
       return
     end if
-    call dset_str(fid, 'key', target_key)
+    call dset_str(fid, 'key', self%key)
     call attr_str(fid, 'kind', 'robin_contact checkpoint')
     call h5gcreate_f(fid, 'state', gid, err)
     call attr_int(gid, 'it', st%it)
@@ -83,8 +76,8 @@ contains
     call h5gclose_f(gid, err)
     call write_history(fid, res)
     call h5fclose_f(fid, err)
-    call atomic_rename(tmp, target_file, ok)
-    if (.not. ok .or. err /= 0) write_failed = .true.
+    call atomic_rename(tmp, self%file, ok)
+    if (.not. ok .or. err /= 0) self%failed = .true.
   end subroutine checkpoint_write
 
   !> Read a checkpoint. ok = .false. with msg if it cannot be read or was made from

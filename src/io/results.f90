@@ -10,7 +10,7 @@ module results
   use mesh, only: mesh_t
   use assembly, only: body_system_t, expand, nodal_stress
   use condense, only: interface_t, body_condensed_t
-  use contact, only: contact_result_t
+  use contact_types, only: contact_result_t
   implicit none
   private
 

@@ -1,0 +1,282 @@
+!> Text helpers shared by every stage: case folding, numbers to text (short round-trip
+!! form for decks, fixed forms for messages and summary lines), namelist string literals,
+!! blank-separated word lists, and the floating-point guard around READs of numbers.
+!!
+!! Thread safety: `itoa` and `rtoa` return fixed-length results for use inside code that
+!! runs on two threads (MPRGP): deferred-length character results built into
+!! concatenations were seen to corrupt memory when two threads ran the same statement
+!! (gfortran 12, AddressSanitizer). The deferred-length helpers are for serial code.
+module strings
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: ieee_exceptions, only: ieee_usual, ieee_get_halting_mode, &
+                                           ieee_set_halting_mode, ieee_get_flag, ieee_set_flag
+  use kinds, only: wp
+  implicit none (type, external)
+  private
+
+  public :: fpstate_t, fp_read_begin, fp_read_end, lower, is_ident, is_letter, first_nonblank
+  public :: i2s, r2s, itoa, rtoa, sci, fmt_real, quote, quoted_list, next_word, index_of, word
+
+  !> Saved floating-point halting modes and flags.
+  type :: fpstate_t
+    logical :: halt(size(ieee_usual)) = .false.
+    logical :: flag(size(ieee_usual)) = .false.
+  end type fpstate_t
+
+contains
+
+  !> Disable floating-point halting around a READ (an overflowing literal such as 1e400
+  !! would trap in a -ffpe-trap build; it is reported as non-finite instead).
+  subroutine fp_read_begin(fp)
+    type(fpstate_t), intent(out) :: fp
+    call ieee_get_halting_mode(ieee_usual, fp%halt)
+    call ieee_get_flag(ieee_usual, fp%flag)
+    call ieee_set_halting_mode(ieee_usual, .false.)
+  end subroutine fp_read_begin
+
+  !> Restore the halting modes and exception flags saved by fp_read_begin.
+  subroutine fp_read_end(fp)
+    type(fpstate_t), intent(in) :: fp
+    call ieee_set_flag(ieee_usual, fp%flag)
+    call ieee_set_halting_mode(ieee_usual, fp%halt)
+  end subroutine fp_read_end
+
+  pure function lower(s) result(r)
+    character(len=*), intent(in) :: s
+    character(len=len(s)) :: r
+    integer :: i, c
+    r = s
+    do i = 1, len(s)
+      c = iachar(s(i:i))
+      if (c >= iachar('A') .and. c <= iachar('Z')) r(i:i) = achar(c + 32)
+    end do
+  end function lower
+
+  pure logical function is_ident(c)
+    character, intent(in) :: c
+    is_ident = is_letter(c) .or. (c >= '0' .and. c <= '9') .or. c == '_'
+  end function is_ident
+
+  pure logical function is_letter(c)
+    character, intent(in) :: c
+    is_letter = (c >= 'a' .and. c <= 'z') .or. (c >= 'A' .and. c <= 'Z')
+  end function is_letter
+
+  pure integer function first_nonblank(s)
+    character(len=*), intent(in) :: s
+    first_nonblank = max(1, verify(s, ' '))
+  end function first_nonblank
+
+  pure function i2s(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=24) :: buf
+    write (buf, '(i0)') i
+    s = trim(buf)
+  end function i2s
+
+  !> A character value as a namelist string literal (quotes doubled).
+  pure function quote(s) result(r)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: r
+    integer :: i
+    r = ''''
+    do i = 1, len(s)
+      if (s(i:i) == '''') then
+        r = r//''''''
+      else
+        r = r//s(i:i)
+      end if
+    end do
+    r = r//''''
+  end function quote
+
+  !> 'a', 'b' or 'c' from a blank-separated list; with prefix '&': &a, &b, &c.
+  function quoted_list(list, prefix) result(s)
+    character(len=*), intent(in) :: list, prefix
+    character(len=:), allocatable :: s
+    integer :: p, q, n, k
+    n = 0
+    p = 1
+    do while (p <= len(list))
+      call next_word(list, p, q)
+      if (q < p) exit
+      n = n + 1
+      p = q + 1
+    end do
+    s = ''
+    do k = 1, n
+      if (k > 1 .and. k < n) s = s//', '
+      if (k > 1 .and. k == n) s = s//' or '
+      if (prefix == '&') then
+        s = s//'&'//word(list, k)
+      else
+        s = s//''''//word(list, k)//''''
+      end if
+    end do
+  end function quoted_list
+
+  !> Shortest text that reads back to exactly x (decimal form for moderate exponents).
+  function r2s(x) result(s)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: s
+    character(len=48) :: buf
+    character(len=16) :: fmt
+    character(len=:), allocatable :: digits, ip, fp
+    integer :: d, ios, epos, e, k
+    real(wp) :: y
+    logical :: neg
+    type(fpstate_t) :: fps
+
+    if (.not. ieee_is_finite(x)) then
+      write (buf, *) x
+      s = trim(adjustl(buf))
+      return
+    end if
+    if (x == 0.0_wp) then
+      s = '0.0'
+      return
+    end if
+    call fp_read_begin(fps)   ! a short rendering of a huge value may overflow when read
+    do d = 1, 17
+      write (fmt, '(a,i0,a)') '(es40.', d - 1, 'e4)'
+      write (buf, fmt) x
+      read (buf, *, iostat=ios) y
+      if (ios == 0 .and. y == x) exit
+    end do
+    call fp_read_end(fps)
+    buf = adjustl(buf)
+    neg = buf(1:1) == '-'
+    if (neg) buf = buf(2:)
+    epos = index(buf, 'E')
+    read (buf(epos + 1:), *) e
+    digits = ''
+    do k = 1, epos - 1
+      if (buf(k:k) /= '.') digits = digits//buf(k:k)
+    end do
+    do while (len(digits) > 1)
+      if (digits(len(digits):) /= '0') exit
+      digits = digits(1:len(digits) - 1)
+    end do
+    if (e >= -3 .and. e <= 5) then
+      if (e >= 0) then
+        if (len(digits) <= e + 1) then
+          ip = digits//repeat('0', e + 1 - len(digits))
+          fp = '0'
+        else
+          ip = digits(1:e + 1)
+          fp = digits(e + 2:)
+        end if
+      else
+        ip = '0'
+        fp = repeat('0', -e - 1)//digits
+      end if
+      s = ip//'.'//fp
+    else
+      if (len(digits) > 1) then
+        s = digits(1:1)//'.'//digits(2:)//'e'//i2s(e)
+      else
+        s = digits//'.0e'//i2s(e)
+      end if
+    end if
+    if (neg) s = '-'//s
+  end function r2s
+
+  !> Find the next blank-separated word at or after p: on return table(p:q) (q < p if none).
+  subroutine next_word(table, p, q)
+    character(len=*), intent(in) :: table
+    integer, intent(inout) :: p
+    integer, intent(out) :: q
+    do while (p <= len(table))
+      if (table(p:p) /= ' ') exit
+      p = p + 1
+    end do
+    q = p - 1
+    do while (q < len(table))
+      if (table(q + 1:q + 1) == ' ') exit
+      q = q + 1
+    end do
+  end subroutine next_word
+
+  !> Position (1-based) of word `w` in a blank-separated list, 0 if absent.
+  integer function index_of(list, w)
+    character(len=*), intent(in) :: list, w
+    integer :: p, q, k
+    index_of = 0
+    k = 0
+    p = 1
+    do while (p <= len(list))
+      call next_word(list, p, q)
+      if (q < p) exit
+      k = k + 1
+      if (lower(list(p:q)) == lower(w)) then
+        index_of = k
+        return
+      end if
+      p = q + 1
+    end do
+  end function index_of
+
+  !> The k-th word of a blank-separated list.
+  function word(list, k) result(w)
+    character(len=*), intent(in) :: list
+    integer, intent(in) :: k
+    character(len=:), allocatable :: w
+    integer :: p, q, j
+    w = ''
+    p = 1
+    do j = 1, k
+      call next_word(list, p, q)
+      if (q < p) return
+      if (j == k) w = list(p:q)
+      p = q + 1
+    end do
+  end function word
+
+  !> Integer to text, fixed length (thread-safe; use with trim).
+  function itoa(k) result(s)
+    integer, intent(in) :: k
+    character(len=24) :: s
+    write (s, '(i0)') k
+  end function itoa
+
+  !> Real to text as es12.4, fixed length, left-adjusted (thread-safe; use with trim).
+  function rtoa(v) result(s)
+    real(wp), intent(in) :: v
+    character(len=24) :: s
+    write (s, '(es12.4)') v
+    s = adjustl(s)
+  end function rtoa
+
+  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308).
+  function sci(x) result(t)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: t
+    character(len=24) :: buf
+    if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
+      write (buf, '(es11.3e3)') x
+    else
+      write (buf, '(es10.3)') x
+    end if
+    t = trim(adjustl(buf))
+  end function sci
+
+  !> A fixed-point number in format `fmt` with a leading 0 (0.95, 0.012); trailing zeros
+  !! are dropped except for the format '(f0.3)' (times keep their three decimals).
+  function fmt_real(x, fmt) result(s)
+    real(wp), intent(in) :: x
+    character(len=*), intent(in) :: fmt
+    character(len=:), allocatable :: s
+    character(len=40) :: buf
+    write (buf, fmt) x
+    s = trim(adjustl(buf))
+    if (index(s, '.') > 0 .and. fmt /= '(f0.3)') then
+      do while (s(len(s):len(s)) == '0')
+        s = s(1:len(s) - 1)
+      end do
+      if (s(len(s):len(s)) == '.') s = s(1:len(s) - 1)
+    end if
+    if (s(1:1) == '.') s = '0'//s
+  end function fmt_real
+
+end module strings

@@ -1,0 +1,136 @@
+!> The types the contact solvers produce and carry, apart from the solvers so that output
+!! and checkpoint modules can read and write them without importing a solver:
+!! the result of a contact solve with its outer history, the outer state of the Robin
+!! iteration (what a checkpoint holds), and the abstract checkpointer that the Robin
+!! iteration calls.
+module contact_types
+  use kinds, only: wp
+  implicit none (type, external)
+  private
+
+  !> Outcome of a contact solve, with the outer history.
+  type, public :: contact_result_t
+    character(len=16) :: status = 'none'       !< converged | max_outer | diverged | failed | interrupted
+    character(len=16) :: method = ''           !< robin | monolithic
+    character(len=256) :: message = ''         !< why it failed, if it did
+    integer :: outer = 0                       !< outer iterations (1 for monolithic)
+    integer :: inner = 0                       !< Hessian multiplications, all subproblems (IT_inner)
+    integer :: inner_maxit_hits = 0            !< subproblems that stopped on inner_max_it
+    real(wp), allocatable :: lam(:)            !< (m) normal contact force, mean of the bodies' [force]
+    real(wp), allocatable :: lam_body(:, :)    !< (m,2) each body's contact force [force]
+    real(wp), allocatable :: w(:, :)           !< (m,2) B_a u_a, normal interface displacement [length]
+    real(wp), allocatable :: gap(:)            !< (m) B_1u_1 + B_2u_2 - g0 [length]
+    real(wp), allocatable :: obstacle(:, :)    !< (m,2) final obstacles G_a [length]
+    real(wp) :: criterion = 0.0_wp             !< last value of the stopping criterion
+    real(wp) :: residual = 0.0_wp              !< max(imbalance, penetration, complementarity)
+    real(wp) :: imbalance = 0.0_wp             !< |lam_1 - lam_2| / |lam|
+    real(wp) :: penetration = 0.0_wp           !< max(gap, 0) / displacement scale
+    real(wp) :: complementarity = 0.0_wp       !< max lam_i |gap_i| / (max lam * displacement scale)
+    real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
+    real(wp) :: kappa = 0.0_wp                 !< condition number estimate of F_1 + F_2
+    integer :: active = 0                      !< nodes with lam > 0
+    integer :: nhist = 0                       !< entries in the history
+    real(wp), allocatable :: h_criterion(:)    !< per outer iteration
+    real(wp), allocatable :: h_residual(:)     !< per outer iteration
+    real(wp), allocatable :: h_wall(:)         !< wall time since the start of the iteration [s]
+    integer, allocatable :: h_inner(:)         !< cumulative inner multiplications
+    integer, allocatable :: h_active(:)        !< active contact nodes
+  end type contact_result_t
+
+  integer, parameter, public :: ANDERSON_DEPTH = 5   !< history depth of Anderson acceleration
+
+  !> Everything the outer iteration carries from one iteration to the next: with it a
+  !! run resumes bitwise identically from a checkpoint.
+  type, public :: robin_state_t
+    integer :: it = 0                          !< completed outer iterations
+    integer :: inner = 0                       !< cumulative Hessian multiplications
+    integer :: nacc = 0                        !< acceleration steps taken
+    integer :: stalled = 0                     !< consecutive iterations with a small increment but a large residual
+    integer :: it_best = 0                     !< iteration of the last 1% improvement of the residual
+    real(wp) :: res_best = huge(1.0_wp)        !< residual at it_best
+    real(wp) :: crit = huge(1.0_wp)            !< last criterion
+    real(wp) :: progress = huge(1.0_wp)        !< min(increment, residual) of the last iteration
+    real(wp) :: best = huge(1.0_wp)            !< best criterion so far
+    real(wp) :: omega = 0.0_wp                 !< Aitken relaxation
+    real(wp) :: wall = 0.0_wp                  !< wall time spent in the iteration so far [s]
+    real(wp) :: flam(2) = 0.0_wp               !< |F_a lam_a| of the last iterate [length]
+    real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
+    real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
+    real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
+    real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
+    real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
+  end type robin_state_t
+
+  !> Where the Robin iteration saves its state: `save` is called every `every` outer
+  !! iterations (0: never) and when the run is stopped by a signal. A failed save must not
+  !! stop the iteration; the implementation records it and the driver reports it.
+  type, abstract, public :: checkpointer_t
+    integer :: every = 0     !< outer iterations between checkpoints (0: only on a signal)
+  contains
+    procedure(checkpointer_save_iface), deferred :: save   !< write (state, history)
+  end type checkpointer_t
+
+  abstract interface
+    !> Save the outer state after iteration st%it and the history so far.
+    subroutine checkpointer_save_iface(self, st, res)
+      import :: checkpointer_t, robin_state_t, contact_result_t
+      class(checkpointer_t), intent(inout) :: self
+      type(robin_state_t), intent(in) :: st
+      type(contact_result_t), intent(in) :: res
+    end subroutine checkpointer_save_iface
+  end interface
+
+  abstract interface
+    !> True when the run must stop at the end of this outer iteration (a signal came).
+    logical function stop_iface()
+    end function stop_iface
+  end interface
+
+  public :: state_init, alloc_result, grow_history, stop_iface
+
+contains
+
+  !> Fresh outer state: obstacles at the initial gap, no contact force.
+  subroutine state_init(st, m, g0)
+    type(robin_state_t), intent(out) :: st   !< state to initialise
+    integer, intent(in) :: m                 !< interface size
+    real(wp), intent(in) :: g0(:)            !< initial gap
+    allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
+    allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
+    st%G(:, 1) = g0
+    st%G(:, 2) = g0
+    st%lam = 0.0_wp
+    st%r_prev = 0.0_wp
+    st%x_prev = 0.0_wp
+    st%dX = 0.0_wp
+    st%dR = 0.0_wp
+  end subroutine state_init
+
+  !> Allocate the result for m contact nodes and a history of nh entries, all zero.
+  subroutine alloc_result(res, m, nh)
+    type(contact_result_t), intent(inout) :: res
+    integer, intent(in) :: m, nh
+    if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
+    if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, res%h_active)
+    allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
+    allocate (res%h_criterion(nh), res%h_residual(nh), res%h_wall(nh), res%h_inner(nh), res%h_active(nh))
+    res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = 0.0_wp
+    res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
+  end subroutine alloc_result
+
+  !> Grow the history arrays to nh entries, keeping the first res%nhist.
+  subroutine grow_history(res, nh)
+    type(contact_result_t), intent(inout) :: res
+    integer, intent(in) :: nh
+    real(wp), allocatable :: r(:)
+    integer, allocatable :: i(:)
+    integer :: n
+    n = res%nhist
+    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_criterion(1:n); call move_alloc(r, res%h_criterion)
+    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_residual(1:n); call move_alloc(r, res%h_residual)
+    allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_wall(1:n); call move_alloc(r, res%h_wall)
+    allocate (i(nh)); i = 0; i(1:n) = res%h_inner(1:n); call move_alloc(i, res%h_inner)
+    allocate (i(nh)); i = 0; i(1:n) = res%h_active(1:n); call move_alloc(i, res%h_active)
+  end subroutine grow_history
+
+end module contact_types
