@@ -10,7 +10,7 @@ program robin_contact
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: fatal, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
                     EXIT_INTERRUPTED
-  use config, only: deck_t, output_cfg_t
+  use config, only: deck_t, output_cfg_t, METHOD_ROBIN, METHOD_MONOLITHIC
   use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand
@@ -30,7 +30,7 @@ program robin_contact
   type(mesh_t) :: msh(2)
   type(body_system_t) :: sys(2)
   type(interface_t) :: itf
-  type(body_condensed_t) :: bc(2)
+  type(body_condensed_t) :: cb(2)   ! the bodies condensed on the interface
   type(contact_result_t) :: res
   type(timing_t) :: tm
   character(len=:), allocatable :: deck_path, restart_file, key
@@ -46,7 +46,7 @@ program robin_contact
   t_start = omp_get_wtime()
   call parse_arguments(deck_path, overrides, restart_file)
   call read_deck(deck_path, overrides, d)
-  if (len(restart_file) > 0 .and. d%solver%method /= 'robin') &
+  if (len(restart_file) > 0 .and. d%solver%method /= METHOD_ROBIN) &
     call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': --restart applies to method=''robin'' only')
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
   key = physics_key(d)
@@ -78,7 +78,7 @@ program robin_contact
   do a = 1, 2
     if (info(a) /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))
   end do
-  call build_interface(d, msh, sys, itf, info1, msg1)
+  call build_interface(d%body, d%contact, msh, sys, itf, info1, msg1)
   if (info1 /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg1))
   tm%assemble = omp_get_wtime() - t0
   write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') 'assembled: n1=', sys(1)%n, ' n2=', sys(2)%n, &
@@ -88,7 +88,7 @@ program robin_contact
   t0 = omp_get_wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
-    call factor_body(d, itf, a, msh(a), sys(a), bc(a), info(a), msg(a))
+    call factor_body(d%solver%factor, itf, a, msh(a), sys(a), cb(a), info(a), msg(a))
   end do
   !$omp end parallel do
   do a = 1, 2
@@ -98,24 +98,24 @@ program robin_contact
   t0 = omp_get_wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
-    call condense_body(sys(a), bc(a), info(a), msg(a))
+    call condense_body(sys(a), cb(a), info(a), msg(a))
   end do
   !$omp end parallel do
   do a = 1, 2
     if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': condensation failed: '//trim(msg(a)))
-    if (.not. (all(ieee_is_finite(bc(a)%flex)) .and. all(ieee_is_finite(bc(a)%b)))) then
+    if (.not. (all(ieee_is_finite(cb(a)%flex)) .and. all(ieee_is_finite(cb(a)%b)))) then
       write (msg1, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
         d%body(a)%young, '): the stiffness is out of the range of double precision; rescale the units'
       call fatal(EXIT_NUMERICAL, trim(msg1))
     end if
   end do
   tm%condense = omp_get_wtime() - t0
-  tm%factor_mb = (bc(1)%chol%mem_bytes + bc(2)%chol%mem_bytes)/1048576.0_wp
+  tm%factor_mb = (cb(1)%chol%mem_bytes + cb(2)%chol%mem_bytes)/1048576.0_wp
 
   ! ---- contact ----------------------------------------------------------------------
   t0 = omp_get_wtime()
-  if (d%solver%method == 'monolithic') then
-    call solve_monolithic(d, itf, bc, res)
+  if (d%solver%method == METHOD_MONOLITHIC) then
+    call solve_monolithic(d%solver, itf, cb, res)
   else
     if (len(restart_file) > 0) then
       call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
@@ -124,10 +124,10 @@ program robin_contact
     ckpt%file = checkpoint_file(d%output%file)
     ckpt%key = key
     ckpt%every = d%output%checkpoint_every
-    call solve_robin(d, itf, bc, res, output_unit, state, ckpt, stop_requested)
+    call solve_robin(d%solver, itf, cb, res, output_unit, d%output%progress_lines, state, ckpt, stop_requested)
     if (ckpt%failed) call warn('a checkpoint could not be written to '//checkpoint_file(d%output%file))
   end if
-  if (res%status /= 'failed') call error_bound(itf, bc, res)
+  if (res%status /= 'failed') call error_bound(itf, cb, res)
   ! displacements of both bodies under their own contact forces
   maxndof = max(sys(1)%ndof, sys(2)%ndof)
   allocate (u(maxndof, 2))
@@ -136,7 +136,7 @@ program robin_contact
     !$omp parallel do num_threads(nthr) schedule(static, 1) private(ufree)
     do a = 1, 2
       allocate (ufree(sys(a)%n))
-      call recover_displacement(sys(a), bc(a), res%lam_body(:, a), ufree)
+      call recover_displacement(sys(a), cb(a), res%lam_body(:, a), ufree)
       call expand(sys(a), ufree, u(1:sys(a)%ndof, a))
       deallocate (ufree)
     end do

@@ -1,5 +1,5 @@
 !> Contact solver tests: the monolithic solution satisfies the KKT conditions of
-!! METHOD.md and the equilibrium of each body (reactions + loads + contact forces);
+!! the README (Method as implemented) and the equilibrium of each body (reactions + loads + contact forces);
 !! the Robin iterate equals the monolithic solution on the paper's scene, on a
 !! partial-contact scene (parabolic gap) and on a scene whose load lifts part of the
 !! interface; the recovered displacements reproduce the condensed ones.
@@ -13,8 +13,8 @@ program test_contact
                       recover_displacement
   use contact_types, only: contact_result_t
   use contact, only: solve_robin, solve_monolithic, error_bound
-  implicit none
-  integer :: nfail = 0
+  use testing, only: report, test_summary
+  implicit none (type, external)
   character(len=4096) :: none(0)
 
   call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.95, tol=1e-10 /"], .false.)
@@ -35,10 +35,7 @@ program test_contact
   call scene('inputs/hard/contrast_1e6.nml', [character(len=80) :: &
     "&solver robin_operator='steklov', delta=0.95, max_outer=200 /"], .false., expect_converged=.false.)
 
-  if (nfail > 0) then
-    write (*, '(i0,a)') nfail, ' check(s) failed'
-    stop 1
-  end if
+  call test_summary()
 
 contains
 
@@ -46,12 +43,7 @@ contains
     logical, intent(in) :: ok
     character(len=*), intent(in) :: what
     real(wp), intent(in) :: val, tol
-    if (ok) then
-      write (*, '(a,a,a,es10.3,a,es9.2,a)') 'PASS  ', what, ' (', val, ' <= ', tol, ')'
-    else
-      write (*, '(a,a,a,es10.3,a,es9.2,a)') 'FAIL  ', what, ' (', val, ' > ', tol, ')'
-      nfail = nfail + 1
-    end if
+    call report(ok, what, val, tol)
   end subroutine check
 
   subroutine scene(path, over, expect_partial, expect_converged, max_outer_expected)
@@ -83,17 +75,17 @@ contains
       call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d, msh, sys, itf, info, msg)
+    call build_interface(d%body, d%contact, msh, sys, itf, info, msg)
     if (info /= 0) error stop 'interface failed'
     do a = 1, 2
-      call factor_body(d, itf, a, msh(a), sys(a), bc(a), info, msg)
+      call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a), info, msg)
       if (info /= 0) error stop 'factor failed'
       call condense_body(sys(a), bc(a), info, msg)
       if (info /= 0) error stop 'condense failed'
     end do
 
-    ! ---- monolithic: KKT of METHOD.md -------------------------------------------------
-    call solve_monolithic(d, itf, bc, mono)
+    ! ---- monolithic: KKT conditions -------------------------------------------------
+    call solve_monolithic(d%solver, itf, bc, mono)
     call check(mono%status == 'converged', 'monolithic converged', 0.0_wp, 0.0_wp)
     lnorm = maxval(abs(mono%lam))
     uscale = max(maxval(abs(bc(1)%b)), maxval(abs(bc(2)%b)), maxval(abs(itf%g0)))
@@ -146,7 +138,7 @@ contains
     write (*, '(a,es14.6,a,i0,a,i0)') '      total contact force ', sum(mono%lam), ' active ', mono%active, ' of ', itf%m
 
     ! ---- Robin equals monolithic --------------------------------------------------------
-    call solve_robin(d, itf, bc, rob)
+    call solve_robin(d%solver, itf, bc, rob)
     call error_bound(itf, bc, rob)
     ! the a posteriori bound holds whatever the outcome
     e = norm2(rob%lam - mono%lam)

@@ -10,7 +10,7 @@
 program test_ordering
   use, intrinsic :: iso_fortran_env, only: int64, output_unit
   use kinds, only: wp
-  use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, &
+  use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, ORDER_METIS, ORDER_ND, &
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT
   use mesh, only: mesh_t, mesh_build, side_nodes, node_id
@@ -325,6 +325,7 @@ contains
     type(body_condensed_t) :: bc(2, 2)
     type(traction_cfg_t) :: tr(2)
     character(len=5), parameter :: ords(2) = ['metis', 'nd   ']
+    integer, parameter :: ord_codes(2) = [ORDER_METIS, ORDER_ND]
     integer :: a, o, info
     character(len=256) :: msg
     real(wp) :: dflex, db
@@ -344,13 +345,13 @@ contains
       call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d, msh, sys, itf, info, msg)
+    call build_interface(d%body, d%contact, msh, sys, itf, info, msg)
     call report(info == 0 .and. itf%m > 0, 'two-body scene: interface built '//trim(msg))
     if (info /= 0) return
     do o = 1, 2
-      d%solver%ordering = ords(o)
+      d%solver%factor%ordering = ord_codes(o)
       do a = 1, 2
-        call factor_body(d, itf, a, msh(a), sys(a), bc(a, o), info, msg)
+        call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a, o), info, msg)
         call report(info == 0 .and. bc(a, o)%chol%interface_last_ok, &
                     'factor_body ordering='''//trim(ords(o))//''', body '//achar(48 + a)//': ok, interface last '//trim(msg))
         if (info /= 0) return

@@ -1,16 +1,18 @@
 !> Interface condensation: the contact line shared by the two bodies, and for each
 !! body its factorization, normal flexibility F_a = B_a K_a^-1 B_a' and the normal
-!! interface displacement under the load alone b_a = B_a K_a^-1 f_a (METHOD.md).
+!! interface displacement under the load alone b_a = B_a K_a^-1 f_a (README, "Method as implemented").
 !! The interface DOFs are ordered last in the Cholesky factorization, so F_a comes
 !! from the trailing block of the factor at a cost of O(m^3), not m solves.
 module condense
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-  use config, only: deck_t, BC_CONTACT, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
+  use config, only: body_cfg_t, contact_cfg_t, factor_cfg_t, BC_CONTACT, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, &
+                    SIDE_TOP, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
   use mesh, only: mesh_t, side_nodes
   use assembly, only: body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: nested_dissection
+  use clock, only: wtime
   implicit none
   private
 
@@ -47,8 +49,9 @@ contains
 
   !> Find the contact line and pair the nodes of the two bodies.
   !! info /= 0 with msg when the contact sides do not match node for node.
-  subroutine build_interface(d, msh, sys, itf, info, msg)
-    type(deck_t), intent(in) :: d                    !< the deck
+  subroutine build_interface(body, cc, msh, sys, itf, info, msg)
+    type(body_cfg_t), intent(in) :: body(2)          !< the two bodies (their contact sides)
+    type(contact_cfg_t), intent(in) :: cc            !< the interface settings (initial gap)
     type(mesh_t), intent(in) :: msh(2)               !< meshes of body 1 and 2
     type(body_system_t), intent(in) :: sys(2)        !< assembled systems
     type(interface_t), intent(out) :: itf            !< the contact line
@@ -65,7 +68,7 @@ contains
     do a = 1, 2
       itf%side(a) = 0
       do k = 1, 4
-        if (d%body(a)%bc(k) == BC_CONTACT) itf%side(a) = k
+        if (body(a)%bc(k) == BC_CONTACT) itf%side(a) = k
       end do
       if (itf%side(a) == 0) then
         info = 1
@@ -87,7 +90,7 @@ contains
     else
       itf%axis = 2; c = 1
     end if
-    scale = max(d%body(1)%width, d%body(1)%height, d%body(2)%width, d%body(2)%height)
+    scale = max(body(1)%width, body(1)%height, body(2)%width, body(2)%height)
     allocate (keep(nline), sl(nline), tl(nline))
     do i = 1, nline
       x1 = msh(1)%xy(:, nodes1(i))
@@ -127,8 +130,8 @@ contains
       itf%trib(k) = tl(i)
       itf%node(k, 1) = nodes1(i)
       itf%node(k, 2) = nodes2(i)
-      if (d%gap_radius > 0.0_wp) then
-        itf%g0(k) = (sl(i) - d%gap_center)**2/(2.0_wp*d%gap_radius)
+      if (cc%gap_radius > 0.0_wp) then
+        itf%g0(k) = (sl(i) - cc%gap_center)**2/(2.0_wp*cc%gap_radius)
       else
         itf%g0(k) = 0.0_wp
       end if
@@ -166,8 +169,8 @@ contains
   !> Factorize K_a with the interface DOFs ordered last. ordering='nd' orders the
   !! other DOFs by geometric nested dissection of the body's grid (module ordering);
   !! its time is part of t_factor.
-  subroutine factor_body(d, itf, a, msh, sys, bc, info, msg)
-    type(deck_t), intent(in) :: d                    !< the deck (factorization, ordering)
+  subroutine factor_body(fc, itf, a, msh, sys, bc, info, msg)
+    type(factor_cfg_t), intent(in) :: fc             !< factorization and ordering
     type(interface_t), intent(in) :: itf             !< the contact line
     integer, intent(in) :: a                         !< body number
     type(mesh_t), intent(in) :: msh                  !< mesh of body a
@@ -181,14 +184,15 @@ contains
 
     t0 = wtime()
     call interface_dofs(itf, a, sys, bc)
-    method = FACT_CHOLMOD
-    if (d%solver%factorization == 'banded') method = FACT_BANDED
-    select case (d%solver%ordering)
-    case ('amd')
+    ! the deck's choice as the Cholesky module's method and ordering ('nd' is our own
+    ! permutation of the interior, given to CHOLMOD)
+    method = merge(FACT_BANDED, FACT_CHOLMOD, fc%factorization == FACTOR_BANDED)
+    select case (fc%ordering)
+    case (ORDER_AMD)
       iord = ORD_AMD
-    case ('natural')
+    case (ORDER_NATURAL)
       iord = ORD_NATURAL
-    case ('nd')
+    case (ORDER_ND)
       iord = ORD_GIVEN
     case default
       iord = ORD_METIS
@@ -262,10 +266,5 @@ contains
     if (info /= 0) r = ieee_value(1.0_wp, ieee_quiet_nan)
     u_free = bc%u0 - r
   end subroutine recover_displacement
-
-  real(wp) function wtime()
-    use omp_lib, only: omp_get_wtime
-    wtime = omp_get_wtime()
-  end function wtime
 
 end module condense

@@ -1,4 +1,4 @@
-!> Two-body contact on the condensed interface (METHOD.md):
+!> Two-body contact on the condensed interface (README, "Method as implemented"):
 !! `solve_robin`: the Robin domain-decomposition iteration (each body's contact
 !! problem against an obstacle by MPRGP, obstacles relaxed until the bodies agree);
 !! `solve_monolithic`: the same discrete problem in one piece, the reference.
@@ -6,8 +6,9 @@
 module contact
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use config, only: deck_t
-  use linop, only: dense_op_t, dense_op_init
+  use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC, STOP_RESIDUAL, ACCEL_AITKEN, ACCEL_ANDERSON
+  use linop, only: linop_t, dense_op_t, dense_op_init
+  use clock, only: wtime
   use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, lambda_max_estimate, &
                    MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
   use condense, only: interface_t, body_condensed_t
@@ -16,11 +17,29 @@ module contact
   implicit none
   private
 
-
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
+  !> y = alpha x ./ w: the constant Robin operator alpha M^-1 (M: tributary lengths).
+  type, extends(linop_t) :: inv_diag_op_t
+    real(wp) :: alpha = 0.0_wp               !< Robin parameter [length/stress]
+    real(wp), allocatable :: w(:)            !< (m) tributary lengths [length]
+  contains
+    procedure :: apply => inv_diag_apply
+  end type inv_diag_op_t
 
+  !> The Robin correction of the obstacles, chosen before the outer loop: body 1's obstacle
+  !! moves by S_1 d, body 2's by -S_2 d (d = lam_1 - lam_2). When S_1 and S_2 are one
+  !! operator, one product serves both.
+  type :: robin_correction_t
+    class(linop_t), pointer :: s1 => null()   !< S_1 (body 1's obstacle)
+    class(linop_t), pointer :: s2 => null()   !< S_2 (body 2's obstacle)
+    class(linop_t), pointer :: own => null()  !< the operator, when not a body's flexibility
+    integer :: cost = 0                       !< Hessian-sized products per application (IT_inner)
+  contains
+    procedure :: apply => correction_apply
+    procedure :: free => correction_free
+  end type robin_correction_t
 
   public :: solve_robin, solve_monolithic, interface_residual
   public :: error_bound
@@ -28,8 +47,8 @@ module contact
 contains
 
   !> The monolithic reference: min 1/2 lam'(F1+F2)lam - lam'(b1+b2-g0), lam >= 0.
-  subroutine solve_monolithic(d, itf, bc, res)
-    type(deck_t), intent(in) :: d                      !< deck (solver settings)
+  subroutine solve_monolithic(s, itf, bc, res)
+    type(solver_cfg_t), intent(in) :: s                !< solver settings
     type(interface_t), intent(in) :: itf               !< contact line
     type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
     type(contact_result_t), intent(out) :: res         !< solution and status
@@ -49,8 +68,8 @@ contains
     c = bc(1)%b + bc(2)%b - itf%g0
     lb = 0.0_wp
     lam = 0.0_wp
-    opts%rtol = d%solver%monolithic_rtol
-    opts%max_it = d%solver%inner_max_it
+    opts%rtol = s%monolithic_rtol
+    opts%max_it = s%inner_max_it
     if (m > 0) then
       call mprgp_solve(op, c, lb, lam, opts, st, g)
       res%inner = st%n_matvec
@@ -67,7 +86,7 @@ contains
     res%lam = lam
     do a = 1, 2
       res%lam_body(:, a) = lam
-      res%w(:, a) = bc(a)%b - matmul_sym(bc(a)%flex, lam)
+      res%w(:, a) = bc(a)%b - matmul(bc(a)%flex, lam)
       res%obstacle(:, a) = 0.0_wp
     end do
     call interface_residual(itf, bc, res)
@@ -84,38 +103,33 @@ contains
     end if
   end subroutine solve_monolithic
 
-  !> The Robin iteration of METHOD.md: each body's contact problem against its
-  !! obstacle (MPRGP, in parallel), the force imbalance d = lam_1 - lam_2, its
-  !! correction S d, and the relaxed (or accelerated) update of the obstacles.
-  !! Robin operators S: 'steklov' (the paper's: F_2 for body 1's obstacle, F_1 for
-  !! body 2's), 'constant' (alpha M^-1) and 'harmonic' (S = 2 F_1 (F_1+F_2)^-1 F_2
-  !! for both, which makes the linearised iteration independent of the contrast of
-  !! the bodies: see the README). Acceleration of the obstacle fixed point: 'none',
-  !! 'aitken' (dynamic relaxation) or 'anderson' (depth 5).
+  !> The Robin iteration (README, "Method as implemented"): each body's contact problem
+  !! against its obstacle (MPRGP, in parallel), the force imbalance d = lam_1 - lam_2, its
+  !! Robin correction S d, and the relaxed (or accelerated) update of the obstacles.
+  !! The Robin operator is chosen once, before the loop (`robin_correction_init`).
   !! With `state` the iteration resumes from a checkpoint; `ckpt%save` is called
   !! every ckpt%every iterations and when `stop_requested` turns true.
-  subroutine solve_robin(d, itf, bc, res, progress_unit, state, ckpt, stop_requested)
-    type(deck_t), intent(in) :: d                      !< deck (solver settings)
+  subroutine solve_robin(s, itf, bc, res, progress_unit, progress_lines, state, ckpt, stop_requested)
+    type(solver_cfg_t), intent(in) :: s                !< solver settings
     type(interface_t), intent(in) :: itf               !< contact line
     type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
     type(contact_result_t), intent(inout) :: res       !< solution, status and history (in: history of a restart)
     integer, intent(in), optional :: progress_unit     !< unit for progress lines (none if absent)
+    integer, intent(in), optional :: progress_lines    !< at most about this many progress lines (default 30)
     type(robin_state_t), intent(inout), optional :: state   !< in: state to resume from (state%it > 0)
     class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     type(robin_state_t) :: st_
-    type(dense_op_t) :: op(2)
-    type(mprgp_opts_t) :: opts(2)
-    type(mprgp_stats_t) :: st(2)
-    real(wp), allocatable :: Gnew(:, :), grad(:, :), rhs(:, :), lb(:), dlam(:), corr(:, :), w(:, :), S(:, :)
-    real(wp) :: delta, rtol_in, t0, denom(2), ref, lmax(2), incr, uref
-    integer :: m, a, it, every, nmv(2), maxout, nthr, it0, info
+    type(dense_op_t), target :: op(2)
+    type(robin_correction_t) :: corr_op
+    real(wp), allocatable :: Gnew(:, :), w(:, :), dlam(:), corr(:, :)
+    real(wp) :: rtol_in, t0, lmax(2), uref
+    integer :: m, it, every, maxout, info
     logical :: printed, resumed
 
     m = itf%m
     t0 = wtime()
-    nthr = body_threads()
-    maxout = d%solver%max_outer
+    maxout = s%max_outer
     resumed = .false.
     if (present(state)) resumed = state%it > 0
     if (resumed) then
@@ -127,212 +141,59 @@ contains
       call state_init(st_, m, itf%g0)
     end if
     res%method = 'robin'
-    allocate (Gnew(m, 2), grad(m, 2), rhs(m, 2), lb(m), dlam(m), corr(m, 2), w(m, 2))
-    delta = d%solver%delta
-    lb = 0.0_wp
-    ref = tiny(1.0_wp) + 1.0e-14_wp*(maxabs(bc(1)%b) + maxabs(bc(2)%b) + maxabs(itf%g0))
+    allocate (Gnew(m, 2), w(m, 2), dlam(m), corr(m, 2))
     uref = max(maxabs(bc(1)%b), maxabs(bc(2)%b), maxabs(itf%g0), tiny(1.0_wp))
 
-    ! Hessians and their largest eigenvalues, once per body (counted in IT_inner).
-    nmv = 0
-    lmax = 0.0_wp
-    !$omp parallel do num_threads(nthr) schedule(static, 1) if (m > 64)
-    do a = 1, 2
-      call dense_op_init(op(a), bc(a)%flex)
-      if (m > 0) lmax(a) = lambda_max_estimate(op(a), 30, nmv(a))
-    end do
-    !$omp end parallel do
-    if (.not. resumed) st_%inner = sum(nmv)
-    if (d%solver%robin_operator == 'harmonic' .and. m > 0) then
-      call harmonic_operator(bc(1)%flex, bc(2)%flex, S, info)
-      if (info /= 0) then
-        res%status = 'failed'
-        write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
-        return
-      end if
+    call body_operators(bc, op, lmax, st_, resumed)
+    call robin_correction_init(corr_op, s, itf, bc, op, info)
+    if (info /= 0) then
+      res%status = 'failed'
+      write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
+      return
     end if
-    every = max(1, maxout/max(1, d%output%progress_lines))
+    every = 30
+    if (present(progress_lines)) every = progress_lines
+    every = max(1, maxout/max(1, every))
     res%status = 'max_outer'
     printed = .false.
     if (present(progress_unit)) then
       if (resumed) write (progress_unit, '(a,i0)') 'resuming after outer iteration ', st_%it
       write (progress_unit, '(a)') '  outer   criterion    residual  active       inner'
     end if
-    it0 = st_%it + 1
 
-    do it = it0, maxout
-      if (d%solver%robin_operator == 'harmonic') then
-        ! the harmonic operator makes the linearised outer map nilpotent at delta = 0.5:
-        ! the outer iteration is as exact as its subproblems, so solve them tightly
-        ! (scaled by the contrast of the bodies: the stiff body's obstacle is built from
-        ! the soft body's displacement, whose error the contrast amplifies)
-        ! The floor is what rounding lets the projected gradient reach (a product with
-        ! an m x m matrix carries ~ sqrt(m) eps of relative error): asking for less
-        ! only spins MPRGP up to inner_max_it.
-        rtol_in = max(sqrt(real(max(m, 1), wp))*epsilon(1.0_wp), &
-                      d%solver%inner_factor*d%solver%tol*minval(lmax)/max(maxval(lmax), tiny(1.0_wp)))
-      else if (it == 1) then
-        rtol_in = d%solver%inner_rtol_max
-      else
-        rtol_in = min(d%solver%inner_rtol_max, max(d%solver%inner_rtol_min, d%solver%inner_factor*st_%progress))
-      end if
+    do it = st_%it + 1, maxout
       ! 1. each body against its obstacle, in parallel
-      !$omp parallel do num_threads(nthr) schedule(static, 1) if (m > 64)
-      do a = 1, 2
-        rhs(:, a) = bc(a)%b - st_%G(:, a)
-        ! The tolerance is measured against the body's own contact displacement
-        ! |F_a lam_a| (previous iterate), not against |b_a - G_a|: with a large
-        ! material contrast the stiff body's b_a - G_a is a small difference of the
-        ! soft body's large displacements, and a tolerance relative to it would leave
-        ! the stiff body's force inaccurate by the contrast ratio.
-        if (st_%flam(a) > 0.0_wp) then
-          opts(a)%rtol = 0.0_wp
-          opts(a)%atol = max(rtol_in*st_%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs(:, a)))
-        else
-          opts(a)%rtol = rtol_in
-          opts(a)%atol = 0.0_wp
-        end if
-        opts(a)%max_it = d%solver%inner_max_it
-        opts(a)%lambda_max = lmax(a)
-        if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st_%lam(:, a), opts(a), st(a), grad(:, a))
-      end do
-      !$omp end parallel do
+      rtol_in = inner_tolerance(s, it, m, st_%progress, lmax)
+      call solve_subproblems(s, bc, op, lmax, rtol_in, it, st_, w, res)
       if (m == 0) then
         res%status = 'converged'
         res%outer = it
         exit
       end if
-      do a = 1, 2
-        st_%inner = st_%inner + st(a)%n_matvec
-        if (st(a)%status == MPRGP_MAX_IT) then
-          res%inner_maxit_hits = res%inner_maxit_hits + 1
-        else if (st(a)%status /= MPRGP_CONVERGED) then
-          res%status = 'failed'
-          write (res%message, '(a,i0,a,i0,a)') 'MPRGP failed on body ', a, ' at outer iteration ', it, &
-            ': '//trim(mprgp_status_name(st(a)%status))//': '//trim(st(a)%message)
-          exit
-        end if
-        ! B_a u_a = b_a - F_a lam_a = G_a - grad_a
-        w(:, a) = st_%G(:, a) - grad(:, a)
-        st_%flam(a) = norm2(grad(:, a) + rhs(:, a))
-      end do
       if (res%status == 'failed') then
         res%outer = it
         exit
       end if
       ! 2. force imbalance and its Robin correction
       dlam = st_%lam(:, 1) - st_%lam(:, 2)
-      select case (trim(d%solver%robin_operator))
-      case ('constant')
-        corr(:, 1) = d%solver%alpha*dlam/itf%trib
-        corr(:, 2) = corr(:, 1)
-      case ('harmonic')
-        call dsymv('U', m, 1.0_wp, S, m, dlam, 1, 0.0_wp, corr(:, 1), 1)
-        corr(:, 2) = corr(:, 1)
-        st_%inner = st_%inner + 1
-      case default
-        call op(2)%apply(dlam, corr(:, 1))   ! F_2 d, for body 1's obstacle
-        call op(1)%apply(dlam, corr(:, 2))   ! F_1 d, for body 2's obstacle
-        st_%inner = st_%inner + 2
-      end select
+      call corr_op%apply(dlam, corr, st_%inner)
       ! 3. the fixed-point map T(G) and the relaxed or accelerated update
       Gnew(:, 1) = itf%g0 - w(:, 2) + corr(:, 1)
       Gnew(:, 2) = itf%g0 - w(:, 1) - corr(:, 2)
-      call accelerate(d%solver%acceleration, delta, st_, Gnew)
-
+      call accelerate(s%acceleration, s%delta, st_, Gnew)
       ! a non-finite iterate is not kept: the result holds the last finite one
       if (.not. (all_finite(Gnew) .and. all_finite(st_%lam) .and. all_finite(w))) then
         res%status = 'diverged'
         write (res%message, '(a,i0)') 'non-finite values in the outer iteration at iteration ', it
         exit
       end if
-      ! true residual of the current iterate
-      res%lam_body = st_%lam
-      res%w = w
-      call interface_residual(itf, bc, res)
-      ! increment of the obstacles (the paper's criterion) and the stopping criterion
-      do a = 1, 2
-        denom(a) = max(norm2(Gnew(:, a)), ref)
-      end do
-      incr = norm2(Gnew(:, 1) - st_%G(:, 1))/denom(1) + norm2(Gnew(:, 2) - st_%G(:, 2))/denom(2)
-      if (d%solver%stop == 'residual') then
-        st_%crit = res%residual
-      else
-        st_%crit = incr
-      end if
-      ! the inner tolerance follows the outer progress: both the increment and the
-      ! residual must shrink before the subproblems are solved tightly (a tolerance
-      ! tied to the residual alone can freeze the obstacles and stall the iteration)
-      st_%progress = min(incr, res%residual)
-      st_%G = Gnew
-      st_%it = it
-      st_%wall = wtime() - t0
-      res%obstacle = st_%G
-      res%outer = it
-      res%inner = st_%inner
-      res%criterion = st_%crit
-      res%nhist = it
-      res%h_criterion(it) = st_%crit
-      res%h_residual(it) = res%residual
-      res%h_inner(it) = st_%inner
-      res%h_active(it) = res%active
-      res%h_wall(it) = st_%wall
+      call record_iteration(s, itf, bc, it, Gnew, w, t0, st_, res)
       printed = .false.
       if (present(progress_unit) .and. (it <= 5 .or. mod(it, every) == 0)) then
         write (progress_unit, '(i7,2es12.3,i8,i12)') it, st_%crit, res%residual, res%active, st_%inner
         printed = .true.
       end if
-      if (.not. ieee_is_finite(st_%crit)) then
-        res%status = 'diverged'
-        write (res%message, '(a,i0)') 'non-finite criterion at iteration ', it
-        exit
-      end if
-      st_%best = min(st_%best, st_%crit)
-      if (it > 10 .and. st_%crit > 1.0e4_wp*st_%best .and. st_%crit > 1.0_wp) then
-        res%status = 'diverged'
-        write (res%message, '(a,es10.3,a,es10.3)') 'criterion grew to ', st_%crit, ' from its best ', st_%best
-        exit
-      end if
-      ! a relative increment stays bounded while the iterates blow up geometrically:
-      ! watch the size of the obstacles against the displacements the loads cause
-      if (maxval(abs(st_%G)) > 1.0e6_wp*uref) then
-        res%status = 'diverged'
-        write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(st_%G)), &
-          ' (1e6 times the load displacement scale ', uref, ')'
-        exit
-      end if
-      ! the residual stop: a residual that has not improved by 1% in FLAT_LIMIT iterations
-      ! has reached the floor that rounding and conditioning allow; tol is out of reach
-      if (res%residual < 0.99_wp*st_%res_best) then
-        st_%res_best = res%residual
-        st_%it_best = it
-      end if
-      if (d%solver%stop == 'residual' .and. st_%crit > d%solver%tol .and. it - st_%it_best >= FLAT_LIMIT) then
-        res%status = 'diverged'
-        write (res%message, '(a,es10.3,a,i0,a,es10.3,a)') 'stagnated: the residual has stayed near ', &
-          st_%res_best, ' for ', FLAT_LIMIT, ' iterations; tol = ', d%solver%tol, ' is out of reach'
-        exit
-      end if
-      if (st_%crit <= d%solver%tol) then
-        if (d%solver%stop /= 'residual' .and. res%residual > 1.0e2_wp*d%solver%tol) then
-          ! the obstacles stopped moving but the bodies do not agree yet: a small
-          ! increment is not a small error. Go on (the inner tolerance follows the
-          ! smaller increment); if it persists, the iteration has stagnated.
-          st_%stalled = st_%stalled + 1
-          if (st_%stalled >= STALL_LIMIT) then
-            res%status = 'diverged'
-            write (res%message, '(a,es10.3,a,es10.3,a,i0,a)') 'stagnated: increment ', st_%crit, &
-              ' below tol but residual ', res%residual, ' above 100 tol for ', STALL_LIMIT, &
-              ' iterations (the bodies do not agree)'
-            exit
-          end if
-        else
-          res%status = 'converged'
-          exit
-        end if
-      else
-        st_%stalled = 0
-      end if
+      if (check_termination(s, it, uref, st_, res)) exit
       if (present(stop_requested)) then
         if (stop_requested()) then
           res%status = 'interrupted'
@@ -351,8 +212,294 @@ contains
       write (progress_unit, '(i7,2es12.3,i8,i12)') res%outer, res%criterion, res%residual, res%active, res%inner
     if (res%status == 'max_outer') write (res%message, '(a,i0,a,es10.3)') 'max_outer = ', maxout, &
       ' reached; last criterion ', res%criterion
+    call corr_op%free()
     if (present(state)) state = st_
   end subroutine solve_robin
+
+  !> Each body's Hessian F_a as an operator and its largest eigenvalue (power iterations,
+  !! counted in IT_inner unless the run resumes).
+  subroutine body_operators(bc, op, lmax, st, resumed)
+    type(body_condensed_t), intent(in) :: bc(2)
+    type(dense_op_t), intent(out) :: op(2)
+    real(wp), intent(out) :: lmax(2)
+    type(robin_state_t), intent(inout) :: st
+    logical, intent(in) :: resumed
+    integer :: a, nmv(2), m
+    m = bc(1)%m
+    nmv = 0
+    lmax = 0.0_wp
+    !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
+    do a = 1, 2
+      call dense_op_init(op(a), bc(a)%flex)
+      if (m > 0) lmax(a) = lambda_max_estimate(op(a), 30, nmv(a))
+    end do
+    !$omp end parallel do
+    if (.not. resumed) st%inner = sum(nmv)
+  end subroutine body_operators
+
+  !> The Robin correction S_a of the obstacles: 'steklov' (the paper's: F_2 for body 1's
+  !! obstacle, F_1 for body 2's, the bodies' own operators), 'constant' (alpha M^-1, a
+  !! diagonal operator) and 'harmonic' (S = 2 F_1 (F_1+F_2)^-1 F_2 for both, a dense
+  !! operator, which makes the linearised iteration independent of the contrast of the
+  !! bodies: see the README). info /= 0 if F_1 + F_2 is not positive definite.
+  subroutine robin_correction_init(c, s, itf, bc, op, info)
+    type(robin_correction_t), intent(out) :: c
+    type(solver_cfg_t), intent(in) :: s
+    type(interface_t), intent(in) :: itf
+    type(body_condensed_t), intent(in) :: bc(2)
+    type(dense_op_t), target, intent(in) :: op(2)
+    integer, intent(out) :: info
+    real(wp), allocatable :: S_h(:, :)
+    info = 0
+    select case (s%robin_operator)
+    case (ROBIN_CONSTANT)
+      allocate (inv_diag_op_t :: c%own)
+      select type (o => c%own)
+      type is (inv_diag_op_t)
+        o%n = itf%m
+        o%alpha = s%alpha
+        o%w = itf%trib
+      end select
+      c%s1 => c%own
+      c%s2 => c%own
+      c%cost = 0
+    case (ROBIN_HARMONIC)
+      allocate (dense_op_t :: c%own)
+      if (itf%m > 0) then
+        call harmonic_operator(bc(1)%flex, bc(2)%flex, S_h, info)
+        if (info /= 0) return
+        select type (o => c%own)
+        type is (dense_op_t)
+          call dense_op_init(o, S_h)
+        end select
+      end if
+      c%s1 => c%own
+      c%s2 => c%own
+      c%cost = 1
+    case default
+      c%s1 => op(2)
+      c%s2 => op(1)
+      c%cost = 2
+    end select
+  end subroutine robin_correction_init
+
+  !> corr(:, 1) = S_1 d (body 1's obstacle), corr(:, 2) = S_2 d (body 2's); `count` grows
+  !! by the Hessian-sized products it took.
+  subroutine correction_apply(self, d, corr, count)
+    class(robin_correction_t), intent(inout) :: self
+    real(wp), intent(in) :: d(:)
+    real(wp), intent(out) :: corr(:, :)
+    integer, intent(inout) :: count
+    call self%s1%apply(d, corr(:, 1))
+    if (associated(self%s2, self%s1)) then
+      corr(:, 2) = corr(:, 1)
+    else
+      call self%s2%apply(d, corr(:, 2))
+    end if
+    count = count + self%cost
+  end subroutine correction_apply
+
+  !> Release an operator owned by the correction.
+  subroutine correction_free(self)
+    class(robin_correction_t), intent(inout) :: self
+    nullify (self%s1, self%s2)
+    if (associated(self%own)) deallocate (self%own)
+  end subroutine correction_free
+
+  !> y = alpha x ./ w (the constant Robin operator alpha M^-1, M the tributary lengths).
+  subroutine inv_diag_apply(self, x, y)
+    class(inv_diag_op_t), intent(inout) :: self
+    real(wp), intent(in) :: x(:)
+    real(wp), intent(out) :: y(:)
+    y = self%alpha*x/self%w
+  end subroutine inv_diag_apply
+
+  !> The inner tolerance of outer iteration `it`. The harmonic operator makes the
+  !! linearised outer map nilpotent at delta = 0.5: the outer iteration is as exact as its
+  !! subproblems, so they are solved tightly (scaled by the contrast of the bodies: the
+  !! stiff body's obstacle is built from the soft body's displacement, whose error the
+  !! contrast amplifies), down to what rounding lets the projected gradient reach (a
+  !! product with an m x m matrix carries ~ sqrt(m) eps of relative error: asking for less
+  !! only spins MPRGP up to inner_max_it). The other operators follow the outer progress,
+  !! min(increment, residual) of the previous iteration, times inner_factor, clamped.
+  real(wp) function inner_tolerance(s, it, m, progress, lmax) result(rtol_in)
+    type(solver_cfg_t), intent(in) :: s
+    integer, intent(in) :: it, m
+    real(wp), intent(in) :: progress, lmax(2)
+    if (s%robin_operator == ROBIN_HARMONIC) then
+      rtol_in = max(sqrt(real(max(m, 1), wp))*epsilon(1.0_wp), &
+                    s%inner_factor*s%tol*minval(lmax)/max(maxval(lmax), tiny(1.0_wp)))
+    else if (it == 1) then
+      rtol_in = s%inner_rtol_max
+    else
+      rtol_in = min(s%inner_rtol_max, max(s%inner_rtol_min, s%inner_factor*progress))
+    end if
+  end function inner_tolerance
+
+  !> Step 1: each body's contact problem against its obstacle (MPRGP, one thread per
+  !! body), warm-started from the last contact forces. On return st%lam holds the forces,
+  !! w(:, a) = B_a u_a, and res%status is 'failed' if an inner solve broke down.
+  subroutine solve_subproblems(s, bc, op, lmax, rtol_in, it, st, w, res)
+    type(solver_cfg_t), intent(in) :: s
+    type(body_condensed_t), intent(in) :: bc(2)
+    type(dense_op_t), intent(inout) :: op(2)
+    real(wp), intent(in) :: lmax(2), rtol_in
+    integer, intent(in) :: it
+    type(robin_state_t), intent(inout) :: st
+    real(wp), intent(out) :: w(:, :)
+    type(contact_result_t), intent(inout) :: res
+    type(mprgp_opts_t) :: opts(2)
+    type(mprgp_stats_t) :: ms(2)
+    real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:)
+    integer :: a, m
+    m = size(w, 1)
+    allocate (rhs(m, 2), grad(m, 2), lb(m))
+    lb = 0.0_wp
+    !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
+    do a = 1, 2
+      rhs(:, a) = bc(a)%b - st%G(:, a)
+      ! The tolerance is measured against the body's own contact displacement
+      ! |F_a lam_a| (previous iterate), not against |b_a - G_a|: with a large
+      ! material contrast the stiff body's b_a - G_a is a small difference of the
+      ! soft body's large displacements, and a tolerance relative to it would leave
+      ! the stiff body's force inaccurate by the contrast ratio.
+      if (st%flam(a) > 0.0_wp) then
+        opts(a)%rtol = 0.0_wp
+        opts(a)%atol = max(rtol_in*st%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs(:, a)))
+      else
+        opts(a)%rtol = rtol_in
+        opts(a)%atol = 0.0_wp
+      end if
+      opts(a)%max_it = s%inner_max_it
+      opts(a)%lambda_max = lmax(a)
+      if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a))
+    end do
+    !$omp end parallel do
+    if (m == 0) return
+    do a = 1, 2
+      st%inner = st%inner + ms(a)%n_matvec
+      if (ms(a)%status == MPRGP_MAX_IT) then
+        res%inner_maxit_hits = res%inner_maxit_hits + 1
+      else if (ms(a)%status /= MPRGP_CONVERGED) then
+        res%status = 'failed'
+        write (res%message, '(a,i0,a,i0,a)') 'MPRGP failed on body ', a, ' at outer iteration ', it, &
+          ': '//trim(mprgp_status_name(ms(a)%status))//': '//trim(ms(a)%message)
+        return
+      end if
+      ! B_a u_a = b_a - F_a lam_a = G_a - grad_a
+      w(:, a) = st%G(:, a) - grad(:, a)
+      st%flam(a) = norm2(grad(:, a) + rhs(:, a))
+    end do
+  end subroutine solve_subproblems
+
+  !> The true residual of the iterate, the increment of the obstacles (the paper's
+  !! criterion), the stopping criterion, the new state and one history entry.
+  subroutine record_iteration(s, itf, bc, it, Gnew, w, t0, st, res)
+    type(solver_cfg_t), intent(in) :: s
+    type(interface_t), intent(in) :: itf
+    type(body_condensed_t), intent(in) :: bc(2)
+    integer, intent(in) :: it
+    real(wp), intent(in) :: Gnew(:, :), w(:, :), t0
+    type(robin_state_t), intent(inout) :: st
+    type(contact_result_t), intent(inout) :: res
+    real(wp) :: denom(2), ref, incr
+    integer :: a
+    res%lam_body = st%lam
+    res%w = w
+    call interface_residual(itf, bc, res)
+    ref = tiny(1.0_wp) + 1.0e-14_wp*(maxabs(bc(1)%b) + maxabs(bc(2)%b) + maxabs(itf%g0))
+    do a = 1, 2
+      denom(a) = max(norm2(Gnew(:, a)), ref)
+    end do
+    incr = norm2(Gnew(:, 1) - st%G(:, 1))/denom(1) + norm2(Gnew(:, 2) - st%G(:, 2))/denom(2)
+    if (s%stop == STOP_RESIDUAL) then
+      st%crit = res%residual
+    else
+      st%crit = incr
+    end if
+    ! the inner tolerance follows the outer progress: both the increment and the
+    ! residual must shrink before the subproblems are solved tightly (a tolerance
+    ! tied to the residual alone can freeze the obstacles and stall the iteration)
+    st%progress = min(incr, res%residual)
+    st%G = Gnew
+    st%it = it
+    st%wall = wtime() - t0
+    res%obstacle = st%G
+    res%outer = it
+    res%inner = st%inner
+    res%criterion = st%crit
+    res%nhist = it
+    res%h_criterion(it) = st%crit
+    res%h_residual(it) = res%residual
+    res%h_inner(it) = st%inner
+    res%h_active(it) = res%active
+    res%h_wall(it) = st%wall
+  end subroutine record_iteration
+
+  !> True when the iteration ends after iteration `it`: converged, or diverged (a
+  !! non-finite or exploding criterion, obstacles beyond 1e6 times the load displacement
+  !! scale `uref`, a residual stop that stagnates, a small increment with a large residual
+  !! for too long). Sets res%status and res%message.
+  logical function check_termination(s, it, uref, st, res) result(done)
+    type(solver_cfg_t), intent(in) :: s
+    integer, intent(in) :: it
+    real(wp), intent(in) :: uref
+    type(robin_state_t), intent(inout) :: st
+    type(contact_result_t), intent(inout) :: res
+    done = .true.
+    if (.not. ieee_is_finite(st%crit)) then
+      res%status = 'diverged'
+      write (res%message, '(a,i0)') 'non-finite criterion at iteration ', it
+      return
+    end if
+    st%best = min(st%best, st%crit)
+    if (it > 10 .and. st%crit > 1.0e4_wp*st%best .and. st%crit > 1.0_wp) then
+      res%status = 'diverged'
+      write (res%message, '(a,es10.3,a,es10.3)') 'criterion grew to ', st%crit, ' from its best ', st%best
+      return
+    end if
+    ! a relative increment stays bounded while the iterates blow up geometrically:
+    ! watch the size of the obstacles against the displacements the loads cause
+    if (maxval(abs(st%G)) > 1.0e6_wp*uref) then
+      res%status = 'diverged'
+      write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(st%G)), &
+        ' (1e6 times the load displacement scale ', uref, ')'
+      return
+    end if
+    ! the residual stop: a residual that has not improved by 1% in FLAT_LIMIT iterations
+    ! has reached the floor that rounding and conditioning allow; tol is out of reach
+    if (res%residual < 0.99_wp*st%res_best) then
+      st%res_best = res%residual
+      st%it_best = it
+    end if
+    if (s%stop == STOP_RESIDUAL .and. st%crit > s%tol .and. it - st%it_best >= FLAT_LIMIT) then
+      res%status = 'diverged'
+      write (res%message, '(a,es10.3,a,i0,a,es10.3,a)') 'stagnated: the residual has stayed near ', &
+        st%res_best, ' for ', FLAT_LIMIT, ' iterations; tol = ', s%tol, ' is out of reach'
+      return
+    end if
+    if (st%crit <= s%tol) then
+      if (s%stop /= STOP_RESIDUAL .and. res%residual > 1.0e2_wp*s%tol) then
+        ! the obstacles stopped moving but the bodies do not agree yet: a small
+        ! increment is not a small error. Go on (the inner tolerance follows the
+        ! smaller increment); if it persists, the iteration has stagnated.
+        st%stalled = st%stalled + 1
+        if (st%stalled >= STALL_LIMIT) then
+          res%status = 'diverged'
+          write (res%message, '(a,es10.3,a,es10.3,a,i0,a)') 'stagnated: increment ', st%crit, &
+            ' below tol but residual ', res%residual, ' above 100 tol for ', STALL_LIMIT, &
+            ' iterations (the bodies do not agree)'
+          return
+        end if
+      else
+        res%status = 'converged'
+        return
+      end if
+    else
+      st%stalled = 0
+    end if
+    done = .false.
+  end function check_termination
 
   !> A posteriori bound of the error of res%lam against the monolithic solution lam*
   !! of the same discrete problem: for the strongly convex QP min 1/2 l'Hl - c'l, l >= 0
@@ -428,7 +575,7 @@ contains
   !> Relaxed or accelerated fixed-point update: on entry Gnew = T(G), on exit the
   !! next obstacles. The residual of the fixed point is r = T(G) - G.
   subroutine accelerate(kind, delta, st, Gnew)
-    character(len=*), intent(in) :: kind
+    integer, intent(in) :: kind                  !< ACCEL_*
     real(wp), intent(in) :: delta
     type(robin_state_t), intent(inout) :: st
     real(wp), intent(inout) :: Gnew(:, :)
@@ -439,8 +586,8 @@ contains
     allocate (x(n2), r(n2))
     x = reshape(st%G, [n2])
     r = reshape(Gnew, [n2]) - x
-    select case (trim(kind))
-    case ('aitken')
+    select case (kind)
+    case (ACCEL_AITKEN)
       ! Irons-Tuck dynamic relaxation: omega_k = -omega_{k-1} r_{k-1}'(r_k - r_{k-1}) / |r_k - r_{k-1}|^2
       if (st%nacc == 0) then
         st%omega = delta
@@ -458,7 +605,7 @@ contains
       st%r_prev = r
       st%nacc = st%nacc + 1
       x = x + st%omega*r
-    case ('anderson')
+    case (ACCEL_ANDERSON)
       ! Anderson mixing of depth ANDERSON_DEPTH with mixing parameter delta:
       ! x+ = x + delta r - (dX + delta dR) gamma, gamma = argmin |r - dR gamma|
       if (st%nacc > 0) then
@@ -549,12 +696,6 @@ contains
   end subroutine interface_residual
 
 
-  function matmul_sym(a, x) result(y)
-    real(wp), intent(in) :: a(:, :), x(:)
-    real(wp) :: y(size(x))
-    y = matmul(a, x)
-  end function matmul_sym
-
   real(wp) function maxabs(x)
     real(wp), intent(in) :: x(:)
     maxabs = 0.0_wp
@@ -572,11 +713,6 @@ contains
       all_finite = .false.
     end select
   end function all_finite
-
-  real(wp) function wtime()
-    use omp_lib, only: omp_get_wtime
-    wtime = omp_get_wtime()
-  end function wtime
 
   !> Threads for the two bodies: min(2, OMP max threads).
   integer function body_threads()

@@ -1,9 +1,13 @@
 !> The data model of an input deck: scene, bodies, loads, contact, solver and output
 !! settings, with their defaults. `deck` fills it from namelists; every later stage
 !! (mesh, assembly, solvers, output) reads it and never writes it.
+!!
+!! Every enumeration of the deck is decoded here, once, into a named integer constant; its
+!! spellings are one blank-separated list (`*_CHOICES`, in code order), used by the deck
+!! reader to accept and by every writer to print it (`strings%word(list, code)`).
 module config
   use kinds, only: wp
-  implicit none
+  implicit none (type, external)
   private
 
   integer, parameter, public :: SIDE_LEFT = 1    !< x = x0
@@ -23,6 +27,39 @@ module config
   integer, parameter, public :: ELEM_Q1 = 1  !< bilinear quadrilateral, 2x2 Gauss
   integer, parameter, public :: ELEM_P1 = 2  !< linear triangle, each cell split in two
   character(len=2), parameter, public :: element_names(2) = ['Q1', 'P1']
+
+  integer, parameter, public :: METHOD_ROBIN = 1        !< Robin domain decomposition
+  integer, parameter, public :: METHOD_MONOLITHIC = 2   !< the monolithic reference
+  character(len=*), parameter, public :: METHOD_CHOICES = 'robin monolithic'
+
+  integer, parameter, public :: ROBIN_STEKLOV = 1    !< the paper's operator: the other body's flexibility
+  integer, parameter, public :: ROBIN_CONSTANT = 2   !< alpha M^-1 (constant Robin parameter)
+  integer, parameter, public :: ROBIN_HARMONIC = 3   !< 2 F_1 (F_1+F_2)^-1 F_2, contrast-robust
+  character(len=*), parameter, public :: ROBIN_CHOICES = 'steklov constant harmonic'
+
+  integer, parameter, public :: STOP_INCREMENT = 1   !< the paper's relative increment of the obstacles
+  integer, parameter, public :: STOP_RESIDUAL = 2    !< the true residual of the iterate
+  character(len=*), parameter, public :: STOP_CHOICES = 'increment residual'
+
+  integer, parameter, public :: FACTOR_CHOLMOD = 1   !< sparse Cholesky (SuiteSparse CHOLMOD)
+  integer, parameter, public :: FACTOR_BANDED = 2    !< banded Cholesky (RCM + LAPACK dpbtrf)
+  character(len=*), parameter, public :: FACTOR_CHOICES = 'cholmod banded'
+
+  integer, parameter, public :: ORDER_METIS = 1      !< CHOLMOD with METIS nested dissection
+  integer, parameter, public :: ORDER_AMD = 2        !< CHOLMOD with AMD
+  integer, parameter, public :: ORDER_NATURAL = 3    !< CHOLMOD in the natural order
+  integer, parameter, public :: ORDER_ND = 4         !< our geometric nested dissection
+  character(len=*), parameter, public :: ORDER_CHOICES = 'metis amd natural nd'
+
+  integer, parameter, public :: ACCEL_NONE = 1       !< plain relaxation
+  integer, parameter, public :: ACCEL_AITKEN = 2     !< Aitken (Irons-Tuck) dynamic relaxation
+  integer, parameter, public :: ACCEL_ANDERSON = 3   !< Anderson mixing
+  character(len=*), parameter, public :: ACCEL_CHOICES = 'none aitken anderson'
+
+  character(len=*), parameter, public :: SIDE_CHOICES = 'left right bottom top'       !< SIDE_* order
+  character(len=*), parameter, public :: BC_CHOICES = 'free clamped roller contact displacement'  !< BC_* order, from 0
+  character(len=*), parameter, public :: ELEMENT_CHOICES = 'Q1 P1'                    !< ELEM_* order
+  character(len=*), parameter, public :: PLANE_CHOICES = 'strain stress'
 
   !> One elastic body: a rectangle meshed by nx x ny cells.
   type, public :: body_cfg_t
@@ -49,18 +86,29 @@ module config
     real(wp) :: t1(2) = 0.0_wp        !< [stress/length]
   end type traction_cfg_t
 
-  !> Outer and inner solver settings.
+  !> How each body's stiffness is factorized (what the condensation stage needs).
+  type, public :: factor_cfg_t
+    integer :: factorization = FACTOR_CHOLMOD         !< FACTOR_*
+    integer :: ordering = ORDER_METIS                 !< ORDER_* (cholmod only)
+  end type factor_cfg_t
+
+  !> The contact interface: an initial gap on top of the geometry's.
+  type, public :: contact_cfg_t
+    real(wp) :: gap_radius = 0.0_wp                   !< R of the parabolic initial gap, 0: none [length]
+    real(wp) :: gap_center = 0.0_wp                   !< xc of the parabolic gap [length]
+  end type contact_cfg_t
+
+  !> Outer and inner solver settings (what the contact stage needs, and the factorization).
   type, public :: solver_cfg_t
-    character(len=16) :: method = 'robin'             !< 'robin' | 'monolithic'
-    character(len=16) :: robin_operator = 'steklov'   !< 'steklov' | 'constant'
+    integer :: method = METHOD_ROBIN                  !< METHOD_*
+    integer :: robin_operator = ROBIN_STEKLOV         !< ROBIN_*
     real(wp) :: alpha = 0.0_wp                        !< constant Robin parameter [length/stress]
     real(wp) :: delta = 0.95_wp                       !< relaxation, 0 < delta <= 1
     real(wp) :: tol = 1.0e-8_wp                       !< outer tolerance
-    character(len=16) :: stop = 'increment'           !< 'increment' | 'residual'
+    integer :: stop = STOP_INCREMENT                  !< STOP_*
     integer :: max_outer = 800                        !< outer iteration limit
-    character(len=16) :: factorization = 'cholmod'    !< 'cholmod' | 'banded'
-    character(len=16) :: ordering = 'metis'           !< 'metis' | 'amd' | 'natural' | 'nd' (cholmod only)
-    character(len=16) :: acceleration = 'none'        !< outer acceleration: 'none' | 'aitken' | 'anderson'
+    type(factor_cfg_t) :: factor                      !< factorization and ordering
+    integer :: acceleration = ACCEL_NONE              !< ACCEL_*
     real(wp) :: inner_factor = 1.0e-3_wp              !< inner rtol = inner_factor * outer progress (clamped)
     real(wp) :: inner_rtol_min = 1.0e-12_wp           !< floor of the adaptive inner tolerance
     real(wp) :: inner_rtol_max = 1.0e-2_wp            !< ceiling of the adaptive inner tolerance
@@ -83,8 +131,7 @@ module config
     type(body_cfg_t) :: body(2)                       !< indexed by id
     integer :: ntraction = 0                          !< number of tractions in use
     type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)
-    real(wp) :: gap_radius = 0.0_wp                   !< R of the parabolic initial gap, 0: none [length]
-    real(wp) :: gap_center = 0.0_wp                   !< xc of the parabolic gap [length]
+    type(contact_cfg_t) :: contact                    !< the contact interface (&contact)
     type(solver_cfg_t) :: solver
     type(output_cfg_t) :: output
     character(len=:), allocatable :: effective        !< effective deck as namelist text
