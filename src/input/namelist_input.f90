@@ -241,8 +241,8 @@ contains
           action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) call fatal(EXIT_INPUT, 'cannot open the deck file '''//path//''': '//trim(msg))
     inquire (unit=u, size=n)
-    if (n < 0) then
-      ! a stream has no size: read it record by record
+    if (n <= 0) then
+      ! a stream (pipe) has no size (-1, or 0 for some): read it record by record
       close (u)
       call read_stream(path, text)
     else
