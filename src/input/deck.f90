@@ -54,6 +54,7 @@ module deck
     type(str_t) :: body_at(2)                   ! 'line N' or 'command-line override k'
     type(str_t), allocatable :: trac_at(:)      ! per traction
     integer :: disp_line(4, 2) = 0              ! deck line of the &displacement per side, body
+    logical :: disp_given(4, 2) = .false.       ! a &displacement gives the side's vector
     integer :: once_line(7) = 0                 ! deck line of each singleton group
   end type state_t
 
@@ -414,6 +415,7 @@ contains
       '); the two bodies must have ids 1 and 2')
     fresh%id = id
     call apply_body(g, src, fresh, d%body(id))
+    st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
     st%nbody = st%nbody + 1
     st%body_line(id) = g%line
     st%body_at(id)%s = '&body at line '//i2s(g%line)
@@ -436,6 +438,7 @@ contains
       'is not a body id: the two bodies have ids 1 and 2')
     copy = d%body(id)
     call apply_body(g, src, copy, d%body(id))
+    st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
     st%body_at(id)%s = st%body_at(id)%s//', changed by '//src%label
   end subroutine override_body
 
@@ -523,6 +526,10 @@ contains
     if (d%body(body)%bc(s) == BC_CONTACT) call bad_value(g, src, 'side', "'"//side//"'", &
       'is the contact side of body '//i2s(body)//'; a contact side cannot have a '// &
       'prescribed displacement')
+    if (d%body(body)%bc(s) == BC_CLAMPED .or. d%body(body)%bc(s) == BC_ROLLER) call bad_value(g, src, &
+      'side', "'"//side//"'", 'is '''//trim(bc_names(d%body(body)%bc(s)))//''' on body '//i2s(body)// &
+      '; a side is either '''//trim(bc_names(d%body(body)%bc(s)))//''' or has a prescribed '// &
+      'displacement: declare it '//side//'=''displacement'' (or ''free'') in its &body')
     if (src%is_file) then
       if (st%disp_line(s, body) > 0) call die_at(src, g%line, 'in group &displacement: side '''// &
         side//''' of body '//i2s(body)//' already has a prescribed displacement (line '// &
@@ -531,6 +538,7 @@ contains
     end if
     d%body(body)%bc(s) = BC_DISPLACEMENT
     d%body(body)%u_side(:, s) = t%u
+    st%disp_given(s, body) = .true.
   end subroutine apply_displacement
 
   !> Check the body= and side= of a &traction or &displacement.
@@ -639,6 +647,15 @@ contains
           'on one horizontal (top/bottom) and one vertical (left/right) side; the contact '// &
           'side does not count')
       end associate
+    end do
+
+    do b = 1, 2
+      do s = 1, 4
+        if (d%body(b)%bc(s) == BC_DISPLACEMENT .and. .not. st%disp_given(s, b)) call fatal(EXIT_INPUT, &
+          p//'body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '//trim(side_names(s))//' side '// &
+          '''displacement'' but no &displacement group gives that displacement; add &displacement '// &
+          'body='//i2s(b)//', side='''//trim(side_names(s))//''', u=ux, uy /')
+      end do
     end do
 
     do i = 1, d%ntraction
