@@ -174,23 +174,33 @@ program robin_contact
 
 contains
 
+  !> The closing lines. A summary that cannot be written (standard output on a full disk or
+  !! a closed pipe) is a failure: scripts read the result: line.
   subroutine summary()
     real(wp) :: ftot
+    integer :: ios(6)
+    ios = 0
     ftot = 0.0_wp
     if (itf%m > 0) ftot = sum(res%lam)
-    write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
+    write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)', iostat=ios(1)) 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
-    write (output_unit, '(a)') 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
+    write (output_unit, '(a)', iostat=ios(2)) 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
       ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
-    if (code /= EXIT_NUMERICAL) write (output_unit, '(a)') 'output: '//trim(d%output%file)
-    write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
+    if (code /= EXIT_NUMERICAL) write (output_unit, '(a)', iostat=ios(3)) 'output: '//trim(d%output%file)
+    write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)', iostat=ios(4)) 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
       ' peak_mb=', tm%peak_rss_mb, ' factor_mb=', tm%factor_mb
-    write (output_unit, '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', trim(res%status), &
+    write (output_unit, '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)', iostat=ios(5)) 'result: status=', trim(res%status), &
       ' method=', trim(res%method), ' outer=', res%outer, ' inner=', res%inner, ' n1=', sys(1)%n, &
       ' n2=', sys(2)%n, ' m=', itf%m, ' delta=', fmt_real(d%solver%delta, '(f0.6)'), ' residual=', res%residual, &
       ' wall_s=', fmt_real(tm%total, '(f0.3)')
+    flush (output_unit, iostat=ios(6))
+    if (any(ios /= 0)) then
+      write (error_unit, '(a)') 'robin_contact: error: cannot write the summary to standard output '// &
+        '(full disk or closed pipe?); the run''s status was '//trim(res%status)
+      code = EXIT_NUMERICAL
+    end if
   end subroutine summary
 
   !> The effective deck without the settings that may change between a run and its
