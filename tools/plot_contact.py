@@ -32,7 +32,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from rc_common import hertz_pressure, hertz_zone, num_attr, run_label, save_figure, \
+from rc_common import finish_plot, hertz_pressure, hertz_zone, num_attr, run_label, \
     text_attr, text_dataset  # noqa: E402
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)"
@@ -176,14 +176,10 @@ def main(argv=None):
                   f"E*={h['Es']:.6g}{' (plane stress)' if h['pstress'] else ''} a={h['a']:.6g} "
                   f"p0={h['p0']:.6g} (R, xc from {h['src']})")
     ax.axhline(0.0, color="0.5", lw=0.6)
-    ax.set_xlabel("x along the contact line")
-    ax.set_ylabel("normal contact pressure")
-    ax.set_title(a.title or "contact pressure" + (" and Hertz line contact" if seen else ""))
     ax.grid(True, alpha=0.4)
-    ax.legend(fontsize=7, loc="best")
-    save_figure(fig, a.output)
-    print(f"plot_contact: wrote {a.output} ({len(runs)} runs, {len(seen)} Hertz curves)")
-    return 0
+    return finish_plot(fig, ax, a.output, "plot_contact", f"{len(runs)} runs, {len(seen)} Hertz curves",
+                       "x along the contact line", "normal contact pressure",
+                       a.title or "contact pressure" + (" and Hertz line contact" if seen else ""))
 
 
 if __name__ == "__main__":

@@ -22,7 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from rc_common import num_attr, run_label, save_figure, text_attr  # noqa: E402
+from rc_common import finish_plot, num_attr, run_label, text_attr  # noqa: E402
 
 
 def positive(v):
@@ -65,15 +65,11 @@ def main(argv=None):
                         label=label + ": residual")
         drawn += 1
     ax.set_yscale("log")
-    ax.set_xlabel("outer iteration")
-    ax.set_ylabel("criterion (solid), residual (dashed)")
-    ax.set_title(a.title or "robin_contact convergence history")
     ax.grid(True, which="major", alpha=0.4)
     ax.grid(True, which="minor", alpha=0.15)
-    ax.legend(fontsize=7, loc="best")
-    save_figure(fig, a.output)
-    print(f"plot_history: wrote {a.output} ({drawn} of {len(a.files)} runs with history)")
-    return 0
+    return finish_plot(fig, ax, a.output, "plot_history", f"{drawn} of {len(a.files)} runs with history",
+                       "outer iteration", "criterion (solid), residual (dashed)",
+                       a.title or "robin_contact convergence history")
 
 
 if __name__ == "__main__":

@@ -29,7 +29,7 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 import matplotlib.tri as mtri  # noqa: E402
 
-from rc_common import save_figure, text_attr  # noqa: E402
+from rc_common import finish_plot, text_attr  # noqa: E402
 
 
 def read_body(g):
@@ -144,15 +144,10 @@ def main(argv=None):
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.04)
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
     name = os.path.basename(a.file)
     first = a.title or f"{name}: {method}, {status}, {bodies[0]['element']}/{bodies[1]['element']}"
-    ax.set_title(f"{first}\ndeformed shape, displacement magnified ×{S:g} ({how})", fontsize=10)
-    ax.legend(fontsize=7, loc="best")
-    save_figure(fig, a.output)
-    print(f"plot_solution: wrote {a.output} (magnification {S:g})")
-    return 0
+    return finish_plot(fig, ax, a.output, "plot_solution", f"magnification {S:g}", "x", "y",
+                       f"{first}\ndeformed shape, displacement magnified ×{S:g} ({how})", fontsize=10)
 
 
 if __name__ == "__main__":

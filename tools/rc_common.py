@@ -7,7 +7,7 @@ The program's console output ends with key=value lines (see README, "Output"):
 This module parses them (result_fields, time_fields, line_fields, contact_force), runs
 the program (solver_env, run_solver), reads result files (text_attr, num_attr,
 text_dataset, read_lam), computes shared quantities (rel_err, hertz_zone, hertz_pressure),
-labels and saves figures (run_label, save_figure), prints Markdown tables (md_header,
+labels and saves figures (run_label, save_figure, finish_plot), prints Markdown tables (md_header,
 md_row) and counts the PASS/FAIL lines of the tests (Checks).
 
 Tools in tools/ import it directly (`import rc_common`: a script's own folder is on
@@ -165,6 +165,19 @@ def save_figure(fig, path, dpi=None):
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
+
+
+def finish_plot(fig, ax, path, tool, note, xlabel, ylabel, title, **title_kw):
+    """The tail of the one-axes plot tools: axis labels, title (title_kw: e.g. fontsize),
+    legend, save_figure(fig, path), and the line '<tool>: wrote <path> (<note>)'.
+    Returns 0, the tool's exit status."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, **title_kw)
+    ax.legend(fontsize=7, loc="best")
+    save_figure(fig, path)
+    print(f"{tool}: wrote {path} ({note})")
+    return 0
 
 
 # ---- tables ---------------------------------------------------------------------------------
