@@ -5,53 +5,41 @@ converged (exit 2, file flagged), one and two OpenMP threads bitwise identical, 
 Table 1 regression (outer/inner counts against tests/table1_reference.txt, lam against
 the monolithic solution)."""
 import os
-import re
-import subprocess
 import sys
 
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools"))
+from rc_common import RESULT_LINE, TIME_LINE, Checks, read_lam, result_fields, run_solver, \
+    solver_env, text_attr  # noqa: E402
+
 BIN = os.environ.get("BIN", "bin/robin_contact")
 OUT = os.path.join(os.environ.get("BUILD", "build/release"), "test-out", "runs")
 os.makedirs(OUT, exist_ok=True)
-FAILS = []
-
-RESULT = re.compile(r"^result: status=(\w+) method=(\w+) outer=(\d+) inner=(\d+) n1=(\d+) n2=(\d+) "
-                    r"m=(\d+) delta=([0-9.eE+-]+) residual=([0-9.eE+-]+) wall_s=([0-9.eE+-]+)$", re.M)
-TIME = re.compile(r"^time: assemble=[0-9.]+ factor=[0-9.]+ condense=[0-9.]+ iterate=[0-9.]+ output=[0-9.]+ "
-                  r"total=[0-9.]+", re.M)
-
-
-def check(ok, what, detail=""):
-    print(("PASS  " if ok else "FAIL  ") + what + (f" ({detail})" if detail else ""))
-    if not ok:
-        FAILS.append(what)
+check = Checks()
 
 
 def run(deck, *over, threads="2", name="run"):
+    """Run deck with overrides; returns (process, result fields or None when the result line
+    does not have the documented shape, result file)."""
     out = os.path.join(OUT, name + ".h5")
     if os.path.exists(out):
         os.remove(out)
-    env = dict(os.environ, OMP_NUM_THREADS=threads)
-    p = subprocess.run([BIN, deck, *over, f"&output file='{out}' /"], capture_output=True, text=True, env=env)
-    m = RESULT.search(p.stdout)
+    p, _ = run_solver(BIN, deck, *over, f"&output file='{out}' /", env=solver_env(threads))
+    m = result_fields(p.stdout) if RESULT_LINE.search(p.stdout) else None
     return p, m, out
-
-
-def lam(path):
-    with h5py.File(path, "r") as f:
-        return np.array(f["/contact/normal_force"])
 
 
 # 1. a converged run: result line, time line, HDF5 contents
 p, m, out = run("inputs/table1/q1_16x8.nml", name="q1_16x8")
 check(p.returncode == 0, "paper scene 16x8 exits 0", f"exit {p.returncode}")
-check(m is not None, "result line has the documented shape", m.group(0) if m else p.stdout[-300:])
-check(TIME.search(p.stdout) is not None, "time line present")
+line = RESULT_LINE.search(p.stdout)
+check(line is not None, "result line has the documented shape", line.group(0) if line else p.stdout[-300:])
+check(TIME_LINE.search(p.stdout) is not None, "time line present")
 if m:
-    check(m.group(1) == "converged" and m.group(2) == "robin", "status=converged method=robin")
-    check((m.group(5), m.group(6), m.group(7)) == ("288", "288", "16"), "n1=288 n2=288 m=16 as in the paper")
+    check(m["status"] == "converged" and m["method"] == "robin", "status=converged method=robin")
+    check((m["n1"], m["n2"], m["m"]) == ("288", "288", "16"), "n1=288 n2=288 m=16 as in the paper")
     nlines = len(p.stdout.splitlines())
     check(nlines < 200, "output stays short", f"{nlines} lines")
 if os.path.exists(out):
@@ -64,9 +52,8 @@ if os.path.exists(out):
         attrs = {k: f.attrs[k] for k in f.attrs}
         check(all(k in attrs for k in ["status", "method", "outer_iterations", "inner_iterations"]),
               "HDF5 root attributes present")
-        st = attrs.get("status", b"")
-        st = st.decode() if isinstance(st, bytes) else str(st)
-        check(st.strip() == "converged", "status attribute = converged", st)
+        st = text_attr(f, "status")
+        check(st == "converged", "status attribute = converged", st)
         x = np.array(f["/contact/x"])
         check(x.shape == (16,) and np.all(np.diff(x) > 0) and abs(x[-1] - 3.0) < 1e-12, "contact x along the line")
         u = np.array(f["/body1/displacement"])
@@ -85,12 +72,11 @@ else:
 # 2. delta = 1 does not converge: exit 2, status max_outer or diverged, file flagged
 p, m, out = run("inputs/table1/q1_6x2.nml", "&solver delta=1.0 /", name="delta1")
 check(p.returncode == 2, "delta=1 exits 2", f"exit {p.returncode}")
-check(m is not None and m.group(1) in ("max_outer", "diverged"), "delta=1 status max_outer or diverged",
-      m.group(1) if m else "no result line")
+check(m is not None and m["status"] in ("max_outer", "diverged"), "delta=1 status max_outer or diverged",
+      m["status"] if m else "no result line")
 if os.path.exists(out):
     with h5py.File(out, "r") as f:
-        st = f.attrs["status"]
-        st = (st.decode() if isinstance(st, bytes) else str(st)).strip()
+        st = text_attr(f, "status")
         check(st in ("max_outer", "diverged"), "delta=1 result file flagged", st)
 else:
     check(False, "delta=1 result file written and flagged")
@@ -107,7 +93,8 @@ if p1.returncode == 0 and p2.returncode == 0:
         for k in ["/contact/normal_force", "/contact/gap", "/body1/displacement", "/body2/displacement"]:
             same &= np.array_equal(np.array(f1[k]), np.array(f2[k]))
     check(same, "OMP_NUM_THREADS=1 and 2 bitwise identical")
-    check(m1.group(3) == m2.group(3) and m1.group(4) == m2.group(4), "same outer/inner counts with 1 and 2 threads")
+    check(m1 is not None and m2 is not None and (m1["outer"], m1["inner"]) == (m2["outer"], m2["inner"]),
+          "same outer/inner counts with 1 and 2 threads")
 
 # 4. Table 1 regression for two meshes
 ref = {}
@@ -122,7 +109,7 @@ for mesh in ["3x1", "6x2", "16x8"]:
     if pm.returncode != 0:
         check(False, f"table1 {mesh} monolithic converged")
         continue
-    lref = lam(om)
+    lref = read_lam(om)
     for delta in [0.1, 0.5, 0.7, 0.95, 1.0]:
         if (mesh, delta) not in ref:
             continue
@@ -131,7 +118,7 @@ for mesh in ["3x1", "6x2", "16x8"]:
         if not m:
             check(False, f"table1 {mesh} delta={delta} result line")
             continue
-        got = (m.group(1), int(m.group(3)), int(m.group(4)))
+        got = (m["status"], int(m["outer"]), int(m["inner"]))
         # counts: exact match expected on the same build; allow +-1 outer and 3% inner for
         # other BLAS kernels / CPUs (summation order changes the last bits)
         if st == "converged":
@@ -140,8 +127,8 @@ for mesh in ["3x1", "6x2", "16x8"]:
             ok = got[0] in ("max_outer", "diverged")
         check(ok, f"table1 {mesh} delta={delta}: {got[0]} {got[1]}/{got[2]} vs reference {st} {outer}/{inner}")
         if got[0] == "converged":
-            e = np.linalg.norm(lam(out) - lref) / np.linalg.norm(lref)
+            e = np.linalg.norm(read_lam(out) - lref) / np.linalg.norm(lref)
             check(e <= 1e-6, f"table1 {mesh} delta={delta}: |lam - lam_mono|/|lam_mono| <= 1e-6", f"{e:.2e}")
 
-print(f"{len(FAILS)} failed checks")
-sys.exit(1 if FAILS else 0)
+print(f"{len(check.failed)} failed checks")
+sys.exit(1 if check.failed else 0)

@@ -35,6 +35,12 @@ png_ok() {   # name file
   fi
 }
 
+solve() {   # deck out.h5 log: run $BIN on deck into out.h5; true when it exits 0 (in rc) with out.h5 written
+  "$BIN" "$1" "&output file='$2' /" >"$3" 2>&1
+  rc=$?
+  [ $rc -eq 0 ] && [ -f "$2" ]
+}
+
 plot_case() {   # tool out.png args...
   local tool=$1 out=$2; shift 2
   local what="$tool $(basename "${1:-}")${2:+ ${*:2}} -o $(basename "$out")"
@@ -57,9 +63,7 @@ if [ ! -x "$BIN" ]; then
   echo "test_tools: $fails failed check(s)"; exit 1
 fi
 h5=$tmp/a.h5
-"$BIN" inputs/table1/q1_16x8.nml "&output file='$h5' /" >"$tmp/run.log" 2>&1
-rc=$?
-if [ $rc -eq 0 ] && [ -f "$h5" ]; then
+if solve inputs/table1/q1_16x8.nml "$h5" "$tmp/run.log"; then
   pass "robin_contact inputs/table1/q1_16x8.nml -> $(basename "$h5") (exit 0)"
   plot_case plot_history.py "$tmp/history.png" "$h5"
   plot_case plot_contact.py "$tmp/contact.png" "$h5"
@@ -77,9 +81,7 @@ fi
 
 if [ -f tests/decks/gap.nml ]; then
   g=$tmp/gap.h5
-  "$BIN" tests/decks/gap.nml "&output file='$g' /" >"$tmp/gap.log" 2>&1
-  rc=$?
-  if [ $rc -eq 0 ] && [ -f "$g" ]; then
+  if solve tests/decks/gap.nml "$g" "$tmp/gap.log"; then
     "$PYTHON" tools/plot_contact.py "$g" "$h5" --hertz -o "$tmp/gap.png" >"$tmp/gapplot.log" 2>&1
     rc=$?
     if [ $rc -eq 0 ] && grep -q "^plot_contact: Hertz for gap: P=.* R=2000 xc=1.5 " "$tmp/gapplot.log" \

@@ -28,19 +28,14 @@ import numpy as np
 import h5py
 import meshio
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools"))
+from rc_common import Checks, run_solver, text_attr  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DECK = "inputs/table1/q1_6x2.nml"
 BODY_XDMF = "{stem}_body{b}.xdmf"          # per-body files that meshio can read
 FIELDS = ("displacement", "von_mises", "contact_pressure")
-nfail = 0
-
-
-def check(ok, what):
-    global nfail
-    print(("PASS  " if ok else "FAIL  ") + what, flush=True)
-    if not ok:
-        nfail += 1
-    return ok
+check = Checks()
 
 
 def binary():
@@ -51,15 +46,6 @@ def binary():
         if os.path.exists(os.path.join(base, b)):
             return os.path.abspath(os.path.join(base, b))
     return os.path.join(ROOT, b)
-
-
-def text_attr(obj, name):
-    v = obj.attrs.get(name, b"")
-    if isinstance(v, np.ndarray):
-        v = v.reshape(-1)[0] if v.size else b""
-    if isinstance(v, (bytes, np.bytes_)):
-        v = v.decode("utf-8", "replace")
-    return str(v).strip().strip("\x00").strip()
 
 
 def check_collection(xdmf, h5path, f, tag):
@@ -174,7 +160,7 @@ def run_case(tmp, tag, overrides):
     h5 = os.path.join(tmp, f"{tag}.h5")
     cmd = [binary(), DECK] + overrides + [f"&output file='{h5}' /"]
     try:
-        p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, timeout=600)
+        p, _ = run_solver(*cmd, env=dict(os.environ), cwd=ROOT, timeout=600)
     except (OSError, subprocess.TimeoutExpired) as e:
         check(False, f"{tag}: run {' '.join(cmd)}: {e}")
         return
@@ -210,8 +196,8 @@ def main():
     with tempfile.TemporaryDirectory(prefix="test_xdmf_") as tmp:
         run_case(tmp, "q1_6x2_Q1", [])
         run_case(tmp, "q1_6x2_P1", ['&body id=1, element="P1" /', '&body id=2, element="P1" /'])
-    print(f"test_xdmf: {nfail} failed check(s)")
-    return 1 if nfail else 0
+    print(f"test_xdmf: {len(check.failed)} failed check(s)")
+    return 1 if check.failed else 0
 
 
 if __name__ == "__main__":

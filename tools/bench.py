@@ -44,7 +44,6 @@ import os
 import re
 import resource
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -52,9 +51,7 @@ import time
 import h5py
 import numpy as np
 
-RESULT_RE = re.compile(r"^result: (.*)$", re.M)
-TIME_RE = re.compile(r"^time: (.*)$", re.M)
-FORCE_RE = re.compile(r"^contact: total normal force=\s*(\S+)", re.M)
+from rc_common import contact_force, md_header, md_row, rel_err, run_solver, solver_env, time_fields
 
 COLUMNS = [
     "group", "level", "nx", "ny", "label", "method", "operator", "delta", "factorization",
@@ -131,8 +128,7 @@ class Runner:
         stem = f"run{self.count:03d}"
         h5 = os.path.join(self.workdir, stem + ".h5")
         args = [self.binary, self.deck] + overrides + [f"&output file='{h5}', progress_lines=0 /"]
-        env = dict(os.environ)
-        env["OMP_NUM_THREADS"] = str(threads)
+        env = solver_env(threads)
         env.pop("OMP_THREAD_LIMIT", None)
         env.update(extra_env or {})
         row["load1"] = round(os.getloadavg()[0], 2)
@@ -142,7 +138,7 @@ class Runner:
         t0 = time.monotonic()
         tot0, idle0 = cpu_times()
         ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        p = subprocess.run(args, capture_output=True, text=True, env=env)
+        p, r = run_solver(*args, env=env)
         tot1, idle1 = cpu_times()
         ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         wall = time.monotonic() - t0
@@ -151,16 +147,13 @@ class Runner:
         mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
         row["busy_during"] = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
         row["exit"] = p.returncode
-        res = RESULT_RE.findall(p.stdout)
-        tim = TIME_RE.findall(p.stdout)
-        if not res or not tim:
+        t = time_fields(p.stdout)
+        if r is None or t is None:
             sys.stderr.write(f"bench: no result/time line from: {row['cmdline']} (exit {p.returncode})\n")
             sys.stderr.write(p.stdout[-1500:] + p.stderr[-1500:] + "\n")
             row["status"] = "error"
             self._clean(stem)
             return row, None
-        r = dict(kv.split("=", 1) for kv in res[-1].split())
-        t = dict(kv.split("=", 1) for kv in tim[-1].split())
         row["status"] = r.get("status")
         for k in ("n1", "n2", "m", "outer", "inner"):
             row[k] = int(r[k])
@@ -171,15 +164,15 @@ class Runner:
         row["factor_mb"] = fnum(t.get("factor_mb"))
         row["solve_s"] = row["factor_s"] + row["condense_s"] + row["iterate_s"]
         row["solve_over_factor"] = row["solve_s"] / row["factor_s"] if row["factor_s"] > 0 else float("nan")
-        fm = FORCE_RE.findall(p.stdout)
+        fm = contact_force(p.stdout)
         c = None
         if os.path.exists(h5):
             with h5py.File(h5, "r") as f:
                 c = {k: np.array(f["/contact/" + k]) for k in
                      ("normal_force", "pressure", "x", "tributary_length", "active")}
             row["force"] = float(np.sum(c["normal_force"]))
-        elif fm:
-            row["force"] = fnum(fm[-1])
+        elif fm is not None:
+            row["force"] = fnum(fm)
         self._clean(stem)
         return row, c
 
@@ -229,11 +222,6 @@ def overrides_of(row):
     return ov + [s + " /"]
 
 
-def rel(a, b):
-    nb = np.linalg.norm(b)
-    return float(np.linalg.norm(a - b) / nb) if nb > 0 else float("nan")
-
-
 def pressure_error(coarse, fine, edge_window=None):
     """Relative L2 error of the coarse pressure against the fine one at the coarse nodes;
     with edge_window, leave out the nodes within edge_window * (line length) of a change
@@ -270,9 +258,7 @@ def fmt(x, spec):
 
 
 def table(head, rows):
-    out = ["| " + " | ".join(head) + " |", "|" + "|".join("---" for _ in head) + "|"]
-    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
-    return "\n".join(out)
+    return "\n".join(md_header(head) + [md_row(r) for r in rows])
 
 
 def main():
@@ -367,7 +353,8 @@ def main():
             continue
         m = C.get(id(mono[r["level"]]))
         if m is not None and r is not mono[r["level"]]:
-            r["alg_err"] = rel(c["normal_force"], m["normal_force"])
+            e = rel_err(c["normal_force"], m["normal_force"])
+            r["alg_err"] = float("nan") if e is None else e
         if fine is not None and r["level"] < top:
             r["p_err"] = pressure_error(c, fine)
             r["p_err_away"] = pressure_error(c, fine, a.edge_window)

@@ -31,14 +31,14 @@ import math
 import os
 import re
 import shlex
-import subprocess
 import sys
 import time
 
 import h5py
 import numpy as np
 
-RESULT_RE = re.compile(r"^result: (.*)$", re.M)
+from rc_common import hertz_pressure, hertz_zone, md_header, md_row, rel_err, run_solver, solver_env
+
 BUG_TOL = 1.0e-5          # largest error against monolithic accepted from a 'converged' run
 
 HARD = "inputs/hard"
@@ -114,8 +114,7 @@ class Runner:
         self.out = out
         self.log = log
         self.bugs = []
-        self.env = dict(os.environ)
-        self.env.setdefault("OMP_NUM_THREADS", "2")
+        self.env = solver_env()
 
     def run(self, tag, deck, overrides):
         """Run one deck; returns a dict (status, outer, inner, residual, wall, lam, file, ok...)."""
@@ -125,7 +124,7 @@ class Runner:
         cmd = [self.bin, deck] + list(overrides) + [f"&output file='{h5}' /"]
         cmdline = f"OMP_NUM_THREADS={self.env['OMP_NUM_THREADS']} " + " ".join(shell_word(c) for c in cmd)
         t0 = time.time()
-        p = subprocess.run(cmd, capture_output=True, text=True, env=self.env)
+        p, fields = run_solver(*cmd, env=self.env)
         elapsed = time.time() - t0
         with open(os.path.join(self.out, tag + ".log"), "w") as f:
             f.write("$ " + cmdline + "\n" + p.stdout + p.stderr + f"\n[exit {p.returncode}]\n")
@@ -133,14 +132,12 @@ class Runner:
              "status": "crash", "outer": "-", "inner": "-", "residual": float("nan"),
              "wall": elapsed, "lam": None, "bound": float("nan"),
              "message": (p.stderr.strip().splitlines() or [""])[-1]}
-        m = RESULT_RE.findall(p.stdout)
         problems = []
         if p.returncode not in (0, 2):
             problems.append(f"exit code {p.returncode}")
-        if not m:
+        if fields is None:
             problems.append("no result line")
         else:
-            fields = dict(kv.split("=", 1) for kv in m[-1].split())
             r["status"] = fields.get("status", "?")
             r["outer"] = fields.get("outer", "-")
             r["inner"] = fields.get("inner", "-")
@@ -182,6 +179,16 @@ class Runner:
         print(line, flush=True)
         self.log.append(line)
 
+    def head(self, head, widths):
+        """Print a table header in columns of the given widths; returns the table's Markdown lines."""
+        self.say("  ".join(h.ljust(w) for h, w in zip(head, widths)))
+        return md_header(head)
+
+    def row(self, md, cells, widths):
+        """Print a table row in columns of the given widths and add it to the Markdown lines md."""
+        self.say("  ".join(c.ljust(w) for c, w in zip(cells, widths)))
+        md.append(md_row(cells))
+
 
 def shell_word(w):
     """A shell word for a copy-pasteable command line: namelist overrides in double quotes."""
@@ -206,15 +213,6 @@ def nonfinite_datasets(path):
             if isinstance(v, (float, np.floating)) and not np.isfinite(v):
                 bad.append("@" + k)
     return bad
-
-
-def rel_err(lam, ref):
-    if lam is None or ref is None or lam.shape != ref.shape:
-        return None
-    n = np.linalg.norm(ref)
-    if n == 0.0:
-        return None
-    return float(np.linalg.norm(lam - ref) / n)
 
 
 def fmt(v, spec=".2e"):
@@ -267,8 +265,7 @@ def main_table(R, only):
     widths = (26, 25, 10, 6, 7, 9, 11, 9, 7, 14)
     R.say("== main table (err_vs_mono: |lam - lam_mono| / |lam_mono|; bound: the run's reported a posteriori")
     R.say("   bound of err_vs_mono, which must hold; wall_s: the solver's own) ==")
-    R.say("  ".join(h.ljust(w) for h, w in zip(head, widths)))
-    md = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    md = R.head(head, widths)
     csv = [",".join(head) + ",exit,bug"]
     for case, label, r, err, expect in rows:
         st = r["status"]
@@ -283,8 +280,7 @@ def main_table(R, only):
             exp = "BUG"
         cells = (case, label, st, str(r["outer"]), str(r["inner"]), fmt(r["residual"], ".1e"),
                  "ref" if label == "monolithic" else fmt(err), fmt(r["bound"], ".1e"), fmt(r["wall"], ".2f"), exp)
-        R.say("  ".join(c.ljust(w) for c, w in zip(cells, widths)))
-        md.append("| " + " | ".join(cells) + " |")
+        R.row(md, cells, widths)
         csv.append(",".join(c.replace(",", ";") for c in cells) + f",{r['exit']},{r.get('bug', '')}")
     return results, md, csv
 
@@ -319,8 +315,7 @@ def hertz_analysis(r):
     Es = 1.0 / ((1 - n1 ** 2) / E1 + (1 - n2 ** 2) / E2)          # plane strain
     lam, x, p, trib = r["lam"], r["x"], r["p"], r["trib"]
     P = float(lam.sum())
-    a_h = math.sqrt(4 * P * R_ / (math.pi * Es))
-    p0 = 2 * P / (math.pi * a_h)
+    a_h, p0 = hertz_zone(P, R_, Es)
     act = np.nonzero(lam > 0)[0]
     i0, i1 = act[0], act[-1]
     h = float(np.median(np.diff(x)))
@@ -333,7 +328,7 @@ def hertz_analysis(r):
     if i1 < len(x) - 1:
         xr = min(xr, x[i1 + 1])
     a_num = 0.5 * (xr - xl)
-    ph = p0 * np.sqrt(np.clip(1 - ((x - xc) / a_h) ** 2, 0.0, None))
+    ph = hertz_pressure(x, xc, a_h, p0)
     zone = (ph > 0) | (lam > 0)
     l2 = math.sqrt(np.sum(trib[zone] * (p[zone] - ph[zone]) ** 2) / np.sum(trib[zone] * ph[zone] ** 2))
     core = np.abs(x - xc) < 0.8 * a_h
@@ -360,8 +355,7 @@ def hertz_study(R, results):
     head = ("mesh", "h", "active", "P [N/m]", "a_H", "a_num", "in", "err a", "p0 [Pa]", "err p0", "L2 err p",
             "L2 core", "order a", "order L2", "order core")
     widths = (15, 7, 6, 10, 7, 7, 3, 8, 9, 8, 8, 8, 7, 8, 10)
-    R.say("  ".join(s.ljust(w) for s, w in zip(head, widths)))
-    md = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    md = R.head(head, widths)
     prev = None
     out = []
     runs = [(f"{nx}x{ny}", nx, ny, []) for nx, ny in HERTZ_MESHES]
@@ -385,8 +379,7 @@ def hertz_study(R, results):
                  f"{a['a_h']:.4f}", f"{a['a_num']:.4f}", "yes" if a["bracket"] else "NO", f"{a['err_a']:.2e}",
                  f"{a['p0']:.3e}", f"{a['err_p0']:.2e}", f"{a['l2']:.2e}", f"{a['l2core']:.2e}",
                  fmt(o_a, ".2f"), fmt(o_l2, ".2f"), fmt(o_c, ".2f"))
-        R.say("  ".join(c.ljust(w) for c, w in zip(cells, widths)))
-        md.append("| " + " | ".join(cells) + " |")
+        R.row(md, cells, widths)
         out.append(a)
         prev = a
     return md
@@ -398,8 +391,7 @@ def scaling_study(R, results):
     R.say("== scaling (linear problem: lam_case / factor must equal lam of the unscaled paper scene) ==")
     head = ("case", "factor", "variant", "outer", "outer ref", "linearity err", "x err", "p err")
     widths = (12, 7, 23, 6, 9, 13, 8, 8)
-    R.say("  ".join(s.ljust(w) for s, w in zip(head, widths)))
-    md = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    md = R.head(head, widths)
     variants = ["monolithic"] + [v[0][0] for v in CASES[[c[0] for c in CASES].index("paper scene (unscaled)")][3]]
     for case, deck, fac in SCALES:
         label = [c[0] for c in CASES if c[1] == deck][0]
@@ -414,8 +406,7 @@ def scaling_study(R, results):
             xe = float(np.max(np.abs(r["x"] / xf - ref["x"])) / np.max(np.abs(ref["x"])))
             pe = rel_err(r["p"] / pf, ref["p"])
             cells = (case, f"{fac:g}", v, str(r["outer"]), str(ref["outer"]), fmt(lin), fmt(xe, ".1e"), fmt(pe, ".1e"))
-            R.say("  ".join(c.ljust(w) for c, w in zip(cells, widths)))
-            md.append("| " + " | ".join(cells) + " |")
+            R.row(md, cells, widths)
     return md
 
 
@@ -430,8 +421,8 @@ def contrast_ladder(R):
     R.say("")
     R.say("== contrast ladder: harmonic operator, delta 0.5, tol 1e-8 (pushed scene); cells: outer/inner, err vs monolithic ==")
     head = ["mesh"] + [f"E1/E2={c:g}" for c in CONTRASTS]
-    R.say("  ".join(h.ljust(22) for h in head))
-    md = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    widths = [22] * len(head)
+    md = R.head(head, widths)
     worst = 0
     for nx, ny in LADDER:
         cells = [f"{nx}x{ny}"]
@@ -450,8 +441,7 @@ def contrast_ladder(R):
             else:
                 worst = 10 ** 9
                 cells.append(f"{r['status']} {r['outer']}")
-        R.say("  ".join(x.ljust(22) for x in cells))
-        md.append("| " + " | ".join(cells) + " |")
+        R.row(md, cells, widths)
     R.say("largest outer count: " + (str(worst) if worst < 10 ** 9 else "not all converged") +
           " (target <= 20)")
     return md
@@ -466,8 +456,7 @@ def locking_study(R):
     R.say("middle 80% of the line (ends excluded); pmax/pmean over the whole line")
     head = ("element", "nu", "mesh", "open", "P [N/m]", "P/P(0.3)", "dP finer", "spike", "pmax/pmean")
     widths = (7, 6, 7, 4, 10, 8, 9, 8, 10)
-    R.say("  ".join(s.ljust(w) for s, w in zip(head, widths)))
-    md = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    md = R.head(head, widths)
     data = {}
     for el in ("q1", "p1"):
         for nu, deck, over in (("0.3", f"{HARD}/incomp_{el}_nu049.nml", "poisson=0.3, "),
@@ -497,8 +486,7 @@ def locking_study(R):
                 spike = float(np.max(np.abs(p[idx] - 0.5 * (p[idx - 1] + p[idx + 1]))) / np.mean(p[idx]))
                 cells = (el.upper(), nu, f"{nx}x{ny}", str(int(np.sum(r["lam"] <= 0))), f"{P:.4e}", f"{P / P3:.3f}",
                          fmt(dP, "+.2%"), f"{spike:.3f}", f"{p.max() / np.mean(p):.3f}")
-                R.say("  ".join(c.ljust(w) for c, w in zip(cells, widths)))
-                md.append("| " + " | ".join(cells) + " |")
+                R.row(md, cells, widths)
     return md
 
 

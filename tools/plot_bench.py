@@ -23,6 +23,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from rc_common import save_figure  # noqa: E402
+
 PHASES = ["assemble_s", "factor_s", "condense_s", "iterate_s", "output_s"]
 COLORS = {"monolithic": "tab:gray", "robin-steklov": "tab:blue", "robin-harmonic": "tab:orange"}
 
@@ -104,9 +106,7 @@ def work_precision(rows, out):
     ax2.set_ylabel("total run time [s]")
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    plt.close(fig)
+    save_figure(fig, out, dpi=120)
 
 
 def phases(rows, out):
@@ -138,9 +138,7 @@ def phases(rows, out):
         axes[k // ncol][k % ncol].axis("off")
     fig.legend(loc="lower right", fontsize=8)
     fig.suptitle("time per phase (2 threads; CHOLMOD with METIS/AMD ordering, banded = RCM + LAPACK band)")
-    fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    plt.close(fig)
+    save_figure(fig, out, dpi=110)
 
 
 def main():

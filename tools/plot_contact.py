@@ -32,37 +32,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from rc_common import finish_plot, hertz_pressure, hertz_zone, num_attr, run_label, \
+    text_attr, text_dataset  # noqa: E402
+
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)"
-
-
-def text_attr(obj, name, default=""):
-    """A string attribute as str (fixed-length HDF5 strings: bytes / numpy bytes)."""
-    if name not in obj.attrs:
-        return default
-    v = obj.attrs[name]
-    if isinstance(v, np.ndarray):
-        v = v.reshape(-1)[0] if v.size else b""
-    if isinstance(v, (bytes, np.bytes_)):
-        v = v.decode("utf-8", "replace")
-    return str(v).strip().strip("\x00").strip()
-
-
-def num_attr(obj, name, default=None):
-    if name not in obj.attrs:
-        return default
-    v = np.asarray(obj.attrs[name]).reshape(-1)
-    return float(v[0]) if v.size else default
-
-
-def text_dataset(f, name):
-    if name not in f:
-        return None
-    v = f[name][()]
-    if isinstance(v, np.ndarray):
-        v = b"".join(x if isinstance(x, (bytes, np.bytes_)) else str(x).encode() for x in v.reshape(-1))
-    if isinstance(v, (bytes, np.bytes_)):
-        v = v.decode("utf-8", "replace")
-    return str(v)
 
 
 def strip_comments(text):
@@ -141,8 +114,7 @@ def hertz(f, path):
             return None, f"/{b} has no young/poisson attributes"
         inv += (1.0 if pstress else 1.0 - nu * nu) / E
     Es = 1.0 / inv
-    a = np.sqrt(4.0 * P * R / (np.pi * Es))
-    p0 = 2.0 * P / (np.pi * a)
+    a, p0 = hertz_zone(P, R, Es)
     return dict(P=P, R=R, xc=xc, Es=Es, a=a, p0=p0, src=src, pstress=pstress), None
 
 
@@ -150,8 +122,7 @@ def hertz_curve(h, xmin, xmax, n=401):
     lo, hi = min(xmin, h["xc"] - h["a"]), max(xmax, h["xc"] + h["a"])
     x = np.linspace(lo, hi, n)
     x = np.union1d(x, [h["xc"] - h["a"], h["xc"] + h["a"]])
-    r = 1.0 - ((x - h["xc"]) / h["a"]) ** 2
-    return x, h["p0"] * np.sqrt(np.clip(r, 0.0, None))
+    return x, hertz_pressure(x, h["xc"], h["a"], h["p0"])
 
 
 def main(argv=None):
@@ -179,12 +150,7 @@ def main(argv=None):
         except (OSError, KeyError) as e:
             print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
             return 1
-        name = os.path.basename(path)
-        name = name[:-3] if name.endswith(".h5") else name
-        label = f"{name} ({method}"
-        if method != "monolithic" and np.isfinite(delta):
-            label += f", δ={delta:g}"
-        label += f", {status})"
+        name, label = run_label(path, method, status, delta)
         order = np.argsort(x, kind="stable")
         c = colours[k % len(colours)]
         ax.plot(x[order], p[order], "o-", color=c, ms=3.5, lw=1.3, label=label)
@@ -210,18 +176,10 @@ def main(argv=None):
                   f"E*={h['Es']:.6g}{' (plane stress)' if h['pstress'] else ''} a={h['a']:.6g} "
                   f"p0={h['p0']:.6g} (R, xc from {h['src']})")
     ax.axhline(0.0, color="0.5", lw=0.6)
-    ax.set_xlabel("x along the contact line")
-    ax.set_ylabel("normal contact pressure")
-    ax.set_title(a.title or "contact pressure" + (" and Hertz line contact" if seen else ""))
     ax.grid(True, alpha=0.4)
-    ax.legend(fontsize=7, loc="best")
-    fig.tight_layout()
-    out_dir = os.path.dirname(a.output)
-    if out_dir:
-        os.makedirs(out_dir, exist_ok=True)
-    fig.savefig(a.output)
-    print(f"plot_contact: wrote {a.output} ({len(runs)} runs, {len(seen)} Hertz curves)")
-    return 0
+    return finish_plot(fig, ax, a.output, "plot_contact", f"{len(runs)} runs, {len(seen)} Hertz curves",
+                       "x along the contact line", "normal contact pressure",
+                       a.title or "contact pressure" + (" and Hertz line contact" if seen else ""))
 
 
 if __name__ == "__main__":

@@ -13,7 +13,6 @@ legend with a note and no curve. Exit 0 on success, 1 on a missing or unreadable
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
 """
 import argparse
-import os
 import sys
 
 import numpy as np
@@ -23,25 +22,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-
-def text_attr(obj, name, default=""):
-    """A string attribute as str: fixed-length HDF5 strings come back as bytes or numpy
-    bytes (possibly blank-padded by Fortran), sometimes inside a 1-element array."""
-    if name not in obj.attrs:
-        return default
-    v = obj.attrs[name]
-    if isinstance(v, np.ndarray):
-        v = v.reshape(-1)[0] if v.size else b""
-    if isinstance(v, (bytes, np.bytes_)):
-        v = v.decode("utf-8", "replace")
-    return str(v).strip().strip("\x00").strip()
-
-
-def num_attr(obj, name, default=float("nan")):
-    if name not in obj.attrs:
-        return default
-    v = np.asarray(obj.attrs[name]).reshape(-1)
-    return float(v[0]) if v.size else default
+from rc_common import finish_plot, num_attr, run_label, text_attr  # noqa: E402
 
 
 def positive(v):
@@ -65,19 +46,13 @@ def main(argv=None):
             with h5py.File(path, "r") as f:
                 method = text_attr(f, "method", "?")
                 status = text_attr(f, "status", "?")
-                delta = num_attr(f, "delta")
+                delta = num_attr(f, "delta", float("nan"))
                 crit = np.array(f["/history/criterion"]) if "/history/criterion" in f else np.zeros(0)
                 res = np.array(f["/history/residual"]) if "/history/residual" in f else np.zeros(0)
         except (OSError, KeyError) as e:
             print(f"plot_history: cannot read {path}: {e}", file=sys.stderr)
             return 1
-        name = os.path.basename(path)
-        if name.endswith(".h5"):
-            name = name[:-3]
-        label = f"{name} ({method}"
-        if method != "monolithic" and np.isfinite(delta):
-            label += f", δ={delta:g}"
-        label += f", {status})"
+        _, label = run_label(path, method, status, delta)
         c = colours[k % len(colours)]
         if crit.size == 0 and res.size == 0:
             ax.plot([], [], color=c, label=label + ": no outer history")
@@ -90,19 +65,11 @@ def main(argv=None):
                         label=label + ": residual")
         drawn += 1
     ax.set_yscale("log")
-    ax.set_xlabel("outer iteration")
-    ax.set_ylabel("criterion (solid), residual (dashed)")
-    ax.set_title(a.title or "robin_contact convergence history")
     ax.grid(True, which="major", alpha=0.4)
     ax.grid(True, which="minor", alpha=0.15)
-    ax.legend(fontsize=7, loc="best")
-    fig.tight_layout()
-    out_dir = os.path.dirname(a.output)
-    if out_dir:
-        os.makedirs(out_dir, exist_ok=True)
-    fig.savefig(a.output)
-    print(f"plot_history: wrote {a.output} ({drawn} of {len(a.files)} runs with history)")
-    return 0
+    return finish_plot(fig, ax, a.output, "plot_history", f"{drawn} of {len(a.files)} runs with history",
+                       "outer iteration", "criterion (solid), residual (dashed)",
+                       a.title or "robin_contact convergence history")
 
 
 if __name__ == "__main__":

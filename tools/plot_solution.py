@@ -29,17 +29,7 @@ from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 import matplotlib.tri as mtri  # noqa: E402
 
-
-def text_attr(obj, name, default=""):
-    """A string attribute as str (fixed-length HDF5 strings: bytes / numpy bytes)."""
-    if name not in obj.attrs:
-        return default
-    v = obj.attrs[name]
-    if isinstance(v, np.ndarray):
-        v = v.reshape(-1)[0] if v.size else b""
-    if isinstance(v, (bytes, np.bytes_)):
-        v = v.decode("utf-8", "replace")
-    return str(v).strip().strip("\x00").strip()
+from rc_common import finish_plot, text_attr  # noqa: E402
 
 
 def read_body(g):
@@ -154,19 +144,10 @@ def main(argv=None):
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.04)
-    ax.set_xlabel("x")
-    ax.set_ylabel("y")
     name = os.path.basename(a.file)
     first = a.title or f"{name}: {method}, {status}, {bodies[0]['element']}/{bodies[1]['element']}"
-    ax.set_title(f"{first}\ndeformed shape, displacement magnified ×{S:g} ({how})", fontsize=10)
-    ax.legend(fontsize=7, loc="best")
-    fig.tight_layout()
-    out_dir = os.path.dirname(a.output)
-    if out_dir:
-        os.makedirs(out_dir, exist_ok=True)
-    fig.savefig(a.output)
-    print(f"plot_solution: wrote {a.output} (magnification {S:g})")
-    return 0
+    return finish_plot(fig, ax, a.output, "plot_solution", f"magnification {S:g}", "x", "y",
+                       f"{first}\ndeformed shape, displacement magnified ×{S:g} ({how})", fontsize=10)
 
 
 if __name__ == "__main__":

@@ -40,6 +40,7 @@
 set -u
 
 die() { echo "sweep: $*" >&2; exit 1; }
+usage() { sed -n '2,/^set -u/p' "$0" | sed '$d;s/^# \{0,1\}//'; }   # the comment above
 
 BIN=${BIN:-bin/robin_contact}
 export OMP_NUM_THREADS=${OMP_NUM_THREADS:-2}
@@ -48,13 +49,13 @@ while [ $# -gt 0 ]; do
   case "$1" in
     --csv) [ $# -ge 2 ] || die "--csv needs a file"; csv=$2; shift 2 ;;
     --csv=*) csv=${1#--csv=}; shift ;;
-    -h|--help) sed -n '2,/^set -u/p' "$0" | sed '$d;s/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) usage; exit 0 ;;
     --) shift; break ;;
     -*) die "unknown option $1 (see --help)" ;;
     *) break ;;
   esac
 done
-[ $# -ge 2 ] || { sed -n '2,/^set -u/p' "$0" | sed '$d;s/^# \{0,1\}//' >&2; exit 1; }
+[ $# -ge 2 ] || { usage >&2; exit 1; }
 deck=$1; outdir=$2; shift 2
 [ -f "$deck" ] || die "no deck file '$deck'"
 [ -x "$BIN" ] || die "no executable '$BIN' (build it with make, or set BIN)"

@@ -10,12 +10,11 @@ Usage: tools/table1.py [--bin bin/robin_contact] [--out results/table1] [--csv F
 """
 import argparse
 import os
-import re
-import subprocess
 import sys
 
-import h5py
 import numpy as np
+
+from rc_common import read_lam, run_solver
 
 PAPER = {  # n/m -> {delta: (outer, inner) or None}
     "3x1": ("12/3", {0.1: (287, 903), 0.5: (76, 243), 0.7: (62, 208), 0.95: (47, 160), 1.0: None}),
@@ -24,25 +23,13 @@ PAPER = {  # n/m -> {delta: (outer, inner) or None}
     "24x16": ("816/24", {0.1: (296, 957), 0.5: (92, 332), 0.7: (93, 340), 0.95: (47, 204), 1.0: None}),
 }
 
-RESULT_RE = re.compile(r"^result: (.*)$", re.M)
-
-
 def run(binary, deck, overrides):
-    env = dict(os.environ)
-    env.setdefault("OMP_NUM_THREADS", "2")
-    p = subprocess.run([binary, deck] + overrides, capture_output=True, text=True, env=env)
-    m = RESULT_RE.findall(p.stdout)
-    if not m:
+    p, fields = run_solver(binary, deck, *overrides)
+    if fields is None:
         sys.stderr.write(p.stdout[-2000:] + p.stderr[-2000:])
         raise SystemExit(f"table1: no result line from {deck} {overrides} (exit {p.returncode})")
-    fields = dict(kv.split("=", 1) for kv in m[-1].split())
     fields["exit"] = p.returncode
     return fields
-
-
-def lam_of(path):
-    with h5py.File(path, "r") as f:
-        return np.array(f["/contact/normal_force"])
 
 
 def main():
@@ -64,14 +51,14 @@ def main():
         deck = os.path.join(a.decks, f"q1_{mesh}.nml")
         mono_file = os.path.join(a.out, f"q1_{mesh}_mono.h5")
         mono = run(a.bin, deck, a.extra + ["&solver method='monolithic' /", f"&output file='{mono_file}' /"])
-        lam_ref = lam_of(mono_file)
+        lam_ref = read_lam(mono_file)
         cells, diffs = [], []
         for dl in deltas:
             f = os.path.join(a.out, f"q1_{mesh}_d{dl:g}.h5")
             r = run(a.bin, deck, a.extra + [f"&solver method='robin', delta={dl} /", f"&output file='{f}' /"])
             diff = float("nan")
             if r["status"] == "converged":
-                lam = lam_of(f)
+                lam = read_lam(f)
                 diff = np.linalg.norm(lam - lam_ref) / max(np.linalg.norm(lam_ref), 1e-300)
                 diffs.append(diff)
                 cells.append(f"{r['outer']}/{r['inner']}")

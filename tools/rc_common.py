@@ -1,0 +1,207 @@
+"""Helpers shared by the robin_contact tools (tools/*.py) and the Python tests (tests/*.py).
+
+The program's console output ends with key=value lines (see README, "Output"):
+  result: status=converged method=robin outer=189 inner=2491 n1=816 n2=816 m=24 delta=0.5 residual=... wall_s=0.036
+  time: assemble=... factor=... condense=... iterate=... output=... total=... peak_mb=... factor_mb=...
+  contact: total normal force= ...
+This module parses them (result_fields, time_fields, line_fields, contact_force), runs
+the program (solver_env, run_solver), reads result files (text_attr, num_attr,
+text_dataset, read_lam), computes shared quantities (rel_err, hertz_zone, hertz_pressure),
+labels and saves figures (run_label, save_figure, finish_plot), prints Markdown tables (md_header,
+md_row) and counts the PASS/FAIL lines of the tests (Checks).
+
+Tools in tools/ import it directly (`import rc_common`: a script's own folder is on
+sys.path); tests put tools/ on sys.path first. Importing it loads numpy only: h5py and
+matplotlib are imported by the functions that need them.
+"""
+import os
+import re
+import subprocess
+
+import numpy as np
+
+# ---- the program's output lines -------------------------------------------------------
+RESULT_KEYS = ("status", "method", "outer", "inner", "n1", "n2", "m", "delta", "residual", "wall_s")
+# the documented shape of the result and time lines, checked to the letter by tests/test_runs.py
+RESULT_LINE = re.compile(r"^result: status=(\w+) method=(\w+) outer=(\d+) inner=(\d+) n1=(\d+) n2=(\d+) "
+                         r"m=(\d+) delta=([0-9.eE+-]+) residual=([0-9.eE+-]+) wall_s=([0-9.eE+-]+)$", re.M)
+TIME_LINE = re.compile(r"^time: assemble=[0-9.]+ factor=[0-9.]+ condense=[0-9.]+ iterate=[0-9.]+ output=[0-9.]+ "
+                       r"total=[0-9.]+", re.M)
+FORCE_RE = re.compile(r"^contact: total normal force=\s*(\S+)", re.M)
+
+
+def line_fields(text, tag):
+    """The key=value fields (strings) of the last line `<tag>: ...` of the output text, as a
+    dict in line order, or None when there is no such line. Words without '=' are skipped."""
+    lines = re.findall(r"^" + re.escape(tag) + r": (.*)$", text, re.M)
+    if not lines:
+        return None
+    return dict(kv.split("=", 1) for kv in lines[-1].split() if "=" in kv)
+
+
+def result_fields(text):
+    """Fields of the last `result:` line (status, method, outer, inner, ... as strings), or None."""
+    return line_fields(text, "result")
+
+
+def time_fields(text):
+    """Fields of the last `time:` line (assemble, factor, ..., total, peak_mb, factor_mb), or None."""
+    return line_fields(text, "time")
+
+
+def contact_force(text):
+    """The total normal force of the last `contact:` line, as a string, or None."""
+    m = FORCE_RE.findall(text)
+    return m[-1] if m else None
+
+
+# ---- running the program ----------------------------------------------------------------
+def solver_env(threads=None, base=None):
+    """A copy of the environment (base, default os.environ) for a run: OMP_NUM_THREADS =
+    threads if given, else the inherited value, else 2."""
+    env = dict(os.environ if base is None else base)
+    if threads is None:
+        env.setdefault("OMP_NUM_THREADS", "2")
+    else:
+        env["OMP_NUM_THREADS"] = str(threads)
+    return env
+
+
+def run_solver(binary, *args, env=None, **kwargs):
+    """Run `binary args...` with its output captured as text (env: default solver_env()).
+    Extra keyword arguments go to subprocess.run (cwd, timeout, ...).
+    Returns (CompletedProcess, result_fields(stdout))."""
+    p = subprocess.run([binary, *args], capture_output=True, text=True,
+                       env=solver_env() if env is None else env, **kwargs)
+    return p, result_fields(p.stdout)
+
+
+# ---- result files -------------------------------------------------------------------------
+def text_attr(obj, name, default=""):
+    """A string attribute of an HDF5 object as str: fixed-length HDF5 strings come back as
+    bytes or numpy bytes (possibly blank-padded by Fortran), sometimes inside a 1-element
+    array. default when there is no such attribute."""
+    if name not in obj.attrs:
+        return default
+    v = obj.attrs[name]
+    if isinstance(v, np.ndarray):
+        v = v.reshape(-1)[0] if v.size else b""
+    if isinstance(v, (bytes, np.bytes_)):
+        v = v.decode("utf-8", "replace")
+    return str(v).strip().strip("\x00").strip()
+
+
+def num_attr(obj, name, default=None):
+    """A numeric attribute as float (first element of an array), or default."""
+    if name not in obj.attrs:
+        return default
+    v = np.asarray(obj.attrs[name]).reshape(-1)
+    return float(v[0]) if v.size else default
+
+
+def text_dataset(f, name):
+    """A string dataset (e.g. input_deck) as str, or None when there is none."""
+    if name not in f:
+        return None
+    v = f[name][()]
+    if isinstance(v, np.ndarray):
+        v = b"".join(x if isinstance(x, (bytes, np.bytes_)) else str(x).encode() for x in v.reshape(-1))
+    if isinstance(v, (bytes, np.bytes_)):
+        v = v.decode("utf-8", "replace")
+    return str(v)
+
+
+def read_lam(path):
+    """The contact force lam (/contact/normal_force) of a result file."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        return np.array(f["/contact/normal_force"])
+
+
+def rel_err(a, ref):
+    """|a - ref| / |ref| (2-norms), or None when either is None, the shapes differ or ref = 0."""
+    if a is None or ref is None or np.shape(a) != np.shape(ref):
+        return None
+    n = np.linalg.norm(ref)
+    if n == 0.0:
+        return None
+    return float(np.linalg.norm(a - ref) / n)
+
+
+# ---- Hertz line contact --------------------------------------------------------------------
+def hertz_zone(P, R, Es):
+    """Half-width a = sqrt(4 P R / (pi E*)) and peak pressure p0 = 2 P / (pi a) of the Hertz
+    line contact: total force P per unit thickness, gap radius R, contact modulus E*."""
+    a = np.sqrt(4.0 * P * R / (np.pi * Es))
+    return a, 2.0 * P / (np.pi * a)
+
+
+def hertz_pressure(x, xc, a, p0):
+    """Hertz pressure p0 sqrt(1 - (x - xc)^2 / a^2) at x (0 outside the contact zone)."""
+    return p0 * np.sqrt(np.clip(1.0 - ((x - xc) / a) ** 2, 0.0, None))
+
+
+# ---- figures ----------------------------------------------------------------------------------
+def run_label(path, method, status, delta=float("nan")):
+    """(name, label) of a run in a legend: name = file name without .h5, label =
+    'name (method, δ=delta, status)' (δ only for Robin runs with a finite delta)."""
+    name = os.path.basename(path)
+    if name.endswith(".h5"):
+        name = name[:-3]
+    label = f"{name} ({method}"
+    if method != "monolithic" and np.isfinite(delta):
+        label += f", δ={delta:g}"
+    return name, label + f", {status})"
+
+
+def save_figure(fig, path, dpi=None):
+    """The tail of every plot: tight layout, create the output folder, save (dpi: default the
+    figure's), close the figure. Returns path."""
+    import matplotlib.pyplot as plt
+    fig.tight_layout()
+    out_dir = os.path.dirname(path)
+    if out_dir:
+        os.makedirs(out_dir, exist_ok=True)
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
+def finish_plot(fig, ax, path, tool, note, xlabel, ylabel, title, **title_kw):
+    """The tail of the one-axes plot tools: axis labels, title (title_kw: e.g. fontsize),
+    legend, save_figure(fig, path), and the line '<tool>: wrote <path> (<note>)'.
+    Returns 0, the tool's exit status."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, **title_kw)
+    ax.legend(fontsize=7, loc="best")
+    save_figure(fig, path)
+    print(f"{tool}: wrote {path} ({note})")
+    return 0
+
+
+# ---- tables ---------------------------------------------------------------------------------
+def md_header(head):
+    """The two header lines of a Markdown table."""
+    return ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+
+
+def md_row(cells):
+    """One Markdown table row."""
+    return "| " + " | ".join(str(c) for c in cells) + " |"
+
+
+# ---- tests ------------------------------------------------------------------------------------
+class Checks:
+    """The PASS/FAIL lines of a test script: checks(ok, what, detail="") prints
+    'PASS  what (detail)' or 'FAIL  what (detail)' and returns bool(ok); the failed ones
+    are listed in checks.failed."""
+
+    def __init__(self):
+        self.failed = []
+
+    def __call__(self, ok, what, detail=""):
+        print(("PASS  " if ok else "FAIL  ") + what + (f" ({detail})" if detail else ""), flush=True)
+        if not ok:
+            self.failed.append(what)
+        return bool(ok)
