@@ -2,13 +2,13 @@
 !! passed to assemble_body as a procedure argument (no internal-procedure trampoline).
 module test_fem_manufactured
   use kinds, only: wp
-  implicit none
+  implicit none (type, external)
   private
-  public :: ms_u, ms_force, ms_lam, ms_mu
+  public :: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
   real(wp), parameter :: pi = acos(-1.0_wp)
   real(wp), parameter :: ka = pi, kb = 0.5_wp*pi, kc = 0.75_wp*pi, kd_ = pi
-  real(wp) :: ms_lam = 0.0_wp   !< Lame lambda of the manufactured problem
-  real(wp) :: ms_mu = 0.0_wp    !< shear modulus of the manufactured problem
+  real(wp) :: ms_lame_lambda = 0.0_wp   !< Lame lambda of the manufactured problem
+  real(wp) :: ms_lame_mu = 0.0_wp       !< shear modulus of the manufactured problem
 
 contains
 
@@ -24,7 +24,7 @@ contains
     g(2, 2) = kd_*cos(kc*x)*cos(kd_*y)
   end subroutine ms_u
 
-  !> f = -div sigma = -(lam + mu) grad div u - mu lap u.
+  !> f = -div sigma = -(lambda + mu) grad div u - mu lap u.
   subroutine ms_force(x, y, f)
     real(wp), intent(in) :: x, y
     real(wp), intent(out) :: f(2)
@@ -35,15 +35,15 @@ contains
     u2xx = -kc**2*cos(kc*x)*sin(kd_*y)
     u2yy = -kd_**2*cos(kc*x)*sin(kd_*y)
     u2xy = -kc*kd_*sin(kc*x)*cos(kd_*y)
-    f(1) = -(ms_lam + ms_mu)*(u1xx + u2xy) - ms_mu*(u1xx + u1yy)
-    f(2) = -(ms_lam + ms_mu)*(u1xy + u2yy) - ms_mu*(u2xx + u2yy)
+    f(1) = -(ms_lame_lambda + ms_lame_mu)*(u1xx + u2xy) - ms_lame_mu*(u1xx + u1yy)
+    f(2) = -(ms_lame_lambda + ms_lame_mu)*(u1xy + u2yy) - ms_lame_mu*(u2xx + u2yy)
   end subroutine ms_force
 
 end module test_fem_manufactured
 
 !> Unit tests of modules mesh and assembly: sparse structure, patch test on a distorted
 !! mesh, convergence rates against a manufactured solution, traction loads, unit scaling
-!! and error reporting. Solves use LAPACK's banded Cholesky (dpbsv) directly.
+!! and error reporting. Solves use LAPACK's banded Cholesky (testing's band_solve).
 program test_fem
   use kinds, only: wp
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
@@ -51,22 +51,11 @@ program test_fem
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec
-  use test_fem_manufactured, only: ms_u, ms_force, ms_lam, ms_mu
-  use testing, only: band_solve
-  implicit none
-
-  interface
-    subroutine dpbsv(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, kd, nrhs, ldab, ldb
-      real(wp), intent(inout) :: ab(ldab, *), b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dpbsv
-  end interface
+  use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
+  use testing, only: report, test_summary, band_solve
+  implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
-  integer :: nfail = 0, npass = 0
 
   call test_structure(ELEM_Q1)
   call test_structure(ELEM_P1)
@@ -82,24 +71,9 @@ program test_fem
   call test_units(ELEM_P1, .false.)
   call test_errors()
 
-  write (*, '(i0,a,i0,a)') npass, ' passed, ', nfail, ' failed'
-  if (nfail > 0) error stop 1
+  call test_summary()
 
 contains
-
-  subroutine check(what, ok, value, tol)
-    character(len=*), intent(in) :: what
-    logical, intent(in) :: ok
-    real(wp), intent(in) :: value, tol
-    if (ok) then
-      npass = npass + 1
-      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'PASS  ', what, ' (', value, ', tol ', tol, ')'
-    else
-      nfail = nfail + 1
-      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'FAIL  ', what, ' (', value, ', tol ', tol, ')'
-    end if
-  end subroutine check
-
 
   !> Mesh, assemble and solve one body; stops the test on an assembly error.
   subroutine solve_body(body, plane_strain, tr, ntr, m, sys, u_full, u_prescribed, distort)
@@ -169,7 +143,7 @@ contains
     character(len=256) :: msg
     character(len=2) :: en
     logical :: sorted, found
-    real(wp) :: asym, diff, scale, x(200), y(200), lam, mu, x0, x1, y0, y1, ix2, iy2, ixy, energy
+    real(wp) :: asym, diff, scale, x(200), y(200), lame_lambda, lame_mu, x0, x1, y0, y1, ix2, iy2, ixy, energy
     real(wp), allocatable :: uf(:), r(:), u(:)
 
     en = element_names(element)
@@ -191,18 +165,19 @@ contains
     tr(1)%t1 = [0.0_wp, 0.5_wp]
     call mesh_build(m, body)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check(en//' assemble_body info = 0 on a valid body', info == 0, real(info, wp), 0.0_wp)
+    call report(info == 0, en//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
 
     ! 6 x 4 nodes = 48 dofs; left clamped 8, bottom roller 5 more y's, right both 8
     ! minus the bottom-right y already prescribed: 7; free 48 - 20 = 28.
-    call check(en//' free dof count (expect 28)', sys%n == 28, real(sys%n, wp), 0.0_wp)
-    call check(en//' corner rule: bottom-right y takes the later side (roller, 0)', &
-               sys%u_fixed(2*6) == 0.0_wp .and. sys%u_fixed(2*6 - 1) == 0.01_wp, sys%u_fixed(2*6), 0.0_wp)
+    call report(sys%n == 28, en//' free dof count (expect 28)', real(sys%n, wp), 0.0_wp)
+    call report(sys%u_fixed(2*6) == 0.0_wp .and. sys%u_fixed(2*6 - 1) == 0.01_wp, &
+                en//' corner rule: bottom-right y takes the later side (roller, 0)', sys%u_fixed(2*6), 0.0_wp)
 
     ! nnz from first principles: count couplings between free dofs through cells.
     nnz_expect = count_couplings(m, sys)
-    call check(en//' nnz equals the free-free couplings through cells', &
-               sys%colptr(sys%n + 1) == nnz_expect, real(sys%colptr(sys%n + 1), wp), real(nnz_expect, wp))
+    call report(sys%colptr(sys%n + 1) == nnz_expect, &
+                en//' nnz equals the free-free couplings through cells', &
+                real(sys%colptr(sys%n + 1), wp), real(nnz_expect, wp))
 
     sorted = .true.
     asym = 0.0_wp
@@ -222,9 +197,9 @@ contains
         if (.not. found) asym = huge(1.0_wp)
       end do
     end do
-    call check(en//' rows strictly increasing in every column', sorted, 0.0_wp, 0.0_wp)
-    call check(en//' pattern and values symmetric (max |Kij-Kji|/|K|)', &
-               asym <= 10*eps*sys%k_norm, asym/sys%k_norm, 10*eps)
+    call report(sorted, en//' rows strictly increasing in every column', 0.0_wp, 0.0_wp)
+    call report(asym <= 10*eps*sys%k_norm, &
+                en//' pattern and values symmetric (max |Kij-Kji|/|K|)', asym/sys%k_norm, 10*eps)
 
     ! Matvec on free dofs + lifting against the element loop on all dofs:
     ! (K_full u_full - f_applied)_free = K_ff u_f - f.
@@ -240,13 +215,12 @@ contains
       diff = max(diff, abs(r(sys%dof_of(k)) - (y(k) - sys%f(k))))
     end do
     scale = sys%k_norm*maxval(abs(uf)) + maxval(abs(sys%f_applied))
-    call check(en//' csc_matvec and lifting agree with the element loop', diff <= 100*eps*scale, &
-               diff/scale, 100*eps)
+    call report(diff <= 100*eps*scale, &
+                en//' csc_matvec and lifting agree with the element loop', diff/scale, 100*eps)
 
     ! k_norm is the infinity norm: at least every |K_jj|, at most the sum of all entries.
-    call check(en//' k_norm between max |K_jj| and sum |K_ij|', &
-               sys%k_norm >= maxval(abs(sys%val))*(1 - eps) .and. sys%k_norm <= sum(abs(sys%val)), &
-               sys%k_norm, 0.0_wp)
+    call report(sys%k_norm >= maxval(abs(sys%val))*(1 - eps) .and. sys%k_norm <= sum(abs(sys%val)), &
+                en//' k_norm between max |K_jj| and sum |K_ij|', sys%k_norm, 0.0_wp)
 
     ! Rigid-body modes produce no force.
     allocate (u(sys%ndof))
@@ -256,12 +230,12 @@ contains
       u(2*k) = -1.1_wp + 0.7_wp*m%xy(1, k)
     end do
     call residual_full(m, body, .true., u, uf, r)
-    call check(en//' rigid-body motion gives zero nodal forces', &
-               maxval(abs(r)) <= 100*eps*sys%k_norm*maxval(abs(u)), &
-               maxval(abs(r))/(sys%k_norm*maxval(abs(u))), 100*eps)
+    call report(maxval(abs(r)) <= 100*eps*sys%k_norm*maxval(abs(u)), &
+                en//' rigid-body motion gives zero nodal forces', &
+                maxval(abs(r))/(sys%k_norm*maxval(abs(u))), 100*eps)
 
     ! Q1: the bilinear field u = (xy, xy) is in the element space; its strain energy
-    ! u'Ku must equal the exact integral of lam (tr eps)^2 + 2 mu eps:eps (this checks the
+    ! u'Ku must equal the exact integral of lambda (tr eps)^2 + 2 mu eps:eps (this checks the
     ! quadrature of the element stiffness, which the patch test cannot see).
     if (element == ELEM_Q1) then
       do k = 1, m%nnode
@@ -269,8 +243,8 @@ contains
         u(2*k) = m%xy(1, k)*m%xy(2, k)
       end do
       call residual_full(m, body, .true., u, uf, r)
-      mu = body%young/(2*(1 + body%poisson))
-      lam = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
+      lame_mu = body%young/(2*(1 + body%poisson))
+      lame_lambda = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
       x0 = body%x0
       x1 = body%x0 + body%width
       y0 = body%y0
@@ -278,10 +252,10 @@ contains
       ix2 = (y1 - y0)*(x1**3 - x0**3)/3
       iy2 = (x1 - x0)*(y1**3 - y0**3)/3
       ixy = (x1**2 - x0**2)*(y1**2 - y0**2)/4
-      energy = (lam + mu)*(ix2 + iy2 + 2*ixy) + 2*mu*(ix2 + iy2)
+      energy = (lame_lambda + lame_mu)*(ix2 + iy2 + 2*ixy) + 2*lame_mu*(ix2 + iy2)
       diff = abs(dot_product(u, r) - energy)
-      call check(en//' strain energy of a bilinear field is exact (rel err)', diff <= 1.0e-13_wp*energy, &
-                 diff/energy, 1.0e-13_wp)
+      call report(diff <= 1.0e-13_wp*energy, &
+                  en//' strain energy of a bilinear field is exact (rel err)', diff/energy, 1.0e-13_wp)
     end if
   end subroutine test_structure
 
@@ -321,7 +295,7 @@ contains
     type(body_system_t) :: sys
     type(traction_cfg_t) :: tr(1)
     real(wp), allocatable :: u_ex(:), u(:), sigma(:, :), vm(:)
-    real(wp) :: a(0:2), b(0:2), e, nu, lam, mu, exx, eyy, gxy, s_ex(4), vm_ex, err, umax
+    real(wp) :: a(0:2), b(0:2), e, nu, lame_lambda, lame_mu, exx, eyy, gxy, s_ex(4), vm_ex, err, umax
     integer :: k, i, j
     character(len=32) :: what
 
@@ -360,22 +334,22 @@ contains
       end do
     end do
     umax = maxval(abs(u_ex))
-    call check('patch '//trim(what)//': interior displacements (max rel err)', err <= 1.0e-12_wp*umax, &
-               err/umax, 1.0e-12_wp)
+    call report(err <= 1.0e-12_wp*umax, &
+                'patch '//trim(what)//': interior displacements (max rel err)', err/umax, 1.0e-12_wp)
 
     ! Stress of the linear field, from the textbook moduli (independent of module assembly).
-    mu = e/(2*(1 + nu))
+    lame_mu = e/(2*(1 + nu))
     if (plane_strain) then
-      lam = e*nu/((1 + nu)*(1 - 2*nu))
+      lame_lambda = e*nu/((1 + nu)*(1 - 2*nu))
     else
-      lam = e*nu/(1 - nu**2)
+      lame_lambda = e*nu/(1 - nu**2)
     end if
     exx = a(1)
     eyy = b(2)
     gxy = a(2) + b(1)
-    s_ex(1) = (lam + 2*mu)*exx + lam*eyy
-    s_ex(2) = lam*exx + (lam + 2*mu)*eyy
-    s_ex(3) = mu*gxy
+    s_ex(1) = (lame_lambda + 2*lame_mu)*exx + lame_lambda*eyy
+    s_ex(2) = lame_lambda*exx + (lame_lambda + 2*lame_mu)*eyy
+    s_ex(3) = lame_mu*gxy
     s_ex(4) = merge(nu*(s_ex(1) + s_ex(2)), 0.0_wp, plane_strain)
     vm_ex = sqrt(0.5_wp*((s_ex(1) - s_ex(2))**2 + (s_ex(2) - s_ex(4))**2 + (s_ex(4) - s_ex(1))**2) &
                  + 3*s_ex(3)**2)
@@ -385,10 +359,12 @@ contains
     do k = 1, m%nnode
       err = max(err, maxval(abs(sigma(:, k) - s_ex)))
     end do
-    call check('patch '//trim(what)//': nodal stress = D eps (max rel err)', &
-               err <= 1.0e-11_wp*maxval(abs(s_ex)), err/maxval(abs(s_ex)), 1.0e-11_wp)
+    call report(err <= 1.0e-11_wp*maxval(abs(s_ex)), &
+                'patch '//trim(what)//': nodal stress = D eps (max rel err)', &
+                err/maxval(abs(s_ex)), 1.0e-11_wp)
     err = maxval(abs(vm - vm_ex))
-    call check('patch '//trim(what)//': von Mises (max rel err)', err <= 1.0e-11_wp*vm_ex, err/vm_ex, 1.0e-11_wp)
+    call report(err <= 1.0e-11_wp*vm_ex, &
+                'patch '//trim(what)//': von Mises (max rel err)', err/vm_ex, 1.0e-11_wp)
   end subroutine test_patch
 
   ! ---------------------------------------------------------------------------------
@@ -497,8 +473,8 @@ contains
     body%young = 1.0_wp
     body%poisson = 0.3_wp
     body%bc = BC_CLAMPED
-    ms_mu = body%young/(2*(1 + body%poisson))
-    ms_lam = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
+    ms_lame_mu = body%young/(2*(1 + body%poisson))
+    ms_lame_lambda = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
     do lev = 1, nlev
       body%nx = 2**(lev + 1)
       body%ny = 2**(lev + 1)
@@ -526,10 +502,10 @@ contains
       rh1 = log(eh1(lev - 1)/eh1(lev))/log(2.0_wp)
       write (what, '(a,a,a,i0,a,i0)') 'manufactured ', element_names(element), ' L2 rate ', &
         2**lev, ' -> ', 2**(lev + 1)
-      call check(trim(what)//' (>= 1.8)', rl2 >= 1.8_wp, rl2, 1.8_wp)
+      call report(rl2 >= 1.8_wp, trim(what)//' (>= 1.8)', rl2, 1.8_wp)
       write (what, '(a,a,a,i0,a,i0)') 'manufactured ', element_names(element), ' H1 rate ', &
         2**lev, ' -> ', 2**(lev + 1)
-      call check(trim(what)//' (>= 0.9)', rh1 >= 0.9_wp, rh1, 0.9_wp)
+      call report(rh1 >= 0.9_wp, trim(what)//' (>= 0.9)', rh1, 0.9_wp)
     end do
   end subroutine test_manufactured
 
@@ -604,11 +580,11 @@ contains
         write (what, '(a,a,1x,a,1x,a)') 'traction ', element_names(element), &
           trim(merge('uniform', 'linear ', kase == 1)), trim(side_names(side))
         err = maxval(abs(fsum - fex))
-        call check(trim(what)//': resultant exact', err <= 20*eps*scale, err/scale, 20*eps)
+        call report(err <= 20*eps*scale, trim(what)//': resultant exact', err/scale, 20*eps)
         err = maxval(abs(fmom - mex))
-        call check(trim(what)//': first moment exact', err <= 20*eps*scale*max(abs(sa), abs(sb)), &
-                   err/(scale*max(abs(sa), abs(sb))), 20*eps)
-        call check(trim(what)//': no load off the side', other == 0.0_wp, other, 0.0_wp)
+        call report(err <= 20*eps*scale*max(abs(sa), abs(sb)), &
+                    trim(what)//': first moment exact', err/(scale*max(abs(sa), abs(sb))), 20*eps)
+        call report(other == 0.0_wp, trim(what)//': no load off the side', other, 0.0_wp)
       end do
     end do
   end subroutine test_tractions
@@ -661,8 +637,9 @@ contains
     call solve_body(b_mm, plane_strain, t_mm, 2, m, sys, u_mm)
     scale = maxval(abs(u_mm))
     err = maxval(abs(u_mm - 1.0e3_wp*u_si))
-    call check('units '//element_names(element)//' '//merge('strain', 'stress', plane_strain)// &
-               ': u[mm] = 1e3 u[m] (max rel err)', err <= 1.0e-12_wp*scale, err/scale, 1.0e-12_wp)
+    call report(err <= 1.0e-12_wp*scale, &
+                'units '//element_names(element)//' '//merge('strain', 'stress', plane_strain)// ': u[mm] = 1e3 u[m] (max rel err)', &
+                err/scale, 1.0e-12_wp)
   end subroutine test_units
 
   ! ---------------------------------------------------------------------------------
@@ -685,32 +662,32 @@ contains
     tr(1)%side = 7
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
     write (*, '(a,a)') '      message: ', trim(msg)
-    call check('errors: traction side 7 gives info /= 0 and a message', info /= 0 .and. len_trim(msg) > 0, &
-               real(info, wp), 0.0_wp)
+    call report(info /= 0 .and. len_trim(msg) > 0, &
+                'errors: traction side 7 gives info /= 0 and a message', real(info, wp), 0.0_wp)
     call assemble_body(m, body, .true., tr, 2, sys, info, msg)
-    call check('errors: ntraction > size(tractions) gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: ntraction > size(tractions) gives info /= 0', real(info, wp), 0.0_wp)
     tr(1)%side = SIDE_TOP
     body%poisson = 0.5_wp
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check('errors: Poisson ratio 0.5 gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: Poisson ratio 0.5 gives info /= 0', real(info, wp), 0.0_wp)
     body%poisson = 0.3_wp
     body%bc(SIDE_TOP) = 9
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check('errors: unknown side condition gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: unknown side condition gives info /= 0', real(info, wp), 0.0_wp)
     body%bc(SIDE_TOP) = BC_FREE
     up = 0.0_wp
     call assemble_body(m, body, .true., tr, 1, sys, info, msg, u_prescribed=up)
-    call check('errors: u_prescribed of the wrong size gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: u_prescribed of the wrong size gives info /= 0', real(info, wp), 0.0_wp)
     m%xy(1, 2) = m%xy(1, 2) + 2*body%width    ! fold a cell over
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
     write (*, '(a,a)') '      message: ', trim(msg)
-    call check('errors: an inverted cell gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: an inverted cell gives info /= 0', real(info, wp), 0.0_wp)
     body%nx = 0
     call mesh_build(m, body, info, msg)
-    call check('errors: mesh_build with nx = 0 gives info /= 0', info /= 0 .and. m%nnode == 0, &
-               real(info, wp), 0.0_wp)
+    call report(info /= 0 .and. m%nnode == 0, &
+                'errors: mesh_build with nx = 0 gives info /= 0', real(info, wp), 0.0_wp)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check('errors: assemble_body on an empty mesh gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: assemble_body on an empty mesh gives info /= 0', real(info, wp), 0.0_wp)
   end subroutine test_errors
 
 end program test_fem
