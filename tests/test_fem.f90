@@ -50,7 +50,8 @@ program test_fem
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
-  use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec
+  use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
+                      body_force_fn
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
   use testing, only: report, test_summary, band_solve
   implicit none (type, external)
@@ -75,27 +76,22 @@ program test_fem
 
 contains
 
-  !> Mesh, assemble and solve one body; stops the test on an assembly error.
-  subroutine solve_body(body, plane_strain, tr, ntr, m, sys, u_full, u_prescribed, distort)
+  !> Assemble and solve one body on its mesh; stops the test on an assembly error.
+  subroutine solve_body(m, body, plane_strain, tr, ntr, sys, u_full, u_prescribed, body_force)
+    type(mesh_t), intent(in) :: m
     type(body_cfg_t), intent(in) :: body
     logical, intent(in) :: plane_strain
     type(traction_cfg_t), intent(in) :: tr(:)
     integer, intent(in) :: ntr
-    type(mesh_t), intent(out) :: m
     type(body_system_t), intent(out) :: sys
     real(wp), allocatable, intent(out) :: u_full(:)
     real(wp), intent(in), optional :: u_prescribed(:)
-    real(wp), intent(in), optional :: distort
+    procedure(body_force_fn), optional :: body_force
     integer :: info
     character(len=256) :: msg
     real(wp), allocatable :: u(:)
-    call mesh_build(m, body)
-    if (present(distort)) call distort_interior(m, distort)
-    if (present(u_prescribed)) then
-      call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed)
-    else
-      call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg)
-    end if
+    call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed, &
+                       body_force=body_force)
     if (info /= 0) then
       write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
       error stop 1
@@ -104,6 +100,25 @@ contains
     call band_solve(sys, u)
     call expand(sys, u, u_full)
   end subroutine solve_body
+
+  !> Body `id`, the rectangle [x0, x0+width] x [y0, y0+height] on an nx x ny grid of
+  !! `element`; material young, poisson where given, else the type's defaults; sides free.
+  function rect_body(id, x0, y0, width, height, nx, ny, element, young, poisson) result(body)
+    integer, intent(in) :: id, nx, ny, element
+    real(wp), intent(in) :: x0, y0, width, height
+    real(wp), intent(in), optional :: young, poisson
+    type(body_cfg_t) :: body
+    body%id = id
+    body%x0 = x0
+    body%y0 = y0
+    body%width = width
+    body%height = height
+    body%nx = nx
+    body%ny = ny
+    body%element = element
+    if (present(young)) body%young = young
+    if (present(poisson)) body%poisson = poisson
+  end function rect_body
 
   !> Deterministic pseudo-random number in [-0.5, 0.5) for integer pair (i, j).
   pure real(wp) function hash01(i, j)
@@ -147,16 +162,7 @@ contains
     real(wp), allocatable :: uf(:), r(:), u(:)
 
     en = element_names(element)
-    body%id = 1
-    body%x0 = -0.4_wp
-    body%y0 = 0.3_wp
-    body%width = 2.5_wp
-    body%height = 1.2_wp
-    body%nx = 5
-    body%ny = 3
-    body%element = element
-    body%young = 70.0_wp
-    body%poisson = 0.33_wp
+    body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, 5, 3, element, young=70.0_wp, poisson=0.33_wp)
     body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
     body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
     tr(1)%body = 1
@@ -302,21 +308,11 @@ contains
     write (what, '(a,a,a)') element_names(element), ' ', merge('plane strain', 'plane stress', plane_strain)
     a = [1.0e-3_wp, 2.0e-3_wp, -1.0e-3_wp]
     b = [-5.0e-4_wp, 1.5e-3_wp, 3.0e-3_wp]
-    body%id = 1
-    body%x0 = 0.2_wp
-    body%y0 = -0.3_wp
-    body%width = 1.2_wp
-    body%height = 1.0_wp
-    body%nx = 6
-    body%ny = 5
-    body%element = element
-    body%young = 200.0_wp
-    body%poisson = 0.3_wp
+    body = rect_body(1, 0.2_wp, -0.3_wp, 1.2_wp, 1.0_wp, 6, 5, element, young=200.0_wp, poisson=0.3_wp)
     body%bc = BC_CLAMPED
     e = body%young
     nu = body%poisson
 
-    ! The mesh is built twice (here and in solve_body) with the same distortion.
     call mesh_build(m, body)
     call distort_interior(m, 0.3_wp)
     allocate (u_ex(2*m%nnode))
@@ -324,7 +320,7 @@ contains
       u_ex(2*k - 1) = a(0) + a(1)*m%xy(1, k) + a(2)*m%xy(2, k)
       u_ex(2*k) = b(0) + b(1)*m%xy(1, k) + b(2)*m%xy(2, k)
     end do
-    call solve_body(body, plane_strain, tr, 0, m, sys, u, u_prescribed=u_ex, distort=0.3_wp)
+    call solve_body(m, body, plane_strain, tr, 0, sys, u, u_prescribed=u_ex)
 
     err = 0.0_wp
     do j = 1, m%ny - 1
@@ -459,19 +455,11 @@ contains
     type(body_system_t) :: sys
     type(traction_cfg_t) :: tr(1)
     real(wp) :: el2(nlev), eh1(nlev), rl2, rh1, ue(2), ge(2, 2)
-    real(wp), allocatable :: up(:), x(:), u(:)
-    integer :: lev, info, k
-    character(len=256) :: msg
+    real(wp), allocatable :: up(:), u(:)
+    integer :: lev, k
     character(len=80) :: what
 
-    body%id = 1
-    body%x0 = 0.5_wp
-    body%y0 = -0.25_wp
-    body%width = 1.5_wp
-    body%height = 1.0_wp
-    body%element = element
-    body%young = 1.0_wp
-    body%poisson = 0.3_wp
+    body = rect_body(1, 0.5_wp, -0.25_wp, 1.5_wp, 1.0_wp, 4, 4, element, young=1.0_wp, poisson=0.3_wp)
     body%bc = BC_CLAMPED
     ms_lame_mu = body%young/(2*(1 + body%poisson))
     ms_lame_lambda = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
@@ -484,18 +472,11 @@ contains
         call ms_u(m%xy(1, k), m%xy(2, k), ue, ge)
         up(2*k - 1:2*k) = ue
       end do
-      call assemble_body(m, body, .true., tr, 0, sys, info, msg, u_prescribed=up, body_force=ms_force)
-      if (info /= 0) then
-        write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
-        error stop 1
-      end if
-      allocate (x(sys%n), u(sys%ndof))
-      call band_solve(sys, x)
-      call expand(sys, x, u)
+      call solve_body(m, body, .true., tr, 0, sys, u, u_prescribed=up, body_force=ms_force)
       call ms_errors(m, u, el2(lev), eh1(lev))
       write (*, '(a,a,1x,i3,a,i3,a,es11.4,a,es11.4)') '      manufactured ', element_names(element), &
         body%nx, ' x', body%ny, ': L2 error ', el2(lev), '  H1-seminorm error ', eh1(lev)
-      deallocate (up, x, u)
+      deallocate (up, u)
     end do
     do lev = 2, nlev
       rl2 = log(el2(lev - 1)/el2(lev))/log(2.0_wp)
@@ -526,14 +507,7 @@ contains
     real(wp), allocatable :: s_of(:)
     logical, allocatable :: onside(:)
 
-    body%id = 2
-    body%x0 = 0.5_wp
-    body%y0 = 1.0_wp
-    body%width = 2.0_wp
-    body%height = 1.2_wp
-    body%nx = 7
-    body%ny = 5
-    body%element = element
+    body = rect_body(2, 0.5_wp, 1.0_wp, 2.0_wp, 1.2_wp, 7, 5, element)
     body%bc = BC_FREE
     call mesh_build(m, body)
     allocate (onside(m%nnode))
@@ -601,16 +575,7 @@ contains
     real(wp), allocatable :: u_si(:), u_mm(:)
     real(wp) :: err, scale
 
-    b_si%id = 1
-    b_si%x0 = 0.1_wp
-    b_si%y0 = 0.2_wp
-    b_si%width = 0.5_wp
-    b_si%height = 0.3_wp
-    b_si%nx = 10
-    b_si%ny = 6
-    b_si%element = element
-    b_si%young = 7.0e10_wp
-    b_si%poisson = 0.33_wp
+    b_si = rect_body(1, 0.1_wp, 0.2_wp, 0.5_wp, 0.3_wp, 10, 6, element, young=7.0e10_wp, poisson=0.33_wp)
     b_si%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
     b_si%u_side(:, SIDE_RIGHT) = [1.0e-4_wp, -2.0e-4_wp]
     t_si(1)%body = 1
@@ -633,8 +598,10 @@ contains
     t_mm(1)%t1 = t_si(1)%t1*1.0e-9_wp
     t_mm(2)%t0 = t_si(2)%t0*1.0e-6_wp
 
-    call solve_body(b_si, plane_strain, t_si, 2, m, sys, u_si)
-    call solve_body(b_mm, plane_strain, t_mm, 2, m, sys, u_mm)
+    call mesh_build(m, b_si)
+    call solve_body(m, b_si, plane_strain, t_si, 2, sys, u_si)
+    call mesh_build(m, b_mm)
+    call solve_body(m, b_mm, plane_strain, t_mm, 2, sys, u_mm)
     scale = maxval(abs(u_mm))
     err = maxval(abs(u_mm - 1.0e3_wp*u_si))
     call report(err <= 1.0e-12_wp*scale, &
