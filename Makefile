@@ -40,7 +40,7 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings config sysinfo signals namelist_input deck mesh assembly ordering linop mprgp cholmod_iface banded cholesky \
+MODS := kinds errors clock strings config sysinfo signals namelist_input deck mesh elements linop assembly ordering mprgp cholmod_iface banded cholesky \
         condense contact_types contact h5io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
 
@@ -89,7 +89,8 @@ $(BUILD)/strings.o:       $(BUILD)/kinds.o
 $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o
 $(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
-$(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o
+$(BUILD)/elements.o:      $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements.o $(BUILD)/linop.o
 $(BUILD)/ordering.o:      $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
 $(BUILD)/linop.o:         $(BUILD)/kinds.o
 $(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o

@@ -2,29 +2,17 @@
 !! left free: the applied loads have the right resultant, and the reactions at the
 !! clamped side balance them in force and moment; the same scene in mm, N, MPa gives
 !! the same displacements. Q1 and P1, plane strain and plane stress. Solves use LAPACK's
-!! banded Cholesky (dpbsv) directly.
+!! banded Cholesky (testing's band_solve).
 program test_equilibrium
   use kinds, only: wp
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, BC_CLAMPED, BC_CONTACT
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand, residual_full
-  use testing, only: band_solve
-  implicit none
+  use testing, only: report, test_summary, band_solve
+  implicit none (type, external)
 
-  interface
-    subroutine dpbsv(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, kd, nrhs, ldab, ldb
-      real(wp), intent(inout) :: ab(ldab, *), b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dpbsv
-  end interface
-
-  real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: load_y = -11.5e6_wp   ! total applied vertical load [N/m]
-  integer :: nfail = 0, npass = 0
 
   call scene(ELEM_Q1, .true.)
   call scene(ELEM_P1, .true.)
@@ -32,24 +20,9 @@ program test_equilibrium
   call scene(ELEM_P1, .false.)
   call dof_counts()
 
-  write (*, '(i0,a,i0,a)') npass, ' passed, ', nfail, ' failed'
-  if (nfail > 0) error stop 1
+  call test_summary()
 
 contains
-
-  subroutine check(what, ok, value, tol)
-    character(len=*), intent(in) :: what
-    logical, intent(in) :: ok
-    real(wp), intent(in) :: value, tol
-    if (ok) then
-      npass = npass + 1
-      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'PASS  ', what, ' (', value, ', tol ', tol, ')'
-    else
-      nfail = nfail + 1
-      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'FAIL  ', what, ' (', value, ', tol ', tol, ')'
-    end if
-  end subroutine check
-
 
   !> The seed's body 1 in SI units (scale = 1) or in mm, N, MPa (scale = 1e3 mm per m).
   subroutine seed_body(element, nx, ny, to_mm, body, tr)
@@ -121,10 +94,11 @@ contains
     call solve(body, tr, plane_strain, m, sys, u)
 
     fsum = [sum(sys%f_applied(1::2)), sum(sys%f_applied(2::2))]
-    call check(trim(tag)//' applied load y = -11.5e6 N/m (rel err)', &
-               abs(fsum(2) - load_y) <= 1.0e-12_wp*abs(load_y), abs(fsum(2) - load_y)/abs(load_y), 1.0e-12_wp)
-    call check(trim(tag)//' applied load x = 0 (rel)', abs(fsum(1)) <= 1.0e-12_wp*abs(load_y), &
-               abs(fsum(1))/abs(load_y), 1.0e-12_wp)
+    call report(abs(fsum(2) - load_y) <= 1.0e-12_wp*abs(load_y), &
+                trim(tag)//' applied load y = -11.5e6 N/m (rel err)', &
+                abs(fsum(2) - load_y)/abs(load_y), 1.0e-12_wp)
+    call report(abs(fsum(1)) <= 1.0e-12_wp*abs(load_y), &
+                trim(tag)//' applied load x = 0 (rel)', abs(fsum(1))/abs(load_y), 1.0e-12_wp)
 
     ! Reactions: r = K_full u - f_full, non-zero only at the clamped DOFs.
     allocate (r(sys%ndof))
@@ -148,26 +122,28 @@ contains
         rfree = max(rfree, abs(r(2*k)))
       end if
     end do
-    call check(trim(tag)//' residual at free DOFs ~ 0 (max |r|/|F|)', rfree <= 1.0e-10_wp*abs(load_y), &
-               rfree/abs(load_y), 1.0e-10_wp)
-    call check(trim(tag)//' reactions + loads = 0 in x (rel)', abs(rsum(1) + fsum(1)) <= 1.0e-10_wp*abs(load_y), &
-               abs(rsum(1) + fsum(1))/abs(load_y), 1.0e-10_wp)
-    call check(trim(tag)//' reactions + loads = 0 in y (rel)', abs(rsum(2) + fsum(2)) <= 1.0e-10_wp*abs(load_y), &
-               abs(rsum(2) + fsum(2))/abs(load_y), 1.0e-10_wp)
+    call report(rfree <= 1.0e-10_wp*abs(load_y), &
+                trim(tag)//' residual at free DOFs ~ 0 (max |r|/|F|)', rfree/abs(load_y), 1.0e-10_wp)
+    call report(abs(rsum(1) + fsum(1)) <= 1.0e-10_wp*abs(load_y), &
+                trim(tag)//' reactions + loads = 0 in x (rel)', &
+                abs(rsum(1) + fsum(1))/abs(load_y), 1.0e-10_wp)
+    call report(abs(rsum(2) + fsum(2)) <= 1.0e-10_wp*abs(load_y), &
+                trim(tag)//' reactions + loads = 0 in y (rel)', &
+                abs(rsum(2) + fsum(2))/abs(load_y), 1.0e-10_wp)
     ! Moments about the origin; the lever arm scale is the body's size (3 m).
-    call check(trim(tag)//' reaction moment + load moment = 0 (rel)', &
-               abs(mom_react + mom_load) <= 1.0e-10_wp*abs(mom_load), &
-               abs(mom_react + mom_load)/abs(mom_load), 1.0e-10_wp)
+    call report(abs(mom_react + mom_load) <= 1.0e-10_wp*abs(mom_load), &
+                trim(tag)//' reaction moment + load moment = 0 (rel)', &
+                abs(mom_react + mom_load)/abs(mom_load), 1.0e-10_wp)
     ! The same scene in mm, N, MPa.
     call seed_body(element, 24, 16, .true., body, tr)
     call solve(body, tr, plane_strain, m, sys, u_mm)
     scale = maxval(abs(u_mm))
     err = maxval(abs(u_mm - 1.0e3_wp*u))
-    call check(trim(tag)//' mm/N/MPa displacements = 1e3 x SI (max rel err)', err <= 1.0e-10_wp*scale, &
-               err/scale, 1.0e-10_wp)
-    call check(trim(tag)//' mm/N/MPa applied load y = -11.5e3 N/mm (rel)', &
-               abs(sum(sys%f_applied(2::2)) - load_y*1.0e-3_wp) <= 1.0e-12_wp*abs(load_y)*1.0e-3_wp, &
-               abs(sum(sys%f_applied(2::2)) - load_y*1.0e-3_wp)/(abs(load_y)*1.0e-3_wp), 1.0e-12_wp)
+    call report(err <= 1.0e-10_wp*scale, &
+                trim(tag)//' mm/N/MPa displacements = 1e3 x SI (max rel err)', err/scale, 1.0e-10_wp)
+    call report(abs(sum(sys%f_applied(2::2)) - load_y*1.0e-3_wp) <= 1.0e-12_wp*abs(load_y)*1.0e-3_wp, &
+                trim(tag)//' mm/N/MPa applied load y = -11.5e3 N/mm (rel)', &
+                abs(sum(sys%f_applied(2::2)) - load_y*1.0e-3_wp)/(abs(load_y)*1.0e-3_wp), 1.0e-12_wp)
   end subroutine scene
 
   !> The seed's Table 1 DOF counts of one body (n) for its four meshes, left side clamped.
@@ -185,7 +161,7 @@ contains
       call mesh_build(m, body)
       call assemble_body(m, body, .true., tr, 2, sys, info, msg)
       write (what, '(a,i0,a,i0,a,i0,a)') 'seed mesh ', nxs(i), 'x', nys(i), ': n = ', nexp(i), ' free DOFs'
-      call check(trim(what), info == 0 .and. sys%n == nexp(i), real(sys%n, wp), real(nexp(i), wp))
+      call report(info == 0 .and. sys%n == nexp(i), trim(what), real(sys%n, wp), real(nexp(i), wp))
     end do
   end subroutine dof_counts
 

@@ -2,13 +2,13 @@
 !! passed to assemble_body as a procedure argument (no internal-procedure trampoline).
 module test_fem_manufactured
   use kinds, only: wp
-  implicit none
+  implicit none (type, external)
   private
-  public :: ms_u, ms_force, ms_lam, ms_mu
+  public :: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
   real(wp), parameter :: pi = acos(-1.0_wp)
   real(wp), parameter :: ka = pi, kb = 0.5_wp*pi, kc = 0.75_wp*pi, kd_ = pi
-  real(wp) :: ms_lam = 0.0_wp   !< Lame lambda of the manufactured problem
-  real(wp) :: ms_mu = 0.0_wp    !< shear modulus of the manufactured problem
+  real(wp) :: ms_lame_lambda = 0.0_wp   !< Lame lambda of the manufactured problem
+  real(wp) :: ms_lame_mu = 0.0_wp       !< shear modulus of the manufactured problem
 
 contains
 
@@ -24,7 +24,7 @@ contains
     g(2, 2) = kd_*cos(kc*x)*cos(kd_*y)
   end subroutine ms_u
 
-  !> f = -div sigma = -(lam + mu) grad div u - mu lap u.
+  !> f = -div sigma = -(lambda + mu) grad div u - mu lap u.
   subroutine ms_force(x, y, f)
     real(wp), intent(in) :: x, y
     real(wp), intent(out) :: f(2)
@@ -35,38 +35,28 @@ contains
     u2xx = -kc**2*cos(kc*x)*sin(kd_*y)
     u2yy = -kd_**2*cos(kc*x)*sin(kd_*y)
     u2xy = -kc*kd_*sin(kc*x)*cos(kd_*y)
-    f(1) = -(ms_lam + ms_mu)*(u1xx + u2xy) - ms_mu*(u1xx + u1yy)
-    f(2) = -(ms_lam + ms_mu)*(u1xy + u2yy) - ms_mu*(u2xx + u2yy)
+    f(1) = -(ms_lame_lambda + ms_lame_mu)*(u1xx + u2xy) - ms_lame_mu*(u1xx + u1yy)
+    f(2) = -(ms_lame_lambda + ms_lame_mu)*(u1xy + u2yy) - ms_lame_mu*(u2xx + u2yy)
   end subroutine ms_force
 
 end module test_fem_manufactured
 
 !> Unit tests of modules mesh and assembly: sparse structure, patch test on a distorted
 !! mesh, convergence rates against a manufactured solution, traction loads, unit scaling
-!! and error reporting. Solves use LAPACK's banded Cholesky (dpbsv) directly.
+!! and error reporting. Solves use LAPACK's banded Cholesky (testing's band_solve).
 program test_fem
   use kinds, only: wp
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
-  use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec
-  use test_fem_manufactured, only: ms_u, ms_force, ms_lam, ms_mu
-  use testing, only: band_solve
-  implicit none
-
-  interface
-    subroutine dpbsv(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, kd, nrhs, ldab, ldb
-      real(wp), intent(inout) :: ab(ldab, *), b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dpbsv
-  end interface
+  use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
+                      body_force_fn
+  use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
+  use testing, only: report, test_summary, band_solve
+  implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
-  integer :: nfail = 0, npass = 0
 
   call test_structure(ELEM_Q1)
   call test_structure(ELEM_P1)
@@ -82,46 +72,26 @@ program test_fem
   call test_units(ELEM_P1, .false.)
   call test_errors()
 
-  write (*, '(i0,a,i0,a)') npass, ' passed, ', nfail, ' failed'
-  if (nfail > 0) error stop 1
+  call test_summary()
 
 contains
 
-  subroutine check(what, ok, value, tol)
-    character(len=*), intent(in) :: what
-    logical, intent(in) :: ok
-    real(wp), intent(in) :: value, tol
-    if (ok) then
-      npass = npass + 1
-      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'PASS  ', what, ' (', value, ', tol ', tol, ')'
-    else
-      nfail = nfail + 1
-      write (*, '(a,a,a,es10.3,a,es10.3,a)') 'FAIL  ', what, ' (', value, ', tol ', tol, ')'
-    end if
-  end subroutine check
-
-
-  !> Mesh, assemble and solve one body; stops the test on an assembly error.
-  subroutine solve_body(body, plane_strain, tr, ntr, m, sys, u_full, u_prescribed, distort)
+  !> Assemble and solve one body on its mesh; stops the test on an assembly error.
+  subroutine solve_body(m, body, plane_strain, tr, ntr, sys, u_full, u_prescribed, body_force)
+    type(mesh_t), intent(in) :: m
     type(body_cfg_t), intent(in) :: body
     logical, intent(in) :: plane_strain
     type(traction_cfg_t), intent(in) :: tr(:)
     integer, intent(in) :: ntr
-    type(mesh_t), intent(out) :: m
     type(body_system_t), intent(out) :: sys
     real(wp), allocatable, intent(out) :: u_full(:)
     real(wp), intent(in), optional :: u_prescribed(:)
-    real(wp), intent(in), optional :: distort
+    procedure(body_force_fn), optional :: body_force
     integer :: info
     character(len=256) :: msg
     real(wp), allocatable :: u(:)
-    call mesh_build(m, body)
-    if (present(distort)) call distort_interior(m, distort)
-    if (present(u_prescribed)) then
-      call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed)
-    else
-      call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg)
-    end if
+    call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed, &
+                       body_force=body_force)
     if (info /= 0) then
       write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
       error stop 1
@@ -130,6 +100,25 @@ contains
     call band_solve(sys, u)
     call expand(sys, u, u_full)
   end subroutine solve_body
+
+  !> Body `id`, the rectangle [x0, x0+width] x [y0, y0+height] on an nx x ny grid of
+  !! `element`; material young, poisson where given, else the type's defaults; sides free.
+  function rect_body(id, x0, y0, width, height, nx, ny, element, young, poisson) result(body)
+    integer, intent(in) :: id, nx, ny, element
+    real(wp), intent(in) :: x0, y0, width, height
+    real(wp), intent(in), optional :: young, poisson
+    type(body_cfg_t) :: body
+    body%id = id
+    body%x0 = x0
+    body%y0 = y0
+    body%width = width
+    body%height = height
+    body%nx = nx
+    body%ny = ny
+    body%element = element
+    if (present(young)) body%young = young
+    if (present(poisson)) body%poisson = poisson
+  end function rect_body
 
   !> Deterministic pseudo-random number in [-0.5, 0.5) for integer pair (i, j).
   pure real(wp) function hash01(i, j)
@@ -169,20 +158,11 @@ contains
     character(len=256) :: msg
     character(len=2) :: en
     logical :: sorted, found
-    real(wp) :: asym, diff, scale, x(200), y(200), lam, mu, x0, x1, y0, y1, ix2, iy2, ixy, energy
+    real(wp) :: asym, diff, scale, x(200), y(200), lame_lambda, lame_mu, x0, x1, y0, y1, ix2, iy2, ixy, energy
     real(wp), allocatable :: uf(:), r(:), u(:)
 
     en = element_names(element)
-    body%id = 1
-    body%x0 = -0.4_wp
-    body%y0 = 0.3_wp
-    body%width = 2.5_wp
-    body%height = 1.2_wp
-    body%nx = 5
-    body%ny = 3
-    body%element = element
-    body%young = 70.0_wp
-    body%poisson = 0.33_wp
+    body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, 5, 3, element, young=70.0_wp, poisson=0.33_wp)
     body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
     body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
     tr(1)%body = 1
@@ -191,18 +171,19 @@ contains
     tr(1)%t1 = [0.0_wp, 0.5_wp]
     call mesh_build(m, body)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check(en//' assemble_body info = 0 on a valid body', info == 0, real(info, wp), 0.0_wp)
+    call report(info == 0, en//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
 
     ! 6 x 4 nodes = 48 dofs; left clamped 8, bottom roller 5 more y's, right both 8
     ! minus the bottom-right y already prescribed: 7; free 48 - 20 = 28.
-    call check(en//' free dof count (expect 28)', sys%n == 28, real(sys%n, wp), 0.0_wp)
-    call check(en//' corner rule: bottom-right y takes the later side (roller, 0)', &
-               sys%u_fixed(2*6) == 0.0_wp .and. sys%u_fixed(2*6 - 1) == 0.01_wp, sys%u_fixed(2*6), 0.0_wp)
+    call report(sys%n == 28, en//' free dof count (expect 28)', real(sys%n, wp), 0.0_wp)
+    call report(sys%u_fixed(2*6) == 0.0_wp .and. sys%u_fixed(2*6 - 1) == 0.01_wp, &
+                en//' corner rule: bottom-right y takes the later side (roller, 0)', sys%u_fixed(2*6), 0.0_wp)
 
     ! nnz from first principles: count couplings between free dofs through cells.
     nnz_expect = count_couplings(m, sys)
-    call check(en//' nnz equals the free-free couplings through cells', &
-               sys%colptr(sys%n + 1) == nnz_expect, real(sys%colptr(sys%n + 1), wp), real(nnz_expect, wp))
+    call report(sys%colptr(sys%n + 1) == nnz_expect, &
+                en//' nnz equals the free-free couplings through cells', &
+                real(sys%colptr(sys%n + 1), wp), real(nnz_expect, wp))
 
     sorted = .true.
     asym = 0.0_wp
@@ -222,9 +203,9 @@ contains
         if (.not. found) asym = huge(1.0_wp)
       end do
     end do
-    call check(en//' rows strictly increasing in every column', sorted, 0.0_wp, 0.0_wp)
-    call check(en//' pattern and values symmetric (max |Kij-Kji|/|K|)', &
-               asym <= 10*eps*sys%k_norm, asym/sys%k_norm, 10*eps)
+    call report(sorted, en//' rows strictly increasing in every column', 0.0_wp, 0.0_wp)
+    call report(asym <= 10*eps*sys%k_norm, &
+                en//' pattern and values symmetric (max |Kij-Kji|/|K|)', asym/sys%k_norm, 10*eps)
 
     ! Matvec on free dofs + lifting against the element loop on all dofs:
     ! (K_full u_full - f_applied)_free = K_ff u_f - f.
@@ -240,13 +221,12 @@ contains
       diff = max(diff, abs(r(sys%dof_of(k)) - (y(k) - sys%f(k))))
     end do
     scale = sys%k_norm*maxval(abs(uf)) + maxval(abs(sys%f_applied))
-    call check(en//' csc_matvec and lifting agree with the element loop', diff <= 100*eps*scale, &
-               diff/scale, 100*eps)
+    call report(diff <= 100*eps*scale, &
+                en//' csc_matvec and lifting agree with the element loop', diff/scale, 100*eps)
 
     ! k_norm is the infinity norm: at least every |K_jj|, at most the sum of all entries.
-    call check(en//' k_norm between max |K_jj| and sum |K_ij|', &
-               sys%k_norm >= maxval(abs(sys%val))*(1 - eps) .and. sys%k_norm <= sum(abs(sys%val)), &
-               sys%k_norm, 0.0_wp)
+    call report(sys%k_norm >= maxval(abs(sys%val))*(1 - eps) .and. sys%k_norm <= sum(abs(sys%val)), &
+                en//' k_norm between max |K_jj| and sum |K_ij|', sys%k_norm, 0.0_wp)
 
     ! Rigid-body modes produce no force.
     allocate (u(sys%ndof))
@@ -256,12 +236,12 @@ contains
       u(2*k) = -1.1_wp + 0.7_wp*m%xy(1, k)
     end do
     call residual_full(m, body, .true., u, uf, r)
-    call check(en//' rigid-body motion gives zero nodal forces', &
-               maxval(abs(r)) <= 100*eps*sys%k_norm*maxval(abs(u)), &
-               maxval(abs(r))/(sys%k_norm*maxval(abs(u))), 100*eps)
+    call report(maxval(abs(r)) <= 100*eps*sys%k_norm*maxval(abs(u)), &
+                en//' rigid-body motion gives zero nodal forces', &
+                maxval(abs(r))/(sys%k_norm*maxval(abs(u))), 100*eps)
 
     ! Q1: the bilinear field u = (xy, xy) is in the element space; its strain energy
-    ! u'Ku must equal the exact integral of lam (tr eps)^2 + 2 mu eps:eps (this checks the
+    ! u'Ku must equal the exact integral of lambda (tr eps)^2 + 2 mu eps:eps (this checks the
     ! quadrature of the element stiffness, which the patch test cannot see).
     if (element == ELEM_Q1) then
       do k = 1, m%nnode
@@ -269,8 +249,8 @@ contains
         u(2*k) = m%xy(1, k)*m%xy(2, k)
       end do
       call residual_full(m, body, .true., u, uf, r)
-      mu = body%young/(2*(1 + body%poisson))
-      lam = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
+      lame_mu = body%young/(2*(1 + body%poisson))
+      lame_lambda = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
       x0 = body%x0
       x1 = body%x0 + body%width
       y0 = body%y0
@@ -278,10 +258,10 @@ contains
       ix2 = (y1 - y0)*(x1**3 - x0**3)/3
       iy2 = (x1 - x0)*(y1**3 - y0**3)/3
       ixy = (x1**2 - x0**2)*(y1**2 - y0**2)/4
-      energy = (lam + mu)*(ix2 + iy2 + 2*ixy) + 2*mu*(ix2 + iy2)
+      energy = (lame_lambda + lame_mu)*(ix2 + iy2 + 2*ixy) + 2*lame_mu*(ix2 + iy2)
       diff = abs(dot_product(u, r) - energy)
-      call check(en//' strain energy of a bilinear field is exact (rel err)', diff <= 1.0e-13_wp*energy, &
-                 diff/energy, 1.0e-13_wp)
+      call report(diff <= 1.0e-13_wp*energy, &
+                  en//' strain energy of a bilinear field is exact (rel err)', diff/energy, 1.0e-13_wp)
     end if
   end subroutine test_structure
 
@@ -321,28 +301,18 @@ contains
     type(body_system_t) :: sys
     type(traction_cfg_t) :: tr(1)
     real(wp), allocatable :: u_ex(:), u(:), sigma(:, :), vm(:)
-    real(wp) :: a(0:2), b(0:2), e, nu, lam, mu, exx, eyy, gxy, s_ex(4), vm_ex, err, umax
+    real(wp) :: a(0:2), b(0:2), e, nu, lame_lambda, lame_mu, exx, eyy, gxy, s_ex(4), vm_ex, err, umax
     integer :: k, i, j
     character(len=32) :: what
 
     write (what, '(a,a,a)') element_names(element), ' ', merge('plane strain', 'plane stress', plane_strain)
     a = [1.0e-3_wp, 2.0e-3_wp, -1.0e-3_wp]
     b = [-5.0e-4_wp, 1.5e-3_wp, 3.0e-3_wp]
-    body%id = 1
-    body%x0 = 0.2_wp
-    body%y0 = -0.3_wp
-    body%width = 1.2_wp
-    body%height = 1.0_wp
-    body%nx = 6
-    body%ny = 5
-    body%element = element
-    body%young = 200.0_wp
-    body%poisson = 0.3_wp
+    body = rect_body(1, 0.2_wp, -0.3_wp, 1.2_wp, 1.0_wp, 6, 5, element, young=200.0_wp, poisson=0.3_wp)
     body%bc = BC_CLAMPED
     e = body%young
     nu = body%poisson
 
-    ! The mesh is built twice (here and in solve_body) with the same distortion.
     call mesh_build(m, body)
     call distort_interior(m, 0.3_wp)
     allocate (u_ex(2*m%nnode))
@@ -350,7 +320,7 @@ contains
       u_ex(2*k - 1) = a(0) + a(1)*m%xy(1, k) + a(2)*m%xy(2, k)
       u_ex(2*k) = b(0) + b(1)*m%xy(1, k) + b(2)*m%xy(2, k)
     end do
-    call solve_body(body, plane_strain, tr, 0, m, sys, u, u_prescribed=u_ex, distort=0.3_wp)
+    call solve_body(m, body, plane_strain, tr, 0, sys, u, u_prescribed=u_ex)
 
     err = 0.0_wp
     do j = 1, m%ny - 1
@@ -360,22 +330,22 @@ contains
       end do
     end do
     umax = maxval(abs(u_ex))
-    call check('patch '//trim(what)//': interior displacements (max rel err)', err <= 1.0e-12_wp*umax, &
-               err/umax, 1.0e-12_wp)
+    call report(err <= 1.0e-12_wp*umax, &
+                'patch '//trim(what)//': interior displacements (max rel err)', err/umax, 1.0e-12_wp)
 
     ! Stress of the linear field, from the textbook moduli (independent of module assembly).
-    mu = e/(2*(1 + nu))
+    lame_mu = e/(2*(1 + nu))
     if (plane_strain) then
-      lam = e*nu/((1 + nu)*(1 - 2*nu))
+      lame_lambda = e*nu/((1 + nu)*(1 - 2*nu))
     else
-      lam = e*nu/(1 - nu**2)
+      lame_lambda = e*nu/(1 - nu**2)
     end if
     exx = a(1)
     eyy = b(2)
     gxy = a(2) + b(1)
-    s_ex(1) = (lam + 2*mu)*exx + lam*eyy
-    s_ex(2) = lam*exx + (lam + 2*mu)*eyy
-    s_ex(3) = mu*gxy
+    s_ex(1) = (lame_lambda + 2*lame_mu)*exx + lame_lambda*eyy
+    s_ex(2) = lame_lambda*exx + (lame_lambda + 2*lame_mu)*eyy
+    s_ex(3) = lame_mu*gxy
     s_ex(4) = merge(nu*(s_ex(1) + s_ex(2)), 0.0_wp, plane_strain)
     vm_ex = sqrt(0.5_wp*((s_ex(1) - s_ex(2))**2 + (s_ex(2) - s_ex(4))**2 + (s_ex(4) - s_ex(1))**2) &
                  + 3*s_ex(3)**2)
@@ -385,10 +355,12 @@ contains
     do k = 1, m%nnode
       err = max(err, maxval(abs(sigma(:, k) - s_ex)))
     end do
-    call check('patch '//trim(what)//': nodal stress = D eps (max rel err)', &
-               err <= 1.0e-11_wp*maxval(abs(s_ex)), err/maxval(abs(s_ex)), 1.0e-11_wp)
+    call report(err <= 1.0e-11_wp*maxval(abs(s_ex)), &
+                'patch '//trim(what)//': nodal stress = D eps (max rel err)', &
+                err/maxval(abs(s_ex)), 1.0e-11_wp)
     err = maxval(abs(vm - vm_ex))
-    call check('patch '//trim(what)//': von Mises (max rel err)', err <= 1.0e-11_wp*vm_ex, err/vm_ex, 1.0e-11_wp)
+    call report(err <= 1.0e-11_wp*vm_ex, &
+                'patch '//trim(what)//': von Mises (max rel err)', err/vm_ex, 1.0e-11_wp)
   end subroutine test_patch
 
   ! ---------------------------------------------------------------------------------
@@ -483,22 +455,14 @@ contains
     type(body_system_t) :: sys
     type(traction_cfg_t) :: tr(1)
     real(wp) :: el2(nlev), eh1(nlev), rl2, rh1, ue(2), ge(2, 2)
-    real(wp), allocatable :: up(:), x(:), u(:)
-    integer :: lev, info, k
-    character(len=256) :: msg
+    real(wp), allocatable :: up(:), u(:)
+    integer :: lev, k
     character(len=80) :: what
 
-    body%id = 1
-    body%x0 = 0.5_wp
-    body%y0 = -0.25_wp
-    body%width = 1.5_wp
-    body%height = 1.0_wp
-    body%element = element
-    body%young = 1.0_wp
-    body%poisson = 0.3_wp
+    body = rect_body(1, 0.5_wp, -0.25_wp, 1.5_wp, 1.0_wp, 4, 4, element, young=1.0_wp, poisson=0.3_wp)
     body%bc = BC_CLAMPED
-    ms_mu = body%young/(2*(1 + body%poisson))
-    ms_lam = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
+    ms_lame_mu = body%young/(2*(1 + body%poisson))
+    ms_lame_lambda = body%young*body%poisson/((1 + body%poisson)*(1 - 2*body%poisson))
     do lev = 1, nlev
       body%nx = 2**(lev + 1)
       body%ny = 2**(lev + 1)
@@ -508,28 +472,21 @@ contains
         call ms_u(m%xy(1, k), m%xy(2, k), ue, ge)
         up(2*k - 1:2*k) = ue
       end do
-      call assemble_body(m, body, .true., tr, 0, sys, info, msg, u_prescribed=up, body_force=ms_force)
-      if (info /= 0) then
-        write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
-        error stop 1
-      end if
-      allocate (x(sys%n), u(sys%ndof))
-      call band_solve(sys, x)
-      call expand(sys, x, u)
+      call solve_body(m, body, .true., tr, 0, sys, u, u_prescribed=up, body_force=ms_force)
       call ms_errors(m, u, el2(lev), eh1(lev))
       write (*, '(a,a,1x,i3,a,i3,a,es11.4,a,es11.4)') '      manufactured ', element_names(element), &
         body%nx, ' x', body%ny, ': L2 error ', el2(lev), '  H1-seminorm error ', eh1(lev)
-      deallocate (up, x, u)
+      deallocate (up, u)
     end do
     do lev = 2, nlev
       rl2 = log(el2(lev - 1)/el2(lev))/log(2.0_wp)
       rh1 = log(eh1(lev - 1)/eh1(lev))/log(2.0_wp)
       write (what, '(a,a,a,i0,a,i0)') 'manufactured ', element_names(element), ' L2 rate ', &
         2**lev, ' -> ', 2**(lev + 1)
-      call check(trim(what)//' (>= 1.8)', rl2 >= 1.8_wp, rl2, 1.8_wp)
+      call report(rl2 >= 1.8_wp, trim(what)//' (>= 1.8)', rl2, 1.8_wp)
       write (what, '(a,a,a,i0,a,i0)') 'manufactured ', element_names(element), ' H1 rate ', &
         2**lev, ' -> ', 2**(lev + 1)
-      call check(trim(what)//' (>= 0.9)', rh1 >= 0.9_wp, rh1, 0.9_wp)
+      call report(rh1 >= 0.9_wp, trim(what)//' (>= 0.9)', rh1, 0.9_wp)
     end do
   end subroutine test_manufactured
 
@@ -550,14 +507,7 @@ contains
     real(wp), allocatable :: s_of(:)
     logical, allocatable :: onside(:)
 
-    body%id = 2
-    body%x0 = 0.5_wp
-    body%y0 = 1.0_wp
-    body%width = 2.0_wp
-    body%height = 1.2_wp
-    body%nx = 7
-    body%ny = 5
-    body%element = element
+    body = rect_body(2, 0.5_wp, 1.0_wp, 2.0_wp, 1.2_wp, 7, 5, element)
     body%bc = BC_FREE
     call mesh_build(m, body)
     allocate (onside(m%nnode))
@@ -604,11 +554,11 @@ contains
         write (what, '(a,a,1x,a,1x,a)') 'traction ', element_names(element), &
           trim(merge('uniform', 'linear ', kase == 1)), trim(side_names(side))
         err = maxval(abs(fsum - fex))
-        call check(trim(what)//': resultant exact', err <= 20*eps*scale, err/scale, 20*eps)
+        call report(err <= 20*eps*scale, trim(what)//': resultant exact', err/scale, 20*eps)
         err = maxval(abs(fmom - mex))
-        call check(trim(what)//': first moment exact', err <= 20*eps*scale*max(abs(sa), abs(sb)), &
-                   err/(scale*max(abs(sa), abs(sb))), 20*eps)
-        call check(trim(what)//': no load off the side', other == 0.0_wp, other, 0.0_wp)
+        call report(err <= 20*eps*scale*max(abs(sa), abs(sb)), &
+                    trim(what)//': first moment exact', err/(scale*max(abs(sa), abs(sb))), 20*eps)
+        call report(other == 0.0_wp, trim(what)//': no load off the side', other, 0.0_wp)
       end do
     end do
   end subroutine test_tractions
@@ -625,16 +575,7 @@ contains
     real(wp), allocatable :: u_si(:), u_mm(:)
     real(wp) :: err, scale
 
-    b_si%id = 1
-    b_si%x0 = 0.1_wp
-    b_si%y0 = 0.2_wp
-    b_si%width = 0.5_wp
-    b_si%height = 0.3_wp
-    b_si%nx = 10
-    b_si%ny = 6
-    b_si%element = element
-    b_si%young = 7.0e10_wp
-    b_si%poisson = 0.33_wp
+    b_si = rect_body(1, 0.1_wp, 0.2_wp, 0.5_wp, 0.3_wp, 10, 6, element, young=7.0e10_wp, poisson=0.33_wp)
     b_si%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
     b_si%u_side(:, SIDE_RIGHT) = [1.0e-4_wp, -2.0e-4_wp]
     t_si(1)%body = 1
@@ -657,12 +598,15 @@ contains
     t_mm(1)%t1 = t_si(1)%t1*1.0e-9_wp
     t_mm(2)%t0 = t_si(2)%t0*1.0e-6_wp
 
-    call solve_body(b_si, plane_strain, t_si, 2, m, sys, u_si)
-    call solve_body(b_mm, plane_strain, t_mm, 2, m, sys, u_mm)
+    call mesh_build(m, b_si)
+    call solve_body(m, b_si, plane_strain, t_si, 2, sys, u_si)
+    call mesh_build(m, b_mm)
+    call solve_body(m, b_mm, plane_strain, t_mm, 2, sys, u_mm)
     scale = maxval(abs(u_mm))
     err = maxval(abs(u_mm - 1.0e3_wp*u_si))
-    call check('units '//element_names(element)//' '//merge('strain', 'stress', plane_strain)// &
-               ': u[mm] = 1e3 u[m] (max rel err)', err <= 1.0e-12_wp*scale, err/scale, 1.0e-12_wp)
+    call report(err <= 1.0e-12_wp*scale, &
+                'units '//element_names(element)//' '//merge('strain', 'stress', plane_strain)// ': u[mm] = 1e3 u[m] (max rel err)', &
+                err/scale, 1.0e-12_wp)
   end subroutine test_units
 
   ! ---------------------------------------------------------------------------------
@@ -685,32 +629,32 @@ contains
     tr(1)%side = 7
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
     write (*, '(a,a)') '      message: ', trim(msg)
-    call check('errors: traction side 7 gives info /= 0 and a message', info /= 0 .and. len_trim(msg) > 0, &
-               real(info, wp), 0.0_wp)
+    call report(info /= 0 .and. len_trim(msg) > 0, &
+                'errors: traction side 7 gives info /= 0 and a message', real(info, wp), 0.0_wp)
     call assemble_body(m, body, .true., tr, 2, sys, info, msg)
-    call check('errors: ntraction > size(tractions) gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: ntraction > size(tractions) gives info /= 0', real(info, wp), 0.0_wp)
     tr(1)%side = SIDE_TOP
     body%poisson = 0.5_wp
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check('errors: Poisson ratio 0.5 gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: Poisson ratio 0.5 gives info /= 0', real(info, wp), 0.0_wp)
     body%poisson = 0.3_wp
     body%bc(SIDE_TOP) = 9
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check('errors: unknown side condition gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: unknown side condition gives info /= 0', real(info, wp), 0.0_wp)
     body%bc(SIDE_TOP) = BC_FREE
     up = 0.0_wp
     call assemble_body(m, body, .true., tr, 1, sys, info, msg, u_prescribed=up)
-    call check('errors: u_prescribed of the wrong size gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: u_prescribed of the wrong size gives info /= 0', real(info, wp), 0.0_wp)
     m%xy(1, 2) = m%xy(1, 2) + 2*body%width    ! fold a cell over
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
     write (*, '(a,a)') '      message: ', trim(msg)
-    call check('errors: an inverted cell gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: an inverted cell gives info /= 0', real(info, wp), 0.0_wp)
     body%nx = 0
     call mesh_build(m, body, info, msg)
-    call check('errors: mesh_build with nx = 0 gives info /= 0', info /= 0 .and. m%nnode == 0, &
-               real(info, wp), 0.0_wp)
+    call report(info /= 0 .and. m%nnode == 0, &
+                'errors: mesh_build with nx = 0 gives info /= 0', real(info, wp), 0.0_wp)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call check('errors: assemble_body on an empty mesh gives info /= 0', info /= 0, real(info, wp), 0.0_wp)
+    call report(info /= 0, 'errors: assemble_body on an empty mesh gives info /= 0', real(info, wp), 0.0_wp)
   end subroutine test_errors
 
 end program test_fem

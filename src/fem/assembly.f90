@@ -1,6 +1,8 @@
 !> Plane linear elasticity on a structured mesh (module mesh): the stiffness of one body
 !! on its free DOFs in compressed sparse columns, the consistent load of its tractions,
-!! elimination of prescribed displacements, reactions and nodal stresses.
+!! elimination of prescribed displacements, reactions and nodal stresses. The
+!! per-element work (shape functions, element stiffness, loads, stress) is module
+!! elements'; this module loops over cells and sides and places the results.
 !!
 !! DOFs: node k, component c (1 = x, 2 = y) is global dof 2*(k-1)+c. Free DOFs are
 !! numbered in increasing global order, so the stiffness on free DOFs keeps the natural
@@ -12,8 +14,11 @@ module assembly
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
-  use mesh, only: mesh_t, side_nodes
-  implicit none
+  use mesh, only: mesh_t, side_nodes, node_id
+  use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
+                      element_stiffness, element_body_force, edge_traction, element_stress
+  use linop, only: csc_symv
+  implicit none (type, external)
   private
 
   public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters
@@ -35,45 +40,23 @@ module assembly
     real(wp) :: k_norm = 0.0_wp               !< max abs row sum of K (infinity norm) [stress]
   end type body_system_t
 
-  abstract interface
-    !> A body force density b(x, y) [force/length^3] (per unit thickness: [force/length^2]/[length]).
-    subroutine body_force_fn(x, y, b)
-      import :: wp
-      real(wp), intent(in) :: x            !< position x [length]
-      real(wp), intent(in) :: y            !< position y [length]
-      real(wp), intent(out) :: b(2)        !< body force density [force/length^3]
-    end subroutine body_force_fn
-  end interface
-
-  real(wp), parameter :: xa_q1(4) = [-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp]  ! reference nodes of Q1
-  real(wp), parameter :: ea_q1(4) = [-1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp]
-
-  !> Cache of the last element stiffness: congruent cells (a uniform grid) reuse it.
-  type :: ke_cache_t
-    logical :: valid = .false.
-    real(wp) :: rel(2, 4) = 0.0_wp   ! vertex coordinates relative to vertex 1
-    real(wp) :: tol = 0.0_wp         ! coordinate tolerance below which cells are the same
-    real(wp) :: ke(8, 8) = 0.0_wp
-    real(wp) :: minjac = 0.0_wp
-  end type ke_cache_t
-
 contains
 
   !> Lame parameters of the body: plane strain uses lambda, mu; plane stress the
   !! reduced lambda* = 2 lambda mu / (lambda + 2 mu).
-  pure subroutine lame_parameters(body, plane_strain, lam, mu)
+  pure subroutine lame_parameters(body, plane_strain, lame_lambda, lame_mu)
     type(body_cfg_t), intent(in) :: body     !< young [stress], poisson [-]
     logical, intent(in) :: plane_strain      !< .true. plane strain, .false. plane stress
-    real(wp), intent(out) :: lam             !< (effective) first Lame parameter [stress]
-    real(wp), intent(out) :: mu              !< shear modulus [stress]
+    real(wp), intent(out) :: lame_lambda     !< (effective) first Lame parameter [stress]
+    real(wp), intent(out) :: lame_mu         !< shear modulus [stress]
     real(wp) :: e, nu
     e = body%young
     nu = body%poisson
-    mu = e/(2.0_wp*(1.0_wp + nu))
+    lame_mu = e/(2.0_wp*(1.0_wp + nu))
     if (plane_strain) then
-      lam = e*nu/((1.0_wp + nu)*(1.0_wp - 2.0_wp*nu))
+      lame_lambda = e*nu/((1.0_wp + nu)*(1.0_wp - 2.0_wp*nu))
     else
-      lam = e*nu/(1.0_wp - nu*nu)   ! = 2 lambda mu / (lambda + 2 mu)
+      lame_lambda = e*nu/(1.0_wp - nu*nu)   ! = 2 lambda mu / (lambda + 2 mu)
     end if
   end subroutine lame_parameters
 
@@ -99,22 +82,39 @@ contains
     real(wp), intent(in), optional :: u_prescribed(:)
     !> optional body force density, integrated with 3x3 Gauss (Q1) or a degree-2 rule (P1)
     procedure(body_force_fn), optional :: body_force
-
-    integer :: ndof, n, k, c, p, q, s, t, side, nv, nd, a, b, fc, pos, pend, nstencil
-    integer :: i, j, ii, jj, m, cc, kk
-    integer(i8) :: nnz
-    integer, allocatable :: nodes(:)
     logical, allocatable :: pres(:)
-    integer :: di(9), dj(9), ldof(8), lfree(8), perm(8)
-    real(wp) :: lam, mu, xe(2, 4), ke(8, 8), ue(8), minjac, colsum
-    logical :: lift
-    type(ke_cache_t) :: cache
+    real(wp) :: lame_lambda, lame_mu
+
+    sys%id = body%id
+    call check_input(mesh, body, tractions, ntraction, info, msg, u_prescribed)
+    if (info /= 0) return
+    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+
+    call prescribed_dofs(mesh, body, pres, sys, u_prescribed)
+    call number_free_dofs(pres, sys)
+    call stiffness_pattern(mesh, sys, info, msg)
+    if (info /= 0) return
+    call applied_loads(mesh, body%id, tractions(1:ntraction), sys, body_force)
+    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg)
+    if (info /= 0) return
+    call add_applied_loads(sys)
+    sys%k_norm = stiffness_norm(sys)
+  end subroutine assemble_body
+
+  !> Check the arguments of assemble_body: a built mesh of a known element, a valid
+  !! material, known side conditions, tractions on sides 1..4, u_prescribed of size ndof.
+  subroutine check_input(mesh, body, tractions, ntraction, info, msg, u_prescribed)
+    type(mesh_t), intent(in) :: mesh
+    type(body_cfg_t), intent(in) :: body
+    type(traction_cfg_t), intent(in) :: tractions(:)
+    integer, intent(in) :: ntraction
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    real(wp), intent(in), optional :: u_prescribed(:)
+    integer :: side, t
 
     info = 0
     msg = ''
-    sys%id = body%id
-
-    ! ---- check the arguments --------------------------------------------------------
     if (mesh%nnode < 1 .or. .not. allocated(mesh%xy) .or. .not. allocated(mesh%cells)) then
       info = 1
       write (msg, '(a,i0,a)') 'body ', body%id, ': the mesh is empty (call mesh_build first)'
@@ -159,26 +159,32 @@ contains
         return
       end if
     end do
-    ndof = 2*mesh%nnode
     if (present(u_prescribed)) then
-      if (size(u_prescribed) /= ndof) then
+      if (size(u_prescribed) /= 2*mesh%nnode) then
         info = 5
         write (msg, '(a,i0,a,i0,a,i0)') 'body ', body%id, ': u_prescribed has ', size(u_prescribed), &
-          ' values, expected ndof = ', ndof
+          ' values, expected ndof = ', 2*mesh%nnode
         return
       end if
     end if
+  end subroutine check_input
 
-    call lame_parameters(body, plane_strain, lam, mu)
-    nv = mesh%nvert
-    nd = 2*nv
+  !> Which DOFs the side conditions prescribe (`pres`), and their values (sys%ndof,
+  !! sys%u_fixed). Sides are visited in SIDE_* order; a corner shared by two sides gets
+  !! the union of their constraints, and where both prescribe the same component with
+  !! different values the later side in SIDE_* order (left, right, bottom, top) wins.
+  !! `u_prescribed`, where given, replaces the values at every prescribed DOF.
+  subroutine prescribed_dofs(mesh, body, pres, sys, u_prescribed)
+    type(mesh_t), intent(in) :: mesh
+    type(body_cfg_t), intent(in) :: body
+    logical, allocatable, intent(out) :: pres(:)
+    type(body_system_t), intent(inout) :: sys
+    real(wp), intent(in), optional :: u_prescribed(:)
+    integer, allocatable :: nodes(:)
+    integer :: side, k, cc
 
-    ! ---- prescribed DOFs ------------------------------------------------------------
-    ! Sides are visited in SIDE_* order; a corner shared by two sides gets the union of
-    ! their constraints, and where both prescribe the same component with different
-    ! values the later side in SIDE_* order (left, right, bottom, top) wins.
-    sys%ndof = ndof
-    allocate (pres(ndof), sys%u_fixed(ndof))
+    sys%ndof = 2*mesh%nnode
+    allocate (pres(sys%ndof), sys%u_fixed(sys%ndof))
     pres = .false.
     sys%u_fixed = 0.0_wp
     do side = 1, 4
@@ -211,10 +217,18 @@ contains
     if (present(u_prescribed)) then
       where (pres) sys%u_fixed = u_prescribed
     end if
+  end subroutine prescribed_dofs
 
-    allocate (sys%free_of(ndof))
+  !> Number the DOFs that are not prescribed 1..n in increasing global order
+  !! (sys%n, sys%free_of, sys%dof_of).
+  subroutine number_free_dofs(pres, sys)
+    logical, intent(in) :: pres(:)
+    type(body_system_t), intent(inout) :: sys
+    integer :: k, n
+
+    allocate (sys%free_of(sys%ndof))
     n = 0
-    do k = 1, ndof
+    do k = 1, sys%ndof
       if (pres(k)) then
         sys%free_of(k) = 0
       else
@@ -224,13 +238,21 @@ contains
     end do
     sys%n = n
     allocate (sys%dof_of(n))
-    do k = 1, ndof
+    do k = 1, sys%ndof
       if (sys%free_of(k) > 0) sys%dof_of(sys%free_of(k)) = k
     end do
+  end subroutine number_free_dofs
 
-    ! ---- sparsity pattern from the node stencil of the grid -------------------------
-    ! Neighbours of node (i,j) in increasing node id order: Q1 the 3x3 block, P1 (diagonal
-    ! lower-left to upper-right) the same without (i+1,j-1) and (i-1,j+1).
+  !> The nodes that share a cell with grid node k (k itself included), in increasing
+  !! node id order: Q1 the 3x3 block around it, P1 (diagonal lower-left to upper-right)
+  !! the same without (i+1,j-1) and (i-1,j+1).
+  pure subroutine node_stencil(mesh, k, nbr, nnbr)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: k
+    integer, intent(out) :: nbr(9)
+    integer, intent(out) :: nnbr
+    integer :: di(9), dj(9), nstencil, i, j, ii, jj, s
+
     if (mesh%element == ELEM_Q1) then
       nstencil = 9
       di(1:9) = [-1, 0, 1, -1, 0, 1, -1, 0, 1]
@@ -240,43 +262,56 @@ contains
       di(1:7) = [-1, 0, -1, 0, 1, 0, 1]
       dj(1:7) = [-1, -1, 0, 0, 0, 1, 1]
     end if
-    allocate (sys%colptr(n + 1))
+    i = mod(k - 1, mesh%nx + 1)
+    j = (k - 1)/(mesh%nx + 1)
+    nnbr = 0
+    do s = 1, nstencil
+      ii = i + di(s)
+      jj = j + dj(s)
+      if (ii < 0 .or. ii > mesh%nx .or. jj < 0 .or. jj > mesh%ny) cycle
+      nnbr = nnbr + 1
+      nbr(nnbr) = node_id(mesh, ii, jj)
+    end do
+  end subroutine node_stencil
+
+  !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
+  !! rows sorted in every column, from the node stencil of the grid. info = 6 when the
+  !! number of entries does not fit 32-bit indices.
+  subroutine stiffness_pattern(mesh, sys, info, msg)
+    type(mesh_t), intent(in) :: mesh
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    integer :: p, s, cc, q, pos, nbr(9), nnbr
+    integer(i8) :: nnz
+
+    info = 0
+    msg = ''
+    allocate (sys%colptr(sys%n + 1))
     nnz = 0
     sys%colptr(1) = 0
-    do p = 1, n
-      k = (sys%dof_of(p) - 1)/2 + 1
-      i = mod(k - 1, mesh%nx + 1)
-      j = (k - 1)/(mesh%nx + 1)
-      do s = 1, nstencil
-        ii = i + di(s)
-        jj = j + dj(s)
-        if (ii < 0 .or. ii > mesh%nx .or. jj < 0 .or. jj > mesh%ny) cycle
-        m = 1 + ii + jj*(mesh%nx + 1)
+    do p = 1, sys%n
+      call node_stencil(mesh, (sys%dof_of(p) - 1)/2 + 1, nbr, nnbr)
+      do s = 1, nnbr
         do cc = 1, 2
-          if (sys%free_of(2*(m - 1) + cc) > 0) nnz = nnz + 1
+          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
         end do
       end do
       if (nnz > int(huge(1), i8)) then
         info = 6
-        write (msg, '(a,i0,a)') 'body ', body%id, ': the stiffness has more than 2^31-1 entries; '// &
+        write (msg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
           'the mesh is too large for 32-bit CSC indices'
         return
       end if
       sys%colptr(p + 1) = int(nnz)
     end do
     allocate (sys%rowind(nnz), sys%val(nnz))
-    do p = 1, n
-      k = (sys%dof_of(p) - 1)/2 + 1
-      i = mod(k - 1, mesh%nx + 1)
-      j = (k - 1)/(mesh%nx + 1)
+    do p = 1, sys%n
+      call node_stencil(mesh, (sys%dof_of(p) - 1)/2 + 1, nbr, nnbr)
       pos = sys%colptr(p)
-      do s = 1, nstencil
-        ii = i + di(s)
-        jj = j + dj(s)
-        if (ii < 0 .or. ii > mesh%nx .or. jj < 0 .or. jj > mesh%ny) cycle
-        m = 1 + ii + jj*(mesh%nx + 1)
+      do s = 1, nnbr
         do cc = 1, 2
-          q = sys%free_of(2*(m - 1) + cc)
+          q = sys%free_of(2*(nbr(s) - 1) + cc)
           if (q > 0) then
             pos = pos + 1
             sys%rowind(pos) = q - 1
@@ -285,98 +320,162 @@ contains
       end do
     end do
     sys%val = 0.0_wp
+  end subroutine stiffness_pattern
 
-    ! ---- loads ----------------------------------------------------------------------
-    allocate (sys%f(n), sys%f_applied(ndof))
+  !> The applied nodal loads on all DOFs (sys%f_applied): the tractions on this body,
+  !! then the body force if any; sys%f = 0.
+  subroutine applied_loads(mesh, body_id, tractions, sys, body_force)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: body_id
+    type(traction_cfg_t), intent(in) :: tractions(:)
+    type(body_system_t), intent(inout) :: sys
+    procedure(body_force_fn), optional :: body_force
+    integer :: t
+
+    allocate (sys%f(sys%n), sys%f_applied(sys%ndof))
     sys%f = 0.0_wp
     sys%f_applied = 0.0_wp
-    do t = 1, ntraction
-      if (tractions(t)%body /= body%id) cycle
+    do t = 1, size(tractions)
+      if (tractions(t)%body /= body_id) cycle
       call add_traction(mesh, tractions(t), sys%f_applied)
     end do
     if (present(body_force)) call add_body_force(mesh, body_force, sys%f_applied)
+  end subroutine applied_loads
 
-    ! ---- element loop: stiffness into CSC, lifting of prescribed values into f ----------
-    cache%tol = 16.0_wp*epsilon(1.0_wp)*max(maxval(abs(mesh%xy)), tiny(1.0_wp))
+  !> The element loop: each cell's stiffness into the CSC values, and the lifting
+  !! f -= K_fd u_d of its prescribed values. info = 7 on a cell with a non-positive
+  !! Jacobian, 8 on a coupling outside the pattern (an internal error).
+  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg)
+    type(mesh_t), intent(in) :: mesh
+    real(wp), intent(in) :: lame_lambda, lame_mu
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    integer :: c, nd, ldof(MAX_NDOF)
+    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), minjac
+    type(ke_cache_t) :: cache
+
+    info = 0
+    msg = ''
+    nd = 2*mesh%nvert
+    call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
-      do a = 1, nv
-        xe(:, a) = mesh%xy(:, mesh%cells(a, c))
-      end do
-      call element_stiffness(mesh%element, xe, lam, mu, cache, ke, minjac)
+      call cell_coords(mesh, c, xe)
+      call element_stiffness(mesh%element, xe, lame_lambda, lame_mu, ke, minjac, cache)
       if (.not. (minjac > 0.0_wp)) then
         info = 7
-        write (msg, '(a,i0,a,i0,a)') 'body ', body%id, ': cell ', c, &
+        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': cell ', c, &
           ' has a non-positive Jacobian (inverted or degenerate element)'
         return
       end if
-      do a = 1, nv
-        ldof(2*a - 1) = 2*(mesh%cells(a, c) - 1) + 1
-        ldof(2*a) = 2*(mesh%cells(a, c) - 1) + 2
+      call cell_dofs(mesh, c, ldof)
+      call scatter_element(sys, ldof(1:nd), ke, info)
+      if (info /= 0) then
+        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': internal error, cell ', c, &
+          ' couples DOFs outside the stiffness pattern'
+        return
+      end if
+      call lift_prescribed(sys, ldof(1:nd), ke)
+    end do
+  end subroutine stiffness_and_lifting
+
+  !> Add the free-free block of an element stiffness to the CSC values. The element's
+  !! DOFs are merged in increasing global (hence free) order with the sorted rows of
+  !! each column. info = 8 when a coupling is missing from the pattern.
+  subroutine scatter_element(sys, ldof, ke, info)
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
+    real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
+    integer, intent(out) :: info
+    integer :: nd, a, b, kk, fc, pos, pend, lfree(MAX_NDOF), perm(MAX_NDOF)
+
+    info = 0
+    nd = size(ldof)
+    ! Local dofs in increasing global order (insertion sort).
+    do a = 1, nd
+      perm(a) = a
+    end do
+    do a = 2, nd
+      kk = perm(a)
+      b = a - 1
+      do while (b >= 1)
+        if (ldof(perm(b)) <= ldof(kk)) exit
+        perm(b + 1) = perm(b)
+        b = b - 1
       end do
-      ! Local dofs in increasing global (hence free) order, for the merge with the
-      ! sorted rows of each column.
-      do a = 1, nd
-        perm(a) = a
-      end do
-      do a = 2, nd
-        kk = perm(a)
-        b = a - 1
-        do while (b >= 1)
-          if (ldof(perm(b)) <= ldof(kk)) exit
-          perm(b + 1) = perm(b)
-          b = b - 1
+      perm(b + 1) = kk
+    end do
+    do a = 1, nd
+      lfree(a) = sys%free_of(ldof(a))
+    end do
+    do b = 1, nd
+      fc = lfree(b)
+      if (fc == 0) cycle
+      pos = sys%colptr(fc) + 1
+      pend = sys%colptr(fc + 1)
+      do kk = 1, nd
+        a = perm(kk)
+        if (lfree(a) == 0) cycle
+        do while (sys%rowind(pos) /= lfree(a) - 1)
+          pos = pos + 1
+          if (pos > pend) then
+            info = 8
+            return
+          end if
         end do
-        perm(b + 1) = kk
+        sys%val(pos) = sys%val(pos) + ke(a, b)
       end do
-      lift = .false.
-      do a = 1, nd
-        lfree(a) = sys%free_of(ldof(a))
-        if (lfree(a) == 0) then
-          ue(a) = sys%u_fixed(ldof(a))
-          if (ue(a) /= 0.0_wp) lift = .true.
-        else
-          ue(a) = 0.0_wp
-        end if
-      end do
-      do b = 1, nd
-        fc = lfree(b)
-        if (fc == 0) cycle
-        pos = sys%colptr(fc) + 1
-        pend = sys%colptr(fc + 1)
-        do kk = 1, nd
-          a = perm(kk)
-          if (lfree(a) == 0) cycle
-          do while (sys%rowind(pos) /= lfree(a) - 1)
-            pos = pos + 1
-            if (pos > pend) then
-              info = 8
-              write (msg, '(a,i0,a,i0,a)') 'body ', body%id, ': internal error, cell ', c, &
-                ' couples DOFs outside the stiffness pattern'
-              return
-            end if
-          end do
-          sys%val(pos) = sys%val(pos) + ke(a, b)
-        end do
-      end do
-      if (lift) then
-        do a = 1, nd
-          if (lfree(a) == 0) cycle
-          sys%f(lfree(a)) = sys%f(lfree(a)) - dot_product(ke(a, 1:nd), ue(1:nd))
-        end do
+    end do
+  end subroutine scatter_element
+
+  !> Lifting of an element's prescribed values: f(free) -= K_fd u_d, skipped when all
+  !! its prescribed values are 0.
+  subroutine lift_prescribed(sys, ldof, ke)
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
+    real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
+    integer :: nd, a, fa
+    real(wp) :: ue(MAX_NDOF)
+    logical :: lift
+
+    nd = size(ldof)
+    lift = .false.
+    do a = 1, nd
+      if (sys%free_of(ldof(a)) == 0) then
+        ue(a) = sys%u_fixed(ldof(a))
+        if (ue(a) /= 0.0_wp) lift = .true.
+      else
+        ue(a) = 0.0_wp
       end if
     end do
+    if (.not. lift) return
+    do a = 1, nd
+      fa = sys%free_of(ldof(a))
+      if (fa == 0) cycle
+      sys%f(fa) = sys%f(fa) - dot_product(ke(a, 1:nd), ue(1:nd))
+    end do
+  end subroutine lift_prescribed
 
-    do p = 1, n
+  !> f += the applied loads at the free DOFs.
+  subroutine add_applied_loads(sys)
+    type(body_system_t), intent(inout) :: sys
+    integer :: p
+    do p = 1, sys%n
       sys%f(p) = sys%f(p) + sys%f_applied(sys%dof_of(p))
     end do
+  end subroutine add_applied_loads
 
-    ! Infinity norm; the pattern is symmetric, so column sums are row sums.
-    sys%k_norm = 0.0_wp
-    do p = 1, n
+  !> Infinity norm of K; the pattern is symmetric, so column sums are row sums.
+  pure real(wp) function stiffness_norm(sys) result(k_norm)
+    type(body_system_t), intent(in) :: sys
+    integer :: p
+    real(wp) :: colsum
+    k_norm = 0.0_wp
+    do p = 1, sys%n
       colsum = sum(abs(sys%val(sys%colptr(p) + 1:sys%colptr(p + 1))))
-      sys%k_norm = max(sys%k_norm, colsum)
+      k_norm = max(k_norm, colsum)
     end do
-  end subroutine assemble_body
+  end function stiffness_norm
 
   !> Full displacement vector from the free unknowns: u_full = u_fixed + scatter(u_free).
   subroutine expand(sys, u_free, u_full)
@@ -399,22 +498,18 @@ contains
     real(wp), intent(in) :: u_full(:)        !< (ndof) displacements [length]
     real(wp), intent(in) :: f_full(:)        !< (ndof) nodal loads [force]
     real(wp), intent(out) :: r(:)            !< (ndof) residual [force]
-    integer :: c, a, nv, nd, ldof(8)
-    real(wp) :: lam, mu, xe(2, 4), ke(8, 8), ue(8), minjac
+    integer :: c, nd, ldof(MAX_NDOF)
+    real(wp) :: lame_lambda, lame_mu, xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
     type(ke_cache_t) :: cache
 
-    call lame_parameters(body, plane_strain, lam, mu)
-    nv = mesh%nvert
-    nd = 2*nv
-    cache%tol = 16.0_wp*epsilon(1.0_wp)*max(maxval(abs(mesh%xy)), tiny(1.0_wp))
+    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    nd = 2*mesh%nvert
+    call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:2*mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
-      do a = 1, nv
-        xe(:, a) = mesh%xy(:, mesh%cells(a, c))
-        ldof(2*a - 1) = 2*(mesh%cells(a, c) - 1) + 1
-        ldof(2*a) = 2*(mesh%cells(a, c) - 1) + 2
-      end do
-      call element_stiffness(mesh%element, xe, lam, mu, cache, ke, minjac)
+      call cell_coords(mesh, c, xe)
+      call cell_dofs(mesh, c, ldof)
+      call element_stiffness(mesh%element, xe, lame_lambda, lame_mu, ke, minjac, cache)
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
     end do
@@ -432,43 +527,22 @@ contains
     !> (4, nnode) sxx, syy, sxy, szz [stress]; szz = nu (sxx + syy) in plane strain, 0 in plane stress
     real(wp), intent(out) :: sigma(:, :)
     real(wp), intent(out) :: von_mises(:)       !< (nnode) von Mises stress [stress]
-    integer :: c, a, k, nv
+    integer :: c, a, k, nd, ldof(MAX_NDOF)
     integer, allocatable :: cnt(:)
-    real(wp) :: lam, mu, xe(2, 4), g(2, 4), nfun(4), det, exx, eyy, gxy, cs(4)
+    real(wp) :: lame_lambda, lame_mu, xe(2, MAX_NVERT), ue(MAX_NDOF), cs(4)
     real(wp) :: sxx, syy, sxy, szz
 
-    call lame_parameters(body, plane_strain, lam, mu)
-    nv = mesh%nvert
+    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    nd = 2*mesh%nvert
     allocate (cnt(mesh%nnode))
     cnt = 0
     sigma(:, 1:mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
-      do a = 1, nv
-        xe(:, a) = mesh%xy(:, mesh%cells(a, c))
-      end do
-      if (mesh%element == ELEM_Q1) then
-        call q1_gradients(xe, 0.0_wp, 0.0_wp, nfun, g, det)
-      else
-        call p1_gradients(xe, g, det)
-      end if
-      exx = 0.0_wp
-      eyy = 0.0_wp
-      gxy = 0.0_wp
-      do a = 1, nv
-        k = mesh%cells(a, c)
-        exx = exx + g(1, a)*u_full(2*k - 1)
-        eyy = eyy + g(2, a)*u_full(2*k)
-        gxy = gxy + g(2, a)*u_full(2*k - 1) + g(1, a)*u_full(2*k)
-      end do
-      cs(1) = (lam + 2.0_wp*mu)*exx + lam*eyy
-      cs(2) = lam*exx + (lam + 2.0_wp*mu)*eyy
-      cs(3) = mu*gxy
-      if (plane_strain) then
-        cs(4) = lam*(exx + eyy)    ! = nu (sxx + syy)
-      else
-        cs(4) = 0.0_wp
-      end if
-      do a = 1, nv
+      call cell_coords(mesh, c, xe)
+      call cell_dofs(mesh, c, ldof)
+      ue(1:nd) = u_full(ldof(1:nd))
+      call element_stress(mesh%element, xe, ue, lame_lambda, lame_mu, plane_strain, cs)
+      do a = 1, mesh%nvert
         k = mesh%cells(a, c)
         sigma(:, k) = sigma(:, k) + cs
         cnt(k) = cnt(k) + 1
@@ -484,146 +558,51 @@ contains
     end do
   end subroutine nodal_stress
 
-  !> y = K x on the free DOFs (the pattern is symmetric: column j is row j).
+  !> y = K x on the free DOFs (linop's csc_symv: the pattern is symmetric, column j is row j).
   subroutine csc_matvec(sys, x, y)
     type(body_system_t), intent(in) :: sys   !< the body's system
     real(wp), intent(in) :: x(:)             !< (n) [length]
     real(wp), intent(out) :: y(:)            !< (n) [force]
-    integer :: j, p
-    real(wp) :: acc
-    do j = 1, sys%n
-      acc = 0.0_wp
-      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
-        acc = acc + sys%val(p)*x(sys%rowind(p) + 1)
-      end do
-      y(j) = acc
-    end do
+    call csc_symv(sys%n, sys%colptr, sys%rowind, sys%val, x, y)
   end subroutine csc_matvec
 
   ! ---------------------------------------------------------------------------------
-  ! Element routines
+  ! Cells and sides
   ! ---------------------------------------------------------------------------------
 
-  !> Shape functions and their x, y gradients of the bilinear quadrilateral at (xi, eta).
-  pure subroutine q1_gradients(xe, xi, eta, nfun, g, det)
-    real(wp), intent(in) :: xe(2, 4)
-    real(wp), intent(in) :: xi, eta
-    real(wp), intent(out) :: nfun(4), g(2, 4), det
-    real(wp) :: dxi(4), deta(4), j11, j12, j21, j22
+  !> Vertex coordinates of cell c (columns past mesh%nvert are 0).
+  pure subroutine cell_coords(mesh, c, xe)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: c
+    real(wp), intent(out) :: xe(2, MAX_NVERT)
     integer :: a
-    do a = 1, 4
-      nfun(a) = 0.25_wp*(1.0_wp + xi*xa_q1(a))*(1.0_wp + eta*ea_q1(a))
-      dxi(a) = 0.25_wp*xa_q1(a)*(1.0_wp + eta*ea_q1(a))
-      deta(a) = 0.25_wp*ea_q1(a)*(1.0_wp + xi*xa_q1(a))
+    xe = 0.0_wp
+    do a = 1, mesh%nvert
+      xe(:, a) = mesh%xy(:, mesh%cells(a, c))
     end do
-    j11 = sum(dxi*xe(1, :))
-    j12 = sum(dxi*xe(2, :))
-    j21 = sum(deta*xe(1, :))
-    j22 = sum(deta*xe(2, :))
-    det = j11*j22 - j12*j21
-    if (det > 0.0_wp) then
-      do a = 1, 4
-        g(1, a) = (j22*dxi(a) - j12*deta(a))/det
-        g(2, a) = (-j21*dxi(a) + j11*deta(a))/det
-      end do
-    else
-      g = 0.0_wp
-    end if
-  end subroutine q1_gradients
+  end subroutine cell_coords
 
-  !> Constant gradients of the linear triangle's shape functions; det = twice its area.
-  pure subroutine p1_gradients(xe, g, det)
-    real(wp), intent(in) :: xe(2, 4)
-    real(wp), intent(out) :: g(2, 4), det
-    det = (xe(1, 2) - xe(1, 1))*(xe(2, 3) - xe(2, 1)) - (xe(1, 3) - xe(1, 1))*(xe(2, 2) - xe(2, 1))
-    g = 0.0_wp
-    if (det > 0.0_wp) then
-      g(1, 1) = (xe(2, 2) - xe(2, 3))/det
-      g(2, 1) = (xe(1, 3) - xe(1, 2))/det
-      g(1, 2) = (xe(2, 3) - xe(2, 1))/det
-      g(2, 2) = (xe(1, 1) - xe(1, 3))/det
-      g(1, 3) = (xe(2, 1) - xe(2, 2))/det
-      g(2, 3) = (xe(1, 2) - xe(1, 1))/det
-    end if
-  end subroutine p1_gradients
-
-  !> Add w * B^T D B to ke for the gradients g of nv shape functions (isotropic D).
-  pure subroutine add_btdb(nv, g, w, lam, mu, ke)
-    integer, intent(in) :: nv
-    real(wp), intent(in) :: g(2, 4), w, lam, mu
-    real(wp), intent(inout) :: ke(8, 8)
-    integer :: a, b
-    real(wp) :: c11, xa, ya, xb, yb
-    c11 = lam + 2.0_wp*mu
-    do b = 1, nv
-      xb = g(1, b)*w
-      yb = g(2, b)*w
-      do a = 1, nv
-        xa = g(1, a)
-        ya = g(2, a)
-        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + c11*xa*xb + mu*ya*yb
-        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + lam*ya*xb + mu*xa*yb
-        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + lam*xa*yb + mu*ya*xb
-        ke(2*a, 2*b) = ke(2*a, 2*b) + c11*ya*yb + mu*xa*xb
-      end do
+  !> Global dofs of cell c, interleaved by vertex (entries past 2*mesh%nvert are 0).
+  pure subroutine cell_dofs(mesh, c, ldof)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: c
+    integer, intent(out) :: ldof(MAX_NDOF)
+    integer :: a
+    ldof = 0
+    do a = 1, mesh%nvert
+      ldof(2*a - 1) = 2*(mesh%cells(a, c) - 1) + 1
+      ldof(2*a) = 2*(mesh%cells(a, c) - 1) + 2
     end do
-  end subroutine add_btdb
+  end subroutine cell_dofs
 
-  !> Element stiffness (Q1: 2x2 Gauss; P1: exact), reusing the cached one when the cell is
-  !! a translate of the last computed cell. minjac: smallest Jacobian determinant seen.
-  subroutine element_stiffness(element, xe, lam, mu, cache, ke, minjac)
-    integer, intent(in) :: element
-    real(wp), intent(in) :: xe(2, 4), lam, mu
-    type(ke_cache_t), intent(inout) :: cache
-    real(wp), intent(out) :: ke(8, 8), minjac
-    real(wp), parameter :: gp = 0.577350269189625764509148780502_wp   ! 1/sqrt(3)
-    real(wp) :: rel(2, 4), g(2, 4), nfun(4), det
-    integer :: nv, a, ig, jg
-
-    nv = 4
-    if (element == ELEM_P1) nv = 3
-    do a = 1, nv
-      rel(:, a) = xe(:, a) - xe(:, 1)
-    end do
-    if (cache%valid) then
-      if (all(abs(rel(:, 1:nv) - cache%rel(:, 1:nv)) <= cache%tol)) then
-        ke = cache%ke
-        minjac = cache%minjac
-        return
-      end if
-    end if
-
-    ke = 0.0_wp
-    if (element == ELEM_Q1) then
-      minjac = huge(1.0_wp)
-      do jg = -1, 1, 2
-        do ig = -1, 1, 2
-          call q1_gradients(xe, ig*gp, jg*gp, nfun, g, det)
-          minjac = min(minjac, det)
-          if (det > 0.0_wp) call add_btdb(4, g, det, lam, mu, ke)   ! Gauss weights are 1
-        end do
-      end do
-    else
-      call p1_gradients(xe, g, det)
-      minjac = det
-      if (det > 0.0_wp) call add_btdb(3, g, 0.5_wp*det, lam, mu, ke)
-    end if
-    cache%valid = .true.
-    cache%rel(:, 1:nv) = rel(:, 1:nv)
-    cache%ke = ke
-    cache%minjac = minjac
-  end subroutine element_stiffness
-
-  !> Consistent nodal loads of a linear traction on one side, 2-point Gauss per edge
-  !! (exact for a linear traction times linear shape functions).
+  !> Add the consistent nodal loads of a linear traction on one side to f, edge by edge.
   subroutine add_traction(mesh, tr, f)
     type(mesh_t), intent(in) :: mesh
     type(traction_cfg_t), intent(in) :: tr
     real(wp), intent(inout) :: f(:)
-    real(wp), parameter :: gp = 0.577350269189625764509148780502_wp
     integer, allocatable :: nodes(:)
-    integer :: e, ig, na, nb, coord
-    real(wp) :: xa(2), xb(2), len, xi, wa, wb, s, tv(2)
+    integer :: e, na, nb, coord
+    real(wp) :: fe(2, 2)
 
     call side_nodes(mesh, tr%side, nodes)
     coord = 1
@@ -631,66 +610,34 @@ contains
     do e = 1, size(nodes) - 1
       na = nodes(e)
       nb = nodes(e + 1)
-      xa = mesh%xy(:, na)
-      xb = mesh%xy(:, nb)
-      len = norm2(xb - xa)
-      do ig = -1, 1, 2
-        xi = ig*gp
-        wa = 0.5_wp*(1.0_wp - xi)
-        wb = 0.5_wp*(1.0_wp + xi)
-        s = wa*xa(coord) + wb*xb(coord)
-        tv = tr%t0 + tr%t1*s
-        ! Gauss weight 1, Jacobian len/2.
-        f(2*na - 1:2*na) = f(2*na - 1:2*na) + 0.5_wp*len*wa*tv
-        f(2*nb - 1:2*nb) = f(2*nb - 1:2*nb) + 0.5_wp*len*wb*tv
-      end do
+      fe(:, 1) = f(2*na - 1:2*na)
+      fe(:, 2) = f(2*nb - 1:2*nb)
+      call edge_traction(mesh%xy(:, na), mesh%xy(:, nb), coord, tr%t0, tr%t1, fe)
+      f(2*na - 1:2*na) = fe(:, 1)
+      f(2*nb - 1:2*nb) = fe(:, 2)
     end do
   end subroutine add_traction
 
-  !> Consistent nodal loads of a body force density: Q1 3x3 Gauss, P1 the 3-point
-  !! interior rule of degree 2.
+  !> Add the consistent nodal loads of a body force density to f, cell by cell.
   subroutine add_body_force(mesh, bf, f)
     type(mesh_t), intent(in) :: mesh
     procedure(body_force_fn) :: bf
     real(wp), intent(inout) :: f(:)
-    real(wp), parameter :: q3(3) = [-0.774596669241483377035853079956_wp, 0.0_wp, &
-                                     0.774596669241483377035853079956_wp]
-    real(wp), parameter :: w3(3) = [5.0_wp/9.0_wp, 8.0_wp/9.0_wp, 5.0_wp/9.0_wp]
-    real(wp), parameter :: bary(3, 3) = reshape([2.0_wp/3.0_wp, 1.0_wp/6.0_wp, 1.0_wp/6.0_wp, &
-                                                 1.0_wp/6.0_wp, 2.0_wp/3.0_wp, 1.0_wp/6.0_wp, &
-                                                 1.0_wp/6.0_wp, 1.0_wp/6.0_wp, 2.0_wp/3.0_wp], [3, 3])
-    integer :: c, a, k, ig, jg, nv
-    real(wp) :: xe(2, 4), nfun(4), g(2, 4), det, xq(2), bv(2)
+    integer :: c, a, k
+    real(wp) :: xe(2, MAX_NVERT), fe(2, MAX_NVERT)
 
-    nv = mesh%nvert
+    fe = 0.0_wp
     do c = 1, mesh%ncell
-      do a = 1, nv
-        xe(:, a) = mesh%xy(:, mesh%cells(a, c))
+      call cell_coords(mesh, c, xe)
+      do a = 1, mesh%nvert
+        k = mesh%cells(a, c)
+        fe(:, a) = f(2*k - 1:2*k)
       end do
-      if (mesh%element == ELEM_Q1) then
-        do jg = 1, 3
-          do ig = 1, 3
-            call q1_gradients(xe, q3(ig), q3(jg), nfun, g, det)
-            xq = matmul(xe, nfun)
-            call bf(xq(1), xq(2), bv)
-            do a = 1, 4
-              k = mesh%cells(a, c)
-              f(2*k - 1:2*k) = f(2*k - 1:2*k) + w3(ig)*w3(jg)*det*nfun(a)*bv
-            end do
-          end do
-        end do
-      else
-        call p1_gradients(xe, g, det)
-        do ig = 1, 3
-          xq = matmul(xe(:, 1:3), bary(:, ig))
-          call bf(xq(1), xq(2), bv)
-          do a = 1, 3
-            k = mesh%cells(a, c)
-            ! weight area/3 = det/6
-            f(2*k - 1:2*k) = f(2*k - 1:2*k) + (det/6.0_wp)*bary(a, ig)*bv
-          end do
-        end do
-      end if
+      call element_body_force(mesh%element, xe, bf, fe)
+      do a = 1, mesh%nvert
+        k = mesh%cells(a, c)
+        f(2*k - 1:2*k) = fe(:, a)
+      end do
     end do
   end subroutine add_body_force
 

@@ -11,7 +11,7 @@
 module mesh
   use kinds, only: wp
   use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
-  implicit none
+  implicit none (type, external)
   private
 
   public :: mesh_build, side_nodes, node_id

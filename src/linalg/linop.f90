@@ -39,6 +39,8 @@ module linop
     procedure :: apply => dense_apply
   end type dense_op_t
 
+  public :: csc_symv
+
   !> Sparse symmetric matrix in compressed sparse column form, both triangles
   !! stored, 0-based indices (CHOLMOD/SciPy convention).
   type, extends(linop_t) :: csc_op_t
@@ -135,15 +137,29 @@ contains
     class(csc_op_t), intent(inout) :: self  !< the operator
     real(wp), intent(in) :: x(:)            !< input vector (size n)
     real(wp), intent(out) :: y(:)           !< output A x (size n)
-    integer :: j, k
-    real(wp) :: xj
-    y(1:self%n) = 0.0_wp
-    do j = 1, self%n
-      xj = x(j)
-      do k = self%colptr(j) + 1, self%colptr(j + 1)
-        y(self%rowind(k) + 1) = y(self%rowind(k) + 1) + self%val(k) * xj
-      end do
-    end do
+    call csc_symv(self%n, self%colptr, self%rowind, self%val, x, y)
   end subroutine csc_apply
+
+  !> y = A x for a symmetric n x n matrix in compressed sparse columns, both triangles
+  !! stored, 0-based indices: y(j) is column j (= row j) dotted with x, summed in the
+  !! stored row order. The one sparse product of the code (csc_op_t, assembly's
+  !! csc_matvec). For a matrix that is not symmetric this is A^T x.
+  pure subroutine csc_symv(n, colptr, rowind, val, x, y)
+    integer, intent(in) :: n              !< matrix size
+    integer, intent(in) :: colptr(:)      !< (n+1) column starts, 0-based
+    integer, intent(in) :: rowind(:)      !< (nnz) row indices, 0-based
+    real(wp), intent(in) :: val(:)        !< (nnz) values
+    real(wp), intent(in) :: x(:)          !< (n) input vector
+    real(wp), intent(out) :: y(:)         !< (n) output A x
+    integer :: j, p
+    real(wp) :: acc
+    do j = 1, n
+      acc = 0.0_wp
+      do p = colptr(j) + 1, colptr(j + 1)
+        acc = acc + val(p)*x(rowind(p) + 1)
+      end do
+      y(j) = acc
+    end do
+  end subroutine csc_symv
 
 end module linop

@@ -1,0 +1,290 @@
+!> Element kernels of plane linear elasticity: shape functions and their gradients,
+!! element stiffness, element loads (edge tractions, body force) and element stress,
+!! for the bilinear quadrilateral (Q1, 2x2 Gauss) and the linear triangle (P1, exact).
+!!
+!! Every kernel takes the element's vertex coordinates `xe(2, MAX_NVERT)` (counter-
+!! clockwise, the first 3 used by P1), never grid indices, so it serves any mesh of
+!! these elements. Element DOFs are interleaved: vertex a, component c (1 = x, 2 = y)
+!! is local dof 2*(a-1)+c. Isotropic material given by its (effective) Lame parameters.
+!! Units are the deck's, consistently: [length], [stress] = [force]/[length]^2, forces
+!! per unit thickness.
+module elements
+  use kinds, only: wp
+  use config, only: ELEM_Q1, ELEM_P1
+  implicit none (type, external)
+  private
+
+  public :: element_nvert, q1_gradients, p1_gradients, element_stiffness, ke_cache_init
+  public :: element_body_force, edge_traction, element_stress, body_force_fn
+
+  integer, parameter, public :: MAX_NVERT = 4            !< most vertices of an element (Q1)
+  integer, parameter, public :: MAX_NDOF = 2*MAX_NVERT   !< most DOFs of an element (Q1)
+
+  abstract interface
+    !> A body force density b(x, y) [force/length^3] (per unit thickness: [force/length^2]/[length]).
+    subroutine body_force_fn(x, y, b)
+      import :: wp
+      real(wp), intent(in) :: x            !< position x [length]
+      real(wp), intent(in) :: y            !< position y [length]
+      real(wp), intent(out) :: b(2)        !< body force density [force/length^3]
+    end subroutine body_force_fn
+  end interface
+
+  !> Cache of the last element stiffness computed: a cell that is a translate of it (as
+  !! on a uniform grid) reuses it. Set it up with `ke_cache_init`.
+  type, public :: ke_cache_t
+    private
+    logical :: valid = .false.
+    real(wp) :: rel(2, MAX_NVERT) = 0.0_wp   ! vertex coordinates relative to vertex 1 [length]
+    real(wp) :: tol = 0.0_wp                 ! coordinate tolerance below which cells are the same [length]
+    real(wp) :: ke(MAX_NDOF, MAX_NDOF) = 0.0_wp
+    real(wp) :: minjac = 0.0_wp
+  end type ke_cache_t
+
+  real(wp), parameter :: xa_q1(4) = [-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp]  ! reference nodes of Q1
+  real(wp), parameter :: ea_q1(4) = [-1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp]
+  real(wp), parameter :: gp2 = 0.577350269189625764509148780502_wp      ! 1/sqrt(3)
+
+contains
+
+  !> Number of vertices of an element: 4 for ELEM_Q1, 3 for ELEM_P1.
+  pure integer function element_nvert(element)
+    integer, intent(in) :: element   !< ELEM_Q1 or ELEM_P1 (module config)
+    element_nvert = 4
+    if (element == ELEM_P1) element_nvert = 3
+  end function element_nvert
+
+  !> An empty cache whose cells count as the same when their vertex offsets agree to
+  !! 16 eps times `coord_max`, the largest absolute coordinate of the mesh [length].
+  pure subroutine ke_cache_init(cache, coord_max)
+    type(ke_cache_t), intent(out) :: cache    !< the cache
+    real(wp), intent(in) :: coord_max         !< largest absolute node coordinate [length]
+    cache%tol = 16.0_wp*epsilon(1.0_wp)*max(coord_max, tiny(1.0_wp))
+  end subroutine ke_cache_init
+
+  !> Shape functions and their x, y gradients of the bilinear quadrilateral at the
+  !! reference point (xi, eta) in [-1,1]^2. Where the Jacobian is not positive, g = 0.
+  pure subroutine q1_gradients(xe, xi, eta, nfun, g, det)
+    real(wp), intent(in) :: xe(2, MAX_NVERT)   !< vertex coordinates [length]
+    real(wp), intent(in) :: xi                 !< reference coordinate xi [-]
+    real(wp), intent(in) :: eta                !< reference coordinate eta [-]
+    real(wp), intent(out) :: nfun(4)           !< shape functions [-]
+    real(wp), intent(out) :: g(2, MAX_NVERT)   !< (d/dx, d/dy) of each shape function [1/length]
+    real(wp), intent(out) :: det               !< Jacobian determinant [length^2]
+    real(wp) :: dxi(4), deta(4), j11, j12, j21, j22
+    integer :: a
+    do a = 1, 4
+      nfun(a) = 0.25_wp*(1.0_wp + xi*xa_q1(a))*(1.0_wp + eta*ea_q1(a))
+      dxi(a) = 0.25_wp*xa_q1(a)*(1.0_wp + eta*ea_q1(a))
+      deta(a) = 0.25_wp*ea_q1(a)*(1.0_wp + xi*xa_q1(a))
+    end do
+    j11 = sum(dxi*xe(1, :))
+    j12 = sum(dxi*xe(2, :))
+    j21 = sum(deta*xe(1, :))
+    j22 = sum(deta*xe(2, :))
+    det = j11*j22 - j12*j21
+    if (det > 0.0_wp) then
+      do a = 1, 4
+        g(1, a) = (j22*dxi(a) - j12*deta(a))/det
+        g(2, a) = (-j21*dxi(a) + j11*deta(a))/det
+      end do
+    else
+      g = 0.0_wp
+    end if
+  end subroutine q1_gradients
+
+  !> Constant gradients of the linear triangle's shape functions. Where the triangle is
+  !! not counter-clockwise (det <= 0), g = 0.
+  pure subroutine p1_gradients(xe, g, det)
+    real(wp), intent(in) :: xe(2, MAX_NVERT)   !< vertex coordinates, the first 3 used [length]
+    real(wp), intent(out) :: g(2, MAX_NVERT)   !< (d/dx, d/dy) of each shape function, column 4 = 0 [1/length]
+    real(wp), intent(out) :: det               !< twice the signed area [length^2]
+    det = (xe(1, 2) - xe(1, 1))*(xe(2, 3) - xe(2, 1)) - (xe(1, 3) - xe(1, 1))*(xe(2, 2) - xe(2, 1))
+    g = 0.0_wp
+    if (det > 0.0_wp) then
+      g(1, 1) = (xe(2, 2) - xe(2, 3))/det
+      g(2, 1) = (xe(1, 3) - xe(1, 2))/det
+      g(1, 2) = (xe(2, 3) - xe(2, 1))/det
+      g(2, 2) = (xe(1, 1) - xe(1, 3))/det
+      g(1, 3) = (xe(2, 1) - xe(2, 2))/det
+      g(2, 3) = (xe(1, 2) - xe(1, 1))/det
+    end if
+  end subroutine p1_gradients
+
+  !> Add w * B^T D B to ke for the gradients g of nv shape functions (isotropic D).
+  pure subroutine add_btdb(nv, g, w, lame_lambda, lame_mu, ke)
+    integer, intent(in) :: nv
+    real(wp), intent(in) :: g(2, MAX_NVERT), w, lame_lambda, lame_mu
+    real(wp), intent(inout) :: ke(MAX_NDOF, MAX_NDOF)
+    integer :: a, b
+    real(wp) :: c11, xa, ya, xb, yb
+    c11 = lame_lambda + 2.0_wp*lame_mu
+    do b = 1, nv
+      xb = g(1, b)*w
+      yb = g(2, b)*w
+      do a = 1, nv
+        xa = g(1, a)
+        ya = g(2, a)
+        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + c11*xa*xb + lame_mu*ya*yb
+        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + lame_lambda*ya*xb + lame_mu*xa*yb
+        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + lame_lambda*xa*yb + lame_mu*ya*xb
+        ke(2*a, 2*b) = ke(2*a, 2*b) + c11*ya*yb + lame_mu*xa*xb
+      end do
+    end do
+  end subroutine add_btdb
+
+  !> Element stiffness (Q1: 2x2 Gauss; P1: exact) and the smallest Jacobian determinant
+  !! met, which is not positive for an inverted or degenerate element. With `cache`, a
+  !! cell that is a translate of the last one computed reuses its stiffness.
+  pure subroutine element_stiffness(element, xe, lame_lambda, lame_mu, ke, minjac, cache)
+    integer, intent(in) :: element                          !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)                !< vertex coordinates [length]
+    real(wp), intent(in) :: lame_lambda                     !< (effective) first Lame parameter [stress]
+    real(wp), intent(in) :: lame_mu                         !< shear modulus [stress]
+    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)         !< element stiffness [stress]
+    real(wp), intent(out) :: minjac                         !< smallest Jacobian determinant [length^2]
+    type(ke_cache_t), intent(inout), optional :: cache      !< the last stiffness computed
+    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), nfun(4), det
+    integer :: nv, a, ig, jg
+
+    nv = element_nvert(element)
+    if (present(cache)) then
+      do a = 1, nv
+        rel(:, a) = xe(:, a) - xe(:, 1)
+      end do
+      if (cache%valid) then
+        if (all(abs(rel(:, 1:nv) - cache%rel(:, 1:nv)) <= cache%tol)) then
+          ke = cache%ke
+          minjac = cache%minjac
+          return
+        end if
+      end if
+    end if
+
+    ke = 0.0_wp
+    if (element == ELEM_Q1) then
+      minjac = huge(1.0_wp)
+      do jg = -1, 1, 2
+        do ig = -1, 1, 2
+          call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
+          minjac = min(minjac, det)
+          if (det > 0.0_wp) call add_btdb(4, g, det, lame_lambda, lame_mu, ke)   ! Gauss weights are 1
+        end do
+      end do
+    else
+      call p1_gradients(xe, g, det)
+      minjac = det
+      if (det > 0.0_wp) call add_btdb(3, g, 0.5_wp*det, lame_lambda, lame_mu, ke)
+    end if
+    if (present(cache)) then
+      cache%valid = .true.
+      cache%rel(:, 1:nv) = rel(:, 1:nv)
+      cache%ke = ke
+      cache%minjac = minjac
+    end if
+  end subroutine element_stiffness
+
+  !> Add the consistent nodal loads of a body force density to `fe`: Q1 3x3 Gauss,
+  !! P1 the 3-point interior rule of degree 2.
+  subroutine element_body_force(element, xe, bf, fe)
+    integer, intent(in) :: element                  !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)        !< vertex coordinates [length]
+    procedure(body_force_fn) :: bf                  !< body force density
+    real(wp), intent(inout) :: fe(2, MAX_NVERT)     !< nodal loads of the vertices, added to [force]
+    real(wp), parameter :: q3(3) = [-0.774596669241483377035853079956_wp, 0.0_wp, &
+                                     0.774596669241483377035853079956_wp]
+    real(wp), parameter :: w3(3) = [5.0_wp/9.0_wp, 8.0_wp/9.0_wp, 5.0_wp/9.0_wp]
+    real(wp), parameter :: bary(3, 3) = reshape([2.0_wp/3.0_wp, 1.0_wp/6.0_wp, 1.0_wp/6.0_wp, &
+                                                 1.0_wp/6.0_wp, 2.0_wp/3.0_wp, 1.0_wp/6.0_wp, &
+                                                 1.0_wp/6.0_wp, 1.0_wp/6.0_wp, 2.0_wp/3.0_wp], [3, 3])
+    integer :: a, ig, jg
+    real(wp) :: nfun(4), g(2, MAX_NVERT), det, xq(2), bv(2)
+
+    if (element == ELEM_Q1) then
+      do jg = 1, 3
+        do ig = 1, 3
+          call q1_gradients(xe, q3(ig), q3(jg), nfun, g, det)
+          xq = matmul(xe, nfun)
+          call bf(xq(1), xq(2), bv)
+          do a = 1, 4
+            fe(:, a) = fe(:, a) + w3(ig)*w3(jg)*det*nfun(a)*bv
+          end do
+        end do
+      end do
+    else
+      call p1_gradients(xe, g, det)
+      do ig = 1, 3
+        xq = matmul(xe(:, 1:3), bary(:, ig))
+        call bf(xq(1), xq(2), bv)
+        do a = 1, 3
+          ! weight area/3 = det/6
+          fe(:, a) = fe(:, a) + (det/6.0_wp)*bary(a, ig)*bv
+        end do
+      end do
+    end if
+  end subroutine element_body_force
+
+  !> Add the consistent nodal loads of a linear traction t(s) = t0 + t1 s on the straight
+  !! edge from xa to xb to `fe`, s being coordinate `coord` of the point; 2-point Gauss
+  !! (exact for a linear traction times linear shape functions).
+  pure subroutine edge_traction(xa, xb, coord, t0, t1, fe)
+    real(wp), intent(in) :: xa(2)            !< first end of the edge [length]
+    real(wp), intent(in) :: xb(2)            !< second end of the edge [length]
+    integer, intent(in) :: coord             !< s is x (1) or y (2)
+    real(wp), intent(in) :: t0(2)            !< traction at s = 0 [stress]
+    real(wp), intent(in) :: t1(2)            !< traction slope d t / d s [stress/length]
+    real(wp), intent(inout) :: fe(2, 2)      !< nodal loads of the two ends, added to [force]
+    integer :: ig
+    real(wp) :: len, xi, wa, wb, s, tv(2)
+
+    len = norm2(xb - xa)
+    do ig = -1, 1, 2
+      xi = ig*gp2
+      wa = 0.5_wp*(1.0_wp - xi)
+      wb = 0.5_wp*(1.0_wp + xi)
+      s = wa*xa(coord) + wb*xb(coord)
+      tv = t0 + t1*s
+      ! Gauss weight 1, Jacobian len/2.
+      fe(:, 1) = fe(:, 1) + 0.5_wp*len*wa*tv
+      fe(:, 2) = fe(:, 2) + 0.5_wp*len*wb*tv
+    end do
+  end subroutine edge_traction
+
+  !> Stress of an element from its displacements: Q1 at the cell centre, P1 the constant
+  !! value; cs = (sxx, syy, sxy, szz), szz = lambda (exx + eyy) = nu (sxx + syy) in plane
+  !! strain and 0 in plane stress.
+  pure subroutine element_stress(element, xe, ue, lame_lambda, lame_mu, plane_strain, cs)
+    integer, intent(in) :: element               !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)     !< vertex coordinates [length]
+    real(wp), intent(in) :: ue(MAX_NDOF)         !< element displacements, interleaved [length]
+    real(wp), intent(in) :: lame_lambda          !< (effective) first Lame parameter [stress]
+    real(wp), intent(in) :: lame_mu              !< shear modulus [stress]
+    logical, intent(in) :: plane_strain          !< .true. plane strain, .false. plane stress
+    real(wp), intent(out) :: cs(4)               !< sxx, syy, sxy, szz [stress]
+    real(wp) :: g(2, MAX_NVERT), nfun(4), det, exx, eyy, gxy
+    integer :: a
+
+    if (element == ELEM_Q1) then
+      call q1_gradients(xe, 0.0_wp, 0.0_wp, nfun, g, det)
+    else
+      call p1_gradients(xe, g, det)
+    end if
+    exx = 0.0_wp
+    eyy = 0.0_wp
+    gxy = 0.0_wp
+    do a = 1, element_nvert(element)
+      exx = exx + g(1, a)*ue(2*a - 1)
+      eyy = eyy + g(2, a)*ue(2*a)
+      gxy = gxy + g(2, a)*ue(2*a - 1) + g(1, a)*ue(2*a)
+    end do
+    cs(1) = (lame_lambda + 2.0_wp*lame_mu)*exx + lame_lambda*eyy
+    cs(2) = lame_lambda*exx + (lame_lambda + 2.0_wp*lame_mu)*eyy
+    cs(3) = lame_mu*gxy
+    if (plane_strain) then
+      cs(4) = lame_lambda*(exx + eyy)    ! = nu (sxx + syy)
+    else
+      cs(4) = 0.0_wp
+    end if
+  end subroutine element_stress
+
+end module elements
