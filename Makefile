@@ -40,7 +40,7 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings config sysinfo signals deck mesh assembly ordering linop mprgp cholmod_iface banded cholesky \
+MODS := kinds errors clock strings config sysinfo signals deck mesh assembly ordering lapack linop mprgp cholmod_iface banded cholesky \
         condense contact_types contact h5io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
 
@@ -90,11 +90,12 @@ $(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o 
 $(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o
 $(BUILD)/ordering.o:      $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
-$(BUILD)/linop.o:         $(BUILD)/kinds.o
+$(BUILD)/lapack.o:        $(BUILD)/kinds.o
+$(BUILD)/linop.o:         $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
 $(BUILD)/cholmod_iface.o: $(BUILD)/kinds.o
-$(BUILD)/banded.o:        $(BUILD)/kinds.o
-$(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/banded.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/lapack.o
+$(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o $(BUILD)/lapack.o
 $(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
 $(BUILD)/contact_types.o: $(BUILD)/kinds.o

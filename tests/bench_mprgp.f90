@@ -16,7 +16,7 @@ program bench_mprgp
   use kinds, only: wp
   use linop, only: csc_op_t, dense_op_t, csc_op_init, dense_op_init, linop_t
   use mprgp
-  implicit none
+  implicit none (type, external)
 
   integer :: ns(3) = [100, 1000, 5000], ms(3) = [500, 1000, 2000]
   real(wp) :: rtols(2) = [1.0e-4_wp, 1.0e-8_wp]

@@ -6,21 +6,12 @@ program test_mprgp
   use kinds, only: wp
   use linop, only: linop_t, dense_op_t, csc_op_t, dense_op_init, csc_op_init
   use mprgp
-  implicit none
+  use lapack, only: dposv
+  implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: nobound = -huge(1.0_wp)
   integer :: npass = 0, nfail = 0
-
-  interface
-    subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
-      import :: wp
-      character(len=1), intent(in) :: uplo
-      integer, intent(in) :: n, nrhs, lda, ldb
-      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dposv
-  end interface
 
   call set_seed(20240611)
   call test_enumeration()

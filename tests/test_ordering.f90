@@ -18,8 +18,9 @@ program test_ordering
   use ordering, only: nested_dissection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
-  use testing, only: report, report_le, wtime, test_summary
-  implicit none
+  use clock, only: wtime
+  use testing, only: report, report_le, test_summary
+  implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: RES_TOL = 10.0_wp        ! scaled residual threshold

@@ -1,18 +1,19 @@
 !> Helpers shared by the Fortran test programs: PASS/FAIL reporting with counters and
-!! the closing line, a wall clock, and an independent direct solve of an assembled body
+!! the closing line, and an independent direct solve of an assembled body
 !! (LAPACK band Cholesky in the natural order) so the FE tests do not depend on the
 !! Cholesky module that other tests check.
 module testing
-  use, intrinsic :: iso_fortran_env, only: output_unit, int64
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
   use assembly, only: body_system_t
-  implicit none
+  use lapack, only: dpbsv
+  implicit none (type, external)
   private
 
   integer, public, protected :: npass = 0   !< checks passed so far
   integer, public, protected :: nfail = 0   !< checks failed so far
 
-  public :: report, report_le, wtime, test_summary, band_solve
+  public :: report, report_le, test_summary, band_solve
 
 contains
 
@@ -39,14 +40,6 @@ contains
     character(len=*), intent(in) :: what  !< what was checked
     call report(value <= tol, what, value, tol)
   end subroutine report_le
-
-  !> Wall clock [s].
-  function wtime() result(t)
-    real(wp) :: t
-    integer(int64) :: cnt, rate
-    call system_clock(cnt, rate)
-    t = real(cnt, wp)/real(rate, wp)
-  end function wtime
 
   !> Print `N checks passed, M failed` and stop with status 1 if anything failed.
   subroutine test_summary()

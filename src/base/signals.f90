@@ -2,7 +2,7 @@
 !! that the outer iteration polls through `stop_requested`.
 module signals
   use, intrinsic :: iso_c_binding, only: c_int
-  implicit none
+  implicit none (type, external)
   private
 
   interface

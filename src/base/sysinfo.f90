@@ -2,7 +2,7 @@
 module sysinfo
   use kinds, only: wp
   use, intrinsic :: iso_c_binding, only: c_int, c_long
-  implicit none
+  implicit none (type, external)
   private
 
   !> struct rusage on Linux/x86_64: two struct timeval, then 14 longs.

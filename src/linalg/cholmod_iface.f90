@@ -7,7 +7,7 @@ module cholmod_iface
   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int, &
                                          c_double, c_char, c_null_char
   use kinds, only: wp
-  implicit none
+  implicit none (type, external)
   private
 
   integer, parameter, public :: CM_OK = 0             !< success

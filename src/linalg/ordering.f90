@@ -12,7 +12,7 @@ module ordering
   use kinds, only: i8
   use mesh, only: mesh_t
   use assembly, only: body_system_t
-  implicit none
+  implicit none (type, external)
   private
 
   public :: nested_dissection
