@@ -42,7 +42,8 @@ endif
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings config sysinfo signals deck mesh assembly ordering lapack linop mprgp cholmod_iface banded cholesky \
         condense contact_types contact h5io results checkpoint
-OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
+OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
+        $(BUILD)/sysinfo_shim.o
 
 TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact
 BENCH_F := bench_mprgp
@@ -106,6 +107,7 @@ $(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(B
                           $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o $(BUILD)/results.o
 $(BUILD)/signals.o:
+$(BUILD)/sysinfo_shim.o:  include/sysinfo_shim.h
 $(BUILD)/robin_contact.o: $(OBJS)
 
 # ---- link ----------------------------------------------------------------------
