@@ -15,7 +15,7 @@
 program bench_mprgp
   use kinds, only: wp
   use linop, only: csc_op_t, dense_op_t, csc_op_init, dense_op_init, linop_t
-  use mprgp
+  use mprgp, only: mprgp_solve, mprgp_opts_t, mprgp_stats_t, mprgp_status_name
   implicit none (type, external)
 
   integer :: ns(3) = [100, 1000, 5000], ms(3) = [500, 1000, 2000]

@@ -5,10 +5,11 @@
 !! Every result is checked against dense LAPACK. One line per check; exits non-zero
 !! if any check fails.
 program test_cholesky
-  use, intrinsic :: iso_fortran_env, only: int64, output_unit
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use omp_lib, only: omp_get_max_threads
   use kinds, only: wp
-  use cholesky
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, &
+                      CHOL_NOT_POSDEF, CHOL_FAILURE
   use banded, only: rcm_order, band_width
   use lapack, only: dpotrf, dpotri, dposv, dpocon
   use clock, only: wtime

@@ -5,7 +5,8 @@ program test_mprgp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
   use linop, only: linop_t, dense_op_t, csc_op_t, dense_op_init, csc_op_init
-  use mprgp
+  use mprgp, only: mprgp_solve, lambda_max_estimate, mprgp_status_name, mprgp_opts_t, mprgp_stats_t, &
+                   MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG
   use lapack, only: dposv
   implicit none (type, external)
 

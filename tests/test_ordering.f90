@@ -8,7 +8,7 @@
 !! invalid inputs are reported; two bodies condensed with 'nd' equal 'metis'.
 !! One line per check; exits non-zero if any check fails.
 program test_ordering
-  use, intrinsic :: iso_fortran_env, only: int64, output_unit
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
   use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, &
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &

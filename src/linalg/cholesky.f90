@@ -12,7 +12,7 @@
 !! once, one chol_t must not. Do not copy a chol_t (it owns a C handle): pass it
 !! by reference and release it with `free`.
 module cholesky
-  use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_int
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
