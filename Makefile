@@ -40,9 +40,10 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings config sysinfo signals namelist_input deck mesh elements linop assembly ordering mprgp cholmod_iface banded cholesky \
+MODS := kinds errors clock strings config sysinfo signals namelist_input deck mesh elements lapack linop assembly ordering mprgp cholmod_iface banded cholesky \
         condense contact_types contact h5io results checkpoint
-OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o
+OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
+        $(BUILD)/sysinfo_shim.o
 
 TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact
 BENCH_F := bench_mprgp
@@ -92,11 +93,12 @@ $(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/elements.o:      $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements.o $(BUILD)/linop.o
 $(BUILD)/ordering.o:      $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
-$(BUILD)/linop.o:         $(BUILD)/kinds.o
+$(BUILD)/lapack.o:        $(BUILD)/kinds.o
+$(BUILD)/linop.o:         $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
 $(BUILD)/cholmod_iface.o: $(BUILD)/kinds.o
-$(BUILD)/banded.o:        $(BUILD)/kinds.o
-$(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/banded.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/lapack.o
+$(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o $(BUILD)/lapack.o
 $(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
 $(BUILD)/contact_types.o: $(BUILD)/kinds.o
@@ -107,6 +109,7 @@ $(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(B
                           $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o $(BUILD)/results.o
 $(BUILD)/signals.o:
+$(BUILD)/sysinfo_shim.o:  include/sysinfo_shim.h
 $(BUILD)/robin_contact.o: $(OBJS)
 
 # ---- link ----------------------------------------------------------------------

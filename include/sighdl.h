@@ -1,4 +1,4 @@
-/* Signal handling for robin_contact (see src/sighdl.c). */
+/* Signal handling for robin_contact (see src/base/sighdl.c). */
 #ifndef RC_SIGHDL_H
 #define RC_SIGHDL_H
 /* Install handlers for SIGTERM and SIGINT; 0 on success. */

@@ -10,13 +10,15 @@
 !!    F_a of the contact solver), b_i = sin(3 pi x_i), l = 0 (about a third active).
 !!
 !! Columns: size, rtol, products with A (power iterations included), CG /
-!! expansion / proportioning steps, wall time per solve (system_clock, averaged
+!! expansion / proportioning steps, wall time per solve (module clock, averaged
 !! over repeated solves), final |gP|/|b| (at the true gradient), status.
 program bench_mprgp
   use kinds, only: wp
-  use linop, only: csc_op_t, dense_op_t, csc_op_init, dense_op_init, linop_t
-  use mprgp
-  implicit none
+  use linop, only: csc_op_t, dense_op_t, dense_op_init, linop_t
+  use mprgp, only: mprgp_solve, mprgp_opts_t, mprgp_stats_t, mprgp_status_name
+  use clock, only: wtime
+  use testing, only: obstacle_problem
+  implicit none (type, external)
 
   integer :: ns(3) = [100, 1000, 5000], ms(3) = [500, 1000, 2000]
   real(wp) :: rtols(2) = [1.0e-4_wp, 1.0e-8_wp]
@@ -49,29 +51,8 @@ contains
     integer, intent(in) :: n
     real(wp), intent(in) :: rtol
     type(csc_op_t) :: op
-    integer, allocatable :: cp(:), ri(:)
-    real(wp), allocatable :: v(:), b(:), l(:)
-    integer :: j, k, info
-    real(wp) :: h2
-    h2 = real(n + 1, wp)**2
-    allocate (cp(n + 1), ri(3 * n), v(3 * n))
-    k = 0
-    cp(1) = 0
-    do j = 1, n
-      if (j > 1) then
-        k = k + 1; ri(k) = j - 2; v(k) = -h2
-      end if
-      k = k + 1; ri(k) = j - 1; v(k) = 2.0_wp * h2
-      if (j < n) then
-        k = k + 1; ri(k) = j; v(k) = -h2
-      end if
-      cp(j + 1) = k
-    end do
-    call csc_op_init(op, n, cp, ri, v, info)
-    if (info /= 0) error stop 'csc_op_init failed'
-    allocate (b(n), l(n))
-    b = -15.0_wp
-    l = -1.0_wp
+    real(wp), allocatable :: b(:), l(:)
+    call obstacle_problem(n, op, b, l, 1.0_wp)
     call timed(op, b, l, n, rtol)
   end subroutine run_obstacle
 
@@ -107,22 +88,20 @@ contains
     type(mprgp_opts_t) :: opts
     type(mprgp_stats_t) :: st
     real(wp), allocatable :: x(:)
-    integer(kind=8) :: t0, t1, rate
     integer :: reps
-    real(wp) :: elapsed
+    real(wp) :: t0, elapsed
     allocate (x(n))
     opts%rtol = rtol
     opts%max_it = 1000000
     x = 0.0_wp
     call mprgp_solve(op, b, l, x, opts, st)   ! warm-up, not timed
     reps = 0
-    call system_clock(t0, rate)
+    t0 = wtime()
     do
       x = 0.0_wp
       call mprgp_solve(op, b, l, x, opts, st)
       reps = reps + 1
-      call system_clock(t1)
-      elapsed = real(t1 - t0, wp) / real(rate, wp)
+      elapsed = wtime() - t0
       if (elapsed >= 0.5_wp .or. reps >= 1000) exit
     end do
     write (*, '(i6,es10.1,i13,3i8,es18.3,es11.2,3x,a)') n, rtol, st%n_matvec, st%n_cg, st%n_exp, &

@@ -5,13 +5,16 @@
 !! Every result is checked against dense LAPACK. One line per check; exits non-zero
 !! if any check fails.
 program test_cholesky
-  use, intrinsic :: iso_fortran_env, only: int64, output_unit
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use omp_lib, only: omp_get_max_threads
   use kinds, only: wp
-  use cholesky
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, &
+                      CHOL_NOT_POSDEF, CHOL_FAILURE
   use banded, only: rcm_order, band_width
-  use testing, only: report, report_le, wtime, test_summary
-  implicit none
+  use lapack, only: dpotrf, dpotri, dposv, dpocon
+  use clock, only: wtime
+  use testing, only: report, report_le, test_summary
+  implicit none (type, external)
 
   !> A sparse symmetric matrix in full 0-based CSC.
   type :: csc_t
@@ -19,38 +22,6 @@ program test_cholesky
     integer, allocatable :: colptr(:), rowind(:)
     real(wp), allocatable :: val(:)
   end type csc_t
-
-  interface
-    subroutine dpotrf(uplo, n, a, lda, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, lda
-      real(wp), intent(inout) :: a(lda, *)
-      integer, intent(out) :: info
-    end subroutine dpotrf
-    subroutine dpotri(uplo, n, a, lda, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, lda
-      real(wp), intent(inout) :: a(lda, *)
-      integer, intent(out) :: info
-    end subroutine dpotri
-    subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, nrhs, lda, ldb
-      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dposv
-    subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, lda
-      real(wp), intent(in) :: a(lda, *), anorm
-      real(wp), intent(out) :: rcond, work(*)
-      integer, intent(out) :: iwork(*), info
-    end subroutine dpocon
-  end interface
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: RES_TOL = 10.0_wp     ! scaled residual threshold

@@ -4,23 +4,16 @@
 program test_mprgp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
-  use linop, only: linop_t, dense_op_t, csc_op_t, dense_op_init, csc_op_init
-  use mprgp
-  implicit none
+  use linop, only: linop_t, dense_op_t, csc_op_t, dense_op_init
+  use mprgp, only: mprgp_solve, lambda_max_estimate, mprgp_status_name, mprgp_opts_t, mprgp_stats_t, &
+                   MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG
+  use lapack, only: dposv
+  use strings, only: i2s
+  use testing, only: report, test_summary, obstacle_problem
+  implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: nobound = -huge(1.0_wp)
-  integer :: npass = 0, nfail = 0
-
-  interface
-    subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
-      import :: wp
-      character(len=1), intent(in) :: uplo
-      integer, intent(in) :: n, nrhs, lda, ldb
-      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dposv
-  end interface
 
   call set_seed(20240611)
   call test_enumeration()
@@ -32,32 +25,11 @@ program test_mprgp
   call test_scaling()
   call test_threads()
 
-  write (*, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
-  if (nfail > 0) error stop 1
+  call test_summary()
 
 contains
 
   ! ------------------------------------------------------------------ helpers
-
-  subroutine check(ok, what, val, tol)
-    logical, intent(in) :: ok
-    character(len=*), intent(in) :: what
-    real(wp), intent(in), optional :: val, tol
-    character(len=64) :: extra
-    extra = ''
-    if (present(val) .and. present(tol)) then
-      write (extra, '(a,es10.3,a,es10.3,a)') ' (', val, ', tol ', tol, ')'
-    else if (present(val)) then
-      write (extra, '(a,es10.3,a)') ' (', val, ')'
-    end if
-    if (ok) then
-      npass = npass + 1
-      write (*, '(a)') 'PASS  '//what//trim(extra)
-    else
-      nfail = nfail + 1
-      write (*, '(a)') 'FAIL  '//what//trim(extra)
-    end if
-  end subroutine check
 
   subroutine set_seed(s0)
     integer, intent(in) :: s0
@@ -81,8 +53,8 @@ contains
     integer, intent(in) :: n
     real(wp), intent(in) :: cexp
     real(wp), intent(out) :: a(n, n), lmin, lmax
-    real(wp) :: d(n), v(n), q(n, n)
-    integer :: i, k
+    real(wp) :: d(n)
+    integer :: i
     do i = 1, n
       d(i) = 10.0_wp**(cexp * urand(0.0_wp, 1.0_wp))
     end do
@@ -90,20 +62,7 @@ contains
       d(1) = 1.0_wp
       d(2) = 10.0_wp**cexp
     end if
-    q = 0.0_wp
-    do i = 1, n
-      q(i, i) = 1.0_wp
-    end do
-    do k = 1, 3   ! product of three random Householder reflectors
-      do i = 1, n
-        v(i) = urand(-1.0_wp, 1.0_wp)
-      end do
-      call reflect(n, q, v)
-    end do
-    do i = 1, n
-      a(:, i) = matmul(q, d * q(i, :))
-    end do
-    a = 0.5_wp * (a + transpose(a))
+    call spd_from_eigs(n, d, a)
     lmin = minval(d)
     lmax = maxval(d)
   end subroutine random_spd
@@ -206,39 +165,6 @@ contains
     end do
   end function kkt_ratio
 
-  !> 1D obstacle problem: -u'' = -15 on (0,1), u(0) = u(1) = 0, u >= -1 (flat
-  !! obstacle). Exact solution: u = 7.5 x^2 - 15 a x on [0,a], -1 on [a,1-a],
-  !! symmetric, a = sqrt(2/15). FD matrix tridiag(-1,2,-1)*(n+1)^2 in CSC.
-  subroutine obstacle_problem(n, op, b, l, scale_a)
-    integer, intent(in) :: n
-    type(csc_op_t), intent(out) :: op
-    real(wp), allocatable, intent(out) :: b(:), l(:)
-    real(wp), intent(in) :: scale_a
-    integer, allocatable :: cp(:), ri(:)
-    real(wp), allocatable :: v(:)
-    integer :: j, k, info
-    real(wp) :: h2
-    h2 = real(n + 1, wp)**2
-    allocate (cp(n + 1), ri(3 * n), v(3 * n))
-    k = 0
-    cp(1) = 0
-    do j = 1, n
-      if (j > 1) then
-        k = k + 1; ri(k) = j - 2; v(k) = -h2 * scale_a
-      end if
-      k = k + 1; ri(k) = j - 1; v(k) = 2.0_wp * h2 * scale_a
-      if (j < n) then
-        k = k + 1; ri(k) = j; v(k) = -h2 * scale_a
-      end if
-      cp(j + 1) = k
-    end do
-    call csc_op_init(op, n, cp, ri, v, info)
-    if (info /= 0) error stop 'csc_op_init failed'
-    allocate (b(n), l(n))
-    b = -15.0_wp
-    l = -1.0_wp
-  end subroutine obstacle_problem
-
   !> Tridiagonal product written independently of linop (for KKT checks).
   subroutine tridiag_mul(n, c, x, y)
     integer, intent(in) :: n
@@ -330,14 +256,14 @@ contains
       gerr = norm2(g - gt) / (n * eps * (anorm * norm2(x) + norm2(b)))
       worst_g = max(worst_g, gerr)
     end do
-    call check(nfound == nprob, 'enumeration: KKT active set found for every problem', real(nfound, wp))
-    call check(nact_tot > nprob, 'enumeration: active bounds at the solutions (total count)', real(nact_tot, wp))
-    call check(nconv == nprob, 'enumeration: all 200 random problems converged', real(nconv, wp))
-    call check(nerr == 0, 'enumeration: |x - x*| <= 10 (|gP| + 10 n eps |A||x*|)/lambda_min, worst ratio', &
+    call report(nfound == nprob, 'enumeration: KKT active set found for every problem', real(nfound, wp))
+    call report(nact_tot > nprob, 'enumeration: active bounds at the solutions (total count)', real(nact_tot, wp))
+    call report(nconv == nprob, 'enumeration: all 200 random problems converged', real(nconv, wp))
+    call report(nerr == 0, 'enumeration: |x - x*| <= 10 (|gP| + 10 n eps |A||x*|)/lambda_min, worst ratio', &
                worst_err, 1.0_wp)
-    call check(nkkt == 0, 'enumeration: KKT (feasible, g>=0 active, g=0 free, compl.), worst ratio', &
+    call report(nkkt == 0, 'enumeration: KKT (feasible, g>=0 active, g=0 free, compl.), worst ratio', &
                worst_kkt, 1.0_wp)
-    call check(worst_g <= 10.0_wp, 'enumeration: returned g = Ax - b, worst |dg|/(n eps (|A||x|+|b|))', &
+    call report(worst_g <= 10.0_wp, 'enumeration: returned g = Ax - b, worst |dg|/(n eps (|A||x|+|b|))', &
                worst_g, 10.0_wp)
   end subroutine test_enumeration
 
@@ -405,27 +331,19 @@ contains
       if (st%status /= MPRGP_MAX_IT .or. st%n_cg /= k .or. st%n_exp /= 0 .or. st%n_prop /= 0 .or. st%n_matvec /= k + 2) &
         nbadcount = nbadcount + 1
     end do
-    call check(worst <= 1.0e-12_wp, 'plain CG (n = 200, cond 10): all iterates equal, max |x_k - x_k^CG|/|x|', &
+    call report(worst <= 1.0e-12_wp, 'plain CG (n = 200, cond 10): all iterates equal, max |x_k - x_k^CG|/|x|', &
                worst, 1.0e-12_wp)
-    call check(nbadcount == 0, 'plain CG: after k < k_CG steps max_it, n_cg = k, n_exp = n_prop = 0, '// &
+    call report(nbadcount == 0, 'plain CG: after k < k_CG steps max_it, n_cg = k, n_exp = n_prop = 0, '// &
                'n_matvec = k+2 (initial + final true gradient, no power its)')
     opts%max_it = 10000
     x = 0.0_wp
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_CONVERGED .and. st%n_cg == kcg, &
-               'plain CG: converged with the same step count as CG ('//itoa(kcg)//')', real(st%n_cg, wp))
-    call check(st%n_exp == 0 .and. st%n_prop == 0 .and. st%n_matvec == st%n_cg + 2, &
+    call report(st%status == MPRGP_CONVERGED .and. st%n_cg == kcg, &
+               'plain CG: converged with the same step count as CG ('//i2s(kcg)//')', real(st%n_cg, wp))
+    call report(st%n_exp == 0 .and. st%n_prop == 0 .and. st%n_matvec == st%n_cg + 2, &
                'plain CG: n_exp = n_prop = 0, n_matvec = n_cg + 2 (initial + confirming product)', &
                real(st%n_matvec, wp))
   end subroutine test_plain_cg
-
-  function itoa(k) result(s)
-    integer, intent(in) :: k
-    character(len=:), allocatable :: s
-    character(len=16) :: buf
-    write (buf, '(i0)') k
-    s = trim(buf)
-  end function itoa
 
   !> 1D obstacle problem, n = 100, 1000, 5000.
   subroutine test_obstacle()
@@ -447,22 +365,22 @@ contains
       write (line, '(a,i0,a,i0,a,i0,a,i0,a,i0,a,es9.2)') 'obstacle n = ', n, ': ', st%n_matvec, &
         ' products (cg ', st%n_cg, ', exp ', st%n_exp, ', prop ', st%n_prop, '), |gP|/|b| = ', &
         st%gp_norm / st%b_norm
-      call check(st%status == MPRGP_CONVERGED, trim(line))
+      call report(st%status == MPRGP_CONVERGED, trim(line))
       c = real(n + 1, wp)**2
       call tridiag_mul(n, c, x, gt)
       gt = gt - b
       anorm = 4.0_wp * c
       tolg = opts%rtol * norm2(b) + 10.0_wp * n * eps * (anorm * norm2(x) + norm2(b))
       rk = kkt_ratio(n, x, l, gt, tolg)
-      call check(rk <= 1.0_wp, 'obstacle n = '//itoa(n)//': KKT residual / tolerance', rk, 1.0_wp)
+      call report(rk <= 1.0_wp, 'obstacle n = '//i2s(n)//': KKT residual / tolerance', rk, 1.0_wp)
       ncontact = count(x <= l)
       h = 1.0_wp / (n + 1)
       err = 0.0_wp
       do i = 1, n
         err = max(err, abs(x(i) - obstacle_exact(i * h)))
       end do
-      call check(err <= 2.0_wp * h .and. ncontact > n / 5, 'obstacle n = '//itoa(n)// &
-                 ': max |u - u_exact| <= 2h (contact nodes '//itoa(ncontact)//')', err, 2.0_wp * h)
+      call report(err <= 2.0_wp * h .and. ncontact > n / 5, 'obstacle n = '//i2s(n)// &
+                 ': max |u - u_exact| <= 2h (contact nodes '//i2s(ncontact)//')', err, 2.0_wp * h)
       deallocate (x, g, gt)
     end do
   end subroutine test_obstacle
@@ -484,28 +402,28 @@ contains
     x = 0.0_wp
     xs = 0.0_wp
     call mprgp_solve(op, b, l, xs, opts, st)
-    call check(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
+    call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: size(x) /= n -> bad argument: "'//trim(st%message)//'"')
     call mprgp_solve(op, b(1:n - 1), l, x, opts, st)
-    call check(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
+    call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: size(b) /= n -> bad argument')
     call mprgp_solve(op, b, l, x, opts, st, gsmall)
-    call check(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
+    call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: size(g) /= n -> bad argument')
     bad = opts
     bad%rtol = -1.0e-6_wp
     call mprgp_solve(op, b, l, x, bad, st)
-    call check(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
+    call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: rtol < 0 -> bad argument: "'//trim(st%message)//'"')
     bad = opts
     bad%max_it = -3
     call mprgp_solve(op, b, l, x, bad, st)
-    call check(st%status == MPRGP_BAD_ARG, 'bad args: max_it < 0 -> bad argument')
+    call report(st%status == MPRGP_BAD_ARG, 'bad args: max_it < 0 -> bad argument')
     bad = opts
     bad%gamma = 0.0_wp
     call mprgp_solve(op, b, l, x, bad, st)
-    call check(st%status == MPRGP_BAD_ARG, 'bad args: gamma = 0 -> bad argument')
-    call check(mprgp_status_name(MPRGP_BAD_ARG) == 'bad argument' .and. &
+    call report(st%status == MPRGP_BAD_ARG, 'bad args: gamma = 0 -> bad argument')
+    call report(mprgp_status_name(MPRGP_BAD_ARG) == 'bad argument' .and. &
                mprgp_status_name(MPRGP_NOT_SPD) == 'not SPD' .and. &
                mprgp_status_name(MPRGP_NONFINITE) == 'non-finite' .and. &
                mprgp_status_name(MPRGP_MAX_IT) == 'max_it' .and. &
@@ -513,19 +431,19 @@ contains
     ! NaN in b, NaN in lb
     b(3) = ieee_value(1.0_wp, ieee_quiet_nan)
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_NONFINITE .and. len_trim(st%message) > 0, &
+    call report(st%status == MPRGP_NONFINITE .and. len_trim(st%message) > 0, &
                'NaN in b -> non-finite: "'//trim(st%message)//'"')
     b(3) = 0.5_wp
     l(5) = ieee_value(1.0_wp, ieee_quiet_nan)
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_NONFINITE, 'NaN in lb -> non-finite')
+    call report(st%status == MPRGP_NONFINITE, 'NaN in lb -> non-finite')
     l(5) = 0.0_wp
     ! max_it reached is reported, not silent
     bad = opts
     bad%max_it = 2
     x = 0.0_wp
     call mprgp_solve(op, b, -b * 0.0_wp - 1.0_wp, x, bad, st)
-    call check(st%status == MPRGP_MAX_IT .and. len_trim(st%message) > 0, &
+    call report(st%status == MPRGP_MAX_IT .and. len_trim(st%message) > 0, &
                'max_it = 2 -> max_it: "'//trim(st%message)//'"')
     ! indefinite matrix (eigenvalues of both signs), no bounds, generic b
     do i = 1, n
@@ -536,28 +454,29 @@ contains
     l = nobound
     x = 0.0_wp
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_NOT_SPD, 'indefinite A, no bounds -> not SPD: "'//trim(st%message)//'"')
+    call report(st%status == MPRGP_NOT_SPD, 'indefinite A, no bounds -> not SPD: "'//trim(st%message)//'"')
     ! negative definite with bounds: every direction has p'Ap < 0
     call spd_from_eigs(n, -abs(d), a)
     call dense_op_init(op, a)
     l = -1.0_wp
     x = 0.0_wp
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status /= MPRGP_CONVERGED .and. st%status /= MPRGP_BAD_ARG, &
+    call report(st%status /= MPRGP_CONVERGED .and. st%status /= MPRGP_BAD_ARG, &
                'negative definite A with bounds -> not converged ('//mprgp_status_name(st%status)//')')
     ! zero matrix
     a = 0.0_wp
     call dense_op_init(op, a)
     x = 0.0_wp
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_NOT_SPD, 'zero A -> not SPD ('//mprgp_status_name(st%status)//')')
+    call report(st%status == MPRGP_NOT_SPD, 'zero A -> not SPD ('//mprgp_status_name(st%status)//')')
     ! empty problem
     call dense_op_init(op, a(1:0, 1:0))
     call mprgp_solve(op, b(1:0), l(1:0), x(1:0), opts, st)
-    call check(st%status == MPRGP_CONVERGED, 'n = 0 -> converged')
+    call report(st%status == MPRGP_CONVERGED, 'n = 0 -> converged')
   end subroutine test_bad_arguments
 
-  !> Symmetric matrix with given eigenvalues (random orthogonal basis).
+  !> Symmetric matrix Q diag(d) Q' with given eigenvalues d; Q is a product of three
+  !! random Householder reflectors.
   subroutine spd_from_eigs(n, d, a)
     integer, intent(in) :: n
     real(wp), intent(in) :: d(n)
@@ -595,7 +514,7 @@ contains
     l = -1.0_wp
     x = 0.3_wp
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_CONVERGED .and. maxval(abs(x)) <= 1.0e3_wp * eps, &
+    call report(st%status == MPRGP_CONVERGED .and. maxval(abs(x)) <= 1.0e3_wp * eps, &
                'b = 0, l < 0: converged to x = 0 ('//trim(st%message)//')', maxval(abs(x)))
     do i = 1, n
       l(i) = merge(0.5_wp, nobound, mod(i, 2) == 0)
@@ -605,14 +524,14 @@ contains
     call enumerate_qp(n, a, b, l, xs, ok)
     gt = matmul(a, x) - b
     tolg = 100.0_wp * n * eps * lmax * norm2(x)
-    call check(st%status == MPRGP_CONVERGED .and. kkt_ratio(n, x, l, gt, tolg) <= 1.0_wp .and. &
+    call report(st%status == MPRGP_CONVERGED .and. kkt_ratio(n, x, l, gt, tolg) <= 1.0_wp .and. &
                norm2(x - xs) <= 1.0e-10_wp * lmax / lmin * norm2(xs), &
                'b = 0, some l > 0, rtol = atol = 0 floor: converged, KKT, = enumeration', &
                norm2(x - xs) / norm2(xs))
     opts%atol = 1.0e-6_wp
     x = 0.0_wp
     call mprgp_solve(op, b, l, x, opts, st)
-    call check(st%status == MPRGP_CONVERGED .and. st%gp_norm <= 1.0e-6_wp, &
+    call report(st%status == MPRGP_CONVERGED .and. st%gp_norm <= 1.0e-6_wp, &
                'b = 0 with atol = 1e-6: converged on the absolute floor', st%gp_norm, 1.0e-6_wp)
   end subroutine test_zero_rhs
 
@@ -631,7 +550,7 @@ contains
     call obstacle_problem(n, cop, b, l, 1.0_wp)
     lam_true = 4.0_wp * real(n + 1, wp)**2 * sin(real(n, wp) * acos(-1.0_wp) / (2.0_wp * (n + 1)))**2
     est = lambda_max_estimate(cop, 20, nmv)
-    call check(est <= lam_true * (1.0_wp + 1.0e-12_wp) .and. est >= 0.95_wp * lam_true .and. nmv == 20, &
+    call report(est <= lam_true * (1.0_wp + 1.0e-12_wp) .and. est >= 0.95_wp * lam_true .and. nmv == 20, &
                'lambda_max_estimate: 20 power its within [0.95, 1] lambda_max (obstacle n = 200)', est / lam_true)
     call guard_case(cop, b, l, lam_true, acos(-1.0_wp)**2, 'obstacle n = 200')
     call random_spd(nd, 3.0_wp, a, lmin, lmax)
@@ -643,7 +562,7 @@ contains
       l(i) = urand(-0.005_wp, 0.005_wp)
     end do
     est = lambda_max_estimate(dop, 20, nmv)
-    call check(est <= lmax * (1.0_wp + 1.0e-12_wp) .and. est >= 0.9_wp * lmax, &
+    call report(est <= lmax * (1.0_wp + 1.0e-12_wp) .and. est >= 0.9_wp * lmax, &
                'lambda_max_estimate: within [0.9, 1] lambda_max (dense n = 150, cond 1e3)', est / lmax)
     call guard_case(dop, b, l, lmax, lmin, 'dense n = 150')
   end subroutine test_alpha_guard
@@ -668,17 +587,17 @@ contains
     call mprgp_solve(op, b, l, x2, opts, st2)
     tolx = 10.0_wp * opts%rtol * norm2(b) / lam_min
     d = max(norm2(x1 - x0), norm2(x2 - x0))
-    call check(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. &
+    call report(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. &
                st2%status == MPRGP_CONVERGED .and. d <= tolx, 'alpha guard ('//name// &
                '): default, lambda_max/10, alpha_bar = 20/lambda_max converge to the same x', d, tolx)
-    call check(st0%alpha_bar * lam_true <= 2.0_wp .and. st0%alpha_bar * lam_true >= 1.8_wp, &
+    call report(st0%alpha_bar * lam_true <= 2.0_wp .and. st0%alpha_bar * lam_true >= 1.8_wp, &
                'alpha guard ('//name//'): default alpha_bar*lambda_max in [1.8, 2] ('// &
-               itoa(st0%n_exp)//' expansions)', st0%alpha_bar * lam_true, 2.0_wp)
-    call check(st1%alpha_bar < 19.0_wp / lam_true .and. st2%alpha_bar < 20.0_wp / lam_true .and. &
+               i2s(st0%n_exp)//' expansions)', st0%alpha_bar * lam_true, 2.0_wp)
+    call report(st1%alpha_bar < 19.0_wp / lam_true .and. st2%alpha_bar < 20.0_wp / lam_true .and. &
                st1%alpha_bar * st1%lambda_max <= 2.0_wp .and. st2%alpha_bar * st2%lambda_max <= 2.0_wp, &
                'alpha guard ('//name//'): bad alpha_bar cut to alpha_bar*lambda_max = '// &
                ftoa(st1%alpha_bar * lam_true)//', '//ftoa(st2%alpha_bar * lam_true)//'; products '// &
-               itoa(st1%n_matvec)//', '//itoa(st2%n_matvec)//' vs '//itoa(st0%n_matvec))
+               i2s(st1%n_matvec)//', '//i2s(st2%n_matvec)//' vs '//i2s(st0%n_matvec))
   end subroutine guard_case
 
   function ftoa(v) result(s)
@@ -711,10 +630,10 @@ contains
     call mprgp_solve(op1, 1.0e6_wp * b, 1.0e-5_wp * l, x1, opts, st1)
     tolx = 10.0_wp * opts%rtol * norm2(b) / (acos(-1.0_wp)**2)
     d = norm2(1.0e5_wp * x1 - x0)
-    call check(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. d <= tolx, &
+    call report(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. d <= tolx, &
                'scaling (obstacle n=100): 1e5 x(1e11 A, 1e6 b) = x(A, b)', d, tolx)
-    call check(abs(st1%n_matvec - st0%n_matvec) <= 0.1_wp * st0%n_matvec + 5, &
-               'scaling (obstacle n=100): products '//itoa(st1%n_matvec)//' vs '//itoa(st0%n_matvec))
+    call report(abs(st1%n_matvec - st0%n_matvec) <= 0.1_wp * st0%n_matvec + 5, &
+               'scaling (obstacle n=100): products '//i2s(st1%n_matvec)//' vs '//i2s(st0%n_matvec))
     call random_spd(nr, 2.0_wp, a, lmin, lmax)
     do i = 1, nr
       br(i) = urand(-1.0_wp, 1.0_wp)
@@ -728,9 +647,9 @@ contains
     call mprgp_solve(dop1, 1.0e6_wp * br, 1.0e-5_wp * lr, xr1, opts, st1)
     tolx = 10.0_wp * opts%rtol * norm2(br) / lmin
     d = norm2(1.0e5_wp * xr1 - xr0)
-    call check(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. d <= tolx .and. &
+    call report(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. d <= tolx .and. &
                abs(st1%n_matvec - st0%n_matvec) <= 0.1_wp * st0%n_matvec + 3, &
-               'scaling (random n=10): same x, products '//itoa(st1%n_matvec)//' vs '//itoa(st0%n_matvec), &
+               'scaling (random n=10): same x, products '//i2s(st1%n_matvec)//' vs '//i2s(st0%n_matvec), &
                d, tolx)
   end subroutine test_scaling
 
@@ -774,7 +693,7 @@ contains
       ok = ok .and. t1%status == MPRGP_CONVERGED .and. t2%status == MPRGP_CONVERGED .and. &
            t1%n_matvec == s1%n_matvec .and. t2%n_matvec == s2%n_matvec
     end do
-    call check(ok .and. d <= 1.0e-12_wp, 'threads: 2 concurrent solves x 20 = serial results', d, 1.0e-12_wp)
+    call report(ok .and. d <= 1.0e-12_wp, 'threads: 2 concurrent solves x 20 = serial results', d, 1.0e-12_wp)
   end subroutine test_threads
 
 end program test_mprgp

@@ -8,7 +8,7 @@
 !! invalid inputs are reported; two bodies condensed with 'nd' equal 'metis'.
 !! One line per check; exits non-zero if any check fails.
 program test_ordering
-  use, intrinsic :: iso_fortran_env, only: int64, output_unit
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
   use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, ORDER_METIS, ORDER_ND, &
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
@@ -18,8 +18,9 @@ program test_ordering
   use ordering, only: nested_dissection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
-  use testing, only: report, report_le, wtime, test_summary
-  implicit none
+  use clock, only: wtime
+  use testing, only: report, report_le, test_summary
+  implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: RES_TOL = 10.0_wp        ! scaled residual threshold

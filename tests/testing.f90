@@ -1,29 +1,36 @@
 !> Helpers shared by the Fortran test programs: PASS/FAIL reporting with counters and
-!! the closing line, a wall clock, and an independent direct solve of an assembled body
+!! the closing line, the 1D obstacle problem of the MPRGP test and benchmark, and an independent direct solve of an assembled body
 !! (LAPACK band Cholesky in the natural order) so the FE tests do not depend on the
 !! Cholesky module that other tests check.
 module testing
-  use, intrinsic :: iso_fortran_env, only: output_unit, int64
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
   use assembly, only: body_system_t
-  implicit none
+  use linop, only: csc_op_t, csc_op_init
+  use lapack, only: dpbsv
+  implicit none (type, external)
   private
 
   integer, public, protected :: npass = 0   !< checks passed so far
   integer, public, protected :: nfail = 0   !< checks failed so far
 
-  public :: report, report_le, wtime, test_summary, band_solve
+  public :: report, report_le, test_summary, band_solve, obstacle_problem
 
 contains
 
-  !> Print one check as `PASS  what (value, tol)` or `FAIL  ...` and count it.
+  !> Print one check as `PASS  what (value, tol)`, `PASS  what (value)` or `FAIL  ...`
+  !! and count it.
   subroutine report(ok, what, value, tol)
     logical, intent(in) :: ok                         !< outcome
     character(len=*), intent(in) :: what              !< what was checked
     real(wp), intent(in), optional :: value, tol      !< measured value and its tolerance
     character(len=64) :: extra
     extra = ''
-    if (present(value) .and. present(tol)) write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
+    if (present(value) .and. present(tol)) then
+      write (extra, '(a,es9.2,a,es9.2,a)') ' (', value, ', tol ', tol, ')'
+    else if (present(value)) then
+      write (extra, '(a,es9.2,a)') ' (', value, ')'
+    end if
     if (ok) then
       npass = npass + 1
       write (output_unit, '(a)') 'PASS  '//what//trim(extra)
@@ -39,14 +46,6 @@ contains
     character(len=*), intent(in) :: what  !< what was checked
     call report(value <= tol, what, value, tol)
   end subroutine report_le
-
-  !> Wall clock [s].
-  function wtime() result(t)
-    real(wp) :: t
-    integer(int64) :: cnt, rate
-    call system_clock(cnt, rate)
-    t = real(cnt, wp)/real(rate, wp)
-  end function wtime
 
   !> Print `N checks passed, M failed` and stop with status 1 if anything failed.
   subroutine test_summary()
@@ -83,5 +82,39 @@ contains
       error stop 1
     end if
   end subroutine band_solve
+
+  !> 1D obstacle problem: -u'' = -15 on (0,1), u(0) = u(1) = 0, u >= -1 (flat
+  !! obstacle), by finite differences: A = tridiag(-1,2,-1)*(n+1)^2*scale_a in CSC,
+  !! b = -15, l = -1. Exact solution for scale_a = 1: u = 7.5 x^2 - 15 a x on [0,a],
+  !! -1 on [a,1-a], symmetric, a = sqrt(2/15).
+  subroutine obstacle_problem(n, op, b, l, scale_a)
+    integer, intent(in) :: n                          !< number of interior grid points
+    type(csc_op_t), intent(out) :: op                 !< the matrix A
+    real(wp), allocatable, intent(out) :: b(:), l(:)  !< right-hand side and lower bound
+    real(wp), intent(in) :: scale_a                   !< factor applied to A
+    integer, allocatable :: cp(:), ri(:)
+    real(wp), allocatable :: v(:)
+    integer :: j, k, info
+    real(wp) :: h2
+    h2 = real(n + 1, wp)**2
+    allocate (cp(n + 1), ri(3 * n), v(3 * n))
+    k = 0
+    cp(1) = 0
+    do j = 1, n
+      if (j > 1) then
+        k = k + 1; ri(k) = j - 2; v(k) = -h2 * scale_a
+      end if
+      k = k + 1; ri(k) = j - 1; v(k) = 2.0_wp * h2 * scale_a
+      if (j < n) then
+        k = k + 1; ri(k) = j; v(k) = -h2 * scale_a
+      end if
+      cp(j + 1) = k
+    end do
+    call csc_op_init(op, n, cp, ri, v, info)
+    if (info /= 0) error stop 'csc_op_init failed'
+    allocate (b(n), l(n))
+    b = -15.0_wp
+    l = -1.0_wp
+  end subroutine obstacle_problem
 
 end module testing

@@ -5,7 +5,7 @@
 !! handler elsewhere.
 module errors
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
-  implicit none
+  implicit none (type, external)
   private
 
   integer, parameter, public :: EXIT_OK = 0             !< converged

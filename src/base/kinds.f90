@@ -2,7 +2,7 @@
 module kinds
   use, intrinsic :: iso_fortran_env, only: real64, int32, int64
   use, intrinsic :: iso_c_binding, only: c_int, c_double, c_ptr, c_null_ptr, c_char, c_long
-  implicit none
+  implicit none (type, external)
   private
   integer, parameter, public :: wp = real64   !< working real kind (double precision)
   integer, parameter, public :: ip = int32    !< default integer kind

@@ -1,8 +1,8 @@
-!> SIGTERM/SIGINT from a batch scheduler: the C handler (src/sighdl.c) sets a flag
+!> SIGTERM/SIGINT from a batch scheduler: the C handler (src/base/sighdl.c) sets a flag
 !! that the outer iteration polls through `stop_requested`.
 module signals
   use, intrinsic :: iso_c_binding, only: c_int
-  implicit none
+  implicit none (type, external)
   private
 
   interface

@@ -1,33 +1,27 @@
-!> Process information from the C library: peak resident memory (getrusage).
+!> Process information from the C library (src/base/sysinfo_shim.c): peak resident
+!! memory (getrusage).
 module sysinfo
+  use, intrinsic :: iso_c_binding, only: c_double
   use kinds, only: wp
-  use, intrinsic :: iso_c_binding, only: c_int, c_long
-  implicit none
+  implicit none (type, external)
   private
 
-  !> struct rusage on Linux/x86_64: two struct timeval, then 14 longs.
-  type, bind(c) :: rusage_t
-    integer(c_long) :: utime(2), stime(2)
-    integer(c_long) :: fields(14)
-  end type rusage_t
-
   interface
-    integer(c_int) function c_getrusage(who, usage) bind(c, name='getrusage')
-      import :: c_int, rusage_t
-      integer(c_int), value :: who
-      type(rusage_t), intent(out) :: usage
-    end function c_getrusage
+    !> Peak resident set size [MiB], 0 if getrusage failed.
+    function rc_peak_rss_mb() bind(c, name='rc_peak_rss_mb') result(mb)
+      import :: c_double
+      implicit none
+      real(c_double) :: mb
+    end function rc_peak_rss_mb
   end interface
 
   public :: peak_rss_mb
 
 contains
 
-  !> Peak resident set size of this process so far [MiB] (ru_maxrss is in KiB on Linux).
+  !> Peak resident set size of this process so far [MiB].
   real(wp) function peak_rss_mb()
-    type(rusage_t) :: ru
-    peak_rss_mb = 0.0_wp
-    if (c_getrusage(0_c_int, ru) == 0) peak_rss_mb = real(ru%fields(1), wp)/1024.0_wp
+    peak_rss_mb = real(rc_peak_rss_mb(), wp)
   end function peak_rss_mb
 
 end module sysinfo

@@ -9,12 +9,13 @@ module contact
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC, STOP_RESIDUAL, ACCEL_AITKEN, ACCEL_ANDERSON
   use linop, only: linop_t, dense_op_t, dense_op_init
   use clock, only: wtime
+  use lapack, only: dsymv, dgemm, dpotrf, dpotrs, dposv, dgels
   use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, lambda_max_estimate, &
                    MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
   use condense, only: interface_t, body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, ANDERSON_DEPTH, &
                            state_init, alloc_result, grow_history
-  implicit none
+  implicit none (type, external)
   private
 
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'

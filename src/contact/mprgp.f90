@@ -29,7 +29,7 @@ module mprgp
   use kinds, only: wp
   use linop, only: linop_t
   use strings, only: itoa, rtoa
-  implicit none
+  implicit none (type, external)
   private
 
   public :: mprgp_solve, lambda_max_estimate, mprgp_status_name

@@ -2,9 +2,10 @@
 !! reverse Cuthill-McKee (RCM) ordering, LAPACK band storage, `dpbtrf`/`dpbtrs`.
 !! A simple, dependency-free alternative to CHOLMOD for small problems and checks.
 module banded
-  use, intrinsic :: iso_fortran_env, only: int64
   use kinds, only: wp, i8
-  implicit none
+  use clock, only: wtime
+  use lapack, only: dpbtrf, dpbtrs
+  implicit none (type, external)
   private
 
   !> One banded Cholesky factorization P K P' = L L' (P from RCM).
@@ -24,33 +25,7 @@ module banded
 
   public :: rcm_order, band_width
 
-  interface
-    subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, kd, ldab
-      real(wp), intent(inout) :: ab(ldab, *)
-      integer, intent(out) :: info
-    end subroutine dpbtrf
-    subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, kd, nrhs, ldab, ldb
-      real(wp), intent(in) :: ab(ldab, *)
-      real(wp), intent(inout) :: b(ldb, *)
-      integer, intent(out) :: info
-    end subroutine dpbtrs
-  end interface
-
 contains
-
-  !> Wall-clock time [s].
-  function wtime() result(t)
-    real(wp) :: t
-    integer(int64) :: cnt, rate
-    call system_clock(cnt, rate)
-    t = real(cnt, wp) / real(rate, wp)
-  end function wtime
 
   !> Reverse Cuthill-McKee ordering of a symmetric sparsity pattern.
   !! Each connected component is numbered by a breadth-first search from a

@@ -12,13 +12,14 @@
 !! once, one chol_t must not. Do not copy a chol_t (it owns a C handle): pass it
 !! by reference and release it with `free`.
 module cholesky
-  use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_int
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
                            CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN
   use banded, only: band_t
-  implicit none
+  use lapack, only: dpotri
+  implicit none (type, external)
   private
 
   integer, parameter, public :: FACT_CHOLMOD = 1   !< CHOLMOD supernodal LL'
@@ -59,16 +60,6 @@ module cholesky
     procedure :: summary => chol_summary
     procedure :: free => chol_free
   end type chol_t
-
-  interface
-    subroutine dpotri(uplo, n, a, lda, info)
-      import :: wp
-      character, intent(in) :: uplo
-      integer, intent(in) :: n, lda
-      real(wp), intent(inout) :: a(lda, *)
-      integer, intent(out) :: info
-    end subroutine dpotri
-  end interface
 
 contains
 

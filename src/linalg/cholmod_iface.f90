@@ -1,4 +1,4 @@
-!> Fortran side of the CHOLMOD shim (src/cholmod_shim.c, include/cholmod_shim.h):
+!> Fortran side of the CHOLMOD shim (src/linalg/cholmod_shim.c, include/cholmod_shim.h):
 !! `bind(c)` interfaces and thin typed wrappers around an opaque handle.
 !! One handle holds one factorization with its own CHOLMOD workspace, so two
 !! threads may use two different handles at once (never one handle from two
@@ -7,7 +7,7 @@ module cholmod_iface
   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int, &
                                          c_double, c_char, c_null_char
   use kinds, only: wp
-  implicit none
+  implicit none (type, external)
   private
 
   integer, parameter, public :: CM_OK = 0             !< success
@@ -58,7 +58,7 @@ module cholmod_iface
       real(c_double), intent(in) :: val(*)
       integer(c_int), value :: ordering, nlast
       integer(c_int), intent(in) :: last(*)
-      integer(c_int), intent(in) :: interior(*)
+      integer(c_int), intent(in), optional :: interior(*)   ! absent: NULL
       character(kind=c_char), intent(out) :: msg(*)
       integer(c_int), value :: msglen
       integer(c_int) :: code
@@ -148,7 +148,9 @@ contains
   !> Analyze and factorize a symmetric positive definite matrix (full symmetric CSC,
   !! 0-based, rows sorted). `last0` (0-based, may be empty) lists DOFs to order last.
   !! With CM_ORD_GIVEN, `interior0` (0-based, size n - size(last0)) is the order of
-  !! all the other DOFs; it is required then and ignored otherwise.
+  !! all the other DOFs; it is required then and ignored otherwise. Module cholesky
+  !! checks the arguments (with the user-facing messages); the shim checks again that
+  !! the interior order is given and is a permutation of the other DOFs.
   subroutine cm_factorize(h, n, colptr, rowind, val, ordering, last0, info, msg, interior0)
     type(c_ptr), intent(in) :: h                  !< handle from cm_create
     integer, intent(in) :: n                      !< matrix order
@@ -161,27 +163,13 @@ contains
     character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
     integer(c_int), intent(in), optional :: interior0(:)  !< interior order, 0-based (CM_ORD_GIVEN)
     character(kind=c_char) :: buf(MSG_LEN)
-    integer(c_int) :: none(1)
     msg = ''
     if (ordering == CM_ORD_GIVEN) then
-      if (.not. present(interior0)) then
-        info = CM_FAILURE
-        msg = 'cm_factorize: ordering GIVEN needs the interior order.'
-        return
-      end if
-      if (size(interior0) /= n - size(last0)) then
-        info = CM_FAILURE
-        msg = 'cm_factorize: the interior order must have n - size(last) entries.'
-        return
-      end if
-    end if
-    none = 0
-    if (present(interior0) .and. ordering == CM_ORD_GIVEN .and. n > size(last0)) then
       info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
                             int(size(last0), c_int), last0, interior0, buf, MSG_LEN)
     else
       info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
-                            int(size(last0), c_int), last0, none, buf, MSG_LEN)
+                            int(size(last0), c_int), last0, msg=buf, msglen=MSG_LEN)
     end if
     if (info /= CM_OK) msg = c_to_f(buf)
   end subroutine cm_factorize

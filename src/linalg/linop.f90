@@ -8,7 +8,8 @@
 !! binding takes `intent(inout)` so that extensions may keep work space).
 module linop
   use kinds, only: wp
-  implicit none
+  use lapack, only: dsymv
+  implicit none (type, external)
   private
 
   public :: linop_t, dense_op_t, csc_op_t, dense_op_init, csc_op_init
@@ -50,18 +51,6 @@ module linop
   contains
     procedure :: apply => csc_apply
   end type csc_op_t
-
-  interface
-    !> BLAS: y := alpha A x + beta y, A symmetric (reference BLAS signature).
-    subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
-      import :: wp
-      character(len=1), intent(in) :: uplo
-      integer, intent(in) :: n, lda, incx, incy
-      real(wp), intent(in) :: alpha, beta
-      real(wp), intent(in) :: a(lda, *), x(*)
-      real(wp), intent(inout) :: y(*)
-    end subroutine dsymv
-  end interface
 
 contains
 

@@ -12,7 +12,7 @@ module ordering
   use kinds, only: i8
   use mesh, only: mesh_t
   use assembly, only: body_system_t
-  implicit none
+  implicit none (type, external)
   private
 
   public :: nested_dissection
@@ -51,16 +51,13 @@ contains
     if (present(msg)) msg = ''
     if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
         .or. .not. allocated(sys%free_of)) then
-      info = ND_BAD_SYSTEM
       write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
         ' DOFs) does not belong to a ', mesh%nx, ' x ', mesh%ny, ' cell mesh.'
+      call fail(ND_BAD_SYSTEM)
+      return
     else if (size(sys%free_of) /= sys%ndof) then
-      info = ND_BAD_SYSTEM
       emsg = 'nested dissection: the free-DOF map has the wrong size.'
-    end if
-    if (info /= ND_OK) then
-      allocate (perm(0))
-      if (present(msg)) msg = emsg
+      call fail(ND_BAD_SYSTEM)
       return
     end if
 
@@ -68,15 +65,12 @@ contains
     skip = .false.
     do k = 1, size(last)
       if (last(k) < 1 .or. last(k) > sys%n) then
-        info = ND_BAD_LAST
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
+        call fail(ND_BAD_LAST)
+        return
       else if (skip(last(k))) then
-        info = ND_BAD_LAST
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
-      end if
-      if (info /= ND_OK) then
-        allocate (perm(0))
-        if (present(msg)) msg = emsg
+        call fail(ND_BAD_LAST)
         return
       end if
       skip(last(k)) = .true.
@@ -89,15 +83,21 @@ contains
     call dissect(0, mesh%nx, 0, mesh%ny)
     if (bad_map .or. pos /= size(perm)) then
       ! free_of is not a bijection onto 1..n: the system is inconsistent
-      info = ND_BAD_SYSTEM
       write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', pos, ' DOFs but expected ', size(perm), &
         ' (inconsistent free-DOF map).'
-      deallocate (perm)
-      allocate (perm(0))
-      if (present(msg)) msg = emsg
+      call fail(ND_BAD_SYSTEM)
     end if
 
   contains
+
+    !> Record a failure: the code, the sentence in emsg, an empty perm.
+    subroutine fail(code)
+      integer, intent(in) :: code
+      info = code
+      if (allocated(perm)) deallocate (perm)
+      allocate (perm(0))
+      if (present(msg)) msg = emsg
+    end subroutine fail
 
     !> Order the box of grid nodes [i0,i1] x [j0,j1] (empty if i1 < i0 or j1 < j0).
     recursive subroutine dissect(i0, i1, j0, j1)

@@ -1,0 +1,191 @@
+!> Explicit interfaces for every BLAS and LAPACK routine robin_contact calls (reference
+!! BLAS/LAPACK signatures, 32-bit integers, double precision), so that a wrong argument
+!! is a compile-time error instead of a crash. Linked against OpenBLAS and LAPACK.
+!!
+!! Thread safety: the routines keep no state; module cholmod_iface (`cm_init`) holds
+!! OpenBLAS to one thread so that two OpenMP threads may call them at once.
+module lapack
+  use kinds, only: wp
+  implicit none (type, external)
+  private
+
+  public :: dsymv, dgemm
+  public :: dpotrf, dpotrs, dpotri, dposv, dpocon
+  public :: dpbtrf, dpbtrs, dpbsv
+  public :: dgels
+
+  interface
+
+    ! ---- BLAS ----
+
+    !> y := alpha A x + beta y, A symmetric n x n (triangle `uplo` referenced).
+    subroutine dsymv(uplo, n, alpha, a, lda, x, incx, beta, y, incy)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L': the stored triangle of A
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a, >= max(1, n)
+      integer, intent(in) :: incx           !< stride of x
+      integer, intent(in) :: incy           !< stride of y
+      real(wp), intent(in) :: alpha         !< scale of A x
+      real(wp), intent(in) :: a(lda, *)     !< the matrix
+      real(wp), intent(in) :: x(*)          !< input vector
+      real(wp), intent(in) :: beta          !< scale of y on entry
+      real(wp), intent(inout) :: y(*)       !< output vector
+    end subroutine dsymv
+
+    !> C := alpha op(A) op(B) + beta C; op(A) is m x k, op(B) is k x n.
+    subroutine dgemm(transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: transa  !< 'N' or 'T': op(A) = A or A'
+      character(len=1), intent(in) :: transb  !< 'N' or 'T': op(B) = B or B'
+      integer, intent(in) :: m                !< rows of op(A) and C
+      integer, intent(in) :: n                !< columns of op(B) and C
+      integer, intent(in) :: k                !< columns of op(A), rows of op(B)
+      integer, intent(in) :: lda              !< leading dimension of a
+      integer, intent(in) :: ldb              !< leading dimension of b
+      integer, intent(in) :: ldc              !< leading dimension of c, >= max(1, m)
+      real(wp), intent(in) :: alpha           !< scale of op(A) op(B)
+      real(wp), intent(in) :: a(lda, *)       !< matrix A
+      real(wp), intent(in) :: b(ldb, *)       !< matrix B
+      real(wp), intent(in) :: beta            !< scale of C on entry
+      real(wp), intent(inout) :: c(ldc, *)    !< matrix C, m x n
+    end subroutine dgemm
+
+    ! ---- LAPACK: symmetric positive definite, full storage ----
+
+    !> Cholesky factorization A = U'U or L L' in place.
+    !! info: 0 ok; < 0 argument -info illegal; > 0 leading minor info not positive definite.
+    subroutine dpotrf(uplo, n, a, lda, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L': the triangle stored and factorized
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a, >= max(1, n)
+      integer, intent(out) :: info          !< status (see above)
+      real(wp), intent(inout) :: a(lda, *)  !< A on entry, its Cholesky factor on exit
+    end subroutine dpotrf
+
+    !> Solve A X = B with the Cholesky factor from dpotrf.
+    subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L', as given to dpotrf
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: nrhs           !< number of right-hand sides
+      integer, intent(in) :: lda            !< leading dimension of a
+      integer, intent(in) :: ldb            !< leading dimension of b, >= max(1, n)
+      integer, intent(out) :: info          !< 0 ok; < 0 argument -info illegal
+      real(wp), intent(in) :: a(lda, *)     !< the Cholesky factor
+      real(wp), intent(inout) :: b(ldb, *)  !< right-hand sides in, solutions out (n x nrhs)
+    end subroutine dpotrs
+
+    !> Inverse of A from its Cholesky factor (dpotrf), in place (triangle `uplo`).
+    subroutine dpotri(uplo, n, a, lda, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L', as given to dpotrf
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a, >= max(1, n)
+      integer, intent(out) :: info          !< 0 ok; < 0 argument -info illegal; > 0 singular factor
+      real(wp), intent(inout) :: a(lda, *)  !< the factor on entry, the triangle of A^-1 on exit
+    end subroutine dpotri
+
+    !> Solve A X = B, A symmetric positive definite (dpotrf + dpotrs).
+    subroutine dposv(uplo, n, nrhs, a, lda, b, ldb, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L': the triangle of A referenced
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: nrhs           !< number of right-hand sides
+      integer, intent(in) :: lda            !< leading dimension of a, >= max(1, n)
+      integer, intent(in) :: ldb            !< leading dimension of b, >= max(1, n)
+      integer, intent(out) :: info          !< 0 ok; < 0 argument illegal; > 0 not positive definite
+      real(wp), intent(inout) :: a(lda, *)  !< A on entry, its Cholesky factor on exit
+      real(wp), intent(inout) :: b(ldb, *)  !< right-hand sides in, solutions out (n x nrhs)
+    end subroutine dposv
+
+    !> Estimate of the reciprocal 1-norm condition number from the Cholesky factor.
+    subroutine dpocon(uplo, n, a, lda, anorm, rcond, work, iwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L', as given to dpotrf
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a
+      integer, intent(out) :: iwork(*)      !< workspace, size n
+      integer, intent(out) :: info          !< 0 ok; < 0 argument -info illegal
+      real(wp), intent(in) :: a(lda, *)     !< the Cholesky factor
+      real(wp), intent(in) :: anorm         !< 1-norm of the original A
+      real(wp), intent(out) :: rcond        !< 1 / (|A|_1 |A^-1|_1), estimated
+      real(wp), intent(out) :: work(*)      !< workspace, size 3 n
+    end subroutine dpocon
+
+    ! ---- LAPACK: symmetric positive definite, band storage ----
+
+    !> Cholesky factorization of a band matrix in place (kd sub- or super-diagonals).
+    !! info: 0 ok; < 0 argument -info illegal; > 0 leading minor info not positive definite.
+    subroutine dpbtrf(uplo, n, kd, ab, ldab, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo    !< 'U' or 'L': the triangle stored
+      integer, intent(in) :: n                !< order of A
+      integer, intent(in) :: kd               !< half-bandwidth
+      integer, intent(in) :: ldab             !< leading dimension of ab, >= kd + 1
+      integer, intent(out) :: info            !< status (see above)
+      real(wp), intent(inout) :: ab(ldab, *)  !< A in band storage on entry, its factor on exit
+    end subroutine dpbtrf
+
+    !> Solve A X = B with the band Cholesky factor from dpbtrf.
+    subroutine dpbtrs(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L', as given to dpbtrf
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: kd             !< half-bandwidth
+      integer, intent(in) :: nrhs           !< number of right-hand sides
+      integer, intent(in) :: ldab           !< leading dimension of ab, >= kd + 1
+      integer, intent(in) :: ldb            !< leading dimension of b, >= max(1, n)
+      integer, intent(out) :: info          !< 0 ok; < 0 argument -info illegal
+      real(wp), intent(in) :: ab(ldab, *)   !< the band Cholesky factor
+      real(wp), intent(inout) :: b(ldb, *)  !< right-hand sides in, solutions out (n x nrhs)
+    end subroutine dpbtrs
+
+    !> Solve A X = B, A symmetric positive definite in band storage (dpbtrf + dpbtrs).
+    subroutine dpbsv(uplo, n, kd, nrhs, ab, ldab, b, ldb, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo    !< 'U' or 'L': the triangle stored
+      integer, intent(in) :: n                !< order of A
+      integer, intent(in) :: kd               !< half-bandwidth
+      integer, intent(in) :: nrhs             !< number of right-hand sides
+      integer, intent(in) :: ldab             !< leading dimension of ab, >= kd + 1
+      integer, intent(in) :: ldb              !< leading dimension of b, >= max(1, n)
+      integer, intent(out) :: info            !< 0 ok; < 0 argument illegal; > 0 not positive definite
+      real(wp), intent(inout) :: ab(ldab, *)  !< A in band storage on entry, its factor on exit
+      real(wp), intent(inout) :: b(ldb, *)    !< right-hand sides in, solutions out (n x nrhs)
+    end subroutine dpbsv
+
+    ! ---- LAPACK: least squares ----
+
+    !> Least squares min |B - op(A) X| (or minimum norm) by QR/LQ of a full-rank A.
+    !! lwork = -1: workspace query, the optimal lwork is returned in work(1).
+    subroutine dgels(trans, m, n, nrhs, a, lda, b, ldb, work, lwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: trans  !< 'N': op(A) = A; 'T': op(A) = A'
+      integer, intent(in) :: m               !< rows of A
+      integer, intent(in) :: n               !< columns of A
+      integer, intent(in) :: nrhs            !< number of right-hand sides
+      integer, intent(in) :: lda             !< leading dimension of a, >= max(1, m)
+      integer, intent(in) :: ldb             !< leading dimension of b, >= max(1, m, n)
+      integer, intent(in) :: lwork           !< size of work, or -1 for a workspace query
+      integer, intent(out) :: info           !< 0 ok; < 0 argument illegal; > 0 A rank deficient
+      real(wp), intent(inout) :: a(lda, *)   !< A on entry, its QR or LQ factors on exit
+      real(wp), intent(inout) :: b(ldb, *)   !< right-hand sides in, solutions out
+      real(wp), intent(out) :: work(*)       !< workspace; work(1) = optimal lwork on exit
+    end subroutine dgels
+
+  end interface
+
+end module lapack
