@@ -23,8 +23,9 @@ program robin_contact
   use signals, only: signals_install, stop_requested
   use sysinfo, only: peak_rss_mb
   use strings, only: sci, fmt_real
-  use omp_lib, only: omp_get_wtime, omp_get_max_threads, omp_set_max_active_levels
-  implicit none
+  use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
+  use clock, only: wtime
+  implicit none (type, external)
 
   type(deck_t) :: d
   type(mesh_t) :: msh(2)
@@ -43,7 +44,7 @@ program robin_contact
   real(wp), allocatable :: u(:, :), ufree(:)
   logical :: ok
 
-  t_start = omp_get_wtime()
+  t_start = wtime()
   call parse_arguments(deck_path, overrides, restart_file)
   call read_deck(deck_path, overrides, d)
   if (len(restart_file) > 0 .and. d%solver%method /= METHOD_ROBIN) &
@@ -68,7 +69,7 @@ program robin_contact
   call remove_stale_results(d%output%file)
 
   ! ---- assemble both bodies --------------------------------------------------------
-  t0 = omp_get_wtime()
+  t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
     call mesh_build(msh(a), d%body(a))
@@ -80,12 +81,12 @@ program robin_contact
   end do
   call build_interface(d%body, d%contact, msh, sys, itf, info1, msg1)
   if (info1 /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg1))
-  tm%assemble = omp_get_wtime() - t0
+  tm%assemble = wtime() - t0
   write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') 'assembled: n1=', sys(1)%n, ' n2=', sys(2)%n, &
     ' m=', itf%m, ' threads=', nthr
 
   ! ---- factorize and condense (one thread per body) -------------------------------
-  t0 = omp_get_wtime()
+  t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
     call factor_body(d%solver%factor, itf, a, msh(a), sys(a), cb(a), info(a), msg(a))
@@ -94,8 +95,8 @@ program robin_contact
   do a = 1, 2
     if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': factorization failed: '//trim(msg(a)))
   end do
-  tm%factor = omp_get_wtime() - t0
-  t0 = omp_get_wtime()
+  tm%factor = wtime() - t0
+  t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
     call condense_body(sys(a), cb(a), info(a), msg(a))
@@ -109,11 +110,11 @@ program robin_contact
       call fatal(EXIT_NUMERICAL, trim(msg1))
     end if
   end do
-  tm%condense = omp_get_wtime() - t0
+  tm%condense = wtime() - t0
   tm%factor_mb = (cb(1)%chol%mem_bytes + cb(2)%chol%mem_bytes)/1048576.0_wp
 
   ! ---- contact ----------------------------------------------------------------------
-  t0 = omp_get_wtime()
+  t0 = wtime()
   if (d%solver%method == METHOD_MONOLITHIC) then
     call solve_monolithic(d%solver, itf, cb, res)
   else
@@ -142,7 +143,7 @@ program robin_contact
     end do
     !$omp end parallel do
   end if
-  tm%iterate = omp_get_wtime() - t0
+  tm%iterate = wtime() - t0
 
   select case (trim(res%status))
   case ('converged')
@@ -157,17 +158,17 @@ program robin_contact
   if (res%status /= 'converged') write (error_unit, '(a)') 'robin_contact: '//trim(res%status)//': '//trim(res%message)
 
   ! ---- output -------------------------------------------------------------------------
-  t0 = omp_get_wtime()
+  t0 = wtime()
   if (code /= EXIT_NUMERICAL) then
     tm%peak_rss_mb = peak_rss_mb()
-    tm%total = omp_get_wtime() - t_start
+    tm%total = wtime() - t_start
     call write_results(d%output%file, d, msh, sys, itf, res, u, tm, ok, msg1)
     if (.not. ok) call fatal(EXIT_NUMERICAL, 'output: '//trim(msg1))
     ! a converged run has no use for its checkpoint; a run that stopped keeps it
     if (code == EXIT_OK) call remove_file(checkpoint_file(d%output%file))
   end if
-  tm%output = omp_get_wtime() - t0
-  tm%total = omp_get_wtime() - t_start
+  tm%output = wtime() - t0
+  tm%total = wtime() - t_start
   tm%peak_rss_mb = peak_rss_mb()
   call summary()
   call terminate(code)

@@ -6,7 +6,7 @@ program deck_echo
   use errors, only: terminate, EXIT_INPUT
   use config, only: deck_t
   use deck, only: read_deck, print_deck, deck_usage
-  implicit none
+  implicit none (type, external)
   type(deck_t) :: d
   character(len=:), allocatable :: path
   character(len=4096), allocatable :: overrides(:)

@@ -13,7 +13,7 @@ module condense
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: nested_dissection
   use clock, only: wtime
-  implicit none
+  implicit none (type, external)
   private
 
   !> The contact line: m node pairs where both bodies' normal displacement is free.
