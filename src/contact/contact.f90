@@ -139,7 +139,7 @@ contains
     !$omp parallel do num_threads(nthr) schedule(static, 1) if (m > 64)
     do a = 1, 2
       call dense_op_init(op(a), bc(a)%flex)
-      if (m > 0) lmax(a) = lambda_max_estimate(op(a), 30, nmv(a))
+      if (m > 0) lmax(a) = lambda_max_estimate(op(a), 10, nmv(a))
     end do
     !$omp end parallel do
     if (.not. resumed) st_%inner = sum(nmv)
@@ -194,7 +194,10 @@ contains
         end if
         opts(a)%max_it = d%solver%inner_max_it
         opts(a)%lambda_max = lmax(a)
-        if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st_%lam(:, a), opts(a), st(a), grad(:, a))
+        ! F_a is the same in every iteration and the warm start is the last solution:
+        ! its gradient comes from F_a lam_a of the last solve (no initial product)
+        opts(a)%use_ax = st_%reuse == 1
+        if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st_%lam(:, a), opts(a), st(a), grad(:, a), st_%flam_v(:, a))
       end do
       !$omp end parallel do
       if (m == 0) then
@@ -220,6 +223,7 @@ contains
         res%outer = it
         exit
       end if
+      st_%reuse = 1
       ! 2. force imbalance and its Robin correction
       dlam = st_%lam(:, 1) - st_%lam(:, 2)
       select case (trim(d%solver%robin_operator))
