@@ -19,6 +19,7 @@ module contact
   private
 
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
+  integer, parameter :: POWER_ITS = 10               !< power iterations for each body's lambda_max (MPRGP guards an underestimate)
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
   !> y = alpha x ./ w: the constant Robin operator alpha M^-1 (M: tributary lengths).
@@ -232,7 +233,7 @@ contains
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
       call dense_op_init(op(a), bc(a)%flex)
-      if (m > 0) lmax(a) = lambda_max_estimate(op(a), 30, nmv(a))
+      if (m > 0) lmax(a) = lambda_max_estimate(op(a), POWER_ITS, nmv(a))
     end do
     !$omp end parallel do
     if (.not. resumed) st%inner = sum(nmv)
@@ -373,7 +374,10 @@ contains
       end if
       opts(a)%max_it = s%inner_max_it
       opts(a)%lambda_max = lmax(a)
-      if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a))
+      ! F_a is the same in every iteration and the warm start is the last solution:
+      ! its gradient comes from F_a lam_a of the last solve (no initial product)
+      opts(a)%use_ax = st%reuse == 1
+      if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a))
     end do
     !$omp end parallel do
     if (m == 0) return
@@ -391,6 +395,7 @@ contains
       w(:, a) = st%G(:, a) - grad(:, a)
       st%flam(a) = norm2(grad(:, a) + rhs(:, a))
     end do
+    st%reuse = 1
   end subroutine solve_subproblems
 
   !> The true residual of the iterate, the increment of the obstacles (the paper's

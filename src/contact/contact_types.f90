@@ -56,6 +56,8 @@ module contact_types
     real(wp) :: flam(2) = 0.0_wp               !< |F_a lam_a| of the last iterate [length]
     real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
     real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
+    integer :: reuse = 0                       !< 1: flam_v holds F_a lam_a (0: not known, e.g. an older checkpoint)
+    real(wp), allocatable :: flam_v(:, :)      !< (m,2) F_a lam_a, the last product of the body's solve [length]
     real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
     real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
     real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
@@ -97,6 +99,9 @@ contains
     real(wp), intent(in) :: g0(:)            !< initial gap
     allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
     allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
+    allocate (st%flam_v(m, 2))
+    st%flam_v = 0.0_wp   ! F_a 0 with lam = 0: exact
+    st%reuse = 1
     st%G(:, 1) = g0
     st%G(:, 2) = g0
     st%lam = 0.0_wp

@@ -56,6 +56,7 @@ module mprgp
     real(wp) :: alpha_bar = 0.0_wp   !< expansion step length; <= 0: 1.9/lambda_max (units 1/[A])
     real(wp) :: lambda_max = 0.0_wp  !< > 0: use this largest eigenvalue of A instead of estimating
     integer :: power_its = 20        !< power iterations for the lambda_max estimate
+    logical :: use_ax = .false.      !< the argument `ax` holds A x at the warm start: no initial product
   end type mprgp_opts_t
 
   !> What `mprgp_solve` did.
@@ -170,7 +171,12 @@ contains
   !!
   !! Cost per step: one product with A (two for an expansion) and O(n) work; the
   !! only allocations are four work vectors per call.
-  subroutine mprgp_solve(A, b, lb, x, opts, stats, g)
+  !!
+  !! Reuse across a sequence of solves with the same A (the outer contact iteration):
+  !! with opts%use_ax, `ax` holds A x at the warm start and the initial product is
+  !! skipped; on exit `ax` holds A x at the returned x (the confirming product, so the
+  !! next solve, warm-started from x, starts from it).
+  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax)
     class(linop_t), intent(inout) :: A          !< SPD operator (size A%n)
     real(wp), intent(in) :: b(:)                !< linear term (size n)
     real(wp), intent(in) :: lb(:)               !< lower bounds (size n); -huge(1.0_wp): none
@@ -178,6 +184,7 @@ contains
     type(mprgp_opts_t), intent(in) :: opts      !< options
     type(mprgp_stats_t), intent(out) :: stats   !< status, counts, message
     real(wp), intent(out), optional :: g(:)     !< Ax - b at the returned x (size n; unset if bad input)
+    real(wp), intent(inout), optional :: ax(:)  !< in (opts%use_ax): A x at the warm start; out: A x at the returned x
 
     real(wp), allocatable :: gr(:), p(:), ap(:), w(:)
     real(wp), parameter :: big = huge(1.0_wp)
@@ -200,6 +207,15 @@ contains
       write (stats%message, '(a,i0,a,i0,a,i0,a,i0)') 'size mismatch: A%n = ', n, &
         ', size(b) = ', size(b), ', size(lb) = ', size(lb), ', size(x) = ', size(x)
       stats%status = MPRGP_BAD_ARG
+      return
+    end if
+    if (present(ax)) then
+      if (size(ax) /= n) then
+        call fail(MPRGP_BAD_ARG, 'size mismatch: size(ax) /= A%n')
+        return
+      end if
+    else if (opts%use_ax) then
+      call fail(MPRGP_BAD_ARG, 'opts%use_ax without ax')
       return
     end if
     if (present(g)) then
@@ -275,9 +291,14 @@ contains
     ! ---- start: project, gradient ------------------------------------------------------
     x = max(x, lb)
     xscale0 = norm2(x)
-    call A%apply(x, gr)
-    stats%n_matvec = 1
-    gr = gr - b
+    if (opts%use_ax) then
+      gr = ax - b
+    else
+      call A%apply(x, gr)
+      stats%n_matvec = 1
+      if (present(ax)) ax = gr
+      gr = gr - b
+    end if
     fresh = .true.
     call set_p_to_phi()
     it = 0
@@ -488,8 +509,10 @@ contains
       stats%gp_norm = proj_grad_norm()
     end if
     if (present(g)) g = gr
+    if (present(ax) .and. .not. fresh) ax = gr + b
 
   contains
+
 
     !> Record a failure.
     subroutine fail(code, msg)
@@ -529,6 +552,7 @@ contains
     subroutine true_gradient()
       call A%apply(x, gr)
       stats%n_matvec = stats%n_matvec + 1
+      if (present(ax)) ax = gr
       gr = gr - b
       fresh = .true.
     end subroutine true_gradient

@@ -73,6 +73,8 @@ contains
     call dset_r1(gid, 'x_prev', st%x_prev)
     call dset_r2(gid, 'dX', st%dX)
     call dset_r2(gid, 'dR', st%dR)
+    call attr_int(gid, 'reuse', st%reuse)
+    call dset_r2(gid, 'flam_v', st%flam_v)
     call h5gclose_f(gid, err)
     call write_history(fid, res)
     call h5fclose_f(fid, err)
@@ -92,7 +94,7 @@ contains
     logical, intent(out) :: ok                    !< success
     character(len=*), intent(out) :: msg          !< why not
     integer(hid_t) :: fid, gid
-    integer :: err, e(20), n, i
+    integer :: err, e(20), ere(2), n, i
     character(len=:), allocatable :: k
     real(wp), allocatable :: r(:)
     integer, allocatable :: iv(:)
@@ -145,6 +147,10 @@ contains
     call read_r1(gid, 'x_prev', st%x_prev, e(15))
     call read_r2(gid, 'dX', st%dX, e(16))
     call read_r2(gid, 'dR', st%dR, e(17))
+    ! F_a lam_a (absent from older checkpoints: recomputed by the first solve)
+    call read_attr_int(gid, 'reuse', st%reuse, ere(1))
+    call read_r2(gid, 'flam_v', st%flam_v, ere(2))
+    if (any(ere /= 0)) st%reuse = 0
     call h5gclose_f(gid, err)
     if (any(e /= 0)) then
       msg = 'restart file '//trim(file)//' is incomplete'
@@ -155,6 +161,11 @@ contains
       msg = 'restart file '//trim(file)//' has a different number of contact nodes'
       call h5fclose_f(fid, err)
       return
+    end if
+    if (st%reuse == 0) then
+      if (allocated(st%flam_v)) deallocate (st%flam_v)
+      allocate (st%flam_v(m, 2))
+      st%flam_v = 0.0_wp
     end if
     n = st%it
     if (n > maxout) then
