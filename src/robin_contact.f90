@@ -20,9 +20,9 @@ program robin_contact
   use contact, only: solve_robin, solve_monolithic, error_bound
   use results, only: timing_t, write_results, program_version
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
-  use signals, only: signals_install, stop_requested
+  use signals, only: signals_install, stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
-  use strings, only: sci, fmt_real
+  use strings, only: sci, fmt_real, i2s
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
   implicit none (type, external)
@@ -43,6 +43,7 @@ program robin_contact
   real(wp) :: t_start, t0
   real(wp), allocatable :: u(:, :), ufree(:)
   logical :: ok
+  logical :: written = .false.   ! the result file of this run exists
 
   t_start = wtime()
   call parse_arguments(deck_path, overrides, restart_file)
@@ -82,6 +83,7 @@ program robin_contact
   call build_interface(d%body, d%contact, msh, sys, itf, info1, msg1)
   if (info1 /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg1))
   tm%assemble = wtime() - t0
+  call check_interrupt('assembly')
   write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') 'assembled: n1=', sys(1)%n, ' n2=', sys(2)%n, &
     ' m=', itf%m, ' threads=', nthr
 
@@ -96,6 +98,7 @@ program robin_contact
     if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': factorization failed: '//trim(msg(a)))
   end do
   tm%factor = wtime() - t0
+  call check_interrupt('factorization')
   t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
@@ -111,12 +114,13 @@ program robin_contact
     end if
   end do
   tm%condense = wtime() - t0
+  call check_interrupt('condensation')
   tm%factor_mb = (cb(1)%chol%mem_bytes + cb(2)%chol%mem_bytes)/1048576.0_wp
 
   ! ---- contact ----------------------------------------------------------------------
   t0 = wtime()
   if (d%solver%method == METHOD_MONOLITHIC) then
-    call solve_monolithic(d%solver, itf, cb, res)
+    call solve_monolithic(d%solver, itf, cb, res, stop_requested)
   else
     if (len(restart_file) > 0) then
       call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
@@ -163,6 +167,7 @@ program robin_contact
     tm%peak_rss_mb = peak_rss_mb()
     tm%total = wtime() - t_start
     call write_results(d%output%file, d, msh, sys, itf, res, u, tm, ok, msg1)
+    written = ok
     if (.not. ok) call fatal(EXIT_NUMERICAL, 'output: '//trim(msg1))
     ! a converged run has no use for its checkpoint; a run that stopped keeps it
     if (code == EXIT_OK) call remove_file(checkpoint_file(d%output%file))
@@ -175,6 +180,23 @@ program robin_contact
 
 contains
 
+  !> A signal before the outer iteration (during assembly, ordering, factorization or
+  !! condensation, where the libraries cannot be interrupted safely): stop at the end of
+  !! the phase with exit 4. There is nothing to checkpoint yet and nothing is written.
+  subroutine check_interrupt(phase)
+    character(len=*), intent(in) :: phase
+    if (.not. stop_requested()) return
+    res%status = 'interrupted'
+    res%method = merge('robin     ', 'monolithic', d%solver%method == METHOD_ROBIN)
+    code = EXIT_INTERRUPTED
+    write (error_unit, '(a)') 'robin_contact: interrupted: signal '//i2s(pending_signal())//' during the '// &
+      phase//'; stopped before the first outer iteration, so there is no checkpoint and nothing was written'
+    tm%total = wtime() - t_start
+    tm%peak_rss_mb = peak_rss_mb()
+    call summary()
+    call terminate(code)
+  end subroutine check_interrupt
+
   !> The closing lines. A summary that cannot be written (standard output on a full disk or
   !! a closed pipe) is a failure: scripts read the result: line.
   subroutine summary()
@@ -182,13 +204,13 @@ contains
     integer :: ios(6)
     ios = 0
     ftot = 0.0_wp
-    if (itf%m > 0) ftot = sum(res%lam)
+    if (allocated(res%lam)) ftot = sum(res%lam)
     write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)', iostat=ios(1)) 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
     write (output_unit, '(a)', iostat=ios(2)) 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
       ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
-    if (code /= EXIT_NUMERICAL) write (output_unit, '(a)', iostat=ios(3)) 'output: '//trim(d%output%file)
+    if (written) write (output_unit, '(a)', iostat=ios(3)) 'output: '//trim(d%output%file)
     write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)', iostat=ios(4)) 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
       ' peak_mb=', tm%peak_rss_mb, ' factor_mb=', tm%factor_mb

@@ -11,7 +11,8 @@ module contact
   use clock, only: wtime
   use lapack, only: dsymv, dgemm, dpotrf, dpotrs, dposv, dgels
   use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, lambda_max_estimate, &
-                   MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
+                   MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, mprgp_status_name
+  use strings, only: itoa
   use condense, only: interface_t, body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, ANDERSON_DEPTH, &
                            state_init, alloc_result, grow_history
@@ -49,11 +50,12 @@ module contact
 contains
 
   !> The monolithic reference: min 1/2 lam'(F1+F2)lam - lam'(b1+b2-g0), lam >= 0.
-  subroutine solve_monolithic(s, itf, bc, res)
+  subroutine solve_monolithic(s, itf, bc, res, stop_requested)
     type(solver_cfg_t), intent(in) :: s                !< solver settings
     type(interface_t), intent(in) :: itf               !< contact line
     type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
     type(contact_result_t), intent(out) :: res         !< solution and status
+    procedure(stop_iface), optional :: stop_requested  !< true when the run must stop (signal)
     type(dense_op_t) :: op
     type(mprgp_opts_t) :: opts
     type(mprgp_stats_t) :: st
@@ -72,10 +74,15 @@ contains
     lam = 0.0_wp
     opts%rtol = s%monolithic_rtol
     opts%max_it = s%inner_max_it
+    if (present(stop_requested)) opts%stop => stop_requested
     if (m > 0) then
       call mprgp_solve(op, c, lb, lam, opts, st, g)
       res%inner = st%n_matvec
-      if (st%status /= MPRGP_CONVERGED) then
+      if (st%status == MPRGP_STOPPED) then
+        res%status = 'interrupted'
+        res%message = 'monolithic MPRGP stopped by a signal after '//trim(itoa(st%n_cg + st%n_exp + st%n_prop))// &
+                      ' steps (no checkpoint: the monolithic solve is one step)'
+      else if (st%status /= MPRGP_CONVERGED) then
         res%status = merge('max_outer', 'failed   ', st%status == MPRGP_MAX_IT)
         res%message = 'monolithic MPRGP: '//trim(mprgp_status_name(st%status))//': '//trim(st%message)
       else

@@ -34,13 +34,20 @@ module mprgp
 
   public :: mprgp_solve, lambda_max_estimate, mprgp_status_name
   public :: mprgp_opts_t, mprgp_stats_t
-  public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG
+  public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
 
   integer, parameter :: MPRGP_CONVERGED = 0  !< |gP| <= max(rtol |b|, atol) at the true gradient
   integer, parameter :: MPRGP_MAX_IT = 1     !< max_it steps done without convergence
   integer, parameter :: MPRGP_NONFINITE = 2  !< NaN/Inf in the input or during the iteration
   integer, parameter :: MPRGP_NOT_SPD = 3    !< a direction with p'Ap <= 0 was met (A not SPD)
   integer, parameter :: MPRGP_BAD_ARG = 4    !< inconsistent sizes or invalid options
+  integer, parameter :: MPRGP_STOPPED = 5    !< opts%stop turned true (a signal): x is the current iterate
+
+  abstract interface
+    !> True when the solve must stop now (polled once per step).
+    logical function mprgp_stop_iface()
+    end function mprgp_stop_iface
+  end interface
 
   !> Safety factor: default alpha_bar = ALPHA_FACTOR / lambda_max (theory: (0, 2/|A|]).
   real(wp), parameter :: ALPHA_FACTOR = 1.9_wp
@@ -57,6 +64,7 @@ module mprgp
     real(wp) :: lambda_max = 0.0_wp  !< > 0: use this largest eigenvalue of A instead of estimating
     integer :: power_its = 20        !< power iterations for the lambda_max estimate
     logical :: use_ax = .false.      !< the argument `ax` holds A x at the warm start: no initial product
+    procedure(mprgp_stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
   end type mprgp_opts_t
 
   !> What `mprgp_solve` did.
@@ -90,6 +98,8 @@ contains
       name = 'not SPD'
     case (MPRGP_BAD_ARG)
       name = 'bad argument'
+    case (MPRGP_STOPPED)
+      name = 'stopped'
     case default
       name = 'unknown status'
     end select
@@ -358,6 +368,13 @@ contains
         stats%message = 'not converged: |gP| = '//trim(adjustl(s1))//' > '//trim(adjustl(s2))// &
                         ' after max_it = '//trim(itoa(opts%max_it))//' steps'
         exit main
+      end if
+      if (associated(opts%stop)) then
+        if (opts%stop()) then
+          stats%status = MPRGP_STOPPED
+          stats%message = 'stopped on request after '//trim(itoa(it))//' steps'
+          exit main
+        end if
       end if
       it = it + 1
 
