@@ -41,7 +41,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings config sysinfo signals namelist_input deck mesh elements lapack linop assembly ordering mprgp cholmod_iface banded cholesky \
-        condense contact_types contact h5io results checkpoint
+        condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o
 
@@ -105,9 +105,13 @@ $(BUILD)/contact_types.o: $(BUILD)/kinds.o
 $(BUILD)/contact.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/linop.o \
                           $(BUILD)/mprgp.o $(BUILD)/condense.o $(BUILD)/contact_types.o
 $(BUILD)/h5io.o:          $(BUILD)/kinds.o
+$(BUILD)/files.o:
+$(BUILD)/history_io.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o
 $(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
-                          $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
-$(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o $(BUILD)/results.o
+                          $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
+                          $(BUILD)/history_io.o $(BUILD)/files.o
+$(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o \
+                          $(BUILD)/history_io.o $(BUILD)/files.o
 $(BUILD)/signals.o:
 $(BUILD)/sysinfo_shim.o:  include/sysinfo_shim.h
 $(BUILD)/robin_contact.o: $(OBJS)

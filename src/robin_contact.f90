@@ -18,8 +18,9 @@ program robin_contact
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t
   use contact, only: solve_robin, solve_monolithic, error_bound
-  use results, only: timing_t, write_results, program_version
+  use results, only: timing_t, write_results, remove_results, program_version
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
+  use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
   use strings, only: sci, fmt_real, i2s
@@ -67,7 +68,7 @@ program robin_contact
 
   ! A result file left at this path by an earlier run must not pass for this run's if
   ! this one fails: remove it (and its XDMF files) now that the input is valid.
-  call remove_stale_results(d%output%file)
+  call remove_results(d%output%file)
 
   ! ---- assemble both bodies --------------------------------------------------------
   t0 = wtime()
@@ -130,7 +131,7 @@ program robin_contact
     ckpt%key = key
     ckpt%every = d%output%checkpoint_every
     call solve_robin(d%solver, itf, cb, res, output_unit, d%output%progress_lines, state, ckpt, stop_requested)
-    if (ckpt%failed) call warn('a checkpoint could not be written to '//checkpoint_file(d%output%file))
+    if (ckpt%failed) call warn(ckpt%message)
   end if
   if (res%status /= 'failed') call error_bound(itf, cb, res)
   ! displacements of both bodies under their own contact forces
@@ -240,31 +241,6 @@ contains
     d1%solver%max_outer = 1
     call deck_text(d1, k)
   end function physics_key
-
-  subroutine remove_stale_results(file)
-    character(len=*), intent(in) :: file
-    character(len=:), allocatable :: stem
-    integer :: l
-    l = len_trim(file)
-    stem = trim(file)
-    if (l > 3) then
-      if (file(l - 2:l) == '.h5') stem = file(1:l - 3)
-    end if
-    call remove_file(trim(file))
-    call remove_file(stem//'.xdmf')
-    call remove_file(stem//'_body1.xdmf')
-    call remove_file(stem//'_body2.xdmf')
-  end subroutine remove_stale_results
-
-  subroutine remove_file(path)
-    character(len=*), intent(in) :: path
-    integer :: u, ios
-    logical :: ex
-    inquire (file=path, exist=ex)
-    if (.not. ex) return
-    open (newunit=u, file=path, status='old', iostat=ios)
-    if (ios == 0) close (u, status='delete', iostat=ios)
-  end subroutine remove_file
 
   subroutine parse_arguments(path, extra, restart)
     character(len=:), allocatable, intent(out) :: path

@@ -4,20 +4,22 @@
 !! identically and refuses a checkpoint made from a different deck or mesh.
 module checkpoint
   use kinds, only: wp
-  use hdf5, only: hid_t, h5open_f, h5fcreate_f, h5fopen_f, h5fclose_f, h5gcreate_f, h5gopen_f, &
-                  h5gclose_f, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F
-  use h5io, only: dset_r1, dset_r2, dset_str, attr_int, attr_real, attr_str, &
-                  read_r1, read_r2, read_i1, read_str, read_attr_int, read_attr_real
+  use hdf5, only: hid_t
+  use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, &
+                  write_dset, write_attr, read_dset, read_attr
+  use history_io, only: write_history, read_history
+  use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
   use contact_types, only: robin_state_t, contact_result_t, checkpointer_t
-  use results, only: ensure_parent_dir, atomic_rename, write_history
-  implicit none
+  implicit none (type, external)
   private
 
-  !> Checkpoints of the Robin iteration in an HDF5 file, replaced atomically.
+  !> Checkpoints of the Robin iteration in an HDF5 file, replaced atomically: a checkpoint
+  !! that cannot be written whole leaves the previous one in place.
   type, extends(checkpointer_t), public :: h5_checkpointer_t
-    character(len=:), allocatable :: file   !< where checkpoints go
-    character(len=:), allocatable :: key    !< fingerprint of the deck and mesh
-    logical :: failed = .false.             !< a checkpoint could not be written
+    character(len=:), allocatable :: file     !< where checkpoints go
+    character(len=:), allocatable :: key      !< fingerprint of the deck and mesh
+    logical :: failed = .false.               !< a checkpoint could not be written
+    character(len=:), allocatable :: message  !< why the first failed one failed, naming the file
   contains
     procedure :: save => checkpoint_write
   end type h5_checkpointer_t
@@ -33,53 +35,58 @@ contains
     p = trim(result_file)//'.ckpt.h5'
   end function checkpoint_file
 
-  !> Write the outer state and history.
+  !> Write the outer state and history to a temporary file and rename it over the
+  !! previous checkpoint only when complete; on failure remove it and record why.
   subroutine checkpoint_write(self, st, res)
     class(h5_checkpointer_t), intent(inout) :: self  !< target file and key
     type(robin_state_t), intent(in) :: st       !< outer state after iteration st%it
     type(contact_result_t), intent(in) :: res   !< history so far
     integer(hid_t) :: fid, gid
-    integer :: err
+    type(h5_status_t) :: hs
     character(len=:), allocatable :: tmp
     logical :: ok
     if (.not. allocated(self%file)) return
     call ensure_parent_dir(self%file)
-    tmp = self%file//'.tmp'
-    call h5open_f(err)
-    call h5fcreate_f(tmp, H5F_ACC_TRUNC_F, fid, err)
-    if (err /= 0) then
-      self%failed = .true.
-      return
+    tmp = temp_name(self%file)
+    call file_open(tmp, fid, hs, create=.true.)
+    call write_dset(fid, 'key', self%key, hs)
+    call write_attr(fid, 'kind', 'robin_contact checkpoint', hs)
+    call group_open(fid, 'state', gid, hs, create=.true.)
+    call write_attr(gid, 'it', st%it, hs)
+    call write_attr(gid, 'inner', st%inner, hs)
+    call write_attr(gid, 'nacc', st%nacc, hs)
+    call write_attr(gid, 'stalled', st%stalled, hs)
+    call write_attr(gid, 'it_best', st%it_best, hs)
+    call write_attr(gid, 'res_best', st%res_best, hs)
+    call write_attr(gid, 'inner_maxit_hits', res%inner_maxit_hits, hs)
+    call write_attr(gid, 'crit', st%crit, hs)
+    call write_attr(gid, 'progress', st%progress, hs)
+    call write_attr(gid, 'best', st%best, hs)
+    call write_attr(gid, 'omega', st%omega, hs)
+    call write_attr(gid, 'wall', st%wall, hs)
+    call write_dset(gid, 'flam', st%flam, hs)
+    call write_dset(gid, 'G', st%G, hs)
+    call write_dset(gid, 'lam', st%lam, hs)
+    call write_dset(gid, 'r_prev', st%r_prev, hs)
+    call write_dset(gid, 'x_prev', st%x_prev, hs)
+    call write_dset(gid, 'dX', st%dX, hs)
+    call write_dset(gid, 'dR', st%dR, hs)
+    call write_attr(gid, 'reuse', st%reuse, hs)
+    call write_dset(gid, 'flam_v', st%flam_v, hs)
+    call group_close(gid, hs)
+    call write_history(fid, res, hs)
+    call file_close(fid, hs)
+    ok = .not. hs%failed
+    if (ok) then
+      call atomic_rename(tmp, self%file, ok)
+      if (.not. ok) hs%what = 'failed to rename '//tmp//' to it'
     end if
-    call dset_str(fid, 'key', self%key)
-    call attr_str(fid, 'kind', 'robin_contact checkpoint')
-    call h5gcreate_f(fid, 'state', gid, err)
-    call attr_int(gid, 'it', st%it)
-    call attr_int(gid, 'inner', st%inner)
-    call attr_int(gid, 'nacc', st%nacc)
-    call attr_int(gid, 'stalled', st%stalled)
-    call attr_int(gid, 'it_best', st%it_best)
-    call attr_real(gid, 'res_best', st%res_best)
-    call attr_int(gid, 'inner_maxit_hits', res%inner_maxit_hits)
-    call attr_real(gid, 'crit', st%crit)
-    call attr_real(gid, 'progress', st%progress)
-    call attr_real(gid, 'best', st%best)
-    call attr_real(gid, 'omega', st%omega)
-    call attr_real(gid, 'wall', st%wall)
-    call dset_r1(gid, 'flam', st%flam)
-    call dset_r2(gid, 'G', st%G)
-    call dset_r2(gid, 'lam', st%lam)
-    call dset_r1(gid, 'r_prev', st%r_prev)
-    call dset_r1(gid, 'x_prev', st%x_prev)
-    call dset_r2(gid, 'dX', st%dX)
-    call dset_r2(gid, 'dR', st%dR)
-    call attr_int(gid, 'reuse', st%reuse)
-    call dset_r2(gid, 'flam_v', st%flam_v)
-    call h5gclose_f(gid, err)
-    call write_history(fid, res)
-    call h5fclose_f(fid, err)
-    call atomic_rename(tmp, self%file, ok)
-    if (.not. ok .or. err /= 0) self%failed = .true.
+    if (.not. ok) then
+      call remove_file(tmp)
+      if (.not. self%failed) self%message = 'a checkpoint could not be written to '//self%file// &
+                                            ' ('//hs%what//'); the previous one, if any, is kept'
+      self%failed = .true.
+    end if
   end subroutine checkpoint_write
 
   !> Read a checkpoint. ok = .false. with msg if it cannot be read or was made from
@@ -94,10 +101,10 @@ contains
     logical, intent(out) :: ok                    !< success
     character(len=*), intent(out) :: msg          !< why not
     integer(hid_t) :: fid, gid
-    integer :: err, e(20), ere(2), n, i
+    type(h5_status_t) :: hs
+    integer :: n
     character(len=:), allocatable :: k
     real(wp), allocatable :: r(:)
-    integer, allocatable :: iv(:)
     logical :: exists
 
     ok = .false.
@@ -107,98 +114,98 @@ contains
       msg = 'restart file '//trim(file)//' does not exist'
       return
     end if
-    call h5open_f(err)
-    call h5fopen_f(file, H5F_ACC_RDONLY_F, fid, err)
-    if (err /= 0) then
+    call file_open(file, fid, hs)
+    if (hs%failed) then
       msg = 'restart file '//trim(file)//' is not an HDF5 file'
       return
     end if
-    call read_str(fid, 'key', k, err)
-    if (err /= 0) then
+    call read_dset(fid, 'key', k, hs)
+    if (hs%failed) then
       msg = 'restart file '//trim(file)//' is not a robin_contact checkpoint'
-      call h5fclose_f(fid, err)
-      return
-    end if
-    if (trim(k) /= trim(key)) then
+    else if (trim(k) /= trim(key)) then
       msg = 'restart file '//trim(file)//' was made from a different deck or mesh '// &
             '(its bodies, loads, contact or solver settings differ from this run''s)'
-      call h5fclose_f(fid, err)
-      return
+    else
+      call read_state()
     end if
-    e = 0
-    call h5gopen_f(fid, 'state', gid, e(1))
-    call read_attr_int(gid, 'it', st%it, e(2))
-    call read_attr_int(gid, 'inner', st%inner, e(3))
-    call read_attr_int(gid, 'nacc', st%nacc, e(4))
-    call read_attr_int(gid, 'inner_maxit_hits', res%inner_maxit_hits, e(5))
-    call read_attr_int(gid, 'stalled', st%stalled, e(18))
-    call read_attr_int(gid, 'it_best', st%it_best, e(19))
-    call read_attr_real(gid, 'res_best', st%res_best, e(20))
-    call read_attr_real(gid, 'crit', st%crit, e(6))
-    call read_attr_real(gid, 'progress', st%progress, e(7))
-    call read_attr_real(gid, 'best', st%best, e(8))
-    call read_attr_real(gid, 'omega', st%omega, e(9))
-    call read_attr_real(gid, 'wall', st%wall, e(10))
-    call read_r1(gid, 'flam', r, e(11))
-    if (e(11) == 0) st%flam = r(1:2)
-    call read_r2(gid, 'G', st%G, e(12))
-    call read_r2(gid, 'lam', st%lam, e(13))
-    call read_r1(gid, 'r_prev', st%r_prev, e(14))
-    call read_r1(gid, 'x_prev', st%x_prev, e(15))
-    call read_r2(gid, 'dX', st%dX, e(16))
-    call read_r2(gid, 'dR', st%dR, e(17))
-    ! F_a lam_a (absent from older checkpoints: recomputed by the first solve)
-    call read_attr_int(gid, 'reuse', st%reuse, ere(1))
-    call read_r2(gid, 'flam_v', st%flam_v, ere(2))
-    if (any(ere /= 0)) st%reuse = 0
-    call h5gclose_f(gid, err)
-    if (any(e /= 0)) then
-      msg = 'restart file '//trim(file)//' is incomplete'
-      call h5fclose_f(fid, err)
-      return
-    end if
-    if (size(st%G, 1) /= m) then
-      msg = 'restart file '//trim(file)//' has a different number of contact nodes'
-      call h5fclose_f(fid, err)
-      return
-    end if
-    if (st%reuse == 0) then
-      if (allocated(st%flam_v)) deallocate (st%flam_v)
-      allocate (st%flam_v(m, 2))
-      st%flam_v = 0.0_wp
-    end if
-    n = st%it
-    if (n > maxout) then
-      write (msg, '(a,i0,a,i0)') 'restart file '//trim(file)//' is at outer iteration ', n, &
-        ', beyond max_outer = ', maxout
-      call h5fclose_f(fid, err)
-      return
-    end if
-    ! history
-    if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, res%h_active)
-    allocate (res%h_criterion(maxout), res%h_residual(maxout), res%h_wall(maxout), res%h_inner(maxout), &
-              res%h_active(maxout))
-    res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
-    if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
-    allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
-    res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = st%G
-    call h5gopen_f(fid, 'history', gid, e(1))
-    call read_r1(gid, 'criterion', r, e(2)); if (e(2) == 0) res%h_criterion(1:n) = r(1:n)
-    call read_r1(gid, 'residual', r, e(3)); if (e(3) == 0) res%h_residual(1:n) = r(1:n)
-    call read_r1(gid, 'wall_s', r, e(4)); if (e(4) == 0) res%h_wall(1:n) = r(1:n)
-    call read_i1(gid, 'inner', iv, e(5)); if (e(5) == 0) res%h_inner(1:n) = iv(1:n)
-    call read_i1(gid, 'active', iv, e(6)); if (e(6) == 0) res%h_active(1:n) = iv(1:n)
-    call h5gclose_f(gid, err)
-    call h5fclose_f(fid, err)
-    if (any(e(1:6) /= 0)) then
-      msg = 'restart file '//trim(file)//' has an incomplete history'
-      return
-    end if
-    res%nhist = n
-    res%outer = n
-    res%inner = st%inner
-    i = 0
-    ok = .true.
+    call file_close(fid, hs)
+    ok = len_trim(msg) == 0
+
+  contains
+
+    subroutine read_state()
+      call group_open(fid, 'state', gid, hs)
+      call read_attr(gid, 'it', st%it, hs)
+      call read_attr(gid, 'inner', st%inner, hs)
+      call read_attr(gid, 'nacc', st%nacc, hs)
+      call read_attr(gid, 'inner_maxit_hits', res%inner_maxit_hits, hs)
+      call read_attr(gid, 'stalled', st%stalled, hs)
+      call read_attr(gid, 'it_best', st%it_best, hs)
+      call read_attr(gid, 'res_best', st%res_best, hs)
+      call read_attr(gid, 'crit', st%crit, hs)
+      call read_attr(gid, 'progress', st%progress, hs)
+      call read_attr(gid, 'best', st%best, hs)
+      call read_attr(gid, 'omega', st%omega, hs)
+      call read_attr(gid, 'wall', st%wall, hs)
+      call read_dset(gid, 'flam', r, hs)
+      if (.not. hs%failed) then
+        if (size(r) == 2) st%flam = r
+      end if
+      call read_dset(gid, 'G', st%G, hs)
+      call read_dset(gid, 'lam', st%lam, hs)
+      call read_dset(gid, 'r_prev', st%r_prev, hs)
+      call read_dset(gid, 'x_prev', st%x_prev, hs)
+      call read_dset(gid, 'dX', st%dX, hs)
+      call read_dset(gid, 'dR', st%dR, hs)
+      call read_optional_products()
+      call group_close(gid, hs)
+      if (hs%failed) then
+        msg = 'restart file '//trim(file)//' is incomplete ('//hs%what//')'
+        return
+      end if
+      if (size(st%G, 1) /= m) then
+        msg = 'restart file '//trim(file)//' has a different number of contact nodes'
+        return
+      end if
+      n = st%it
+      if (n > maxout) then
+        write (msg, '(a,i0,a,i0)') 'restart file '//trim(file)//' is at outer iteration ', n, &
+          ', beyond max_outer = ', maxout
+        return
+      end if
+      ! history
+      if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, &
+                                                  res%h_active)
+      allocate (res%h_criterion(maxout), res%h_residual(maxout), res%h_wall(maxout), res%h_inner(maxout), &
+                res%h_active(maxout))
+      res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
+      if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
+      allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
+      res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = st%G
+      call read_history(fid, n, res, hs)
+      if (hs%failed) then
+        msg = 'restart file '//trim(file)//' has an incomplete history ('//hs%what//')'
+        return
+      end if
+      res%nhist = n
+      res%outer = n
+      res%inner = st%inner
+    end subroutine read_state
+
+    !> F_a lam_a of the last solves (absent from older checkpoints: then the first solve
+    !! after the restart computes it).
+    subroutine read_optional_products()
+      type(h5_status_t) :: ho
+      call read_attr(gid, 'reuse', st%reuse, ho)
+      call read_dset(gid, 'flam_v', st%flam_v, ho)
+      if (ho%failed) then
+        st%reuse = 0
+        if (allocated(st%flam_v)) deallocate (st%flam_v)
+        allocate (st%flam_v(m, 2))
+        st%flam_v = 0.0_wp
+      end if
+    end subroutine read_optional_products
+
   end subroutine checkpoint_read
 
 end module checkpoint

@@ -1,252 +1,458 @@
-!> Small HDF5 helpers: write and read datasets and attributes of the kinds the result
-!! and checkpoint files use (real and integer arrays of rank 1 and 2, scalars, text).
+!> HDF5 access for the result and checkpoint files: files, groups, and one path each
+!! to write and to read a dataset or an attribute of the kinds the files hold (real and
+!! integer arrays of any rank, real and integer scalars, text).
+!!
+!! Every call takes an `h5_status_t` that keeps the first failure (what could not be done
+!! to which object); once it is set, writes and reads do nothing and only closing still
+!! happens, so a caller checks the status once, at the end. HDF5's own error printing is
+!! switched off: failures reach the user only through the caller's message.
 module h5io
   use kinds, only: wp
-  use hdf5
-  implicit none
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char
+  use hdf5, only: hid_t, hsize_t, size_t, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5S_SCALAR_F, &
+                  H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, &
+                  h5open_f, h5dont_atexit_f, h5eset_auto_f, h5fcreate_f, h5fopen_f, h5fclose_f, &
+                  h5gcreate_f, h5gopen_f, h5gclose_f, h5iget_name_f, h5screate_f, &
+                  h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
+                  h5sget_simple_extent_dims_f, h5dcreate_f, h5dopen_f, h5dclose_f, h5dwrite_f, &
+                  h5dread_f, h5dget_space_f, h5dget_type_f, h5acreate_f, h5aopen_f, h5aclose_f, &
+                  h5awrite_f, h5aread_f, h5tcopy_f, h5tset_size_f, h5tget_size_f, h5tclose_f
+  implicit none (type, external)
   private
 
-  public :: dset_r1, dset_r2, dset_i1, dset_i2, dset_str, attr_str, attr_int, attr_real
-  public :: read_r1, read_r2, read_i1, read_str, read_attr_int, read_attr_real
+  !> Outcome of a sequence of HDF5 calls: set by the first call that fails, then kept.
+  type, public :: h5_status_t
+    logical :: failed = .false.                 !< some call has failed
+    character(len=:), allocatable :: what       !< the first failure, e.g. 'failed to write dataset /contact/gap'
+  end type h5_status_t
+
+  public :: file_open, file_close, group_open, group_close
+  public :: write_dset, write_attr, read_dset, read_attr
+
+  !> Write a dataset: a real or integer array of any rank, a real or integer scalar, or
+  !! a string.
+  interface write_dset
+    module procedure dset_real, dset_int, dset_text
+  end interface write_dset
+
+  !> Read a dataset into an allocatable: real of rank 1 or 2, integer of rank 1, or a
+  !! scalar string.
+  interface read_dset
+    module procedure read_real, read_int, read_str
+  end interface read_dset
+
+  integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]   ! the shape of a scalar
+  logical, save :: initialised = .false.
 
 contains
 
-  subroutine dset_r1(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), intent(in) :: v(:)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = size(v)
-    call h5screate_simple_f(1, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_r1
+  ! ---- files and groups ---------------------------------------------------------------
 
-  subroutine dset_r2(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), intent(in), contiguous :: v(:, :)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(2)
-    integer :: err
-    dims = shape(v)
-    call h5screate_simple_f(2, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_r2
-
-  subroutine dset_i1(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: v(:)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = size(v)
-    call h5screate_simple_f(1, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_i1
-
-  subroutine dset_i2(loc, name, v)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(in), contiguous :: v(:, :)
-    integer(hid_t) :: sp, ds
-    integer(hsize_t) :: dims(2)
-    integer :: err
-    dims = shape(v)
-    call h5screate_simple_f(2, dims, sp, err)
-    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, sp, ds, err)
-    if (size(v) > 0) call h5dwrite_f(ds, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-  end subroutine dset_i2
-
-  subroutine dset_str(loc, name, s)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name, s
-    integer(hid_t) :: sp, ds, ty
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5tcopy_f(H5T_FORTRAN_S1, ty, err)
-    call h5tset_size_f(ty, int(max(1, len(s)), size_t), err)
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5dcreate_f(loc, name, ty, sp, ds, err)
-    call h5dwrite_f(ds, ty, s, dims, err)
-    call h5dclose_f(ds, err)
-    call h5sclose_f(sp, err)
-    call h5tclose_f(ty, err)
-  end subroutine dset_str
-
-  subroutine attr_str(loc, name, s)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name, s
-    integer(hid_t) :: sp, at, ty
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5tcopy_f(H5T_FORTRAN_S1, ty, err)
-    call h5tset_size_f(ty, int(max(1, len(s)), size_t), err)
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5acreate_f(loc, name, ty, sp, at, err)
-    if (len(s) > 0) then
-      call h5awrite_f(at, ty, s, dims, err)
+  !> Open the HDF5 file `path` for reading, or create (truncate) it for writing when
+  !! `create` is present and true; fid = -1 on failure.
+  subroutine file_open(path, fid, st, create)
+    character(len=*), intent(in) :: path        !< file path
+    integer(hid_t), intent(out) :: fid          !< the open file
+    type(h5_status_t), intent(inout) :: st      !< status
+    logical, intent(in), optional :: create     !< create the file (default: read it)
+    logical :: new
+    integer :: e
+    fid = -1
+    new = .false.
+    if (present(create)) new = create
+    call library_init(st)
+    if (st%failed) return
+    if (new) then
+      call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, e)
     else
-      call h5awrite_f(at, ty, ' ', dims, err)
+      call h5fopen_f(path, H5F_ACC_RDONLY_F, fid, e)
     end if
-    call h5aclose_f(at, err)
-    call h5sclose_f(sp, err)
-    call h5tclose_f(ty, err)
-  end subroutine attr_str
+    if (e /= 0) then
+      fid = -1
+      call fail(st, merge('failed to create ', 'failed to open   ', new)//path)
+    end if
+  end subroutine file_open
 
-  subroutine attr_int(loc, name, v)
-    integer(hid_t), intent(in) :: loc
+  !> Close a file (whatever the status: this releases it); closing flushes the data, so a
+  !! full disk may show only here. Nothing happens for fid < 0.
+  subroutine file_close(fid, st)
+    integer(hid_t), intent(inout) :: fid        !< the file; -1 on return
+    type(h5_status_t), intent(inout) :: st      !< status
+    integer :: e
+    if (fid < 0) return
+    call h5fclose_f(fid, e)
+    if (e /= 0) call fail(st, 'failed to close (flush to disk) the file')
+    fid = -1
+  end subroutine file_close
+
+  !> Open the group `name` of `loc`, or create it when `create` is present and true;
+  !! gid = -1 if that fails or the status is already set.
+  subroutine group_open(loc, name, gid, st, create)
+    integer(hid_t), intent(in) :: loc           !< file or group
+    character(len=*), intent(in) :: name        !< group name
+    integer(hid_t), intent(out) :: gid          !< the open group
+    type(h5_status_t), intent(inout) :: st      !< status
+    logical, intent(in), optional :: create     !< create the group (default: open it)
+    logical :: new
+    integer :: e
+    gid = -1
+    if (st%failed) return
+    new = .false.
+    if (present(create)) new = create
+    if (new) then
+      call h5gcreate_f(loc, name, gid, e)
+    else
+      call h5gopen_f(loc, name, gid, e)
+    end if
+    if (e /= 0) then
+      gid = -1
+      call fail(st, merge('failed to create group', 'failed to open group  ', new), loc, name)
+    end if
+  end subroutine group_open
+
+  !> Close a group (whatever the status). Nothing happens for gid < 0.
+  subroutine group_close(gid, st)
+    integer(hid_t), intent(inout) :: gid        !< the group; -1 on return
+    type(h5_status_t), intent(inout) :: st      !< status
+    integer :: e
+    if (gid < 0) return
+    call h5gclose_f(gid, e)
+    if (e /= 0) call fail(st, 'failed to close group', gid, '')
+    gid = -1
+  end subroutine group_close
+
+  ! ---- writing --------------------------------------------------------------------------
+
+  !> Write a real array of any rank (or a scalar) as the dataset `name` of `loc`; an
+  !! (n1, n2) array shows as (n2, n1) in h5py.
+  subroutine dset_real(loc, name, v, st)
+    real(wp), intent(in), target, contiguous :: v(..)       !< the data
+    integer(hid_t), intent(in) :: loc                       !< file or group
+    character(len=*), intent(in) :: name                    !< dataset name
+    type(h5_status_t), intent(inout) :: st                  !< status
+    call put_data(loc, name, H5T_NATIVE_DOUBLE, v, st)
+  end subroutine dset_real
+
+  !> Write an integer array of any rank (or a scalar) as the dataset `name` of `loc`.
+  subroutine dset_int(loc, name, v, st)
+    integer, intent(in), target, contiguous :: v(..)        !< the data
+    integer(hid_t), intent(in) :: loc                       !< file or group
+    character(len=*), intent(in) :: name                    !< dataset name
+    type(h5_status_t), intent(inout) :: st                  !< status
+    call put_data(loc, name, H5T_NATIVE_INTEGER, v, st)
+  end subroutine dset_int
+
+  !> A numeric dataset of memory type `mtype` from contiguous data of any rank.
+  subroutine put_data(loc, name, mtype, v, st)
+    integer(hid_t), intent(in) :: loc, mtype
     character(len=*), intent(in) :: name
-    integer, intent(in) :: v
-    integer(hid_t) :: sp, at
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5acreate_f(loc, name, H5T_NATIVE_INTEGER, sp, at, err)
-    call h5awrite_f(at, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5aclose_f(at, err)
-    call h5sclose_f(sp, err)
-  end subroutine attr_int
+    type(*), intent(in), target, contiguous :: v(..)
+    type(h5_status_t), intent(inout) :: st
+    type(c_ptr) :: p
+    p = c_null_ptr
+    if (size(v) > 0) p = c_loc(v)
+    call put(loc, name, .false., mtype, shape(v, kind=hsize_t), p, st)
+  end subroutine put_data
 
-  subroutine attr_real(loc, name, v)
+  !> Write a string as the scalar dataset `name` of `loc`.
+  subroutine dset_text(loc, name, s, st)
+    integer(hid_t), intent(in) :: loc                       !< file or group
+    character(len=*), intent(in) :: name                    !< dataset name
+    character(len=*), intent(in) :: s                       !< the text
+    type(h5_status_t), intent(inout) :: st                  !< status
+    call put_string(loc, name, .false., s, st)
+  end subroutine dset_text
+
+  !> Write the scalar attribute `name` of `loc`: real, integer or string.
+  subroutine write_attr(loc, name, v, st)
+    integer(hid_t), intent(in) :: loc                   !< file, group or dataset
+    character(len=*), intent(in) :: name                !< attribute name
+    class(*), intent(in), target :: v                   !< its value
+    type(h5_status_t), intent(inout) :: st              !< status
+    select type (v)
+    type is (real(wp))
+      call put(loc, name, .true., H5T_NATIVE_DOUBLE, SCALAR, c_loc(v), st)
+    type is (integer)
+      call put(loc, name, .true., H5T_NATIVE_INTEGER, SCALAR, c_loc(v), st)
+    type is (character(*))
+      call put_string(loc, name, .true., v, st)
+    class default
+      call fail(st, 'cannot write this type as', loc, name)
+    end select
+  end subroutine write_attr
+
+  !> A scalar fixed-length string (Fortran, space padded; an empty one is stored as ' ').
+  subroutine put_string(loc, name, attr, s, st)
     integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), intent(in) :: v
-    integer(hid_t) :: sp, at
-    integer(hsize_t) :: dims(1)
-    integer :: err
-    dims = 1
-    call h5screate_f(H5S_SCALAR_F, sp, err)
-    call h5acreate_f(loc, name, H5T_NATIVE_DOUBLE, sp, at, err)
-    call h5awrite_f(at, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5aclose_f(at, err)
-    call h5sclose_f(sp, err)
-  end subroutine attr_real
+    character(len=*), intent(in) :: name, s
+    logical, intent(in) :: attr
+    type(h5_status_t), intent(inout) :: st
+    character(kind=c_char), allocatable, target :: c(:)
+    integer(hid_t) :: ty
+    integer :: n, e, ec
+    if (st%failed) return
+    n = max(1, len(s))
+    c = transfer(s//' ', 'a', n)
+    call h5tcopy_f(H5T_FORTRAN_S1, ty, e)
+    if (e /= 0) then
+      call fail(st, 'failed to make the string type of', loc, name)
+      return
+    end if
+    call h5tset_size_f(ty, int(n, size_t), e)
+    if (e /= 0) call fail(st, 'failed to make the string type of', loc, name)
+    call put(loc, name, attr, ty, SCALAR, c_loc(c), st)
+    call h5tclose_f(ty, ec)
+  end subroutine put_string
 
-
-  !> Read a real dataset of rank 1 into v (allocated to the stored size).
-  subroutine read_r1(loc, name, v, err)
-    integer(hid_t), intent(in) :: loc
+  !> The one writer: create `name` in `loc` as a dataset, or an attribute when `attr`, of
+  !! memory (and file) type `mtype` and shape `dims` (none: scalar), and write the data at
+  !! `buf` (not touched when the shape has no element).
+  subroutine put(loc, name, attr, mtype, dims, buf, st)
+    integer(hid_t), intent(in) :: loc, mtype
     character(len=*), intent(in) :: name
-    real(wp), allocatable, intent(out) :: v(:)
-    integer, intent(out) :: err
-    integer(hid_t) :: ds, sp
-    integer(hsize_t) :: dims(1), maxd(1)
-    call h5dopen_f(loc, name, ds, err)
-    if (err /= 0) return
-    call h5dget_space_f(ds, sp, err)
-    call h5sget_simple_extent_dims_f(sp, dims, maxd, err)
-    allocate (v(dims(1)))
-    err = 0
-    if (dims(1) > 0) call h5dread_f(ds, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5sclose_f(sp, err)
-    call h5dclose_f(ds, err)
-  end subroutine read_r1
+    logical, intent(in) :: attr
+    integer(hsize_t), intent(in) :: dims(:)
+    type(c_ptr), intent(in) :: buf
+    type(h5_status_t), intent(inout) :: st
+    integer(hid_t) :: sp, obj
+    integer :: e, ec
+    if (st%failed) return
+    if (size(dims) == 0) then
+      call h5screate_f(H5S_SCALAR_F, sp, e)
+    else
+      call h5screate_simple_f(size(dims), dims, sp, e)
+    end if
+    if (e /= 0) then
+      call fail(st, 'failed to make the dataspace of', loc, name)
+      return
+    end if
+    if (attr) then
+      call h5acreate_f(loc, name, mtype, sp, obj, e)
+    else
+      call h5dcreate_f(loc, name, mtype, sp, obj, e)
+    end if
+    if (e /= 0) then
+      call fail(st, 'failed to create '//kind_name(attr), loc, name)
+    else
+      if (product(dims) > 0) then
+        if (attr) then
+          call h5awrite_f(obj, mtype, buf, e)
+        else
+          call h5dwrite_f(obj, mtype, buf, e)
+        end if
+        if (e /= 0) call fail(st, 'failed to write '//kind_name(attr), loc, name)
+      end if
+      call close_object(attr, obj, loc, name, st)
+    end if
+    call h5sclose_f(sp, ec)
+  end subroutine put
 
-  !> Read a real dataset of rank 2 (Fortran shape) into v.
-  subroutine read_r2(loc, name, v, err)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    real(wp), allocatable, intent(out) :: v(:, :)
-    integer, intent(out) :: err
-    integer(hid_t) :: ds, sp
-    integer(hsize_t) :: dims(2), maxd(2)
-    call h5dopen_f(loc, name, ds, err)
-    if (err /= 0) return
-    call h5dget_space_f(ds, sp, err)
-    call h5sget_simple_extent_dims_f(sp, dims, maxd, err)
-    allocate (v(dims(1), dims(2)))
-    err = 0
-    if (size(v) > 0) call h5dread_f(ds, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5sclose_f(sp, err)
-    call h5dclose_f(ds, err)
-  end subroutine read_r2
+  ! ---- reading --------------------------------------------------------------------------
 
-  !> Read an integer dataset of rank 1 into v.
-  subroutine read_i1(loc, name, v, err)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, allocatable, intent(out) :: v(:)
-    integer, intent(out) :: err
-    integer(hid_t) :: ds, sp
-    integer(hsize_t) :: dims(1), maxd(1)
-    call h5dopen_f(loc, name, ds, err)
-    if (err /= 0) return
-    call h5dget_space_f(ds, sp, err)
-    call h5sget_simple_extent_dims_f(sp, dims, maxd, err)
-    allocate (v(dims(1)))
-    err = 0
-    if (dims(1) > 0) call h5dread_f(ds, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5sclose_f(sp, err)
-    call h5dclose_f(ds, err)
-  end subroutine read_i1
+  !> Read a real dataset of rank 1 or 2 into v, allocated to the stored shape.
+  subroutine read_real(loc, name, v, st)
+    integer(hid_t), intent(in) :: loc                       !< file or group
+    character(len=*), intent(in) :: name                    !< dataset name
+    real(wp), allocatable, target, intent(out) :: v(..)     !< the data
+    type(h5_status_t), intent(inout) :: st                  !< status
+    integer(hsize_t) :: d(2)
+    if (rank(v) > 2) call fail(st, 'cannot read an array of rank above 2 from dataset', loc, name)
+    if (st%failed) return
+    call extent(loc, name, d(1:rank(v)), st)
+    if (st%failed) return
+    select rank (v)
+    rank (1)
+      allocate (v(d(1)))
+    rank (2)
+      allocate (v(d(1), d(2)))
+    end select
+    if (size(v) > 0) call get(loc, name, .false., H5T_NATIVE_DOUBLE, c_loc(v), st)
+  end subroutine read_real
 
-  !> Read a scalar fixed-length string dataset.
-  subroutine read_str(loc, name, s, err)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    character(len=:), allocatable, intent(out) :: s
-    integer, intent(out) :: err
+  !> Read an integer dataset of rank 1 into v, allocated to the stored size.
+  subroutine read_int(loc, name, v, st)
+    integer(hid_t), intent(in) :: loc                       !< file or group
+    character(len=*), intent(in) :: name                    !< dataset name
+    integer, allocatable, target, intent(out) :: v(:)       !< the data
+    type(h5_status_t), intent(inout) :: st                  !< status
+    integer(hsize_t) :: d(1)
+    call extent(loc, name, d, st)
+    if (st%failed) return
+    allocate (v(d(1)))
+    if (d(1) > 0) call get(loc, name, .false., H5T_NATIVE_INTEGER, c_loc(v), st)
+  end subroutine read_int
+
+  !> Read a scalar fixed-length string dataset into s (its stored length).
+  subroutine read_str(loc, name, s, st)
+    integer(hid_t), intent(in) :: loc                       !< file or group
+    character(len=*), intent(in) :: name                    !< dataset name
+    character(len=:), allocatable, intent(out) :: s         !< the text
+    type(h5_status_t), intent(inout) :: st                  !< status
+    character(kind=c_char), allocatable, target :: c(:)
     integer(hid_t) :: ds, ty
     integer(size_t) :: n
-    integer(hsize_t) :: dims(1)
-    dims = 1
-    call h5dopen_f(loc, name, ds, err)
-    if (err /= 0) return
-    call h5dget_type_f(ds, ty, err)
-    call h5tget_size_f(ty, n, err)
-    allocate (character(len=n) :: s)
-    call h5dread_f(ds, ty, s, dims, err)
-    call h5tclose_f(ty, err)
-    call h5dclose_f(ds, err)
+    integer :: e, ec
+    s = ''
+    if (st%failed) return
+    call h5dopen_f(loc, name, ds, e)
+    if (e /= 0) then
+      call fail(st, 'failed to open dataset', loc, name)
+      return
+    end if
+    call h5dget_type_f(ds, ty, e)
+    call h5dclose_f(ds, ec)
+    n = 0
+    if (e == 0) call h5tget_size_f(ty, n, e)
+    if (e /= 0 .or. n < 1) then
+      call fail(st, 'failed to read the string type of dataset', loc, name)
+    else
+      allocate (c(n))
+      call get(loc, name, .false., ty, c_loc(c), st)
+      s = transfer(c, repeat(' ', int(n)))
+    end if
+    if (e == 0) call h5tclose_f(ty, ec)
   end subroutine read_str
 
-  !> Read a scalar integer attribute.
-  subroutine read_attr_int(loc, name, v, err)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
-    integer, intent(out) :: v
-    integer, intent(out) :: err
-    integer(hid_t) :: at
-    integer(hsize_t) :: dims(1)
-    dims = 1
-    v = 0
-    call h5aopen_f(loc, name, at, err)
-    if (err /= 0) return
-    call h5aread_f(at, H5T_NATIVE_INTEGER, v, dims, err)
-    call h5aclose_f(at, err)
-  end subroutine read_attr_int
+  !> Read the scalar attribute `name` of `loc` into v (real or integer).
+  subroutine read_attr(loc, name, v, st)
+    integer(hid_t), intent(in) :: loc                   !< file, group or dataset
+    character(len=*), intent(in) :: name                !< attribute name
+    class(*), intent(inout), target :: v                !< receives the value
+    type(h5_status_t), intent(inout) :: st              !< status
+    select type (v)
+    type is (real(wp))
+      call get(loc, name, .true., H5T_NATIVE_DOUBLE, c_loc(v), st)
+    type is (integer)
+      call get(loc, name, .true., H5T_NATIVE_INTEGER, c_loc(v), st)
+    class default
+      call fail(st, 'cannot read this type from attribute', loc, name)
+    end select
+  end subroutine read_attr
 
-  !> Read a scalar real attribute.
-  subroutine read_attr_real(loc, name, v, err)
+  !> The one reader: read the dataset, or the attribute when `attr`, `name` of `loc` as
+  !! memory type `mtype` into the memory at `buf` (allocated by the caller).
+  subroutine get(loc, name, attr, mtype, buf, st)
+    integer(hid_t), intent(in) :: loc, mtype
+    character(len=*), intent(in) :: name
+    logical, intent(in) :: attr
+    type(c_ptr), intent(in) :: buf
+    type(h5_status_t), intent(inout) :: st
+    integer(hid_t) :: obj
+    type(c_ptr) :: p
+    integer :: e, eo
+    if (st%failed) return
+    p = buf   ! HDF5 declares the buffer intent(inout)
+    if (attr) then
+      call h5aopen_f(loc, name, obj, eo)
+      if (eo == 0) call h5aread_f(obj, mtype, p, e)
+    else
+      call h5dopen_f(loc, name, obj, eo)
+      if (eo == 0) call h5dread_f(obj, mtype, p, e)
+    end if
+    if (eo /= 0) e = eo
+    if (e /= 0) call fail(st, 'failed to read '//kind_name(attr), loc, name)
+    if (eo == 0) call close_object(attr, obj, loc, name, st)
+  end subroutine get
+
+  !> The stored shape of dataset `name`; a failure when its rank is not size(dims).
+  subroutine extent(loc, name, dims, st)
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name
-    real(wp), intent(out) :: v
-    integer, intent(out) :: err
-    integer(hid_t) :: at
-    integer(hsize_t) :: dims(1)
-    dims = 1
-    v = 0.0_wp
-    call h5aopen_f(loc, name, at, err)
-    if (err /= 0) return
-    call h5aread_f(at, H5T_NATIVE_DOUBLE, v, dims, err)
-    call h5aclose_f(at, err)
-  end subroutine read_attr_real
+    integer(hsize_t), intent(out) :: dims(:)
+    type(h5_status_t), intent(inout) :: st
+    integer(hsize_t) :: maxd(size(dims))
+    integer(hid_t) :: ds, sp
+    integer :: e, ec, r
+    dims = 0
+    if (st%failed) return
+    call h5dopen_f(loc, name, ds, e)
+    if (e /= 0) then
+      call fail(st, 'failed to open dataset', loc, name)
+      return
+    end if
+    r = -1
+    call h5dget_space_f(ds, sp, e)
+    if (e == 0) then
+      call h5sget_simple_extent_ndims_f(sp, r, e)
+      ! this call returns the rank (not 0) in its error argument on success
+      if (e == 0 .and. r == size(dims)) call h5sget_simple_extent_dims_f(sp, dims, maxd, e)
+      call h5sclose_f(sp, ec)
+    end if
+    call h5dclose_f(ds, ec)
+    if (e < 0 .or. r /= size(dims)) call fail(st, 'dataset does not have the expected rank:', loc, name)
+  end subroutine extent
+
+  ! ---- support ------------------------------------------------------------------------
+
+  !> Open the library once: no HDF5 error printing, and no HDF5 clean-up at exit (a file
+  !! whose flush failed would make it loop; every file is closed explicitly).
+  subroutine library_init(st)
+    type(h5_status_t), intent(inout) :: st
+    integer :: e
+    if (initialised) return
+    call h5dont_atexit_f(e)
+    call h5open_f(e)
+    if (e /= 0) then
+      call fail(st, 'failed to initialise the HDF5 library')
+      return
+    end if
+    call h5eset_auto_f(0, e)
+    initialised = .true.
+  end subroutine library_init
+
+  subroutine close_object(attr, obj, loc, name, st)
+    logical, intent(in) :: attr
+    integer(hid_t), intent(in) :: obj, loc
+    character(len=*), intent(in) :: name
+    type(h5_status_t), intent(inout) :: st
+    integer :: e
+    if (attr) then
+      call h5aclose_f(obj, e)
+    else
+      call h5dclose_f(obj, e)
+    end if
+    if (e /= 0) call fail(st, 'failed to close '//kind_name(attr), loc, name)
+  end subroutine close_object
+
+  pure function kind_name(attr) result(k)
+    logical, intent(in) :: attr
+    character(len=:), allocatable :: k
+    k = merge('attribute', 'dataset  ', attr)
+    k = trim(k)
+  end function kind_name
+
+  !> Record the first failure: `text`, followed by the path of `name` in `loc` if given.
+  subroutine fail(st, text, loc, name)
+    type(h5_status_t), intent(inout) :: st
+    character(len=*), intent(in) :: text
+    integer(hid_t), intent(in), optional :: loc
+    character(len=*), intent(in), optional :: name
+    if (st%failed) return
+    st%failed = .true.
+    st%what = trim(text)
+    if (present(loc) .and. present(name)) st%what = st%what//' '//object_path(loc, name)
+  end subroutine fail
+
+  !> The path of `name` in the object `loc` ('/contact/gap'), for messages.
+  function object_path(loc, name) result(p)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    character(len=:), allocatable :: p
+    character(len=1024) :: buf
+    integer(size_t) :: n
+    integer :: e
+    buf = ''
+    call h5iget_name_f(loc, buf, int(len(buf), size_t), n, e)
+    p = trim(buf)
+    if (e /= 0) p = ''
+    if (len(name) == 0) return
+    if (len(p) == 0) then
+      p = name
+    else if (p(len(p):len(p)) == '/') then
+      p = p//name
+    else
+      p = p//'/'//name
+    end if
+  end function object_path
 
 end module h5io
