@@ -61,6 +61,20 @@ module config
   character(len=*), parameter, public :: ELEMENT_CHOICES = 'Q1 P1'                    !< ELEM_* order
   character(len=*), parameter, public :: PLANE_CHOICES = 'strain stress'
 
+  integer, parameter, public :: UNITS_SI = 1       !< m, N, Pa
+  integer, parameter, public :: UNITS_MM = 2       !< mm, N, MPa (consistent: N/mm^2 = MPa)
+  integer, parameter, public :: UNITS_CUSTOM = 3   !< names given by length_unit, force_unit, stress_unit
+  character(len=*), parameter, public :: UNITS_CHOICES = 'SI mm-N-MPa custom'
+
+  !> The units the deck's numbers are in. The solver is unit-free (any consistent set works);
+  !! the names label the result file's datasets, the plots and the summary lines.
+  type, public :: units_cfg_t
+    integer :: system = UNITS_SI                    !< UNITS_*
+    character(len=16) :: length = 'm'               !< length unit name
+    character(len=16) :: force = 'N'                !< force unit name
+    character(len=16) :: stress = 'Pa'             !< stress unit name (force/length^2)
+  end type units_cfg_t
+
   !> One elastic body: a rectangle meshed by nx x ny cells.
   type, public :: body_cfg_t
     integer :: id = 0                 !< 1 or 2
@@ -128,6 +142,7 @@ module config
     character(len=512) :: source = ''                 !< deck path as given
     character(len=256) :: title = ''                  !< free text
     logical :: plane_strain = .true.                  !< .true.: plane strain, .false.: plane stress
+    type(units_cfg_t) :: units                        !< unit names (&scene units=...)
     type(body_cfg_t) :: body(2)                       !< indexed by id
     integer :: ntraction = 0                          !< number of tractions in use
     type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)

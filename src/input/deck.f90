@@ -23,7 +23,8 @@ module deck
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     METHOD_CHOICES, ROBIN_CHOICES, ROBIN_CONSTANT, STOP_CHOICES, FACTOR_CHOICES, &
-                    ORDER_CHOICES, ACCEL_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES
+                    ORDER_CHOICES, ACCEL_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
+                    UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t
   implicit none (type, external)
   private
 
@@ -240,6 +241,10 @@ contains
     type(vars_t), intent(out) :: v
     call v%str('title', d%title)
     call v%enum('plane', sc%plane, PLANE_CHOICES)
+    call v%enum('units', d%units%system, UNITS_CHOICES)
+    call v%str('length_unit', d%units%length)
+    call v%str('force_unit', d%units%force)
+    call v%str('stress_unit', d%units%stress)
   end subroutine scene_vars
 
   subroutine body_vars(b, v)
@@ -339,7 +344,53 @@ contains
     call scene_vars(d, sc, v)
     call read_group(g, src, v)
     d%plane_strain = (sc%plane == 1)
+    call check_units(g, src, d%units)
   end subroutine apply_scene
+
+  !> The unit names of a named system are fixed (given ones must agree); 'custom' needs all three.
+  subroutine check_units(g, src, u)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(units_cfg_t), intent(inout) :: u
+    character(len=16) :: names(3)
+    character(len=*), parameter :: vars(3) = ['length_unit', 'force_unit ', 'stress_unit']
+    integer :: k
+    select case (u%system)
+    case (UNITS_SI)
+      names = [character(len=16) :: 'm', 'N', 'Pa']
+    case (UNITS_MM)
+      names = [character(len=16) :: 'mm', 'N', 'MPa']
+    case default
+      do k = 1, 3
+        if (len_trim(unit_name(u, k)) == 0) call bad_value(g, src, trim(vars(k)), "''", &
+          'is empty: with units=''custom'' give length_unit, force_unit and stress_unit')
+      end do
+      return
+    end select
+    do k = 1, 3
+      if (find_asg(g, trim(vars(k))) > 0 .and. unit_name(u, k) /= names(k)) call bad_value(g, src, &
+        trim(vars(k)), "'"//trim(unit_name(u, k))//"'", 'does not belong to units='''// &
+        word(UNITS_CHOICES, u%system)//''' (whose '//trim(vars(k))//' is '''//trim(names(k))// &
+        '''); use units=''custom'' to name your own')
+    end do
+    u%length = names(1)
+    u%force = names(2)
+    u%stress = names(3)
+  end subroutine check_units
+
+  function unit_name(u, k) result(s)
+    type(units_cfg_t), intent(in) :: u
+    integer, intent(in) :: k
+    character(len=16) :: s
+    select case (k)
+    case (1)
+      s = u%length
+    case (2)
+      s = u%force
+    case default
+      s = u%stress
+    end select
+  end function unit_name
 
   subroutine apply_contact(g, src, c)
     type(grp_t), intent(in) :: g
