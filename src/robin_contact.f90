@@ -66,10 +66,6 @@ program robin_contact
     call omp_set_max_active_levels(1)
   end if
 
-  ! A result file left at this path by an earlier run must not pass for this run's if
-  ! this one fails: remove it (and its XDMF files) now that the input is valid.
-  call remove_results(d%output%file)
-
   ! ---- assemble both bodies --------------------------------------------------------
   t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
@@ -83,6 +79,14 @@ program robin_contact
   end do
   call build_interface(d%body, d%contact, msh, sys, itf, info1, msg1)
   if (info1 /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg1))
+  ! the checkpoint to restart from is input too: read and check it before touching any file
+  if (len(restart_file) > 0) then
+    call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
+    if (.not. ok) call fatal(EXIT_INPUT, trim(msg1))
+  end if
+  ! A result file left at this path by an earlier run must not pass for this run's if
+  ! this one fails: remove it (and its XDMF files) now that all the input is valid.
+  call remove_results(d%output%file)
   tm%assemble = wtime() - t0
   call check_interrupt('assembly')
   write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') 'assembled: n1=', sys(1)%n, ' n2=', sys(2)%n, &
@@ -123,10 +127,6 @@ program robin_contact
   if (d%solver%method == METHOD_MONOLITHIC) then
     call solve_monolithic(d%solver, itf, cb, res, stop_requested)
   else
-    if (len(restart_file) > 0) then
-      call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
-      if (.not. ok) call fatal(EXIT_INPUT, trim(msg1))
-    end if
     ckpt%file = checkpoint_file(d%output%file)
     ckpt%key = key
     ckpt%every = d%output%checkpoint_every

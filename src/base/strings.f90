@@ -23,7 +23,40 @@ module strings
     logical :: flag(size(ieee_usual)) = .false.
   end type fpstate_t
 
+  !> Text built piece by piece in amortised linear time (the buffer doubles as it fills).
+  type, public :: text_buffer_t
+    character(len=:), allocatable :: buf   !< storage; the text is buf(1:n)
+    integer :: n = 0                        !< characters in use
+  contains
+    procedure :: add => text_buffer_add    !< append a piece
+    procedure :: text => text_buffer_text  !< the text so far
+  end type text_buffer_t
+
 contains
+
+  subroutine text_buffer_add(self, piece)
+    class(text_buffer_t), intent(inout) :: self
+    character(len=*), intent(in) :: piece   !< text to append
+    character(len=:), allocatable :: bigger
+    if (.not. allocated(self%buf)) allocate (character(len=max(1024, 2*len(piece))) :: self%buf)
+    if (self%n + len(piece) > len(self%buf)) then
+      allocate (character(len=2*(self%n + len(piece))) :: bigger)
+      bigger(1:self%n) = self%buf(1:self%n)
+      call move_alloc(bigger, self%buf)
+    end if
+    self%buf(self%n + 1:self%n + len(piece)) = piece
+    self%n = self%n + len(piece)
+  end subroutine text_buffer_add
+
+  function text_buffer_text(self) result(t)
+    class(text_buffer_t), intent(in) :: self
+    character(len=:), allocatable :: t
+    if (allocated(self%buf)) then
+      t = self%buf(1:self%n)
+    else
+      t = ''
+    end if
+  end function text_buffer_text
 
   !> Disable floating-point halting around a READ (an overflowing literal such as 1e400
   !! would trap in a -ffpe-trap build; it is reported as non-finite instead).

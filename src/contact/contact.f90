@@ -21,6 +21,7 @@ module contact
 
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
   integer, parameter :: POWER_ITS = 10               !< power iterations for each body's lambda_max (MPRGP guards an underestimate)
+  integer, parameter :: HISTORY_CHUNK = 256          !< initial history entries (grown by doubling)
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
   !> y = alpha x ./ w: the constant Robin operator alpha M^-1 (M: tributary lengths).
@@ -143,10 +144,10 @@ contains
     if (present(state)) resumed = state%it > 0
     if (resumed) then
       st_ = state
-      if (size(res%h_criterion) < maxout) call grow_history(res, maxout)
       t0 = t0 - st_%wall
     else
-      call alloc_result(res, m, maxout)
+      ! the history grows as the run goes (max_outer may be huge)
+      call alloc_result(res, m, min(maxout, HISTORY_CHUNK))
       call state_init(st_, m, itf%g0)
     end if
     res%method = 'robin'
@@ -165,6 +166,11 @@ contains
     every = max(1, maxout/max(1, every))
     res%status = 'max_outer'
     printed = .false.
+    if (resumed .and. st_%it >= maxout) then
+      call restore_iterate(itf, bc, op, st_, res)
+      if (present(progress_unit)) write (progress_unit, '(a,i0,a)') 'the checkpoint is at outer iteration ', &
+        st_%it, ' = max_outer: nothing left to do, its result is written again (raise max_outer to go on)'
+    end if
     if (present(progress_unit)) then
       if (resumed) write (progress_unit, '(a,i0)') 'resuming after outer iteration ', st_%it
       write (progress_unit, '(a)') '  outer   criterion    residual  active       inner'
@@ -224,6 +230,31 @@ contains
     call corr_op%free()
     if (present(state)) state = st_
   end subroutine solve_robin
+
+  !> A run resumed from a checkpoint taken at max_outer has nothing left to do: its
+  !! result is the checkpointed iterate (contact forces, obstacles, history), with the
+  !! normal displacements B_a u_a = b_a - F_a lam_a and the residuals recomputed.
+  subroutine restore_iterate(itf, bc, op, st, res)
+    type(interface_t), intent(in) :: itf
+    type(body_condensed_t), intent(in) :: bc(2)
+    type(dense_op_t), intent(inout) :: op(2)
+    type(robin_state_t), intent(in) :: st
+    type(contact_result_t), intent(inout) :: res
+    real(wp), allocatable :: flam(:)
+    integer :: a
+    allocate (flam(itf%m))
+    res%lam_body = st%lam
+    do a = 1, 2
+      if (itf%m > 0) call op(a)%apply(st%lam(:, a), flam)
+      res%w(:, a) = bc(a)%b - flam
+    end do
+    call interface_residual(itf, bc, res)
+    res%obstacle = st%G
+    res%outer = st%it
+    res%inner = st%inner
+    res%criterion = st%crit
+    res%nhist = st%it
+  end subroutine restore_iterate
 
   !> Each body's Hessian F_a as an operator and its largest eigenvalue (power iterations,
   !! counted in IT_inner unless the run resumes).
@@ -442,6 +473,7 @@ contains
     res%inner = st%inner
     res%criterion = st%crit
     res%nhist = it
+    if (it > size(res%h_criterion)) call grow_history(res, min(s%max_outer, 2*size(res%h_criterion) + HISTORY_CHUNK))
     res%h_criterion(it) = st%crit
     res%h_residual(it) = res%residual
     res%h_inner(it) = st%inner

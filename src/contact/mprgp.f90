@@ -613,6 +613,15 @@ contains
                   trim(itoa(it))//' steps')
         return
       end if
+      if (dad_ <= 0.0_wp .and. dd_ <= tiny(1.0_wp)) then
+        ! the direction has vanished (underflowed): the iterate is exact to working
+        ! precision and a tolerance below that cannot be reached; not a curvature failure
+        stats%status = MPRGP_CONVERGED
+        write (s1, '(es10.3)') stats%gp_norm
+        stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
+                        ' (the tolerance asked for is below what double precision resolves)'
+        return
+      end if
       if (dad_ <= 0.0_wp) then
         write (s1, '(es10.3)') dad_
         call fail(MPRGP_NOT_SPD, 'p''Ap = '//trim(adjustl(s1))//' <= 0 along the '//what// &

@@ -16,7 +16,7 @@
 module deck
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
-  use strings, only: i2s, r2s, quoted_list, index_of, word
+  use strings, only: i2s, r2s, quoted_list, index_of, word, text_buffer_t
   use namelist_input, only: str_t, src_t, grp_t, vars_t, load_file, text_source, parse_source, &
                             read_group, render_group, find_asg, find_int, die_at, bad_value, unknown_group
   use config, only: deck_t, body_cfg_t, traction_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
@@ -172,15 +172,16 @@ contains
     type(load_in_t), target :: t
     type(vars_t) :: v
     integer :: b, s, i
+    type(text_buffer_t) :: tb
 
     c = d
-    text = '! effective deck (every value, defaults included); source: '//trim(c%source)//NL
+    call tb%add('! effective deck (every value, defaults included); source: '//trim(c%source)//NL)
     sc%plane = merge(1, 2, c%plane_strain)
     call scene_vars(c, sc, v)
-    text = text//render_group('scene', v, WIDTH)
+    call tb%add(render_group('scene', v, WIDTH))
     do b = 1, 2
       call body_vars(c%body(b), v)
-      text = text//render_group('body', v, WIDTH)
+      call tb%add(render_group('body', v, WIDTH))
     end do
     do i = 1, c%ntraction
       t%body = c%traction(i)%body
@@ -188,7 +189,7 @@ contains
       t%t0 = c%traction(i)%t0
       t%t1 = c%traction(i)%t1
       call traction_vars(t, v)
-      text = text//render_group('traction', v, WIDTH)
+      call tb%add(render_group('traction', v, WIDTH))
     end do
     do b = 1, 2
       do s = 1, 4
@@ -197,15 +198,16 @@ contains
         t%side = s
         t%u = c%body(b)%u_side(:, s)
         call displacement_vars(t, v)
-        text = text//render_group('displacement', v, WIDTH)
+        call tb%add(render_group('displacement', v, WIDTH))
       end do
     end do
     call contact_vars(c%contact, v)
-    text = text//render_group('contact', v, WIDTH)
+    call tb%add(render_group('contact', v, WIDTH))
     call solver_vars(c%solver, v)
-    text = text//render_group('solver', v, WIDTH)
+    call tb%add(render_group('solver', v, WIDTH))
     call output_vars(c%output, v)
-    text = text//render_group('output', v, WIDTH)
+    call tb%add(render_group('output', v, WIDTH))
+    text = tb%text()
   end subroutine deck_text
 
   !> Print the effective deck as namelist text on `unit` (renders it if `d%effective` is unset).

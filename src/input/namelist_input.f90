@@ -14,7 +14,7 @@ module namelist_input
   use kinds, only: wp
   use errors, only: fatal, EXIT_INPUT
   use strings, only: fpstate_t, fp_read_begin, fp_read_end, lower, is_ident, is_letter, first_nonblank, &
-                     i2s, r2s, quote, quoted_list, index_of, word
+                     i2s, r2s, quote, quoted_list, index_of, word, text_buffer_t
   implicit none (type, external)
   private
 
@@ -263,36 +263,22 @@ contains
     character(len=*), intent(in) :: path
     character(len=:), allocatable, intent(out) :: text
     character(len=4096) :: chunk
-    character(len=:), allocatable :: buf
-    integer :: u, ios, nread, used
+    type(text_buffer_t) :: tb
+    integer :: u, ios, nread
     character(len=512) :: msg
     open (newunit=u, file=path, access='sequential', form='formatted', status='old', &
           action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) call fatal(EXIT_INPUT, 'cannot open the deck file '''//path//''': '//trim(msg))
-    allocate (character(len=65536) :: buf)
-    used = 0
     do
       read (u, '(a)', advance='no', size=nread, iostat=ios, iomsg=msg) chunk
       if (is_iostat_end(ios)) exit
       if (ios /= 0 .and. .not. is_iostat_eor(ios)) &
         call fatal(EXIT_INPUT, 'cannot read the deck file '''//path//''': '//trim(msg))
-      call append(chunk(1:nread))
-      if (is_iostat_eor(ios)) call append(NL)
+      call tb%add(chunk(1:nread))
+      if (is_iostat_eor(ios)) call tb%add(NL)
     end do
     close (u)
-    text = buf(1:used)
-  contains
-    subroutine append(piece)
-      character(len=*), intent(in) :: piece
-      character(len=:), allocatable :: bigger
-      if (used + len(piece) > len(buf)) then
-        allocate (character(len=2*(used + len(piece))) :: bigger)
-        bigger(1:used) = buf(1:used)
-        call move_alloc(bigger, buf)
-      end if
-      buf(used + 1:used + len(piece)) = piece
-      used = used + len(piece)
-    end subroutine append
+    text = tb%text()
   end subroutine read_stream
 
   subroutine text_source(text, label, src)
