@@ -40,7 +40,7 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings config sysinfo signals namelist_input deck mesh elements lapack linop assembly ordering mprgp cholmod_iface banded cholesky \
+MODS := kinds errors clock strings config sysinfo signals namelist_input deck budget mesh elements lapack linop assembly ordering mprgp cholmod_iface banded cholesky \
         condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o
@@ -89,6 +89,7 @@ $(BUILD)/clock.o:         $(BUILD)/kinds.o
 $(BUILD)/strings.o:       $(BUILD)/kinds.o
 $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o
+$(BUILD)/budget.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o
 $(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/elements.o:      $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements.o $(BUILD)/linop.o

@@ -3,4 +3,6 @@
 #define RC_SYSINFO_SHIM_H
 /* Peak resident set size of this process so far [MiB]; 0 if unavailable. */
 double rc_peak_rss_mb(void);
+/* Memory this process may use [MiB] (MemAvailable, cgroup memory.max, ulimit -v); 0 if unknown. */
+double rc_memory_limit_mb(void);
 #endif

@@ -22,7 +22,8 @@ program robin_contact
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
   use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
-  use sysinfo, only: peak_rss_mb
+  use sysinfo, only: peak_rss_mb, memory_limit_mb
+  use budget, only: check_budget
   use strings, only: sci, fmt_real, i2s
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
@@ -35,7 +36,7 @@ program robin_contact
   type(body_condensed_t) :: cb(2)   ! the bodies condensed on the interface
   type(contact_result_t) :: res
   type(timing_t) :: tm
-  character(len=:), allocatable :: deck_path, restart_file, key
+  character(len=:), allocatable :: deck_path, restart_file, key, budget_msg
   character(len=4096), allocatable :: overrides(:)
   type(robin_state_t) :: state
   type(h5_checkpointer_t) :: ckpt
@@ -52,6 +53,9 @@ program robin_contact
   if (len(restart_file) > 0 .and. d%solver%method /= METHOD_ROBIN) &
     call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': --restart applies to method=''robin'' only')
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
+  ! a deck that cannot fit this machine is refused before anything is allocated
+  call check_budget(d, memory_limit_mb(), ok, budget_msg)
+  if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
   key = physics_key(d)
   write (output_unit, '(a)') 'robin_contact '//program_version//': effective input'
   call print_deck(d, output_unit)

@@ -1,0 +1,108 @@
+!> What a deck costs before anything is allocated: the memory estimate of a run (meshes,
+!! assembled matrices, Cholesky factors, interface matrices) and the checks that it fits
+!! the machine and the 32-bit indices of the sparse matrices. A deck that cannot fit is
+!! bad input (exit 1) with the estimate and the limit in the message: a run must not
+!! allocate until the kernel's OOM killer ends it.
+!!
+!! The factor estimate is calibrated on measured runs (README, "Performance"): nested
+!! dissection orderings (metis, nd, amd) of a structured 2D body of n DOFs fill about
+!! 8 n log2(n) entries; the banded factorization and the natural order fill n times the
+!! half-bandwidth. Counts are computed in double precision, so no integer overflows.
+module budget
+  use kinds, only: wp
+  use config, only: deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
+  use strings, only: i2s
+  implicit none (type, external)
+  private
+
+  real(wp), parameter :: MIB = 1048576.0_wp
+  real(wp), parameter :: INDEX_MAX = 2147483647.0_wp   ! largest 32-bit index
+  real(wp), parameter :: BASE_MB = 64.0_wp             ! the program, libraries and small arrays
+
+  public :: body_memory_mb, run_memory_mb, check_budget
+
+contains
+
+  !> Memory of one body [MiB]: mesh, assembled matrix and load, factor, work vectors.
+  !! `nnz_matrix` returns the matrix entries (both triangles) and `nnz_factor` the factor's.
+  real(wp) function body_memory_mb(b, fc, nnz_matrix, nnz_factor) result(mb)
+    type(body_cfg_t), intent(in) :: b        !< the body
+    type(factor_cfg_t), intent(in) :: fc     !< its factorization
+    real(wp), intent(out) :: nnz_matrix      !< stored matrix entries
+    real(wp), intent(out) :: nnz_factor      !< factor entries
+    real(wp) :: nodes, cells, n, half_band
+    nodes = (real(b%nx, wp) + 1.0_wp)*(real(b%ny, wp) + 1.0_wp)
+    cells = real(b%nx, wp)*real(b%ny, wp)
+    n = 2.0_wp*nodes
+    nnz_matrix = 18.0_wp*n                    ! 9 neighbour nodes x 2 components per row
+    if (fc%factorization == FACTOR_BANDED .or. fc%ordering == ORDER_NATURAL) then
+      half_band = 2.0_wp*(real(min(b%nx, b%ny), wp) + 2.0_wp)
+      nnz_factor = n*half_band
+    else
+      nnz_factor = 8.0_wp*n*log(max(n, 2.0_wp))/log(2.0_wp)
+    end if
+    mb = (16.0_wp*nodes + merge(16.0_wp, 24.0_wp, b%element == ELEM_Q1)*cells &   ! mesh
+          + 12.0_wp*nnz_matrix + 64.0_wp*n &                                      ! matrix, vectors
+          + 8.0_wp*nnz_factor + 4.0_wp*nnz_factor/16.0_wp)/MIB                    ! factor values, indices
+  end function body_memory_mb
+
+  !> Memory of the whole run [MiB] (both bodies, interface matrices, a base).
+  real(wp) function run_memory_mb(d) result(mb)
+    type(deck_t), intent(in) :: d   !< the deck
+    real(wp) :: nm, nf, m
+    integer :: a
+    mb = BASE_MB
+    m = 0.0_wp
+    do a = 1, 2
+      mb = mb + body_memory_mb(d%body(a), d%solver%factor, nm, nf)
+      m = max(m, real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp)
+    end do
+    mb = mb + 10.0_wp*8.0_wp*m*m/MIB          ! F_1, F_2, their operators, S, the bound's copies
+  end function run_memory_mb
+
+  !> Refuse a deck that cannot run here: a body whose matrix or factor overflows 32-bit
+  !! indices, or a run whose estimate exceeds `limit_mb` (0: no limit known). ok = .false.
+  !! with msg naming the deck, the estimate and the limit.
+  subroutine check_budget(d, limit_mb, ok, msg)
+    type(deck_t), intent(in) :: d                       !< the deck
+    real(wp), intent(in) :: limit_mb                    !< memory this process may use [MiB]
+    logical, intent(out) :: ok                          !< the run fits
+    character(len=:), allocatable, intent(out) :: msg   !< why not
+    real(wp) :: nm, nf, mb, est
+    integer :: a
+    ok = .true.
+    msg = ''
+    do a = 1, 2
+      mb = body_memory_mb(d%body(a), d%solver%factor, nm, nf)
+      if (nm > INDEX_MAX .or. nf > INDEX_MAX) then
+        ok = .false.
+        msg = 'deck '//trim(d%source)//': body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
+              i2s(d%body(a)%ny)//') needs about '//two(nm/1.0e9_wp)//'e9 matrix and '//two(nf/1.0e9_wp)// &
+              'e9 factor entries, beyond the 2^31 (2.1e9) that the 32-bit indices of this build hold; '// &
+              'use fewer cells'
+        return
+      end if
+    end do
+    est = run_memory_mb(d)
+    if (limit_mb > 0.0_wp .and. est > limit_mb) then
+      ok = .false.
+      msg = 'deck '//trim(d%source)//': the run needs about '//two(est/1024.0_wp)// &
+            ' GiB (body 1: '//two(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp)// &
+            ' GiB, body 2: '//two(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp)// &
+            ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
+            two(limit_mb/1024.0_wp)//' GiB (available memory, cgroup or ulimit -v); '// &
+            'use fewer cells or a machine with more memory'
+    end if
+  end subroutine check_budget
+
+  !> x with two decimals ('12.34', '0.50').
+  function two(x) result(s)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: s
+    character(len=32) :: buf
+    write (buf, '(f0.2)') x
+    s = trim(adjustl(buf))
+    if (s(1:1) == '.') s = '0'//s
+  end function two
+
+end module budget
