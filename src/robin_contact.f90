@@ -23,7 +23,7 @@ program robin_contact
   use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb, memory_limit_mb
-  use budget, only: check_budget
+  use budget, only: check_budget, check_load_range
   use strings, only: sci, fmt_real, i2s
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
@@ -55,6 +55,8 @@ program robin_contact
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
   ! a deck that cannot fit this machine is refused before anything is allocated
   call check_budget(d, memory_limit_mb(), ok, budget_msg)
+  if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+  call check_load_range(d, ok, budget_msg)
   if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
   key = physics_key(d)
   write (output_unit, '(a)') 'robin_contact '//program_version//': effective input'
@@ -151,6 +153,11 @@ program robin_contact
       deallocate (ufree)
     end do
     !$omp end parallel do
+  end if
+  if (res%status /= 'failed' .and. .not. all(ieee_is_finite(u))) then
+    ! a derived field that is not finite is a failure, never a result
+    res%status = 'failed'
+    res%message = 'the displacements are not finite: the problem is beyond double precision; rescale the units'
   end if
   tm%iterate = wtime() - t0
 

@@ -1,6 +1,7 @@
 !> What a deck costs before anything is allocated: the memory estimate of a run (meshes,
 !! assembled matrices, Cholesky factors, interface matrices) and the checks that it fits
-!! the machine and the 32-bit indices of the sparse matrices. A deck that cannot fit is
+!! the machine and the 32-bit indices of the sparse matrices; and loads whose stresses stay
+!! within double precision. A deck that cannot fit is
 !! bad input (exit 1) with the estimate and the limit in the message: a run must not
 !! allocate until the kernel's OOM killer ends it.
 !!
@@ -11,7 +12,7 @@
 module budget
   use kinds, only: wp
   use config, only: deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
-  use strings, only: i2s
+  use strings, only: i2s, sci
   implicit none (type, external)
   private
 
@@ -19,7 +20,7 @@ module budget
   real(wp), parameter :: INDEX_MAX = 2147483647.0_wp   ! largest 32-bit index
   real(wp), parameter :: BASE_MB = 64.0_wp             ! the program, libraries and small arrays
 
-  public :: body_memory_mb, run_memory_mb, check_budget
+  public :: body_memory_mb, run_memory_mb, check_budget, check_load_range
 
 contains
 
@@ -94,6 +95,47 @@ contains
             'use fewer cells or a machine with more memory'
     end if
   end subroutine check_budget
+
+  !> Loads within double precision: a traction or prescribed displacement whose stresses
+  !! would overflow (1e308 Pa) is refused, with a margin of 1e6 for the products of
+  !! assembly and stress recovery. ok = .false. with msg naming the group and the value.
+  subroutine check_load_range(d, ok, msg)
+    type(deck_t), intent(in) :: d                       !< the deck
+    logical, intent(out) :: ok                          !< the loads are representable
+    character(len=:), allocatable, intent(out) :: msg   !< why not
+    real(wp), parameter :: MARGIN = 1.0e6_wp
+    real(wp) :: ext, t, h, u
+    integer :: i, a, s
+    ok = .true.
+    msg = ''
+    ext = 1.0_wp
+    do a = 1, 2
+      ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
+    end do
+    do i = 1, d%ntraction
+      t = maxval(abs(d%traction(i)%t0)) + maxval(abs(d%traction(i)%t1))*ext
+      if (.not. t*ext*MARGIN < huge(1.0_wp)) then
+        ok = .false.
+        msg = 'deck '//trim(d%source)//': &traction '//i2s(i)//' (body '//i2s(d%traction(i)%body)// &
+              ') reaches '//sci(t)//' [stress]: its stresses would overflow double precision; '// &
+              'rescale the units (e.g. &scene units=''mm-N-MPa'')'
+        return
+      end if
+    end do
+    do a = 1, 2
+      h = min(d%body(a)%width/real(d%body(a)%nx, wp), d%body(a)%height/real(d%body(a)%ny, wp))
+      do s = 1, 4
+        u = maxval(abs(d%body(a)%u_side(:, s)))
+        if (.not. u*d%body(a)%young/h*MARGIN < huge(1.0_wp)) then
+          ok = .false.
+          msg = 'deck '//trim(d%source)//': the &displacement of body '//i2s(a)//' ('//sci(u)// &
+                ' [length]) with young = '//sci(d%body(a)%young)//' gives stresses beyond double '// &
+                'precision; rescale the units'
+          return
+        end if
+      end do
+    end do
+  end subroutine check_load_range
 
   !> x with two decimals ('12.34', '0.50').
   function two(x) result(s)
