@@ -75,6 +75,9 @@ contains
     call dset_r2(gid, 'dR', st%dR)
     call attr_int(gid, 'reuse', st%reuse)
     call dset_r2(gid, 'flam_v', st%flam_v)
+    call attr_int(gid, 'nsrch', st%nsrch)
+    call dset_r2(gid, 'srch', st%srch)
+    call dset_r2(gid, 'fsrch', st%fsrch)
     call h5gclose_f(gid, err)
     call write_history(fid, res)
     call h5fclose_f(fid, err)
@@ -94,7 +97,7 @@ contains
     logical, intent(out) :: ok                    !< success
     character(len=*), intent(out) :: msg          !< why not
     integer(hid_t) :: fid, gid
-    integer :: err, e(20), ere(2), n, i
+    integer :: err, e(20), ere(2), ers(3), n, i
     character(len=:), allocatable :: k
     real(wp), allocatable :: r(:)
     integer, allocatable :: iv(:)
@@ -151,6 +154,11 @@ contains
     call read_attr_int(gid, 'reuse', st%reuse, ere(1))
     call read_r2(gid, 'flam_v', st%flam_v, ere(2))
     if (any(ere /= 0)) st%reuse = 0
+    ! the last change of lam_a (absent from older checkpoints: no line search at first)
+    call read_attr_int(gid, 'nsrch', st%nsrch, ers(1))
+    call read_r2(gid, 'srch', st%srch, ers(2))
+    call read_r2(gid, 'fsrch', st%fsrch, ers(3))
+    if (any(ers /= 0)) st%nsrch = 0
     call h5gclose_f(gid, err)
     if (any(e /= 0)) then
       msg = 'restart file '//trim(file)//' is incomplete'
@@ -166,6 +174,21 @@ contains
       if (allocated(st%flam_v)) deallocate (st%flam_v)
       allocate (st%flam_v(m, 2))
       st%flam_v = 0.0_wp
+    end if
+    if (st%nsrch /= 0) then
+      if (.not. (allocated(st%srch) .and. allocated(st%fsrch))) then
+        st%nsrch = 0
+      else if (size(st%srch, 1) /= m .or. size(st%fsrch, 1) /= m .or. size(st%srch, 2) /= 2 .or. &
+               size(st%fsrch, 2) /= 2) then
+        st%nsrch = 0
+      end if
+    end if
+    if (st%nsrch == 0) then
+      if (allocated(st%srch)) deallocate (st%srch)
+      if (allocated(st%fsrch)) deallocate (st%fsrch)
+      allocate (st%srch(m, 2), st%fsrch(m, 2))
+      st%srch = 0.0_wp
+      st%fsrch = 0.0_wp
     end if
     n = st%it
     if (n > maxout) then
