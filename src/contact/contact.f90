@@ -20,6 +20,7 @@ module contact
   private
 
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
+  real(wp), parameter :: SMOOTH_RATE_TOL = 0.1_wp   !< rate change below which the outer iteration counts as smooth
   integer, parameter :: POWER_ITS = 10               !< power iterations for each body's lambda_max (MPRGP guards an underestimate)
   integer, parameter :: HISTORY_CHUNK = 256          !< initial history entries (grown by doubling)
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
@@ -390,11 +391,19 @@ contains
     type(contact_result_t), intent(inout) :: res
     type(mprgp_opts_t) :: opts(2)
     type(mprgp_stats_t) :: ms(2)
-    real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:)
+    real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:), lam0(:, :), flam0(:, :)
     integer :: a, m
+    logical :: search
     m = size(w, 1)
-    allocate (rhs(m, 2), grad(m, 2), lb(m))
+    allocate (rhs(m, 2), grad(m, 2), lb(m), lam0(m, 2), flam0(m, 2))
     lb = 0.0_wp
+    ! A first line search along the last change of lam_a (its image under F_a is a
+    ! difference of known products: no product) only while the outer iteration contracts
+    ! at a steady rate: then the changes of lam_a are nearly parallel from one iteration to
+    ! the next (linearised outer map), and the search puts the warm start close to the
+    ! solution. In the transient (active set settling, delta = 1 oscillating) it is not
+    ! used: there the outcome of the outer iteration depends on the inner iterates.
+    search = st%nsrch == 1 .and. smooth_outer(res, it)
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
       rhs(:, a) = bc(a)%b - st%G(:, a)
@@ -415,7 +424,16 @@ contains
       ! F_a is the same in every iteration and the warm start is the last solution:
       ! its gradient comes from F_a lam_a of the last solve (no initial product)
       opts(a)%use_ax = st%reuse == 1
-      if (m > 0) call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a))
+      lam0(:, a) = st%lam(:, a)
+      flam0(:, a) = st%flam_v(:, a)
+      if (m > 0 .and. search) then
+        call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a), &
+                         st%srch(:, a), st%fsrch(:, a))
+      else if (m > 0) then
+        call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a))
+      end if
+      st%srch(:, a) = st%lam(:, a) - lam0(:, a)
+      st%fsrch(:, a) = st%flam_v(:, a) - flam0(:, a)
     end do
     !$omp end parallel do
     if (m == 0) return
@@ -433,8 +451,24 @@ contains
       w(:, a) = st%G(:, a) - grad(:, a)
       st%flam(a) = norm2(grad(:, a) + rhs(:, a))
     end do
+    st%nsrch = st%reuse
     st%reuse = 1
   end subroutine solve_subproblems
+
+  !> True when the outer criterion decreased over the last three iterations at a steady
+  !! rate (the two last ratios differ by at most SMOOTH_RATE_TOL).
+  logical function smooth_outer(res, it) result(ok)
+    type(contact_result_t), intent(in) :: res
+    integer, intent(in) :: it
+    real(wp) :: c1, c2, c3
+    ok = .false.
+    if (it <= 3 .or. res%nhist < it - 1) return
+    c1 = res%h_criterion(it - 1)
+    c2 = res%h_criterion(it - 2)
+    c3 = res%h_criterion(it - 3)
+    if (.not. (c1 < c2 .and. c2 < c3)) return
+    ok = abs(c1/c2 - c2/c3) <= SMOOTH_RATE_TOL
+  end function smooth_outer
 
   !> The true residual of the iterate, the increment of the obstacles (the paper's
   !! criterion), the stopping criterion, the new state and one history entry.

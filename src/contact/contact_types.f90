@@ -58,6 +58,9 @@ module contact_types
     real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
     integer :: reuse = 0                       !< 1: flam_v holds F_a lam_a (0: not known, e.g. an older checkpoint)
     real(wp), allocatable :: flam_v(:, :)      !< (m,2) F_a lam_a, the last product of the body's solve [length]
+    integer :: nsrch = 0                       !< 1: srch, fsrch hold the last change of lam_a and F_a times it
+    real(wp), allocatable :: srch(:, :)        !< (m,2) lam_a after its last solve minus before it [force]
+    real(wp), allocatable :: fsrch(:, :)       !< (m,2) F_a srch (difference of the two products F_a lam_a) [length]
     real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
     real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
     real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
@@ -99,7 +102,9 @@ contains
     real(wp), intent(in) :: g0(:)            !< initial gap
     allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
     allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
-    allocate (st%flam_v(m, 2))
+    allocate (st%flam_v(m, 2), st%srch(m, 2), st%fsrch(m, 2))
+    st%srch = 0.0_wp
+    st%fsrch = 0.0_wp
     st%flam_v = 0.0_wp   ! F_a 0 with lam = 0: exact
     st%reuse = 1
     st%G(:, 1) = g0

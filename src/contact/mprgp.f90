@@ -74,6 +74,7 @@ module mprgp
     integer :: n_exp = 0               !< expansion steps
     integer :: n_prop = 0              !< proportioning steps
     integer :: n_matvec = 0            !< products with A, power iterations included
+    integer :: n_recycled = 0          !< line searches along the given direction s (no product)
     real(wp) :: gp_norm = 0.0_wp       !< |gP| at the returned x (units of b)
     real(wp) :: b_norm = 0.0_wp        !< |b|
     real(wp) :: lambda_max = 0.0_wp    !< lambda_max used (largest of estimate and observed Rayleigh quotients); 0: not needed
@@ -185,8 +186,10 @@ contains
   !! Reuse across a sequence of solves with the same A (the outer contact iteration):
   !! with opts%use_ax, `ax` holds A x at the warm start and the initial product is
   !! skipped; on exit `ax` holds A x at the returned x (the confirming product, so the
-  !! next solve, warm-started from x, starts from it).
-  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax)
+  !! next solve, warm-started from x, starts from it). With a direction s and as = A s
+  !! (e.g. the change of x in the previous solve and of A x), the iteration starts with
+  !! an exact line search along s, cut at the bounds, which costs no product.
+  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax, s, as)
     class(linop_t), intent(inout) :: A          !< SPD operator (size A%n)
     real(wp), intent(in) :: b(:)                !< linear term (size n)
     real(wp), intent(in) :: lb(:)               !< lower bounds (size n); -huge(1.0_wp): none
@@ -195,6 +198,8 @@ contains
     type(mprgp_stats_t), intent(out) :: stats   !< status, counts, message
     real(wp), intent(out), optional :: g(:)     !< Ax - b at the returned x (size n; unset if bad input)
     real(wp), intent(inout), optional :: ax(:)  !< in (opts%use_ax): A x at the warm start; out: A x at the returned x
+    real(wp), intent(in), optional :: s(:)      !< direction of a first line search (size n; needs as)
+    real(wp), intent(in), optional :: as(:)     !< A s (size n)
 
     real(wp), allocatable :: gr(:), p(:), ap(:), w(:)
     real(wp), parameter :: big = huge(1.0_wp)
@@ -227,6 +232,16 @@ contains
     else if (opts%use_ax) then
       call fail(MPRGP_BAD_ARG, 'opts%use_ax without ax')
       return
+    end if
+    if (present(s) .neqv. present(as)) then
+      call fail(MPRGP_BAD_ARG, 's and as must be given together')
+      return
+    end if
+    if (present(s)) then
+      if (size(s) /= n .or. size(as) /= n) then
+        call fail(MPRGP_BAD_ARG, 'size mismatch: size(s) or size(as) /= A%n')
+        return
+      end if
     end if
     if (present(g)) then
       if (size(g) /= n) then
@@ -310,6 +325,7 @@ contains
       gr = gr - b
     end if
     fresh = .true.
+    if (present(s)) call recycled_search()
     call set_p_to_phi()
     it = 0
 
@@ -530,6 +546,29 @@ contains
 
   contains
 
+
+    !> Exact line search along s (A s is given: no product), cut at the bounds.
+    subroutine recycled_search()
+      integer :: j
+      real(wp) :: sas, t, v
+      sas = dot_product(s, as)
+      if (.not. (sas > 0.0_wp .and. ieee_is_finite(sas))) return
+      t = -dot_product(gr, s) / sas
+      if (.not. ieee_is_finite(t)) return
+      do j = 1, n
+        v = t * s(j)
+        if (v < 0.0_wp .and. lb(j) > -big) then
+          if (x(j) + v < lb(j)) t = t * max(0.0_wp, (x(j) - lb(j)) / (-v))
+        end if
+      end do
+      if (t == 0.0_wp) return
+      do j = 1, n
+        x(j) = max(x(j) + t * s(j), lb(j))
+        gr(j) = gr(j) + t * as(j)
+      end do
+      stats%n_recycled = 1
+      fresh = .false.
+    end subroutine recycled_search
 
     !> Record a failure.
     subroutine fail(code, msg)

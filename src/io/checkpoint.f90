@@ -73,6 +73,9 @@ contains
     call write_dset(gid, 'dR', st%dR, hs)
     call write_attr(gid, 'reuse', st%reuse, hs)
     call write_dset(gid, 'flam_v', st%flam_v, hs)
+    call write_attr(gid, 'nsrch', st%nsrch, hs)
+    call write_dset(gid, 'srch', st%srch, hs)
+    call write_dset(gid, 'fsrch', st%fsrch, hs)
     call group_close(gid, hs)
     call write_history(fid, res, hs)
     call file_close(fid, hs)
@@ -203,6 +206,23 @@ contains
         if (allocated(st%flam_v)) deallocate (st%flam_v)
         allocate (st%flam_v(m, 2))
         st%flam_v = 0.0_wp
+      end if
+      ! the last change of lam_a and F_a times it (absent from older checkpoints: no line
+      ! search in the first iteration after the restart)
+      ho%failed = .false.
+      call read_attr(gid, 'nsrch', st%nsrch, ho)
+      call read_dset(gid, 'srch', st%srch, ho)
+      call read_dset(gid, 'fsrch', st%fsrch, ho)
+      if (.not. ho%failed) then
+        if (any(shape(st%srch) /= [m, 2]) .or. any(shape(st%fsrch) /= [m, 2])) ho%failed = .true.
+      end if
+      if (ho%failed) then
+        st%nsrch = 0
+        if (allocated(st%srch)) deallocate (st%srch)
+        if (allocated(st%fsrch)) deallocate (st%fsrch)
+        allocate (st%srch(m, 2), st%fsrch(m, 2))
+        st%srch = 0.0_wp
+        st%fsrch = 0.0_wp
       end if
     end subroutine read_optional_products
 
