@@ -5,4 +5,6 @@
 double rc_peak_rss_mb(void);
 /* Memory this process may use [MiB] (MemAvailable, cgroup memory.max, ulimit -v); 0 if unknown. */
 double rc_memory_limit_mb(void);
+/* Write n bytes to standard output (write(2)); 0 on success, else errno. */
+int rc_stdout_write(const char *buf, int n);
 #endif

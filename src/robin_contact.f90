@@ -22,7 +22,7 @@ program robin_contact
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
   use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
-  use sysinfo, only: peak_rss_mb, memory_limit_mb
+  use sysinfo, only: peak_rss_mb, memory_limit_mb, write_stdout_checked
   use budget, only: check_budget, check_load_range
   use strings, only: sci, fmt_real, i2s
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
@@ -213,25 +213,31 @@ contains
   !! a closed pipe) is a failure: scripts read the result: line.
   subroutine summary()
     real(wp) :: ftot
-    integer :: ios(6)
-    ios = 0
+    character(len=1024) :: line(5)
+    integer :: err(5), k
+    err = 0
     ftot = 0.0_wp
     if (allocated(res%lam)) ftot = sum(res%lam)
-    write (output_unit, '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)', iostat=ios(1)) 'contact: total normal force=', ftot, &
+    write (line(1), '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
-    write (output_unit, '(a)', iostat=ios(2)) 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
+    line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
       ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
-    if (written) write (output_unit, '(a)', iostat=ios(3)) 'output: '//trim(d%output%file)
-    write (output_unit, '(a,6(a,f0.3),a,f0.1,a,f0.1)', iostat=ios(4)) 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
+    write (line(3), '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
       ' peak_mb=', tm%peak_rss_mb, ' factor_mb=', tm%factor_mb
-    write (output_unit, '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)', iostat=ios(5)) 'result: status=', trim(res%status), &
+    write (line(4), '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', trim(res%status), &
       ' method=', trim(res%method), ' outer=', res%outer, ' inner=', res%inner, ' n1=', sys(1)%n, &
       ' n2=', sys(2)%n, ' m=', itf%m, ' delta=', fmt_real(d%solver%delta, '(f0.6)'), ' residual=', res%residual, &
       ' wall_s=', fmt_real(tm%total, '(f0.3)')
-    flush (output_unit, iostat=ios(6))
-    if (any(ios /= 0)) then
+    ! the output line sits before the time line when a result file was written
+    do k = 1, 4
+      if (k == 3 .and. written) then
+        call write_stdout_checked('output: '//trim(d%output%file), err(5))
+      end if
+      call write_stdout_checked(trim(line(k)), err(k))
+    end do
+    if (any(err /= 0)) then
       write (error_unit, '(a)') 'robin_contact: error: cannot write the summary to standard output '// &
         '(full disk or closed pipe?); the run''s status was '//trim(res%status)
       code = EXIT_NUMERICAL

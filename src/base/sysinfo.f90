@@ -1,7 +1,8 @@
 !> Process information from the C library (src/base/sysinfo_shim.c): peak resident
 !! memory (getrusage) and the memory a run may use.
 module sysinfo
-  use, intrinsic :: iso_c_binding, only: c_double
+  use, intrinsic :: iso_c_binding, only: c_double, c_int, c_char
+  use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
   implicit none (type, external)
   private
@@ -19,9 +20,17 @@ module sysinfo
       implicit none
       real(c_double) :: mb
     end function rc_memory_limit_mb
+    !> write(2) to standard output; 0 or errno.
+    function rc_stdout_write(buf, n) bind(c, name='rc_stdout_write') result(err)
+      import :: c_int, c_char
+      implicit none
+      character(kind=c_char), intent(in) :: buf(*)
+      integer(c_int), value :: n
+      integer(c_int) :: err
+    end function rc_stdout_write
   end interface
 
-  public :: peak_rss_mb, memory_limit_mb
+  public :: peak_rss_mb, memory_limit_mb, write_stdout_checked
 
 contains
 
@@ -35,5 +44,15 @@ contains
   real(wp) function memory_limit_mb()
     memory_limit_mb = real(rc_memory_limit_mb(), wp)
   end function memory_limit_mb
+
+  !> Write one line to standard output and report whether it got there (gfortran's unit 6
+  !! silently drops write errors, e.g. on a full disk or /dev/full). Fortran output written
+  !! before is flushed first, so the order is kept. err = 0 on success, else errno.
+  subroutine write_stdout_checked(line, err)
+    character(len=*), intent(in) :: line   !< the line, without its newline
+    integer, intent(out) :: err            !< 0, or the errno of the failed write
+    flush (output_unit)
+    err = int(rc_stdout_write(line//achar(10), int(len(line) + 1, c_int)))
+  end subroutine write_stdout_checked
 
 end module sysinfo

@@ -1,7 +1,9 @@
 /* Process information for module sysinfo: peak resident memory from getrusage, and the
  * memory limit a run must fit in. */
+#include <errno.h>
 #include <stdio.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include "sysinfo_shim.h"
 
@@ -41,4 +43,20 @@ double rc_memory_limit_mb(void)
         if (lim == 0.0 || v < lim) lim = v;
     }
     return lim;
+}
+
+/* Write n bytes to standard output with write(2), retrying short writes; 0 on success,
+ * else errno. (gfortran's unit 6 does not report write errors, e.g. on /dev/full.) */
+int rc_stdout_write(const char *buf, int n)
+{
+    while (n > 0) {
+        ssize_t k = write(1, buf, (size_t) n);
+        if (k < 0) {
+            if (errno == EINTR) continue;
+            return errno != 0 ? errno : EIO;
+        }
+        buf += k;
+        n -= (int) k;
+    }
+    return 0;
 }
