@@ -48,28 +48,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from rc_common import axis_label, contact_edges, dataset_unit, hertz_pressure, hertz_zone, num_attr, \
-    plain_axis, result_units, run_label, save_figure, si_scale, text_attr, text_dataset, \
-    tool_main  # noqa: E402
+    plain_axis, result_units, run_label, save_figure, si_scale, strip_comments, text_attr, \
+    text_dataset, tool_main  # noqa: E402
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)"
-
-
-def strip_comments(text):
-    """Drop Fortran '!' comments (outside quotes) from namelist text."""
-    out = []
-    for line in text.splitlines():
-        q = None
-        for i, ch in enumerate(line):
-            if q:
-                if ch == q:
-                    q = None
-            elif ch in "'\"":
-                q = ch
-            elif ch == "!":
-                line = line[:i]
-                break
-        out.append(line)
-    return "\n".join(out)
 
 
 def deck_value(text, name):

@@ -199,6 +199,62 @@ def clip_limits(values, percent):
     return lo, hi, bool(vmin < lo or vmax > hi)
 
 
+# ---- decks ----------------------------------------------------------------------------------
+def strip_comments(text):
+    """Drop Fortran '!' comments (outside quotes) from namelist text."""
+    out = []
+    for line in text.splitlines():
+        q = None
+        for i, ch in enumerate(line):
+            if q:
+                if ch == q:
+                    q = None
+            elif ch in "'\"":
+                q = ch
+            elif ch == "!":
+                line = line[:i]
+                break
+        out.append(line)
+    return "\n".join(out)
+
+
+def namelist_groups(text, group):
+    """The bodies of every `&group ... /` in namelist text (comments dropped; a '/' inside a
+    quoted string does not end the group), in order."""
+    text = strip_comments(text)
+    out = []
+    for m in re.finditer(r"&" + re.escape(group) + r"\b", text, flags=re.I):
+        q = None
+        for i in range(m.end(), len(text)):
+            ch = text[i]
+            if q:
+                if ch == q:
+                    q = None
+            elif ch in "'\"":
+                q = ch
+            elif ch == "/":
+                out.append(text[m.end():i])
+                break
+    return out
+
+
+def deck_result_file(deck, overrides=()):
+    """The result file a run of `robin_contact deck overrides...` writes: the last
+    `file = '...'` of the &output groups of the deck, then of the overrides; by default
+    results/<deck name without .nml>.h5 (deck.f90). Relative to the working directory."""
+    with open(deck, encoding="utf-8", errors="replace") as fh:
+        texts = [fh.read(), *overrides]
+    result = None
+    for t in texts:
+        for body in namelist_groups(t, "output"):
+            for m in re.finditer(r"(?<![\w%])file\s*=\s*(?:'([^']*)'|\"([^\"]*)\")", body, flags=re.I):
+                result = (m.group(1) if m.group(1) is not None else m.group(2)).strip()
+    if not result:
+        base = os.path.basename(deck)
+        result = "results/" + (base[:-4] if base.lower().endswith(".nml") else base) + ".h5"
+    return result
+
+
 def rel_err(a, ref):
     """|a - ref| / |ref| (2-norms), or None when either is None, the shapes differ or ref = 0."""
     if a is None or ref is None or np.shape(a) != np.shape(ref):
@@ -331,3 +387,17 @@ class Checks:
         if not ok:
             self.failed.append(what)
         return bool(ok)
+
+
+if __name__ == "__main__":
+    # command-line use by the shell tools: rc_common.py result-file DECK [OVERRIDE ...]
+    import sys
+    if len(sys.argv) >= 3 and sys.argv[1] == "result-file":
+        try:
+            print(deck_result_file(sys.argv[2], sys.argv[3:]))
+        except OSError as e:
+            print(f"rc_common: cannot read deck {sys.argv[2]}: {e}", file=sys.stderr)
+            sys.exit(1)
+        sys.exit(0)
+    print("usage: rc_common.py result-file DECK.nml [OVERRIDE ...]", file=sys.stderr)
+    sys.exit(1)
