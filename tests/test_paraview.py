@@ -48,7 +48,6 @@ def picture(path, what):
     if not check(os.path.isfile(path), f"{what}: {os.path.basename(path)} written"):
         return
     import matplotlib.image as mpimg
-    import numpy as np
     img = mpimg.imread(path)
     grey = img[..., :3].mean(axis=2) if img.ndim == 3 else img
     check(grey.std() > 0.05, f"{what}: picture is not blank (grey-level std {grey.std():.3f} > 0.05)",

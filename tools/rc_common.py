@@ -289,17 +289,16 @@ def hertz_edge(x, p, i, j):
 def contact_edges(x, p, lam):
     """Edges (xl, xr) of the contact zone along a line sorted by x: the zero of p^2
     extrapolated from the two outermost active nodes (lam > 0) on each side, kept between
-    the last active and the first open node. None when no node is active."""
+    the last active and the first open node; an active end node of the line is the edge
+    there (no extrapolation beyond the line). None when no node is active."""
     act = np.nonzero(np.asarray(lam) > 0)[0]
     if not act.size:
         return None
     i0, i1 = act[0], act[-1]
     xl = hertz_edge(x, p, i0, i0 + 1) if i1 > i0 else x[i0]
     xr = hertz_edge(x, p, i1, i1 - 1) if i1 > i0 else x[i1]
-    if i0 > 0:
-        xl = max(xl, x[i0 - 1])
-    if i1 < len(x) - 1:
-        xr = min(xr, x[i1 + 1])
+    xl = max(xl, x[i0 - 1]) if i0 > 0 else x[0]
+    xr = min(xr, x[i1 + 1]) if i1 < len(x) - 1 else x[-1]
     return float(xl), float(xr)
 
 
