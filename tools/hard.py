@@ -37,7 +37,7 @@ import time
 import h5py
 import numpy as np
 
-from rc_common import hertz_pressure, hertz_zone, md_header, md_row, rel_err, run_solver, solver_env
+from rc_common import contact_edges, hertz_pressure, hertz_zone, md_header, md_row, rel_err, run_solver, solver_env
 
 BUG_TOL = 1.0e-5          # largest error against monolithic accepted from a 'converged' run
 
@@ -298,14 +298,6 @@ def deck_value(text, body, key):
     return None
 
 
-def hertz_edge(x, p, i, j):
-    """Zero of p^2, linear through nodes i (active, the edge) and j (its active neighbour inward)."""
-    p2i, p2j = p[i] ** 2, p[j] ** 2
-    if p2j <= p2i:
-        return x[i]
-    return x[i] - p2i * (x[j] - x[i]) / (p2j - p2i)
-
-
 def hertz_analysis(r):
     t = r["deck_text"]
     E1, E2 = deck_value(t, 1, "young"), deck_value(t, 2, "young")
@@ -320,13 +312,8 @@ def hertz_analysis(r):
     i0, i1 = act[0], act[-1]
     h = float(np.median(np.diff(x)))
     # edge of the contact zone: zero of p^2 extrapolated from the two outermost active
-    # nodes, kept between the last active and the first open node
-    xl = hertz_edge(x, p, i0, i0 + 1) if i1 > i0 else x[i0]
-    xr = hertz_edge(x, p, i1, i1 - 1) if i1 > i0 else x[i1]
-    if i0 > 0:
-        xl = max(xl, x[i0 - 1])
-    if i1 < len(x) - 1:
-        xr = min(xr, x[i1 + 1])
+    # nodes, kept between the last active and the first open node (rc_common.contact_edges)
+    xl, xr = contact_edges(x, p, lam)
     a_num = 0.5 * (xr - xl)
     ph = hertz_pressure(x, xc, a_h, p0)
     zone = (ph > 0) | (lam > 0)

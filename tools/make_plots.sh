@@ -1,9 +1,10 @@
 #!/bin/bash
 # make_plots.sh: what `make plots` does: solve the default deck, then draw
 #   results/history.png   (tools/plot_history.py: criterion and residual per outer iteration)
-#   results/contact.png   (tools/plot_contact.py --hertz: contact pressure; the Hertz curve
-#                          is added only when the deck has a parabolic gap)
-#   results/solution.png  (tools/plot_solution.py: deformed bodies coloured by von Mises)
+#   results/contact.png   (tools/plot_contact.py --hertz: contact pressure and gap; the Hertz
+#                          curve and p/p0 panel are added only when the deck has a parabolic gap)
+#   results/solution.png  (tools/plot_solution.py: deformed bodies coloured by von Mises,
+#                          rasterised, colour scale clipped at the 99.5th percentile)
 #
 # Usage: tools/make_plots.sh            (from the repository root; make plots calls it as
 #                                        BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh)
@@ -33,7 +34,17 @@ case $rc in
   *) echo "make_plots: $BIN $DECK failed (exit $rc)" >&2; exit 1 ;;
 esac
 [ -f "$RESULT" ] || { echo "make_plots: no result file $RESULT" >&2; exit 1; }
-"$PYTHON" tools/plot_history.py "$RESULT" -o results/history.png || exit 1
-"$PYTHON" tools/plot_contact.py "$RESULT" --hertz -o results/contact.png || exit 1
-"$PYTHON" tools/plot_solution.py "$RESULT" -o results/solution.png || exit 1
+plot() {   # tool args...: run a plot tool; a failure is said, also a death by a signal
+  "$PYTHON" "tools/$1" "${@:2}"
+  local rc=$?
+  if [ $rc -gt 128 ]; then
+    echo "make_plots: tools/$1 killed by signal $((rc - 128)) (out of memory? see dmesg)" >&2
+  elif [ $rc -ne 0 ]; then
+    echo "make_plots: tools/$1 failed (exit $rc)" >&2
+  fi
+  return $rc
+}
+plot plot_history.py "$RESULT" -o results/history.png || exit 1
+plot plot_contact.py "$RESULT" --hertz -o results/contact.png || exit 1
+plot plot_solution.py "$RESULT" -o results/solution.png || exit 1
 echo "make_plots: results/history.png results/contact.png results/solution.png"

@@ -1,10 +1,17 @@
 #!/usr/bin/python3
-"""Normal contact pressure along the contact line of robin_contact runs, several runs
-overlaid, optionally with the Hertz line-contact pressure of a parabolic-gap scene.
+"""Normal contact pressure and gap along the contact line of robin_contact runs, several
+runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-gap scene.
 
 Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [-o contact.png] [--title TEXT]
 
-Plots /contact/pressure (nodal force / tributary length [stress]) against /contact/x.
+Top panel: /contact/pressure (nodal force / tributary length) against /contact/x; the
+legend gives each run's total normal force P = sum of /contact/normal_force (force per
+unit thickness); dotted vertical lines mark the edges of each run's contact zone (the zero
+of p^2 extrapolated from the two outermost active nodes, rc_common.contact_edges).
+Middle panel: the gap /contact/gap = B1u1 + B2u2 - g0 (<= 0; < 0 where the bodies are apart).
+Units from the result file (root attributes unit_length/unit_force/unit_stress and the
+datasets' `units` attributes; SI m, N, Pa when absent), values scaled to an SI prefix
+(MPa, µm, MN/m) written in the axis labels: no matplotlib offset text.
 With --hertz, for each run with a parabolic initial gap g0 = (x - xc)^2 / (2 R):
   P  = sum of /contact/normal_force             (total force per unit thickness)
   R, xc from the root attributes gap_radius/gap_center if present, else from the
@@ -13,11 +20,19 @@ With --hertz, for each run with a parabolic initial gap g0 = (x - xc)^2 / (2 R):
   1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2  (plane strain; 1/E1 + 1/E2 in plane stress),
         E, nu from the young/poisson attributes of /body1 and /body2
   a  = sqrt(4 P R / (pi E*)),  p0 = 2 P / (pi a),  p(x) = p0 sqrt(1 - (x - xc)^2 / a^2)
+the Hertz curve is added to the top panel and a bottom panel shows p/p0 against (x - xc)/a
+(zoomed on the contact zone, |x - xc| <= 1.6 a) with sqrt(1 - s^2); the errors against
+Hertz are printed (stdout line 'plot_contact: Hertz for NAME: ... err_a=... err_p0=...
+err_L2=...') and written in that panel's legend:
+  err_a   |a_num - a| / a, a_num half the distance between the contact-zone edges
+  err_p0  |max p - p0| / p0
+  err_L2  sqrt(sum w (p - p_H)^2 / sum w p_H^2) over the nodes where p_H > 0 or lam > 0,
+          w the tributary lengths (/contact/tributary_length)
 Hertz assumes two half-spaces: with finite bodies and a coarse mesh expect agreement
 only when the contact width 2a is small against the bodies and spans several elements.
 A run without a parabolic gap (gap_radius = 0) gets no Hertz curve (a note on stderr).
 Runs that are identical for Hertz (same P, R, xc, E*) share one curve.
-Exit 0 on success, 1 on a missing or unreadable file.
+Exit 0 on success, 1 (with a message) on a missing or unreadable file or any other failure.
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
 """
 import argparse
@@ -32,28 +47,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from rc_common import finish_plot, hertz_pressure, hertz_zone, num_attr, run_label, \
-    text_attr, text_dataset  # noqa: E402
+from rc_common import axis_label, contact_edges, dataset_unit, hertz_pressure, hertz_zone, num_attr, \
+    plain_axis, result_units, run_label, save_figure, si_scale, strip_comments, text_attr, \
+    text_dataset, tool_main  # noqa: E402
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)"
-
-
-def strip_comments(text):
-    """Drop Fortran '!' comments (outside quotes) from namelist text."""
-    out = []
-    for line in text.splitlines():
-        q = None
-        for i, ch in enumerate(line):
-            if q:
-                if ch == q:
-                    q = None
-            elif ch in "'\"":
-                q = ch
-            elif ch == "!":
-                line = line[:i]
-                break
-        out.append(line)
-    return "\n".join(out)
 
 
 def deck_value(text, name):
@@ -125,62 +123,170 @@ def hertz_curve(h, xmin, xmax, n=401):
     return x, hertz_pressure(x, h["xc"], h["a"], h["p0"])
 
 
+def hertz_errors(r, h):
+    """err_a, err_p0, err_L2 of one run against its Hertz solution h (see the docstring)."""
+    x, p, lam, w = r["x"], r["p"], r["lam"], r["trib"]
+    ph = hertz_pressure(x, h["xc"], h["a"], h["p0"])
+    e = {"err_a": float("nan"), "err_p0": abs(float(p.max(initial=0.0)) - h["p0"]) / h["p0"],
+         "err_L2": float("nan"), "a_num": float("nan")}
+    if r["edges"] is not None:
+        e["a_num"] = 0.5 * (r["edges"][1] - r["edges"][0])
+        e["err_a"] = abs(e["a_num"] - h["a"]) / h["a"]
+    zone = (ph > 0.0) | (lam > 0.0)
+    if w.shape != x.shape:
+        w = np.gradient(x) if x.size > 1 else np.ones_like(x)
+    den = float(np.sum(w[zone] * ph[zone] ** 2))
+    if den > 0.0:
+        e["err_L2"] = float(np.sqrt(np.sum(w[zone] * (p[zone] - ph[zone]) ** 2) / den))
+    return e
+
+
+def read_run(path, want_hertz):
+    with h5py.File(path, "r") as f:
+        u = result_units(f)
+        x = np.array(f["/contact/x"], dtype=float)
+        order = np.argsort(x, kind="stable")
+        lam = np.array(f["/contact/normal_force"], dtype=float)
+        r = dict(x=x[order], p=np.array(f["/contact/pressure"], dtype=float)[order], lam=lam[order],
+                 gap=np.array(f["/contact/gap"], dtype=float)[order] if "/contact/gap" in f else None,
+                 trib=np.array(f["/contact/tributary_length"], dtype=float)[order]
+                 if "/contact/tributary_length" in f else np.zeros(0),
+                 method=text_attr(f, "method", "?"), status=text_attr(f, "status", "?"),
+                 delta=num_attr(f, "delta", float("nan")),
+                 ux=dataset_unit(f["/contact/x"], u["length"]),
+                 up=dataset_unit(f["/contact/pressure"], u["stress"]),
+                 uf=dataset_unit(f["/contact/normal_force"], u["line_force"]),
+                 ug=dataset_unit(f["/contact/gap"], u["length"]) if "/contact/gap" in f else u["length"])
+        r["h"], r["why"] = hertz(f, path) if want_hertz else (None, None)
+    r["P"] = float(np.sum(lam))
+    r["edges"] = contact_edges(r["x"], r["p"], r["lam"])
+    return r
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("files", nargs="+", metavar="FILE.h5", help="robin_contact result files")
-    ap.add_argument("--hertz", action="store_true", help="add the Hertz line-contact pressure")
+    ap.add_argument("--hertz", action="store_true", help="add the Hertz line-contact pressure and p/p0 panel")
     ap.add_argument("-o", "--output", default="contact.png", help="output image (default contact.png)")
     ap.add_argument("--title", default=None, help="figure title")
     a = ap.parse_args(argv)
 
-    fig, ax = plt.subplots(figsize=(8.0, 5.0), dpi=120)
-    colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
-    seen = []
-    xmin, xmax = np.inf, -np.inf
     runs = []
-    for k, path in enumerate(a.files):
+    for path in a.files:
         try:
-            with h5py.File(path, "r") as f:
-                x = np.array(f["/contact/x"], dtype=float)
-                p = np.array(f["/contact/pressure"], dtype=float)
-                method = text_attr(f, "method", "?")
-                status = text_attr(f, "status", "?")
-                delta = num_attr(f, "delta", float("nan"))
-                h, why = hertz(f, path) if a.hertz else (None, None)
+            r = read_run(path, a.hertz)
         except (OSError, KeyError) as e:
             print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
             return 1
-        name, label = run_label(path, method, status, delta)
-        order = np.argsort(x, kind="stable")
-        c = colours[k % len(colours)]
-        ax.plot(x[order], p[order], "o-", color=c, ms=3.5, lw=1.3, label=label)
-        if x.size:
-            xmin, xmax = min(xmin, x.min()), max(xmax, x.max())
-        runs.append((name, c, h, why))
+        r["name"], r["label"] = run_label(path, r["method"], r["status"], r["delta"])
+        runs.append(r)
+    ux, up, uf, ug = (runs[0][k] for k in ("ux", "up", "uf", "ug"))
+    for r in runs[1:]:
+        if (r["ux"], r["up"], r["uf"], r["ug"]) != (ux, up, uf, ug):
+            print(f"plot_contact: warning: {r['name']} has other units ({r['ux']}, {r['up']}, {r['uf']}, "
+                  f"{r['ug']}) than {runs[0]['name']}; drawn in {ux}, {up}", file=sys.stderr)
 
+    # Hertz solutions (one curve per distinct P, R, xc, E*)
+    seen = []
     if a.hertz:
-        for name, c, h, why in runs:
+        for r in runs:
+            h = r["h"]
             if h is None:
-                print(f"plot_contact: {name}: no Hertz curve: {why}", file=sys.stderr)
+                print(f"plot_contact: {r['name']}: no Hertz curve: {r['why']}", file=sys.stderr)
                 continue
+            r["err"] = hertz_errors(r, h)
             key = tuple(float(f"{h[q]:.6g}") for q in ("P", "R", "xc", "Es"))
-            if key in seen:
-                continue
-            seen.append(key)
-            hx, hp = hertz_curve(h, xmin if np.isfinite(xmin) else h["xc"] - h["a"],
-                                 xmax if np.isfinite(xmax) else h["xc"] + h["a"])
-            ax.plot(hx, hp, "--", color=c if len(runs) > 1 else "k", lw=1.4,
-                    label=f"Hertz for {name}: P={h['P']:.4g}, R={h['R']:.4g}, "
-                          f"a={h['a']:.4g}, p0={h['p0']:.4g}")
-            print(f"plot_contact: Hertz for {name}: P={h['P']:.6g} R={h['R']:.6g} xc={h['xc']:.6g} "
+            r["new_curve"] = key not in seen
+            if r["new_curve"]:
+                seen.append(key)
+            e = r["err"]
+            print(f"plot_contact: Hertz for {r['name']}: P={h['P']:.6g} R={h['R']:.6g} xc={h['xc']:.6g} "
                   f"E*={h['Es']:.6g}{' (plane stress)' if h['pstress'] else ''} a={h['a']:.6g} "
-                  f"p0={h['p0']:.6g} (R, xc from {h['src']})")
+                  f"p0={h['p0']:.6g} (R, xc from {h['src']}) a_num={e['a_num']:.6g} err_a={e['err_a']:.3g} "
+                  f"err_p0={e['err_p0']:.3g} err_L2={e['err_L2']:.3g}")
+    with_hertz = bool(seen)
+
+    nrow = 3 if with_hertz else 2
+    fig = plt.figure(figsize=(8.0, 9.5 if with_hertz else 7.0), dpi=120)
+    gs = fig.add_gridspec(nrow, 1, height_ratios=[2.2, 1.0, 2.0][:nrow])
+    ax = fig.add_subplot(gs[0])
+    axg = fig.add_subplot(gs[1], sharex=ax)
+    colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
+    fx, lx = si_scale(np.concatenate([r["x"] for r in runs]), ux)
+    fp, lp = si_scale(np.concatenate([r["p"] for r in runs] + [[r["h"]["p0"]] for r in runs if r.get("h")]), up)
+    gaps = [r["gap"] for r in runs if r["gap"] is not None]
+    fg, lg = si_scale(np.concatenate(gaps) if gaps else np.zeros(0), ug)
+    xmin = min((r["x"].min() for r in runs if r["x"].size), default=0.0)
+    xmax = max((r["x"].max() for r in runs if r["x"].size), default=1.0)
+    for k, r in enumerate(runs):
+        c = r["colour"] = colours[k % len(colours)]
+        fP, lP = si_scale([r["P"]], uf)
+        mk = "o-" if r["x"].size <= 150 else "-"
+        ax.plot(r["x"] / fx, r["p"] / fp, mk, color=c, ms=3.0, lw=1.3,
+                label=f"{r['label']}: P = Σλ = {r['P'] / fP:.4g} {lP}")
+        if r["gap"] is not None:
+            axg.plot(r["x"] / fx, r["gap"] / fg, mk, color=c, ms=2.5, lw=1.1)
+        if r["edges"] is not None:
+            xl, xr = r["edges"]
+            for i, xe in enumerate((xl, xr)):
+                for axx in (ax, axg):
+                    axx.axvline(xe / fx, color=c, ls=":", lw=1.0,
+                                label=(f"contact zone edges x = {xl / fx:.4g}, {xr / fx:.4g} {lx}"
+                                       if i == 0 and axx is ax else None))
+        h = r.get("h")
+        if h is not None and r.get("new_curve"):
+            hx, hp = hertz_curve(h, xmin, xmax, 801)
+            ax.plot(hx / fx, hp / fp, "--",
+                    color=c if len(runs) > 1 else "k", lw=1.3,
+                    label=f"Hertz for {r['name']}: R = {h['R']:.4g} {ux}, a = {h['a'] / fx:.4g} {lx}, "
+                          f"p0 = {h['p0'] / fp:.4g} {lp}")
     ax.axhline(0.0, color="0.5", lw=0.6)
+    axg.axhline(0.0, color="0.5", lw=0.6)
     ax.grid(True, alpha=0.4)
-    return finish_plot(fig, ax, a.output, "plot_contact", f"{len(runs)} runs, {len(seen)} Hertz curves",
-                       "x along the contact line", "normal contact pressure",
-                       a.title or "contact pressure" + (" and Hertz line contact" if seen else ""))
+    axg.grid(True, alpha=0.4)
+    ax.set_ylabel(axis_label("contact pressure p", lp))
+    axg.set_ylabel(axis_label("gap", lg))
+    axg.set_xlabel(axis_label("x along the contact line", lx))
+    ax.tick_params(labelbottom=False)
+    ax.set_title(a.title or "contact pressure (top) and gap (below; < 0: apart)"
+                 + (", Hertz line contact" if with_hertz else ""), fontsize=10)
+    ax.legend(fontsize=7, loc="best")
+    plain_axis(ax)
+    plain_axis(axg)
+
+    if with_hertz:
+        axh = fig.add_subplot(gs[2])
+        s = np.linspace(-1.6, 1.6, 641)
+        axh.plot(s, np.sqrt(np.clip(1.0 - s * s, 0.0, None)), "k--", lw=1.3, label="Hertz sqrt(1 - s²)")
+        for r in runs:
+            h = r.get("h")
+            if h is None:
+                continue
+            sr = (r["x"] - h["xc"]) / h["a"]
+            sel = np.abs(sr) <= 1.6
+            e = r["err"]
+            axh.plot(sr[sel], r["p"][sel] / h["p0"], "o-" if sel.sum() <= 150 else "-", color=r["colour"],
+                     ms=3.0, lw=1.2,
+                     label=f"{r['name']}: err_a = {e['err_a']:.2g}, err_p0 = {e['err_p0']:.2g}, "
+                           f"err_L2 = {e['err_L2']:.2g} ({int(np.sum(r['lam'] > 0))} active nodes)")
+            if r["edges"] is not None:
+                for xe in r["edges"]:
+                    axh.axvline((xe - h["xc"]) / h["a"], color=r["colour"], ls=":", lw=1.0)
+        axh.set_xlim(-1.6, 1.6)
+        axh.set_ylim(-0.05, 1.45)
+        axh.axhline(0.0, color="0.5", lw=0.6)
+        axh.grid(True, alpha=0.4)
+        axh.set_xlabel("s = (x - xc) / a  (a: Hertz half-width)")
+        axh.set_ylabel("p / p0 [-]")
+        axh.set_title("zoom on the contact zone, normalised by Hertz (dotted: contact-zone edges; "
+                      "errors against Hertz in the legend)",
+                      fontsize=9)
+        axh.legend(fontsize=7, loc="upper right")
+        plain_axis(axh)
+    save_figure(fig, a.output)
+    print(f"plot_contact: wrote {a.output} ({len(runs)} runs, {len(seen)} Hertz curves)")
+    return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    tool_main(main, "plot_contact")

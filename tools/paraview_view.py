@@ -1,0 +1,304 @@
+#!/usr/bin/env pvpython
+"""ParaView picture of a robin_contact result: open its XDMF, warp by the displacement,
+colour by a chosen point or cell array, write a PNG. Runs headless.
+
+Usage:
+  pvpython tools/paraview_view.py RESULT [-o view.png] [--field NAME] [--scale S|auto]
+                                  [--clip P] [--range MIN MAX] [--edges] [--size WxH]
+  pvpython tools/paraview_view.py RESULT --list      (the point and cell arrays, then exit)
+RESULT is results/x.xdmf or results/x.h5 (then its sibling results/x.xdmf is opened).
+It also runs with pvbatch, or with /usr/bin/python3 when ParaView's Python modules are
+installed (Debian's `paraview` package puts them in dist-packages).
+
+  --field NAME   any point or cell array of the file (default von_mises); a vector
+                 (displacement) is coloured by its magnitude, NAME:X / :Y / :Z picks a
+                 component. A name that is not there: exit 1 and the list of the arrays.
+  --scale S      warp magnification (default auto: 10% of the larger extent of the
+                 mesh over the largest |displacement|, 3 significant digits; 0: no warp).
+  --clip P       colour range from the (100-P)th to the P-th percentile of the array
+                 (default 99.5, as tools/plot_solution.py; 100: full range); --range
+                 MIN MAX sets it explicitly. The scalar bar title says which.
+  --edges        draw the element edges (Surface With Edges).
+  --size WxH     image size in pixels (default 1200x800).
+
+Headless nodes: rendering needs an X display, or an offscreen (EGL/OSMesa) ParaView build.
+Without DISPLAY the tool re-runs itself as `xvfb-run -a pvbatch tools/paraview_view.py ...`
+when xvfb-run is installed (Debian: apt-get install xvfb); with an offscreen build set
+RC_PV_OFFSCREEN=1 to skip that. Without either it exits 1 and says so (plain pvpython
+would crash in the X window code).
+The file is always opened by its absolute path: Debian's Xdmf3 readers abort on a bare
+file name (they look for 'default.xdmfdefault.h5').
+Exit 0 on success, 1 with a message on any failure.
+"""
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+
+TOOL = "paraview_view"
+
+
+def fail(msg):
+    print(f"{TOOL}: {msg}", file=sys.stderr)
+    return 1
+
+
+def parse(argv):
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("result", metavar="RESULT", help="results/x.xdmf or results/x.h5")
+    ap.add_argument("-o", "--output", default="view.png", help="output PNG (default view.png)")
+    ap.add_argument("--field", default="von_mises", help="point or cell array to colour by (NAME or NAME:X|Y|Z)")
+    ap.add_argument("--scale", default="auto", help="warp magnification, 'auto' (default) or a number (0: none)")
+    ap.add_argument("--clip", type=float, default=99.5, help="colour range percentile (default 99.5; 100: full)")
+    ap.add_argument("--range", type=float, nargs=2, metavar=("MIN", "MAX"), help="explicit colour range")
+    ap.add_argument("--edges", action="store_true", help="draw the element edges")
+    ap.add_argument("--size", default="1200x800", help="image size WxH in pixels (default 1200x800)")
+    ap.add_argument("--list", action="store_true", help="list the point and cell arrays and exit")
+    return ap.parse_args(argv)
+
+
+def xdmf_path(result):
+    """Absolute path of the XDMF file of a result (x.h5 -> x.xdmf), or None."""
+    p = os.path.abspath(result)
+    if p.endswith(".h5"):
+        p = p[:-3] + ".xdmf"
+    return p if os.path.isfile(p) else None
+
+
+def headless_reexec(argv):
+    """Without a display: run this script again under xvfb-run (returns its exit code), or
+    None when rendering can go ahead here (display present, offscreen build, already
+    wrapped, or only --list)."""
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or os.environ.get("RC_PV_OFFSCREEN") \
+            or os.environ.get("RC_PV_WRAPPED") or "--list" in argv:
+        return None
+    xvfb = shutil.which("xvfb-run")
+    if not xvfb:
+        return fail("no X display (DISPLAY unset) and no xvfb-run: install xvfb (apt-get install xvfb), or "
+                    "run 'xvfb-run -a pvbatch tools/paraview_view.py ...', or with an offscreen (EGL/OSMesa) "
+                    "ParaView build set RC_PV_OFFSCREEN=1")
+    interp = shutil.which("pvbatch") or shutil.which("pvpython") or sys.executable
+    env = dict(os.environ, RC_PV_WRAPPED="1")
+    cmd = [xvfb, "-a", interp, os.path.abspath(__file__), *argv]
+    return subprocess.call(cmd, env=env)
+
+
+def arrays(src):
+    """{name: ('POINTS' | 'CELLS', number of components)} of a pipeline source."""
+    out = {}
+    for assoc, data in (("CELLS", src.CellData), ("POINTS", src.PointData)):
+        for name in data.keys():
+            out[name] = (assoc, data[name].GetNumberOfComponents())
+    return out
+
+
+def list_text(arr):
+    pts = [f"{n} ({c} comp.)" if c > 1 else n for n, (a, c) in sorted(arr.items()) if a == "POINTS"]
+    cls = [f"{n} ({c} comp.)" if c > 1 else n for n, (a, c) in sorted(arr.items()) if a == "CELLS"]
+    return f"point arrays: {', '.join(pts) or '(none)'}\ncell arrays: {', '.join(cls) or '(none)'}"
+
+
+def field_unit(xdmf, name):
+    """Unit of an XDMF attribute: the `units` attribute of the HDF5 dataset it points to,
+    else the root unit_length/unit_stress attributes (SI m, Pa when absent) by the kind of
+    field ('' for an unknown one)."""
+    import xml.etree.ElementTree as ET
+    kind = "length" if name.startswith("displacement") or name in ("gap", "g0") else \
+        "stress" if name in ("von_mises", "contact_pressure", "pressure", "sxx", "syy", "sxy", "szz", "stress") \
+        else None
+    default = {"length": "m", "stress": "Pa", None: ""}[kind]
+    try:
+        import h5py
+        ref = None
+        for att in ET.parse(xdmf).getroot().iter("Attribute"):
+            if att.get("Name") == name:
+                item = att.find("DataItem")
+                if item is not None and item.text and ":" in item.text:
+                    ref = item.text.strip()
+                    break
+        h5 = os.path.join(os.path.dirname(xdmf), ref.split(":", 1)[0]) if ref else xdmf[:-5] + ".h5"
+        with h5py.File(h5, "r") as f:
+            def text(obj, key):
+                v = obj.attrs.get(key)
+                if hasattr(v, "reshape"):                     # numpy array or scalar
+                    v = v.reshape(-1)[0] if v.size else b""
+                if isinstance(v, bytes):
+                    v = v.decode("utf-8", "replace")
+                return "" if v is None else str(v).strip().strip("\x00").strip()
+            if ref and ref.split(":", 1)[1] in f:
+                u = text(f[ref.split(":", 1)[1]], "units")
+                if u:
+                    return u
+            return (text(f, "unit_" + kind) or default) if kind else default
+    except Exception:  # noqa: BLE001 - no h5py, unreadable file: the SI default
+        return default
+
+
+def values(src, name, assoc, comp):
+    """The array as a numpy vector (component comp, -1: magnitude) over all blocks, or None."""
+    import numpy as np
+    from paraview import servermanager
+    from paraview.vtk.numpy_interface import dataset_adapter as dsa
+    data = dsa.WrapDataObject(servermanager.Fetch(src))
+    a = (data.PointData if assoc == "POINTS" else data.CellData)[name]
+    chunks = a.Arrays if hasattr(a, "Arrays") else [a]
+    out = []
+    for c in chunks:
+        if c is None or isinstance(c, dsa.VTKNoneArray):      # a block without this array
+            continue
+        c = np.asarray(c, dtype=float)
+        if c.ndim == 2:
+            c = np.sqrt((c * c).sum(axis=1)) if comp < 0 else c[:, comp]
+        out.append(c.reshape(-1))
+    v = np.concatenate(out) if out else np.zeros(0)
+    v = v[np.isfinite(v)]
+    return v if v.size else None
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else argv
+    a = parse(argv)
+    xdmf = xdmf_path(a.result)
+    if xdmf is None:
+        return fail(f"no XDMF file for {a.result!r} (expected {os.path.abspath(a.result)}"
+                    f"{'' if a.result.endswith('.xdmf') else ' or its .xdmf sibling'})")
+    try:
+        w, h = (int(t) for t in a.size.lower().split("x"))
+        assert 16 <= w <= 8000 and 16 <= h <= 8000
+    except (ValueError, AssertionError):
+        return fail(f"--size must be WxH in pixels (16-8000), not {a.size!r}")
+    field, _, compname = a.field.partition(":")
+    rc = headless_reexec(argv)
+    if rc is not None:
+        return rc
+    try:
+        import paraview.simple as pvs
+    except ImportError as e:
+        return fail(f"ParaView's Python modules not found ({e}): run with pvpython or pvbatch "
+                    "(Debian: apt-get install paraview xvfb)")
+
+    reader = pvs.Xdmf3ReaderS(FileName=[xdmf])          # absolute path: see the docstring
+    reader.UpdatePipeline()
+    arr = arrays(reader)
+    if a.list:
+        print(f"{TOOL}: {xdmf}\n{list_text(arr)}")
+        return 0
+    if field not in arr:
+        return fail(f"no array '{field}' in {xdmf}\n{list_text(arr)}")
+    assoc, ncomp = arr[field]
+    comp = -1
+    if compname:
+        names = {"X": 0, "Y": 1, "Z": 2, "MAGNITUDE": -1}
+        comp = names.get(compname.upper(), int(compname) if compname.isdigit() else None)
+        if comp is None or comp >= ncomp:
+            return fail(f"component '{compname}' of '{field}' ({ncomp} components): use X, Y, Z or Magnitude")
+    elif ncomp == 1:
+        comp = 0
+
+    # warp
+    src, scale, how = reader, 0.0, "no warp"
+    if "displacement" in arr and arr["displacement"][0] == "POINTS" and a.scale not in ("0", "0.0", "none"):
+        info = reader.GetDataInformation()
+        b = info.GetBounds()
+        size = max(b[1] - b[0], b[3] - b[2], b[5] - b[4])
+        umax = reader.PointData["displacement"].GetRange(-1)[1]
+        if a.scale == "auto":
+            scale = float(f"{0.1 * size / umax:.3g}") if umax > 0.0 and size > 0.0 else 1.0
+            how = f"auto: 10% of extent {size:.3g} over largest displacement {umax:.3g}"
+        else:
+            try:
+                scale = float(a.scale)
+            except ValueError:
+                return fail(f"--scale must be a number or 'auto', not {a.scale!r}")
+            how = f"largest displacement {umax:.3g}"
+        if scale != 0.0:
+            src = pvs.WarpByVector(Input=reader, Vectors=["POINTS", "displacement"], ScaleFactor=scale)
+    elif a.scale not in ("0", "0.0", "none"):
+        how = "no 'displacement' point array: not warped"
+
+    # colour range
+    if a.range:
+        lo, hi = a.range
+        rng_note = "range set by --range"
+    else:
+        v = values(reader, field, assoc, comp)
+        if v is None:
+            return fail(f"array '{field}' has no finite values")
+        import numpy as np
+        vmin, vmax = float(v.min()), float(v.max())
+        if a.clip >= 100.0:
+            lo, hi, rng_note = vmin, vmax, "full range"
+        else:
+            lo, hi = (float(q) for q in np.percentile(v, [100.0 - a.clip, a.clip]))
+            if vmin >= 0.0 and lo <= 0.01 * hi:
+                lo = vmin
+            rng_note = f"clipped at the {a.clip:g}th percentile (all: {vmin:.4g} to {vmax:.4g})" \
+                if (vmin < lo or vmax > hi) else "full range"
+        if not hi > lo:
+            hi = lo + (abs(lo) or 1.0)
+
+    view = pvs.CreateRenderView()
+    view.ViewSize = [w, h]
+    for prop, val in (("UseColorPaletteForBackground", 0), ("Background", [1.0, 1.0, 1.0]),
+                      ("OrientationAxesVisibility", 0)):
+        if hasattr(view, prop):
+            setattr(view, prop, val)
+    disp = pvs.Show(src, view)
+    disp.Representation = "Surface With Edges" if a.edges else "Surface"
+    if not a.edges and hasattr(disp, "LineWidth"):
+        disp.LineWidth = 3.0           # polyline grids (a contact line) stay visible
+    pvs.ColorBy(disp, (assoc, field) if comp < 0 and ncomp > 1 and not compname
+                else (assoc, field, "Magnitude" if comp < 0 else "XYZ"[comp] if ncomp <= 3 else str(comp)))
+    lut = pvs.GetColorTransferFunction(field)
+    lut.ApplyPreset("Viridis (matplotlib)", True)
+    if ncomp > 1:
+        lut.VectorMode = "Magnitude" if comp < 0 else "Component"
+        if comp >= 0:
+            lut.VectorComponent = comp
+    lut.RescaleTransferFunction(lo, hi)
+    if hasattr(lut, "AutomaticRescaleRangeMode"):
+        lut.AutomaticRescaleRangeMode = "Never"
+    disp.SetScalarBarVisibility(view, True)
+    bar = pvs.GetScalarBar(lut, view)
+    label = field + (f" ({'magnitude' if comp < 0 else 'XYZ'[comp]})" if ncomp > 1 else "")
+    unit = field_unit(xdmf, field)
+    bar.Title = f"{label} [{unit or '-'}]"
+    bar.ComponentTitle = "(clipped)" if rng_note.startswith("clipped") else ""
+    for prop in ("TitleColor", "LabelColor"):
+        if hasattr(bar, prop):
+            setattr(bar, prop, [0.0, 0.0, 0.0])
+    title = pvs.Text(Text=f"{os.path.basename(xdmf)}: {label} [{unit or '-'}], {rng_note}\n"
+                          f"warped by displacement x{scale:g} ({how})")
+    td = pvs.Show(title, view)
+    td.WindowLocation = "Upper Center"
+    td.FontSize = 14
+    if hasattr(td, "Color"):
+        td.Color = [0.0, 0.0, 0.0]
+    view.InteractionMode = "2D"
+    view.CameraPosition = [0.0, 0.0, 1.0]
+    view.CameraFocalPoint = [0.0, 0.0, 0.0]
+    view.CameraViewUp = [0.0, 1.0, 0.0]
+    view.ResetCamera()
+    out = os.path.abspath(a.output)
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    pvs.SaveScreenshot(out, view, ImageResolution=[w, h])
+    if not os.path.isfile(out):
+        return fail(f"ParaView wrote no {out}")
+    print(f"{TOOL}: wrote {a.output} ({label}, {assoc.lower()[:-1]} data, colour {lo:.4g} to {hi:.4g}{' ' + unit if unit else ''}, "
+          f"{rng_note}, magnification {scale:g})")
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        status = main()
+    except SystemExit as e:
+        status = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+    except Exception as e:  # noqa: BLE001 - report every failure with a message
+        status = fail(f"error: {type(e).__name__}: {e}")
+    # os._exit: skip ParaView's teardown, which under xvfb-run can end in an X error
+    # (GLXBadContext) and exit status 1 after the picture was written.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)
