@@ -6,7 +6,8 @@ program test_mprgp
   use kinds, only: wp
   use linop, only: linop_t, dense_op_t, csc_op_t, dense_op_init
   use mprgp, only: mprgp_solve, lambda_max_estimate, mprgp_status_name, mprgp_opts_t, mprgp_stats_t, &
-                   MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG
+                   MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, &
+                   MPRGP_STOPPED
   use lapack, only: dposv
   use strings, only: i2s
   use testing, only: report, test_summary, obstacle_problem
@@ -14,6 +15,7 @@ program test_mprgp
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
   real(wp), parameter :: nobound = -huge(1.0_wp)
+  integer :: calls = 0   ! polls of the stop hook
 
   call set_seed(20240611)
   call test_enumeration()
@@ -24,10 +26,38 @@ program test_mprgp
   call test_alpha_guard()
   call test_scaling()
   call test_threads()
+  call test_stop_hook()
 
   call test_summary()
 
 contains
+
+  !> The stop hook: a solve asked to stop returns MPRGP_STOPPED at once with a feasible
+  !! iterate, after fewer steps than it needs to converge.
+  subroutine test_stop_hook()
+    type(csc_op_t) :: op
+    real(wp), allocatable :: b(:), l(:), x(:)
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st
+    integer :: n
+    n = 200
+    call obstacle_problem(n, op, b, l, 1.0_wp)
+    allocate (x(n))
+    x = 0.0_wp
+    opts%rtol = 1.0e-10_wp
+    opts%stop => stop_after_five
+    calls = 0
+    call mprgp_solve(op, b, l, x, opts, st)
+    call report(st%status == MPRGP_STOPPED .and. st%n_cg + st%n_exp + st%n_prop == 5 .and. all(x >= l), &
+                'stop hook: stops after the step it turned true at (5 steps), iterate feasible', &
+                real(st%n_cg + st%n_exp + st%n_prop, wp))
+  end subroutine test_stop_hook
+
+  logical function stop_after_five()
+    calls = calls + 1
+    stop_after_five = calls > 5
+  end function stop_after_five
+
 
   ! ------------------------------------------------------------------ helpers
 
