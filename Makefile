@@ -117,6 +117,7 @@ $(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_type
 $(BUILD)/signals.o:
 $(BUILD)/sysinfo_shim.o:  include/sysinfo_shim.h
 $(BUILD)/files_shim.o:    include/files_shim.h
+$(BUILD)/checkpoint.o:    $(BUILD)/strings.o
 $(BUILD)/robin_contact.o: $(OBJS)
 
 # ---- link ----------------------------------------------------------------------
