@@ -59,11 +59,15 @@ def leftovers(d):
 
 
 def total_force(h5):
+    if not os.path.isfile(h5):
+        return float("nan"), None, None
     with h5py.File(h5, "r") as f:
         return float(np.sum(f["/contact/normal_force"][()])), text_attr(f, "title"), text_attr(f, "run_id")
 
 
 def xdmf_run_id(path):
+    if not os.path.isfile(path):
+        return None
     m = re.search(r"<!-- robin_contact \S+ run_id (\S+) -->", open(path, encoding="utf-8").read())
     return m.group(1) if m else None
 

@@ -282,7 +282,8 @@ def check_run_marker(f, paths, tag):
     rid = f.attrs.get("run_id")
     bad = []
     for p in paths:
-        mk = re.search(r"<!-- robin_contact \S+ run_id (\S+) -->", open(p, encoding="utf-8").read())
+        text = open(p, encoding="utf-8").read() if os.path.isfile(p) else ""
+        mk = re.search(r"<!-- robin_contact \S+ run_id (\S+) -->", text)
         if mk is None or mk.group(1) != rid:
             bad.append(f"{os.path.basename(p)}: {mk.group(1) if mk else None}")
     check(isinstance(rid, str) and rid and not bad, f"{tag}: every XDMF file has the run_id of the HDF5 file ({rid})",
