@@ -185,7 +185,10 @@ contains
     ! contact
     call group_open(fid, 'contact', gid, st, create=.true.)
     call write_dset(gid, 'x', itf%s, st, ul)
-    call write_dset(gid, 'coordinates', transpose(itf%xy), st, ul)
+    allocate (w2(itf%m, 2))
+    w2 = transpose(itf%xy)   ! contiguous (gfortran passes a transpose as a strided view)
+    call write_dset(gid, 'coordinates', w2, st, ul)
+    deallocate (w2)
     call write_dset(gid, 'g0', itf%g0, st, ul)
     call write_dset(gid, 'tributary_length', itf%trib, st, ul)
     call write_dset(gid, 'normal_force', res%lam, st, uf)
@@ -236,7 +239,7 @@ contains
       call write_dset(gid, 'stress', sigt, st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
       do k = 1, 4
-        call write_dset(gid, comp(k), sig(k, :), st, us)
+        call write_dset(gid, comp(k), sigt(:, k), st, us)
       end do
       call write_dset(gid, 'von_mises', vm, st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
