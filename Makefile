@@ -44,10 +44,12 @@ MODS := kinds errors clock strings config sysinfo signals namelist_input deck bu
         condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o
+OBJS += $(BUILD)/files_shim.o
 
 TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact
 BENCH_F := bench_mprgp
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
+TEST_BINS  += $(BUILD)/tests/test_files
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
 
 DEPS_STAMP := build/.deps-ok
@@ -115,6 +117,8 @@ $(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_type
                           $(BUILD)/history_io.o $(BUILD)/files.o
 $(BUILD)/signals.o:
 $(BUILD)/sysinfo_shim.o:  include/sysinfo_shim.h
+$(BUILD)/files_shim.o:    include/files_shim.h
+$(BUILD)/checkpoint.o:    $(BUILD)/strings.o
 $(BUILD)/robin_contact.o: $(OBJS)
 
 # ---- link ----------------------------------------------------------------------

@@ -18,7 +18,7 @@ program robin_contact
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t
   use contact, only: solve_robin, solve_monolithic, error_bound
-  use results, only: timing_t, write_results, remove_results, program_version
+  use results, only: timing_t, write_results, program_version
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
   use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
@@ -72,6 +72,9 @@ program robin_contact
     call omp_set_max_active_levels(1)
   end if
 
+  ! An earlier result at this path stays until this run's result replaces it whole
+  ! (write_results); a run that fails leaves it untouched.
+
   ! ---- assemble both bodies --------------------------------------------------------
   t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
@@ -90,9 +93,6 @@ program robin_contact
     call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
     if (.not. ok) call fatal(EXIT_INPUT, trim(msg1))
   end if
-  ! A result file left at this path by an earlier run must not pass for this run's if
-  ! this one fails: remove it (and its XDMF files) now that all the input is valid.
-  call remove_results(d%output%file)
   tm%assemble = wtime() - t0
   call check_interrupt('assembly')
   write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') 'assembled: n1=', sys(1)%n, ' n2=', sys(2)%n, &

@@ -6,18 +6,23 @@ Real write failures, no test hook in the program:
      in a private mount namespace (`unshare --mount --map-root-user`, which needs no root
      where user namespaces are allowed; as root without unshare, a plain mount). HDF5 fails
      while writing a dataset or flushing on close. Skipped, saying so, when neither works.
-  2. the result's temporary name `<file>.tmp` is a symbolic link to /dev/full (fails for
-     root too): creating the HDF5 file fails.
+  2. the result's temporary name is a symbolic link to /dev/full (fails for root too):
+     creating the HDF5 file fails. Temporary names are unique per run,
+     `<file>.<host>.<pid>.<n>.tmp` with n counting the names the run makes (the HDF5 file
+     takes the first); a shell makes the link for its own pid and then execs the program.
   In both: exit code 3, one message `output: cannot write <file> (...)` on stderr, no HDF5
   error stack or Fortran runtime text, and no file under the result's names (.h5, .xdmf,
-  _body1.xdmf, _body2.xdmf) nor a `.tmp` leftover.
-  3. a checkpoint that fails keeps the previous one, byte for byte: (a) `<file>.ckpt.h5.tmp`
-     a link to /dev/full: warning naming the checkpoint, run continues (exit 2), old
-     checkpoint unchanged, link removed; (b) on the full tmpfs (a filler file takes the free
-     space): checkpoint and result fail with ENOSPC, exit 3, old checkpoint unchanged.
+  _body1.xdmf, _body2.xdmf, _contact.xdmf) nor a `.tmp` leftover.
+  3. a checkpoint that fails keeps the previous one, byte for byte: (a) the checkpoint's
+     temporary name (`<file>.ckpt.h5.<host>.<pid>.1.tmp`, the run's first) a link to
+     /dev/full: warning naming the checkpoint, run continues (exit 2), old checkpoint
+     unchanged, link removed; (b) on the full tmpfs (a filler file takes the free space):
+     checkpoint and result fail with ENOSPC, exit 3, old checkpoint unchanged.
 """
 import filecmp
 import os
+import re
+import socket
 import shutil
 import subprocess
 import sys
@@ -38,7 +43,19 @@ def check(ok, what, detail=""):
 
 def result_names(h5):
     stem = h5[:-3]
-    return [h5, stem + ".xdmf", stem + "_body1.xdmf", stem + "_body2.xdmf"]
+    return [h5, stem + ".xdmf", stem + "_body1.xdmf", stem + "_body2.xdmf", stem + "_contact.xdmf"]
+
+
+# the host part of the program's temporary names: the host name reduced to [A-Za-z0-9_-]
+HOST_TOKEN = re.sub(r"[^A-Za-z0-9_-]", "_", socket.gethostname())[:64]
+
+
+def run_with_devfull_temp(final, args):
+    """Run BIN args with the run's first temporary name, <final>.<host>.<pid>.1.tmp, a
+    symbolic link to /dev/full: the shell links it for its own pid, then execs BIN."""
+    script = 'ln -s /dev/full "$0.$HOST_TOKEN.$$.1.tmp" || exit 99; exec "$@"'
+    return subprocess.run(["sh", "-c", script, final, BIN, *args], capture_output=True, text=True,
+                          env=dict(ENV, HOST_TOKEN=HOST_TOKEN))
 
 
 def out(h5, extra=""):
@@ -132,8 +149,7 @@ else:
 d = os.path.join(OUT, "devfull")
 os.makedirs(d)
 h5 = os.path.join(d, "r.h5")
-os.symlink("/dev/full", h5 + ".tmp")
-p = subprocess.run([BIN, DECK, out(h5)], capture_output=True, text=True, env=ENV)
+p = run_with_devfull_temp(h5, [DECK, out(h5)])
 check_failed_result("/dev/full", p.returncode, p.stderr, h5, os.listdir(d))
 
 # 3a. a checkpoint that cannot be written keeps the previous one
@@ -147,17 +163,16 @@ check(p.returncode == 2 and os.path.exists(ck), "checkpoint run: exit 2 with a c
 good = os.path.join(OUT, "good.ckpt.h5")
 if os.path.exists(ck):
     shutil.copyfile(ck, good)
-    os.symlink("/dev/full", ck + ".tmp")
     # one checkpoint is due (iteration 15), and it fails
-    p = subprocess.run([BIN, DECK, "&solver max_outer=20 /", out(h5, ", checkpoint_every=15")],
-                       capture_output=True, text=True, env=ENV)
+    p = run_with_devfull_temp(ck, [DECK, "&solver max_outer=20 /", out(h5, ", checkpoint_every=15")])
     check(p.returncode == 2, "failed checkpoint: the run goes on (exit 2)", f"exit {p.returncode}")
     check("warning" in p.stderr and ck in p.stderr, "failed checkpoint: a warning names the checkpoint",
           p.stderr.strip()[-300:])
     check("HDF5" not in p.stderr, "failed checkpoint: no HDF5 error stack", p.stderr.strip()[:200])
     check(os.path.isfile(ck) and not os.path.islink(ck) and filecmp.cmp(ck, good, shallow=False),
           "failed checkpoint: the previous checkpoint is kept unchanged")
-    check(not os.path.lexists(ck + ".tmp"), "failed checkpoint: no .tmp leftover")
+    tmp = [n for n in os.listdir(d) if n.endswith(".tmp")]
+    check(not tmp, "failed checkpoint: no .tmp leftover", " ".join(tmp))
 
     # 3b. full disk: the checkpoint (of a larger mesh) is created, its data do not fit
     d = os.path.join(OUT, "ckbig")

@@ -4,12 +4,15 @@
 !! identically and refuses a checkpoint made from a different deck or mesh.
 module checkpoint
   use kinds, only: wp
-  use hdf5, only: hid_t
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use hdf5, only: hid_t, hsize_t
   use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, &
-                  write_dset, write_attr, read_dset, read_attr
+                  write_dset, write_attr, read_dset, read_attr, describe, exists, &
+                  CLASS_INTEGER, CLASS_REAL, CLASS_STRING, CLASS_VSTRING
+  use strings, only: i2s
   use history_io, only: write_history, read_history
   use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
-  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t
+  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, ANDERSON_DEPTH
   implicit none (type, external)
   private
 
@@ -92,8 +95,12 @@ contains
     end if
   end subroutine checkpoint_write
 
-  !> Read a checkpoint. ok = .false. with msg if it cannot be read or was made from
-  !! another deck or mesh (its key differs from `key`).
+  !> Read a checkpoint. ok = .false. with msg if it cannot be read, was made from another
+  !! deck or mesh (its key differs from `key`), or does not hold what this deck implies.
+  !! Nothing in the file is trusted: before anything is read, every dataset and attribute
+  !! is checked for its type class and shape (m contact nodes, ANDERSON_DEPTH, a history
+  !! of at least `it` and at most max_outer entries), and after reading, the counters for
+  !! their ranges and the arrays for finite values; msg names the file and the object.
   subroutine checkpoint_read(file, key, m, maxout, st, res, ok, msg)
     character(len=*), intent(in) :: file          !< checkpoint path
     character(len=*), intent(in) :: key           !< fingerprint of this run
@@ -103,41 +110,168 @@ contains
     type(contact_result_t), intent(inout) :: res  !< receives the history
     logical, intent(out) :: ok                    !< success
     character(len=*), intent(out) :: msg          !< why not
-    integer(hid_t) :: fid, gid
+    integer(hid_t) :: fid, gid, hid
     type(h5_status_t) :: hs
-    integer :: n
-    character(len=:), allocatable :: k
+    integer :: n, nh
+    character(len=:), allocatable :: k, src
     real(wp), allocatable :: r(:)
-    logical :: exists
+    logical :: exists_, has_products, has_search
+    integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
+    character(len=*), parameter :: INT_ATTRS(6) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
+                                                   'it_best', 'inner_maxit_hits']
+    character(len=*), parameter :: REAL_ATTRS(6) = [character(len=16) :: 'res_best', 'crit', 'progress', &
+                                                    'best', 'omega', 'wall']
+    integer :: j
 
     ok = .false.
     msg = ''
-    inquire (file=file, exist=exists)
-    if (.not. exists) then
-      msg = 'restart file '//trim(file)//' does not exist'
+    src = 'restart file '//trim(file)
+    gid = -1
+    hid = -1
+    inquire (file=file, exist=exists_)
+    if (.not. exists_) then
+      msg = src//' does not exist'
       return
     end if
     call file_open(file, fid, hs)
     if (hs%failed) then
-      msg = 'restart file '//trim(file)//' is not an HDF5 file'
+      msg = src//' is not an HDF5 file'
       return
     end if
-    call read_dset(fid, 'key', k, hs)
-    if (hs%failed) then
-      msg = 'restart file '//trim(file)//' is not a robin_contact checkpoint'
-    else if (trim(k) /= trim(key)) then
-      msg = 'restart file '//trim(file)//' was made from a different deck or mesh '// &
-            '(its bodies, loads, contact or solver settings differ from this run''s)'
+    if (.not. exists(fid, 'key', .false.)) then
+      msg = src//' is not a robin_contact checkpoint (it has no dataset /key)'
     else
-      call read_state()
+      call need(fid, '/', 'key', .false., CLASS_STRING, SCALAR, 'a scalar string')
     end if
+    if (len_trim(msg) == 0) then
+      call read_dset(fid, 'key', k, hs)
+      if (hs%failed) then
+        msg = src//' is not a robin_contact checkpoint ('//hs%what//')'
+      else if (trim(k) /= trim(key)) then
+        msg = src//' was made from a different deck or mesh '// &
+              '(its bodies, loads, contact or solver settings differ from this run''s)'
+      end if
+    end if
+    if (len_trim(msg) == 0) call check_layout()
+    if (len_trim(msg) == 0) call read_state()
+    call group_close(hid, hs)
+    call group_close(gid, hs)
     call file_close(fid, hs)
     ok = len_trim(msg) == 0
 
   contains
 
+    !> Every object the state is read from, checked for class and shape before reading.
+    subroutine check_layout()
+      integer(hsize_t) :: m2, hdims(1)
+      integer(hsize_t), allocatable :: dims(:)
+      integer :: cls
+      character(len=*), parameter :: hist(5) = [character(len=9) :: 'criterion', 'residual', 'wall_s', &
+                                                'inner', 'active']
+      m2 = int(m, hsize_t)
+      call group(fid, 'state', gid)
+      call group(fid, 'history', hid)
+      if (len_trim(msg) > 0) return
+      do j = 1, size(INT_ATTRS)
+        call need(gid, '/state', trim(INT_ATTRS(j)), .true., CLASS_INTEGER, SCALAR, 'a scalar')
+      end do
+      do j = 1, size(REAL_ATTRS)
+        call need(gid, '/state', trim(REAL_ATTRS(j)), .true., CLASS_REAL, SCALAR, 'a scalar')
+      end do
+      call need(gid, '/state', 'flam', .false., CLASS_REAL, [2_hsize_t], 'the two bodies')
+      call need(gid, '/state', 'G', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
+      call need(gid, '/state', 'lam', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
+      call need(gid, '/state', 'r_prev', .false., CLASS_REAL, [2*m2], contact_nodes())
+      call need(gid, '/state', 'x_prev', .false., CLASS_REAL, [2*m2], contact_nodes())
+      call need(gid, '/state', 'dX', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
+                contact_nodes()//' and Anderson depth '//i2s(ANDERSON_DEPTH))
+      call need(gid, '/state', 'dR', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
+                contact_nodes()//' and Anderson depth '//i2s(ANDERSON_DEPTH))
+      ! F_a lam_a of the last solves: absent from older checkpoints, checked when present
+      has_products = exists(gid, 'reuse', .true.) .or. exists(gid, 'flam_v', .false.)
+      if (has_products) then
+        call need(gid, '/state', 'reuse', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+        call need(gid, '/state', 'flam_v', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
+      end if
+      ! the last change of lam_a and F_a times it: absent from older checkpoints, checked when present
+      has_search = exists(gid, 'nsrch', .true.) .or. exists(gid, 'srch', .false.) .or. exists(gid, 'fsrch', .false.)
+      if (has_search) then
+        call need(gid, '/state', 'nsrch', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+        call need(gid, '/state', 'srch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
+        call need(gid, '/state', 'fsrch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
+      end if
+      if (len_trim(msg) > 0) return
+      ! the history: five arrays of one length nh, it <= nh <= max_outer (checked after reading it)
+      call need(hid, '/history', 'criterion', .false., CLASS_REAL, [-1_hsize_t], 'one entry per outer iteration')
+      if (len_trim(msg) > 0) return
+      call describe(hid, 'criterion', .false., cls, dims, hs)
+      hdims = dims
+      do j = 1, size(hist)
+        call need(hid, '/history', trim(hist(j)), .false., merge(CLASS_INTEGER, CLASS_REAL, j > 3), hdims, &
+                  'one entry per outer iteration, as /history/criterion')
+      end do
+      nh = int(hdims(1))
+      if (len_trim(msg) == 0 .and. nh > maxout) &
+        msg = src//': dataset /history/criterion has '//i2s(nh)//' entries, more than max_outer = '//i2s(maxout)
+    end subroutine check_layout
+
+    !> Open group `name` of the file into g; msg when it is not there.
+    subroutine group(loc, name, g)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(out) :: g
+      g = -1
+      if (len_trim(msg) > 0) return
+      if (.not. exists(loc, name, .false.)) then
+        msg = src//' has no group /'//name
+        return
+      end if
+      call group_open(loc, name, g, hs)
+      if (hs%failed) msg = src//': '//hs%what
+    end subroutine group
+
+    !> Check that `name` in `loc` (path `path`) is a dataset, or an attribute when `attr`, of
+    !! class `cls` and shape `dims` (Fortran order; -1: any extent); `what` says what the
+    !! shape stands for. On the first mismatch msg names the file and the object.
+    subroutine need(loc, path, name, attr, cls, dims, what)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: path, name, what
+      logical, intent(in) :: attr
+      integer, intent(in) :: cls
+      integer(hsize_t), intent(in) :: dims(:)
+      integer(hsize_t), allocatable :: got(:)
+      integer :: c
+      character(len=:), allocatable :: obj
+      type(h5_status_t) :: ds
+      if (len_trim(msg) > 0) return
+      if (attr) then
+        obj = 'attribute '//trim(name)//' of '//path
+      else
+        obj = 'dataset '//path//'/'//name
+        if (path == '/') obj = 'dataset /'//name
+      end if
+      if (.not. exists(loc, name, attr)) then
+        msg = src//' has no '//obj
+        return
+      end if
+      call describe(loc, name, attr, c, got, ds)
+      if (ds%failed) then
+        msg = src//': '//ds%what
+      else if (c /= cls) then
+        msg = src//': '//obj//' holds '//class_name(c)//', expected '//class_name(cls)
+      else if (size(got) /= size(dims)) then
+        msg = src//': '//obj//' has shape '//shape_text(got)//', expected '//shape_text(dims)//' ('//what//')'
+      else if (any(got /= dims .and. dims >= 0)) then
+        msg = src//': '//obj//' has shape '//shape_text(got)//', expected '//shape_text(dims)//' ('//what//')'
+      end if
+    end subroutine need
+
+    function contact_nodes() result(t)
+      character(len=:), allocatable :: t
+      t = 'this deck has '//i2s(m)//' contact nodes'
+    end function contact_nodes
+
     subroutine read_state()
-      call group_open(fid, 'state', gid, hs)
       call read_attr(gid, 'it', st%it, hs)
       call read_attr(gid, 'inner', st%inner, hs)
       call read_attr(gid, 'nacc', st%nacc, hs)
@@ -151,43 +285,83 @@ contains
       call read_attr(gid, 'omega', st%omega, hs)
       call read_attr(gid, 'wall', st%wall, hs)
       call read_dset(gid, 'flam', r, hs)
-      if (.not. hs%failed) then
-        if (size(r) == 2) st%flam = r
-      end if
+      if (.not. hs%failed) st%flam = r
       call read_dset(gid, 'G', st%G, hs)
       call read_dset(gid, 'lam', st%lam, hs)
       call read_dset(gid, 'r_prev', st%r_prev, hs)
       call read_dset(gid, 'x_prev', st%x_prev, hs)
       call read_dset(gid, 'dX', st%dX, hs)
       call read_dset(gid, 'dR', st%dR, hs)
-      call read_optional_products()
-      call group_close(gid, hs)
+      if (has_products) then
+        call read_attr(gid, 'reuse', st%reuse, hs)
+        call read_dset(gid, 'flam_v', st%flam_v, hs)
+      else
+        ! an older checkpoint: the first solve after the restart computes F_a lam_a
+        st%reuse = 0
+        allocate (st%flam_v(m, 2))
+        st%flam_v = 0.0_wp
+      end if
+      if (has_search) then
+        call read_attr(gid, 'nsrch', st%nsrch, hs)
+        call read_dset(gid, 'srch', st%srch, hs)
+        call read_dset(gid, 'fsrch', st%fsrch, hs)
+      else
+        ! an older checkpoint: no line search in the first iteration after the restart
+        st%nsrch = 0
+        allocate (st%srch(m, 2), st%fsrch(m, 2))
+        st%srch = 0.0_wp
+        st%fsrch = 0.0_wp
+      end if
       if (hs%failed) then
-        msg = 'restart file '//trim(file)//' is incomplete ('//hs%what//')'
+        msg = src//' cannot be read ('//hs%what//')'
         return
       end if
-      if (size(st%G, 1) /= m) then
-        msg = 'restart file '//trim(file)//' has a different number of contact nodes'
-        return
-      end if
+      ! ranges of the counters, finite values
       n = st%it
-      if (n > maxout) then
-        write (msg, '(a,i0,a,i0)') 'restart file '//trim(file)//' is at outer iteration ', n, &
-          ', beyond max_outer = ', maxout
-        return
+      if (n < 1 .or. n > maxout) then
+        msg = src//': attribute it of /state is '//i2s(n)//', outside 1 .. max_outer = '//i2s(maxout)
+      else if (n > nh) then
+        msg = src//': attribute it of /state is '//i2s(n)//', beyond the '//i2s(nh)// &
+              ' entries of /history/criterion'
+      else if (min(st%inner, st%nacc, st%stalled, res%inner_maxit_hits) < 0) then
+        msg = src//': a counter of /state (inner, nacc, stalled, inner_maxit_hits) is negative'
+      else if (st%it_best < 0 .or. st%it_best > n) then
+        msg = src//': attribute it_best of /state is '//i2s(st%it_best)//', outside 0 .. it = '//i2s(n)
+      else if (st%reuse /= 0 .and. st%reuse /= 1) then
+        msg = src//': attribute reuse of /state is '//i2s(st%reuse)//', not 0 or 1'
+      else if (.not. all(ieee_is_finite(st%G))) then
+        msg = src//': dataset /state/G holds values that are not finite'
+      else if (.not. all(ieee_is_finite(st%lam))) then
+        msg = src//': dataset /state/lam holds values that are not finite'
+      else if (.not. (all(ieee_is_finite(st%r_prev)) .and. all(ieee_is_finite(st%x_prev)) .and. &
+                      all(ieee_is_finite(st%dX)) .and. all(ieee_is_finite(st%dR)) .and. &
+                      all(ieee_is_finite(st%flam)) .and. all(ieee_is_finite(st%flam_v)))) then
+        msg = src//': a dataset of /state (flam, r_prev, x_prev, dX, dR, flam_v) holds values that are not finite'
+      else if (.not. all(ieee_is_finite([st%res_best, st%crit, st%progress, st%best, st%omega, st%wall]))) then
+        msg = src//': an attribute of /state (res_best, crit, progress, best, omega, wall) is not finite'
       end if
+      if (len_trim(msg) > 0) return
       ! history
       if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, &
                                                   res%h_active)
-      allocate (res%h_criterion(maxout), res%h_residual(maxout), res%h_wall(maxout), res%h_inner(maxout), &
-                res%h_active(maxout))
+      ! the history grows as the run goes on: room for what the checkpoint holds
+      allocate (res%h_criterion(n), res%h_residual(n), res%h_wall(n), res%h_inner(n), res%h_active(n))
       res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
       if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
       allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
       res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = st%G
       call read_history(fid, n, res, hs)
       if (hs%failed) then
-        msg = 'restart file '//trim(file)//' has an incomplete history ('//hs%what//')'
+        msg = src//' has an incomplete history ('//hs%what//')'
+        return
+      end if
+      if (.not. (all(ieee_is_finite(res%h_criterion(1:n))) .and. all(ieee_is_finite(res%h_residual(1:n))) .and. &
+                 all(ieee_is_finite(res%h_wall(1:n))))) then
+        msg = src//': a dataset of /history (criterion, residual, wall_s) holds values that are not finite'
+        return
+      end if
+      if (any(res%h_inner(1:n) < 0) .or. any(res%h_active(1:n) < 0) .or. any(res%h_active(1:n) > m)) then
+        msg = src//': dataset /history/inner or /history/active holds counts out of range'
         return
       end if
       res%nhist = n
@@ -195,37 +369,43 @@ contains
       res%inner = st%inner
     end subroutine read_state
 
-    !> F_a lam_a of the last solves (absent from older checkpoints: then the first solve
-    !! after the restart computes it).
-    subroutine read_optional_products()
-      type(h5_status_t) :: ho
-      call read_attr(gid, 'reuse', st%reuse, ho)
-      call read_dset(gid, 'flam_v', st%flam_v, ho)
-      if (ho%failed) then
-        st%reuse = 0
-        if (allocated(st%flam_v)) deallocate (st%flam_v)
-        allocate (st%flam_v(m, 2))
-        st%flam_v = 0.0_wp
-      end if
-      ! the last change of lam_a and F_a times it (absent from older checkpoints: no line
-      ! search in the first iteration after the restart)
-      ho%failed = .false.
-      call read_attr(gid, 'nsrch', st%nsrch, ho)
-      call read_dset(gid, 'srch', st%srch, ho)
-      call read_dset(gid, 'fsrch', st%fsrch, ho)
-      if (.not. ho%failed) then
-        if (any(shape(st%srch) /= [m, 2]) .or. any(shape(st%fsrch) /= [m, 2])) ho%failed = .true.
-      end if
-      if (ho%failed) then
-        st%nsrch = 0
-        if (allocated(st%srch)) deallocate (st%srch)
-        if (allocated(st%fsrch)) deallocate (st%fsrch)
-        allocate (st%srch(m, 2), st%fsrch(m, 2))
-        st%srch = 0.0_wp
-        st%fsrch = 0.0_wp
-      end if
-    end subroutine read_optional_products
-
   end subroutine checkpoint_read
+
+  !> The name of a type class, for messages.
+  function class_name(c) result(t)
+    integer, intent(in) :: c
+    character(len=:), allocatable :: t
+    select case (c)
+    case (CLASS_INTEGER)
+      t = 'integers'
+    case (CLASS_REAL)
+      t = 'real numbers'
+    case (CLASS_STRING)
+      t = 'a fixed-length string'
+    case (CLASS_VSTRING)
+      t = 'a variable-length string'
+    case default
+      t = 'data of another type'
+    end select
+  end function class_name
+
+  !> A shape as h5py shows it (C order, the reverse of Fortran's): '(2, 16)', '()' for a
+  !! scalar, 'n' for an extent that may be anything.
+  function shape_text(d) result(t)
+    integer(hsize_t), intent(in) :: d(:)
+    character(len=:), allocatable :: t
+    integer :: i
+    t = '('
+    do i = size(d), 1, -1
+      if (d(i) < 0) then
+        t = t//'n'
+      else
+        t = t//i2s(int(d(i)))
+      end if
+      if (i > 1) t = t//', '
+    end do
+    if (size(d) == 1) t = t//','
+    t = t//')'
+  end function shape_text
 
 end module checkpoint

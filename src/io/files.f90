@@ -1,13 +1,20 @@
-!> File-system helpers of the output stage: temporary names, atomic rename, parent
-!! folders, removal and whole-file text output. Result and checkpoint files are written
-!! under `temp_name(file)` and renamed to `file` only when complete.
+!> File-system helpers of the output stage: temporary names, atomic rename, committing a
+!! set of files together, parent folders, removal and whole-file text output.
+!!
+!! Result and checkpoint files are written under a temporary name of their own run
+!! (`temp_name`: `<file>.<host>.<pid>.<n>.tmp`, so two runs writing the same result never
+!! share one) and renamed to their final names only when complete; the rename is the
+!! only step runs share. A result made of several files is committed by `commit_files`:
+!! under a lock of the folder, all final names are checked first, the files already
+!! there are kept aside, and any failure puts them back, so readers see either all the
+!! old files or all the new ones.
 module files
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
   implicit none (type, external)
   private
 
-  public :: temp_name, replace_suffix, base_name, ensure_parent_dir, atomic_rename, remove_file, &
-            write_text
+  public :: temp_name, run_id, replace_suffix, base_name, dir_name, ensure_parent_dir, atomic_rename, &
+            remove_file, write_text, commit_files
 
   interface
     integer(c_int) function c_rename(old, new) bind(c, name='rename')
@@ -15,6 +22,11 @@ module files
       implicit none (type, external)
       character(kind=c_char), intent(in) :: old(*), new(*)
     end function c_rename
+    integer(c_int) function c_link(old, new) bind(c, name='link')
+      import :: c_int, c_char
+      implicit none (type, external)
+      character(kind=c_char), intent(in) :: old(*), new(*)
+    end function c_link
     integer(c_int) function c_mkdir(path, mode) bind(c, name='mkdir')
       import :: c_int, c_char
       implicit none (type, external)
@@ -26,17 +38,91 @@ module files
       implicit none (type, external)
       character(kind=c_char), intent(in) :: path(*)
     end function c_unlink
+    integer(c_int) function rc_run_token(buf, n) bind(c, name='rc_run_token')
+      import :: c_int, c_char
+      implicit none (type, external)
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_int), value :: n
+    end function rc_run_token
+    integer(c_int) function rc_lock_dir(dir) bind(c, name='rc_lock_dir')
+      import :: c_int, c_char
+      implicit none (type, external)
+      character(kind=c_char), intent(in) :: dir(*)
+    end function rc_lock_dir
+    subroutine rc_unlock_dir(fd) bind(c, name='rc_unlock_dir')
+      import :: c_int
+      implicit none (type, external)
+      integer(c_int), value :: fd
+    end subroutine rc_unlock_dir
+    integer(c_int) function rc_path_kind(path) bind(c, name='rc_path_kind')
+      import :: c_int, c_char
+      implicit none (type, external)
+      character(kind=c_char), intent(in) :: path(*)
+    end function rc_path_kind
+    integer(c_int) function rc_dir_writable(dir) bind(c, name='rc_dir_writable')
+      import :: c_int, c_char
+      implicit none (type, external)
+      character(kind=c_char), intent(in) :: dir(*)
+    end function rc_dir_writable
   end interface
+
+  integer, save :: counter = 0                       ! unique names made by this process
+  character(len=:), allocatable, save :: token       ! '<host>.<pid>'
+  character(len=:), allocatable, save :: id          ! token and start time
+
+  integer, parameter :: KEPT_NONE = 0     ! no earlier file at the final name
+  integer, parameter :: KEPT_LINK = 1     ! earlier file kept aside as a hard link (still in place)
+  integer, parameter :: KEPT_MOVED = 2    ! earlier file renamed aside (final name free)
 
 contains
 
-  !> The temporary name under which `file` is written before it is renamed: `<file>.tmp`,
-  !! in the same folder so that the rename is atomic.
+  !> A temporary name for `file`, unique to this run and to this call:
+  !! `<file>.<host>.<pid>.<n>.tmp` with n counting the names this process has made (1, 2,
+  !! ...), in the same folder so that the final rename is atomic.
   function temp_name(file) result(t)
     character(len=*), intent(in) :: file   !< final path
     character(len=:), allocatable :: t
-    t = trim(file)//'.tmp'
+    t = unique_name(file, '.tmp')
   end function temp_name
+
+  !> The identity of this run, `<host>.<pid>.<yyyymmddThhmmss>` (fixed at the first call):
+  !! stored in the result file and in its XDMF files, so that they can be matched.
+  function run_id() result(r)
+    character(len=:), allocatable :: r
+    character(len=8) :: date
+    character(len=10) :: time
+    if (.not. allocated(id)) then
+      call date_and_time(date, time)
+      id = run_token()//'.'//date//'T'//time(1:6)
+    end if
+    r = id
+  end function run_id
+
+  !> `<file>.<host>.<pid>.<n><suffix>` with the next n of this process.
+  function unique_name(file, suffix) result(t)
+    character(len=*), intent(in) :: file, suffix
+    character(len=:), allocatable :: t
+    character(len=16) :: n
+    integer :: k
+    !$omp critical (files_counter)
+    counter = counter + 1
+    k = counter
+    !$omp end critical (files_counter)
+    write (n, '(i0)') k
+    t = trim(file)//'.'//run_token()//'.'//trim(n)//suffix
+  end function unique_name
+
+  !> '<host>.<pid>', the host name reduced to [A-Za-z0-9_-].
+  function run_token() result(t)
+    character(len=:), allocatable :: t
+    character(kind=c_char) :: buf(128)
+    integer :: n
+    if (.not. allocated(token)) then
+      n = rc_run_token(buf, int(size(buf), c_int))
+      token = transfer(buf(1:n), repeat(' ', n))
+    end if
+    t = token
+  end function run_token
 
   !> `file` with its ending `old` replaced by `new` (`new` appended when it does not end
   !! so): replace_suffix('a/x.h5', '.h5', '.xdmf') is 'a/x.xdmf'.
@@ -62,6 +148,22 @@ contains
     b = trim(file(i + 1:))
   end function base_name
 
+  !> The folder of a path: dir_name('a/b/x.h5') is 'a/b', dir_name('x.h5') is '.',
+  !! dir_name('/x.h5') is '/'.
+  function dir_name(file) result(d)
+    character(len=*), intent(in) :: file   !< a path
+    character(len=:), allocatable :: d
+    integer :: i
+    i = index(trim(file), '/', back=.true.)
+    if (i == 0) then
+      d = '.'
+    else if (i == 1) then
+      d = '/'
+    else
+      d = file(1:i - 1)
+    end if
+  end function dir_name
+
   !> Create the folders leading to `file` (like mkdir -p of its parent); existing ones are
   !! left alone, failures show when the file itself is created.
   subroutine ensure_parent_dir(file)
@@ -86,6 +188,121 @@ contains
     integer :: rc
     rc = c_unlink(trim(path)//c_null_char)
   end subroutine remove_file
+
+  !> Rename the complete files tmp(k) to final(k), k = 1, 2, ... in this order, all or
+  !! nothing; the final names must be in one folder. Under an exclusive lock of that
+  !! folder (concurrent commits into it wait for each other): (1) every final name must
+  !! be free or hold a file (not a folder or a device) and the folder must be writable;
+  !! (2) the files already at the final names are kept aside (a hard link, or a rename
+  !! where links are not supported); (3) the renames; (4) the kept files are removed.
+  !! When a step fails, what this call renamed into place is undone, the kept files are
+  !! put back, the temporary files are removed, ok = .false. and msg says what failed.
+  subroutine commit_files(tmp, final, ok, msg)
+    character(len=*), intent(in) :: tmp(:)                 !< complete files, temporary names
+    character(len=*), intent(in) :: final(:)               !< their final names
+    logical, intent(out) :: ok                             !< all renamed
+    character(len=:), allocatable, intent(out) :: msg      !< what failed
+    character(len=len(final) + 160) :: bak(size(final))
+    integer :: kept(size(final)), k, j, fd, kind
+    character(len=:), allocatable :: dir
+    logical :: done
+
+    ok = .false.
+    msg = ''
+    kept = KEPT_NONE
+    dir = dir_name(final(1))
+    fd = rc_lock_dir(dir//c_null_char)
+    ! 1. every final name can be replaced
+    if (rc_dir_writable(dir//c_null_char) /= 1) msg = 'the folder '//dir//' is not writable'
+    do k = 1, size(final)
+      if (len(msg) > 0) exit
+      kind = rc_path_kind(trim(final(k))//c_null_char)
+      if (kind == 2) then
+        msg = trim(final(k))//' is a folder'
+      else if (kind == 3) then
+        msg = trim(final(k))//' is not a regular file'
+      else if (kind < 0) then
+        msg = 'cannot inspect '//trim(final(k))
+      end if
+    end do
+    if (len(msg) > 0) then
+      msg = msg//'; nothing was replaced'
+      call finish()
+      return
+    end if
+    ! 2. keep the earlier files aside
+    do k = 1, size(final)
+      if (rc_path_kind(trim(final(k))//c_null_char) == 0) cycle
+      bak(k) = unique_name(final(k), '.bak')
+      if (c_link(trim(final(k))//c_null_char, trim(bak(k))//c_null_char) == 0) then
+        kept(k) = KEPT_LINK
+      else if (c_rename(trim(final(k))//c_null_char, trim(bak(k))//c_null_char) == 0) then
+        kept(k) = KEPT_MOVED
+      else
+        msg = 'cannot keep the earlier '//trim(final(k))//' aside'//restore(1, size(final), .false.)// &
+              '; nothing was replaced'
+        call finish()
+        return
+      end if
+    end do
+    ! 3. the renames
+    do k = 1, size(final)
+      call atomic_rename(tmp(k), final(k), done)
+      if (.not. done) then
+        msg = 'cannot rename '//trim(tmp(k))//' to '//trim(final(k))//restore(1, k - 1, .true.)// &
+              restore(k, size(final), .false.)
+        call finish()
+        return
+      end if
+    end do
+    ! 4. the earlier files are no longer needed
+    do k = 1, size(final)
+      if (kept(k) /= KEPT_NONE) call remove_file(bak(k))
+    end do
+    ok = .true.
+    call finish()
+
+  contains
+
+    !> Put back the earlier files of final(k1:k2): renamed = .true. when this call has
+    !! renamed a new file into their place. Returns '' or a note of what could not be put back.
+    function restore(k1, k2, renamed) result(note)
+      integer, intent(in) :: k1, k2
+      logical, intent(in) :: renamed
+      character(len=:), allocatable :: note
+      integer :: i
+      logical :: back
+      note = ''
+      do i = k1, k2
+        back = .true.
+        select case (kept(i))
+        case (KEPT_NONE)
+          if (renamed) call remove_file(final(i))
+        case (KEPT_LINK)
+          if (renamed) then
+            call atomic_rename(bak(i), final(i), back)
+          else
+            call remove_file(bak(i))
+          end if
+        case (KEPT_MOVED)
+          call atomic_rename(bak(i), final(i), back)
+        end select
+        if (.not. back) note = note//'; the earlier '//trim(final(i))//' could not be put back: it is '//trim(bak(i))
+        kept(i) = KEPT_NONE
+      end do
+      if (len(note) == 0 .and. renamed) note = '; the earlier files were put back'
+    end function restore
+
+    subroutine finish()
+      if (.not. ok) then
+        do j = 1, size(tmp)
+          call remove_file(tmp(j))
+        end do
+      end if
+      call rc_unlock_dir(fd)
+    end subroutine finish
+
+  end subroutine commit_files
 
   !> Write `text` as the whole content of `path` (replaced). ok = .false. when the file
   !! cannot be created, written or closed (a full disk shows at the latest on close).

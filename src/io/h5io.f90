@@ -6,11 +6,23 @@
 !! to which object); once it is set, writes and reads do nothing and only closing still
 !! happens, so a caller checks the status once, at the end. HDF5's own error printing is
 !! switched off: failures reach the user only through the caller's message.
+!!
+!! Reading never trusts the file: every reader first checks the stored type class and
+!! shape against what it reads into (a real dataset is a floating-point one, an attribute
+!! holds one value, a string is a scalar fixed-length one), so a forged or foreign file
+!! is a failure with the object named, never a buffer overrun. `describe` tells a caller
+!! the class and shape of an object, to check them against what it expects.
+!!
+!! String attributes are variable-length UTF-8 (h5py reads them as `str`); string
+!! datasets are fixed-length.
 module h5io
   use kinds, only: wp
-  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_null_char
   use hdf5, only: hid_t, hsize_t, size_t, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5S_SCALAR_F, &
-                  H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, &
+                  H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_C_S1, H5T_CSET_UTF8_F, &
+                  H5T_STR_NULLTERM_F, H5T_INTEGER_F, H5T_FLOAT_F, H5T_STRING_F, &
+                  h5tset_cset_f, h5tset_strpad_f, h5tget_class_f, h5tis_variable_str_f, &
+                  h5aget_space_f, h5aget_type_f, h5lexists_f, h5aexists_f, &
                   h5open_f, h5dont_atexit_f, h5eset_auto_f, h5fcreate_f, h5fopen_f, h5fclose_f, &
                   h5gcreate_f, h5gopen_f, h5gclose_f, h5iget_name_f, h5screate_f, &
                   h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
@@ -27,7 +39,13 @@ module h5io
   end type h5_status_t
 
   public :: file_open, file_close, group_open, group_close
-  public :: write_dset, write_attr, read_dset, read_attr
+  public :: write_dset, write_attr, read_dset, read_attr, describe, exists
+
+  integer, parameter, public :: CLASS_OTHER = 0     !< a type class the files do not use
+  integer, parameter, public :: CLASS_INTEGER = 1   !< integer numbers
+  integer, parameter, public :: CLASS_REAL = 2      !< floating-point numbers
+  integer, parameter, public :: CLASS_STRING = 3    !< fixed-length string
+  integer, parameter, public :: CLASS_VSTRING = 4   !< variable-length string
 
   !> Write a dataset: a real or integer array of any rank, a real or integer scalar, or
   !! a string.
@@ -124,34 +142,39 @@ contains
   ! ---- writing --------------------------------------------------------------------------
 
   !> Write a real array of any rank (or a scalar) as the dataset `name` of `loc`; an
-  !! (n1, n2) array shows as (n2, n1) in h5py.
-  subroutine dset_real(loc, name, v, st)
+  !! (n1, n2) array shows as (n2, n1) in h5py. With `units`, the dataset gets the string
+  !! attribute `units` (such as 'm', 'N/m', '1').
+  subroutine dset_real(loc, name, v, st, units)
     real(wp), intent(in), target, contiguous :: v(..)       !< the data
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
     type(h5_status_t), intent(inout) :: st                  !< status
-    call put_data(loc, name, H5T_NATIVE_DOUBLE, v, st)
+    character(len=*), intent(in), optional :: units         !< unit of the values
+    call put_data(loc, name, H5T_NATIVE_DOUBLE, v, st, units)
   end subroutine dset_real
 
-  !> Write an integer array of any rank (or a scalar) as the dataset `name` of `loc`.
-  subroutine dset_int(loc, name, v, st)
+  !> Write an integer array of any rank (or a scalar) as the dataset `name` of `loc`,
+  !! with the attribute `units` when given.
+  subroutine dset_int(loc, name, v, st, units)
     integer, intent(in), target, contiguous :: v(..)        !< the data
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
     type(h5_status_t), intent(inout) :: st                  !< status
-    call put_data(loc, name, H5T_NATIVE_INTEGER, v, st)
+    character(len=*), intent(in), optional :: units         !< unit of the values
+    call put_data(loc, name, H5T_NATIVE_INTEGER, v, st, units)
   end subroutine dset_int
 
   !> A numeric dataset of memory type `mtype` from contiguous data of any rank.
-  subroutine put_data(loc, name, mtype, v, st)
+  subroutine put_data(loc, name, mtype, v, st, units)
     integer(hid_t), intent(in) :: loc, mtype
     character(len=*), intent(in) :: name
     type(*), intent(in), target, contiguous :: v(..)
     type(h5_status_t), intent(inout) :: st
+    character(len=*), intent(in), optional :: units
     type(c_ptr) :: p
     p = c_null_ptr
     if (size(v) > 0) p = c_loc(v)
-    call put(loc, name, .false., mtype, shape(v, kind=hsize_t), p, st)
+    call put(loc, name, .false., mtype, shape(v, kind=hsize_t), p, st, units)
   end subroutine put_data
 
   !> Write a string as the scalar dataset `name` of `loc`.
@@ -181,39 +204,61 @@ contains
     end select
   end subroutine write_attr
 
-  !> A scalar fixed-length string (Fortran, space padded; an empty one is stored as ' ').
-  subroutine put_string(loc, name, attr, s, st)
+  !> A scalar string: an attribute as a variable-length UTF-8 string (h5py reads `str`),
+  !! a dataset as a fixed-length one (Fortran, space padded; an empty one is stored as ' ').
+  recursive subroutine put_string(loc, name, attr, s, st)
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name, s
     logical, intent(in) :: attr
     type(h5_status_t), intent(inout) :: st
     character(kind=c_char), allocatable, target :: c(:)
+    type(c_ptr), target :: pv(1)
     integer(hid_t) :: ty
     integer :: n, e, ec
     if (st%failed) return
-    n = max(1, len(s))
-    c = transfer(s//' ', 'a', n)
-    call h5tcopy_f(H5T_FORTRAN_S1, ty, e)
+    if (attr) then
+      n = len(s) + 1
+      c = transfer(s//c_null_char, 'a', n)
+      pv(1) = c_loc(c)
+      call h5tcopy_f(H5T_C_S1, ty, e)
+    else
+      n = max(1, len(s))
+      c = transfer(s//' ', 'a', n)
+      call h5tcopy_f(H5T_FORTRAN_S1, ty, e)
+    end if
     if (e /= 0) then
       call fail(st, 'failed to make the string type of', loc, name)
       return
     end if
-    call h5tset_size_f(ty, int(n, size_t), e)
+    if (attr) then
+      ! H5T_VARIABLE is (size_t)-1, which the Fortran library passes on as it is
+      call h5tset_size_f(ty, -1_size_t, e)
+      if (e == 0) call h5tset_strpad_f(ty, H5T_STR_NULLTERM_F, e)
+      if (e == 0) call h5tset_cset_f(ty, H5T_CSET_UTF8_F, e)
+    else
+      call h5tset_size_f(ty, int(n, size_t), e)
+    end if
     if (e /= 0) call fail(st, 'failed to make the string type of', loc, name)
-    call put(loc, name, attr, ty, SCALAR, c_loc(c), st)
+    if (attr) then
+      call put(loc, name, attr, ty, SCALAR, c_loc(pv), st)
+    else
+      call put(loc, name, attr, ty, SCALAR, c_loc(c), st)
+    end if
     call h5tclose_f(ty, ec)
   end subroutine put_string
 
   !> The one writer: create `name` in `loc` as a dataset, or an attribute when `attr`, of
   !! memory (and file) type `mtype` and shape `dims` (none: scalar), and write the data at
-  !! `buf` (not touched when the shape has no element).
-  subroutine put(loc, name, attr, mtype, dims, buf, st)
+  !! `buf` (not touched when the shape has no element); a dataset gets the attribute
+  !! `units` when given.
+  recursive subroutine put(loc, name, attr, mtype, dims, buf, st, units)
     integer(hid_t), intent(in) :: loc, mtype
     character(len=*), intent(in) :: name
     logical, intent(in) :: attr
     integer(hsize_t), intent(in) :: dims(:)
     type(c_ptr), intent(in) :: buf
     type(h5_status_t), intent(inout) :: st
+    character(len=*), intent(in), optional :: units
     integer(hid_t) :: sp, obj
     integer :: e, ec
     if (st%failed) return
@@ -242,12 +287,96 @@ contains
         end if
         if (e /= 0) call fail(st, 'failed to write '//kind_name(attr), loc, name)
       end if
+      if (present(units) .and. .not. attr) call put_string(obj, 'units', .true., units, st)
       call close_object(attr, obj, loc, name, st)
     end if
     call h5sclose_f(sp, ec)
   end subroutine put
 
   ! ---- reading --------------------------------------------------------------------------
+
+  !> Whether the dataset (or group), or the attribute when `attr`, `name` of `loc` exists.
+  logical function exists(loc, name, attr)
+    integer(hid_t), intent(in) :: loc                   !< file, group or dataset
+    character(len=*), intent(in) :: name                !< its name
+    logical, intent(in) :: attr                         !< an attribute (else a dataset or group)
+    integer :: e
+    exists = .false.
+    if (attr) then
+      call h5aexists_f(loc, name, exists, e)
+    else
+      call h5lexists_f(loc, name, exists, e)
+    end if
+    if (e /= 0) exists = .false.
+  end function exists
+
+  !> The type class (CLASS_*) and the shape of the dataset, or of the attribute when
+  !! `attr`, `name` of `loc`, without reading it. dims is in Fortran order (h5py shows it
+  !! reversed), of size 0 for a scalar. A failure when the object cannot be opened.
+  subroutine describe(loc, name, attr, cls, dims, st)
+    integer(hid_t), intent(in) :: loc                       !< file, group or dataset
+    character(len=*), intent(in) :: name                    !< object name
+    logical, intent(in) :: attr                             !< an attribute (else a dataset)
+    integer, intent(out) :: cls                             !< CLASS_*
+    integer(hsize_t), allocatable, intent(out) :: dims(:)   !< stored shape
+    type(h5_status_t), intent(inout) :: st                  !< status
+    integer(hid_t) :: obj, ty, sp
+    integer(hsize_t), allocatable :: maxd(:)
+    integer :: e, ec, r, tc
+    logical :: vl
+    cls = CLASS_OTHER
+    allocate (dims(0))
+    if (st%failed) return
+    if (attr) then
+      call h5aopen_f(loc, name, obj, e)
+    else
+      call h5dopen_f(loc, name, obj, e)
+    end if
+    if (e /= 0) then
+      call fail(st, 'failed to open '//kind_name(attr), loc, name)
+      return
+    end if
+    if (attr) then
+      call h5aget_type_f(obj, ty, e)
+    else
+      call h5dget_type_f(obj, ty, e)
+    end if
+    if (e == 0) then
+      call h5tget_class_f(ty, tc, e)
+      if (e == 0) then
+        if (tc == H5T_INTEGER_F) then
+          cls = CLASS_INTEGER
+        else if (tc == H5T_FLOAT_F) then
+          cls = CLASS_REAL
+        else if (tc == H5T_STRING_F) then
+          call h5tis_variable_str_f(ty, vl, e)
+          cls = merge(CLASS_VSTRING, CLASS_STRING, vl)
+        end if
+      end if
+      call h5tclose_f(ty, ec)
+    end if
+    r = -1
+    if (e == 0) then
+      if (attr) then
+        call h5aget_space_f(obj, sp, e)
+      else
+        call h5dget_space_f(obj, sp, e)
+      end if
+      if (e == 0) then
+        call h5sget_simple_extent_ndims_f(sp, r, e)
+        ! this call returns the rank (not 0) in its error argument on success
+        if (e >= 0 .and. r >= 0) then
+          deallocate (dims)
+          allocate (dims(r), maxd(r))
+          e = 0
+          if (r > 0) call h5sget_simple_extent_dims_f(sp, dims, maxd, e)
+        end if
+        call h5sclose_f(sp, ec)
+      end if
+    end if
+    if (e < 0 .or. r < 0) call fail(st, 'failed to read the type and shape of '//kind_name(attr), loc, name)
+    call close_object(attr, obj, loc, name, st)
+  end subroutine describe
 
   !> Read a real dataset of rank 1 or 2 into v, allocated to the stored shape.
   subroutine read_real(loc, name, v, st)
@@ -258,7 +387,7 @@ contains
     integer(hsize_t) :: d(2)
     if (rank(v) > 2) call fail(st, 'cannot read an array of rank above 2 from dataset', loc, name)
     if (st%failed) return
-    call extent(loc, name, d(1:rank(v)), st)
+    call extent(loc, name, CLASS_REAL, d(1:rank(v)), st)
     if (st%failed) return
     select rank (v)
     rank (1)
@@ -276,7 +405,7 @@ contains
     integer, allocatable, target, intent(out) :: v(:)       !< the data
     type(h5_status_t), intent(inout) :: st                  !< status
     integer(hsize_t) :: d(1)
-    call extent(loc, name, d, st)
+    call extent(loc, name, CLASS_INTEGER, d, st)
     if (st%failed) return
     allocate (v(d(1)))
     if (d(1) > 0) call get(loc, name, .false., H5T_NATIVE_INTEGER, c_loc(v), st)
@@ -289,11 +418,17 @@ contains
     character(len=:), allocatable, intent(out) :: s         !< the text
     type(h5_status_t), intent(inout) :: st                  !< status
     character(kind=c_char), allocatable, target :: c(:)
+    integer(hsize_t), allocatable :: dims(:)
     integer(hid_t) :: ds, ty
     integer(size_t) :: n
-    integer :: e, ec
+    integer :: e, ec, cls
     s = ''
+    call describe(loc, name, .false., cls, dims, st)
     if (st%failed) return
+    if (cls /= CLASS_STRING .or. size(dims) /= 0) then
+      call fail(st, 'not a scalar fixed-length string:', loc, name)
+      return
+    end if
     call h5dopen_f(loc, name, ds, e)
     if (e /= 0) then
       call fail(st, 'failed to open dataset', loc, name)
@@ -313,24 +448,41 @@ contains
     if (e == 0) call h5tclose_f(ty, ec)
   end subroutine read_str
 
-  !> Read the scalar attribute `name` of `loc` into v (real or integer).
+  !> Read the scalar attribute `name` of `loc` into v (real or integer); a failure unless
+  !! the attribute holds one number of that class.
   subroutine read_attr(loc, name, v, st)
     integer(hid_t), intent(in) :: loc                   !< file, group or dataset
     character(len=*), intent(in) :: name                !< attribute name
     class(*), intent(inout), target :: v                !< receives the value
     type(h5_status_t), intent(inout) :: st              !< status
+    integer(hsize_t), allocatable :: dims(:)
+    integer :: cls, want
+    select type (v)
+    type is (real(wp))
+      want = CLASS_REAL
+    type is (integer)
+      want = CLASS_INTEGER
+    class default
+      call fail(st, 'cannot read this type from attribute', loc, name)
+      return
+    end select
+    call describe(loc, name, .true., cls, dims, st)
+    if (st%failed) return
+    if (cls /= want .or. product(dims) /= 1) then
+      call fail(st, 'not a single '//merge('real   ', 'integer', want == CLASS_REAL)//' value: attribute', loc, name)
+      return
+    end if
     select type (v)
     type is (real(wp))
       call get(loc, name, .true., H5T_NATIVE_DOUBLE, c_loc(v), st)
     type is (integer)
       call get(loc, name, .true., H5T_NATIVE_INTEGER, c_loc(v), st)
-    class default
-      call fail(st, 'cannot read this type from attribute', loc, name)
     end select
   end subroutine read_attr
 
   !> The one reader: read the dataset, or the attribute when `attr`, `name` of `loc` as
-  !! memory type `mtype` into the memory at `buf` (allocated by the caller).
+  !! memory type `mtype` into the memory at `buf` (allocated by the caller to the size
+  !! the caller has checked).
   subroutine get(loc, name, attr, mtype, buf, st)
     integer(hid_t), intent(in) :: loc, mtype
     character(len=*), intent(in) :: name
@@ -354,32 +506,26 @@ contains
     if (eo == 0) call close_object(attr, obj, loc, name, st)
   end subroutine get
 
-  !> The stored shape of dataset `name`; a failure when its rank is not size(dims).
-  subroutine extent(loc, name, dims, st)
+  !> The stored shape of dataset `name`; a failure when its rank is not size(dims) or its
+  !! class is not `cls`.
+  subroutine extent(loc, name, cls, dims, st)
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name
+    integer, intent(in) :: cls
     integer(hsize_t), intent(out) :: dims(:)
     type(h5_status_t), intent(inout) :: st
-    integer(hsize_t) :: maxd(size(dims))
-    integer(hid_t) :: ds, sp
-    integer :: e, ec, r
+    integer(hsize_t), allocatable :: d(:)
+    integer :: c
     dims = 0
+    call describe(loc, name, .false., c, d, st)
     if (st%failed) return
-    call h5dopen_f(loc, name, ds, e)
-    if (e /= 0) then
-      call fail(st, 'failed to open dataset', loc, name)
-      return
+    if (c /= cls) then
+      call fail(st, 'dataset does not hold '//merge('real numbers', 'integers    ', cls == CLASS_REAL)//':', loc, name)
+    else if (size(d) /= size(dims)) then
+      call fail(st, 'dataset does not have the expected rank:', loc, name)
+    else
+      dims = d
     end if
-    r = -1
-    call h5dget_space_f(ds, sp, e)
-    if (e == 0) then
-      call h5sget_simple_extent_ndims_f(sp, r, e)
-      ! this call returns the rank (not 0) in its error argument on success
-      if (e == 0 .and. r == size(dims)) call h5sget_simple_extent_dims_f(sp, dims, maxd, e)
-      call h5sclose_f(sp, ec)
-    end if
-    call h5dclose_f(ds, ec)
-    if (e < 0 .or. r /= size(dims)) call fail(st, 'dataset does not have the expected rank:', loc, name)
   end subroutine extent
 
   ! ---- support ------------------------------------------------------------------------

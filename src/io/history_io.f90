@@ -12,18 +12,19 @@ module history_io
 
 contains
 
-  !> Write the group /history of an open file from the first res%nhist entries.
+  !> Write the group /history of an open file from the first res%nhist entries; units:
+  !! '1' (relative criterion and residual, counts), 's' (wall time).
   subroutine write_history(fid, res, st)
     integer(hid_t), intent(in) :: fid              !< open file
     type(contact_result_t), intent(in) :: res      !< history source
     type(h5_status_t), intent(inout) :: st         !< status (first failure kept)
     integer(hid_t) :: gid
     call group_open(fid, 'history', gid, st, create=.true.)
-    call write_dset(gid, 'criterion', res%h_criterion(1:res%nhist), st)
-    call write_dset(gid, 'residual', res%h_residual(1:res%nhist), st)
-    call write_dset(gid, 'inner', res%h_inner(1:res%nhist), st)
-    call write_dset(gid, 'active', res%h_active(1:res%nhist), st)
-    call write_dset(gid, 'wall_s', res%h_wall(1:res%nhist), st)
+    call write_dset(gid, 'criterion', res%h_criterion(1:res%nhist), st, '1')
+    call write_dset(gid, 'residual', res%h_residual(1:res%nhist), st, '1')
+    call write_dset(gid, 'inner', res%h_inner(1:res%nhist), st, '1')
+    call write_dset(gid, 'active', res%h_active(1:res%nhist), st, '1')
+    call write_dset(gid, 'wall_s', res%h_wall(1:res%nhist), st, 's')
     call group_close(gid, st)
   end subroutine write_history
 

@@ -1,14 +1,18 @@
 !> Result files: one HDF5 file per run, written whole or not at all (temporary
-!! name in the same folder, then rename), and an XDMF 3 file beside it so that
-!! ParaView opens both bodies directly.
+!! name in the same folder, then rename), and XDMF 3 files beside it so that
+!! ParaView opens both bodies and the contact line directly, and meshio reads each.
+!!
+!! Every numeric dataset has a string attribute `units` (the deck's unit names: length,
+!! stress, force/length for the nodal contact force in 2D, '1' for pure numbers and
+!! counts, 's' for wall times); the root has `unit_length`, `unit_force`, `unit_stress`.
 module results
   use kinds, only: wp
   use hdf5, only: hid_t
   use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, write_dset, write_attr
   use history_io, only: write_history
-  use files, only: temp_name, replace_suffix, base_name, ensure_parent_dir, atomic_rename, remove_file, &
-                   write_text
-  use config, only: deck_t, ELEM_Q1, element_names
+  use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
+                   write_text, commit_files
+  use config, only: deck_t, units_cfg_t, ELEM_Q1, element_names
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t
@@ -32,11 +36,15 @@ module results
 
   public :: write_results, remove_results
 
+  integer, parameter :: NFILES = 5   ! the HDF5 file and four XDMF files
+
 contains
 
-  !> Write the HDF5 result and its XDMF companions, each under a temporary name first and
-  !! renamed only when all are complete. ok = .false. and msg (naming the file and what
-  !! failed) otherwise; then no file is left under a result name nor a temporary one.
+  !> Write the HDF5 result and its XDMF companions, each under a temporary name of this
+  !! run first, and commit them together (`commit_files`: companions first, the HDF5 file
+  !! last) only when all are complete. ok = .false. and msg (naming the file and what
+  !! failed) otherwise; then the files of an earlier result at these names are as they
+  !! were, and no temporary file is left.
   subroutine write_results(file, d, msh, sys, itf, res, u, tm, ok, msg)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
@@ -48,7 +56,9 @@ contains
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     logical, intent(out) :: ok                         !< success
     character(len=*), intent(out) :: msg               !< failure description
-    character(len=len_trim(file) + 16) :: name(4)
+    character(len=len_trim(file) + 16) :: name(NFILES)
+    character(len=len_trim(file) + 128) :: tmp(NFILES)
+    character(len=:), allocatable :: why, h5
     type(h5_status_t) :: st
     integer :: k, a
 
@@ -56,69 +66,66 @@ contains
     msg = ''
     call ensure_parent_dir(file)
     call result_files(file, name)
-    call write_h5(temp_name(name(1)), d, msh, sys, itf, res, u, tm, st)
+    do k = 1, NFILES
+      tmp(k) = temp_name(name(k))
+    end do
+    call write_h5(tmp(1), d, msh, sys, itf, res, u, tm, run_id(), st)
     if (st%failed) then
       msg = 'cannot write '//trim(file)//' ('//st%what//')'
-      call remove_all(.false.)
+      call remove_temps()
       return
     end if
-    ! the XDMF files: both bodies (ParaView), then one body each (meshio)
-    call write_text(temp_name(name(2)), xdmf_text([1, 2], base_name(file), msh), ok)
-    do a = 1, 2
-      if (ok) call write_text(temp_name(name(2 + a)), xdmf_text([a], base_name(file), msh), ok)
+    ! the XDMF files: both bodies and the contact line (ParaView), then one grid each (meshio)
+    h5 = base_name(file)
+    call write_text(tmp(2), xdmf_text([1, 2, 3], h5, msh, itf%m, run_id()), ok)
+    do a = 1, 3
+      if (ok) call write_text(tmp(2 + a), xdmf_text([a], h5, msh, itf%m, run_id()), ok)
     end do
     if (.not. ok) then
       msg = 'cannot write the XDMF files beside '//trim(file)
-      call remove_all(.false.)
+      call remove_temps()
       return
     end if
     ! companions first, the HDF5 file last: it appears only with its XDMF files
-    do k = size(name), 1, -1
-      call atomic_rename(temp_name(name(k)), name(k), ok)
-      if (.not. ok) then
-        msg = 'cannot rename '//temp_name(name(k))//' to '//trim(name(k))
-        call remove_all(.true.)
-        return
-      end if
-    end do
+    call commit_files(tmp(NFILES:1:-1), name(NFILES:1:-1), ok, why)
+    if (.not. ok) msg = 'cannot write '//trim(file)//': '//why
 
   contains
 
-    subroutine remove_all(finals)
-      logical, intent(in) :: finals   ! also the final names (some renames were done)
+    subroutine remove_temps()
       integer :: j
-      do j = 1, size(name)
-        call remove_file(temp_name(name(j)))
-        if (finals) call remove_file(name(j))
+      do j = 1, NFILES
+        call remove_file(tmp(j))
       end do
-    end subroutine remove_all
+    end subroutine remove_temps
 
   end subroutine write_results
 
-  !> Remove the files of a result (the HDF5 file and its XDMF companions), so that a run
-  !! that ends before writing leaves none of an earlier run's behind.
+  !> Remove the files of a result (the HDF5 file and its XDMF companions).
   subroutine remove_results(file)
     character(len=*), intent(in) :: file   !< result path (.h5)
-    character(len=len_trim(file) + 16) :: name(4)
+    character(len=len_trim(file) + 16) :: name(NFILES)
     integer :: k
     call result_files(file, name)
-    do k = 1, size(name)
+    do k = 1, NFILES
       call remove_file(name(k))
     end do
   end subroutine remove_results
 
-  !> The files of a result: the HDF5 file, <stem>.xdmf, <stem>_body1.xdmf, <stem>_body2.xdmf.
+  !> The files of a result: the HDF5 file, <stem>.xdmf, <stem>_body1.xdmf,
+  !! <stem>_body2.xdmf, <stem>_contact.xdmf.
   subroutine result_files(file, name)
     character(len=*), intent(in) :: file
-    character(len=*), intent(out) :: name(4)
+    character(len=*), intent(out) :: name(NFILES)
     name(1) = file
     name(2) = replace_suffix(file, '.h5', '.xdmf')
     name(3) = replace_suffix(file, '.h5', '_body1.xdmf')
     name(4) = replace_suffix(file, '.h5', '_body2.xdmf')
+    name(5) = replace_suffix(file, '.h5', '_contact.xdmf')
   end subroutine result_files
 
   !> The HDF5 result file `path`, whole; st records the first failure.
-  subroutine write_h5(path, d, msh, sys, itf, res, u, tm, st)
+  subroutine write_h5(path, d, msh, sys, itf, res, u, tm, run_id, st)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(2)
@@ -127,12 +134,18 @@ contains
     type(contact_result_t), intent(in) :: res
     real(wp), intent(in) :: u(:, :)
     type(timing_t), intent(in) :: tm
+    character(len=*), intent(in) :: run_id
     type(h5_status_t), intent(inout) :: st
     integer(hid_t) :: fid, gid
     integer :: a, k, i
     real(wp), allocatable :: sig(:, :), vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
     character(len=8) :: bname
+    character(len=:), allocatable :: ul, us, uf
+    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
 
+    ul = trim(d%units%length)
+    us = trim(d%units%stress)
+    uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
     call file_open(path, fid, st, create=.true.)
     ! root attributes
     call write_attr(fid, 'status', trim(res%status), st)
@@ -141,6 +154,10 @@ contains
     call write_attr(fid, 'version', program_version, st)
     call write_attr(fid, 'title', trim(d%title), st)
     call write_attr(fid, 'deck', trim(d%source), st)
+    call write_attr(fid, 'run_id', run_id, st)
+    call write_attr(fid, 'unit_length', ul, st)
+    call write_attr(fid, 'unit_force', trim(d%units%force), st)
+    call write_attr(fid, 'unit_stress', us, st)
     call write_attr(fid, 'outer_iterations', res%outer, st)
     call write_attr(fid, 'inner_iterations', res%inner, st)
     call write_attr(fid, 'contact_nodes', itf%m, st)
@@ -167,26 +184,32 @@ contains
     call group_close(gid, st)
     ! contact
     call group_open(fid, 'contact', gid, st, create=.true.)
-    call write_dset(gid, 'x', itf%s, st)
-    call write_dset(gid, 'coordinates', transpose(itf%xy), st)
-    call write_dset(gid, 'g0', itf%g0, st)
-    call write_dset(gid, 'tributary_length', itf%trib, st)
-    call write_dset(gid, 'normal_force', res%lam, st)
-    call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st)
-    call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st)
+    call write_dset(gid, 'x', itf%s, st, ul)
+    allocate (w2(itf%m, 2))
+    w2 = transpose(itf%xy)   ! contiguous (gfortran passes a transpose as a strided view)
+    call write_dset(gid, 'coordinates', w2, st, ul)
+    deallocate (w2)
+    call write_dset(gid, 'g0', itf%g0, st, ul)
+    call write_dset(gid, 'tributary_length', itf%trib, st, ul)
+    call write_dset(gid, 'normal_force', res%lam, st, uf)
+    call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
+    call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
     allocate (pres(itf%m))
     where (itf%trib > 0.0_wp)
       pres = res%lam/itf%trib
     elsewhere
       pres = 0.0_wp
     end where
-    call write_dset(gid, 'pressure', pres, st)
-    call write_dset(gid, 'gap', res%gap, st)
-    call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st)
-    call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st)
-    call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st)
-    call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st)
-    call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st)
+    call write_dset(gid, 'pressure', pres, st, us)
+    call write_dset(gid, 'gap', res%gap, st, ul)
+    call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
+    call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
+    call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
+    call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
+    call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
+    ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
+    call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
+    call write_dset(gid, 'segments', line_cells(itf%m), st, '1')
     call group_close(gid, st)
     call write_history(fid, res, st)
     ! bodies
@@ -201,26 +224,31 @@ contains
       allocate (w2(msh(a)%nnode, 2), w3(3, msh(a)%nnode), ua(sys(a)%ndof))
       ua = u(1:sys(a)%ndof, a)
       w2 = transpose(msh(a)%xy)
-      call write_dset(gid, 'coordinates', w2, st)
+      call write_dset(gid, 'coordinates', w2, st, ul)
       w2 = transpose(reshape(ua, [2, msh(a)%nnode]))
-      call write_dset(gid, 'displacement', w2, st)
+      call write_dset(gid, 'displacement', w2, st, ul)
       w3 = pad3(msh(a)%xy)
-      call write_dset(gid, 'geometry_xyz', w3, st)
+      call write_dset(gid, 'geometry_xyz', w3, st, ul)
       w3 = pad3(reshape(ua, [2, msh(a)%nnode]))
-      call write_dset(gid, 'displacement_xyz', w3, st)
-      call write_dset(gid, 'cells', msh(a)%cells - 1, st)
+      call write_dset(gid, 'displacement_xyz', w3, st, ul)
+      call write_dset(gid, 'cells', msh(a)%cells - 1, st, '1')
+      call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
       allocate (sig(4, msh(a)%nnode), vm(msh(a)%nnode), sigt(msh(a)%nnode, 4))
       call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sig, vm)
       sigt = transpose(sig)
-      call write_dset(gid, 'stress', sigt, st)
-      call write_dset(gid, 'von_mises', vm, st)
+      call write_dset(gid, 'stress', sigt, st, us)
+      ! the components once more, one dataset each (what XDMF readers show as fields)
+      do k = 1, 4
+        call write_dset(gid, comp(k), sigt(:, k), st, us)
+      end do
+      call write_dset(gid, 'von_mises', vm, st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
       vm = 0.0_wp
       do k = 1, itf%m
         i = itf%node(k, a)
         vm(i) = pres(k)
       end do
-      call write_dset(gid, 'contact_pressure', vm, st)
+      call write_dset(gid, 'contact_pressure', vm, st, us)
       deallocate (w2, w3, ua, sigt, sig, vm)
       call group_close(gid, st)
     end do
@@ -234,25 +262,52 @@ contains
     p(3, :) = 0.0_wp
   end function pad3
 
-  !> An XDMF 3 file, as text, describing the bodies `bodies` of the HDF5 file `h5`: one
-  !! uniform grid directly under Domain for one body (the layout meshio reads), a spatial
-  !! collection for both (ParaView).
-  function xdmf_text(bodies, h5, msh) result(t)
-    integer, intent(in) :: bodies(:)
+  !> The cells of the contact line over its m nodes (0-based, h5py shape (cells, n)):
+  !! m - 1 segments (k, k+1), or for m < 2 the m nodes as vertices.
+  function line_cells(m) result(c)
+    integer, intent(in) :: m
+    integer, allocatable :: c(:, :)
+    integer :: k
+    if (m >= 2) then
+      allocate (c(2, m - 1))
+      do k = 1, m - 1
+        c(:, k) = [k - 1, k]
+      end do
+    else
+      allocate (c(1, m))
+      c(1, :) = [(k - 1, k = 1, m)]
+    end if
+  end function line_cells
+
+  !> An XDMF 3 file, as text, describing the grids `grids` (1, 2: the bodies, 3: the
+  !! contact line) of the HDF5 file `h5`: one uniform grid directly under Domain for one
+  !! grid (the layout meshio reads), a spatial collection for several (ParaView). A
+  !! comment names the run that wrote it (the HDF5 file's attribute run_id).
+  function xdmf_text(grids, h5, msh, m, run_id) result(t)
+    integer, intent(in) :: grids(:)
     character(len=*), intent(in) :: h5
     type(mesh_t), intent(in) :: msh(2)
-    character(len=:), allocatable :: t
+    integer, intent(in) :: m
+    character(len=*), intent(in) :: run_id
+    character(len=:), allocatable :: t, h
     integer :: k
-    t = line('<?xml version="1.0" ?>')//line('<Xdmf Version="3.0">')//line('  <Domain>')
-    if (size(bodies) > 1) t = t//line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
-    do k = 1, size(bodies)
-      t = t//grid_text(bodies(k), h5, msh(bodies(k)))
+    h = xml_escape(h5)
+    t = line('<?xml version="1.0" ?>')//line('<!-- robin_contact '//program_version//' run_id '//run_id//' -->')// &
+        line('<Xdmf Version="3.0">')//line('  <Domain>')
+    if (size(grids) > 1) t = t//line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
+    do k = 1, size(grids)
+      if (grids(k) <= 2) then
+        t = t//grid_text(grids(k), h, msh(grids(k)))
+      else
+        t = t//contact_grid_text(h, m)
+      end if
     end do
-    if (size(bodies) > 1) t = t//line('    </Grid>')
+    if (size(grids) > 1) t = t//line('    </Grid>')
     t = t//line('  </Domain>')//line('</Xdmf>')
   end function xdmf_text
 
-  !> One body as an XDMF uniform grid (topology, XYZ geometry, nodal fields).
+  !> One body as an XDMF uniform grid (topology, XYZ geometry, nodal fields, body id per
+  !! cell); h5 is the HDF5 file name, escaped for XML.
   function grid_text(a, h5, msh) result(t)
     integer, intent(in) :: a
     character(len=*), intent(in) :: h5
@@ -261,6 +316,8 @@ contains
     character(len=16) :: topo
     character(len=64) :: nn, nc, nv
     character(len=:), allocatable :: g
+    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    integer :: k
     if (msh%element == ELEM_Q1) then
       topo = 'Quadrilateral'
     else
@@ -275,25 +332,98 @@ contains
     t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
                 '" NumberType="Int" Precision="4" Format="HDF">'//g//'/cells</DataItem>')
     t = t//line('        </Topology>')
-    t = t//line('        <Geometry GeometryType="XYZ">')
-    t = t//line('          <DataItem Dimensions="'//trim(nn)//' 3" NumberType="Float" Precision="8" '// &
-                'Format="HDF">'//g//'/geometry_xyz</DataItem>')
-    t = t//line('        </Geometry>')
+    t = t//geometry_text(trim(nn), g//'/geometry_xyz')
     t = t//field_text('displacement', 'Vector', trim(nn)//' 3', g//'/displacement_xyz')
     t = t//field_text('von_mises', 'Scalar', trim(nn), g//'/von_mises')
     t = t//field_text('contact_pressure', 'Scalar', trim(nn), g//'/contact_pressure')
+    do k = 1, 4
+      t = t//field_text(comp(k), 'Scalar', trim(nn), g//'/'//comp(k))
+    end do
+    t = t//field_text('body_id', 'Scalar', trim(nc), g//'/body_id', 'Cell')
     t = t//line('      </Grid>')
   end function grid_text
 
-  !> A nodal field of a grid.
-  function field_text(name, kind, dims, path) result(t)
-    character(len=*), intent(in) :: name, kind, dims, path
+  !> The contact line as an XDMF uniform grid: a polyline over the m contact nodes with
+  !! the contact fields at its nodes.
+  function contact_grid_text(h5, m) result(t)
+    character(len=*), intent(in) :: h5
+    integer, intent(in) :: m
+    character(len=:), allocatable :: t, g
+    character(len=64) :: nn, nc, nv
+    character(len=25), parameter :: f(5) = [character(len=25) :: 'pressure', 'normal_force', 'gap', &
+                                            'normal_displacement_body1', 'normal_displacement_body2']
+    integer :: k
+    write (nn, '(i0)') m
+    if (m >= 2) then
+      write (nc, '(i0)') m - 1
+      nv = '2'
+      t = '        <Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="'
+    else
+      write (nc, '(i0)') m
+      nv = '1'
+      t = '        <Topology TopologyType="Polyvertex" NodesPerElement="1" NumberOfElements="'
+    end if
+    g = h5//':/contact'
+    t = line('      <Grid Name="contact" GridType="Uniform">')//line(t//trim(nc)//'">')
+    t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
+                '" NumberType="Int" Precision="4" Format="HDF">'//g//'/segments</DataItem>')
+    t = t//line('        </Topology>')
+    t = t//geometry_text(trim(nn), g//'/geometry_xyz')
+    do k = 1, size(f)
+      t = t//field_text(trim(f(k)), 'Scalar', trim(nn), g//'/'//trim(f(k)))
+    end do
+    t = t//line('      </Grid>')
+  end function contact_grid_text
+
+  !> The XYZ geometry of a grid of n points.
+  function geometry_text(n, path) result(t)
+    character(len=*), intent(in) :: n, path
     character(len=:), allocatable :: t
-    t = line('        <Attribute Name="'//name//'" AttributeType="'//kind//'" Center="Node">')// &
-        line('          <DataItem Dimensions="'//dims//'" NumberType="Float" Precision="8" '// &
+    t = line('        <Geometry GeometryType="XYZ">')// &
+        line('          <DataItem Dimensions="'//n//' 3" NumberType="Float" Precision="8" '// &
              'Format="HDF">'//path//'</DataItem>')// &
+        line('        </Geometry>')
+  end function geometry_text
+
+  !> A field of a grid: nodal (default) or per cell (center = 'Cell', integer data).
+  function field_text(name, kind, dims, path, center) result(t)
+    character(len=*), intent(in) :: name, kind, dims, path
+    character(len=*), intent(in), optional :: center
+    character(len=:), allocatable :: t, c, ty
+    c = 'Node'
+    ty = 'NumberType="Float" Precision="8"'
+    if (present(center)) then
+      c = center
+      ty = 'NumberType="Int" Precision="4"'
+    end if
+    t = line('        <Attribute Name="'//name//'" AttributeType="'//kind//'" Center="'//c//'">')// &
+        line('          <DataItem Dimensions="'//dims//'" '//ty//' Format="HDF">'//path//'</DataItem>')// &
         line('        </Attribute>')
   end function field_text
+
+  !> s with the XML special characters & < > " ' replaced by entities.
+  pure function xml_escape(s) result(t)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: t
+    integer :: i
+    t = ''
+    do i = 1, len(s)
+      select case (s(i:i))
+      case ('&')
+        t = t//'&amp;'
+      case ('<')
+        t = t//'&lt;'
+      case ('>')
+        t = t//'&gt;'
+      case ('"')
+        t = t//'&quot;'
+      case ("'")
+        t = t//'&apos;'
+      case default
+        t = t//s(i:i)
+      end select
+    end do
+  end function xml_escape
 
   pure function line(s) result(t)
     character(len=*), intent(in) :: s

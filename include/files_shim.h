@@ -1,0 +1,18 @@
+/* File-system calls of the output stage (see src/io/files_shim.c), for module files. */
+#ifndef RC_FILES_SHIM_H
+#define RC_FILES_SHIM_H
+/* Write "<host>.<pid>" into buf (n bytes, NUL-terminated), the host name reduced to the
+   characters [A-Za-z0-9_-] (others become '_'); returns its length. */
+int rc_run_token(char *buf, int n);
+/* Open the folder dir and take an exclusive flock on it (waits for other holders; retried
+   when a signal interrupts the wait). Returns the descriptor, or -1 when the folder cannot
+   be opened or locked (then the caller goes on without the lock). */
+int rc_lock_dir(const char *dir);
+/* Release a lock from rc_lock_dir (closes the descriptor); nothing for fd < 0. */
+void rc_unlock_dir(int fd);
+/* What is at path (not following a final symbolic link): 0 nothing, 1 a regular file or a
+   symbolic link, 2 a folder, 3 something else (device, fifo, socket), -1 cannot tell. */
+int rc_path_kind(const char *path);
+/* 1 when the folder dir can take new entries (write and search permission), else 0. */
+int rc_dir_writable(const char *dir);
+#endif

@@ -1,0 +1,58 @@
+/* File-system calls of module files that Fortran cannot make portably: open(2) is
+   variadic, struct stat has no fixed layout. */
+#define _DEFAULT_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <stdio.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "files_shim.h"
+
+int rc_run_token(char *buf, int n)
+{
+    char host[256] = "host";
+    if (n < 1) return 0;
+    if (gethostname(host, sizeof host) != 0) snprintf(host, sizeof host, "host");
+    host[sizeof host - 1] = '\0';
+    for (char *c = host; *c; c++) {
+        int ok = (*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
+                 *c == '_' || *c == '-';
+        if (!ok) *c = '_';
+    }
+    int len = snprintf(buf, (size_t) n, "%.64s.%ld", host, (long) getpid());
+    return len < n ? len : n - 1;
+}
+
+int rc_lock_dir(const char *dir)
+{
+    int fd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) return -1;
+    while (flock(fd, LOCK_EX) != 0) {
+        if (errno != EINTR) {
+            close(fd);
+            return -1;
+        }
+    }
+    return fd;
+}
+
+void rc_unlock_dir(int fd)
+{
+    if (fd >= 0) close(fd);
+}
+
+int rc_path_kind(const char *path)
+{
+    struct stat s;
+    if (lstat(path, &s) != 0) return errno == ENOENT ? 0 : -1;
+    if (S_ISREG(s.st_mode) || S_ISLNK(s.st_mode)) return 1;
+    if (S_ISDIR(s.st_mode)) return 2;
+    return 3;
+}
+
+int rc_dir_writable(const char *dir)
+{
+    return access(dir, W_OK | X_OK) == 0;
+}
