@@ -21,7 +21,7 @@ module contact
 
   integer, parameter :: STALL_LIMIT = 25              !< iterations of small increment / large residual before 'diverged'
   real(wp), parameter :: SMOOTH_RATE_TOL = 0.1_wp   !< rate change below which the outer iteration counts as smooth
-  integer, parameter :: POWER_ITS = 10               !< power iterations for each body's lambda_max (MPRGP guards an underestimate)
+  integer, parameter :: POWER_ITS = 10               !< power iterations for each body's lambda_max (harmonic operator only)
   integer, parameter :: HISTORY_CHUNK = 256          !< initial history entries (grown by doubling)
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
@@ -155,7 +155,7 @@ contains
     allocate (Gnew(m, 2), w(m, 2), dlam(m), corr(m, 2))
     uref = max(maxabs(bc(1)%b), maxabs(bc(2)%b), maxabs(itf%g0), tiny(1.0_wp))
 
-    call body_operators(bc, op, lmax, st_, resumed)
+    call body_operators(bc, op, lmax, st_, resumed, s%robin_operator == ROBIN_HARMONIC)
     call robin_correction_init(corr_op, s, itf, bc, op, info)
     if (info /= 0) then
       res%status = 'failed'
@@ -257,14 +257,19 @@ contains
     res%nhist = st%it
   end subroutine restore_iterate
 
-  !> Each body's Hessian F_a as an operator and its largest eigenvalue (power iterations,
-  !! counted in IT_inner unless the run resumes).
-  subroutine body_operators(bc, op, lmax, st, resumed)
+  !> Each body's Hessian F_a as an operator and a bound of its largest eigenvalue for
+  !! MPRGP's expansion step length. Default: the row-sum norm |F_a|_inf, an upper bound of
+  !! lambda_max for a symmetric matrix (so alpha_bar = 1.9/|F_a|_inf is admissible without
+  !! MPRGP's guard): one pass over F_a (m^2 flops, the cost of one product, but no product:
+  !! not counted in IT_inner). With `power` (the harmonic operator, whose inner tolerance
+  !! uses the ratio of the two estimates): POWER_ITS power iterations, counted in IT_inner
+  !! unless the run resumes.
+  subroutine body_operators(bc, op, lmax, st, resumed, power)
     type(body_condensed_t), intent(in) :: bc(2)
     type(dense_op_t), intent(out) :: op(2)
     real(wp), intent(out) :: lmax(2)
     type(robin_state_t), intent(inout) :: st
-    logical, intent(in) :: resumed
+    logical, intent(in) :: resumed, power
     integer :: a, nmv(2), m
     m = bc(1)%m
     nmv = 0
@@ -272,7 +277,13 @@ contains
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
       call dense_op_init(op(a), bc(a)%flex)
-      if (m > 0) lmax(a) = lambda_max_estimate(op(a), POWER_ITS, nmv(a))
+      if (m > 0) then
+        if (power) then
+          lmax(a) = lambda_max_estimate(op(a), POWER_ITS, nmv(a))
+        else
+          lmax(a) = maxval(sum(abs(bc(a)%flex), dim=1))
+        end if
+      end if
     end do
     !$omp end parallel do
     if (.not. resumed) st%inner = sum(nmv)
