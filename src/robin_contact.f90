@@ -23,7 +23,7 @@ program robin_contact
   use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb, memory_limit_mb, write_stdout_checked
-  use budget, only: check_budget, check_load_range
+  use budget, only: check_budget, check_load_range, body_memory_mb
   use strings, only: sci, fmt_real, i2s
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
@@ -76,6 +76,7 @@ program robin_contact
   ! (write_results); a run that fails leaves it untouched.
 
   ! ---- assemble both bodies --------------------------------------------------------
+  call phase('assembly of both bodies')
   t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
@@ -99,6 +100,8 @@ program robin_contact
     ' m=', itf%m, ' threads=', nthr
 
   ! ---- factorize and condense (one thread per body) -------------------------------
+  call phase('ordering and factorization (estimated factors: body 1 '//factor_estimate(1)//', body 2 '// &
+             factor_estimate(2)//')')
   t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
@@ -129,6 +132,7 @@ program robin_contact
   tm%factor_mb = (cb(1)%chol%mem_bytes + cb(2)%chol%mem_bytes)/1048576.0_wp
 
   ! ---- contact ----------------------------------------------------------------------
+  call phase(merge('Robin iteration  ', 'monolithic solve ', d%solver%method == METHOD_ROBIN))
   t0 = wtime()
   if (d%solver%method == METHOD_MONOLITHIC) then
     call solve_monolithic(d%solver, itf, cb, res, stop_requested)
@@ -174,6 +178,7 @@ program robin_contact
   if (res%status /= 'converged') write (error_unit, '(a)') 'robin_contact: '//trim(res%status)//': '//trim(res%message)
 
   ! ---- output -------------------------------------------------------------------------
+  call phase('output')
   t0 = wtime()
   if (code /= EXIT_NUMERICAL) then
     tm%peak_rss_mb = peak_rss_mb()
@@ -191,6 +196,29 @@ program robin_contact
   call terminate(code)
 
 contains
+
+  !> One line as each phase starts (flushed), so that a batch log shows where a run is.
+  subroutine phase(what)
+    character(len=*), intent(in) :: what
+    write (output_unit, '(a)') 'phase: '//trim(what)//' (at '//fmt_real(wtime() - t_start, '(f0.1)')//' s)'
+    flush (output_unit)
+  end subroutine phase
+
+  !> The budget's estimate of body a's Cholesky factor, '123 MiB' or '1.2 GiB'.
+  function factor_estimate(a) result(s)
+    integer, intent(in) :: a
+    character(len=:), allocatable :: s
+    real(wp) :: nm, nf, mib
+    character(len=24) :: buf
+    mib = body_memory_mb(d%body(a), d%solver%factor, nm, nf)   ! the body's total; the factor's part:
+    mib = 8.5_wp*nf/1048576.0_wp                              ! values and supernodal indices
+    if (mib >= 1024.0_wp) then
+      write (buf, '(f0.1,a)') mib/1024.0_wp, ' GiB'
+    else
+      write (buf, '(i0,a)') nint(mib), ' MiB'
+    end if
+    s = trim(buf)
+  end function factor_estimate
 
   !> A signal before the outer iteration (during assembly, ordering, factorization or
   !! condensation, where the libraries cannot be interrupted safely): stop at the end of
