@@ -40,16 +40,14 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings config sysinfo signals namelist_input deck budget mesh elements lapack linop assembly ordering mprgp cholmod_iface banded cholesky \
-        condense contact_types contact h5io files history_io results checkpoint
+MODS := kinds errors clock strings sysinfo signals config namelist_input deck budget mesh elements lapack linop assembly ordering \
+        cholmod_iface banded cholesky mprgp condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
-        $(BUILD)/sysinfo_shim.o
-OBJS += $(BUILD)/files_shim.o
+        $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact
+TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact test_files
 BENCH_F := bench_mprgp
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
-TEST_BINS  += $(BUILD)/tests/test_files
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
 
 DEPS_STAMP := build/.deps-ok
@@ -83,43 +81,47 @@ $(BUILD)/%.o: %.c include/cholmod_shim.h include/sighdl.h | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) -c $< -o $@
 
-# Explicit module dependencies.
+# Explicit module dependencies: each object depends on the modules its source `use`s
+# (tests/test_makefile_deps.py checks that these lines are exactly the real ones).
+$(BUILD)/kinds.o:
 $(BUILD)/errors.o:
-$(BUILD)/config.o:        $(BUILD)/kinds.o
-$(BUILD)/sysinfo.o:       $(BUILD)/kinds.o
-$(BUILD)/clock.o:         $(BUILD)/kinds.o
-$(BUILD)/strings.o:       $(BUILD)/kinds.o
-$(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
-$(BUILD)/deck.o:          $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o
-$(BUILD)/budget.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o
-$(BUILD)/mesh.o:          $(BUILD)/kinds.o $(BUILD)/config.o
-$(BUILD)/elements.o:      $(BUILD)/kinds.o $(BUILD)/config.o
-$(BUILD)/assembly.o:      $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements.o $(BUILD)/linop.o
-$(BUILD)/ordering.o:      $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
-$(BUILD)/lapack.o:        $(BUILD)/kinds.o
-$(BUILD)/linop.o:         $(BUILD)/kinds.o $(BUILD)/lapack.o
-$(BUILD)/mprgp.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
-$(BUILD)/cholmod_iface.o: $(BUILD)/kinds.o
-$(BUILD)/banded.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/lapack.o
-$(BUILD)/cholesky.o:      $(BUILD)/kinds.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o $(BUILD)/lapack.o
-$(BUILD)/condense.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                          $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
-$(BUILD)/contact_types.o: $(BUILD)/kinds.o
-$(BUILD)/contact.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/linop.o \
-                          $(BUILD)/mprgp.o $(BUILD)/condense.o $(BUILD)/contact_types.o
-$(BUILD)/h5io.o:          $(BUILD)/kinds.o
-$(BUILD)/files.o:
-$(BUILD)/history_io.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o
-$(BUILD)/results.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
-                          $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
-                          $(BUILD)/history_io.o $(BUILD)/files.o
-$(BUILD)/checkpoint.o:    $(BUILD)/kinds.o $(BUILD)/h5io.o $(BUILD)/contact_types.o \
-                          $(BUILD)/history_io.o $(BUILD)/files.o
+$(BUILD)/clock.o:          $(BUILD)/kinds.o
+$(BUILD)/strings.o:        $(BUILD)/kinds.o
+$(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
-$(BUILD)/sysinfo_shim.o:  include/sysinfo_shim.h
-$(BUILD)/files_shim.o:    include/files_shim.h
-$(BUILD)/checkpoint.o:    $(BUILD)/strings.o
-$(BUILD)/robin_contact.o: $(OBJS)
+$(BUILD)/config.o:         $(BUILD)/kinds.o
+$(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
+$(BUILD)/deck.o:           $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/config.o \
+                           $(BUILD)/namelist_input.o
+$(BUILD)/budget.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
+$(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/lapack.o:         $(BUILD)/kinds.o
+$(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
+$(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements.o \
+                           $(BUILD)/linop.o
+$(BUILD)/ordering.o:       $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
+$(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
+$(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/lapack.o
+$(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
+$(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
+                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
+$(BUILD)/contact_types.o:  $(BUILD)/kinds.o
+$(BUILD)/contact.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/strings.o $(BUILD)/config.o \
+                           $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/condense.o \
+                           $(BUILD)/contact_types.o
+$(BUILD)/h5io.o:           $(BUILD)/kinds.o
+$(BUILD)/files.o:
+$(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
+$(BUILD)/results.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
+                           $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
+                           $(BUILD)/history_io.o
+$(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
+                           $(BUILD)/files.o $(BUILD)/history_io.o
+$(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
+$(BUILD)/files_shim.o:     include/files_shim.h
+$(BUILD)/robin_contact.o:  $(OBJS)
 
 # ---- link ----------------------------------------------------------------------
 $(BUILD)/robin_contact: $(BUILD)/robin_contact.o $(OBJS)

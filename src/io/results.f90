@@ -12,7 +12,7 @@ module results
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
-  use config, only: deck_t, units_cfg_t, ELEM_Q1, element_names
+  use config, only: deck_t, ELEM_Q1, element_names
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t
