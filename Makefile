@@ -40,8 +40,8 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings sysinfo signals config namelist_input deck budget mesh elements lapack linop assembly ordering \
-        cholmod_iface banded cholesky mprgp condense contact_types contact h5io files history_io results checkpoint
+MODS := kinds errors clock strings sorting sysinfo signals config namelist_input deck budget mesh elements lapack linop assembly \
+        ordering cholmod_iface banded cholesky mprgp condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
@@ -87,6 +87,7 @@ $(BUILD)/kinds.o:
 $(BUILD)/errors.o:
 $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
+$(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
 $(BUILD)/config.o:         $(BUILD)/kinds.o
@@ -98,11 +99,11 @@ $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
-$(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements.o \
-                           $(BUILD)/linop.o
+$(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
+                           $(BUILD)/elements.o $(BUILD)/linop.o
 $(BUILD)/ordering.o:       $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
-$(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/lapack.o
+$(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \

@@ -11,6 +11,7 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp, i8
+  use sorting, only: sort_by_key
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
@@ -395,16 +396,7 @@ contains
     do a = 1, nd
       perm(a) = a
     end do
-    do a = 2, nd
-      kk = perm(a)
-      b = a - 1
-      do while (b >= 1)
-        if (ldof(perm(b)) <= ldof(kk)) exit
-        perm(b + 1) = perm(b)
-        b = b - 1
-      end do
-      perm(b + 1) = kk
-    end do
+    call sort_by_key(perm(1:nd), ldof)
     do a = 1, nd
       lfree(a) = sys%free_of(ldof(a))
     end do

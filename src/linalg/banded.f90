@@ -4,6 +4,7 @@
 module banded
   use kinds, only: wp, i8
   use clock, only: wtime
+  use sorting, only: sort_by_key
   use lapack, only: dpbtrf, dpbtrs
   implicit none (type, external)
   private
@@ -100,16 +101,7 @@ contains
           end if
         end do
         ! insertion sort of the new nodes by degree
-        do k = first_new + 1, tail
-          t = perm(k)
-          i = k - 1
-          do while (i >= first_new)
-            if (deg(perm(i)) <= deg(t)) exit
-            perm(i + 1) = perm(i)
-            i = i - 1
-          end do
-          perm(i + 1) = t
-        end do
+        call sort_by_key(perm(first_new:tail), deg)
       end do
       nnum = tail
     end do
