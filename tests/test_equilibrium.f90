@@ -8,8 +8,8 @@ program test_equilibrium
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, BC_CLAMPED, BC_CONTACT
   use mesh, only: mesh_t, mesh_build
-  use assembly, only: body_system_t, assemble_body, expand, residual_full
-  use testing, only: report, test_summary, band_solve
+  use assembly, only: body_system_t, assemble_body, residual_full
+  use testing, only: report, test_summary, solve_full
   implicit none (type, external)
 
   real(wp), parameter :: load_y = -11.5e6_wp   ! total applied vertical load [N/m]
@@ -63,18 +63,11 @@ contains
     type(mesh_t), intent(out) :: m
     type(body_system_t), intent(out) :: sys
     real(wp), allocatable, intent(out) :: u(:)
-    real(wp), allocatable :: x(:)
     integer :: info
     character(len=256) :: msg
     call mesh_build(m, body, info, msg)
     if (info == 0) call assemble_body(m, body, plane_strain, tr, size(tr), sys, info, msg)
-    if (info /= 0) then
-      write (*, '(a,a)') 'FAIL  mesh/assembly: ', trim(msg)
-      error stop 1
-    end if
-    allocate (x(sys%n), u(sys%ndof))
-    call band_solve(sys, x)
-    call expand(sys, x, u)
+    call solve_full(sys, info, msg, 'mesh/assembly', u)
   end subroutine solve
 
   subroutine scene(element, plane_strain)

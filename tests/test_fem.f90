@@ -53,7 +53,7 @@ program test_fem
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
                       body_force_fn
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
-  use testing, only: report, test_summary, band_solve
+  use testing, only: report, test_summary, solve_full
   implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -89,16 +89,9 @@ contains
     procedure(body_force_fn), optional :: body_force
     integer :: info
     character(len=256) :: msg
-    real(wp), allocatable :: u(:)
     call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed, &
                        body_force=body_force)
-    if (info /= 0) then
-      write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
-      error stop 1
-    end if
-    allocate (u(sys%n), u_full(sys%ndof))
-    call band_solve(sys, u)
-    call expand(sys, u, u_full)
+    call solve_full(sys, info, msg, 'assemble_body', u_full)
   end subroutine solve_body
 
   !> Body `id`, the rectangle [x0, x0+width] x [y0, y0+height] on an nx x ny grid of

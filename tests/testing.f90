@@ -5,7 +5,7 @@
 module testing
   use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
-  use assembly, only: body_system_t
+  use assembly, only: body_system_t, expand
   use linop, only: csc_op_t, csc_op_init
   use lapack, only: dpbsv
   implicit none (type, external)
@@ -14,7 +14,7 @@ module testing
   integer, public, protected :: npass = 0   !< checks passed so far
   integer, public, protected :: nfail = 0   !< checks failed so far
 
-  public :: report, report_le, test_summary, band_solve, obstacle_problem
+  public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem
 
 contains
 
@@ -82,6 +82,24 @@ contains
       error stop 1
     end if
   end subroutine band_solve
+
+  !> The displacement at every DOF of an assembled body (banded solve, then the prescribed
+  !! values filled in); stops the test program with `what` and msg if info /= 0 (a failed
+  !! mesh or assembly before it).
+  subroutine solve_full(sys, info, msg, what, u_full)
+    type(body_system_t), intent(in) :: sys              !< assembled body
+    integer, intent(in) :: info                         !< status of the mesh and assembly
+    character(len=*), intent(in) :: msg, what           !< their message, and what they were
+    real(wp), allocatable, intent(out) :: u_full(:)     !< displacement at all DOFs
+    real(wp), allocatable :: x(:)
+    if (info /= 0) then
+      write (*, '(a)') 'FAIL  '//what//': '//trim(msg)
+      error stop 1
+    end if
+    allocate (x(sys%n), u_full(sys%ndof))
+    call band_solve(sys, x)
+    call expand(sys, x, u_full)
+  end subroutine solve_full
 
   !> 1D obstacle problem: -u'' = -15 on (0,1), u(0) = u(1) = 0, u >= -1 (flat
   !! obstacle), by finite differences: A = tridiag(-1,2,-1)*(n+1)^2*scale_a in CSC,
