@@ -6,6 +6,7 @@
 !! stress, force/length for the nodal contact force in 2D, '1' for pure numbers and
 !! counts, 's' for wall times); the root has `unit_length`, `unit_force`, `unit_stress`.
 module results
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use hdf5, only: hid_t
   use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, write_dset, write_attr
@@ -235,6 +236,11 @@ contains
       call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
       allocate (sig(4, msh(a)%nnode), vm(msh(a)%nnode), sigt(msh(a)%nnode, 4))
       call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sig, vm)
+      if (.not. (all(ieee_is_finite(sig)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed) then
+        ! a derived field that is not finite is a failure, never part of a result
+        st%failed = .true.
+        st%what = 'the stresses of body '//achar(48 + a)//' are not finite: beyond double precision, rescale the units'
+      end if
       sigt = transpose(sig)
       call write_dset(gid, 'stress', sigt, st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
