@@ -517,8 +517,8 @@ contains
     res%outer = it
     res%inner = st%inner
     res%criterion = st%crit
-    res%nhist = it
     if (it > size(res%h_criterion)) call grow_history(res, min(s%max_outer, 2*size(res%h_criterion) + HISTORY_CHUNK))
+    res%nhist = it
     res%h_criterion(it) = st%crit
     res%h_residual(it) = res%residual
     res%h_inner(it) = st%inner

@@ -135,7 +135,7 @@ contains
     real(wp), allocatable :: r(:)
     integer, allocatable :: i(:)
     integer :: n
-    n = res%nhist
+    n = min(res%nhist, size(res%h_criterion), nh)
     allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_criterion(1:n); call move_alloc(r, res%h_criterion)
     allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_residual(1:n); call move_alloc(r, res%h_residual)
     allocate (r(nh)); r = 0.0_wp; r(1:n) = res%h_wall(1:n); call move_alloc(r, res%h_wall)
