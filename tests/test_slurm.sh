@@ -75,7 +75,7 @@ CMD=("$DECK" "${MESH[@]}" "$SLOW" "&solver max_outer=40000 /" "&output file='$re
 shell=$!
 step=""
 for _ in $(seq 100); do                       # wait for the solver (the step) to start iterating
-  step=$(pgrep -P "$shell" -x robin_contact || true)
+  step=$(pgrep -P "$shell" -f "^$BIN " || true)   # the binary by its path (robin_contact_debug too)
   [ -n "$step" ] && break
   sleep 0.05
 done
