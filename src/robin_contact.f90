@@ -249,8 +249,12 @@ contains
     write (line(1), '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
       ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
       ' complementarity=', res%complementarity
-    line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
-      ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
+    if (res%outer > 0) then
+      line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
+        ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
+    else
+      line(2) = 'accuracy: none (stopped before the first outer iteration: no contact forces to bound)'
+    end if
     write (line(3), '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
       ' peak_mb=', tm%peak_rss_mb, ' factor_mb=', tm%factor_mb

@@ -2,6 +2,7 @@
  * memory limit a run must fit in. */
 #include <errno.h>
 #include <stdio.h>
+#include <string.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -14,8 +15,53 @@ double rc_peak_rss_mb(void)
     return (double) ru.ru_maxrss / 1024.0;   /* ru_maxrss is in KiB on Linux */
 }
 
+/* The smallest memory limit [MiB] of this process's cgroup and its ancestors, 0 if none:
+ * cgroup v2 (`0::/path`, files memory.max) or v1 (the `memory` controller's path, files
+ * memory.limit_in_bytes). A batch scheduler's --mem is such a limit. */
+static double cgroup_limit_mb(void)
+{
+    char line[1024], path[1200], file[1400];
+    const char *root = NULL, *name = NULL;
+    double lim = 0.0;
+    FILE *f = fopen("/proc/self/cgroup", "r");
+    if (f == NULL) return 0.0;
+    path[0] = '\0';
+    while (fgets(line, sizeof line, f) != NULL) {
+        char *p = strchr(line, ':'), *q;
+        if (p == NULL || (q = strchr(p + 1, ':')) == NULL) continue;
+        q[strcspn(q, "\n")] = '\0';
+        if (strncmp(line, "0::", 3) == 0 && root == NULL) {            /* v2 (unless v1 memory found) */
+            snprintf(path, sizeof path, "%s", q + 1);
+            root = "/sys/fs/cgroup"; name = "memory.max";
+        } else if (strstr(p + 1, "memory") != NULL && (size_t) (q - p - 1) >= 6) {   /* v1 memory */
+            snprintf(path, sizeof path, "%s", q + 1);
+            root = "/sys/fs/cgroup/memory"; name = "memory.limit_in_bytes";
+        }
+    }
+    fclose(f);
+    if (root == NULL) return 0.0;
+    for (;;) {   /* this cgroup, then each ancestor */
+        FILE *g;
+        snprintf(file, sizeof file, "%s%s/%s", root, strcmp(path, "/") == 0 ? "" : path, name);
+        g = fopen(file, "r");
+        if (g != NULL) {
+            unsigned long long b;
+            if (fgets(line, sizeof line, g) != NULL && sscanf(line, "%llu", &b) == 1 && b < (1ULL << 60)) {
+                double v = (double) b / 1048576.0;
+                if (lim == 0.0 || v < lim) lim = v;
+            }
+            fclose(g);
+        }
+        if (strcmp(path, "/") == 0 || path[0] == '\0') break;
+        char *slash = strrchr(path, '/');
+        if (slash == NULL) break;
+        if (slash == path) strcpy(path, "/"); else *slash = '\0';
+    }
+    return lim;
+}
+
 /* Memory this process may use [MiB]: the smallest of the memory the kernel reports as
- * available (MemAvailable), the cgroup v2 limit (memory.max) and the address-space
+ * available (MemAvailable), the cgroup limit (v1 or v2, this cgroup and its ancestors) and the address-space
  * rlimit (ulimit -v); 0 if none can be read. */
 double rc_memory_limit_mb(void)
 {
@@ -29,15 +75,8 @@ double rc_memory_limit_mb(void)
             if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) { lim = (double) kb / 1024.0; break; }
         fclose(f);
     }
-    f = fopen("/sys/fs/cgroup/memory.max", "r");
-    if (f != NULL) {
-        unsigned long long b;
-        if (fgets(line, sizeof line, f) != NULL && sscanf(line, "%llu", &b) == 1) {
-            v = (double) b / 1048576.0;
-            if (lim == 0.0 || v < lim) lim = v;
-        }
-        fclose(f);
-    }
+    v = cgroup_limit_mb();
+    if (v > 0.0 && (lim == 0.0 || v < lim)) lim = v;
     if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
         v = (double) rl.rlim_cur / 1048576.0;
         if (lim == 0.0 || v < lim) lim = v;
