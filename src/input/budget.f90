@@ -12,7 +12,7 @@
 module budget
   use kinds, only: wp
   use config, only: deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
-  use strings, only: i2s, sci
+  use strings, only: i2s, sci, fmt_real
   implicit none (type, external)
   private
 
@@ -78,7 +78,7 @@ contains
       if (nm > INDEX_MAX .or. nf > INDEX_MAX) then
         ok = .false.
         msg = 'deck '//trim(d%source)//': body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
-              i2s(d%body(a)%ny)//') needs about '//two(nm/1.0e9_wp)//'e9 matrix and '//two(nf/1.0e9_wp)// &
+              i2s(d%body(a)%ny)//') needs about '//fmt_real(nm/1.0e9_wp, '(f0.2)')//'e9 matrix and '//fmt_real(nf/1.0e9_wp, '(f0.2)')// &
               'e9 factor entries, beyond the 2^31 (2.1e9) that the 32-bit indices of this build hold; '// &
               'use fewer cells'
         return
@@ -87,11 +87,11 @@ contains
     est = run_memory_mb(d)
     if (limit_mb > 0.0_wp .and. est > limit_mb) then
       ok = .false.
-      msg = 'deck '//trim(d%source)//': the run needs about '//two(est/1024.0_wp)// &
-            ' GiB (body 1: '//two(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp)// &
-            ' GiB, body 2: '//two(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp)// &
+      msg = 'deck '//trim(d%source)//': the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
+            ' GiB (body 1: '//fmt_real(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
+            ' GiB, body 2: '//fmt_real(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
-            two(limit_mb/1024.0_wp)//' GiB (available memory, cgroup or ulimit -v); '// &
+            fmt_real(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
             'use fewer cells or a machine with more memory'
     end if
   end subroutine check_budget
@@ -145,15 +145,5 @@ contains
       end do
     end do
   end subroutine check_load_range
-
-  !> x with two decimals ('12.34', '0.50').
-  function two(x) result(s)
-    real(wp), intent(in) :: x
-    character(len=:), allocatable :: s
-    character(len=32) :: buf
-    write (buf, '(f0.2)') x
-    s = trim(adjustl(buf))
-    if (s(1:1) == '.') s = '0'//s
-  end function two
 
 end module budget
