@@ -35,7 +35,7 @@ module results
     real(wp) :: factor_mb = 0.0_wp            !< memory of the two Cholesky factors [MiB]
   end type timing_t
 
-  public :: write_results, remove_results
+  public :: write_results
 
   integer, parameter :: NFILES = 5   ! the HDF5 file and four XDMF files
 
@@ -101,17 +101,6 @@ contains
     end subroutine remove_temps
 
   end subroutine write_results
-
-  !> Remove the files of a result (the HDF5 file and its XDMF companions).
-  subroutine remove_results(file)
-    character(len=*), intent(in) :: file   !< result path (.h5)
-    character(len=len_trim(file) + 16) :: name(NFILES)
-    integer :: k
-    call result_files(file, name)
-    do k = 1, NFILES
-      call remove_file(name(k))
-    end do
-  end subroutine remove_results
 
   !> The files of a result: the HDF5 file, <stem>.xdmf, <stem>_body1.xdmf,
   !! <stem>_body2.xdmf, <stem>_contact.xdmf.
