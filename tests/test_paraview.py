@@ -5,7 +5,10 @@ solved result by its bare file name from the result folder (the case Debian's Xd
 abort on without an absolute path), check the PNG is a real picture (not blank), that a
 missing array exits 1 listing the available ones, that --list works, and that cell arrays
 and a polyline grid without displacement (the XDMF layout being added: body id, contact
-line) are handled. Without pvpython the test is skipped, and says so (exit 0)."""
+line) are handled, that the bodies are coloured (not grey: the fraction of saturated pixels
+in the drawn region), and that a dead display from xvfb-run is retried once and any other
+abnormal end of the re-run is one line and exit 1. Without pvpython the test is skipped,
+and says so (exit 0)."""
 import os
 import re
 import shutil
@@ -43,15 +46,38 @@ def view(*args, cwd=OUT):
     return q.returncode, q.stdout, q.stderr
 
 
-def picture(path, what):
-    """PNG exists and is not (almost) uniform: pixel standard deviation of the grey levels."""
+def picture(path, what, coloured=True):
+    """PNG exists and is not (almost) uniform: pixel standard deviation of the grey levels;
+    coloured: the drawn bodies are coloured by the colour map, not left grey (ParaView's
+    solid colour when the rendered geometry lost the array, as Xdmf3ReaderS does on the
+    Collection): of the non-background pixels (not near-white, the scalar bar strip at the
+    right edge left out), at least MIN_SATURATED carry an HSV saturation above 0.3. Every
+    colour of the default map (Viridis) has saturation 0.7-1; ParaView's grey 0.06, the
+    black text 0."""
     if not check(os.path.isfile(path), f"{what}: {os.path.basename(path)} written"):
         return
     import matplotlib.image as mpimg
+    import matplotlib.colors as mcolors
+    import numpy as np
     img = mpimg.imread(path)
     grey = img[..., :3].mean(axis=2) if img.ndim == 3 else img
     check(grey.std() > 0.05, f"{what}: picture is not blank (grey-level std {grey.std():.3f} > 0.05)",
           f"{img.shape[1]}x{img.shape[0]}")
+    if not coloured:
+        return
+    rgb = np.asarray(img[..., :3], dtype=float) if img.ndim == 3 else np.repeat(img[..., None], 3, axis=2)
+    if rgb.max() > 1.0:                                   # 8-bit PNG read as integers
+        rgb = rgb / 255.0
+    rgb = rgb[:, : int(rgb.shape[1] * 0.88)]              # the scalar bar sits at the right edge
+    sat = mcolors.rgb_to_hsv(np.clip(rgb, 0.0, 1.0))[..., 1]
+    drawn = rgb.min(axis=2) < 0.9                         # not the white background
+    frac = float((sat[drawn] > 0.3).mean()) if drawn.any() else 0.0
+    check(frac >= MIN_SATURATED, f"{what}: bodies coloured, not grey ({100 * frac:.1f}% of the "
+          f"{int(drawn.sum())} drawn pixels saturated, at least {100 * MIN_SATURATED:.0f}%)")
+
+
+MIN_SATURATED = 0.5   # measured (default deck): coloured 96-98%; the grey bodies of Xdmf3ReaderS 0% (14% with
+#                       the dark blue element edges of --edges)
 
 
 # 1. bare file name from the result folder (absolute path passed to the reader)
@@ -111,6 +137,58 @@ picture(f"{OUT}/body.png", "body_id")
 rc, so, se = view("future.xdmf", "--field", "line_pressure", "-o", "line.png")
 check(rc == 0, "future layout: --field line_pressure (on the polyline grid only) exits 0",
       f"exit {rc} {se.strip()[-300:]}")
+picture(f"{OUT}/line.png", "line_pressure", coloured=False)   # the bodies lack it: grey by design
+
+# 5. a dead display from xvfb-run -a (seen in 2 of 36 headless runs: ParaView says "bad X
+# server connection" and aborts, exit 134): a stand-in xvfb-run on PATH hands out a display
+# no X server listens on, the first time only (then the real xvfb-run: the retry renders)
+# or every time (exit 1 with a one-line message, no stack trace)
+dead = next(n for n in range(473, 600) if not os.path.exists(f"/tmp/.X11-unix/X{n}"))
+env = {k: v for k, v in os.environ.items()
+       if k not in ("DISPLAY", "WAYLAND_DISPLAY", "RC_PV_OFFSCREEN", "RC_PV_WRAPPED")}
+
+
+def fake_xvfb(name, body):
+    d = os.path.join(OUT, name)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, "xvfb-run"), "w") as f:
+        f.write("#!/bin/sh\n" + body)
+    os.chmod(os.path.join(d, "xvfb-run"), 0o755)
+    return dict(env, PATH=d + os.pathsep + env.get("PATH", ""))
+
+
+def headless(env_, *args):
+    q = subprocess.run([pv, TOOL, "r.xdmf", "--size", "320x240", *args], cwd=OUT, env=env_,
+                       capture_output=True, text=True, timeout=300)
+    return q.returncode, q.stdout, q.stderr
+
+
+real_xvfb = shutil.which("xvfb-run")
+if real_xvfb:
+    once = (f'if [ ! -e "$(dirname "$0")/used" ]; then : > "$(dirname "$0")/used"; '
+            f'shift; DISPLAY=:{dead} exec "$@"; fi\nexec {real_xvfb} "$@"\n')
+    rc, so, se = headless(fake_xvfb("once_dead", once), "-o", "retry.png")
+    if rc == 1 and "retrying once" in se and "on the retry: " in se and "bad X server connection" in se:
+        # the real xvfb-run -a handed out a dead display too (what this guards against, rare)
+        print(f"INFO  the real xvfb-run also gave a dead display on the retry: {se.strip().splitlines()[-1]}")
+        check(len(se.strip().splitlines()) == 2, "a dead display the first time: retried once, then one line",
+              se.strip()[-300:])
+    else:
+        check(rc == 0 and "retrying once" in se and os.path.isfile(f"{OUT}/retry.png"),
+              "a dead display the first time: one retry under xvfb-run, the picture written",
+              f"exit {rc} {se.strip()[-300:]}")
+else:
+    print("SKIP  the dead-display retry that renders: no xvfb-run")
+rc, so, se = headless(fake_xvfb("always_dead", f'shift; DISPLAY=:{dead} exec "$@"\n'), "-o", "dead.png")
+last = se.strip().splitlines()[-1] if se.strip() else ""
+check(rc == 1 and last.startswith("paraview_view: rendering under xvfb-run ended abnormally")
+      and "bad X server connection" in last and "Stack trace" not in se
+      and not os.path.exists(f"{OUT}/dead.png"),
+      "a dead display twice: exit 1, a one-line message, no stack trace", f"exit {rc} {se.strip()[-300:]}")
+rc, so, se = headless(fake_xvfb("crash", 'echo "some failure" >&2\nkill -SEGV $$\n'), "-o", "crash.png")
+check(rc == 1 and se.strip().splitlines() == ["paraview_view: rendering under xvfb-run ended abnormally, "
+                                               "signal 11 (SIGSEGV): some failure"],
+      "any other abnormal end of the re-run (SIGSEGV): exit 1 and one line", f"exit {rc} {se.strip()[-300:]}")
 
 print(f"{len(check.failed)} failed checks")
 sys.exit(1 if check.failed else 0)

@@ -25,16 +25,27 @@ Headless nodes: rendering needs an X display, or an offscreen (EGL/OSMesa) ParaV
 Without DISPLAY the tool re-runs itself as `xvfb-run -a pvbatch tools/paraview_view.py ...`
 when xvfb-run is installed (Debian: apt-get install xvfb); with an offscreen build set
 RC_PV_OFFSCREEN=1 to skip that. Without either it exits 1 and says so (plain pvpython
-would crash in the X window code).
-The file is always opened by its absolute path: Debian's Xdmf3 readers abort on a bare
-file name (they look for 'default.xdmfdefault.h5').
+would crash in the X window code). When xvfb-run hands out a dead display (ParaView:
+"bad X server connection", SIGABRT, exit 134; seen in 2 of 36 runs) the re-run is tried
+once more; any other abnormal end of the re-run becomes a one-line message and exit 1.
+The file is opened with Xdmf3ReaderT, which reads the spatial Collection of x.xdmf
+(body1, body2, contact) as one block per grid. Not Xdmf3ReaderS: it reads the grids of a
+spatial Collection as pieces of one dataset, and ParaView merges the pieces for rendering
+keeping only the arrays every piece has; the contact line shares none with the bodies, so
+the bodies are drawn grey (solid colour) although the scalar bar is shown. The file is
+always opened by its absolute path: Debian's Xdmf3 readers abort on a bare file name
+(they look for 'default.xdmfdefault.h5').
 Exit 0 on success, 1 with a message on any failure.
 """
 import argparse
 import os
+import random
+import re
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
 TOOL = "paraview_view"
 
@@ -81,7 +92,57 @@ def headless_reexec(argv):
     interp = shutil.which("pvbatch") or shutil.which("pvpython") or sys.executable
     env = dict(os.environ, RC_PV_WRAPPED="1")
     cmd = [xvfb, "-a", interp, os.path.abspath(__file__), *argv]
-    return subprocess.call(cmd, env=env)
+    for attempt in (1, 2):
+        try:
+            q = subprocess.run(cmd, env=env, stderr=subprocess.PIPE, text=True, errors="replace")
+        except OSError as e:
+            return fail(f"cannot run {xvfb}: {e}")
+        err, rc = q.stderr or "", q.returncode
+        clean = ANSI.sub("", err)
+        dead = DEAD_DISPLAY.search(clean)
+        # a dead display: xvfb-run -a can hand out a server number another xvfb-run took at the
+        # same moment; ParaView then aborts (SIGABRT, exit 134) or xvfb-run exits 1
+        if attempt == 1 and dead and (rc in (134, -signal.SIGABRT) or (rc == 1 and "xvfb-run:" in dead.group(0))):
+            print(f"{TOOL}: note: xvfb-run gave a dead X display ({oneline(dead.group(0))}), retrying once",
+                  file=sys.stderr)
+            time.sleep(1.0 + random.random())
+            continue
+        if rc in (0, 1):               # the child's own result, its one-line message on exit 1
+            sys.stderr.write(err)
+            return rc
+        how = f"signal {-rc} ({signal.Signals(-rc).name})" if rc < 0 and -rc in signal.valid_signals() \
+            else f"exit {rc}" + (f" (signal {signal.Signals(rc - 128).name})" if 128 < rc < 160 and
+                                 rc - 128 in signal.valid_signals() else "")
+        line = key_line(clean, dead)
+        return fail(f"rendering under xvfb-run ended abnormally, {how}"
+                    f"{' on the retry' if attempt == 2 else ''}{': ' + line if line else ''}"
+                    f"{' (rerun)' if dead else ''}")
+    return fail("unreachable")  # pragma: no cover
+
+
+ANSI = re.compile(r"\x1b\[[0-9;]*m")
+DEAD_DISPLAY = re.compile(r"[^\n]*(bad X server connection|cannot open display|can't open display|"
+                          r"unable to open display|could not open display|Xvfb failed to start)[^\n]*", re.I)
+
+
+def oneline(text, n=200):
+    """text squeezed to one line of at most n characters (loguru's prefix dropped)."""
+    t = re.sub(r"^\(\s*[0-9.]+s\)\s*\[[^]]*\]\s*\S*\s*(ERR|FATL|WARN)\|\s*", "", text.strip())
+    t = " ".join(re.sub(r" \(0x[0-9a-fA-F]+\)", "", t).split())          # object addresses
+    return t if len(t) <= n else t[: n - 3] + "..."
+
+
+def key_line(text, dead=None):
+    """The line of a crashed child's stderr that says why: the dead display, else the last
+    error/fatal/exception line, else the last line that is not part of a stack trace."""
+    if dead:
+        return oneline(dead.group(0))
+    lines = [t for t in text.splitlines() if t.strip()]
+    for t in reversed(lines):
+        if re.search(r"ERR\||what\(\)|Error|error:|Traceback|Segmentation|Abort", t) and "FATL| Signal" not in t:
+            return oneline(t)
+    rest = [t for t in lines if not re.match(r"\s*\d+\s+0x[0-9a-f]+", t) and "Stack trace" not in t]
+    return oneline(rest[-1]) if rest else ""
 
 
 def arrays(src):
@@ -178,7 +239,7 @@ def main(argv=None):
         return fail(f"ParaView's Python modules not found ({e}): run with pvpython or pvbatch "
                     "(Debian: apt-get install paraview xvfb)")
 
-    reader = pvs.Xdmf3ReaderS(FileName=[xdmf])          # absolute path: see the docstring
+    reader = pvs.Xdmf3ReaderT(FileName=[xdmf])          # T, not S; absolute path: see the docstring
     reader.UpdatePipeline()
     arr = arrays(reader)
     if a.list:
