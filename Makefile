@@ -60,7 +60,7 @@ $(DEPS_STAMP): tools/install-deps.sh
 	@if command -v $(FC) >/dev/null 2>&1 && command -v $(CC) >/dev/null 2>&1 \
 	   && [ -f /usr/include/suitesparse/cholmod.h ] && [ -f $(HDF5_INC)/hdf5.mod ] \
 	   && [ -f /usr/include/metis.h ] && [ -e /usr/lib/x86_64-linux-gnu/libopenblas.so ] \
-	   && [ -e /usr/lib/x86_64-linux-gnu/liblapack.so ] \
+	   && [ -e /usr/lib/x86_64-linux-gnu/liblapack.so ] && command -v pgrep >/dev/null 2>&1 \
 	   && [ -x $(PYTHON) ] && $(PYTHON) -c 'import numpy, h5py, meshio, matplotlib' 2>/dev/null; then :; \
 	 else bash tools/install-deps.sh; fi
 	@mkdir -p build && touch $@

@@ -3,7 +3,7 @@
 # As root: apt-get update (once) + apt-get install. Otherwise: print the exact command.
 set -eu
 pkgs="gfortran gcc make libsuitesparse-dev libmetis-dev libhdf5-dev libopenblas-dev liblapack-dev pkg-config
-python3 python3-numpy python3-matplotlib python3-h5py python3-meshio"
+python3 python3-numpy python3-matplotlib python3-h5py python3-meshio procps"
 missing=""
 for p in $pkgs; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
