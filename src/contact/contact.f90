@@ -160,6 +160,7 @@ contains
     if (info /= 0) then
       res%status = 'failed'
       write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
+      call corr_op%free()
       return
     end if
     every = 30
