@@ -52,7 +52,9 @@ int rc_signals_install(void)
     memset(&sa, 0, sizeof sa);
     sa.sa_sigaction = rc_handler;
     sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESTART | SA_SIGINFO;
+    /* SA_NODEFER: a library handler reached from ours may longjmp out of it; the signal
+     * must not stay blocked in that thread afterwards (the stop request would be lost) */
+    sa.sa_flags = SA_RESTART | SA_SIGINFO | SA_NODEFER;
     if (sigaction(SIGTERM, &sa, NULL) != 0) return -1;
     if (sigaction(SIGINT, &sa, NULL) != 0) return -1;
     rc_installed = 1;

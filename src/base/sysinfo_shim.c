@@ -18,6 +18,19 @@ double rc_peak_rss_mb(void)
 /* The smallest memory limit [MiB] of this process's cgroup and its ancestors, 0 if none:
  * cgroup v2 (`0::/path`, files memory.max) or v1 (the `memory` controller's path, files
  * memory.limit_in_bytes). A batch scheduler's --mem is such a limit. */
+/* True if the comma-separated controller list [a, end) holds exactly `name`. */
+static int controller_is(const char *a, const char *end, const char *name)
+{
+    size_t n = strlen(name);
+    while (a < end) {
+        const char *c = memchr(a, ',', (size_t) (end - a));
+        const char *e = c != NULL ? c : end;
+        if ((size_t) (e - a) == n && strncmp(a, name, n) == 0) return 1;
+        a = e + 1;
+    }
+    return 0;
+}
+
 static double cgroup_limit_mb(void)
 {
     char line[1024], path[1200], file[1400];
@@ -33,7 +46,7 @@ static double cgroup_limit_mb(void)
         if (strncmp(line, "0::", 3) == 0 && root == NULL) {            /* v2 (unless v1 memory found) */
             snprintf(path, sizeof path, "%s", q + 1);
             root = "/sys/fs/cgroup"; name = "memory.max";
-        } else if (strstr(p + 1, "memory") != NULL && (size_t) (q - p - 1) >= 6) {   /* v1 memory */
+        } else if (controller_is(p + 1, q, "memory")) {                 /* v1 memory */
             snprintf(path, sizeof path, "%s", q + 1);
             root = "/sys/fs/cgroup/memory"; name = "memory.limit_in_bytes";
         }

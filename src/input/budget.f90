@@ -36,9 +36,15 @@ contains
     cells = real(b%nx, wp)*real(b%ny, wp)
     n = 2.0_wp*nodes
     nnz_matrix = 18.0_wp*n                    ! 9 neighbour nodes x 2 components per row
-    if (fc%factorization == FACTOR_BANDED .or. fc%ordering == ORDER_NATURAL) then
+    if (fc%factorization == FACTOR_BANDED) then
+      ! reverse Cuthill-McKee: the half-bandwidth follows the shorter side
       half_band = 2.0_wp*(real(min(b%nx, b%ny), wp) + 2.0_wp)
       nnz_factor = n*half_band
+    else if (fc%ordering == ORDER_NATURAL) then
+      ! nodes numbered along x, and the interface DOFs (at most both components of the
+      ! longer side) ordered last fill their rows
+      half_band = 2.0_wp*(real(b%nx, wp) + 2.0_wp)
+      nnz_factor = n*half_band + n*2.0_wp*(real(max(b%nx, b%ny), wp) + 1.0_wp)
     else
       nnz_factor = 8.0_wp*n*log(max(n, 2.0_wp))/log(2.0_wp)
     end if

@@ -573,10 +573,12 @@ contains
           end if
           call split_items(a%value, items)
           ! count the values first: too many is an error whatever they are
+          ! (a count above what the variable takes stops the sum before it can overflow)
           nitem = 0
           do i = 1, size(items)
             call repeat_count(items(i)%s, rep, tok)
-            nitem = nitem + rep
+            nitem = nitem + min(rep, v%nval + 1)
+            if (nitem > v%nval) exit
           end do
           if (nitem > merge(1, v%nval, a%sub > 0)) then
             if (v%nval == 1 .or. a%sub > 0) then

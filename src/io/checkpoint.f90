@@ -333,6 +333,12 @@ contains
         msg = src//': dataset /state/G holds values that are not finite'
       else if (.not. all(ieee_is_finite(st%lam))) then
         msg = src//': dataset /state/lam holds values that are not finite'
+      else if (any(st%lam < 0.0_wp)) then
+        msg = src//': dataset /state/lam holds negative contact forces'
+      else if (.not. (all(ieee_is_finite(st%srch)) .and. all(ieee_is_finite(st%fsrch)))) then
+        msg = src//': dataset /state/srch or fsrch holds values that are not finite'
+      else if (st%nsrch /= 0 .and. st%nsrch /= 1) then
+        msg = src//': attribute nsrch of /state is '//i2s(st%nsrch)//', not 0 or 1'
       else if (.not. (all(ieee_is_finite(st%r_prev)) .and. all(ieee_is_finite(st%x_prev)) .and. &
                       all(ieee_is_finite(st%dX)) .and. all(ieee_is_finite(st%dR)) .and. &
                       all(ieee_is_finite(st%flam)) .and. all(ieee_is_finite(st%flam_v)))) then
