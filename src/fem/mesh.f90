@@ -8,13 +8,28 @@
 !! upper-right corner, (i,j)-(i+1,j+1), into triangle 2c-1 = (i,j), (i+1,j), (i+1,j+1)
 !! (below the diagonal) and triangle 2c = (i,j), (i+1,j+1), (i,j+1) (above it), both
 !! counter-clockwise.
+!!
+!! The same type holds a general 2D mesh read from a file (module gmsh_msh): cells of mixed
+!! types (`cell_type`), counter-clockwise after reading, with the file's tags kept for
+!! messages, and named groups of boundary edges (`group`) on which conditions and the
+!! contact surface are given. A structured mesh has the groups 'left', 'right', 'bottom'
+!! and 'top'. Every group edge is a boundary edge of one cell, oriented counter-clockwise
+!! around the body (the body on its left), so its outward normal is (dy, -dx)/length.
 module mesh
   use kinds, only: wp
   use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
   implicit none (type, external)
   private
 
-  public :: mesh_build, side_nodes, node_id
+  public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes
+
+  !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side).
+  type, public :: edge_group_t
+    character(len=:), allocatable :: name      !< the group's name (Gmsh physical name)
+    integer :: nedge = 0                       !< edges of this body in the group
+    integer, allocatable :: edge(:, :)         !< (2, nedge) node ids, the body on the left
+    integer, allocatable :: cell(:)            !< (nedge) the cell each edge bounds
+  end type edge_group_t
 
   !> A structured mesh of one rectangular body.
   type, public :: mesh_t
@@ -30,6 +45,15 @@ module mesh
     real(wp) :: height = 0.0_wp           !< extent in y [length]
     real(wp), allocatable :: xy(:, :)     !< (2, nnode) node coordinates [length]
     integer, allocatable :: cells(:, :)   !< (nvert, ncell) 1-based node ids, counter-clockwise
+                                          !! (a triangle in a mixed mesh: cells(4, c) = 0)
+    logical :: structured = .true.        !< built by mesh_build (nx, ny, x0... valid)
+    character(len=:), allocatable :: source  !< the mesh file ('' for a structured mesh)
+    integer, allocatable :: cell_type(:)  !< (ncell) ELEM_Q1 or ELEM_P1 of each cell
+    integer, allocatable :: node_tag(:)   !< (nnode) the file's node tag (structured: the node id)
+    integer, allocatable :: cell_tag(:)   !< (ncell) the file's element tag (structured: the cell id)
+    integer :: ngroup = 0                 !< named edge groups of this body
+    type(edge_group_t), allocatable :: group(:)   !< (ngroup) the groups
+    character(len=:), allocatable :: file_groups  !< every physical curve name of the file, for messages
   end type mesh_t
 
 contains
@@ -111,7 +135,106 @@ contains
         end if
       end do
     end do
+    mesh%structured = .true.
+    mesh%source = ''
+    allocate (mesh%cell_type(mesh%ncell), mesh%node_tag(mesh%nnode), mesh%cell_tag(mesh%ncell))
+    mesh%cell_type = mesh%element
+    mesh%node_tag = [(i, i=1, mesh%nnode)]
+    mesh%cell_tag = [(i, i=1, mesh%ncell)]
+    call side_groups(mesh)
   end subroutine mesh_build
+
+  !> The four sides of a structured mesh as edge groups 'left', 'right', 'bottom', 'top'.
+  subroutine side_groups(mesh)
+    type(mesh_t), intent(inout) :: mesh
+    integer :: side, k, ne
+    integer, allocatable :: nodes(:)
+    character(len=6), parameter :: names(4) = ['left  ', 'right ', 'bottom', 'top   ']
+
+    mesh%ngroup = 4
+    allocate (mesh%group(4))
+    mesh%file_groups = 'left right bottom top'
+    do side = 1, 4
+      call side_nodes(mesh, side, nodes)
+      ne = size(nodes) - 1
+      mesh%group(side)%name = trim(names(side))
+      mesh%group(side)%nedge = ne
+      allocate (mesh%group(side)%edge(2, ne), mesh%group(side)%cell(ne))
+      do k = 1, ne
+        ! counter-clockwise around the body: bottom and right along increasing s, top and
+        ! left against it
+        if (side == SIDE_BOTTOM .or. side == SIDE_RIGHT) then
+          mesh%group(side)%edge(:, k) = [nodes(k), nodes(k + 1)]
+        else
+          mesh%group(side)%edge(:, k) = [nodes(k + 1), nodes(k)]
+        end if
+        mesh%group(side)%cell(k) = side_cell(mesh, side, k)
+      end do
+    end do
+  end subroutine side_groups
+
+  !> The cell bounded by edge k (1-based along increasing s) of a side of a structured mesh.
+  pure integer function side_cell(mesh, side, k) result(c)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: side, k
+    integer :: i, j, q
+    select case (side)
+    case (SIDE_LEFT)
+      i = 0; j = k - 1
+    case (SIDE_RIGHT)
+      i = mesh%nx - 1; j = k - 1
+    case (SIDE_BOTTOM)
+      i = k - 1; j = 0
+    case default
+      i = k - 1; j = mesh%ny - 1
+    end select
+    q = 1 + i + j*mesh%nx
+    if (mesh%element == ELEM_Q1) then
+      c = q
+    else if (side == SIDE_BOTTOM .or. side == SIDE_RIGHT) then
+      c = 2*q - 1    ! below the diagonal
+    else
+      c = 2*q        ! above the diagonal
+    end if
+  end function side_cell
+
+  !> The index of the group called `name` (case-sensitive, as Gmsh writes it), 0 if none.
+  pure integer function group_index(mesh, name) result(g)
+    type(mesh_t), intent(in) :: mesh
+    character(len=*), intent(in) :: name
+    do g = 1, mesh%ngroup
+      if (mesh%group(g)%name == trim(name)) return
+    end do
+    g = 0
+  end function group_index
+
+  !> The names of the body's groups, quoted and comma-separated (for messages).
+  function group_names(mesh) result(s)
+    type(mesh_t), intent(in) :: mesh
+    character(len=:), allocatable :: s
+    integer :: g
+    s = ''
+    do g = 1, mesh%ngroup
+      if (g > 1) s = s//', '
+      s = s//"'"//mesh%group(g)%name//"'"
+    end do
+    if (mesh%ngroup == 0) s = '(none)'
+  end function group_names
+
+  !> The distinct nodes of group g, in increasing node id.
+  subroutine group_nodes(mesh, g, nodes)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: g
+    integer, allocatable, intent(out) :: nodes(:)
+    logical, allocatable :: on(:)
+    integer :: k
+    allocate (on(mesh%nnode))
+    on = .false.
+    do k = 1, mesh%group(g)%nedge
+      on(mesh%group(g)%edge(:, k)) = .true.
+    end do
+    nodes = pack([(k, k=1, mesh%nnode)], on)
+  end subroutine group_nodes
 
   !> The nodes on one side of the mesh, ordered by increasing s (x on bottom/top,
   !! y on left/right), corners included. An unknown side gives an empty list.
