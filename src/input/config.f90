@@ -26,7 +26,8 @@ module config
 
   integer, parameter, public :: ELEM_Q1 = 1  !< bilinear quadrilateral, 2x2 Gauss
   integer, parameter, public :: ELEM_P1 = 2  !< linear triangle, each cell split in two
-  character(len=2), parameter, public :: element_names(2) = ['Q1', 'P1']
+  integer, parameter, public :: ELEM_MIXED = 3  !< a mesh file's mix of Q1 and P1 cells
+  character(len=5), parameter, public :: element_names(3) = ['Q1   ', 'P1   ', 'mixed']
 
   integer, parameter, public :: METHOD_ROBIN = 1        !< Robin domain decomposition
   integer, parameter, public :: METHOD_MONOLITHIC = 2   !< the monolithic reference
@@ -75,9 +76,11 @@ module config
     character(len=16) :: stress = 'Pa'             !< stress unit name (force/length^2)
   end type units_cfg_t
 
-  !> One elastic body: a rectangle meshed by nx x ny cells.
+  !> One elastic body: a rectangle meshed by nx x ny cells, or the cells of a Gmsh file.
   type, public :: body_cfg_t
     integer :: id = 0                 !< 1 or 2
+    character(len=512) :: mesh = ''   !< Gmsh MSH 4.1 file ('' : the rectangle below); absolute after reading
+    character(len=128) :: region = '' !< physical surface of the file that is this body ('' : the only one)
     real(wp) :: x0 = 0.0_wp           !< lower-left corner x [length]
     real(wp) :: y0 = 0.0_wp           !< lower-left corner y [length]
     real(wp) :: width = 1.0_wp        !< extent in x [length]
@@ -91,14 +94,29 @@ module config
     real(wp) :: u_side(2, 4) = 0.0_wp !< prescribed displacement per side when bc = BC_DISPLACEMENT [length]
   end type body_cfg_t
 
-  !> A linear traction t(s) = t0 + t1*s on one side of one body; s is the global
-  !! coordinate along the side (x on top/bottom, y on left/right).
+  !> A traction on one side of a rectangle, t(s) = t0 + t1*s with s the global coordinate
+  !! along the side (x on top/bottom, y on left/right); or on a named edge group of a body
+  !! (group /= ''), t(x,y) = t0 + tx*x + ty*y - pressure*n with n the outward normal.
   type, public :: traction_cfg_t
     integer :: body = 0               !< body id
-    integer :: side = 0               !< SIDE_*
+    integer :: side = 0               !< SIDE_* (0 with a group)
+    character(len=128) :: group = ''  !< edge group name ('' : the side)
     real(wp) :: t0(2) = 0.0_wp        !< [stress]
-    real(wp) :: t1(2) = 0.0_wp        !< [stress/length]
+    real(wp) :: t1(2) = 0.0_wp        !< [stress/length] (side)
+    real(wp) :: tx(2) = 0.0_wp        !< d t / d x [stress/length] (group)
+    real(wp) :: ty(2) = 0.0_wp        !< d t / d y [stress/length] (group)
+    real(wp) :: pressure = 0.0_wp     !< normal pressure, positive pushing in [stress] (group)
+    character(len=64) :: origin = ''  !< where the deck gave it ('line N', 'command-line override k')
   end type traction_cfg_t
+
+  !> Prescribed displacement components on a named edge group (&boundary).
+  type, public :: boundary_cfg_t
+    integer :: body = 0               !< body id
+    character(len=128) :: group = ''  !< edge group name
+    logical :: fix(2) = .false.       !< which components are prescribed (ux, uy)
+    real(wp) :: u(2) = 0.0_wp         !< their values [length]
+    character(len=64) :: origin = ''  !< where the deck gave it
+  end type boundary_cfg_t
 
   !> How each body's stiffness is factorized (what the condensation stage needs).
   type, public :: factor_cfg_t
@@ -106,8 +124,11 @@ module config
     integer :: ordering = ORDER_METIS                 !< ORDER_* (cholmod only)
   end type factor_cfg_t
 
-  !> The contact interface: an initial gap on top of the geometry's.
+  !> The contact interface: the two contact surfaces (rectangle sides declared 'contact', or
+  !! named edge groups, then paired by mortar), and an initial gap on top of the geometry's.
   type, public :: contact_cfg_t
+    character(len=128) :: body_group(2) = ''          !< contact edge group of each body ('' : sides)
+    integer :: slave = 0                              !< mortar slave body, 0: the finer surface
     real(wp) :: gap_radius = 0.0_wp                   !< R of the parabolic initial gap, 0: none [length]
     real(wp) :: gap_center = 0.0_wp                   !< xc of the parabolic gap [length]
   end type contact_cfg_t
@@ -146,6 +167,8 @@ module config
     type(body_cfg_t) :: body(2)                       !< indexed by id
     integer :: ntraction = 0                          !< number of tractions in use
     type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)
+    integer :: nboundary = 0                          !< number of &boundary groups
+    type(boundary_cfg_t), allocatable :: boundary(:)  !< prescribed components on groups (size >= nboundary)
     type(contact_cfg_t) :: contact                    !< the contact interface (&contact)
     type(solver_cfg_t) :: solver
     type(output_cfg_t) :: output

@@ -19,7 +19,7 @@ module deck
   use strings, only: i2s, r2s, quoted_list, index_of, word, text_buffer_t
   use namelist_input, only: str_t, src_t, grp_t, vars_t, load_file, text_source, parse_source, &
                             read_group, render_group, find_asg, find_int, die_at, bad_value, unknown_group
-  use config, only: deck_t, body_cfg_t, traction_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     METHOD_CHOICES, ROBIN_CHOICES, ROBIN_CONSTANT, STOP_CHOICES, FACTOR_CHOICES, &
@@ -44,7 +44,7 @@ module deck
     '  Exit codes: 0 converged, 1 bad input or usage, 2 not converged, 3 numerical failure,'//NL// &
     '              4 interrupted (after a checkpoint).'
 
-  character(len=*), parameter :: GROUP_NAMES = 'scene body traction displacement contact solver output'
+  character(len=*), parameter :: GROUP_NAMES = 'scene body traction displacement boundary contact solver output'
   integer, parameter :: WIDTH = 92   ! rendered lines are wrapped before this column
 
   !> Where things came from, for cross-field messages.
@@ -56,7 +56,8 @@ module deck
     type(str_t), allocatable :: trac_at(:)      ! per traction
     integer :: disp_line(4, 2) = 0              ! deck line of the &displacement per side, body
     logical :: disp_given(4, 2) = .false.       ! a &displacement gives the side's vector
-    integer :: once_line(7) = 0                 ! deck line of each singleton group
+    integer :: once_line(8) = 0                 ! deck line of each singleton group
+    logical :: has_boundary(2) = .false.        ! a &boundary names a group of the body
   end type state_t
 
   !> The variables of &scene that are not stored as they are read.
@@ -64,13 +65,20 @@ module deck
     integer :: plane = 1                        ! PLANE_CHOICES code
   end type scene_in_t
 
-  !> A &traction or &displacement as read, before it is checked and stored.
+  !> A &traction, &displacement or &boundary as read, before it is checked and stored.
   type :: load_in_t
     integer :: body = 0
     integer :: side = 0                         ! SIDE_*; 0 = not given
+    character(len=128) :: group = ''            ! edge group ('' = not given)
     real(wp) :: t0(2) = 0.0_wp, t1(2) = 0.0_wp  ! traction
+    real(wp) :: tx(2) = 0.0_wp, ty(2) = 0.0_wp  ! traction gradient (group)
+    real(wp) :: pressure = 0.0_wp               ! normal pressure (group)
     real(wp) :: u(2) = 0.0_wp                   ! displacement
+    real(wp) :: ux = 0.0_wp, uy = 0.0_wp        ! &boundary components
   end type load_in_t
+
+  ! which variables a table holds: all (reading), or those of one form (rendering)
+  integer, parameter :: ALL_FORMS = 0, SIDE_FORM = 1, GROUP_FORM = 2, UX_ONLY = 3, UY_ONLY = 4, UXY = 5
 
 contains
 
@@ -93,8 +101,9 @@ contains
 
     d%source = path
     st%path = path
-    allocate (d%traction(4), st%trac_at(4))
+    allocate (d%traction(4), st%trac_at(4), d%boundary(4))
     d%ntraction = 0
+    d%nboundary = 0
     do k = 1, 2
       d%body(k)%id = 0
     end do
@@ -108,7 +117,7 @@ contains
       ig = index_of(GROUP_NAMES, gs(i)%name)
       if (ig == 0) call unknown_group(gs(i), src, GROUP_NAMES)
       select case (gs(i)%name)
-      case ('traction', 'displacement')
+      case ('traction', 'displacement', 'boundary')
         cycle
       case ('body')
         call new_body(gs(i), src, d, st)
@@ -132,6 +141,7 @@ contains
     do i = 1, size(gs)
       if (gs(i)%name == 'traction') call add_traction(gs(i), src, d, st, 'line '//i2s(gs(i)%line))
       if (gs(i)%name == 'displacement') call apply_displacement(gs(i), src, d, st)
+      if (gs(i)%name == 'boundary') call add_boundary(gs(i), src, d, st, 'line '//i2s(gs(i)%line))
     end do
 
     ! Command-line overrides, in order.
@@ -151,6 +161,8 @@ contains
           call add_traction(gs(i), src, d, st, olabel)
         case ('displacement')
           call apply_displacement(gs(i), src, d, st)
+        case ('boundary')
+          call add_boundary(gs(i), src, d, st, olabel)
         case default
           call apply_single(gs(i), src, d)
         end select
@@ -180,16 +192,32 @@ contains
     call scene_vars(c, sc, v)
     call tb%add(render_group('scene', v, WIDTH))
     do b = 1, 2
-      call body_vars(c%body(b), v)
+      call body_vars(c%body(b), v, merge(GROUP_FORM, SIDE_FORM, len_trim(c%body(b)%mesh) > 0))
       call tb%add(render_group('body', v, WIDTH))
     end do
     do i = 1, c%ntraction
       t%body = c%traction(i)%body
       t%side = c%traction(i)%side
+      t%group = c%traction(i)%group
       t%t0 = c%traction(i)%t0
       t%t1 = c%traction(i)%t1
-      call traction_vars(t, v)
+      t%tx = c%traction(i)%tx
+      t%ty = c%traction(i)%ty
+      t%pressure = c%traction(i)%pressure
+      call traction_vars(t, v, merge(GROUP_FORM, SIDE_FORM, len_trim(t%group) > 0))
       call tb%add(render_group('traction', v, WIDTH))
+    end do
+    do i = 1, c%nboundary
+      t%body = c%boundary(i)%body
+      t%group = c%boundary(i)%group
+      t%ux = c%boundary(i)%u(1)
+      t%uy = c%boundary(i)%u(2)
+      if (all(c%boundary(i)%fix)) then
+        call boundary_vars(t, v, UXY)
+      else
+        call boundary_vars(t, v, merge(UX_ONLY, UY_ONLY, c%boundary(i)%fix(1)))
+      end if
+      call tb%add(render_group('boundary', v, WIDTH))
     end do
     do b = 1, 2
       do s = 1, 4
@@ -249,33 +277,63 @@ contains
     call v%str('stress_unit', d%units%stress)
   end subroutine scene_vars
 
-  subroutine body_vars(b, v)
+  !> &body: `form` ALL_FORMS reads every variable; SIDE_FORM renders a rectangle,
+  !! GROUP_FORM a body from a mesh file.
+  subroutine body_vars(b, v, form)
     type(body_cfg_t), target, intent(inout) :: b
     type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
     call v%int('id', b%id)
-    call v%real('x0', b%x0)
-    call v%real('y0', b%y0)
-    call v%real('width', b%width)
-    call v%real('height', b%height)
-    call v%int('nx', b%nx)
-    call v%int('ny', b%ny)
-    call v%enum('element', b%element, ELEMENT_CHOICES)
+    if (form /= SIDE_FORM) then
+      call v%str('mesh', b%mesh)
+      call v%str('region', b%region)
+    end if
+    if (form /= GROUP_FORM) then
+      call v%real('x0', b%x0)
+      call v%real('y0', b%y0)
+      call v%real('width', b%width)
+      call v%real('height', b%height)
+      call v%int('nx', b%nx)
+      call v%int('ny', b%ny)
+      call v%enum('element', b%element, ELEMENT_CHOICES)
+    end if
     call v%real('young', b%young)
     call v%real('poisson', b%poisson)
-    call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE)
-    call v%enum('right', b%bc(SIDE_RIGHT), BC_CHOICES, base=BC_FREE)
-    call v%enum('top', b%bc(SIDE_TOP), BC_CHOICES, base=BC_FREE)
-    call v%enum('bottom', b%bc(SIDE_BOTTOM), BC_CHOICES, base=BC_FREE)
+    if (form /= GROUP_FORM) then
+      call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE)
+      call v%enum('right', b%bc(SIDE_RIGHT), BC_CHOICES, base=BC_FREE)
+      call v%enum('top', b%bc(SIDE_TOP), BC_CHOICES, base=BC_FREE)
+      call v%enum('bottom', b%bc(SIDE_BOTTOM), BC_CHOICES, base=BC_FREE)
+    end if
   end subroutine body_vars
 
-  subroutine traction_vars(t, v)
+  !> &traction: on a side (t0, t1) or on a group (t0, tx, ty, pressure).
+  subroutine traction_vars(t, v, form)
     type(load_in_t), target, intent(inout) :: t
     type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
     call v%int('body', t%body)
-    call v%enum('side', t%side, SIDE_CHOICES)
+    if (form /= GROUP_FORM) call v%enum('side', t%side, SIDE_CHOICES)
+    if (form /= SIDE_FORM) call v%str('group', t%group)
     call v%pair('t0', t%t0)
-    call v%pair('t1', t%t1)
+    if (form /= GROUP_FORM) call v%pair('t1', t%t1)
+    if (form /= SIDE_FORM) then
+      call v%pair('tx', t%tx)
+      call v%pair('ty', t%ty)
+      call v%real('pressure', t%pressure)
+    end if
   end subroutine traction_vars
+
+  !> &boundary: prescribed components on a group; rendered with the components given.
+  subroutine boundary_vars(t, v, form)
+    type(load_in_t), target, intent(inout) :: t
+    type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
+    call v%int('body', t%body)
+    call v%str('group', t%group)
+    if (form /= UY_ONLY) call v%real('ux', t%ux)
+    if (form /= UX_ONLY) call v%real('uy', t%uy)
+  end subroutine boundary_vars
 
   subroutine displacement_vars(t, v)
     type(load_in_t), target, intent(inout) :: t
@@ -288,6 +346,9 @@ contains
   subroutine contact_vars(c, v)
     type(contact_cfg_t), target, intent(inout) :: c
     type(vars_t), intent(out) :: v
+    call v%str('body1_group', c%body_group(1))
+    call v%str('body2_group', c%body_group(2))
+    call v%int('slave', c%slave)
     call v%real('gap_radius', c%gap_radius)
     call v%real('gap_center', c%gap_center)
   end subroutine contact_vars
@@ -403,6 +464,8 @@ contains
     call read_group(g, src, v)
     if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
       'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
+    if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
+      'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')
   end subroutine apply_contact
 
   subroutine apply_solver(g, src, s)
@@ -506,8 +569,9 @@ contains
     integer :: s
 
     c = b0
-    call body_vars(c, v)
+    call body_vars(c, v, ALL_FORMS)
     call read_group(g, src, v)
+    if (len_trim(c%mesh) > 0) call mesh_body(g, src, c)
     if (.not. c%width > 0.0_wp) call bad_value(g, src, 'width', r2s(c%width), 'must be > 0')
     if (.not. c%height > 0.0_wp) call bad_value(g, src, 'height', r2s(c%height), 'must be > 0')
     if (c%nx < 1) call bad_value(g, src, 'nx', i2s(c%nx), 'must be >= 1 (cells along x)')
@@ -539,9 +603,9 @@ contains
     type(str_t), allocatable :: wtmp(:)
     integer :: n
 
-    call traction_vars(t, v)
+    call traction_vars(t, v, ALL_FORMS)
     call read_group(g, src, v)
-    call body_and_side(g, src, t)
+    call traction_form(g, src, t)
     n = d%ntraction
     if (n == size(d%traction)) then   ! grow geometrically: many tractions stay linear
       allocate (tmp(max(4, 2*n)), wtmp(max(4, 2*n)))
@@ -554,10 +618,128 @@ contains
     d%ntraction = n
     d%traction(n)%body = t%body
     d%traction(n)%side = t%side
+    d%traction(n)%group = t%group
     d%traction(n)%t0 = t%t0
     d%traction(n)%t1 = t%t1
+    d%traction(n)%tx = t%tx
+    d%traction(n)%ty = t%ty
+    d%traction(n)%pressure = t%pressure
+    d%traction(n)%origin = '&traction at '//origin
     st%trac_at(n)%s = origin
   end subroutine add_traction
+
+  !> A traction is on a side (side=, t0, t1) or on a group (group=, t0, tx, ty, pressure).
+  subroutine traction_form(g, src, t)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(load_in_t), intent(inout) :: t
+    integer :: k
+    if (len_trim(t%group) > 0) then
+      if (find_asg(g, 'side') > 0) call die_at(src, g%line, 'in group &traction: give side= '// &
+        '(a rectangle''s side) or group= (a named edge group), not both')
+      if (find_asg(g, 't1') > 0) call die_at(src, g%line, 'in group &traction: t1 belongs to a '// &
+        'side traction; on a group the traction is t0 + tx*x + ty*y - pressure*n')
+      call body_given(g, src, t%body)
+    else
+      do k = 1, 3
+        if (find_asg(g, trim(word('tx ty pressure', k))) > 0) call die_at(src, g%line, &
+          'in group &traction: '//trim(word('tx ty pressure', k))//' belongs to a group traction '// &
+          '(group=''NAME''); on a side the traction is t0 + t1*s')
+      end do
+      call body_and_side(g, src, t)
+    end if
+  end subroutine traction_form
+
+  !> A &boundary group (deck or override): prescribed components on a named edge group.
+  subroutine add_boundary(g, src, d, st, origin)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    character(len=*), intent(in) :: origin
+    type(load_in_t), target :: t
+    type(vars_t) :: v
+    type(boundary_cfg_t), allocatable :: tmp(:)
+    integer :: n
+
+    call boundary_vars(t, v, ALL_FORMS)
+    call read_group(g, src, v)
+    call body_given(g, src, t%body)
+    if (len_trim(t%group) == 0) call die_at(src, g%line, 'in group &boundary: no group; give '// &
+      'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
+      '''bottom'', ''top'')')
+    if (find_asg(g, 'ux') == 0 .and. find_asg(g, 'uy') == 0) call die_at(src, g%line, &
+      'in group &boundary: neither ux nor uy is given; give the components to prescribe '// &
+      '(ux=0.0 for a roller on a vertical wall, ux=0.0, uy=0.0 to clamp)')
+    n = d%nboundary
+    if (n == size(d%boundary)) then
+      allocate (tmp(max(4, 2*n)))
+      tmp(1:n) = d%boundary(1:n)
+      call move_alloc(tmp, d%boundary)
+    end if
+    n = n + 1
+    d%nboundary = n
+    d%boundary(n)%body = t%body
+    d%boundary(n)%group = t%group
+    d%boundary(n)%fix = [find_asg(g, 'ux') > 0, find_asg(g, 'uy') > 0]
+    d%boundary(n)%u = [t%ux, t%uy]
+    d%boundary(n)%origin = '&boundary at '//origin
+    st%has_boundary(t%body) = .true.
+  end subroutine add_boundary
+
+  !> The body= of a &traction, &displacement or &boundary: given, and 1 or 2.
+  subroutine body_given(g, src, body)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    integer, intent(in) :: body
+    integer :: k
+    k = find_asg(g, 'body')
+    if (k == 0) then
+      call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
+    else if (len_trim(g%a(k)%value) == 0) then
+      call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
+    end if
+    if (body /= 1 .and. body /= 2) call bad_value(g, src, 'body', i2s(body), &
+      'does not exist: the bodies have ids 1 and 2')
+  end subroutine body_given
+
+  !> A body read from a mesh file: the rectangle's variables have no meaning; the path is
+  !! made absolute, relative to the deck's folder.
+  subroutine mesh_body(g, src, c)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(body_cfg_t), intent(inout) :: c
+    character(len=*), parameter :: RECT = 'x0 y0 width height nx ny element left right top bottom'
+    integer :: k
+    do k = 1, 11
+      if (find_asg(g, trim(word(RECT, k))) > 0) call die_at(src, g%line, 'in group &body: '// &
+        trim(word(RECT, k))//' describes a built-in rectangle, but this body comes from mesh='''// &
+        trim(c%mesh)//'''; give its conditions with &boundary and &traction on the mesh''s groups')
+    end do
+    if (c%mesh(1:1) /= '/') c%mesh = deck_folder(src)//trim(c%mesh)
+    c%bc = BC_FREE
+  end subroutine mesh_body
+
+  !> The absolute folder of the deck file, with a trailing '/' (the working folder for a
+  !! command-line override or a deck read from /dev/).
+  function deck_folder(src) result(f)
+    type(src_t), intent(in) :: src
+    character(len=:), allocatable :: f
+    character(len=4096) :: cwd
+    integer :: k, stat
+    call getcwd(cwd, stat)
+    if (stat /= 0) cwd = '.'
+    f = ''
+    if (src%is_file .and. src%label(1:min(5, len(src%label))) /= '/dev/') then
+      k = index(src%label, '/', back=.true.)
+      if (k > 0) f = src%label(1:k)
+    end if
+    if (len(f) == 0) then
+      f = trim(cwd)//'/'
+    else if (f(1:1) /= '/') then
+      f = trim(cwd)//'/'//f
+    end if
+  end function deck_folder
 
   !> A &displacement group (deck or override): prescribes a displacement on a side.
   subroutine apply_displacement(g, src, d, st)
@@ -573,6 +755,9 @@ contains
     call displacement_vars(t, v)
     call read_group(g, src, v)
     call body_and_side(g, src, t)
+    if (len_trim(d%body(t%body)%mesh) > 0) call die_at(src, g%line, 'in group &displacement: body '// &
+      i2s(t%body)//' comes from a mesh file and has no sides; prescribe its displacement with '// &
+      '&boundary body='//i2s(t%body)//', group=''NAME'', ux=..., uy=... /')
     body = t%body
     s = t%side
     side = trim(side_names(s))
@@ -622,9 +807,19 @@ contains
     integer :: b, s, nc, cs(2), i, n1, n2
     character(len=:), allocatable :: p, lst, what
     real(wp) :: scale, tol, c1, c2, a1, a2, e1, e2
-    logical :: fixed, roll_h, roll_v, horizontal
+    logical :: fixed, roll_h, roll_v, horizontal, groups
 
     p = st%path//': '
+    groups = len_trim(d%contact%body_group(1)) > 0 .or. len_trim(d%contact%body_group(2)) > 0
+    if (groups) then
+      call check_groups(d, st)
+      return
+    end if
+    do b = 1, 2
+      if (len_trim(d%body(b)%mesh) > 0) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
+        st%body_at(b)%s//') comes from a mesh file: name the contact surfaces with &contact '// &
+        'body1_group=''NAME1'', body2_group=''NAME2'' /')
+    end do
     do b = 1, 2
       nc = count(d%body(b)%bc == BC_CONTACT)
       if (nc /= 1) then
@@ -694,7 +889,7 @@ contains
         fixed = any(y%bc == BC_CLAMPED .or. y%bc == BC_DISPLACEMENT)
         roll_h = y%bc(SIDE_TOP) == BC_ROLLER .or. y%bc(SIDE_BOTTOM) == BC_ROLLER
         roll_v = y%bc(SIDE_LEFT) == BC_ROLLER .or. y%bc(SIDE_RIGHT) == BC_ROLLER
-        if (.not. (fixed .or. (roll_h .and. roll_v))) call fatal(EXIT_INPUT, p//'body '// &
+        if (.not. (fixed .or. (roll_h .and. roll_v) .or. st%has_boundary(b))) call fatal(EXIT_INPUT, p//'body '// &
           i2s(b)//' ('//st%body_at(b)%s//') is not supported against rigid motion ('// &
           side_list(y)//'): it needs a ''clamped'' side, a &displacement side, or ''roller'' '// &
           'on one horizontal (top/bottom) and one vertical (left/right) side; the contact '// &
@@ -711,8 +906,22 @@ contains
       end do
     end do
 
+    call check_loads(d, st)
+  end subroutine check_cross
+
+  !> Side tractions on rectangles: not on a contact side; no effect on a prescribed side.
+  subroutine check_loads(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: i, s
+    character(len=:), allocatable :: p
+    p = st%path//': '
     do i = 1, d%ntraction
       associate (t => d%traction(i))
+        if (len_trim(t%group) > 0) cycle
+        if (len_trim(d%body(t%body)%mesh) > 0) call fatal(EXIT_INPUT, p//'the &traction at '// &
+          st%trac_at(i)%s//' loads side '''//trim(side_names(t%side))//''' of body '//i2s(t%body)// &
+          ', which comes from a mesh file and has no sides; load a group: group=''NAME''')
         s = d%body(t%body)%bc(t%side)
         if (s == BC_CONTACT) call fatal(EXIT_INPUT, p//'the &traction at '//st%trac_at(i)%s// &
           ' loads side '''//trim(side_names(t%side))//''' of body '//i2s(t%body)//', which is '// &
@@ -723,7 +932,32 @@ contains
           trim(bc_names(s))//'''); that traction has no effect')
       end associate
     end do
-  end subroutine check_cross
+  end subroutine check_loads
+
+  !> Contact on named groups (mortar): both groups given, no rectangle side declared
+  !! 'contact', sides with 'displacement' given. Supports and group names are checked on
+  !! the meshes (module assembly, condense).
+  subroutine check_groups(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: b, s
+    character(len=:), allocatable :: p
+    p = st%path//': '
+    do b = 1, 2
+      if (len_trim(d%contact%body_group(b)) == 0) call fatal(EXIT_INPUT, p//'&contact names '// &
+        'the contact group of one body only; give both, body1_group=''NAME1'', body2_group=''NAME2''')
+      if (any(d%body(b)%bc == BC_CONTACT)) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
+        st%body_at(b)%s//') declares a ''contact'' side, but &contact names the contact groups; '// &
+        'use one or the other (a rectangle''s sides are the groups ''left'', ''right'', '// &
+        '''bottom'', ''top'')')
+      do s = 1, 4
+        if (d%body(b)%bc(s) == BC_DISPLACEMENT .and. .not. st%disp_given(s, b)) call fatal(EXIT_INPUT, &
+          p//'body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '//trim(side_names(s))//' side '// &
+          '''displacement'' but no &displacement group gives that displacement')
+      end do
+    end do
+    call check_loads(d, st)
+  end subroutine check_groups
 
   !> A side as a segment: the fixed coordinate c and the extent [a, e] along the side.
   subroutine side_line(b, s, c, a, e)

@@ -206,7 +206,7 @@ contains
     do a = 1, 2
       write (bname, '(a,i0)') 'body', a
       call group_open(fid, trim(bname), gid, st, create=.true.)
-      call write_attr(gid, 'element', element_names(msh(a)%element), st)
+      call write_attr(gid, 'element', trim(element_names(msh(a)%element)), st)
       call write_attr(gid, 'young', d%body(a)%young, st)
       call write_attr(gid, 'poisson', d%body(a)%poisson, st)
       call write_attr(gid, 'free_dofs', sys(a)%n, st)
