@@ -81,7 +81,8 @@ program robin_contact
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
     call mesh_build(msh(a), d%body(a))
-    call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a))
+    call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a), &
+                       boundaries=d%boundary(1:d%nboundary))
   end do
   !$omp end parallel do
   do a = 1, 2

@@ -12,10 +12,10 @@
 module assembly
   use kinds, only: wp, i8
   use sorting, only: sort_by_key
-  use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, &
+  use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
-  use mesh, only: mesh_t, side_nodes, node_id
+  use mesh, only: mesh_t, side_nodes, node_id, group_index, group_names, group_nodes
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress
   use linop, only: csc_symv
@@ -68,7 +68,7 @@ contains
   !! f -= K_fd u_d. Tractions with %body == body%id are integrated exactly on the side.
   !! On an impossible input `info` is non-zero, `msg` says why, and `sys` is incomplete.
   subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, info, msg, &
-                           u_prescribed, body_force)
+                           u_prescribed, body_force, boundaries)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -83,6 +83,9 @@ contains
     real(wp), intent(in), optional :: u_prescribed(:)
     !> optional body force density, integrated with 3x3 Gauss (Q1) or a degree-2 rule (P1)
     procedure(body_force_fn), optional :: body_force
+    !> optional prescribed components on named edge groups (&boundary; those of other
+    !! bodies are skipped), applied after the side conditions, in order
+    type(boundary_cfg_t), intent(in), optional :: boundaries(:)
     logical, allocatable :: pres(:)
     real(wp) :: lame_lambda, lame_mu
 
@@ -92,10 +95,19 @@ contains
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
 
     call prescribed_dofs(mesh, body, pres, sys, u_prescribed)
+    if (present(boundaries)) then
+      call group_conditions(mesh, body%id, boundaries, pres, sys, info, msg)
+      if (info /= 0) return
+      if (size(boundaries) > 0 .or. .not. mesh%structured) then
+        call check_supports(mesh, body%id, pres, info, msg)
+        if (info /= 0) return
+      end if
+    end if
     call number_free_dofs(pres, sys)
     call stiffness_pattern(mesh, sys, info, msg)
     if (info /= 0) return
-    call applied_loads(mesh, body%id, tractions(1:ntraction), sys, body_force)
+    call applied_loads(mesh, body%id, tractions(1:ntraction), sys, info, msg, body_force)
+    if (info /= 0) return
     call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg)
     if (info /= 0) return
     call add_applied_loads(sys)
@@ -121,7 +133,7 @@ contains
       write (msg, '(a,i0,a)') 'body ', body%id, ': the mesh is empty (call mesh_build first)'
       return
     end if
-    if (mesh%element /= ELEM_Q1 .and. mesh%element /= ELEM_P1) then
+    if (mesh%element /= ELEM_Q1 .and. mesh%element /= ELEM_P1 .and. mesh%element /= ELEM_MIXED) then
       info = 1
       write (msg, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', mesh%element
       return
@@ -153,6 +165,13 @@ contains
     end if
     do t = 1, ntraction
       if (tractions(t)%body /= body%id) cycle
+      if (len_trim(tractions(t)%group) > 0) cycle
+      if (.not. mesh%structured) then
+        info = 4
+        write (msg, '(a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
+          ' is on a side, but the body comes from a mesh file: load a group'
+        return
+      end if
       if (tractions(t)%side < SIDE_LEFT .or. tractions(t)%side > SIDE_TOP) then
         info = 4
         write (msg, '(a,i0,a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
@@ -220,6 +239,124 @@ contains
     end if
   end subroutine prescribed_dofs
 
+  !> The &boundary conditions of this body: the components given are prescribed on every
+  !! node of the group (a later condition overrides an earlier value). info = 1 when the
+  !! group is not one of the body's.
+  subroutine group_conditions(mesh, body_id, boundaries, pres, sys, info, msg)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: body_id
+    type(boundary_cfg_t), intent(in) :: boundaries(:)
+    logical, intent(inout) :: pres(:)
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    integer :: i, g, k, cc, dof
+    integer, allocatable :: nodes(:)
+
+    info = 0
+    msg = ''
+    do i = 1, size(boundaries)
+      if (boundaries(i)%body /= body_id) cycle
+      g = group_index(mesh, boundaries(i)%group)
+      if (g == 0) then
+        info = 1
+        msg = trim(boundaries(i)%origin)//': '//unknown_group(mesh, boundaries(i)%group)
+        return
+      end if
+      call group_nodes(mesh, g, nodes)
+      do k = 1, size(nodes)
+        do cc = 1, 2
+          if (.not. boundaries(i)%fix(cc)) cycle
+          dof = 2*(nodes(k) - 1) + cc
+          pres(dof) = .true.
+          sys%u_fixed(dof) = boundaries(i)%u(cc)
+        end do
+      end do
+    end do
+  end subroutine group_conditions
+
+  !> The sentence for a group name the body's mesh does not have.
+  function unknown_group(mesh, name) result(s)
+    type(mesh_t), intent(in) :: mesh
+    character(len=*), intent(in) :: name
+    character(len=:), allocatable :: s, src
+    src = 'the rectangle'
+    if (allocated(mesh%source)) then
+      if (len(mesh%source) > 0) src = mesh%source
+    end if
+    s = 'group '''//trim(name)//''' has no edge on the boundary of this body ('//src// &
+        '); its groups are '//group_names(mesh)
+    if (allocated(mesh%file_groups) .and. .not. mesh%structured) then
+      if (len_trim(mesh%file_groups) > 0) s = s//' (physical curves of the file: '//trim(mesh%file_groups)//')'
+    end if
+  end function unknown_group
+
+  !> The prescribed DOFs must hold the body against the three rigid motions (translation
+  !! along x and y, rotation): the rigid modes restricted to them have rank 3. info = 1
+  !! (a bad input) with the motion left free.
+  subroutine check_supports(mesh, body_id, pres, info, msg)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: body_id
+    logical, intent(in) :: pres(:)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    real(wp) :: g(3, 3), r(3), xc(2), h, piv, f
+    integer :: k, cc, i, j, rank
+    logical :: used(3)
+    character(len=:), allocatable :: what
+
+    info = 0
+    msg = ''
+    xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
+    h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
+    g = 0.0_wp
+    do k = 1, mesh%nnode
+      do cc = 1, 2
+        if (.not. pres(2*(k - 1) + cc)) cycle
+        r = 0.0_wp
+        r(cc) = 1.0_wp
+        if (cc == 1) r(3) = -(mesh%xy(2, k) - xc(2))/h
+        if (cc == 2) r(3) = (mesh%xy(1, k) - xc(1))/h
+        do j = 1, 3
+          g(:, j) = g(:, j) + r*r(j)
+        end do
+      end do
+    end do
+    ! rank of the 3 x 3 Gram matrix by Gaussian elimination with complete pivoting
+    rank = 0
+    used = .false.
+    f = max(maxval(abs(g)), tiny(1.0_wp))
+    do
+      piv = 0.0_wp
+      i = 0
+      do j = 1, 3
+        if (.not. used(j) .and. abs(g(j, j)) > piv) then
+          piv = abs(g(j, j))
+          i = j
+        end if
+      end do
+      if (i == 0 .or. piv <= 1.0e-10_wp*f) exit
+      rank = rank + 1
+      used(i) = .true.
+      do j = 1, 3
+        if (.not. used(j)) g(j, :) = g(j, :) - g(j, i)/g(i, i)*g(i, :)
+      end do
+    end do
+    if (rank == 3) return
+    if (.not. any(pres(1::2))) then
+      what = 'translation along x'
+    else if (.not. any(pres(2::2))) then
+      what = 'translation along y'
+    else
+      what = 'a rotation'
+    end if
+    info = 1
+    write (msg, '(a,i0,a)') 'body ', body_id, ' is not held against rigid motion: its prescribed '// &
+      'displacements leave '//what//' free (a body held only by contact is not supported yet); '// &
+      'prescribe ux and uy on one group, or ux on one group and uy on another that does not '// &
+      'lie on the same line'
+  end subroutine check_supports
+
   !> Number the DOFs that are not prescribed 1..n in increasing global order
   !! (sys%n, sys%free_of, sys%dof_of).
   subroutine number_free_dofs(pres, sys)
@@ -283,16 +420,27 @@ contains
     type(body_system_t), intent(inout) :: sys
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
-    integer :: p, s, cc, q, pos, nbr(9), nnbr
+    integer :: p, s, cc, q, pos, nbr(9), nnbr, k
     integer(i8) :: nnz
+    integer, allocatable :: aptr(:), adj(:)
 
     info = 0
     msg = ''
+    if (.not. mesh%structured) call node_adjacency(mesh, aptr, adj)
     allocate (sys%colptr(sys%n + 1))
     nnz = 0
     sys%colptr(1) = 0
     do p = 1, sys%n
-      call node_stencil(mesh, (sys%dof_of(p) - 1)/2 + 1, nbr, nnbr)
+      k = (sys%dof_of(p) - 1)/2 + 1
+      if (.not. mesh%structured) then
+        do s = aptr(k), aptr(k + 1) - 1
+          do cc = 1, 2
+            if (sys%free_of(2*(adj(s) - 1) + cc) > 0) nnz = nnz + 1
+          end do
+        end do
+        cycle
+      end if
+      call node_stencil(mesh, k, nbr, nnbr)
       do s = 1, nnbr
         do cc = 1, 2
           if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
@@ -308,8 +456,21 @@ contains
     end do
     allocate (sys%rowind(nnz), sys%val(nnz))
     do p = 1, sys%n
-      call node_stencil(mesh, (sys%dof_of(p) - 1)/2 + 1, nbr, nnbr)
+      k = (sys%dof_of(p) - 1)/2 + 1
       pos = sys%colptr(p)
+      if (.not. mesh%structured) then
+        do s = aptr(k), aptr(k + 1) - 1
+          do cc = 1, 2
+            q = sys%free_of(2*(adj(s) - 1) + cc)
+            if (q > 0) then
+              pos = pos + 1
+              sys%rowind(pos) = q - 1
+            end if
+          end do
+        end do
+        cycle
+      end if
+      call node_stencil(mesh, k, nbr, nnbr)
       do s = 1, nnbr
         do cc = 1, 2
           q = sys%free_of(2*(nbr(s) - 1) + cc)
@@ -323,22 +484,104 @@ contains
     sys%val = 0.0_wp
   end subroutine stiffness_pattern
 
+  !> The nodes that share a cell with each node (itself included), in increasing node id:
+  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). Built from the cells by one sort of
+  !! the (node, neighbour) pairs, for any mesh.
+  subroutine node_adjacency(mesh, aptr, adj)
+    type(mesh_t), intent(in) :: mesh
+    integer, allocatable, intent(out) :: aptr(:), adj(:)
+    integer, allocatable :: cnt(:), pairs(:), pos(:)
+    integer :: c, a, b, nv, k, np, i, last
+    ! pairs (k, l) of every cell, bucketed by k, then sorted and deduplicated per node
+    allocate (cnt(mesh%nnode + 1))
+    cnt = 0
+    do c = 1, mesh%ncell
+      nv = cell_nv(mesh, c)
+      do a = 1, nv
+        k = mesh%cells(a, c)
+        cnt(k + 1) = cnt(k + 1) + nv
+      end do
+    end do
+    cnt(1) = 1
+    do k = 1, mesh%nnode
+      cnt(k + 1) = cnt(k + 1) + cnt(k)
+    end do
+    np = cnt(mesh%nnode + 1) - 1
+    allocate (pairs(np), pos(mesh%nnode))
+    pos = cnt(1:mesh%nnode)
+    do c = 1, mesh%ncell
+      nv = cell_nv(mesh, c)
+      do a = 1, nv
+        k = mesh%cells(a, c)
+        do b = 1, nv
+          pairs(pos(k)) = mesh%cells(b, c)
+          pos(k) = pos(k) + 1
+        end do
+      end do
+    end do
+    allocate (aptr(mesh%nnode + 1), adj(np))
+    aptr(1) = 1
+    i = 0
+    do k = 1, mesh%nnode
+      call sort_ints(pairs(cnt(k):cnt(k + 1) - 1))
+      last = 0
+      do a = cnt(k), cnt(k + 1) - 1
+        if (pairs(a) == last) cycle
+        last = pairs(a)
+        i = i + 1
+        adj(i) = last
+      end do
+      aptr(k + 1) = i + 1
+    end do
+  end subroutine node_adjacency
+
+  !> Sort a short list of integers in place (insertion sort: a node has a few dozen pairs).
+  pure subroutine sort_ints(v)
+    integer, intent(inout) :: v(:)
+    integer :: i, j, x
+    do i = 2, size(v)
+      x = v(i)
+      j = i - 1
+      do while (j >= 1)
+        if (v(j) <= x) exit
+        v(j + 1) = v(j)
+        j = j - 1
+      end do
+      v(j + 1) = x
+    end do
+  end subroutine sort_ints
+
   !> The applied nodal loads on all DOFs (sys%f_applied): the tractions on this body,
-  !! then the body force if any; sys%f = 0.
-  subroutine applied_loads(mesh, body_id, tractions, sys, body_force)
+  !! then the body force if any; sys%f = 0. info = 1 when a traction names a group the
+  !! body does not have.
+  subroutine applied_loads(mesh, body_id, tractions, sys, info, msg, body_force)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id
     type(traction_cfg_t), intent(in) :: tractions(:)
     type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
     procedure(body_force_fn), optional :: body_force
-    integer :: t
+    integer :: t, g
 
+    info = 0
+    msg = ''
     allocate (sys%f(sys%n), sys%f_applied(sys%ndof))
     sys%f = 0.0_wp
     sys%f_applied = 0.0_wp
     do t = 1, size(tractions)
       if (tractions(t)%body /= body_id) cycle
-      call add_traction(mesh, tractions(t), sys%f_applied)
+      if (len_trim(tractions(t)%group) > 0) then
+        g = group_index(mesh, tractions(t)%group)
+        if (g == 0) then
+          info = 1
+          msg = trim(tractions(t)%origin)//': '//unknown_group(mesh, tractions(t)%group)
+          return
+        end if
+        call add_group_traction(mesh, g, tractions(t), sys%f_applied)
+      else
+        call add_traction(mesh, tractions(t), sys%f_applied)
+      end if
     end do
     if (present(body_force)) call add_body_force(mesh, body_force, sys%f_applied)
   end subroutine applied_loads
@@ -358,14 +601,14 @@ contains
 
     info = 0
     msg = ''
-    nd = 2*mesh%nvert
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
+      nd = 2*cell_nv(mesh, c)
       call cell_coords(mesh, c, xe)
-      call element_stiffness(mesh%element, xe, lame_lambda, lame_mu, ke, minjac, cache)
+      call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
       if (.not. (minjac > 0.0_wp)) then
         info = 7
-        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': cell ', c, &
+        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': cell ', mesh%cell_tag(c), &
           ' has a non-positive Jacobian (inverted or degenerate element)'
         return
       end if
@@ -495,13 +738,13 @@ contains
     type(ke_cache_t) :: cache
 
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
-    nd = 2*mesh%nvert
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:2*mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
+      nd = 2*cell_nv(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
-      call element_stiffness(mesh%element, xe, lame_lambda, lame_mu, ke, minjac, cache)
+      call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
     end do
@@ -525,16 +768,16 @@ contains
     real(wp) :: sxx, syy, sxy, szz
 
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
-    nd = 2*mesh%nvert
     allocate (cnt(mesh%nnode))
     cnt = 0
     sigma(:, 1:mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
+      nd = 2*cell_nv(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
       ue(1:nd) = u_full(ldof(1:nd))
-      call element_stress(mesh%element, xe, ue, lame_lambda, lame_mu, plane_strain, cs)
-      do a = 1, mesh%nvert
+      call element_stress(cell_elem(mesh, c), xe, ue, lame_lambda, lame_mu, plane_strain, cs)
+      do a = 1, nd/2
         k = mesh%cells(a, c)
         sigma(:, k) = sigma(:, k) + cs
         cnt(k) = cnt(k) + 1
@@ -562,14 +805,32 @@ contains
   ! Cells and sides
   ! ---------------------------------------------------------------------------------
 
-  !> Vertex coordinates of cell c (columns past mesh%nvert are 0).
+  !> The element of cell c (ELEM_Q1 or ELEM_P1).
+  pure integer function cell_elem(mesh, c)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: c
+    if (allocated(mesh%cell_type)) then
+      cell_elem = mesh%cell_type(c)
+    else
+      cell_elem = mesh%element
+    end if
+  end function cell_elem
+
+  !> The number of vertices of cell c.
+  pure integer function cell_nv(mesh, c)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: c
+    cell_nv = merge(4, 3, cell_elem(mesh, c) == ELEM_Q1)
+  end function cell_nv
+
+  !> Vertex coordinates of cell c (columns past its vertices are 0).
   pure subroutine cell_coords(mesh, c, xe)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: c
     real(wp), intent(out) :: xe(2, MAX_NVERT)
     integer :: a
     xe = 0.0_wp
-    do a = 1, mesh%nvert
+    do a = 1, cell_nv(mesh, c)
       xe(:, a) = mesh%xy(:, mesh%cells(a, c))
     end do
   end subroutine cell_coords
@@ -581,7 +842,7 @@ contains
     integer, intent(out) :: ldof(MAX_NDOF)
     integer :: a
     ldof = 0
-    do a = 1, mesh%nvert
+    do a = 1, cell_nv(mesh, c)
       ldof(2*a - 1) = 2*(mesh%cells(a, c) - 1) + 1
       ldof(2*a) = 2*(mesh%cells(a, c) - 1) + 2
     end do
@@ -610,6 +871,30 @@ contains
     end do
   end subroutine add_traction
 
+  !> Add the consistent nodal loads of t(x,y) = t0 + tx*x + ty*y - pressure*n on the edges
+  !! of group g (n the edge's outward unit normal): exact for a traction linear along each
+  !! straight edge, f_a += L/6 (2 t_a + t_b), f_b += L/6 (t_a + 2 t_b).
+  subroutine add_group_traction(mesh, g, tr, f)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: g
+    type(traction_cfg_t), intent(in) :: tr
+    real(wp), intent(inout) :: f(:)
+    integer :: e, na, nb
+    real(wp) :: xa(2), xb(2), len, nrm(2), ta(2), tb(2)
+    do e = 1, mesh%group(g)%nedge
+      na = mesh%group(g)%edge(1, e)
+      nb = mesh%group(g)%edge(2, e)
+      xa = mesh%xy(:, na)
+      xb = mesh%xy(:, nb)
+      len = norm2(xb - xa)
+      nrm = [xb(2) - xa(2), -(xb(1) - xa(1))]/len
+      ta = tr%t0 + tr%tx*xa(1) + tr%ty*xa(2) - tr%pressure*nrm
+      tb = tr%t0 + tr%tx*xb(1) + tr%ty*xb(2) - tr%pressure*nrm
+      f(2*na - 1:2*na) = f(2*na - 1:2*na) + len/6.0_wp*(2.0_wp*ta + tb)
+      f(2*nb - 1:2*nb) = f(2*nb - 1:2*nb) + len/6.0_wp*(ta + 2.0_wp*tb)
+    end do
+  end subroutine add_group_traction
+
   !> Add the consistent nodal loads of a body force density to f, cell by cell.
   subroutine add_body_force(mesh, bf, f)
     type(mesh_t), intent(in) :: mesh
@@ -621,12 +906,12 @@ contains
     fe = 0.0_wp
     do c = 1, mesh%ncell
       call cell_coords(mesh, c, xe)
-      do a = 1, mesh%nvert
+      do a = 1, cell_nv(mesh, c)
         k = mesh%cells(a, c)
         fe(:, a) = f(2*k - 1:2*k)
       end do
-      call element_body_force(mesh%element, xe, bf, fe)
-      do a = 1, mesh%nvert
+      call element_body_force(cell_elem(mesh, c), xe, bf, fe)
+      do a = 1, cell_nv(mesh, c)
         k = mesh%cells(a, c)
         f(2*k - 1:2*k) = fe(:, a)
       end do

@@ -35,6 +35,7 @@ module elements
   type, public :: ke_cache_t
     private
     logical :: valid = .false.
+    integer :: element = 0                   ! the element of the cached stiffness
     real(wp) :: rel(2, MAX_NVERT) = 0.0_wp   ! vertex coordinates relative to vertex 1 [length]
     real(wp) :: tol = 0.0_wp                 ! coordinate tolerance below which cells are the same [length]
     real(wp) :: ke(MAX_NDOF, MAX_NDOF) = 0.0_wp
@@ -152,7 +153,7 @@ contains
       do a = 1, nv
         rel(:, a) = xe(:, a) - xe(:, 1)
       end do
-      if (cache%valid) then
+      if (cache%valid .and. cache%element == element) then
         if (all(abs(rel(:, 1:nv) - cache%rel(:, 1:nv)) <= cache%tol)) then
           ke = cache%ke
           minjac = cache%minjac
@@ -178,6 +179,7 @@ contains
     end if
     if (present(cache)) then
       cache%valid = .true.
+      cache%element = element
       cache%rel(:, 1:nv) = rel(:, 1:nv)
       cache%ke = ke
       cache%minjac = minjac
