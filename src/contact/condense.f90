@@ -1,8 +1,12 @@
-!> Interface condensation: the contact line shared by the two bodies, and for each
-!! body its factorization, normal flexibility F_a = B_a K_a^-1 B_a' and the normal
-!! interface displacement under the load alone b_a = B_a K_a^-1 f_a (README, "Method as implemented").
-!! The interface DOFs are ordered last in the Cholesky factorization, so F_a comes
-!! from the trailing block of the factor at a cost of O(m^3), not m solves.
+!> Interface condensation: the contact interface of the two bodies (its m constraint rows
+!! B_1 u_1 + B_2 u_2 <= g0), and for each body its factorization, normal flexibility
+!! F_a = B_a K_a^-1 B_a' and the normal interface displacement under the load alone
+!! b_a = B_a K_a^-1 f_a (plus B_a's part on prescribed DOFs) (README, "Method as implemented").
+!! Two ways to build the rows: rectangle sides declared 'contact' that match node for node
+!! (row i = the normal displacement of node pair i), or named edge groups paired by dual
+!! mortar (module mortar; row j = the weighted normal gap at slave node j). The free DOFs
+!! that B_a touches are ordered last in the Cholesky factorization, so F_a comes from the
+!! trailing block of the factor at a cost of O(k^3) (k those DOFs), not m solves.
 module condense
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
@@ -16,25 +20,39 @@ module condense
   implicit none (type, external)
   private
 
-  !> The contact line: m node pairs where both bodies' normal displacement is free.
+  !> The m rows of one body's B_a (compressed rows over global DOFs 2*(node-1)+c).
+  type, public :: brows_t
+    integer, allocatable :: ptr(:)          !< (m+1) row k is entries ptr(k) .. ptr(k+1)-1
+    integer, allocatable :: dof(:)          !< global DOF of each entry
+    real(wp), allocatable :: val(:)         !< coefficient of each entry [-]
+  end type brows_t
+
+  !> The contact interface: m constraint rows, one per contact node of the slave side.
   type, public :: interface_t
-    integer :: m = 0                        !< contact node pairs
-    integer :: side(2) = 0                  !< contact side of each body (SIDE_*)
-    integer :: axis = 1                     !< coordinate along the line: 1 = x, 2 = y
-    real(wp), allocatable :: s(:)           !< (m) coordinate along the line [length]
-    real(wp), allocatable :: xy(:, :)       !< (2,m) node coordinates [length]
+    integer :: m = 0                        !< contact constraints (slave nodes with a multiplier)
+    logical :: mortar = .false.             !< rows from dual mortar on named groups
+    integer :: slave = 1                    !< body whose nodes carry the rows
+    integer :: side(2) = 0                  !< contact side of each body (SIDE_*; side mode)
+    integer :: axis = 1                     !< side mode: coordinate along the line, 1 = x, 2 = y
+    real(wp), allocatable :: s(:)           !< (m) position along the contact curve [length]
+                                            !! (side mode: the coordinate; mortar: arc length)
+    real(wp), allocatable :: xy(:, :)       !< (2,m) slave node coordinates [length]
+    real(wp), allocatable :: normal(:, :)   !< (2,m) unit normal, outward from the slave body
     real(wp), allocatable :: g0(:)          !< (m) initial normal gap [length]
-    real(wp), allocatable :: trib(:)        !< (m) tributary length [length]
-    integer, allocatable :: node(:, :)      !< (m,2) mesh node of each body
+    real(wp), allocatable :: trib(:)        !< (m) tributary length D_jj [length]
+    integer, allocatable :: node(:, :)      !< (m,2) mesh node of each body (0: none, mortar master)
+    type(brows_t) :: b(2)                   !< B_1, B_2
   end type interface_t
 
   !> One body reduced to the interface.
   type, public :: body_condensed_t
     integer :: m = 0                        !< interface size
     integer :: n = 0                        !< free DOFs of the body
-    real(wp) :: normal(2) = 0.0_wp          !< outward normal of the contact side
-    integer, allocatable :: idx(:)          !< (m) free DOF of the normal component
-    real(wp), allocatable :: sgn(:)         !< (m) normal component of the outward normal (+-1)
+    integer, allocatable :: idx(:)          !< (k) the free DOFs B_a touches, ordered last
+    integer, allocatable :: bptr(:)         !< (m+1) B_a on them: row i is entries bptr(i)..bptr(i+1)-1,
+    integer, allocatable :: bpos(:)         !<   position in idx of each entry
+    real(wp), allocatable :: bval(:)        !<   and its coefficient
+    real(wp), allocatable :: bfix(:)        !< (m) B_a's part on prescribed DOFs, B_a,d u_d [length]
     real(wp), allocatable :: flex(:, :)     !< (m,m) F_a [length/force]
     real(wp), allocatable :: b(:)           !< (m) B_a K_a^-1 f_a [length]
     real(wp), allocatable :: u0(:)          !< (n) K_a^-1 f_a [length]
@@ -43,7 +61,7 @@ module condense
     real(wp) :: t_condense = 0.0_wp         !< wall time of F_a and b_a [s]
   end type body_condensed_t
 
-  public :: build_interface, factor_body, condense_body, recover_displacement, apply_bt
+  public :: build_interface, factor_body, condense_body, recover_displacement, apply_bt, apply_b
 
 contains
 
@@ -120,7 +138,10 @@ contains
       if (i < nline) tl(i) = tl(i) + 0.5_wp*(sl(i + 1) - sl(i))
     end do
     itf%m = count(keep)
-    allocate (itf%s(itf%m), itf%xy(2, itf%m), itf%g0(itf%m), itf%trib(itf%m), itf%node(itf%m, 2))
+    itf%mortar = .false.
+    itf%slave = 1
+    allocate (itf%s(itf%m), itf%xy(2, itf%m), itf%g0(itf%m), itf%trib(itf%m), itf%node(itf%m, 2), &
+              itf%normal(2, itf%m))
     k = 0
     do i = 1, nline
       if (.not. keep(i)) cycle
@@ -135,35 +156,82 @@ contains
       else
         itf%g0(k) = 0.0_wp
       end if
+      itf%normal(:, k) = side_normal(itf%side(1))
+    end do
+    ! row k of B_a: the normal displacement of node k with body a's outward normal
+    c = merge(2, 1, itf%axis == 1)
+    do a = 1, 2
+      allocate (itf%b(a)%ptr(itf%m + 1), itf%b(a)%dof(itf%m), itf%b(a)%val(itf%m))
+      x1 = side_normal(itf%side(a))
+      do k = 1, itf%m
+        itf%b(a)%ptr(k) = k
+        itf%b(a)%dof(k) = 2*(itf%node(k, a) - 1) + c
+        itf%b(a)%val(k) = x1(c)
+      end do
+      itf%b(a)%ptr(itf%m + 1) = itf%m + 1
     end do
   end subroutine build_interface
 
-  !> Normal DOF indices and signs of body a on the interface.
+  !> The outward unit normal of a rectangle's side.
+  pure function side_normal(side) result(nrm)
+    integer, intent(in) :: side
+    real(wp) :: nrm(2)
+    select case (side)
+    case (SIDE_LEFT)
+      nrm = [-1.0_wp, 0.0_wp]
+    case (SIDE_RIGHT)
+      nrm = [1.0_wp, 0.0_wp]
+    case (SIDE_BOTTOM)
+      nrm = [0.0_wp, -1.0_wp]
+    case default
+      nrm = [0.0_wp, 1.0_wp]
+    end select
+  end function side_normal
+
+  !> B_a on the free DOFs of body a: the DOFs it touches with a non-zero coefficient, in the
+  !! order the rows first touch them (these are ordered last in the factorization), the
+  !! rows over their positions, and the constant part on prescribed DOFs.
   subroutine interface_dofs(itf, a, sys, bc)
     type(interface_t), intent(in) :: itf
     integer, intent(in) :: a
     type(body_system_t), intent(in) :: sys
     type(body_condensed_t), intent(inout) :: bc
-    integer :: i, c
-    select case (itf%side(a))
-    case (SIDE_LEFT)
-      bc%normal = [-1.0_wp, 0.0_wp]
-    case (SIDE_RIGHT)
-      bc%normal = [1.0_wp, 0.0_wp]
-    case (SIDE_BOTTOM)
-      bc%normal = [0.0_wp, -1.0_wp]
-    case default
-      bc%normal = [0.0_wp, 1.0_wp]
-    end select
-    c = merge(2, 1, itf%axis == 1)
+    integer :: i, e, p, k, ne
+    integer, allocatable :: pos_of(:), idx(:)
+
     bc%m = itf%m
     bc%n = sys%n
-    if (allocated(bc%idx)) deallocate (bc%idx, bc%sgn)
-    allocate (bc%idx(itf%m), bc%sgn(itf%m))
-    do i = 1, itf%m
-      bc%idx(i) = sys%free_of(2*(itf%node(i, a) - 1) + c)
-      bc%sgn(i) = bc%normal(c)
-    end do
+    if (allocated(bc%idx)) deallocate (bc%idx)
+    if (allocated(bc%bptr)) deallocate (bc%bptr, bc%bpos, bc%bval, bc%bfix)
+    associate (b => itf%b(a))
+      ne = b%ptr(itf%m + 1) - 1
+      allocate (pos_of(sys%n), idx(ne), bc%bptr(itf%m + 1), bc%bpos(ne), bc%bval(ne), bc%bfix(itf%m))
+      pos_of = 0
+      k = 0
+      ne = 0
+      bc%bptr(1) = 1
+      do i = 1, itf%m
+        bc%bfix(i) = 0.0_wp
+        do e = b%ptr(i), b%ptr(i + 1) - 1
+          if (b%val(e) == 0.0_wp) cycle
+          p = sys%free_of(b%dof(e))
+          if (p == 0) then
+            bc%bfix(i) = bc%bfix(i) + b%val(e)*sys%u_fixed(b%dof(e))
+            cycle
+          end if
+          if (pos_of(p) == 0) then
+            k = k + 1
+            idx(k) = p
+            pos_of(p) = k
+          end if
+          ne = ne + 1
+          bc%bpos(ne) = pos_of(p)
+          bc%bval(ne) = b%val(e)
+        end do
+        bc%bptr(i + 1) = ne + 1
+      end do
+    end associate
+    bc%idx = idx(1:k)
   end subroutine interface_dofs
 
   !> Factorize K_a with the interface DOFs ordered last. ordering='nd' orders the
@@ -218,7 +286,9 @@ contains
     integer, intent(out) :: info                     !< 0 ok
     character(len=*), intent(out) :: msg             !< description of a failure
     real(wp) :: t0
-    integer :: i
+    integer :: i, j, e, f, k, st
+    real(wp) :: acc
+    real(wp), allocatable :: x(:, :)
     t0 = wtime()
     if (allocated(bc%flex)) deallocate (bc%flex)
     if (allocated(bc%b)) deallocate (bc%b)
@@ -226,27 +296,62 @@ contains
     allocate (bc%flex(bc%m, bc%m), bc%b(bc%m), bc%u0(sys%n))
     info = 0
     msg = ''
-    if (bc%m > 0) then
-      call bc%chol%flexibility(bc%idx, bc%sgn, bc%flex, info, msg)
+    k = size(bc%idx)
+    if (bc%m > 0) bc%flex = 0.0_wp
+    if (bc%m > 0 .and. k > 0) then
+      ! X = (K^-1) on the interface DOFs, then F = B X B' over the few entries of each row
+      allocate (x(k, k), stat=st)
+      if (st /= 0) then
+        info = 2
+        msg = 'out of memory for the interface block of K^-1'
+        return
+      end if
+      call bc%chol%flexibility(bc%idx, spread(1.0_wp, 1, k), x, info, msg)
       if (info /= 0) return
+      do j = 1, bc%m
+        do i = 1, bc%m
+          acc = 0.0_wp
+          do f = bc%bptr(j), bc%bptr(j + 1) - 1
+            do e = bc%bptr(i), bc%bptr(i + 1) - 1
+              acc = acc + (bc%bval(e)*bc%bval(f))*x(bc%bpos(e), bc%bpos(f))
+            end do
+          end do
+          bc%flex(i, j) = acc
+        end do
+      end do
     end if
     bc%u0 = sys%f
     call bc%chol%solve(bc%u0, info, msg)
     if (info /= 0) return
-    do i = 1, bc%m
-      bc%b(i) = bc%sgn(i)*bc%u0(bc%idx(i))
-    end do
+    call apply_b(bc, bc%u0, bc%b)
     bc%t_condense = wtime() - t0
   end subroutine condense_body
+
+  !> w(m) = B_a u: the rows on the free displacements u (n) plus the part on prescribed DOFs.
+  subroutine apply_b(bc, u, w)
+    type(body_condensed_t), intent(in) :: bc         !< condensed body
+    real(wp), intent(in) :: u(:)                     !< (n) free displacements [length]
+    real(wp), intent(out) :: w(:)                    !< (m) B_a u [length]
+    integer :: i, e
+    do i = 1, bc%m
+      w(i) = 0.0_wp
+      do e = bc%bptr(i), bc%bptr(i + 1) - 1
+        w(i) = w(i) + bc%bval(e)*u(bc%idx(bc%bpos(e)))
+      end do
+      w(i) = w(i) + bc%bfix(i)
+    end do
+  end subroutine apply_b
 
   !> r(n) = B_a' lam: scatter the interface forces onto the normal DOFs.
   subroutine apply_bt(bc, lam, r)
     type(body_condensed_t), intent(in) :: bc         !< condensed body
     real(wp), intent(in) :: lam(:)                   !< (m) interface forces [force]
     real(wp), intent(inout) :: r(:)                  !< (n) r += B_a' lam
-    integer :: i
+    integer :: i, e
     do i = 1, bc%m
-      r(bc%idx(i)) = r(bc%idx(i)) + bc%sgn(i)*lam(i)
+      do e = bc%bptr(i), bc%bptr(i + 1) - 1
+        r(bc%idx(bc%bpos(e))) = r(bc%idx(bc%bpos(e))) + bc%bval(e)*lam(i)
+      end do
     end do
   end subroutine apply_bt
 
