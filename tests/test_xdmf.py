@@ -54,7 +54,7 @@ BODY_FIELDS = FIELDS + COMPONENTS + ("body_id",)           # body_id: per cell
 CONTACT_XDMF = "{stem}_contact.xdmf"                       # the contact line, for meshio
 CONTACT_FIELDS = ("pressure", "normal_force", "gap", "normal_displacement_body1", "normal_displacement_body2")
 # the unit of every numeric dataset: L length, S stress, F/L force per unit length, 1, s
-UNITS = {"contact/x": "L", "contact/coordinates": "L", "contact/g0": "L", "contact/tributary_length": "L",
+UNITS = {"contact/x": "L", "contact/y": "L", "contact/s": "L", "contact/normal": "1", "contact/coordinates": "L", "contact/g0": "L", "contact/tributary_length": "L",
          "contact/normal_force": "F/L", "contact/normal_force_body1": "F/L", "contact/normal_force_body2": "F/L",
          "contact/pressure": "S", "contact/gap": "L", "contact/active": "1",
          "contact/normal_displacement_body1": "L", "contact/normal_displacement_body2": "L",

@@ -169,7 +169,7 @@ class Runner:
         if os.path.exists(h5):
             with h5py.File(h5, "r") as f:
                 c = {k: np.array(f["/contact/" + k]) for k in
-                     ("normal_force", "pressure", "x", "tributary_length", "active")}
+                     ("normal_force", "pressure", "s", "tributary_length", "active")}
             row["force"] = float(np.sum(c["normal_force"]))
         elif fm is not None:
             row["force"] = fnum(fm)
@@ -226,7 +226,7 @@ def pressure_error(coarse, fine, edge_window=None):
     """Relative L2 error of the coarse pressure against the fine one at the coarse nodes;
     with edge_window, leave out the nodes within edge_window * (line length) of a change
     active <-> inactive of the fine solution (the contact-zone edges)."""
-    xc, xf = coarse["x"], fine["x"]
+    xc, xf = coarse["s"], fine["s"]
     hf = np.min(np.diff(xf)) if xf.size > 1 else 1.0
     pos = np.interp(xc, xf, np.arange(xf.size))
     if np.max(np.abs(pos - np.rint(pos))) > 1e-6:
@@ -418,7 +418,7 @@ def main():
     if fine is not None:
         act = np.asarray(fine["active"]).astype(bool)
         flips = np.nonzero(act[1:] != act[:-1])[0]
-        xe = ", ".join(f"{0.5 * (fine['x'][i] + fine['x'][i + 1]):.4f}" for i in flips)
+        xe = ", ".join(f"{0.5 * (fine['s'][i] + fine['s'][i + 1]):.4f}" for i in flips)
         print(f"\n(contact-zone edges of the finest solution at x = {xe}; "
               f"'away from edge' leaves out +-{a.edge_window:g} of the line length around them)")
     if "ordering" not in skip:

@@ -160,7 +160,7 @@ class Runner:
                         problems.append("NaN/Inf in " + ", ".join(bad[:6]) + (" ..." if len(bad) > 6 else ""))
                     with h5py.File(h5, "r") as f:
                         r["lam"] = np.array(f["/contact/normal_force"], dtype=float)
-                        r["x"] = np.array(f["/contact/x"], dtype=float)
+                        r["x"] = np.array(f["/contact/s"], dtype=float)
                         r["p"] = np.array(f["/contact/pressure"], dtype=float)
                         r["trib"] = np.array(f["/contact/tributary_length"], dtype=float)
                         r["deck_text"] = f["input_deck"][()].decode()

@@ -4,7 +4,7 @@ runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-ga
 
 Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [-o contact.png] [--title TEXT]
 
-Top panel: /contact/pressure (nodal force / tributary length) against /contact/x; the
+Top panel: /contact/pressure (nodal force / tributary length) against /contact/s (arc length along the contact curve); the
 legend gives each run's total normal force P = sum of /contact/normal_force (force per
 unit thickness); dotted vertical lines mark the edges of each run's contact zone (the zero
 of p^2 extrapolated from the two outermost active nodes, rc_common.contact_edges).
@@ -144,7 +144,10 @@ def hertz_errors(r, h):
 def read_run(path, want_hertz):
     with h5py.File(path, "r") as f:
         u = result_units(f)
-        x = np.array(f["/contact/x"], dtype=float)
+        # position along the contact curve: /contact/s (arc length, or the coordinate along a
+        # rectangle's side); files of older versions have only /contact/x
+        sname = "/contact/s" if "/contact/s" in f else "/contact/x"
+        x = np.array(f[sname], dtype=float)
         order = np.argsort(x, kind="stable")
         lam = np.array(f["/contact/normal_force"], dtype=float)
         r = dict(x=x[order], p=np.array(f["/contact/pressure"], dtype=float)[order], lam=lam[order],
@@ -153,7 +156,7 @@ def read_run(path, want_hertz):
                  if "/contact/tributary_length" in f else np.zeros(0),
                  method=text_attr(f, "method", "?"), status=text_attr(f, "status", "?"),
                  delta=num_attr(f, "delta", float("nan")),
-                 ux=dataset_unit(f["/contact/x"], u["length"]),
+                 ux=dataset_unit(f[sname], u["length"]),
                  up=dataset_unit(f["/contact/pressure"], u["stress"]),
                  uf=dataset_unit(f["/contact/normal_force"], u["line_force"]),
                  ug=dataset_unit(f["/contact/gap"], u["length"]) if "/contact/gap" in f else u["length"])
@@ -246,7 +249,7 @@ def main(argv=None):
     axg.grid(True, alpha=0.4)
     ax.set_ylabel(axis_label("contact pressure p", lp))
     axg.set_ylabel(axis_label("gap", lg))
-    axg.set_xlabel(axis_label("x along the contact line", lx))
+    axg.set_xlabel(axis_label("s, position along the contact curve", lx))
     ax.tick_params(labelbottom=False)
     ax.set_title(a.title or "contact pressure (top) and gap (below; < 0: apart)"
                  + (", Hertz line contact" if with_hertz else ""), fontsize=10)

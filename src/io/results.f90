@@ -13,7 +13,7 @@ module results
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
-  use config, only: deck_t, ELEM_Q1, element_names
+  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t
@@ -174,8 +174,12 @@ contains
     call group_close(gid, st)
     ! contact
     call group_open(fid, 'contact', gid, st, create=.true.)
-    call write_dset(gid, 'x', itf%s, st, ul)
+    call write_dset(gid, 'x', itf%xy(1, :), st, ul)
+    call write_dset(gid, 'y', itf%xy(2, :), st, ul)
+    call write_dset(gid, 's', itf%s, st, ul)
     allocate (w2(itf%m, 2))
+    w2 = transpose(itf%normal)
+    call write_dset(gid, 'normal', w2, st, '1')
     w2 = transpose(itf%xy)   ! contiguous (gfortran passes a transpose as a strided view)
     call write_dset(gid, 'coordinates', w2, st, ul)
     deallocate (w2)
@@ -221,7 +225,9 @@ contains
       call write_dset(gid, 'geometry_xyz', w3, st, ul)
       w3 = pad3(reshape(ua, [2, msh(a)%nnode]))
       call write_dset(gid, 'displacement_xyz', w3, st, ul)
+      ! 0-based; a triangle of a mixed mesh has -1 as its fourth vertex
       call write_dset(gid, 'cells', msh(a)%cells - 1, st, '1')
+      if (msh(a)%element == ELEM_MIXED) call write_dset(gid, 'topology', mixed_topology(msh(a)), st, '1')
       call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
       allocate (sig(4, msh(a)%nnode), vm(msh(a)%nnode), sigt(msh(a)%nnode, 4))
       call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sig, vm)
@@ -241,7 +247,7 @@ contains
       vm = 0.0_wp
       do k = 1, itf%m
         i = itf%node(k, a)
-        vm(i) = pres(k)
+        if (i > 0) vm(i) = pres(k)
       end do
       call write_dset(gid, 'contact_pressure', vm, st, us)
       deallocate (w2, w3, ua, sigt, sig, vm)
@@ -249,6 +255,22 @@ contains
     end do
     call file_close(fid, st)
   end subroutine write_h5
+
+  !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral)
+  !! and its 0-based vertices.
+  function mixed_topology(msh) result(t)
+    type(mesh_t), intent(in) :: msh
+    integer, allocatable :: t(:)
+    integer :: c, k, nv
+    allocate (t(count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type /= ELEM_Q1)*4))
+    k = 0
+    do c = 1, msh%ncell
+      nv = merge(4, 3, msh%cell_type(c) == ELEM_Q1)
+      t(k + 1) = merge(5, 4, nv == 4)
+      t(k + 2:k + 1 + nv) = msh%cells(1:nv, c) - 1
+      k = k + 1 + nv
+    end do
+  end function mixed_topology
 
   function pad3(v) result(p)
     real(wp), intent(in) :: v(:, :)
@@ -315,8 +337,10 @@ contains
     integer :: k
     if (msh%element == ELEM_Q1) then
       topo = 'Quadrilateral'
-    else
+    else if (msh%element == ELEM_P1) then
       topo = 'Triangle'
+    else
+      topo = 'Mixed'
     end if
     write (nn, '(i0)') msh%nnode
     write (nc, '(i0)') msh%ncell
@@ -324,8 +348,14 @@ contains
     g = h5//':/body'//achar(48 + a)
     t = line('      <Grid Name="body'//achar(48 + a)//'" GridType="Uniform">')
     t = t//line('        <Topology TopologyType="'//trim(topo)//'" NumberOfElements="'//trim(nc)//'">')
-    t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
-                '" NumberType="Int" Precision="4" Format="HDF">'//g//'/cells</DataItem>')
+    if (msh%element == ELEM_MIXED) then
+      write (nv, '(i0)') 5*count(msh%cell_type == ELEM_Q1) + 4*count(msh%cell_type /= ELEM_Q1)
+      t = t//line('          <DataItem Dimensions="'//trim(nv)// &
+                  '" NumberType="Int" Precision="4" Format="HDF">'//g//'/topology</DataItem>')
+    else
+      t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
+                  '" NumberType="Int" Precision="4" Format="HDF">'//g//'/cells</DataItem>')
+    end if
     t = t//line('        </Topology>')
     t = t//geometry_text(trim(nn), g//'/geometry_xyz')
     t = t//field_text('displacement', 'Vector', trim(nn)//' 3', g//'/displacement_xyz')
