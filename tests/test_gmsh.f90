@@ -391,6 +391,7 @@ contains
     integer :: info
     character(len=512) :: msg
 
+    allocate (l(0))
     call msh_read(tmp//'missing.msh', 'sq', 3, m, info, msg)
     call report(info == 1 .and. index(msg, tmp//'missing.msh') > 0 .and. index(msg, 'body 3') > 0, &
                 'a missing file is bad input naming it')
@@ -454,6 +455,9 @@ contains
     call expect_error('dup.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
                       '1', '2', '2', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']), 'sq', 1, &
                       [character(len=20) :: 'node tag 2', 'twice'], 'a repeated node tag is refused')
+    l = square()
+    call expect_error('twice.msh', [l, l(14:25)], 'sq', 1, [character(len=24) :: 'second $Nodes', 'line 33'], &
+                      'a second $Nodes section is refused')
     call expect_error('notmsh.msh', [character(len=20) :: 'hello', 'world'], 'sq', 1, &
                       [character(len=20) :: 'not a Gmsh MSH', 'line 1'], 'a file that is not MSH is refused')
   end subroutine test_bad_inputs

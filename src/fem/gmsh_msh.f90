@@ -7,8 +7,8 @@
 !! seconds for the 4 million numbers of a 500k-node mesh, which this reads in about 1 s
 !! (peak memory about 2.8 times the file). Node tags are looked up through a hash table, so
 !! tags may be sparse and unordered; the body's nodes are renumbered 1..nnode in increasing
-!! tag order. Cells are
-!! reoriented counter-clockwise; degenerate cells and non-convex quadrangles are refused.
+!! tag order. Cells are reoriented counter-clockwise; degenerate cells and non-convex
+!! quadrangles are refused.
 !! A group keeps the line elements of its physical curve that are boundary edges of the body
 !! (edges of exactly one body cell), oriented as that cell traverses them.
 !!
@@ -34,7 +34,6 @@ module gmsh_msh
     1.0e0_wp, 1.0e1_wp, 1.0e2_wp, 1.0e3_wp, 1.0e4_wp, 1.0e5_wp, 1.0e6_wp, 1.0e7_wp, 1.0e8_wp, &
     1.0e9_wp, 1.0e10_wp, 1.0e11_wp, 1.0e12_wp, 1.0e13_wp, 1.0e14_wp, 1.0e15_wp, 1.0e16_wp, &
     1.0e17_wp, 1.0e18_wp, 1.0e19_wp, 1.0e20_wp, 1.0e21_wp, 1.0e22_wp]
-  character(len=*), parameter :: WHITE = ' '//achar(9)//achar(10)//achar(13)
 
   !> The file's text and a reading position, with the first error met.
   type :: cursor_t
@@ -80,7 +79,7 @@ module gmsh_msh
     integer :: ncell = 0                       ! triangles and quadrangles, file order
     integer, allocatable :: ctag(:), cent(:), cnode(:, :)   ! tag, entity index (0: none), 4 file indices (0)
     integer :: nline = 0                       ! 2-node lines
-    integer, allocatable :: ltag(:), lent(:), lnode(:, :)
+    integer, allocatable :: lent(:), lnode(:, :)              ! entity index, 2 file indices
     logical :: has_format = .false., has_nodes = .false., has_elements = .false.
   end type msh_data_t
 
@@ -450,6 +449,11 @@ contains
         return
       end if
       cur%section = tok
+      if ((tok == '$Entities' .and. allocated(d%ent)) .or. (tok == '$Nodes' .and. d%has_nodes) .or. &
+          (tok == '$Elements' .and. d%has_elements) .or. (tok == '$MeshFormat' .and. d%has_format)) then
+        call fail(cur, 'has a second '//tok//' section')
+        return
+      end if
       select case (tok)
       case ('$MeshFormat')
         call read_format(cur)
@@ -717,7 +721,7 @@ contains
       return
     end if
     ! sized for the worst case; the lines are a small part of a 2D mesh but bounded by ntotal too
-    allocate (d%ctag(ntotal), d%cent(ntotal), d%cnode(4, ntotal), d%ltag(ntotal), d%lent(ntotal), &
+    allocate (d%ctag(ntotal), d%cent(ntotal), d%cnode(4, ntotal), d%lent(ntotal), &
               d%lnode(2, ntotal), stat=st)
     if (st /= 0) then
       call fail(cur, 'not enough memory for '//i2s(ntotal)//' elements', OTHER_FAILURE)
@@ -758,7 +762,6 @@ contains
         tag = get_int(cur, 'an element tag')
         if (etype == 1) then
           d%nline = d%nline + 1
-          d%ltag(d%nline) = tag
           d%lent(d%nline) = ent
         else if (etype /= 15) then
           d%ncell = d%ncell + 1
