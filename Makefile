@@ -3,6 +3,7 @@
 #   make            build bin/robin_contact (installs missing Debian packages first)
 #   make run        build and solve inputs/default.nml
 #   make check      build and run every test (last line: N passed, M failed)
+#   make meshes     regenerate the shipped Gmsh meshes inputs/gmsh/*.msh from their .geo
 #   make DEBUG=1    checked build (-fcheck=all, FP traps, backtrace) in build/debug,
 #                   bin/robin_contact_debug; `make check DEBUG=1` tests that one
 
@@ -40,19 +41,19 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings sorting sysinfo signals config namelist_input deck budget mesh elements lapack linop assembly \
+MODS := kinds errors clock strings sorting sysinfo signals config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
         ordering cholmod_iface banded cholesky mprgp condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_equilibrium test_contact test_files
+TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_equilibrium test_contact test_files
 BENCH_F := bench_mprgp
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
 
 DEPS_STAMP := build/.deps-ok
 
-.PHONY: all run check bench-mprgp table1 bench hard plots clean deps FORCE
+.PHONY: all run check bench-mprgp table1 bench hard plots meshes clean deps FORCE
 all: $(PROG)
 
 # ---- system packages: install what is missing (Debian 12) --------------------
@@ -96,6 +97,7 @@ $(BUILD)/deck.o:           $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
                            $(BUILD)/namelist_input.o
 $(BUILD)/budget.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/mesh.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
@@ -169,6 +171,23 @@ bench: $(PROG)
 
 plots: $(PROG)
 	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh
+
+# The Gmsh meshes of inputs/gmsh are shipped (make check reads them without gmsh); this
+# regenerates them from their .geo where gmsh is installed.
+GMSH      ?= gmsh
+GMSH_MSH  := $(GMSH) -2 -format msh41 -v 2
+meshes:
+	@if ! command -v $(GMSH) >/dev/null 2>&1; then \
+	   echo "meshes: gmsh is not installed (apt-get install gmsh); the shipped inputs/gmsh/*.msh are kept"; \
+	 else \
+	   set -ex; cd inputs/gmsh; \
+	   $(GMSH_MSH) paper.geo -o paper.msh; \
+	   $(GMSH_MSH) patch.geo -o patch.msh; \
+	   for h in 0.04 0.02 0.01; do $(GMSH_MSH) -setnumber h $$h hertz.geo -o hertz_h$$h.msh; done; \
+	   for n in 12:18 24:36 48:72; do nu=$${n%:*}; nl=$${n#*:}; \
+	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \
+	   done; \
+	 fi
 
 clean:
 	rm -rf build bin

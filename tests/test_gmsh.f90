@@ -1,0 +1,582 @@
+!> Unit tests of module gmsh_msh: the shipped meshes of inputs/gmsh (counts, areas, grid
+!! coordinates, boundary groups and their outward normals, refinement), and small bad or
+!! unusual MSH files written here (binary, version 2.2, missing node, 3D, second order,
+!! unknown region, clockwise cells, degenerate and non-convex cells, sparse unordered tags,
+!! truncation, unknown sections, numbers in every form).
+!!
+!! With arguments, `test_gmsh file.msh [region]` only reads that file and prints the time
+!! taken (the read benchmark).
+program test_gmsh
+  use kinds, only: wp
+  use config, only: ELEM_Q1, ELEM_P1
+  use mesh, only: mesh_t, group_index
+  use gmsh_msh, only: msh_read, ELEM_MIXED
+  use strings, only: i2s, word
+  use testing, only: report, report_le, test_summary
+  implicit none (type, external)
+
+  real(wp), parameter :: pi = acos(-1.0_wp), eps = epsilon(1.0_wp)
+  character(len=*), parameter :: dir = 'inputs/gmsh/'
+  character(len=:), allocatable :: tmp
+  character(len=256) :: arg
+
+  if (command_argument_count() >= 1) then
+    call get_command_argument(1, arg)
+    call bench(trim(arg))
+    stop
+  end if
+  call get_environment_variable('BUILD', arg)
+  if (len_trim(arg) == 0) arg = 'build/release'
+  tmp = trim(arg)//'/test_gmsh_'
+
+  call test_paper()
+  call test_nonmatching()
+  call test_patch()
+  call test_hertz()
+  call test_bad_inputs()
+  call test_unusual_inputs()
+  call test_summary()
+
+contains
+
+  ! ---- helpers --------------------------------------------------------------------------
+
+  subroutine read_ok(path, region, m)
+    character(len=*), intent(in) :: path, region
+    type(mesh_t), intent(out) :: m
+    integer :: info
+    character(len=512) :: msg
+    call msh_read(path, region, 1, m, info, msg)
+    call report(info == 0, 'read '//path//" region '"//region//"'"//merge('          ', ': '//msg(1:8), info == 0))
+    if (info /= 0) then
+      write (*, '(a)') trim(msg)
+      call test_summary()
+      error stop 1
+    end if
+  end subroutine read_ok
+
+  !> Twice the signed area of cell c.
+  pure real(wp) function area2(m, c)
+    type(mesh_t), intent(in) :: m
+    integer, intent(in) :: c
+    integer :: nv, i, a, b
+    nv = merge(4, 3, m%cell_type(c) == ELEM_Q1)
+    area2 = 0.0_wp
+    do i = 1, nv
+      a = m%cells(i, c)
+      b = m%cells(modulo(i, nv) + 1, c)
+      area2 = area2 + m%xy(1, a)*m%xy(2, b) - m%xy(1, b)*m%xy(2, a)
+    end do
+  end function area2
+
+  real(wp) function total_area(m)
+    type(mesh_t), intent(in) :: m
+    integer :: c
+    total_area = 0.0_wp
+    do c = 1, m%ncell
+      total_area = total_area + 0.5_wp*area2(m, c)
+    end do
+  end function total_area
+
+  logical function all_ccw(m)
+    type(mesh_t), intent(in) :: m
+    integer :: c
+    all_ccw = .true.
+    do c = 1, m%ncell
+      all_ccw = all_ccw .and. area2(m, c) > 0.0_wp
+    end do
+  end function all_ccw
+
+  !> Group g's edges: the largest deviation of their unit outward normal from `normal`,
+  !! and the sum of their lengths.
+  subroutine group_normal(m, name, normal, dev, length, nedge)
+    type(mesh_t), intent(in) :: m
+    character(len=*), intent(in) :: name
+    real(wp), intent(in) :: normal(2)
+    real(wp), intent(out) :: dev, length
+    integer, intent(out) :: nedge
+    integer :: g, k
+    real(wp) :: d(2), l
+    dev = huge(1.0_wp)
+    length = 0.0_wp
+    nedge = 0
+    g = group_index(m, name)
+    if (g == 0) return
+    dev = 0.0_wp
+    nedge = m%group(g)%nedge
+    do k = 1, nedge
+      d = m%xy(:, m%group(g)%edge(2, k)) - m%xy(:, m%group(g)%edge(1, k))
+      l = norm2(d)
+      length = length + l
+      dev = max(dev, norm2([d(2), -d(1)]/l - normal))
+    end do
+  end subroutine group_normal
+
+  !> Every group edge is two consecutive vertices of its cell, in the cell's order.
+  logical function groups_follow_cells(m)
+    type(mesh_t), intent(in) :: m
+    integer :: g, k, c, i, nv
+    logical :: found
+    groups_follow_cells = .true.
+    do g = 1, m%ngroup
+      do k = 1, m%group(g)%nedge
+        c = m%group(g)%cell(k)
+        nv = merge(4, 3, m%cell_type(c) == ELEM_Q1)
+        found = .false.
+        do i = 1, nv
+          found = found .or. (m%cells(i, c) == m%group(g)%edge(1, k) .and. &
+                              m%cells(modulo(i, nv) + 1, c) == m%group(g)%edge(2, k))
+        end do
+        groups_follow_cells = groups_follow_cells .and. found
+      end do
+    end do
+  end function groups_follow_cells
+
+  !> The x coordinates of a group's nodes.
+  function group_x(m, name) result(x)
+    type(mesh_t), intent(in) :: m
+    character(len=*), intent(in) :: name
+    real(wp), allocatable :: x(:)
+    integer :: g
+    g = group_index(m, name)
+    allocate (x(0))
+    if (g > 0) x = [m%xy(1, m%group(g)%edge(1, :)), m%xy(1, m%group(g)%edge(2, :))]
+  end function group_x
+
+  subroutine write_file(path, lines)
+    character(len=*), intent(in) :: path
+    character(len=*), intent(in) :: lines(:)
+    integer :: u, k
+    open (newunit=u, file=path, status='replace', action='write')
+    do k = 1, size(lines)
+      write (u, '(a)') trim(lines(k))
+    end do
+    close (u)
+  end subroutine write_file
+
+  !> Write `lines` to a temporary file, read it, and check info and that msg holds every
+  !! key word (the file name is always one).
+  subroutine expect_error(name, lines, region, want_info, keys, what)
+    character(len=*), intent(in) :: name, lines(:), region
+    integer, intent(in) :: want_info
+    character(len=*), intent(in) :: keys(:), what
+    type(mesh_t) :: m
+    integer :: info, k, u
+    character(len=1024) :: msg
+    logical :: has
+    call write_file(tmp//name, lines)
+    call msh_read(tmp//name, region, 2, m, info, msg)
+    has = index(msg, tmp//name) > 0 .and. index(msg, 'body 2') > 0
+    do k = 1, size(keys)
+      has = has .and. index(msg, trim(keys(k))) > 0
+    end do
+    call report(info == want_info .and. has, what)
+    write (*, '(a)') '      msg: '//trim(msg)
+    open (newunit=u, file=tmp//name)
+    close (u, status='delete')
+  end subroutine expect_error
+
+  ! ---- the shipped meshes ---------------------------------------------------------------
+
+  subroutine test_paper()
+    type(mesh_t) :: up, lo
+    real(wp) :: dev, length, offgrid
+    integer :: ne, k, info
+    character(len=512) :: msg
+
+    call read_ok(dir//'paper.msh', 'upper', up)
+    call report(up%nnode == 25*17 .and. up%ncell == 24*16, 'paper upper: 25*17 nodes, 24*16 cells')
+    call report(up%element == ELEM_Q1 .and. up%nvert == 4 .and. all(up%cell_type == ELEM_Q1), &
+                'paper upper: all Q1')
+    call report_le(abs(total_area(up) - 3.0_wp), 100*eps*3, 'paper upper: area 3')
+    call report(all_ccw(up), 'paper upper: cells counter-clockwise')
+    offgrid = 0.0_wp
+    do k = 1, up%nnode
+      offgrid = max(offgrid, abs(up%xy(1, k)*8 - nint(up%xy(1, k)*8)), &
+                    abs((up%xy(2, k) - 1)*16 - nint((up%xy(2, k) - 1)*16)))
+    end do
+    call report_le(offgrid, 8*eps, 'paper upper: nodes on the uniform 24x16 grid')
+    call report(up%x0 == 0.0_wp .and. up%y0 == 1.0_wp .and. abs(up%width - 3) < 1e-14_wp .and. &
+                abs(up%height - 1) < 1e-14_wp, 'paper upper: bounding box (0,3)x(1,2)')
+    call report(all(up%node_tag(2:) > up%node_tag(:up%nnode - 1)), 'paper upper: nodes in increasing tag order')
+    call report(.not. up%structured .and. up%source == dir//'paper.msh' .and. up%nx == 0, &
+                'paper upper: unstructured, source is the file')
+    call group_normal(up, 'upper_bottom', [0.0_wp, -1.0_wp], dev, length, ne)
+    call report(ne == 24, 'paper upper_bottom: 24 edges')
+    call report_le(dev, 1.0e-12_wp, 'paper upper_bottom: outward normal (0,-1)')
+    call report_le(abs(length - 3), 1.0e-12_wp, 'paper upper_bottom: length 3')
+    call group_normal(up, 'upper_left', [-1.0_wp, 0.0_wp], dev, length, ne)
+    call report(ne == 16 .and. dev < 1e-12_wp .and. abs(length - 1) < 1e-12_wp, &
+                'paper upper_left: 16 edges, normal (-1,0), length 1')
+    call group_normal(up, 'upper_right', [1.0_wp, 0.0_wp], dev, length, ne)
+    call report(ne == 16 .and. dev < 1e-12_wp, 'paper upper_right: 16 edges, normal (1,0)')
+    call group_normal(up, 'upper_top', [0.0_wp, 1.0_wp], dev, length, ne)
+    call report(ne == 24 .and. dev < 1e-12_wp, 'paper upper_top: 24 edges, normal (0,1)')
+    call report(up%ngroup == 4 .and. group_index(up, 'lower_top') == 0, &
+                'paper upper: only its 4 groups (none of the lower body)')
+    call report(index(up%file_groups, 'lower_top') > 0 .and. index(up%file_groups, 'upper_left') > 0, &
+                'paper upper: file_groups lists every physical curve')
+    call report(groups_follow_cells(up), 'paper upper: group edges follow their cells')
+
+    call read_ok(dir//'paper.msh', 'lower', lo)
+    call report(lo%nnode == 25*17 .and. lo%ncell == 24*16 .and. lo%y0 == 0.0_wp, &
+                'paper lower: 25*17 nodes, 24*16 cells, from y = 0')
+    call report(minval(lo%node_tag) > maxval(up%node_tag) .or. maxval(lo%node_tag) < minval(up%node_tag) &
+                .or. .not. any([(any(lo%node_tag == up%node_tag(k)), k=1, up%nnode)]), &
+                'paper: the bodies have distinct nodes')
+    call group_normal(lo, 'lower_top', [0.0_wp, 1.0_wp], dev, length, ne)
+    call report(ne == 24 .and. dev < 1e-12_wp .and. abs(length - 3) < 1e-12_wp, &
+                'paper lower_top: 24 edges, normal (0,1), length 3')
+    call group_normal(lo, 'lower_left', [-1.0_wp, 0.0_wp], dev, length, ne)
+    call report(ne == 16 .and. dev < 1e-12_wp .and. abs(length - 1) < 1e-12_wp, &
+                'paper lower_left: 16 edges, normal (-1,0), length 1')
+    call group_normal(lo, 'lower_right', [1.0_wp, 0.0_wp], dev, length, ne)
+    call report(ne == 16 .and. dev < 1e-12_wp, 'paper lower_right: 16 edges, normal (1,0)')
+    call group_normal(lo, 'lower_bottom', [0.0_wp, -1.0_wp], dev, length, ne)
+    call report(ne == 24 .and. dev < 1e-12_wp, 'paper lower_bottom: 24 edges, normal (0,-1)')
+
+    call msh_read(dir//'paper.msh', '', 1, lo, info, msg)
+    call report(info == 1 .and. index(msg, "'upper'") > 0 .and. index(msg, "'lower'") > 0, &
+                'paper: no region with two physical surfaces is refused, naming them')
+    write (*, '(a)') '      msg: '//trim(msg)
+    call msh_read(dir//'paper.msh', 'middle', 1, lo, info, msg)
+    call report(info == 1 .and. index(msg, "'middle'") > 0 .and. index(msg, "'upper', 'lower'") > 0 &
+                .and. index(msg, 'paper.msh') > 0, 'paper: an unknown region is refused, listing the surfaces')
+    write (*, '(a)') '      msg: '//trim(msg)
+  end subroutine test_paper
+
+  subroutine test_nonmatching()
+    type(mesh_t) :: up, lo
+    integer :: k
+    integer, parameter :: nu(3) = [12, 24, 48], nl(3) = [18, 36, 72]
+    character(len=64) :: name
+    do k = 1, 3
+      write (name, '(a,i0,a,i0,a)') 'paper_nonmatching_', nu(k), '_', nl(k), '.msh'
+      call read_ok(dir//trim(name), 'upper', up)
+      call read_ok(dir//trim(name), 'lower', lo)
+      call report(up%ncell == nu(k)*(2*nu(k)/3) .and. up%nnode == (nu(k) + 1)*(2*nu(k)/3 + 1) .and. &
+                  lo%ncell == nl(k)*(2*nl(k)/3) .and. lo%nnode == (nl(k) + 1)*(2*nl(k)/3 + 1) .and. &
+                  up%element == ELEM_Q1 .and. lo%element == ELEM_Q1, trim(name)//': cell and node counts')
+      call report(abs(total_area(up) - 3) < 1e-12_wp .and. abs(total_area(lo) - 3) < 1e-12_wp, &
+                  trim(name)//': areas 3 and 3')
+      call report(size(group_x(up, 'upper_bottom')) == 2*nu(k) .and. &
+                  size(group_x(lo, 'lower_top')) == 2*nl(k), trim(name)//': contact edges nu and nl')
+    end do
+  end subroutine test_nonmatching
+
+  subroutine test_patch()
+    type(mesh_t) :: top, bot
+    real(wp) :: dev, length
+    real(wp), allocatable :: xt(:), xb(:)
+    integer :: ne, i, ncommon
+
+    allocate (xt(0), xb(0))
+    call read_ok(dir//'patch.msh', 'top', top)
+    call read_ok(dir//'patch.msh', 'bottom', bot)
+    call report(top%element == ELEM_P1 .and. top%nvert == 3 .and. all(top%cell_type == ELEM_P1), &
+                'patch top: triangles')
+    call report(bot%element == ELEM_Q1 .and. bot%ncell == 25, 'patch bottom: 5x5 quadrangles')
+    call report_le(abs(total_area(top) - 0.5_wp), 100*eps, 'patch top: triangle areas sum to 0.5')
+    call report_le(abs(total_area(bot) - 1.0_wp), 100*eps, 'patch bottom: quadrangle areas sum to 1')
+    call report(all_ccw(top) .and. all_ccw(bot), 'patch: cells counter-clockwise')
+    call group_normal(top, 'top_bottom', [0.0_wp, -1.0_wp], dev, length, ne)
+    call report(ne == 7 .and. dev < 1e-12_wp .and. abs(length - 1) < 1e-12_wp, &
+                'patch top_bottom: 7 edges, normal (0,-1), length 1')
+    call group_normal(bot, 'bottom_top', [0.0_wp, 1.0_wp], dev, length, ne)
+    call report(ne == 5 .and. dev < 1e-12_wp .and. abs(length - 1) < 1e-12_wp, &
+                'patch bottom_top: 5 edges, normal (0,1), length 1')
+    xt = group_x(top, 'top_bottom')
+    xb = group_x(bot, 'bottom_top')
+    ncommon = 0
+    do i = 1, size(xt)
+      if (any(abs(xb - xt(i)) < 1e-9_wp)) ncommon = ncommon + 1
+    end do
+    ! only the ends x = 0 and x = 1 coincide (each listed once per edge it ends)
+    call report(ncommon == 2 .and. size(xt) == 14, 'patch: contact nodes do not match (only the two ends)')
+    call report(groups_follow_cells(top) .and. groups_follow_cells(bot), 'patch: group edges follow their cells')
+  end subroutine test_patch
+
+  subroutine test_hertz()
+    type(mesh_t) :: disc, block
+    character(len=*), parameter :: hs(3) = ['0.04', '0.02', '0.01']
+    real(wp) :: h, a, seg, rdev, c(2), d(2), mid(2), boundary, lmin, dev, length
+    integer :: k, g, e, ne
+    character(len=:), allocatable :: name
+    logical :: outward
+    character(len=8) :: hbuf
+
+    c = [0.0_wp, 2.0_wp]
+    do k = 1, 3
+      name = 'hertz_h'//hs(k)//'.msh'
+      hbuf = hs(k)
+      read (hbuf, *) h
+      call read_ok(dir//name, 'disc', disc)
+      call read_ok(dir//name, 'block', block)
+      call report(disc%element == ELEM_P1 .and. block%element == ELEM_P1 .and. all_ccw(disc) .and. &
+                  all_ccw(block), name//': triangles, counter-clockwise')
+      ! the disc: the cells' area is the polygon's (shoelace over its boundary groups), and
+      ! short of pi/2 by the circular segments cut off by the arc's chords
+      a = total_area(disc)
+      boundary = 0.0_wp
+      seg = 0.0_wp
+      rdev = 0.0_wp
+      outward = .true.
+      lmin = huge(1.0_wp)
+      do g = 1, disc%ngroup
+        do e = 1, disc%group(g)%nedge
+          associate (p => disc%xy(:, disc%group(g)%edge(1, e)), q => disc%xy(:, disc%group(g)%edge(2, e)))
+            boundary = boundary + 0.5_wp*(p(1)*q(2) - q(1)*p(2))
+            if (disc%group(g)%name == 'disc_arc') then
+              d = q - p
+              seg = seg + norm2(d)**3/12.0_wp          ! segment area ~ chord^3 / (12 R)
+              rdev = max(rdev, abs(norm2(p - c) - 1), abs(norm2(q - c) - 1))
+              mid = 0.5_wp*(p + q)
+              outward = outward .and. dot_product([d(2), -d(1)], mid - c) > 0.0_wp
+              lmin = min(lmin, norm2(d))
+            end if
+          end associate
+        end do
+      end do
+      call report(disc%ngroup == 2 .and. group_index(disc, 'disc_top') > 0 .and. &
+                  group_index(disc, 'disc_arc') > 0, name//': disc groups disc_top, disc_arc')
+      call report_le(abs(a - boundary), 1e-12_wp, name//': disc cells fill its boundary polygon')
+      call report(pi/2 - a > 0.0_wp .and. abs(pi/2 - a - seg) <= 0.02_wp*seg, &
+                  name//': disc area pi/2 less the chord segments', pi/2 - a, seg)
+      call report_le(rdev, 1e-12_wp, name//': disc_arc nodes on the circle')
+      call report(outward, name//': disc_arc outward normals point away from the centre')
+      call report(lmin <= 1.2_wp*h .and. lmin >= 0.5_wp*h, name//': arc edges of size h at the contact', lmin, h)
+      call group_normal(disc, 'disc_top', [0.0_wp, 1.0_wp], dev, length, ne)
+      call report(dev < 1e-12_wp .and. abs(length - 2) < 1e-12_wp, name//': disc_top normal (0,1), length 2')
+      call group_normal(block, 'block_top', [0.0_wp, 1.0_wp], dev, length, ne)
+      call report(dev < 1e-12_wp .and. abs(length - 8) < 1e-12_wp, name//': block_top normal (0,1), length 8')
+      call report(block%ngroup == 4 .and. abs(total_area(block) - 32) < 1e-12_wp*32 .and. &
+                  block%x0 == -4 .and. block%y0 == -3, name//': block (-4,4)x(-3,1), 4 groups')
+      call report(any(disc%xy(1, :) == 0 .and. disc%xy(2, :) == 1) .and. &
+                  any(block%xy(1, :) == 0 .and. block%xy(2, :) == 1), name//': both bodies have a node at (0,1)')
+    end do
+  end subroutine test_hertz
+
+  ! ---- small files ------------------------------------------------------------------------
+
+  !> A unit square: nodes 1-4, the quadrangle 7 on surface 1 (physical "sq"), the line 8 on
+  !! curve 1 (physical "base"). Line numbers: node 3's coordinates at 23, $Elements at 26,
+  !! the quadrangle at 31.
+  function square(format_line, node_lines, element_lines) result(l)
+    character(len=*), intent(in), optional :: format_line
+    character(len=*), intent(in), optional :: node_lines(:), element_lines(:)
+    character(len=60), allocatable :: l(:)
+    character(len=60) :: fl
+    fl = '4.1 0 8'
+    if (present(format_line)) fl = format_line
+    l = [character(len=60) :: '$MeshFormat', fl, '$EndMeshFormat', &
+         '$PhysicalNames', '2', '1 10 "base"', '2 20 "sq"', '$EndPhysicalNames', &
+         '$Entities', '0 1 1 0', '1 0 0 0 1 0 0 1 10 0', '1 0 0 0 1 1 0 1 20 0', '$EndEntities']
+    if (present(node_lines)) then
+      l = [l, node_lines]
+    else
+      l = [l, [character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', '1', '2', '3', '4', &
+                                    '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']]
+    end if
+    if (present(element_lines)) then
+      l = [l, element_lines]
+    else
+      l = [l, [character(len=60) :: '$Elements', '2 2 1 8', '1 1 1 1', '8 1 2', '2 1 3 1', &
+                                    '7 1 2 3 4', '$EndElements']]
+    end if
+  end function square
+
+  subroutine test_bad_inputs()
+    character(len=60), allocatable :: l(:)
+    type(mesh_t) :: m
+    integer :: info
+    character(len=512) :: msg
+
+    allocate (l(0))
+    call msh_read(tmp//'missing.msh', 'sq', 3, m, info, msg)
+    call report(info == 1 .and. index(msg, tmp//'missing.msh') > 0 .and. index(msg, 'body 3') > 0, &
+                'a missing file is bad input naming it')
+    write (*, '(a)') '      msg: '//trim(msg)
+
+    call expect_error('binary.msh', square('4.1 1 8'), 'sq', 1, [character(len=20) :: 'binary', 'line 2'], &
+                      'binary MSH is refused')
+    call expect_error('v22.msh', [character(len=40) :: '$MeshFormat', '2.2 0 8', '$EndMeshFormat', &
+                      '$Nodes', '1', '1 0 0 0', '$EndNodes'], 'sq', 1, &
+                      [character(len=20) :: 'version 2.2', 'gmsh -format msh41', 'MshFileVersion'], &
+                      'MSH 2.2 is refused, saying how to write 4.1')
+    call expect_error('v40.msh', square('4 0 8'), 'sq', 1, [character(len=20) :: 'version 4 ', 'msh41'], &
+                      'MSH 4.0 is refused')
+    call expect_error('nonode.msh', square(element_lines=[character(len=60) :: '$Elements', '2 2 1 8', &
+                      '1 1 1 1', '8 1 2', '2 1 3 1', '7 1 2 99 4', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: 'node 99', 'element 7', 'line 31'], 'a missing node is refused, with its element and line')
+    call expect_error('hex.msh', square(element_lines=[character(len=60) :: '$Elements', '1 1 1 1', &
+                      '3 1 5 1', '1 1 2 3 4 1 2 3 4', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: '3D', 'line 28'], 'a 3D element block is refused')
+    call expect_error('tet.msh', square(element_lines=[character(len=60) :: '$Elements', '1 1 1 1', &
+                      '2 1 4 1', '1 1 2 3 4', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: '3D', 'type 4'], 'a tetrahedron type is refused as 3D')
+    call expect_error('z.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                      '1', '2', '3', '4', '0 0 0', '1 0 0', '1 1 0.5', '0 1 0', '$EndNodes']), 'sq', 1, &
+                      [character(len=20) :: 'node 3', 'z =', '3D', 'line 23'], 'a node off z = 0 is refused')
+    call expect_error('p2.msh', square(element_lines=[character(len=60) :: '$Elements', '1 1 1 1', &
+                      '2 1 9 1', '1 1 2 3 4 1 2', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: 'type 9', 'first-order'], 'a second-order triangle is refused')
+    call expect_error('region.msh', square(), 'nowhere', 1, [character(len=20) :: "'nowhere'", "'sq'"], &
+                      'an unknown region is refused, listing the surfaces')
+    call expect_error('nocell.msh', square(element_lines=[character(len=60) :: '$Elements', '1 1 8 8', &
+                      '1 1 1 1', '8 1 2', '$EndElements']), 'sq', 1, [character(len=30) :: "'sq' has no triangles"], &
+                      'a region without cells is refused')
+    call expect_error('degenerate.msh', square(element_lines=[character(len=60) :: '$Elements', '1 2 41 42', &
+                      '2 1 2 2', '41 1 2 3', '42 1 2 1', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: 'element 42', 'degenerate'], 'a degenerate triangle is refused by tag')
+    call expect_error('flat.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                      '1', '2', '3', '4', '0 0 0', '1 0 0', '2 0 0', '0.5 1e-14 0', '$EndNodes']), 'sq', 1, &
+                      [character(len=20) :: 'element 7', 'degenerate'], 'a nearly flat quadrangle is refused by tag')
+    call expect_error('bowtie.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                      '1', '2', '3', '4', '0 0 0', '1 0 0', '2 1 0', '0 1 0', '$EndNodes'], &
+                      element_lines=[character(len=60) :: '$Elements', '1 1 43 43', &
+                      '2 1 3 1', '43 1 2 4 3', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: 'element 43', 'convex'], 'a self-crossing quadrangle is refused by tag')
+    call expect_error('dart.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                      '1', '2', '3', '4', '0 0 0', '1 0 0', '0.3 0.3 0', '0 1 0', '$EndNodes']), 'sq', 1, &
+                      [character(len=20) :: 'element 7', 'convex', 'node 3'], 'a re-entrant quadrangle is refused by tag')
+    l = square()
+    call expect_error('trunc_end.msh', l(1:size(l) - 1), 'sq', 1, [character(len=20) :: 'truncated', '$EndElements'], &
+                      'a file cut before $EndElements is refused')
+    call expect_error('trunc_nodes.msh', l(1:20), 'sq', 1, [character(len=20) :: 'truncated', '$Nodes'], &
+                      'a file cut inside $Nodes is refused')
+    call expect_error('no_elements.msh', l(1:25), 'sq', 1, [character(len=20) :: 'no $Elements'], &
+                      'a file without $Elements is refused')
+    call expect_error('count.msh', square(element_lines=[character(len=60) :: '$Elements', '2 3 1 8', &
+                      '1 1 1 1', '8 1 2', '2 1 3 1', '7 1 2 3 4', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: '2 elements', '3 announced'], 'an element count mismatch is refused')
+    call expect_error('word.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                      '1', '2', '3', '4', '0 0 0', '1 0 0', '1 one 0', '0 1 0', '$EndNodes']), 'sq', 1, &
+                      [character(len=20) :: "'one'", 'line 23'], 'a word for a number is refused with its line')
+    call expect_error('dup.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                      '1', '2', '2', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']), 'sq', 1, &
+                      [character(len=20) :: 'node tag 2', 'twice'], 'a repeated node tag is refused')
+    l = square()
+    call expect_error('twice.msh', [l, l(14:25)], 'sq', 1, [character(len=24) :: 'second $Nodes', 'line 33'], &
+                      'a second $Nodes section is refused')
+    call expect_error('notmsh.msh', [character(len=20) :: 'hello', 'world'], 'sq', 1, &
+                      [character(len=20) :: 'not a Gmsh MSH', 'line 1'], 'a file that is not MSH is refused')
+  end subroutine test_bad_inputs
+
+  subroutine test_unusual_inputs()
+    type(mesh_t) :: m
+    integer :: info, k, u, g
+    character(len=512) :: msg
+    character(len=32), parameter :: numbers(8) = [character(len=32) :: '0.1', '-2.5E+2', '1e-3', &
+      '0.9999999999999998', '3.0000000000000004', '0.12345678901234567890123', '-7.25e-30', '+4']
+    real(wp) :: want(8)
+    character(len=32) :: nbuf
+    character(len=60) :: one
+    character(len=60), allocatable :: l(:)
+
+    ! a clockwise quadrangle is accepted and reoriented, keeping its first vertex
+    call write_file(tmp//'cw.msh', square(element_lines=[character(len=60) :: '$Elements', '1 1 7 7', &
+                    '2 1 3 1', '7 1 4 3 2', '$EndElements']))
+    call msh_read(tmp//'cw.msh', 'sq', 1, m, info, msg)
+    call report(info == 0 .and. m%ncell == 1, 'a clockwise quadrangle is accepted')
+    if (info == 0) call report(all(m%node_tag(m%cells(:, 1)) == [1, 2, 3, 4]) .and. area2(m, 1) > 0, &
+                               'a clockwise quadrangle is reoriented counter-clockwise')
+
+    ! sparse, unordered node tags in two blocks; a $Comments section and a $NodeData
+    ! section with quoted strings are skipped; a missing region name picks the only surface
+    call write_file(tmp//'sparse.msh', [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', &
+      '$Comments', 'anything $Nodes 1 2', '$EndComments', &
+      '$PhysicalNames', '2', '1 10 "base with blank"', '2 20 "sq"', '$EndPhysicalNames', &
+      '$Entities', '0 1 1 0', '1 0 0 0 1 0 0 1 10 0', '1 0 0 0 1 1 0 1 20 0', '$EndEntities', &
+      '$Nodes', '2 4 5 1000000', '1 1 1 2', '1000000', '5', '1 0 0 0.5', '0 0 0 0.0', &
+      '2 1 1 2', '77', '12', '1 1 0 0.3 0.4', '0 1 0 0.1 0.2', '$EndNodes', &
+      '$Elements', '2 2 1 8', '1 1 1 1', '8 5 1000000', '2 1 3 1', '7 1000000 77 12 5', '$EndElements', &
+      '$NodeData', '1', '"a $view"', '0', '0', '$EndNodeData'])
+    call msh_read(tmp//'sparse.msh', '', 1, m, info, msg)
+    call report(info == 0, 'sparse unordered node tags and unknown sections are read')
+    if (info /= 0) write (*, '(a)') trim(msg)
+    if (info == 0) then
+      call report(all(m%node_tag == [5, 12, 77, 1000000]), 'nodes renumbered in increasing tag order')
+      call report(all(m%xy(:, 1) == [0.0_wp, 0.0_wp]) .and. all(m%xy(:, 2) == [0.0_wp, 1.0_wp]) .and. &
+                  all(m%xy(:, 3) == [1.0_wp, 1.0_wp]) .and. all(m%xy(:, 4) == [1.0_wp, 0.0_wp]), &
+                  'sparse tags: coordinates follow their tags')
+      call report(area2(m, 1) > 0 .and. abs(total_area(m) - 1) < 1e-15_wp, 'sparse tags: the cell, counter-clockwise')
+      g = group_index(m, 'base with blank')
+      call report(m%ngroup == 1 .and. g == 1, 'a physical name with a blank is kept')
+      if (g == 1) call report(m%group(1)%nedge == 1 .and. all(m%group(1)%edge(:, 1) == [1, 4]), &
+                              'the base edge oriented with the body on its left')
+    end if
+
+    ! a line after a skipped section keeps its line number
+    call expect_error('skipline.msh', [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', &
+      '$Comments', 'a', 'b', '$EndComments', '$Nodes', '1 1 1 1', '2 1 0 1', '1', '0 0 0', '$EndNodes', &
+      '$Elements', '1 1 1 1', '2 1 2 1', '1 1 1 5', '$EndElements'], '', 1, &
+      [character(len=20) :: 'node 5', 'line 17'], 'line numbers count across skipped sections')
+
+    ! a mixed mesh without physical groups: every 2D element, a triangle has cells(4,c) = 0
+    call write_file(tmp//'mixed.msh', [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', &
+      '$Nodes', '1 5 1 5', '2 1 0 5', '1', '2', '3', '4', '5', &
+      '0 0 0', '1 0 0', '1 1 0', '0 1 0', '2 0.5 0', '$EndNodes', &
+      '$Elements', '2 2 1 2', '2 1 3 1', '1 1 2 3 4', '2 1 2 1', '2 2 5 3', '$EndElements'])
+    call msh_read(tmp//'mixed.msh', '', 1, m, info, msg)
+    call report(info == 0, 'a mesh without physical groups is read whole')
+    if (info == 0) call report(m%element == ELEM_MIXED .and. m%nvert == 4 .and. m%ncell == 2 .and. &
+                               all(m%cell_type == [ELEM_Q1, ELEM_P1]) .and. m%cells(4, 2) == 0 .and. &
+                               m%ngroup == 0 .and. abs(total_area(m) - 1.5_wp) < 1e-15_wp, &
+                               'mixed mesh: ELEM_MIXED, triangle with cells(4,c) = 0, area 1.5')
+
+    ! numbers in every form are read exactly as a formatted READ reads them: triangle k has
+    ! the nodes (0,0), (1,0) and (number k, 1), each its own
+    l = [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', '$Nodes', '1 24 1 24', '2 1 0 24']
+    do k = 1, 24
+      one = i2s(k)
+      l = [l, one]
+    end do
+    do k = 1, 8
+      nbuf = numbers(k)
+      read (nbuf, *) want(k)
+      one = trim(numbers(k))//' 1 0'
+      l = [l, [character(len=60) :: '0 0 0', '1 0 0'], one]
+    end do
+    l = [l, [character(len=60) :: '$EndNodes', '$Elements', '1 8 1 8', '2 1 2 8']]
+    do k = 1, 8
+      one = i2s(k)//' '//i2s(3*k - 2)//' '//i2s(3*k - 1)//' '//i2s(3*k)
+      l = [l, one]
+    end do
+    l = [l, [character(len=60) :: '$EndElements']]
+    call write_file(tmp//'numbers.msh', l)
+    call msh_read(tmp//'numbers.msh', '', 1, m, info, msg)
+    call report(info == 0, 'a file with numbers in every form is read')
+    if (info == 0) then
+      call report(all(m%xy(1, 3:24:3) == want), &
+                  'reals: exactly what a formatted READ gives (0.1, -2.5E+2, 17 and 23 digits, 1e-30, +4)')
+    else
+      write (*, '(a)') trim(msg)
+    end if
+    do k = 1, 4
+      open (newunit=u, file=tmp//trim(word('cw sparse mixed numbers', k))//'.msh')
+      close (u, status='delete')
+    end do
+  end subroutine test_unusual_inputs
+
+  ! ---- benchmark ----------------------------------------------------------------------------
+
+  subroutine bench(path)
+    character(len=*), intent(in) :: path
+    type(mesh_t) :: m
+    integer :: info
+    integer(8) :: t0, t1, rate
+    character(len=512) :: msg, region
+    region = ''
+    if (command_argument_count() >= 2) call get_command_argument(2, region)
+    call system_clock(t0, rate)
+    call msh_read(path, trim(region), 1, m, info, msg)
+    call system_clock(t1)
+    if (info /= 0) then
+      write (*, '(a)') trim(msg)
+      error stop 1
+    end if
+    write (*, '(a,i0,a,i0,a,i0,a,i0,a,f8.3,a)') 'read ', m%nnode, ' nodes (', 2*m%nnode, ' DOFs), ', &
+      m%ncell, ' cells, ', m%ngroup, ' groups in ', real(t1 - t0, wp)/real(rate, wp), ' s'
+  end subroutine bench
+
+end program test_gmsh
