@@ -52,8 +52,12 @@
 !!   are rebuilt); with a single facing chain this does not happen (the own covered segment
 !!   gives at least about 1/2).
 !! - g0_j = sum_l wm_l n_j.(x^m_l - x^s_j) - sum_k ws_k n_j.(x^s_k - x^s_j): the row at u = 0
-!!   for the gap function g(x) = (x^m(pi(x)) - x).n_j, written relative to x^s_j (the same
-!!   value, since the weight sums agree, with less rounding for large coordinates).
+!!   for the gap function g(x) = (x^m(pi(x)) - x).n_j, i.e. int Phi_j g ds / D_jj, written
+!!   relative to x^s_j (the same value, since the weight sums agree, with less rounding for
+!!   large coordinates). It includes the extra slave entries (METHOD.md's G0 has only x^s_j,
+!!   the same where a row has no extra entry). A uniform gap h gives g0 = h times the row's
+!!   weight sum: h where the row is the plain one, more next to a removed node, less at a
+!!   partly covered end.
 module mortar
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
@@ -69,7 +73,7 @@ module mortar
     integer, allocatable :: snode(:)          !< (m) the slave node of each row (slave body's node id)
     real(wp), allocatable :: normal(:, :)     !< (2,m) averaged unit normal at the slave node, outward from the slave body
     real(wp), allocatable :: d(:)             !< (m) D_jj [length] (tributary length on the slave side)
-    real(wp), allocatable :: s(:)             !< (m) arc length of the slave node along its contact curve [length]
+    real(wp), allocatable :: s(:)             !< (m) arc length of the slave node from the chain's first node (where no slave edge ends) [length]
     real(wp), allocatable :: g0(:)            !< (m) initial weighted normal gap [length] (>= 0 expected; can be < 0)
     integer, allocatable :: sptr(:)           !< (m+1) CSR pointers of the slave entries (row j: sptr(j) .. sptr(j+1)-1)
     integer, allocatable :: snod(:)           !< slave node ids (the row's own node first)
@@ -263,6 +267,7 @@ contains
       facing = dot_product(ns, nm) < -MIN_FACING * norm2(ns) * norm2(nm)
     end function facing
 
+    !> Double the capacity of the piece arrays.
     subroutine grow()
       integer, allocatable :: ti(:)
       real(wp), allocatable :: tr(:)
@@ -651,6 +656,7 @@ contains
     n = n / norm2(n)
   end function edge_normal
 
+  !> The 2D cross product a x b = a1 b2 - a2 b1.
   pure real(wp) function cross(a, b)
     real(wp), intent(in) :: a(2), b(2)
     cross = a(1) * b(2) - a(2) * b(1)
