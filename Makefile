@@ -42,11 +42,11 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings sorting sysinfo signals config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
-        ordering cholmod_iface banded cholesky mprgp condense contact_types contact h5io files history_io results checkpoint
+        ordering cholmod_iface banded cholesky mprgp mortar condense contact_types contact h5io files history_io results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_equilibrium test_contact test_files
+TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files
 BENCH_F := bench_mprgp
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
@@ -108,6 +108,7 @@ $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
+$(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o

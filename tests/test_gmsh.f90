@@ -8,9 +8,9 @@
 !! taken (the read benchmark).
 program test_gmsh
   use kinds, only: wp
-  use config, only: ELEM_Q1, ELEM_P1
+  use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use mesh, only: mesh_t, group_index
-  use gmsh_msh, only: msh_read, ELEM_MIXED
+  use gmsh_msh, only: msh_read
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary
   implicit none (type, external)

@@ -17,13 +17,12 @@
 !! 4-node quadrangles, points) in the plane z = 0 are read.
 module gmsh_msh
   use kinds, only: wp, i8
-  use config, only: ELEM_Q1, ELEM_P1
+  use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use strings, only: i2s, fpstate_t, fp_read_begin, fp_read_end
   use mesh, only: mesh_t
   implicit none (type, external)
   private
 
-  integer, parameter, public :: ELEM_MIXED = 3  !< mesh_t%element of a mesh of triangles and quadrangles
 
   public :: msh_read
 

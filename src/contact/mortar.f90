@@ -1,0 +1,665 @@
+!> Dual mortar coupling of a non-matching or curved two-body contact interface in 2D
+!! (METHOD.md, "Non-matching and curved interfaces"). Pure geometry: from the slave and
+!! master contact edges it builds, per slave node that carries a multiplier, the weighted
+!! normal gap constraint
+!!
+!!     sum_k ws_k n_j.u^s_k - sum_l wm_l n_j.u^m_l <= g0_j,
+!!     ws_k = int Phi_j N_k ds / D_jj,  wm_l = M_jl / D_jj = int Phi_j (N^m_l o pi) ds / D_jj,
+!!
+!! with D_jj = int N_j ds (tributary length), N_k the slave hat functions, Phi_j their dual
+!! functions (Phi_1 = (1 - 3 xi)/2, Phi_2 = (1 + 3 xi)/2 on a segment, xi in [-1, 1]) and pi
+!! the projection along the slave normal onto the master curve. Rules as implemented:
+!!
+!! - Chains. Each side's edges must form one open chain (linked by shared nodes through a
+!!   node -> edge map, O(n)); a branching node, inconsistent orientation, a closed loop,
+!!   more than one chain, a zero-length edge or a fold-back (two adjacent edges reversing)
+!!   is bad input. Orientation: the body lies on the left of each edge, so an edge's
+!!   outward normal is (dy, -dx)/len.
+!! - Nodal normals. At an interior slave node, the sum of the two adjacent edges' unit
+!!   normals weighted by the inverse edge length, normalised: this is the normal of the
+!!   circle through the node and its two neighbours, so for a polygon inscribed in a
+!!   circle it is exactly radial whatever the spacing (the unweighted mean is only for
+!!   uniform spacing). An end node takes its only edge's normal.
+!! - Projection. Along the slave normal field n(xi) interpolated linearly between the two
+!!   nodal normals of a slave segment: a master node x is placed at the xi where
+!!   (x - x_s(xi)) x n(xi) = 0 (a quadratic), a slave Gauss point at the master point hit
+!!   by the line along its n(xi) (linear). The field is continuous from segment to segment,
+!!   so the projected master nodes tile the slave curve without gaps or overlaps at slave
+!!   kinks (the segment's own normal would leave both at a kink). On a flat slave both are
+!!   the same. The slave segment of a master node is found by walking along the slave chain
+!!   from the previous master node's segment (the sign of (x - x_i) x n_i changes once along
+!!   the chain), O(n_s + n_m) for one chain against another.
+!! - Clipping and quadrature. Each master segment maps to an interval of the slave chain;
+!!   its pieces on the slave segments are integrated with 5 Gauss points (exact to degree 9:
+!!   the flat integrand is of degree 2, the curved one is rational and 5 points put the
+!!   quadrature error far below the polygon's). A piece whose master segment does not face
+!!   the slave normal (cosine of the angle between n_s and -n_m below 1e-3) is dropped
+!!   (the back of a curved master, or a reversed edge list).
+!! - Coverage and removed nodes. A slave node is covered when a kept piece reaches it
+!!   (within 1e-10 in xi). A node carries a row when it is covered and not `removable`.
+!!   A node without a row makes its neighbours' dual functions 1 on the segment they share
+!!   with it, so the remaining Phi still sum to one; the neighbour's row then has an extra
+!!   slave entry for that node, (int of N_r over the covered part of the segment)/D_jj,
+!!   which is (L/2)/D_jj when the segment is covered. D_jj stays int N_j over the whole
+!!   support.
+!! - Partial overlap (a master end inside a slave segment). Both sides of a row are
+!!   integrated over the covered part only: on a partly covered segment the slave weights
+!!   are int_cov Phi_j N_k / D_jj (numerically, so the own weight of such an end row is
+!!   below 1), on covered segments they are exact (own weight 1). So every row satisfies
+!!   sum ws = sum wm (invariant under rigid translation) and g0 is the weighted gap of the
+!!   geometry, independent of the origin. A row whose master weight sum is below 1e-3 is
+!!   dropped as not covered (its neighbours' functions are modified as above, and the rows
+!!   are rebuilt); with a single facing chain this does not happen (the own covered segment
+!!   gives at least about 1/2).
+!! - g0_j = sum_l wm_l n_j.(x^m_l - x^s_j) - sum_k ws_k n_j.(x^s_k - x^s_j): the row at u = 0
+!!   for the gap function g(x) = (x^m(pi(x)) - x).n_j, i.e. int Phi_j g ds / D_jj, written
+!!   relative to x^s_j (the same value, since the weight sums agree, with less rounding for
+!!   large coordinates). It includes the extra slave entries (METHOD.md's G0 has only x^s_j,
+!!   the same where a row has no extra entry). A uniform gap h gives g0 = h times the row's
+!!   weight sum: h where the row is the plain one, more next to a removed node, less at a
+!!   partly covered end.
+module mortar
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use kinds, only: wp
+  use strings, only: i2s
+  implicit none (type, external)
+  private
+
+  !> One row per slave node that carries a contact multiplier: the weighted normal gap
+  !! constraint  sum_k ws_k n_j.u^s_k - sum_l wm_l n_j.u^m_l <= g0_j  (weights already
+  !! divided by D_jj). Rows in the order of the slave chain.
+  type, public :: mortar_t
+    integer :: m = 0                          !< rows (slave nodes with a multiplier)
+    integer, allocatable :: snode(:)          !< (m) the slave node of each row (slave body's node id)
+    real(wp), allocatable :: normal(:, :)     !< (2,m) averaged unit normal at the slave node, outward from the slave body
+    real(wp), allocatable :: d(:)             !< (m) D_jj [length] (tributary length on the slave side)
+    real(wp), allocatable :: s(:)             !< (m) arc length of the slave node from the chain's first node (where no slave edge ends) [length]
+    real(wp), allocatable :: g0(:)            !< (m) initial weighted normal gap [length] (>= 0 expected; can be < 0)
+    integer, allocatable :: sptr(:)           !< (m+1) CSR pointers of the slave entries (row j: sptr(j) .. sptr(j+1)-1)
+    integer, allocatable :: snod(:)           !< slave node ids (the row's own node first)
+    real(wp), allocatable :: sval(:)          !< slave weights int Phi_j N_k / D_jj [1]
+    integer, allocatable :: mptr(:)           !< (m+1) CSR pointers of the master entries
+    integer, allocatable :: mnod(:)           !< master node ids
+    real(wp), allocatable :: mval(:)          !< master weights M_jl / D_jj [1]
+  end type mortar_t
+
+  public :: mortar_build
+
+  integer, parameter :: NGAUSS = 5
+  real(wp), parameter :: GZ(NGAUSS) = [-0.9061798459386639927976269_wp, -0.5384693101056830910363144_wp, 0.0_wp, &
+                                       0.5384693101056830910363144_wp, 0.9061798459386639927976269_wp]
+  real(wp), parameter :: GW(NGAUSS) = [0.2369268850561890875142640_wp, 0.4786286704993664680412915_wp, &
+                                       0.5688888888888888888888889_wp, 0.4786286704993664680412915_wp, &
+                                       0.2369268850561890875142640_wp]
+  real(wp), parameter :: TOL_COVER = 1.0e-10_wp    ! a piece this close (in xi) to a node covers it
+  real(wp), parameter :: TOL_FULL = 1.0e-12_wp     ! relative shortfall of a segment still counted as covered
+  real(wp), parameter :: MIN_FACING = 1.0e-3_wp    ! cosine between n_s and -n_m below which a piece is dropped
+  real(wp), parameter :: MIN_WEIGHT = 1.0e-3_wp    ! a row whose master weights sum below this is dropped
+
+contains
+
+  !> Build the dual mortar rows of a slave contact chain against a master chain.
+  !! info = 1 with msg (which side, which edge or node) on bad input, or when no slave
+  !! node ends up with a row (no overlap, master edges facing away, all removable).
+  subroutine mortar_build(xs, es, removable, xm, em, mt, info, msg)
+    real(wp), intent(in) :: xs(:, :)        !< (2, nnode_s) slave body node coordinates [length]
+    integer, intent(in) :: es(:, :)         !< (2, ne_s) slave contact edges (node ids), slave body on the left of es(1)->es(2)
+    logical, intent(in) :: removable(:)     !< (nnode_s) the slave node may carry no multiplier (normal displacement prescribed on both bodies)
+    real(wp), intent(in) :: xm(:, :)        !< (2, nnode_m) master body node coordinates [length]
+    integer, intent(in) :: em(:, :)         !< (2, ne_m) master contact edges, master body on the left
+    type(mortar_t), intent(out) :: mt       !< the constraint rows
+    integer, intent(out) :: info            !< 0 ok, 1 bad input
+    character(len=*), intent(out) :: msg    !< why, when info /= 0
+    integer, allocatable :: cs(:), cm(:), mstat(:), mseg(:), pk(:), pq(:), kptr(:), ord(:)
+    real(wp), allocatable :: slen(:), nn(:, :), arc(:), mxi(:), plo(:), phi(:), covlen(:)
+    logical, allocatable :: covered(:), full(:), isrow(:)
+    integer :: nes, nem, i, k, q, np, nrej, klo, khi, iter, nbad
+    real(wp) :: lo, hi, xlo, xhi
+
+    info = 0
+    msg = ''
+    if (size(xs, 1) /= 2 .or. size(xm, 1) /= 2) then
+      info = 1
+      msg = 'mortar: node coordinates must be (2, nnode) arrays'
+      return
+    end if
+    if (size(removable) /= size(xs, 2)) then
+      info = 1
+      msg = 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes'
+      return
+    end if
+    call chain_order(xs, es, 'slave', cs, info, msg)
+    if (info /= 0) return
+    call chain_order(xm, em, 'master', cm, info, msg)
+    if (info /= 0) return
+    nes = size(es, 2)
+    nem = size(em, 2)
+
+    ! Slave segment lengths, arc length and nodal normals (inverse-length weighted).
+    allocate (slen(nes), arc(0:nes), nn(2, 0:nes))
+    arc(0) = 0.0_wp
+    nn = 0.0_wp
+    do k = 1, nes
+      slen(k) = norm2(xs(:, cs(k)) - xs(:, cs(k - 1)))
+      arc(k) = arc(k - 1) + slen(k)
+      nn(:, k - 1) = nn(:, k - 1) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
+      nn(:, k) = nn(:, k) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
+    end do
+    do i = 0, nes
+      lo = 0.0_wp
+      if (i > 0) lo = lo + 1.0_wp / slen(i)
+      if (i < nes) lo = lo + 1.0_wp / slen(i + 1)
+      hi = norm2(nn(:, i))
+      if (hi <= 1.0e-8_wp * lo) then
+        info = 1
+        msg = 'mortar: the slave chain folds back on itself at node '//i2s(cs(i))//' (its two edges are opposite)'
+        return
+      end if
+      nn(:, i) = nn(:, i) / hi
+    end do
+
+    ! Each master node's place on the slave chain: segment mseg and xi (mstat 0), or before
+    ! the chain's start (mstat -1) or beyond its end (+1).
+    allocate (mstat(0:nem), mseg(0:nem), mxi(0:nem))
+    call project_master_nodes(xs, cs, nn, xm, cm, mstat, mseg, mxi)
+
+    ! Clip: each master segment covers a slave interval; its pieces per slave segment.
+    np = 0
+    nrej = 0
+    allocate (pk(nes + nem + 8), pq(nes + nem + 8), plo(nes + nem + 8), phi(nes + nem + 8))
+    do q = 1, nem
+      if (mstat(q - 1) /= 0 .and. mstat(q - 1) == mstat(q)) cycle
+      call place(q - 1, k, lo)
+      call place(q, i, hi)
+      if (i < k .or. (i == k .and. hi < lo)) then
+        klo = i; xlo = hi; khi = k; xhi = lo
+      else
+        klo = k; xlo = lo; khi = i; xhi = hi
+      end if
+      do k = klo, khi
+        lo = -1.0_wp
+        hi = 1.0_wp
+        if (k == klo) lo = xlo
+        if (k == khi) hi = xhi
+        if (hi <= lo) cycle
+        if (.not. facing(k, q, 0.5_wp * (lo + hi))) then
+          nrej = nrej + 1
+          cycle
+        end if
+        if (np == size(pk)) call grow()
+        np = np + 1
+        pk(np) = k; pq(np) = q; plo(np) = lo; phi(np) = hi
+      end do
+    end do
+
+    ! Pieces grouped by slave segment (counting sort), coverage of segments and nodes.
+    allocate (kptr(nes + 1), ord(np), covlen(nes), full(nes), covered(0:nes))
+    kptr = 0
+    do i = 1, np
+      kptr(pk(i) + 1) = kptr(pk(i) + 1) + 1
+    end do
+    kptr(1) = 1
+    do k = 1, nes
+      kptr(k + 1) = kptr(k + 1) + kptr(k)
+    end do
+    covlen = 0.0_wp
+    covered = .false.
+    block
+      integer, allocatable :: fill(:)
+      allocate (fill(nes))
+      fill = kptr(1:nes)
+      do i = 1, np
+        k = pk(i)
+        ord(fill(k)) = i
+        fill(k) = fill(k) + 1
+        covlen(k) = covlen(k) + (phi(i) - plo(i))
+        if (plo(i) <= -1.0_wp + TOL_COVER) covered(k - 1) = .true.
+        if (phi(i) >= 1.0_wp - TOL_COVER) covered(k) = .true.
+      end do
+    end block
+    full = covlen >= 2.0_wp * (1.0_wp - TOL_FULL)
+
+    allocate (isrow(0:nes))
+    do i = 0, nes
+      isrow(i) = covered(i) .and. .not. removable(cs(i))
+    end do
+    do iter = 1, nes + 2
+      call build_rows(nbad)
+      if (nbad == 0) exit
+    end do
+
+    if (mt%m == 0) then
+      info = 1
+      if (np == 0 .and. nrej > 0) then
+        msg = 'mortar: every master edge over the slave faces away from it (n_s.n_m >= 0): both bodies must lie '// &
+              'on the left of their edges; is one edge list reversed?'
+      else if (np == 0) then
+        msg = 'mortar: the master curve does not overlap the slave curve along the slave normals'
+      else
+        msg = 'mortar: no slave node carries a multiplier (every covered slave node is removable)'
+      end if
+    end if
+
+  contains
+
+    !> Where master chain node p sits on the slave chain, as (segment, xi), ends clamped.
+    subroutine place(p, kk, xx)
+      integer, intent(in) :: p
+      integer, intent(out) :: kk
+      real(wp), intent(out) :: xx
+      select case (mstat(p))
+      case (-1)
+        kk = 1; xx = -1.0_wp
+      case (1)
+        kk = nes; xx = 1.0_wp
+      case default
+        kk = mseg(p); xx = mxi(p)
+      end select
+    end subroutine place
+
+    !> Does master segment qq face the slave normal of segment kk at xi?
+    logical function facing(kk, qq, xi)
+      integer, intent(in) :: kk, qq
+      real(wp), intent(in) :: xi
+      real(wp) :: ns(2), nm(2)
+      ns = 0.5_wp * (1.0_wp - xi) * nn(:, kk - 1) + 0.5_wp * (1.0_wp + xi) * nn(:, kk)
+      nm = edge_normal(xm(:, cm(qq - 1)), xm(:, cm(qq)))
+      facing = dot_product(ns, nm) < -MIN_FACING * norm2(ns) * norm2(nm)
+    end function facing
+
+    !> Double the capacity of the piece arrays.
+    subroutine grow()
+      integer, allocatable :: ti(:)
+      real(wp), allocatable :: tr(:)
+      integer :: nw
+      nw = 2 * size(pk)
+      allocate (ti(nw)); ti(1:np) = pk(1:np); call move_alloc(ti, pk)
+      allocate (ti(nw)); ti(1:np) = pq(1:np); call move_alloc(ti, pq)
+      allocate (tr(nw)); tr(1:np) = plo(1:np); call move_alloc(tr, plo)
+      allocate (tr(nw)); tr(1:np) = phi(1:np); call move_alloc(tr, phi)
+    end subroutine grow
+
+    !> Fill mt from isrow; rows whose master weights sum below MIN_WEIGHT are switched off
+    !! (nbad of them), in which case the caller builds again.
+    subroutine build_rows(nbad)
+      integer, intent(out) :: nbad
+      integer :: j, m, cap, ns_, nm_, side, kk, other, ii, g, l, l1, l2, e, e2, pc, s0, m0_
+      integer, allocatable :: pos(:)
+      real(wp) :: dj, ws(-1:1), xa(2), xb(2), c0(2), c1(2), mm0(2), mm1(2), p1(2), dq(2), half, mid, xi, w, &
+                  ph, p(2), ng(2), den, t, sw, g0
+      logical :: dual, isb
+
+      m = count(isrow)
+      cap = 0
+      do ii = 0, nes
+        if (.not. isrow(ii)) cycle
+        if (ii > 0) cap = cap + 2 * (kptr(ii + 1) - kptr(ii))
+        if (ii < nes) cap = cap + 2 * (kptr(ii + 2) - kptr(ii + 1))
+      end do
+      mt%m = m
+      if (allocated(mt%snode)) deallocate (mt%snode, mt%normal, mt%d, mt%s, mt%g0, mt%sptr, mt%snod, mt%sval, &
+                                           mt%mptr, mt%mnod, mt%mval)
+      allocate (mt%snode(m), mt%normal(2, m), mt%d(m), mt%s(m), mt%g0(m), mt%sptr(m + 1), mt%snod(3 * m), &
+                mt%sval(3 * m), mt%mptr(m + 1), mt%mnod(cap), mt%mval(cap))
+      allocate (pos(size(xm, 2)))
+      pos = 0
+      nbad = 0
+      j = 0
+      ns_ = 0
+      nm_ = 0
+      do ii = 0, nes
+        if (.not. isrow(ii)) cycle
+        j = j + 1
+        mt%snode(j) = cs(ii)
+        mt%normal(:, j) = nn(:, ii)
+        mt%s(j) = arc(ii)
+        mt%sptr(j) = ns_ + 1
+        mt%mptr(j) = nm_ + 1
+        m0_ = nm_
+        dj = 0.0_wp
+        ws = 0.0_wp
+        do side = -1, 1, 2
+          ! side -1: segment ii (nodes ii-1, ii; this node is its end b); +1: segment ii+1 (node a).
+          if (side == -1) then
+            if (ii == 0) cycle
+            kk = ii
+          else
+            if (ii == nes) cycle
+            kk = ii + 1
+          end if
+          isb = side == -1
+          other = ii + side
+          dual = isrow(other)
+          dj = dj + 0.5_wp * slen(kk)
+          if (full(kk)) then
+            ws(0) = ws(0) + 0.5_wp * slen(kk)
+            if (.not. dual) ws(side) = ws(side) + 0.5_wp * slen(kk)
+          end if
+          xa = xs(:, cs(kk - 1)); xb = xs(:, cs(kk))
+          c0 = 0.5_wp * (xa + xb); c1 = 0.5_wp * (xb - xa)
+          mm0 = 0.5_wp * (nn(:, kk - 1) + nn(:, kk)); mm1 = 0.5_wp * (nn(:, kk) - nn(:, kk - 1))
+          do e = kptr(kk), kptr(kk + 1) - 1
+            pc = ord(e)
+            l1 = cm(pq(pc) - 1); l2 = cm(pq(pc))
+            p1 = xm(:, l1); dq = xm(:, l2) - p1
+            half = 0.5_wp * (phi(pc) - plo(pc))
+            mid = 0.5_wp * (phi(pc) + plo(pc))
+            do g = 1, NGAUSS
+              xi = mid + half * GZ(g)
+              w = GW(g) * half * 0.5_wp * slen(kk)
+              if (.not. dual) then
+                ph = 1.0_wp
+              else if (isb) then
+                ph = 0.5_wp * (1.0_wp + 3.0_wp * xi)
+              else
+                ph = 0.5_wp * (1.0_wp - 3.0_wp * xi)
+              end if
+              p = c0 + xi * c1
+              ng = mm0 + xi * mm1
+              den = cross(dq, ng)
+              if (den /= 0.0_wp) then
+                t = min(1.0_wp, max(0.0_wp, cross(p - p1, ng) / den))
+              else
+                t = 0.5_wp
+              end if
+              do e2 = 1, 2
+                l = merge(l1, l2, e2 == 1)
+                if (pos(l) == 0) then
+                  nm_ = nm_ + 1
+                  pos(l) = nm_
+                  mt%mnod(nm_) = l
+                  mt%mval(nm_) = 0.0_wp
+                end if
+                mt%mval(pos(l)) = mt%mval(pos(l)) + w * ph * merge(1.0_wp - t, t, e2 == 1)
+              end do
+              if (.not. full(kk)) then
+                ! Partly covered: slave weights over the covered part. N of this node is
+                ! (1 + xi)/2 when it is end b of the segment, (1 - xi)/2 when it is end a.
+                if (isb) then
+                  ws(0) = ws(0) + w * ph * 0.5_wp * (1.0_wp + xi)
+                  ws(side) = ws(side) + w * ph * 0.5_wp * (1.0_wp - xi)
+                else
+                  ws(0) = ws(0) + w * ph * 0.5_wp * (1.0_wp - xi)
+                  ws(side) = ws(side) + w * ph * 0.5_wp * (1.0_wp + xi)
+                end if
+              end if
+            end do
+          end do
+        end do
+        mt%d(j) = dj
+        ! Slave entries: own node first, then a neighbour with a modified or partly covered function.
+        ns_ = ns_ + 1
+        mt%snod(ns_) = cs(ii)
+        mt%sval(ns_) = ws(0) / dj
+        s0 = ns_
+        do side = -1, 1, 2
+          other = ii + side
+          if (other < 0 .or. other > nes) cycle
+          kk = ii + max(side, 0)
+          if (isrow(other) .and. full(kk)) cycle   ! dual pair on a covered segment: int Phi_j N_other = 0
+          if (ws(side) == 0.0_wp) cycle                 ! no covered part on that segment
+          ns_ = ns_ + 1
+          mt%snod(ns_) = cs(other)
+          mt%sval(ns_) = ws(side) / dj
+        end do
+        ! Master weights / D, the gap relative to the node, and the weight sum.
+        sw = 0.0_wp
+        g0 = 0.0_wp
+        do e = m0_ + 1, nm_
+          l = mt%mnod(e)
+          pos(l) = 0
+          mt%mval(e) = mt%mval(e) / dj
+          sw = sw + mt%mval(e)
+          g0 = g0 + mt%mval(e) * dot_product(nn(:, ii), xm(:, l) - xs(:, cs(ii)))
+        end do
+        do e = s0 + 1, ns_
+          g0 = g0 - mt%sval(e) * dot_product(nn(:, ii), xs(:, mt%snod(e)) - xs(:, cs(ii)))
+        end do
+        mt%g0(j) = g0
+        if (.not. (sw >= MIN_WEIGHT)) then
+          nbad = nbad + 1
+          isrow(ii) = .false.
+        end if
+      end do
+      mt%sptr(m + 1) = ns_ + 1
+      mt%mptr(m + 1) = nm_ + 1
+      if (nbad == 0) then
+        mt%snod = mt%snod(1:ns_)
+        mt%sval = mt%sval(1:ns_)
+        mt%mnod = mt%mnod(1:nm_)
+        mt%mval = mt%mval(1:nm_)
+      end if
+    end subroutine build_rows
+
+  end subroutine mortar_build
+
+  !> Order the edges of one side into a single open chain: c(0:ne) are its nodes from the
+  !! start (the node no edge ends at), edge k joining c(k-1) -> c(k).
+  subroutine chain_order(x, e, what, c, info, msg)
+    real(wp), intent(in) :: x(:, :)            !< (2, nnode) coordinates
+    integer, intent(in) :: e(:, :)             !< (2, ne) edges
+    character(len=*), intent(in) :: what       !< 'slave' or 'master', for messages
+    integer, allocatable, intent(out) :: c(:)  !< (0:ne) nodes in chain order
+    integer, intent(inout) :: info             !< set to 1 on bad input
+    character(len=*), intent(inout) :: msg     !< why
+    integer, allocatable :: eout(:), ein(:), deg(:)
+    integer :: ne, nnode, k, a, b, nstart, start, n
+    real(wp) :: lo(2), hi(2), diag
+
+    ne = size(e, 2)
+    nnode = size(x, 2)
+    if (size(e, 1) /= 2) then
+      info = 1
+      msg = 'mortar: the '//what//' edges must be a (2, ne) array'
+      return
+    end if
+    if (ne == 0) then
+      info = 1
+      msg = 'mortar: no '//what//' contact edges'
+      return
+    end if
+    do k = 1, ne
+      if (any(e(:, k) < 1) .or. any(e(:, k) > nnode)) then
+        info = 1
+        msg = 'mortar: '//what//' edge '//i2s(k)//' refers to node '//i2s(merge(e(1, k), e(2, k), &
+              e(1, k) < 1 .or. e(1, k) > nnode))//', outside 1..'//i2s(nnode)
+        return
+      end if
+      if (.not. all(ieee_is_finite(x(:, e(:, k))))) then
+        info = 1
+        msg = 'mortar: '//what//' edge '//i2s(k)//' has a node with a non-finite coordinate'
+        return
+      end if
+    end do
+    lo = huge(1.0_wp)
+    hi = -huge(1.0_wp)
+    do k = 1, ne
+      do a = 1, 2
+        lo = min(lo, x(:, e(a, k)))
+        hi = max(hi, x(:, e(a, k)))
+      end do
+    end do
+    diag = norm2(hi - lo)
+    do k = 1, ne
+      if (e(1, k) == e(2, k) .or. norm2(x(:, e(2, k)) - x(:, e(1, k))) <= 1.0e-12_wp * diag) then
+        info = 1
+        msg = 'mortar: '//what//' edge '//i2s(k)//' (nodes '//i2s(e(1, k))//', '//i2s(e(2, k))//') has zero length'
+        return
+      end if
+    end do
+    allocate (eout(nnode), ein(nnode), deg(nnode))
+    eout = 0
+    ein = 0
+    deg = 0
+    do k = 1, ne
+      deg(e(:, k)) = deg(e(:, k)) + 1
+    end do
+    do k = 1, ne
+      do a = 1, 2
+        if (deg(e(a, k)) > 2) then
+          info = 1
+          msg = 'mortar: the '//what//' edges branch at node '//i2s(e(a, k))//' ('//i2s(deg(e(a, k)))// &
+                ' edges meet there); one chain is required'
+          return
+        end if
+      end do
+    end do
+    do k = 1, ne
+      a = e(1, k)
+      b = e(2, k)
+      if (eout(a) /= 0) then
+        info = 1
+        msg = 'mortar: '//what//' edges '//i2s(eout(a))//' and '//i2s(k)//' both start at node '//i2s(a)// &
+              ': they are not consistently oriented (the body must lie on the left of every edge)'
+        return
+      end if
+      if (ein(b) /= 0) then
+        info = 1
+        msg = 'mortar: '//what//' edges '//i2s(ein(b))//' and '//i2s(k)//' both end at node '//i2s(b)// &
+              ': they are not consistently oriented (the body must lie on the left of every edge)'
+        return
+      end if
+      eout(a) = k
+      ein(b) = k
+    end do
+    nstart = 0
+    start = 0
+    do k = 1, ne
+      a = e(1, k)
+      if (ein(a) == 0) then
+        nstart = nstart + 1
+        start = a
+      end if
+    end do
+    if (nstart == 0) then
+      info = 1
+      msg = 'mortar: the '//what//' edges form a closed loop; one open chain is required'
+      return
+    end if
+    if (nstart > 1) then
+      info = 1
+      msg = 'mortar: the '//what//' edges form '//i2s(nstart)//' separate chains; one chain is required'
+      return
+    end if
+    allocate (c(0:ne))
+    c(0) = start
+    n = 0
+    do while (eout(c(n)) /= 0)
+      if (n == ne) exit
+      k = eout(c(n))
+      n = n + 1
+      c(n) = e(2, k)
+    end do
+    if (n /= ne) then
+      info = 1
+      msg = 'mortar: the '//what//' edges form more than one chain (a chain of '//i2s(n)//' edges and a closed '// &
+            'loop of the other '//i2s(ne - n)//'); one chain is required'
+      return
+    end if
+  end subroutine chain_order
+
+  !> Place every master chain node on the slave chain along the interpolated slave normal:
+  !! the segment k where sigma_i = (x - x_i) x n_i changes sign from <= 0 at node k-1 to
+  !! >= 0 at node k, found by walking from the previous node's segment.
+  subroutine project_master_nodes(xs, cs, nn, xm, cm, mstat, mseg, mxi)
+    real(wp), intent(in) :: xs(:, :), nn(:, 0:), xm(:, :)
+    integer, intent(in) :: cs(0:), cm(0:)
+    integer, intent(out) :: mstat(0:), mseg(0:)
+    real(wp), intent(out) :: mxi(0:)
+    integer :: nes, k, p
+    real(wp) :: x(2)
+    nes = size(cs) - 1
+    k = nes
+    do p = 0, size(cm) - 1
+      x = xm(:, cm(p))
+      mseg(p) = 0
+      mxi(p) = 0.0_wp
+      do
+        if (cross(x - xs(:, cs(k - 1)), nn(:, k - 1)) > 0.0_wp) then
+          if (k == 1) then
+            mstat(p) = -1
+            exit
+          end if
+          k = k - 1
+        else if (cross(x - xs(:, cs(k)), nn(:, k)) < 0.0_wp) then
+          if (k == nes) then
+            mstat(p) = 1
+            exit
+          end if
+          k = k + 1
+        else
+          mstat(p) = 0
+          mseg(p) = k
+          mxi(p) = project_on_segment(x, xs(:, cs(k - 1)), xs(:, cs(k)), nn(:, k - 1), nn(:, k))
+          exit
+        end if
+      end do
+    end do
+  end subroutine project_master_nodes
+
+  !> The xi in [-1, 1] where (x - x_s(xi)) x n(xi) = 0 on the segment xa -> xb with nodal
+  !! normals na, nb interpolated linearly (a quadratic; the caller has checked the sign
+  !! change between the ends).
+  pure real(wp) function project_on_segment(x, xa, xb, na, nb) result(xi)
+    real(wp), intent(in) :: x(2), xa(2), xb(2), na(2), nb(2)
+    real(wp) :: c0(2), c1(2), m0(2), m1(2), d(2), a, b, c, disc, q, r(2), fl, fm, lo, hi
+    integer :: it, i
+    c0 = 0.5_wp * (xa + xb)
+    c1 = 0.5_wp * (xb - xa)
+    m0 = 0.5_wp * (na + nb)
+    m1 = 0.5_wp * (nb - na)
+    d = x - c0
+    a = -cross(c1, m1)
+    b = cross(d, m1) - cross(c1, m0)
+    c = cross(d, m0)
+    ! f(xi) = c + b xi + a xi^2
+    if (a == 0.0_wp) then
+      if (b /= 0.0_wp) then
+        xi = min(1.0_wp, max(-1.0_wp, -c / b))
+        return
+      end if
+    else
+      disc = b * b - 4.0_wp * a * c
+      if (disc >= 0.0_wp) then
+        q = -0.5_wp * (b + sign(sqrt(disc), b))
+        r = huge(1.0_wp)
+        r(1) = q / a
+        if (q /= 0.0_wp) r(2) = c / q
+        i = minloc(abs(r), 1)
+        if (abs(r(i)) <= 1.0_wp + 1.0e-8_wp) then
+          xi = min(1.0_wp, max(-1.0_wp, r(i)))
+          return
+        end if
+      end if
+    end if
+    ! Fallback: bisection on the bracket.
+    lo = -1.0_wp
+    hi = 1.0_wp
+    fl = c - b + a
+    do it = 1, 60
+      xi = 0.5_wp * (lo + hi)
+      fm = c + xi * (b + xi * a)
+      if ((fm <= 0.0_wp) .eqv. (fl <= 0.0_wp)) then
+        lo = xi
+        fl = fm
+      else
+        hi = xi
+      end if
+    end do
+  end function project_on_segment
+
+  !> Outward normal (dy, -dx)/len of the edge xa -> xb (body on the left).
+  pure function edge_normal(xa, xb) result(n)
+    real(wp), intent(in) :: xa(2), xb(2)
+    real(wp) :: n(2)
+    n = [xb(2) - xa(2), xa(1) - xb(1)]
+    n = n / norm2(n)
+  end function edge_normal
+
+  !> The 2D cross product a x b = a1 b2 - a2 b1.
+  pure real(wp) function cross(a, b)
+    real(wp), intent(in) :: a(2), b(2)
+    cross = a(1) * b(2) - a(2) * b(1)
+  end function cross
+
+end module mortar
