@@ -13,6 +13,7 @@ program robin_contact
   use config, only: deck_t, output_cfg_t, METHOD_ROBIN, METHOD_MONOLITHIC
   use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
+  use gmsh_msh, only: msh_read
   use assembly, only: body_system_t, assemble_body, expand
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
@@ -80,7 +81,12 @@ program robin_contact
   t0 = wtime()
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
-    call mesh_build(msh(a), d%body(a))
+    if (len_trim(d%body(a)%mesh) > 0) then
+      call msh_read(trim(d%body(a)%mesh), trim(d%body(a)%region), a, msh(a), info(a), msg(a))
+      if (info(a) /= 0) cycle
+    else
+      call mesh_build(msh(a), d%body(a))
+    end if
     call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a), &
                        boundaries=d%boundary(1:d%nboundary))
   end do

@@ -12,7 +12,9 @@ module condense
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use config, only: body_cfg_t, contact_cfg_t, factor_cfg_t, BC_CONTACT, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, &
                     SIDE_TOP, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
-  use mesh, only: mesh_t, side_nodes
+  use mesh, only: mesh_t, side_nodes, group_index, group_names
+  use mortar, only: mortar_t, mortar_build
+  use strings, only: i2s, r2s
   use assembly, only: body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: nested_dissection
@@ -83,6 +85,10 @@ contains
 
     info = 0
     msg = ''
+    if (len_trim(cc%body_group(1)) > 0) then
+      call mortar_interface(cc, msh, sys, itf, info, msg)
+      return
+    end if
     do a = 1, 2
       itf%side(a) = 0
       do k = 1, 4
@@ -171,6 +177,140 @@ contains
       itf%b(a)%ptr(itf%m + 1) = itf%m + 1
     end do
   end subroutine build_interface
+
+  !> The interface of two named edge groups by dual mortar (module mortar): the slave is
+  !! cc%slave, or the body whose contact group has the shorter mean edge (body 1 on a tie).
+  !! A slave node carries no row when its normal displacement and that of every master node
+  !! its row involves are prescribed (the constraint would only repeat the supports): found
+  !! by a first build, then the rows are built again without those nodes. info = 1 (bad
+  !! input) for an unknown group, a group facing nothing, or an initial overlap.
+  subroutine mortar_interface(cc, msh, sys, itf, info, msg)
+    type(contact_cfg_t), intent(in) :: cc
+    type(mesh_t), intent(in) :: msh(2)
+    type(body_system_t), intent(in) :: sys(2)
+    type(interface_t), intent(out) :: itf
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    integer :: g(2), a, sl, ma, j, e, k, ne
+    real(wp) :: hmean(2), tol, gmin
+    logical, allocatable :: removable(:)
+    type(mortar_t) :: mt
+    character(len=512) :: why
+
+    info = 0
+    msg = ''
+    do a = 1, 2
+      g(a) = group_index(msh(a), cc%body_group(a))
+      if (g(a) == 0) then
+        info = 1
+        msg = '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)// &
+              ' has no such group with edges on its boundary; its groups are '//group_names(msh(a))
+        return
+      end if
+      associate (gr => msh(a)%group(g(a)))
+        hmean(a) = 0.0_wp
+        do e = 1, gr%nedge
+          hmean(a) = hmean(a) + norm2(msh(a)%xy(:, gr%edge(2, e)) - msh(a)%xy(:, gr%edge(1, e)))
+        end do
+        hmean(a) = hmean(a)/max(1, gr%nedge)
+      end associate
+    end do
+    sl = cc%slave
+    if (sl == 0) sl = merge(2, 1, hmean(2) < hmean(1)*(1.0_wp - 1.0e-12_wp))
+    ma = 3 - sl
+    itf%mortar = .true.
+    itf%slave = sl
+
+    allocate (removable(msh(sl)%nnode))
+    removable = .false.
+    call mortar_build(msh(sl)%xy, msh(sl)%group(g(sl))%edge, removable, msh(ma)%xy, &
+                      msh(ma)%group(g(ma))%edge, mt, info, why)
+    if (info == 0) then
+      do j = 1, mt%m
+        removable(mt%snode(j)) = normal_fixed(sys(sl), mt%snode(j), mt%normal(:, j))
+        do k = mt%mptr(j), mt%mptr(j + 1) - 1
+          if (abs(mt%mval(k)) > 1.0e-12_wp) removable(mt%snode(j)) = removable(mt%snode(j)) .and. &
+            normal_fixed(sys(ma), mt%mnod(k), mt%normal(:, j))
+        end do
+      end do
+      if (any(removable)) call mortar_build(msh(sl)%xy, msh(sl)%group(g(sl))%edge, removable, msh(ma)%xy, &
+                                            msh(ma)%group(g(ma))%edge, mt, info, why)
+    end if
+    if (info /= 0) then
+      info = 1
+      msg = 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(sl)//' (slave) and '''// &
+            trim(cc%body_group(ma))//''' of body '//i2s(ma)//' (master): '//trim(why)
+      return
+    end if
+
+    ! an initial overlap beyond a thousandth of the slave's mean edge is bad input
+    tol = 1.0e-3_wp*hmean(sl)
+    gmin = minval(mt%g0)
+    if (gmin < -tol) then
+      j = minloc(mt%g0, dim=1)
+      info = 1
+      msg = 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
+            ''' overlap in the initial configuration: the gap at slave node '//i2s(msh(sl)%node_tag(mt%snode(j)))// &
+            ' of body '//i2s(sl)//' at ('//r2s(msh(sl)%xy(1, mt%snode(j)))//', '//r2s(msh(sl)%xy(2, mt%snode(j)))// &
+            ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart'
+      return
+    end if
+
+    itf%m = mt%m
+    allocate (itf%s(mt%m), itf%xy(2, mt%m), itf%g0(mt%m), itf%trib(mt%m), itf%node(mt%m, 2), &
+              itf%normal(2, mt%m))
+    itf%s = mt%s
+    itf%xy = msh(sl)%xy(:, mt%snode)
+    itf%normal = mt%normal
+    itf%trib = mt%d
+    itf%node(:, sl) = mt%snode
+    itf%node(:, ma) = 0
+    itf%g0 = mt%g0
+    if (cc%gap_radius > 0.0_wp) itf%g0 = itf%g0 + (itf%xy(1, :) - cc%gap_center)**2/(2.0_wp*cc%gap_radius)
+    ! B_s: + sum_k ws_k n_j.u_k ; B_m: - sum_l wm_l n_j.u_l (both components of each node)
+    ne = 2*(mt%sptr(mt%m + 1) - 1)
+    allocate (itf%b(sl)%ptr(mt%m + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
+    ne = 2*(mt%mptr(mt%m + 1) - 1)
+    allocate (itf%b(ma)%ptr(mt%m + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
+    call fill_rows(mt%sptr, mt%snod, mt%sval, 1.0_wp, itf%b(sl))
+    call fill_rows(mt%mptr, mt%mnod, mt%mval, -1.0_wp, itf%b(ma))
+
+  contains
+
+    !> Rows of one body: each node entry (weight w) gives sgn*w*n_j on both its DOFs.
+    subroutine fill_rows(ptr, nod, val, sgn, b)
+      integer, intent(in) :: ptr(:), nod(:)
+      real(wp), intent(in) :: val(:), sgn
+      type(brows_t), intent(inout) :: b
+      integer :: jj, kk, q, c
+      q = 0
+      b%ptr(1) = 1
+      do jj = 1, mt%m
+        do kk = ptr(jj), ptr(jj + 1) - 1
+          do c = 1, 2
+            q = q + 1
+            b%dof(q) = 2*(nod(kk) - 1) + c
+            b%val(q) = sgn*val(kk)*mt%normal(c, jj)
+          end do
+        end do
+        b%ptr(jj + 1) = q + 1
+      end do
+    end subroutine fill_rows
+
+  end subroutine mortar_interface
+
+  !> Whether the displacement of node k along nrm is prescribed in the body: every
+  !! component that nrm has is a prescribed DOF.
+  pure logical function normal_fixed(sys, k, nrm)
+    type(body_system_t), intent(in) :: sys
+    integer, intent(in) :: k
+    real(wp), intent(in) :: nrm(2)
+    integer :: c
+    normal_fixed = .true.
+    do c = 1, 2
+      if (abs(nrm(c)) > 1.0e-12_wp .and. sys%free_of(2*(k - 1) + c) > 0) normal_fixed = .false.
+    end do
+  end function normal_fixed
 
   !> The outward unit normal of a rectangle's side.
   pure function side_normal(side) result(nrm)

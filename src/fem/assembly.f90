@@ -438,14 +438,14 @@ contains
             if (sys%free_of(2*(adj(s) - 1) + cc) > 0) nnz = nnz + 1
           end do
         end do
-        cycle
-      end if
-      call node_stencil(mesh, k, nbr, nnbr)
-      do s = 1, nnbr
-        do cc = 1, 2
-          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
+      else
+        call node_stencil(mesh, k, nbr, nnbr)
+        do s = 1, nnbr
+          do cc = 1, 2
+            if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
+          end do
         end do
-      end do
+      end if
       if (nnz > int(huge(1), i8)) then
         info = 6
         write (msg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
