@@ -530,7 +530,7 @@ contains
       'is used twice (also by the &body at line '//i2s(st%body_line(id))// &
       '); the two bodies must have ids 1 and 2')
     fresh%id = id
-    call apply_body(g, src, fresh, d%body(id))
+    call apply_body(g, src, fresh, d%body(id), st%path)
     st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
     st%nbody = st%nbody + 1
     st%body_line(id) = g%line
@@ -553,17 +553,18 @@ contains
     if (id /= 1 .and. id /= 2) call bad_value(g, src, 'id', i2s(id), &
       'is not a body id: the two bodies have ids 1 and 2')
     copy = d%body(id)
-    call apply_body(g, src, copy, d%body(id))
+    call apply_body(g, src, copy, d%body(id), st%path)
     st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
     st%body_at(id)%s = st%body_at(id)%s//', changed by '//src%label
   end subroutine override_body
 
   !> Read a &body group into a copy of `b0` (its current values) and store it in `b`.
-  subroutine apply_body(g, src, b0, b)
+  subroutine apply_body(g, src, b0, b, deck_path)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(body_cfg_t), intent(in) :: b0
     type(body_cfg_t), intent(inout) :: b
+    character(len=*), intent(in) :: deck_path
     type(body_cfg_t), target :: c
     type(vars_t) :: v
     integer :: s
@@ -571,7 +572,7 @@ contains
     c = b0
     call body_vars(c, v, ALL_FORMS)
     call read_group(g, src, v)
-    if (len_trim(c%mesh) > 0) call mesh_body(g, src, c)
+    if (len_trim(c%mesh) > 0 .and. find_asg(g, 'mesh') > 0) call mesh_body(g, src, c, deck_path)
     if (.not. c%width > 0.0_wp) call bad_value(g, src, 'width', r2s(c%width), 'must be > 0')
     if (.not. c%height > 0.0_wp) call bad_value(g, src, 'height', r2s(c%height), 'must be > 0')
     if (c%nx < 1) call bad_value(g, src, 'nx', i2s(c%nx), 'must be >= 1 (cells along x)')
@@ -704,11 +705,12 @@ contains
   end subroutine body_given
 
   !> A body read from a mesh file: the rectangle's variables have no meaning; the path is
-  !! made absolute, relative to the deck's folder.
-  subroutine mesh_body(g, src, c)
+  !! made absolute, relative to the deck's folder (for a command-line override too).
+  subroutine mesh_body(g, src, c, deck_path)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(body_cfg_t), intent(inout) :: c
+    character(len=*), intent(in) :: deck_path
     character(len=*), parameter :: RECT = 'x0 y0 width height nx ny element left right top bottom'
     integer :: k
     do k = 1, 11
@@ -716,23 +718,23 @@ contains
         trim(word(RECT, k))//' describes a built-in rectangle, but this body comes from mesh='''// &
         trim(c%mesh)//'''; give its conditions with &boundary and &traction on the mesh''s groups')
     end do
-    if (c%mesh(1:1) /= '/') c%mesh = deck_folder(src)//trim(c%mesh)
+    if (c%mesh(1:1) /= '/') c%mesh = deck_folder(deck_path)//trim(c%mesh)
     c%bc = BC_FREE
   end subroutine mesh_body
 
   !> The absolute folder of the deck file, with a trailing '/' (the working folder for a
-  !! command-line override or a deck read from /dev/).
-  function deck_folder(src) result(f)
-    type(src_t), intent(in) :: src
+  !! deck read from /dev/, e.g. a pipe).
+  function deck_folder(path) result(f)
+    character(len=*), intent(in) :: path
     character(len=:), allocatable :: f
     character(len=4096) :: cwd
     integer :: k, stat
     call getcwd(cwd, stat)
     if (stat /= 0) cwd = '.'
     f = ''
-    if (src%is_file .and. src%label(1:min(5, len(src%label))) /= '/dev/') then
-      k = index(src%label, '/', back=.true.)
-      if (k > 0) f = src%label(1:k)
+    if (path(1:min(5, len(path))) /= '/dev/') then
+      k = index(path, '/', back=.true.)
+      if (k > 0) f = path(1:k)
     end if
     if (len(f) == 0) then
       f = trim(cwd)//'/'
@@ -804,7 +806,7 @@ contains
   subroutine check_cross(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
-    integer :: b, s, nc, cs(2), i, n1, n2
+    integer :: b, s, nc, cs(2), n1, n2
     character(len=:), allocatable :: p, lst, what
     real(wp) :: scale, tol, c1, c2, a1, a2, e1, e2
     logical :: fixed, roll_h, roll_v, horizontal, groups
