@@ -6,7 +6,7 @@
 // R/4 at distance 2. The bodies share no point (each has its own node at (0,1)).
 // Physical surfaces "disc", "block"; physical curves "disc_top" (flat side), "disc_arc"
 // (curved side), "block_top", "block_bottom", "block_left", "block_right".
-// `make meshes` writes hertz_h0.04.msh, hertz_h0.02.msh, hertz_h0.01.msh:
+// `make meshes` writes hertz_h0.04.msh, hertz_h0.02.msh, hertz_h0.01.msh, hertz_h0.005.msh:
 //   gmsh -2 -format msh41 -setnumber h 0.02 hertz.geo -o hertz_h0.02.msh
 Geometry.AutoCoherence = 0;
 If (!Exists(h))

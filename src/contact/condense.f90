@@ -19,6 +19,7 @@ module condense
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: nested_dissection
   use clock, only: wtime
+  use lapack, only: dpstrf
   implicit none (type, external)
   private
 
@@ -56,6 +57,11 @@ module condense
     real(wp), allocatable :: bval(:)        !<   and its coefficient
     real(wp), allocatable :: bfix(:)        !< (m) B_a's part on prescribed DOFs, B_a,d u_d [length]
     real(wp), allocatable :: flex(:, :)     !< (m,m) F_a [length/force]
+    !> > 0 when F_a is singular (mortar: a master surface coarser than the slave has fewer
+    !! normal DOFs than the slave has rows): the weight of the proximal term that pins the
+    !! body's subproblem multipliers in the kernel of F_a to the other body's (contact.f90)
+    real(wp) :: prox = 0.0_wp             !< [length/force]
+    integer :: rank = 0                   !< numerical rank of F_a
     real(wp), allocatable :: b(:)           !< (m) B_a K_a^-1 f_a [length]
     real(wp), allocatable :: u0(:)          !< (n) K_a^-1 f_a [length]
     type(chol_t) :: chol                    !< the factorization of K_a
@@ -194,6 +200,7 @@ contains
     integer :: g(2), a, sl, ma, j, e, k, ne
     real(wp) :: hmean(2), tol, gmin
     logical, allocatable :: removable(:)
+    real(wp), allocatable :: gdist(:)
     type(mortar_t) :: mt
     character(len=512) :: why
 
@@ -244,10 +251,16 @@ contains
     end if
 
     ! an initial overlap beyond a thousandth of the slave's mean edge is bad input
+    ! (the gap of a row divided by its slave weight sum: the distance, where the row's
+    ! weights sum to more or less than one next to a removed node or at a partly covered end)
     tol = 1.0e-3_wp*hmean(sl)
-    gmin = minval(mt%g0)
+    allocate (gdist(mt%m))
+    do j = 1, mt%m
+      gdist(j) = mt%g0(j)/sum(mt%sval(mt%sptr(j):mt%sptr(j + 1) - 1))
+    end do
+    gmin = minval(gdist)
     if (gmin < -tol) then
-      j = minloc(mt%g0, dim=1)
+      j = minloc(gdist, dim=1)
       info = 1
       msg = 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
             ''' overlap in the initial configuration: the gap at slave node '//i2s(msh(sl)%node_tag(mt%snode(j)))// &
@@ -460,12 +473,44 @@ contains
         end do
       end do
     end if
+    bc%rank = bc%m
+    bc%prox = 0.0_wp
+    if (bc%m > 0 .and. .not. selection_rows(bc)) call flex_rank(bc)
     bc%u0 = sys%f
     call bc%chol%solve(bc%u0, info, msg)
     if (info /= 0) return
     call apply_b(bc, bc%u0, bc%b)
     bc%t_condense = wtime() - t0
   end subroutine condense_body
+
+  !> True when every row of B_a picks one DOF, each a different one (F_a is then a principal
+  !! block of K_a^-1 up to signs, positive definite).
+  pure logical function selection_rows(bc)
+    type(body_condensed_t), intent(in) :: bc
+    selection_rows = size(bc%idx) == bc%m .and. size(bc%bpos) == bc%m
+  end function selection_rows
+
+  !> The numerical rank of F_a by Cholesky with complete pivoting (pivots below
+  !! 1e-10 max diag stop it); when it is rank deficient, the proximal weight is a
+  !! hundredth of its largest diagonal entry.
+  subroutine flex_rank(bc)
+    type(body_condensed_t), intent(inout) :: bc
+    real(wp), allocatable :: f(:, :), work(:)
+    integer, allocatable :: piv(:)
+    integer :: lapinfo, r
+    real(wp) :: dmax
+    integer :: i
+    dmax = 0.0_wp
+    do i = 1, bc%m
+      dmax = max(dmax, bc%flex(i, i))
+    end do
+    allocate (f(bc%m, bc%m), work(2*bc%m), piv(bc%m))
+    f = bc%flex
+    call dpstrf('L', bc%m, f, bc%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)
+    if (lapinfo < 0) return
+    bc%rank = r
+    if (r < bc%m) bc%prox = 1.0e-2_wp*dmax
+  end subroutine flex_rank
 
   !> w(m) = B_a u: the rows on the free displacements u (n) plus the part on prescribed DOFs.
   subroutine apply_b(bc, u, w)

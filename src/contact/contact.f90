@@ -131,7 +131,7 @@ contains
     class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     type(robin_state_t) :: st_
-    type(dense_op_t), target :: op(2)
+    type(dense_op_t), target :: op(2), opsub(2)
     type(robin_correction_t) :: corr_op
     real(wp), allocatable :: Gnew(:, :), w(:, :), dlam(:), corr(:, :)
     real(wp) :: rtol_in, t0, lmax(2), uref
@@ -156,6 +156,7 @@ contains
     uref = max(maxabs(bc(1)%b), maxabs(bc(2)%b), maxabs(itf%g0), tiny(1.0_wp))
 
     call body_operators(bc, op, lmax, st_, resumed, s%robin_operator == ROBIN_HARMONIC)
+    call subproblem_operators(bc, op, opsub)
     call robin_correction_init(corr_op, s, itf, bc, op, info)
     if (info /= 0) then
       res%status = 'failed'
@@ -181,7 +182,7 @@ contains
     do it = st_%it + 1, maxout
       ! 1. each body against its obstacle, in parallel
       rtol_in = inner_tolerance(s, it, m, st_%progress, lmax)
-      call solve_subproblems(s, bc, op, lmax, rtol_in, it, st_, w, res)
+      call solve_subproblems(s, bc, opsub, lmax + [bc(1)%prox, bc(2)%prox], rtol_in, it, st_, w, res)
       if (m == 0) then
         res%status = 'converged'
         res%outer = it
@@ -289,6 +290,26 @@ contains
     !$omp end parallel do
     if (.not. resumed) st%inner = sum(nmv)
   end subroutine body_operators
+
+  !> The Hessian of each body's subproblem: F_a, or F_a + prox I when F_a is singular
+  !! (module condense): the proximal term prox/2 |lam_a - lam_other|^2 pins the part of
+  !! lam_a in the kernel of F_a (which the body's own problem leaves undetermined) to the
+  !! other body's last contact force. At a fixed point lam_1 = lam_2, so the term vanishes
+  !! and the fixed point is still the monolithic solution.
+  subroutine subproblem_operators(bc, op, opsub)
+    type(body_condensed_t), intent(in) :: bc(2)
+    type(dense_op_t), intent(in) :: op(2)
+    type(dense_op_t), intent(out) :: opsub(2)
+    integer :: a, i
+    do a = 1, 2
+      opsub(a) = op(a)
+      if (bc(a)%prox > 0.0_wp) then
+        do i = 1, bc(a)%m
+          opsub(a)%a(i, i) = opsub(a)%a(i, i) + bc(a)%prox
+        end do
+      end if
+    end do
+  end subroutine subproblem_operators
 
   !> The Robin correction S_a of the obstacles: 'steklov' (the paper's: F_2 for body 1's
   !! obstacle, F_1 for body 2's, the bodies' own operators), 'constant' (alpha M^-1, a
@@ -403,12 +424,13 @@ contains
     type(contact_result_t), intent(inout) :: res
     type(mprgp_opts_t) :: opts(2)
     type(mprgp_stats_t) :: ms(2)
-    real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:), lam0(:, :), flam0(:, :)
+    real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:), lam0(:, :), flam0(:, :), lprev(:, :)
     integer :: a, m
     logical :: search
     m = size(w, 1)
     allocate (rhs(m, 2), grad(m, 2), lb(m), lam0(m, 2), flam0(m, 2))
     lb = 0.0_wp
+    lprev = st%lam   ! the other body's last force, for a proximal term (subproblem_operators)
     ! A first line search along the last change of lam_a (its image under F_a is a
     ! difference of known products: no product) only while the outer iteration contracts
     ! at a steady rate: then the changes of lam_a are nearly parallel from one iteration to
@@ -419,6 +441,7 @@ contains
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
       rhs(:, a) = bc(a)%b - st%G(:, a)
+      if (bc(a)%prox > 0.0_wp) rhs(:, a) = rhs(:, a) + bc(a)%prox*lprev(:, 3 - a)
       ! The tolerance is measured against the body's own contact displacement
       ! |F_a lam_a| (previous iterate), not against |b_a - G_a|: with a large
       ! material contrast the stiff body's b_a - G_a is a small difference of the
@@ -459,9 +482,13 @@ contains
           ': '//trim(mprgp_status_name(ms(a)%status))//': '//trim(ms(a)%message)
         return
       end if
-      ! B_a u_a = b_a - F_a lam_a = G_a - grad_a
+      ! B_a u_a = b_a - F_a lam_a = G_a - grad_a (+ the proximal term's part)
       w(:, a) = st%G(:, a) - grad(:, a)
       st%flam(a) = norm2(grad(:, a) + rhs(:, a))
+      if (bc(a)%prox > 0.0_wp) then
+        w(:, a) = w(:, a) + bc(a)%prox*(st%lam(:, a) - lprev(:, 3 - a))
+        st%flam(a) = norm2(grad(:, a) + rhs(:, a) - bc(a)%prox*st%lam(:, a))
+      end if
     end do
     st%nsrch = st%reuse
     st%reuse = 1

@@ -10,7 +10,7 @@ module lapack
   private
 
   public :: dsymv, dgemm
-  public :: dpotrf, dpotrs, dpotri, dposv, dpocon
+  public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels
 
@@ -66,6 +66,23 @@ module lapack
       integer, intent(out) :: info          !< status (see above)
       real(wp), intent(inout) :: a(lda, *)  !< A on entry, its Cholesky factor on exit
     end subroutine dpotrf
+
+    !> Cholesky factorization with complete pivoting of a symmetric positive semidefinite A:
+    !! P' A P = L L', its numerical rank in `rank` (pivots below tol stop it). info = 1 when
+    !! A is rank deficient (rank < n), < 0 for a bad argument.
+    subroutine dpstrf(uplo, n, a, lda, piv, rank, tol, work, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L'
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a
+      real(wp), intent(inout) :: a(lda, *)  !< A on entry, the factor on exit
+      integer, intent(out) :: piv(*)        !< (n) the permutation
+      integer, intent(out) :: rank          !< numerical rank
+      real(wp), intent(in) :: tol           !< pivot tolerance (< 0: n eps max|A_kk|)
+      real(wp), intent(out) :: work(*)      !< (2n) workspace
+      integer, intent(out) :: info          !< status
+    end subroutine dpstrf
 
     !> Solve A X = B with the Cholesky factor from dpotrf.
     subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
