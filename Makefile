@@ -110,7 +110,7 @@ $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_i
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
 $(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o
+                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/strings.o $(BUILD)/config.o \
                            $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/condense.o \
