@@ -27,6 +27,7 @@ program test_mprgp
   call test_scaling()
   call test_threads()
   call test_stop_hook()
+  call test_recycle()
 
   call test_summary()
 
@@ -52,6 +53,81 @@ contains
                 'stop hook: stops after the step it turned true at (5 steps), iterate feasible', &
                 real(st%n_cg + st%n_exp + st%n_prop, wp))
   end subroutine test_stop_hook
+
+  !> A sequence of bound-constrained solves with one operator and right-hand sides that
+  !! converge geometrically (as in the outer contact iteration), warm-started from the last
+  !! solution and its stored product: with the stored directions of the earlier solves
+  !! (opts%recycle) every solve still meets its tolerance on a true gradient, with fewer
+  !! products in total; the stored images are A times the stored directions, A-normalised;
+  !! a warm start that meets the tolerance costs no product; inconsistent arguments are refused.
+  subroutine test_recycle()
+    integer, parameter :: n = 60, kr = 16, nsolve = 14
+    real(wp) :: a(n, n), b0(n), db(n), b(n), l(n), lmin, lmax, tol
+    real(wp) :: x(n, 2), ax(n, 2), g(n), rw(n, kr), raw(n, kr), err, worst_gp
+    integer :: nrw(2), i, k, v, nmv(2), nbad
+    type(dense_op_t) :: op
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st
+    call random_spd(n, 3.0_wp, a, lmin, lmax)
+    call dense_op_init(op, a)
+    do i = 1, n
+      b0(i) = urand(-1.0_wp, 1.0_wp)
+      db(i) = urand(-1.0_wp, 1.0_wp)
+    end do
+    l = 0.0_wp
+    x = 0.0_wp
+    ax = 0.0_wp
+    rw = 0.0_wp
+    raw = 0.0_wp
+    nrw = [0, 1]
+    nmv = 0
+    nbad = 0
+    worst_gp = 0.0_wp
+    opts%lambda_max = lmax
+    opts%use_ax = .true.
+    opts%rtol = 0.0_wp
+    do k = 1, nsolve
+      b = b0 + (-0.4_wp)**k * db
+      tol = 1.0e-3_wp * 0.4_wp**k * norm2(b0)
+      opts%atol = tol
+      do v = 1, 2
+        opts%recycle = v == 1
+        if (v == 1) then
+          call mprgp_solve(op, b, l, x(:, v), opts, st, g, ax(:, v), rw=rw, raw=raw, nrw=nrw)
+        else
+          call mprgp_solve(op, b, l, x(:, v), opts, st, g, ax(:, v))
+        end if
+        nmv(v) = nmv(v) + st%n_matvec
+        ! the stopping test on the true gradient A x - b
+        g = matmul(a, x(:, v)) - b
+        where (x(:, v) <= l) g = min(g, 0.0_wp)
+        worst_gp = max(worst_gp, norm2(g) / tol)
+        if (st%status /= MPRGP_CONVERGED .or. any(x(:, v) < l)) nbad = nbad + 1
+      end do
+    end do
+    call report(nbad == 0 .and. worst_gp <= 1.0_wp + 1.0e-6_wp, 'recycle: '//i2s(nsolve)// &
+                ' solves converged, feasible, true |gP| / tol', worst_gp, 1.0_wp)
+    call report(nmv(1) < nmv(2), 'recycle: products with stored directions ('//i2s(nmv(1))// &
+                ') fewer than without ('//i2s(nmv(2))//')', real(nmv(1), wp), real(nmv(2), wp))
+    err = 0.0_wp
+    do k = 1, nrw(1)
+      err = max(err, maxval(abs(matmul(a, rw(:, k)) - raw(:, k))) / (lmax * maxval(abs(rw(:, k)))), &
+                abs(dot_product(rw(:, k), raw(:, k)) - 1.0_wp))
+    end do
+    call report(nrw(1) == kr .and. err <= 1.0e-12_wp, 'recycle: ring full ('//i2s(nrw(1))// &
+                '), raw = A rw and rw''A rw = 1 to rounding', err, 1.0e-12_wp)
+    ! the same problem again: the warm start meets the tolerance, no product
+    call mprgp_solve(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, raw=raw, nrw=nrw)
+    call report(st%status == MPRGP_CONVERGED .and. st%n_matvec == 0, &
+                'recycle: a warm start that meets the tolerance costs no product', real(st%n_matvec, wp), 0.0_wp)
+    call mprgp_solve(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, nrw=nrw)
+    call report(st%status == MPRGP_BAD_ARG, 'recycle: rw without raw refused ('// &
+                mprgp_status_name(st%status)//')')
+    nrw = [kr + 1, 1]
+    call mprgp_solve(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, raw=raw, nrw=nrw)
+    call report(st%status == MPRGP_BAD_ARG, 'recycle: nrw out of range refused ('// &
+                mprgp_status_name(st%status)//')')
+  end subroutine test_recycle
 
   logical function stop_after_five()
     calls = calls + 1

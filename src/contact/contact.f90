@@ -6,7 +6,7 @@
 module contact
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC, STOP_RESIDUAL, ACCEL_AITKEN, ACCEL_ANDERSON
+  use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC, STOP_RESIDUAL, ACCEL_NONE, ACCEL_AITKEN, ACCEL_ANDERSON
   use linop, only: linop_t, dense_op_t, dense_op_init
   use clock, only: wtime
   use lapack, only: dsymv, dgemm, dpotrf, dpotrs, dposv, dgels
@@ -425,7 +425,7 @@ contains
     type(mprgp_opts_t) :: opts(2)
     type(mprgp_stats_t) :: ms(2)
     real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:), lam0(:, :), flam0(:, :), lprev(:, :)
-    integer :: a, m
+    integer :: a, m, k
     logical :: search
     m = size(w, 1)
     allocate (rhs(m, 2), grad(m, 2), lb(m), lam0(m, 2), flam0(m, 2))
@@ -437,6 +437,13 @@ contains
     ! the next (linearised outer map), and the search puts the warm start close to the
     ! solution. In the transient (active set settling, delta = 1 oscillating) it is not
     ! used: there the outcome of the outer iteration depends on the inner iterates.
+    ! Krylov recycling (README, Method): the last RECYCLE_DEPTH conjugate gradient
+    ! directions of each body's solves are kept with their images under F_a, and each solve
+    ! starts from the minimum over the warm start plus their span (and the last change of
+    ! lam_a while `search`), no product; the step is taken only when it is feasible as a
+    ! whole and leaves a proportional iterate with a smaller projected gradient. Not with
+    ! Aitken or Anderson acceleration, whose updates difference past iterates and so
+    ! amplify the (smaller but differently placed) inner errors.
     search = st%nsrch == 1 .and. smooth_outer(res, it)
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
@@ -461,11 +468,15 @@ contains
       opts(a)%use_ax = st%reuse == 1
       lam0(:, a) = st%lam(:, a)
       flam0(:, a) = st%flam_v(:, a)
+      opts(a)%recycle = s%acceleration == ACCEL_NONE
+      k = size(st%rw, 2)/2
       if (m > 0 .and. search) then
         call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a), &
-                         st%srch(:, a), st%fsrch(:, a))
+                         st%srch(:, a), st%fsrch(:, a), st%rw(:, (a - 1)*k + 1:a*k), st%raw(:, (a - 1)*k + 1:a*k), &
+                         st%nrw(:, a))
       else if (m > 0) then
-        call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a))
+        call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a), &
+                         rw=st%rw(:, (a - 1)*k + 1:a*k), raw=st%raw(:, (a - 1)*k + 1:a*k), nrw=st%nrw(:, a))
       end if
       st%srch(:, a) = st%lam(:, a) - lam0(:, a)
       st%fsrch(:, a) = st%flam_v(:, a) - flam0(:, a)

@@ -38,6 +38,7 @@ module contact_types
   end type contact_result_t
 
   integer, parameter, public :: ANDERSON_DEPTH = 5   !< history depth of Anderson acceleration
+  integer, parameter, public :: RECYCLE_DEPTH = 32   !< directions (with their images under F_a) kept per body
 
   !> Everything the outer iteration carries from one iteration to the next: with it a
   !! run resumes bitwise identically from a checkpoint.
@@ -61,6 +62,9 @@ module contact_types
     integer :: nsrch = 0                       !< 1: srch, fsrch hold the last change of lam_a and F_a times it
     real(wp), allocatable :: srch(:, :)        !< (m,2) lam_a after its last solve minus before it [force]
     real(wp), allocatable :: fsrch(:, :)       !< (m,2) F_a srch (difference of the two products F_a lam_a) [length]
+    integer :: nrw(2, 2) = reshape([0, 1, 0, 1], [2, 2])  !< per body: directions held in rw, next slot to fill
+    real(wp), allocatable :: rw(:, :)          !< (m, 2 k) per body k F_a-orthonormal directions of its solves [1/sqrt(length force)]
+    real(wp), allocatable :: raw(:, :)         !< (m, 2 k) F_a rw, body 1 in columns 1..k, body 2 in k+1..2k
     real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
     real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
     real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
@@ -91,7 +95,7 @@ module contact_types
     end function stop_iface
   end interface
 
-  public :: state_init, alloc_result, grow_history, stop_iface
+  public :: state_init, alloc_result, grow_history, stop_iface, recycle_size
 
 contains
 
@@ -103,6 +107,10 @@ contains
     allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
     allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
     allocate (st%flam_v(m, 2), st%srch(m, 2), st%fsrch(m, 2))
+    allocate (st%rw(m, 2*recycle_size(m)), st%raw(m, 2*recycle_size(m)))
+    st%rw = 0.0_wp
+    st%raw = 0.0_wp
+    st%nrw = reshape([0, 1, 0, 1], [2, 2])
     st%srch = 0.0_wp
     st%fsrch = 0.0_wp
     st%flam_v = 0.0_wp   ! F_a 0 with lam = 0: exact
@@ -115,6 +123,12 @@ contains
     st%dX = 0.0_wp
     st%dR = 0.0_wp
   end subroutine state_init
+
+  !> Directions kept per body for m contact nodes: RECYCLE_DEPTH, at most m.
+  pure integer function recycle_size(m)
+    integer, intent(in) :: m   !< interface size
+    recycle_size = max(0, min(RECYCLE_DEPTH, m))
+  end function recycle_size
 
   !> Allocate the result for m contact nodes and a history of nh entries, all zero.
   subroutine alloc_result(res, m, nh)

@@ -64,6 +64,7 @@ module mprgp
     real(wp) :: lambda_max = 0.0_wp  !< > 0: use this largest eigenvalue of A instead of estimating
     integer :: power_its = 20        !< power iterations for the lambda_max estimate
     logical :: use_ax = .false.      !< the argument `ax` holds A x at the warm start: no initial product
+    logical :: recycle = .false.     !< start with exact line searches along the stored directions `rw` (no product)
     procedure(mprgp_stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
   end type mprgp_opts_t
 
@@ -74,7 +75,7 @@ module mprgp
     integer :: n_exp = 0               !< expansion steps
     integer :: n_prop = 0              !< proportioning steps
     integer :: n_matvec = 0            !< products with A, power iterations included
-    integer :: n_recycled = 0          !< line searches along the given direction s (no product)
+    integer :: n_recycled = 0          !< line searches along s and the stored directions that moved x (no product)
     real(wp) :: gp_norm = 0.0_wp       !< |gP| at the returned x (units of b)
     real(wp) :: b_norm = 0.0_wp        !< |b|
     real(wp) :: lambda_max = 0.0_wp    !< lambda_max used (largest of estimate and observed Rayleigh quotients); 0: not needed
@@ -189,7 +190,16 @@ contains
   !! next solve, warm-started from x, starts from it). With a direction s and as = A s
   !! (e.g. the change of x in the previous solve and of A x), the iteration starts with
   !! an exact line search along s, cut at the bounds, which costs no product.
-  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax, s, as)
+  !! Krylov recycling: with rw, raw, nrw (a ring of A-normalised directions and their
+  !! images, filled by every conjugate gradient step of the solves that share it) and
+  !! opts%recycle, the iteration starts from the minimum over x plus the span of s and of
+  !! the stored directions that vanish where x is at its bound (A-orthogonalised; a
+  !! direction with less than 1% of its A-norm left is dropped, so the recurrence gradient
+  !! stays accurate), taken only if the whole step is feasible and leaves a proportional
+  !! iterate with a smaller projected gradient: again no product.
+  !! A warm start whose projected gradient (from opts%use_ax) already meets the tolerance
+  !! is returned without a search or a product.
+  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax, s, as, rw, raw, nrw)
     class(linop_t), intent(inout) :: A          !< SPD operator (size A%n)
     real(wp), intent(in) :: b(:)                !< linear term (size n)
     real(wp), intent(in) :: lb(:)               !< lower bounds (size n); -huge(1.0_wp): none
@@ -200,8 +210,11 @@ contains
     real(wp), intent(inout), optional :: ax(:)  !< in (opts%use_ax): A x at the warm start; out: A x at the returned x
     real(wp), intent(in), optional :: s(:)      !< direction of a first line search (size n; needs as)
     real(wp), intent(in), optional :: as(:)     !< A s (size n)
+    real(wp), intent(inout), optional :: rw(:, :)   !< (n, k) stored directions, A-normalised (needs raw, nrw)
+    real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
+    integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
 
-    real(wp), allocatable :: gr(:), p(:), ap(:), w(:)
+    real(wp), allocatable :: gr(:), p(:), ap(:), w(:), v(:), av(:)
     real(wp), parameter :: big = huge(1.0_wp)
     integer :: n, i, it, blk, retry, nmv_pow
     logical :: fresh, proportional, zero_tol
@@ -240,6 +253,20 @@ contains
     if (present(s)) then
       if (size(s) /= n .or. size(as) /= n) then
         call fail(MPRGP_BAD_ARG, 'size mismatch: size(s) or size(as) /= A%n')
+        return
+      end if
+    end if
+    if ((present(rw) .neqv. present(raw)) .or. (present(rw) .neqv. present(nrw))) then
+      call fail(MPRGP_BAD_ARG, 'rw, raw and nrw must be given together')
+      return
+    end if
+    if (present(rw)) then
+      if (size(rw, 1) /= n .or. size(raw, 1) /= n .or. size(raw, 2) /= size(rw, 2)) then
+        call fail(MPRGP_BAD_ARG, 'size mismatch: rw or raw is not (A%n, k)')
+        return
+      end if
+      if (nrw(1) < 0 .or. nrw(1) > size(rw, 2) .or. nrw(2) < 1 .or. nrw(2) > max(1, size(rw, 2))) then
+        call fail(MPRGP_BAD_ARG, 'nrw out of range')
         return
       end if
     end if
@@ -308,7 +335,7 @@ contains
     tol = max(opts%rtol * bnorm, opts%atol)
     zero_tol = (tol <= 0.0_wp)
 
-    allocate (gr(n), p(n), ap(n), w(n))
+    allocate (gr(n), p(n), ap(n), w(n), v(n), av(n))
     ab = 0.0_wp       ! alpha_bar in use (0: not yet needed)
     lam_lo = 0.0_wp   ! largest known lower bound of lambda_max
     if (opts%lambda_max > 0.0_wp) lam_lo = opts%lambda_max
@@ -325,7 +352,14 @@ contains
       gr = gr - b
     end if
     fresh = .true.
-    if (present(s)) call recycled_search()
+    ! a warm start that already meets the tolerance is returned as it is (no product)
+    if (zero_tol .or. proj_grad_norm() > tol) then
+      if (present(rw) .and. opts%recycle) then
+        call recycled_subspace()
+      else if (present(s)) then
+        call line_search(s, as, .false.)
+      end if
+    end if
     call set_p_to_phi()
     it = 0
 
@@ -425,6 +459,7 @@ contains
           gtp = gtp + gr(i) * p(i)
         end do
         if (.not. check_curvature(pap, pp, 'conjugate gradient direction')) exit main
+        if (present(rw)) call store_direction(p, ap)
         acg = gtp / pap
         ! Largest feasible step along -p, capped at acg (no division can overflow).
         af = acg
@@ -547,28 +582,122 @@ contains
   contains
 
 
-    !> Exact line search along s (A s is given: no product), cut at the bounds.
-    subroutine recycled_search()
+    !> Exact line search along d (A d is given: no product), cut at the bounds; with
+    !! `whole`, only the whole step, and only if it helps (see below).
+    subroutine line_search(d, ad, whole)
+      real(wp), intent(in) :: d(:), ad(:)
+      logical, intent(in) :: whole
       integer :: j
-      real(wp) :: sas, t, v
-      sas = dot_product(s, as)
-      if (.not. (sas > 0.0_wp .and. ieee_is_finite(sas))) return
-      t = -dot_product(gr, s) / sas
+      real(wp) :: dad_, t, vj, gp_before, gp_after, bb_after
+      dad_ = dot_product(d, ad)
+      if (.not. (dad_ > 0.0_wp .and. ieee_is_finite(dad_))) return
+      t = -dot_product(gr, d) / dad_
       if (.not. ieee_is_finite(t)) return
       do j = 1, n
-        v = t * s(j)
-        if (v < 0.0_wp .and. lb(j) > -big) then
-          if (x(j) + v < lb(j)) t = t * max(0.0_wp, (x(j) - lb(j)) / (-v))
+        vj = t * d(j)
+        if (vj < 0.0_wp .and. lb(j) > -big) then
+          if (x(j) + vj < lb(j)) then
+            if (whole) return
+            t = t * max(0.0_wp, (x(j) - lb(j)) / (-vj))
+          end if
         end if
       end do
       if (t == 0.0_wp) return
-      do j = 1, n
-        x(j) = max(x(j) + t * s(j), lb(j))
-        gr(j) = gr(j) + t * as(j)
-      end do
-      stats%n_recycled = 1
+      if (whole) then
+        ! p and ap are free here: the candidate is kept only if its projected gradient is
+        ! smaller and it is proportional (|chopped|^2 <= Gamma^2 |free|^2); otherwise MPRGP
+        ! would first release bounds and redo what the step did (delta = 1 cycles)
+        gp_before = proj_grad_norm()
+        do j = 1, n
+          p(j) = max(x(j) + t * d(j), lb(j))
+          ap(j) = gr(j) + t * ad(j)
+        end do
+        gp_after = 0.0_wp
+        bb_after = 0.0_wp
+        do j = 1, n
+          if (p(j) > lb(j)) then
+            gp_after = gp_after + ap(j)**2
+          else
+            bb_after = bb_after + min(ap(j), 0.0_wp)**2
+          end if
+        end do
+        if (.not. (sqrt(gp_after + bb_after) < gp_before .and. bb_after <= opts%gamma**2 * gp_after)) return
+        x = p
+        gr = ap
+      else
+        do j = 1, n
+          x(j) = max(x(j) + t * d(j), lb(j))
+          gr(j) = gr(j) + t * ad(j)
+        end do
+      end if
+      stats%n_recycled = stats%n_recycled + 1
       fresh = .false.
-    end subroutine recycled_search
+    end subroutine line_search
+
+    !> The minimum over the warm start plus the span of s and of the stored directions
+    !! that vanish where x is at its bound (no product: all the images under A are known),
+    !! taken only if the whole Galerkin step is feasible (a step cut at a bound would fix
+    !! variables that belong to the free set). A direction keeps its place only if at
+    !! least 1e-4 of its A-norm squared is left after the A-orthogonalisation: the rounding
+    !! of its image then stays within 100 times that of a product.
+    subroutine recycled_subspace()
+      real(wp), allocatable :: q(:, :), aq(:, :)
+      integer :: j, l, k, pass
+      real(wp) :: c, d0, dn
+      allocate (q(n, nrw(1) + 1), aq(n, nrw(1) + 1))
+      k = 0
+      do j = 0, nrw(1)
+        if (j == 0) then
+          if (.not. present(s)) cycle
+          v = s
+          av = as
+        else
+          v = rw(:, j)
+          av = raw(:, j)
+        end if
+        if (any(v /= 0.0_wp .and. x <= lb)) cycle
+        d0 = dot_product(v, av)
+        if (.not. (d0 > 0.0_wp .and. ieee_is_finite(d0))) cycle
+        do pass = 1, 2
+          do l = 1, k
+            c = dot_product(aq(:, l), v)
+            v = v - c * q(:, l)
+            av = av - c * aq(:, l)
+          end do
+        end do
+        dn = dot_product(v, av)
+        if (.not. (dn > 1.0e-4_wp * d0 .and. ieee_is_finite(dn))) cycle
+        k = k + 1
+        q(:, k) = v / sqrt(dn)
+        aq(:, k) = av / sqrt(dn)
+      end do
+      if (k == 0) return
+      v = 0.0_wp
+      av = 0.0_wp
+      do l = 1, k
+        c = -dot_product(gr, q(:, l))
+        v = v + c * q(:, l)
+        av = av + c * aq(:, l)
+      end do
+      call line_search(v, av, .true.)
+    end subroutine recycled_subspace
+
+    !> Keep the direction d (with A d), A-normalised, in the ring rw, raw (the oldest
+    !! makes room when it is full).
+    subroutine store_direction(d, ad)
+      real(wp), intent(in) :: d(:), ad(:)
+      integer :: k
+      real(wp) :: d0
+      k = size(rw, 2)
+      if (k == 0) return
+      d0 = dot_product(d, ad)
+      if (.not. (d0 > 0.0_wp .and. ieee_is_finite(d0))) return
+      d0 = 1.0_wp / sqrt(d0)
+      rw(:, nrw(2)) = d0 * d
+      raw(:, nrw(2)) = d0 * ad
+      nrw(1) = min(nrw(1) + 1, k)
+      nrw(2) = mod(nrw(2), k) + 1
+    end subroutine store_direction
 
     !> Record a failure.
     subroutine fail(code, msg)

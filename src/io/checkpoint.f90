@@ -12,7 +12,7 @@ module checkpoint
   use strings, only: i2s
   use history_io, only: write_history, read_history
   use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
-  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, ANDERSON_DEPTH
+  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, ANDERSON_DEPTH, recycle_size
   implicit none (type, external)
   private
 
@@ -79,6 +79,9 @@ contains
     call write_attr(gid, 'nsrch', st%nsrch, hs)
     call write_dset(gid, 'srch', st%srch, hs)
     call write_dset(gid, 'fsrch', st%fsrch, hs)
+    call write_dset(gid, 'nrw', reshape(st%nrw, [4]), hs)
+    call write_dset(gid, 'rw', st%rw, hs)
+    call write_dset(gid, 'raw', st%raw, hs)
     call group_close(gid, hs)
     call write_history(fid, res, hs)
     call file_close(fid, hs)
@@ -112,10 +115,11 @@ contains
     character(len=*), intent(out) :: msg          !< why not
     integer(hid_t) :: fid, gid, hid
     type(h5_status_t) :: hs
-    integer :: n, nh
+    integer :: n, nh, kr
     character(len=:), allocatable :: k, src
     real(wp), allocatable :: r(:)
-    logical :: exists_, has_products, has_search
+    integer, allocatable :: ir(:)
+    logical :: exists_, has_products, has_search, has_recycle
     integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
     character(len=*), parameter :: INT_ATTRS(6) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
                                                    'it_best', 'inner_maxit_hits']
@@ -199,6 +203,17 @@ contains
         call need(gid, '/state', 'nsrch', .true., CLASS_INTEGER, SCALAR, 'a scalar')
         call need(gid, '/state', 'srch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
         call need(gid, '/state', 'fsrch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
+      end if
+      ! the stored directions of the bodies' solves and their images: absent from older
+      ! checkpoints, checked when present
+      kr = recycle_size(m)
+      has_recycle = exists(gid, 'nrw', .false.) .or. exists(gid, 'rw', .false.) .or. exists(gid, 'raw', .false.)
+      if (has_recycle) then
+        call need(gid, '/state', 'nrw', .false., CLASS_INTEGER, [4_hsize_t], 'two counters per body')
+        call need(gid, '/state', 'rw', .false., CLASS_REAL, [m2, int(2*kr, hsize_t)], &
+                  contact_nodes()//' and '//i2s(kr)//' directions per body')
+        call need(gid, '/state', 'raw', .false., CLASS_REAL, [m2, int(2*kr, hsize_t)], &
+                  contact_nodes()//' and '//i2s(kr)//' directions per body')
       end if
       if (len_trim(msg) > 0) return
       ! the history: five arrays of one length nh, it <= nh <= max_outer (checked after reading it)
@@ -312,6 +327,18 @@ contains
         st%srch = 0.0_wp
         st%fsrch = 0.0_wp
       end if
+      if (has_recycle) then
+        call read_dset(gid, 'nrw', ir, hs)
+        if (.not. hs%failed) st%nrw = reshape(ir, [2, 2])
+        call read_dset(gid, 'rw', st%rw, hs)
+        call read_dset(gid, 'raw', st%raw, hs)
+      else
+        ! an older checkpoint: the bodies' solves start again without stored directions
+        st%nrw = reshape([0, 1, 0, 1], [2, 2])
+        allocate (st%rw(m, 2*kr), st%raw(m, 2*kr))
+        st%rw = 0.0_wp
+        st%raw = 0.0_wp
+      end if
       if (hs%failed) then
         msg = src//' cannot be read ('//hs%what//')'
         return
@@ -337,6 +364,11 @@ contains
         msg = src//': dataset /state/lam holds negative contact forces'
       else if (.not. (all(ieee_is_finite(st%srch)) .and. all(ieee_is_finite(st%fsrch)))) then
         msg = src//': dataset /state/srch or fsrch holds values that are not finite'
+      else if (any(st%nrw(1, :) < 0 .or. st%nrw(1, :) > kr .or. st%nrw(2, :) < 1 .or. st%nrw(2, :) > max(1, kr))) then
+        msg = src//': dataset /state/nrw holds counters outside 0 .. '//i2s(kr)//' (held) or 1 .. '// &
+              i2s(max(1, kr))//' (next slot)'
+      else if (.not. (all(ieee_is_finite(st%rw)) .and. all(ieee_is_finite(st%raw)))) then
+        msg = src//': dataset /state/rw or raw holds values that are not finite'
       else if (st%nsrch /= 0 .and. st%nsrch /= 1) then
         msg = src//': attribute nsrch of /state is '//i2s(st%nsrch)//', not 0 or 1'
       else if (.not. (all(ieee_is_finite(st%r_prev)) .and. all(ieee_is_finite(st%x_prev)) .and. &
