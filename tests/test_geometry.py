@@ -81,6 +81,27 @@ for meth, over in (("monolithic", (MONO,)), ("robin", ())):
         check(pr.size >= 6 and x.min() == 0.0 and x.max() == 1.0, "patch test: the slave rows cover the line",
               f"{pr.size} rows, x in [{x.min()}, {x.max()}]")
 
+# 2b. the patch test with a mixed body (triangles and quadrilaterals in the top block); its XDMF
+mixed = ("&body id=1, mesh='gmsh/patch_mixed.msh' /", "&body id=2, mesh='gmsh/patch_mixed.msh' /")
+for meth, over in (("monolithic", (MONO,)), ("robin", ())):
+    p, m, out = run("inputs/patch.nml", *mixed, *over, name=f"patch_mixed_{meth}")
+    if check(p.returncode == 0, f"patch test, mixed top body ({meth}) converges", f"exit {p.returncode}"):
+        with h5py.File(out, "r") as f:
+            pr = np.array(f["/contact/pressure"])
+            etype = f["/body1"].attrs["element"]
+            ncell = f["/body1/cells"].shape[0]
+        e = float(np.max(np.abs(pr / p_exact - 1)))
+        check(e <= 1e-8, f"patch test, mixed top body ({meth}): pressure exact to 1e-8", f"{e:.2e}")
+        check(etype == "mixed", "mixed body: element attribute 'mixed'", str(etype))
+        if meth == "monolithic":
+            xd = open(out[:-3] + "_body1.xdmf").read()
+            check('TopologyType="Mixed"' in xd, "mixed body: XDMF Mixed topology")
+            import meshio  # noqa: E402
+            mm_ = meshio.read(out[:-3] + "_body1.xdmf")
+            kinds = sorted((c.type, len(c.data)) for c in mm_.cells)
+            check(sum(n for _, n in kinds) == ncell and {k for k, _ in kinds} == {"triangle", "quad"},
+                  "mixed body: meshio reads its triangles and quadrilaterals", str(kinds))
+
 # 3. non-matching paper scene
 nm = ("&body id=1, mesh='gmsh/paper_nonmatching_24_36.msh' /",
       "&body id=2, mesh='gmsh/paper_nonmatching_24_36.msh' /")
