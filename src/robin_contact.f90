@@ -32,6 +32,7 @@ program robin_contact
 
   type(deck_t) :: d
   type(mesh_t) :: msh(2)
+  type(deck_t) :: dsized
   type(body_system_t) :: sys(2)
   type(interface_t) :: itf
   type(body_condensed_t) :: cb(2)   ! the bodies condensed on the interface
@@ -83,10 +84,29 @@ program robin_contact
   do a = 1, 2
     if (len_trim(d%body(a)%mesh) > 0) then
       call msh_read(trim(d%body(a)%mesh), trim(d%body(a)%region), a, msh(a), info(a), msg(a))
-      if (info(a) /= 0) cycle
     else
       call mesh_build(msh(a), d%body(a))
+      info(a) = 0
     end if
+  end do
+  !$omp end parallel do
+  do a = 1, 2
+    if (info(a) == 1) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))
+    if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))
+  end do
+  ! a body from a mesh file is sized now: the memory check again, with its node count
+  dsized = d
+  if (len_trim(d%body(1)%mesh) > 0 .or. len_trim(d%body(2)%mesh) > 0) then
+    do a = 1, 2
+      if (len_trim(d%body(a)%mesh) == 0) cycle
+      dsized%body(a)%nx = max(1, nint(sqrt(real(msh(a)%nnode, wp))) - 1)
+      dsized%body(a)%ny = max(1, msh(a)%nnode/(dsized%body(a)%nx + 1) - 1)
+    end do
+    call check_budget(dsized, memory_limit_mb(), ok, budget_msg)
+    if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+  end if
+  !$omp parallel do num_threads(nthr) schedule(static, 1)
+  do a = 1, 2
     call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a), &
                        boundaries=d%boundary(1:d%nboundary))
   end do
@@ -217,7 +237,7 @@ contains
     character(len=:), allocatable :: s
     real(wp) :: nm, nf, mib
     character(len=24) :: buf
-    mib = body_memory_mb(d%body(a), d%solver%factor, nm, nf)   ! the body's total; the factor's part:
+    mib = body_memory_mb(dsized%body(a), d%solver%factor, nm, nf)   ! the body's total; the factor's part:
     mib = 8.5_wp*nf/1048576.0_wp                              ! values and supernodal indices
     if (mib >= 1024.0_wp) then
       write (buf, '(f0.1,a)') mib/1024.0_wp, ' GiB'
