@@ -1,15 +1,23 @@
-!> Fill-reducing orderings computed from the geometry of the structured mesh (module
-!! mesh), without a graph partitioner: geometric nested dissection of the node grid.
+!> Fill-reducing orderings computed from the geometry of a body's mesh (module mesh),
+!! without a graph partitioner: geometric nested dissection.
 !!
-!! Both element types (Q1, and P1 with its cells split along one diagonal) couple only
-!! the nodes of a common grid cell, so one whole grid line of nodes separates the grid
-!! into the nodes on either side of it. Nested dissection orders a box of nodes as: the
-!! box on one side of its middle line, the box on the other side, then the line; boxes
-!! below a small size are ordered naturally. On an N x N grid this gives O(N^2 log N)
-!! nonzeros in the Cholesky factor, like METIS on these meshes, but it is deterministic,
-!! linear in the number of nodes, and needs no global state (thread safe).
+!! Structured meshes: both element types (Q1, and P1 with its cells split along one
+!! diagonal) couple only the nodes of a common grid cell, so one whole grid line of nodes
+!! separates the grid into the nodes on either side of it. Nested dissection orders a box
+!! of nodes as: the box on one side of its middle line, the box on the other side, then
+!! the line; boxes below a small size are ordered naturally. On an N x N grid this gives
+!! O(N^2 log N) nonzeros in the Cholesky factor, like METIS on these meshes, but it is
+!! deterministic, linear in the number of nodes, and needs no global state (thread safe).
+!!
+!! Any other mesh (read from a file): recursive coordinate bisection of the node graph
+!! (two nodes adjacent when the stiffness couples them). A node set is split at the
+!! median coordinate of its longer extent; the separator is the smaller of the two sets
+!! "nodes of one half with a neighbour in the other half"; the two halves without it are
+!! ordered first (recursively), then the separator. Nodes are kept sorted by x and by y
+!! (one sort at the start, stable partitions after), so the whole ordering costs
+!! O(nnz log n) and is deterministic.
 module ordering
-  use kinds, only: i8
+  use kinds, only: wp, i8
   use mesh, only: mesh_t
   use assembly, only: body_system_t
   implicit none (type, external)
@@ -26,30 +34,44 @@ module ordering
   integer, parameter, public :: ND_BAD_SYSTEM = 1    !< info: mesh and system do not match
   integer, parameter, public :: ND_BAD_LAST = 2      !< info: an entry of `last` is out of range or repeated
 
+  !> Unstructured meshes: node sets with fewer nodes than this are not bisected further.
+  integer, parameter, public :: RCB_LEAF_NODES = 16
+
 contains
 
   !> Nested-dissection permutation of the free DOFs of one body that are not in `last`.
   !! perm(k) is the free DOF (1-based, 1..sys%n) placed k-th; size sys%n - size(last).
   !! Both DOFs of a node are consecutive; prescribed DOFs and DOFs in `last` are
   !! skipped. The caller appends `last` to obtain a full ordering with the interface
-  !! last. Cost O(number of nodes).
+  !! last. A structured mesh is dissected along its grid lines (cost O(number of
+  !! nodes)); any other mesh by recursive coordinate bisection of the node graph of
+  !! sys%colptr, sys%rowind (cost O(nnz log n)).
   !! info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg (perm empty).
   subroutine nested_dissection(mesh, sys, last, perm, info, msg)
-    type(mesh_t), intent(in) :: mesh                  !< the body's structured mesh
-    type(body_system_t), intent(in) :: sys            !< its assembled system (free_of, n)
+    type(mesh_t), intent(in) :: mesh                  !< the body's mesh (structured or general)
+    type(body_system_t), intent(in) :: sys            !< its assembled system (free_of, n; general meshes
+                                                      !! also dof_of, colptr, rowind)
     integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
     logical, allocatable :: skip(:)
-    integer :: k, pos, nx1
+    integer :: k, pos, nx1, stamp
     logical :: bad_map
     character(len=200) :: emsg
+    ! general meshes: node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)),
+    ! partition labels, a work array
+    integer, allocatable :: xadj(:), adj(:), srt(:, :), lab(:), tmp(:)
 
     info = ND_OK
     emsg = ''
     if (present(msg)) msg = ''
-    if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
+    if (.not. mesh%structured) then
+      if (.not. general_system_ok()) then
+        call fail(ND_BAD_SYSTEM)
+        return
+      end if
+    else if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
         .or. .not. allocated(sys%free_of)) then
       write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
         ' DOFs) does not belong to a ', mesh%nx, ' x ', mesh%ny, ' cell mesh.'
@@ -77,10 +99,19 @@ contains
     end do
 
     allocate (perm(sys%n - size(last)))
-    nx1 = mesh%nx + 1
     pos = 0
     bad_map = .false.
-    call dissect(0, mesh%nx, 0, mesh%ny)
+    if (mesh%structured) then
+      nx1 = mesh%nx + 1
+      call dissect(0, mesh%nx, 0, mesh%ny)
+    else
+      if (.not. node_graph()) then
+        call fail(ND_BAD_SYSTEM)
+        return
+      end if
+      stamp = 0
+      call bisect(1, size(srt, 1))
+    end if
     if (bad_map .or. pos /= size(perm)) then
       ! free_of is not a bijection onto 1..n: the system is inconsistent
       write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', pos, ' DOFs but expected ', size(perm), &
@@ -157,6 +188,234 @@ contains
         if (pos <= size(perm)) perm(pos) = f
       end do
     end subroutine emit_node
+
+    !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
+    logical function general_system_ok() result(ok)
+      ok = .false.
+      if (mesh%nnode < 1 .or. sys%ndof /= 2*mesh%nnode .or. .not. allocated(mesh%xy)) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
+          ' DOFs) does not belong to a mesh of ', mesh%nnode, ' nodes.'
+      else if (size(mesh%xy, 2) /= mesh%nnode) then
+        emsg = 'nested dissection: the mesh has the wrong number of node coordinates.'
+      else if (.not. allocated(sys%free_of) .or. .not. allocated(sys%dof_of) .or. &
+               .not. allocated(sys%colptr) .or. .not. allocated(sys%rowind)) then
+        emsg = 'nested dissection: the system has no DOF maps or no stiffness pattern.'
+      else if (size(sys%free_of) /= sys%ndof) then
+        emsg = 'nested dissection: the free-DOF map has the wrong size.'
+      else if (size(sys%dof_of) /= sys%n .or. size(sys%colptr) /= sys%n + 1) then
+        emsg = 'nested dissection: the DOF map or the column pointers have the wrong size.'
+      else if (sys%colptr(sys%n + 1) > size(sys%rowind)) then
+        emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
+      else
+        ok = .true.
+      end if
+    end function general_system_ok
+
+    !> The node graph of a general mesh (xadj, adj: the neighbours of each node through
+    !! the stiffness, both DOFs merged, DOFs in `last` left out), the ordered nodes (those
+    !! with a free DOF not in `last`) sorted by x and by y, and the work arrays.
+    !! .false. with a sentence in emsg on a pattern or DOF map out of range.
+    logical function node_graph() result(ok)
+      integer, allocatable :: mark(:)
+      integer :: nn, node, c, p, q, kk, nb, cnt, na, pass
+      logical, allocatable :: active(:)
+
+      ok = .false.
+      nn = mesh%nnode
+      allocate (xadj(nn + 1), mark(nn), active(nn), lab(nn))
+      active = .false.
+      lab = 0
+      do p = 1, sys%n
+        if (sys%dof_of(p) < 1 .or. sys%dof_of(p) > sys%ndof) then
+          write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
+            sys%dof_of(p), ', out of range.'
+          return
+        end if
+        if (.not. skip(p)) active((sys%dof_of(p) + 1)/2) = .true.
+      end do
+      do pass = 1, 2            ! 1: count the neighbours, 2: store them
+        mark = 0
+        xadj(1) = 0
+        do node = 1, nn
+          cnt = xadj(node)
+          if (active(node)) then
+            do c = 1, 2
+              p = sys%free_of(2*(node - 1) + c)
+              if (p < 1 .or. p > sys%n) cycle
+              if (skip(p)) cycle
+              do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
+                q = sys%rowind(kk) + 1
+                if (q < 1 .or. q > sys%n) then
+                  write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
+                    ' of free DOF ', p, ' is out of range.'
+                  return
+                end if
+                if (skip(q)) cycle
+                nb = (sys%dof_of(q) + 1)/2
+                if (nb == node .or. mark(nb) == node) cycle
+                mark(nb) = node
+                cnt = cnt + 1
+                if (pass == 2) adj(cnt) = nb
+              end do
+            end do
+          end if
+          if (pass == 1) then
+            xadj(node + 1) = cnt
+          else if (cnt /= xadj(node + 1)) then
+            emsg = 'nested dissection: internal error building the node graph.'
+            return
+          end if
+        end do
+        if (pass == 1) allocate (adj(xadj(nn + 1)))
+      end do
+
+      na = count(active)
+      allocate (srt(na, 2), tmp(na))
+      srt(:, 1) = pack([(node, node=1, nn)], active)
+      srt(:, 2) = srt(:, 1)
+      call sort_nodes(srt(:, 1), 1)
+      call sort_nodes(srt(:, 2), 2)
+      ok = .true.
+    end function node_graph
+
+    !> Stable merge sort of node ids by coordinate `axis`, then by the other coordinate.
+    subroutine sort_nodes(ids, axis)
+      integer, intent(inout) :: ids(:)
+      integer, intent(in) :: axis
+      integer :: width, lo, mid, hi, i, j, k, n
+      n = size(ids)
+      width = 1
+      do while (width < n)
+        lo = 1
+        do while (lo <= n - width)
+          mid = lo + width - 1
+          hi = min(lo + 2*width - 1, n)
+          i = lo
+          j = mid + 1
+          k = lo
+          do while (i <= mid .and. j <= hi)
+            if (before(ids(j), ids(i), axis)) then
+              tmp(k) = ids(j)
+              j = j + 1
+            else
+              tmp(k) = ids(i)
+              i = i + 1
+            end if
+            k = k + 1
+          end do
+          if (i <= mid) tmp(k:hi) = ids(i:mid)
+          if (j <= hi) tmp(k:hi) = ids(j:hi)
+          ids(lo:hi) = tmp(lo:hi)
+          lo = lo + 2*width
+        end do
+        width = 2*width
+      end do
+    end subroutine sort_nodes
+
+    !> Node a strictly before node b: smaller coordinate `axis`, then smaller other one.
+    pure logical function before(a, b, axis)
+      integer, intent(in) :: a, b, axis
+      if (mesh%xy(axis, a) /= mesh%xy(axis, b)) then
+        before = mesh%xy(axis, a) < mesh%xy(axis, b)
+      else
+        before = mesh%xy(3 - axis, a) < mesh%xy(3 - axis, b)
+      end if
+    end function before
+
+    !> Order the nodes srt(lo:hi, :) (the same set in both columns) by recursive
+    !! coordinate bisection: split at the median of the longer extent, separator = the
+    !! smaller set of nodes of one half with a neighbour in the other, halves first.
+    recursive subroutine bisect(lo, hi)
+      integer, intent(in) :: lo, hi
+      integer :: m, axis, mid, p, i, a, k, lset, rset, sset, nsl, nsr, nl, nr, lbl
+      real(wp) :: ext(2), v
+
+      m = hi - lo + 1
+      if (m <= 0) return
+      ext(1) = mesh%xy(1, srt(hi, 1)) - mesh%xy(1, srt(lo, 1))
+      ext(2) = mesh%xy(2, srt(hi, 2)) - mesh%xy(2, srt(lo, 2))
+      axis = 1
+      if (ext(2) > ext(1)) axis = 2
+      if (m < RCB_LEAF_NODES .or. .not. ext(axis) > 0.0_wp) then
+        ! a leaf: along the longer extent, the shorter one varying fastest
+        do i = lo, hi
+          call emit_node(srt(i, axis))
+        end do
+        return
+      end if
+
+      ! halves: coordinate < v and >= v, v the median (<= v and > v if v is the minimum)
+      mid = lo + m/2
+      v = mesh%xy(axis, srt(mid, axis))
+      p = mid
+      do while (p > lo)
+        if (mesh%xy(axis, srt(p - 1, axis)) < v) exit
+        p = p - 1
+      end do
+      if (p == lo) then
+        p = mid + 1
+        do while (p <= hi)
+          if (mesh%xy(axis, srt(p, axis)) > v) exit
+          p = p + 1
+        end do
+      end if
+      lset = stamp + 1
+      rset = stamp + 2
+      sset = stamp + 3
+      stamp = stamp + 3
+      lab(srt(lo:p - 1, axis)) = lset
+      lab(srt(p:hi, axis)) = rset
+      nsl = count_touching(lo, p - 1, axis, rset, .false.)
+      nsr = count_touching(p, hi, axis, lset, .false.)
+      if (nsl < nsr) then
+        nsl = count_touching(lo, p - 1, axis, rset, .true.)
+      else
+        nsr = count_touching(p, hi, axis, lset, .true.)
+      end if
+      lab(srt(lo:hi, axis)) = merge(sset, lab(srt(lo:hi, axis)), lab(srt(lo:hi, axis)) < 0)
+
+      ! stable partition of both sorted lists: left half, right half, separator
+      do a = 1, 2
+        k = lo - 1
+        do lbl = lset, sset
+          do i = lo, hi
+            if (lab(srt(i, a)) == lbl) then
+              k = k + 1
+              tmp(k) = srt(i, a)
+            end if
+          end do
+          if (a == 1 .and. lbl == lset) nl = k - lo + 1
+          if (a == 1 .and. lbl == rset) nr = k - lo + 1 - nl
+        end do
+        srt(lo:hi, a) = tmp(lo:hi)
+      end do
+
+      call bisect(lo, lo + nl - 1)
+      call bisect(lo + nl, lo + nl + nr - 1)
+      ! the separator, along its length (sorted by the other coordinate)
+      do i = lo + nl + nr, hi
+        call emit_node(srt(i, 3 - axis))
+      end do
+    end subroutine bisect
+
+    !> How many of the nodes srt(i0:i1, axis) have a neighbour labelled `other`; with
+    !! `flag`, those nodes are also labelled -1 (the separator, relabelled by the caller).
+    integer function count_touching(i0, i1, axis, other, flag) result(cnt)
+      integer, intent(in) :: i0, i1, axis, other
+      logical, intent(in) :: flag
+      integer :: i, node, kk
+      cnt = 0
+      do i = i0, i1
+        node = srt(i, axis)
+        do kk = xadj(node) + 1, xadj(node + 1)
+          if (lab(adj(kk)) == other) then
+            cnt = cnt + 1
+            if (flag) lab(node) = -1
+            exit
+          end if
+        end do
+      end do
+    end function count_touching
 
   end subroutine nested_dissection
 
