@@ -59,9 +59,12 @@ contains
     integer :: k, pos, nx1, stamp
     logical :: bad_map
     character(len=200) :: emsg
-    ! general meshes: node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)),
-    ! partition labels, a work array
-    integer, allocatable :: xadj(:), adj(:), srt(:, :), lab(:), tmp(:)
+    ! general meshes (local node numbers 1..na): mesh node of each (glob), coordinates,
+    ! node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)), partition
+    ! labels, a work array, the largest edge extent in x and y
+    integer, allocatable :: glob(:), xadj(:), adj(:), srt(:, :), lab(:), tmp(:)
+    real(wp), allocatable :: xyl(:, :)
+    real(wp) :: emax(2)
 
     info = ND_OK
     emsg = ''
@@ -211,20 +214,21 @@ contains
       end if
     end function general_system_ok
 
-    !> The node graph of a general mesh (xadj, adj: the neighbours of each node through
-    !! the stiffness, both DOFs merged, DOFs in `last` left out), the ordered nodes (those
-    !! with a free DOF not in `last`) sorted by x and by y, and the work arrays.
+    !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
+    !! `last`) renumbered 1..na by increasing x (glob: local -> mesh node, so that the
+    !! graph sweeps touch memory in order), their coordinates xyl, their neighbours
+    !! through the stiffness (xadj, adj; both DOFs merged, DOFs in `last` left out), the
+    !! largest edge extents emax, the nodes sorted by x (srt(:,1)) and by y (srt(:,2)).
     !! .false. with a sentence in emsg on a pattern or DOF map out of range.
     logical function node_graph() result(ok)
-      integer, allocatable :: mark(:)
-      integer :: nn, node, c, p, q, kk, nb, cnt, na, pass
+      integer, allocatable :: mark(:), loc(:)
+      integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
       logical, allocatable :: active(:)
 
       ok = .false.
       nn = mesh%nnode
-      allocate (xadj(nn + 1), mark(nn), active(nn), lab(nn))
+      allocate (active(nn), loc(nn))
       active = .false.
-      lab = 0
       do p = 1, sys%n
         if (sys%dof_of(p) < 1 .or. sys%dof_of(p) > sys%ndof) then
           write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
@@ -233,57 +237,74 @@ contains
         end if
         if (.not. skip(p)) active((sys%dof_of(p) + 1)/2) = .true.
       end do
+      na = count(active)
+      allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na))
+      glob = pack([(node, node=1, nn)], active)
+      call sort_nodes(glob, 1, mesh%xy)
+      loc = 0
+      loc(glob) = [(i, i=1, na)]
+      xyl = mesh%xy(:, glob)
+      lab = 0
+
       do pass = 1, 2            ! 1: count the neighbours, 2: store them
         mark = 0
         xadj(1) = 0
-        do node = 1, nn
-          cnt = xadj(node)
-          if (active(node)) then
-            do c = 1, 2
-              p = sys%free_of(2*(node - 1) + c)
-              if (p < 1 .or. p > sys%n) cycle
-              if (skip(p)) cycle
-              do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
-                q = sys%rowind(kk) + 1
-                if (q < 1 .or. q > sys%n) then
-                  write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
-                    ' of free DOF ', p, ' is out of range.'
-                  return
-                end if
-                if (skip(q)) cycle
-                nb = (sys%dof_of(q) + 1)/2
-                if (nb == node .or. mark(nb) == node) cycle
-                mark(nb) = node
-                cnt = cnt + 1
-                if (pass == 2) adj(cnt) = nb
-              end do
+        do i = 1, na
+          node = glob(i)
+          cnt = xadj(i)
+          do c = 1, 2
+            p = sys%free_of(2*(node - 1) + c)
+            if (p < 1 .or. p > sys%n) cycle
+            if (skip(p)) cycle
+            do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
+              q = sys%rowind(kk) + 1
+              if (q < 1 .or. q > sys%n) then
+                write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
+                  ' of free DOF ', p, ' is out of range.'
+                return
+              end if
+              if (skip(q)) cycle
+              nb = loc((sys%dof_of(q) + 1)/2)
+              if (nb == i .or. nb == 0) cycle
+              if (mark(nb) == i) cycle
+              mark(nb) = i
+              cnt = cnt + 1
+              if (pass == 2) adj(cnt) = nb
             end do
-          end if
+          end do
           if (pass == 1) then
-            xadj(node + 1) = cnt
-          else if (cnt /= xadj(node + 1)) then
+            xadj(i + 1) = cnt
+          else if (cnt /= xadj(i + 1)) then
             emsg = 'nested dissection: internal error building the node graph.'
             return
           end if
         end do
-        if (pass == 1) allocate (adj(xadj(nn + 1)))
+        if (pass == 1) allocate (adj(xadj(na + 1)))
       end do
 
-      na = count(active)
-      allocate (srt(na, 2), tmp(na))
-      srt(:, 1) = pack([(node, node=1, nn)], active)
+      emax = 0.0_wp
+      do i = 1, na
+        do kk = xadj(i) + 1, xadj(i + 1)
+          emax = max(emax, abs(xyl(:, adj(kk)) - xyl(:, i)))
+        end do
+      end do
+      emax = emax*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
+      srt(:, 1) = [(i, i=1, na)]
       srt(:, 2) = srt(:, 1)
-      call sort_nodes(srt(:, 1), 1)
-      call sort_nodes(srt(:, 2), 2)
+      call sort_nodes(srt(:, 2), 2, xyl)
       ok = .true.
     end function node_graph
 
-    !> Stable merge sort of node ids by coordinate `axis`, then by the other coordinate.
-    subroutine sort_nodes(ids, axis)
+    !> Stable merge sort of the points ids by coordinate `axis` of xyc, then by the other.
+    subroutine sort_nodes(ids, axis, xyc)
       integer, intent(inout) :: ids(:)
       integer, intent(in) :: axis
+      real(wp), intent(in) :: xyc(:, :)
+      integer, allocatable :: buf(:)
       integer :: width, lo, mid, hi, i, j, k, n
+      logical :: first
       n = size(ids)
+      allocate (buf(n))
       width = 1
       do while (width < n)
         lo = 1
@@ -294,35 +315,31 @@ contains
           j = mid + 1
           k = lo
           do while (i <= mid .and. j <= hi)
-            if (before(ids(j), ids(i), axis)) then
-              tmp(k) = ids(j)
+            ! point ids(j) strictly before ids(i)?
+            if (xyc(axis, ids(j)) /= xyc(axis, ids(i))) then
+              first = xyc(axis, ids(j)) < xyc(axis, ids(i))
+            else
+              first = xyc(3 - axis, ids(j)) < xyc(3 - axis, ids(i))
+            end if
+            if (first) then
+              buf(k) = ids(j)
               j = j + 1
             else
-              tmp(k) = ids(i)
+              buf(k) = ids(i)
               i = i + 1
             end if
             k = k + 1
           end do
-          if (i <= mid) tmp(k:hi) = ids(i:mid)
-          if (j <= hi) tmp(k:hi) = ids(j:hi)
-          ids(lo:hi) = tmp(lo:hi)
+          if (i <= mid) buf(k:hi) = ids(i:mid)
+          if (j <= hi) buf(k:hi) = ids(j:hi)
+          ids(lo:hi) = buf(lo:hi)
           lo = lo + 2*width
         end do
         width = 2*width
       end do
     end subroutine sort_nodes
 
-    !> Node a strictly before node b: smaller coordinate `axis`, then smaller other one.
-    pure logical function before(a, b, axis)
-      integer, intent(in) :: a, b, axis
-      if (mesh%xy(axis, a) /= mesh%xy(axis, b)) then
-        before = mesh%xy(axis, a) < mesh%xy(axis, b)
-      else
-        before = mesh%xy(3 - axis, a) < mesh%xy(3 - axis, b)
-      end if
-    end function before
-
-    !> Order the nodes srt(lo:hi, :) (the same set in both columns) by recursive
+    !> Order the (local) nodes srt(lo:hi, :) (the same set in both columns) by recursive
     !! coordinate bisection: split at the median of the longer extent, separator = the
     !! smaller set of nodes of one half with a neighbour in the other, halves first.
     recursive subroutine bisect(lo, hi)
@@ -332,30 +349,30 @@ contains
 
       m = hi - lo + 1
       if (m <= 0) return
-      ext(1) = mesh%xy(1, srt(hi, 1)) - mesh%xy(1, srt(lo, 1))
-      ext(2) = mesh%xy(2, srt(hi, 2)) - mesh%xy(2, srt(lo, 2))
+      ext(1) = xyl(1, srt(hi, 1)) - xyl(1, srt(lo, 1))
+      ext(2) = xyl(2, srt(hi, 2)) - xyl(2, srt(lo, 2))
       axis = 1
       if (ext(2) > ext(1)) axis = 2
       if (m < RCB_LEAF_NODES .or. .not. ext(axis) > 0.0_wp) then
         ! a leaf: along the longer extent, the shorter one varying fastest
         do i = lo, hi
-          call emit_node(srt(i, axis))
+          call emit_node(glob(srt(i, axis)))
         end do
         return
       end if
 
       ! halves: coordinate < v and >= v, v the median (<= v and > v if v is the minimum)
       mid = lo + m/2
-      v = mesh%xy(axis, srt(mid, axis))
+      v = xyl(axis, srt(mid, axis))
       p = mid
       do while (p > lo)
-        if (mesh%xy(axis, srt(p - 1, axis)) < v) exit
+        if (xyl(axis, srt(p - 1, axis)) < v) exit
         p = p - 1
       end do
       if (p == lo) then
         p = mid + 1
         do while (p <= hi)
-          if (mesh%xy(axis, srt(p, axis)) > v) exit
+          if (xyl(axis, srt(p, axis)) > v) exit
           p = p + 1
         end do
       end if
@@ -365,14 +382,14 @@ contains
       stamp = stamp + 3
       lab(srt(lo:p - 1, axis)) = lset
       lab(srt(p:hi, axis)) = rset
-      nsl = count_touching(lo, p - 1, axis, rset, .false.)
-      nsr = count_touching(p, hi, axis, lset, .false.)
+      ! only nodes within one edge extent of the cut can touch the other half
+      nsl = count_touching(p - 1, lo, -1, axis, rset, 0)
+      nsr = count_touching(p, hi, 1, axis, lset, 0)
       if (nsl < nsr) then
-        nsl = count_touching(lo, p - 1, axis, rset, .true.)
+        nsl = count_touching(p - 1, lo, -1, axis, rset, sset)
       else
-        nsr = count_touching(p, hi, axis, lset, .true.)
+        nsr = count_touching(p, hi, 1, axis, lset, sset)
       end if
-      lab(srt(lo:hi, axis)) = merge(sset, lab(srt(lo:hi, axis)), lab(srt(lo:hi, axis)) < 0)
 
       ! stable partition of both sorted lists: left half, right half, separator
       do a = 1, 2
@@ -394,23 +411,27 @@ contains
       call bisect(lo + nl, lo + nl + nr - 1)
       ! the separator, along its length (sorted by the other coordinate)
       do i = lo + nl + nr, hi
-        call emit_node(srt(i, 3 - axis))
+        call emit_node(glob(srt(i, 3 - axis)))
       end do
     end subroutine bisect
 
-    !> How many of the nodes srt(i0:i1, axis) have a neighbour labelled `other`; with
-    !! `flag`, those nodes are also labelled -1 (the separator, relabelled by the caller).
-    integer function count_touching(i0, i1, axis, other, flag) result(cnt)
-      integer, intent(in) :: i0, i1, axis, other
-      logical, intent(in) :: flag
+    !> How many of the nodes srt(i0, axis), srt(i0 + step, axis), ... (towards i1, from
+    !! the cut outwards, stopping one edge extent away from it) have a neighbour labelled
+    !! `other`; with sep > 0, those nodes are relabelled sep (the separator).
+    integer function count_touching(i0, i1, step, axis, other, sep) result(cnt)
+      integer, intent(in) :: i0, i1, step, axis, other, sep
       integer :: i, node, kk
+      real(wp) :: cut
       cnt = 0
-      do i = i0, i1
+      if ((i1 - i0)*step < 0) return
+      cut = xyl(axis, srt(i0, axis))
+      do i = i0, i1, step
         node = srt(i, axis)
+        if (abs(xyl(axis, node) - cut) > emax(axis)) exit
         do kk = xadj(node) + 1, xadj(node + 1)
           if (lab(adj(kk)) == other) then
             cnt = cnt + 1
-            if (flag) lab(node) = -1
+            if (sep > 0) lab(node) = sep
             exit
           end if
         end do
