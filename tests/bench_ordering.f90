@@ -24,6 +24,7 @@ program bench_ordering
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
   use clock, only: wtime
   use testing, only: general_body
+  use omp_lib, only: omp_set_max_active_levels
   implicit none (type, external)
 
   character(len=*), parameter :: onames(3) = [character(len=5) :: 'metis', 'amd', 'nd']
@@ -34,6 +35,9 @@ program bench_ordering
   type(body_system_t) :: sys
   integer, allocatable :: last(:)
 
+  ! as in the program with one thread: CHOLMOD's own OpenMP regions (a fixed
+  ! num_threads(4)) would otherwise start 4 threads on the cores being measured
+  call omp_set_max_active_levels(0)
   max_nx = 1024
   if (command_argument_count() >= 1) then
     call get_command_argument(1, arg)

@@ -62,7 +62,7 @@ contains
     ! general meshes (local node numbers 1..na): mesh node of each (glob), coordinates,
     ! node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)), partition
     ! labels, a work array, the largest edge extent in x and y
-    integer, allocatable :: glob(:), xadj(:), adj(:), srt(:, :), lab(:), tmp(:)
+    integer, allocatable :: glob(:), xadj(:), adj(:), srt(:, :), lab(:), tmp(:), rank(:, :)
     real(wp), allocatable :: xyl(:, :)
     real(wp) :: emax(2)
 
@@ -238,7 +238,7 @@ contains
         if (.not. skip(p)) active((sys%dof_of(p) + 1)/2) = .true.
       end do
       na = count(active)
-      allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na))
+      allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na), rank(na, 2))
       glob = pack([(node, node=1, nn)], active)
       call sort_nodes(glob, 1, mesh%xy)
       loc = 0
@@ -340,12 +340,16 @@ contains
     end subroutine sort_nodes
 
     !> Order the (local) nodes srt(lo:hi, :) (the same set in both columns) by recursive
-    !! coordinate bisection: split at the median of the longer extent, separator = the
-    !! smaller set of nodes of one half with a neighbour in the other, halves first.
+    !! coordinate bisection: cut across x or y (both are tried when neither extent is
+    !! below half the other) at the median or at 40, 45, 55 or 60% of the nodes, keeping
+    !! the cut with the smallest separator (the smaller set of nodes of one side with a
+    !! neighbour on the other); the two sides without it first, then the separator.
     recursive subroutine bisect(lo, hi)
       integer, intent(in) :: lo, hi
-      integer :: m, axis, mid, p, i, a, k, lset, rset, sset, nsl, nsr, nl, nr, lbl
-      real(wp) :: ext(2), v
+      integer, parameter :: fracs(5) = [50, 45, 55, 40, 60]   ! candidate cuts [% of the nodes]
+      integer :: m, axis, ax, p, i, a, k, f, seg, lset, rset, sset, nl, nr, lbl, ns, nsl, nsr
+      integer :: best, best_ax, best_p, best_side
+      real(wp) :: ext(2)
 
       m = hi - lo + 1
       if (m <= 0) return
@@ -361,37 +365,56 @@ contains
         return
       end if
 
-      ! halves: coordinate < v and >= v, v the median (<= v and > v if v is the minimum)
-      mid = lo + m/2
-      v = xyl(axis, srt(mid, axis))
-      p = mid
-      do while (p > lo)
-        if (xyl(axis, srt(p - 1, axis)) < v) exit
-        p = p - 1
-      end do
-      if (p == lo) then
-        p = mid + 1
-        do while (p <= hi)
-          if (xyl(axis, srt(p, axis)) > v) exit
-          p = p + 1
+      ! this set's nodes: label seg, and their positions in both sorted lists
+      seg = stamp + 1
+      lset = stamp + 2
+      rset = stamp + 3
+      sset = stamp + 4
+      stamp = stamp + 4
+      lab(srt(lo:hi, 1)) = seg
+      do a = 1, 2
+        do i = lo, hi
+          rank(srt(i, a), a) = i
         end do
+      end do
+      best = huge(1)
+      best_ax = axis
+      best_p = 0
+      best_side = 1
+      do k = 0, 1
+        ax = merge(axis, 3 - axis, k == 0)
+        if (k == 1 .and. .not. ext(ax) >= 0.5_wp*ext(axis)) exit
+        do f = 1, size(fracs)
+          p = cut_at(lo, hi, ax, lo + int((int(m, i8)*fracs(f))/100))
+          if (p <= lo .or. p > hi) cycle
+          nsl = touching(p - 1, lo, -1, ax, p, 0)
+          nsr = touching(p, hi, 1, ax, p, 0)
+          ns = min(nsl, nsr)
+          if (ns < best) then
+            best = ns
+            best_ax = ax
+            best_p = p
+            best_side = merge(-1, 1, nsl < nsr)
+          end if
+        end do
+      end do
+      if (best_p == 0) then                  ! no cut possible (cannot happen: ext > 0)
+        do i = lo, hi
+          call emit_node(glob(srt(i, axis)))
+        end do
+        return
       end if
-      lset = stamp + 1
-      rset = stamp + 2
-      sset = stamp + 3
-      stamp = stamp + 3
+      axis = best_ax
+      p = best_p
       lab(srt(lo:p - 1, axis)) = lset
       lab(srt(p:hi, axis)) = rset
-      ! only nodes within one edge extent of the cut can touch the other half
-      nsl = count_touching(p - 1, lo, -1, axis, rset, 0)
-      nsr = count_touching(p, hi, 1, axis, lset, 0)
-      if (nsl < nsr) then
-        nsl = count_touching(p - 1, lo, -1, axis, rset, sset)
+      if (best_side < 0) then
+        ns = touching(p - 1, lo, -1, axis, p, sset)
       else
-        nsr = count_touching(p, hi, 1, axis, lset, sset)
+        ns = touching(p, hi, 1, axis, p, sset)
       end if
 
-      ! stable partition of both sorted lists: left half, right half, separator
+      ! stable partition of both sorted lists: left side, right side, separator
       do a = 1, 2
         k = lo - 1
         do lbl = lset, sset
@@ -415,28 +438,61 @@ contains
       end do
     end subroutine bisect
 
-    !> How many of the nodes srt(i0, axis), srt(i0 + step, axis), ... (towards i1, from
-    !! the cut outwards, stopping one edge extent away from it) have a neighbour labelled
-    !! `other`; with sep > 0, those nodes are relabelled sep (the separator).
-    integer function count_touching(i0, i1, step, axis, other, sep) result(cnt)
-      integer, intent(in) :: i0, i1, step, axis, other, sep
-      integer :: i, node, kk
+    !> The first position of the right side of a cut of srt(lo:hi, axis) near position
+    !! mid: right = coordinate >= v = that of srt(mid), or > v when v is the least.
+    integer function cut_at(lo, hi, axis, mid) result(p)
+      integer, intent(in) :: lo, hi, axis, mid
+      real(wp) :: v
+      v = xyl(axis, srt(mid, axis))
+      p = mid
+      do while (p > lo)
+        if (xyl(axis, srt(p - 1, axis)) < v) exit
+        p = p - 1
+      end do
+      if (p == lo) then
+        p = mid + 1
+        do while (p <= hi)
+          if (xyl(axis, srt(p, axis)) > v) exit
+          p = p + 1
+        end do
+      end if
+    end function cut_at
+
+    !> For the cut of the current set (label seg) before position p of srt(:, axis): how
+    !! many of the nodes srt(i0, axis), srt(i0 + step, axis), ... (towards i1, from the
+    !! cut outwards, stopping one edge extent away from it) have a neighbour on the other
+    !! side; with sep > 0 those nodes are labelled sep (the separator).
+    integer function touching(i0, i1, step, axis, p, sep) result(cnt)
+      integer, intent(in) :: i0, i1, step, axis, p, sep
+      integer :: i, node, kk, nb, seg
       real(wp) :: cut
       cnt = 0
       if ((i1 - i0)*step < 0) return
+      seg = lab(srt(i0, axis))
+      if (sep > 0) seg = -1                  ! labels already split: the other side is lset/rset
       cut = xyl(axis, srt(i0, axis))
       do i = i0, i1, step
         node = srt(i, axis)
         if (abs(xyl(axis, node) - cut) > emax(axis)) exit
         do kk = xadj(node) + 1, xadj(node + 1)
-          if (lab(adj(kk)) == other) then
-            cnt = cnt + 1
-            if (sep > 0) lab(node) = sep
-            exit
+          nb = adj(kk)
+          if (sep > 0) then
+            if (lab(nb) /= sep - 2 .and. lab(nb) /= sep - 1) cycle   ! not in this set
+            if (lab(nb) == sep - 2 .eqv. step > 0) then
+              cnt = cnt + 1
+              lab(node) = sep
+              exit
+            end if
+          else
+            if (lab(nb) /= seg) cycle
+            if ((rank(nb, axis) < p) .eqv. step > 0) then
+              cnt = cnt + 1
+              exit
+            end if
           end if
         end do
       end do
-    end function count_touching
+    end function touching
 
   end subroutine nested_dissection
 
