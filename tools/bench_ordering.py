@@ -77,6 +77,28 @@ def run_once(binary, deck, nx, ordering, threads, workdir, quiet_wait):
     return row
 
 
+def speedup(a):
+    """factor + condense at 256x128, 1 vs 2 threads, interleaved repeats: min and median."""
+    fc = {(o, t): [] for o in ORDERINGS for t in (1, 2)}
+    with tempfile.TemporaryDirectory() as wd:
+        for k in range(a.speedup_repeat):
+            for o in ORDERINGS:
+                for thr in (1, 2):
+                    r = run_once(a.bin, a.deck, 256, o, thr, wd, 0.0)
+                    fc[(o, thr)].append(r["factor"] + r["condense"])
+            sys.stderr.write(f"  speed-up round {k + 1}/{a.speedup_repeat}, load {os.getloadavg()[0]:.1f}\n")
+    print(f"256x128, factor + condense [s], {a.speedup_repeat} interleaved runs each "
+          f"(load average at the end {os.getloadavg()[0]:.1f}):\n")
+    print("\n".join(md_header(["ordering", "1 thr min / median", "2 thr min / median", "speed-up (min)",
+                                "speed-up (median)"])))
+    for o in ORDERINGS:
+        t1, t2 = sorted(fc[(o, 1)]), sorted(fc[(o, 2)])
+        m1, m2 = t1[len(t1) // 2], t2[len(t2) // 2]
+        print(md_row([o, f"{t1[0]:.3f} / {m1:.3f}", f"{t2[0]:.3f} / {m2:.3f}", f"{t1[0] / t2[0]:.2f}x",
+                      f"{m1 / m2:.2f}x"]))
+    print()
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--max-nx", type=int, default=1024)
@@ -87,7 +109,16 @@ def main():
     ap.add_argument("--csv", default="results/bench_ordering.csv")
     ap.add_argument("--quiet-wait", type=float, default=60.0)
     ap.add_argument("--skip-runs", action="store_true", help="only the per-body phase table")
+    ap.add_argument("--speedup-repeat", type=int, default=0,
+                    help="also run 256x128 with 1 and 2 threads this many times, interleaved, for each "
+                         "ordering, and report min and median of factor + condense (robust on a shared machine)")
+    ap.add_argument("--speedup-only", action="store_true", help="only the --speedup-repeat runs")
     a = ap.parse_args()
+
+    if a.speedup_repeat > 0:
+        speedup(a)
+        if a.speedup_only:
+            return 0
 
     meshes = [nx for nx in (128, 256, 512, 1024) if nx <= a.max_nx]
     rows = []

@@ -103,7 +103,7 @@ module config
   !> How each body's stiffness is factorized (what the condensation stage needs).
   type, public :: factor_cfg_t
     integer :: factorization = FACTOR_CHOLMOD         !< FACTOR_*
-    integer :: ordering = ORDER_METIS                 !< ORDER_* (cholmod only)
+    integer :: ordering = ORDER_ND                    !< ORDER_* (cholmod only)
   end type factor_cfg_t
 
   !> The contact interface: an initial gap on top of the geometry's.

