@@ -47,13 +47,13 @@ OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
 TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files
-BENCH_F := bench_mprgp
+BENCH_F := bench_mprgp bench_ordering
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
 
 DEPS_STAMP := build/.deps-ok
 
-.PHONY: all run check bench-mprgp table1 bench hard plots meshes clean deps FORCE
+.PHONY: all run check bench-mprgp bench-ordering table1 bench hard plots meshes clean deps FORCE
 all: $(PROG)
 
 # ---- system packages: install what is missing (Debian 12) --------------------
@@ -159,6 +159,10 @@ check: $(PROG) $(TEST_BINS)
 
 bench-mprgp: $(BENCH_BINS)
 	$(BUILD)/tests/bench_mprgp
+
+# the ordering ladder: metis / amd / nd, 128x64 ... 1024x512, 1 and 2 threads (about 6 min)
+bench-ordering: $(PROG) $(BENCH_BINS)
+	$(PYTHON) tools/bench_ordering.py --bin $(PROG) --bench $(BUILD)/tests/bench_ordering
 
 table1: $(PROG)
 	$(PYTHON) tools/table1.py --bin $(PROG) --csv results/table1.csv

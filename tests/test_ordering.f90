@@ -5,7 +5,10 @@
 !! are adjacent; the top-level separator (the middle grid line across the longer side)
 !! comes last; a real FE body factored with nd, METIS and AMD gives the same solution
 !! (scaled residual) and the same interface flexibility from the trailing block;
-!! invalid inputs are reported; two bodies condensed with 'nd' equal 'metis'.
+!! invalid inputs are reported; two bodies condensed with 'nd' equal 'metis'; on general
+!! meshes (a grid renumbered at random, interior nodes moved: structured = .false.) the
+!! coordinate bisection is a permutation with node DOFs together, factors to the METIS
+!! solution and flexibility, with nnz(L) within 1.5x METIS's.
 !! One line per check; exits non-zero if any check fails.
 program test_ordering
   use, intrinsic :: iso_fortran_env, only: output_unit
@@ -19,7 +22,7 @@ program test_ordering
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
   use clock, only: wtime
-  use testing, only: report, report_le, test_summary
+  use testing, only: report, report_le, test_summary, general_body
   implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -50,6 +53,13 @@ program test_ordering
 
   ! ---- condense two bodies with ordering 'nd' vs 'metis' ----
   call check_condense()
+
+  ! ---- general meshes: recursive coordinate bisection ----
+  call check_general('general Q1 64x64, moved 0.3', 64, 64, ELEM_Q1, 0.3_wp, 7)
+  call check_general('general P1 40x25, moved 0.2', 40, 25, ELEM_P1, 0.2_wp, 11)
+  call check_general('general Q1 64x32, not moved', 64, 32, ELEM_Q1, 0.0_wp, 3)
+  call check_general('general Q1 5x3, moved 0.3', 5, 3, ELEM_Q1, 0.3_wp, 5)
+  call check_general_bad()
 
   ! ---- a large grid: ordering time at 1024 x 512 cells (printed, not asserted) ----
   call check_large()
@@ -368,6 +378,129 @@ contains
       call bc(a, 2)%chol%free()
     end do
   end subroutine check_condense
+
+  !> A general body (renumbered, moved, structured = .false.): the coordinate bisection is
+  !! a permutation of the free non-interface DOFs with node DOFs adjacent; factored with
+  !! it, with METIS and with AMD the solutions and flexibilities agree; nnz(L) <= 1.5 x METIS.
+  subroutine check_general(name, nx, ny, elem, perturb, seed)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: nx, ny, elem, seed
+    real(wp), intent(in) :: perturb
+    character(len=*), parameter :: onames(3) = [character(len=5) :: 'metis', 'amd', 'nd']
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    type(chol_t) :: ch
+    integer, allocatable :: last(:), perm(:), cnt(:)
+    logical, allocatable :: is_last(:)
+    real(wp), allocatable :: u(:, :), r(:), sgn(:), flex(:, :, :)
+    real(wp) :: res, d, nnz(3), t0, t_nd
+    integer :: o, info, m, k, f, g
+    logical :: ok, used
+    character(len=256) :: msg
+    character(len=64) :: tag
+
+    call general_body(make_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), perturb, seed, &
+                      msh, sys, last)
+    m = size(last)
+    t0 = wtime()
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    t_nd = wtime() - t0
+    call report(info == ND_OK, name//': nested_dissection info = 0 '//trim(msg))
+    if (info /= ND_OK) return
+    allocate (cnt(sys%n), is_last(sys%n))
+    cnt = 0
+    is_last = .false.
+    is_last(last) = .true.
+    ok = size(perm) == sys%n - m .and. all(perm >= 1 .and. perm <= sys%n)
+    if (ok) then
+      do k = 1, size(perm)
+        cnt(perm(k)) = cnt(perm(k)) + 1
+      end do
+      ok = all(merge(cnt == 0, cnt == 1, is_last))
+    end if
+    call report(ok, name//': a permutation of exactly the free non-interface DOFs')
+    if (.not. ok) return
+    ok = .true.
+    do k = 1, size(perm)
+      g = sys%dof_of(perm(k))
+      if (mod(g, 2) == 0) cycle
+      f = sys%free_of(g + 1)               ! the node's y DOF follows its x DOF
+      if (f > 0) then
+        if (.not. is_last(f)) ok = ok .and. k < size(perm)
+        if (.not. is_last(f) .and. k < size(perm)) ok = ok .and. perm(k + 1) == f
+      end if
+    end do
+    call report(ok, name//': the two DOFs of a node are adjacent, x first')
+
+    allocate (u(sys%n, 3), r(sys%n), sgn(m), flex(m, m, 3))
+    sgn = -1.0_wp
+    nnz = 0.0_wp
+    u = 0.0_wp
+    do o = 1, 3
+      tag = name//' '//trim(onames(o))
+      select case (o)
+      case (1)
+        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
+      case (2)
+        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
+      case default
+        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                       interior_perm=perm)
+      end select
+      call report(info == 0 .and. ch%interface_last_ok, trim(tag)//': factor ok, interface last '//trim(msg))
+      if (info /= 0) cycle
+      write (output_unit, '(a)') '      '//ch%summary()
+      nnz(o) = real(ch%nnz_factor, wp)
+      u(:, o) = sys%f
+      call ch%solve(u(:, o), info, msg)
+      call csc_matvec(sys, u(:, o), r)
+      res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u(:, o)))*eps)
+      call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
+      if (m > 0) then
+        call ch%flexibility(last, sgn, flex(:, :, o), info, msg, used_block=used)
+        call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
+      end if
+      call ch%free()
+    end do
+    do o = 2, 3
+      d = norm2(u(:, o) - u(:, 1))/norm2(u(:, 1))
+      call report_le(d, 1.0e-12_wp, name//' '//trim(onames(o))//': solution = METIS''s (relative)')
+      if (m > 0) then
+        d = norm2(flex(:, :, o) - flex(:, :, 1))/norm2(flex(:, :, 1))
+        call report_le(d, FLEX_TOL, name//' '//trim(onames(o))//': flexibility = METIS''s (relative)')
+      end if
+    end do
+    write (output_unit, '(a,3(a,es10.3),a,f0.4,a)') '      '//name//' nnz(L):', ' metis=', nnz(1), ' amd=', nnz(2), &
+      ' nd=', nnz(3), ' (nd ordering ', t_nd, ' s)'
+    call report(nnz(3) > 0.0_wp .and. nnz(3) <= 1.5_wp*nnz(1), name//': nnz(L) nd <= 1.5 x METIS', &
+                nnz(3)/max(nnz(1), 1.0_wp), 1.5_wp)
+  end subroutine check_general
+
+  !> A general mesh whose system lacks its pattern, or whose coordinates do not match,
+  !! is reported, not crashed on.
+  subroutine check_general_bad()
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys, bare
+    integer, allocatable :: last(:), perm(:)
+    integer :: info
+    character(len=256) :: msg
+
+    call general_body(make_body(6, 4, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), 0.2_wp, 1, &
+                      msh, sys, last)
+    bare%ndof = sys%ndof
+    bare%n = sys%n
+    bare%free_of = sys%free_of
+    call nested_dissection(msh, bare, last, perm, info, msg)
+    call report(info /= ND_OK .and. size(perm) == 0 .and. len_trim(msg) > 0, &
+                'general mesh, system without a pattern rejected: '//trim(msg))
+    msh%nnode = msh%nnode + 1
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    call report(info /= ND_OK .and. len_trim(msg) > 0, 'general mesh of another size rejected: '//trim(msg))
+    msh%nnode = msh%nnode - 1
+    sys%rowind(1) = sys%n + 5
+    call nested_dissection(msh, sys, last, perm, info, msg)
+    call report(info /= ND_OK .and. len_trim(msg) > 0, 'general mesh, row index out of range rejected: '//trim(msg))
+  end subroutine check_general_bad
 
   !> Ordering a 1024 x 512 cell grid (about 1M DOFs; only free_of is needed): time printed.
   subroutine check_large()

@@ -121,7 +121,7 @@ module config
   !> How each body's stiffness is factorized (what the condensation stage needs).
   type, public :: factor_cfg_t
     integer :: factorization = FACTOR_CHOLMOD         !< FACTOR_*
-    integer :: ordering = ORDER_METIS                 !< ORDER_* (cholmod only)
+    integer :: ordering = ORDER_ND                    !< ORDER_* (cholmod only)
   end type factor_cfg_t
 
   !> The contact interface: the two contact surfaces (rectangle sides declared 'contact', or

