@@ -174,10 +174,11 @@ contains
     call group_close(gid, st)
     ! contact
     call group_open(fid, 'contact', gid, st, create=.true.)
-    call write_dset(gid, 'x', itf%xy(1, :), st, ul)
-    call write_dset(gid, 'y', itf%xy(2, :), st, ul)
-    call write_dset(gid, 's', itf%s, st, ul)
     allocate (w2(itf%m, 2))
+    w2 = transpose(itf%xy)   ! columns are contiguous: x, y
+    call write_dset(gid, 'x', w2(:, 1), st, ul)
+    call write_dset(gid, 'y', w2(:, 2), st, ul)
+    call write_dset(gid, 's', itf%s, st, ul)
     w2 = transpose(itf%normal)
     call write_dset(gid, 'normal', w2, st, '1')
     w2 = transpose(itf%xy)   ! contiguous (gfortran passes a transpose as a strided view)
