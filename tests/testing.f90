@@ -6,7 +6,8 @@
 module testing
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use kinds, only: wp
-  use config, only: body_cfg_t, traction_cfg_t, SIDE_TOP, SIDE_BOTTOM
+  use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, SIDE_TOP, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, &
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
   use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness
   use assembly, only: body_system_t, expand, assemble_body, lame_parameters
@@ -153,12 +154,13 @@ contains
     type(body_system_t), intent(out) :: sys           !< its system (all fields but u_fixed, f_applied)
     integer, allocatable, intent(out) :: last(:)      !< interface DOFs (bottom side, y)
     type(mesh_t) :: grid
-    type(body_system_t) :: s0
+    type(body_cfg_t) :: free
     type(traction_cfg_t) :: tr(1)
-    integer, allocatable :: new_of(:), ncell_of(:), cell_ptr(:), cell_list(:), mark(:), nbr(:), bottom(:)
-    integer :: info, k, j, i, t, c, a, bb, node, nn, nd, cnt, p, q, kk, ldof(MAX_NDOF), pass
+    type(boundary_cfg_t) :: bd(4)
+    integer, allocatable :: new_of(:), bottom(:)
+    integer :: info, k, j, i, t, nn, q, g, side, nbd
     integer(int64) :: state
-    real(wp) :: hx, hy, lam, mu, xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), minjac
+    real(wp) :: hx, hy
     character(len=256) :: msg
 
     tr(1)%body = b%id
@@ -167,8 +169,6 @@ contains
     tr(1)%t1 = [0.0_wp, -1.0e6_wp]
     call mesh_build(grid, b, info, msg)
     if (info /= 0) error stop 'general_body: mesh_build failed'
-    call assemble_body(grid, b, .true., tr, 1, s0, info, msg)
-    if (info /= 0) error stop 'general_body: assemble_body failed'
     nn = grid%nnode
 
     ! a random renumbering (Fisher-Yates with the Park-Miller generator)
@@ -206,123 +206,39 @@ contains
     msh%node_tag = [(k, k=1, nn)]
     msh%cell_tag = grid%cell_tag
 
-    ! DOFs: prescribed as in the grid's system, free ones numbered in increasing order
-    sys%id = b%id
-    sys%ndof = 2*nn
-    allocate (sys%free_of(sys%ndof))
-    sys%free_of = 0
-    do k = 1, nn
-      do c = 1, 2
-        if (s0%free_of(2*(k - 1) + c) > 0) sys%free_of(2*(new_of(k) - 1) + c) = 1
-      end do
+    ! the grid's sides as groups of the general mesh, its side conditions as &boundary
+    ! conditions and its top traction as a group traction: assemble_body on any mesh
+    msh%ngroup = grid%ngroup
+    msh%group = grid%group
+    do g = 1, msh%ngroup
+      msh%group(g)%edge = reshape(new_of(reshape(grid%group(g)%edge, [2*grid%group(g)%nedge])), &
+                                  [2, grid%group(g)%nedge])
     end do
-    sys%n = 0
-    do k = 1, sys%ndof
-      if (sys%free_of(k) > 0) then
-        sys%n = sys%n + 1
-        sys%free_of(k) = sys%n
-      end if
+    msh%file_groups = grid%file_groups
+    nbd = 0
+    do side = 1, 4
+      select case (b%bc(side))
+      case (BC_CLAMPED, BC_DISPLACEMENT)
+        nbd = nbd + 1
+        bd(nbd)%fix = .true.
+        bd(nbd)%u = merge(b%u_side(:, side), [0.0_wp, 0.0_wp], b%bc(side) == BC_DISPLACEMENT)
+      case (BC_ROLLER)
+        nbd = nbd + 1
+        bd(nbd)%fix = [side == SIDE_LEFT .or. side == SIDE_RIGHT, side == SIDE_BOTTOM .or. side == SIDE_TOP]
+      case default
+        cycle
+      end select
+      bd(nbd)%body = b%id
+      bd(nbd)%group = trim(grid%group(side)%name)
     end do
-    allocate (sys%dof_of(sys%n), sys%f(sys%n))
-    do k = 1, sys%ndof
-      if (sys%free_of(k) > 0) sys%dof_of(sys%free_of(k)) = k
-    end do
-    do p = 1, s0%n
-      k = (s0%dof_of(p) + 1)/2
-      c = s0%dof_of(p) - 2*(k - 1)
-      sys%f(sys%free_of(2*(new_of(k) - 1) + c)) = s0%f(p)
-    end do
-
-    ! the cells of each node, then the pattern: the nodes sharing a cell, increasing
-    allocate (ncell_of(nn + 1), mark(nn), nbr(0))
-    ncell_of = 0
-    do c = 1, msh%ncell
-      do a = 1, msh%nvert
-        ncell_of(msh%cells(a, c) + 1) = ncell_of(msh%cells(a, c) + 1) + 1
-      end do
-    end do
-    cell_ptr = [0, (sum(ncell_of(2:k + 1)), k=1, nn)]
-    allocate (cell_list(cell_ptr(nn + 1)))
-    ncell_of = cell_ptr(1:nn + 1)
-    do c = 1, msh%ncell
-      do a = 1, msh%nvert
-        node = msh%cells(a, c)
-        ncell_of(node) = ncell_of(node) + 1
-        cell_list(ncell_of(node)) = c
-      end do
-    end do
-    allocate (sys%colptr(sys%n + 1))
-    mark = 0
-    do pass = 1, 2
-      sys%colptr(1) = 0
-      do p = 1, sys%n
-        node = (sys%dof_of(p) + 1)/2
-        if (mod(sys%dof_of(p), 2) == 0 .and. p > 1) then
-          if ((sys%dof_of(p - 1) + 1)/2 == node) then     ! the y DOF: same rows as the x DOF
-            cnt = sys%colptr(p) - sys%colptr(p - 1)
-            if (pass == 2) sys%rowind(sys%colptr(p) + 1:sys%colptr(p) + cnt) = &
-              sys%rowind(sys%colptr(p - 1) + 1:sys%colptr(p))
-            sys%colptr(p + 1) = sys%colptr(p) + cnt
-            cycle
-          end if
-        end if
-        nbr = [integer ::]
-        do kk = cell_ptr(node) + 1, cell_ptr(node + 1)
-          do a = 1, msh%nvert
-            q = msh%cells(a, cell_list(kk))
-            if (mark(q) == p) cycle
-            mark(q) = p
-            nbr = [nbr, q]
-          end do
-        end do
-        call isort(nbr)
-        cnt = 0
-        do kk = 1, size(nbr)
-          do c = 1, 2
-            q = sys%free_of(2*(nbr(kk) - 1) + c)
-            if (q == 0) cycle
-            cnt = cnt + 1
-            if (pass == 2) sys%rowind(sys%colptr(p) + cnt) = q - 1
-          end do
-        end do
-        sys%colptr(p + 1) = sys%colptr(p) + cnt
-      end do
-      if (pass == 1) allocate (sys%rowind(sys%colptr(sys%n + 1)))
-      mark = 0
-    end do
-
-    ! the stiffness of the moved cells
-    allocate (sys%val(size(sys%rowind)))
-    sys%val = 0.0_wp
-    call lame_parameters(b, .true., lam, mu)
-    nd = 2*msh%nvert
-    do c = 1, msh%ncell
-      xe = 0.0_wp
-      do a = 1, msh%nvert
-        xe(:, a) = msh%xy(:, msh%cells(a, c))
-        ldof(2*a - 1) = 2*(msh%cells(a, c) - 1) + 1
-        ldof(2*a) = 2*(msh%cells(a, c) - 1) + 2
-      end do
-      call element_stiffness(msh%element, xe, lam, mu, ke, minjac)
-      if (.not. minjac > 0.0_wp) error stop 'general_body: an inverted cell (perturb too large)'
-      do bb = 1, nd
-        p = sys%free_of(ldof(bb))
-        if (p == 0) cycle
-        do a = 1, nd
-          q = sys%free_of(ldof(a))
-          if (q == 0) cycle
-          do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
-            if (sys%rowind(kk) == q - 1) exit
-          end do
-          if (kk > sys%colptr(p + 1)) error stop 'general_body: coupling outside the pattern'
-          sys%val(kk) = sys%val(kk) + ke(a, bb)
-        end do
-      end do
-    end do
-    sys%k_norm = 0.0_wp
-    do p = 1, sys%n
-      sys%k_norm = max(sys%k_norm, sum(abs(sys%val(sys%colptr(p) + 1:sys%colptr(p + 1)))))
-    end do
+    free = b
+    free%bc = BC_FREE
+    tr(1)%side = 0
+    tr(1)%group = 'top'
+    tr(1)%tx = tr(1)%t1
+    tr(1)%t1 = 0.0_wp
+    call assemble_body(msh, free, .true., tr, 1, sys, info, msg, boundaries=bd(1:nbd))
+    if (info /= 0) error stop 'general_body: assemble_body failed on the general mesh'
 
     call side_nodes(grid, SIDE_BOTTOM, bottom)
     allocate (last(0))
@@ -342,20 +258,6 @@ contains
       uniform = real(next(), wp)/2147483647.0_wp
     end function uniform
 
-    subroutine isort(v)
-      integer, intent(inout) :: v(:)
-      integer :: i1, j1, t1
-      do i1 = 2, size(v)
-        t1 = v(i1)
-        j1 = i1 - 1
-        do while (j1 >= 1)
-          if (v(j1) <= t1) exit
-          v(j1 + 1) = v(j1)
-          j1 = j1 - 1
-        end do
-        v(j1 + 1) = t1
-      end do
-    end subroutine isort
 
   end subroutine general_body
 

@@ -11,7 +11,7 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp, i8
-  use sorting, only: sort_by_key
+  use sorting, only: sort_by_key, sort_ints
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
@@ -534,22 +534,6 @@ contains
       aptr(k + 1) = i + 1
     end do
   end subroutine node_adjacency
-
-  !> Sort a short list of integers in place (insertion sort: a node has a few dozen pairs).
-  pure subroutine sort_ints(v)
-    integer, intent(inout) :: v(:)
-    integer :: i, j, x
-    do i = 2, size(v)
-      x = v(i)
-      j = i - 1
-      do while (j >= 1)
-        if (v(j) <= x) exit
-        v(j + 1) = v(j)
-        j = j - 1
-      end do
-      v(j + 1) = x
-    end do
-  end subroutine sort_ints
 
   !> The applied nodal loads on all DOFs (sys%f_applied): the tractions on this body,
   !! then the body force if any; sys%f = 0. info = 1 when a traction names a group the

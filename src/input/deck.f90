@@ -786,15 +786,7 @@ contains
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(load_in_t), intent(in) :: t
-    integer :: k
-    k = find_asg(g, 'body')
-    if (k == 0) then
-      call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
-    else if (len_trim(g%a(k)%value) == 0) then
-      call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
-    end if
-    if (t%body /= 1 .and. t%body /= 2) call bad_value(g, src, 'body', i2s(t%body), &
-      'does not exist: the bodies have ids 1 and 2')
+    call body_given(g, src, t%body)
     if (t%side == 0) call die_at(src, g%line, 'in group &'//g%name//': no side; give '// &
       'side='//quoted_list(SIDE_CHOICES, ''))
   end subroutine body_and_side
