@@ -19,7 +19,7 @@ module condense
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: nested_dissection
   use clock, only: wtime
-  use lapack, only: dpstrf
+  use lapack, only: dpstrf, dsyev
   implicit none (type, external)
   private
 
@@ -58,10 +58,14 @@ module condense
     real(wp), allocatable :: bfix(:)        !< (m) B_a's part on prescribed DOFs, B_a,d u_d [length]
     real(wp), allocatable :: flex(:, :)     !< (m,m) F_a [length/force]
     !> > 0 when F_a is singular (mortar: a master surface coarser than the slave has fewer
-    !! normal DOFs than the slave has rows): the weight of the proximal term that pins the
-    !! body's subproblem multipliers in the kernel of F_a to the other body's (contact.f90)
+    !! normal DOFs than the slave has rows): then the body's subproblem gets a proximal term
+    !! that pins its multipliers to the other body's (contact.f90 `subproblem_operators`);
+    !! its value, 1e-2 max diag F_a, is the scale of F_a
     real(wp) :: prox = 0.0_wp             !< [length/force]
     integer :: rank = 0                   !< numerical rank of F_a
+    !> (m, m - rank) orthonormal basis Z of the numerical kernel of F_a (unallocated when F_a
+    !! is nonsingular): the proximal term and the obstacle act on Z Z' only (contact.f90)
+    real(wp), allocatable :: kern(:, :)
     real(wp), allocatable :: b(:)           !< (m) B_a K_a^-1 f_a [length]
     real(wp), allocatable :: u0(:)          !< (n) K_a^-1 f_a [length]
     type(chol_t) :: chol                    !< the factorization of K_a
@@ -491,13 +495,14 @@ contains
   end function selection_rows
 
   !> The numerical rank of F_a by Cholesky with complete pivoting (pivots below
-  !! 1e-10 max diag stop it); when it is rank deficient, the proximal weight is a
-  !! hundredth of its largest diagonal entry.
+  !! 1e-10 max diag stop it); when it is rank deficient, `prox` is a hundredth of its
+  !! largest diagonal entry and `kern` an orthonormal basis of the kernel:
+  !! the eigenvectors of the m - rank smallest eigenvalues (LAPACK dsyev, once, O(m^3)).
   subroutine flex_rank(bc)
     type(body_condensed_t), intent(inout) :: bc
-    real(wp), allocatable :: f(:, :), work(:)
+    real(wp), allocatable :: f(:, :), work(:), ev(:)
     integer, allocatable :: piv(:)
-    integer :: lapinfo, r
+    integer :: lapinfo, r, lwork
     real(wp) :: dmax
     integer :: i
     dmax = 0.0_wp
@@ -509,7 +514,17 @@ contains
     call dpstrf('L', bc%m, f, bc%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)
     if (lapinfo < 0) return
     bc%rank = r
-    if (r < bc%m) bc%prox = 1.0e-2_wp*dmax
+    if (r == bc%m) return
+    bc%prox = 1.0e-2_wp*dmax
+    f = bc%flex
+    allocate (ev(bc%m))
+    call dsyev('V', 'L', bc%m, f, bc%m, ev, work, -1, lapinfo)
+    lwork = max(3*bc%m, int(work(1)))
+    deallocate (work)
+    allocate (work(lwork))
+    call dsyev('V', 'L', bc%m, f, bc%m, ev, work, lwork, lapinfo)
+    ! no eigenvectors (dsyev did not converge): contact.f90 then uses the other body's F
+    if (lapinfo == 0) bc%kern = f(:, 1:bc%m - r)
   end subroutine flex_rank
 
   !> w(m) = B_a u: the rows on the free displacements u (n) plus the part on prescribed DOFs.

@@ -131,10 +131,10 @@ contains
     class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     type(robin_state_t) :: st_
-    type(dense_op_t), target :: op(2), opsub(2)
+    type(dense_op_t), target :: op(2), opsub(2), pin(2)
     type(robin_correction_t) :: corr_op
     real(wp), allocatable :: Gnew(:, :), w(:, :), dlam(:), corr(:, :)
-    real(wp) :: rtol_in, t0, lmax(2), uref
+    real(wp) :: rtol_in, t0, lmax(2), lsub(2), uref
     integer :: m, it, every, maxout, info
     logical :: printed, resumed
 
@@ -156,7 +156,7 @@ contains
     uref = max(maxabs(bc(1)%b), maxabs(bc(2)%b), maxabs(itf%g0), tiny(1.0_wp))
 
     call body_operators(bc, op, lmax, st_, resumed, s%robin_operator == ROBIN_HARMONIC)
-    call subproblem_operators(bc, op, opsub)
+    call subproblem_operators(bc, op, lmax, s%robin_operator == ROBIN_HARMONIC, opsub, pin, lsub)
     call robin_correction_init(corr_op, s, itf, bc, op, info)
     if (info /= 0) then
       res%status = 'failed'
@@ -182,7 +182,7 @@ contains
     do it = st_%it + 1, maxout
       ! 1. each body against its obstacle, in parallel
       rtol_in = inner_tolerance(s, it, m, st_%progress, lmax)
-      call solve_subproblems(s, bc, opsub, lmax + [bc(1)%prox, bc(2)%prox], rtol_in, it, st_, w, res)
+      call solve_subproblems(s, bc, opsub, pin, lsub, rtol_in, it, st_, w, res)
       if (m == 0) then
         res%status = 'converged'
         res%outer = it
@@ -291,23 +291,85 @@ contains
     if (.not. resumed) st%inner = sum(nmv)
   end subroutine body_operators
 
-  !> The Hessian of each body's subproblem: F_a, or F_a + prox I when F_a is singular
-  !! (module condense): the proximal term prox/2 |lam_a - lam_other|^2 pins the part of
-  !! lam_a in the kernel of F_a (which the body's own problem leaves undetermined) to the
-  !! other body's last contact force. At a fixed point lam_1 = lam_2, so the term vanishes
-  !! and the fixed point is still the monolithic solution.
-  subroutine subproblem_operators(bc, op, opsub)
+  !> The Hessian of each body's subproblem, F_a + Pi_a, and a bound of its largest
+  !! eigenvalue. Pi_a = 0 unless F_a is singular (module condense: a mortar master coarser
+  !! than the slave has fewer normal DOFs than the slave has rows); then the proximal term
+  !! 1/2 (l - lam_o)' Pi_a (l - lam_o), lam_o the other body's last contact force, fixes the
+  !! part of lam_a that body a's own problem leaves undetermined (ker F_a = ker B_a').
+  !!
+  !! Fixed point. The master's KKT reads G_m - B_m u_m - Pi_m d = g_m >= 0 (d = lam_s - lam_m,
+  !! lam_o = lam_s at a fixed point): an extra Robin term on its obstacle. With the two
+  !! obstacle updates (slave: G_s = g0 - B_m u_m + S_s d, master: G_m = g0 - B_s u_s - S_m d)
+  !! and gap = B_s u_s + B_m u_m - g0: S_s d - gap = g_s, -(S_m + Pi_m) d - gap = g_m, so
+  !! (S_s + S_m + Pi_m) d = g_s - g_m, and d'(g_s - g_m) = -lam_s'g_m - lam_m'g_s <= 0
+  !! (complementarity), so d'(S_s + S_m + Pi_m) d <= 0 and d = 0 whenever
+  !! S_s + S_m + Pi_m is definite: the fixed point is the monolithic solution, active set
+  !! included, for every Pi_m >= 0.
+  !!
+  !! Rate (linearised outer map, all nodes active, slave s, singular master m, e_a the error
+  !! of G_a): dlam_s = -F_s^-1 e_s, dlam_m = -H_m^-1 e_m + H_m^-1 Pi_m dlam_s_prev with
+  !! H_m = F_m + Pi_m. 'steklov' (S_s = F_m on the slave's obstacle, S_m = F_s on the
+  !! master's): e_s -> F_m dlam_s = -F_m F_s^-1 e_s, whatever the master does, and
+  !! e_m -> -F_s H_m^-1 e_m + (terms in e_s): block triangular, eigenvalues of the relaxed map
+  !! 1 - delta (1 + mu), mu in eig(F_m F_s^-1) (zero on F_s ker F_m: rate 1 - delta) and in
+  !! eig(F_s H_m^-1). The former Pi_m = prox I, prox = 1e-2 max diag F_m, puts F_s / prox
+  !! (~ 100) in the second set: divergence. Pi_m on the kernel only (Z (Z'F_sZ) Z', Z a basis
+  !! of ker F_m) gives mu = 1 there but keeps the range part, where F_s exceeds the master's
+  !! mortar flexibility on the near-kernel modes (paper scene 24/36: mu up to 1.44, so
+  !! delta = 0.95 diverges). Pi_m = F_s gives mu in eig(F_s (F_m + F_s)^-1), inside (0, 1):
+  !! that block converges for every delta < 1 and the rate is the slave's, as on matching
+  !! meshes ('constant' likewise: measured, not triangular). The term is then a Robin
+  !! condition with the slave's Steklov-Poincare operator on the master's side.
+  !! 'harmonic' (`kernel_only`): S = 2 F_s (F_s+F_m)^-1 F_m annihilates ker F_m, so only
+  !! the kernel needs pinning and Pi_m = Z (Z'F_sZ) Z' leaves the master exact on
+  !! range F_m (Pi_m = F_s would cost it its contrast independence). Without a kernel
+  !! basis (dsyev failed) it falls back to F_s as well.
+  subroutine subproblem_operators(bc, op, lmax, kernel_only, opsub, pin, lsub)
     type(body_condensed_t), intent(in) :: bc(2)
     type(dense_op_t), intent(in) :: op(2)
-    type(dense_op_t), intent(out) :: opsub(2)
-    integer :: a, i
+    real(wp), intent(in) :: lmax(2)              !< bounds of lambda_max(F_a)
+    logical, intent(in) :: kernel_only           !< Pi_a on ker F_a only (harmonic operator)
+    type(dense_op_t), intent(out) :: opsub(2)    !< F_a + Pi_a
+    type(dense_op_t), intent(out) :: pin(2)      !< Pi_a (n = 0 when F_a is nonsingular)
+    real(wp), intent(out) :: lsub(2)             !< bounds of lambda_max(F_a + Pi_a)
+    real(wp), allocatable :: zf(:, :), zr(:, :), r(:, :), p(:, :)
+    real(wp) :: floor
+    integer :: a, i, k, m
+    m = bc(1)%m
+    lsub = lmax
     do a = 1, 2
       opsub(a) = op(a)
-      if (bc(a)%prox > 0.0_wp) then
-        do i = 1, bc(a)%m
-          opsub(a)%a(i, i) = opsub(a)%a(i, i) + bc(a)%prox
+      pin(a)%n = 0
+      if (.not. bc(a)%prox > 0.0_wp) cycle
+      allocate (p(m, m))
+      if (kernel_only .and. allocated(bc(a)%kern)) then
+        k = size(bc(a)%kern, 2)
+        allocate (zf(k, m), zr(m, k), r(k, k))
+        ! R = Z' F_o Z (k x k), floored so that F_a + Pi_a is definite even if F_o is
+        ! nearly singular on ker F_a; Pi_a = Z R Z'
+        call dgemm('T', 'N', k, m, m, 1.0_wp, bc(a)%kern, m, bc(3 - a)%flex, m, 0.0_wp, zf, k)
+        call dgemm('N', 'N', k, k, m, 1.0_wp, zf, k, bc(a)%kern, m, 0.0_wp, r, k)
+        r = 0.5_wp*(r + transpose(r))
+        floor = 0.0_wp
+        do i = 1, m
+          floor = max(floor, 1.0e-10_wp*bc(3 - a)%flex(i, i))
         end do
+        do i = 1, k
+          r(i, i) = r(i, i) + floor
+        end do
+        call dgemm('N', 'N', m, k, k, 1.0_wp, bc(a)%kern, m, r, k, 0.0_wp, zr, m)
+        call dgemm('N', 'T', m, m, k, 1.0_wp, zr, m, bc(a)%kern, m, 0.0_wp, p, m)
+        p = 0.5_wp*(p + transpose(p))
+        deallocate (zf, zr, r)
+      else
+        ! F_a + F_o is definite (the monolithic Hessian)
+        p = bc(3 - a)%flex
       end if
+      call dense_op_init(pin(a), p)
+      opsub(a)%a = opsub(a)%a + p
+      ! lambda_max(F_a + Pi_a) <= lambda_max(F_a) + |Pi_a|_inf
+      lsub(a) = lmax(a) + maxval(sum(abs(p), dim=1))
+      deallocate (p)
     end do
   end subroutine subproblem_operators
 
@@ -413,10 +475,11 @@ contains
   !> Step 1: each body's contact problem against its obstacle (MPRGP, one thread per
   !! body), warm-started from the last contact forces. On return st%lam holds the forces,
   !! w(:, a) = B_a u_a, and res%status is 'failed' if an inner solve broke down.
-  subroutine solve_subproblems(s, bc, op, lmax, rtol_in, it, st, w, res)
+  subroutine solve_subproblems(s, bc, op, pin, lmax, rtol_in, it, st, w, res)
     type(solver_cfg_t), intent(in) :: s
     type(body_condensed_t), intent(in) :: bc(2)
-    type(dense_op_t), intent(inout) :: op(2)
+    type(dense_op_t), intent(inout) :: op(2)      !< the subproblem Hessians F_a + Pi_a
+    type(dense_op_t), intent(inout) :: pin(2)     !< Pi_a (subproblem_operators; n = 0: none)
     real(wp), intent(in) :: lmax(2), rtol_in
     integer, intent(in) :: it
     type(robin_state_t), intent(inout) :: st
@@ -448,7 +511,11 @@ contains
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
       rhs(:, a) = bc(a)%b - st%G(:, a)
-      if (bc(a)%prox > 0.0_wp) rhs(:, a) = rhs(:, a) + bc(a)%prox*lprev(:, 3 - a)
+      if (pin(a)%n > 0) then
+        ! a singular body is pinned to the other body's last force (subproblem_operators)
+        call pin(a)%apply(lprev(:, 3 - a), grad(:, a))
+        rhs(:, a) = rhs(:, a) + grad(:, a)
+      end if
       ! The tolerance is measured against the body's own contact displacement
       ! |F_a lam_a| (previous iterate), not against |b_a - G_a|: with a large
       ! material contrast the stiff body's b_a - G_a is a small difference of the
@@ -493,12 +560,16 @@ contains
           ': '//trim(mprgp_status_name(ms(a)%status))//': '//trim(ms(a)%message)
         return
       end if
-      ! B_a u_a = b_a - F_a lam_a = G_a - grad_a (+ the proximal term's part)
-      w(:, a) = st%G(:, a) - grad(:, a)
-      st%flam(a) = norm2(grad(:, a) + rhs(:, a))
-      if (bc(a)%prox > 0.0_wp) then
-        w(:, a) = w(:, a) + bc(a)%prox*(st%lam(:, a) - lprev(:, 3 - a))
-        st%flam(a) = norm2(grad(:, a) + rhs(:, a) - bc(a)%prox*st%lam(:, a))
+      ! B_a u_a = b_a - F_a lam_a = G_a - grad_a (with a proximal term: F_a lam_a is the
+      ! Hessian's image grad_a + rhs_a less the proximal part)
+      if (pin(a)%n > 0) then
+        call pin(a)%apply(st%lam(:, a), flam0(:, a))
+        flam0(:, a) = grad(:, a) + rhs(:, a) - flam0(:, a)
+        w(:, a) = bc(a)%b - flam0(:, a)
+        st%flam(a) = norm2(flam0(:, a))
+      else
+        w(:, a) = st%G(:, a) - grad(:, a)
+        st%flam(a) = norm2(grad(:, a) + rhs(:, a))
       end if
     end do
     st%nsrch = st%reuse

@@ -10,7 +10,7 @@ module lapack
   private
 
   public :: dsymv, dgemm
-  public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf
+  public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels
 
@@ -83,6 +83,22 @@ module lapack
       real(wp), intent(out) :: work(*)      !< (2n) workspace
       integer, intent(out) :: info          !< status
     end subroutine dpstrf
+
+    !> Eigenvalues (ascending) and, with jobz = 'V', orthonormal eigenvectors of a symmetric A.
+    !! lwork = -1: workspace query (the optimal size in work(1)). info > 0: no convergence.
+    subroutine dsyev(jobz, uplo, n, a, lda, w, work, lwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: jobz  !< 'N' eigenvalues only, 'V' also eigenvectors
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L'
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a
+      real(wp), intent(inout) :: a(lda, *)  !< A on entry, the eigenvectors (jobz = 'V') on exit
+      real(wp), intent(out) :: w(*)         !< (n) eigenvalues, ascending
+      real(wp), intent(out) :: work(*)      !< (lwork) workspace
+      integer, intent(in) :: lwork          !< size of work (-1: query)
+      integer, intent(out) :: info          !< status
+    end subroutine dsyev
 
     !> Solve A X = B with the Cholesky factor from dpotrf.
     subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
