@@ -40,7 +40,7 @@ contains
     integer, allocatable :: deg(:), bydeg(:), cnt(:), mark(:), lev(:)
     logical, allocatable :: done(:)
     integer :: i, j, p, k, nnum, head, tail, ptr, root, cand, ecc, ecc_new, maxdeg, stamp
-    integer :: first_new, t, v, x
+    integer :: first_new, v, x
 
     allocate (deg(n), done(n), mark(n), lev(n))
     do j = 1, n
