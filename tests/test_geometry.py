@@ -118,6 +118,12 @@ if check(pr_.returncode == 0 and pm.returncode == 0, "non-matching paper scene: 
           f"{lm.sum():.6e} vs {ld.sum():.6e}: {e:.2e}")
     check(int(mm["m"]) == 36, "non-matching: the finer lower surface is the slave (36 rows)", f"m = {mm['m']}")
 
+# 3b. the shipped non-matching deck (steklov, delta 0.95) converges to the same forces
+p, m, out = run("inputs/nonmatching.nml", name="nm_deck")
+if check(p.returncode == 0, "inputs/nonmatching.nml converges (steklov, delta 0.95)", f"exit {p.returncode}"):
+    e = rel(read_lam(out), read_lam(om))
+    check(e <= 1e-6, "inputs/nonmatching.nml: Robin (steklov) = monolithic to 1e-6", f"{e:.2e}")
+
 # 4. Hertz with real geometry
 p, m, out = run("inputs/hertz.nml", MONO, name="hertz_mono")
 if check(p.returncode == 0, "Hertz (h = 0.005) converges", f"exit {p.returncode}"):
