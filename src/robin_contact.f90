@@ -13,7 +13,7 @@ program robin_contact
   use config, only: deck_t, output_cfg_t, METHOD_ROBIN, METHOD_MONOLITHIC
   use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
-  use gmsh_msh, only: msh_read
+  use gmsh_msh, only: msh_read, msh_read_pair
   use assembly, only: body_system_t, assemble_body, expand
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
@@ -80,16 +80,21 @@ program robin_contact
   ! ---- assemble both bodies --------------------------------------------------------
   call phase('assembly of both bodies')
   t0 = wtime()
-  !$omp parallel do num_threads(nthr) schedule(static, 1)
-  do a = 1, 2
-    if (len_trim(d%body(a)%mesh) > 0) then
-      call msh_read(trim(d%body(a)%mesh), trim(d%body(a)%region), a, msh(a), info(a), msg(a))
-    else
-      call mesh_build(msh(a), d%body(a))
-      info(a) = 0
-    end if
-  end do
-  !$omp end parallel do
+  if (len_trim(d%body(1)%mesh) > 0 .and. d%body(1)%mesh == d%body(2)%mesh) then
+    ! one file holds both bodies: read and parse it once
+    call msh_read_pair(trim(d%body(1)%mesh), [d%body(1)%region, d%body(2)%region], msh, info, msg, nthr)
+  else
+    !$omp parallel do num_threads(nthr) schedule(static, 1)
+    do a = 1, 2
+      if (len_trim(d%body(a)%mesh) > 0) then
+        call msh_read(trim(d%body(a)%mesh), trim(d%body(a)%region), a, msh(a), info(a), msg(a))
+      else
+        call mesh_build(msh(a), d%body(a))
+        info(a) = 0
+      end if
+    end do
+    !$omp end parallel do
+  end if
   do a = 1, 2
     if (info(a) == 1) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))
     if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))

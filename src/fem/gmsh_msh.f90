@@ -24,7 +24,7 @@ module gmsh_msh
   private
 
 
-  public :: msh_read
+  public :: msh_read, msh_read_pair
 
   integer, parameter :: BAD_INPUT = 1, OTHER_FAILURE = 3
   integer(i8), parameter :: EMPTY = -1_i8            ! an unused hash slot
@@ -120,6 +120,47 @@ contains
       mesh%ncell = 0
     end if
   end subroutine msh_read
+
+  !> Both bodies from one .msh file (the same path for both): the file is read and parsed
+  !! once, then each body is built from it (the bodies in parallel on two threads when
+  !! `nthr` is 2). Arguments as msh_read's, one per body.
+  subroutine msh_read_pair(path, region, mesh, info, msg, nthr)
+    character(len=*), intent(in) :: path          !< the .msh file of both bodies
+    character(len=*), intent(in) :: region(2)     !< physical surface name of each body
+    type(mesh_t), intent(out) :: mesh(2)          !< the bodies' meshes
+    integer, intent(out) :: info(2)               !< 0; 1 bad input; 3 other failure
+    character(len=*), intent(out) :: msg(2)       !< one sentence when info /= 0
+    integer, intent(in) :: nthr                   !< threads for the two builds (1 or 2)
+    type(cursor_t) :: cur, cb(2)
+    type(msh_data_t) :: d
+    integer :: a
+
+    cur%path = path
+    cur%section = ''
+    allocate (d%pdim(8), d%ptag(8), d%pname(8))
+    call load_file(path, cur)
+    if (cur%info == 0) call parse(cur, d)
+    if (allocated(cur%text)) deallocate (cur%text)
+    do a = 1, 2
+      cb(a) = cur
+    end do
+    !$omp parallel do num_threads(nthr) schedule(static, 1)
+    do a = 1, 2
+      if (cb(a)%info == 0) call build_body(cb(a), d, trim(region(a)), mesh(a))
+    end do
+    !$omp end parallel do
+    do a = 1, 2
+      info(a) = cb(a)%info
+      msg(a) = ''
+      if (info(a) /= 0) then
+        msg(a) = 'body '//i2s(a)//": mesh file '"//trim(path)//"'"
+        if (cb(a)%err_line > 0) msg(a) = trim(msg(a))//', line '//i2s(cb(a)%err_line)
+        msg(a) = trim(msg(a))//': '//cb(a)%err//'.'
+        mesh(a)%nnode = 0
+        mesh(a)%ncell = 0
+      end if
+    end do
+  end subroutine msh_read_pair
 
   ! ---- errors ---------------------------------------------------------------------------
 
