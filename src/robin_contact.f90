@@ -327,7 +327,7 @@ contains
   !! in turn; otherwise half each, an odd one out to the body with more unknowns. The
   !! lower world ranks form body 1's group, so world rank 0 hosts body 1.
   subroutine mumps_groups()
-    integer :: g1
+    integer :: g1, b
     if (nranks == 1) then
       mine = .true.
       host = 0
@@ -338,8 +338,17 @@ contains
     if (mod(nranks, 2) == 1 .and. sys(1)%n >= sys(2)%n) g1 = g1 + 1
     host = [0, g1]
     mine = [me < g1, me >= g1]
+    do b = 1, 2
+      if (merge(g1, nranks - g1, b == 1) > msh(b)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(d%source)// &
+        ': '//i2s(merge(g1, nranks - g1, b == 1))//' ranks for body '//achar(48 + b)//', which has '// &
+        i2s(msh(b)%ncell)//' cells: use at most '//i2s(2*min(msh(1)%ncell, msh(2)%ncell))//' ranks')
+    end do
     call par_split(merge(1, 2, me < g1), gcomm)
     write (output_unit, '(a,i0,a,i0,a)') 'mumps: ', g1, ' rank(s) on body 1, ', nranks - g1, ' on body 2'
+    ! only a body's host hands its matrix to MUMPS (centralized input): the others drop theirs
+    do b = 1, 2
+      if (me /= host(b)) deallocate (sys(b)%colptr, sys(b)%rowind, sys(b)%val)
+    end do
   end subroutine mumps_groups
 
   !> Every rank learns the worst status of the bodies' groups; a failure is fatal (exit 3)

@@ -5,11 +5,15 @@ passes): factorization='mumps' under mpirun -np 1, 2 and 4 gives the CHOLMOD pat
 contact forces to 1e-10 relative, Robin and monolithic, on the paper's scene and on a
 partial-contact scene (a parabolic initial gap); factorization='mumps' in the serial binary
 is bad input naming the MPI binary; bad input and an injected MUMPS failure end every rank
-with exit 1 / 3 and one message, within a timeout (no rank left hanging)."""
+with exit 1 / 3 and one message, within a timeout (no rank left hanging); SIGTERM to
+the ranks (as srun sends it) in the Robin iteration: exit 4, a checkpoint, and a restart
+that converges as an uninterrupted run."""
 import os
 import shutil
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 
@@ -110,6 +114,43 @@ for np_ in (1, 2, 4):
         check(len(el) == 1 and "MUMPS" in el[0] and "INFO(1) = -19" in el[0], f"-np {np_} MUMPS failure: one "
               "message with the code and its meaning", el[0] if el else q.stderr[-200:])
         check(not os.path.exists(out), f"-np {np_} MUMPS failure writes no result file")
+
+# 5. SIGTERM to the ranks (as srun delivers it; OpenMPI's mpirun kills its ranks instead)
+# during the Robin iteration: every rank exits 4, rank 0 writes the checkpoint, and the
+# same command with --restart resumes from it and converges as an uninterrupted run
+big = ["inputs/default.nml", "&body id=1, nx=512, ny=256 /", "&body id=2, nx=512, ny=256 /",
+       "&solver factorization='mumps', delta=0.02 /"]
+out = os.path.join(OUT, "sigterm.h5")
+ckpt = out + ".ckpt.h5"
+for f in (out, ckpt):
+    if os.path.exists(f):
+        os.remove(f)
+cmd = ["mpirun", "--oversubscribe", "-np", "2", MPI_BIN, *big, f"&output file='{out}', checkpoint_every=50 /"]
+log = os.path.join(OUT, "sigterm.log")
+with open(log, "w") as lf:
+    pr = subprocess.Popen(cmd, stdout=lf, stderr=subprocess.STDOUT, env=mpi_env())
+    t0 = time.time()
+    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
+        time.sleep(0.1)
+    time.sleep(1.0)
+    ranks = subprocess.run(["pgrep", "-P", str(pr.pid)], capture_output=True, text=True).stdout.split()
+    for r in ranks:
+        os.kill(int(r), signal.SIGTERM)
+    try:
+        rc = pr.wait(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        pr.kill()
+        rc = None
+text = open(log).read()
+check(rc == 4, "SIGTERM to the ranks in the Robin iteration: exit 4", f"exit {rc}, {len(ranks)} ranks signalled")
+check("status=interrupted" in text and os.path.exists(ckpt), "status=interrupted, checkpoint written")
+if os.path.exists(ckpt):
+    q, _ = mpirun(2, *big, "--restart", ckpt, name="sigterm")
+    check(q is not None and q.returncode == 0 and "resuming after outer iteration" in q.stdout,
+          "the same command with --restart resumes and converges", f"exit {q.returncode if q else None}")
+    r = result_fields(q.stdout) if q else None
+    check(r is not None and (r["outer"], r["inner"]) == ("413", "2032"), "its outer/inner counts are those of "
+          "an uninterrupted run (413/2032)", f"{r and (r['outer'], r['inner'])}")
 
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)

@@ -22,7 +22,7 @@ contains
   subroutine factor_body_mumps(itf, a, sys, comm, bc, mt, info, msg)
     type(interface_t), intent(in) :: itf             !< the contact line
     integer, intent(in) :: a                         !< body number
-    type(body_system_t), intent(in) :: sys           !< assembled system of body a (host: whole)
+    type(body_system_t), intent(in) :: sys           !< assembled system of body a (the matrix: host only)
     integer, intent(in) :: comm                      !< the body's group of ranks
     type(body_condensed_t), intent(inout) :: bc      !< receives the interface DOFs and rows
     type(mumps_t), intent(inout) :: mt               !< receives the MUMPS instance
@@ -31,7 +31,12 @@ contains
     real(wp) :: t0
     t0 = wtime()
     call interface_dofs(itf, a, sys, bc)
-    call mumps_schur_factor(mt, comm, sys%n, sys%colptr, sys%rowind, sys%val, bc%idx, a, info, msg)
+    if (allocated(sys%val)) then
+      call mumps_schur_factor(mt, comm, sys%n, sys%colptr, sys%rowind, sys%val, bc%idx, a, info, msg)
+    else
+      ! a rank other than the group's host has dropped the matrix (it only takes part)
+      call mumps_schur_factor(mt, comm, sys%n, [integer ::], [integer ::], [real(wp) ::], bc%idx, a, info, msg)
+    end if
     bc%t_factor = wtime() - t0
   end subroutine factor_body_mumps
 
