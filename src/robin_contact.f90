@@ -19,7 +19,7 @@ program robin_contact
   use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read
-  use assembly, only: body_system_t, assemble_body, expand
+  use assembly, only: body_system_t, assemble_body, expand, cell_triplets
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t
@@ -60,7 +60,9 @@ program robin_contact
   ! MPI binary: this rank, the world's size, whether this run factorizes by MUMPS, the world
   ! rank hosting each body's group, this rank's group, and whether a fatal error now is met
   ! by every rank alike (deck, collective checks) or by this rank alone (then MPI_Abort)
-  integer :: me = 0, nranks = 1, host(2) = 0, gcomm = 0
+  integer :: me = 0, nranks = 1, host(2) = 0, gcomm = 0, grank(2) = 0, gsize(2) = 1
+  integer, allocatable :: irn(:), jcn(:)   ! this rank's share of a stiffness (MUMPS input)
+  real(wp), allocatable :: kval(:)
   logical :: use_mumps = .false., mine(2) = .true., collective = .true.
   type(mumps_t) :: mt(2)
 
@@ -140,8 +142,9 @@ program robin_contact
   end if
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
+    ! MUMPS: the DOF numbering and the load only; each rank assembles its cells' share later
     call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a), &
-                       boundaries=d%boundary(1:d%nboundary))
+                       boundaries=d%boundary(1:d%nboundary), matrix=.not. use_mumps)
   end do
   !$omp end parallel do
   do a = 1, 2
@@ -168,7 +171,12 @@ program robin_contact
     do a = 1, 2
       info(a) = 0
       msg(a) = ''
-      if (mine(a)) call factor_body_mumps(itf, a, sys(a), gcomm, cb(a), mt(a), info(a), msg(a))
+      if (.not. mine(a)) cycle
+      ! this rank's share of body a's cells (rank r of g: cells r*nc/g+1 .. (r+1)*nc/g)
+      call cell_triplets(msh(a), d%body(a), d%plane_strain, sys(a), grank(a)*msh(a)%ncell/gsize(a) + 1, &
+                         (grank(a) + 1)*msh(a)%ncell/gsize(a), irn, jcn, kval, info(a), msg(a))
+      if (info(a) == 0) call factor_body_mumps(itf, a, sys(a), irn, jcn, kval, gcomm, cb(a), mt(a), info(a), msg(a))
+      deallocate (irn, jcn, kval)
     end do
     call agree_fatal('factorization failed')
   else
@@ -338,6 +346,8 @@ contains
     if (mod(nranks, 2) == 1 .and. sys(1)%n >= sys(2)%n) g1 = g1 + 1
     host = [0, g1]
     mine = [me < g1, me >= g1]
+    gsize = [g1, nranks - g1]
+    grank = [me, me - g1]
     do b = 1, 2
       if (merge(g1, nranks - g1, b == 1) > msh(b)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(d%source)// &
         ': '//i2s(merge(g1, nranks - g1, b == 1))//' ranks for body '//achar(48 + b)//', which has '// &
@@ -345,10 +355,6 @@ contains
     end do
     call par_split(merge(1, 2, me < g1), gcomm)
     write (output_unit, '(a,i0,a,i0,a)') 'mumps: ', g1, ' rank(s) on body 1, ', nranks - g1, ' on body 2'
-    ! only a body's host hands its matrix to MUMPS (centralized input): the others drop theirs
-    do b = 1, 2
-      if (me /= host(b)) deallocate (sys(b)%colptr, sys(b)%rowind, sys(b)%val)
-    end do
   end subroutine mumps_groups
 
   !> Every rank learns the worst status of the bodies' groups; a failure is fatal (exit 3)

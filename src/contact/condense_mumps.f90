@@ -19,10 +19,12 @@ contains
 
   !> Analyse and factorize K_a over the group with the interface DOFs as Schur variables;
   !! on the host, X = S^-1. info 0 ok, 3 MUMPS failed or K_a singular (msg says which).
-  subroutine factor_body_mumps(itf, a, sys, comm, bc, mt, info, msg)
+  subroutine factor_body_mumps(itf, a, sys, irn, jcn, val, comm, bc, mt, info, msg)
     type(interface_t), intent(in) :: itf             !< the contact line
     integer, intent(in) :: a                         !< body number
-    type(body_system_t), intent(in) :: sys           !< assembled system of body a (the matrix: host only)
+    type(body_system_t), intent(in) :: sys           !< body a's DOF numbering and load
+    integer, intent(in) :: irn(:), jcn(:)            !< this rank's share of K_a (assembly%cell_triplets)
+    real(wp), intent(in) :: val(:)                   !< its entries [stress]
     integer, intent(in) :: comm                      !< the body's group of ranks
     type(body_condensed_t), intent(inout) :: bc      !< receives the interface DOFs and rows
     type(mumps_t), intent(inout) :: mt               !< receives the MUMPS instance
@@ -31,12 +33,7 @@ contains
     real(wp) :: t0
     t0 = wtime()
     call interface_dofs(itf, a, sys, bc)
-    if (allocated(sys%val)) then
-      call mumps_schur_factor(mt, comm, sys%n, sys%colptr, sys%rowind, sys%val, bc%idx, a, info, msg)
-    else
-      ! a rank other than the group's host has dropped the matrix (it only takes part)
-      call mumps_schur_factor(mt, comm, sys%n, [integer ::], [integer ::], [real(wp) ::], bc%idx, a, info, msg)
-    end if
+    call mumps_schur_factor(mt, comm, sys%n, irn, jcn, val, bc%idx, a, info, msg)
     bc%t_factor = wtime() - t0
   end subroutine factor_body_mumps
 

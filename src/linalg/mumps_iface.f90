@@ -4,7 +4,8 @@
 !! and X = S^-1 = (K^-1)_GG follows by LAPACK (dpotrf/dpotri), as the CHOLMOD path's trailing
 !! block. A solve K u = r reduces the right-hand side (ICNTL(26) = 1: r_G - K_GI K_II^-1 r_I),
 !! solves the interface part with X, and expands it to the interior (ICNTL(26) = 2).
-!! Input is the assembled matrix centralized on the group's host (ICNTL(18) = 0).
+!! Input is distributed assembled (ICNTL(18) = 3): each rank gives the entries of its
+!! share of the cells (assembly%cell_triplets), which MUMPS sums; no rank holds the matrix.
 !! Every routine here is collective over the group's communicator. The serial binary
 !! compiles mumps_iface_none.f90 (same API, every call an error) instead.
 module mumps_iface
@@ -36,20 +37,21 @@ module mumps_iface
 
 contains
 
-  !> Analyse and factorize K (n x n, both triangles in 0-based CSC, given on the host) with
-  !! the DOFs schur(:) (1-based) as Schur variables; on the host, X = S^-1.
+  !> Analyse and factorize K (n x n, symmetric positive definite; each rank gives its
+  !! entries of the lower triangle, summed over ranks) with the DOFs schur(:) (1-based) as
+  !! Schur variables; on the host, X = S^-1.
   !! info: 0 ok, 3 MUMPS failed or S is not positive definite (msg says which and why).
-  subroutine mumps_schur_factor(mt, comm, n, colptr, rowind, val, schur, body, info, msg)
+  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, info, msg)
     type(mumps_t), intent(inout) :: mt        !< receives the instance
     integer, intent(in) :: comm               !< the group's communicator (host: its rank 0)
     integer, intent(in) :: n                  !< unknowns (same on every rank)
-    integer, intent(in) :: colptr(:), rowind(:)  !< host: the pattern (others: ignored)
-    real(wp), intent(in) :: val(:)            !< host: the entries [stress]
+    integer, intent(in) :: irn(:), jcn(:)     !< this rank's entries: rows and columns, 1-based, row >= column
+    real(wp), intent(in) :: val(:)            !< this rank's entries [stress]
     integer, intent(in) :: schur(:)           !< (k) host: the Schur variables, 1-based
     integer, intent(in) :: body               !< body number, for messages
     integer, intent(out) :: info              !< 0 ok, 3 failure
     character(len=*), intent(out) :: msg      !< description of a failure
-    integer :: j, p, q, nz, lap, k, i, cap, st
+    integer :: j, lap, k, i, cap, st
     character(len=32) :: env
 
     info = 0
@@ -60,6 +62,8 @@ contains
     mt%id%JOB = -1
     call dmumps(mt%id)
     mt%alive = .true.
+    nullify (mt%id%IRN_loc, mt%id%JCN_loc, mt%id%A_loc, mt%id%LISTVAR_SCHUR, mt%id%SCHUR, mt%id%RHS, &
+             mt%id%REDRHS)
     if (mt%id%INFOG(1) < 0) then
       call fail('initialization')
       return
@@ -69,7 +73,7 @@ contains
     mt%id%ICNTL(2) = -1
     mt%id%ICNTL(3) = -1
     mt%id%ICNTL(4) = 0
-    mt%id%ICNTL(18) = 0      ! assembled matrix centralized on the host
+    mt%id%ICNTL(18) = 3      ! distributed assembled input: each rank its entries
     ! ROBIN_MUMPS_MAX_MB caps MUMPS's working memory per rank (ICNTL(23), MB): a job's
     ! per-rank share of memory; the tests use a tiny cap to make the factorization fail
     call get_environment_variable('ROBIN_MUMPS_MAX_MB', env, status=st)
@@ -83,27 +87,11 @@ contains
     if (mt%host) k = size(schur)
     call bcast_int(k)
     mt%k = k
-    if (mt%host) then
-      ! the lower triangle, 1-based coordinates
-      nz = 0
-      do j = 1, n
-        do p = colptr(j) + 1, colptr(j + 1)
-          if (rowind(p) + 1 >= j) nz = nz + 1
-        end do
-      end do
-      mt%id%NNZ = int(nz, 8)
-      allocate (mt%id%IRN(nz), mt%id%JCN(nz), mt%id%A(nz))
-      q = 0
-      do j = 1, n
-        do p = colptr(j) + 1, colptr(j + 1)
-          if (rowind(p) + 1 < j) cycle
-          q = q + 1
-          mt%id%IRN(q) = rowind(p) + 1
-          mt%id%JCN(q) = j
-          mt%id%A(q) = val(p)
-        end do
-      end do
-    end if
+    mt%id%NNZ_loc = int(size(val), 8)
+    allocate (mt%id%IRN_loc(size(val)), mt%id%JCN_loc(size(val)), mt%id%A_loc(size(val)))
+    mt%id%IRN_loc = irn
+    mt%id%JCN_loc = jcn
+    mt%id%A_loc = val
     if (k > 0) then
       mt%id%ICNTL(19) = 1    ! Schur complement centralized on the host
       mt%id%SIZE_SCHUR = k
@@ -120,6 +108,7 @@ contains
     end if
     mt%mem_bytes = max(0.0_wp, real(mt%id%INFOG(22), wp))*1048576.0_wp   ! MB summed over ranks
     mt%max_rank_mb = real(mt%id%INFOG(21), wp)
+    deallocate (mt%id%IRN_loc, mt%id%JCN_loc, mt%id%A_loc)   ! MUMPS has its own copy now
     if (mt%host .and. k > 0) then
       ! S comes as its upper triangle by columns (the lower by rows) in a k x k array, in
       ! the order of schur(:); X = S^-1 by Cholesky (dpotrf/dpotri)
@@ -233,8 +222,8 @@ contains
   subroutine mumps_end(mt)
     type(mumps_t), intent(inout) :: mt
     if (.not. mt%alive) return
+    if (associated(mt%id%IRN_loc)) deallocate (mt%id%IRN_loc, mt%id%JCN_loc, mt%id%A_loc)
     if (mt%host) then
-      if (associated(mt%id%IRN)) deallocate (mt%id%IRN, mt%id%JCN, mt%id%A)
       if (associated(mt%id%LISTVAR_SCHUR)) deallocate (mt%id%LISTVAR_SCHUR)
     end if
     mt%id%JOB = -2

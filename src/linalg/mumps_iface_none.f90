@@ -25,13 +25,13 @@ module mumps_iface
 contains
 
   !> Not available: info = 1.
-  subroutine mumps_schur_factor(mt, comm, n, colptr, rowind, val, schur, body, info, msg)
+  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, info, msg)
     type(mumps_t), intent(inout) :: mt
-    integer, intent(in) :: comm, n, colptr(:), rowind(:), schur(:), body
+    integer, intent(in) :: comm, n, irn(:), jcn(:), schur(:), body
     real(wp), intent(in) :: val(:)
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
-    mt%n = n + 0*(comm + body + size(colptr) + size(rowind) + size(val) + size(schur))
+    mt%n = n + 0*(comm + body + size(irn) + size(jcn) + size(val) + size(schur))
     info = 1
     msg = NONE
   end subroutine mumps_schur_factor
