@@ -6,9 +6,10 @@
 !! Exit codes: 0 converged, 1 bad input or usage, 2 did not converge,
 !! 3 numerical failure, 4 interrupted (checkpoint written).
 !! The same source is both binaries: module mpi_env (and mumps_iface) is compiled in its
-!! serial or its MPI version by the Makefile. In the MPI binary every rank reads the deck
-!! and assembles; each body's group of ranks factorizes it by MUMPS; rank 0 alone runs the
-!! contact iteration, prints and writes; every rank ends with the same exit code.
+!! serial or its MPI version by the Makefile. In the MPI binary every rank reads the deck,
+!! meshes and numbers both bodies and integrates their loads; each body's group of ranks
+!! computes its share of the body's element matrices and factorizes it by MUMPS; rank 0
+!! alone runs the contact iteration, prints and writes; every rank ends with the same code.
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
@@ -176,7 +177,7 @@ program robin_contact
       call cell_triplets(msh(a), d%body(a), d%plane_strain, sys(a), grank(a)*msh(a)%ncell/gsize(a) + 1, &
                          (grank(a) + 1)*msh(a)%ncell/gsize(a), irn, jcn, kval, info(a), msg(a))
       if (info(a) == 0) call factor_body_mumps(itf, a, sys(a), irn, jcn, kval, gcomm, cb(a), mt(a), info(a), msg(a))
-      deallocate (irn, jcn, kval)
+      if (allocated(irn)) deallocate (irn, jcn, kval)
     end do
     call agree_fatal('factorization failed')
   else
