@@ -6,16 +6,27 @@
 #   make meshes     regenerate the shipped Gmsh meshes inputs/gmsh/*.msh from their .geo
 #   make DEBUG=1    checked build (-fcheck=all, FP traps, backtrace) in build/debug,
 #                   bin/robin_contact_debug; `make check DEBUG=1` tests that one
+#   make MPI=1      the MPI binary bin/robin_contact_mpi (mpif90/mpicc, MUMPS) in build/mpi;
+#                   `make check` builds it too where mpif90 and libmumps-dev are installed
 
 FC      ?= gfortran
 CC      ?= gcc
 PYTHON  ?= /usr/bin/python3
 DEBUG   ?= 0
+MPI     ?= 0
 ifeq ($(origin FC),default)
 FC := gfortran
 endif
+ifeq ($(MPI),1)
+FC := mpif90
+CC := mpicc
+endif
 
-ifeq ($(DEBUG),1)
+ifeq ($(MPI),1)
+BUILD   := build/mpi
+FOPT    := -O2 -g
+COPT    := -O2 -g
+else ifeq ($(DEBUG),1)
 BUILD   := build/debug
 FOPT    := -g -O0 -fcheck=all -ffpe-trap=invalid,zero,overflow -fbacktrace
 COPT    := -g -O0
@@ -31,9 +42,22 @@ FFLAGS  := $(FOPT) -fopenmp -ffree-line-length-none -Wall -Wno-maybe-uninitializ
            -J$(BUILD) -I$(BUILD) -I$(HDF5_INC) $(EXTRA_FFLAGS)
 CFLAGS  := $(COPT) -fopenmp -Wall -Iinclude -I/usr/include/suitesparse $(EXTRA_CFLAGS)
 LDLIBS  := -L$(HDF5_LIB) -lhdf5_fortran -lhdf5 -lcholmod -lsuitesparseconfig -lmetis -llapack -lopenblas -lm
+# The parallel environment and MUMPS: one module each, in a serial and an MPI version
+# (Debian's libdmumps is linked shared: it brings its ScaLAPACK/BLACS and PORD itself).
+ifeq ($(MPI),1)
+MPI_ENV_SRC := src/parallel/mpi_env_mpi.f90
+MUMPS_SRC   := src/linalg/mumps_iface.f90
+FFLAGS  += -I/usr/include
+LDLIBS  := -ldmumps -lmumps_common $(LDLIBS)
+else
+MPI_ENV_SRC := src/parallel/mpi_env_serial.f90
+MUMPS_SRC   := src/linalg/mumps_iface_none.f90
+endif
 
 BIN     := bin
-ifeq ($(DEBUG),1)
+ifeq ($(MPI),1)
+PROG    := $(BIN)/robin_contact_mpi
+else ifeq ($(DEBUG),1)
 PROG    := $(BIN)/robin_contact_debug
 else
 PROG    := $(BIN)/robin_contact
@@ -41,8 +65,9 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings sorting sysinfo signals config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
-        ordering cholmod_iface banded cholesky mprgp mortar condense contact_types contact h5io files history_io results checkpoint
+MODS := kinds errors clock strings sorting sysinfo signals mpi_env config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp mortar condense condense_mumps contact_types contact h5io files history_io \
+        results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
@@ -52,8 +77,13 @@ TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
 
 DEPS_STAMP := build/.deps-ok
+ifeq ($(MPI),1)
+DEPS_STAMP := build/.deps-mpi-ok
+endif
+# mpif90 and MUMPS's headers present: `make check` builds and tests the MPI binary too
+MPI_READY := $(shell command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ] && echo 1)
 
-.PHONY: all run check bench-mprgp bench-ordering table1 bench bench-gmsh hard plots meshes clean deps FORCE
+.PHONY: all mpi run check bench-mprgp bench-ordering table1 bench bench-gmsh hard plots meshes clean deps FORCE
 all: $(PROG)
 
 # ---- system packages: install what is missing (Debian 12) --------------------
@@ -64,13 +94,15 @@ $(DEPS_STAMP): tools/install-deps.sh
 	   && [ -e /usr/lib/x86_64-linux-gnu/liblapack.so ] && command -v pgrep >/dev/null 2>&1 \
 	   && [ -x $(PYTHON) ] && $(PYTHON) -c 'import numpy, h5py, meshio, matplotlib' 2>/dev/null; then :; \
 	 else bash tools/install-deps.sh; fi
+	@if [ "$(MPI)" = 1 ] && ! { command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; }; then \
+	   bash tools/install-deps.sh; fi
 	@mkdir -p build && touch $@
 deps: $(DEPS_STAMP)
 
 # ---- compile -------------------------------------------------------------------
 # Sources are grouped by stage (src/base, input, fem, linalg, contact, io; the driver at
 # the top); objects and modules go flat into $(BUILD).
-SRC_DIRS := src src/base src/input src/fem src/linalg src/contact src/io
+SRC_DIRS := src src/base src/input src/fem src/linalg src/contact src/io src/parallel
 vpath %.f90 $(SRC_DIRS)
 vpath %.c $(SRC_DIRS)
 
@@ -91,6 +123,7 @@ $(BUILD)/strings.o:        $(BUILD)/kinds.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
+$(BUILD)/mpi_env.o:        $(BUILD)/kinds.o
 $(BUILD)/config.o:         $(BUILD)/kinds.o
 $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck.o:           $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/config.o \
@@ -107,10 +140,13 @@ $(BUILD)/ordering.o:       $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
 $(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o
+$(BUILD)/condense_mumps.o: $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o $(BUILD)/condense.o \
+                           $(BUILD)/mumps_iface.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/strings.o $(BUILD)/config.o \
                            $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/condense.o \
@@ -126,6 +162,14 @@ $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/contact_
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
 $(BUILD)/files_shim.o:     include/files_shim.h
 $(BUILD)/robin_contact.o:  $(OBJS)
+
+# the two modules with a serial and an MPI source (MPI_ENV_SRC, MUMPS_SRC above)
+$(BUILD)/mpi_env.o: $(MPI_ENV_SRC) | $(DEPS_STAMP)
+	@mkdir -p $(BUILD)
+	$(FC) $(FFLAGS) -c $< -o $@
+$(BUILD)/mumps_iface.o: $(MUMPS_SRC) | $(DEPS_STAMP)
+	@mkdir -p $(BUILD)
+	$(FC) $(FFLAGS) -c $< -o $@
 
 # ---- link ----------------------------------------------------------------------
 $(BUILD)/robin_contact: $(BUILD)/robin_contact.o $(OBJS)
@@ -154,8 +198,12 @@ run: $(PROG)
 	@mkdir -p results
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PROG) inputs/default.nml
 
-check: $(PROG) $(TEST_BINS)
+# with MPI_READY the MPI binary is built first and tests/test_mpi.py runs it (else it skips)
+check: $(PROG) $(TEST_BINS) $(if $(MPI_READY),mpi)
 	@BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
+
+mpi:
+	$(MAKE) MPI=1 all
 
 bench-mprgp: $(BENCH_BINS)
 	$(BUILD)/tests/bench_mprgp

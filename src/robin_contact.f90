@@ -2,19 +2,25 @@
 !! (Lions-type) nonoverlapping domain decomposition (Sassi, Ipopa, Roux).
 !!
 !! Usage: robin_contact DECK.nml ['&group var=value ... /' ...]
+!!        mpirun -np N robin_contact_mpi DECK.nml ... (factorization='mumps')
 !! Exit codes: 0 converged, 1 bad input or usage, 2 did not converge,
 !! 3 numerical failure, 4 interrupted (checkpoint written).
+!! The same source is both binaries: module mpi_env (and mumps_iface) is compiled in its
+!! serial or its MPI version by the Makefile. In the MPI binary every rank reads the deck,
+!! meshes and numbers both bodies and integrates their loads; each body's group of ranks
+!! computes its share of the body's element matrices and factorizes it by MUMPS; rank 0
+!! alone runs the contact iteration, prints and writes; every rank ends with the same code.
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use errors, only: fatal, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
+  use errors, only: fatal, fatal_handler, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
                     EXIT_INTERRUPTED
-  use config, only: deck_t, output_cfg_t, METHOD_ROBIN, METHOD_MONOLITHIC
+  use config, only: deck_t, output_cfg_t, METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
   use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
-  use assembly, only: body_system_t, assemble_body, expand
+  use assembly, only: body_system_t, assemble_body, expand, cell_triplets
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t
@@ -25,9 +31,13 @@ program robin_contact
   use signals, only: signals_install, stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb, memory_limit_mb, write_stdout_checked
   use budget, only: check_budget, check_load_range, body_memory_mb
-  use strings, only: sci, fmt_real, i2s
+  use strings, only: sci, fmt_real, i2s, word
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
+  use mpi_env, only: par_built, par_init, par_finalize, par_rank, par_size, par_split, par_bcast_reals, &
+                     par_bcast_ints, par_agree, par_any, par_abort
+  use mumps_iface, only: mumps_t, mumps_end
+  use condense_mumps, only: factor_body_mumps, condense_body_mumps, recover_displacement_mumps
   implicit none (type, external)
 
   type(deck_t) :: d
@@ -48,10 +58,36 @@ program robin_contact
   real(wp), allocatable :: u(:, :), ufree(:)
   logical :: ok
   logical :: written = .false.   ! the result file of this run exists
+  ! MPI binary: this rank, the world's size, whether this run factorizes by MUMPS, the world
+  ! rank hosting each body's group, this rank's group, and whether a fatal error now is met
+  ! by every rank alike (deck, collective checks) or by this rank alone (then MPI_Abort)
+  integer :: me = 0, nranks = 1, host(2) = 0, gcomm = 0, grank(2) = 0, gsize(2) = 1
+  integer, allocatable :: irn(:), jcn(:)   ! this rank's share of a stiffness (MUMPS input)
+  real(wp), allocatable :: kval(:)
+  logical :: use_mumps = .false., mine(2) = .true., collective = .true.
+  type(mumps_t) :: mt(2)
 
   t_start = wtime()
+  call par_init()
+  if (par_built) then
+    me = par_rank()
+    nranks = par_size()
+    fatal_handler => par_fatal
+    ! printing is rank 0's: the others write their standard units to /dev/null
+    if (me /= 0) then
+      open (unit=output_unit, file='/dev/null', action='write')
+      open (unit=error_unit, file='/dev/null', action='write')
+    end if
+  end if
   call parse_arguments(deck_path, overrides, restart_file)
   call read_deck(deck_path, overrides, d)
+  use_mumps = d%solver%factor%factorization == FACTOR_MUMPS
+  if (use_mumps .and. .not. par_built) call fatal(EXIT_INPUT, 'deck '//trim(d%source)// &
+    ': factorization=''mumps'' needs the MPI binary: run mpirun -np N bin/robin_contact_mpi '// &
+    trim(d%source)//' (built by make MPI=1); this binary has no MPI or MUMPS')
+  if (.not. use_mumps .and. nranks > 1) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': factorization='''// &
+    word(FACTOR_CHOICES, d%solver%factor%factorization)//''' runs on one rank, and this run has '//i2s(nranks)// &
+    '; use factorization=''mumps'' or mpirun -np 1')
   if (len(restart_file) > 0 .and. d%solver%method /= METHOD_ROBIN) &
     call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': --restart applies to method=''robin'' only')
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
@@ -112,8 +148,9 @@ program robin_contact
   end if
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
+    ! MUMPS: the DOF numbering and the load only; each rank assembles its cells' share later
     call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a), &
-                       boundaries=d%boundary(1:d%nboundary))
+                       boundaries=d%boundary(1:d%nboundary), matrix=.not. use_mumps)
   end do
   !$omp end parallel do
   do a = 1, 2
@@ -135,22 +172,45 @@ program robin_contact
   call phase('ordering and factorization (estimated factors: body 1 '//factor_estimate(1)//', body 2 '// &
              factor_estimate(2)//')')
   t0 = wtime()
-  !$omp parallel do num_threads(nthr) schedule(static, 1)
-  do a = 1, 2
-    call factor_body(d%solver%factor, itf, a, msh(a), sys(a), cb(a), info(a), msg(a))
-  end do
-  !$omp end parallel do
-  do a = 1, 2
-    if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': factorization failed: '//trim(msg(a)))
-  end do
+  if (use_mumps) then
+    call mumps_groups()
+    do a = 1, 2
+      info(a) = 0
+      msg(a) = ''
+      if (.not. mine(a)) cycle
+      ! this rank's share of body a's cells (rank r of g: cells r*nc/g+1 .. (r+1)*nc/g)
+      call cell_triplets(msh(a), d%body(a), d%plane_strain, sys(a), grank(a)*msh(a)%ncell/gsize(a) + 1, &
+                         (grank(a) + 1)*msh(a)%ncell/gsize(a), irn, jcn, kval, info(a), msg(a))
+      if (info(a) == 0) call factor_body_mumps(itf, a, sys(a), irn, jcn, kval, gcomm, cb(a), mt(a), info(a), msg(a))
+      if (allocated(irn)) deallocate (irn, jcn, kval)
+    end do
+    call agree_fatal('factorization failed')
+  else
+    !$omp parallel do num_threads(nthr) schedule(static, 1)
+    do a = 1, 2
+      call factor_body(d%solver%factor, itf, a, msh(a), sys(a), cb(a), info(a), msg(a))
+    end do
+    !$omp end parallel do
+    do a = 1, 2
+      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': factorization failed: '//trim(msg(a)))
+    end do
+  end if
   tm%factor = wtime() - t0
   call check_interrupt('factorization')
   t0 = wtime()
-  !$omp parallel do num_threads(nthr) schedule(static, 1)
-  do a = 1, 2
-    call condense_body(sys(a), cb(a), info(a), msg(a))
-  end do
-  !$omp end parallel do
+  if (use_mumps) then
+    do a = 1, 2
+      if (mine(a)) call condense_body_mumps(sys(a), cb(a), mt(a), a, info(a), msg(a))
+    end do
+    call agree_fatal('condensation failed')
+    call share_condensed()
+  else
+    !$omp parallel do num_threads(nthr) schedule(static, 1)
+    do a = 1, 2
+      call condense_body(sys(a), cb(a), info(a), msg(a))
+    end do
+    !$omp end parallel do
+  end if
   do a = 1, 2
     if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': condensation failed: '//trim(msg(a)))
     if (.not. (all(ieee_is_finite(cb(a)%flex)) .and. all(ieee_is_finite(cb(a)%b)))) then
@@ -161,12 +221,19 @@ program robin_contact
   end do
   tm%condense = wtime() - t0
   call check_interrupt('condensation')
-  tm%factor_mb = (cb(1)%chol%mem_bytes + cb(2)%chol%mem_bytes)/1048576.0_wp
+  if (use_mumps) then
+    tm%factor_mb = (mt(1)%mem_bytes + mt(2)%mem_bytes)/1048576.0_wp
+  else
+    tm%factor_mb = (cb(1)%chol%mem_bytes + cb(2)%chol%mem_bytes)/1048576.0_wp
+  end if
 
   ! ---- contact ----------------------------------------------------------------------
   call phase(merge('Robin iteration  ', 'monolithic solve ', d%solver%method == METHOD_ROBIN))
   t0 = wtime()
-  if (d%solver%method == METHOD_MONOLITHIC) then
+  collective = .false.
+  if (me /= 0) then
+    ! the contact iteration is rank 0's; the others wait for its contact forces
+  else if (d%solver%method == METHOD_MONOLITHIC) then
     call solve_monolithic(d%solver, itf, cb, res, stop_requested)
   else
     ckpt%file = checkpoint_file(d%output%file)
@@ -175,12 +242,16 @@ program robin_contact
     call solve_robin(d%solver, itf, cb, res, output_unit, d%output%progress_lines, state, ckpt, stop_requested)
     if (ckpt%failed) call warn(ckpt%message)
   end if
-  if (res%status /= 'failed') call error_bound(itf, cb, res)
+  if (me == 0 .and. res%status /= 'failed') call error_bound(itf, cb, res)
+  collective = .true.
+  if (use_mumps) call share_contact_forces()
   ! displacements of both bodies under their own contact forces
   maxndof = max(sys(1)%ndof, sys(2)%ndof)
   allocate (u(maxndof, 2))
   u = 0.0_wp
-  if (res%status /= 'failed') then
+  if (use_mumps .and. res%status /= 'failed') then
+    call recover_mumps()
+  else if (res%status /= 'failed') then
     !$omp parallel do num_threads(nthr) schedule(static, 1) private(ufree)
     do a = 1, 2
       allocate (ufree(sys(a)%n))
@@ -212,7 +283,8 @@ program robin_contact
   ! ---- output -------------------------------------------------------------------------
   call phase('output')
   t0 = wtime()
-  if (code /= EXIT_NUMERICAL) then
+  collective = .false.
+  if (code /= EXIT_NUMERICAL .and. me == 0) then
     tm%peak_rss_mb = peak_rss_mb()
     tm%total = wtime() - t_start
     call write_results(d%output%file, d, msh, sys, itf, res, u, tm, ok, msg1)
@@ -221,13 +293,166 @@ program robin_contact
     ! a converged run has no use for its checkpoint; a run that stopped keeps it
     if (code == EXIT_OK) call remove_file(checkpoint_file(d%output%file))
   end if
+  collective = .true.
+  if (use_mumps) then
+    ! rank 0 decides the exit code (the output may have failed there)
+    info(1) = code
+    call par_bcast_ints(info, 1, 0)
+    code = info(1)
+  end if
   tm%output = wtime() - t0
   tm%total = wtime() - t_start
   tm%peak_rss_mb = peak_rss_mb()
   call summary()
-  call terminate(code)
+  call finish(code)
 
 contains
+
+  !> End the run with code on every rank (MPI binary: MUMPS instances freed, MPI finalized).
+  subroutine finish(code)
+    integer, intent(in) :: code
+    integer :: b
+    if (use_mumps) then
+      do b = 1, 2
+        if (mine(b)) call mumps_end(mt(b))
+      end do
+    end if
+    call par_finalize()
+    call terminate(code)
+  end subroutine finish
+
+  !> The MPI binary's fatal-error route: rank 0 prints the one message; when every rank
+  !! meets the error alike (the deck, a status agreed by par_agree) they all finalize and
+  !! exit with the code, otherwise (rank 0's output, its contact iteration) MPI_Abort ends
+  !! them all with it.
+  subroutine par_fatal(code, msg)
+    integer, intent(in) :: code
+    character(len=*), intent(in) :: msg
+    if (me == 0) write (error_unit, '(a)') 'robin_contact: error: '//trim(msg)
+    flush (error_unit)
+    if (collective) then
+      call par_finalize()
+      call terminate(code)
+    end if
+    call par_abort(code)
+  end subroutine par_fatal
+
+  !> Split the ranks into one group per body (MPI_Comm_split): one rank does both bodies
+  !! in turn; otherwise half each, an odd one out to the body with more unknowns. The
+  !! lower world ranks form body 1's group, so world rank 0 hosts body 1.
+  subroutine mumps_groups()
+    integer :: g1, b
+    if (nranks == 1) then
+      mine = .true.
+      host = 0
+      call par_split(0, gcomm)
+      return
+    end if
+    g1 = nranks/2
+    if (mod(nranks, 2) == 1 .and. sys(1)%n >= sys(2)%n) g1 = g1 + 1
+    host = [0, g1]
+    mine = [me < g1, me >= g1]
+    gsize = [g1, nranks - g1]
+    grank = [me, me - g1]
+    do b = 1, 2
+      if (merge(g1, nranks - g1, b == 1) > msh(b)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(d%source)// &
+        ': '//i2s(merge(g1, nranks - g1, b == 1))//' ranks for body '//achar(48 + b)//', which has '// &
+        i2s(msh(b)%ncell)//' cells: use at most '//i2s(2*min(msh(1)%ncell, msh(2)%ncell))//' ranks')
+    end do
+    call par_split(merge(1, 2, me < g1), gcomm)
+    write (output_unit, '(a,i0,a,i0,a)') 'mumps: ', g1, ' rank(s) on body 1, ', nranks - g1, ' on body 2'
+  end subroutine mumps_groups
+
+  !> Every rank learns the worst status of the bodies' groups; a failure is fatal (exit 3)
+  !! on all ranks with the message of the lowest failing rank.
+  subroutine agree_fatal(what)
+    character(len=*), intent(in) :: what
+    integer :: st, b
+    character(len=512) :: m1
+    st = 0
+    m1 = ''
+    do b = 2, 1, -1
+      if (info(b) /= 0) then
+        st = EXIT_NUMERICAL
+        m1 = 'body '//achar(48 + b)//': '//what//': '//trim(msg(b))
+      end if
+    end do
+    call par_agree(st, m1)
+    if (st /= 0) call fatal(st, trim(m1))
+  end subroutine agree_fatal
+
+  !> Each group's host sends its body's F_a, b_a and the proximal weight to every rank.
+  subroutine share_condensed()
+    integer :: b, iv(1)
+    real(wp) :: rv(3)
+    do b = 1, 2
+      if (.not. (mine(b) .and. mt(b)%host)) then
+        if (allocated(cb(b)%flex)) deallocate (cb(b)%flex)
+        allocate (cb(b)%flex(itf%m, itf%m))
+        cb(b)%m = itf%m
+      end if
+      if (.not. allocated(cb(b)%b)) allocate (cb(b)%b(itf%m))
+      call par_bcast_reals(cb(b)%flex, itf%m*itf%m, host(b))
+      call par_bcast_reals(cb(b)%b, itf%m, host(b))
+      rv = [cb(b)%prox, mt(b)%mem_bytes, mt(b)%max_rank_mb]
+      call par_bcast_reals(rv, 3, host(b))
+      cb(b)%prox = rv(1)
+      mt(b)%mem_bytes = rv(2)
+      mt(b)%max_rank_mb = rv(3)
+      iv(1) = cb(b)%rank
+      call par_bcast_ints(iv, 1, host(b))
+      cb(b)%rank = iv(1)
+      info(b) = 0
+    end do
+    write (output_unit, '(a,2(f0.1,a))') 'mumps: largest rank''s factorization memory: body 1 ', &
+      mt(1)%max_rank_mb, ' MB, body 2 ', mt(2)%max_rank_mb, ' MB'
+  end subroutine share_condensed
+
+  !> Rank 0's contact forces and status to every rank (the others need lam to recover their
+  !! body's displacement, and the status to end alike).
+  subroutine share_contact_forces()
+    integer :: iv(1)
+    iv(1) = 0
+    if (me == 0) then
+      select case (trim(res%status))
+      case ('failed')
+        iv(1) = 1
+      case ('converged')
+        iv(1) = 0
+      case default
+        iv(1) = 2
+      end select
+    end if
+    call par_bcast_ints(iv, 1, 0)
+    if (me /= 0) then
+      res%status = merge('failed   ', 'converged', iv(1) == 1)
+      if (iv(1) == 2) res%status = 'other'
+      if (allocated(res%lam_body)) deallocate (res%lam_body)
+      allocate (res%lam_body(itf%m, 2))
+    end if
+    if (iv(1) /= 1) call par_bcast_reals(res%lam_body, 2*itf%m, 0)
+  end subroutine share_contact_forces
+
+  !> Each group solves its body under its contact forces; the hosts send the displacements
+  !! to rank 0 (broadcast: every rank receives them in this first version).
+  subroutine recover_mumps()
+    integer :: b
+    real(wp), allocatable :: uf(:)
+    do b = 1, 2
+      info(b) = 0
+      msg(b) = ''
+      if (.not. mine(b)) cycle
+      allocate (uf(sys(b)%n))
+      uf = 0.0_wp
+      call recover_displacement_mumps(sys(b), cb(b), mt(b), b, res%lam_body(:, b), uf, info(b), msg(b))
+      if (mt(b)%host) call expand(sys(b), uf, u(1:sys(b)%ndof, b))
+      deallocate (uf)
+    end do
+    call agree_fatal('displacement recovery failed')
+    do b = 1, 2
+      if (host(b) /= 0) call par_bcast_reals(u(1, b), sys(b)%ndof, host(b))
+    end do
+  end subroutine recover_mumps
 
   !> One line as each phase starts (flushed), so that a batch log shows where a run is.
   subroutine phase(what)
@@ -257,7 +482,7 @@ contains
   !! the phase with exit 4. There is nothing to checkpoint yet and nothing is written.
   subroutine check_interrupt(phase)
     character(len=*), intent(in) :: phase
-    if (.not. stop_requested()) return
+    if (.not. par_any(stop_requested())) return
     res%status = 'interrupted'
     res%method = merge('robin     ', 'monolithic', d%solver%method == METHOD_ROBIN)
     code = EXIT_INTERRUPTED
@@ -266,7 +491,7 @@ contains
     tm%total = wtime() - t_start
     tm%peak_rss_mb = peak_rss_mb()
     call summary()
-    call terminate(code)
+    call finish(code)
   end subroutine check_interrupt
 
   !> The closing lines. A summary that cannot be written (standard output on a full disk or
@@ -275,6 +500,7 @@ contains
     real(wp) :: ftot
     character(len=1024) :: line(5)
     integer :: err(5), k
+    if (me /= 0) return
     err = 0
     ftot = 0.0_wp
     if (allocated(res%lam)) ftot = sum(res%lam)
@@ -334,7 +560,7 @@ contains
     call get_command_argument(1, arg, l)
     if (trim(arg) == '-h' .or. trim(arg) == '--help') then
       write (output_unit, '(a)') deck_usage
-      call terminate(EXIT_OK)
+      call finish(EXIT_OK)
     end if
     path = trim(arg)
     restart = ''

@@ -51,7 +51,7 @@ program test_fem
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
-                      body_force_fn
+                      body_force_fn, cell_triplets
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
   use testing, only: report, test_summary, solve_full
   implicit none (type, external)
@@ -71,6 +71,9 @@ program test_fem
   call test_units(ELEM_Q1, .true.)
   call test_units(ELEM_P1, .false.)
   call test_errors()
+  call test_triplets(ELEM_Q1, 1)
+  call test_triplets(ELEM_Q1, 3)
+  call test_triplets(ELEM_P1, 4)
 
   call test_summary()
 
@@ -141,6 +144,57 @@ contains
   ! ---------------------------------------------------------------------------------
   !> CSC structure: counts, sorted rows, symmetry, matvec against the element loop,
   !! the lifting of prescribed values, rigid-body modes.
+  !> The distributed assembly of the MPI binary: the cells split in nparts consecutive
+  !! shares (as ranks r of a body's group take them), each share's triplets
+  !! (cell_triplets) summed add up to the serial matrix's lower triangle; assemble_body
+  !! with matrix=.false. gives the same DOF numbering and load without a matrix.
+  subroutine test_triplets(element, nparts)
+    integer, intent(in) :: element, nparts
+    type(body_cfg_t) :: body
+    type(mesh_t) :: m
+    type(body_system_t) :: sys, sys0
+    type(traction_cfg_t) :: tr(1)
+    integer :: info, r, q, j, p
+    integer, allocatable :: irn(:), jcn(:)
+    real(wp), allocatable :: a(:), dense(:, :), ref(:, :)
+    character(len=256) :: msg
+    character(len=32) :: what
+
+    write (what, '(a,a,i0,a)') trim(element_names(element)), ' ', nparts, ' shares:'
+    body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, 7, 4, element, young=70.0_wp, poisson=0.33_wp)
+    body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
+    body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
+    tr(1)%body = 1
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [0.3_wp, -1.0_wp]
+    call mesh_build(m, body)
+    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys0, info, msg, matrix=.false.)
+    call report(info == 0 .and. .not. allocated(sys0%val) .and. sys0%n == sys%n .and. &
+                all(sys0%free_of == sys%free_of) .and. maxval(abs(sys0%f - sys%f)) <= 1.0e-14_wp*maxval(abs(sys%f)), &
+                trim(what)//' assemble_body(matrix=.false.): same numbering and load, no matrix')
+    allocate (dense(sys%n, sys%n), ref(sys%n, sys%n))
+    dense = 0.0_wp
+    ref = 0.0_wp
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        if (sys%rowind(p) + 1 >= j) ref(sys%rowind(p) + 1, j) = sys%val(p)
+      end do
+    end do
+    do r = 0, nparts - 1
+      call cell_triplets(m, body, .true., sys0, r*m%ncell/nparts + 1, (r + 1)*m%ncell/nparts, irn, jcn, a, info, msg)
+      if (info /= 0 .or. any(irn < jcn)) then
+        call report(.false., trim(what)//' cell_triplets info = 0, lower triangle only')
+        return
+      end if
+      do q = 1, size(a)
+        dense(irn(q), jcn(q)) = dense(irn(q), jcn(q)) + a(q)
+      end do
+    end do
+    call report(maxval(abs(dense - ref)) <= 1.0e-13_wp*maxval(abs(ref)), trim(what)// &
+                ' the shares add up to the serial matrix (lower triangle)', maxval(abs(dense - ref))/maxval(abs(ref)), 1.0e-13_wp)
+  end subroutine test_triplets
+
   subroutine test_structure(element)
     integer, intent(in) :: element
     type(body_cfg_t) :: body

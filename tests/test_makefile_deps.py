@@ -20,7 +20,8 @@ for f in glob.glob("src/**/*.f90", recursive=True):
     m = re.search(r"^\s*module\s+(\w+)\s*$", text, re.M | re.I)
     name = m.group(1).lower() if m else os.path.basename(f)[:-4]
     path[name] = f
-    uses[name] = {u.lower() for u in re.findall(r"^\s*use\s+(\w+)", text, re.M | re.I)}
+    # a module with a serial and an MPI source (mpi_env, mumps_iface): the union of their uses
+    uses.setdefault(name, set()).update(u.lower() for u in re.findall(r"^\s*use\s+(\w+)", text, re.M | re.I))
 own = set(path)
 
 mk = re.sub(r"\\\n", " ", open("Makefile").read())

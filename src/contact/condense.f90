@@ -73,7 +73,8 @@ module condense
     real(wp) :: t_condense = 0.0_wp         !< wall time of F_a and b_a [s]
   end type body_condensed_t
 
-  public :: build_interface, factor_body, condense_body, recover_displacement, apply_bt, apply_b
+  public :: build_interface, factor_body, condense_body, recover_displacement, apply_bt, apply_b, &
+            interface_dofs, flex_from_x
 
 contains
 
@@ -349,10 +350,10 @@ contains
   !! order the rows first touch them (these are ordered last in the factorization), the
   !! rows over their positions, and the constant part on prescribed DOFs.
   subroutine interface_dofs(itf, a, sys, bc)
-    type(interface_t), intent(in) :: itf
-    integer, intent(in) :: a
-    type(body_system_t), intent(in) :: sys
-    type(body_condensed_t), intent(inout) :: bc
+    type(interface_t), intent(in) :: itf             !< the contact line
+    integer, intent(in) :: a                         !< body number
+    type(body_system_t), intent(in) :: sys           !< assembled system of body a
+    type(body_condensed_t), intent(inout) :: bc      !< receives m, n, idx and the rows on it
     integer :: i, e, p, k, ne
     integer, allocatable :: pos_of(:), idx(:)
 
@@ -443,18 +444,16 @@ contains
     integer, intent(out) :: info                     !< 0 ok
     character(len=*), intent(out) :: msg             !< description of a failure
     real(wp) :: t0
-    integer :: i, j, e, f, k, st
-    real(wp) :: acc
+    integer :: k, st
     real(wp), allocatable :: x(:, :)
     t0 = wtime()
     if (allocated(bc%flex)) deallocate (bc%flex)
     if (allocated(bc%b)) deallocate (bc%b)
     if (allocated(bc%u0)) deallocate (bc%u0)
-    allocate (bc%flex(bc%m, bc%m), bc%b(bc%m), bc%u0(sys%n))
+    allocate (bc%b(bc%m), bc%u0(sys%n))
     info = 0
     msg = ''
     k = size(bc%idx)
-    if (bc%m > 0) bc%flex = 0.0_wp
     if (bc%m > 0 .and. k > 0) then
       ! X = (K^-1) on the interface DOFs, then F = B X B' over the few entries of each row
       allocate (x(k, k), stat=st)
@@ -465,6 +464,28 @@ contains
       end if
       call bc%chol%flexibility(bc%idx, spread(1.0_wp, 1, k), x, info, msg)
       if (info /= 0) return
+    end if
+    if (.not. allocated(x)) allocate (x(0, 0))
+    call flex_from_x(bc, x)
+    bc%u0 = sys%f
+    call bc%chol%solve(bc%u0, info, msg)
+    if (info /= 0) return
+    call apply_b(bc, bc%u0, bc%b)
+    bc%t_condense = wtime() - t0
+  end subroutine condense_body
+
+  !> F_a = B_a X B_a' from X = (K_a^-1) on the interface DOFs bc%idx (any factorization:
+  !! CHOLMOD's trailing block or MUMPS's inverse Schur complement), over the few entries of
+  !! each row; then F_a's numerical rank and the proximal weight (flex_rank).
+  subroutine flex_from_x(bc, x)
+    type(body_condensed_t), intent(inout) :: bc      !< body with its rows; receives flex, rank, prox
+    real(wp), intent(in) :: x(:, :)                  !< (k,k) (K_a^-1) on bc%idx [length/force]
+    integer :: i, j, e, f
+    real(wp) :: acc
+    if (allocated(bc%flex)) deallocate (bc%flex)
+    allocate (bc%flex(bc%m, bc%m))
+    if (bc%m > 0) bc%flex = 0.0_wp
+    if (bc%m > 0 .and. size(bc%idx) > 0) then
       do j = 1, bc%m
         do i = 1, bc%m
           acc = 0.0_wp
@@ -480,12 +501,7 @@ contains
     bc%rank = bc%m
     bc%prox = 0.0_wp
     if (bc%m > 0 .and. .not. selection_rows(bc)) call flex_rank(bc)
-    bc%u0 = sys%f
-    call bc%chol%solve(bc%u0, info, msg)
-    if (info /= 0) return
-    call apply_b(bc, bc%u0, bc%b)
-    bc%t_condense = wtime() - t0
-  end subroutine condense_body
+  end subroutine flex_from_x
 
   !> True when every row of B_a picks one DOF, each a different one (F_a is then a principal
   !! block of K_a^-1 up to signs, positive definite).

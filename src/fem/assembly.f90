@@ -22,7 +22,7 @@ module assembly
   implicit none (type, external)
   private
 
-  public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters
+  public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters, cell_triplets
   public :: body_force_fn
 
   !> The linear system of one body on its free DOFs.
@@ -68,7 +68,7 @@ contains
   !! f -= K_fd u_d. Tractions with %body == body%id are integrated exactly on the side.
   !! On an impossible input `info` is non-zero, `msg` says why, and `sys` is incomplete.
   subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, info, msg, &
-                           u_prescribed, body_force, boundaries)
+                           u_prescribed, body_force, boundaries, matrix)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -86,8 +86,16 @@ contains
     !> optional prescribed components on named edge groups (&boundary; those of other
     !! bodies are skipped), applied after the side conditions, in order
     type(boundary_cfg_t), intent(in), optional :: boundaries(:)
+    !> .false.: no stiffness matrix (colptr, rowind, val stay unallocated, k_norm 0): the
+    !! DOF numbering and the load only, for a run whose ranks each assemble their share of
+    !! the cells (cell_triplets); default .true.
+    logical, intent(in), optional :: matrix
     logical, allocatable :: pres(:)
     real(wp) :: lame_lambda, lame_mu
+    logical :: with_k
+
+    with_k = .true.
+    if (present(matrix)) with_k = matrix
 
     sys%id = body%id
     call check_input(mesh, body, tractions, ntraction, info, msg, u_prescribed)
@@ -104,15 +112,74 @@ contains
       end if
     end if
     call number_free_dofs(pres, sys)
-    call stiffness_pattern(mesh, sys, info, msg)
-    if (info /= 0) return
+    if (with_k) then
+      call stiffness_pattern(mesh, sys, info, msg)
+      if (info /= 0) return
+    end if
     call applied_loads(mesh, body%id, tractions(1:ntraction), sys, info, msg, body_force)
     if (info /= 0) return
-    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg)
+    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg, with_k)
     if (info /= 0) return
     call add_applied_loads(sys)
-    sys%k_norm = stiffness_norm(sys)
+    if (with_k) sys%k_norm = stiffness_norm(sys)
   end subroutine assemble_body
+
+  !> The stiffness entries of cells c1..c2 on the free DOFs as coordinate triplets of the
+  !! lower triangle (1-based free indices, row >= column; a DOF pair shared by cells
+  !! appears once per cell, to be summed): one rank's share of the matrix, MUMPS's
+  !! distributed assembled input (ICNTL(18) = 3). sys needs its DOF numbering only
+  !! (assemble_body with matrix=.false.). info = 7 on a cell with a non-positive Jacobian.
+  subroutine cell_triplets(mesh, body, plane_strain, sys, c1, c2, irn, jcn, a, info, msg)
+    type(mesh_t), intent(in) :: mesh                     !< the body's mesh
+    type(body_cfg_t), intent(in) :: body                 !< material
+    logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
+    type(body_system_t), intent(in) :: sys               !< the body's DOF numbering (free_of)
+    integer, intent(in) :: c1, c2                        !< the cells, c1..c2 (none if c2 < c1)
+    integer, allocatable, intent(out) :: irn(:), jcn(:)  !< row and column of each entry (free, 1-based)
+    real(wp), allocatable, intent(out) :: a(:)           !< the entries [stress]
+    integer, intent(out) :: info                         !< 0 ok, 7 bad cell
+    character(len=*), intent(out) :: msg                 !< error sentence when info /= 0
+    integer :: c, nd, i, j, q, fi, fj, ldof(MAX_NDOF)
+    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), minjac, lame_lambda, lame_mu
+    type(ke_cache_t) :: cache
+    integer, allocatable :: ti(:), tj(:)
+    real(wp), allocatable :: ta(:)
+
+    info = 0
+    msg = ''
+    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    call ke_cache_init(cache, maxval(abs(mesh%xy)))
+    q = max(0, c2 - c1 + 1)*(MAX_NDOF*(MAX_NDOF + 1))/2
+    allocate (ti(q), tj(q), ta(q))
+    q = 0
+    do c = max(1, c1), min(mesh%ncell, c2)
+      nd = 2*cell_nv(mesh, c)
+      call cell_coords(mesh, c, xe)
+      call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+      if (.not. (minjac > 0.0_wp)) then
+        info = 7
+        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': cell ', mesh%cell_tag(c), &
+          ' has a non-positive Jacobian (inverted or degenerate element)'
+        return
+      end if
+      call cell_dofs(mesh, c, ldof)
+      do j = 1, nd
+        fj = sys%free_of(ldof(j))
+        if (fj == 0) cycle
+        do i = 1, nd
+          fi = sys%free_of(ldof(i))
+          if (fi < fj) cycle
+          q = q + 1
+          ti(q) = fi
+          tj(q) = fj
+          ta(q) = ke(i, j)
+        end do
+      end do
+    end do
+    irn = ti(1:q)
+    jcn = tj(1:q)
+    a = ta(1:q)
+  end subroutine cell_triplets
 
   !> Check the arguments of assemble_body: a built mesh of a known element, a valid
   !! material, known side conditions, tractions on sides 1..4, u_prescribed of size ndof.
@@ -573,12 +640,13 @@ contains
   !> The element loop: each cell's stiffness into the CSC values, and the lifting
   !! f -= K_fd u_d of its prescribed values. info = 7 on a cell with a non-positive
   !! Jacobian, 8 on a coupling outside the pattern (an internal error).
-  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg)
+  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg, with_k)
     type(mesh_t), intent(in) :: mesh
     real(wp), intent(in) :: lame_lambda, lame_mu
     type(body_system_t), intent(inout) :: sys
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
+    logical, intent(in) :: with_k                       ! .false.: the lifting only
     integer :: c, nd, ldof(MAX_NDOF)
     real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), minjac
     type(ke_cache_t) :: cache
@@ -597,7 +665,7 @@ contains
         return
       end if
       call cell_dofs(mesh, c, ldof)
-      call scatter_element(sys, ldof(1:nd), ke, info)
+      if (with_k) call scatter_element(sys, ldof(1:nd), ke, info)
       if (info /= 0) then
         write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': internal error, cell ', c, &
           ' couples DOFs outside the stiffness pattern'

@@ -44,7 +44,8 @@ module config
 
   integer, parameter, public :: FACTOR_CHOLMOD = 1   !< sparse Cholesky (SuiteSparse CHOLMOD)
   integer, parameter, public :: FACTOR_BANDED = 2    !< banded Cholesky (RCM + LAPACK dpbtrf)
-  character(len=*), parameter, public :: FACTOR_CHOICES = 'cholmod banded'
+  integer, parameter, public :: FACTOR_MUMPS = 3     !< MUMPS over MPI ranks, interface as Schur variables (bin/robin_contact_mpi)
+  character(len=*), parameter, public :: FACTOR_CHOICES = 'cholmod banded mumps'
 
   integer, parameter, public :: ORDER_METIS = 1      !< CHOLMOD with METIS nested dissection
   integer, parameter, public :: ORDER_AMD = 2        !< CHOLMOD with AMD

@@ -1,0 +1,64 @@
+!> The serial binary's stand-in for module mumps_iface (mumps_iface.f90, MPI build only):
+!! the same API, and every call is an error, so the code that uses it compiles in both
+!! binaries. The driver refuses factorization='mumps' before any call reaches here.
+module mumps_iface
+  use kinds, only: wp
+  implicit none (type, external)
+  private
+
+  logical, parameter, public :: mumps_built = .false.   !< this binary has no MUMPS
+
+  !> Placeholder of one factorized body.
+  type, public :: mumps_t
+    logical :: host = .true.                  !< this rank is the group's host
+    integer :: n = 0                          !< unknowns
+    integer :: k = 0                          !< Schur (interface) variables
+    real(wp), allocatable :: x(:, :)          !< (k,k) S^-1 (never set here)
+    real(wp) :: mem_bytes = 0.0_wp            !< factor memory [byte]
+    real(wp) :: max_rank_mb = 0.0_wp          !< the largest rank's factorization memory [MiB]
+  end type mumps_t
+
+  public :: mumps_schur_factor, mumps_solve, mumps_end, mumps_error_text
+
+  character(len=*), parameter :: NONE = 'this binary is built without MUMPS: run bin/robin_contact_mpi under mpirun'
+
+contains
+
+  !> Not available: info = 1.
+  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, info, msg)
+    type(mumps_t), intent(inout) :: mt
+    integer, intent(in) :: comm, n, irn(:), jcn(:), schur(:), body
+    real(wp), intent(in) :: val(:)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    mt%n = n + 0*(comm + body + size(irn) + size(jcn) + size(val) + size(schur))
+    info = 1
+    msg = NONE
+  end subroutine mumps_schur_factor
+
+  !> Not available: info = 1.
+  subroutine mumps_solve(mt, r, body, info, msg)
+    type(mumps_t), intent(inout) :: mt
+    real(wp), intent(inout) :: r(:)
+    integer, intent(in) :: body
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    mt%k = mt%k + 0*(size(r) + body)
+    info = 1
+    msg = NONE
+  end subroutine mumps_solve
+
+  !> Nothing to free.
+  subroutine mumps_end(mt)
+    type(mumps_t), intent(inout) :: mt
+    mt%k = 0
+  end subroutine mumps_end
+
+  !> A sentence for a MUMPS error code.
+  function mumps_error_text(info1, info2, body) result(s)
+    integer, intent(in) :: info1, info2, body
+    character(len=:), allocatable :: s
+    s = NONE//repeat(' ', 0*(info1 + info2 + body))
+  end function mumps_error_text
+
+end module mumps_iface

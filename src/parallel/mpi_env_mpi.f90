@@ -1,0 +1,110 @@
+!> The parallel environment of bin/robin_contact_mpi: MPI_COMM_WORLD, its split into one
+!! group per body, and the few collectives the driver needs on interface-sized data
+!! (broadcasts of small arrays, agreement on a status). The serial binary compiles
+!! mpi_env_serial.f90 instead, with the same API.
+module mpi_env
+  use kinds, only: wp
+  use mpi
+  implicit none (type, external)
+  private
+
+  logical, parameter, public :: par_built = .true.    !< .true. only in bin/robin_contact_mpi
+
+  public :: par_init, par_finalize, par_rank, par_size, par_split, par_bcast_reals, par_bcast_ints, &
+            par_bcast_str, par_agree, par_any, par_abort, par_comm_world
+
+contains
+
+  !> Start MPI (once).
+  subroutine par_init()
+    integer :: ierr
+    logical :: up
+    call MPI_Initialized(up, ierr)
+    if (.not. up) call MPI_Init(ierr)
+  end subroutine par_init
+
+  !> End MPI (every rank calls it, collectively).
+  subroutine par_finalize()
+    integer :: ierr
+    logical :: up, down
+    call MPI_Initialized(up, ierr)
+    call MPI_Finalized(down, ierr)
+    if (up .and. .not. down) call MPI_Finalize(ierr)
+  end subroutine par_finalize
+
+  !> This rank in MPI_COMM_WORLD.
+  integer function par_rank()
+    integer :: ierr
+    call MPI_Comm_rank(MPI_COMM_WORLD, par_rank, ierr)
+  end function par_rank
+
+  !> Ranks in MPI_COMM_WORLD.
+  integer function par_size()
+    integer :: ierr
+    call MPI_Comm_size(MPI_COMM_WORLD, par_size, ierr)
+  end function par_size
+
+  !> MPI_COMM_WORLD (the handle MUMPS takes).
+  integer function par_comm_world()
+    par_comm_world = MPI_COMM_WORLD
+  end function par_comm_world
+
+  !> Split MPI_COMM_WORLD by color (MPI_Comm_split, ranks keep their world order).
+  subroutine par_split(color, comm)
+    integer, intent(in) :: color     !< group of this rank
+    integer, intent(out) :: comm     !< the group's communicator
+    integer :: ierr
+    call MPI_Comm_split(MPI_COMM_WORLD, color, par_rank(), comm, ierr)
+  end subroutine par_split
+
+  !> Broadcast n reals from world rank root.
+  subroutine par_bcast_reals(x, n, root)
+    integer, intent(in) :: n, root
+    real(wp), intent(inout) :: x(*)
+    integer :: ierr
+    if (n > 0) call MPI_Bcast(x, n, MPI_DOUBLE_PRECISION, root, MPI_COMM_WORLD, ierr)
+  end subroutine par_bcast_reals
+
+  !> Broadcast n integers from world rank root.
+  subroutine par_bcast_ints(x, n, root)
+    integer, intent(in) :: n, root
+    integer, intent(inout) :: x(*)
+    integer :: ierr
+    if (n > 0) call MPI_Bcast(x, n, MPI_INTEGER, root, MPI_COMM_WORLD, ierr)
+  end subroutine par_bcast_ints
+
+  !> Broadcast a string from world rank root.
+  subroutine par_bcast_str(s, root)
+    character(len=*), intent(inout) :: s
+    integer, intent(in) :: root
+    integer :: ierr
+    call MPI_Bcast(s, len(s), MPI_CHARACTER, root, MPI_COMM_WORLD, ierr)
+  end subroutine par_bcast_str
+
+  !> Agree on a status: every rank ends with the largest info of all ranks and the message
+  !! of the lowest rank that has it (collective over the world).
+  subroutine par_agree(info, msg)
+    integer, intent(inout) :: info         !< in: this rank's status; out: the world's
+    character(len=*), intent(inout) :: msg  !< in: this rank's message; out: the chosen one
+    integer :: pair(2), best(2), ierr
+    pair = [info, par_rank()]
+    call MPI_Allreduce(pair, best, 1, MPI_2INTEGER, MPI_MAXLOC, MPI_COMM_WORLD, ierr)
+    info = best(1)
+    if (info /= 0) call MPI_Bcast(msg, len(msg), MPI_CHARACTER, best(2), MPI_COMM_WORLD, ierr)
+  end subroutine par_agree
+
+  !> Whether flag is true on any rank (collective).
+  logical function par_any(flag)
+    logical, intent(in) :: flag
+    integer :: ierr
+    call MPI_Allreduce(flag, par_any, 1, MPI_LOGICAL, MPI_LOR, MPI_COMM_WORLD, ierr)
+  end function par_any
+
+  !> Stop every rank with code (MPI_Abort): only for a failure that one rank meets alone.
+  subroutine par_abort(code)
+    integer, intent(in) :: code
+    integer :: ierr
+    call MPI_Abort(MPI_COMM_WORLD, code, ierr)
+  end subroutine par_abort
+
+end module mpi_env
