@@ -203,7 +203,7 @@ contains
     type(traction_cfg_t) :: tr(1)
     integer :: info, i, j, p, q, nnz_expect, k
     character(len=256) :: msg
-    character(len=2) :: en
+    character(len=5) :: en
     logical :: sorted, found
     real(wp) :: asym, diff, scale, x(200), y(200), lame_lambda, lame_mu, x0, x1, y0, y1, ix2, iy2, ixy, energy
     real(wp), allocatable :: uf(:), r(:), u(:)
@@ -218,18 +218,18 @@ contains
     tr(1)%t1 = [0.0_wp, 0.5_wp]
     call mesh_build(m, body)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call report(info == 0, en//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
+    call report(info == 0, trim(en)//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
 
     ! 6 x 4 nodes = 48 dofs; left clamped 8, bottom roller 5 more y's, right both 8
     ! minus the bottom-right y already prescribed: 7; free 48 - 20 = 28.
-    call report(sys%n == 28, en//' free dof count (expect 28)', real(sys%n, wp), 0.0_wp)
+    call report(sys%n == 28, trim(en)//' free dof count (expect 28)', real(sys%n, wp), 0.0_wp)
     call report(sys%u_fixed(2*6) == 0.0_wp .and. sys%u_fixed(2*6 - 1) == 0.01_wp, &
-                en//' corner rule: bottom-right y takes the later side (roller, 0)', sys%u_fixed(2*6), 0.0_wp)
+                trim(en)//' corner rule: bottom-right y takes the later side (roller, 0)', sys%u_fixed(2*6), 0.0_wp)
 
     ! nnz from first principles: count couplings between free dofs through cells.
     nnz_expect = count_couplings(m, sys)
     call report(sys%colptr(sys%n + 1) == nnz_expect, &
-                en//' nnz equals the free-free couplings through cells', &
+                trim(en)//' nnz equals the free-free couplings through cells', &
                 real(sys%colptr(sys%n + 1), wp), real(nnz_expect, wp))
 
     sorted = .true.
@@ -250,9 +250,9 @@ contains
         if (.not. found) asym = huge(1.0_wp)
       end do
     end do
-    call report(sorted, en//' rows strictly increasing in every column', 0.0_wp, 0.0_wp)
+    call report(sorted, trim(en)//' rows strictly increasing in every column', 0.0_wp, 0.0_wp)
     call report(asym <= 10*eps*sys%k_norm, &
-                en//' pattern and values symmetric (max |Kij-Kji|/|K|)', asym/sys%k_norm, 10*eps)
+                trim(en)//' pattern and values symmetric (max |Kij-Kji|/|K|)', asym/sys%k_norm, 10*eps)
 
     ! Matvec on free dofs + lifting against the element loop on all dofs:
     ! (K_full u_full - f_applied)_free = K_ff u_f - f.
@@ -269,11 +269,11 @@ contains
     end do
     scale = sys%k_norm*maxval(abs(uf)) + maxval(abs(sys%f_applied))
     call report(diff <= 100*eps*scale, &
-                en//' csc_matvec and lifting agree with the element loop', diff/scale, 100*eps)
+                trim(en)//' csc_matvec and lifting agree with the element loop', diff/scale, 100*eps)
 
     ! k_norm is the infinity norm: at least every |K_jj|, at most the sum of all entries.
     call report(sys%k_norm >= maxval(abs(sys%val))*(1 - eps) .and. sys%k_norm <= sum(abs(sys%val)), &
-                en//' k_norm between max |K_jj| and sum |K_ij|', sys%k_norm, 0.0_wp)
+                trim(en)//' k_norm between max |K_jj| and sum |K_ij|', sys%k_norm, 0.0_wp)
 
     ! Rigid-body modes produce no force.
     allocate (u(sys%ndof))
@@ -284,7 +284,7 @@ contains
     end do
     call residual_full(m, body, .true., u, uf, r)
     call report(maxval(abs(r)) <= 100*eps*sys%k_norm*maxval(abs(u)), &
-                en//' rigid-body motion gives zero nodal forces', &
+                trim(en)//' rigid-body motion gives zero nodal forces', &
                 maxval(abs(r))/(sys%k_norm*maxval(abs(u))), 100*eps)
 
     ! Q1: the bilinear field u = (xy, xy) is in the element space; its strain energy
@@ -308,7 +308,7 @@ contains
       energy = (lame_lambda + lame_mu)*(ix2 + iy2 + 2*ixy) + 2*lame_mu*(ix2 + iy2)
       diff = abs(dot_product(u, r) - energy)
       call report(diff <= 1.0e-13_wp*energy, &
-                  en//' strain energy of a bilinear field is exact (rel err)', diff/energy, 1.0e-13_wp)
+                  trim(en)//' strain energy of a bilinear field is exact (rel err)', diff/energy, 1.0e-13_wp)
     end if
   end subroutine test_structure
 
