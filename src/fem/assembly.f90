@@ -140,7 +140,7 @@ contains
     integer, intent(out) :: info                         !< 0 ok, 7 bad cell
     character(len=*), intent(out) :: msg                 !< error sentence when info /= 0
     integer :: c, nd, i, j, q, fi, fj, ldof(MAX_NDOF)
-    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), minjac, lame_lambda, lame_mu
+    real(wp) :: ke(MAX_NDOF, MAX_NDOF), lame_lambda, lame_mu
     type(ke_cache_t) :: cache
     integer, allocatable :: ti(:), tj(:)
     real(wp), allocatable :: ta(:)
@@ -153,16 +153,8 @@ contains
     allocate (ti(q), tj(q), ta(q))
     q = 0
     do c = max(1, c1), min(mesh%ncell, c2)
-      nd = 2*cell_nv(mesh, c)
-      call cell_coords(mesh, c, xe)
-      call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
-      if (.not. (minjac > 0.0_wp)) then
-        info = 7
-        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': cell ', mesh%cell_tag(c), &
-          ' has a non-positive Jacobian (inverted or degenerate element)'
-        return
-      end if
-      call cell_dofs(mesh, c, ldof)
+      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, info, msg)
+      if (info /= 0) return
       do j = 1, nd
         fj = sys%free_of(ldof(j))
         if (fj == 0) cycle
@@ -648,23 +640,15 @@ contains
     character(len=*), intent(out) :: msg
     logical, intent(in) :: with_k                       ! .false.: the lifting only
     integer :: c, nd, ldof(MAX_NDOF)
-    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), minjac
+    real(wp) :: ke(MAX_NDOF, MAX_NDOF)
     type(ke_cache_t) :: cache
 
     info = 0
     msg = ''
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
-      nd = 2*cell_nv(mesh, c)
-      call cell_coords(mesh, c, xe)
-      call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
-      if (.not. (minjac > 0.0_wp)) then
-        info = 7
-        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': cell ', mesh%cell_tag(c), &
-          ' has a non-positive Jacobian (inverted or degenerate element)'
-        return
-      end if
-      call cell_dofs(mesh, c, ldof)
+      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, info, msg)
+      if (info /= 0) return
       if (with_k) call scatter_element(sys, ldof(1:nd), ke, info)
       if (info /= 0) then
         write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': internal error, cell ', c, &
@@ -674,6 +658,30 @@ contains
       call lift_prescribed(sys, ldof(1:nd), ke)
     end do
   end subroutine stiffness_and_lifting
+
+  !> The stiffness of cell c (nd = its DOF count, ldof its global DOFs); info = 7 with a
+  !! message naming the cell's tag when its Jacobian is not positive (inverted or degenerate).
+  subroutine cell_stiffness(mesh, body_id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, info, msg)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: body_id, c
+    real(wp), intent(in) :: lame_lambda, lame_mu
+    type(ke_cache_t), intent(inout) :: cache
+    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)
+    integer, intent(out) :: nd, ldof(MAX_NDOF), info
+    character(len=*), intent(inout) :: msg
+    real(wp) :: xe(2, MAX_NVERT), minjac
+    info = 0
+    nd = 2*cell_nv(mesh, c)
+    call cell_coords(mesh, c, xe)
+    call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+    if (.not. (minjac > 0.0_wp)) then
+      info = 7
+      write (msg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
+        ' has a non-positive Jacobian (inverted or degenerate element)'
+      return
+    end if
+    call cell_dofs(mesh, c, ldof)
+  end subroutine cell_stiffness
 
   !> Add the free-free block of an element stiffness to the CSC values. The element's
   !! DOFs are merged in increasing global (hence free) order with the sorted rows of
