@@ -155,7 +155,7 @@ $(BUILD)/files.o:
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
                            $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
-                           $(BUILD)/history_io.o
+                           $(BUILD)/history_io.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h

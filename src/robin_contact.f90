@@ -72,6 +72,7 @@ program robin_contact
   if (par_built) then
     me = par_rank()
     nranks = par_size()
+    tm%ranks = nranks
     fatal_handler => par_fatal
     ! printing is rank 0's: the others write their standard units to /dev/null
     if (me /= 0) then

@@ -15,10 +15,11 @@ import subprocess
 import sys
 import time
 
+import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools"))
-from rc_common import Checks, read_lam, rel_err, result_fields, run_solver, solver_env  # noqa: E402
+from rc_common import Checks, read_lam, rel_err, result_fields, run_solver, solver_env, text_attr  # noqa: E402
 
 BIN = os.environ.get("BIN", "bin/robin_contact")
 MPI_BIN = os.environ.get("MPI_BIN", "bin/robin_contact_mpi")
@@ -90,6 +91,10 @@ for scene, over in (("paper", []), ("gap", [GAP])):
             check(e is not None and e < 1e-10, f"{what}: contact forces = CHOLMOD's to 1e-10", f"rel. error {e}")
             r = result_fields(q.stdout)
             check(r is not None and r["status"] == "converged", f"{what}: one result line, converged")
+            with h5py.File(out, "r") as f:
+                fa, ra = text_attr(f, "factorization"), int(f.attrs.get("ranks", -1))
+            check(fa == "mumps" and ra == np_, f"{what}: the file says factorization='mumps', ranks={np_}",
+                  f"{fa!r}, {ra}")
             check(q.stdout.count("result: ") == 1 and q.stdout.count("phase: assembly") == 1,
                   f"{what}: progress and summary printed once", f"{q.stdout.count('result: ')} result lines")
 

@@ -13,7 +13,8 @@ module results
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
-  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names
+  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES
+  use strings, only: word
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t
@@ -33,6 +34,7 @@ module results
     real(wp) :: total = 0.0_wp                !< whole run [s]
     real(wp) :: peak_rss_mb = 0.0_wp          !< peak resident memory [MiB]
     real(wp) :: factor_mb = 0.0_wp            !< memory of the two Cholesky factors [MiB]
+    integer :: ranks = 1                      !< MPI processes of the run (1: the serial binary)
   end type timing_t
 
   public :: write_results
@@ -151,6 +153,9 @@ contains
     call write_attr(fid, 'outer_iterations', res%outer, st)
     call write_attr(fid, 'inner_iterations', res%inner, st)
     call write_attr(fid, 'contact_nodes', itf%m, st)
+    ! which engine wrote the file: the factorization and the number of MPI processes
+    call write_attr(fid, 'factorization', trim(word(FACTOR_CHOICES, d%solver%factor%factorization)), st)
+    call write_attr(fid, 'ranks', tm%ranks, st)
     call write_attr(fid, 'residual', res%residual, st)
     call write_attr(fid, 'criterion', res%criterion, st)
     call write_attr(fid, 'imbalance', res%imbalance, st)
