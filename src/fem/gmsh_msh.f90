@@ -110,15 +110,7 @@ contains
     if (cur%info == 0) call parse(cur, d)
     if (cur%info == 0) call build_body(cur, d, trim(region), mesh)
     if (allocated(cur%text)) deallocate (cur%text)
-    info = cur%info
-    msg = ''
-    if (info /= 0) then
-      msg = 'body '//i2s(body_id)//": mesh file '"//trim(path)//"'"
-      if (cur%err_line > 0) msg = trim(msg)//', line '//i2s(cur%err_line)
-      msg = trim(msg)//': '//cur%err//'.'
-      mesh%nnode = 0
-      mesh%ncell = 0
-    end if
+    call outcome(cur, path, body_id, mesh, info, msg)
   end subroutine msh_read
 
   !> Both bodies from one .msh file (the same path for both): the file is read and parsed
@@ -150,17 +142,28 @@ contains
     end do
     !$omp end parallel do
     do a = 1, 2
-      info(a) = cb(a)%info
-      msg(a) = ''
-      if (info(a) /= 0) then
-        msg(a) = 'body '//i2s(a)//": mesh file '"//trim(path)//"'"
-        if (cb(a)%err_line > 0) msg(a) = trim(msg(a))//', line '//i2s(cb(a)%err_line)
-        msg(a) = trim(msg(a))//': '//cb(a)%err//'.'
-        mesh(a)%nnode = 0
-        mesh(a)%ncell = 0
-      end if
+      call outcome(cb(a), path, a, mesh(a), info(a), msg(a))
     end do
   end subroutine msh_read_pair
+
+  !> The status of a read: info from the cursor and, on failure, one sentence naming the body,
+  !! the file and the line, and an empty mesh.
+  subroutine outcome(cur, path, body_id, mesh, info, msg)
+    type(cursor_t), intent(in) :: cur
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: body_id
+    type(mesh_t), intent(inout) :: mesh
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    info = cur%info
+    msg = ''
+    if (info == 0) return
+    msg = 'body '//i2s(body_id)//": mesh file '"//trim(path)//"'"
+    if (cur%err_line > 0) msg = trim(msg)//', line '//i2s(cur%err_line)
+    msg = trim(msg)//': '//cur%err//'.'
+    mesh%nnode = 0
+    mesh%ncell = 0
+  end subroutine outcome
 
   ! ---- errors ---------------------------------------------------------------------------
 
