@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings sorting sysinfo signals mpi_env config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp mortar condense condense_mumps contact_types contact h5io files history_io \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp smalbe mortar condense condense_mumps floating contact_types contact h5io files history_io \
         results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
@@ -134,21 +134,24 @@ $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                           $(BUILD)/elements.o $(BUILD)/linop.o
+                           $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/lapack.o
 $(BUILD)/ordering.o:       $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
+$(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/mprgp.o
 $(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o
 $(BUILD)/condense_mumps.o: $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o $(BUILD)/condense.o \
                            $(BUILD)/mumps_iface.o
+$(BUILD)/floating.o:       $(BUILD)/kinds.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/lapack.o \
+                           $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/strings.o $(BUILD)/config.o \
-                           $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/condense.o \
+                           $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o $(BUILD)/condense.o \
                            $(BUILD)/contact_types.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o
 $(BUILD)/files.o:

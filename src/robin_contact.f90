@@ -25,6 +25,7 @@ program robin_contact
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t
   use contact, only: solve_robin, solve_monolithic, error_bound
+  use floating, only: rigid_rows, check_held, free_list, fixing_list
   use results, only: timing_t, write_results, program_version
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
   use files, only: remove_file
@@ -151,7 +152,8 @@ program robin_contact
   do a = 1, 2
     ! MUMPS: the DOF numbering and the load only; each rank assembles its cells' share later
     call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info(a), msg(a), &
-                       boundaries=d%boundary(1:d%nboundary), matrix=.not. use_mumps)
+                       boundaries=d%boundary(1:d%nboundary), matrix=.not. use_mumps, &
+                       contact_group=d%contact%body_group(a))
   end do
   !$omp end parallel do
   do a = 1, 2
@@ -159,6 +161,19 @@ program robin_contact
   end do
   call build_interface(d%body, d%contact, msh, sys, itf, info1, msg1)
   if (info1 /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg1))
+  ! a body held only by contact: its equilibrium rows, and whether the contact can hold it
+  do a = 1, 2
+    call rigid_rows(itf, a, sys(a), cb(a))
+  end do
+  if (sys(1)%nrig + sys(2)%nrig > 0) then
+    call check_held(sys, cb, info1, msg1)
+    if (info1 /= 0) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg1))
+    do a = 1, 2
+      if (sys(a)%nrig > 0) write (output_unit, '(a)') 'floating: body '//achar(48 + a)//' is held only by '// &
+        'contact (free: '//free_list(sys(a))//'); fixing DOFs for its generalized inverse: '//fixing_list(sys(a))// &
+        '; kernel check |K R|/(|K| |R|) = '//sci(sys(a)%rig_residual)
+    end do
+  end if
   ! the checkpoint to restart from is input too: read and check it before touching any file
   if (len(restart_file) > 0) then
     call checkpoint_read(restart_file, key, itf%m, d%solver%max_outer, state, res, ok, msg1)
@@ -261,6 +276,12 @@ program robin_contact
       deallocate (ufree)
     end do
     !$omp end parallel do
+  end if
+  ! a floating body's rigid part: u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a (rank 0 writes)
+  if (res%status /= 'failed' .and. me == 0) then
+    do a = 1, 2
+      if (sys(a)%nrig > 0) u(1:sys(a)%ndof, a) = u(1:sys(a)%ndof, a) + matmul(sys(a)%rig, res%rigid(1:sys(a)%nrig, a))
+    end do
   end if
   if (res%status /= 'failed' .and. .not. all(ieee_is_finite(u))) then
     ! a derived field that is not finite is a failure, never a result

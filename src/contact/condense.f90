@@ -66,6 +66,12 @@ module condense
     !> (m, m - rank) orthonormal basis Z of the numerical kernel of F_a (unallocated when F_a
     !! is nonsingular): the proximal term and the obstacle act on Z Z' only (contact.f90)
     real(wp), allocatable :: kern(:, :)
+    !> A body held only by contact (assembly: sys%nrig > 0): K_a^-1 above is the generalized
+    !! inverse K_a^+ of the factor with the fixing DOFs removed, and the equilibrium of the
+    !! body is the equality G_a lam = e_a on its contact forces (module floating)
+    integer :: nrig = 0                     !< rigid motions the supports leave free
+    real(wp), allocatable :: rg(:, :)       !< (nrig, m) G_a = R_a' B_a' [-]
+    real(wp), allocatable :: re(:)          !< (nrig) e_a = R_a' f_a [force]
     real(wp), allocatable :: b(:)           !< (m) B_a K_a^-1 f_a [length]
     real(wp), allocatable :: u0(:)          !< (n) K_a^-1 f_a [length]
     type(chol_t) :: chol                    !< the factorization of K_a
@@ -143,7 +149,8 @@ contains
         info = 1
         write (msg, '(a,es12.4,a,i0,a)') 'contact node at s = ', sl(i), &
           ': its normal displacement is prescribed in body ', merge(1, 2, d1 == 0), &
-          ' but free in the other; prescribe it in both or in neither'
+          ' but free in the other; prescribe it in both or in neither (or give the contact by '// &
+          'groups, &contact body1_group/body2_group, whose rows allow it)'
         return
       end if
       keep(i) = d1 > 0

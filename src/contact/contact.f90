@@ -9,9 +9,10 @@ module contact
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC, STOP_RESIDUAL, ACCEL_NONE, ACCEL_AITKEN, ACCEL_ANDERSON
   use linop, only: linop_t, dense_op_t, dense_op_init
   use clock, only: wtime
-  use lapack, only: dsymv, dgemm, dpotrf, dpotrs, dposv, dgels
+  use lapack, only: dsymv, dgemm, dpotrf, dpotrs, dposv, dgels, dsyev, dgesv
   use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, lambda_max_estimate, &
                    MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, mprgp_status_name
+  use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
   use condense, only: interface_t, body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, ANDERSON_DEPTH, &
@@ -24,6 +25,21 @@ module contact
   integer, parameter :: POWER_ITS = 10               !< power iterations for each body's lambda_max (harmonic operator only)
   integer, parameter :: HISTORY_CHUNK = 256          !< initial history entries (grown by doubling)
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
+
+  real(wp), parameter :: RHO_FACTOR = 10.0_wp     !< SMALBE penalty rho = RHO_FACTOR lambda_max(H) / |G G'|
+  real(wp), parameter :: FEAS_RTOL = 1.0e-12_wp     !< equilibrium of a floating body: |G lam - e| <= FEAS_RTOL |e|
+
+  !> The equality rows of a QP with floating bodies (module floating): G lam = e, and the
+  !! SMALBE settings that go with the Hessian H they are added to (A = H + rho G'G).
+  type :: eq_t
+    integer :: r = 0                          !< rows (0: no equality, plain MPRGP)
+    real(wp), allocatable :: g(:, :)          !< (r, m) G [-]
+    real(wp), allocatable :: e(:)             !< (r) e [force]
+    real(wp) :: rho = 0.0_wp                  !< penalty [length/force]
+    real(wp) :: gg = 0.0_wp                   !< lambda_max(G G') [-]
+    real(wp) :: m0 = 0.0_wp                   !< SMALBE's initial M [length/force]
+    real(wp) :: feas = 0.0_wp                 !< |G lam - e| that counts as equilibrium [force]
+  end type eq_t
 
   !> y = alpha x ./ w: the constant Robin operator alpha M^-1 (M: tributary lengths).
   type, extends(linop_t) :: inv_diag_op_t
@@ -61,8 +77,10 @@ contains
     type(dense_op_t) :: op
     type(mprgp_opts_t) :: opts
     type(mprgp_stats_t) :: st
-    real(wp), allocatable :: c(:), lb(:), g(:), lam(:)
-    integer :: m, a
+    type(smalbe_stats_t) :: sst
+    type(eq_t) :: eq
+    real(wp), allocatable :: c(:), lb(:), g(:), lam(:), gs(:, :), es(:), mu(:)
+    integer :: m, a, r1
     real(wp) :: t0
 
     m = itf%m
@@ -77,8 +95,30 @@ contains
     opts%rtol = s%monolithic_rtol
     opts%max_it = s%inner_max_it
     if (present(stop_requested)) opts%stop => stop_requested
+    ! floating bodies: both bodies' equilibrium rows, stacked
+    r1 = bc(1)%nrig
+    if (r1 + bc(2)%nrig > 0 .and. m > 0) then
+      allocate (gs(r1 + bc(2)%nrig, m), es(r1 + bc(2)%nrig), mu(r1 + bc(2)%nrig))
+      if (r1 > 0) gs(1:r1, :) = bc(1)%rg
+      if (r1 > 0) es(1:r1) = bc(1)%re
+      if (bc(2)%nrig > 0) gs(r1 + 1:, :) = bc(2)%rg
+      if (bc(2)%nrig > 0) es(r1 + 1:) = bc(2)%re
+      opts%lambda_max = maxval(sum(abs(op%a), dim=1))
+      call eq_init(eq, gs, es, opts%lambda_max)
+      call eq_add(eq, op, opts%lambda_max)
+      mu = 0.0_wp
+    end if
     if (m > 0) then
-      call mprgp_solve(op, c, lb, lam, opts, st, g)
+      if (eq%r > 0) then
+        call smalbe_solve(op, c, eq%g, eq%e, eq%rho, lb, lam, mu, opts, eq%m0, eq%feas, sst, g)
+        st = sst%inner
+        st%n_matvec = sst%n_matvec
+        res%eq_updates = sst%updates
+        if (r1 > 0) res%rigid(1:r1, 1) = -mu(1:r1)
+        if (bc(2)%nrig > 0) res%rigid(1:bc(2)%nrig, 2) = -mu(r1 + 1:)
+      else
+        call mprgp_solve(op, c, lb, lam, opts, st, g)
+      end if
       res%inner = st%n_matvec
       if (st%status == MPRGP_STOPPED) then
         res%status = 'interrupted'
@@ -97,7 +137,9 @@ contains
     res%lam = lam
     do a = 1, 2
       res%lam_body(:, a) = lam
+      ! B_a u_a with the rigid part B_a R_a alpha_a = G_a' alpha_a of a floating body
       res%w(:, a) = bc(a)%b - matmul(bc(a)%flex, lam)
+      if (bc(a)%nrig > 0) res%w(:, a) = res%w(:, a) + matmul(res%rigid(1:bc(a)%nrig, a), bc(a)%rg)
       res%obstacle(:, a) = 0.0_wp
     end do
     call interface_residual(itf, bc, res)
@@ -131,11 +173,12 @@ contains
     class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     type(robin_state_t) :: st_
-    type(dense_op_t), target :: op(2), opsub(2), pin(2)
+    type(dense_op_t), target :: op(2), opsub(2), pin(2), opc(2)
     type(robin_correction_t) :: corr_op
+    type(eq_t) :: eq(2)
     real(wp), allocatable :: Gnew(:, :), w(:, :), dlam(:), corr(:, :)
     real(wp) :: rtol_in, t0, lmax(2), lsub(2), uref
-    integer :: m, it, every, maxout, info
+    integer :: m, it, every, maxout, info, a
     logical :: printed, resumed
 
     m = itf%m
@@ -157,7 +200,19 @@ contains
 
     call body_operators(bc, op, lmax, st_, resumed, s%robin_operator == ROBIN_HARMONIC)
     call subproblem_operators(bc, op, lmax, s%robin_operator == ROBIN_HARMONIC, opsub, pin, lsub)
-    call robin_correction_init(corr_op, s, itf, bc, op, info)
+    ! a floating body's subproblem has its equilibrium as an equality (SMALBE-M)
+    do a = 1, 2
+      if (bc(a)%nrig == 0 .or. m == 0) cycle
+      call eq_init(eq(a), bc(a)%rg, bc(a)%re, lsub(a))
+      call eq_add(eq(a), opsub(a), lsub(a))
+    end do
+    ! a floating body's correction uses its flexibility on self-equilibrated forces only
+    ! (projected_flex): F_a = B_a K_a^+ B_a' depends on the fixing DOFs along G_a'
+    do a = 1, 2
+      opc(a)%n = 0
+      if (bc(a)%nrig > 0 .and. m > 0) call dense_op_init(opc(a), projected_flex(bc(a)))
+    end do
+    call robin_correction_init(corr_op, s, itf, bc, op, opc, info)
     if (info /= 0) then
       res%status = 'failed'
       write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
@@ -182,7 +237,7 @@ contains
     do it = st_%it + 1, maxout
       ! 1. each body against its obstacle, in parallel
       rtol_in = inner_tolerance(s, it, m, st_%progress, lmax)
-      call solve_subproblems(s, bc, opsub, pin, lsub, rtol_in, it, st_, w, res)
+      call solve_subproblems(s, bc, opsub, pin, eq, lsub, rtol_in, it, st_, w, res)
       if (m == 0) then
         res%status = 'converged'
         res%outer = it
@@ -250,7 +305,9 @@ contains
     do a = 1, 2
       if (itf%m > 0) call op(a)%apply(st%lam(:, a), flam)
       res%w(:, a) = bc(a)%b - flam
+      if (bc(a)%nrig > 0) res%w(:, a) = res%w(:, a) - matmul(st%mu(1:bc(a)%nrig, a), bc(a)%rg)
     end do
+    res%rigid = -st%mu
     call interface_residual(itf, bc, res)
     res%obstacle = st%G
     res%outer = st%it
@@ -378,12 +435,13 @@ contains
   !! diagonal operator) and 'harmonic' (S = 2 F_1 (F_1+F_2)^-1 F_2 for both, a dense
   !! operator, which makes the linearised iteration independent of the contrast of the
   !! bodies: see the README). info /= 0 if F_1 + F_2 is not positive definite.
-  subroutine robin_correction_init(c, s, itf, bc, op, info)
+  subroutine robin_correction_init(c, s, itf, bc, op, opc, info)
     type(robin_correction_t), intent(out) :: c
     type(solver_cfg_t), intent(in) :: s
     type(interface_t), intent(in) :: itf
     type(body_condensed_t), intent(in) :: bc(2)
     type(dense_op_t), target, intent(in) :: op(2)
+    type(dense_op_t), target, intent(in) :: opc(2)   !< floating bodies: P_a F_a P_a (n = 0: use op)
     integer, intent(out) :: info
     real(wp), allocatable :: S_h(:, :)
     info = 0
@@ -402,7 +460,11 @@ contains
     case (ROBIN_HARMONIC)
       allocate (dense_op_t :: c%own)
       if (itf%m > 0) then
-        call harmonic_operator(bc(1)%flex, bc(2)%flex, S_h, info)
+        if (bc(1)%nrig + bc(2)%nrig > 0) then
+          call harmonic_floating(bc, S_h, info)
+        else
+          call harmonic_operator(bc(1)%flex, bc(2)%flex, S_h, info)
+        end if
         if (info /= 0) return
         select type (o => c%own)
         type is (dense_op_t)
@@ -414,10 +476,111 @@ contains
       c%cost = 1
     case default
       c%s1 => op(2)
+      if (opc(2)%n > 0) c%s1 => opc(2)
       c%s2 => op(1)
+      if (opc(1)%n > 0) c%s2 => opc(1)
       c%cost = 2
     end select
   end subroutine robin_correction_init
+
+  !> The harmonic operator with a floating body: S = 2 (Sigma_1 + Sigma_2)^-1 with
+  !! Sigma_a = F_a^-1 for a supported body (then S = 2 F_1 (F_1+F_2)^-1 F_2, the supported
+  !! formula) and, for a floating one, its interface stiffness on balanced forces, the
+  !! projected inverse Q_a = F_a^-1 - F_a^-1 G_a' (G_a F_a^-1 G_a')^-1 G_a F_a^-1
+  !! (independent of the fixing DOFs; zero on the rigid normal displacements G_a'). The
+  !! linearised outer map is then nilpotent at delta = 0.5 as for supported bodies
+  !! (README, "Bodies held only by contact"). One floating body f, the other o supported:
+  !! S = 2 (I + F_o Q_f)^-1 F_o, which needs no inverse of F_o (singular when a mortar row
+  !! has none of body o's free DOFs). Both floating: S = 2 (Q_1 + Q_2)^-1 (definite unless
+  !! the pair is free together, which module floating refuses). info /= 0: a
+  !! factorization failed (a floating body's F_a must be definite).
+  subroutine harmonic_floating(bc, S, info)
+    type(body_condensed_t), intent(in) :: bc(2)
+    real(wp), allocatable, intent(out) :: S(:, :)
+    integer, intent(out) :: info
+    real(wp), allocatable :: q(:, :, :), a(:, :)
+    integer, allocatable :: ipiv(:)
+    integer :: m, f, o, i
+    m = bc(1)%m
+    allocate (q(m, m, 2), S(m, m), a(m, m), ipiv(m))
+    do f = 1, 2
+      if (bc(f)%nrig == 0) cycle
+      call projected_inverse(bc(f), q(:, :, f), info)
+      if (info /= 0) return
+    end do
+    if (bc(1)%nrig > 0 .and. bc(2)%nrig > 0) then
+      a = q(:, :, 1) + q(:, :, 2)
+      a = 0.5_wp*(a + transpose(a))
+      S = 0.0_wp
+      do i = 1, m
+        S(i, i) = 2.0_wp
+      end do
+      call dposv('U', m, m, a, m, S, m, info)
+    else
+      f = merge(1, 2, bc(1)%nrig > 0)
+      o = 3 - f
+      ! (I + F_o Q_f) X = F_o, S = 2 X
+      a = matmul(bc(o)%flex, q(:, :, f))
+      do i = 1, m
+        a(i, i) = a(i, i) + 1.0_wp
+      end do
+      S = 2.0_wp*bc(o)%flex
+      call dgesv(m, m, a, m, ipiv, S, m, info)
+    end if
+    S = 0.5_wp*(S + transpose(S))
+  end subroutine harmonic_floating
+
+  !> The projected inverse Q = F^-1 - F^-1 G' (G F^-1 G')^-1 G F^-1 of a floating body.
+  subroutine projected_inverse(bc, q, info)
+    type(body_condensed_t), intent(in) :: bc
+    real(wp), intent(out) :: q(:, :)
+    integer, intent(out) :: info
+    real(wp), allocatable :: h(:, :), y(:, :), gg(:, :), t(:, :)
+    integer :: m, r, i
+    m = bc%m
+    r = bc%nrig
+    allocate (h(m, m), y(m, r), gg(r, r), t(r, m))
+    h = bc%flex
+    q = 0.0_wp
+    do i = 1, m
+      q(i, i) = 1.0_wp
+    end do
+    call dposv('U', m, m, h, m, q, m, info)
+    if (info /= 0) return
+    ! y = F^-1 G', gg = G F^-1 G': q -= y gg^-1 y'
+    y = matmul(q, transpose(bc%rg))
+    gg = matmul(bc%rg, y)
+    t = transpose(y)
+    call dposv('U', r, m, gg, r, t, r, info)
+    if (info /= 0) return
+    q = q - matmul(y, t)
+    q = 0.5_wp*(q + transpose(q))
+  end subroutine projected_inverse
+
+  !> P F_a P with P = I - G_a'(G_a G_a')^-1 G_a, the orthogonal projector on the forces
+  !! that G_a sees as balanced: a floating body's F_a = B_a K_a^+ B_a' depends on its fixing
+  !! DOFs by terms in G_a' (rigid motions), and its response to a self-equilibrated force
+  !! does not. The Robin correction of the other body's obstacle uses P F_a P: it vanishes
+  !! on the rigid part, which the floating body's own equality settles, so the linearised
+  !! outer map keeps the eigenvalues of the supported case (README, "Bodies held only by
+  !! contact"); S_1 + S_2 stays definite (the other body's part is), so the fixed point is
+  !! still the monolithic solution.
+  function projected_flex(bc) result(pf)
+    type(body_condensed_t), intent(in) :: bc
+    real(wp), allocatable :: pf(:, :), q(:, :), gg(:, :), y(:, :)
+    integer :: m, r, info
+    m = bc%m
+    r = bc%nrig
+    allocate (pf(m, m), q(r, m), gg(r, r), y(m, m))
+    ! q = (G G')^-1 G, so that P x = x - G' (q x)
+    gg = matmul(bc%rg, transpose(bc%rg))
+    q = bc%rg
+    call dposv('U', r, m, gg, r, q, r, info)
+    ! y = P F = F - G' (q F);  pf = y P = y - (y q') G
+    y = bc%flex - matmul(transpose(bc%rg), matmul(q, bc%flex))
+    pf = y - matmul(matmul(y, transpose(q)), bc%rg)
+    pf = 0.5_wp*(pf + transpose(pf))
+  end function projected_flex
 
   !> corr(:, 1) = S_1 d (body 1's obstacle), corr(:, 2) = S_2 d (body 2's); `count` grows
   !! by the Hessian-sized products it took.
@@ -475,11 +638,12 @@ contains
   !> Step 1: each body's contact problem against its obstacle (MPRGP, one thread per
   !! body), warm-started from the last contact forces. On return st%lam holds the forces,
   !! w(:, a) = B_a u_a, and res%status is 'failed' if an inner solve broke down.
-  subroutine solve_subproblems(s, bc, op, pin, lmax, rtol_in, it, st, w, res)
+  subroutine solve_subproblems(s, bc, op, pin, eq, lmax, rtol_in, it, st, w, res)
     type(solver_cfg_t), intent(in) :: s
     type(body_condensed_t), intent(in) :: bc(2)
-    type(dense_op_t), intent(inout) :: op(2)      !< the subproblem Hessians F_a + Pi_a
+    type(dense_op_t), intent(inout) :: op(2)      !< the subproblem Hessians F_a + Pi_a (+ rho G_a'G_a)
     type(dense_op_t), intent(inout) :: pin(2)     !< Pi_a (subproblem_operators; n = 0: none)
+    type(eq_t), intent(in) :: eq(2)               !< equilibrium rows of floating bodies (r = 0: none)
     real(wp), intent(in) :: lmax(2), rtol_in
     integer, intent(in) :: it
     type(robin_state_t), intent(inout) :: st
@@ -487,8 +651,9 @@ contains
     type(contact_result_t), intent(inout) :: res
     type(mprgp_opts_t) :: opts(2)
     type(mprgp_stats_t) :: ms(2)
+    type(smalbe_stats_t) :: ss(2)
     real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:), lam0(:, :), flam0(:, :), lprev(:, :)
-    integer :: a, m, k
+    integer :: a, m, k, r
     logical :: search
     m = size(w, 1)
     allocate (rhs(m, 2), grad(m, 2), lb(m), lam0(m, 2), flam0(m, 2))
@@ -537,7 +702,23 @@ contains
       flam0(:, a) = st%flam_v(:, a)
       opts(a)%recycle = s%acceleration == ACCEL_NONE
       k = size(st%rw, 2)/2
-      if (m > 0 .and. search) then
+      r = eq(a)%r
+      ss(a)%updates = 0
+      if (m > 0 .and. r > 0) then
+        ! a floating body: its equilibrium G_a lam = e_a as an equality (SMALBE-M)
+        if (search) then
+          call smalbe_solve(op(a), rhs(:, a), eq(a)%g, eq(a)%e, eq(a)%rho, lb, st%lam(:, a), st%mu(1:r, a), &
+                            opts(a), eq(a)%m0, eq(a)%feas, ss(a), grad(:, a), st%flam_v(:, a), &
+                            st%srch(:, a), st%fsrch(:, a), st%rw(:, (a - 1)*k + 1:a*k), &
+                            st%raw(:, (a - 1)*k + 1:a*k), st%nrw(:, a))
+        else
+          call smalbe_solve(op(a), rhs(:, a), eq(a)%g, eq(a)%e, eq(a)%rho, lb, st%lam(:, a), st%mu(1:r, a), &
+                            opts(a), eq(a)%m0, eq(a)%feas, ss(a), grad(:, a), st%flam_v(:, a), &
+                            rw=st%rw(:, (a - 1)*k + 1:a*k), raw=st%raw(:, (a - 1)*k + 1:a*k), nrw=st%nrw(:, a))
+        end if
+        ms(a) = ss(a)%inner
+        ms(a)%n_matvec = ss(a)%n_matvec
+      else if (m > 0 .and. search) then
         call mprgp_solve(op(a), rhs(:, a), lb, st%lam(:, a), opts(a), ms(a), grad(:, a), st%flam_v(:, a), &
                          st%srch(:, a), st%fsrch(:, a), st%rw(:, (a - 1)*k + 1:a*k), st%raw(:, (a - 1)*k + 1:a*k), &
                          st%nrw(:, a))
@@ -552,6 +733,7 @@ contains
     if (m == 0) return
     do a = 1, 2
       st%inner = st%inner + ms(a)%n_matvec
+      res%eq_updates = res%eq_updates + ss(a)%updates
       if (ms(a)%status == MPRGP_MAX_IT) then
         res%inner_maxit_hits = res%inner_maxit_hits + 1
       else if (ms(a)%status /= MPRGP_CONVERGED) then
@@ -605,6 +787,7 @@ contains
     integer :: a
     res%lam_body = st%lam
     res%w = w
+    res%rigid = -st%mu
     call interface_residual(itf, bc, res)
     ref = tiny(1.0_wp) + 1.0e-14_wp*(maxabs(bc(1)%b) + maxabs(bc(2)%b) + maxabs(itf%g0))
     do a = 1, 2
@@ -701,6 +884,98 @@ contains
     done = .false.
   end function check_termination
 
+  !> z = the Euclidean projection of y on {l >= 0, G l = e} (G, e: both bodies'
+  !! equilibrium rows, stacked), by SMALBE-M on the Hessian I + rho G'G; perr bounds
+  !! |z - exact projection| by its final projected gradient and equilibrium error.
+  subroutine project_feasible(bc, y, z, perr)
+    type(body_condensed_t), intent(in) :: bc(2)
+    real(wp), intent(in) :: y(:)
+    real(wp), allocatable, intent(out) :: z(:)
+    real(wp), intent(out) :: perr
+    type(eq_t) :: q
+    type(dense_op_t) :: op
+    type(mprgp_opts_t) :: o
+    type(smalbe_stats_t) :: st
+    real(wp), allocatable :: gs(:, :), es(:), mu(:), eye(:, :), lb(:), g(:)
+    real(wp) :: lm
+    integer :: m, r1, r, i
+    m = size(y)
+    r1 = bc(1)%nrig
+    r = r1 + bc(2)%nrig
+    allocate (gs(r, m), es(r), mu(r), eye(m, m), lb(m), g(m))
+    if (r1 > 0) gs(1:r1, :) = bc(1)%rg
+    if (r1 > 0) es(1:r1) = bc(1)%re
+    if (bc(2)%nrig > 0) gs(r1 + 1:, :) = bc(2)%rg
+    if (bc(2)%nrig > 0) es(r1 + 1:) = bc(2)%re
+    eye = 0.0_wp
+    do i = 1, m
+      eye(i, i) = 1.0_wp
+    end do
+    call dense_op_init(op, eye)
+    lm = 1.0_wp
+    call eq_init(q, gs, es, lm)
+    call eq_add(q, op, lm)
+    o%rtol = 1.0e-14_wp
+    o%lambda_max = lm
+    o%max_it = 100*m + 1000
+    z = max(y, 0.0_wp)
+    mu = 0.0_wp
+    lb = 0.0_wp
+    call smalbe_solve(op, y, q%g, q%e, q%rho, lb, z, mu, o, q%m0, q%feas, st, g)
+    ! |z - z*| <= 2 |natural residual| for the identity Hessian; the equilibrium error
+    ! through the smallest singular value of G (at least sqrt of its Gram's)
+    perr = 2.0_wp*st%inner%gp_norm + st%feas/sqrt(max(minval_gram(gs), tiny(1.0_wp)))
+  end subroutine project_feasible
+
+  !> Smallest eigenvalue of G G'.
+  real(wp) function minval_gram(gs) result(v)
+    real(wp), intent(in) :: gs(:, :)
+    real(wp) :: ev(6), work(64)
+    real(wp), allocatable :: gg(:, :)
+    integer :: r, info
+    r = size(gs, 1)
+    gg = matmul(gs, transpose(gs))
+    call dsyev('N', 'U', r, gg, r, ev, work, size(work), info)
+    v = ev(1)
+    if (info /= 0) v = 0.0_wp
+  end function minval_gram
+
+  !> The equality rows G lam = e of floating bodies for a QP whose Hessian H has its
+  !! largest eigenvalue below lmax: the penalty rho = RHO_FACTOR lmax / lambda_max(G G')
+  !! (A = H + rho G'G stays within (1 + RHO_FACTOR) lmax, and a multiplier update
+  !! reduces |G lam - e| by about 1 / (1 + RHO_FACTOR)), SMALBE's initial
+  !! M = lmax / sqrt(lambda_max(G G')) (a gradient per unit of force imbalance), and the
+  !! equilibrium tolerance FEAS_RTOL |e|.
+  subroutine eq_init(q, g, e, lmax)
+    type(eq_t), intent(out) :: q
+    real(wp), intent(in) :: g(:, :), e(:), lmax
+    real(wp), allocatable :: gg(:, :)
+    real(wp) :: ev(6), work(64)
+    integer :: info
+    q%r = size(g, 1)
+    q%g = g
+    q%e = e
+    allocate (gg(q%r, q%r))
+    gg = matmul(g, transpose(g))
+    call dsyev('N', 'U', q%r, gg, q%r, ev, work, size(work), info)
+    q%gg = max(ev(q%r), tiny(1.0_wp))
+    if (info /= 0) q%gg = max(maxval(sum(abs(gg), dim=1)), tiny(1.0_wp))
+    q%rho = RHO_FACTOR*lmax/q%gg
+    q%m0 = lmax/sqrt(q%gg)
+    q%feas = FEAS_RTOL*max(norm2(e), tiny(1.0_wp))
+  end subroutine eq_init
+
+  !> Add the penalty rho G'G to the dense Hessian and its bound to lmax.
+  subroutine eq_add(q, op, lmax)
+    type(eq_t), intent(in) :: q
+    type(dense_op_t), intent(inout) :: op
+    real(wp), intent(inout) :: lmax
+    integer :: m
+    m = size(q%g, 2)
+    call dgemm('T', 'N', m, m, q%r, q%rho, q%g, q%r, q%g, q%r, 1.0_wp, op%a, m)
+    lmax = lmax + q%rho*q%gg
+  end subroutine eq_add
+
   !> A posteriori bound of the error of res%lam against the monolithic solution lam*
   !! of the same discrete problem: for the strongly convex QP min 1/2 l'Hl - c'l, l >= 0
   !! (H = F_1 + F_2, c = b_1 + b_2 - g0) and the natural residual
@@ -712,7 +987,7 @@ contains
     type(body_condensed_t), intent(in) :: bc(2)        !< condensed bodies
     type(contact_result_t), intent(inout) :: res       !< lam in; error_bound, kappa out
     real(wp), allocatable :: H(:, :), A(:, :), g(:), r(:), x(:), y(:)
-    real(wp) :: lmax, lmin, nl
+    real(wp) :: lmax, lmin, nl, perr
     integer :: m, i, k, info
     m = itf%m
     res%error_bound = 0.0_wp
@@ -761,11 +1036,21 @@ contains
     ! natural residual of the mean contact force
     call dsymv('U', m, 1.0_wp, H, m, res%lam, 1, 0.0_wp, g, 1)
     g = g - (bc(1)%b + bc(2)%b - itf%g0)
-    r = res%lam - max(0.0_wp, res%lam - g/lmax)
+    if (bc(1)%nrig + bc(2)%nrig > 0) then
+      ! floating bodies: the feasible set is {l >= 0, G l = e}, and the bound holds with
+      ! the projection on it (the proof only uses the projection's variational inequality
+      ! and the strong convexity of the objective on R^m), computed by SMALBE-M; its own
+      ! inaccuracy (projected gradient and equilibrium of the projection) is added
+      call project_feasible(bc, res%lam - g/lmax, y, perr)
+      r = res%lam - y
+    else
+      r = res%lam - max(0.0_wp, res%lam - g/lmax)
+      perr = 0.0_wp
+    end if
     nl = norm2(res%lam)
     ! the residual itself is computed in floating point: add its rounding level
     if (nl > 0.0_wp) then
-      res%error_bound = 2.0_wp*res%kappa*(norm2(r)/nl + 10.0_wp*real(m, wp)*epsilon(1.0_wp))
+      res%error_bound = 2.0_wp*res%kappa*((norm2(r) + perr)/nl + 10.0_wp*real(m, wp)*epsilon(1.0_wp))
     else
       res%error_bound = merge(0.0_wp, huge(1.0_wp), norm2(r) == 0.0_wp)
     end if

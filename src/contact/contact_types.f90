@@ -29,6 +29,10 @@ module contact_types
     real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
     real(wp) :: kappa = 0.0_wp                 !< condition number estimate of F_1 + F_2
     integer :: active = 0                      !< nodes with lam > 0
+    !> bodies held only by contact: the amplitudes alpha_a of their rigid motions R_a
+    !! (u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a; alpha_a = -mu_a, the equality multipliers)
+    real(wp) :: rigid(3, 2) = 0.0_wp           !< [length] (R_a's columns are dimensionless)
+    integer :: eq_updates = 0                  !< SMALBE multiplier updates, all solves
     integer :: nhist = 0                       !< entries in the history
     real(wp), allocatable :: h_criterion(:)    !< per outer iteration
     real(wp), allocatable :: h_residual(:)     !< per outer iteration
@@ -55,6 +59,7 @@ module contact_types
     real(wp) :: omega = 0.0_wp                 !< Aitken relaxation
     real(wp) :: wall = 0.0_wp                  !< wall time spent in the iteration so far [s]
     real(wp) :: flam(2) = 0.0_wp               !< |F_a lam_a| of the last iterate [length]
+    real(wp) :: mu(3, 2) = 0.0_wp              !< equality multipliers of floating bodies (SMALBE warm start) [length]
     real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
     real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
     integer :: reuse = 0                       !< 1: flam_v holds F_a lam_a (0: not known, e.g. an older checkpoint)

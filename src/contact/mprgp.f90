@@ -65,6 +65,11 @@ module mprgp
     integer :: power_its = 20        !< power iterations for the lambda_max estimate
     logical :: use_ax = .false.      !< the argument `ax` holds A x at the warm start: no initial product
     logical :: recycle = .false.     !< start with exact line searches along the stored directions `rw` (no product)
+    !> With equality rows (arguments eq_g, eq_e: SMALBE's inner solve) a projected gradient
+    !! below the tolerance stops only when it is also below eq_m |eq_g x - eq_e| or the
+    !! equality already holds to eq_feas (Dostal's SMALBE-M precision control)
+    real(wp) :: eq_m = 0.0_wp        !< M of SMALBE-M (units of b per unit of eq_e)
+    real(wp) :: eq_feas = 0.0_wp     !< |eq_g x - eq_e| that counts as feasible (units of eq_e)
     procedure(mprgp_stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
   end type mprgp_opts_t
 
@@ -199,7 +204,7 @@ contains
   !! iterate with a smaller projected gradient: again no product.
   !! A warm start whose projected gradient (from opts%use_ax) already meets the tolerance
   !! is returned without a search or a product.
-  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax, s, as, rw, raw, nrw)
+  subroutine mprgp_solve(A, b, lb, x, opts, stats, g, ax, s, as, rw, raw, nrw, eq_g, eq_e)
     class(linop_t), intent(inout) :: A          !< SPD operator (size A%n)
     real(wp), intent(in) :: b(:)                !< linear term (size n)
     real(wp), intent(in) :: lb(:)               !< lower bounds (size n); -huge(1.0_wp): none
@@ -213,12 +218,14 @@ contains
     real(wp), intent(inout), optional :: rw(:, :)   !< (n, k) stored directions, A-normalised (needs raw, nrw)
     real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
     integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
+    real(wp), intent(in), optional :: eq_g(:, :)    !< (r, n) equality rows (SMALBE; with eq_e, opts%eq_m)
+    real(wp), intent(in), optional :: eq_e(:)       !< (r) their right-hand side
 
     real(wp), allocatable :: gr(:), p(:), ap(:), w(:), v(:), av(:)
     real(wp), parameter :: big = huge(1.0_wp)
     integer :: n, i, it, blk, retry, nmv_pow
     logical :: fresh, proportional, zero_tol
-    real(wp) :: tol, tol_now, ab, lam_lo, bnorm, xscale0
+    real(wp) :: tol, tol_now, ab, lam_lo, bnorm, xscale0, feas, floor_eq
     real(wp) :: phiphi, phitphi, betabeta, gp2, phi, phit, beta, slack
     real(wp) :: pap, pp, gtp, acg, af, gam, num, df, dd, dad, ab_prev, lam_pow
     character(len=24) :: s1, s2
@@ -397,6 +404,14 @@ contains
         if (.not. ensure_alpha()) exit main
         tol_now = 10.0_wp * sqrt(real(n, wp)) * epsilon(1.0_wp) * max(lam_lo, ALPHA_FACTOR / ab) * &
                   max(norm2(x), xscale0)
+      end if
+      if (present(eq_g) .and. stats%gp_norm <= tol_now .and. opts%eq_m > 0.0_wp) then
+        ! SMALBE-M: solve more precisely while the equality is far from holding
+        feas = norm2(matmul(eq_g, x) - eq_e)
+        if (feas > opts%eq_feas) then
+          floor_eq = 10.0_wp*sqrt(real(n, wp))*epsilon(1.0_wp)*lam_lo*max(norm2(x), xscale0)
+          tol_now = max(min(tol_now, opts%eq_m*feas), floor_eq)
+        end if
       end if
       if (stats%gp_norm <= tol_now) then
         if (fresh) then

@@ -14,16 +14,17 @@ module assembly
   use sorting, only: sort_by_key, sort_ints
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
-                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, BC_CONTACT
   use mesh, only: mesh_t, side_nodes, node_id, group_index, group_names, group_nodes
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress
   use linop, only: csc_symv
+  use lapack, only: dsyev
   implicit none (type, external)
   private
 
   public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters, cell_triplets
-  public :: body_force_fn
+  public :: body_force_fn, rigid_motion_name
 
   !> The linear system of one body on its free DOFs.
   type, public :: body_system_t
@@ -39,6 +40,17 @@ module assembly
     real(wp), allocatable :: f(:)             !< (n) load on free dofs incl. the lifting -K_fd u_d [force]
     real(wp), allocatable :: f_applied(:)     !< (ndof) applied nodal loads (tractions, optional body force), all dofs [force]
     real(wp) :: k_norm = 0.0_wp               !< max abs row sum of K (infinity norm) [stress]
+    !> A body whose prescribed displacements leave rigid motions free (held only by
+    !! contact, README "Bodies held only by contact"): nrig > 0 kernel vectors R of K, and
+    !! as many fixing DOFs, prescribed to 0 in the factorized system only, so that the
+    !! factor is a generalized inverse K^+ (K K^+ K = K) and u = K^+ (f - B'lam) + R alpha
+    integer :: nrig = 0                       !< rigid motions left free (0..3)
+    real(wp), allocatable :: rig(:, :)        !< (ndof, nrig) kernel of K, zero at prescribed DOFs [length/length]
+    real(wp), allocatable :: rig_coef(:, :)   !< (3, nrig) each column in the basis (1,0), (0,1), (-(y-yc), x-xc)/h
+    real(wp) :: rig_xc(2) = 0.0_wp            !< centre of the rotation basis [length]
+    real(wp) :: rig_h = 1.0_wp                !< scale of the rotation basis (largest extent) [length]
+    integer, allocatable :: fixing(:)         !< (nrig) the fixing DOFs (global dof numbers)
+    real(wp) :: rig_residual = 0.0_wp         !< max |K R| / (k_norm max |R|), the check of the kernel
   end type body_system_t
 
 contains
@@ -68,7 +80,7 @@ contains
   !! f -= K_fd u_d. Tractions with %body == body%id are integrated exactly on the side.
   !! On an impossible input `info` is non-zero, `msg` says why, and `sys` is incomplete.
   subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, info, msg, &
-                           u_prescribed, body_force, boundaries, matrix)
+                           u_prescribed, body_force, boundaries, matrix, contact_group)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -90,6 +102,9 @@ contains
     !! DOF numbering and the load only, for a run whose ranks each assemble their share of
     !! the cells (cell_triplets); default .true.
     logical, intent(in), optional :: matrix
+    !> the body's contact group (&contact body1_group/body2_group), kept clear of fixing
+    !! DOFs when the body is held only by contact (a rectangle's 'contact' side is too)
+    character(len=*), intent(in), optional :: contact_group
     logical, allocatable :: pres(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
@@ -106,10 +121,12 @@ contains
     if (present(boundaries)) then
       call group_conditions(mesh, body%id, boundaries, pres, sys, info, msg)
       if (info /= 0) return
-      if (size(boundaries) > 0 .or. .not. mesh%structured) then
-        call check_supports(mesh, body%id, pres, info, msg)
-        if (info /= 0) return
-      end if
+    end if
+    ! rigid motions the supports leave free: a body held only by contact
+    call rigid_kernel(mesh, pres, sys)
+    if (sys%nrig > 0) then
+      call choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
+      if (info /= 0) return
     end if
     call number_free_dofs(pres, sys)
     if (with_k) then
@@ -122,6 +139,7 @@ contains
     if (info /= 0) return
     call add_applied_loads(sys)
     if (with_k) sys%k_norm = stiffness_norm(sys)
+    if (sys%nrig > 0) call check_kernel(mesh, body, plane_strain, sys, info, msg)
   end subroutine assemble_body
 
   !> The stiffness entries of cells c1..c2 on the free DOFs as coordinate triplets of the
@@ -350,71 +368,267 @@ contains
     end if
   end function unknown_group
 
-  !> The prescribed DOFs must hold the body against the three rigid motions (translation
-  !! along x and y, rotation): the rigid modes restricted to them have rank 3. info = 1
-  !! (a bad input) with the motion left free.
-  subroutine check_supports(mesh, body_id, pres, info, msg)
+  !> The rigid motions that the prescribed DOFs leave free: the null space of the three
+  !! rigid modes (1,0), (0,1), (-(y-yc), x-xc)/h restricted to the prescribed DOFs (the
+  !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
+  !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
+  !! sys%rig (ndof x nrig, zero at prescribed DOFs).
+  subroutine rigid_kernel(mesh, pres, sys)
     type(mesh_t), intent(in) :: mesh
-    integer, intent(in) :: body_id
     logical, intent(in) :: pres(:)
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
-    real(wp) :: g(3, 3), r(3), xc(2), h, piv, f
-    integer :: k, cc, i, j, rank
-    logical :: used(3)
-    character(len=:), allocatable :: what
+    type(body_system_t), intent(inout) :: sys
+    real(wp) :: g(3, 3), r(3), ev(3), work(64), top
+    integer :: k, cc, j, lapinfo, nk
 
-    info = 0
-    msg = ''
-    xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
-    h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
+    sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
+    sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
     g = 0.0_wp
     do k = 1, mesh%nnode
       do cc = 1, 2
         if (.not. pres(2*(k - 1) + cc)) cycle
-        r = 0.0_wp
-        r(cc) = 1.0_wp
-        if (cc == 1) r(3) = -(mesh%xy(2, k) - xc(2))/h
-        if (cc == 2) r(3) = (mesh%xy(1, k) - xc(1))/h
+        r = rigid_row(sys, mesh%xy(:, k), cc)
         do j = 1, 3
           g(:, j) = g(:, j) + r*r(j)
         end do
       end do
     end do
-    ! rank of the 3 x 3 Gram matrix by Gaussian elimination with complete pivoting
-    rank = 0
-    used = .false.
-    f = max(maxval(abs(g)), tiny(1.0_wp))
-    do
-      piv = 0.0_wp
-      i = 0
-      do j = 1, 3
-        if (.not. used(j) .and. abs(g(j, j)) > piv) then
-          piv = abs(g(j, j))
-          i = j
-        end if
-      end do
-      if (i == 0 .or. piv <= 1.0e-10_wp*f) exit
-      rank = rank + 1
-      used(i) = .true.
-      do j = 1, 3
-        if (.not. used(j)) g(j, :) = g(j, :) - g(j, i)/g(i, i)*g(i, :)
+    call dsyev('V', 'U', 3, g, 3, ev, work, size(work), lapinfo)
+    top = max(ev(3), 0.0_wp)
+    nk = 0
+    if (lapinfo == 0) nk = count(ev <= 1.0e-10_wp*top)
+    if (top <= 0.0_wp) nk = 3
+    sys%nrig = nk
+    if (nk == 0) return
+    ! ascending eigenvalues: the kernel is the first nk columns (nothing prescribed: identity)
+    allocate (sys%rig_coef(3, nk), sys%rig(sys%ndof, nk))
+    if (top <= 0.0_wp) then
+      sys%rig_coef = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+    else
+      sys%rig_coef = g(:, 1:nk)
+      call tidy_basis(sys%rig_coef)
+    end if
+    do j = 1, nk
+      do k = 1, mesh%nnode
+        do cc = 1, 2
+          if (pres(2*(k - 1) + cc)) then
+            sys%rig(2*(k - 1) + cc, j) = 0.0_wp
+          else
+            sys%rig(2*(k - 1) + cc, j) = dot_product(rigid_row(sys, mesh%xy(:, k), cc), sys%rig_coef(:, j))
+          end if
+        end do
       end do
     end do
-    if (rank == 3) return
-    if (.not. any(pres(1::2))) then
-      what = 'translation along x'
-    else if (.not. any(pres(2::2))) then
-      what = 'translation along y'
+  end subroutine rigid_kernel
+
+  !> Component cc of the three basis rigid modes at the point x.
+  pure function rigid_row(sys, x, cc) result(r)
+    type(body_system_t), intent(in) :: sys
+    real(wp), intent(in) :: x(2)
+    integer, intent(in) :: cc
+    real(wp) :: r(3)
+    r = 0.0_wp
+    r(cc) = 1.0_wp
+    if (cc == 1) r(3) = -(x(2) - sys%rig_xc(2))/sys%rig_h
+    if (cc == 2) r(3) = (x(1) - sys%rig_xc(1))/sys%rig_h
+  end function rigid_row
+
+  !> Round a kernel basis to its simplest form: entries below 1e-12 become 0 and each
+  !! column gets a positive largest entry (a pure translation reads (0, 1, 0)).
+  pure subroutine tidy_basis(c)
+    real(wp), intent(inout) :: c(:, :)
+    integer :: j
+    do j = 1, size(c, 2)
+      where (abs(c(:, j)) < 1.0e-12_wp) c(:, j) = 0.0_wp
+      if (c(maxloc(abs(c(:, j)), dim=1), j) < 0.0_wp) c(:, j) = -c(:, j)
+      c(:, j) = c(:, j)/norm2(c(:, j))
+    end do
+  end subroutine tidy_basis
+
+  !> The rigid motion with coefficients c (basis of rigid_kernel) in words: 'translation
+  !! along x', 'translation along (0.6, 0.8)', 'rotation about (x0, y0)'.
+  function rigid_motion_name(sys, c) result(s)
+    type(body_system_t), intent(in) :: sys
+    real(wp), intent(in) :: c(3)
+    character(len=:), allocatable :: s
+    character(len=64) :: buf
+    real(wp) :: w, t(2)
+    w = c(3)/sys%rig_h
+    t = c(1:2)
+    if (abs(c(3)) <= 1.0e-8_wp*norm2(c)) then
+      if (abs(t(2)) <= 1.0e-8_wp*norm2(t)) then
+        s = 'translation along x'
+      else if (abs(t(1)) <= 1.0e-8_wp*norm2(t)) then
+        s = 'translation along y'
+      else
+        write (buf, '(a,f7.4,a,f7.4,a)') 'translation along (', t(1)/norm2(t), ', ', t(2)/norm2(t), ')'
+        s = trim(buf)
+      end if
     else
-      what = 'a rotation'
+      write (buf, '(a,g12.5,a,g12.5,a)') 'rotation about (', sys%rig_xc(1) - t(2)/w, ', ', &
+        sys%rig_xc(2) + t(1)/w, ')'
+      s = trim(buf)
     end if
-    info = 1
-    write (msg, '(a,i0,a)') 'body ', body_id, ' is not held against rigid motion: its prescribed '// &
-      'displacements leave '//what//' free (a body held only by contact is not supported yet); '// &
-      'prescribe ux and uy on one group, or ux on one group and uy on another that does not '// &
-      'lie on the same line'
-  end subroutine check_supports
+  end function rigid_motion_name
+
+  !> The fixing DOFs of a floating body: sys%nrig DOFs that are not prescribed, not on the
+  !! contact (the contact group, or a rectangle's 'contact' side), on which the kernel is
+  !! nonsingular, taken from two nodes far apart (the node farthest from the contact, and
+  !! the node farthest from that one) for the largest |det| of the kernel restricted to
+  !! them. They are prescribed to 0 (pres) for the factorization only.
+  subroutine choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
+    type(mesh_t), intent(in) :: mesh
+    type(body_cfg_t), intent(in) :: body
+    logical, intent(inout) :: pres(:)
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    character(len=*), intent(in), optional :: contact_group
+    logical, allocatable :: avoid(:)
+    integer, allocatable :: nodes(:)
+    integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
+    real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
+
+    info = 0
+    msg = ''
+    r = sys%nrig
+    allocate (avoid(mesh%nnode))
+    avoid = .false.
+    do side = 1, 4
+      if (body%bc(side) /= BC_CONTACT) cycle
+      call side_nodes(mesh, side, nodes)
+      avoid(nodes) = .true.
+    end do
+    if (present(contact_group)) then
+      g = 0
+      if (len_trim(contact_group) > 0) g = group_index(mesh, contact_group)
+      if (g > 0) then
+        call group_nodes(mesh, g, nodes)
+        avoid(nodes) = .true.
+      end if
+    end if
+    ! the first node: farthest from the contact (from the centre when there is none)
+    ctr = sys%rig_xc
+    if (any(avoid)) then
+      ctr(1) = sum(mesh%xy(1, :), mask=avoid)/count(avoid)
+      ctr(2) = sum(mesh%xy(2, :), mask=avoid)/count(avoid)
+    end if
+    p = 0
+    dbest = -1.0_wp
+    do k = 1, mesh%nnode
+      if (avoid(k) .or. (pres(2*k - 1) .and. pres(2*k))) cycle
+      d = norm2(mesh%xy(:, k) - ctr)
+      if (d > dbest) then
+        dbest = d
+        p(1) = k
+      end if
+    end do
+    if (p(1) == 0) then
+      info = 1
+      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
+        'contact or prescribed: no node is left to fix its rigid motion for the factorization; '// &
+        'refine the mesh or support the body'
+      return
+    end if
+    dbest = -1.0_wp
+    do k = 1, mesh%nnode
+      if (avoid(k) .or. (pres(2*k - 1) .and. pres(2*k))) cycle
+      d = norm2(mesh%xy(:, k) - mesh%xy(:, p(1)))
+      if (d > dbest) then
+        dbest = d
+        p(2) = k
+      end if
+    end do
+    nc = 0
+    do i = 1, 2
+      do j = 1, 2
+        k = 2*(p(i) - 1) + j
+        if (.not. pres(k) .and. .not. any(cand(1:nc) == k)) then
+          nc = nc + 1
+          cand(nc) = k
+        end if
+      end do
+    end do
+    ! the r candidates with the largest |det R(fix, :)| (at most 4 choose 3 tries)
+    detbest = 0.0_wp
+    best = 0
+    do i = 1, nc
+      do j = merge(i + 1, i, r > 1), merge(nc, i, r > 1)
+        do l = merge(j + 1, j, r > 2), merge(nc, j, r > 2)
+          if (r > 1 .and. j == i) cycle
+          if (r > 2 .and. l == j) cycle
+          sub = 0.0_wp
+          sub(1, 1:r) = sys%rig(cand(i), 1:r)
+          if (r > 1) sub(2, 1:r) = sys%rig(cand(j), 1:r)
+          if (r > 2) sub(3, 1:r) = sys%rig(cand(l), 1:r)
+          det = abs(small_det(sub, r))
+          if (det > detbest) then
+            detbest = det
+            best = [cand(i), cand(j), cand(l)]
+          end if
+        end do
+      end do
+    end do
+    if (.not. detbest > 1.0e-6_wp) then
+      info = 1
+      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
+        'from the contact fixes its free rigid motion for the factorization; support the body'
+      return
+    end if
+    allocate (sys%fixing(r))
+    sys%fixing = best(1:r)
+    pres(sys%fixing) = .true.
+    sys%u_fixed(sys%fixing) = 0.0_wp
+  end subroutine choose_fixing
+
+  !> Determinant of the leading r x r block (r = 1..3).
+  pure real(wp) function small_det(a, r) result(d)
+    real(wp), intent(in) :: a(3, 3)
+    integer, intent(in) :: r
+    select case (r)
+    case (1)
+      d = a(1, 1)
+    case (2)
+      d = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+    case default
+      d = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
+          a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
+    end select
+  end function small_det
+
+  !> The kernel is computed, not guessed: |K R| over the DOFs that are not prescribed
+  !! (fixing DOFs included) must be at rounding level, 1e-9 |K| |R|. info = 3 otherwise.
+  subroutine check_kernel(mesh, body, plane_strain, sys, info, msg)
+    type(mesh_t), intent(in) :: mesh
+    type(body_cfg_t), intent(in) :: body
+    logical, intent(in) :: plane_strain
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    real(wp), allocatable :: kr(:), zero(:)
+    real(wp) :: worst, knorm
+    integer :: j
+    logical, allocatable :: live(:)
+    info = 0
+    msg = ''
+    allocate (kr(sys%ndof), zero(sys%ndof), live(sys%ndof))
+    zero = 0.0_wp
+    live = sys%free_of > 0
+    live(sys%fixing) = .true.
+    ! no assembled matrix (MUMPS ranks): Young's modulus is the scale of K's entries
+    knorm = sys%k_norm
+    if (knorm <= 0.0_wp) knorm = max(body%young, tiny(1.0_wp))
+    worst = 0.0_wp
+    do j = 1, sys%nrig
+      call residual_full(mesh, body, plane_strain, sys%rig(:, j), zero, kr)
+      worst = max(worst, maxval(abs(kr), mask=live)/(knorm*max(maxval(abs(sys%rig(:, j))), tiny(1.0_wp))))
+    end do
+    sys%rig_residual = worst
+    if (worst > 1.0e-9_wp) then
+      info = 3
+      write (msg, '(a,i0,a,es10.3,a)') 'body ', body%id, ': its rigid-motion kernel fails the check |K R| = ', &
+        worst, ' |K| |R| (expected rounding level)'
+    end if
+  end subroutine check_kernel
 
   !> Number the DOFs that are not prescribed 1..n in increasing global order
   !! (sys%n, sys%free_of, sys%dof_of).

@@ -801,7 +801,7 @@ contains
     integer :: b, s, nc, cs(2), n1, n2
     character(len=:), allocatable :: p, lst, what
     real(wp) :: scale, tol, c1, c2, a1, a2, e1, e2
-    logical :: fixed, roll_h, roll_v, horizontal, groups
+    logical :: horizontal, groups
 
     p = st%path//': '
     groups = len_trim(d%contact%body_group(1)) > 0 .or. len_trim(d%contact%body_group(2)) > 0
@@ -878,18 +878,8 @@ contains
       i2s(n2)//' along its '//trim(side_names(cs(2)))//' side; the meshes need the same '// &
       'number of cells along the contact line')
 
-    do b = 1, 2
-      associate (y => d%body(b))
-        fixed = any(y%bc == BC_CLAMPED .or. y%bc == BC_DISPLACEMENT)
-        roll_h = y%bc(SIDE_TOP) == BC_ROLLER .or. y%bc(SIDE_BOTTOM) == BC_ROLLER
-        roll_v = y%bc(SIDE_LEFT) == BC_ROLLER .or. y%bc(SIDE_RIGHT) == BC_ROLLER
-        if (.not. (fixed .or. (roll_h .and. roll_v) .or. st%has_boundary(b))) call fatal(EXIT_INPUT, p//'body '// &
-          i2s(b)//' ('//st%body_at(b)%s//') is not supported against rigid motion ('// &
-          side_list(y)//'): it needs a ''clamped'' side, a &displacement side, or ''roller'' '// &
-          'on one horizontal (top/bottom) and one vertical (left/right) side; the contact '// &
-          'side does not count')
-      end associate
-    end do
+    ! support against rigid motion is the mesh's business (assembly: a body the supports
+    ! leave free is held only by contact, and module floating checks that the contact can)
 
     do b = 1, 2
       do s = 1, 4

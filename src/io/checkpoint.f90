@@ -82,6 +82,7 @@ contains
     call write_dset(gid, 'nrw', reshape(st%nrw, [4]), hs)
     call write_dset(gid, 'rw', st%rw, hs)
     call write_dset(gid, 'raw', st%raw, hs)
+    call write_dset(gid, 'mu', st%mu, hs)
     call group_close(gid, hs)
     call write_history(fid, res, hs)
     call file_close(fid, hs)
@@ -117,9 +118,9 @@ contains
     type(h5_status_t) :: hs
     integer :: n, nh, kr
     character(len=:), allocatable :: k, src
-    real(wp), allocatable :: r(:)
+    real(wp), allocatable :: r(:), rmu(:, :)
     integer, allocatable :: ir(:)
-    logical :: exists_, has_products, has_search, has_recycle
+    logical :: exists_, has_products, has_search, has_recycle, has_mu
     integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
     character(len=*), parameter :: INT_ATTRS(6) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
                                                    'it_best', 'inner_maxit_hits']
@@ -215,6 +216,10 @@ contains
         call need(gid, '/state', 'raw', .false., CLASS_REAL, [m2, int(2*kr, hsize_t)], &
                   contact_nodes()//' and '//i2s(kr)//' directions per body')
       end if
+      ! the equality multipliers of floating bodies: absent from older checkpoints
+      has_mu = exists(gid, 'mu', .false.)
+      if (has_mu) call need(gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, 2_hsize_t], &
+                            'three multipliers per body')
       if (len_trim(msg) > 0) return
       ! the history: five arrays of one length nh, it <= nh <= max_outer (checked after reading it)
       call need(hid, '/history', 'criterion', .false., CLASS_REAL, [-1_hsize_t], 'one entry per outer iteration')
@@ -326,6 +331,11 @@ contains
         allocate (st%srch(m, 2), st%fsrch(m, 2))
         st%srch = 0.0_wp
         st%fsrch = 0.0_wp
+      end if
+      st%mu = 0.0_wp
+      if (has_mu) then
+        call read_dset(gid, 'mu', rmu, hs)
+        if (.not. hs%failed) st%mu = rmu
       end if
       if (has_recycle) then
         call read_dset(gid, 'nrw', ir, hs)

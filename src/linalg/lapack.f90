@@ -12,7 +12,7 @@ module lapack
   public :: dsymv, dgemm
   public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev
   public :: dpbtrf, dpbtrs, dpbsv
-  public :: dgels
+  public :: dgels, dgesv
 
   interface
 
@@ -198,6 +198,20 @@ module lapack
       real(wp), intent(inout) :: ab(ldab, *)  !< A in band storage on entry, its factor on exit
       real(wp), intent(inout) :: b(ldb, *)    !< right-hand sides in, solutions out (n x nrhs)
     end subroutine dpbsv
+
+    !> A X = B for a general square A by LU with partial pivoting.
+    subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
+      import :: wp
+      implicit none
+      integer, intent(in) :: n                !< order of A
+      integer, intent(in) :: nrhs             !< number of right-hand sides
+      integer, intent(in) :: lda              !< leading dimension of a, >= max(1, n)
+      integer, intent(in) :: ldb              !< leading dimension of b, >= max(1, n)
+      integer, intent(out) :: ipiv(*)         !< pivot indices (n)
+      integer, intent(out) :: info            !< 0 ok; < 0 argument illegal; > 0 A singular
+      real(wp), intent(inout) :: a(lda, *)    !< A on entry, its LU factors on exit
+      real(wp), intent(inout) :: b(ldb, *)    !< right-hand sides in, solutions out (n x nrhs)
+    end subroutine dgesv
 
     ! ---- LAPACK: least squares ----
 

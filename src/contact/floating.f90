@@ -1,0 +1,221 @@
+!> Bodies held only by contact (README, "Bodies held only by contact"): the equilibrium
+!! rows of a floating body, G_a = R_a' B_a' and e_a = R_a' f_a (its load balanced by its
+!! contact forces: G_a lam = e_a), and the checks that the contact can hold it: every
+!! free rigid motion has a contact normal component (else the body slides or turns
+!! freely: bad input), the load can be balanced by compressive forces lam >= 0 (else it
+!! pulls the body away: bad input), and two floating bodies are not free as a pair.
+module floating
+  use kinds, only: wp
+  use assembly, only: body_system_t, rigid_motion_name
+  use condense, only: body_condensed_t, interface_t
+  use lapack, only: dsyev, dgels
+  use strings, only: i2s, r2s
+  implicit none (type, external)
+  private
+
+  public :: rigid_rows, check_held, nnls, free_list, fixing_list
+
+contains
+
+  !> bc%rg = R_a' B_a' (row k: B_a applied to kernel vector k, from the interface's rows
+  !! over global DOFs; B_a never touches a fixing DOF) and bc%re = R_a' f_a (the applied
+  !! load along each free motion: the lifting of prescribed displacements has no part
+  !! along R_a, since K R_a = 0). Needs no factorization: the checks run before it.
+  subroutine rigid_rows(itf, a, sys, bc)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: a
+    type(body_system_t), intent(in) :: sys
+    type(body_condensed_t), intent(inout) :: bc
+    integer :: k, i, e
+    bc%nrig = sys%nrig
+    if (allocated(bc%rg)) deallocate (bc%rg, bc%re)
+    allocate (bc%rg(sys%nrig, itf%m), bc%re(sys%nrig))
+    do k = 1, sys%nrig
+      do i = 1, itf%m
+        bc%rg(k, i) = 0.0_wp
+        do e = itf%b(a)%ptr(i), itf%b(a)%ptr(i + 1) - 1
+          bc%rg(k, i) = bc%rg(k, i) + itf%b(a)%val(e)*sys%rig(itf%b(a)%dof(e), k)
+        end do
+      end do
+      bc%re(k) = dot_product(sys%rig(:, k), sys%f_applied)
+    end do
+  end subroutine rigid_rows
+
+  !> Can the contact hold the floating bodies? info = 1 (bad input) with the sentence
+  !! when a free motion has no contact normal component, when the load cannot be balanced
+  !! by compressive contact forces, when nothing presses the body into the contact, or
+  !! when two floating bodies are free together.
+  subroutine check_held(sys, bc, info, msg)
+    type(body_system_t), intent(in) :: sys(2)
+    type(body_condensed_t), intent(in) :: bc(2)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    real(wp), allocatable :: gg(:, :), lam(:), gs(:, :), es(:)
+    real(wp) :: ev(6), work(64), c(3), fx, fy, along, res, enorm
+    integer :: a, r, m, lapinfo, k
+    character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
+      'a ''roller'', or ux/uy on a group (&boundary)'
+
+    info = 0
+    msg = ''
+    m = size(bc(1)%rg, 2)
+    do a = 1, 2
+      r = bc(a)%nrig
+      if (r == 0) cycle
+      fx = sum(sys(a)%f_applied(1::2))
+      fy = sum(sys(a)%f_applied(2::2))
+      ! 1. every free motion must meet a contact normal: the Gram matrix G G' is definite
+      allocate (gg(r, r))
+      gg = matmul(bc(a)%rg, transpose(bc(a)%rg))
+      call dsyev('V', 'U', r, gg, r, ev, work, size(work), lapinfo)
+      if (lapinfo == 0 .and. ev(1) <= 1.0e-10_wp*max(real(m, wp), ev(r))) then
+        c = matmul(sys(a)%rig_coef, gg(:, 1))
+        along = dot_product(gg(:, 1), bc(a)%re)
+        info = 1
+        msg = 'body '//i2s(a)//' is held only by contact (its supports leave rigid motion free), '// &
+              'but the contact cannot hold its '//rigid_motion_name(sys(a), c)//': no contact normal '// &
+              'has a component along it (frictionless contact lets the body slide or turn)'
+        if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = trim(msg)// &
+          '; its load has a component '//r2s(along)//' along that motion, which no contact force balances'
+        msg = trim(msg)//'; '//hold
+        return
+      end if
+      deallocate (gg)
+      ! 2. something must press it into the contact
+      enorm = norm2(bc(a)%re)
+      if (.not. enorm > 1.0e-12_wp*max(sum(abs(sys(a)%f_applied)), tiny(1.0_wp)) .or. m == 0) then
+        info = 1
+        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(sys(a))//'), but no load '// &
+              'presses it into the contact (load resultant ('//r2s(fx)//', '//r2s(fy)//')): its position '// &
+              'is undetermined; load it towards the other body, or '//hold
+        return
+      end if
+      ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
+      allocate (lam(m))
+      call nnls(bc(a)%rg, bc(a)%re, lam, res)
+      if (res > 1.0e-8_wp*enorm) then
+        info = 1
+        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(sys(a))//'), but its load '// &
+              '(resultant ('//r2s(fx)//', '//r2s(fy)//')) pulls it away from the contact: no compressive '// &
+              'contact force balances it (an unbalanced part '//r2s(res)//' remains); reverse the load '// &
+              'or '//hold
+        return
+      end if
+      deallocate (lam)
+    end do
+    ! 4. both floating: the pair together must be held too (stacked rows of full rank)
+    if (bc(1)%nrig > 0 .and. bc(2)%nrig > 0) then
+      r = bc(1)%nrig + bc(2)%nrig
+      allocate (gs(r, m), es(r), gg(r, r))
+      gs(1:bc(1)%nrig, :) = bc(1)%rg
+      gs(bc(1)%nrig + 1:, :) = bc(2)%rg
+      es(1:bc(1)%nrig) = bc(1)%re
+      es(bc(1)%nrig + 1:) = bc(2)%re
+      gg = matmul(gs, transpose(gs))
+      call dsyev('V', 'U', r, gg, r, ev, work, size(work), lapinfo)
+      if (lapinfo == 0 .and. ev(1) <= 1.0e-10_wp*max(real(m, wp), ev(r))) then
+        ! the free motion of the pair, as body 1's part of it
+        k = bc(1)%nrig
+        c = matmul(sys(1)%rig_coef, gg(1:k, 1))
+        info = 1
+        msg = 'bodies 1 and 2 are both held only by contact, and together they are free: the pair can '// &
+              'move as a whole ('//rigid_motion_name(sys(1), c)//' of both) and nothing holds it; '// &
+              'support one of the bodies against that rigid motion'
+        return
+      end if
+      allocate (lam(m))
+      call nnls(gs, es, lam, res)
+      if (res > 1.0e-8_wp*norm2(es)) then
+        info = 1
+        msg = 'bodies 1 and 2 are both held only by contact, and their loads cannot be balanced by '// &
+              'compressive contact forces between them (unbalanced part '//r2s(res)//'); support one of them'
+        return
+      end if
+    end if
+  end subroutine check_held
+
+  !> The rigid motions a body's supports leave free, in words.
+  function free_list(sys) result(s)
+    type(body_system_t), intent(in) :: sys
+    character(len=:), allocatable :: s
+    integer :: k
+    s = ''
+    do k = 1, sys%nrig
+      if (k > 1) s = s//', '
+      s = s//rigid_motion_name(sys, sys%rig_coef(:, k))
+    end do
+  end function free_list
+
+  !> The fixing DOFs in words: 'node 12 uy, node 40 ux' (node numbers of the body's mesh).
+  function fixing_list(sys) result(s)
+    type(body_system_t), intent(in) :: sys
+    character(len=:), allocatable :: s
+    integer :: k
+    s = ''
+    do k = 1, sys%nrig
+      if (k > 1) s = s//', '
+      s = s//'node '//i2s((sys%fixing(k) + 1)/2)//merge(' ux', ' uy', mod(sys%fixing(k), 2) == 1)
+    end do
+  end function fixing_list
+
+  !> Non-negative least squares min |G x - e|, x >= 0 (Lawson and Hanson's active set
+  !! method; G is r x m with r small, so at most r columns are ever passive). res is
+  !! the residual norm |G x - e| at the returned x.
+  subroutine nnls(g, e, x, res)
+    real(wp), intent(in) :: g(:, :)     !< (r, m)
+    real(wp), intent(in) :: e(:)        !< (r)
+    real(wp), intent(out) :: x(:)       !< (m)
+    real(wp), intent(out) :: res
+    real(wp), allocatable :: w(:), z(:), a(:, :), rhs(:), work(:)
+    logical, allocatable :: passive(:)
+    integer, allocatable :: pidx(:)
+    integer :: r, m, j, np, it, inner, lapinfo
+    real(wp) :: tol, alpha, t
+
+    r = size(g, 1)
+    m = size(g, 2)
+    allocate (w(m), z(m), passive(m), rhs(max(r, m)), work(64*(r + m) + 64))
+    x = 0.0_wp
+    passive = .false.
+    tol = 1.0e-12_wp*max(maxval(abs(g))*norm2(e), tiny(1.0_wp))
+    do it = 1, 3*m + 10
+      w = matmul(e - matmul(g, x), g)
+      j = 0
+      t = tol
+      do np = 1, m
+        if (.not. passive(np) .and. w(np) > t) then
+          t = w(np)
+          j = np
+        end if
+      end do
+      if (j == 0) exit
+      passive(j) = .true.
+      do inner = 1, 3*m + 10
+        pidx = pack([(np, np=1, m)], passive)
+        np = size(pidx)
+        allocate (a(r, np))
+        a = g(:, pidx)
+        rhs = 0.0_wp
+        rhs(1:r) = e
+        call dgels('N', r, np, 1, a, r, rhs, max(r, np), work, size(work), lapinfo)
+        deallocate (a)
+        z = 0.0_wp
+        if (lapinfo == 0) z(pidx) = rhs(1:np)
+        if (all(z(pidx) > 0.0_wp)) exit
+        alpha = 1.0_wp
+        do np = 1, size(pidx)
+          j = pidx(np)
+          if (z(j) <= 0.0_wp) alpha = min(alpha, x(j)/max(x(j) - z(j), tiny(1.0_wp)))
+        end do
+        x = x + alpha*(z - x)
+        where (passive .and. x <= 1.0e-14_wp*maxval(abs(x))) passive = .false.
+        where (.not. passive) x = 0.0_wp
+        if (.not. any(passive)) exit
+      end do
+      x = z
+      where (.not. passive) x = 0.0_wp
+    end do
+    res = norm2(matmul(g, x) - e)
+  end subroutine nnls
+
+end module floating

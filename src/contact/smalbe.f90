@@ -1,0 +1,120 @@
+!> SMALBE-M: semi-monotonic augmented Lagrangian for bound and equality constraints,
+!!
+!!     minimise 1/2 x'Hx - c'x   subject to   x >= l,   G x = e      (G: r x n, r small)
+!!
+!! with MPRGP (module mprgp) as its inner solver. Z. Dostal, "Optimal Quadratic
+!! Programming Algorithms", Springer 2009, ch. 9; the form used here (README, "Bodies
+!! held only by contact"): for a fixed penalty rho and multipliers mu,
+!!
+!!     L(x, mu, rho) = 1/2 x'Hx - c'x + mu'(Gx - e) + rho/2 |Gx - e|^2
+!!
+!! is minimised over x >= l by MPRGP with the Hessian A = H + rho G'G (the caller passes
+!! A: its products are the only ones, and since A does not change from one solve to the
+!! next MPRGP's stored directions stay valid) and the linear term c - G'mu + rho G'e, to
+!! a projected gradient below min(M |Gx - e|, eta); then mu <- mu + rho (Gx - e), and
+!! M <- beta M when L did not grow by at least rho/2 |Gx - e|^2. It stops when the
+!! projected gradient is below eta and |Gx - e| below feas.
+!!
+!! On return g = Hx - c + G'mu (the gradient of the Lagrangian at the final multipliers,
+!! which is MPRGP's last gradient), so for contact `G_a - g` is still B_a u_a with the
+!! rigid part of u_a = R_a alpha_a, alpha_a = -mu_a.
+module smalbe
+  use kinds, only: wp
+  use linop, only: linop_t
+  use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, MPRGP_CONVERGED, MPRGP_MAX_IT
+  implicit none (type, external)
+  private
+
+  public :: smalbe_solve, smalbe_stats_t, SMALBE_MAX_UPDATES
+
+  integer, parameter :: SMALBE_MAX_UPDATES = 200   !< multiplier updates before giving up
+  real(wp), parameter :: BETA = 0.2_wp              !< M <- BETA M when L did not grow enough
+
+  !> What smalbe_solve did.
+  type :: smalbe_stats_t
+    type(mprgp_stats_t) :: inner        !< the last MPRGP solve (status: MPRGP_*, converged or not)
+    integer :: n_matvec = 0             !< products with A over all MPRGP solves
+    integer :: updates = 0              !< multiplier updates (SMALBE outer iterations)
+    real(wp) :: feas = 0.0_wp           !< |Gx - e| at the returned x
+    real(wp) :: m_final = 0.0_wp        !< M at the end
+  end type smalbe_stats_t
+
+contains
+
+  !> Solve the bound- and equality-constrained QP (module header). opts is MPRGP's
+  !! options for every inner solve (rtol/atol give eta; use_ax, recycle as in mprgp_solve,
+  !! the first solve only for use_ax); m0 > 0 the initial M. mu holds the warm start of
+  !! the multipliers and returns them. stats%inner%status is MPRGP_CONVERGED only when
+  !! both the projected gradient and |Gx - e| met their tolerances.
+  subroutine smalbe_solve(A, c, gm, e, rho, lb, x, mu, opts, m0, feas, stats, g, ax, s, as, rw, raw, nrw)
+    class(linop_t), intent(inout) :: A          !< H + rho G'G
+    real(wp), intent(in) :: c(:)                !< (n) linear term
+    real(wp), intent(in) :: gm(:, :)            !< (r, n) equality rows G
+    real(wp), intent(in) :: e(:)                !< (r) right-hand side
+    real(wp), intent(in) :: rho                 !< the penalty folded into A
+    real(wp), intent(in) :: lb(:)               !< (n) lower bounds
+    real(wp), intent(inout) :: x(:)             !< in: warm start; out: solution
+    real(wp), intent(inout) :: mu(:)            !< (r) in: warm start; out: multipliers
+    type(mprgp_opts_t), intent(in) :: opts      !< inner options (tolerance eta, max_it, lambda_max of A...)
+    real(wp), intent(in) :: m0                  !< initial M (units of c per unit of e)
+    real(wp), intent(in) :: feas                !< |Gx - e| that counts as feasible (units of e)
+    type(smalbe_stats_t), intent(out) :: stats
+    real(wp), intent(out) :: g(:)               !< (n) Hx - c + G'mu at the returned x, mu
+    real(wp), intent(inout), optional :: ax(:)  !< as in mprgp_solve (A x)
+    real(wp), intent(in), optional :: s(:), as(:)             !< first line search (first solve only)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_solve)
+    integer, intent(inout), optional :: nrw(2)
+    type(mprgp_opts_t) :: o
+    real(wp), allocatable :: rhs(:), r(:), axl(:)
+    real(wp) :: lag_old, lag_new, rr, mm
+    integer :: n, k
+    logical :: have_ax
+
+    n = size(x)
+    allocate (rhs(n), r(size(e)), axl(n))
+    o = opts
+    o%eq_feas = feas
+    mm = m0
+    have_ax = opts%use_ax .and. present(ax)
+    if (have_ax) axl = ax
+    lag_old = -huge(1.0_wp)
+    stats%updates = 0
+    do k = 1, SMALBE_MAX_UPDATES
+      o%eq_m = mm
+      o%use_ax = have_ax
+      ! linear term of L(., mu, rho) with the penalty's part: c - G'mu + rho G'e
+      rhs = c - matmul(mu - rho*e, gm)
+      if (k == 1 .and. present(s) .and. present(rw)) then
+        call mprgp_solve(A, rhs, lb, x, o, stats%inner, g, axl, s, as, rw, raw, nrw, eq_g=gm, eq_e=e)
+      else if (present(rw)) then
+        call mprgp_solve(A, rhs, lb, x, o, stats%inner, g, axl, rw=rw, raw=raw, nrw=nrw, eq_g=gm, eq_e=e)
+      else
+        call mprgp_solve(A, rhs, lb, x, o, stats%inner, g, axl, eq_g=gm, eq_e=e)
+      end if
+      have_ax = .true.
+      stats%n_matvec = stats%n_matvec + stats%inner%n_matvec
+      if (stats%inner%status /= MPRGP_CONVERGED) exit
+      r = matmul(gm, x) - e
+      rr = norm2(r)
+      stats%feas = rr
+      ! the new multipliers; MPRGP's gradient is the Lagrangian's gradient at them
+      mu = mu + rho*r
+      ! L(x, mu_new, rho) = 1/2 x'Ax - x'rhs(mu_old) + mu_old'(Gx - e)... written out:
+      ! 1/2 x'Hx - c'x + mu_new'(Gx - e) + rho/2 |Gx - e|^2, with x'Hx = x'Ax - rho |Gx|^2
+      lag_new = 0.5_wp*(dot_product(x, axl) - rho*sum(matmul(gm, x)**2)) - dot_product(c, x) + &
+                dot_product(mu, r) + 0.5_wp*rho*rr*rr
+      stats%updates = k
+      if (rr <= feas) exit
+      if (lag_new < lag_old + 0.5_wp*rho*rr*rr) mm = BETA*mm
+      lag_old = lag_new
+    end do
+    stats%m_final = mm
+    if (stats%inner%status == MPRGP_CONVERGED .and. stats%feas > feas) then
+      stats%inner%status = MPRGP_MAX_IT
+      write (stats%inner%message, '(a,i0,a,es10.3,a,es10.3)') 'SMALBE: ', SMALBE_MAX_UPDATES, &
+        ' multiplier updates without |Gx - e| = ', stats%feas, ' <= ', feas
+    end if
+    if (present(ax)) ax = axl
+  end subroutine smalbe_solve
+
+end module smalbe
