@@ -14,7 +14,10 @@ groups, dual mortar on non-matching and curved contact surfaces), run by `make c
    on h = 0.01, Robin (harmonic) = monolithic to 1e-6;
 5. a rectangle's sides are groups: the default scene with &boundary/&traction on 'left'/'top'
    and contact by groups gives the contact forces of the side-based deck to 1e-10;
-6. bad input (exit 1, a message naming the file/group, no Fortran backtrace, no result file).
+6. bad input (exit 1, a message naming the file/group, no Fortran backtrace, no result file);
+8. groups of nodes (inputs/gmsh/hertz_force_h0.04.msh): the disc held by ux = 0 on its axis (a
+   curve inside it) and uy at its centre (a physical point) runs, and the result has those
+   displacements; a point or an inside curve as a traction or contact group is bad input.
 """
 import math
 import os
@@ -252,6 +255,44 @@ for op, over in (("steklov", "&solver robin_operator='steklov', delta=0.95 /"),
         e = rel(read_lam(orr), read_lam(onm))
         check(e <= 1e-6, f"non-matching paper scene: Robin ({op}) = monolithic to 1e-6",
               f"{e:.2e} ({mr['outer']} outer iterations)")
+
+# 8. groups of nodes: a physical point and a curve inside the body hold the disc
+HF_MESH = os.path.abspath("inputs/gmsh/hertz_force_h0.04.msh")
+HF_DECK = write("hertz_force.nml", f"""&scene plane='strain' /
+&body id=1, mesh='{HF_MESH}', region='disc', young=1000.0, poisson=0.3 /
+&body id=2, mesh='{HF_MESH}', region='block', young=1000.0, poisson=0.3 /
+&boundary body=1, group='disc_axis', ux=0.0 /
+&boundary body=1, group='disc_centre', uy=-0.01 /
+&traction body=1, group='disc_top', pressure=1.0 /
+&boundary body=2, group='block_bottom', ux=0.0, uy=0.0 /
+&contact body1_group='disc_arc', body2_group='block_top' /
+&solver robin_operator='harmonic', delta=0.5, tol=1e-10 /
+""")
+p, _, ohf = run(HF_DECK, name="hertz_force_points")
+if check(p.returncode == 0, "point groups: disc held by ux on its axis and uy at its centre runs", p.stderr[-300:]):
+    with h5py.File(ohf, "r") as f:
+        x = np.array(f["/body1/coordinates"])
+        u = np.array(f["/body1/displacement"])
+    axis = x[0] == 0
+    centre = axis & (x[1] == 2)
+    check(centre.sum() == 1 and abs(u[1, centre][0] + 0.01) < 1e-14 and np.all(u[0, axis] == 0)
+          and axis.sum() > 10, "point groups: uy = -0.01 at disc_centre, ux = 0 on every disc_axis node",
+          f"centre nodes {centre.sum()}, axis nodes {axis.sum()}")
+for k, (what, over, words) in enumerate([
+        ("traction on a physical point", "&traction body=1, group='disc_centre', pressure=1.0 /",
+         ["'disc_centre' is a physical point", "traction"]),
+        ("contact on a physical point", "&contact body1_group='disc_centre' /",
+         ["'disc_centre' is a physical point", "contact"]),
+        ("traction on a curve inside the body", "&traction body=1, group='disc_axis', pressure=1.0 /",
+         ["'disc_axis' is a curve inside the body"]),
+        ("a point of the other body", "&boundary body=2, group='disc_centre', uy=0.0 /",
+         ["disc_centre", "physical points: disc_centre"])]):
+    out = os.path.join(tmp, f"never_pt{k}.h5")
+    p, _ = run_solver(BIN, HF_DECK, over, f"&output file='{out}' /")
+    text = p.stdout + p.stderr
+    check(p.returncode == 1 and all(w in text for w in words) and "Backtrace" not in text
+          and not os.path.exists(out), f"bad input: {what}: exit 1, message names {words}, nothing written",
+          f"exit {p.returncode}: {p.stderr.strip()[-260:]}")
 
 if check.failed:
     print(f"test_geometry: {len(check.failed)} failed check(s)")

@@ -2,14 +2,15 @@
 !! coordinates, boundary groups and their outward normals, refinement), and small bad or
 !! unusual MSH files written here (binary, version 2.2, missing node, 3D, second order,
 !! unknown region, clockwise cells, degenerate and non-convex cells, sparse unordered tags,
-!! truncation, unknown sections, numbers in every form).
+!! truncation, unknown sections, numbers in every form), and groups of nodes (physical
+!! points, a physical curve inside a body).
 !!
 !! With arguments, `test_gmsh file.msh [region]` only reads that file and prints the time
 !! taken (the read benchmark).
 program test_gmsh
   use kinds, only: wp
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
-  use mesh, only: mesh_t, group_index
+  use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal
   use gmsh_msh, only: msh_read
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary
@@ -33,7 +34,9 @@ program test_gmsh
   call test_nonmatching()
   call test_patch()
   call test_hertz()
+  call test_hertz_force()
   call test_bad_inputs()
+  call test_point_groups()
   call test_unusual_inputs()
   call test_summary()
 
@@ -355,6 +358,137 @@ contains
                   any(block%xy(1, :) == 0 .and. block%xy(2, :) == 1), name//': both bodies have a node at (0,1)')
     end do
   end subroutine test_hertz
+
+  !> The force-controlled Hertz geometry: the disc in two quarters, its axis a curve inside
+  !! it, its centre a physical point sharing the disc mesh's node.
+  subroutine test_hertz_force()
+    type(mesh_t) :: disc, block
+    character(len=*), parameter :: hs(2) = ['0.04', '0.02']
+    integer, allocatable :: nodes(:)
+    integer :: k, g, ne
+    real(wp) :: h, dev, length
+    character(len=:), allocatable :: name
+    character(len=8) :: hbuf
+
+    do k = 1, 2
+      name = 'hertz_force_h'//hs(k)//'.msh'
+      hbuf = hs(k)
+      read (hbuf, *) h
+      call read_ok(dir//name, 'disc', disc)
+      call read_ok(dir//name, 'block', block)
+      call report(disc%element == ELEM_P1 .and. all_ccw(disc) .and. all_ccw(block), &
+                  name//': triangles, counter-clockwise')
+      call group_normal(disc, 'disc_top', [0.0_wp, 1.0_wp], dev, length, ne)
+      call report(dev < 1e-12_wp .and. abs(length - 2) < 1e-12_wp, name//': disc_top (both halves) normal (0,1), length 2')
+      g = group_index(disc, 'disc_centre')
+      call report(g > 0, name//': the disc has the point group disc_centre')
+      if (g > 0) then
+        call group_nodes(disc, g, nodes)
+        call report(nodes_only(disc, g) .and. disc%group(g)%point .and. size(nodes) == 1, &
+                    name//': disc_centre is one node, no edge')
+        if (size(nodes) == 1) call report(all(disc%xy(:, nodes(1)) == [0.0_wp, 2.0_wp]) .and. &
+                                          any(disc%cells == nodes(1)), name//': disc_centre is the disc''s node at (0,2)')
+      end if
+      g = group_index(disc, 'disc_axis')
+      call report(g > 0, name//': the disc has the group disc_axis')
+      if (g > 0) then
+        call group_nodes(disc, g, nodes)
+        call report(nodes_only(disc, g) .and. .not. disc%group(g)%point .and. size(nodes) == count(disc%xy(1, :) == 0) .and. &
+                    all(disc%xy(1, nodes) == 0) .and. minval(disc%xy(2, nodes)) == 1 .and. &
+                    maxval(disc%xy(2, nodes)) == 2, name//': disc_axis: every node of x = 0, 1 <= y <= 2, no edge')
+      end if
+      call report(group_index(block, 'disc_centre') == 0 .and. group_index(block, 'disc_axis') == 0 .and. &
+                  block%ngroup == 4, name//': the block has neither disc_centre nor disc_axis')
+      call report(index(block%file_groups, 'physical points: disc_centre') > 0, &
+                  name//': file_groups lists the physical point')
+    end do
+  end subroutine test_hertz_force
+
+  !> Groups of nodes in a small file of two bodies: body 'a' (two triangles, their shared
+  !! diagonal on the curve 'diag'), body 'b' (a quadrangle). The physical point 'corner' is
+  !! a node of a; 'free_pt' is a node in no cell, at the place of a node of b; 'both' holds
+  !! both points; the point 'base' is named as the curve 'base' (its node joins the curve's).
+  subroutine test_point_groups()
+    type(mesh_t) :: a, b
+    integer, allocatable :: nodes(:)
+    integer :: info, g, u
+    character(len=512) :: msg
+    character(len=:), allocatable :: s
+
+    call write_file(tmp//'points.msh', [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', &
+      '$PhysicalNames', '8', '0 1 "corner"', '0 2 "free_pt"', '0 3 "both"', '0 4 "base"', &
+      '1 10 "base"', '1 11 "diag"', '2 20 "a"', '2 21 "b"', '$EndPhysicalNames', &
+      '$Entities', '3 2 2 0', '1 1 1 0 2 1 3', '2 0 3 0 2 2 3', '3 0 0 0 1 4', &
+      '1 0 0 0 1 0 0 1 10 0', '2 0 0 0 1 1 0 1 11 0', '1 0 0 0 1 1 0 1 20 0', '2 0 2 0 1 3 0 1 21 0', &
+      '$EndEntities', &
+      '$Nodes', '1 9 1 9', '2 1 0 9', '1', '2', '3', '4', '5', '6', '7', '8', '9', &
+      '0 0 0', '1 0 0', '1 1 0', '0 1 0', '0 2 0', '1 2 0', '1 3 0', '0 3 0', '0 3 0', '$EndNodes', &
+      '$Elements', '7 8 101 401', '0 1 15 1', '101 3', '0 2 15 1', '102 9', '0 3 15 1', '103 1', &
+      '1 1 1 1', '201 1 2', '1 2 1 1', '202 1 3', '2 1 2 2', '301 1 2 3', '302 1 3 4', &
+      '2 2 3 1', '401 5 6 7 8', '$EndElements'])
+    call msh_read(tmp//'points.msh', 'a', 1, a, info, msg)
+    call report(info == 0, 'physical points: body a is read')
+    if (info /= 0) write (*, '(a)') trim(msg)
+    call msh_read(tmp//'points.msh', 'b', 2, b, info, msg)
+    call report(info == 0, 'physical points: body b is read')
+    if (info /= 0) write (*, '(a)') trim(msg)
+    open (newunit=u, file=tmp//'points.msh')
+    close (u, status='delete')
+    if (a%nnode /= 4 .or. b%nnode /= 4) return
+
+    g = group_index(a, 'corner')
+    call report(g > 0, "body a has the point group 'corner'")
+    if (g > 0) then
+      call group_nodes(a, g, nodes)
+      call report(nodes_only(a, g) .and. a%group(g)%point .and. a%group(g)%nedge == 0 .and. size(nodes) == 1, &
+                  "'corner': one node, no edge")
+      if (size(nodes) == 1) call report(a%node_tag(nodes(1)) == 3, "'corner' is the node of tag 3 (shared with the cells)")
+      s = nodes_only_refusal(a, g, 'a traction needs')
+      call report(index(s, "group 'corner' is a physical point: a traction needs a curve") > 0, &
+                  'a point group is refused for a traction: '//s)
+    end if
+    call report(group_index(a, 'free_pt') == 0, "body a has no 'free_pt' (its node is at b's place)")
+    g = group_index(a, 'both')
+    if (g > 0) call group_nodes(a, g, nodes)
+    call report(g > 0, "body a has the group 'both'")
+    if (g > 0) call report(size(nodes) == 1 .and. a%node_tag(nodes(1)) == 3, "'both' in a: the node of tag 3 only")
+    g = group_index(a, 'diag')
+    call report(g > 0, "body a has the curve 'diag' inside it")
+    if (g > 0) then
+      call group_nodes(a, g, nodes)
+      call report(nodes_only(a, g) .and. .not. a%group(g)%point .and. size(nodes) == 2, &
+                  "'diag': the nodes of an inside curve, no edge")
+      if (size(nodes) == 2) call report(all(a%node_tag(nodes) == [1, 3]), "'diag': nodes of tags 1 and 3")
+      s = nodes_only_refusal(a, g, 'contact needs')
+      call report(index(s, "group 'diag' is a curve inside the body") > 0, 'an inside curve is refused for contact: '//s)
+    end if
+    g = group_index(a, 'base')
+    call report(g > 0, "body a has the curve 'base'")
+    if (g > 0) then
+      call group_nodes(a, g, nodes)
+      call report(.not. nodes_only(a, g) .and. a%group(g)%nedge == 1 .and. size(nodes) == 2, &
+                  "'base': its edge, and the point 'base' on its node")
+      if (size(nodes) == 2) call report(all(a%node_tag(nodes) == [1, 2]), "'base': nodes of tags 1 and 2")
+    end if
+    s = group_names(a)
+    call report(index(s, "'corner' (point)") > 0 .and. index(s, "'diag' (inside the body)") > 0, &
+                'group_names marks points and inside curves: '//s)
+    call report(index(a%file_groups, 'physical points: corner free_pt both base') > 0, &
+                'file_groups lists the physical points: '//a%file_groups)
+
+    g = group_index(b, 'free_pt')
+    call report(g > 0, "body b has 'free_pt' (a free node at its node's place)")
+    if (g > 0) then
+      call group_nodes(b, g, nodes)
+      call report(size(nodes) == 1 .and. b%node_tag(nodes(1)) == 8, "'free_pt' is b's node of tag 8 (same place)")
+    end if
+    g = group_index(b, 'both')
+    if (g > 0) call group_nodes(b, g, nodes)
+    call report(g > 0, "body b has the group 'both'")
+    if (g > 0) call report(size(nodes) == 1 .and. b%node_tag(nodes(1)) == 8, "'both' in b: the node of tag 8 only")
+    call report(group_index(b, 'corner') == 0 .and. group_index(b, 'diag') == 0 .and. group_index(b, 'base') == 0, &
+                "body b has neither 'corner' nor a's curves")
+  end subroutine test_point_groups
 
   ! ---- small files ------------------------------------------------------------------------
 

@@ -12,7 +12,7 @@ module condense
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use config, only: body_cfg_t, contact_cfg_t, factor_cfg_t, BC_CONTACT, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, &
                     SIDE_TOP, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
-  use mesh, only: mesh_t, side_nodes, group_index, group_names
+  use mesh, only: mesh_t, side_nodes, group_index, group_names, nodes_only, nodes_only_refusal
   use mortar, only: mortar_t, mortar_build
   use strings, only: i2s, r2s
   use assembly, only: body_system_t
@@ -224,6 +224,12 @@ contains
         info = 1
         msg = '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)// &
               ' has no such group with edges on its boundary; its groups are '//group_names(msh(a))
+        return
+      end if
+      if (nodes_only(msh(a), g(a))) then
+        info = 1
+        msg = '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)//': '// &
+              nodes_only_refusal(msh(a), g(a), 'contact needs')
         return
       end if
       associate (gr => msh(a)%group(g(a)))

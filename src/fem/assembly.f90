@@ -15,7 +15,8 @@ module assembly
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, BC_CONTACT
-  use mesh, only: mesh_t, side_nodes, node_id, group_index, group_names, group_nodes
+  use mesh, only: mesh_t, side_nodes, node_id, group_index, group_names, group_nodes, &
+                  nodes_only, nodes_only_refusal
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress
   use linop, only: csc_symv
@@ -833,6 +834,11 @@ contains
         if (g == 0) then
           info = 1
           msg = trim(tractions(t)%origin)//': '//unknown_group(mesh, tractions(t)%group)
+          return
+        end if
+        if (nodes_only(mesh, g)) then
+          info = 1
+          msg = trim(tractions(t)%origin)//': '//nodes_only_refusal(mesh, g, 'a traction needs')
           return
         end if
         call add_group_traction(mesh, g, tractions(t), sys%f_applied)

@@ -10,7 +10,12 @@
 !! tag order. Cells are reoriented counter-clockwise; degenerate cells and non-convex
 !! quadrangles are refused.
 !! A group keeps the line elements of its physical curve that are boundary edges of the body
-!! (edges of exactly one body cell), oriented as that cell traverses them.
+!! (edges of exactly one body cell), oriented as that cell traverses them; the nodes of its
+!! lines inside the body (edges of two body cells) are kept as single nodes. A physical point
+!! (point elements, type 15) is a group of single nodes: those of its points that are nodes
+!! of the body. Gmsh gives a point that bounds or is embedded in a meshed surface the node of
+!! the surface's mesh; a point's node in no cell of the file (a free geometry point) is the
+!! body's node at the same place, within 1e-9 times the body's size, if it has one.
 !!
 !! Errors: info = 1 for bad input (msg names the file and the line or element tag), 3 for
 !! other failures (memory). Only first-order elements (2-node lines, 3-node triangles,
@@ -57,7 +62,7 @@ module gmsh_msh
     character(len=:), allocatable :: s
   end type name_t
 
-  !> A curve or surface entity and its physical tags.
+  !> A point, curve or surface entity and its physical tags.
   type :: entity_t
     integer :: dim = 0, tag = 0
     integer, allocatable :: phys(:)
@@ -68,7 +73,7 @@ module gmsh_msh
     integer :: nphys = 0                       ! physical groups (named or not)
     integer, allocatable :: pdim(:), ptag(:)
     type(name_t), allocatable :: pname(:)
-    integer :: nent = 0                        ! curve and surface entities
+    integer :: nent = 0                        ! point, curve and surface entities
     type(entity_t), allocatable :: ent(:)
     integer :: nnode = 0                       ! nodes, in file order
     integer, allocatable :: ntag(:)
@@ -79,6 +84,8 @@ module gmsh_msh
     integer, allocatable :: ctag(:), cent(:), cnode(:, :)   ! tag, entity index (0: none), 4 file indices (0)
     integer :: nline = 0                       ! 2-node lines
     integer, allocatable :: lent(:), lnode(:, :)              ! entity index, 2 file indices
+    integer :: npoint = 0                      ! point elements
+    integer, allocatable :: pent(:), pnode(:)                 ! entity index, file index
     logical :: has_format = .false., has_nodes = .false., has_elements = .false.
   end type msh_data_t
 
@@ -90,9 +97,10 @@ contains
   !! region = '' the file may hold at most one physical surface, and a file without physical
   !! groups gives every 2D element. `mesh` gets the body's nodes (renumbered by increasing
   !! Gmsh tag, `node_tag` keeps the tag), its cells counter-clockwise (`cell_tag`,
-  !! `cell_type`), element = ELEM_Q1, ELEM_P1 or ELEM_MIXED, the bounding box, and one edge
-  !! group per physical curve with edges on the body's boundary (`file_groups` lists every
-  !! physical curve name of the file).
+  !! `cell_type`), element = ELEM_Q1, ELEM_P1 or ELEM_MIXED, the bounding box, one edge
+  !! group per physical curve with edges on the body's boundary, then one node group per
+  !! physical point with nodes of the body (`file_groups` lists every physical curve and
+  !! point name of the file).
   subroutine msh_read(path, region, body_id, mesh, info, msg)
     character(len=*), intent(in) :: path     !< the .msh file
     character(len=*), intent(in) :: region   !< physical surface name of the body, or ''
@@ -622,7 +630,7 @@ contains
     d%pname(d%nphys)%s = name
   end subroutine add_physical
 
-  !> $Entities: the physical tags of every curve and surface (points and volumes skipped).
+  !> $Entities: the physical tags of every point, curve and surface (volumes skipped).
   subroutine read_entities(cur, d)
     type(cursor_t), intent(inout) :: cur
     type(msh_data_t), intent(inout) :: d
@@ -637,7 +645,7 @@ contains
       call fail(cur, 'negative numbers of entities')
       return
     end if
-    allocate (d%ent(nents(1) + nents(2)))
+    allocate (d%ent(nents(0) + nents(1) + nents(2)))
     do dim = 0, 3
       do k = 1, nents(dim)
         tag = get_int(cur, 'an entity tag')
@@ -661,7 +669,7 @@ contains
           end do
         end if
         if (cur%info /= 0) return
-        if (dim == 1 .or. dim == 2) then
+        if (dim <= 2) then
           d%nent = d%nent + 1
           d%ent(d%nent)%dim = dim
           d%ent(d%nent)%tag = tag
@@ -765,7 +773,7 @@ contains
     end if
     ! sized for the worst case; the lines are a small part of a 2D mesh but bounded by ntotal too
     allocate (d%ctag(ntotal), d%cent(ntotal), d%cnode(4, ntotal), d%lent(ntotal), &
-              d%lnode(2, ntotal), stat=st)
+              d%lnode(2, ntotal), d%pent(ntotal), d%pnode(ntotal), stat=st)
     if (st /= 0) then
       call fail(cur, 'not enough memory for '//i2s(ntotal)//' elements', OTHER_FAILURE)
       return
@@ -806,7 +814,10 @@ contains
         if (etype == 1) then
           d%nline = d%nline + 1
           d%lent(d%nline) = ent
-        else if (etype /= 15) then
+        else if (etype == 15) then
+          d%npoint = d%npoint + 1
+          d%pent(d%npoint) = ent
+        else
           d%ncell = d%ncell + 1
           d%ctag(d%ncell) = tag
           d%cent(d%ncell) = ent
@@ -822,7 +833,9 @@ contains
           end if
           if (etype == 1) then
             d%lnode(j, d%nline) = d%slot_node(slot)
-          else if (etype /= 15) then
+          else if (etype == 15) then
+            d%pnode(d%npoint) = d%slot_node(slot)
+          else
             d%cnode(j, d%ncell) = d%slot_node(slot)
           end if
         end do
@@ -857,7 +870,7 @@ contains
     end select
   end function unsupported_type
 
-  !> The index in d%ent of entity (dim, tag), 0 if it has none (points, or no $Entities).
+  !> The index in d%ent of entity (dim, tag), 0 if it has none (no $Entities).
   integer function entity_index(d, dim, tag) result(k)
     type(msh_data_t), intent(in) :: d
     integer, intent(in) :: dim, tag
@@ -996,6 +1009,7 @@ contains
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
     call boundary_groups(cur, d, body_node, mesh)
+    if (cur%info == 0) call point_groups(d, body_node, mesh)
   end subroutine build_body
 
   !> Put cell k counter-clockwise; refuse it if degenerate or (a quadrangle) not convex.
@@ -1040,29 +1054,33 @@ contains
     end if
   end subroutine orient_cell
 
-  !> One edge group per physical curve: its lines that are boundary edges of the body.
-  !! The lines' edges are hashed (a small table), then every cell edge is looked up in it:
-  !! a line edge met in exactly one cell is a boundary edge, oriented as that cell has it.
+  !> One edge group per physical curve: its lines that are boundary edges of the body, and
+  !! the nodes of its lines inside the body as single nodes (a curve inside the body gives
+  !! a group of nodes only). The lines' edges are hashed (a small table), then every cell
+  !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
+  !! oriented as that cell has it; one met in two is inside the body.
   subroutine boundary_groups(cur, d, body_node, mesh)
     type(cursor_t), intent(inout) :: cur
     type(msh_data_t), intent(in) :: d
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
     type(hash_t) :: h
-    integer, allocatable :: line_slot(:), ecount(:), ecell(:), elocal(:), edges(:, :), cells(:)
-    integer :: c, i, nv, a, b, slot, st, p, l, ne, ng
+    integer, allocatable :: line_slot(:), ecount(:), ecell(:), elocal(:), edges(:, :), cells(:), inner(:)
+    logical, allocatable :: on(:)
+    integer :: c, i, nv, a, b, slot, st, p, l, ne, ng, ni
     integer(i8) :: key, nn1
 
     ! the body's line edges, keyed by their two nodes (line_slot = 0: not a body edge)
     call hash_init(h, d%nline, st)
     if (st == 0) allocate (line_slot(d%nline), ecount(0:h%mask), ecell(0:h%mask), elocal(0:h%mask), &
-                           edges(2, d%nline), cells(d%nline), stat=st)
+                           edges(2, d%nline), cells(d%nline), inner(2*d%nline), on(mesh%nnode), stat=st)
     if (st /= 0) then
       call fail(cur, 'not enough memory for the boundary edges', OTHER_FAILURE, .false.)
       return
     end if
     line_slot = -1
     ecount = 0
+    on = .false.
     nn1 = mesh%nnode + 1
     do l = 1, d%nline
       if (d%lent(l) == 0) cycle
@@ -1091,33 +1109,127 @@ contains
     end do
 
     mesh%file_groups = ''
-    allocate (mesh%group(count(d%pdim(1:d%nphys) == 1)))
+    allocate (mesh%group(count(d%pdim(1:d%nphys) == 1 .or. d%pdim(1:d%nphys) == 0)))  ! room for points
     ng = 0
     do p = 1, d%nphys
       if (d%pdim(p) /= 1) cycle
       mesh%file_groups = trim(mesh%file_groups//' '//d%pname(p)%s)
       ne = 0
+      ni = 0
       do l = 1, d%nline
         if (line_slot(l) < 0) cycle
         if (.not. any(d%ent(d%lent(l))%phys == d%ptag(p))) cycle
         slot = line_slot(l)
-        if (ecount(slot) /= 1) cycle          ! an interior edge
+        if (ecount(slot) == 0) cycle          ! not an edge of the body's cells
+        if (ecount(slot) > 1) then            ! inside the body: its nodes, once each
+          do i = 1, 2
+            a = body_node(d%lnode(i, l))
+            if (on(a)) cycle
+            on(a) = .true.
+            ni = ni + 1
+            inner(ni) = a
+          end do
+          cycle
+        end if
         c = ecell(slot)
         nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
         ne = ne + 1
         edges(:, ne) = [mesh%cells(elocal(slot), c), mesh%cells(modulo(elocal(slot), nv) + 1, c)]
         cells(ne) = c
       end do
-      if (ne == 0) cycle
+      on(inner(1:ni)) = .false.
+      if (ne == 0 .and. ni == 0) cycle
       ng = ng + 1
       mesh%group(ng)%name = d%pname(p)%s
       mesh%group(ng)%nedge = ne
       mesh%group(ng)%edge = edges(:, 1:ne)
       mesh%group(ng)%cell = cells(1:ne)
+      mesh%group(ng)%nnode = ni
+      mesh%group(ng)%node = inner(1:ni)
     end do
     mesh%file_groups = trim(adjustl(mesh%file_groups))
     mesh%ngroup = ng
   end subroutine boundary_groups
+
+  !> One node group per physical point with nodes in the body, after the edge groups (a
+  !! physical point named as a physical curve adds its nodes to the curve's group); the
+  !! points' names go to file_groups. A point's node is the body's if the body's cells have
+  !! it; a node in no cell of the file is matched to the body's node at its place.
+  subroutine point_groups(d, body_node, mesh)
+    type(msh_data_t), intent(in) :: d
+    integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
+    type(mesh_t), intent(inout) :: mesh
+    logical, allocatable :: in_cell(:)
+    integer, allocatable :: nodes(:)
+    integer :: p, l, n, nn, g, c, i
+    real(wp) :: tol
+    character(len=:), allocatable :: names
+
+    names = ''
+    allocate (nodes(d%npoint))
+    tol = 1.0e-9_wp*max(mesh%width, mesh%height)
+    do p = 1, d%nphys
+      if (d%pdim(p) /= 0) cycle
+      names = names//' '//d%pname(p)%s
+      nn = 0
+      do l = 1, d%npoint
+        if (d%pent(l) == 0) cycle
+        if (.not. any(d%ent(d%pent(l))%phys == d%ptag(p))) cycle
+        n = body_node(d%pnode(l))
+        if (n == 0) then
+          if (.not. allocated(in_cell)) then
+            allocate (in_cell(d%nnode))
+            in_cell = .false.
+            do c = 1, d%ncell
+              do i = 1, 4
+                if (d%cnode(i, c) > 0) in_cell(d%cnode(i, c)) = .true.
+              end do
+            end do
+          end if
+          if (.not. in_cell(d%pnode(l))) n = node_at(mesh, d%nxy(:, d%pnode(l)), tol)
+        end if
+        if (n == 0) cycle
+        if (any(nodes(1:nn) == n)) cycle
+        nn = nn + 1
+        nodes(nn) = n
+      end do
+      if (nn == 0) cycle
+      g = 0
+      do c = 1, mesh%ngroup
+        if (mesh%group(c)%name == d%pname(p)%s) g = c
+      end do
+      if (g == 0) then
+        mesh%ngroup = mesh%ngroup + 1
+        g = mesh%ngroup
+        mesh%group(g)%name = d%pname(p)%s
+        mesh%group(g)%point = .true.
+        allocate (mesh%group(g)%edge(2, 0), mesh%group(g)%cell(0))
+      end if
+      if (.not. allocated(mesh%group(g)%node)) allocate (mesh%group(g)%node(0))
+      mesh%group(g)%node = [mesh%group(g)%node, nodes(1:nn)]
+      mesh%group(g)%nnode = size(mesh%group(g)%node)
+    end do
+    if (len(names) == 0) return
+    if (len(mesh%file_groups) == 0) mesh%file_groups = '(none)'
+    mesh%file_groups = mesh%file_groups//'; physical points:'//names
+  end subroutine point_groups
+
+  !> The body node within tol of xy (the nearest), 0 if none.
+  integer function node_at(mesh, xy, tol) result(n)
+    type(mesh_t), intent(in) :: mesh
+    real(wp), intent(in) :: xy(2), tol
+    real(wp) :: dist, best
+    integer :: k
+    n = 0
+    best = tol
+    do k = 1, mesh%nnode
+      dist = maxval(abs(mesh%xy(:, k) - xy))
+      if (dist <= best) then
+        n = k
+        best = dist
+      end if
+    end do
+  end function node_at
 
   !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
   subroutine sort_by_tag(idx, tag)

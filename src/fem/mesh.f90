@@ -12,8 +12,9 @@
 !! The same type holds a general 2D mesh read from a file (module gmsh_msh): cells of mixed
 !! types (`cell_type`), counter-clockwise after reading, with the file's tags kept for
 !! messages, and named groups of boundary edges (`group`) on which conditions and the
-!! contact surface are given. A structured mesh has the groups 'left', 'right', 'bottom'
-!! and 'top'. Every group edge is a boundary edge of one cell, oriented counter-clockwise
+!! contact surface are given; a group may also hold single nodes (a Gmsh physical point, or
+!! the nodes of a physical curve inside the body), usable for prescribed displacements only. A structured mesh has the groups 'left',
+!! 'right', 'bottom' and 'top'. Every group edge is a boundary edge of one cell, oriented counter-clockwise
 !! around the body (the body on its left), so its outward normal is (dy, -dx)/length.
 module mesh
   use kinds, only: wp
@@ -21,14 +22,20 @@ module mesh
   implicit none (type, external)
   private
 
-  public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes
+  public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes, &
+            nodes_only, nodes_only_refusal
 
-  !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side).
+  !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side)
+  !! and of single nodes (a Gmsh physical point, or where a physical curve runs inside the
+  !! body: its nodes off the boundary edges).
   type, public :: edge_group_t
     character(len=:), allocatable :: name      !< the group's name (Gmsh physical name)
     integer :: nedge = 0                       !< edges of this body in the group
     integer, allocatable :: edge(:, :)         !< (2, nedge) node ids, the body on the left
     integer, allocatable :: cell(:)            !< (nedge) the cell each edge bounds
+    integer :: nnode = 0                       !< single nodes of this body in the group
+    integer, allocatable :: node(:)            !< (nnode) their node ids
+    logical :: point = .false.                 !< a Gmsh physical point (nedge = 0)
   end type edge_group_t
 
   !> A structured mesh of one rectangular body.
@@ -53,7 +60,9 @@ module mesh
     integer, allocatable :: cell_tag(:)   !< (ncell) the file's element tag (structured: the cell id)
     integer :: ngroup = 0                 !< named edge groups of this body
     type(edge_group_t), allocatable :: group(:)   !< (ngroup) the groups
-    character(len=:), allocatable :: file_groups  !< every physical curve name of the file, for messages
+    !> every physical curve name of the file, then '; physical points: ' and every physical
+    !! point name if there are any, for messages
+    character(len=:), allocatable :: file_groups
   end type mesh_t
 
 contains
@@ -208,7 +217,8 @@ contains
     g = 0
   end function group_index
 
-  !> The names of the body's groups, quoted and comma-separated (for messages).
+  !> The names of the body's groups, quoted and comma-separated, a physical point's
+  !! followed by ' (point)', a curve's inside the body by ' (inside the body)' (for messages).
   function group_names(mesh) result(s)
     type(mesh_t), intent(in) :: mesh
     character(len=:), allocatable :: s
@@ -217,11 +227,17 @@ contains
     do g = 1, mesh%ngroup
       if (g > 1) s = s//', '
       s = s//"'"//mesh%group(g)%name//"'"
+      if (mesh%group(g)%point) then
+        s = s//' (point)'
+      else if (nodes_only(mesh, g)) then
+        s = s//' (inside the body)'
+      end if
     end do
     if (mesh%ngroup == 0) s = '(none)'
   end function group_names
 
-  !> The distinct nodes of group g, in increasing node id.
+  !> The distinct nodes of group g (those of its edges and its single nodes), in
+  !! increasing node id.
   subroutine group_nodes(mesh, g, nodes)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: g
@@ -233,8 +249,36 @@ contains
     do k = 1, mesh%group(g)%nedge
       on(mesh%group(g)%edge(:, k)) = .true.
     end do
+    do k = 1, mesh%group(g)%nnode
+      on(mesh%group(g)%node(k)) = .true.
+    end do
     nodes = pack([(k, k=1, mesh%nnode)], on)
   end subroutine group_nodes
+
+  !> Whether group g has nodes but no boundary edge (a physical point, or a physical curve
+  !! inside the body): it can carry prescribed displacements, but no traction and no contact.
+  pure logical function nodes_only(mesh, g)
+    type(mesh_t), intent(in) :: mesh   !< the body's mesh
+    integer, intent(in) :: g           !< a group index (group_index), 1..ngroup
+    nodes_only = mesh%group(g)%nedge == 0 .and. mesh%group(g)%nnode > 0
+  end function nodes_only
+
+  !> The sentence refusing group g (nodes_only) where boundary edges are needed: `use` is
+  !! what needs them, with its verb, e.g. 'a traction needs' or 'contact needs'.
+  function nodes_only_refusal(mesh, g, use) result(s)
+    type(mesh_t), intent(in) :: mesh        !< the body's mesh
+    integer, intent(in) :: g                !< a group without edges (nodes_only)
+    character(len=*), intent(in) :: use     !< what needs a curve, with its verb
+    character(len=:), allocatable :: s
+    if (mesh%group(g)%point) then
+      s = "group '"//mesh%group(g)%name//"' is a physical point: "//use//' a curve'
+    else
+      s = "group '"//mesh%group(g)%name//"' is a curve inside the body, with no edge on its "// &
+          'boundary: '//use//' a curve on the boundary'
+    end if
+    s = s//' (a physical curve with edges on the boundary of the body); a group of nodes can '// &
+        'only prescribe displacements (&boundary)'
+  end function nodes_only_refusal
 
   !> The nodes on one side of the mesh, ordered by increasing s (x on bottom/top,
   !! y on left/right), corners included. An unknown side gives an empty list.
