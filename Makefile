@@ -157,7 +157,7 @@ $(BUILD)/h5io.o:           $(BUILD)/kinds.o
 $(BUILD)/files.o:
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
-                           $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
+                           $(BUILD)/condense.o $(BUILD)/floating.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
                            $(BUILD)/history_io.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o

@@ -259,6 +259,16 @@ program robin_contact
     if (ckpt%failed) call warn(ckpt%message)
   end if
   if (me == 0 .and. res%status /= 'failed') call error_bound(itf, cb, res)
+  if (me == 0 .and. res%status /= 'failed' .and. itf%m > 0) then
+    ! a floating body's load against its contact force: the equality the solver enforced
+    do a = 1, 2
+      if (sys(a)%nrig == 0) cycle
+      write (output_unit, '(a)') 'equilibrium: body '//achar(48 + a)//' |G lam - e|/|e| = '// &
+        sci(norm2(matmul(cb(a)%rg, res%lam_body(:, a)) - cb(a)%re)/norm2(cb(a)%re))//' (its own force), '// &
+        sci(norm2(matmul(cb(a)%rg, res%lam) - cb(a)%re)/norm2(cb(a)%re))//' (mean force); rigid motion '// &
+        'amplitude '//sci(res%rigid(1, a))//'; SMALBE multiplier updates (all solves) '//i2s(res%eq_updates)
+    end do
+  end if
   collective = .true.
   if (use_mumps) call share_contact_forces()
   ! displacements of both bodies under their own contact forces

@@ -439,8 +439,8 @@ contains
     real(wp), intent(inout) :: c(:, :)
     integer :: j
     do j = 1, size(c, 2)
-      where (abs(c(:, j)) < 1.0e-12_wp) c(:, j) = 0.0_wp
       if (c(maxloc(abs(c(:, j)), dim=1), j) < 0.0_wp) c(:, j) = -c(:, j)
+      where (abs(c(:, j)) < 1.0e-12_wp) c(:, j) = 0.0_wp
       c(:, j) = c(:, j)/norm2(c(:, j))
     end do
   end subroutine tidy_basis

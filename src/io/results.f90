@@ -19,6 +19,7 @@ module results
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t
   use contact_types, only: contact_result_t
+  use floating, only: free_list
   implicit none (type, external)
   private
 
@@ -220,6 +221,15 @@ contains
       call write_attr(gid, 'young', d%body(a)%young, st)
       call write_attr(gid, 'poisson', d%body(a)%poisson, st)
       call write_attr(gid, 'free_dofs', sys(a)%n, st)
+      ! a body held only by contact: its free rigid motions, their amplitudes (the
+      ! displacement includes them) and the fixing DOFs of the generalized inverse
+      call write_attr(gid, 'free_rigid_motions', sys(a)%nrig, st)
+      if (sys(a)%nrig > 0) then
+        call write_attr(gid, 'rigid_motions', free_list(sys(a)), st)
+        call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
+        call write_dset(gid, 'rigid_basis', sys(a)%rig_coef, st, '1')
+        call write_dset(gid, 'fixing_dofs', sys(a)%fixing - 1, st, '1')
+      end if
       ! (nnode, 2) in Fortran order -> h5py shape (2, nnode)
       allocate (w2(msh(a)%nnode, 2), w3(3, msh(a)%nnode), ua(sys(a)%ndof))
       ua = u(1:sys(a)%ndof, a)
