@@ -1176,7 +1176,15 @@ contains
       end do
       res%complementarity = res%complementarity/(lmax*uscale)
     end if
-    res%residual = max(res%imbalance, res%penetration, res%complementarity)
+    ! a floating body's equilibrium (its load against its own contact force): an inner
+    ! solve that stopped on inner_max_it may leave it unmet, and then no run converges
+    res%equilibrium = 0.0_wp
+    do i = 1, 2
+      if (bc(i)%nrig == 0) cycle
+      res%equilibrium = max(res%equilibrium, norm2(matmul(bc(i)%rg, res%lam_body(:, i)) - bc(i)%re)/ &
+                            max(norm2(bc(i)%re), tiny(1.0_wp)))
+    end do
+    res%residual = max(res%imbalance, res%penetration, res%complementarity, res%equilibrium)
     res%active = count(res%lam > 0.0_wp)
   end subroutine interface_residual
 

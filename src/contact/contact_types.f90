@@ -22,10 +22,11 @@ module contact_types
     real(wp), allocatable :: gap(:)            !< (m) B_1u_1 + B_2u_2 - g0 [length]
     real(wp), allocatable :: obstacle(:, :)    !< (m,2) final obstacles G_a [length]
     real(wp) :: criterion = 0.0_wp             !< last value of the stopping criterion
-    real(wp) :: residual = 0.0_wp              !< max(imbalance, penetration, complementarity)
+    real(wp) :: residual = 0.0_wp              !< max(imbalance, penetration, complementarity, equilibrium)
     real(wp) :: imbalance = 0.0_wp             !< |lam_1 - lam_2| / |lam|
     real(wp) :: penetration = 0.0_wp           !< max(gap, 0) / displacement scale
     real(wp) :: complementarity = 0.0_wp       !< max lam_i |gap_i| / (max lam * displacement scale)
+    real(wp) :: equilibrium = 0.0_wp           !< floating bodies: max_a |G_a lam_a - e_a| / |e_a| (0: none)
     real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
     real(wp) :: kappa = 0.0_wp                 !< condition number estimate of F_1 + F_2
     integer :: active = 0                      !< nodes with lam > 0
