@@ -10,7 +10,11 @@ Runs (each a separate process of bin/robin_contact, OMP_NUM_THREADS=2 unless sai
   threads  robin/steklov at 512x256 and 1024x512 with OMP_NUM_THREADS=1 and 2,
            METIS and AMD orderings, run back to back;
   sweep    256x128, tol 1e-2 ... 1e-10, stop='residual' and 'increment', both Robin
-           operators, plus monolithic with monolithic_rtol 1e-2 ... 1e-10.
+           operators, plus monolithic with monolithic_rtol 1e-2 ... 1e-10;
+  floating the paper's size (24x16) and the finest level, contact by groups, body 1 clamped
+           on its left side (supported) against body 1 with ux = 0 only there (held only
+           by contact, floating vertically: README "Bodies held only by contact"), Robin
+           harmonic delta 0.5 and monolithic: the extra cost of a floating body.
 
 Error columns:
   alg_err   |lam - lam_mono| / |lam_mono| against the monolithic run of the same mesh
@@ -208,9 +212,19 @@ def new_row(group, level, label, method, operator, factorization="cholmod", orde
     return row
 
 
+# the floating group: the paper's scene with contact by groups; body 1 supported (ux, uy = 0
+# on its left side) or floating vertically (ux = 0 only)
+FLOAT_SCENE = ["&body id=1, left='free', bottom='free' /", "&body id=2, left='free', top='free' /",
+               "&boundary body=2, group='left', ux=0.0, uy=0.0 /",
+               "&contact body1_group='bottom', body2_group='top' /"]
+
+
 def overrides_of(row):
     nx, ny = row["nx"], row["ny"]
     ov = [f"&body id=1, nx={nx}, ny={ny} /", f"&body id=2, nx={nx}, ny={ny} /"]
+    if row["group"] == "floating":
+        ov += FLOAT_SCENE + ["&boundary body=1, group='left', ux=0.0 /" if row["label"].startswith("floating")
+                             else "&boundary body=1, group='left', ux=0.0, uy=0.0 /"]
     s = f"&solver method='{row['method']}', factorization='{row['factorization']}'"
     if row["factorization"] == "cholmod":
         s += f", ordering='{row['ordering']}'"
@@ -274,7 +288,8 @@ def main():
     ap.add_argument("--orderings", default="amd,nd",
                     help="comma list of CHOLMOD orderings compared with metis (ordering and threads "
                          "groups), e.g. amd,nd (default amd)")
-    ap.add_argument("--skip", default="", help="comma list of groups to skip: ordering,threads,sweep")
+    ap.add_argument("--skip", default="", help="comma list of groups to skip: ordering,threads,sweep,floating")
+    ap.add_argument("--only-floating", action="store_true", help="run the floating group only")
     ap.add_argument("--quiet-wait", type=float, default=120.0,
                     help="before each run at >= 512x256 and each thread-comparison run, wait up to this "
                          "many s until other processes keep < 0.5 core busy")
@@ -316,7 +331,7 @@ def main():
     sys.stderr.write(f"bench: levels 0..{top}, work folder {workdir}\n")
     mono = {}
     banded_prev = None
-    for lv in range(top + 1):
+    for lv in range(-1 if a.only_floating else top + 1):
         mono[lv] = go(new_row("ladder", lv, "monolithic", "monolithic", "", mono_rtol=a.ref_rtol))
         go(new_row("ladder", lv, "robin-steklov", "robin", "steklov"))
         go(new_row("ladder", lv, "robin-harmonic", "robin", "harmonic"))
@@ -326,6 +341,8 @@ def main():
             if banded_prev is None or banded_prev * 16.0 < a.banded_limit:
                 r = go(new_row("ordering", lv, "robin-steklov", "robin", "steklov", factorization="banded"))
                 banded_prev = r["total_s"] if r["status"] != "error" else 1e30
+    if a.only_floating:
+        skip |= {"threads", "sweep"}
     if "threads" not in skip:
         tlevels = [lv for lv in (5, 6) if lv <= top] or [top]
         for lv in tlevels:
@@ -344,12 +361,22 @@ def main():
         for tol in tols:
             go(new_row("sweep", sweep_level, "monolithic", "monolithic", "", mono_rtol=tol))
 
+    if "floating" not in skip:
+        for lv in sorted({-1, top}):
+            for kind in ("supported", "floating"):
+                for meth, op in (("robin", "harmonic"), ("monolithic", "")):
+                    r = new_row("floating", max(lv, 0), f"{kind} {meth}", meth, op, tol=1e-10,
+                                mono_rtol=1e-12)
+                    if lv < 0:   # the paper's own mesh
+                        r.update(nx=24, ny=16, level=-1)
+                    go(r, repeats=a.repeat if lv >= 5 else a.repeat_small)
+
     # ---- errors ---------------------------------------------------------------------
     C = R.contact
-    fine = C.get(id(mono[top]))
+    fine = C.get(id(mono[top])) if top in mono else None
     for r in rows:
         c = C.get(id(r))
-        if c is None:
+        if c is None or r["group"] == "floating":
             continue
         m = C.get(id(mono[r["level"]]))
         if m is not None and r is not mono[r["level"]]:
@@ -377,6 +404,16 @@ def main():
                 if i >= 2 and ser[i - 2]["level"] == r["level"] - 2:
                     q = ser[i - 2]
                     r["force_order3"] = order(abs(q["force"] - p["force"]), abs(p["force"] - r["force"]))
+
+    # floating group: each Robin run against the monolithic run of the same mesh and support
+    fl = [r for r in rows if r["group"] == "floating"]
+    for r in fl:
+        ref = [q for q in fl if q["method"] == "monolithic" and (q["nx"], q["ny"]) == (r["nx"], r["ny"])
+               and q["label"].split()[0] == r["label"].split()[0]]
+        c, m = C.get(id(r)), (C.get(id(ref[0])) if ref else None)
+        if c is not None and m is not None and ref[0] is not r:
+            e = rel_err(c["normal_force"], m["normal_force"])
+            r["alg_err"] = float("nan") if e is None else e
 
     os.makedirs(os.path.dirname(a.csv) or ".", exist_ok=True)
     with open(a.csv, "w", newline="") as fh:
@@ -474,6 +511,22 @@ def main():
                     [[r["label"], r["stop"] or "(mono rtol)", fmt(r["tol"] if r["tol"] != "" else r["mono_rtol"], ".0e"),
                       r["status"], oi(r), fmt(r["iterate_s"], ".3f"), fmt(r["solve_s"], ".3f"),
                       fmt(r["residual"], ".1e"), fmt(r["alg_err"], ".1e")] for r in sr]))
+    if fl:
+        print("\n## A body held only by contact: body 1 clamped on its left side (supported) or with "
+              "ux = 0 only there (floating vertically), contact by groups, Robin harmonic delta 0.5 tol 1e-10 "
+              "and monolithic; ratio = total / total of the supported run\n")
+        out = []
+        for r in fl:
+            sup = [q for q in fl if q["label"] == r["label"].replace("floating", "supported")
+                   and (q["nx"], q["ny"]) == (r["nx"], r["ny"])]
+            ratio = (r["total_s"] / sup[0]["total_s"] if sup and r["status"] != "error" and sup[0]["status"] != "error"
+                     and sup[0]["total_s"] > 0 else float("nan"))
+            out.append([f"{r['nx']}x{r['ny']}", r["n1"], r["m"], r["label"] + st(r), oi(r),
+                        fmt(r["factor_s"], ".3f"), fmt(r["condense_s"], ".3f"), fmt(r["iterate_s"], ".3f"),
+                        fmt(r["total_s"], ".3f"), fmt(ratio, ".2f"), fmt(r["peak_mb"], ".0f"),
+                        fmt(r["force"], ".6e"), fmt(r["alg_err"], ".1e"), r["busy_during"]])
+        print(table(["mesh", "DOFs/body", "m", "run", "outer/inner", "factor", "condense", "iterate", "total",
+                     "ratio", "peak MB", "total force", "alg. err", "busy"], out))
     fin = [r for r in rows if r["group"] == "ladder" and r["level"] == top and r["label"] == "robin-steklov"]
     if fin and fin[0]["status"] != "error":
         r = fin[0]
