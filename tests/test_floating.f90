@@ -173,7 +173,9 @@ contains
     call report(sys%nrig == nexp, tag//': kernel dimension', real(sys%nrig, wp), real(nexp, wp))
     if (sys%nrig /= nexp) return
     if (nexp == 0) then
-      call report(.not. allocated(sys%fixing) .or. size(sys%fixing) == 0, tag//': no fixing DOFs')
+      names_ok = .true.   ! (no short-circuit .or. in Fortran)
+      if (allocated(sys%fixing)) names_ok = size(sys%fixing) == 0
+      call report(names_ok, tag//': no fixing DOFs')
       return
     end if
     allocate (v(sys%ndof), kr(sys%ndof), live(sys%ndof), pres(sys%ndof))

@@ -38,7 +38,7 @@ from hertz_study import hertz_fit  # noqa: E402
 
 BIN = os.environ.get("BIN", "bin/robin_contact")
 MPI_BIN = os.environ.get("MPI_BIN", "bin/robin_contact_mpi")
-OUT = os.path.join(os.environ.get("BUILD", "build/release"), "test-out", "floating")
+OUT = os.path.join(os.environ.get("BUILD", "build/release"), "test-out", "floating_runs")
 shutil.rmtree(OUT, ignore_errors=True)
 os.makedirs(OUT)
 check = Checks()
