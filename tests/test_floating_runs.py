@@ -13,6 +13,9 @@ by contact"):
     body 1 floats vertically; Robin (harmonic) = monolithic to 1e-6; the vertical contact
     force equals the applied -11.5e6 N/m to 1e-10; the floating line and the result file
     name the free motion; the rigid amplitude is the displacement at the fixing DOF;
+(c2) the same with ux = 0 on body 1's top instead: two free motions (vertical translation,
+    rotation about a point of the top line); force and moment of the contact balance the
+    load's (from the deck's tractions) to 1e-10; Robin = monolithic to 1e-6;
 (d) a run stopped at max_outer with a checkpoint and restarted ends bitwise identical to an
     uninterrupted run;
 (e) 1 and 2 OpenMP threads give identical contact forces;
@@ -62,8 +65,15 @@ with open(ROLLER, "w") as f:
 &contact body1_group='bottom', body2_group='top' /
 &solver robin_operator='harmonic', delta=0.5, tol=1e-10 /
 """)
+# the same, ux = 0 on body 1's top instead: free are the vertical translation and a rotation
+# about a point of the top line (two equilibrium rows: force and moment)
+ROLLER_TOP = os.path.join(OUT, "paper_roller_top.nml")
+with open(ROLLER_TOP, "w") as f:
+    f.write(open(ROLLER).read().replace("group='left', ux=0.0 /\n&boundary body=2", "group='top', ux=0.0 /\n&boundary body=2"))
 # applied vertical load on body 1: top -(3e6 + 1e6 x) over x in (0, 3) = -13.5e6, right side +2e6 over 1
 LOAD_Y = -(3.0e6 * 3.0 + 1.0e6 * 4.5) + 2.0e6 * 1.0
+# its moment about (1.5, 2): top -int_0^3 (x - 1.5)(3e6 + 1e6 x) dx = -2.25e6, right side 1.5 * 2e6
+MOMENT_TOP = -2.25e6 + 3.0e6
 
 
 def info(what):
@@ -212,6 +222,35 @@ if len(pr_) == 2:
         eu = rel_err(np.array(fr["/body1/displacement"]), np.array(fm["/body1/displacement"]))
     check(ea is not None and ea <= 1e-6 and eu is not None and eu <= 1e-6,
           "paper roller: Robin = monolithic rigid amplitude and body 1 displacement (1e-6)", f"{ea:.2e}, {eu:.2e}")
+
+# ---- (c2) body 1 held by ux = 0 on its top: two free motions ---------------------------------
+pt = {}
+for method in ("robin", "monolithic"):
+    p, res, path = run(ROLLER_TOP, f"&solver method='{method}' /", name=f"roller_top_{method}")
+    if not ok_run(p, res, f"ux=0 on body 1's top, {method}"):
+        continue
+    pt[method] = path
+    info(f"ux=0 on body 1's top, {method}: outer {res['outer']} inner {res['inner']}")
+    fl = "".join(ln for ln in p.stdout.splitlines() if ln.startswith("floating:"))
+    check("translation along y" in fl and "rotation about" in fl and "2.0000" in fl,
+          f"ux=0 on body 1's top, {method}: free translation along y and a rotation about a point of y = 2", fl[:160])
+    lam, n = contact(path)
+    with h5py.File(path, "r") as f:
+        x = np.array(f["/contact/x"])
+        y = np.array(f["/contact/y"])
+        nfree = int(np.asarray(f["/body1"].attrs.get("free_rigid_motions", -1)).reshape(-1)[0])
+    fx, fy = -lam * n[0, :], -lam * n[1, :]   # the contact's force on body 1 at each node
+    mom = float(np.sum((x - 1.5) * fy - (y - 2.0) * fx))
+    check(nfree == 2, f"ux=0 on body 1's top, {method}: /body1 records 2 free motions", str(nfree))
+    check(abs(np.sum(fy) + LOAD_Y) <= 1e-10 * abs(LOAD_Y),
+          f"ux=0 on body 1's top, {method}: vertical contact force = 11.5e6 (1e-10 rel)",
+          f"{abs(np.sum(fy) + LOAD_Y) / abs(LOAD_Y):.2e}")
+    check(abs(mom + MOMENT_TOP) <= 1e-10 * abs(LOAD_Y) * 1.5,
+          f"ux=0 on body 1's top, {method}: contact moment about (1.5, 2) balances the load's 0.75e6",
+          f"{mom:.6e}, rel {abs(mom + MOMENT_TOP) / (abs(LOAD_Y) * 1.5):.2e}")
+if len(pt) == 2:
+    e = rel_err(contact(pt["robin"])[0], contact(pt["monolithic"])[0])
+    check(e is not None and e <= 1e-6, "ux=0 on body 1's top: Robin = monolithic contact forces (1e-6)", f"{e:.2e}")
 
 # ---- (d) checkpoint and restart ------------------------------------------------------------------
 if "robin" in pr_:
