@@ -560,11 +560,14 @@ contains
   !> P F_a P with P = I - G_a'(G_a G_a')^-1 G_a, the orthogonal projector on the forces
   !! that G_a sees as balanced: a floating body's F_a = B_a K_a^+ B_a' depends on its fixing
   !! DOFs by terms in G_a' (rigid motions), and its response to a self-equilibrated force
-  !! does not. The Robin correction of the other body's obstacle uses P F_a P: it vanishes
-  !! on the rigid part, which the floating body's own equality settles, so the linearised
-  !! outer map keeps the eigenvalues of the supported case (README, "Bodies held only by
-  !! contact"); S_1 + S_2 stays definite (the other body's part is), so the fixed point is
-  !! still the monolithic solution.
+  !! does not (P F_a P is the pseudo-inverse of the projected inverse Q_a, harmonic_floating).
+  !! The 'steklov' correction of the other body's obstacle uses P F_a P: it vanishes on the
+  !! rigid part, which the floating body's own equality settles, and S_1 + S_2 stays definite
+  !! (the other body's part is), so the fixed point is still the monolithic solution. Its
+  !! rate is not the supported case's: a floating body is far more flexible on balanced
+  !! loads (a free-free block bends), and the relaxation must stay below 2 / (1 + mu_max),
+  !! mu_max the largest eigenvalue of P F_a P F_o^-1 (README: 14 on the 24x8 roller scene;
+  !! the paper's scene on a roller stalls at delta >= 0.5, converges at 0.3).
   function projected_flex(bc) result(pf)
     type(body_condensed_t), intent(in) :: bc
     real(wp), allocatable :: pf(:, :), q(:, :), gg(:, :), y(:, :)
