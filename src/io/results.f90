@@ -163,6 +163,7 @@ contains
     call write_attr(fid, 'penetration', res%penetration, st)
     call write_attr(fid, 'complementarity', res%complementarity, st)
     call write_attr(fid, 'equilibrium', res%equilibrium, st)
+    call write_attr(fid, 'equality_updates', res%eq_updates, st)
     call write_attr(fid, 'error_bound', res%error_bound, st)
     call write_attr(fid, 'kappa', res%kappa, st)
     call write_attr(fid, 'delta', d%solver%delta, st)
