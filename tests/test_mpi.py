@@ -187,5 +187,61 @@ if os.path.exists(ckpt):
     check(r is not None and (r["outer"], r["inner"]) == ("1460", "6221"), "its outer/inner counts are those of "
           "an uninterrupted run (1460/6221, the serial binary's)", f"{r and (r['outer'], r['inner'])}")
 
+# 6. SIGUSR1 to mpirun itself (OpenMPI forwards SIGUSR1 to its ranks, while it answers
+# SIGTERM by killing them): the binary takes it as SIGTERM, so rank 0 writes the checkpoint
+# and mpirun exits 4 (the ranks' code)
+small = ["inputs/default.nml", "&body id=1, nx=256, ny=128 /", "&body id=2, nx=256, ny=128 /",
+         "&solver factorization='mumps', delta=0.005, max_outer=20000 /"]
+out = os.path.join(OUT, "sigusr1.h5")
+ckpt = out + ".ckpt.h5"
+for f in (out, ckpt):
+    if os.path.exists(f):
+        os.remove(f)
+log = os.path.join(OUT, "sigusr1.log")
+with open(log, "w") as lf:
+    pr = subprocess.Popen(["mpirun", "--oversubscribe", "-np", "2", MPI_BIN, *small,
+                           f"&output file='{out}', checkpoint_every=50 /"], stdout=lf, stderr=subprocess.STDOUT,
+                          env=mpi_env())
+    t0 = time.time()
+    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
+        time.sleep(0.05)
+    time.sleep(0.3)
+    pr.send_signal(signal.SIGUSR1)
+    try:
+        rc = pr.wait(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        pr.kill()
+        rc = None
+text = open(log).read()
+check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt), "SIGUSR1 to mpirun in the Robin "
+      "iteration: exit 4, status=interrupted, checkpoint written", f"exit {rc}")
+
+# 7. the Slurm MPI script without srun (mpirun, NP ranks): a SIGTERM to the script (as a
+# scheduler or a user sends it) becomes SIGUSR1 for mpirun: exit 4 and a checkpoint
+for f in (out, ckpt):
+    if os.path.exists(f):
+        os.remove(f)
+log = os.path.join(OUT, "sbatch_term.log")
+env = mpi_env({"NP": "2", "BIN": MPI_BIN})
+for k in [k for k in env if k.startswith("SLURM_")]:
+    del env[k]
+with open(log, "w") as lf:
+    pr = subprocess.Popen(["bash", "tools/slurm/run_deck_mpi.sbatch", *small,
+                           f"&output file='{out}', checkpoint_every=50 /"], stdout=lf, stderr=subprocess.STDOUT, env=env)
+    t0 = time.time()
+    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
+        time.sleep(0.05)
+    time.sleep(0.3)
+    pr.send_signal(signal.SIGTERM)
+    try:
+        rc = pr.wait(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        pr.kill()
+        rc = None
+text = open(log).read()
+check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt) and "resubmit with --restart" in text,
+      "tools/slurm/run_deck_mpi.sbatch under mpirun: SIGTERM to the script gives exit 4 and a checkpoint",
+      f"exit {rc}")
+
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)
