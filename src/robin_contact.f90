@@ -346,7 +346,7 @@ contains
     type(deck_t), intent(in) :: dd
     real(wp) :: est, node_est
     integer :: st, node_ranks
-    character(len=512) :: m1
+    character(len=1024) :: m1
     if (.not. use_mumps) then
       call check_budget(dd, memory_limit_mb(), ok, budget_msg)
       if (.not. ok) call fatal(EXIT_INPUT, budget_msg)

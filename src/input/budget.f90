@@ -149,7 +149,7 @@ contains
       mb = mb + body_memory_mb(d%body(a), d%solver%factor, nm, nf) &
            - (12.0_wp*nm + 8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB       ! mesh, vectors: every rank
       m = max(m, real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp)
-      first = merge(0, g(1), a == 1)                                 ! the group's host
+      first = merge(0, g(1), a == 1 .or. ranks <= 1)                 ! the group's host
       if (ranks > 1 .and. (rank < first .or. rank >= first + g(a))) cycle
       fs = fs + MUMPS_OVERHEAD*(8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB/real(g(a), wp)
       share = share + MUMPS_OVERHEAD*12.0_wp*nm/MIB/real(g(a), wp)
