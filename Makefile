@@ -236,7 +236,7 @@ bench-gmsh: $(PROG)
 # The MPI binary beside the serial one (issue 16): the paper's scene at 1024x512 per body,
 # serial CHOLMOD and MUMPS at -np 2, 4, 8 (oversubscribed here), time per phase and the
 # largest per-rank peak memory; then the largest body per path (CHOLMOD, -np 2, -np 4) by a
-# ladder (about 30 min); results/bench_mpi.csv and Markdown tables
+# ladder (about 25 min); results/bench_mpi.csv and Markdown tables
 bench-mpi: $(PROG)
 	$(MAKE) MPI=1 all
 	$(PYTHON) tools/bench_mpi.py --bin $(PROG) --mpi-bin bin/robin_contact_mpi --ladder
