@@ -128,7 +128,9 @@ for np_ in (2, 4):
         continue
     el = error_lines(q)
     m = PER_RANK.search(el[0]) if len(el) == 1 else None
-    check(q.returncode == 1 and m is not None and f"the {np_} rank(s) on its node" in el[0] and "2.93 GiB" in el[0],
+    lim = re.search(r"may use only ([0-9.]+) GiB", el[0]) if len(el) == 1 else None
+    check(q.returncode == 1 and m is not None and f"the {np_} rank(s) on its node" in el[0] and lim is not None
+          and float(lim.group(1)) <= 2.93,
           f"-np {np_} over the node's memory: exit 1, one message naming the estimate per rank, the node's sum "
           "and the limit", f"exit {q.returncode}: {el[0][:300] if el else q.stderr[-300:]}")
     check(not os.path.exists(out) and "phase: assembly" not in q.stdout, f"-np {np_}: refused before assembly, "
