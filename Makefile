@@ -82,7 +82,7 @@ DEPS_STAMP := build/.deps-mpi-ok
 endif
 # mpif90 and MUMPS's headers present: `make check` builds and tests the MPI binary too
 
-.PHONY: all mpi mpi-deps run check bench-mprgp bench-ordering table1 bench bench-gmsh hard plots meshes clean deps FORCE
+.PHONY: all mpi mpi-deps run check bench-mprgp bench-ordering table1 bench bench-gmsh bench-mpi hard plots meshes clean deps FORCE
 all: $(PROG)
 
 # ---- system packages: install what is missing (Debian 12) --------------------
@@ -235,6 +235,14 @@ bench: $(PROG)
 # 0.0025: 20k ... 1.27M DOFs per body), time per phase; results/bench_gmsh.csv
 bench-gmsh: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/bench_gmsh.py --bin $(PROG) --gmsh $(GMSH) --structured
+
+# The MPI binary beside the serial one (issue 16): the paper's scene at 1024x512 per body,
+# serial CHOLMOD and MUMPS at -np 2, 4, 8 (oversubscribed here), time per phase and the
+# largest per-rank peak memory; then the largest body per path (CHOLMOD, -np 2, -np 4) by a
+# ladder (about 25 min); results/bench_mpi.csv and Markdown tables
+bench-mpi: $(PROG)
+	$(MAKE) MPI=1 all
+	$(PYTHON) tools/bench_mpi.py --bin $(PROG) --mpi-bin bin/robin_contact_mpi --ladder
 
 plots: $(PROG)
 	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh

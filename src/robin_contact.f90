@@ -30,13 +30,13 @@ program robin_contact
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
   use files, only: remove_file
   use signals, only: signals_install, stop_requested, pending_signal
-  use sysinfo, only: peak_rss_mb, memory_limit_mb, write_stdout_checked
-  use budget, only: check_budget, check_load_range, body_memory_mb
+  use sysinfo, only: peak_rss_mb, memory_limit_mb, node_memory_limit_mb, process_memory_limit_mb, write_stdout_checked
+  use budget, only: check_budget, check_load_range, body_memory_mb, rank_memory_mb, check_budget_ranks
   use strings, only: sci, fmt_real, i2s, word
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
   use mpi_env, only: par_built, par_init, par_finalize, par_rank, par_size, par_split, par_bcast_reals, &
-                     par_bcast_ints, par_agree, par_any, par_abort
+                     par_bcast_ints, par_agree, par_any, par_abort, par_max_real, par_sum_real, par_node_sum
   use mumps_iface, only: mumps_t, mumps_end
   use condense_mumps, only: factor_body_mumps, condense_body_mumps, recover_displacement_mumps
   implicit none (type, external)
@@ -66,6 +66,7 @@ program robin_contact
   integer, allocatable :: irn(:), jcn(:)   ! this rank's share of a stiffness (MUMPS input)
   real(wp), allocatable :: kval(:)
   logical :: use_mumps = .false., mine(2) = .true., collective = .true.
+  real(wp) :: assembly_peak_mb = 0.0_wp   ! this rank's peak RSS when the factorization starts [MiB]
   type(mumps_t) :: mt(2)
 
   t_start = wtime()
@@ -94,8 +95,7 @@ program robin_contact
     call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': --restart applies to method=''robin'' only')
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
   ! a deck that cannot fit this machine is refused before anything is allocated
-  call check_budget(d, memory_limit_mb(), ok, budget_msg)
-  if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+  call check_memory(d)
   call check_load_range(d, ok, budget_msg)
   if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
   key = physics_key(d)
@@ -145,8 +145,7 @@ program robin_contact
       dsized%body(a)%nx = max(1, nint(sqrt(real(msh(a)%nnode, wp))) - 1)
       dsized%body(a)%ny = max(1, msh(a)%nnode/(dsized%body(a)%nx + 1) - 1)
     end do
-    call check_budget(dsized, memory_limit_mb(), ok, budget_msg)
-    if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+    call check_memory(dsized)
   end if
   !$omp parallel do num_threads(nthr) schedule(static, 1)
   do a = 1, 2
@@ -335,6 +334,7 @@ program robin_contact
   tm%output = wtime() - t0
   tm%total = wtime() - t_start
   tm%peak_rss_mb = peak_rss_mb()
+  if (use_mumps) call report_rank_peaks()
   call summary()
   call finish(code)
 
@@ -369,11 +369,36 @@ contains
     call par_abort(code)
   end subroutine par_fatal
 
+  !> Refuse a deck that does not fit (exit 1, nothing allocated yet). One process: the
+  !! whole run against this process's memory. MUMPS on ranks: each rank's estimate (its
+  !! share of its body's factor, the meshes of both bodies) against ulimit -v, and the sum
+  !! over the ranks of each node against the node's memory; every rank agrees (collective).
+  subroutine check_memory(dd)
+    type(deck_t), intent(in) :: dd
+    real(wp) :: est, node_est
+    integer :: st, node_ranks
+    character(len=1024) :: m1
+    if (.not. use_mumps) then
+      call check_budget(dd, memory_limit_mb(), ok, budget_msg)
+      if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+      return
+    end if
+    est = rank_memory_mb(dd, nranks, me)
+    call par_node_sum(est, node_est, node_ranks)
+    call check_budget_ranks(dd, nranks, me, est, node_est, node_ranks, node_memory_limit_mb(), &
+                            process_memory_limit_mb(), ok, budget_msg)
+    st = merge(0, EXIT_INPUT, ok)
+    m1 = budget_msg
+    call par_agree(st, m1)
+    if (st /= 0) call fatal(EXIT_INPUT, trim(m1))
+  end subroutine check_memory
+
   !> Split the ranks into one group per body (MPI_Comm_split): one rank does both bodies
   !! in turn; otherwise half each, an odd one out to the body with more unknowns. The
   !! lower world ranks form body 1's group, so world rank 0 hosts body 1.
   subroutine mumps_groups()
     integer :: g1, b
+    assembly_peak_mb = peak_rss_mb()   ! meshes, numbering and loads of both bodies
     if (nranks == 1) then
       mine = .true.
       host = 0
@@ -394,6 +419,20 @@ contains
     call par_split(merge(1, 2, me < g1), gcomm)
     write (output_unit, '(a,i0,a,i0,a)') 'mumps: ', g1, ' rank(s) on body 1, ', nranks - g1, ' on body 2'
   end subroutine mumps_groups
+
+  !> One line with the largest peak resident memory (VmHWM, getrusage) of any rank, which
+  !! rank, and the sum over the ranks (what the job needs on one node); the largest peak
+  !! at the start of the factorization tells the meshes' and loads' share. Collective.
+  subroutine report_rank_peaks()
+    real(wp) :: pmax, psum, amax
+    integer :: where, awhere
+    call par_max_real(peak_rss_mb(), pmax, where)
+    psum = par_sum_real(peak_rss_mb())
+    call par_max_real(assembly_peak_mb, amax, awhere)
+    write (output_unit, '(a,i0,a,f0.1,a,i0,a,f0.1,a,f0.1)') 'mpi: ranks=', nranks, ' peak_rss_max_rank_mb=', pmax, &
+      ' max_rank=', where, ' peak_rss_sum_mb=', psum, ' assembly_peak_max_rank_mb=', amax
+    flush (output_unit)
+  end subroutine report_rank_peaks
 
   !> Every rank learns the worst status of the bodies' groups; a failure is fatal (exit 3)
   !! on all ranks with the message of the lowest failing rank.

@@ -9,6 +9,7 @@ with exit 1 / 3 and one message, within a timeout (no rank left hanging); SIGTER
 the ranks (as srun sends it) in the Robin iteration: exit 4, a checkpoint, and a restart
 that converges as an uninterrupted run."""
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -95,6 +96,10 @@ for scene, over in (("paper", []), ("gap", [GAP])):
                 fa, ra = text_attr(f, "factorization"), int(f.attrs.get("ranks", -1))
             check(fa == "mumps" and ra == np_, f"{what}: the file says factorization='mumps', ranks={np_}",
                   f"{fa!r}, {ra}")
+            mp = re.findall(r"^mpi: ranks=(\d+) peak_rss_max_rank_mb=([0-9.]+) max_rank=(\d+) peak_rss_sum_mb=([0-9.]+)",
+                            q.stdout, re.M)
+            check(len(mp) == 1 and int(mp[0][0]) == np_ and 0 < float(mp[0][1]) <= float(mp[0][3]),
+                  f"{what}: one line with the largest peak memory of any rank and the sum over ranks", f"{mp}")
             check(q.stdout.count("result: ") == 1 and q.stdout.count("phase: assembly") == 1,
                   f"{what}: progress and summary printed once", f"{q.stdout.count('result: ')} result lines")
 
@@ -108,6 +113,33 @@ q, _ = mpirun(2, "inputs/default.nml", name="cholmod_np2")
 if check(q is not None, "-np 2 with factorization='cholmod' ends"):
     check(q.returncode == 1 and "mumps" in q.stderr, "-np 2 with factorization='cholmod' exits 1, pointing to "
           "'mumps'", f"exit {q.returncode}")
+
+# 3b. the memory check sizes each rank (its share of its body's factor, the meshes of both
+# bodies) and sums the ranks of a node: with the node's memory declared at 3000 MB
+# (ROBIN_MEMORY_LIMIT_MB) a 1024x512 body per rank is refused before anything is
+# allocated, exit 1, one message naming the estimate per rank; the estimate per rank falls
+# with the ranks per body (nearly halves from 1 to 2, the factor share exactly)
+PER_RANK = re.compile(r"a rank needs about ([0-9.]+) GiB \(rank \d+: its share of the MUMPS factor ([0-9.]+) GiB")
+est = {}
+for np_ in (2, 4):
+    q, out = mpirun(np_, "inputs/default.nml", "&body id=1, nx=1024, ny=512 /", "&body id=2, nx=1024, ny=512 /",
+                    MUMPS, name=f"budget_np{np_}", extra_env={"ROBIN_MEMORY_LIMIT_MB": "3000"})
+    if not check(q is not None, f"-np {np_} over the node's memory: every rank ends within {TIMEOUT} s"):
+        continue
+    el = error_lines(q)
+    m = PER_RANK.search(el[0]) if len(el) == 1 else None
+    lim = re.search(r"may use only ([0-9.]+) GiB", el[0]) if len(el) == 1 else None
+    check(q.returncode == 1 and m is not None and f"the {np_} rank(s) on its node" in el[0] and lim is not None
+          and float(lim.group(1)) <= 2.93,
+          f"-np {np_} over the node's memory: exit 1, one message naming the estimate per rank, the node's sum "
+          "and the limit", f"exit {q.returncode}: {el[0][:300] if el else q.stderr[-300:]}")
+    check(not os.path.exists(out) and "phase: assembly" not in q.stdout, f"-np {np_}: refused before assembly, "
+          "nothing written")
+    if m:
+        est[np_] = (float(m.group(1)), float(m.group(2)))
+if len(est) == 2:
+    check(est[4][0] < 0.65 * est[2][0] and abs(est[4][1] - est[2][1] / 2) <= 0.011,
+          "the estimate per rank falls with the ranks per body (2 per body against 1)", f"{est}")
 
 # 4. a MUMPS failure (working memory capped at 1 MB per rank): exit 3 on every rank, one message
 for np_ in (1, 2, 4):
@@ -156,6 +188,62 @@ if os.path.exists(ckpt):
     r = result_fields(q.stdout) if q else None
     check(r is not None and (r["outer"], r["inner"]) == ("1460", "6221"), "its outer/inner counts are those of "
           "an uninterrupted run (1460/6221, the serial binary's)", f"{r and (r['outer'], r['inner'])}")
+
+# 6. SIGUSR1 to mpirun itself (OpenMPI forwards SIGUSR1 to its ranks, while it answers
+# SIGTERM by killing them): the binary takes it as SIGTERM, so rank 0 writes the checkpoint
+# and mpirun exits 4 (the ranks' code)
+small = ["inputs/default.nml", "&body id=1, nx=256, ny=128 /", "&body id=2, nx=256, ny=128 /",
+         "&solver factorization='mumps', delta=0.005, max_outer=20000 /"]
+out = os.path.join(OUT, "sigusr1.h5")
+ckpt = out + ".ckpt.h5"
+for f in (out, ckpt):
+    if os.path.exists(f):
+        os.remove(f)
+log = os.path.join(OUT, "sigusr1.log")
+with open(log, "w") as lf:
+    pr = subprocess.Popen(["mpirun", "--oversubscribe", "-np", "2", MPI_BIN, *small,
+                           f"&output file='{out}', checkpoint_every=50 /"], stdout=lf, stderr=subprocess.STDOUT,
+                          env=mpi_env())
+    t0 = time.time()
+    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
+        time.sleep(0.05)
+    time.sleep(0.3)
+    pr.send_signal(signal.SIGUSR1)
+    try:
+        rc = pr.wait(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        pr.kill()
+        rc = None
+text = open(log).read()
+check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt), "SIGUSR1 to mpirun in the Robin "
+      "iteration: exit 4, status=interrupted, checkpoint written", f"exit {rc}")
+
+# 7. the Slurm MPI script without srun (mpirun, NP ranks): a SIGTERM to the script (as a
+# scheduler or a user sends it) becomes SIGUSR1 for mpirun: exit 4 and a checkpoint
+for f in (out, ckpt):
+    if os.path.exists(f):
+        os.remove(f)
+log = os.path.join(OUT, "sbatch_term.log")
+env = mpi_env({"NP": "2", "BIN": MPI_BIN})
+for k in [k for k in env if k.startswith("SLURM_")]:
+    del env[k]
+with open(log, "w") as lf:
+    pr = subprocess.Popen(["bash", "tools/slurm/run_deck_mpi.sbatch", *small,
+                           f"&output file='{out}', checkpoint_every=50 /"], stdout=lf, stderr=subprocess.STDOUT, env=env)
+    t0 = time.time()
+    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
+        time.sleep(0.05)
+    time.sleep(0.3)
+    pr.send_signal(signal.SIGTERM)
+    try:
+        rc = pr.wait(timeout=TIMEOUT)
+    except subprocess.TimeoutExpired:
+        pr.kill()
+        rc = None
+text = open(log).read()
+check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt) and "resubmit with --restart" in text,
+      "tools/slurm/run_deck_mpi.sbatch under mpirun: SIGTERM to the script gives exit 4 and a checkpoint",
+      f"exit {rc}")
 
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)

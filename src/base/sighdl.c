@@ -1,7 +1,10 @@
-/* Signal handling for batch schedulers: SIGTERM and SIGINT set a flag that the program
+/* Signal handling for batch schedulers: SIGTERM, SIGINT and SIGUSR1 set a flag that the program
  * polls (the outer iteration, the phase boundaries, the monolithic solver); the run then
  * writes what it can save (checkpoint, result flagged "interrupted") and exits with code
- * 4. Only async-signal-safe work in the handler.
+ * 4. Only async-signal-safe work in the handler. SIGUSR1 is there for OpenMPI's mpirun,
+ * which forwards SIGUSR1 and SIGUSR2 to its ranks but answers SIGTERM by killing them
+ * (SIGTERM, then SIGKILL a second later): `kill -USR1 <mpirun>` is the checkpoint request
+ * of an MPI run (README, "MPI and MUMPS").
  *
  * METIS (GKlib, bundled in Debian's libmetis) installs its own SIGTERM handler with
  * signal() around every ordering and restores ours afterwards: a SIGTERM from the
@@ -35,7 +38,7 @@ static int slot(int sig) { return sig == SIGTERM ? 0 : 1; }
 
 static void rc_handler(int sig, siginfo_t *si, void *ctx)
 {
-    rc_sighandler_t h = rc_library_handler[slot(sig)];
+    rc_sighandler_t h = (sig == SIGTERM || sig == SIGINT) ? rc_library_handler[slot(sig)] : NULL;
     (void)ctx;
     if (h != NULL && h != SIG_DFL && h != SIG_IGN && si != NULL && si->si_code == SI_TKILL
         && si->si_pid == getpid()) {
@@ -57,6 +60,7 @@ int rc_signals_install(void)
     sa.sa_flags = SA_RESTART | SA_SIGINFO | SA_NODEFER;
     if (sigaction(SIGTERM, &sa, NULL) != 0) return -1;
     if (sigaction(SIGINT, &sa, NULL) != 0) return -1;
+    if (sigaction(SIGUSR1, &sa, NULL) != 0) return -1;
     rc_installed = 1;
     return 0;
 }

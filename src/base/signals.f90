@@ -1,4 +1,4 @@
-!> SIGTERM/SIGINT from a batch scheduler: the C handler (src/base/sighdl.c) sets a flag
+!> SIGTERM/SIGINT (and SIGUSR1, which OpenMPI's mpirun forwards to its ranks) from a batch scheduler: the C handler (src/base/sighdl.c) sets a flag
 !! that the outer iteration polls through `stop_requested`.
 module signals
   use, intrinsic :: iso_c_binding, only: c_int
@@ -23,7 +23,7 @@ contains
     signals_install = rc_signals_install() == 0
   end function signals_install
 
-  !> True once SIGTERM or SIGINT has been received.
+  !> True once SIGTERM, SIGINT or SIGUSR1 has been received.
   logical function stop_requested()
     stop_requested = rc_signals_pending() /= 0
   end function stop_requested

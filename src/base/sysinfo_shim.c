@@ -73,24 +73,28 @@ static double cgroup_limit_mb(void)
     return lim;
 }
 
-/* Memory this process may use [MiB]: the smallest of the memory the kernel reports as
- * available (MemAvailable), the cgroup limit (v1 or v2, this cgroup and its ancestors) and the address-space
- * rlimit (ulimit -v); 0 if none can be read. */
-double rc_memory_limit_mb(void)
+/* Memory this process may use [MiB], 0 if none is known. which = RC_LIMIT_ALL: the
+ * smallest of the memory the kernel reports as available (MemAvailable), the cgroup limit
+ * (v1 or v2, this cgroup and its ancestors) and the address-space rlimit (ulimit -v);
+ * RC_LIMIT_NODE: the first two only (shared by the processes of a node or a job's cgroup);
+ * RC_LIMIT_PROCESS: the rlimit only (each process's own). */
+double rc_memory_limit_mb(int which)
 {
     double lim = 0.0, v;
     char line[256];
     struct rlimit rl;
-    FILE *f = fopen("/proc/meminfo", "r");
-    if (f != NULL) {
-        unsigned long long kb;
-        while (fgets(line, sizeof line, f) != NULL)
-            if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) { lim = (double) kb / 1024.0; break; }
-        fclose(f);
+    if (which != RC_LIMIT_PROCESS) {
+        FILE *f = fopen("/proc/meminfo", "r");
+        if (f != NULL) {
+            unsigned long long kb;
+            while (fgets(line, sizeof line, f) != NULL)
+                if (sscanf(line, "MemAvailable: %llu kB", &kb) == 1) { lim = (double) kb / 1024.0; break; }
+            fclose(f);
+        }
+        v = cgroup_limit_mb();
+        if (v > 0.0 && (lim == 0.0 || v < lim)) lim = v;
     }
-    v = cgroup_limit_mb();
-    if (v > 0.0 && (lim == 0.0 || v < lim)) lim = v;
-    if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
+    if (which != RC_LIMIT_NODE && getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) {
         v = (double) rl.rlim_cur / 1048576.0;
         if (lim == 0.0 || v < lim) lim = v;
     }

@@ -9,6 +9,13 @@
 !! dissection orderings (metis, nd, amd) of a structured 2D body of n DOFs fill about
 !! 8 n log2(n) entries; the banded factorization and the natural order fill n times the
 !! half-bandwidth. Counts are computed in double precision, so no integer overflows.
+!!
+!! The MPI binary with factorization='mumps' is sized per rank (`rank_memory_mb`,
+!! `check_budget_ranks`): every rank meshes both bodies and numbers their DOFs and loads,
+!! holds its share of one body's element entries and its share of that body's MUMPS factor
+!! (the factor over the ranks of the body's group, calibrated on bench-mpi at 1024x512:
+!! largest rank 2083/1188/760 MB at 1/2/4 ranks per body); the estimates of the ranks of a
+!! node are summed against the node's memory, each one against ulimit -v.
 module budget
   use kinds, only: wp
   use config, only: deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
@@ -19,8 +26,10 @@ module budget
   real(wp), parameter :: MIB = 1048576.0_wp
   real(wp), parameter :: INDEX_MAX = 2147483647.0_wp   ! largest 32-bit index
   real(wp), parameter :: BASE_MB = 64.0_wp             ! the program, libraries and small arrays
+  real(wp), parameter :: MUMPS_OVERHEAD = 1.1_wp       ! MUMPS's working space beyond the factor
 
-  public :: body_memory_mb, run_memory_mb, check_budget, check_load_range
+  public :: body_memory_mb, run_memory_mb, check_budget, check_load_range, mumps_group_sizes, rank_memory_mb, &
+            check_budget_ranks
 
 contains
 
@@ -101,6 +110,110 @@ contains
             'use fewer cells or a machine with more memory'
     end if
   end subroutine check_budget
+
+  !> The ranks of each body's group as the MPI binary splits them: one rank does both
+  !! bodies in turn (g = [1, 1], shared); otherwise half each, an odd one out to the body
+  !! with more unknowns (estimated from nx, ny here).
+  function mumps_group_sizes(d, ranks) result(g)
+    type(deck_t), intent(in) :: d   !< the deck
+    integer, intent(in) :: ranks    !< ranks in the world
+    integer :: g(2)
+    if (ranks <= 1) then
+      g = 1
+      return
+    end if
+    g(1) = ranks/2
+    if (mod(ranks, 2) == 1 .and. dofs(d%body(1)) >= dofs(d%body(2))) g(1) = g(1) + 1
+    g(2) = ranks - g(1)
+  end function mumps_group_sizes
+
+  !> Memory of one rank of the MPI binary with factorization='mumps' [MiB]: the meshes,
+  !! DOF numbering and loads of both bodies (every rank has them), its share of its body's
+  !! element entries (triplets, and MUMPS's copy) and of the body's factor (MUMPS's working
+  !! space included), on the group's host the right-hand side and the Schur complement and
+  !! X, on world rank 0 the interface matrices of the contact iteration. With one rank, both
+  !! bodies' shares. `factor_share_mb` returns the factor part alone.
+  real(wp) function rank_memory_mb(d, ranks, rank, factor_share_mb) result(mb)
+    type(deck_t), intent(in) :: d                  !< the deck
+    integer, intent(in) :: ranks                   !< ranks in the world
+    integer, intent(in) :: rank                    !< this rank (0-based)
+    real(wp), intent(out), optional :: factor_share_mb   !< its share of its body's factor [MiB]
+    real(wp) :: nm, nf, m, share, fs
+    integer :: a, g(2), first
+    g = mumps_group_sizes(d, ranks)
+    mb = BASE_MB
+    m = 0.0_wp
+    share = 0.0_wp
+    fs = 0.0_wp
+    do a = 1, 2
+      mb = mb + body_memory_mb(d%body(a), d%solver%factor, nm, nf) &
+           - (12.0_wp*nm + 8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB       ! mesh, vectors: every rank
+      m = max(m, real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp)
+      first = merge(0, g(1), a == 1 .or. ranks <= 1)                 ! the group's host
+      if (ranks > 1 .and. (rank < first .or. rank >= first + g(a))) cycle
+      fs = fs + MUMPS_OVERHEAD*(8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB/real(g(a), wp)
+      share = share + MUMPS_OVERHEAD*12.0_wp*nm/MIB/real(g(a), wp)
+      if (rank == first) mb = mb + (24.0_wp*dofs(d%body(a)) + 16.0_wp*(2.0_wp*m)**2)/MIB   ! RHS, S, X
+    end do
+    mb = mb + share + fs
+    if (rank == 0) mb = mb + 10.0_wp*8.0_wp*m*m/MIB   ! F_1, F_2, their operators, the bound's copies
+    if (present(factor_share_mb)) factor_share_mb = fs
+  end function rank_memory_mb
+
+  !> Refuse an MPI run with factorization='mumps' that cannot run on these ranks: a rank's
+  !! share beyond 32-bit indices, a rank whose estimate `rank_mb` exceeds the address-space
+  !! limit `process_limit_mb`, or ranks of a node whose estimates `node_mb` (summed over the
+  !! node's `node_ranks` ranks) exceed `node_limit_mb` (0: no limit known). ok = .false.
+  !! with msg naming the deck, the estimate per rank and the limit.
+  subroutine check_budget_ranks(d, ranks, rank, rank_mb, node_mb, node_ranks, node_limit_mb, process_limit_mb, &
+                                ok, msg)
+    type(deck_t), intent(in) :: d                       !< the deck
+    integer, intent(in) :: ranks, rank                  !< ranks in the world, this rank
+    real(wp), intent(in) :: rank_mb                     !< this rank's estimate (rank_memory_mb) [MiB]
+    real(wp), intent(in) :: node_mb                     !< the sum over the ranks of this node [MiB]
+    integer, intent(in) :: node_ranks                   !< ranks on this node
+    real(wp), intent(in) :: node_limit_mb               !< memory of the node (available, cgroup) [MiB]
+    real(wp), intent(in) :: process_limit_mb            !< ulimit -v of a process [MiB]
+    logical, intent(out) :: ok                          !< the run fits
+    character(len=:), allocatable, intent(out) :: msg   !< why not
+    real(wp) :: fs, x
+    integer :: a, g(2)
+    character(len=:), allocatable :: what
+    ok = .true.
+    msg = ''
+    g = mumps_group_sizes(d, ranks)
+    do a = 1, 2
+      if (dofs(d%body(a)) > INDEX_MAX .or. 9.0_wp*dofs(d%body(a))/real(g(a), wp) > INDEX_MAX) then
+        ok = .false.
+        msg = 'deck '//trim(d%source)//': body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
+              i2s(d%body(a)%ny)//') has too many DOFs or element entries per rank for the 32-bit indices '// &
+              'of this build with '//i2s(g(a))//' rank(s) on it; use more ranks or fewer cells'
+        return
+      end if
+    end do
+    x = rank_memory_mb(d, ranks, rank, fs)
+    what = 'with factorization=''mumps'' on '//i2s(ranks)//' rank(s) ('//i2s(g(1))//' on body 1, '//i2s(g(2))// &
+           ' on body 2) a rank needs about '//fmt_real(rank_mb/1024.0_wp, '(f0.2)')//' GiB (rank '//i2s(rank)// &
+           ': its share of the MUMPS factor '//fmt_real(fs/1024.0_wp, '(f0.2)')//' GiB, the meshes and loads of '// &
+           'both bodies and its element entries the rest)'
+    if (process_limit_mb > 0.0_wp .and. rank_mb > process_limit_mb) then
+      ok = .false.
+      msg = 'deck '//trim(d%source)//': '//what//' but a process may use only '// &
+            fmt_real(process_limit_mb/1024.0_wp, '(f0.2)')//' GiB (ulimit -v); use more ranks per body or fewer cells'
+    else if (node_limit_mb > 0.0_wp .and. node_mb > node_limit_mb) then
+      ok = .false.
+      msg = 'deck '//trim(d%source)//': '//what//', and the '//i2s(node_ranks)//' rank(s) on its node about '// &
+            fmt_real(node_mb/1024.0_wp, '(f0.2)')//' GiB together, but that node may use only '// &
+            fmt_real(node_limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ROBIN_MEMORY_LIMIT_MB); '// &
+            'spread the ranks over more nodes (fewer per node), use more ranks per body, or fewer cells'
+    end if
+  end subroutine check_budget_ranks
+
+  !> Unknowns of a structured body (both components of every node).
+  real(wp) function dofs(b)
+    type(body_cfg_t), intent(in) :: b
+    dofs = 2.0_wp*(real(b%nx, wp) + 1.0_wp)*(real(b%ny, wp) + 1.0_wp)
+  end function dofs
 
   !> Loads within double precision: a traction or prescribed displacement whose stresses
   !! would overflow (1e308 Pa) is refused, with a margin of 1e6 for the products of

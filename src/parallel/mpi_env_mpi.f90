@@ -11,7 +11,7 @@ module mpi_env
   logical, parameter, public :: par_built = .true.    !< .true. only in bin/robin_contact_mpi
 
   public :: par_init, par_finalize, par_rank, par_size, par_split, par_bcast_reals, par_bcast_ints, &
-            par_bcast_str, par_agree, par_any, par_abort, par_comm_world
+            par_bcast_str, par_agree, par_any, par_abort, par_comm_world, par_max_real, par_sum_real, par_node_sum
 
 contains
 
@@ -92,6 +92,38 @@ contains
     info = best(1)
     if (info /= 0) call MPI_Bcast(msg, len(msg), MPI_CHARACTER, best(2), MPI_COMM_WORLD, ierr)
   end subroutine par_agree
+
+  !> The largest x over the ranks and the lowest world rank that has it (collective).
+  subroutine par_max_real(x, xmax, where)
+    real(wp), intent(in) :: x          !< this rank's value
+    real(wp), intent(out) :: xmax      !< the largest over the world
+    integer, intent(out) :: where      !< a world rank that has it
+    real(wp) :: pair(2), best(2)
+    integer :: ierr
+    pair = [x, real(par_rank(), wp)]
+    call MPI_Allreduce(pair, best, 1, MPI_2DOUBLE_PRECISION, MPI_MAXLOC, MPI_COMM_WORLD, ierr)
+    xmax = best(1)
+    where = nint(best(2))
+  end subroutine par_max_real
+
+  !> The sum of x over the ranks (collective).
+  real(wp) function par_sum_real(x)
+    real(wp), intent(in) :: x
+    integer :: ierr
+    call MPI_Allreduce(x, par_sum_real, 1, MPI_DOUBLE_PRECISION, MPI_SUM, MPI_COMM_WORLD, ierr)
+  end function par_sum_real
+
+  !> The sum of x over the ranks of this node (MPI_COMM_TYPE_SHARED) and their number.
+  subroutine par_node_sum(x, total, count)
+    real(wp), intent(in) :: x          !< this rank's value
+    real(wp), intent(out) :: total     !< the sum over the node's ranks
+    integer, intent(out) :: count      !< ranks on this node
+    integer :: node, ierr
+    call MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, par_rank(), MPI_INFO_NULL, node, ierr)
+    call MPI_Allreduce(x, total, 1, MPI_DOUBLE_PRECISION, MPI_SUM, node, ierr)
+    call MPI_Comm_size(node, count, ierr)
+    call MPI_Comm_free(node, ierr)
+  end subroutine par_node_sum
 
   !> Whether flag is true on any rank (collective).
   logical function par_any(flag)

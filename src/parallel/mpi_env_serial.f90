@@ -9,7 +9,7 @@ module mpi_env
   logical, parameter, public :: par_built = .false.   !< .true. only in bin/robin_contact_mpi
 
   public :: par_init, par_finalize, par_rank, par_size, par_split, par_bcast_reals, par_bcast_ints, &
-            par_bcast_str, par_agree, par_any, par_abort, par_comm_world
+            par_bcast_str, par_agree, par_any, par_abort, par_comm_world, par_max_real, par_sum_real, par_node_sum
 
 contains
 
@@ -70,6 +70,30 @@ contains
     character(len=*), intent(inout) :: msg
     if (info < -huge(info)) msg = ''
   end subroutine par_agree
+
+  !> The largest x over the ranks and the rank that has it (one rank: x, 0).
+  subroutine par_max_real(x, xmax, where)
+    real(wp), intent(in) :: x
+    real(wp), intent(out) :: xmax
+    integer, intent(out) :: where
+    xmax = x
+    where = 0
+  end subroutine par_max_real
+
+  !> The sum of x over the ranks (one rank: x).
+  real(wp) function par_sum_real(x)
+    real(wp), intent(in) :: x
+    par_sum_real = x
+  end function par_sum_real
+
+  !> The sum of x over the ranks of this node and their number (one rank: x, 1).
+  subroutine par_node_sum(x, total, count)
+    real(wp), intent(in) :: x
+    real(wp), intent(out) :: total
+    integer, intent(out) :: count
+    total = x
+    count = 1
+  end subroutine par_node_sum
 
   !> Whether flag is true on any rank (one rank: flag).
   logical function par_any(flag)
