@@ -473,6 +473,18 @@ contains
       iv(1) = cb(b)%rank
       call par_bcast_ints(iv, 1, host(b))
       cb(b)%rank = iv(1)
+      ! the kernel basis of a singular F_a (flex_rank; -1: none), which the harmonic
+      ! operator's proximal term needs on rank 0 as much as on the body's host
+      iv(1) = -1
+      if (allocated(cb(b)%kern)) iv(1) = size(cb(b)%kern, 2)
+      call par_bcast_ints(iv, 1, host(b))
+      if (iv(1) >= 0) then
+        if (.not. (mine(b) .and. mt(b)%host)) then
+          if (allocated(cb(b)%kern)) deallocate (cb(b)%kern)
+          allocate (cb(b)%kern(itf%m, iv(1)))
+        end if
+        if (iv(1) > 0) call par_bcast_reals(cb(b)%kern, itf%m*iv(1), host(b))
+      end if
       info(b) = 0
     end do
     write (output_unit, '(a,2(f0.1,a))') 'mumps: largest rank''s factorization memory: body 1 ', &
