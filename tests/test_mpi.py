@@ -199,22 +199,29 @@ ckpt = out + ".ckpt.h5"
 for f in (out, ckpt):
     if os.path.exists(f):
         os.remove(f)
-log = os.path.join(OUT, "sigusr1.log")
-with open(log, "w") as lf:
-    pr = subprocess.Popen(["mpirun", "--oversubscribe", "-np", "2", MPI_BIN, *small,
-                           f"&output file='{out}', checkpoint_every=50 /"], stdout=lf, stderr=subprocess.STDOUT,
-                          env=mpi_env())
-    t0 = time.time()
-    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
-        time.sleep(0.05)
-    time.sleep(0.3)
-    pr.send_signal(signal.SIGUSR1)
-    try:
-        rc = pr.wait(timeout=TIMEOUT)
-    except subprocess.TimeoutExpired:
-        pr.kill()
-        rc = None
-text = open(log).read()
+
+
+def signal_in_robin(cmd, env, log, sig):
+    """Run cmd (output to log), send sig once the Robin iteration has started; the exit
+    code (None after TIMEOUT) and the log's text."""
+    with open(log, "w") as lf:
+        pr = subprocess.Popen(cmd, stdout=lf, stderr=subprocess.STDOUT, env=env)
+        t0 = time.time()
+        while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
+            time.sleep(0.05)
+        time.sleep(0.3)
+        pr.send_signal(sig)
+        try:
+            rc = pr.wait(timeout=TIMEOUT)
+        except subprocess.TimeoutExpired:
+            pr.kill()
+            rc = None
+    return rc, open(log).read()
+
+
+rc, text = signal_in_robin(["mpirun", "--oversubscribe", "-np", "2", MPI_BIN, *small,
+                            f"&output file='{out}', checkpoint_every=50 /"], mpi_env(),
+                           os.path.join(OUT, "sigusr1.log"), signal.SIGUSR1)
 check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt), "SIGUSR1 to mpirun in the Robin "
       "iteration: exit 4, status=interrupted, checkpoint written", f"exit {rc}")
 
@@ -223,24 +230,12 @@ check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt), "SIGUSR
 for f in (out, ckpt):
     if os.path.exists(f):
         os.remove(f)
-log = os.path.join(OUT, "sbatch_term.log")
 env = mpi_env({"NP": "2", "BIN": MPI_BIN})
 for k in [k for k in env if k.startswith("SLURM_")]:
     del env[k]
-with open(log, "w") as lf:
-    pr = subprocess.Popen(["bash", "tools/slurm/run_deck_mpi.sbatch", *small,
-                           f"&output file='{out}', checkpoint_every=50 /"], stdout=lf, stderr=subprocess.STDOUT, env=env)
-    t0 = time.time()
-    while time.time() - t0 < TIMEOUT and "phase: Robin" not in open(log).read() and pr.poll() is None:
-        time.sleep(0.05)
-    time.sleep(0.3)
-    pr.send_signal(signal.SIGTERM)
-    try:
-        rc = pr.wait(timeout=TIMEOUT)
-    except subprocess.TimeoutExpired:
-        pr.kill()
-        rc = None
-text = open(log).read()
+rc, text = signal_in_robin(["bash", "tools/slurm/run_deck_mpi.sbatch", *small,
+                            f"&output file='{out}', checkpoint_every=50 /"], env,
+                           os.path.join(OUT, "sbatch_term.log"), signal.SIGTERM)
 check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt) and "resubmit with --restart" in text,
       "tools/slurm/run_deck_mpi.sbatch under mpirun: SIGTERM to the script gives exit 4 and a checkpoint",
       f"exit {rc}")
