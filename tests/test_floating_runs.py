@@ -252,6 +252,38 @@ if len(pt) == 2:
     e = rel_err(contact(pt["robin"])[0], contact(pt["monolithic"])[0])
     check(e is not None and e <= 1e-6, "ux=0 on body 1's top: Robin = monolithic contact forces (1e-6)", f"{e:.2e}")
 
+# ---- (c3) the lower body floating, softer than the upper one ------------------------------------
+# body 2 (E = 1e10, 21x softer) on rollers on both vertical sides, pushed up by 4e6 on its bottom
+# against body 1 clamped on its top: the floating body is body 2 (its rows enter G with body 2's
+# normal), vertical force 12e6. Once, the harmonic inner tolerance asked the floating body's
+# SMALBE solves for a gradient below the rounding of its augmented Hessian and MPRGP spun to
+# inner_max_it (1.2 M products for m = 25): the product count is bounded here.
+LOWER = os.path.join(OUT, "lower_floating.nml")
+with open(LOWER, "w") as f:
+    f.write("""&body id=1, x0=0.0, y0=1.0, width=3.0, height=1.0, nx=24, ny=16, young=2.1e11, poisson=0.277 /
+&body id=2, x0=0.0, y0=0.0, width=3.0, height=1.0, nx=24, ny=16, young=1.0e10, poisson=0.3 /
+&boundary body=1, group='top', ux=0.0, uy=0.0 /
+&boundary body=2, group='left', ux=0.0 /
+&boundary body=2, group='right', ux=0.0 /
+&traction body=2, side='bottom', t0=0.0, 4.0e6 /
+&contact body1_group='bottom', body2_group='top' /
+&solver robin_operator='harmonic', delta=0.5, tol=1e-10 /
+""")
+lres = {}
+for method in ("robin", "monolithic"):
+    p, res, path = run(LOWER, f"&solver method='{method}' /", name=f"lower_{method}")
+    if ok_run(p, res, f"lower body floating, {method}"):
+        lres[method] = path
+        check("floating: body 2 is held only by contact (free: translation along y)" in p.stdout,
+              f"lower body floating, {method}: body 2 named floating along y")
+        fy = vertical_force(path)
+        check(abs(fy / 12.0e6 - 1.0) <= 1e-10, f"lower body floating, {method}: contact force = the load 12e6 "
+              "(1e-10)", f"{abs(fy / 12.0e6 - 1.0):.2e}")
+        check(int(res["inner"]) <= 5000, f"lower body floating, {method}: at most 5000 products", res["inner"])
+if len(lres) == 2:
+    e = rel_err(contact(lres["robin"])[0], contact(lres["monolithic"])[0])
+    check(e is not None and e <= 1e-8, "lower body floating: Robin = monolithic (1e-8)", f"{e:.2e}")
+
 # ---- (d) checkpoint and restart ------------------------------------------------------------------
 if "robin" in pr_:
     # checkpoint_every lives in &output: the output group whole

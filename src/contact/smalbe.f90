@@ -82,6 +82,12 @@ contains
     do k = 1, SMALBE_MAX_UPDATES
       o%eq_m = mm
       o%use_ax = have_ax
+      ! a projected gradient below the rounding of a product with A cannot be reached (A
+      ! holds rho G'G, about RHO_FACTOR times the Hessian's own scale): floor the tolerance
+      ! there instead of spinning MPRGP up to max_it (a product of an n x n matrix carries
+      ! ~ sqrt(n) eps lambda_max |x| of error)
+      if (opts%lambda_max > 0.0_wp) &
+        o%atol = max(opts%atol, 10.0_wp*sqrt(real(n, wp))*epsilon(1.0_wp)*opts%lambda_max*norm2(x))
       ! linear term of L(., mu, rho) with the penalty's part: c - G'mu + rho G'e
       rhs = c - matmul(mu - rho*e, gm)
       if (k == 1 .and. present(s) .and. present(rw)) then
