@@ -94,6 +94,14 @@ CASES += [
     ("loads x1e-6", f"{HARD}/scale_1em6.nml", [], [(S95, CONV), (S50, CONV), (H50, CONV), (H50R, CONV)]),
     ("loads x1e6", f"{HARD}/scale_1e6.nml", [], [(S95, CONV), (S50, CONV), (H50, CONV), (H50R, CONV)]),
     ("paper scene in mm/N/MPa", f"{HARD}/paper_mm.nml", [], [(S95, CONV), (S50, CONV), (H50, CONV), (H50R, CONV)]),
+    # bodies held only by contact (issue 15): SMALBE-M subproblems, the projected inverse in the
+    # harmonic operator. A soft floating body on a stiff one (E1/E2 = 1e-6) stalls near a
+    # residual of 2e-7: the penalty-augmented Hessian's rounding, amplified by the contrast
+    ("floating, contrast 1e6", f"{HARD}/floating_contrast_1e6.nml", [], [(S50, ANY), (H50, CONV), (H50R, ANY)]),
+    ("floating, contrast 1e-6", f"{HARD}/floating_contrast_1em6.nml", [], [(S50, ANY), (H50, ANY), (H50R, ANY)]),
+    ("floating, Q1 nu=0.4999", f"{HARD}/floating_incomp_q1_nu04999.nml", [], [(S50, ANY), (H50, CONV), (H50R, CONV)]),
+    ("floating, sinks and tilts, partial", f"{HARD}/floating_partial_tilt.nml", [],
+     [(S50, ANY), (H50, CONV), (H50R, CONV)]),
     ("delta=1", f"{HARD}/delta_1.nml", [], [(("steklov d=1", []), NOT)]),
     ("delta=0.01", f"{HARD}/delta_001.nml", [], [(("steklov d=0.01", []), ANY)]),
     ("constant alpha=1e-16", f"{HARD}/alpha_tiny.nml", [], [(("constant d=0.95", []), NOT)]),

@@ -27,7 +27,8 @@ module contact
   integer, parameter :: FLAT_LIMIT = 50               !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
   real(wp), parameter :: RHO_FACTOR = 10.0_wp     !< SMALBE penalty rho = RHO_FACTOR lambda_max(H) / |G G'|
-  real(wp), parameter :: FEAS_RTOL = 1.0e-12_wp     !< equilibrium of a floating body: |G lam - e| <= FEAS_RTOL |e|
+  real(wp), parameter :: FEAS_RTOL = 1.0e-12_wp     !< equilibrium of a floating body: |G lam - e| <= FEAS_RTOL |e| (monolithic)
+  real(wp), parameter :: FEAS_RTOL_MIN = 1.0e-15_wp !< Robin subproblems: max(inner tolerance, rounding, this) |e|
 
   !> The equality rows of a QP with floating bodies (module floating): G lam = e, and the
   !! SMALBE settings that go with the Hessian H they are added to (A = H + rho G'G).
@@ -656,6 +657,7 @@ contains
     type(mprgp_stats_t) :: ms(2)
     type(smalbe_stats_t) :: ss(2)
     real(wp), allocatable :: rhs(:, :), grad(:, :), lb(:), lam0(:, :), flam0(:, :), lprev(:, :)
+    real(wp) :: feas
     integer :: a, m, k, r
     logical :: search
     m = size(w, 1)
@@ -676,7 +678,7 @@ contains
     ! Aitken or Anderson acceleration, whose updates difference past iterates and so
     ! amplify the (smaller but differently placed) inner errors.
     search = st%nsrch == 1 .and. smooth_outer(res, it)
-    !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
+    !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64) private(k, r, feas)
     do a = 1, 2
       rhs(:, a) = bc(a)%b - st%G(:, a)
       if (pin(a)%n > 0) then
@@ -709,14 +711,18 @@ contains
       ss(a)%updates = 0
       if (m > 0 .and. r > 0) then
         ! a floating body: its equilibrium G_a lam = e_a as an equality (SMALBE-M)
+        ! the body's equilibrium to the accuracy asked of its forces (the harmonic operator's
+        ! contrast-scaled tolerance: a soft floating body's rigid motion enters the stiff body's
+        ! obstacle), down to the rounding of G lam
+        feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq(a)%e)
         if (search) then
           call smalbe_solve(op(a), rhs(:, a), eq(a)%g, eq(a)%e, eq(a)%rho, lb, st%lam(:, a), st%mu(1:r, a), &
-                            opts(a), eq(a)%m0, eq(a)%feas, ss(a), grad(:, a), st%flam_v(:, a), &
+                            opts(a), eq(a)%m0, feas, ss(a), grad(:, a), st%flam_v(:, a), &
                             st%srch(:, a), st%fsrch(:, a), st%rw(:, (a - 1)*k + 1:a*k), &
                             st%raw(:, (a - 1)*k + 1:a*k), st%nrw(:, a))
         else
           call smalbe_solve(op(a), rhs(:, a), eq(a)%g, eq(a)%e, eq(a)%rho, lb, st%lam(:, a), st%mu(1:r, a), &
-                            opts(a), eq(a)%m0, eq(a)%feas, ss(a), grad(:, a), st%flam_v(:, a), &
+                            opts(a), eq(a)%m0, feas, ss(a), grad(:, a), st%flam_v(:, a), &
                             rw=st%rw(:, (a - 1)*k + 1:a*k), raw=st%raw(:, (a - 1)*k + 1:a*k), nrw=st%nrw(:, a))
         end if
         ms(a) = ss(a)%inner
@@ -888,46 +894,62 @@ contains
   end function check_termination
 
   !> z = the Euclidean projection of y on {l >= 0, G l = e} (G, e: both bodies'
-  !! equilibrium rows, stacked), by SMALBE-M on the Hessian I + rho G'G; perr bounds
-  !! |z - exact projection| by its final projected gradient and equilibrium error.
+  !! equilibrium rows, stacked): z = max(0, y - G'nu) with nu the minimiser of the convex,
+  !! piecewise quadratic phi(nu) = 1/2 |max(0, y - G'nu)|^2 + e'nu (r <= 6 unknowns), by Newton
+  !! steps on the current positive set (Hessian G_P G_P', a small ridge when it is singular)
+  !! with a backtracking line search on phi: exact once the positive set is right, whatever
+  !! the conditioning of G on it. perr bounds |z - exact projection| by the equilibrium
+  !! left, |G z - e| / sqrt(lambda_min(G_P G_P')).
   subroutine project_feasible(bc, y, z, perr)
     type(body_condensed_t), intent(in) :: bc(2)
     real(wp), intent(in) :: y(:)
     real(wp), allocatable, intent(out) :: z(:)
     real(wp), intent(out) :: perr
-    type(eq_t) :: q
-    type(dense_op_t) :: op
-    type(mprgp_opts_t) :: o
-    type(smalbe_stats_t) :: st
-    real(wp), allocatable :: gs(:, :), es(:), mu(:), eye(:, :), lb(:), g(:)
-    real(wp) :: lm
-    integer :: m, r1, r, i
+    real(wp), allocatable :: gs(:, :), es(:), nu(:), f(:), h(:, :), d(:), nt(:), gp(:, :)
+    real(wp) :: phi, phit, t, ridge, lmin
+    integer :: m, r1, r, it, k, info
     m = size(y)
     r1 = bc(1)%nrig
     r = r1 + bc(2)%nrig
-    allocate (gs(r, m), es(r), mu(r), eye(m, m), lb(m), g(m))
+    allocate (gs(r, m), es(r), nu(r), f(r), h(r, r), d(r), nt(r))
     if (r1 > 0) gs(1:r1, :) = bc(1)%rg
     if (r1 > 0) es(1:r1) = bc(1)%re
     if (bc(2)%nrig > 0) gs(r1 + 1:, :) = bc(2)%rg
     if (bc(2)%nrig > 0) es(r1 + 1:) = bc(2)%re
-    eye = 0.0_wp
-    do i = 1, m
-      eye(i, i) = 1.0_wp
+    nu = 0.0_wp
+    z = max(y - matmul(nu, gs), 0.0_wp)
+    phi = 0.5_wp*sum(z**2) + dot_product(es, nu)
+    ridge = 1.0e-14_wp*maxval(sum(gs**2, dim=2))
+    do it = 1, 200
+      f = matmul(gs, z) - es           ! = -grad phi
+      if (norm2(f) <= 1.0e-15_wp*max(norm2(es), tiny(1.0_wp))) exit
+      gp = gs(:, pack([(k, k=1, m)], z > 0.0_wp))
+      h = matmul(gp, transpose(gp))
+      do k = 1, r
+        h(k, k) = h(k, k) + ridge
+      end do
+      d = f
+      call dposv('U', r, 1, h, r, d, r, info)
+      if (info /= 0) exit
+      ! Newton direction for phi is +d (phi's Hessian G_P G_P', gradient -f); backtrack
+      t = 1.0_wp
+      do k = 1, 60
+        nt = nu + t*d
+        phit = 0.5_wp*sum(max(y - matmul(nt, gs), 0.0_wp)**2) + dot_product(es, nt)
+        if (phit <= phi - 1.0e-4_wp*t*dot_product(f, d)) exit
+        t = 0.5_wp*t
+      end do
+      if (k > 60) exit
+      nu = nt
+      phi = phit
+      z = max(y - matmul(nu, gs), 0.0_wp)
     end do
-    call dense_op_init(op, eye)
-    lm = 1.0_wp
-    call eq_init(q, gs, es, lm)
-    call eq_add(q, op, lm)
-    o%rtol = 1.0e-14_wp
-    o%lambda_max = lm
-    o%max_it = 100*m + 1000
-    z = max(y, 0.0_wp)
-    mu = 0.0_wp
-    lb = 0.0_wp
-    call smalbe_solve(op, y, q%g, q%e, q%rho, lb, z, mu, o, q%m0, q%feas, st, g)
-    ! |z - z*| <= 2 |natural residual| for the identity Hessian; the equilibrium error
-    ! through the smallest singular value of G (at least sqrt of its Gram's)
-    perr = 2.0_wp*st%inner%gp_norm + st%feas/sqrt(max(minval_gram(gs), tiny(1.0_wp)))
+    f = matmul(gs, z) - es
+    gp = gs(:, pack([(k, k=1, m)], z > 0.0_wp))
+    lmin = 0.0_wp
+    if (size(gp, 2) > 0) lmin = minval_gram(gp)
+    perr = norm2(f)/sqrt(max(lmin, tiny(1.0_wp)))
+    if (.not. lmin > 0.0_wp) perr = merge(0.0_wp, huge(1.0_wp), norm2(f) == 0.0_wp)
   end subroutine project_feasible
 
   !> Smallest eigenvalue of G G'.
