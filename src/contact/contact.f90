@@ -566,9 +566,9 @@ contains
   !! rigid part, which the floating body's own equality settles, and S_1 + S_2 stays definite
   !! (the other body's part is), so the fixed point is still the monolithic solution. Its
   !! rate is not the supported case's: a floating body is far more flexible on balanced
-  !! loads (a free-free block bends), and the relaxation must stay below 2 / (1 + mu_max),
-  !! mu_max the largest eigenvalue of P F_a P F_o^-1 (README: 14 on the 24x8 roller scene;
-  !! the paper's scene on a roller stalls at delta >= 0.5, converges at 0.3).
+  !! loads (a free-free block bends; README: the largest eigenvalue of P F_a P F_o^-1 is 14 on
+  !! a 24x8 roller scene), and its measured rates depend on the fixing DOFs through the
+  !! loosely solved first subproblems (README, the operator table).
   function projected_flex(bc) result(pf)
     type(body_condensed_t), intent(in) :: bc
     real(wp), allocatable :: pf(:, :), q(:, :), gg(:, :), y(:, :)
