@@ -265,7 +265,7 @@ program robin_contact
       write (output_unit, '(a)') 'equilibrium: body '//achar(48 + a)//' |G lam - e|/|e| = '// &
         sci(norm2(matmul(cb(a)%rg, res%lam_body(:, a)) - cb(a)%re)/norm2(cb(a)%re))//' (its own force), '// &
         sci(norm2(matmul(cb(a)%rg, res%lam) - cb(a)%re)/norm2(cb(a)%re))//' (mean force); rigid motion '// &
-        'amplitude '//sci(res%rigid(1, a))//'; SMALBE multiplier updates (all solves) '//i2s(res%eq_updates)
+        'amplitudes '//trim(amplitudes(a))//'; SMALBE multiplier updates (this run''s solves) '//i2s(res%eq_updates)
     end do
   end if
   collective = .true.
@@ -339,6 +339,18 @@ program robin_contact
   call finish(code)
 
 contains
+
+  !> Body a's rigid motion amplitudes (the displacement of its fixing DOFs), space-separated.
+  function amplitudes(a) result(t)
+    integer, intent(in) :: a
+    character(len=64) :: t
+    integer :: k
+    t = ''
+    do k = 1, sys(a)%nrig
+      t = trim(t)//' '//sci(res%rigid(k, a))
+    end do
+    t = adjustl(t)
+  end function amplitudes
 
   !> End the run with code on every rank (MPI binary: MUMPS instances freed, MPI finalized).
   subroutine finish(code)

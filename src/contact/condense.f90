@@ -72,6 +72,9 @@ module condense
     integer :: nrig = 0                     !< rigid motions the supports leave free
     real(wp), allocatable :: rg(:, :)       !< (nrig, m) G_a = R_a' B_a' [-]
     real(wp), allocatable :: re(:)          !< (nrig) e_a = R_a' f_a [force]
+    !> (nrig, nrig) S_kl = sum over B_a's entries of coef^2 (r_k . r_l) at the entry's node: v'S v
+    !! is what |G_a' v|^2 would be if every contact normal were along the motion R_a v
+    real(wp), allocatable :: rreach(:, :)
     real(wp), allocatable :: b(:)           !< (m) B_a K_a^-1 f_a [length]
     real(wp), allocatable :: u0(:)          !< (n) K_a^-1 f_a [length]
     type(chol_t) :: chol                    !< the factorization of K_a

@@ -214,7 +214,13 @@ contains
       if (bc(a)%nrig > 0 .and. m > 0) call dense_op_init(opc(a), projected_flex(bc(a)))
     end do
     call robin_correction_init(corr_op, s, itf, bc, op, opc, info)
-    if (info /= 0) then
+    if (info /= 0 .and. bc(1)%nrig + bc(2)%nrig > 0 .and. (bc(1)%rank < m .or. bc(2)%rank < m)) then
+      res%status = 'failed'
+      res%message = 'harmonic operator: a body held only by contact is a mortar master coarser than the '// &
+                    'slave (singular F): make it the slave (&contact slave), or use steklov or monolithic'
+      call corr_op%free()
+      return
+    else if (info /= 0) then
       res%status = 'failed'
       write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
       call corr_op%free()
@@ -1074,7 +1080,10 @@ contains
     end if
     nl = norm2(res%lam)
     ! the residual itself is computed in floating point: add its rounding level
-    if (nl > 0.0_wp) then
+    if (.not. perr < 0.01_wp*huge(1.0_wp)) then
+      ! the projection on the feasible set is not known to any accuracy: no bound
+      res%error_bound = huge(1.0_wp)
+    else if (nl > 0.0_wp) then
       res%error_bound = 2.0_wp*res%kappa*((norm2(r) + perr)/nl + 10.0_wp*real(m, wp)*epsilon(1.0_wp))
     else
       res%error_bound = merge(0.0_wp, huge(1.0_wp), norm2(r) == 0.0_wp)

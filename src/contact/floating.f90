@@ -8,12 +8,16 @@ module floating
   use kinds, only: wp
   use assembly, only: body_system_t, rigid_motion_name
   use condense, only: body_condensed_t, interface_t
-  use lapack, only: dsyev, dgels
+  use lapack, only: dsyev, dgels, dsygv
   use strings, only: i2s, r2s
   implicit none (type, external)
   private
 
   public :: rigid_rows, check_held, nnls, free_list, fixing_list
+
+  !> a free motion counts as held by the contact when at least this fraction of its reach on the
+  !! contact (squared) is normal to it (1%: mu >= 1e-4)
+  real(wp), parameter :: HOLD_MIN = 1.0e-4_wp
 
 contains
 
@@ -27,14 +31,23 @@ contains
     type(body_system_t), intent(in) :: sys
     type(body_condensed_t), intent(inout) :: bc
     integer :: k, i, e
+    integer :: l, nd
     bc%nrig = sys%nrig
     if (allocated(bc%rg)) deallocate (bc%rg, bc%re)
-    allocate (bc%rg(sys%nrig, itf%m), bc%re(sys%nrig))
+    if (allocated(bc%rreach)) deallocate (bc%rreach)
+    allocate (bc%rg(sys%nrig, itf%m), bc%re(sys%nrig), bc%rreach(sys%nrig, sys%nrig))
+    bc%rreach = 0.0_wp
     do k = 1, sys%nrig
       do i = 1, itf%m
         bc%rg(k, i) = 0.0_wp
         do e = itf%b(a)%ptr(i), itf%b(a)%ptr(i + 1) - 1
           bc%rg(k, i) = bc%rg(k, i) + itf%b(a)%val(e)*sys%rig(itf%b(a)%dof(e), k)
+          ! the motions' vectors at the entry's node, against the coefficient's weight
+          nd = (itf%b(a)%dof(e) + 1)/2
+          do l = 1, sys%nrig
+            bc%rreach(k, l) = bc%rreach(k, l) + itf%b(a)%val(e)**2* &
+                              (sys%rig(2*nd - 1, k)*sys%rig(2*nd - 1, l) + sys%rig(2*nd, k)*sys%rig(2*nd, l))
+          end do
         end do
       end do
       bc%re(k) = dot_product(sys%rig(:, k), sys%f_applied)
@@ -50,8 +63,8 @@ contains
     type(body_condensed_t), intent(in) :: bc(2)
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
-    real(wp), allocatable :: gg(:, :), lam(:), gs(:, :), es(:)
-    real(wp) :: ev(6), work(64), c(3), fx, fy, along, res, enorm
+    real(wp), allocatable :: gg(:, :), lam(:), gs(:, :), es(:), sr(:, :)
+    real(wp) :: ev(6), c(3), fx, fy, along, res, enorm
     integer :: a, r, m, lapinfo, k
     character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
       'a ''roller'', or ux/uy on a group (&boundary)'
@@ -64,17 +77,21 @@ contains
       if (r == 0) cycle
       fx = sum(sys(a)%f_applied(1::2))
       fy = sum(sys(a)%f_applied(2::2))
-      ! 1. every free motion must meet a contact normal: the Gram matrix G G' is definite
+      ! 1. every free motion must meet the contact normals: min over motions v of
+      ! |G'v|^2 / (v'S v), the part of the motion's reach on the contact that is normal to it
+      ! (generalized eigenproblem G G' v = mu S v), at least HOLD_MIN. A disc on a flat
+      ! surface turning about its centre has normals through the centre: mu is only the
+      ! discretisation's error of the normals (1e-6), not a hold
       allocate (gg(r, r))
       gg = matmul(bc(a)%rg, transpose(bc(a)%rg))
-      call dsyev('V', 'U', r, gg, r, ev, work, size(work), lapinfo)
-      if (lapinfo == 0 .and. ev(1) <= 1.0e-10_wp*max(real(m, wp), ev(r))) then
+      call held_motions(gg, bc(a)%rreach, r, ev, lapinfo)
+      if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
         c = matmul(sys(a)%rig_coef, gg(:, 1))
         along = dot_product(gg(:, 1), bc(a)%re)
         info = 1
         msg = 'body '//i2s(a)//' is held only by contact (its supports leave rigid motion free), '// &
-              'but the contact cannot hold its '//rigid_motion_name(sys(a), c)//': no contact normal '// &
-              'has a component along it (frictionless contact lets the body slide or turn)'
+              'but the contact cannot hold its '//rigid_motion_name(sys(a), c)//': the contact normals '// &
+              'have (almost) no component along it (frictionless contact lets the body slide or turn)'
         if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = trim(msg)// &
           '; its load has a component '//r2s(along)//' along that motion, which no contact force balances'
         msg = trim(msg)//'; '//hold
@@ -112,8 +129,12 @@ contains
       es(1:bc(1)%nrig) = bc(1)%re
       es(bc(1)%nrig + 1:) = bc(2)%re
       gg = matmul(gs, transpose(gs))
-      call dsyev('V', 'U', r, gg, r, ev, work, size(work), lapinfo)
-      if (lapinfo == 0 .and. ev(1) <= 1.0e-10_wp*max(real(m, wp), ev(r))) then
+      allocate (sr(r, r))
+      sr = 0.0_wp
+      sr(1:bc(1)%nrig, 1:bc(1)%nrig) = bc(1)%rreach
+      sr(bc(1)%nrig + 1:, bc(1)%nrig + 1:) = bc(2)%rreach
+      call held_motions(gg, sr, r, ev, lapinfo)
+      if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
         ! the free motion of the pair, as body 1's part of it
         k = bc(1)%nrig
         c = matmul(sys(1)%rig_coef, gg(1:k, 1))
@@ -133,6 +154,27 @@ contains
       end if
     end if
   end subroutine check_held
+
+  !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of
+  !! each motion's reach on the contact is normal to it. S singular (a motion that does not
+  !! move the contact nodes at all): info /= 0 from dsygv, and then that motion has mu = 0
+  !! (dsyev of G G' alone decides, with a zero threshold scale).
+  subroutine held_motions(gg, s, r, mu, info)
+    real(wp), intent(inout) :: gg(:, :)
+    real(wp), intent(in) :: s(:, :)
+    integer, intent(in) :: r
+    real(wp), intent(out) :: mu(:)
+    integer, intent(out) :: info
+    real(wp) :: b(r, r), g0(r, r), work(64)
+    g0 = gg(1:r, 1:r)
+    b = s(1:r, 1:r)
+    call dsygv(1, 'V', 'U', r, gg, r, b, r, mu, work, size(work), info)
+    if (info /= 0) then
+      gg = g0
+      call dsyev('V', 'U', r, gg, r, mu, work, size(work), info)
+      if (info == 0) mu(1) = 0.0_wp
+    end if
+  end subroutine held_motions
 
   !> The rigid motions a body's supports leave free, in words.
   function free_list(sys) result(s)

@@ -103,12 +103,13 @@ contains
       end if
       have_ax = .true.
       stats%n_matvec = stats%n_matvec + stats%inner%n_matvec
-      if (stats%inner%status /= MPRGP_CONVERGED) exit
       r = matmul(gm, x) - e
       rr = norm2(r)
       stats%feas = rr
-      ! the new multipliers; MPRGP's gradient is the Lagrangian's gradient at them
+      ! the new multipliers; MPRGP's gradient is the Lagrangian's gradient at them (also after
+      ! an inner solve that stopped on max_it: g and mu must agree, the caller's B u uses both)
       mu = mu + rho*r
+      if (stats%inner%status /= MPRGP_CONVERGED) exit
       ! L(x, mu_new, rho) = 1/2 x'Ax - x'rhs(mu_old) + mu_old'(Gx - e)... written out:
       ! 1/2 x'Hx - c'x + mu_new'(Gx - e) + rho/2 |Gx - e|^2, with x'Hx = x'Ax - rho |Gx|^2
       lag_new = 0.5_wp*(dot_product(x, axl) - rho*sum(matmul(gm, x)**2)) - dot_product(c, x) + &

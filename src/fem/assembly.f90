@@ -124,7 +124,13 @@ contains
       if (info /= 0) return
     end if
     ! rigid motions the supports leave free: a body held only by contact
-    call rigid_kernel(mesh, pres, sys)
+    call rigid_kernel(mesh, pres, sys, info)
+    if (info /= 0) then
+      info = 3
+      write (msg, '(a,i0,a)') 'body ', body%id, ': LAPACK dsyev failed on the 3 x 3 Gram matrix of its '// &
+        'rigid modes (the kernel of its supports is unknown)'
+      return
+    end if
     if (sys%nrig > 0) then
       call choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
       if (info /= 0) return
@@ -374,10 +380,11 @@ contains
   !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
   !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
   !! sys%rig (ndof x nrig, zero at prescribed DOFs).
-  subroutine rigid_kernel(mesh, pres, sys)
+  subroutine rigid_kernel(mesh, pres, sys, info)
     type(mesh_t), intent(in) :: mesh
     logical, intent(in) :: pres(:)
     type(body_system_t), intent(inout) :: sys
+    integer, intent(out) :: info                 !< /= 0: dsyev failed
     real(wp) :: g(3, 3), r(3), ev(3), work(64), top
     integer :: k, cc, j, lapinfo, nk
 
@@ -396,7 +403,9 @@ contains
     call dsyev('V', 'U', 3, g, 3, ev, work, size(work), lapinfo)
     top = max(ev(3), 0.0_wp)
     nk = 0
-    if (lapinfo == 0) nk = count(ev <= 1.0e-10_wp*top)
+    info = lapinfo
+    if (lapinfo /= 0) return
+    nk = count(ev <= 1.0e-10_wp*top)
     if (top <= 0.0_wp) nk = 3
     sys%nrig = nk
     if (nk == 0) return
@@ -465,8 +474,10 @@ contains
         s = trim(buf)
       end if
     else
-      write (buf, '(a,g12.5,a,g12.5,a)') 'rotation about (', sys%rig_xc(1) - t(2)/w, ', ', &
-        sys%rig_xc(2) + t(1)/w, ')'
+      ! the centre, its coordinates below 1e-9 of the body's size shown as 0
+      t = [sys%rig_xc(1) - t(2)/w, sys%rig_xc(2) + t(1)/w]
+      where (abs(t) < 1.0e-9_wp*sys%rig_h) t = 0.0_wp
+      write (buf, '(a,g0.6,a,g0.6,a)') 'rotation about (', t(1), ', ', t(2), ')'
       s = trim(buf)
     end if
   end function rigid_motion_name

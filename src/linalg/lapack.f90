@@ -12,7 +12,7 @@ module lapack
   public :: dsymv, dgemm
   public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev
   public :: dpbtrf, dpbtrs, dpbsv
-  public :: dgels, dgesv
+  public :: dgels, dgesv, dsygv
 
   interface
 
@@ -198,6 +198,18 @@ module lapack
       real(wp), intent(inout) :: ab(ldab, *)  !< A in band storage on entry, its factor on exit
       real(wp), intent(inout) :: b(ldb, *)    !< right-hand sides in, solutions out (n x nrhs)
     end subroutine dpbsv
+
+    !> Generalized symmetric-definite eigenproblem A x = lambda B x (itype 1), B positive
+    !! definite; eigenvalues ascending in w, B-orthonormal eigenvectors in a (jobz 'V').
+    subroutine dsygv(itype, jobz, uplo, n, a, lda, b, ldb, w, work, lwork, info)
+      import :: wp
+      implicit none
+      integer, intent(in) :: itype, n, lda, ldb, lwork
+      character(len=1), intent(in) :: jobz, uplo
+      real(wp), intent(inout) :: a(lda, *), b(ldb, *)
+      real(wp), intent(out) :: w(*), work(*)
+      integer, intent(out) :: info
+    end subroutine dsygv
 
     !> A X = B for a general square A by LU with partial pivoting.
     subroutine dgesv(n, nrhs, a, lda, ipiv, b, ldb, info)
