@@ -92,6 +92,22 @@ def busy_cores(dt):
     return (1.0 - (i1 - i0) / max(t1 - t0, 1)) * (os.cpu_count() or 1)
 
 
+def measured_run(args, env):
+    """Run the solver; returns (process, result fields, wall time [s], busy_during = cores kept
+    busy by other processes during the run, the whole machine's busy time less this run's)."""
+    t0 = time.monotonic()
+    tot0, idle0 = cpu_times()
+    ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p, r = run_solver(*args, env=env)
+    tot1, idle1 = cpu_times()
+    ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    wall = time.monotonic() - t0
+    mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
+    hz = os.sysconf("SC_CLK_TCK")
+    busy = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
+    return p, r, wall, busy
+
+
 class Runner:
     def __init__(self, binary, deck, workdir, keep):
         self.binary = binary
@@ -139,17 +155,8 @@ class Runner:
         row["busy_before"] = self.wait_quiet(row)
         row["cmdline"] = "OMP_NUM_THREADS=%d %s%s" % (threads, row["omp_env"] + " " if row["omp_env"] else "", " ".join(
             a if re.fullmatch(r"[\w./=-]+", a) else '"' + a + '"' for a in args[:-1]))
-        t0 = time.monotonic()
-        tot0, idle0 = cpu_times()
-        ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        p, r = run_solver(*args, env=env)
-        tot1, idle1 = cpu_times()
-        ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        wall = time.monotonic() - t0
+        p, r, wall, row["busy_during"] = measured_run(args, env)
         row["process_wall_s"] = round(wall, 3)
-        hz = os.sysconf("SC_CLK_TCK")
-        mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
-        row["busy_during"] = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
         row["exit"] = p.returncode
         t = time_fields(p.stdout)
         if r is None or t is None:

@@ -41,14 +41,13 @@ import argparse
 import csv
 import math
 import os
-import resource
 import shutil
 import subprocess
 import sys
 import time
 
-from bench import cpu_times, busy_cores, fmt, table
-from rc_common import contact_force, run_solver, solver_env, time_fields
+from bench import busy_cores, fmt, measured_run, table
+from rc_common import contact_force, solver_env, time_fields
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
@@ -108,16 +107,7 @@ def run_once(binary, args, workdir):
     env = solver_env(2)
     env.pop("OMP_THREAD_LIMIT", None)
     row = {"load1": round(os.getloadavg()[0], 2)}
-    t0 = time.monotonic()
-    tot0, idle0 = cpu_times()
-    ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    p, r = run_solver(*full, env=env)
-    tot1, idle1 = cpu_times()
-    ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    wall = time.monotonic() - t0
-    mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
-    hz = os.sysconf("SC_CLK_TCK")
-    row["busy_during"] = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
+    p, r, _, row["busy_during"] = measured_run(full, env)
     row["exit"] = p.returncode
     t = time_fields(p.stdout)
     for fn in os.listdir(workdir):      # the result and its .xdmf companions

@@ -29,23 +29,12 @@ import sys
 import tempfile
 import time
 
-from rc_common import md_header, md_row, run_solver, solver_env, time_fields, result_fields
+from bench import busy_cores
+from rc_common import md_header, md_row, run_solver, solver_env, time_fields
 
 ORDERINGS = ("metis", "amd", "nd")
 
 
-def cpu_times():
-    with open("/proc/stat") as f:
-        v = [int(x) for x in f.readline().split()[1:]]
-    return sum(v), v[3] + v[4]
-
-
-def busy_cores(dt):
-    """Average number of busy cores over dt seconds (whole machine)."""
-    t0, i0 = cpu_times()
-    time.sleep(dt)
-    t1, i1 = cpu_times()
-    return (1.0 - (i1 - i0) / max(t1 - t0, 1)) * (os.cpu_count() or 1)
 
 
 def wait_quiet(limit):
