@@ -57,7 +57,6 @@ module deck
     integer :: disp_line(4, 2) = 0              ! deck line of the &displacement per side, body
     logical :: disp_given(4, 2) = .false.       ! a &displacement gives the side's vector
     integer :: once_line(8) = 0                 ! deck line of each singleton group
-    logical :: has_boundary(2) = .false.        ! a &boundary names a group of the body
   end type state_t
 
   !> The variables of &scene that are not stored as they are read.
@@ -141,7 +140,7 @@ contains
     do i = 1, size(gs)
       if (gs(i)%name == 'traction') call add_traction(gs(i), src, d, st, 'line '//i2s(gs(i)%line))
       if (gs(i)%name == 'displacement') call apply_displacement(gs(i), src, d, st)
-      if (gs(i)%name == 'boundary') call add_boundary(gs(i), src, d, st, 'line '//i2s(gs(i)%line))
+      if (gs(i)%name == 'boundary') call add_boundary(gs(i), src, d, 'line '//i2s(gs(i)%line))
     end do
 
     ! Command-line overrides, in order.
@@ -162,7 +161,7 @@ contains
         case ('displacement')
           call apply_displacement(gs(i), src, d, st)
         case ('boundary')
-          call add_boundary(gs(i), src, d, st, olabel)
+          call add_boundary(gs(i), src, d, olabel)
         case default
           call apply_single(gs(i), src, d)
         end select
@@ -652,11 +651,10 @@ contains
   end subroutine traction_form
 
   !> A &boundary group (deck or override): prescribed components on a named edge group.
-  subroutine add_boundary(g, src, d, st, origin)
+  subroutine add_boundary(g, src, d, origin)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(deck_t), intent(inout) :: d
-    type(state_t), intent(inout) :: st
     character(len=*), intent(in) :: origin
     type(load_in_t), target :: t
     type(vars_t) :: v
@@ -685,7 +683,6 @@ contains
     d%boundary(n)%fix = [find_asg(g, 'ux') > 0, find_asg(g, 'uy') > 0]
     d%boundary(n)%u = [t%ux, t%uy]
     d%boundary(n)%origin = '&boundary at '//origin
-    st%has_boundary(t%body) = .true.
   end subroutine add_boundary
 
   !> The body= of a &traction, &displacement or &boundary: given, and 1 or 2.
