@@ -709,32 +709,28 @@ contains
     type(body_system_t), intent(inout) :: sys
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
-    integer :: p, s, cc, q, pos, nbr(9), nnbr, k
+    integer :: p, s, cc, q, pos, nnbr
     integer(i8) :: nnz
-    integer, allocatable :: aptr(:), adj(:)
+    integer, allocatable :: aptr(:), adj(:), nbr(:)
 
     info = 0
     msg = ''
-    if (.not. mesh%structured) call node_adjacency(mesh, aptr, adj)
+    if (mesh%structured) then
+      allocate (nbr(9))
+    else
+      call node_adjacency(mesh, aptr, adj)
+      allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
+    end if
     allocate (sys%colptr(sys%n + 1))
     nnz = 0
     sys%colptr(1) = 0
     do p = 1, sys%n
-      k = (sys%dof_of(p) - 1)/2 + 1
-      if (.not. mesh%structured) then
-        do s = aptr(k), aptr(k + 1) - 1
-          do cc = 1, 2
-            if (sys%free_of(2*(adj(s) - 1) + cc) > 0) nnz = nnz + 1
-          end do
+      call neighbours(p)
+      do s = 1, nnbr
+        do cc = 1, 2
+          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
         end do
-      else
-        call node_stencil(mesh, k, nbr, nnbr)
-        do s = 1, nnbr
-          do cc = 1, 2
-            if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
-          end do
-        end do
-      end if
+      end do
       if (nnz > int(huge(1), i8)) then
         info = 6
         write (msg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
@@ -745,21 +741,8 @@ contains
     end do
     allocate (sys%rowind(nnz), sys%val(nnz))
     do p = 1, sys%n
-      k = (sys%dof_of(p) - 1)/2 + 1
+      call neighbours(p)
       pos = sys%colptr(p)
-      if (.not. mesh%structured) then
-        do s = aptr(k), aptr(k + 1) - 1
-          do cc = 1, 2
-            q = sys%free_of(2*(adj(s) - 1) + cc)
-            if (q > 0) then
-              pos = pos + 1
-              sys%rowind(pos) = q - 1
-            end if
-          end do
-        end do
-        cycle
-      end if
-      call node_stencil(mesh, k, nbr, nnbr)
       do s = 1, nnbr
         do cc = 1, 2
           q = sys%free_of(2*(nbr(s) - 1) + cc)
@@ -771,6 +754,22 @@ contains
       end do
     end do
     sys%val = 0.0_wp
+
+  contains
+
+    !> The nodes sharing a cell with free DOF p's node, in increasing node id: the grid
+    !! stencil of a structured mesh, the adjacency list of any other.
+    subroutine neighbours(p)
+      integer, intent(in) :: p
+      integer :: k
+      k = (sys%dof_of(p) - 1)/2 + 1
+      if (mesh%structured) then
+        call node_stencil(mesh, k, nbr, nnbr)
+      else
+        nnbr = aptr(k + 1) - aptr(k)
+        nbr(1:nnbr) = adj(aptr(k):aptr(k + 1) - 1)
+      end if
+    end subroutine neighbours
   end subroutine stiffness_pattern
 
   !> The nodes that share a cell with each node (itself included), in increasing node id:
