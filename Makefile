@@ -141,7 +141,7 @@ $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o 
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
-$(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/mprgp.o
+$(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
 $(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o

@@ -953,23 +953,28 @@ contains
     f = matmul(gs, z) - es
     gp = gs(:, pack([(k, k=1, m)], z > 0.0_wp))
     lmin = 0.0_wp
-    if (size(gp, 2) > 0) lmin = minval_gram(gp)
+    if (size(gp, 2) > 0) lmin = minval(gram_eigenvalues(gp))
     perr = norm2(f)/sqrt(max(lmin, tiny(1.0_wp)))
     if (.not. lmin > 0.0_wp) perr = merge(0.0_wp, huge(1.0_wp), norm2(f) == 0.0_wp)
   end subroutine project_feasible
 
-  !> Smallest eigenvalue of G G'.
-  real(wp) function minval_gram(gs) result(v)
+  !> The eigenvalues of G G' (r <= 6 rows), ascending; if LAPACK fails, 0 and, last, the
+  !! row-sum bound of the largest (what eq_init's penalty and project_feasible's error bound
+  !! can still use safely).
+  function gram_eigenvalues(gs) result(ev)
     real(wp), intent(in) :: gs(:, :)
-    real(wp) :: ev(6), work(64)
-    real(wp), allocatable :: gg(:, :)
+    real(wp) :: ev(size(gs, 1))
+    real(wp) :: work(64), gg(size(gs, 1), size(gs, 1))
     integer :: r, info
     r = size(gs, 1)
     gg = matmul(gs, transpose(gs))
     call dsyev('N', 'U', r, gg, r, ev, work, size(work), info)
-    v = ev(1)
-    if (info /= 0) v = 0.0_wp
-  end function minval_gram
+    if (info /= 0) then
+      gg = matmul(gs, transpose(gs))
+      ev = 0.0_wp
+      ev(r) = maxval(sum(abs(gg), dim=1))
+    end if
+  end function gram_eigenvalues
 
   !> The equality rows G lam = e of floating bodies for a QP whose Hessian H has its
   !! largest eigenvalue below lmax: the penalty rho = RHO_FACTOR lmax / lambda_max(G G')
@@ -980,17 +985,10 @@ contains
   subroutine eq_init(q, g, e, lmax)
     type(eq_t), intent(out) :: q
     real(wp), intent(in) :: g(:, :), e(:), lmax
-    real(wp), allocatable :: gg(:, :)
-    real(wp) :: ev(6), work(64)
-    integer :: info
     q%r = size(g, 1)
     q%g = g
     q%e = e
-    allocate (gg(q%r, q%r))
-    gg = matmul(g, transpose(g))
-    call dsyev('N', 'U', q%r, gg, q%r, ev, work, size(work), info)
-    q%gg = max(ev(q%r), tiny(1.0_wp))
-    if (info /= 0) q%gg = max(maxval(sum(abs(gg), dim=1)), tiny(1.0_wp))
+    q%gg = max(maxval(gram_eigenvalues(g)), tiny(1.0_wp))
     q%rho = RHO_FACTOR*lmax/q%gg
     q%m0 = lmax/sqrt(q%gg)
     q%feas = FEAS_RTOL*max(norm2(e), tiny(1.0_wp))

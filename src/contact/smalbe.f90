@@ -21,6 +21,7 @@
 module smalbe
   use kinds, only: wp
   use linop, only: linop_t
+  use lapack, only: dposv
   use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, MPRGP_CONVERGED, MPRGP_MAX_IT
   implicit none (type, external)
   private
@@ -148,7 +149,7 @@ contains
     gf = gm(:, pack([(i, i=1, size(x))], free))
     a = matmul(gf, transpose(gf))
     b = -matmul(gf, pack(g0, free))
-    call dposv_small(a, b, info)
+    call dposv('U', r, 1, a, r, b, r, info)
     if (info /= 0) return
     mls = b
     if (proj_norm(g0 + matmul(mls, gm), x, lb) < proj_norm(g0 + matmul(mu, gm), x, lb)) mu = mls
@@ -160,30 +161,5 @@ contains
     v = norm2(merge(g, min(g, 0.0_wp), x > lb))
   end function proj_norm
 
-  !> Solve the small SPD system a y = b (b overwritten) by Cholesky; info /= 0 if not SPD.
-  pure subroutine dposv_small(a, b, info)
-    real(wp), intent(inout) :: a(:, :), b(:)
-    integer, intent(out) :: info
-    integer :: n, i, j
-    n = size(b)
-    info = 0
-    do j = 1, n
-      a(j, j) = a(j, j) - sum(a(j, 1:j - 1)**2)
-      if (.not. a(j, j) > 0.0_wp) then
-        info = j
-        return
-      end if
-      a(j, j) = sqrt(a(j, j))
-      do i = j + 1, n
-        a(i, j) = (a(i, j) - sum(a(i, 1:j - 1)*a(j, 1:j - 1)))/a(j, j)
-      end do
-    end do
-    do i = 1, n
-      b(i) = (b(i) - sum(a(i, 1:i - 1)*b(1:i - 1)))/a(i, i)
-    end do
-    do i = n, 1, -1
-      b(i) = (b(i) - sum(a(i + 1:n, i)*b(i + 1:n)))/a(i, i)
-    end do
-  end subroutine dposv_small
 
 end module smalbe
