@@ -1,0 +1,140 @@
+#!/usr/bin/env python3
+"""Same results as a stored reference: every shipped deck's contact forces and outer count.
+
+  tools/regression.py --store  [--bin bin/robin_contact] [--ref tests/data/regression.json]
+  tools/regression.py [--bin bin/robin_contact] [--ref ...] [--only SUBSTRING] [--quick]
+
+--store runs every deck of inputs/, inputs/hard/, inputs/table1/ and tests/decks/ with its own
+settings, again with method='monolithic' and with the harmonic operator at delta 0.5, and stores, per deck: the exit code, the status, the outer iteration count and the
+nodal contact forces (/contact/normal_force). Without --store it runs them again and compares:
+same exit code, status and outer count, and max |f - f_ref| <= 1e-12 max |f_ref| (scale-aware;
+exactly 0 = 0 for a deck without contact). --quick takes the decks that run in under a second.
+Exit 0 when every deck agrees, 1 otherwise (each difference printed). Runs with
+OMP_NUM_THREADS=2 unless set; results go to a temporary folder, nothing in the tree is written
+but the reference file (--store).
+"""
+import argparse
+import glob
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+DECK_DIRS = ("inputs", "inputs/hard", "inputs/table1", "tests/decks")
+RTOL = 1.0e-12
+
+
+MONO = "&solver method='monolithic' /"
+HARMONIC = "&solver method='robin', robin_operator='harmonic', delta=0.5 /"
+
+
+def decks():
+    """(key, deck, overrides): every shipped deck with its own settings, its monolithic
+    reference (key suffix ' monolithic') and the harmonic operator at delta 0.5 (' harmonic')."""
+    out = []
+    for d in DECK_DIRS:
+        for p in sorted(glob.glob(os.path.join(ROOT, d, "*.nml"))):
+            deck = os.path.relpath(p, ROOT)
+            out += [(deck, deck, []), (deck + " monolithic", deck, [MONO]),
+                    (deck + " harmonic", deck, [HARMONIC])]
+    return out
+
+
+def run_deck(binary, key, deck, overrides, tmp):
+    h5 = os.path.join(tmp, key.replace("/", "_").replace(" ", "_") + ".h5")
+    env = dict(os.environ)
+    env.setdefault("OMP_NUM_THREADS", "2")
+    t0 = time.time()
+    p = subprocess.run([binary, deck, *overrides, f"&output file='{h5}' /"], cwd=ROOT, capture_output=True,
+                       text=True, env=env, timeout=1800)
+    wall = time.time() - t0
+    rec = {"exit": p.returncode, "wall_s": round(wall, 3)}
+    if os.path.exists(h5):
+        with h5py.File(h5, "r") as f:
+            rec["status"] = f.attrs["status"].decode() if isinstance(f.attrs["status"], bytes) \
+                else str(f.attrs["status"])
+            rec["outer"] = int(f.attrs["outer_iterations"])
+            rec["force"] = [float(x) for x in f["contact/normal_force"][()]]
+        os.remove(h5)
+    return rec, p
+
+
+def compare(ref, new):
+    """The differences between two records, as a list of sentences."""
+    diffs = []
+    for key in ("exit", "status", "outer"):
+        if ref.get(key) != new.get(key):
+            diffs.append(f"{key} {ref.get(key)} -> {new.get(key)}")
+    if ("force" in ref) != ("force" in new):
+        diffs.append("result file " + ("missing" if "force" in ref else "new"))
+    elif "force" in ref:
+        fr, fn = np.array(ref["force"]), np.array(new["force"])
+        if fr.shape != fn.shape:
+            diffs.append(f"contact nodes {fr.size} -> {fn.size}")
+        else:
+            scale = np.max(np.abs(fr)) if fr.size else 0.0
+            err = np.max(np.abs(fn - fr)) if fr.size else 0.0
+            if err > RTOL * scale or (scale == 0.0 and err != 0.0):
+                diffs.append(f"contact forces differ: max |df| = {err:.3e} = {err / max(scale, 1e-300):.3e} relative")
+    return diffs
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default="bin/robin_contact")
+    ap.add_argument("--ref", default="tests/data/regression.json")
+    ap.add_argument("--store", action="store_true")
+    ap.add_argument("--only", default="")
+    ap.add_argument("--quick", action="store_true", help="only the decks that ran in under 1 s")
+    a = ap.parse_args()
+    binary = os.path.abspath(os.path.join(ROOT, a.bin)) if not os.path.isabs(a.bin) else a.bin
+    ref_path = os.path.join(ROOT, a.ref)
+    ref = {}
+    if not a.store:
+        with open(ref_path) as f:
+            ref = json.load(f)["decks"]
+    todo = [t for t in decks() if a.only in t[0]]
+    if a.quick:
+        todo = [t for t in todo if t[0] in ref and ref[t[0]]["wall_s"] < 1.0]
+    out, bad = {}, 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for deck, path, overrides in todo:
+            rec, p = run_deck(binary, deck, path, overrides, tmp)
+            out[deck] = rec
+            if a.store:
+                print(f"{deck:56s} exit={rec['exit']} status={rec.get('status')} outer={rec.get('outer')} "
+                      f"m={len(rec.get('force', []))} {rec['wall_s']:.2f} s")
+                continue
+            if deck not in ref:
+                print(f"NEW  {deck}: not in the reference (store it)")
+                bad += 1
+                continue
+            diffs = compare(ref[deck], rec)
+            print(("FAIL " if diffs else "PASS ") + f"{deck} outer={rec.get('outer')} "
+                  + "; ".join(diffs))
+            if diffs:
+                bad += 1
+                print(p.stdout[-2000:] + p.stderr[-2000:])
+    if a.store:
+        with open(ref_path, "w") as f:
+            json.dump({"note": "contact forces and outer counts of every shipped deck, stored by "
+                               "tools/regression.py --store", "decks": out}, f, indent=0)
+        print(f"stored {len(out)} decks in {a.ref}")
+        return 0
+    missing = [d for d in ref if d not in out and a.only in d and not a.quick]
+    for d in missing:
+        print(f"FAIL {d}: in the reference but no longer shipped")
+    bad += len(missing)
+    print(f"{len(out) - bad + len(missing)} passed, {bad} failed")
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
