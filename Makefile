@@ -261,6 +261,8 @@ meshes:
 	   $(GMSH_MSH) patch_mixed.geo -o patch_mixed.msh; \
 	   for h in 0.04 0.02 0.01 0.005; do $(GMSH_MSH) -setnumber h $$h hertz.geo -o hertz_h$$h.msh; done; \
 	   for h in 0.04 0.02 0.01 0.005; do $(GMSH_MSH) -setnumber h $$h hertz_force.geo -o hertz_force_h$$h.msh; done; \
+	   $(GMSH_MSH) pin_hole.geo -o pin_hole.msh; \
+	   $(GMSH_MSH) cylinders.geo -o cylinders.msh; \
 	   for n in 12:18 24:36 48:72; do nu=$${n%:*}; nl=$${n#*:}; \
 	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \
 	   done; \

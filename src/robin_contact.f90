@@ -16,12 +16,12 @@ program robin_contact
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: fatal, fatal_handler, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
                     EXIT_INTERRUPTED
-  use config, only: deck_t, output_cfg_t, METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
+  use config, only: deck_t, output_cfg_t, solver_cfg_t, ROBIN_HARMONIC, METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
   use deck, only: read_deck, print_deck, deck_usage, deck_text
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
   use assembly, only: body_system_t, assemble_body, expand, cell_triplets
-  use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
+  use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, contact_resultant, &
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t
   use contact, only: solve_robin, solve_monolithic, error_bound
@@ -310,6 +310,7 @@ program robin_contact
     code = EXIT_NOT_CONVERGED
   end select
   if (res%status /= 'converged') write (error_unit, '(a)') 'robin_contact: '//trim(res%status)//': '//trim(res%message)
+  if (code == EXIT_NOT_CONVERGED) write (error_unit, '(a)') 'robin_contact: next: '//next_setting(d%solver)
 
   ! ---- output -------------------------------------------------------------------------
   call phase('output')
@@ -592,16 +593,20 @@ contains
   !> The closing lines. A summary that cannot be written (standard output on a full disk or
   !! a closed pipe) is a failure: scripts read the result: line.
   subroutine summary()
-    real(wp) :: ftot
+    real(wp) :: ftot, fres(2)
     character(len=1024) :: line(5)
     integer :: err(5), k
     if (me /= 0) return
     err = 0
     ftot = 0.0_wp
-    if (allocated(res%lam)) ftot = sum(res%lam)
-    write (line(1), '(a,es12.5,a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: total normal force=', ftot, &
-      ' active=', res%active, ' imbalance=', res%imbalance, ' penetration=', res%penetration, &
-      ' complementarity=', res%complementarity
+    fres = 0.0_wp
+    if (allocated(res%lam)) then
+      ftot = sum(res%lam)
+      fres = contact_resultant(itf, 1, res%lam)
+    end if
+    write (line(1), '(a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: resultant_on_body1='// &
+      e6(fres(1))//','//e6(fres(2))//' normal_force_sum='//e6(ftot)//' active=', res%active, &
+      ' imbalance=', res%imbalance, ' penetration=', res%penetration, ' complementarity=', res%complementarity
     if (res%outer > 0) then
       line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
         ' (a posteriori bound, cond(F1+F2) ~ '//sci(res%kappa)//')'
@@ -628,6 +633,35 @@ contains
       code = EXIT_NUMERICAL
     end if
   end subroutine summary
+
+  !> What a user whose Robin run did not converge should try next, in order: the robust
+  !! operator and relaxation (the defaults), then the monolithic reference.
+  function next_setting(sv) result(t)
+    type(solver_cfg_t), intent(in) :: sv
+    character(len=:), allocatable :: t
+    if (sv%robin_operator /= ROBIN_HARMONIC) then
+      t = "try &solver robin_operator='harmonic', delta=0.5 / (robust to material contrast), "// &
+          "or method='monolithic'"
+    else if (abs(sv%delta - 0.5_wp) > 0.01_wp) then
+      t = "try &solver delta=0.5 / (the harmonic operator's best relaxation), or method='monolithic'"
+    else
+      t = "try &solver method='monolithic' / (one QP over both bodies, no outer iteration), "// &
+          "or a larger max_outer"
+    end if
+  end function next_setting
+
+  !> x with six significant digits, no blanks (a value of a key=value summary field).
+  function e6(x) result(t)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: t
+    character(len=24) :: buf
+    if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
+      write (buf, '(es13.5e3)') x
+    else
+      write (buf, '(es12.5)') x
+    end if
+    t = trim(adjustl(buf))
+  end function e6
 
   !> The effective deck without the settings that may change between a run and its
   !! restart (output, max_outer): a checkpoint is only accepted under the same key.

@@ -86,7 +86,8 @@ program test_deck
   call check(e%output%file == 'results/'//trim(tmp(6:))//'_my_case.h5', &
              'defaults: output file results/<deck basename>.h5 ('//trim(e%output%file)//')')
   call check(e%body(1)%width == 1.0_wp .and. e%body(1)%poisson == 0.3_wp .and. &
-             e%solver%delta == 0.95_wp .and. e%contact%gap_radius == 0.0_wp, 'defaults: config.f90 values')
+             e%solver%delta == 0.5_wp .and. e%solver%robin_operator == ROBIN_HARMONIC .and. &
+             e%contact%gap_radius == 0.0_wp, 'defaults: config.f90 values (harmonic at delta 0.5)')
   call check(all(e%body(2)%bc == [BC_ROLLER, BC_FREE, BC_ROLLER, BC_CONTACT]), &
              'forms: upper-case names, mixed-case values, double quotes, two groups on a line')
   call check(e%title == 'a!b, it''s "quoted" / here', 'forms: quotes, ! and / inside a string')

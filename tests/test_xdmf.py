@@ -209,11 +209,20 @@ def compare_body(path, g, contact_xy, tag):
             check(np.array_equal(np.asarray(m.point_data[name]).reshape(-1), g[name][()])
                   and np.asarray(m.point_data[name]).size == nnode,
                   f"{tag}: {name} == /{g.name.strip('/')}/{name} ({nnode} values)")
-    # contact_pressure lives on the contact line only
+    # contact_pressure lives on the contact line only: the polyline of the rows' nodes,
+    # extended at each end by its end segment (a master node next to the last row, or a
+    # node without a row whose neighbour's dual function reaches it)
     cp = g["contact_pressure"][()]
     on = np.zeros(nnode, dtype=bool)
-    for x, y in contact_xy.T:
-        on |= (np.abs(xy[0] - x) <= 1e-12 * (1 + abs(x))) & (np.abs(xy[1] - y) <= 1e-12 * (1 + abs(y)))
+    pts = contact_xy.T
+    if len(pts) >= 2:
+        pts = np.vstack([2 * pts[0] - pts[1], pts, 2 * pts[-1] - pts[-2]])
+    scale = 1.0 + np.abs(pts).max()
+    for k in range(max(len(pts) - 1, 1)):
+        a_, b_ = pts[k], pts[min(k + 1, len(pts) - 1)]
+        d = b_ - a_
+        t = np.clip(((xy.T - a_) @ d) / max(d @ d, 1e-300), 0.0, 1.0)
+        on |= np.hypot(*(xy.T - (a_ + t[:, None] * d)).T) <= 1e-12 * scale
     check(np.all(cp[~on] == 0.0) and np.any(cp[on] > 0.0),
           f"{tag}: contact_pressure is zero off the contact line and positive on part of it "
           f"({int(np.count_nonzero(cp))} nonzero nodes)")

@@ -244,9 +244,14 @@ def main(argv=None):
             ok[c0:c0 + cc.shape[1]] = dist[np.arange(j.size), j] <= tol
         if not ok.any():
             continue
+        # the contact nodes come in the order of the contact chain; a closed loop (a rim) is
+        # drawn closed: its ends are as near each other as two neighbours
         p = b["def"][:, idx[ok]] / fl
-        order = np.lexsort((p[1], p[0]))
-        ax.plot(p[0][order], p[1][order], zorder=4, **st)
+        if p.shape[1] > 2:
+            step = np.hypot(*np.diff(p, axis=1))
+            if np.hypot(*(p[:, -1] - p[:, 0])) <= 1.5 * step.max():
+                p = np.hstack([p, p[:, :1]])
+        ax.plot(p[0], p[1], zorder=4, **st)
         if b is bodies[0]:
             act = np.zeros(ok.size, dtype=bool)
             act[:min(ok.size, act_all.size)] = act_all[:ok.size] > 0

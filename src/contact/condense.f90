@@ -1,18 +1,17 @@
 !> Interface condensation: the contact interface of the two bodies (its m constraint rows
 !! B_1 u_1 + B_2 u_2 <= g0), and for each body its factorization, normal flexibility
 !! F_a = B_a K_a^-1 B_a' and the normal interface displacement under the load alone
-!! b_a = B_a K_a^-1 f_a (plus B_a's part on prescribed DOFs) (README, "Method as implemented").
-!! Two ways to build the rows: rectangle sides declared 'contact' that match node for node
-!! (row i = the normal displacement of node pair i), or named edge groups paired by dual
-!! mortar (module mortar; row j = the weighted normal gap at slave node j). The free DOFs
+!! b_a = B_a K_a^-1 f_a (plus B_a's part on prescribed DOFs) (doc/method.md). The rows come
+!! from two edge groups (named groups, or the rectangle sides declared 'contact') paired by
+!! dual mortar (module mortar; row j = the weighted normal gap at slave node j). The free DOFs
 !! that B_a touches are ordered last in the Cholesky factorization, so F_a comes from the
 !! trailing block of the factor at a cost of O(k^3) (k those DOFs), not m solves.
 module condense
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-  use config, only: body_cfg_t, contact_cfg_t, factor_cfg_t, BC_CONTACT, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, &
-                    SIDE_TOP, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
-  use mesh, only: mesh_t, side_nodes, group_index, group_names, nodes_only, nodes_only_refusal
+  use config, only: body_cfg_t, contact_cfg_t, factor_cfg_t, BC_CONTACT, side_names, &
+                    FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
+  use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
   use mortar, only: mortar_t, mortar_build
   use strings, only: i2s, r2s
   use assembly, only: body_system_t
@@ -35,10 +34,7 @@ module condense
     integer :: m = 0                        !< contact constraints (slave nodes with a multiplier)
     logical :: mortar = .false.             !< rows from dual mortar on named groups
     integer :: slave = 1                    !< body whose nodes carry the rows
-    integer :: side(2) = 0                  !< contact side of each body (SIDE_*; side mode)
-    integer :: axis = 1                     !< side mode: coordinate along the line, 1 = x, 2 = y
-    real(wp), allocatable :: s(:)           !< (m) position along the contact curve [length]
-                                            !! (side mode: the coordinate; mortar: arc length)
+    real(wp), allocatable :: s(:)           !< (m) arc length along the slave contact chain [length]
     real(wp), allocatable :: xy(:, :)       !< (2,m) slave node coordinates [length]
     real(wp), allocatable :: normal(:, :)   !< (2,m) unit normal, outward from the slave body
     real(wp), allocatable :: g0(:)          !< (m) initial normal gap [length]
@@ -83,120 +79,58 @@ module condense
   end type body_condensed_t
 
   public :: build_interface, factor_body, condense_body, recover_displacement, apply_bt, apply_b, &
-            interface_dofs, flex_from_x
+            interface_dofs, flex_from_x, contact_resultant
 
 contains
 
-  !> Find the contact line and pair the nodes of the two bodies.
-  !! info /= 0 with msg when the contact sides do not match node for node.
+  !> The resultant of the contact forces on body a, -sum of B_a' lam by component [force]:
+  !! what balances the body's applied load when contact alone holds it (the sum of the
+  !! nodal normal forces is not a resultant on a curved contact line).
+  pure function contact_resultant(itf, a, lam) result(f)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: a                  !< body
+    real(wp), intent(in) :: lam(:)            !< (m) contact forces [force]
+    real(wp) :: f(2)
+    integer :: k, e, c
+    f = 0.0_wp
+    do k = 1, itf%m
+      do e = itf%b(a)%ptr(k), itf%b(a)%ptr(k + 1) - 1
+        c = 2 - mod(itf%b(a)%dof(e), 2)
+        f(c) = f(c) - itf%b(a)%val(e)*lam(k)
+      end do
+    end do
+  end function contact_resultant
+
+  !> The contact interface of the two bodies, by dual mortar on two edge groups: the named
+  !! groups of &contact, or a rectangle's side declared 'contact' (its mesh has the sides
+  !! as groups 'left', 'right', 'bottom', 'top'). On matching lines the mortar rows are the
+  !! node-to-node ones to rounding, so one path serves every scene.
   subroutine build_interface(body, cc, msh, sys, itf, info, msg)
     type(body_cfg_t), intent(in) :: body(2)          !< the two bodies (their contact sides)
-    type(contact_cfg_t), intent(in) :: cc            !< the interface settings (initial gap)
+    type(contact_cfg_t), intent(in) :: cc            !< the interface settings (groups, slave, initial gap)
     type(mesh_t), intent(in) :: msh(2)               !< meshes of body 1 and 2
     type(body_system_t), intent(in) :: sys(2)        !< assembled systems
     type(interface_t), intent(out) :: itf            !< the contact line
     integer, intent(out) :: info                     !< 0 ok, 1 bad input
     character(len=*), intent(out) :: msg             !< description of a failure
-    integer, allocatable :: nodes1(:), nodes2(:)
-    integer :: a, k, i, c, d1, d2, nline
-    logical, allocatable :: keep(:)
-    real(wp), allocatable :: sl(:), tl(:)
-    real(wp) :: scale, x1(2), x2(2)
+    type(contact_cfg_t) :: ccg
+    integer :: a, side
 
     info = 0
     msg = ''
-    if (len_trim(cc%body_group(1)) > 0) then
-      call mortar_interface(cc, msh, sys, itf, info, msg)
-      return
-    end if
-    do a = 1, 2
-      itf%side(a) = 0
-      do k = 1, 4
-        if (body(a)%bc(k) == BC_CONTACT) itf%side(a) = k
+    ccg = cc
+    if (len_trim(cc%body_group(1)) == 0) then
+      do a = 1, 2
+        side = findloc(body(a)%bc, BC_CONTACT, dim=1)
+        if (side == 0) then
+          info = 1
+          msg = 'body '//i2s(a)//' has no contact side'
+          return
+        end if
+        ccg%body_group(a) = side_names(side)
       end do
-      if (itf%side(a) == 0) then
-        info = 1
-        write (msg, '(a,i0,a)') 'body ', a, ' has no contact side'
-        return
-      end if
-    end do
-    call side_nodes(msh(1), itf%side(1), nodes1)
-    call side_nodes(msh(2), itf%side(2), nodes2)
-    if (size(nodes1) /= size(nodes2)) then
-      info = 1
-      write (msg, '(a,i0,a,i0,a)') 'contact sides do not match node for node (', size(nodes1), &
-        ' nodes on body 1, ', size(nodes2), ' on body 2)'
-      return
     end if
-    nline = size(nodes1)
-    if (itf%side(1) == SIDE_BOTTOM .or. itf%side(1) == SIDE_TOP) then
-      itf%axis = 1; c = 2
-    else
-      itf%axis = 2; c = 1
-    end if
-    scale = max(body(1)%width, body(1)%height, body(2)%width, body(2)%height)
-    allocate (keep(nline), sl(nline), tl(nline))
-    do i = 1, nline
-      x1 = msh(1)%xy(:, nodes1(i))
-      x2 = msh(2)%xy(:, nodes2(i))
-      if (maxval(abs(x1 - x2)) > 1.0e-9_wp*scale) then
-        info = 1
-        write (msg, '(a,i0,a,2es12.4,a,2es12.4,a)') 'contact sides do not match node for node: node ', i, &
-          ' of the contact line is at (', x1, ') in body 1 and (', x2, ') in body 2'
-        return
-      end if
-      sl(i) = x1(itf%axis)
-      d1 = sys(1)%free_of(2*(nodes1(i) - 1) + c)
-      d2 = sys(2)%free_of(2*(nodes2(i) - 1) + c)
-      if ((d1 > 0) .neqv. (d2 > 0)) then
-        info = 1
-        write (msg, '(a,es12.4,a,i0,a)') 'contact node at s = ', sl(i), &
-          ': its normal displacement is prescribed in body ', merge(1, 2, d1 == 0), &
-          ' but free in the other; prescribe it in both or in neither (or give the contact by '// &
-          'groups, &contact body1_group/body2_group, whose rows allow it)'
-        return
-      end if
-      keep(i) = d1 > 0
-    end do
-    ! tributary length along the whole line
-    do i = 1, nline
-      tl(i) = 0.0_wp
-      if (i > 1) tl(i) = tl(i) + 0.5_wp*(sl(i) - sl(i - 1))
-      if (i < nline) tl(i) = tl(i) + 0.5_wp*(sl(i + 1) - sl(i))
-    end do
-    itf%m = count(keep)
-    itf%mortar = .false.
-    itf%slave = 1
-    allocate (itf%s(itf%m), itf%xy(2, itf%m), itf%g0(itf%m), itf%trib(itf%m), itf%node(itf%m, 2), &
-              itf%normal(2, itf%m))
-    k = 0
-    do i = 1, nline
-      if (.not. keep(i)) cycle
-      k = k + 1
-      itf%s(k) = sl(i)
-      itf%xy(:, k) = msh(1)%xy(:, nodes1(i))
-      itf%trib(k) = tl(i)
-      itf%node(k, 1) = nodes1(i)
-      itf%node(k, 2) = nodes2(i)
-      if (cc%gap_radius > 0.0_wp) then
-        itf%g0(k) = (sl(i) - cc%gap_center)**2/(2.0_wp*cc%gap_radius)
-      else
-        itf%g0(k) = 0.0_wp
-      end if
-      itf%normal(:, k) = side_normal(itf%side(1))
-    end do
-    ! row k of B_a: the normal displacement of node k with body a's outward normal
-    c = merge(2, 1, itf%axis == 1)
-    do a = 1, 2
-      allocate (itf%b(a)%ptr(itf%m + 1), itf%b(a)%dof(itf%m), itf%b(a)%val(itf%m))
-      x1 = side_normal(itf%side(a))
-      do k = 1, itf%m
-        itf%b(a)%ptr(k) = k
-        itf%b(a)%dof(k) = 2*(itf%node(k, a) - 1) + c
-        itf%b(a)%val(k) = x1(c)
-      end do
-      itf%b(a)%ptr(itf%m + 1) = itf%m + 1
-    end do
+    call mortar_interface(ccg, msh, sys, itf, info, msg)
   end subroutine build_interface
 
   !> The interface of two named edge groups by dual mortar (module mortar): the slave is
@@ -346,21 +280,6 @@ contains
     end do
   end function normal_fixed
 
-  !> The outward unit normal of a rectangle's side.
-  pure function side_normal(side) result(nrm)
-    integer, intent(in) :: side
-    real(wp) :: nrm(2)
-    select case (side)
-    case (SIDE_LEFT)
-      nrm = [-1.0_wp, 0.0_wp]
-    case (SIDE_RIGHT)
-      nrm = [1.0_wp, 0.0_wp]
-    case (SIDE_BOTTOM)
-      nrm = [0.0_wp, -1.0_wp]
-    case default
-      nrm = [0.0_wp, 1.0_wp]
-    end select
-  end function side_normal
 
   !> B_a on the free DOFs of body a: the DOFs it touches with a non-zero coefficient, in the
   !! order the rows first touch them (these are ordered last in the factorization), the

@@ -10,10 +10,12 @@
 !! functions (Phi_1 = (1 - 3 xi)/2, Phi_2 = (1 + 3 xi)/2 on a segment, xi in [-1, 1]) and pi
 !! the projection along the slave normal onto the master curve. Rules as implemented:
 !!
-!! - Chains. Each side's edges must form one open chain (linked by shared nodes through a
-!!   node -> edge map, O(n)); a branching node, inconsistent orientation, a closed loop,
-!!   more than one chain, a zero-length edge or a fold-back (two adjacent edges reversing)
-!!   is bad input. Orientation: the body lies on the left of each edge, so an edge's
+!! - Chains. Each side's edges must form one open chain or one closed loop (a rim, a bore;
+!!   linked by shared nodes through a node -> edge map, O(n)); a branching node, inconsistent
+!!   orientation, more than one chain, a zero-length edge or a fold-back (two adjacent edges
+!!   reversing) is bad input. A loop is walked as a chain whose last node is its first: that
+!!   node has both its edges (normal, dual function, row), and a master segment across it is
+!!   clipped in two pieces, one at each end of the chain. Orientation: the body lies on the left of each edge, so an edge's
 !!   outward normal is (dy, -dx)/len.
 !! - Nodal normals. At an interior slave node, the sum of the two adjacent edges' unit
 !!   normals weighted by the inverse edge length, normalised: this is the normal of the
@@ -95,6 +97,7 @@ module mortar
   real(wp), parameter :: TOL_FULL = 1.0e-12_wp     ! relative shortfall of a segment still counted as covered
   real(wp), parameter :: MIN_FACING = 1.0e-3_wp    ! cosine between n_s and -n_m below which a piece is dropped
   real(wp), parameter :: MIN_WEIGHT = 1.0e-3_wp    ! a row whose master weights sum below this is dropped
+  integer, parameter :: UNPLACED = 2               ! mstat of a master node no slave normal line reaches
 
 contains
 
@@ -113,8 +116,9 @@ contains
     integer, allocatable :: cs(:), cm(:), mstat(:), mseg(:), pk(:), pq(:), kptr(:), ord(:)
     real(wp), allocatable :: slen(:), nn(:, :), arc(:), mxi(:), plo(:), phi(:), covlen(:)
     logical, allocatable :: covered(:), full(:), isrow(:)
+    logical :: closed, mclosed
     integer :: nes, nem, i, k, q, np, nrej, klo, khi, iter, nbad
-    real(wp) :: lo, hi, xlo, xhi
+    real(wp) :: lo, hi, xlo, xhi, sa, sb
 
     info = 0
     msg = ''
@@ -128,9 +132,9 @@ contains
       msg = 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes'
       return
     end if
-    call chain_order(xs, es, 'slave', cs, info, msg)
+    call chain_order(xs, es, 'slave', cs, closed, info, msg)
     if (info /= 0) return
-    call chain_order(xm, em, 'master', cm, info, msg)
+    call chain_order(xm, em, 'master', cm, mclosed, info, msg)
     if (info /= 0) return
     nes = size(es, 2)
     nem = size(em, 2)
@@ -145,10 +149,15 @@ contains
       nn(:, k - 1) = nn(:, k - 1) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
       nn(:, k) = nn(:, k) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
     end do
+    if (closed) then
+      ! the loop's first and last chain nodes are one node, with both its edges
+      nn(:, 0) = nn(:, 0) + nn(:, nes)
+      nn(:, nes) = nn(:, 0)
+    end if
     do i = 0, nes
       lo = 0.0_wp
-      if (i > 0) lo = lo + 1.0_wp / slen(i)
-      if (i < nes) lo = lo + 1.0_wp / slen(i + 1)
+      if (i > 0 .or. closed) lo = lo + 1.0_wp / slen(merge(i, nes, i > 0))
+      if (i < nes .or. closed) lo = lo + 1.0_wp / slen(merge(i + 1, 1, i < nes))
       hi = norm2(nn(:, i))
       if (hi <= 1.0e-8_wp * lo) then
         info = 1
@@ -161,7 +170,7 @@ contains
     ! Each master node's place on the slave chain: segment mseg and xi (mstat 0), or before
     ! the chain's start (mstat -1) or beyond its end (+1).
     allocate (mstat(0:nem), mseg(0:nem), mxi(0:nem))
-    call project_master_nodes(xs, cs, nn, xm, cm, mstat, mseg, mxi)
+    call project_master_nodes(xs, cs, nn, closed, xm, cm, mstat, mseg, mxi)
 
     ! Clip: each master segment covers a slave interval; its pieces per slave segment.
     np = 0
@@ -169,6 +178,7 @@ contains
     allocate (pk(nes + nem + 8), pq(nes + nem + 8), plo(nes + nem + 8), phi(nes + nem + 8))
     do q = 1, nem
       if (mstat(q - 1) /= 0 .and. mstat(q - 1) == mstat(q)) cycle
+      if (mstat(q - 1) == UNPLACED .or. mstat(q) == UNPLACED) cycle
       call place(q - 1, k, lo)
       call place(q, i, hi)
       if (i < k .or. (i == k .and. hi < lo)) then
@@ -176,20 +186,15 @@ contains
       else
         klo = k; xlo = lo; khi = i; xhi = hi
       end if
-      do k = klo, khi
-        lo = -1.0_wp
-        hi = 1.0_wp
-        if (k == klo) lo = xlo
-        if (k == khi) hi = xhi
-        if (hi <= lo) cycle
-        if (.not. facing(k, q, 0.5_wp * (lo + hi))) then
-          nrej = nrej + 1
-          cycle
-        end if
-        if (np == size(pk)) call grow()
-        np = np + 1
-        pk(np) = k; pq(np) = q; plo(np) = lo; phi(np) = hi
-      end do
+      sa = arc(klo - 1) + 0.5_wp * (xlo + 1.0_wp) * slen(klo)
+      sb = arc(khi - 1) + 0.5_wp * (xhi + 1.0_wp) * slen(khi)
+      if (closed .and. sb - sa > 0.5_wp * arc(nes)) then
+        ! the segment straddles the loop's first node: its two ends of the loop
+        call add_pieces(q, khi, xhi, nes, 1.0_wp)
+        call add_pieces(q, 1, -1.0_wp, klo, xlo)
+      else
+        call add_pieces(q, klo, xlo, khi, xhi)
+      end if
     end do
 
     ! Pieces grouped by slave segment (counting sort), coverage of segments and nodes.
@@ -218,6 +223,10 @@ contains
       end do
     end block
     full = covlen >= 2.0_wp * (1.0_wp - TOL_FULL)
+    if (closed) then
+      covered(0) = covered(0) .or. covered(nes)
+      covered(nes) = covered(0)
+    end if
 
     allocate (isrow(0:nes))
     do i = 0, nes
@@ -241,6 +250,36 @@ contains
     end if
 
   contains
+
+    !> The pieces of master segment qq on the slave chain from (k1, x1) to (k2, x2), one per
+    !! slave segment, those that face the slave normal.
+    subroutine add_pieces(qq, k1, x1, k2, x2)
+      integer, intent(in) :: qq, k1, k2
+      real(wp), intent(in) :: x1, x2
+      integer :: kk
+      real(wp) :: a, b
+      do kk = k1, k2
+        a = -1.0_wp
+        b = 1.0_wp
+        if (kk == k1) a = x1
+        if (kk == k2) b = x2
+        if (b <= a) cycle
+        if (.not. facing(kk, qq, 0.5_wp * (a + b))) then
+          nrej = nrej + 1
+          cycle
+        end if
+        if (np == size(pk)) call grow()
+        np = np + 1
+        pk(np) = kk; pq(np) = qq; plo(np) = a; phi(np) = b
+      end do
+    end subroutine add_pieces
+
+    !> The slave segment before chain node ii (0: none), across the first node of a loop.
+    pure integer function seg_before(ii)
+      integer, intent(in) :: ii
+      seg_before = ii
+      if (ii == 0 .and. closed) seg_before = nes
+    end function seg_before
 
     !> Where master chain node p sits on the slave chain, as (segment, xi), ends clamped.
     subroutine place(p, kk, xx)
@@ -283,17 +322,19 @@ contains
     !! (nbad of them), in which case the caller builds again.
     subroutine build_rows(nbad)
       integer, intent(out) :: nbad
-      integer :: j, m, cap, ns_, nm_, side, kk, other, ii, g, l, l1, l2, e, e2, pc, s0, m0_
+      integer :: j, m, cap, ns_, nm_, side, kk, other, ii, g, l, l1, l2, e, e2, pc, s0, m0_, nlast
       integer, allocatable :: pos(:)
       real(wp) :: dj, ws(-1:1), xa(2), xb(2), c0(2), c1(2), mm0(2), mm1(2), p1(2), dq(2), half, mid, xi, w, &
                   ph, p(2), ng(2), den, t, sw, g0
       logical :: dual, isb
 
-      m = count(isrow)
+      nlast = merge(nes - 1, nes, closed)      ! a loop's last chain node is its first
+      m = count(isrow(0:nlast))
       cap = 0
-      do ii = 0, nes
+      do ii = 0, nlast
         if (.not. isrow(ii)) cycle
-        if (ii > 0) cap = cap + 2 * (kptr(ii + 1) - kptr(ii))
+        kk = seg_before(ii)
+        if (kk > 0) cap = cap + 2 * (kptr(kk + 1) - kptr(kk))
         if (ii < nes) cap = cap + 2 * (kptr(ii + 2) - kptr(ii + 1))
       end do
       mt%m = m
@@ -307,7 +348,7 @@ contains
       j = 0
       ns_ = 0
       nm_ = 0
-      do ii = 0, nes
+      do ii = 0, nlast
         if (.not. isrow(ii)) cycle
         j = j + 1
         mt%snode(j) = cs(ii)
@@ -321,14 +362,15 @@ contains
         do side = -1, 1, 2
           ! side -1: segment ii (nodes ii-1, ii; this node is its end b); +1: segment ii+1 (node a).
           if (side == -1) then
-            if (ii == 0) cycle
-            kk = ii
+            kk = seg_before(ii)
+            if (kk == 0) cycle
           else
             if (ii == nes) cycle
             kk = ii + 1
           end if
           isb = side == -1
           other = ii + side
+          if (other < 0) other = nes - 1
           dual = isrow(other)
           dj = dj + 0.5_wp * slen(kk)
           if (full(kk)) then
@@ -394,8 +436,12 @@ contains
         s0 = ns_
         do side = -1, 1, 2
           other = ii + side
-          if (other < 0 .or. other > nes) cycle
           kk = ii + max(side, 0)
+          if (other < 0 .and. closed) then
+            other = nes - 1
+            kk = nes
+          end if
+          if (other < 0 .or. other > nes) cycle
           if (isrow(other) .and. full(kk)) cycle   ! dual pair on a covered segment: int Phi_j N_other = 0
           if (ws(side) == 0.0_wp) cycle                 ! no covered part on that segment
           ns_ = ns_ + 1
@@ -419,6 +465,7 @@ contains
         if (.not. (sw >= MIN_WEIGHT)) then
           nbad = nbad + 1
           isrow(ii) = .false.
+          if (closed .and. ii == 0) isrow(nes) = .false.
         end if
       end do
       mt%sptr(m + 1) = ns_ + 1
@@ -433,19 +480,22 @@ contains
 
   end subroutine mortar_build
 
-  !> Order the edges of one side into a single open chain: c(0:ne) are its nodes from the
-  !! start (the node no edge ends at), edge k joining c(k-1) -> c(k).
-  subroutine chain_order(x, e, what, c, info, msg)
+  !> Order the edges of one side into a single chain: c(0:ne) are its nodes from the start
+  !! (the node no edge ends at), edge k joining c(k-1) -> c(k). A closed loop (a rim, a bore)
+  !! starts at the first edge's first node and has c(ne) = c(0).
+  subroutine chain_order(x, e, what, c, closed, info, msg)
     real(wp), intent(in) :: x(:, :)            !< (2, nnode) coordinates
     integer, intent(in) :: e(:, :)             !< (2, ne) edges
     character(len=*), intent(in) :: what       !< 'slave' or 'master', for messages
     integer, allocatable, intent(out) :: c(:)  !< (0:ne) nodes in chain order
+    logical, intent(out) :: closed             !< the edges form one closed loop
     integer, intent(inout) :: info             !< set to 1 on bad input
     character(len=*), intent(inout) :: msg     !< why
     integer, allocatable :: eout(:), ein(:), deg(:)
     integer :: ne, nnode, k, a, b, nstart, start, n
     real(wp) :: lo(2), hi(2), diag
 
+    closed = .false.
     ne = size(e, 2)
     nnode = size(x, 2)
     if (size(e, 1) /= 2) then
@@ -532,13 +582,12 @@ contains
       end if
     end do
     if (nstart == 0) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form a closed loop; one open chain is required'
-      return
+      closed = .true.
+      start = e(1, 1)
     end if
     if (nstart > 1) then
       info = 1
-      msg = 'mortar: the '//what//' edges form '//i2s(nstart)//' separate chains; one chain is required'
+      msg = 'mortar: the '//what//' edges form '//i2s(nstart)//' separate chains; one chain or one loop is required'
       return
     end if
     allocate (c(0:ne))
@@ -549,7 +598,14 @@ contains
       k = eout(c(n))
       n = n + 1
       c(n) = e(2, k)
+      if (closed .and. c(n) == start) exit
     end do
+    if (closed .and. n /= ne) then
+      info = 1
+      msg = 'mortar: the '//what//' edges form more than one closed loop (one of '//i2s(n)//' edges, the '// &
+            'other '//i2s(ne - n)//'); one chain or one loop is required'
+      return
+    end if
     if (n /= ne) then
       info = 1
       msg = 'mortar: the '//what//' edges form more than one chain (a chain of '//i2s(n)//' edges and a closed '// &
@@ -560,13 +616,17 @@ contains
 
   !> Place every master chain node on the slave chain along the interpolated slave normal:
   !! the segment k where sigma_i = (x - x_i) x n_i changes sign from <= 0 at node k-1 to
-  !! >= 0 at node k, found by walking from the previous node's segment.
-  subroutine project_master_nodes(xs, cs, nn, xm, cm, mstat, mseg, mxi)
+  !! >= 0 at node k, found by walking from the previous node's segment. Along the slave
+  !! curve sigma grows through the point x projects to (d sigma/ds = 1 + d kappa > 0 while
+  !! x is nearer than the centre of curvature), so on a closed slave loop, where the walk
+  !! wraps around, the rising sign change is the projection; a node with none is UNPLACED.
+  subroutine project_master_nodes(xs, cs, nn, closed, xm, cm, mstat, mseg, mxi)
     real(wp), intent(in) :: xs(:, :), nn(:, 0:), xm(:, :)
     integer, intent(in) :: cs(0:), cm(0:)
+    logical, intent(in) :: closed
     integer, intent(out) :: mstat(0:), mseg(0:)
     real(wp), intent(out) :: mxi(0:)
-    integer :: nes, k, p
+    integer :: nes, k, p, steps
     real(wp) :: x(2)
     nes = size(cs) - 1
     k = nes
@@ -574,15 +634,30 @@ contains
       x = xm(:, cm(p))
       mseg(p) = 0
       mxi(p) = 0.0_wp
+      steps = 0
       do
+        steps = steps + 1
+        if (steps > nes + 2) then
+          mstat(p) = UNPLACED
+          k = nes
+          exit
+        end if
         if (cross(x - xs(:, cs(k - 1)), nn(:, k - 1)) > 0.0_wp) then
           if (k == 1) then
+            if (closed) then
+              k = nes
+              cycle
+            end if
             mstat(p) = -1
             exit
           end if
           k = k - 1
         else if (cross(x - xs(:, cs(k)), nn(:, k)) < 0.0_wp) then
           if (k == nes) then
+            if (closed) then
+              k = 1
+              cycle
+            end if
             mstat(p) = 1
             exit
           end if

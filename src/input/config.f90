@@ -137,9 +137,9 @@ module config
   !> Outer and inner solver settings (what the contact stage needs, and the factorization).
   type, public :: solver_cfg_t
     integer :: method = METHOD_ROBIN                  !< METHOD_*
-    integer :: robin_operator = ROBIN_STEKLOV         !< ROBIN_*
+    integer :: robin_operator = ROBIN_HARMONIC        !< ROBIN_* (harmonic: robust to material contrast)
     real(wp) :: alpha = 0.0_wp                        !< constant Robin parameter [length/stress]
-    real(wp) :: delta = 0.95_wp                       !< relaxation, 0 < delta <= 1
+    real(wp) :: delta = 0.5_wp                        !< relaxation, 0 < delta <= 1
     real(wp) :: tol = 1.0e-8_wp                       !< outer tolerance
     integer :: stop = STOP_INCREMENT                  !< STOP_*
     integer :: max_outer = 800                        !< outer iteration limit

@@ -795,10 +795,9 @@ contains
   subroutine check_cross(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
-    integer :: b, s, nc, cs(2), n1, n2
-    character(len=:), allocatable :: p, lst, what
-    real(wp) :: scale, tol, c1, c2, a1, a2, e1, e2
-    logical :: horizontal, groups
+    integer :: b, s, nc
+    character(len=:), allocatable :: p, lst
+    logical :: groups
 
     p = st%path//': '
     groups = len_trim(d%contact%body_group(1)) > 0 .or. len_trim(d%contact%body_group(2)) > 0
@@ -826,54 +825,10 @@ contains
             ' ''contact'' sides ('//trim(adjustl(lst))//'); each body needs exactly one')
         end if
       end if
-      cs(b) = findloc(d%body(b)%bc, BC_CONTACT, dim=1)
     end do
 
-    if (.not. ((cs(1) == SIDE_BOTTOM .and. cs(2) == SIDE_TOP) .or. &
-               (cs(1) == SIDE_TOP .and. cs(2) == SIDE_BOTTOM) .or. &
-               (cs(1) == SIDE_LEFT .and. cs(2) == SIDE_RIGHT) .or. &
-               (cs(1) == SIDE_RIGHT .and. cs(2) == SIDE_LEFT))) &
-      call fatal(EXIT_INPUT, p//'the contact sides do not face each other: body 1 ('// &
-      st%body_at(1)%s//') has its contact on its '//trim(side_names(cs(1)))//' side, body 2 ('// &
-      st%body_at(2)%s//') on its '//trim(side_names(cs(2)))//' side; the pairs allowed '// &
-      '(body 1/body 2) are bottom/top, top/bottom, left/right and right/left')
-
-    scale = 0.0_wp
-    do b = 1, 2
-      associate (y => d%body(b))
-        scale = max(scale, abs(y%x0), abs(y%x0 + y%width), abs(y%y0), abs(y%y0 + y%height), &
-                    y%width, y%height)
-      end associate
-    end do
-    tol = 1.0e-9_wp * scale
-    horizontal = (cs(1) == SIDE_BOTTOM .or. cs(1) == SIDE_TOP)
-    call side_line(d%body(1), cs(1), c1, a1, e1)
-    call side_line(d%body(2), cs(2), c2, a2, e2)
-    if (abs(c1 - c2) > tol .or. abs(a1 - a2) > tol .or. abs(e1 - e2) > tol) then
-      if (horizontal) then
-        what = 'body 1''s '//trim(side_names(cs(1)))//' side is y = '//r2s(c1)//' for x from '// &
-          r2s(a1)//' to '//r2s(e1)//', body 2''s '//trim(side_names(cs(2)))//' side is y = '// &
-          r2s(c2)//' for x from '//r2s(a2)//' to '//r2s(e2)
-      else
-        what = 'body 1''s '//trim(side_names(cs(1)))//' side is x = '//r2s(c1)//' for y from '// &
-          r2s(a1)//' to '//r2s(e1)//', body 2''s '//trim(side_names(cs(2)))//' side is x = '// &
-          r2s(c2)//' for y from '//r2s(a2)//' to '//r2s(e2)
-      end if
-      call fatal(EXIT_INPUT, p//'the contact sides do not coincide: '//what// &
-        '; they must be the same segment (within 1e-9 relative); check x0, y0, width, height')
-    end if
-    if (horizontal) then
-      n1 = d%body(1)%nx
-      n2 = d%body(2)%nx
-    else
-      n1 = d%body(1)%ny
-      n2 = d%body(2)%ny
-    end if
-    if (n1 /= n2) call fatal(EXIT_INPUT, p//'the contact sides do not match node for node: '// &
-      'body 1 has '//merge('nx', 'ny', horizontal)//' = '//i2s(n1)//' cells along its '// &
-      trim(side_names(cs(1)))//' side, body 2 has '//merge('nx', 'ny', horizontal)//' = '// &
-      i2s(n2)//' along its '//trim(side_names(cs(2)))//' side; the meshes need the same '// &
-      'number of cells along the contact line')
+    ! whether the two sides face each other, overlap and how their nodes pair is the mortar
+    ! interface's business, as for named groups (condense: build_interface)
 
     ! support against rigid motion is the mesh's business (assembly: a body the supports
     ! leave free is held only by contact, and module floating checks that the contact can)
@@ -939,23 +894,6 @@ contains
     end do
     call check_loads(d, st)
   end subroutine check_groups
-
-  !> A side as a segment: the fixed coordinate c and the extent [a, e] along the side.
-  subroutine side_line(b, s, c, a, e)
-    type(body_cfg_t), intent(in) :: b
-    integer, intent(in) :: s
-    real(wp), intent(out) :: c, a, e
-    select case (s)
-    case (SIDE_LEFT, SIDE_RIGHT)
-      c = merge(b%x0, b%x0 + b%width, s == SIDE_LEFT)
-      a = b%y0
-      e = b%y0 + b%height
-    case default
-      c = merge(b%y0, b%y0 + b%height, s == SIDE_BOTTOM)
-      a = b%x0
-      e = b%x0 + b%width
-    end select
-  end subroutine side_line
 
   function side_list(b) result(s)
     type(body_cfg_t), intent(in) :: b

@@ -130,7 +130,7 @@ contains
     character(len=*), intent(in) :: run_id
     type(h5_status_t), intent(inout) :: st
     integer(hid_t) :: fid, gid
-    integer :: a, k, i
+    integer :: a, k
     real(wp), allocatable :: sig(:, :), vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
     character(len=8) :: bname
     character(len=:), allocatable :: ul, us, uf
@@ -262,17 +262,48 @@ contains
       end do
       call write_dset(gid, 'von_mises', vm, st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
-      vm = 0.0_wp
-      do k = 1, itf%m
-        i = itf%node(k, a)
-        if (i > 0) vm(i) = pres(k)
-      end do
+      call nodal_pressure(itf, a, pres, vm)
       call write_dset(gid, 'contact_pressure', vm, st, us)
       deallocate (w2, w3, ua, sigt, sig, vm)
       call group_close(gid, st)
     end do
     call file_close(fid, st)
   end subroutine write_h5
+
+  !> The contact pressure as a nodal field of body a (0 off the contact line): on the slave
+  !! the rows' pressures; on the master the mean of the pressures of the rows that reach a
+  !! node, weighted by their mortar weight times tributary length (a uniform pressure stays
+  !! uniform, and matching lines give the slave's values).
+  subroutine nodal_pressure(itf, a, pres, p)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: a                  !< body
+    real(wp), intent(in) :: pres(:)           !< (m) pressure of each row [stress]
+    real(wp), intent(out) :: p(:)             !< (nnode) nodal field [stress]
+    real(wp), allocatable :: den(:)
+    integer :: k, e, i
+    real(wp) :: w
+    p = 0.0_wp
+    if (a == itf%slave) then
+      do k = 1, itf%m
+        p(itf%node(k, a)) = pres(k)
+      end do
+      return
+    end if
+    allocate (den(size(p)))
+    den = 0.0_wp
+    do k = 1, itf%m
+      ! a node's two entries (x, y) are adjacent: weight |w n| = w
+      do e = itf%b(a)%ptr(k), itf%b(a)%ptr(k + 1) - 2, 2
+        i = (itf%b(a)%dof(e) + 1)/2
+        w = hypot(itf%b(a)%val(e), itf%b(a)%val(e + 1))
+        if (w <= 1.0e-12_wp) cycle             ! a rounding-level weight of a matching line
+        w = w*itf%trib(k)
+        p(i) = p(i) + w*pres(k)
+        den(i) = den(i) + w
+      end do
+    end do
+    where (den > 0.0_wp) p = p/den
+  end subroutine nodal_pressure
 
   !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral)
   !! and its 0-based vertices.
