@@ -56,6 +56,7 @@ CONTACT_FIELDS = ("pressure", "normal_force", "gap", "normal_displacement_body1"
 # the unit of every numeric dataset: L length, S stress, F/L force per unit length, 1, s
 UNITS = {"contact/x": "L", "contact/y": "L", "contact/s": "L", "contact/normal": "1", "contact/coordinates": "L", "contact/g0": "L", "contact/tributary_length": "L",
          "contact/normal_force": "F/L", "contact/normal_force_body1": "F/L", "contact/normal_force_body2": "F/L",
+         "contact/resultant_body1": "F/L",
          "contact/pressure": "S", "contact/gap": "L", "contact/active": "1",
          "contact/normal_displacement_body1": "L", "contact/normal_displacement_body2": "L",
          "contact/obstacle_body1": "L", "contact/obstacle_body2": "L", "contact/geometry_xyz": "L",

@@ -17,7 +17,7 @@ module results
   use strings, only: word
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
-  use condense, only: interface_t
+  use condense, only: interface_t, contact_resultant
   use contact_types, only: contact_result_t
   use floating, only: free_list
   implicit none (type, external)
@@ -197,6 +197,8 @@ contains
     call write_dset(gid, 'normal_force', res%lam, st, uf)
     call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
     call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
+    ! the contact forces' resultant on body 1 (x, y): what balances its load
+    call write_dset(gid, 'resultant_body1', contact_resultant(itf, 1, res%lam), st, uf)
     allocate (pres(itf%m))
     where (itf%trib > 0.0_wp)
       pres = res%lam/itf%trib
