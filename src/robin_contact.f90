@@ -605,7 +605,7 @@ contains
       fres = contact_resultant(itf, 1, res%lam)
     end if
     write (line(1), '(a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: resultant_on_body1='// &
-      e6(fres(1))//','//e6(fres(2))//' normal_force_sum='//e6(ftot)//' active=', res%active, &
+      sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', res%active, &
       ' imbalance=', res%imbalance, ' penetration=', res%penetration, ' complementarity=', res%complementarity
     if (res%outer > 0) then
       line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(res%error_bound)// &
@@ -649,19 +649,6 @@ contains
           "or a larger max_outer"
     end if
   end function next_setting
-
-  !> x with six significant digits, no blanks (a value of a key=value summary field).
-  function e6(x) result(t)
-    real(wp), intent(in) :: x
-    character(len=:), allocatable :: t
-    character(len=24) :: buf
-    if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
-      write (buf, '(es13.5e3)') x
-    else
-      write (buf, '(es12.5)') x
-    end if
-    t = trim(adjustl(buf))
-  end function e6
 
   !> The effective deck without the settings that may change between a run and its
   !! restart (output, max_outer): a checkpoint is only accepted under the same key.

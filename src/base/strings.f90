@@ -281,16 +281,22 @@ contains
     s = adjustl(s)
   end function rtoa
 
-  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308).
-  function sci(x) result(t)
+  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308),
+  !! with `digits` digits after the point (default 3).
+  function sci(x, digits) result(t)
     real(wp), intent(in) :: x
+    integer, intent(in), optional :: digits
     character(len=:), allocatable :: t
-    character(len=24) :: buf
+    character(len=32) :: buf, fmt
+    integer :: d
+    d = 3
+    if (present(digits)) d = digits
     if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
-      write (buf, '(es11.3e3)') x
+      write (fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, 'e3)'
     else
-      write (buf, '(es10.3)') x
+      write (fmt, '(a,i0,a,i0,a)') '(es', d + 7, '.', d, ')'
     end if
+    write (buf, fmt) x
     t = trim(adjustl(buf))
   end function sci
 
