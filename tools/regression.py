@@ -8,7 +8,8 @@
 settings, again with method='monolithic' and with the harmonic operator at delta 0.5, and stores, per deck: the exit code, the status, the outer iteration count and the
 nodal contact forces (/contact/normal_force). Without --store it runs them again and compares:
 same exit code, status and outer count, and max |f - f_ref| <= 1e-12 max |f_ref| (scale-aware;
-exactly 0 = 0 for a deck without contact). --quick takes the decks that run in under a second.
+exactly 0 = 0 for a deck without contact); with --loose (a build that rounds differently, such as
+`make DEBUG=1`) the forces within ten times each run's own a posteriori bound and no outer counts. --quick takes the decks that run in under a second.
 Exit 0 when every deck agrees, 1 otherwise (each difference printed). Runs with
 OMP_NUM_THREADS=2 unless set; results go to a temporary folder, nothing in the tree is written
 but the reference file (--store).
@@ -67,10 +68,12 @@ def run_deck(binary, key, deck, overrides, tmp):
     return rec, p
 
 
-def compare(ref, new):
-    """The differences between two records, as a list of sentences."""
+def compare(ref, new, loose=False):
+    """The differences between two records, as a list of sentences. loose: a build that
+    rounds differently (the checked -O0 build): forces within ten times the run's own a
+    posteriori bound, outer counts not compared."""
     diffs = []
-    for key in ("exit", "status", "outer"):
+    for key in ("exit", "status") + (() if loose else ("outer",)):
         if ref.get(key) != new.get(key):
             diffs.append(f"{key} {ref.get(key)} -> {new.get(key)}")
     if ("force" in ref) != ("force" in new):
@@ -82,7 +85,8 @@ def compare(ref, new):
         else:
             scale = np.max(np.abs(fr)) if fr.size else 0.0
             err = np.max(np.abs(fn - fr)) if fr.size else 0.0
-            if err > RTOL * scale or (scale == 0.0 and err != 0.0):
+            rtol = max(RTOL, 10.0 * new.get("error_bound", 0.0)) if loose else RTOL
+            if err > rtol * scale or (scale == 0.0 and err > RTOL):
                 diffs.append(f"contact forces differ: max |df| = {err:.3e} = {err / max(scale, 1e-300):.3e} relative "
                              f"(the run's own a posteriori bound {new.get('error_bound', float('nan')):.1e})")
     return diffs
@@ -95,6 +99,9 @@ def main():
     ap.add_argument("--store", action="store_true")
     ap.add_argument("--only", default="")
     ap.add_argument("--verbose", action="store_true", help="print the end of a differing run's output")
+    ap.add_argument("--loose", action="store_true",
+                    help="for a build that rounds differently: forces within 10x each run's a posteriori "
+                         "bound, outer counts not compared")
     ap.add_argument("--quick", action="store_true", help="only the decks that ran in under 1 s")
     a = ap.parse_args()
     binary = os.path.abspath(os.path.join(ROOT, a.bin)) if not os.path.isabs(a.bin) else a.bin
@@ -119,7 +126,7 @@ def main():
                 print(f"NEW  {deck}: not in the reference (store it)")
                 bad += 1
                 continue
-            diffs = compare(ref[deck], rec)
+            diffs = compare(ref[deck], rec, a.loose)
             print(("FAIL " if diffs else "PASS ") + f"{deck} outer={rec.get('outer')} "
                   + "; ".join(diffs))
             if diffs:
