@@ -700,8 +700,8 @@ contains
     extra = extra(1:k)
   end subroutine parse_arguments
 
-  !> Write `text` (lines separated by LF, a final LF optional) to standard output and end
-  !! the program with exit code 0 (3 if standard output cannot be written).
+  !> Write `text` (lines separated by LF, a final LF optional) to standard output (rank 0's
+  !! in the MPI binary) and end the program with exit code 0 (3 if it cannot be written).
   subroutine print_and_exit(text)
     character(len=*), intent(in) :: text
     integer :: err, n
@@ -709,7 +709,8 @@ contains
     if (n > 0) then
       if (text(n:n) == achar(10)) n = n - 1
     end if
-    call write_stdout_checked(text(1:n), err)
+    err = 0
+    if (me == 0) call write_stdout_checked(text(1:n), err)
     if (err /= 0) call fatal(EXIT_NUMERICAL, 'cannot write to standard output (full disk or closed pipe?)')
     call finish(EXIT_OK)
   end subroutine print_and_exit
