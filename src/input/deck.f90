@@ -80,9 +80,10 @@ module deck
     'them. The unit column is in those terms: [length], [stress] (force/length^2), their '// &
     'quotients, and [-] for a pure number.'//NL
   character(len=*), parameter :: REF_SCENE = &
-    'The scene: a title, plane strain or stress, and the names of the units. At most once.'
+    'The scene: a title, plane strain or stress, and the names of the units. Optional, at '// &
+    'most once.'
   character(len=*), parameter :: REF_BODY = &
-    'One elastic body. Exactly two, `id=1` and `id=2`. Either a built-in **rectangle** '// &
+    'One elastic body. Required: exactly two, `id=1` and `id=2`. Either a built-in **rectangle** '// &
     '[x0, x0+width] x [y0, y0+height] meshed by nx x ny cells, whose sides get their conditions '// &
     'here (`left`, `right`, `bottom`, `top`) and are its groups `''left''`, `''right''`, '// &
     '`''bottom''`, `''top''`; or the cells of a **mesh file** (`mesh`, `region`), whose '// &
@@ -91,30 +92,33 @@ module deck
     'leave free to move is held only by contact; the program finds that on the mesh and checks '// &
     'that the contact can hold it.'
   character(len=*), parameter :: REF_TRACTION = &
-    'A traction on part of a body''s boundary. Any number; loads on one part add up. Either on a '// &
-    'rectangle''s **side** (`side`, `t0`, `t1`): t(s) = t0 + t1*s with s the global coordinate '// &
-    'along the side; or on a **group** (`group`, `t0`, `tx`, `ty`, `pressure`): '// &
+    'A traction on part of a body''s boundary. Optional, any number; loads on one part add up. '// &
+    'Either on a rectangle''s **side** (`side`, `t0`, `t1`): t(s) = t0 + t1*s with s the global '// &
+    'coordinate along the side; or on a **group** (`group`, `t0`, `tx`, `ty`, `pressure`): '// &
     't(x,y) = t0 + tx*x + ty*y - pressure*n. Give `side` or `group`, not both. A traction on a '// &
     'contact side is bad input; on a clamped or prescribed side it has no effect (a warning).'
   character(len=*), parameter :: REF_DISPLACEMENT = &
-    'A prescribed displacement vector on a side of a rectangle that its `&body` declares '// &
-    '`''displacement''`: one for each such side, and none on a clamped, roller or contact side. '// &
+    'A prescribed displacement vector on a side of a rectangle: a side its `&body` declares '// &
+    '`''displacement''` (each such side needs one), or a `''free''` one (which becomes '// &
+    '`''displacement''`); not a clamped, roller or contact side. One per side in the deck. '// &
     'A body from a mesh file has no sides: use `&boundary`.'
   character(len=*), parameter :: REF_BOUNDARY = &
     'Prescribed displacement components on a group of a body (a physical curve or point of its '// &
-    'mesh, or a rectangle''s side). Any number, applied in order after the side conditions. '// &
-    'The components given (at least one) are prescribed on every node of the group, a component '// &
-    'not given stays free: `ux` alone is a roller on a vertical wall, both clamp or prescribe.'
+    'mesh, or a rectangle''s side). Optional, any number, applied in order after the side '// &
+    'conditions; a body from a mesh file is supported by these alone. The components given (at '// &
+    'least one) are prescribed on every node of the group, a component not given stays free: '// &
+    '`ux` alone is a roller on a vertical wall, both clamp or prescribe.'
   character(len=*), parameter :: REF_CONTACT = &
-    'The contact interface. At most once. Without groups the two sides declared `''contact''` '// &
-    'are paired node for node (they must face each other and match); with `body1_group` and '// &
-    '`body2_group` the two surfaces are paired by dual mortar, matching or not, flat or curved, '// &
-    'and no side may be declared `''contact''`. Pairing and normals are computed once, on the '// &
-    'initial configuration (small deformation).'
+    'The contact interface. Optional, at most once; needed for a body from a mesh file. Without '// &
+    'groups the two sides declared `''contact''` are paired node for node (they must face each '// &
+    'other and match); with `body1_group` and `body2_group` the two surfaces are paired by dual '// &
+    'mortar, matching or not, flat or curved, and no side may be declared `''contact''`. Pairing '// &
+    'and normals are computed once, on the initial configuration (small deformation).'
   character(len=*), parameter :: REF_SOLVER = &
-    'The outer (Robin) iteration, the inner solver (MPRGP) and the factorization. At most once.'
+    'The outer (Robin) iteration, the inner solver (MPRGP) and the factorization. Optional, at '// &
+    'most once.'
   character(len=*), parameter :: REF_OUTPUT = &
-    'The result file, checkpoints and progress lines. At most once.'
+    'The result file, checkpoints and progress lines. Optional, at most once.'
   character(len=*), parameter :: UNIT_NAME_DOC = &
     'With `units=''SI''` or `''mm-N-MPa''` it is set by `units` (a different name given is bad '// &
     'input); with `''custom''` it is free but not empty'
