@@ -106,19 +106,25 @@ contains
   end subroutine push
 
   !> The documentation of a table entry (all optional): what it is, its unit, the values the
-  !! group's checks accept, and whether the group needs it.
+  !! group's checks accept, and whether the group needs it. Absent ones stay unallocated
+  !! (read through `text_of`): tables are built for every group read, documented or not.
   subroutine describe(v, doc, unit, range, required)
     type(var_t), intent(inout) :: v
     character(len=*), intent(in), optional :: doc, unit, range
     logical, intent(in), optional :: required
-    v%doc = ''
-    v%unit = ''
-    v%range = ''
     if (present(doc)) v%doc = doc
     if (present(unit)) v%unit = unit
     if (present(range)) v%range = range
     if (present(required)) v%required = required
   end subroutine describe
+
+  !> An optional text of a table entry, '' when it was not given.
+  pure function text_of(s) result(t)
+    character(len=:), allocatable, intent(in) :: s
+    character(len=:), allocatable :: t
+    t = ''
+    if (allocated(s)) t = s
+  end function text_of
 
   subroutine add_int(self, name, x, doc, range, required)
     class(vars_t), intent(inout) :: self
@@ -131,8 +137,8 @@ contains
     v%name = name
     v%typ = T_INT
     v%ip => x
-    call describe(v, doc=doc, range=range, required=required)
     call push(self, v)
+    call describe(self%v(self%n), doc=doc, range=range, required=required)
   end subroutine add_int
 
   subroutine add_real(self, name, x, doc, unit, range)
@@ -146,8 +152,8 @@ contains
     v%name = name
     v%typ = T_REAL
     v%rs => x
-    call describe(v, doc=doc, unit=unit, range=range)
     call push(self, v)
+    call describe(self%v(self%n), doc=doc, unit=unit, range=range)
   end subroutine add_real
 
   subroutine add_pair(self, name, x, doc, unit)
@@ -161,8 +167,8 @@ contains
     v%typ = T_REAL
     v%nval = 2
     v%rv => x
-    call describe(v, doc=doc, unit=unit)
     call push(self, v)
+    call describe(self%v(self%n), doc=doc, unit=unit)
   end subroutine add_pair
 
   subroutine add_str(self, name, x, doc, required)
@@ -175,8 +181,8 @@ contains
     v%name = name
     v%typ = T_STR
     v%sp => x
-    call describe(v, doc=doc, required=required)
     call push(self, v)
+    call describe(self%v(self%n), doc=doc, required=required)
   end subroutine add_str
 
   subroutine add_enum(self, name, x, choices, base, doc, required)
@@ -193,8 +199,8 @@ contains
     v%ip => x
     v%choices = choices
     if (present(base)) v%base = base
-    call describe(v, doc=doc, required=required)
     call push(self, v)
+    call describe(self%v(self%n), doc=doc, required=required)
   end subroutine add_enum
 
   !> Whether the table holds a variable `name`.
@@ -281,7 +287,7 @@ contains
            '| --- | --- | --- | --- | --- | --- |'//NL
     do k = 1, vars%n
       associate (v => vars%v(k))
-        allowed = v%range
+        allowed = text_of(v%range)
         select case (v%typ)
         case (T_INT)
           typ = 'integer'
@@ -325,8 +331,8 @@ contains
             only = '*'//only//' only:* '
           end if
         end if
-        text = text//'| `'//v%name//'` |'//cell(typ)//cell(def)//cell(v%unit)//cell(allowed)// &
-               cell(only//v%doc)//NL
+        text = text//'| `'//v%name//'` |'//cell(typ)//cell(def)//cell(text_of(v%unit))//cell(allowed)// &
+               cell(only//text_of(v%doc))//NL
       end associate
     end do
   contains
