@@ -16,8 +16,9 @@ program robin_contact
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: fatal, fatal_handler, terminate, warn, EXIT_OK, EXIT_INPUT, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, &
                     EXIT_INTERRUPTED
-  use config, only: deck_t, output_cfg_t, solver_cfg_t, ROBIN_HARMONIC, METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
-  use deck, only: read_deck, print_deck, deck_usage, deck_text
+  use config, only: deck_t, output_cfg_t, solver_cfg_t, ROBIN_HARMONIC, METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, &
+                    FACTOR_CHOICES
+  use deck, only: read_deck, print_deck, deck_usage, deck_text, deck_reference
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
   use assembly, only: body_system_t, assemble_body, expand, cell_triplets
@@ -665,19 +666,40 @@ contains
     call deck_text(d1, k)
   end function physics_key
 
+  !> The command line: DECK [OVERRIDE ...] [--restart FILE]. `--help`, `--version` and
+  !! `--deck-reference` (anywhere) print to standard output and exit 0 without a deck; any
+  !! other argument that starts with '-' is an unknown option (exit 1).
   subroutine parse_arguments(path, extra, restart)
     character(len=:), allocatable, intent(out) :: path
     character(len=4096), allocatable, intent(out) :: extra(:)
     character(len=:), allocatable, intent(out) :: restart
     integer :: n, i, l, k
     character(len=4096) :: arg
+    character(len=*), parameter :: OPTIONS = 'the options are --help, --version, --deck-reference '// &
+      'and --restart FILE.ckpt.h5 (robin_contact --help)'
     n = command_argument_count()
+    i = 1
+    do while (i <= n)
+      call get_command_argument(i, arg, l)
+      select case (trim(arg))
+      case ('-h', '--help')
+        call print_and_exit(deck_usage)
+      case ('--version')
+        call print_and_exit('robin_contact '//program_version)
+      case ('--deck-reference')
+        call print_and_exit(deck_reference())
+      case ('--restart')
+        i = i + 1   ! its file is not an option
+      case default
+        if (arg(1:1) == '-' .and. len_trim(arg) > 1) call fatal(EXIT_INPUT, 'unknown option '''// &
+          trim(arg)//'''; '//OPTIONS)
+      end select
+      i = i + 1
+    end do
     if (n < 1) call fatal(EXIT_INPUT, 'no deck file given'//achar(10)//deck_usage)
     call get_command_argument(1, arg, l)
-    if (trim(arg) == '-h' .or. trim(arg) == '--help') then
-      write (output_unit, '(a)') deck_usage
-      call finish(EXIT_OK)
-    end if
+    if (trim(arg) == '--restart') call fatal(EXIT_INPUT, 'no deck file given: the deck comes '// &
+      'first, robin_contact DECK.nml [OVERRIDE ...] --restart FILE.ckpt.h5')
     path = trim(arg)
     restart = ''
     allocate (extra(n - 1))
@@ -699,5 +721,20 @@ contains
     end do
     extra = extra(1:k)
   end subroutine parse_arguments
+
+  !> Write `text` (lines separated by LF, a final LF optional) to standard output (rank 0's
+  !! in the MPI binary) and end the program with exit code 0 (3 if it cannot be written).
+  subroutine print_and_exit(text)
+    character(len=*), intent(in) :: text
+    integer :: err, n
+    n = len(text)
+    if (n > 0) then
+      if (text(n:n) == achar(10)) n = n - 1
+    end if
+    err = 0
+    if (me == 0) call write_stdout_checked(text(1:n), err)
+    if (err /= 0) call fatal(EXIT_NUMERICAL, 'cannot write to standard output (full disk or closed pipe?)')
+    call finish(EXIT_OK)
+  end subroutine print_and_exit
 
 end program robin_contact

@@ -1,11 +1,13 @@
 !> Tests of module deck on good input: the default deck's values, the round trip
 !! (print_deck output read back gives identical values), override precedence and
-!! semantics, defaults, and a few namelist forms (case, repeat counts, quotes, comments).
+!! semantics, defaults, a few namelist forms (case, repeat counts, quotes, comments), and
+!! the Markdown reference table of a group (cells, required, forms, escaping).
 !! Bad input is tested by tests/test_bad_input.sh (fatal errors end the process).
 program test_deck
   use kinds, only: wp
   use config
   use deck, only: read_deck, print_deck, deck_text
+  use namelist_input, only: vars_t, str_t, reference_table
   use testing, only: report, test_summary
   implicit none (type, external)
   type(deck_t) :: d, e
@@ -13,6 +15,7 @@ program test_deck
   character(len=200) :: none(0)
   character(len=200) :: ov(6)
   character(len=:), allocatable :: t1, t2
+  character(len=*), parameter :: NL = achar(10)
   real(wp) :: r
 
   call random_number(r)
@@ -113,6 +116,46 @@ program test_deck
   call deck_text(d, t1)
   call deck_text(d, t2)
   call check(t1 == t2 .and. t1 == d%effective, 'deck_text is deterministic and equals d%effective')
+
+  ! ---- the reference table of a group (namelist_input%reference_table) -----------------------
+  block
+    type(vars_t) :: v, forms(2)
+    integer, target :: n, code
+    real(wp), target :: x, p(2)
+    character(len=8), target :: s
+    character(len=:), allocatable :: tab
+    n = 3
+    code = 0
+    x = 2.5e11_wp
+    p = [1.0_wp, -0.5_wp]
+    s = 'ab'
+    call v%int('n', n, doc='count', range='>= 1', required=.true.)
+    call v%real('x', x, unit='[stress]', range='> 0', doc='a | b')
+    call v%pair('p', p, unit='[length]', doc='position')
+    call v%str('s', s)
+    call v%enum('c', code, 'one two')
+    call forms(1)%int('n', n)
+    call forms(1)%real('x', x)
+    call forms(2)%int('n', n)
+    call forms(2)%pair('p', p)
+    tab = reference_table(v, forms, [str_t('A'), str_t('B')])
+    call check(index(tab, '| variable | type | default | unit | allowed values | description |'//NL// &
+                     '| --- | --- | --- | --- | --- | --- |'//NL) == 1, 'reference table: header')
+    call check(index(tab, NL//'| `n` | integer | required | | >= 1 | count |'//NL) > 0, &
+               'reference table: a required integer with its range')
+    call check(index(tab, NL//'| `x` | real | `2.5e11` | [stress] | > 0 | *A only:* a \| b |'//NL) > 0, &
+               'reference table: a real with its unit, form and an escaped bar')
+    call check(index(tab, NL//'| `p` | real pair (x, y) | `1.0, -0.5` | [length] | | *B only:* position |'//NL) > 0, &
+               'reference table: a pair')
+    call check(index(tab, NL//'| `s` | string (at most 8 characters) | `''ab''` | | | |'//NL) > 0, &
+               'reference table: a string without a description')
+    call check(index(tab, NL//'| `c` | choice | none | | `''one''`, `''two''` | |'//NL) > 0, &
+               'reference table: a choice without a value')
+    code = 2
+    tab = reference_table(v)
+    call check(index(tab, NL//'| `c` | choice | `''two''` | | `''one''`, `''two''` | |'//NL) > 0 .and. &
+               index(tab, 'only:') == 0, 'reference table: the current value is the default; no forms, no notes')
+  end block
 
   call test_summary()
 
