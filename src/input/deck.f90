@@ -109,11 +109,13 @@ module deck
     'least one) are prescribed on every node of the group, a component not given stays free: '// &
     '`ux` alone is a roller on a vertical wall, both clamp or prescribe.'
   character(len=*), parameter :: REF_CONTACT = &
-    'The contact interface. Optional, at most once; needed for a body from a mesh file. Without '// &
-    'groups the two sides declared `''contact''` are paired node for node (they must face each '// &
-    'other and match); with `body1_group` and `body2_group` the two surfaces are paired by dual '// &
-    'mortar, matching or not, flat or curved, and no side may be declared `''contact''`. Pairing '// &
-    'and normals are computed once, on the initial configuration (small deformation).'
+    'The contact interface. Optional, at most once; needed for a body from a mesh file. The two '// &
+    'contact surfaces are the groups `body1_group` and `body2_group` (a rectangle''s sides are '// &
+    'the groups `''left''`, `''right''`, `''bottom''`, `''top''`), or without groups the two '// &
+    'sides declared `''contact''`; either way they are paired by dual mortar: matching or not, '// &
+    'overlapping in whole or in part, flat or curved, an open chain of edges or a closed curve '// &
+    '(a rim, a bore). Pairing and normals are computed once, on the initial configuration '// &
+    '(small deformation).'
   character(len=*), parameter :: REF_SOLVER = &
     'The outer (Robin) iteration, the inner solver (MPRGP) and the factorization. Optional, at '// &
     'most once.'
@@ -433,8 +435,8 @@ contains
     if (form /= GROUP_FORM) then
       call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE, doc='condition on the side '// &
         'x = x0: `''free''` (traction-free unless a `&traction` loads it), `''clamped''` (u = 0), '// &
-        '`''roller''` (normal displacement 0), `''contact''` (exactly one side per body, facing the '// &
-        'other body''s contact side and matching it node for node), `''displacement''` (given by '// &
+        '`''roller''` (normal displacement 0), `''contact''` (exactly one side per body, paired '// &
+        'with the other body''s contact side by dual mortar), `''displacement''` (given by '// &
         'a `&displacement`)')
       call v%enum('right', b%bc(SIDE_RIGHT), BC_CHOICES, base=BC_FREE, doc='condition on the '// &
         'side x = x0 + width, as `left`')
