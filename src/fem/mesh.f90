@@ -23,7 +23,7 @@ module mesh
   private
 
   public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes, &
-            nodes_only, nodes_only_refusal
+            nodes_only, nodes_only_refusal, cell_element, cell_vertices
 
   !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side)
   !! and of single nodes (a Gmsh physical point, or where a physical curve runs inside the
@@ -74,6 +74,25 @@ contains
     integer, intent(in) :: j          !< grid index along y, 0..ny
     node_id = 1 + i + j*(mesh%nx + 1)
   end function node_id
+
+  !> The element of cell c (ELEM_Q1 or ELEM_P1).
+  pure integer function cell_element(mesh, c)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    integer, intent(in) :: c           !< a cell, 1..ncell
+    if (allocated(mesh%cell_type)) then
+      cell_element = mesh%cell_type(c)
+    else
+      cell_element = mesh%element
+    end if
+  end function cell_element
+
+  !> The number of vertices of cell c.
+  pure integer function cell_vertices(mesh, c)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    integer, intent(in) :: c           !< a cell, 1..ncell
+    cell_vertices = merge(4, 3, cell_element(mesh, c) == ELEM_Q1)
+  end function cell_vertices
+
 
   !> Build the structured mesh of a body (its rectangle, nx x ny grid cells and element).
   !! On a bad body (nx or ny < 1, non-positive extent, unknown element) the mesh is left
