@@ -1,15 +1,18 @@
-!> Fill-reducing orderings computed from the geometry of a body's mesh (module mesh),
-!! without a graph partitioner: geometric nested dissection.
+!> Fill-reducing orderings computed from the geometry of a body's mesh, without a graph
+!! partitioner: geometric nested dissection. The mesh and the system come as plain arrays
+!! (the grid's size or the node coordinates, the DOF maps, the stiffness pattern), so this
+!! module knows nothing of the FE stages.
 !!
-!! Structured meshes: both element types (Q1, and P1 with its cells split along one
-!! diagonal) couple only the nodes of a common grid cell, so one whole grid line of nodes
-!! separates the grid into the nodes on either side of it. Nested dissection orders a box
-!! of nodes as: the box on one side of its middle line, the box on the other side, then
-!! the line; boxes below a small size are ordered naturally. On an N x N grid this gives
-!! O(N^2 log N) nonzeros in the Cholesky factor, like METIS on these meshes, but it is
-!! deterministic, linear in the number of nodes, and needs no global state (thread safe).
+!! Structured meshes (grid_dissection): both element types (Q1, and P1 with its cells split
+!! along one diagonal) couple only the nodes of a common grid cell, so one whole grid line
+!! of nodes separates the grid into the nodes on either side of it. Nested dissection
+!! orders a box of nodes as: the box on one side of its middle line, the box on the other
+!! side, then the line; boxes below a small size are ordered naturally. On an N x N grid
+!! this gives O(N^2 log N) nonzeros in the Cholesky factor, like METIS on these meshes, but
+!! it is deterministic, linear in the number of nodes, and needs no global state (thread
+!! safe).
 !!
-!! Any other mesh (read from a file): recursive coordinate bisection of the node graph
+!! Any other mesh (coordinate_bisection): recursive coordinate bisection of the node graph
 !! (two nodes adjacent when the stiffness couples them). A node set is cut across its
 !! longer extent (and across the other one too when it is at least half as long) at the
 !! median coordinate or at 40, 45, 55 or 60% of its nodes; a cut's separator is the
@@ -20,14 +23,15 @@
 !! nodes within one edge extent of a cut are examined for the separator, so the whole
 !! ordering costs O(n log n) plus the graph (O(nnz)) and is deterministic. On a 64 x 64 Q1
 !! grid with randomly moved nodes nnz(L) is 0.98x METIS's, at 1024 x 512 1.05x.
+!!
+!! DOFs: node k, component c (1 = x, 2 = y) is global DOF 2*(k-1)+c; free_of maps a global
+!! DOF to its free index (0: prescribed), dof_of a free index to its global DOF.
 module ordering
   use kinds, only: wp, i8
-  use mesh, only: mesh_t
-  use assembly, only: body_system_t
   implicit none (type, external)
   private
 
-  public :: nested_dissection
+  public :: grid_dissection, coordinate_bisection
 
   !> Boxes with fewer nodes than this are ordered naturally (no further dissection).
   !! On 512 x 256 Q1 cells, nnz(L) is 2.39e7 with 16, 2.68e7 with 64, 2.36e7 with 4
@@ -43,22 +47,55 @@ module ordering
 
 contains
 
-  !> Nested-dissection permutation of the free DOFs of one body that are not in `last`.
-  !! perm(k) is the free DOF (1-based, 1..sys%n) placed k-th; size sys%n - size(last).
-  !! Both DOFs of a node are consecutive; prescribed DOFs and DOFs in `last` are
-  !! skipped. The caller appends `last` to obtain a full ordering with the interface
-  !! last. A structured mesh is dissected along its grid lines (cost O(number of
-  !! nodes)); any other mesh by recursive coordinate bisection of the node graph of
-  !! sys%colptr, sys%rowind (cost O(nnz log n)).
-  !! info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg (perm empty).
-  subroutine nested_dissection(mesh, sys, last, perm, info, msg)
-    type(mesh_t), intent(in) :: mesh                  !< the body's mesh (structured or general)
-    type(body_system_t), intent(in) :: sys            !< its assembled system (free_of, n; general meshes
-                                                      !! also dof_of, colptr, rowind)
+  !> Nested-dissection permutation of the free DOFs of a body on a structured nx x ny cell
+  !! grid (node (i,j) is node 1 + i + j*(nx+1)) that are not in `last`, along its grid lines
+  !! (cost O(number of nodes)). perm(k) is the free DOF (1-based, 1..n) placed k-th; size
+  !! n - size(last). Both DOFs of a node are consecutive; prescribed DOFs and DOFs in
+  !! `last` are skipped. The caller appends `last` to obtain a full ordering with the
+  !! interface last. info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg
+  !! (perm empty).
+  subroutine grid_dissection(nx, ny, free_of, n, last, perm, info, msg)
+    integer, intent(in) :: nx, ny                     !< grid cells along x and y
+    integer, intent(in) :: free_of(:)                 !< (2*(nx+1)*(ny+1)) free index of each DOF, 0 if prescribed
+    integer, intent(in) :: n                          !< the number of free DOFs
     integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
+    real(wp) :: no_xy(2, 0)
+    integer :: no_map(0)
+    call order_free_dofs(.true., nx, ny, no_xy, free_of, n, no_map, no_map, no_map, last, perm, info, msg)
+  end subroutine grid_dissection
+
+  !> Nested-dissection permutation of the free DOFs not in `last` of a body on any mesh, by
+  !! recursive coordinate bisection of the node graph of the stiffness pattern (cost
+  !! O(nnz log n)). perm as grid_dissection's.
+  subroutine coordinate_bisection(xy, free_of, dof_of, colptr, rowind, last, perm, info, msg)
+    real(wp), intent(in) :: xy(:, :)                  !< (2, nnode) node coordinates [length]
+    integer, intent(in) :: free_of(:)                 !< (2*nnode) free index of each DOF, 0 if prescribed
+    integer, intent(in) :: dof_of(:)                  !< (n) global DOF of each free index
+    integer, intent(in) :: colptr(:)                  !< (n+1) 0-based CSC column pointers of the stiffness
+    integer, intent(in) :: rowind(:)                  !< 0-based row indices (free DOFs)
+    integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
+    integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
+    integer, intent(out) :: info                      !< ND_OK or an error code
+    character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
+    call order_free_dofs(.false., 0, 0, xy, free_of, size(dof_of), dof_of, colptr, rowind, last, perm, info, msg)
+  end subroutine coordinate_bisection
+
+  !> The two orderings: grid lines (structured) or coordinate bisection (any mesh).
+  subroutine order_free_dofs(structured, nx, ny, xy, free_of, n, dof_of, colptr, rowind, last, perm, info, msg)
+    logical, intent(in) :: structured
+    integer, intent(in) :: nx, ny
+    real(wp), intent(in) :: xy(:, :)
+    integer, intent(in) :: free_of(:)
+    integer, intent(in) :: n
+    integer, intent(in) :: dof_of(:), colptr(:), rowind(:)
+    integer, intent(in) :: last(:)
+    integer, allocatable, intent(out) :: perm(:)
+    integer, intent(out) :: info
+    character(len=*), intent(out), optional :: msg
+    integer :: ndof, nnode
     logical, allocatable :: skip(:)
     integer :: k, pos, nx1, stamp
     logical :: bad_map
@@ -70,30 +107,27 @@ contains
     real(wp), allocatable :: xyl(:, :)
     real(wp) :: emax(2)
 
+    ndof = size(free_of)
+    nnode = size(xy, 2)
     info = ND_OK
     emsg = ''
     if (present(msg)) msg = ''
-    if (.not. mesh%structured) then
+    if (.not. structured) then
       if (.not. general_system_ok()) then
         call fail(ND_BAD_SYSTEM)
         return
       end if
-    else if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
-        .or. .not. allocated(sys%free_of)) then
-      write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
-        ' DOFs) does not belong to a ', mesh%nx, ' x ', mesh%ny, ' cell mesh.'
-      call fail(ND_BAD_SYSTEM)
-      return
-    else if (size(sys%free_of) /= sys%ndof) then
-      emsg = 'nested dissection: the free-DOF map has the wrong size.'
+    else if (nx < 1 .or. ny < 1 .or. ndof /= 2*(nx + 1)*(ny + 1)) then
+      write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', ndof, &
+        ' DOFs) does not belong to a ', nx, ' x ', ny, ' cell mesh.'
       call fail(ND_BAD_SYSTEM)
       return
     end if
 
-    allocate (skip(max(sys%n, 0)))
+    allocate (skip(max(n, 0)))
     skip = .false.
     do k = 1, size(last)
-      if (last(k) < 1 .or. last(k) > sys%n) then
+      if (last(k) < 1 .or. last(k) > n) then
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
         call fail(ND_BAD_LAST)
         return
@@ -105,12 +139,12 @@ contains
       skip(last(k)) = .true.
     end do
 
-    allocate (perm(sys%n - size(last)))
+    allocate (perm(n - size(last)))
     pos = 0
     bad_map = .false.
-    if (mesh%structured) then
-      nx1 = mesh%nx + 1
-      call dissect(0, mesh%nx, 0, mesh%ny)
+    if (structured) then
+      nx1 = nx + 1
+      call dissect(0, nx, 0, ny)
     else
       if (.not. node_graph()) then
         call fail(ND_BAD_SYSTEM)
@@ -184,9 +218,9 @@ contains
       integer, intent(in) :: node
       integer :: c, f
       do c = 1, 2
-        f = sys%free_of(2*(node - 1) + c)
+        f = free_of(2*(node - 1) + c)
         if (f <= 0) cycle
-        if (f > sys%n) then
+        if (f > n) then
           bad_map = .true.
           cycle
         end if
@@ -199,19 +233,14 @@ contains
     !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
     logical function general_system_ok() result(ok)
       ok = .false.
-      if (mesh%nnode < 1 .or. sys%ndof /= 2*mesh%nnode .or. .not. allocated(mesh%xy)) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
-          ' DOFs) does not belong to a mesh of ', mesh%nnode, ' nodes.'
-      else if (size(mesh%xy, 2) /= mesh%nnode) then
-        emsg = 'nested dissection: the mesh has the wrong number of node coordinates.'
-      else if (.not. allocated(sys%free_of) .or. .not. allocated(sys%dof_of) .or. &
-               .not. allocated(sys%colptr) .or. .not. allocated(sys%rowind)) then
-        emsg = 'nested dissection: the system has no DOF maps or no stiffness pattern.'
-      else if (size(sys%free_of) /= sys%ndof) then
-        emsg = 'nested dissection: the free-DOF map has the wrong size.'
-      else if (size(sys%dof_of) /= sys%n .or. size(sys%colptr) /= sys%n + 1) then
+      if (nnode < 1 .or. ndof /= 2*nnode) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', ndof, &
+          ' DOFs) does not belong to a mesh of ', nnode, ' nodes.'
+      else if (size(xy, 1) /= 2) then
+        emsg = 'nested dissection: the node coordinates are not (x, y) pairs.'
+      else if (size(dof_of) /= n .or. size(colptr) /= n + 1) then
         emsg = 'nested dissection: the DOF map or the column pointers have the wrong size.'
-      else if (sys%colptr(sys%n + 1) > size(sys%rowind)) then
+      else if (colptr(n + 1) > size(rowind)) then
         emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
       else
         ok = .true.
@@ -230,24 +259,24 @@ contains
       logical, allocatable :: active(:)
 
       ok = .false.
-      nn = mesh%nnode
+      nn = nnode
       allocate (active(nn), loc(nn))
       active = .false.
-      do p = 1, sys%n
-        if (sys%dof_of(p) < 1 .or. sys%dof_of(p) > sys%ndof) then
+      do p = 1, n
+        if (dof_of(p) < 1 .or. dof_of(p) > ndof) then
           write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
-            sys%dof_of(p), ', out of range.'
+            dof_of(p), ', out of range.'
           return
         end if
-        if (.not. skip(p)) active((sys%dof_of(p) + 1)/2) = .true.
+        if (.not. skip(p)) active((dof_of(p) + 1)/2) = .true.
       end do
       na = count(active)
       allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na), rank(na, 2))
       glob = pack([(node, node=1, nn)], active)
-      call sort_nodes(glob, 1, mesh%xy)
+      call sort_nodes(glob, 1, xy)
       loc = 0
       loc(glob) = [(i, i=1, na)]
-      xyl = mesh%xy(:, glob)
+      xyl = xy(:, glob)
       lab = 0
 
       do pass = 1, 2            ! 1: count the neighbours, 2: store them
@@ -257,18 +286,18 @@ contains
           node = glob(i)
           cnt = xadj(i)
           do c = 1, 2
-            p = sys%free_of(2*(node - 1) + c)
-            if (p < 1 .or. p > sys%n) cycle
+            p = free_of(2*(node - 1) + c)
+            if (p < 1 .or. p > n) cycle
             if (skip(p)) cycle
-            do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
-              q = sys%rowind(kk) + 1
-              if (q < 1 .or. q > sys%n) then
+            do kk = colptr(p) + 1, colptr(p + 1)
+              q = rowind(kk) + 1
+              if (q < 1 .or. q > n) then
                 write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
                   ' of free DOF ', p, ' is out of range.'
                 return
               end if
               if (skip(q)) cycle
-              nb = loc((sys%dof_of(q) + 1)/2)
+              nb = loc((dof_of(q) + 1)/2)
               if (nb == i .or. nb == 0) cycle
               if (mark(nb) == i) cycle
               mark(nb) = i
@@ -498,6 +527,6 @@ contains
       end do
     end function touching
 
-  end subroutine nested_dissection
+  end subroutine order_free_dofs
 
 end module ordering
