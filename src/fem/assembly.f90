@@ -1,13 +1,16 @@
-!> Plane linear elasticity on a structured mesh (module mesh): the stiffness of one body
-!! on its free DOFs in compressed sparse columns, the consistent load of its tractions,
-!! elimination of prescribed displacements, reactions and nodal stresses. The
-!! per-element work (shape functions, element stiffness, loads, stress) is module
-!! elements'; this module loops over cells and sides and places the results.
+!> Plane linear elasticity on one body's mesh (module mesh: a structured grid or a mesh
+!! read from a file): the stiffness on its free DOFs in compressed sparse columns, the
+!! consistent load of its tractions and body force, elimination of prescribed displacements,
+!! reactions and nodal stresses. The per-element work (shape functions, element stiffness,
+!! loads, stress) is module elements'; the supports and the free-DOF numbering module
+!! supports', the sparsity pattern module stiffness_pattern's, the rigid motions of a body
+!! held only by contact module rigid_modes'. This module loops over cells and sides and
+!! places the results.
 !!
 !! DOFs: node k, component c (1 = x, 2 = y) is global dof 2*(k-1)+c. Free DOFs are
-!! numbered in increasing global order, so the stiffness on free DOFs keeps the natural
-!! (band) structure of the grid. Isotropic material, plane strain or plane stress;
-!! Q1 with 2x2 Gauss, P1 with one point (exact). Units are whatever the deck uses,
+!! numbered in increasing global order, so the stiffness on free DOFs keeps the structure
+!! of the node numbering (a band on a grid). Isotropic material, plane strain or plane
+!! stress; Q1 with 2x2 Gauss, P1 with one point (exact). Units are whatever the deck uses,
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp
