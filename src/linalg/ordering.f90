@@ -45,6 +45,26 @@ module ordering
   !> Unstructured meshes: node sets with fewer nodes than this are not bisected further.
   integer, parameter, public :: RCB_LEAF_NODES = 16
 
+  !> The order being built: the free DOFs placed so far, and those left out.
+  type :: order_t
+    integer, allocatable :: perm(:)       ! the interior order
+    integer :: pos = 0                    ! entries of perm filled
+    logical, allocatable :: skip(:)       ! (n) the DOFs of `last`
+    logical :: bad_map = .false.          ! free_of maps a DOF beyond n
+  end type order_t
+
+  !> The node graph of a general mesh, on local node numbers 1..na.
+  type :: node_graph_t
+    integer, allocatable :: glob(:)       ! (na) the mesh node of each
+    real(wp), allocatable :: xyl(:, :)    ! (2, na) their coordinates
+    integer, allocatable :: xadj(:), adj(:)   ! neighbours (CSR, 0-based pointers)
+    integer, allocatable :: srt(:, :)     ! (na, 2) nodes sorted by x, by y
+    integer, allocatable :: lab(:)        ! partition labels
+    integer, allocatable :: tmp(:)        ! work array
+    integer, allocatable :: rank(:, :)    ! (na, 2) position of each node in srt(:, axis)
+    real(wp) :: emax(2) = 0.0_wp          ! the largest edge extent in x and y
+  end type node_graph_t
+
 contains
 
   !> Nested-dissection permutation of the free DOFs of a body on a structured nx x ny cell
@@ -62,114 +82,26 @@ contains
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
-    real(wp) :: no_xy(2, 0)
-    integer :: no_map(0)
-    call order_free_dofs(.true., nx, ny, no_xy, free_of, n, no_map, no_map, no_map, last, perm, info, msg)
-  end subroutine grid_dissection
-
-  !> Nested-dissection permutation of the free DOFs not in `last` of a body on any mesh, by
-  !! recursive coordinate bisection of the node graph of the stiffness pattern (cost
-  !! O(nnz log n)). perm as grid_dissection's.
-  subroutine coordinate_bisection(xy, free_of, dof_of, colptr, rowind, last, perm, info, msg)
-    real(wp), intent(in) :: xy(:, :)                  !< (2, nnode) node coordinates [length]
-    integer, intent(in) :: free_of(:)                 !< (2*nnode) free index of each DOF, 0 if prescribed
-    integer, intent(in) :: dof_of(:)                  !< (n) global DOF of each free index
-    integer, intent(in) :: colptr(:)                  !< (n+1) 0-based CSC column pointers of the stiffness
-    integer, intent(in) :: rowind(:)                  !< 0-based row indices (free DOFs)
-    integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
-    integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
-    integer, intent(out) :: info                      !< ND_OK or an error code
-    character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
-    call order_free_dofs(.false., 0, 0, xy, free_of, size(dof_of), dof_of, colptr, rowind, last, perm, info, msg)
-  end subroutine coordinate_bisection
-
-  !> The two orderings: grid lines (structured) or coordinate bisection (any mesh).
-  subroutine order_free_dofs(structured, nx, ny, xy, free_of, n, dof_of, colptr, rowind, last, perm, info, msg)
-    logical, intent(in) :: structured
-    integer, intent(in) :: nx, ny
-    real(wp), intent(in) :: xy(:, :)
-    integer, intent(in) :: free_of(:)
-    integer, intent(in) :: n
-    integer, intent(in) :: dof_of(:), colptr(:), rowind(:)
-    integer, intent(in) :: last(:)
-    integer, allocatable, intent(out) :: perm(:)
-    integer, intent(out) :: info
-    character(len=*), intent(out), optional :: msg
-    integer :: ndof, nnode
-    logical, allocatable :: skip(:)
-    integer :: k, pos, nx1, stamp
-    logical :: bad_map
+    type(order_t) :: ord
+    integer :: nx1
     character(len=200) :: emsg
-    ! general meshes (local node numbers 1..na): mesh node of each (glob), coordinates,
-    ! node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)), partition
-    ! labels, a work array, the largest edge extent in x and y
-    integer, allocatable :: glob(:), xadj(:), adj(:), srt(:, :), lab(:), tmp(:), rank(:, :)
-    real(wp), allocatable :: xyl(:, :)
-    real(wp) :: emax(2)
 
-    ndof = size(free_of)
-    nnode = size(xy, 2)
-    info = ND_OK
     emsg = ''
-    if (present(msg)) msg = ''
-    if (.not. structured) then
-      if (.not. general_system_ok()) then
-        call fail(ND_BAD_SYSTEM)
-        return
-      end if
-    else if (nx < 1 .or. ny < 1 .or. ndof /= 2*(nx + 1)*(ny + 1)) then
-      write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', ndof, &
+    if (nx < 1 .or. ny < 1 .or. size(free_of) /= 2*(nx + 1)*(ny + 1)) then
+      write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', size(free_of), &
         ' DOFs) does not belong to a ', nx, ' x ', ny, ' cell mesh.'
-      call fail(ND_BAD_SYSTEM)
-      return
+      info = ND_BAD_SYSTEM
+    else
+      call start_order(n, last, ord, info, emsg)
     end if
-
-    allocate (skip(max(n, 0)))
-    skip = .false.
-    do k = 1, size(last)
-      if (last(k) < 1 .or. last(k) > n) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
-        call fail(ND_BAD_LAST)
-        return
-      else if (skip(last(k))) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
-        call fail(ND_BAD_LAST)
-        return
-      end if
-      skip(last(k)) = .true.
-    end do
-
-    allocate (perm(n - size(last)))
-    pos = 0
-    bad_map = .false.
-    if (structured) then
+    if (info == ND_OK) then
       nx1 = nx + 1
       call dissect(0, nx, 0, ny)
-    else
-      if (.not. node_graph()) then
-        call fail(ND_BAD_SYSTEM)
-        return
-      end if
-      stamp = 0
-      call bisect(1, size(srt, 1))
+      call finish_order(ord, info, emsg)
     end if
-    if (bad_map .or. pos /= size(perm)) then
-      ! free_of is not a bijection onto 1..n: the system is inconsistent
-      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', pos, ' DOFs but expected ', size(perm), &
-        ' (inconsistent free-DOF map).'
-      call fail(ND_BAD_SYSTEM)
-    end if
+    call hand_over(ord, info, emsg, perm, msg)
 
   contains
-
-    !> Record a failure: the code, the sentence in emsg, an empty perm.
-    subroutine fail(code)
-      integer, intent(in) :: code
-      info = code
-      if (allocated(perm)) deallocate (perm)
-      allocate (perm(0))
-      if (present(msg)) msg = emsg
-    end subroutine fail
 
     !> Order the box of grid nodes [i0,i1] x [j0,j1] (empty if i1 < i0 or j1 < j0).
     recursive subroutine dissect(i0, i1, j0, j1)
@@ -201,178 +133,56 @@ contains
       if (i1 - i0 <= j1 - j0) then
         do j = j0, j1
           do i = i0, i1
-            call emit_node(1 + i + j*nx1)
+            call emit_node(ord, free_of, n, 1 + i + j*nx1)
           end do
         end do
       else
         do i = i0, i1
           do j = j0, j1
-            call emit_node(1 + i + j*nx1)
+            call emit_node(ord, free_of, n, 1 + i + j*nx1)
           end do
         end do
       end if
     end subroutine emit
 
-    !> Append the free, non-skipped DOFs of one node (x then y).
-    subroutine emit_node(node)
-      integer, intent(in) :: node
-      integer :: c, f
-      do c = 1, 2
-        f = free_of(2*(node - 1) + c)
-        if (f <= 0) cycle
-        if (f > n) then
-          bad_map = .true.
-          cycle
-        end if
-        if (skip(f)) cycle
-        pos = pos + 1
-        if (pos <= size(perm)) perm(pos) = f
-      end do
-    end subroutine emit_node
+  end subroutine grid_dissection
 
-    !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
-    logical function general_system_ok() result(ok)
-      ok = .false.
-      if (nnode < 1 .or. ndof /= 2*nnode) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', ndof, &
-          ' DOFs) does not belong to a mesh of ', nnode, ' nodes.'
-      else if (size(xy, 1) /= 2) then
-        emsg = 'nested dissection: the node coordinates are not (x, y) pairs.'
-      else if (size(dof_of) /= n .or. size(colptr) /= n + 1) then
-        emsg = 'nested dissection: the DOF map or the column pointers have the wrong size.'
-      else if (colptr(n + 1) > size(rowind)) then
-        emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
+  !> Nested-dissection permutation of the free DOFs not in `last` of a body on any mesh, by
+  !! recursive coordinate bisection of the node graph of the stiffness pattern (cost
+  !! O(nnz log n)). perm as grid_dissection's.
+  subroutine coordinate_bisection(xy, free_of, dof_of, colptr, rowind, last, perm, info, msg)
+    real(wp), intent(in) :: xy(:, :)                  !< (2, nnode) node coordinates [length]
+    integer, intent(in) :: free_of(:)                 !< (2*nnode) free index of each DOF, 0 if prescribed
+    integer, intent(in) :: dof_of(:)                  !< (n) global DOF of each free index
+    integer, intent(in) :: colptr(:)                  !< (n+1) 0-based CSC column pointers of the stiffness
+    integer, intent(in) :: rowind(:)                  !< 0-based row indices (free DOFs)
+    integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
+    integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
+    integer, intent(out) :: info                      !< ND_OK or an error code
+    character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
+    type(order_t) :: ord
+    type(node_graph_t) :: g
+    integer :: n, stamp
+    character(len=200) :: emsg
+
+    emsg = ''
+    n = size(dof_of)
+    info = ND_BAD_SYSTEM
+    if (general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg)) call start_order(n, last, ord, info, emsg)
+    if (info == ND_OK) then
+      if (build_node_graph(xy, free_of, dof_of, colptr, rowind, n, ord%skip, g, emsg)) then
+        stamp = 0
+        call bisect(1, size(g%srt, 1))
+        call finish_order(ord, info, emsg)
       else
-        ok = .true.
+        info = ND_BAD_SYSTEM
       end if
-    end function general_system_ok
+    end if
+    call hand_over(ord, info, emsg, perm, msg)
 
-    !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
-    !! `last`) renumbered 1..na by increasing x (glob: local -> mesh node, so that the
-    !! graph sweeps touch memory in order), their coordinates xyl, their neighbours
-    !! through the stiffness (xadj, adj; both DOFs merged, DOFs in `last` left out), the
-    !! largest edge extents emax, the nodes sorted by x (srt(:,1)) and by y (srt(:,2)).
-    !! .false. with a sentence in emsg on a pattern or DOF map out of range.
-    logical function node_graph() result(ok)
-      integer, allocatable :: mark(:), loc(:)
-      integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
-      logical, allocatable :: active(:)
+  contains
 
-      ok = .false.
-      nn = nnode
-      allocate (active(nn), loc(nn))
-      active = .false.
-      do p = 1, n
-        if (dof_of(p) < 1 .or. dof_of(p) > ndof) then
-          write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
-            dof_of(p), ', out of range.'
-          return
-        end if
-        if (.not. skip(p)) active((dof_of(p) + 1)/2) = .true.
-      end do
-      na = count(active)
-      allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na), rank(na, 2))
-      glob = pack([(node, node=1, nn)], active)
-      call sort_nodes(glob, 1, xy)
-      loc = 0
-      loc(glob) = [(i, i=1, na)]
-      xyl = xy(:, glob)
-      lab = 0
-
-      do pass = 1, 2            ! 1: count the neighbours, 2: store them
-        mark = 0
-        xadj(1) = 0
-        do i = 1, na
-          node = glob(i)
-          cnt = xadj(i)
-          do c = 1, 2
-            p = free_of(2*(node - 1) + c)
-            if (p < 1 .or. p > n) cycle
-            if (skip(p)) cycle
-            do kk = colptr(p) + 1, colptr(p + 1)
-              q = rowind(kk) + 1
-              if (q < 1 .or. q > n) then
-                write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
-                  ' of free DOF ', p, ' is out of range.'
-                return
-              end if
-              if (skip(q)) cycle
-              nb = loc((dof_of(q) + 1)/2)
-              if (nb == i .or. nb == 0) cycle
-              if (mark(nb) == i) cycle
-              mark(nb) = i
-              cnt = cnt + 1
-              if (pass == 2) adj(cnt) = nb
-            end do
-          end do
-          if (pass == 1) then
-            xadj(i + 1) = cnt
-          else if (cnt /= xadj(i + 1)) then
-            emsg = 'nested dissection: internal error building the node graph.'
-            return
-          end if
-        end do
-        if (pass == 1) allocate (adj(xadj(na + 1)))
-      end do
-
-      emax = 0.0_wp
-      do i = 1, na
-        do kk = xadj(i) + 1, xadj(i + 1)
-          emax = max(emax, abs(xyl(:, adj(kk)) - xyl(:, i)))
-        end do
-      end do
-      emax = emax*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
-      srt(:, 1) = [(i, i=1, na)]
-      srt(:, 2) = srt(:, 1)
-      call sort_nodes(srt(:, 2), 2, xyl)
-      ok = .true.
-    end function node_graph
-
-    !> Stable merge sort of the points ids by coordinate `axis` of xyc, then by the other.
-    subroutine sort_nodes(ids, axis, xyc)
-      integer, intent(inout) :: ids(:)
-      integer, intent(in) :: axis
-      real(wp), intent(in) :: xyc(:, :)
-      integer, allocatable :: buf(:)
-      integer :: width, lo, mid, hi, i, j, k, n
-      logical :: first
-      n = size(ids)
-      allocate (buf(n))
-      width = 1
-      do while (width < n)
-        lo = 1
-        do while (lo <= n - width)
-          mid = lo + width - 1
-          hi = min(lo + 2*width - 1, n)
-          i = lo
-          j = mid + 1
-          k = lo
-          do while (i <= mid .and. j <= hi)
-            ! point ids(j) strictly before ids(i)?
-            if (xyc(axis, ids(j)) /= xyc(axis, ids(i))) then
-              first = xyc(axis, ids(j)) < xyc(axis, ids(i))
-            else
-              first = xyc(3 - axis, ids(j)) < xyc(3 - axis, ids(i))
-            end if
-            if (first) then
-              buf(k) = ids(j)
-              j = j + 1
-            else
-              buf(k) = ids(i)
-              i = i + 1
-            end if
-            k = k + 1
-          end do
-          if (i <= mid) buf(k:hi) = ids(i:mid)
-          if (j <= hi) buf(k:hi) = ids(j:hi)
-          ids(lo:hi) = buf(lo:hi)
-          lo = lo + 2*width
-        end do
-        width = 2*width
-      end do
-    end subroutine sort_nodes
-
-    !> Order the (local) nodes srt(lo:hi, :) (the same set in both columns) by recursive
+    !> Order the (local) nodes g%srt(lo:hi, :) (the same set in both columns) by recursive
     !! coordinate bisection: cut across x or y (both are tried when neither extent is
     !! below half the other) at the median or at 40, 45, 55 or 60% of the nodes, keeping
     !! the cut with the smallest separator (the smaller set of nodes of one side with a
@@ -386,14 +196,14 @@ contains
 
       m = hi - lo + 1
       if (m <= 0) return
-      ext(1) = xyl(1, srt(hi, 1)) - xyl(1, srt(lo, 1))
-      ext(2) = xyl(2, srt(hi, 2)) - xyl(2, srt(lo, 2))
+      ext(1) = g%xyl(1, g%srt(hi, 1)) - g%xyl(1, g%srt(lo, 1))
+      ext(2) = g%xyl(2, g%srt(hi, 2)) - g%xyl(2, g%srt(lo, 2))
       axis = 1
       if (ext(2) > ext(1)) axis = 2
       if (m < RCB_LEAF_NODES .or. .not. ext(axis) > 0.0_wp) then
         ! a leaf: along the longer extent, the shorter one varying fastest
         do i = lo, hi
-          call emit_node(glob(srt(i, axis)))
+          call emit_node(ord, free_of, n, g%glob(g%srt(i, axis)))
         end do
         return
       end if
@@ -404,10 +214,10 @@ contains
       rset = stamp + 3
       sset = stamp + 4
       stamp = stamp + 4
-      lab(srt(lo:hi, 1)) = seg
+      g%lab(g%srt(lo:hi, 1)) = seg
       do a = 1, 2
         do i = lo, hi
-          rank(srt(i, a), a) = i
+          g%rank(g%srt(i, a), a) = i
         end do
       end do
       best = huge(1)
@@ -433,14 +243,14 @@ contains
       end do
       if (best_p == 0) then                  ! no cut possible (cannot happen: ext > 0)
         do i = lo, hi
-          call emit_node(glob(srt(i, axis)))
+          call emit_node(ord, free_of, n, g%glob(g%srt(i, axis)))
         end do
         return
       end if
       axis = best_ax
       p = best_p
-      lab(srt(lo:p - 1, axis)) = lset
-      lab(srt(p:hi, axis)) = rset
+      g%lab(g%srt(lo:p - 1, axis)) = lset
+      g%lab(g%srt(p:hi, axis)) = rset
       if (best_side < 0) then
         ns = touching(p - 1, lo, -1, axis, p, sset)
       else
@@ -452,47 +262,47 @@ contains
         k = lo - 1
         do lbl = lset, sset
           do i = lo, hi
-            if (lab(srt(i, a)) == lbl) then
+            if (g%lab(g%srt(i, a)) == lbl) then
               k = k + 1
-              tmp(k) = srt(i, a)
+              g%tmp(k) = g%srt(i, a)
             end if
           end do
           if (a == 1 .and. lbl == lset) nl = k - lo + 1
           if (a == 1 .and. lbl == rset) nr = k - lo + 1 - nl
         end do
-        srt(lo:hi, a) = tmp(lo:hi)
+        g%srt(lo:hi, a) = g%tmp(lo:hi)
       end do
 
       call bisect(lo, lo + nl - 1)
       call bisect(lo + nl, lo + nl + nr - 1)
       ! the separator, along its length (sorted by the other coordinate)
       do i = lo + nl + nr, hi
-        call emit_node(glob(srt(i, 3 - axis)))
+        call emit_node(ord, free_of, n, g%glob(g%srt(i, 3 - axis)))
       end do
     end subroutine bisect
 
-    !> The first position of the right side of a cut of srt(lo:hi, axis) near position
-    !! mid: right = coordinate >= v = that of srt(mid), or > v when v is the least.
+    !> The first position of the right side of a cut of g%srt(lo:hi, axis) near position
+    !! mid: right = coordinate >= v = that of g%srt(mid), or > v when v is the least.
     integer function cut_at(lo, hi, axis, mid) result(p)
       integer, intent(in) :: lo, hi, axis, mid
       real(wp) :: v
-      v = xyl(axis, srt(mid, axis))
+      v = g%xyl(axis, g%srt(mid, axis))
       p = mid
       do while (p > lo)
-        if (xyl(axis, srt(p - 1, axis)) < v) exit
+        if (g%xyl(axis, g%srt(p - 1, axis)) < v) exit
         p = p - 1
       end do
       if (p == lo) then
         p = mid + 1
         do while (p <= hi)
-          if (xyl(axis, srt(p, axis)) > v) exit
+          if (g%xyl(axis, g%srt(p, axis)) > v) exit
           p = p + 1
         end do
       end if
     end function cut_at
 
-    !> For the cut of the current set (label seg) before position p of srt(:, axis): how
-    !! many of the nodes srt(i0, axis), srt(i0 + step, axis), ... (towards i1, from the
+    !> For the cut of the current set (label seg) before position p of g%srt(:, axis): how
+    !! many of the nodes g%srt(i0, axis), g%srt(i0 + step, axis), ... (towards i1, from the
     !! cut outwards, stopping one edge extent away from it) have a neighbour on the other
     !! side; with sep > 0 those nodes are labelled sep (the separator).
     integer function touching(i0, i1, step, axis, p, sep) result(cnt)
@@ -501,24 +311,24 @@ contains
       real(wp) :: cut
       cnt = 0
       if ((i1 - i0)*step < 0) return
-      seg = lab(srt(i0, axis))
+      seg = g%lab(g%srt(i0, axis))
       if (sep > 0) seg = -1                  ! labels already split: the other side is lset/rset
-      cut = xyl(axis, srt(i0, axis))
+      cut = g%xyl(axis, g%srt(i0, axis))
       do i = i0, i1, step
-        node = srt(i, axis)
-        if (abs(xyl(axis, node) - cut) > emax(axis)) exit
-        do kk = xadj(node) + 1, xadj(node + 1)
-          nb = adj(kk)
+        node = g%srt(i, axis)
+        if (abs(g%xyl(axis, node) - cut) > g%emax(axis)) exit
+        do kk = g%xadj(node) + 1, g%xadj(node + 1)
+          nb = g%adj(kk)
           if (sep > 0) then
-            if (lab(nb) /= sep - 2 .and. lab(nb) /= sep - 1) cycle   ! not in this set
-            if (lab(nb) == sep - 2 .eqv. step > 0) then
+            if (g%lab(nb) /= sep - 2 .and. g%lab(nb) /= sep - 1) cycle   ! not in this set
+            if (g%lab(nb) == sep - 2 .eqv. step > 0) then
               cnt = cnt + 1
-              lab(node) = sep
+              g%lab(node) = sep
               exit
             end if
           else
-            if (lab(nb) /= seg) cycle
-            if ((rank(nb, axis) < p) .eqv. step > 0) then
+            if (g%lab(nb) /= seg) cycle
+            if ((g%rank(nb, axis) < p) .eqv. step > 0) then
               cnt = cnt + 1
               exit
             end if
@@ -527,6 +337,232 @@ contains
       end do
     end function touching
 
-  end subroutine order_free_dofs
+  end subroutine coordinate_bisection
+
+  !> Check `last` (in 1..n, no repeats: else ND_BAD_LAST with a sentence) and start an
+  !! empty order of n - size(last) DOFs.
+  subroutine start_order(n, last, ord, info, emsg)
+    integer, intent(in) :: n, last(:)
+    type(order_t), intent(out) :: ord
+    integer, intent(out) :: info
+    character(len=*), intent(inout) :: emsg
+    integer :: k
+    info = ND_OK
+    allocate (ord%skip(max(n, 0)))
+    ord%skip = .false.
+    do k = 1, size(last)
+      if (last(k) < 1 .or. last(k) > n) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
+        info = ND_BAD_LAST
+        return
+      else if (ord%skip(last(k))) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
+        info = ND_BAD_LAST
+        return
+      end if
+      ord%skip(last(k)) = .true.
+    end do
+    allocate (ord%perm(n - size(last)))
+  end subroutine start_order
+
+  !> Every DOF placed exactly once, else free_of is not a bijection onto 1..n: ND_BAD_SYSTEM.
+  subroutine finish_order(ord, info, emsg)
+    type(order_t), intent(in) :: ord
+    integer, intent(inout) :: info
+    character(len=*), intent(inout) :: emsg
+    if (ord%bad_map .or. ord%pos /= size(ord%perm)) then
+      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', ord%pos, ' DOFs but expected ', size(ord%perm), &
+        ' (inconsistent free-DOF map).'
+      info = ND_BAD_SYSTEM
+    end if
+  end subroutine finish_order
+
+  !> The result: the order, or on failure an empty perm and the sentence in msg.
+  subroutine hand_over(ord, info, emsg, perm, msg)
+    type(order_t), intent(inout) :: ord
+    integer, intent(in) :: info
+    character(len=*), intent(in) :: emsg
+    integer, allocatable, intent(out) :: perm(:)
+    character(len=*), intent(out), optional :: msg
+    if (present(msg)) msg = ''
+    if (info == ND_OK) then
+      call move_alloc(ord%perm, perm)
+    else
+      allocate (perm(0))
+      if (present(msg)) msg = emsg
+    end if
+  end subroutine hand_over
+
+  !> Append the free, non-skipped DOFs of one node (x then y).
+  subroutine emit_node(ord, free_of, n, node)
+    type(order_t), intent(inout) :: ord
+    integer, intent(in) :: free_of(:), n, node
+    integer :: c, f
+    do c = 1, 2
+      f = free_of(2*(node - 1) + c)
+      if (f <= 0) cycle
+      if (f > n) then
+        ord%bad_map = .true.
+        cycle
+      end if
+      if (ord%skip(f)) cycle
+      ord%pos = ord%pos + 1
+      if (ord%pos <= size(ord%perm)) ord%perm(ord%pos) = f
+    end do
+  end subroutine emit_node
+
+  !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
+  logical function general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg) result(ok)
+    real(wp), intent(in) :: xy(:, :)
+    integer, intent(in) :: free_of(:), dof_of(:), colptr(:), rowind(:)
+    character(len=*), intent(inout) :: emsg
+    integer :: ndof, nnode, n
+    ndof = size(free_of)
+    nnode = size(xy, 2)
+    n = size(dof_of)             ! the free DOFs
+    ok = .false.
+    if (nnode < 1 .or. ndof /= 2*nnode) then
+      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', ndof, &
+        ' DOFs) does not belong to a mesh of ', nnode, ' nodes.'
+    else if (size(xy, 1) /= 2) then
+      emsg = 'nested dissection: the node coordinates are not (x, y) pairs.'
+    else if (size(colptr) /= n + 1) then
+      emsg = 'nested dissection: the column pointers do not match the DOF map (size n + 1).'
+    else if (colptr(n + 1) > size(rowind)) then
+      emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
+    else
+      ok = .true.
+    end if
+  end function general_arrays_ok
+
+  !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
+  !! `last`) renumbered 1..na by increasing x (g%glob: local -> mesh node, so that the
+  !! graph sweeps touch memory in order), their coordinates g%xyl, their neighbours
+  !! through the stiffness (g%xadj, g%adj; both DOFs merged, DOFs in `last` left out), the
+  !! largest edge extents g%emax, the nodes sorted by x (g%srt(:,1)) and by y (g%srt(:,2)).
+  !! .false. with a sentence in emsg on a pattern or DOF map out of range.
+  logical function build_node_graph(xy, free_of, dof_of, colptr, rowind, n, skip, g, emsg) result(ok)
+    real(wp), intent(in) :: xy(:, :)
+    integer, intent(in) :: free_of(:), dof_of(:), colptr(:), rowind(:), n
+    logical, intent(in) :: skip(:)
+    type(node_graph_t), intent(out) :: g
+    character(len=*), intent(inout) :: emsg
+    integer, allocatable :: mark(:), loc(:)
+    integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
+    logical, allocatable :: active(:)
+
+    ok = .false.
+    nn = size(xy, 2)
+    allocate (active(nn), loc(nn))
+    active = .false.
+    do p = 1, n
+      if (dof_of(p) < 1 .or. dof_of(p) > size(free_of)) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
+          dof_of(p), ', out of range.'
+        return
+      end if
+      if (.not. skip(p)) active((dof_of(p) + 1)/2) = .true.
+    end do
+    na = count(active)
+    allocate (g%srt(na, 2), g%tmp(na), g%lab(na), mark(na), g%xadj(na + 1), g%xyl(2, na), g%rank(na, 2))
+    g%glob = pack([(node, node=1, nn)], active)
+    call sort_nodes(g%glob, 1, xy)
+    loc = 0
+    loc(g%glob) = [(i, i=1, na)]
+    g%xyl = xy(:, g%glob)
+    g%lab = 0
+
+    do pass = 1, 2            ! 1: count the neighbours, 2: store them
+      mark = 0
+      g%xadj(1) = 0
+      do i = 1, na
+        node = g%glob(i)
+        cnt = g%xadj(i)
+        do c = 1, 2
+          p = free_of(2*(node - 1) + c)
+          if (p < 1 .or. p > n) cycle
+          if (skip(p)) cycle
+          do kk = colptr(p) + 1, colptr(p + 1)
+            q = rowind(kk) + 1
+            if (q < 1 .or. q > n) then
+              write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
+                ' of free DOF ', p, ' is out of range.'
+              return
+            end if
+            if (skip(q)) cycle
+            nb = loc((dof_of(q) + 1)/2)
+            if (nb == i .or. nb == 0) cycle
+            if (mark(nb) == i) cycle
+            mark(nb) = i
+            cnt = cnt + 1
+            if (pass == 2) g%adj(cnt) = nb
+          end do
+        end do
+        if (pass == 1) then
+          g%xadj(i + 1) = cnt
+        else if (cnt /= g%xadj(i + 1)) then
+          emsg = 'nested dissection: internal error building the node graph.'
+          return
+        end if
+      end do
+      if (pass == 1) allocate (g%adj(g%xadj(na + 1)))
+    end do
+
+    g%emax = 0.0_wp
+    do i = 1, na
+      do kk = g%xadj(i) + 1, g%xadj(i + 1)
+        g%emax = max(g%emax, abs(g%xyl(:, g%adj(kk)) - g%xyl(:, i)))
+      end do
+    end do
+    g%emax = g%emax*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
+    g%srt(:, 1) = [(i, i=1, na)]
+    g%srt(:, 2) = g%srt(:, 1)
+    call sort_nodes(g%srt(:, 2), 2, g%xyl)
+    ok = .true.
+  end function build_node_graph
+
+  !> Stable merge sort of the points ids by coordinate `axis` of xyc, then by the other.
+  subroutine sort_nodes(ids, axis, xyc)
+    integer, intent(inout) :: ids(:)
+    integer, intent(in) :: axis
+    real(wp), intent(in) :: xyc(:, :)
+    integer, allocatable :: buf(:)
+    integer :: width, lo, mid, hi, i, j, k, n
+    logical :: first
+    n = size(ids)
+    allocate (buf(n))
+    width = 1
+    do while (width < n)
+      lo = 1
+      do while (lo <= n - width)
+        mid = lo + width - 1
+        hi = min(lo + 2*width - 1, n)
+        i = lo
+        j = mid + 1
+        k = lo
+        do while (i <= mid .and. j <= hi)
+          ! point ids(j) strictly before ids(i)?
+          if (xyc(axis, ids(j)) /= xyc(axis, ids(i))) then
+            first = xyc(axis, ids(j)) < xyc(axis, ids(i))
+          else
+            first = xyc(3 - axis, ids(j)) < xyc(3 - axis, ids(i))
+          end if
+          if (first) then
+            buf(k) = ids(j)
+            j = j + 1
+          else
+            buf(k) = ids(i)
+            i = i + 1
+          end if
+          k = k + 1
+        end do
+        if (i <= mid) buf(k:hi) = ids(i:mid)
+        if (j <= hi) buf(k:hi) = ids(j:hi)
+        ids(lo:hi) = buf(lo:hi)
+        lo = lo + 2*width
+      end do
+      width = 2*width
+    end do
+  end subroutine sort_nodes
 
 end module ordering
