@@ -39,181 +39,181 @@ contains
   ! ---- errors ---------------------------------------------------------------------------
 
   !> Record an error (the first one only) at the current line, or with no line (at_line false).
-  subroutine scan_fail(cur, text, code, at_line)
-    type(scanner_t), intent(inout) :: cur
+  subroutine scan_fail(scanner, text, code, at_line)
+    type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: text
     integer, intent(in), optional :: code
     logical, intent(in), optional :: at_line
-    if (cur%info /= 0) return
-    cur%info = SCAN_BAD_INPUT
-    if (present(code)) cur%info = code
-    cur%err_line = cur%line
+    if (scanner%info /= 0) return
+    scanner%info = SCAN_BAD_INPUT
+    if (present(code)) scanner%info = code
+    scanner%err_line = scanner%line
     if (present(at_line)) then
-      if (.not. at_line) cur%err_line = 0
+      if (.not. at_line) scanner%err_line = 0
     end if
-    cur%err = text
+    scanner%err = text
   end subroutine scan_fail
 
   ! ---- the text -------------------------------------------------------------------------
 
-  !> Read the whole file `path` into cur%text (cur%path names it in messages).
-  subroutine scanner_load(cur, path)
-    type(scanner_t), intent(inout) :: cur   !< the scanner, at the file's start on return
+  !> Read the whole file `path` into scanner%text (scanner%path names it in messages).
+  subroutine scanner_load(scanner, path)
+    type(scanner_t), intent(inout) :: scanner   !< the scanner, at the file's start on return
     character(len=*), intent(in) :: path    !< the file
     integer :: u, ios, st
     integer(i8) :: size_bytes
     character(len=256) :: iom
 
-    cur%path = path
-    cur%section = ''
+    scanner%path = path
+    scanner%section = ''
     open (newunit=u, file=path, access='stream', form='unformatted', status='old', &
           action='read', iostat=ios, iomsg=iom)
     if (ios /= 0) then
-      call scan_fail(cur, 'cannot be opened ('//trim(iom)//')', at_line=.false.)
+      call scan_fail(scanner, 'cannot be opened ('//trim(iom)//')', at_line=.false.)
       return
     end if
     inquire (unit=u, size=size_bytes)
     if (size_bytes <= 0) then
       close (u)
-      call scan_fail(cur, 'is empty or not a regular file', at_line=.false.)
+      call scan_fail(scanner, 'is empty or not a regular file', at_line=.false.)
       return
     end if
-    allocate (character(len=size_bytes) :: cur%text, stat=st)
+    allocate (character(len=size_bytes) :: scanner%text, stat=st)
     if (st /= 0) then
       close (u)
-      call scan_fail(cur, 'needs '//i2s(int(size_bytes/2**20))//' MB of memory to be read', &
+      call scan_fail(scanner, 'needs '//i2s(int(size_bytes/2**20))//' MB of memory to be read', &
                 SCAN_OTHER_FAILURE, .false.)
       return
     end if
-    read (u, iostat=ios, iomsg=iom) cur%text
+    read (u, iostat=ios, iomsg=iom) scanner%text
     close (u)
     if (ios /= 0) then
-      call scan_fail(cur, 'cannot be read ('//trim(iom)//')', at_line=.false.)
+      call scan_fail(scanner, 'cannot be read ('//trim(iom)//')', at_line=.false.)
       return
     end if
-    cur%n = size_bytes
+    scanner%n = size_bytes
   end subroutine scanner_load
 
-  !> The next token (characters above the blank) as text(s:e); s > cur%n at the end of the
+  !> The next token (characters above the blank) as text(s:e); s > scanner%n at the end of the
   !! file. Blanks, tabs, carriage returns and other control characters separate tokens.
-  subroutine next_token(cur, s, e)
-    type(scanner_t), intent(inout) :: cur
+  subroutine next_token(scanner, s, e)
+    type(scanner_t), intent(inout) :: scanner
     integer(i8), intent(out) :: s, e
     integer :: code
-    do while (cur%pos <= cur%n)
-      code = iachar(cur%text(cur%pos:cur%pos))
+    do while (scanner%pos <= scanner%n)
+      code = iachar(scanner%text(scanner%pos:scanner%pos))
       if (code > 32) exit
-      if (code == 10) cur%line = cur%line + 1
-      cur%pos = cur%pos + 1
+      if (code == 10) scanner%line = scanner%line + 1
+      scanner%pos = scanner%pos + 1
     end do
-    s = cur%pos
-    do while (cur%pos <= cur%n)
-      if (iachar(cur%text(cur%pos:cur%pos)) <= 32) exit
-      cur%pos = cur%pos + 1
+    s = scanner%pos
+    do while (scanner%pos <= scanner%n)
+      if (iachar(scanner%text(scanner%pos:scanner%pos)) <= 32) exit
+      scanner%pos = scanner%pos + 1
     end do
-    e = cur%pos - 1
+    e = scanner%pos - 1
   end subroutine next_token
 
   !> Report the end of the file inside a section, or a token that is not `what`.
-  subroutine bad_token(cur, s, e, what)
-    type(scanner_t), intent(inout) :: cur
+  subroutine bad_token(scanner, s, e, what)
+    type(scanner_t), intent(inout) :: scanner
     integer(i8), intent(in) :: s, e
     character(len=*), intent(in) :: what
-    if (s > cur%n) then
-      call scan_fail(cur, 'the file ends inside '//cur%section//' where '//what// &
+    if (s > scanner%n) then
+      call scan_fail(scanner, 'the file ends inside '//scanner%section//' where '//what// &
                 ' was expected (truncated file?)')
     else
-      call scan_fail(cur, 'expected '//what//' in '//cur%section//", found '"// &
-                cur%text(s:min(e, s + 40))//"'")
+      call scan_fail(scanner, 'expected '//what//' in '//scanner%section//", found '"// &
+                scanner%text(s:min(e, s + 40))//"'")
     end if
   end subroutine bad_token
 
   !> The next token as an integer (0 after an error).
-  integer function get_int(cur, what) result(v)
-    type(scanner_t), intent(inout) :: cur
+  integer function get_int(scanner, what) result(v)
+    type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: what   ! what the number is, for messages
     integer(i8) :: s, e
     logical :: ok
     v = 0
-    if (cur%info /= 0) return
-    call next_token(cur, s, e)
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
     ok = s <= e
-    if (ok) call parse_int(cur%text(s:e), v, ok)
-    if (.not. ok) call bad_token(cur, s, e, what//' (an integer)')
+    if (ok) call parse_int(scanner%text(s:e), v, ok)
+    if (.not. ok) call bad_token(scanner, s, e, what//' (an integer)')
   end function get_int
 
   !> The next token as a real (0 after an error).
-  real(wp) function get_real(cur, what) result(v)
-    type(scanner_t), intent(inout) :: cur
+  real(wp) function get_real(scanner, what) result(v)
+    type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: what
     integer(i8) :: s, e
     logical :: ok
     v = 0.0_wp
-    if (cur%info /= 0) return
-    call next_token(cur, s, e)
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
     ok = s <= e
-    if (ok) call parse_real(cur%text(s:e), v, ok)
-    if (.not. ok) call bad_token(cur, s, e, what//' (a finite real)')
+    if (ok) call parse_real(scanner%text(s:e), v, ok)
+    if (.not. ok) call bad_token(scanner, s, e, what//' (a finite real)')
   end function get_real
 
   !> The next token as a count of items that follow in the file (0 after an error): a
   !! non-negative integer. Every count that sizes an allocation is read here, so that the
   !! checks of a count against the file (the bytes left, bytes_left) have one place.
-  integer function read_count(cur, what) result(v)
-    type(scanner_t), intent(inout) :: cur
+  integer function read_count(scanner, what) result(v)
+    type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: what   ! what is counted, for messages
     integer(i8) :: s, e
     logical :: ok
     v = 0
-    if (cur%info /= 0) return
-    call next_token(cur, s, e)
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
     ok = s <= e
-    if (ok) call parse_int(cur%text(s:e), v, ok)
+    if (ok) call parse_int(scanner%text(s:e), v, ok)
     if (ok) ok = v >= 0
     if (.not. ok) then
       v = 0
-      call bad_token(cur, s, e, what//' (an integer >= 0)')
+      call bad_token(scanner, s, e, what//' (an integer >= 0)')
     end if
   end function read_count
 
   !> The characters from the position to the end of the file.
-  pure integer(i8) function bytes_left(cur)
-    type(scanner_t), intent(in) :: cur
-    bytes_left = max(cur%n - cur%pos + 1, 0_i8)
+  pure integer(i8) function bytes_left(scanner)
+    type(scanner_t), intent(in) :: scanner
+    bytes_left = max(scanner%n - scanner%pos + 1, 0_i8)
   end function bytes_left
 
   !> The next token must be `word` (a section's end marker).
-  subroutine expect(cur, word)
-    type(scanner_t), intent(inout) :: cur
+  subroutine expect(scanner, word)
+    type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: word
     integer(i8) :: s, e
-    if (cur%info /= 0) return
-    call next_token(cur, s, e)
-    if (s > cur%n) then
-      call scan_fail(cur, 'the file ends before '//word//' (truncated file?)')
-    else if (cur%text(s:e) /= word) then
-      call scan_fail(cur, 'expected '//word//" to close "//cur%section//", found '"// &
-                cur%text(s:min(e, s + 40))//"'")
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
+    if (s > scanner%n) then
+      call scan_fail(scanner, 'the file ends before '//word//' (truncated file?)')
+    else if (scanner%text(s:e) /= word) then
+      call scan_fail(scanner, 'expected '//word//" to close "//scanner%section//", found '"// &
+                scanner%text(s:min(e, s + 40))//"'")
     end if
   end subroutine expect
 
   !> Move past the first `marker` at or after the position (the end of a section that is
   !! not read).
-  subroutine skip_past(cur, marker)
-    type(scanner_t), intent(inout) :: cur
+  subroutine skip_past(scanner, marker)
+    type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: marker   !< e.g. '$EndComments'
     integer(i8) :: k, stop_at
-    k = index(cur%text(cur%pos:cur%n), marker, kind=i8)
+    k = index(scanner%text(scanner%pos:scanner%n), marker, kind=i8)
     if (k == 0) then
-      call scan_fail(cur, 'the file ends before '//marker//' (truncated file?)')
+      call scan_fail(scanner, 'the file ends before '//marker//' (truncated file?)')
       return
     end if
-    stop_at = cur%pos + k - 1
-    do while (cur%pos < stop_at)
-      if (cur%text(cur%pos:cur%pos) == achar(10)) cur%line = cur%line + 1
-      cur%pos = cur%pos + 1
+    stop_at = scanner%pos + k - 1
+    do while (scanner%pos < stop_at)
+      if (scanner%text(scanner%pos:scanner%pos) == achar(10)) scanner%line = scanner%line + 1
+      scanner%pos = scanner%pos + 1
     end do
-    cur%pos = stop_at + len(marker)
+    scanner%pos = stop_at + len(marker)
   end subroutine skip_past
 
   !> A decimal integer with an optional sign, in the default integer range.

@@ -53,15 +53,15 @@ contains
     type(mesh_t), intent(out) :: mesh        !< the body's mesh
     integer, intent(out) :: info             !< 0; 1 bad input; 3 other failure
     character(len=*), intent(out) :: msg     !< one sentence when info /= 0
-    type(scanner_t) :: cur
-    type(file_mesh_t) :: d
+    type(scanner_t) :: scanner
+    type(file_mesh_t) :: file_mesh
 
-    allocate (d%phys_dim(8), d%phys_tag(8), d%phys_name(8))
-    call scanner_load(cur, path)
-    if (cur%info == 0) call parse(cur, d)
-    if (cur%info == 0) call build(cur, d, trim(region), mesh)
-    if (allocated(cur%text)) deallocate (cur%text)
-    call outcome(cur, path, body_id, mesh, info, msg)
+    allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
+    call scanner_load(scanner, path)
+    if (scanner%info == 0) call parse(scanner, file_mesh)
+    if (scanner%info == 0) call build(scanner, file_mesh, trim(region), mesh)
+    if (allocated(scanner%text)) deallocate (scanner%text)
+    call outcome(scanner, path, body_id, mesh, info, msg)
   end subroutine msh_read
 
   !> Both bodies from one .msh file (the same path for both): the file is read and parsed
@@ -74,64 +74,64 @@ contains
     integer, intent(out) :: info(2)               !< 0; 1 bad input; 3 other failure
     character(len=*), intent(out) :: msg(2)       !< one sentence when info /= 0
     integer, intent(in) :: nthr                   !< threads for the two builds (1 or 2)
-    type(scanner_t) :: cur, cb(2)
-    type(file_mesh_t) :: d
+    type(scanner_t) :: scanner, body_scanner(2)
+    type(file_mesh_t) :: file_mesh
     integer :: a
 
-    allocate (d%phys_dim(8), d%phys_tag(8), d%phys_name(8))
-    call scanner_load(cur, path)
-    if (cur%info == 0) call parse(cur, d)
-    if (allocated(cur%text)) deallocate (cur%text)
+    allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
+    call scanner_load(scanner, path)
+    if (scanner%info == 0) call parse(scanner, file_mesh)
+    if (allocated(scanner%text)) deallocate (scanner%text)
     do a = 1, 2
-      cb(a) = cur
+      body_scanner(a) = scanner
     end do
     !$omp parallel do num_threads(nthr) schedule(static, 1)
     do a = 1, 2
-      if (cb(a)%info == 0) call build(cb(a), d, trim(region(a)), mesh(a))
+      if (body_scanner(a)%info == 0) call build(body_scanner(a), file_mesh, trim(region(a)), mesh(a))
     end do
     !$omp end parallel do
     do a = 1, 2
-      call outcome(cb(a), path, a, mesh(a), info(a), msg(a))
+      call outcome(body_scanner(a), path, a, mesh(a), info(a), msg(a))
     end do
   end subroutine msh_read_pair
 
   !> The status of a read: info from the scanner and, on failure, one sentence naming the body,
   !! the file and the line, and an empty mesh.
-  subroutine outcome(cur, path, body_id, mesh, info, msg)
-    type(scanner_t), intent(in) :: cur
+  subroutine outcome(scanner, path, body_id, mesh, info, msg)
+    type(scanner_t), intent(in) :: scanner
     character(len=*), intent(in) :: path
     integer, intent(in) :: body_id
     type(mesh_t), intent(inout) :: mesh
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
-    info = cur%info
+    info = scanner%info
     msg = ''
     if (info == 0) return
     msg = 'body '//i2s(body_id)//": mesh file '"//trim(path)//"'"
-    if (cur%err_line > 0) msg = trim(msg)//', line '//i2s(cur%err_line)
-    msg = trim(msg)//': '//cur%err//'.'
+    if (scanner%err_line > 0) msg = trim(msg)//', line '//i2s(scanner%err_line)
+    msg = trim(msg)//': '//scanner%err//'.'
     mesh%nnode = 0
     mesh%ncell = 0
   end subroutine outcome
 
   !> Build the body from the parsed file; a failure is recorded in the scanner (no line).
-  subroutine build(cur, d, region, mesh)
-    type(scanner_t), intent(inout) :: cur
-    type(file_mesh_t), intent(in) :: d
+  subroutine build(scanner, file_mesh, region, mesh)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(in) :: file_mesh
     character(len=*), intent(in) :: region
     type(mesh_t), intent(inout) :: mesh
     integer :: info
     character(len=:), allocatable :: err
-    call body_from_file(d, region, cur%path, mesh, info, err)
-    if (info /= 0) call scan_fail(cur, err, info, .false.)
+    call body_from_file(file_mesh, region, scanner%path, mesh, info, err)
+    if (info /= 0) call scan_fail(scanner, err, info, .false.)
   end subroutine build
 
   ! ---- parsing ----------------------------------------------------------------------------
 
-  !> Read every section of the file into d.
-  subroutine parse(cur, d)
-    type(scanner_t), intent(inout) :: cur
-    type(file_mesh_t), intent(inout) :: d
+  !> Read every section of the file into file_mesh.
+  subroutine parse(scanner, file_mesh)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(inout) :: file_mesh
     integer(i8) :: s, e
     character(len=:), allocatable :: tok
     type(node_index_t) :: by_tag
@@ -141,265 +141,265 @@ contains
     has_nodes = .false.
     has_elements = .false.
     do
-      call next_token(cur, s, e)
-      if (s > cur%n) exit
-      tok = cur%text(s:e)
+      call next_token(scanner, s, e)
+      if (s > scanner%n) exit
+      tok = scanner%text(s:e)
       if (.not. has_format .and. tok /= '$MeshFormat') then
-        call scan_fail(cur, "does not start with $MeshFormat (found '"//tok(1:min(len(tok), 40))// &
+        call scan_fail(scanner, "does not start with $MeshFormat (found '"//tok(1:min(len(tok), 40))// &
                   "'): not a Gmsh MSH file")
         return
       end if
-      cur%section = tok
-      if ((tok == '$Entities' .and. allocated(d%ent)) .or. (tok == '$Nodes' .and. has_nodes) .or. &
+      scanner%section = tok
+      if ((tok == '$Entities' .and. allocated(file_mesh%ent)) .or. (tok == '$Nodes' .and. has_nodes) .or. &
           (tok == '$Elements' .and. has_elements) .or. (tok == '$MeshFormat' .and. has_format)) then
-        call scan_fail(cur, 'has a second '//tok//' section')
+        call scan_fail(scanner, 'has a second '//tok//' section')
         return
       end if
       select case (tok)
       case ('$MeshFormat')
-        call read_format(cur)
+        call read_format(scanner)
         has_format = .true.
       case ('$PhysicalNames')
-        call read_physical_names(cur, d)
+        call read_physical_names(scanner, file_mesh)
       case ('$Entities')
-        call read_entities(cur, d)
+        call read_entities(scanner, file_mesh)
       case ('$Nodes')
-        call read_nodes(cur, d, by_tag)
+        call read_nodes(scanner, file_mesh, by_tag)
         has_nodes = .true.
       case ('$Elements')
-        if (.not. has_nodes) call scan_fail(cur, '$Elements comes before $Nodes')
-        call read_elements(cur, d, by_tag)
+        if (.not. has_nodes) call scan_fail(scanner, '$Elements comes before $Nodes')
+        call read_elements(scanner, file_mesh, by_tag)
         has_elements = .true.
       case default
         if (tok(1:1) /= '$' .or. len(tok) < 2) then
-          call scan_fail(cur, "expected a section such as $Nodes, found '"//tok(1:min(len(tok), 40))//"'")
+          call scan_fail(scanner, "expected a section such as $Nodes, found '"//tok(1:min(len(tok), 40))//"'")
         else if (index(tok, '$End') == 1) then
-          call scan_fail(cur, tok//' without its section')
+          call scan_fail(scanner, tok//' without its section')
         else
-          call skip_past(cur, '$End'//tok(2:))
+          call skip_past(scanner, '$End'//tok(2:))
         end if
       end select
-      if (cur%info /= 0) return
+      if (scanner%info /= 0) return
     end do
     if (.not. has_format) then
-      call scan_fail(cur, 'is empty: no $MeshFormat section')
+      call scan_fail(scanner, 'is empty: no $MeshFormat section')
     else if (.not. has_nodes) then
-      call scan_fail(cur, 'has no $Nodes section (truncated file?)')
+      call scan_fail(scanner, 'has no $Nodes section (truncated file?)')
     else if (.not. has_elements) then
-      call scan_fail(cur, 'has no $Elements section (truncated file?)')
+      call scan_fail(scanner, 'has no $Elements section (truncated file?)')
     end if
   end subroutine parse
 
   !> $MeshFormat: version 4.1, ASCII.
-  subroutine read_format(cur)
-    type(scanner_t), intent(inout) :: cur
+  subroutine read_format(scanner)
+    type(scanner_t), intent(inout) :: scanner
     integer(i8) :: s, e
     integer :: file_type, data_size
-    call next_token(cur, s, e)
-    if (s > cur%n) then
-      call scan_fail(cur, 'the file ends inside $MeshFormat (truncated file?)')
+    call next_token(scanner, s, e)
+    if (s > scanner%n) then
+      call scan_fail(scanner, 'the file ends inside $MeshFormat (truncated file?)')
       return
     end if
-    if (cur%text(s:e) /= '4.1') then
-      call scan_fail(cur, 'is MSH version '//cur%text(s:min(e, s + 20))//', and only MSH 4.1 is read; '// &
+    if (scanner%text(s:e) /= '4.1') then
+      call scan_fail(scanner, 'is MSH version '//scanner%text(s:min(e, s + 20))//', and only MSH 4.1 is read; '// &
                 'write version 4.1 with `gmsh -format msh41` or Mesh.MshFileVersion = 4.1')
       return
     end if
-    file_type = get_int(cur, 'the file type')
-    if (cur%info == 0 .and. file_type /= 0) then
-      call scan_fail(cur, 'is a binary MSH file, and only ASCII is read; write it without -bin '// &
+    file_type = get_int(scanner, 'the file type')
+    if (scanner%info == 0 .and. file_type /= 0) then
+      call scan_fail(scanner, 'is a binary MSH file, and only ASCII is read; write it without -bin '// &
                 '(Mesh.Binary = 0)')
       return
     end if
-    data_size = get_int(cur, 'the data size')
-    call expect(cur, '$EndMeshFormat')
+    data_size = get_int(scanner, 'the data size')
+    call expect(scanner, '$EndMeshFormat')
   end subroutine read_format
 
   !> $PhysicalNames: dimension, tag and quoted name of each physical group.
-  subroutine read_physical_names(cur, d)
-    type(scanner_t), intent(inout) :: cur
-    type(file_mesh_t), intent(inout) :: d
+  subroutine read_physical_names(scanner, file_mesh)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(inout) :: file_mesh
     integer :: n, k, dim, tag
     integer(i8) :: q
-    n = read_count(cur, 'the number of physical names')
-    if (cur%info /= 0) return
+    n = read_count(scanner, 'the number of physical names')
+    if (scanner%info /= 0) return
     do k = 1, n
-      dim = get_int(cur, 'a physical dimension')
-      tag = get_int(cur, 'a physical tag')
-      if (cur%info /= 0) return
+      dim = get_int(scanner, 'a physical dimension')
+      tag = get_int(scanner, 'a physical tag')
+      if (scanner%info /= 0) return
       ! the name: from the opening quote to the closing one on the same line
-      do while (cur%pos <= cur%n)
-        if (cur%text(cur%pos:cur%pos) /= ' ' .and. cur%text(cur%pos:cur%pos) /= achar(9)) exit
-        cur%pos = cur%pos + 1
+      do while (scanner%pos <= scanner%n)
+        if (scanner%text(scanner%pos:scanner%pos) /= ' ' .and. scanner%text(scanner%pos:scanner%pos) /= achar(9)) exit
+        scanner%pos = scanner%pos + 1
       end do
-      if (cur%pos > cur%n) then
-        call scan_fail(cur, 'the file ends inside $PhysicalNames (truncated file?)')
+      if (scanner%pos > scanner%n) then
+        call scan_fail(scanner, 'the file ends inside $PhysicalNames (truncated file?)')
         return
       end if
       q = 0
-      if (cur%text(cur%pos:cur%pos) == '"') q = scan(cur%text(cur%pos + 1:min(cur%n, cur%pos + 1024)), '"'//achar(10))
+      if (scanner%text(scanner%pos:scanner%pos) == '"') q = scan(scanner%text(scanner%pos + 1:min(scanner%n, scanner%pos + 1024)), '"'//achar(10))
       if (q == 0) then
-        call scan_fail(cur, 'a physical name must be in double quotes on one line')
+        call scan_fail(scanner, 'a physical name must be in double quotes on one line')
         return
       end if
-      if (cur%text(cur%pos + q:cur%pos + q) /= '"') then
-        call scan_fail(cur, 'a physical name must be in double quotes on one line')
+      if (scanner%text(scanner%pos + q:scanner%pos + q) /= '"') then
+        call scan_fail(scanner, 'a physical name must be in double quotes on one line')
         return
       end if
-      call add_physical(d, dim, tag, cur%text(cur%pos + 1:cur%pos + q - 1))
-      cur%pos = cur%pos + q + 1
+      call add_physical(file_mesh, dim, tag, scanner%text(scanner%pos + 1:scanner%pos + q - 1))
+      scanner%pos = scanner%pos + q + 1
     end do
-    call expect(cur, '$EndPhysicalNames')
+    call expect(scanner, '$EndPhysicalNames')
   end subroutine read_physical_names
 
   !> $Entities: the physical tags of every point, curve and surface (volumes skipped).
-  subroutine read_entities(cur, d)
-    type(scanner_t), intent(inout) :: cur
-    type(file_mesh_t), intent(inout) :: d
+  subroutine read_entities(scanner, file_mesh)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(inout) :: file_mesh
     integer :: nents(0:3), dim, k, j, nb, tag, np, bound
     real(wp) :: r
     integer, allocatable :: phys(:)
     do dim = 0, 3
-      nents(dim) = read_count(cur, 'the number of entities')
+      nents(dim) = read_count(scanner, 'the number of entities')
     end do
-    if (cur%info /= 0) return
-    allocate (d%ent(nents(0) + nents(1) + nents(2)))
+    if (scanner%info /= 0) return
+    allocate (file_mesh%ent(nents(0) + nents(1) + nents(2)))
     do dim = 0, 3
       do k = 1, nents(dim)
-        tag = get_int(cur, 'an entity tag')
+        tag = get_int(scanner, 'an entity tag')
         do j = 1, merge(3, 6, dim == 0)
-          r = get_real(cur, 'an entity coordinate')
+          r = get_real(scanner, 'an entity coordinate')
         end do
-        np = read_count(cur, 'the number of physical tags')
-        if (cur%info /= 0) return
+        np = read_count(scanner, 'the number of physical tags')
+        if (scanner%info /= 0) return
         allocate (phys(np))
         do j = 1, np     ! negative when the entity is reversed in the group
-          phys(j) = abs(get_int(cur, 'a physical tag'))
+          phys(j) = abs(get_int(scanner, 'a physical tag'))
         end do
         if (dim > 0) then
-          nb = read_count(cur, 'the number of bounding entities')
+          nb = read_count(scanner, 'the number of bounding entities')
           do j = 1, nb
-            bound = get_int(cur, 'a bounding entity tag')
+            bound = get_int(scanner, 'a bounding entity tag')
           end do
         end if
-        if (cur%info /= 0) return
+        if (scanner%info /= 0) return
         if (dim <= 2) then
-          d%nent = d%nent + 1
-          d%ent(d%nent)%dim = dim
-          d%ent(d%nent)%tag = tag
-          call move_alloc(phys, d%ent(d%nent)%phys)
+          file_mesh%nent = file_mesh%nent + 1
+          file_mesh%ent(file_mesh%nent)%dim = dim
+          file_mesh%ent(file_mesh%nent)%tag = tag
+          call move_alloc(phys, file_mesh%ent(file_mesh%nent)%phys)
           do j = 1, np        ! physical groups without a name are named by their tag
-            call add_physical(d, dim, d%ent(d%nent)%phys(j), i2s(d%ent(d%nent)%phys(j)))
+            call add_physical(file_mesh, dim, file_mesh%ent(file_mesh%nent)%phys(j), i2s(file_mesh%ent(file_mesh%nent)%phys(j)))
           end do
         else
           deallocate (phys)
         end if
       end do
     end do
-    call expect(cur, '$EndEntities')
+    call expect(scanner, '$EndEntities')
   end subroutine read_entities
 
   !> $Nodes: blocks of tags then coordinates; z must be 0.
-  subroutine read_nodes(cur, d, by_tag)
-    type(scanner_t), intent(inout) :: cur
-    type(file_mesh_t), intent(inout) :: d
+  subroutine read_nodes(scanner, file_mesh, by_tag)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(inout) :: file_mesh
     type(node_index_t), intent(inout) :: by_tag
     integer :: nblock, ntotal, b, edim, etag, param, nb, k, j, st, slot, first
     real(wp) :: z, r
 
-    nblock = read_count(cur, 'the number of node blocks')
-    ntotal = read_count(cur, 'the number of nodes')
-    k = get_int(cur, 'the smallest node tag')
-    k = get_int(cur, 'the largest node tag')
-    if (cur%info /= 0) return
-    allocate (d%node_tag(ntotal), d%node_xy(2, ntotal), stat=st)
+    nblock = read_count(scanner, 'the number of node blocks')
+    ntotal = read_count(scanner, 'the number of nodes')
+    k = get_int(scanner, 'the smallest node tag')
+    k = get_int(scanner, 'the largest node tag')
+    if (scanner%info /= 0) return
+    allocate (file_mesh%node_tag(ntotal), file_mesh%node_xy(2, ntotal), stat=st)
     if (st == 0) call hash_init(by_tag%hash, ntotal, st)
     if (st == 0) allocate (by_tag%node_of_slot(0:by_tag%hash%mask), stat=st)
     if (st /= 0) then
-      call scan_fail(cur, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
       return
     end if
-    d%nnode = 0
+    file_mesh%nnode = 0
     do b = 1, nblock
-      edim = get_int(cur, 'an entity dimension')
-      etag = get_int(cur, 'an entity tag')
-      param = get_int(cur, 'the parametric flag')
-      nb = read_count(cur, 'the number of nodes in the block')
-      if (cur%info /= 0) return
-      if (d%nnode + nb > ntotal) then
-        call scan_fail(cur, 'the node blocks hold more nodes than the '//i2s(ntotal)//' announced')
+      edim = get_int(scanner, 'an entity dimension')
+      etag = get_int(scanner, 'an entity tag')
+      param = get_int(scanner, 'the parametric flag')
+      nb = read_count(scanner, 'the number of nodes in the block')
+      if (scanner%info /= 0) return
+      if (file_mesh%nnode + nb > ntotal) then
+        call scan_fail(scanner, 'the node blocks hold more nodes than the '//i2s(ntotal)//' announced')
         return
       end if
-      first = d%nnode
+      first = file_mesh%nnode
       do k = first + 1, first + nb
-        d%node_tag(k) = get_int(cur, 'a node tag')
-        if (cur%info /= 0) return
-        slot = hash_slot(by_tag%hash, int(d%node_tag(k), i8))
+        file_mesh%node_tag(k) = get_int(scanner, 'a node tag')
+        if (scanner%info /= 0) return
+        slot = hash_slot(by_tag%hash, int(file_mesh%node_tag(k), i8))
         if (by_tag%hash%key(slot) /= HASH_EMPTY) then
-          call scan_fail(cur, 'node tag '//i2s(d%node_tag(k))//' appears twice')
+          call scan_fail(scanner, 'node tag '//i2s(file_mesh%node_tag(k))//' appears twice')
           return
         end if
-        by_tag%hash%key(slot) = d%node_tag(k)
+        by_tag%hash%key(slot) = file_mesh%node_tag(k)
         by_tag%node_of_slot(slot) = k
       end do
       do k = first + 1, first + nb
-        d%node_xy(1, k) = get_real(cur, 'a node x coordinate')
-        d%node_xy(2, k) = get_real(cur, 'a node y coordinate')
-        z = get_real(cur, 'a node z coordinate')
+        file_mesh%node_xy(1, k) = get_real(scanner, 'a node x coordinate')
+        file_mesh%node_xy(2, k) = get_real(scanner, 'a node y coordinate')
+        z = get_real(scanner, 'a node z coordinate')
         if (param /= 0) then
           do j = 1, edim
-            r = get_real(cur, 'a parametric coordinate')
+            r = get_real(scanner, 'a parametric coordinate')
           end do
         end if
-        if (cur%info /= 0) return
+        if (scanner%info /= 0) return
         if (z /= 0.0_wp) then
-          call scan_fail(cur, 'node '//i2s(d%node_tag(k))//' has z = '//trim(real_text(z))// &
+          call scan_fail(scanner, 'node '//i2s(file_mesh%node_tag(k))//' has z = '//trim(real_text(z))// &
                     '; only 2D meshes in the plane z = 0 are read (this is a 3D mesh)')
           return
         end if
       end do
-      d%nnode = first + nb
+      file_mesh%nnode = first + nb
     end do
-    if (d%nnode /= ntotal) then
-      call scan_fail(cur, 'the node blocks hold '//i2s(d%nnode)//' nodes, not the '//i2s(ntotal)//' announced')
+    if (file_mesh%nnode /= ntotal) then
+      call scan_fail(scanner, 'the node blocks hold '//i2s(file_mesh%nnode)//' nodes, not the '//i2s(ntotal)//' announced')
       return
     end if
-    call expect(cur, '$EndNodes')
+    call expect(scanner, '$EndNodes')
   end subroutine read_nodes
 
   !> $Elements: triangles and quadrangles (surface entities), lines (curve entities), points.
-  subroutine read_elements(cur, d, by_tag)
-    type(scanner_t), intent(inout) :: cur
-    type(file_mesh_t), intent(inout) :: d
+  subroutine read_elements(scanner, file_mesh, by_tag)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(inout) :: file_mesh
     type(node_index_t), intent(in) :: by_tag
     integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, st, t, slot
 
-    nblock = read_count(cur, 'the number of element blocks')
-    ntotal = read_count(cur, 'the number of elements')
-    k = get_int(cur, 'the smallest element tag')
-    k = get_int(cur, 'the largest element tag')
-    if (cur%info /= 0) return
+    nblock = read_count(scanner, 'the number of element blocks')
+    ntotal = read_count(scanner, 'the number of elements')
+    k = get_int(scanner, 'the smallest element tag')
+    k = get_int(scanner, 'the largest element tag')
+    if (scanner%info /= 0) return
     ! sized for the worst case; the lines are a small part of a 2D mesh but bounded by ntotal too
-    allocate (d%cell_tag(ntotal), d%cell_entity(ntotal), d%cell_node(4, ntotal), d%line_entity(ntotal), &
-              d%line_node(2, ntotal), d%point_entity(ntotal), d%point_node(ntotal), stat=st)
+    allocate (file_mesh%cell_tag(ntotal), file_mesh%cell_entity(ntotal), file_mesh%cell_node(4, ntotal), file_mesh%line_entity(ntotal), &
+              file_mesh%line_node(2, ntotal), file_mesh%point_entity(ntotal), file_mesh%point_node(ntotal), stat=st)
     if (st /= 0) then
-      call scan_fail(cur, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
       return
     end if
     t = 0
     do b = 1, nblock
-      edim = get_int(cur, 'an entity dimension')
-      etag = get_int(cur, 'an entity tag')
-      etype = get_int(cur, 'an element type')
-      nb = read_count(cur, 'the number of elements in the block')
-      if (cur%info /= 0) return
+      edim = get_int(scanner, 'an entity dimension')
+      etag = get_int(scanner, 'an entity tag')
+      etype = get_int(scanner, 'an element type')
+      nb = read_count(scanner, 'the number of elements in the block')
+      if (scanner%info /= 0) return
       if (t + nb > ntotal) then
-        call scan_fail(cur, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
+        call scan_fail(scanner, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
         return
       end if
       t = t + nb
       if (edim == 3) then
-        call scan_fail(cur, 'has elements of type '//i2s(etype)//' on volume '//i2s(etag)// &
+        call scan_fail(scanner, 'has elements of type '//i2s(etype)//' on volume '//i2s(etag)// &
                   ': a 3D mesh, and only 2D meshes are read')
         return
       end if
@@ -413,47 +413,47 @@ contains
       case (15)
         nv = 1
       case default
-        call scan_fail(cur, unsupported_type(etype))
+        call scan_fail(scanner, unsupported_type(etype))
         return
       end select
-      ent = entity_index(d, edim, etag)
+      ent = entity_index(file_mesh, edim, etag)
       do k = 1, nb
-        tag = get_int(cur, 'an element tag')
+        tag = get_int(scanner, 'an element tag')
         if (etype == 1) then
-          d%nline = d%nline + 1
-          d%line_entity(d%nline) = ent
+          file_mesh%nline = file_mesh%nline + 1
+          file_mesh%line_entity(file_mesh%nline) = ent
         else if (etype == 15) then
-          d%npoint = d%npoint + 1
-          d%point_entity(d%npoint) = ent
+          file_mesh%npoint = file_mesh%npoint + 1
+          file_mesh%point_entity(file_mesh%npoint) = ent
         else
-          d%ncell = d%ncell + 1
-          d%cell_tag(d%ncell) = tag
-          d%cell_entity(d%ncell) = ent
-          d%cell_node(:, d%ncell) = 0
+          file_mesh%ncell = file_mesh%ncell + 1
+          file_mesh%cell_tag(file_mesh%ncell) = tag
+          file_mesh%cell_entity(file_mesh%ncell) = ent
+          file_mesh%cell_node(:, file_mesh%ncell) = 0
         end if
         do j = 1, nv
-          ntg = get_int(cur, 'a node tag')
-          if (cur%info /= 0) return
+          ntg = get_int(scanner, 'a node tag')
+          if (scanner%info /= 0) return
           slot = hash_slot(by_tag%hash, int(ntg, i8))
           if (by_tag%hash%key(slot) == HASH_EMPTY) then
-            call scan_fail(cur, 'element '//i2s(tag)//' refers to node '//i2s(ntg)//', which is not in $Nodes')
+            call scan_fail(scanner, 'element '//i2s(tag)//' refers to node '//i2s(ntg)//', which is not in $Nodes')
             return
           end if
           if (etype == 1) then
-            d%line_node(j, d%nline) = by_tag%node_of_slot(slot)
+            file_mesh%line_node(j, file_mesh%nline) = by_tag%node_of_slot(slot)
           else if (etype == 15) then
-            d%point_node(d%npoint) = by_tag%node_of_slot(slot)
+            file_mesh%point_node(file_mesh%npoint) = by_tag%node_of_slot(slot)
           else
-            d%cell_node(j, d%ncell) = by_tag%node_of_slot(slot)
+            file_mesh%cell_node(j, file_mesh%ncell) = by_tag%node_of_slot(slot)
           end if
         end do
       end do
     end do
     if (t /= ntotal) then
-      call scan_fail(cur, 'the element blocks hold '//i2s(t)//' elements, not the '//i2s(ntotal)//' announced')
+      call scan_fail(scanner, 'the element blocks hold '//i2s(t)//' elements, not the '//i2s(ntotal)//' announced')
       return
     end if
-    call expect(cur, '$EndElements')
+    call expect(scanner, '$EndElements')
   end subroutine read_elements
 
   !> The sentence refusing an element type.

@@ -57,40 +57,40 @@ module mesh_topology
 contains
 
   !> Add a physical group (dim, tag) named `name` unless it is there already.
-  subroutine add_physical(d, dim, tag, name)
-    type(file_mesh_t), intent(inout) :: d
+  subroutine add_physical(file_mesh, dim, tag, name)
+    type(file_mesh_t), intent(inout) :: file_mesh
     integer, intent(in) :: dim, tag
     character(len=*), intent(in) :: name
     integer, allocatable :: idim(:), itag(:)
     type(name_t), allocatable :: nm(:)
     integer :: k
-    if (.not. allocated(d%phys_dim)) allocate (d%phys_dim(8), d%phys_tag(8), d%phys_name(8))
-    do k = 1, d%nphys
-      if (d%phys_dim(k) == dim .and. d%phys_tag(k) == tag) return
+    if (.not. allocated(file_mesh%phys_dim)) allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
+    do k = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(k) == dim .and. file_mesh%phys_tag(k) == tag) return
     end do
-    if (d%nphys == size(d%phys_dim)) then
-      allocate (idim(2*d%nphys), itag(2*d%nphys), nm(2*d%nphys))
-      idim(1:d%nphys) = d%phys_dim
-      itag(1:d%nphys) = d%phys_tag
-      do k = 1, d%nphys
-        call move_alloc(d%phys_name(k)%s, nm(k)%s)
+    if (file_mesh%nphys == size(file_mesh%phys_dim)) then
+      allocate (idim(2*file_mesh%nphys), itag(2*file_mesh%nphys), nm(2*file_mesh%nphys))
+      idim(1:file_mesh%nphys) = file_mesh%phys_dim
+      itag(1:file_mesh%nphys) = file_mesh%phys_tag
+      do k = 1, file_mesh%nphys
+        call move_alloc(file_mesh%phys_name(k)%s, nm(k)%s)
       end do
-      call move_alloc(idim, d%phys_dim)
-      call move_alloc(itag, d%phys_tag)
-      call move_alloc(nm, d%phys_name)
+      call move_alloc(idim, file_mesh%phys_dim)
+      call move_alloc(itag, file_mesh%phys_tag)
+      call move_alloc(nm, file_mesh%phys_name)
     end if
-    d%nphys = d%nphys + 1
-    d%phys_dim(d%nphys) = dim
-    d%phys_tag(d%nphys) = tag
-    d%phys_name(d%nphys)%s = name
+    file_mesh%nphys = file_mesh%nphys + 1
+    file_mesh%phys_dim(file_mesh%nphys) = dim
+    file_mesh%phys_tag(file_mesh%nphys) = tag
+    file_mesh%phys_name(file_mesh%nphys)%s = name
   end subroutine add_physical
 
-  !> The index in d%ent of entity (dim, tag), 0 if it has none.
-  integer function entity_index(d, dim, tag) result(k)
-    type(file_mesh_t), intent(in) :: d
+  !> The index in file_mesh%ent of entity (dim, tag), 0 if it has none.
+  integer function entity_index(file_mesh, dim, tag) result(k)
+    type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: dim, tag
-    do k = 1, d%nent
-      if (d%ent(k)%dim == dim .and. d%ent(k)%tag == tag) return
+    do k = 1, file_mesh%nent
+      if (file_mesh%ent(k)%dim == dim .and. file_mesh%ent(k)%tag == tag) return
     end do
     k = 0
   end function entity_index
@@ -111,31 +111,31 @@ contains
   !! surface `region`), renumber its nodes, orient and check its cells, find its groups.
   !! On failure info = 1 (bad input) or 3 (memory) and err is a phrase about the file
   !! (its subject the file: 'has no physical surface ...').
-  subroutine body_from_file(d, region, path, mesh, info, err)
-    type(file_mesh_t), intent(in) :: d                  !< the file's groups, entities, nodes, elements
+  subroutine body_from_file(file_mesh, region, path, mesh, info, err)
+    type(file_mesh_t), intent(in) :: file_mesh          !< the file's groups, entities, nodes, elements
     character(len=*), intent(in) :: region              !< physical surface name of the body, or ''
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
     integer, intent(out) :: info                        !< 0; 1 bad input; 3 other failure
     character(len=:), allocatable, intent(out) :: err   !< the failure, when info /= 0
-    integer :: target, k, c, nsurf, nc, st, nq
-    logical, allocatable :: in_ent(:)
-    integer, allocatable :: sel(:), body_node(:), order(:)
+    integer :: surface, k, c, nsurf, ncell, st, nquad
+    logical, allocatable :: in_entity(:)
+    integer, allocatable :: cell_of(:), body_node(:), order(:)
     character(len=:), allocatable :: surfaces
 
     info = 0
     ! the physical surface of the body
     surfaces = ''
     nsurf = 0
-    target = 0
-    do k = 1, d%nphys
-      if (d%phys_dim(k) /= 2) cycle
+    surface = 0
+    do k = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(k) /= 2) cycle
       nsurf = nsurf + 1
-      surfaces = surfaces//merge(', ', '  ', nsurf > 1)//"'"//d%phys_name(k)%s//"'"
-      if (len(region) > 0 .and. d%phys_name(k)%s == region) target = k
+      surfaces = surfaces//merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'"
+      if (len(region) > 0 .and. file_mesh%phys_name(k)%s == region) surface = k
     end do
     surfaces = trim(adjustl(surfaces))
-    if (len(region) > 0 .and. target == 0) then
+    if (len(region) > 0 .and. surface == 0) then
       if (nsurf == 0) then
         call refuse(info, err, "has no physical surface '"//region//"' (it has no physical surfaces)")
       else
@@ -149,22 +149,22 @@ contains
       return
     end if
     if (len(region) == 0 .and. nsurf == 1) then
-      do k = 1, d%nphys
-        if (d%phys_dim(k) == 2) target = k
+      do k = 1, file_mesh%nphys
+        if (file_mesh%phys_dim(k) == 2) surface = k
       end do
     end if
 
     ! its cells: those of the surface entities in the group (every one without a group)
-    allocate (in_ent(0:d%nent))
-    in_ent = target == 0
-    do k = 1, d%nent
-      if (target > 0) in_ent(k) = d%ent(k)%dim == 2 .and. any(d%ent(k)%phys == d%phys_tag(target))
+    allocate (in_entity(0:file_mesh%nent))
+    in_entity = surface == 0
+    do k = 1, file_mesh%nent
+      if (surface > 0) in_entity(k) = file_mesh%ent(k)%dim == 2 .and. any(file_mesh%ent(k)%phys == file_mesh%phys_tag(surface))
     end do
-    sel = pack([(c, c=1, d%ncell)], in_ent(d%cell_entity(1:d%ncell)))
-    nc = size(sel)
-    if (nc == 0) then
-      if (target > 0) then
-        call refuse(info, err, "physical surface '"//d%phys_name(target)%s//"' has no triangles or quadrangles")
+    cell_of = pack([(c, c=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
+    ncell = size(cell_of)
+    if (ncell == 0) then
+      if (surface > 0) then
+        call refuse(info, err, "physical surface '"//file_mesh%phys_name(surface)%s//"' has no triangles or quadrangles")
       else
         call refuse(info, err, 'has no triangles or quadrangles')
       end if
@@ -172,49 +172,49 @@ contains
     end if
 
     ! its nodes, in increasing tag order
-    allocate (body_node(d%nnode), stat=st)
+    allocate (body_node(file_mesh%nnode), stat=st)
     if (st /= 0) then
       call refuse(info, err, 'not enough memory', OTHER_FAILURE)
       return
     end if
     body_node = 0
-    do k = 1, nc
+    do k = 1, ncell
       do c = 1, 4
-        if (d%cell_node(c, sel(k)) > 0) body_node(d%cell_node(c, sel(k))) = 1
+        if (file_mesh%cell_node(c, cell_of(k)) > 0) body_node(file_mesh%cell_node(c, cell_of(k))) = 1
       end do
     end do
-    order = pack([(k, k=1, d%nnode)], body_node > 0)
-    call sort_by_tag(order, d%node_tag)
+    order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
+    call sort_by_tag(order, file_mesh%node_tag)
     mesh%nnode = size(order)
     allocate (mesh%xy(2, mesh%nnode), mesh%node_tag(mesh%nnode))
     do k = 1, mesh%nnode
       body_node(order(k)) = k
-      mesh%xy(:, k) = d%node_xy(:, order(k))
-      mesh%node_tag(k) = d%node_tag(order(k))
+      mesh%xy(:, k) = file_mesh%node_xy(:, order(k))
+      mesh%node_tag(k) = file_mesh%node_tag(order(k))
     end do
 
     ! its cells
-    nq = count(d%cell_node(4, sel) > 0)
-    mesh%ncell = nc
-    mesh%nvert = merge(4, 3, nq > 0)
-    if (nq == nc) then
+    nquad = count(file_mesh%cell_node(4, cell_of) > 0)
+    mesh%ncell = ncell
+    mesh%nvert = merge(4, 3, nquad > 0)
+    if (nquad == ncell) then
       mesh%element = ELEM_Q1
-    else if (nq == 0) then
+    else if (nquad == 0) then
       mesh%element = ELEM_P1
     else
       mesh%element = ELEM_MIXED
     end if
-    allocate (mesh%cells(mesh%nvert, nc), mesh%cell_type(nc), mesh%cell_tag(nc))
+    allocate (mesh%cells(mesh%nvert, ncell), mesh%cell_type(ncell), mesh%cell_tag(ncell))
     mesh%cells = 0
-    do k = 1, nc
-      c = sel(k)
-      mesh%cell_tag(k) = d%cell_tag(c)
-      if (d%cell_node(4, c) > 0) then
+    do k = 1, ncell
+      c = cell_of(k)
+      mesh%cell_tag(k) = file_mesh%cell_tag(c)
+      if (file_mesh%cell_node(4, c) > 0) then
         mesh%cell_type(k) = ELEM_Q1
-        mesh%cells(1:4, k) = body_node(d%cell_node(1:4, c))
+        mesh%cells(1:4, k) = body_node(file_mesh%cell_node(1:4, c))
       else
         mesh%cell_type(k) = ELEM_P1
-        mesh%cells(1:3, k) = body_node(d%cell_node(1:3, c))
+        mesh%cells(1:3, k) = body_node(file_mesh%cell_node(1:3, c))
       end if
       call orient_cell(mesh, k, info, err)
       if (info /= 0) return
@@ -229,8 +229,8 @@ contains
     mesh%width = maxval(mesh%xy(1, :)) - mesh%x0
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
-    call boundary_groups(d, body_node, mesh, info, err)
-    if (info == 0) call point_groups(d, body_node, mesh)
+    call boundary_groups(file_mesh, body_node, mesh, info, err)
+    if (info == 0) call point_groups(file_mesh, body_node, mesh)
   end subroutine body_from_file
 
   !> Put cell k counter-clockwise; refuse it if degenerate or (a quadrangle) not convex.
@@ -281,39 +281,40 @@ contains
   !! a group of nodes only). The lines' edges are hashed (a small table), then every cell
   !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
   !! oriented as that cell has it; one met in two is inside the body.
-  subroutine boundary_groups(d, body_node, mesh, info, err)
-    type(file_mesh_t), intent(in) :: d
+  subroutine boundary_groups(file_mesh, body_node, mesh, info, err)
+    type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
     integer, intent(inout) :: info
     character(len=:), allocatable, intent(inout) :: err
-    type(int_hash_t) :: h
-    integer, allocatable :: line_slot(:), ecount(:), ecell(:), elocal(:), edges(:, :), cells(:), inner(:)
-    logical, allocatable :: on(:)
-    integer :: c, i, nv, a, b, slot, st, p, l, ne, ng, ni
-    integer(i8) :: key, nn1
+    type(int_hash_t) :: edge_hash
+    integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
+    logical, allocatable :: marked(:)
+    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner
+    integer(i8) :: key, key_base
 
-    ! the body's line edges, keyed by their two nodes (line_slot = 0: not a body edge)
-    call hash_init(h, d%nline, st)
-    if (st == 0) allocate (line_slot(d%nline), ecount(0:h%mask), ecell(0:h%mask), elocal(0:h%mask), &
-                           edges(2, d%nline), cells(d%nline), inner(2*d%nline), on(mesh%nnode), stat=st)
+    ! the body's line edges, keyed by their two nodes (line_slot = -1: not a body edge)
+    call hash_init(edge_hash, file_mesh%nline, st)
+    if (st == 0) allocate (line_slot(file_mesh%nline), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
+                           edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
+                           inner(2*file_mesh%nline), marked(mesh%nnode), stat=st)
     if (st /= 0) then
       call refuse(info, err, 'not enough memory for the boundary edges', OTHER_FAILURE)
       return
     end if
     line_slot = -1
-    ecount = 0
-    on = .false.
-    nn1 = mesh%nnode + 1
-    do l = 1, d%nline
-      if (d%line_entity(l) == 0) cycle
-      a = body_node(d%line_node(1, l))
-      b = body_node(d%line_node(2, l))
+    edge_count = 0
+    marked = .false.
+    key_base = mesh%nnode + 1
+    do line = 1, file_mesh%nline
+      if (file_mesh%line_entity(line) == 0) cycle
+      a = body_node(file_mesh%line_node(1, line))
+      b = body_node(file_mesh%line_node(2, line))
       if (a == 0 .or. b == 0 .or. a == b) cycle
-      key = min(a, b)*nn1 + max(a, b)
-      slot = hash_slot(h, key)
-      h%key(slot) = key
-      line_slot(l) = slot
+      key = min(a, b)*key_base + max(a, b)
+      slot = hash_slot(edge_hash, key)
+      edge_hash%key(slot) = key
+      line_slot(line) = slot
     end do
 
     ! how many cells have each of them, and the last one
@@ -322,115 +323,115 @@ contains
       do i = 1, nv
         a = mesh%cells(i, c)
         b = mesh%cells(modulo(i, nv) + 1, c)
-        key = min(a, b)*nn1 + max(a, b)
-        slot = hash_slot(h, key)
-        if (h%key(slot) /= key) cycle
-        ecount(slot) = ecount(slot) + 1
-        ecell(slot) = c
-        elocal(slot) = i
+        key = min(a, b)*key_base + max(a, b)
+        slot = hash_slot(edge_hash, key)
+        if (edge_hash%key(slot) /= key) cycle
+        edge_count(slot) = edge_count(slot) + 1
+        edge_cell(slot) = c
+        edge_local(slot) = i
       end do
     end do
 
     mesh%file_groups = ''
-    allocate (mesh%group(count(d%phys_dim(1:d%nphys) == 1 .or. d%phys_dim(1:d%nphys) == 0)))  ! room for points
-    ng = 0
-    do p = 1, d%nphys
-      if (d%phys_dim(p) /= 1) cycle
-      mesh%file_groups = trim(mesh%file_groups//' '//d%phys_name(p)%s)
-      ne = 0
-      ni = 0
-      do l = 1, d%nline
-        if (line_slot(l) < 0) cycle
-        if (.not. any(d%ent(d%line_entity(l))%phys == d%phys_tag(p))) cycle
-        slot = line_slot(l)
-        if (ecount(slot) == 0) cycle          ! not an edge of the body's cells
-        if (ecount(slot) > 1) then            ! inside the body: its nodes, once each
+    allocate (mesh%group(count(file_mesh%phys_dim(1:file_mesh%nphys) == 1 .or. file_mesh%phys_dim(1:file_mesh%nphys) == 0)))  ! room for points
+    ngroup = 0
+    do phys = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(phys) /= 1) cycle
+      mesh%file_groups = trim(mesh%file_groups//' '//file_mesh%phys_name(phys)%s)
+      nedge = 0
+      ninner = 0
+      do line = 1, file_mesh%nline
+        if (line_slot(line) < 0) cycle
+        if (.not. any(file_mesh%ent(file_mesh%line_entity(line))%phys == file_mesh%phys_tag(phys))) cycle
+        slot = line_slot(line)
+        if (edge_count(slot) == 0) cycle          ! not an edge of the body's cells
+        if (edge_count(slot) > 1) then            ! inside the body: its nodes, once each
           do i = 1, 2
-            a = body_node(d%line_node(i, l))
-            if (on(a)) cycle
-            on(a) = .true.
-            ni = ni + 1
-            inner(ni) = a
+            a = body_node(file_mesh%line_node(i, line))
+            if (marked(a)) cycle
+            marked(a) = .true.
+            ninner = ninner + 1
+            inner(ninner) = a
           end do
           cycle
         end if
-        c = ecell(slot)
+        c = edge_cell(slot)
         nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
-        ne = ne + 1
-        edges(:, ne) = [mesh%cells(elocal(slot), c), mesh%cells(modulo(elocal(slot), nv) + 1, c)]
-        cells(ne) = c
+        nedge = nedge + 1
+        edges(:, nedge) = [mesh%cells(edge_local(slot), c), mesh%cells(modulo(edge_local(slot), nv) + 1, c)]
+        cells(nedge) = c
       end do
-      on(inner(1:ni)) = .false.
-      if (ne == 0 .and. ni == 0) cycle
-      ng = ng + 1
-      mesh%group(ng)%name = d%phys_name(p)%s
-      mesh%group(ng)%nedge = ne
-      mesh%group(ng)%edge = edges(:, 1:ne)
-      mesh%group(ng)%cell = cells(1:ne)
-      mesh%group(ng)%nnode = ni
-      mesh%group(ng)%node = inner(1:ni)
+      marked(inner(1:ninner)) = .false.
+      if (nedge == 0 .and. ninner == 0) cycle
+      ngroup = ngroup + 1
+      mesh%group(ngroup)%name = file_mesh%phys_name(phys)%s
+      mesh%group(ngroup)%nedge = nedge
+      mesh%group(ngroup)%edge = edges(:, 1:nedge)
+      mesh%group(ngroup)%cell = cells(1:nedge)
+      mesh%group(ngroup)%nnode = ninner
+      mesh%group(ngroup)%node = inner(1:ninner)
     end do
     mesh%file_groups = trim(adjustl(mesh%file_groups))
-    mesh%ngroup = ng
+    mesh%ngroup = ngroup
   end subroutine boundary_groups
 
   !> One node group per physical point with nodes in the body, after the edge groups (a
   !! physical point named as a physical curve adds its nodes to the curve's group); the
   !! points' names go to file_groups. A point's node is the body's if the body's cells have
   !! it; a node in no cell of the file is matched to the body's node at its place.
-  subroutine point_groups(d, body_node, mesh)
-    type(file_mesh_t), intent(in) :: d
+  subroutine point_groups(file_mesh, body_node, mesh)
+    type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
     logical, allocatable :: in_cell(:)
     integer, allocatable :: nodes(:)
-    integer :: p, l, n, nn, g, c, i
+    integer :: phys, point, n, nfound, group, c, i
     real(wp) :: tol
     character(len=:), allocatable :: names
 
     names = ''
-    allocate (nodes(d%npoint))
+    allocate (nodes(file_mesh%npoint))
     tol = 1.0e-9_wp*max(mesh%width, mesh%height)
-    do p = 1, d%nphys
-      if (d%phys_dim(p) /= 0) cycle
-      names = names//' '//d%phys_name(p)%s
-      nn = 0
-      do l = 1, d%npoint
-        if (d%point_entity(l) == 0) cycle
-        if (.not. any(d%ent(d%point_entity(l))%phys == d%phys_tag(p))) cycle
-        n = body_node(d%point_node(l))
+    do phys = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(phys) /= 0) cycle
+      names = names//' '//file_mesh%phys_name(phys)%s
+      nfound = 0
+      do point = 1, file_mesh%npoint
+        if (file_mesh%point_entity(point) == 0) cycle
+        if (.not. any(file_mesh%ent(file_mesh%point_entity(point))%phys == file_mesh%phys_tag(phys))) cycle
+        n = body_node(file_mesh%point_node(point))
         if (n == 0) then
           if (.not. allocated(in_cell)) then
-            allocate (in_cell(d%nnode))
+            allocate (in_cell(file_mesh%nnode))
             in_cell = .false.
-            do c = 1, d%ncell
+            do c = 1, file_mesh%ncell
               do i = 1, 4
-                if (d%cell_node(i, c) > 0) in_cell(d%cell_node(i, c)) = .true.
+                if (file_mesh%cell_node(i, c) > 0) in_cell(file_mesh%cell_node(i, c)) = .true.
               end do
             end do
           end if
-          if (.not. in_cell(d%point_node(l))) n = node_at(mesh, d%node_xy(:, d%point_node(l)), tol)
+          if (.not. in_cell(file_mesh%point_node(point))) n = node_at(mesh, file_mesh%node_xy(:, file_mesh%point_node(point)), tol)
         end if
         if (n == 0) cycle
-        if (any(nodes(1:nn) == n)) cycle
-        nn = nn + 1
-        nodes(nn) = n
+        if (any(nodes(1:nfound) == n)) cycle
+        nfound = nfound + 1
+        nodes(nfound) = n
       end do
-      if (nn == 0) cycle
-      g = 0
+      if (nfound == 0) cycle
+      group = 0
       do c = 1, mesh%ngroup
-        if (mesh%group(c)%name == d%phys_name(p)%s) g = c
+        if (mesh%group(c)%name == file_mesh%phys_name(phys)%s) group = c
       end do
-      if (g == 0) then
+      if (group == 0) then
         mesh%ngroup = mesh%ngroup + 1
-        g = mesh%ngroup
-        mesh%group(g)%name = d%phys_name(p)%s
-        mesh%group(g)%point = .true.
-        allocate (mesh%group(g)%edge(2, 0), mesh%group(g)%cell(0))
+        group = mesh%ngroup
+        mesh%group(group)%name = file_mesh%phys_name(phys)%s
+        mesh%group(group)%point = .true.
+        allocate (mesh%group(group)%edge(2, 0), mesh%group(group)%cell(0))
       end if
-      if (.not. allocated(mesh%group(g)%node)) allocate (mesh%group(g)%node(0))
-      mesh%group(g)%node = [mesh%group(g)%node, nodes(1:nn)]
-      mesh%group(g)%nnode = size(mesh%group(g)%node)
+      if (.not. allocated(mesh%group(group)%node)) allocate (mesh%group(group)%node(0))
+      mesh%group(group)%node = [mesh%group(group)%node, nodes(1:nfound)]
+      mesh%group(group)%nnode = size(mesh%group(group)%node)
     end do
     if (len(names) == 0) return
     if (len(mesh%file_groups) == 0) mesh%file_groups = '(none)'

@@ -55,14 +55,14 @@ module ordering
 
   !> The node graph of a general mesh, on local node numbers 1..na.
   type :: node_graph_t
-    integer, allocatable :: glob(:)       ! (na) the mesh node of each
-    real(wp), allocatable :: xyl(:, :)    ! (2, na) their coordinates
+    integer, allocatable :: mesh_node(:)      ! (na) the mesh node of each
+    real(wp), allocatable :: xy_local(:, :)   ! (2, na) their coordinates
     integer, allocatable :: xadj(:), adj(:)   ! neighbours (CSR, 0-based pointers)
-    integer, allocatable :: srt(:, :)     ! (na, 2) nodes sorted by x, by y
-    integer, allocatable :: lab(:)        ! partition labels
-    integer, allocatable :: tmp(:)        ! work array
-    integer, allocatable :: rank(:, :)    ! (na, 2) position of each node in srt(:, axis)
-    real(wp) :: emax(2) = 0.0_wp          ! the largest edge extent in x and y
+    integer, allocatable :: sorted(:, :)      ! (na, 2) nodes sorted by x, by y
+    integer, allocatable :: label(:)          ! partition labels
+    integer, allocatable :: work(:)           ! work array
+    integer, allocatable :: position(:, :)    ! (na, 2) position of each node in sorted(:, axis)
+    real(wp) :: edge_extent(2) = 0.0_wp       ! the largest edge extent in x and y
   end type node_graph_t
 
 contains
@@ -82,7 +82,7 @@ contains
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
-    type(order_t) :: ord
+    type(order_t) :: order
     integer :: nx1
     character(len=200) :: emsg
 
@@ -92,14 +92,14 @@ contains
         ' DOFs) does not belong to a ', nx, ' x ', ny, ' cell mesh.'
       info = ND_BAD_SYSTEM
     else
-      call start_order(n, last, ord, info, emsg)
+      call start_order(n, last, order, info, emsg)
     end if
     if (info == ND_OK) then
       nx1 = nx + 1
       call dissect(0, nx, 0, ny)
-      call finish_order(ord, info, emsg)
+      call finish_order(order, info, emsg)
     end if
-    call hand_over(ord, info, emsg, perm, msg)
+    call hand_over(order, info, emsg, perm, msg)
 
   contains
 
@@ -133,13 +133,13 @@ contains
       if (i1 - i0 <= j1 - j0) then
         do j = j0, j1
           do i = i0, i1
-            call emit_node(ord, free_of, n, 1 + i + j*nx1)
+            call emit_node(order, free_of, n, 1 + i + j*nx1)
           end do
         end do
       else
         do i = i0, i1
           do j = j0, j1
-            call emit_node(ord, free_of, n, 1 + i + j*nx1)
+            call emit_node(order, free_of, n, 1 + i + j*nx1)
           end do
         end do
       end if
@@ -160,29 +160,29 @@ contains
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
-    type(order_t) :: ord
-    type(node_graph_t) :: g
+    type(order_t) :: order
+    type(node_graph_t) :: graph
     integer :: n, stamp
     character(len=200) :: emsg
 
     emsg = ''
     n = size(dof_of)
     info = ND_BAD_SYSTEM
-    if (general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg)) call start_order(n, last, ord, info, emsg)
+    if (general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg)) call start_order(n, last, order, info, emsg)
     if (info == ND_OK) then
-      if (build_node_graph(xy, free_of, dof_of, colptr, rowind, n, ord%skip, g, emsg)) then
+      if (build_node_graph(xy, free_of, dof_of, colptr, rowind, n, order%skip, graph, emsg)) then
         stamp = 0
-        call bisect(1, size(g%srt, 1))
-        call finish_order(ord, info, emsg)
+        call bisect(1, size(graph%sorted, 1))
+        call finish_order(order, info, emsg)
       else
         info = ND_BAD_SYSTEM
       end if
     end if
-    call hand_over(ord, info, emsg, perm, msg)
+    call hand_over(order, info, emsg, perm, msg)
 
   contains
 
-    !> Order the (local) nodes g%srt(lo:hi, :) (the same set in both columns) by recursive
+    !> Order the (local) nodes graph%sorted(lo:hi, :) (the same set in both columns) by recursive
     !! coordinate bisection: cut across x or y (both are tried when neither extent is
     !! below half the other) at the median or at 40, 45, 55 or 60% of the nodes, keeping
     !! the cut with the smallest separator (the smaller set of nodes of one side with a
@@ -196,14 +196,14 @@ contains
 
       m = hi - lo + 1
       if (m <= 0) return
-      ext(1) = g%xyl(1, g%srt(hi, 1)) - g%xyl(1, g%srt(lo, 1))
-      ext(2) = g%xyl(2, g%srt(hi, 2)) - g%xyl(2, g%srt(lo, 2))
+      ext(1) = graph%xy_local(1, graph%sorted(hi, 1)) - graph%xy_local(1, graph%sorted(lo, 1))
+      ext(2) = graph%xy_local(2, graph%sorted(hi, 2)) - graph%xy_local(2, graph%sorted(lo, 2))
       axis = 1
       if (ext(2) > ext(1)) axis = 2
       if (m < RCB_LEAF_NODES .or. .not. ext(axis) > 0.0_wp) then
         ! a leaf: along the longer extent, the shorter one varying fastest
         do i = lo, hi
-          call emit_node(ord, free_of, n, g%glob(g%srt(i, axis)))
+          call emit_node(order, free_of, n, graph%mesh_node(graph%sorted(i, axis)))
         end do
         return
       end if
@@ -214,10 +214,10 @@ contains
       rset = stamp + 3
       sset = stamp + 4
       stamp = stamp + 4
-      g%lab(g%srt(lo:hi, 1)) = seg
+      graph%label(graph%sorted(lo:hi, 1)) = seg
       do a = 1, 2
         do i = lo, hi
-          g%rank(g%srt(i, a), a) = i
+          graph%position(graph%sorted(i, a), a) = i
         end do
       end do
       best = huge(1)
@@ -243,14 +243,14 @@ contains
       end do
       if (best_p == 0) then                  ! no cut possible (cannot happen: ext > 0)
         do i = lo, hi
-          call emit_node(ord, free_of, n, g%glob(g%srt(i, axis)))
+          call emit_node(order, free_of, n, graph%mesh_node(graph%sorted(i, axis)))
         end do
         return
       end if
       axis = best_ax
       p = best_p
-      g%lab(g%srt(lo:p - 1, axis)) = lset
-      g%lab(g%srt(p:hi, axis)) = rset
+      graph%label(graph%sorted(lo:p - 1, axis)) = lset
+      graph%label(graph%sorted(p:hi, axis)) = rset
       if (best_side < 0) then
         ns = touching(p - 1, lo, -1, axis, p, sset)
       else
@@ -262,47 +262,47 @@ contains
         k = lo - 1
         do lbl = lset, sset
           do i = lo, hi
-            if (g%lab(g%srt(i, a)) == lbl) then
+            if (graph%label(graph%sorted(i, a)) == lbl) then
               k = k + 1
-              g%tmp(k) = g%srt(i, a)
+              graph%work(k) = graph%sorted(i, a)
             end if
           end do
           if (a == 1 .and. lbl == lset) nl = k - lo + 1
           if (a == 1 .and. lbl == rset) nr = k - lo + 1 - nl
         end do
-        g%srt(lo:hi, a) = g%tmp(lo:hi)
+        graph%sorted(lo:hi, a) = graph%work(lo:hi)
       end do
 
       call bisect(lo, lo + nl - 1)
       call bisect(lo + nl, lo + nl + nr - 1)
       ! the separator, along its length (sorted by the other coordinate)
       do i = lo + nl + nr, hi
-        call emit_node(ord, free_of, n, g%glob(g%srt(i, 3 - axis)))
+        call emit_node(order, free_of, n, graph%mesh_node(graph%sorted(i, 3 - axis)))
       end do
     end subroutine bisect
 
-    !> The first position of the right side of a cut of g%srt(lo:hi, axis) near position
-    !! mid: right = coordinate >= v = that of g%srt(mid), or > v when v is the least.
+    !> The first position of the right side of a cut of graph%sorted(lo:hi, axis) near position
+    !! mid: right = coordinate >= v = that of graph%sorted(mid), or > v when v is the least.
     integer function cut_at(lo, hi, axis, mid) result(p)
       integer, intent(in) :: lo, hi, axis, mid
       real(wp) :: v
-      v = g%xyl(axis, g%srt(mid, axis))
+      v = graph%xy_local(axis, graph%sorted(mid, axis))
       p = mid
       do while (p > lo)
-        if (g%xyl(axis, g%srt(p - 1, axis)) < v) exit
+        if (graph%xy_local(axis, graph%sorted(p - 1, axis)) < v) exit
         p = p - 1
       end do
       if (p == lo) then
         p = mid + 1
         do while (p <= hi)
-          if (g%xyl(axis, g%srt(p, axis)) > v) exit
+          if (graph%xy_local(axis, graph%sorted(p, axis)) > v) exit
           p = p + 1
         end do
       end if
     end function cut_at
 
-    !> For the cut of the current set (label seg) before position p of g%srt(:, axis): how
-    !! many of the nodes g%srt(i0, axis), g%srt(i0 + step, axis), ... (towards i1, from the
+    !> For the cut of the current set (label seg) before position p of graph%sorted(:, axis): how
+    !! many of the nodes graph%sorted(i0, axis), graph%sorted(i0 + step, axis), ... (towards i1, from the
     !! cut outwards, stopping one edge extent away from it) have a neighbour on the other
     !! side; with sep > 0 those nodes are labelled sep (the separator).
     integer function touching(i0, i1, step, axis, p, sep) result(cnt)
@@ -311,24 +311,24 @@ contains
       real(wp) :: cut
       cnt = 0
       if ((i1 - i0)*step < 0) return
-      seg = g%lab(g%srt(i0, axis))
+      seg = graph%label(graph%sorted(i0, axis))
       if (sep > 0) seg = -1                  ! labels already split: the other side is lset/rset
-      cut = g%xyl(axis, g%srt(i0, axis))
+      cut = graph%xy_local(axis, graph%sorted(i0, axis))
       do i = i0, i1, step
-        node = g%srt(i, axis)
-        if (abs(g%xyl(axis, node) - cut) > g%emax(axis)) exit
-        do kk = g%xadj(node) + 1, g%xadj(node + 1)
-          nb = g%adj(kk)
+        node = graph%sorted(i, axis)
+        if (abs(graph%xy_local(axis, node) - cut) > graph%edge_extent(axis)) exit
+        do kk = graph%xadj(node) + 1, graph%xadj(node + 1)
+          nb = graph%adj(kk)
           if (sep > 0) then
-            if (g%lab(nb) /= sep - 2 .and. g%lab(nb) /= sep - 1) cycle   ! not in this set
-            if (g%lab(nb) == sep - 2 .eqv. step > 0) then
+            if (graph%label(nb) /= sep - 2 .and. graph%label(nb) /= sep - 1) cycle   ! not in this set
+            if (graph%label(nb) == sep - 2 .eqv. step > 0) then
               cnt = cnt + 1
-              g%lab(node) = sep
+              graph%label(node) = sep
               exit
             end if
           else
-            if (g%lab(nb) /= seg) cycle
-            if ((g%rank(nb, axis) < p) .eqv. step > 0) then
+            if (graph%label(nb) /= seg) cycle
+            if ((graph%position(nb, axis) < p) .eqv. step > 0) then
               cnt = cnt + 1
               exit
             end if
@@ -341,52 +341,52 @@ contains
 
   !> Check `last` (in 1..n, no repeats: else ND_BAD_LAST with a sentence) and start an
   !! empty order of n - size(last) DOFs.
-  subroutine start_order(n, last, ord, info, emsg)
+  subroutine start_order(n, last, order, info, emsg)
     integer, intent(in) :: n, last(:)
-    type(order_t), intent(out) :: ord
+    type(order_t), intent(out) :: order
     integer, intent(out) :: info
     character(len=*), intent(inout) :: emsg
     integer :: k
     info = ND_OK
-    allocate (ord%skip(max(n, 0)))
-    ord%skip = .false.
+    allocate (order%skip(max(n, 0)))
+    order%skip = .false.
     do k = 1, size(last)
       if (last(k) < 1 .or. last(k) > n) then
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
         info = ND_BAD_LAST
         return
-      else if (ord%skip(last(k))) then
+      else if (order%skip(last(k))) then
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
         info = ND_BAD_LAST
         return
       end if
-      ord%skip(last(k)) = .true.
+      order%skip(last(k)) = .true.
     end do
-    allocate (ord%perm(n - size(last)))
+    allocate (order%perm(n - size(last)))
   end subroutine start_order
 
   !> Every DOF placed exactly once, else free_of is not a bijection onto 1..n: ND_BAD_SYSTEM.
-  subroutine finish_order(ord, info, emsg)
-    type(order_t), intent(in) :: ord
+  subroutine finish_order(order, info, emsg)
+    type(order_t), intent(in) :: order
     integer, intent(inout) :: info
     character(len=*), intent(inout) :: emsg
-    if (ord%bad_map .or. ord%pos /= size(ord%perm)) then
-      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', ord%pos, ' DOFs but expected ', size(ord%perm), &
+    if (order%bad_map .or. order%pos /= size(order%perm)) then
+      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', order%pos, ' DOFs but expected ', size(order%perm), &
         ' (inconsistent free-DOF map).'
       info = ND_BAD_SYSTEM
     end if
   end subroutine finish_order
 
   !> The result: the order, or on failure an empty perm and the sentence in msg.
-  subroutine hand_over(ord, info, emsg, perm, msg)
-    type(order_t), intent(inout) :: ord
+  subroutine hand_over(order, info, emsg, perm, msg)
+    type(order_t), intent(inout) :: order
     integer, intent(in) :: info
     character(len=*), intent(in) :: emsg
     integer, allocatable, intent(out) :: perm(:)
     character(len=*), intent(out), optional :: msg
     if (present(msg)) msg = ''
     if (info == ND_OK) then
-      call move_alloc(ord%perm, perm)
+      call move_alloc(order%perm, perm)
     else
       allocate (perm(0))
       if (present(msg)) msg = emsg
@@ -394,20 +394,20 @@ contains
   end subroutine hand_over
 
   !> Append the free, non-skipped DOFs of one node (x then y).
-  subroutine emit_node(ord, free_of, n, node)
-    type(order_t), intent(inout) :: ord
+  subroutine emit_node(order, free_of, n, node)
+    type(order_t), intent(inout) :: order
     integer, intent(in) :: free_of(:), n, node
     integer :: c, f
     do c = 1, 2
       f = free_of(2*(node - 1) + c)
       if (f <= 0) cycle
       if (f > n) then
-        ord%bad_map = .true.
+        order%bad_map = .true.
         cycle
       end if
-      if (ord%skip(f)) cycle
-      ord%pos = ord%pos + 1
-      if (ord%pos <= size(ord%perm)) ord%perm(ord%pos) = f
+      if (order%skip(f)) cycle
+      order%pos = order%pos + 1
+      if (order%pos <= size(order%perm)) order%perm(order%pos) = f
     end do
   end subroutine emit_node
 
@@ -436,16 +436,16 @@ contains
   end function general_arrays_ok
 
   !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
-  !! `last`) renumbered 1..na by increasing x (g%glob: local -> mesh node, so that the
-  !! graph sweeps touch memory in order), their coordinates g%xyl, their neighbours
-  !! through the stiffness (g%xadj, g%adj; both DOFs merged, DOFs in `last` left out), the
-  !! largest edge extents g%emax, the nodes sorted by x (g%srt(:,1)) and by y (g%srt(:,2)).
+  !! `last`) renumbered 1..na by increasing x (graph%mesh_node: local -> mesh node, so that the
+  !! graph sweeps touch memory in order), their coordinates graph%xy_local, their neighbours
+  !! through the stiffness (graph%xadj, graph%adj; both DOFs merged, DOFs in `last` left out), the
+  !! largest edge extents graph%edge_extent, the nodes sorted by x (graph%sorted(:,1)) and by y (graph%sorted(:,2)).
   !! .false. with a sentence in emsg on a pattern or DOF map out of range.
-  logical function build_node_graph(xy, free_of, dof_of, colptr, rowind, n, skip, g, emsg) result(ok)
+  logical function build_node_graph(xy, free_of, dof_of, colptr, rowind, n, skip, graph, emsg) result(ok)
     real(wp), intent(in) :: xy(:, :)
     integer, intent(in) :: free_of(:), dof_of(:), colptr(:), rowind(:), n
     logical, intent(in) :: skip(:)
-    type(node_graph_t), intent(out) :: g
+    type(node_graph_t), intent(out) :: graph
     character(len=*), intent(inout) :: emsg
     integer, allocatable :: mark(:), loc(:)
     integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
@@ -464,20 +464,21 @@ contains
       if (.not. skip(p)) active((dof_of(p) + 1)/2) = .true.
     end do
     na = count(active)
-    allocate (g%srt(na, 2), g%tmp(na), g%lab(na), mark(na), g%xadj(na + 1), g%xyl(2, na), g%rank(na, 2))
-    g%glob = pack([(node, node=1, nn)], active)
-    call sort_nodes(g%glob, 1, xy)
+    allocate (graph%sorted(na, 2), graph%work(na), graph%label(na), mark(na), graph%xadj(na + 1), &
+              graph%xy_local(2, na), graph%position(na, 2))
+    graph%mesh_node = pack([(node, node=1, nn)], active)
+    call sort_nodes(graph%mesh_node, 1, xy)
     loc = 0
-    loc(g%glob) = [(i, i=1, na)]
-    g%xyl = xy(:, g%glob)
-    g%lab = 0
+    loc(graph%mesh_node) = [(i, i=1, na)]
+    graph%xy_local = xy(:, graph%mesh_node)
+    graph%label = 0
 
     do pass = 1, 2            ! 1: count the neighbours, 2: store them
       mark = 0
-      g%xadj(1) = 0
+      graph%xadj(1) = 0
       do i = 1, na
-        node = g%glob(i)
-        cnt = g%xadj(i)
+        node = graph%mesh_node(i)
+        cnt = graph%xadj(i)
         do c = 1, 2
           p = free_of(2*(node - 1) + c)
           if (p < 1 .or. p > n) cycle
@@ -495,29 +496,29 @@ contains
             if (mark(nb) == i) cycle
             mark(nb) = i
             cnt = cnt + 1
-            if (pass == 2) g%adj(cnt) = nb
+            if (pass == 2) graph%adj(cnt) = nb
           end do
         end do
         if (pass == 1) then
-          g%xadj(i + 1) = cnt
-        else if (cnt /= g%xadj(i + 1)) then
+          graph%xadj(i + 1) = cnt
+        else if (cnt /= graph%xadj(i + 1)) then
           emsg = 'nested dissection: internal error building the node graph.'
           return
         end if
       end do
-      if (pass == 1) allocate (g%adj(g%xadj(na + 1)))
+      if (pass == 1) allocate (graph%adj(graph%xadj(na + 1)))
     end do
 
-    g%emax = 0.0_wp
+    graph%edge_extent = 0.0_wp
     do i = 1, na
-      do kk = g%xadj(i) + 1, g%xadj(i + 1)
-        g%emax = max(g%emax, abs(g%xyl(:, g%adj(kk)) - g%xyl(:, i)))
+      do kk = graph%xadj(i) + 1, graph%xadj(i + 1)
+        graph%edge_extent = max(graph%edge_extent, abs(graph%xy_local(:, graph%adj(kk)) - graph%xy_local(:, i)))
       end do
     end do
-    g%emax = g%emax*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
-    g%srt(:, 1) = [(i, i=1, na)]
-    g%srt(:, 2) = g%srt(:, 1)
-    call sort_nodes(g%srt(:, 2), 2, g%xyl)
+    graph%edge_extent = graph%edge_extent*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
+    graph%sorted(:, 1) = [(i, i=1, na)]
+    graph%sorted(:, 2) = graph%sorted(:, 1)
+    call sort_nodes(graph%sorted(:, 2), 2, graph%xy_local)
     ok = .true.
   end function build_node_graph
 
