@@ -83,7 +83,7 @@ contains
     !> the body's contact group (&contact body1_group/body2_group), kept clear of fixing
     !! DOFs when the body is held only by contact (a rectangle's 'contact' side is too)
     character(len=*), intent(in), optional :: contact_group
-    logical, allocatable :: pres(:)
+    logical, allocatable :: prescribed(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
 
@@ -95,13 +95,13 @@ contains
     if (info /= 0) return
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
 
-    call prescribed_dofs(mesh, body, pres, sys, u_prescribed)
+    call prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
     if (present(boundaries)) then
-      call group_conditions(mesh, body%id, boundaries, pres, sys, info, msg)
+      call group_conditions(mesh, body%id, boundaries, prescribed, sys, info, msg)
       if (info /= 0) return
     end if
     ! rigid motions the supports leave free: a body held only by contact
-    call rigid_kernel(mesh, pres, sys, info)
+    call rigid_kernel(mesh, prescribed, sys, info)
     if (info /= 0) then
       info = 3
       write (msg, '(a,i0,a)') 'body ', body%id, ': LAPACK dsyev failed on the 3 x 3 Gram matrix of its '// &
@@ -109,10 +109,10 @@ contains
       return
     end if
     if (sys%nrig > 0) then
-      call choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
+      call choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
       if (info /= 0) return
     end if
-    call number_free_dofs(pres, sys)
+    call number_free_dofs(prescribed, sys)
     if (with_k) then
       call build_pattern(mesh, sys, info, msg)
       if (info /= 0) return

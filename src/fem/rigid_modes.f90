@@ -21,11 +21,11 @@ contains
   !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
   !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
   !! sys%rig (ndof x nrig, zero at prescribed DOFs).
-  subroutine rigid_kernel(mesh, pres, sys, info)
-    type(mesh_t), intent(in) :: mesh
-    logical, intent(in) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info                 !< /= 0: dsyev failed
+  subroutine rigid_kernel(mesh, prescribed, sys, info)
+    type(mesh_t), intent(in) :: mesh           !< the body's mesh
+    logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys  !< gets nrig, rig, rig_coef, rig_xc, rig_h
+    integer, intent(out) :: info               !< /= 0: dsyev failed
     real(wp) :: g(3, 3), r(3), ev(3), work(64), top
     integer :: k, cc, j, lapinfo, nk
 
@@ -34,7 +34,7 @@ contains
     g = 0.0_wp
     do k = 1, mesh%nnode
       do cc = 1, 2
-        if (.not. pres(2*(k - 1) + cc)) cycle
+        if (.not. prescribed(2*(k - 1) + cc)) cycle
         r = rigid_row(sys, mesh%xy(:, k), cc)
         do j = 1, 3
           g(:, j) = g(:, j) + r*r(j)
@@ -61,7 +61,7 @@ contains
     do j = 1, nk
       do k = 1, mesh%nnode
         do cc = 1, 2
-          if (pres(2*(k - 1) + cc)) then
+          if (prescribed(2*(k - 1) + cc)) then
             sys%rig(2*(k - 1) + cc, j) = 0.0_wp
           else
             sys%rig(2*(k - 1) + cc, j) = dot_product(rigid_row(sys, mesh%xy(:, k), cc), sys%rig_coef(:, j))
@@ -98,8 +98,8 @@ contains
   !> The rigid motion with coefficients c (basis of rigid_kernel) in words: 'translation
   !! along x', 'translation along (0.6, 0.8)', 'rotation about (x0, y0)'.
   function rigid_motion_name(sys, c) result(s)
-    type(body_system_t), intent(in) :: sys
-    real(wp), intent(in) :: c(3)
+    type(body_system_t), intent(in) :: sys  !< the body's system (rig_xc, rig_h)
+    real(wp), intent(in) :: c(3)            !< coefficients in the basis of rigid_kernel
     character(len=:), allocatable :: s
     character(len=64) :: buf
     real(wp) :: w, t(2)
@@ -127,15 +127,15 @@ contains
   !! contact (the contact group, or a rectangle's 'contact' side), on which the kernel is
   !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
   !! and the node farthest from that one) for the largest |det| of the kernel restricted to
-  !! them. They are prescribed to 0 (pres) for the factorization only.
-  subroutine choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
-    type(mesh_t), intent(in) :: mesh
-    type(body_cfg_t), intent(in) :: body
-    logical, intent(inout) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
-    character(len=*), intent(in), optional :: contact_group
+  !! them. They are prescribed to 0 (prescribed) for the factorization only.
+  subroutine choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
+    type(mesh_t), intent(in) :: mesh                         !< the body's mesh
+    type(body_cfg_t), intent(in) :: body                     !< its id and side conditions
+    logical, intent(inout) :: prescribed(:)                  !< (ndof) the fixing DOFs are added
+    type(body_system_t), intent(inout) :: sys                !< gets fixing; its u_fixed is 0 there
+    integer, intent(out) :: info                             !< 0, or 1 when no fixing DOFs are found
+    character(len=*), intent(out) :: msg                     !< the failure, naming the body
+    character(len=*), intent(in), optional :: contact_group  !< the body's contact group, kept clear
     logical, allocatable :: avoid(:)
     integer, allocatable :: nodes(:)
     integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
@@ -172,7 +172,7 @@ contains
     p = 0
     dbest = huge(1.0_wp)
     do k = 1, mesh%nnode
-      if (avoid(k) .or. (pres(2*k - 1) .and. pres(2*k))) cycle
+      if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
       d = norm2(mesh%xy(:, k) - ctr)
       if (d < dbest) then
         dbest = d
@@ -188,7 +188,7 @@ contains
     end if
     dbest = -1.0_wp
     do k = 1, mesh%nnode
-      if (avoid(k) .or. (pres(2*k - 1) .and. pres(2*k))) cycle
+      if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
       d = norm2(mesh%xy(:, k) - mesh%xy(:, p(1)))
       if (d > dbest) then
         dbest = d
@@ -199,7 +199,7 @@ contains
     do i = 1, 2
       do j = 1, 2
         k = 2*(p(i) - 1) + j
-        if (.not. pres(k) .and. .not. any(cand(1:nc) == k)) then
+        if (.not. prescribed(k) .and. .not. any(cand(1:nc) == k)) then
           nc = nc + 1
           cand(nc) = k
         end if
@@ -233,7 +233,7 @@ contains
     end if
     allocate (sys%fixing(r))
     sys%fixing = best(1:r)
-    pres(sys%fixing) = .true.
+    prescribed(sys%fixing) = .true.
     sys%u_fixed(sys%fixing) = 0.0_wp
   end subroutine choose_fixing
 

@@ -48,10 +48,10 @@ contains
   !! rows sorted in every column, from the node stencil of the grid. info = 6 when the
   !! number of entries does not fit 32-bit indices.
   subroutine build_pattern(mesh, sys, info, msg)
-    type(mesh_t), intent(in) :: mesh
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(mesh_t), intent(in) :: mesh           !< the body's mesh
+    type(body_system_t), intent(inout) :: sys  !< with its DOF numbering; gets colptr, rowind, val = 0
+    integer, intent(out) :: info               !< 0, or 6 when the pattern is too large
+    character(len=*), intent(out) :: msg       !< the failure, naming the body
     integer :: p, s, cc, q, pos, nnbr
     integer(i8) :: nnz
     integer, allocatable :: aptr(:), adj(:), nbr(:)

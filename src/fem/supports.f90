@@ -13,23 +13,23 @@ module supports
 
 contains
 
-  !> Which DOFs the side conditions prescribe (`pres`), and their values (sys%ndof,
+  !> Which DOFs the side conditions prescribe (`prescribed`), and their values (sys%ndof,
   !! sys%u_fixed). Sides are visited in SIDE_* order; a corner shared by two sides gets
   !! the union of their constraints, and where both prescribe the same component with
   !! different values the later side in SIDE_* order (left, right, bottom, top) wins.
   !! `u_prescribed`, where given, replaces the values at every prescribed DOF.
-  subroutine prescribed_dofs(mesh, body, pres, sys, u_prescribed)
-    type(mesh_t), intent(in) :: mesh
-    type(body_cfg_t), intent(in) :: body
-    logical, allocatable, intent(out) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    real(wp), intent(in), optional :: u_prescribed(:)
+  subroutine prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
+    type(mesh_t), intent(in) :: mesh                    !< the body's mesh
+    type(body_cfg_t), intent(in) :: body                !< its side conditions (bc, u_side)
+    logical, allocatable, intent(out) :: prescribed(:)  !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys           !< gets ndof and u_fixed
+    real(wp), intent(in), optional :: u_prescribed(:)   !< (ndof) values replacing the side values [length]
     integer, allocatable :: nodes(:)
     integer :: side, k, cc
 
     sys%ndof = 2*mesh%nnode
-    allocate (pres(sys%ndof), sys%u_fixed(sys%ndof))
-    pres = .false.
+    allocate (prescribed(sys%ndof), sys%u_fixed(sys%ndof))
+    prescribed = .false.
     sys%u_fixed = 0.0_wp
     do side = 1, 4
       call side_nodes(mesh, side, nodes)
@@ -37,7 +37,7 @@ contains
       case (BC_CLAMPED)
         do k = 1, size(nodes)
           do cc = 1, 2
-            pres(2*(nodes(k) - 1) + cc) = .true.
+            prescribed(2*(nodes(k) - 1) + cc) = .true.
             sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
           end do
         end do
@@ -45,13 +45,13 @@ contains
         cc = 1
         if (side == SIDE_BOTTOM .or. side == SIDE_TOP) cc = 2
         do k = 1, size(nodes)
-          pres(2*(nodes(k) - 1) + cc) = .true.
+          prescribed(2*(nodes(k) - 1) + cc) = .true.
           sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
         end do
       case (BC_DISPLACEMENT)
         do k = 1, size(nodes)
           do cc = 1, 2
-            pres(2*(nodes(k) - 1) + cc) = .true.
+            prescribed(2*(nodes(k) - 1) + cc) = .true.
             sys%u_fixed(2*(nodes(k) - 1) + cc) = body%u_side(cc, side)
           end do
         end do
@@ -59,21 +59,21 @@ contains
       end select
     end do
     if (present(u_prescribed)) then
-      where (pres) sys%u_fixed = u_prescribed
+      where (prescribed) sys%u_fixed = u_prescribed
     end if
   end subroutine prescribed_dofs
 
   !> The &boundary conditions of this body: the components given are prescribed on every
   !! node of the group (a later condition overrides an earlier value). info = 1 when the
   !! group is not one of the body's.
-  subroutine group_conditions(mesh, body_id, boundaries, pres, sys, info, msg)
-    type(mesh_t), intent(in) :: mesh
-    integer, intent(in) :: body_id
-    type(boundary_cfg_t), intent(in) :: boundaries(:)
-    logical, intent(inout) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+  subroutine group_conditions(mesh, body_id, boundaries, prescribed, sys, info, msg)
+    type(mesh_t), intent(in) :: mesh                   !< the body's mesh
+    integer, intent(in) :: body_id                     !< the body (conditions of the other are skipped)
+    type(boundary_cfg_t), intent(in) :: boundaries(:)  !< the deck's &boundary conditions
+    logical, intent(inout) :: prescribed(:)            !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys          !< its u_fixed gets the values
+    integer, intent(out) :: info                       !< 0, or 1 on an unknown group
+    character(len=*), intent(out) :: msg               !< the failure, naming the condition
     integer :: i, g, k, cc, dof
     integer, allocatable :: nodes(:)
 
@@ -92,7 +92,7 @@ contains
         do cc = 1, 2
           if (.not. boundaries(i)%fix(cc)) cycle
           dof = 2*(nodes(k) - 1) + cc
-          pres(dof) = .true.
+          prescribed(dof) = .true.
           sys%u_fixed(dof) = boundaries(i)%u(cc)
         end do
       end do
@@ -101,8 +101,8 @@ contains
 
   !> The sentence for a group name the body's mesh does not have.
   function unknown_group(mesh, name) result(s)
-    type(mesh_t), intent(in) :: mesh
-    character(len=*), intent(in) :: name
+    type(mesh_t), intent(in) :: mesh      !< the body's mesh
+    character(len=*), intent(in) :: name  !< the group name it lacks
     character(len=:), allocatable :: s, src
     src = 'the rectangle'
     if (allocated(mesh%source)) then
@@ -117,15 +117,15 @@ contains
 
   !> Number the DOFs that are not prescribed 1..n in increasing global order
   !! (sys%n, sys%free_of, sys%dof_of).
-  subroutine number_free_dofs(pres, sys)
-    logical, intent(in) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
+  subroutine number_free_dofs(prescribed, sys)
+    logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys  !< gets n, free_of, dof_of
     integer :: k, n
 
     allocate (sys%free_of(sys%ndof))
     n = 0
     do k = 1, sys%ndof
-      if (pres(k)) then
+      if (prescribed(k)) then
         sys%free_of(k) = 0
       else
         n = n + 1
