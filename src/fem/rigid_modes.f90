@@ -160,10 +160,8 @@ contains
       end if
     end if
     ! the first node: the closest to the contact's centroid off the contact (the centre when
-    ! there is none). Near the contact, K^+'s contact displacements are measured from a near
-    ! point: small, so the rigid part R alpha does not cancel a large pinned deformation (a
-    ! fixing node far from the contact left a soft floating body on a 1e6 stiffer one
-    ! stalling at a residual of 1.4e-7; near it, converged at 7.7e-8, and fewer products)
+    ! there is none), so that K^+'s contact displacements are measured from a near point and
+    ! stay small (the rigid part R alpha then does not cancel a large pinned deformation)
     ctr = sys%rig_xc
     if (any(avoid)) then
       ctr(1) = sum(mesh%xy(1, :), mask=avoid)/count(avoid)
