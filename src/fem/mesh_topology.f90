@@ -120,7 +120,7 @@ contains
     character(len=:), allocatable, intent(out) :: err   !< the failure, when info /= 0
     integer :: surface, k, c, nsurf, ncell, st, nquad
     logical, allocatable :: in_entity(:)
-    integer, allocatable :: cell_of(:), body_node(:), order(:)
+    integer, allocatable :: file_cell(:), body_node(:), order(:)
     character(len=:), allocatable :: surfaces
 
     info = 0
@@ -160,8 +160,8 @@ contains
     do k = 1, file_mesh%nent
       if (surface > 0) in_entity(k) = file_mesh%ent(k)%dim == 2 .and. any(file_mesh%ent(k)%phys == file_mesh%phys_tag(surface))
     end do
-    cell_of = pack([(c, c=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
-    ncell = size(cell_of)
+    file_cell = pack([(c, c=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
+    ncell = size(file_cell)
     if (ncell == 0) then
       if (surface > 0) then
         call refuse(info, err, "physical surface '"//file_mesh%phys_name(surface)%s//"' has no triangles or quadrangles")
@@ -180,7 +180,7 @@ contains
     body_node = 0
     do k = 1, ncell
       do c = 1, 4
-        if (file_mesh%cell_node(c, cell_of(k)) > 0) body_node(file_mesh%cell_node(c, cell_of(k))) = 1
+        if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
       end do
     end do
     order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
@@ -194,7 +194,7 @@ contains
     end do
 
     ! its cells
-    nquad = count(file_mesh%cell_node(4, cell_of) > 0)
+    nquad = count(file_mesh%cell_node(4, file_cell) > 0)
     mesh%ncell = ncell
     mesh%nvert = merge(4, 3, nquad > 0)
     if (nquad == ncell) then
@@ -207,7 +207,7 @@ contains
     allocate (mesh%cells(mesh%nvert, ncell), mesh%cell_type(ncell), mesh%cell_tag(ncell))
     mesh%cells = 0
     do k = 1, ncell
-      c = cell_of(k)
+      c = file_cell(k)
       mesh%cell_tag(k) = file_mesh%cell_tag(c)
       if (file_mesh%cell_node(4, c) > 0) then
         mesh%cell_type(k) = ELEM_Q1
