@@ -20,7 +20,8 @@ module body_system
     integer, allocatable :: rowind(:)         !< (nnz) 0-based row indices, sorted within each column
     real(wp), allocatable :: val(:)           !< (nnz) stiffness entries [stress] (force/length per unit thickness)
     real(wp), allocatable :: f(:)             !< (n) load on free dofs incl. the lifting -K_fd u_d [force]
-    real(wp), allocatable :: f_applied(:)     !< (ndof) applied nodal loads (tractions, optional body force), all dofs [force]
+    !> (ndof) applied nodal loads (tractions, optional body force), all dofs [force]
+    real(wp), allocatable :: f_applied(:)
     real(wp) :: k_norm = 0.0_wp               !< max abs row sum of K (infinity norm) [stress]
     !> A body whose prescribed displacements leave rigid motions free (held only by
     !! contact, README "Bodies held only by contact"): nrig > 0 kernel vectors R of K, and

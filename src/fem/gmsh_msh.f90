@@ -237,7 +237,8 @@ contains
         return
       end if
       q = 0
-      if (scanner%text(scanner%pos:scanner%pos) == '"') q = scan(scanner%text(scanner%pos + 1:min(scanner%n, scanner%pos + 1024)), '"'//achar(10))
+      if (scanner%text(scanner%pos:scanner%pos) == '"') &
+        q = scan(scanner%text(scanner%pos + 1:min(scanner%n, scanner%pos + 1024)), '"'//achar(10))
       if (q == 0) then
         call scan_fail(scanner, 'a physical name must be in double quotes on one line')
         return
@@ -289,7 +290,8 @@ contains
           file_mesh%ent(file_mesh%nent)%tag = tag
           call move_alloc(phys, file_mesh%ent(file_mesh%nent)%phys)
           do j = 1, np        ! physical groups without a name are named by their tag
-            call add_physical(file_mesh, dim, file_mesh%ent(file_mesh%nent)%phys(j), i2s(file_mesh%ent(file_mesh%nent)%phys(j)))
+            call add_physical(file_mesh, dim, file_mesh%ent(file_mesh%nent)%phys(j), &
+                              i2s(file_mesh%ent(file_mesh%nent)%phys(j)))
           end do
         else
           deallocate (phys)
@@ -361,7 +363,8 @@ contains
       file_mesh%nnode = first + nb
     end do
     if (file_mesh%nnode /= ntotal) then
-      call scan_fail(scanner, 'the node blocks hold '//i2s(file_mesh%nnode)//' nodes, not the '//i2s(ntotal)//' announced')
+      call scan_fail(scanner, 'the node blocks hold '//i2s(file_mesh%nnode)//' nodes, not the '//i2s(ntotal)// &
+                     ' announced')
       return
     end if
     call expect(scanner, '$EndNodes')
@@ -380,8 +383,9 @@ contains
     k = get_int(scanner, 'the largest element tag')
     if (scanner%info /= 0) return
     ! sized for the worst case; the lines are a small part of a 2D mesh but bounded by ntotal too
-    allocate (file_mesh%cell_tag(ntotal), file_mesh%cell_entity(ntotal), file_mesh%cell_node(4, ntotal), file_mesh%line_entity(ntotal), &
-              file_mesh%line_node(2, ntotal), file_mesh%point_entity(ntotal), file_mesh%point_node(ntotal), stat=st)
+    allocate (file_mesh%cell_tag(ntotal), file_mesh%cell_entity(ntotal), file_mesh%cell_node(4, ntotal), &
+              file_mesh%line_entity(ntotal), file_mesh%line_node(2, ntotal), file_mesh%point_entity(ntotal), &
+              file_mesh%point_node(ntotal), stat=st)
     if (st /= 0) then
       call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
       return

@@ -64,7 +64,8 @@ contains
     integer, allocatable :: idim(:), itag(:)
     type(name_t), allocatable :: nm(:)
     integer :: k
-    if (.not. allocated(file_mesh%phys_dim)) allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
+    if (.not. allocated(file_mesh%phys_dim)) &
+      allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
     do k = 1, file_mesh%nphys
       if (file_mesh%phys_dim(k) == dim .and. file_mesh%phys_tag(k) == tag) return
     end do
@@ -158,13 +159,15 @@ contains
     allocate (in_entity(0:file_mesh%nent))
     in_entity = surface == 0
     do k = 1, file_mesh%nent
-      if (surface > 0) in_entity(k) = file_mesh%ent(k)%dim == 2 .and. any(file_mesh%ent(k)%phys == file_mesh%phys_tag(surface))
+      if (surface > 0) in_entity(k) = file_mesh%ent(k)%dim == 2 .and. &
+                                      any(file_mesh%ent(k)%phys == file_mesh%phys_tag(surface))
     end do
     file_cell = pack([(c, c=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
     ncell = size(file_cell)
     if (ncell == 0) then
       if (surface > 0) then
-        call refuse(info, err, "physical surface '"//file_mesh%phys_name(surface)%s//"' has no triangles or quadrangles")
+        call refuse(info, err, "physical surface '"//file_mesh%phys_name(surface)%s// &
+                    "' has no triangles or quadrangles")
       else
         call refuse(info, err, 'has no triangles or quadrangles')
       end if
@@ -333,7 +336,8 @@ contains
     end do
 
     mesh%file_groups = ''
-    allocate (mesh%group(count(file_mesh%phys_dim(1:file_mesh%nphys) == 1 .or. file_mesh%phys_dim(1:file_mesh%nphys) == 0)))  ! room for points
+    ! room for the curves' and the points' groups
+    allocate (mesh%group(count(file_mesh%phys_dim(1:file_mesh%nphys) == 1 .or. file_mesh%phys_dim(1:file_mesh%nphys) == 0)))
     ngroup = 0
     do phys = 1, file_mesh%nphys
       if (file_mesh%phys_dim(phys) /= 1) cycle
@@ -410,7 +414,8 @@ contains
               end do
             end do
           end if
-          if (.not. in_cell(file_mesh%point_node(point))) n = node_at(mesh, file_mesh%node_xy(:, file_mesh%point_node(point)), tol)
+          if (.not. in_cell(file_mesh%point_node(point))) &
+            n = node_at(mesh, file_mesh%node_xy(:, file_mesh%point_node(point)), tol)
         end if
         if (n == 0) cycle
         if (any(nodes(1:nfound) == n)) cycle
