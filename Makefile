@@ -65,7 +65,7 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings sorting sysinfo signals mpi_env config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
+MODS := kinds errors clock strings int_hash text_scanner sorting sysinfo signals mpi_env config namelist_input deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface mprgp smalbe mortar condense condense_mumps floating contact_types contact h5io files history_io \
         results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
@@ -119,6 +119,8 @@ $(BUILD)/kinds.o:
 $(BUILD)/errors.o:
 $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
+$(BUILD)/int_hash.o:       $(BUILD)/kinds.o
+$(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
@@ -129,13 +131,20 @@ $(BUILD)/deck.o:           $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
                            $(BUILD)/namelist_input.o
 $(BUILD)/budget.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
-$(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/mesh.o
+$(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
+$(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/text_scanner.o \
+                           $(BUILD)/mesh.o $(BUILD)/mesh_topology.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
+$(BUILD)/body_system.o:    $(BUILD)/kinds.o
+$(BUILD)/supports.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
+$(BUILD)/stiffness_pattern.o: $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
+$(BUILD)/rigid_modes.o:    $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
 $(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                           $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/lapack.o
-$(BUILD)/ordering.o:       $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/assembly.o
+                           $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/body_system.o $(BUILD)/supports.o \
+                           $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o
+$(BUILD)/ordering.o:       $(BUILD)/kinds.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o

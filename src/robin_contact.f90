@@ -134,9 +134,9 @@ program robin_contact
     end do
     !$omp end parallel do
   end if
-  do a = 1, 2
-    if (info(a) == 1) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))
-    if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'deck '//trim(d%source)//', body '//achar(48 + a)//': '//trim(msg(a)))
+  do a = 1, 2   ! the mesh reader's message names the body
+    if (info(a) == 1) call fatal(EXIT_INPUT, 'deck '//trim(d%source)//': '//trim(msg(a)))
+    if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'deck '//trim(d%source)//': '//trim(msg(a)))
   end do
   ! a body from a mesh file is sized now: the memory check again, with its node count
   dsized = d

@@ -17,13 +17,13 @@
 program bench_ordering
   use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
-  use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, SIDE_TOP, SIDE_BOTTOM, BC_FREE, BC_CLAMPED, BC_CONTACT
-  use mesh, only: mesh_t, mesh_build, side_nodes
-  use assembly, only: body_system_t, assemble_body
-  use ordering, only: nested_dissection, ND_OK
+  use config, only: body_cfg_t, ELEM_Q1, BC_FREE, BC_CLAMPED, BC_CONTACT
+  use mesh, only: mesh_t
+  use assembly, only: body_system_t
+  use ordering, only: ND_OK
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
   use clock, only: wtime
-  use testing, only: general_body
+  use testing, only: rectangle_body, structured_body, general_body, order_body
   use omp_lib, only: omp_set_max_active_levels
   implicit none (type, external)
 
@@ -66,46 +66,15 @@ program bench_ordering
 
 contains
 
-  !> The paper's upper body with nx x ny Q1 cells.
+  !> The paper's upper body (3 x 1, clamped on the left, contact below) with nx x ny Q1 cells.
   function body(nx, ny) result(bb)
     integer, intent(in) :: nx, ny
     type(body_cfg_t) :: bb
-    bb%id = 1
-    bb%x0 = 0.0_wp
+    bb = rectangle_body(nx, ny, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE])
     bb%y0 = 1.0_wp
     bb%width = 3.0_wp
-    bb%height = 1.0_wp
-    bb%nx = nx
-    bb%ny = ny
-    bb%element = ELEM_Q1
-    bb%young = 2.1e11_wp
     bb%poisson = 0.277_wp
-    bb%bc = [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]
   end function body
-
-  !> The structured mesh and system of `bb`, its bottom normal DOFs as `last`.
-  subroutine structured_body(bb, msh, sys, last)
-    type(body_cfg_t), intent(in) :: bb
-    type(mesh_t), intent(out) :: msh
-    type(body_system_t), intent(out) :: sys
-    integer, allocatable, intent(out) :: last(:)
-    type(traction_cfg_t) :: tr(1)
-    integer, allocatable :: nodes(:)
-    integer :: info, k
-    character(len=256) :: msg
-    tr(1)%body = 1
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [0.0_wp, -3.0e6_wp]
-    call mesh_build(msh, bb, info, msg)
-    if (info /= 0) error stop 'mesh_build failed'
-    call assemble_body(msh, bb, .true., tr, 1, sys, info, msg)
-    if (info /= 0) error stop 'assemble_body failed'
-    call side_nodes(msh, SIDE_BOTTOM, nodes)
-    allocate (last(0))
-    do k = 1, size(nodes)
-      if (sys%free_of(2*nodes(k)) > 0) last = [last, sys%free_of(2*nodes(k))]
-    end do
-  end subroutine structured_body
 
   !> Order, factor and condense the current body with ordering o; print one row.
   subroutine one(nx, kind, o)
@@ -127,10 +96,10 @@ contains
       call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
     case default
       t0 = wtime()
-      call nested_dissection(msh, sys, last, perm, info, msg)
+      call order_body(msh, sys, last, perm, info, msg)
       t_order = wtime() - t0
       if (info /= ND_OK) then
-        write (output_unit, '(a)') 'nested_dissection failed: '//trim(msg)
+        write (output_unit, '(a)') 'nested dissection failed: '//trim(msg)
         return
       end if
       call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &

@@ -589,6 +589,9 @@ contains
     call expect_error('dup.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
                       '1', '2', '2', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']), 'sq', 1, &
                       [character(len=20) :: 'node tag 2', 'twice'], 'a repeated node tag is refused')
+    call expect_error('negative.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 -4 1 4', '2 1 0 4', &
+                      '1', '2', '3', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']), 'sq', 1, &
+                      [character(len=20) :: 'number of nodes', '>= 0', "'-4'"], 'a negative count is refused')
     l = square()
     call expect_error('twice.msh', [l, l(14:25)], 'sq', 1, [character(len=24) :: 'second $Nodes', 'line 33'], &
                       'a second $Nodes section is refused')

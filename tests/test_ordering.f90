@@ -16,13 +16,15 @@ program test_ordering
   use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, ORDER_METIS, ORDER_ND, &
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT
-  use mesh, only: mesh_t, mesh_build, side_nodes, node_id
+  use mesh, only: mesh_t, mesh_build, node_id
   use assembly, only: body_system_t, assemble_body, csc_matvec
-  use ordering, only: nested_dissection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
+  use ordering, only: grid_dissection, coordinate_bisection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
   use clock, only: wtime
-  use testing, only: report, report_le, test_summary, general_body
+  use strings, only: body_label
+  use testing, only: report, report_le, test_summary, rectangle_body, structured_body, general_body, &
+                     side_free_dofs, order_body
   implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -68,61 +70,6 @@ program test_ordering
 
 contains
 
-
-
-
-  !> A unit-square-ish body with the given grid, element and side conditions.
-  function make_body(nx, ny, elem, bcs) result(b)
-    integer, intent(in) :: nx, ny, elem, bcs(4)
-    type(body_cfg_t) :: b
-    b%id = 1
-    b%x0 = 0.0_wp
-    b%y0 = 0.0_wp
-    b%width = 2.0_wp
-    b%height = 1.0_wp
-    b%nx = nx
-    b%ny = ny
-    b%element = elem
-    b%young = 2.1e11_wp
-    b%poisson = 0.3_wp
-    b%bc = bcs
-  end function make_body
-
-  !> Mesh + assembly of a body (top loaded downwards); stops on failure.
-  subroutine build(b, msh, sys)
-    type(body_cfg_t), intent(in) :: b
-    type(mesh_t), intent(out) :: msh
-    type(body_system_t), intent(out) :: sys
-    type(traction_cfg_t) :: tr(1)
-    integer :: info
-    character(len=256) :: msg
-    tr(1)%body = 1
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
-    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
-    call mesh_build(msh, b, info, msg)
-    if (info /= 0) error stop 'mesh_build failed'
-    call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
-    if (info /= 0) error stop 'assemble_body failed'
-  end subroutine build
-
-  !> Free DOFs of component c of the nodes on `side` (skipping prescribed ones).
-  function side_free_dofs(msh, sys, side, c) result(idx)
-    type(mesh_t), intent(in) :: msh
-    type(body_system_t), intent(in) :: sys
-    integer, intent(in) :: side, c
-    integer, allocatable :: idx(:)
-    integer, allocatable :: nodes(:)
-    integer :: k, f
-    allocate (idx(0))
-    if (side == 0) return
-    call side_nodes(msh, side, nodes)
-    do k = 1, size(nodes)
-      f = sys%free_of(2*(nodes(k) - 1) + c)
-      if (f > 0) idx = [idx, f]
-    end do
-  end function side_free_dofs
-
   !> The ND permutation is exactly the free DOFs not in `last`, node DOFs adjacent,
   !! and the top-level separator line comes last.
   subroutine check_perm(name, nx, ny, elem, bcs, last_side, last_comp)
@@ -136,10 +83,10 @@ contains
     logical :: ok
     character(len=256) :: msg
 
-    call build(make_body(nx, ny, elem, bcs), msh, sys)
+    call structured_body(rectangle_body(nx, ny, elem, bcs), msh, sys, last)
     last = side_free_dofs(msh, sys, last_side, last_comp)
-    call nested_dissection(msh, sys, last, perm, info, msg)
-    call report(info == ND_OK, name//': nested_dissection info = 0 '//trim(msg))
+    call order_body(msh, sys, last, perm, info, msg)
+    call report(info == ND_OK, name//': nested dissection info = 0 '//trim(msg))
     if (info /= ND_OK) return
     call report(size(perm) == sys%n - size(last), name//': size = n - size(last)')
     allocate (cnt(sys%n), is_last(sys%n))
@@ -231,14 +178,13 @@ contains
     character(len=256) :: msg
     character(len=64) :: tag
 
-    call build(make_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys)
-    last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
+    call structured_body(rectangle_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys, last)
     m = size(last)
     allocate (u(sys%n), r(sys%n), sgn(m), flex(m, m, 3))
     sgn = -1.0_wp
     nnz = 0.0_wp
-    call nested_dissection(msh, sys, last, perm, info, msg)
-    call report(info == ND_OK, name//': nested_dissection ok '//trim(msg))
+    call order_body(msh, sys, last, perm, info, msg)
+    call report(info == ND_OK, name//': nested dissection ok '//trim(msg))
     if (info /= ND_OK) return
     write (output_unit, '(a,i0,a,i0)') '      '//name//': n = ', sys%n, ', interface m = ', m
     do o = 1, 3
@@ -285,22 +231,21 @@ contains
     integer :: info, n
     character(len=256) :: msg
 
-    call build(make_body(10, 6, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys)
+    call structured_body(rectangle_body(10, 6, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys, last)
     n = sys%n
-    last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
-    call nested_dissection(msh, sys, [last, 0], perm, info, msg)
+    call order_body(msh, sys, [last, 0], perm, info, msg)
     call report(info == ND_BAD_LAST .and. size(perm) == 0 .and. len_trim(msg) > 0, &
-                'nested_dissection: interface DOF 0 rejected: '//trim(msg))
-    call nested_dissection(msh, sys, [last, last(1)], perm, info, msg)
+                'nested dissection: interface DOF 0 rejected: '//trim(msg))
+    call order_body(msh, sys, [last, last(1)], perm, info, msg)
     call report(info == ND_BAD_LAST .and. len_trim(msg) > 0, &
-                'nested_dissection: repeated interface DOF rejected: '//trim(msg))
+                'nested dissection: repeated interface DOF rejected: '//trim(msg))
     other%nx = 11
     other%ny = 6
-    call nested_dissection(other, sys, last, perm, info, msg)
+    call order_body(other, sys, last, perm, info, msg)
     call report(info /= ND_OK .and. len_trim(msg) > 0, &
-                'nested_dissection: mesh of another size rejected: '//trim(msg))
+                'nested dissection: mesh of another size rejected: '//trim(msg))
 
-    call nested_dissection(msh, sys, last, perm, info, msg)
+    call order_body(msh, sys, last, perm, info, msg)
     call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last)
     call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'ORD_GIVEN without interior_perm: info = 3: '//trim(msg))
     bad = perm(1:size(perm) - 1)
@@ -321,7 +266,7 @@ contains
     call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_BANDED, ORD_GIVEN, info, msg)
     call report(info == 0, 'banded with ORD_GIVEN (ordering ignored): info = 0')
     ! ORD_GIVEN without an interface: the whole order is given
-    call nested_dissection(msh, sys, [integer ::], perm, info, msg)
+    call order_body(msh, sys, [integer ::], perm, info, msg)
     call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, interior_perm=perm)
     call report(info == 0, 'ORD_GIVEN with no interface DOFs: info = 0 '//trim(msg))
     call ch%free()
@@ -341,9 +286,9 @@ contains
     character(len=256) :: msg
     real(wp) :: dflex, db
 
-    d%body(1) = make_body(30, 12, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE])
+    d%body(1) = rectangle_body(30, 12, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE])
     d%body(1)%y0 = 1.0_wp
-    d%body(2) = make_body(30, 10, ELEM_P1, [BC_CLAMPED, BC_FREE, BC_FREE, BC_CONTACT])
+    d%body(2) = rectangle_body(30, 10, ELEM_P1, [BC_CLAMPED, BC_FREE, BC_FREE, BC_CONTACT])
     d%body(2)%id = 2
     tr(1)%body = 1
     tr(1)%side = SIDE_TOP
@@ -364,7 +309,7 @@ contains
       do a = 1, 2
         call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a, o), info, msg)
         call report(info == 0 .and. bc(a, o)%chol%interface_last_ok, &
-                    'factor_body ordering='''//trim(ords(o))//''', body '//achar(48 + a)//': ok, interface last '//trim(msg))
+                    'factor_body ordering='''//trim(ords(o))//''', body '//body_label(a)//': ok, interface last '//trim(msg))
         if (info /= 0) return
         call condense_body(sys(a), bc(a, o), info, msg)
         if (info /= 0) error stop 'condense_body failed'
@@ -373,7 +318,7 @@ contains
     do a = 1, 2
       dflex = norm2(bc(a, 2)%flex - bc(a, 1)%flex)/max(norm2(bc(a, 1)%flex), tiny(1.0_wp))
       db = norm2(bc(a, 2)%b - bc(a, 1)%b)/max(norm2(bc(a, 1)%b), tiny(1.0_wp))
-      call report_le(max(dflex, db), FLEX_TOL, 'body '//achar(48 + a)//': F_a and b_a with ''nd'' = with ''metis''')
+      call report_le(max(dflex, db), FLEX_TOL, 'body '//body_label(a)//': F_a and b_a with ''nd'' = with ''metis''')
       call bc(a, 1)%chol%free()
       call bc(a, 2)%chol%free()
     end do
@@ -399,13 +344,13 @@ contains
     character(len=256) :: msg
     character(len=64) :: tag
 
-    call general_body(make_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), perturb, seed, &
+    call general_body(rectangle_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), perturb, seed, &
                       msh, sys, last)
     m = size(last)
     t0 = wtime()
-    call nested_dissection(msh, sys, last, perm, info, msg)
+    call order_body(msh, sys, last, perm, info, msg)
     t_nd = wtime() - t0
-    call report(info == ND_OK, name//': nested_dissection info = 0 '//trim(msg))
+    call report(info == ND_OK, name//': nested dissection info = 0 '//trim(msg))
     if (info /= ND_OK) return
     allocate (cnt(sys%n), is_last(sys%n))
     cnt = 0
@@ -480,25 +425,20 @@ contains
   !! is reported, not crashed on.
   subroutine check_general_bad()
     type(mesh_t) :: msh
-    type(body_system_t) :: sys, bare
+    type(body_system_t) :: sys
     integer, allocatable :: last(:), perm(:)
     integer :: info
     character(len=256) :: msg
 
-    call general_body(make_body(6, 4, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), 0.2_wp, 1, &
+    call general_body(rectangle_body(6, 4, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), 0.2_wp, 1, &
                       msh, sys, last)
-    bare%ndof = sys%ndof
-    bare%n = sys%n
-    bare%free_of = sys%free_of
-    call nested_dissection(msh, bare, last, perm, info, msg)
+    call coordinate_bisection(msh%xy, sys%free_of, [integer ::], [integer ::], [integer ::], last, perm, info, msg)
     call report(info /= ND_OK .and. size(perm) == 0 .and. len_trim(msg) > 0, &
                 'general mesh, system without a pattern rejected: '//trim(msg))
-    msh%nnode = msh%nnode + 1
-    call nested_dissection(msh, sys, last, perm, info, msg)
+    call coordinate_bisection(msh%xy(:, 2:), sys%free_of, sys%dof_of, sys%colptr, sys%rowind, last, perm, info, msg)
     call report(info /= ND_OK .and. len_trim(msg) > 0, 'general mesh of another size rejected: '//trim(msg))
-    msh%nnode = msh%nnode - 1
     sys%rowind(1) = sys%n + 5
-    call nested_dissection(msh, sys, last, perm, info, msg)
+    call order_body(msh, sys, last, perm, info, msg)
     call report(info /= ND_OK .and. len_trim(msg) > 0, 'general mesh, row index out of range rejected: '//trim(msg))
   end subroutine check_general_bad
 
@@ -530,7 +470,7 @@ contains
     sys%n = n
     last = [(sys%free_of(2*(node_id(msh, k, 0) - 1) + 2), k=1, msh%nx)]
     t0 = wtime()
-    call nested_dissection(msh, sys, last, perm, info, msg)
+    call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, last, perm, info, msg)
     t = wtime() - t0
     write (output_unit, '(a,i0,a,f0.3,a)') '      nested dissection of 1024x512 cells (n = ', n, '): ', t, ' s'
     allocate (seen(n))

@@ -1,8 +1,9 @@
 !> Helpers shared by the Fortran test programs: PASS/FAIL reporting with counters and
 !! the closing line, the 1D obstacle problem of the MPRGP test and benchmark, and an independent direct solve of an assembled body
 !! (LAPACK band Cholesky in the natural order) so the FE tests do not depend on the
-!! Cholesky module that other tests check, and a body on a general (unstructured-looking)
-!! mesh for the ordering test and benchmark.
+!! Cholesky module that other tests check, and the bodies of the ordering test and
+!! benchmark: a rectangle on its structured mesh, the same on a general
+!! (unstructured-looking) mesh, and the ordering of either.
 module testing
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use kinds, only: wp
@@ -13,13 +14,15 @@ module testing
   use assembly, only: body_system_t, expand, assemble_body, lame_parameters
   use linop, only: csc_op_t, csc_op_init
   use lapack, only: dpbsv
+  use ordering, only: grid_dissection, coordinate_bisection
   implicit none (type, external)
   private
 
   integer, public, protected :: npass = 0   !< checks passed so far
   integer, public, protected :: nfail = 0   !< checks failed so far
 
-  public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem, general_body
+  public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem
+  public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body
 
 contains
 
@@ -139,6 +142,84 @@ contains
     b = -15.0_wp
     l = -1.0_wp
   end subroutine obstacle_problem
+
+  !> A 2 x 1 rectangle at the origin (steel: E = 2.1e11, nu = 0.3) with nx x ny cells of
+  !! the element `element` and the side conditions `bcs` (left, right, bottom, top).
+  function rectangle_body(nx, ny, element, bcs) result(b)
+    integer, intent(in) :: nx, ny       !< grid cells along x and y
+    integer, intent(in) :: element      !< ELEM_Q1 or ELEM_P1
+    integer, intent(in) :: bcs(4)       !< BC_* of each side
+    type(body_cfg_t) :: b
+    b%id = 1
+    b%x0 = 0.0_wp
+    b%y0 = 0.0_wp
+    b%width = 2.0_wp
+    b%height = 1.0_wp
+    b%nx = nx
+    b%ny = ny
+    b%element = element
+    b%young = 2.1e11_wp
+    b%poisson = 0.3_wp
+    b%bc = bcs
+  end function rectangle_body
+
+  !> The structured mesh of `b` and its system, its top loaded by a linear traction (that
+  !! of general_body); `last` = the free normal (y) DOFs of the bottom side. Stops the test
+  !! program on failure.
+  subroutine structured_body(b, msh, sys, last)
+    type(body_cfg_t), intent(in) :: b                 !< geometry, grid, element, sides
+    type(mesh_t), intent(out) :: msh                  !< the structured mesh
+    type(body_system_t), intent(out) :: sys           !< its assembled system
+    integer, allocatable, intent(out) :: last(:)      !< interface DOFs (bottom side, y)
+    type(traction_cfg_t) :: tr(1)
+    integer :: info
+    character(len=256) :: msg
+    tr(1)%body = b%id
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
+    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
+    call mesh_build(msh, b, info, msg)
+    if (info /= 0) error stop 'structured_body: mesh_build failed'
+    call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
+    if (info /= 0) error stop 'structured_body: assemble_body failed'
+    last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
+  end subroutine structured_body
+
+  !> The free DOFs of component `component` (1 = x, 2 = y) of the nodes on one side of a
+  !! structured mesh, along the side (side 0: none).
+  function side_free_dofs(msh, sys, side, component) result(idx)
+    type(mesh_t), intent(in) :: msh               !< a structured mesh
+    type(body_system_t), intent(in) :: sys        !< its system
+    integer, intent(in) :: side                   !< SIDE_*, or 0
+    integer, intent(in) :: component              !< 1 or 2
+    integer, allocatable :: idx(:)
+    integer, allocatable :: nodes(:)
+    integer :: k, f
+    allocate (idx(0))
+    if (side == 0) return
+    call side_nodes(msh, side, nodes)
+    do k = 1, size(nodes)
+      f = sys%free_of(2*(nodes(k) - 1) + component)
+      if (f > 0) idx = [idx, f]
+    end do
+  end function side_free_dofs
+
+  !> The nested-dissection order of a body's free DOFs not in `last`, as the program takes
+  !! it (module condense): along the grid lines of a structured mesh, by coordinate
+  !! bisection on any other.
+  subroutine order_body(msh, sys, last, perm, info, msg)
+    type(mesh_t), intent(in) :: msh                   !< the body's mesh
+    type(body_system_t), intent(in) :: sys            !< its system (with its pattern on a general mesh)
+    integer, intent(in) :: last(:)                    !< free DOFs ordered last by the caller
+    integer, allocatable, intent(out) :: perm(:)      !< the interior order
+    integer, intent(out) :: info                      !< ND_OK or an error code
+    character(len=*), intent(out) :: msg              !< the failure, else blank
+    if (msh%structured) then
+      call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, last, perm, info, msg)
+    else
+      call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, last, perm, info, msg)
+    end if
+  end subroutine order_body
 
   !> A body on a general mesh, as a mesh file would give it: the structured mesh of `b`
   !! with its nodes renumbered at random, every interior node moved by up to `perturb`

@@ -15,7 +15,7 @@ module strings
   private
 
   public :: fpstate_t, fp_read_begin, fp_read_end, lower, is_ident, is_letter, first_nonblank
-  public :: i2s, r2s, itoa, rtoa, sci, fmt_real, quote, quoted_list, next_word, index_of, word
+  public :: i2s, r2s, itoa, rtoa, sci, fmt_real, quote, quoted_list, next_word, index_of, word, body_label
 
   !> Saved floating-point halting modes and flags.
   type :: fpstate_t
@@ -107,6 +107,13 @@ contains
     write (buf, '(i0)') i
     s = trim(buf)
   end function i2s
+
+  !> The label of body a in messages and names: '1', '2'.
+  pure function body_label(a) result(s)
+    integer, intent(in) :: a   !< the body's number
+    character(len=:), allocatable :: s
+    s = i2s(a)
+  end function body_label
 
   !> A character value as a namelist string literal (quotes doubled).
   pure function quote(s) result(r)

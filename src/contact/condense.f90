@@ -16,7 +16,7 @@ module condense
   use strings, only: i2s, r2s
   use assembly, only: body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
-  use ordering, only: nested_dissection
+  use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use lapack, only: dpstrf, dsyev
   implicit none (type, external)
@@ -359,7 +359,11 @@ contains
       iord = ORD_METIS
     end select
     if (iord == ORD_GIVEN .and. method == FACT_CHOLMOD) then
-      call nested_dissection(msh, sys, bc%idx, perm, info, msg)
+      if (msh%structured) then
+        call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, bc%idx, perm, info, msg)
+      else
+        call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, bc%idx, perm, info, msg)
+      end if
       if (info /= 0) then
         bc%t_factor = wtime() - t0
         return

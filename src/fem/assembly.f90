@@ -1,58 +1,35 @@
-!> Plane linear elasticity on a structured mesh (module mesh): the stiffness of one body
-!! on its free DOFs in compressed sparse columns, the consistent load of its tractions,
-!! elimination of prescribed displacements, reactions and nodal stresses. The
-!! per-element work (shape functions, element stiffness, loads, stress) is module
-!! elements'; this module loops over cells and sides and places the results.
+!> Plane linear elasticity on one body's mesh (module mesh: a structured grid or a mesh
+!! read from a file): the stiffness on its free DOFs in compressed sparse columns, the
+!! consistent load of its tractions and body force, elimination of prescribed displacements,
+!! reactions and nodal stresses. The per-element work (shape functions, element stiffness,
+!! loads, stress) is module elements'; the supports and the free-DOF numbering module
+!! supports', the sparsity pattern module stiffness_pattern's, the rigid motions of a body
+!! held only by contact module rigid_modes'. This module loops over cells and sides and
+!! places the results.
 !!
 !! DOFs: node k, component c (1 = x, 2 = y) is global dof 2*(k-1)+c. Free DOFs are
-!! numbered in increasing global order, so the stiffness on free DOFs keeps the natural
-!! (band) structure of the grid. Isotropic material, plane strain or plane stress;
-!! Q1 with 2x2 Gauss, P1 with one point (exact). Units are whatever the deck uses,
+!! numbered in increasing global order, so the stiffness on free DOFs keeps the structure
+!! of the node numbering (a band on a grid). Isotropic material, plane strain or plane
+!! stress; Q1 with 2x2 Gauss, P1 with one point (exact). Units are whatever the deck uses,
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
-  use kinds, only: wp, i8
-  use sorting, only: sort_by_key, sort_ints
+  use kinds, only: wp
+  use sorting, only: sort_by_key
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
-                    SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
-                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, BC_CONTACT
-  use mesh, only: mesh_t, side_nodes, node_id, group_index, group_names, group_nodes, &
-                  nodes_only, nodes_only_refusal
+                    SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
+  use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress
   use linop, only: csc_symv
-  use lapack, only: dsyev
+  use body_system, only: body_system_t
+  use supports, only: prescribed_dofs, group_conditions, unknown_group, number_free_dofs
+  use stiffness_pattern, only: build_pattern
+  use rigid_modes, only: rigid_kernel, choose_fixing, rigid_motion_name
   implicit none (type, external)
   private
 
   public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters, cell_triplets
-  public :: body_force_fn, rigid_motion_name
-
-  !> The linear system of one body on its free DOFs.
-  type, public :: body_system_t
-    integer :: id = 0                         !< body id
-    integer :: ndof = 0                       !< 2*nnode
-    integer :: n = 0                          !< number of free (unknown) DOFs
-    integer, allocatable :: free_of(:)        !< (ndof) free index 1..n, or 0 if prescribed
-    integer, allocatable :: dof_of(:)         !< (n) global dof of each free index
-    real(wp), allocatable :: u_fixed(:)       !< (ndof) prescribed displacements, 0 at free dofs [length]
-    integer, allocatable :: colptr(:)         !< (n+1) 0-based CSC column pointers of K (free dofs, both triangles)
-    integer, allocatable :: rowind(:)         !< (nnz) 0-based row indices, sorted within each column
-    real(wp), allocatable :: val(:)           !< (nnz) stiffness entries [stress] (force/length per unit thickness)
-    real(wp), allocatable :: f(:)             !< (n) load on free dofs incl. the lifting -K_fd u_d [force]
-    real(wp), allocatable :: f_applied(:)     !< (ndof) applied nodal loads (tractions, optional body force), all dofs [force]
-    real(wp) :: k_norm = 0.0_wp               !< max abs row sum of K (infinity norm) [stress]
-    !> A body whose prescribed displacements leave rigid motions free (held only by
-    !! contact, README "Bodies held only by contact"): nrig > 0 kernel vectors R of K, and
-    !! as many fixing DOFs, prescribed to 0 in the factorized system only, so that the
-    !! factor is a generalized inverse K^+ (K K^+ K = K) and u = K^+ (f - B'lam) + R alpha
-    integer :: nrig = 0                       !< rigid motions left free (0..3)
-    real(wp), allocatable :: rig(:, :)        !< (ndof, nrig) kernel of K, zero at prescribed DOFs [length/length]
-    real(wp), allocatable :: rig_coef(:, :)   !< (3, nrig) each column in the basis (1,0), (0,1), (-(y-yc), x-xc)/h
-    real(wp) :: rig_xc(2) = 0.0_wp            !< centre of the rotation basis [length]
-    real(wp) :: rig_h = 1.0_wp                !< scale of the rotation basis (largest extent) [length]
-    integer, allocatable :: fixing(:)         !< (nrig) the fixing DOFs (global dof numbers)
-    real(wp) :: rig_residual = 0.0_wp         !< max |K R| / (k_norm max |R|), the check of the kernel
-  end type body_system_t
+  public :: body_system_t, body_force_fn, rigid_motion_name
 
 contains
 
@@ -106,7 +83,7 @@ contains
     !> the body's contact group (&contact body1_group/body2_group), kept clear of fixing
     !! DOFs when the body is held only by contact (a rectangle's 'contact' side is too)
     character(len=*), intent(in), optional :: contact_group
-    logical, allocatable :: pres(:)
+    logical, allocatable :: prescribed(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
 
@@ -118,13 +95,13 @@ contains
     if (info /= 0) return
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
 
-    call prescribed_dofs(mesh, body, pres, sys, u_prescribed)
+    call prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
     if (present(boundaries)) then
-      call group_conditions(mesh, body%id, boundaries, pres, sys, info, msg)
+      call group_conditions(mesh, body%id, boundaries, prescribed, sys, info, msg)
       if (info /= 0) return
     end if
     ! rigid motions the supports leave free: a body held only by contact
-    call rigid_kernel(mesh, pres, sys, info)
+    call rigid_kernel(mesh, prescribed, sys, info)
     if (info /= 0) then
       info = 3
       write (msg, '(a,i0,a)') 'body ', body%id, ': LAPACK dsyev failed on the 3 x 3 Gram matrix of its '// &
@@ -132,12 +109,12 @@ contains
       return
     end if
     if (sys%nrig > 0) then
-      call choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
+      call choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
       if (info /= 0) return
     end if
-    call number_free_dofs(pres, sys)
+    call number_free_dofs(prescribed, sys)
     if (with_k) then
-      call stiffness_pattern(mesh, sys, info, msg)
+      call build_pattern(mesh, sys, info, msg)
       if (info /= 0) return
     end if
     call applied_loads(mesh, body%id, tractions(1:ntraction), sys, info, msg, body_force)
@@ -273,344 +250,6 @@ contains
     end if
   end subroutine check_input
 
-  !> Which DOFs the side conditions prescribe (`pres`), and their values (sys%ndof,
-  !! sys%u_fixed). Sides are visited in SIDE_* order; a corner shared by two sides gets
-  !! the union of their constraints, and where both prescribe the same component with
-  !! different values the later side in SIDE_* order (left, right, bottom, top) wins.
-  !! `u_prescribed`, where given, replaces the values at every prescribed DOF.
-  subroutine prescribed_dofs(mesh, body, pres, sys, u_prescribed)
-    type(mesh_t), intent(in) :: mesh
-    type(body_cfg_t), intent(in) :: body
-    logical, allocatable, intent(out) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    real(wp), intent(in), optional :: u_prescribed(:)
-    integer, allocatable :: nodes(:)
-    integer :: side, k, cc
-
-    sys%ndof = 2*mesh%nnode
-    allocate (pres(sys%ndof), sys%u_fixed(sys%ndof))
-    pres = .false.
-    sys%u_fixed = 0.0_wp
-    do side = 1, 4
-      call side_nodes(mesh, side, nodes)
-      select case (body%bc(side))
-      case (BC_CLAMPED)
-        do k = 1, size(nodes)
-          do cc = 1, 2
-            pres(2*(nodes(k) - 1) + cc) = .true.
-            sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
-          end do
-        end do
-      case (BC_ROLLER)
-        cc = 1
-        if (side == SIDE_BOTTOM .or. side == SIDE_TOP) cc = 2
-        do k = 1, size(nodes)
-          pres(2*(nodes(k) - 1) + cc) = .true.
-          sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
-        end do
-      case (BC_DISPLACEMENT)
-        do k = 1, size(nodes)
-          do cc = 1, 2
-            pres(2*(nodes(k) - 1) + cc) = .true.
-            sys%u_fixed(2*(nodes(k) - 1) + cc) = body%u_side(cc, side)
-          end do
-        end do
-      case default   ! BC_FREE, BC_CONTACT: nothing
-      end select
-    end do
-    if (present(u_prescribed)) then
-      where (pres) sys%u_fixed = u_prescribed
-    end if
-  end subroutine prescribed_dofs
-
-  !> The &boundary conditions of this body: the components given are prescribed on every
-  !! node of the group (a later condition overrides an earlier value). info = 1 when the
-  !! group is not one of the body's.
-  subroutine group_conditions(mesh, body_id, boundaries, pres, sys, info, msg)
-    type(mesh_t), intent(in) :: mesh
-    integer, intent(in) :: body_id
-    type(boundary_cfg_t), intent(in) :: boundaries(:)
-    logical, intent(inout) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
-    integer :: i, g, k, cc, dof
-    integer, allocatable :: nodes(:)
-
-    info = 0
-    msg = ''
-    do i = 1, size(boundaries)
-      if (boundaries(i)%body /= body_id) cycle
-      g = group_index(mesh, boundaries(i)%group)
-      if (g == 0) then
-        info = 1
-        msg = trim(boundaries(i)%origin)//': '//unknown_group(mesh, boundaries(i)%group)
-        return
-      end if
-      call group_nodes(mesh, g, nodes)
-      do k = 1, size(nodes)
-        do cc = 1, 2
-          if (.not. boundaries(i)%fix(cc)) cycle
-          dof = 2*(nodes(k) - 1) + cc
-          pres(dof) = .true.
-          sys%u_fixed(dof) = boundaries(i)%u(cc)
-        end do
-      end do
-    end do
-  end subroutine group_conditions
-
-  !> The sentence for a group name the body's mesh does not have.
-  function unknown_group(mesh, name) result(s)
-    type(mesh_t), intent(in) :: mesh
-    character(len=*), intent(in) :: name
-    character(len=:), allocatable :: s, src
-    src = 'the rectangle'
-    if (allocated(mesh%source)) then
-      if (len(mesh%source) > 0) src = mesh%source
-    end if
-    s = 'group '''//trim(name)//''' has no edge on the boundary of this body ('//src// &
-        '); its groups are '//group_names(mesh)
-    if (allocated(mesh%file_groups) .and. .not. mesh%structured) then
-      if (len_trim(mesh%file_groups) > 0) s = s//' (physical curves of the file: '//trim(mesh%file_groups)//')'
-    end if
-  end function unknown_group
-
-  !> The rigid motions that the prescribed DOFs leave free: the null space of the three
-  !! rigid modes (1,0), (0,1), (-(y-yc), x-xc)/h restricted to the prescribed DOFs (the
-  !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
-  !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
-  !! sys%rig (ndof x nrig, zero at prescribed DOFs).
-  subroutine rigid_kernel(mesh, pres, sys, info)
-    type(mesh_t), intent(in) :: mesh
-    logical, intent(in) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info                 !< /= 0: dsyev failed
-    real(wp) :: g(3, 3), r(3), ev(3), work(64), top
-    integer :: k, cc, j, lapinfo, nk
-
-    sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
-    sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
-    g = 0.0_wp
-    do k = 1, mesh%nnode
-      do cc = 1, 2
-        if (.not. pres(2*(k - 1) + cc)) cycle
-        r = rigid_row(sys, mesh%xy(:, k), cc)
-        do j = 1, 3
-          g(:, j) = g(:, j) + r*r(j)
-        end do
-      end do
-    end do
-    call dsyev('V', 'U', 3, g, 3, ev, work, size(work), lapinfo)
-    top = max(ev(3), 0.0_wp)
-    nk = 0
-    info = lapinfo
-    if (lapinfo /= 0) return
-    nk = count(ev <= 1.0e-10_wp*top)
-    if (top <= 0.0_wp) nk = 3
-    sys%nrig = nk
-    if (nk == 0) return
-    ! ascending eigenvalues: the kernel is the first nk columns (nothing prescribed: identity)
-    allocate (sys%rig_coef(3, nk), sys%rig(sys%ndof, nk))
-    if (top <= 0.0_wp) then
-      sys%rig_coef = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
-    else
-      sys%rig_coef = g(:, 1:nk)
-      call tidy_basis(sys%rig_coef)
-    end if
-    do j = 1, nk
-      do k = 1, mesh%nnode
-        do cc = 1, 2
-          if (pres(2*(k - 1) + cc)) then
-            sys%rig(2*(k - 1) + cc, j) = 0.0_wp
-          else
-            sys%rig(2*(k - 1) + cc, j) = dot_product(rigid_row(sys, mesh%xy(:, k), cc), sys%rig_coef(:, j))
-          end if
-        end do
-      end do
-    end do
-  end subroutine rigid_kernel
-
-  !> Component cc of the three basis rigid modes at the point x.
-  pure function rigid_row(sys, x, cc) result(r)
-    type(body_system_t), intent(in) :: sys
-    real(wp), intent(in) :: x(2)
-    integer, intent(in) :: cc
-    real(wp) :: r(3)
-    r = 0.0_wp
-    r(cc) = 1.0_wp
-    if (cc == 1) r(3) = -(x(2) - sys%rig_xc(2))/sys%rig_h
-    if (cc == 2) r(3) = (x(1) - sys%rig_xc(1))/sys%rig_h
-  end function rigid_row
-
-  !> Round a kernel basis to its simplest form: entries below 1e-12 become 0 and each
-  !! column gets a positive largest entry (a pure translation reads (0, 1, 0)).
-  pure subroutine tidy_basis(c)
-    real(wp), intent(inout) :: c(:, :)
-    integer :: j
-    do j = 1, size(c, 2)
-      if (c(maxloc(abs(c(:, j)), dim=1), j) < 0.0_wp) c(:, j) = -c(:, j)
-      where (abs(c(:, j)) < 1.0e-12_wp) c(:, j) = 0.0_wp
-      c(:, j) = c(:, j)/norm2(c(:, j))
-    end do
-  end subroutine tidy_basis
-
-  !> The rigid motion with coefficients c (basis of rigid_kernel) in words: 'translation
-  !! along x', 'translation along (0.6, 0.8)', 'rotation about (x0, y0)'.
-  function rigid_motion_name(sys, c) result(s)
-    type(body_system_t), intent(in) :: sys
-    real(wp), intent(in) :: c(3)
-    character(len=:), allocatable :: s
-    character(len=64) :: buf
-    real(wp) :: w, t(2)
-    w = c(3)/sys%rig_h
-    t = c(1:2)
-    if (abs(c(3)) <= 1.0e-8_wp*norm2(c)) then
-      if (abs(t(2)) <= 1.0e-8_wp*norm2(t)) then
-        s = 'translation along x'
-      else if (abs(t(1)) <= 1.0e-8_wp*norm2(t)) then
-        s = 'translation along y'
-      else
-        write (buf, '(a,f7.4,a,f7.4,a)') 'translation along (', t(1)/norm2(t), ', ', t(2)/norm2(t), ')'
-        s = trim(buf)
-      end if
-    else
-      ! the centre, its coordinates below 1e-9 of the body's size shown as 0
-      t = [sys%rig_xc(1) - t(2)/w, sys%rig_xc(2) + t(1)/w]
-      where (abs(t) < 1.0e-9_wp*sys%rig_h) t = 0.0_wp
-      write (buf, '(a,g0.6,a,g0.6,a)') 'rotation about (', t(1), ', ', t(2), ')'
-      s = trim(buf)
-    end if
-  end function rigid_motion_name
-
-  !> The fixing DOFs of a floating body: sys%nrig DOFs that are not prescribed, not on the
-  !! contact (the contact group, or a rectangle's 'contact' side), on which the kernel is
-  !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
-  !! and the node farthest from that one) for the largest |det| of the kernel restricted to
-  !! them. They are prescribed to 0 (pres) for the factorization only.
-  subroutine choose_fixing(mesh, body, pres, sys, info, msg, contact_group)
-    type(mesh_t), intent(in) :: mesh
-    type(body_cfg_t), intent(in) :: body
-    logical, intent(inout) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
-    character(len=*), intent(in), optional :: contact_group
-    logical, allocatable :: avoid(:)
-    integer, allocatable :: nodes(:)
-    integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
-    real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
-
-    info = 0
-    msg = ''
-    r = sys%nrig
-    allocate (avoid(mesh%nnode))
-    avoid = .false.
-    do side = 1, 4
-      if (body%bc(side) /= BC_CONTACT) cycle
-      call side_nodes(mesh, side, nodes)
-      avoid(nodes) = .true.
-    end do
-    if (present(contact_group)) then
-      g = 0
-      if (len_trim(contact_group) > 0) g = group_index(mesh, contact_group)
-      if (g > 0) then
-        call group_nodes(mesh, g, nodes)
-        avoid(nodes) = .true.
-      end if
-    end if
-    ! the first node: the closest to the contact's centroid off the contact (the centre when
-    ! there is none). Near the contact, K^+'s contact displacements are measured from a near
-    ! point: small, so the rigid part R alpha does not cancel a large pinned deformation (a
-    ! fixing node far from the contact left a soft floating body on a 1e6 stiffer one
-    ! stalling at a residual of 1.4e-7; near it, converged at 7.7e-8, and fewer products)
-    ctr = sys%rig_xc
-    if (any(avoid)) then
-      ctr(1) = sum(mesh%xy(1, :), mask=avoid)/count(avoid)
-      ctr(2) = sum(mesh%xy(2, :), mask=avoid)/count(avoid)
-    end if
-    p = 0
-    dbest = huge(1.0_wp)
-    do k = 1, mesh%nnode
-      if (avoid(k) .or. (pres(2*k - 1) .and. pres(2*k))) cycle
-      d = norm2(mesh%xy(:, k) - ctr)
-      if (d < dbest) then
-        dbest = d
-        p(1) = k
-      end if
-    end do
-    if (p(1) == 0) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
-        'contact or prescribed: no node is left to fix its rigid motion for the factorization; '// &
-        'refine the mesh or support the body'
-      return
-    end if
-    dbest = -1.0_wp
-    do k = 1, mesh%nnode
-      if (avoid(k) .or. (pres(2*k - 1) .and. pres(2*k))) cycle
-      d = norm2(mesh%xy(:, k) - mesh%xy(:, p(1)))
-      if (d > dbest) then
-        dbest = d
-        p(2) = k
-      end if
-    end do
-    nc = 0
-    do i = 1, 2
-      do j = 1, 2
-        k = 2*(p(i) - 1) + j
-        if (.not. pres(k) .and. .not. any(cand(1:nc) == k)) then
-          nc = nc + 1
-          cand(nc) = k
-        end if
-      end do
-    end do
-    ! the r candidates with the largest |det R(fix, :)| (at most 4 choose 3 tries)
-    detbest = 0.0_wp
-    best = 0
-    do i = 1, nc
-      do j = merge(i + 1, i, r > 1), merge(nc, i, r > 1)
-        do l = merge(j + 1, j, r > 2), merge(nc, j, r > 2)
-          if (r > 1 .and. j == i) cycle
-          if (r > 2 .and. l == j) cycle
-          sub = 0.0_wp
-          sub(1, 1:r) = sys%rig(cand(i), 1:r)
-          if (r > 1) sub(2, 1:r) = sys%rig(cand(j), 1:r)
-          if (r > 2) sub(3, 1:r) = sys%rig(cand(l), 1:r)
-          det = abs(small_det(sub, r))
-          if (det > detbest) then
-            detbest = det
-            best = [cand(i), cand(j), cand(l)]
-          end if
-        end do
-      end do
-    end do
-    if (.not. detbest > 1.0e-6_wp) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
-        'from the contact fixes its free rigid motion for the factorization; support the body'
-      return
-    end if
-    allocate (sys%fixing(r))
-    sys%fixing = best(1:r)
-    pres(sys%fixing) = .true.
-    sys%u_fixed(sys%fixing) = 0.0_wp
-  end subroutine choose_fixing
-
-  !> Determinant of the leading r x r block (r = 1..3).
-  pure real(wp) function small_det(a, r) result(d)
-    real(wp), intent(in) :: a(3, 3)
-    integer, intent(in) :: r
-    select case (r)
-    case (1)
-      d = a(1, 1)
-    case (2)
-      d = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
-    case default
-      d = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
-          a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
-    end select
-  end function small_det
-
   !> The kernel is computed, not guessed: |K R| over the DOFs that are not prescribed
   !! (fixing DOFs included) must be at rounding level, 1e-9 |K| |R|. info = 3 otherwise.
   subroutine check_kernel(mesh, body, plane_strain, sys, info, msg)
@@ -645,183 +284,6 @@ contains
         worst, ' |K| |R| (expected rounding level)'
     end if
   end subroutine check_kernel
-
-  !> Number the DOFs that are not prescribed 1..n in increasing global order
-  !! (sys%n, sys%free_of, sys%dof_of).
-  subroutine number_free_dofs(pres, sys)
-    logical, intent(in) :: pres(:)
-    type(body_system_t), intent(inout) :: sys
-    integer :: k, n
-
-    allocate (sys%free_of(sys%ndof))
-    n = 0
-    do k = 1, sys%ndof
-      if (pres(k)) then
-        sys%free_of(k) = 0
-      else
-        n = n + 1
-        sys%free_of(k) = n
-      end if
-    end do
-    sys%n = n
-    allocate (sys%dof_of(n))
-    do k = 1, sys%ndof
-      if (sys%free_of(k) > 0) sys%dof_of(sys%free_of(k)) = k
-    end do
-  end subroutine number_free_dofs
-
-  !> The nodes that share a cell with grid node k (k itself included), in increasing
-  !! node id order: Q1 the 3x3 block around it, P1 (diagonal lower-left to upper-right)
-  !! the same without (i+1,j-1) and (i-1,j+1).
-  pure subroutine node_stencil(mesh, k, nbr, nnbr)
-    type(mesh_t), intent(in) :: mesh
-    integer, intent(in) :: k
-    integer, intent(out) :: nbr(9)
-    integer, intent(out) :: nnbr
-    integer :: di(9), dj(9), nstencil, i, j, ii, jj, s
-
-    if (mesh%element == ELEM_Q1) then
-      nstencil = 9
-      di(1:9) = [-1, 0, 1, -1, 0, 1, -1, 0, 1]
-      dj(1:9) = [-1, -1, -1, 0, 0, 0, 1, 1, 1]
-    else
-      nstencil = 7
-      di(1:7) = [-1, 0, -1, 0, 1, 0, 1]
-      dj(1:7) = [-1, -1, 0, 0, 0, 1, 1]
-    end if
-    i = mod(k - 1, mesh%nx + 1)
-    j = (k - 1)/(mesh%nx + 1)
-    nnbr = 0
-    do s = 1, nstencil
-      ii = i + di(s)
-      jj = j + dj(s)
-      if (ii < 0 .or. ii > mesh%nx .or. jj < 0 .or. jj > mesh%ny) cycle
-      nnbr = nnbr + 1
-      nbr(nnbr) = node_id(mesh, ii, jj)
-    end do
-  end subroutine node_stencil
-
-  !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
-  !! rows sorted in every column, from the node stencil of the grid. info = 6 when the
-  !! number of entries does not fit 32-bit indices.
-  subroutine stiffness_pattern(mesh, sys, info, msg)
-    type(mesh_t), intent(in) :: mesh
-    type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
-    integer :: p, s, cc, q, pos, nnbr
-    integer(i8) :: nnz
-    integer, allocatable :: aptr(:), adj(:), nbr(:)
-
-    info = 0
-    msg = ''
-    if (mesh%structured) then
-      allocate (nbr(9))
-    else
-      call node_adjacency(mesh, aptr, adj)
-      allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
-    end if
-    allocate (sys%colptr(sys%n + 1))
-    nnz = 0
-    sys%colptr(1) = 0
-    do p = 1, sys%n
-      call neighbours(p)
-      do s = 1, nnbr
-        do cc = 1, 2
-          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
-        end do
-      end do
-      if (nnz > int(huge(1), i8)) then
-        info = 6
-        write (msg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
-          'the mesh is too large for 32-bit CSC indices'
-        return
-      end if
-      sys%colptr(p + 1) = int(nnz)
-    end do
-    allocate (sys%rowind(nnz), sys%val(nnz))
-    do p = 1, sys%n
-      call neighbours(p)
-      pos = sys%colptr(p)
-      do s = 1, nnbr
-        do cc = 1, 2
-          q = sys%free_of(2*(nbr(s) - 1) + cc)
-          if (q > 0) then
-            pos = pos + 1
-            sys%rowind(pos) = q - 1
-          end if
-        end do
-      end do
-    end do
-    sys%val = 0.0_wp
-
-  contains
-
-    !> The nodes sharing a cell with free DOF p's node, in increasing node id: the grid
-    !! stencil of a structured mesh, the adjacency list of any other.
-    subroutine neighbours(p)
-      integer, intent(in) :: p
-      integer :: k
-      k = (sys%dof_of(p) - 1)/2 + 1
-      if (mesh%structured) then
-        call node_stencil(mesh, k, nbr, nnbr)
-      else
-        nnbr = aptr(k + 1) - aptr(k)
-        nbr(1:nnbr) = adj(aptr(k):aptr(k + 1) - 1)
-      end if
-    end subroutine neighbours
-  end subroutine stiffness_pattern
-
-  !> The nodes that share a cell with each node (itself included), in increasing node id:
-  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). Built from the cells by one sort of
-  !! the (node, neighbour) pairs, for any mesh.
-  subroutine node_adjacency(mesh, aptr, adj)
-    type(mesh_t), intent(in) :: mesh
-    integer, allocatable, intent(out) :: aptr(:), adj(:)
-    integer, allocatable :: cnt(:), pairs(:), pos(:)
-    integer :: c, a, b, nv, k, np, i, last
-    ! pairs (k, l) of every cell, bucketed by k, then sorted and deduplicated per node
-    allocate (cnt(mesh%nnode + 1))
-    cnt = 0
-    do c = 1, mesh%ncell
-      nv = cell_nv(mesh, c)
-      do a = 1, nv
-        k = mesh%cells(a, c)
-        cnt(k + 1) = cnt(k + 1) + nv
-      end do
-    end do
-    cnt(1) = 1
-    do k = 1, mesh%nnode
-      cnt(k + 1) = cnt(k + 1) + cnt(k)
-    end do
-    np = cnt(mesh%nnode + 1) - 1
-    allocate (pairs(np), pos(mesh%nnode))
-    pos = cnt(1:mesh%nnode)
-    do c = 1, mesh%ncell
-      nv = cell_nv(mesh, c)
-      do a = 1, nv
-        k = mesh%cells(a, c)
-        do b = 1, nv
-          pairs(pos(k)) = mesh%cells(b, c)
-          pos(k) = pos(k) + 1
-        end do
-      end do
-    end do
-    allocate (aptr(mesh%nnode + 1), adj(np))
-    aptr(1) = 1
-    i = 0
-    do k = 1, mesh%nnode
-      call sort_ints(pairs(cnt(k):cnt(k + 1) - 1))
-      last = 0
-      do a = cnt(k), cnt(k + 1) - 1
-        if (pairs(a) == last) cycle
-        last = pairs(a)
-        i = i + 1
-        adj(i) = last
-      end do
-      aptr(k + 1) = i + 1
-    end do
-  end subroutine node_adjacency
 
   !> The applied nodal loads on all DOFs (sys%f_applied): the tractions on this body,
   !! then the body force if any; sys%f = 0. info = 1 when a traction names a group the
@@ -905,9 +367,9 @@ contains
     character(len=*), intent(inout) :: msg
     real(wp) :: xe(2, MAX_NVERT), minjac
     info = 0
-    nd = 2*cell_nv(mesh, c)
+    nd = 2*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
-    call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+    call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
     if (.not. (minjac > 0.0_wp)) then
       info = 7
       write (msg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
@@ -1035,10 +497,10 @@ contains
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:2*mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
-      nd = 2*cell_nv(mesh, c)
+      nd = 2*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
-      call element_stiffness(cell_elem(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+      call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
     end do
@@ -1066,11 +528,11 @@ contains
     cnt = 0
     sigma(:, 1:mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
-      nd = 2*cell_nv(mesh, c)
+      nd = 2*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
       ue(1:nd) = u_full(ldof(1:nd))
-      call element_stress(cell_elem(mesh, c), xe, ue, lame_lambda, lame_mu, plane_strain, cs)
+      call element_stress(cell_element(mesh, c), xe, ue, lame_lambda, lame_mu, plane_strain, cs)
       do a = 1, nd/2
         k = mesh%cells(a, c)
         sigma(:, k) = sigma(:, k) + cs
@@ -1099,24 +561,6 @@ contains
   ! Cells and sides
   ! ---------------------------------------------------------------------------------
 
-  !> The element of cell c (ELEM_Q1 or ELEM_P1).
-  pure integer function cell_elem(mesh, c)
-    type(mesh_t), intent(in) :: mesh
-    integer, intent(in) :: c
-    if (allocated(mesh%cell_type)) then
-      cell_elem = mesh%cell_type(c)
-    else
-      cell_elem = mesh%element
-    end if
-  end function cell_elem
-
-  !> The number of vertices of cell c.
-  pure integer function cell_nv(mesh, c)
-    type(mesh_t), intent(in) :: mesh
-    integer, intent(in) :: c
-    cell_nv = merge(4, 3, cell_elem(mesh, c) == ELEM_Q1)
-  end function cell_nv
-
   !> Vertex coordinates of cell c (columns past its vertices are 0).
   pure subroutine cell_coords(mesh, c, xe)
     type(mesh_t), intent(in) :: mesh
@@ -1124,7 +568,7 @@ contains
     real(wp), intent(out) :: xe(2, MAX_NVERT)
     integer :: a
     xe = 0.0_wp
-    do a = 1, cell_nv(mesh, c)
+    do a = 1, cell_vertices(mesh, c)
       xe(:, a) = mesh%xy(:, mesh%cells(a, c))
     end do
   end subroutine cell_coords
@@ -1136,7 +580,7 @@ contains
     integer, intent(out) :: ldof(MAX_NDOF)
     integer :: a
     ldof = 0
-    do a = 1, cell_nv(mesh, c)
+    do a = 1, cell_vertices(mesh, c)
       ldof(2*a - 1) = 2*(mesh%cells(a, c) - 1) + 1
       ldof(2*a) = 2*(mesh%cells(a, c) - 1) + 2
     end do
@@ -1200,12 +644,12 @@ contains
     fe = 0.0_wp
     do c = 1, mesh%ncell
       call cell_coords(mesh, c, xe)
-      do a = 1, cell_nv(mesh, c)
+      do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
         fe(:, a) = f(2*k - 1:2*k)
       end do
-      call element_body_force(cell_elem(mesh, c), xe, bf, fe)
-      do a = 1, cell_nv(mesh, c)
+      call element_body_force(cell_element(mesh, c), xe, bf, fe)
+      do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
         f(2*k - 1:2*k) = fe(:, a)
       end do

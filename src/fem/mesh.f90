@@ -1,21 +1,24 @@
-!> Structured meshes of a rectangular body: nodes on a uniform (nx+1) x (ny+1) grid,
-!! bilinear quadrilaterals (Q1) or linear triangles (P1, two per grid cell).
+!> The mesh of one body: a structured grid of a rectangle (mesh_build), or a general 2D
+!! mesh read from a file (module gmsh_msh), in one type.
 !!
-!! Numbering: node (i,j), i = 0..nx along x, j = 0..ny along y, has id 1 + i + j*(nx+1).
-!! Grid cell (i,j), i = 0..nx-1, j = 0..ny-1, is cell 1 + i + j*nx for Q1, with its nodes
-!! counter-clockwise from the lower-left corner: (i,j), (i+1,j), (i+1,j+1), (i,j+1).
-!! For P1 each grid cell c is split along its diagonal from the lower-left to the
-!! upper-right corner, (i,j)-(i+1,j+1), into triangle 2c-1 = (i,j), (i+1,j), (i+1,j+1)
-!! (below the diagonal) and triangle 2c = (i,j), (i+1,j+1), (i,j+1) (above it), both
-!! counter-clockwise.
+!! Structured meshes: nodes on a uniform (nx+1) x (ny+1) grid, bilinear quadrilaterals (Q1)
+!! or linear triangles (P1, two per grid cell). Node (i,j), i = 0..nx along x, j = 0..ny
+!! along y, has id 1 + i + j*(nx+1). Grid cell (i,j), i = 0..nx-1, j = 0..ny-1, is cell
+!! 1 + i + j*nx for Q1, with its nodes counter-clockwise from the lower-left corner: (i,j),
+!! (i+1,j), (i+1,j+1), (i,j+1). For P1 each grid cell c is split along its diagonal from the
+!! lower-left to the upper-right corner, (i,j)-(i+1,j+1), into triangle 2c-1 = (i,j),
+!! (i+1,j), (i+1,j+1) (below the diagonal) and triangle 2c = (i,j), (i+1,j+1), (i,j+1)
+!! (above it), both counter-clockwise. A structured mesh has the groups 'left', 'right',
+!! 'bottom' and 'top'.
 !!
-!! The same type holds a general 2D mesh read from a file (module gmsh_msh): cells of mixed
-!! types (`cell_type`), counter-clockwise after reading, with the file's tags kept for
-!! messages, and named groups of boundary edges (`group`) on which conditions and the
-!! contact surface are given; a group may also hold single nodes (a Gmsh physical point, or
-!! the nodes of a physical curve inside the body), usable for prescribed displacements only. A structured mesh has the groups 'left',
-!! 'right', 'bottom' and 'top'. Every group edge is a boundary edge of one cell, oriented counter-clockwise
-!! around the body (the body on its left), so its outward normal is (dy, -dx)/length.
+!! General meshes: cells of mixed types (`cell_type`), counter-clockwise after reading,
+!! with the file's tags kept for messages, and named groups of boundary edges (`group`) on
+!! which conditions and the contact surface are given; a group may also hold single nodes
+!! (a Gmsh physical point, or the nodes of a physical curve inside the body), usable for
+!! prescribed displacements only.
+!!
+!! Every group edge is a boundary edge of one cell, oriented counter-clockwise around the
+!! body (the body on its left), so its outward normal is (dy, -dx)/length.
 module mesh
   use kinds, only: wp
   use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
@@ -23,7 +26,7 @@ module mesh
   private
 
   public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes, &
-            nodes_only, nodes_only_refusal
+            nodes_only, nodes_only_refusal, cell_element, cell_vertices
 
   !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side)
   !! and of single nodes (a Gmsh physical point, or where a physical curve runs inside the
@@ -38,16 +41,16 @@ module mesh
     logical :: point = .false.                 !< a Gmsh physical point (nedge = 0)
   end type edge_group_t
 
-  !> A structured mesh of one rectangular body.
+  !> The mesh of one body (structured or general).
   type, public :: mesh_t
-    integer :: element = ELEM_Q1          !< ELEM_Q1 or ELEM_P1 (module config)
-    integer :: nx = 0                     !< grid cells along x
-    integer :: ny = 0                     !< grid cells along y
-    integer :: nnode = 0                  !< (nx+1)*(ny+1)
-    integer :: ncell = 0                  !< nx*ny (Q1) or 2*nx*ny (P1)
-    integer :: nvert = 0                  !< vertices per cell: 4 (Q1) or 3 (P1)
-    real(wp) :: x0 = 0.0_wp               !< lower-left corner x [length]
-    real(wp) :: y0 = 0.0_wp               !< lower-left corner y [length]
+    integer :: element = ELEM_Q1          !< ELEM_Q1, ELEM_P1 or (general meshes) ELEM_MIXED (module config)
+    integer :: nx = 0                     !< grid cells along x (0 on a general mesh)
+    integer :: ny = 0                     !< grid cells along y (0 on a general mesh)
+    integer :: nnode = 0                  !< nodes: (nx+1)*(ny+1) on a grid
+    integer :: ncell = 0                  !< cells: nx*ny (Q1) or 2*nx*ny (P1) on a grid
+    integer :: nvert = 0                  !< vertices per cell: 4 (Q1, mixed) or 3 (P1)
+    real(wp) :: x0 = 0.0_wp               !< lower-left corner x (of the bounding box) [length]
+    real(wp) :: y0 = 0.0_wp               !< lower-left corner y (of the bounding box) [length]
     real(wp) :: width = 0.0_wp            !< extent in x [length]
     real(wp) :: height = 0.0_wp           !< extent in y [length]
     real(wp), allocatable :: xy(:, :)     !< (2, nnode) node coordinates [length]
@@ -74,6 +77,25 @@ contains
     integer, intent(in) :: j          !< grid index along y, 0..ny
     node_id = 1 + i + j*(mesh%nx + 1)
   end function node_id
+
+  !> The element of cell c (ELEM_Q1 or ELEM_P1).
+  pure integer function cell_element(mesh, c)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    integer, intent(in) :: c           !< a cell, 1..ncell
+    if (allocated(mesh%cell_type)) then
+      cell_element = mesh%cell_type(c)
+    else
+      cell_element = mesh%element
+    end if
+  end function cell_element
+
+  !> The number of vertices of cell c.
+  pure integer function cell_vertices(mesh, c)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    integer, intent(in) :: c           !< a cell, 1..ncell
+    cell_vertices = merge(4, 3, cell_element(mesh, c) == ELEM_Q1)
+  end function cell_vertices
+
 
   !> Build the structured mesh of a body (its rectangle, nx x ny grid cells and element).
   !! On a bad body (nx or ny < 1, non-positive extent, unknown element) the mesh is left

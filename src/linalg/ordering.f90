@@ -1,15 +1,18 @@
-!> Fill-reducing orderings computed from the geometry of a body's mesh (module mesh),
-!! without a graph partitioner: geometric nested dissection.
+!> Fill-reducing orderings computed from the geometry of a body's mesh, without a graph
+!! partitioner: geometric nested dissection. The mesh and the system come as plain arrays
+!! (the grid's size or the node coordinates, the DOF maps, the stiffness pattern), so this
+!! module knows nothing of the FE stages.
 !!
-!! Structured meshes: both element types (Q1, and P1 with its cells split along one
-!! diagonal) couple only the nodes of a common grid cell, so one whole grid line of nodes
-!! separates the grid into the nodes on either side of it. Nested dissection orders a box
-!! of nodes as: the box on one side of its middle line, the box on the other side, then
-!! the line; boxes below a small size are ordered naturally. On an N x N grid this gives
-!! O(N^2 log N) nonzeros in the Cholesky factor, like METIS on these meshes, but it is
-!! deterministic, linear in the number of nodes, and needs no global state (thread safe).
+!! Structured meshes (grid_dissection): both element types (Q1, and P1 with its cells split
+!! along one diagonal) couple only the nodes of a common grid cell, so one whole grid line
+!! of nodes separates the grid into the nodes on either side of it. Nested dissection
+!! orders a box of nodes as: the box on one side of its middle line, the box on the other
+!! side, then the line; boxes below a small size are ordered naturally. On an N x N grid
+!! this gives O(N^2 log N) nonzeros in the Cholesky factor, like METIS on these meshes, but
+!! it is deterministic, linear in the number of nodes, and needs no global state (thread
+!! safe).
 !!
-!! Any other mesh (read from a file): recursive coordinate bisection of the node graph
+!! Any other mesh (coordinate_bisection): recursive coordinate bisection of the node graph
 !! (two nodes adjacent when the stiffness couples them). A node set is cut across its
 !! longer extent (and across the other one too when it is at least half as long) at the
 !! median coordinate or at 40, 45, 55 or 60% of its nodes; a cut's separator is the
@@ -20,18 +23,18 @@
 !! nodes within one edge extent of a cut are examined for the separator, so the whole
 !! ordering costs O(n log n) plus the graph (O(nnz)) and is deterministic. On a 64 x 64 Q1
 !! grid with randomly moved nodes nnz(L) is 0.98x METIS's, at 1024 x 512 1.05x.
+!!
+!! DOFs: node k, component c (1 = x, 2 = y) is global DOF 2*(k-1)+c; free_of maps a global
+!! DOF to its free index (0: prescribed), dof_of a free index to its global DOF.
 module ordering
   use kinds, only: wp, i8
-  use mesh, only: mesh_t
-  use assembly, only: body_system_t
   implicit none (type, external)
   private
 
-  public :: nested_dissection
+  public :: grid_dissection, coordinate_bisection
 
-  !> Boxes with fewer nodes than this are ordered naturally (no further dissection).
-  !! On 512 x 256 Q1 cells, nnz(L) is 2.39e7 with 16, 2.68e7 with 64, 2.36e7 with 4
-  !! (METIS: 2.50e7); the flop counts differ by under 3%.
+  !> Boxes with fewer nodes than this are ordered naturally (no further dissection); the
+  !! factor's size depends little on it (within 12% from 4 to 64 on 512 x 256 Q1 cells).
   integer, parameter, public :: ND_LEAF_NODES = 16
 
   integer, parameter, public :: ND_OK = 0            !< info: success
@@ -41,101 +44,63 @@ module ordering
   !> Unstructured meshes: node sets with fewer nodes than this are not bisected further.
   integer, parameter, public :: RCB_LEAF_NODES = 16
 
+  !> The order being built: the free DOFs placed so far, and those left out.
+  type :: order_t
+    integer, allocatable :: perm(:)       ! the interior order
+    integer :: pos = 0                    ! entries of perm filled
+    logical, allocatable :: skip(:)       ! (n) the DOFs of `last`
+    logical :: bad_map = .false.          ! free_of maps a DOF beyond n
+  end type order_t
+
+  !> The node graph of a general mesh, on local node numbers 1..na.
+  type :: node_graph_t
+    integer, allocatable :: mesh_node(:)      ! (na) the mesh node of each
+    real(wp), allocatable :: xy_local(:, :)   ! (2, na) their coordinates
+    integer, allocatable :: xadj(:), adj(:)   ! neighbours (CSR, 0-based pointers)
+    integer, allocatable :: sorted(:, :)      ! (na, 2) nodes sorted by x, by y
+    integer, allocatable :: label(:)          ! partition labels
+    integer, allocatable :: work(:)           ! work array
+    integer, allocatable :: position(:, :)    ! (na, 2) position of each node in sorted(:, axis)
+    real(wp) :: edge_extent(2) = 0.0_wp       ! the largest edge extent in x and y
+  end type node_graph_t
+
 contains
 
-  !> Nested-dissection permutation of the free DOFs of one body that are not in `last`.
-  !! perm(k) is the free DOF (1-based, 1..sys%n) placed k-th; size sys%n - size(last).
-  !! Both DOFs of a node are consecutive; prescribed DOFs and DOFs in `last` are
-  !! skipped. The caller appends `last` to obtain a full ordering with the interface
-  !! last. A structured mesh is dissected along its grid lines (cost O(number of
-  !! nodes)); any other mesh by recursive coordinate bisection of the node graph of
-  !! sys%colptr, sys%rowind (cost O(nnz log n)).
-  !! info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg (perm empty).
-  subroutine nested_dissection(mesh, sys, last, perm, info, msg)
-    type(mesh_t), intent(in) :: mesh                  !< the body's mesh (structured or general)
-    type(body_system_t), intent(in) :: sys            !< its assembled system (free_of, n; general meshes
-                                                      !! also dof_of, colptr, rowind)
+  !> Nested-dissection permutation of the free DOFs of a body on a structured nx x ny cell
+  !! grid (node (i,j) is node 1 + i + j*(nx+1)) that are not in `last`, along its grid lines
+  !! (cost O(number of nodes)). perm(k) is the free DOF (1-based, 1..n) placed k-th; size
+  !! n - size(last). Both DOFs of a node are consecutive; prescribed DOFs and DOFs in
+  !! `last` are skipped. The caller appends `last` to obtain a full ordering with the
+  !! interface last. info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg
+  !! (perm empty).
+  subroutine grid_dissection(nx, ny, free_of, n, last, perm, info, msg)
+    integer, intent(in) :: nx, ny                     !< grid cells along x and y
+    integer, intent(in) :: free_of(:)                 !< (2*(nx+1)*(ny+1)) free index of each DOF, 0 if prescribed
+    integer, intent(in) :: n                          !< the number of free DOFs
     integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     integer, intent(out) :: info                      !< ND_OK or an error code
     character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
-    logical, allocatable :: skip(:)
-    integer :: k, pos, nx1, stamp
-    logical :: bad_map
+    type(order_t) :: order
+    integer :: nx1
     character(len=200) :: emsg
-    ! general meshes (local node numbers 1..na): mesh node of each (glob), coordinates,
-    ! node graph (CSR), nodes sorted by x (srt(:,1)) and by y (srt(:,2)), partition
-    ! labels, a work array, the largest edge extent in x and y
-    integer, allocatable :: glob(:), xadj(:), adj(:), srt(:, :), lab(:), tmp(:), rank(:, :)
-    real(wp), allocatable :: xyl(:, :)
-    real(wp) :: emax(2)
 
-    info = ND_OK
     emsg = ''
-    if (present(msg)) msg = ''
-    if (.not. mesh%structured) then
-      if (.not. general_system_ok()) then
-        call fail(ND_BAD_SYSTEM)
-        return
-      end if
-    else if (mesh%nx < 1 .or. mesh%ny < 1 .or. sys%ndof /= 2*(mesh%nx + 1)*(mesh%ny + 1) &
-        .or. .not. allocated(sys%free_of)) then
-      write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
-        ' DOFs) does not belong to a ', mesh%nx, ' x ', mesh%ny, ' cell mesh.'
-      call fail(ND_BAD_SYSTEM)
-      return
-    else if (size(sys%free_of) /= sys%ndof) then
-      emsg = 'nested dissection: the free-DOF map has the wrong size.'
-      call fail(ND_BAD_SYSTEM)
-      return
-    end if
-
-    allocate (skip(max(sys%n, 0)))
-    skip = .false.
-    do k = 1, size(last)
-      if (last(k) < 1 .or. last(k) > sys%n) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
-        call fail(ND_BAD_LAST)
-        return
-      else if (skip(last(k))) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
-        call fail(ND_BAD_LAST)
-        return
-      end if
-      skip(last(k)) = .true.
-    end do
-
-    allocate (perm(sys%n - size(last)))
-    pos = 0
-    bad_map = .false.
-    if (mesh%structured) then
-      nx1 = mesh%nx + 1
-      call dissect(0, mesh%nx, 0, mesh%ny)
+    if (nx < 1 .or. ny < 1 .or. size(free_of) /= 2*(nx + 1)*(ny + 1)) then
+      write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', size(free_of), &
+        ' DOFs) does not belong to a ', nx, ' x ', ny, ' cell mesh.'
+      info = ND_BAD_SYSTEM
     else
-      if (.not. node_graph()) then
-        call fail(ND_BAD_SYSTEM)
-        return
-      end if
-      stamp = 0
-      call bisect(1, size(srt, 1))
+      call start_order(n, last, order, info, emsg)
     end if
-    if (bad_map .or. pos /= size(perm)) then
-      ! free_of is not a bijection onto 1..n: the system is inconsistent
-      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', pos, ' DOFs but expected ', size(perm), &
-        ' (inconsistent free-DOF map).'
-      call fail(ND_BAD_SYSTEM)
+    if (info == ND_OK) then
+      nx1 = nx + 1
+      call dissect(0, nx, 0, ny)
+      call finish_order(order, info, emsg)
     end if
+    call hand_over(order, info, emsg, perm, msg)
 
   contains
-
-    !> Record a failure: the code, the sentence in emsg, an empty perm.
-    subroutine fail(code)
-      integer, intent(in) :: code
-      info = code
-      if (allocated(perm)) deallocate (perm)
-      allocate (perm(0))
-      if (present(msg)) msg = emsg
-    end subroutine fail
 
     !> Order the box of grid nodes [i0,i1] x [j0,j1] (empty if i1 < i0 or j1 < j0).
     recursive subroutine dissect(i0, i1, j0, j1)
@@ -167,183 +132,56 @@ contains
       if (i1 - i0 <= j1 - j0) then
         do j = j0, j1
           do i = i0, i1
-            call emit_node(1 + i + j*nx1)
+            call emit_node(order, free_of, n, 1 + i + j*nx1)
           end do
         end do
       else
         do i = i0, i1
           do j = j0, j1
-            call emit_node(1 + i + j*nx1)
+            call emit_node(order, free_of, n, 1 + i + j*nx1)
           end do
         end do
       end if
     end subroutine emit
 
-    !> Append the free, non-skipped DOFs of one node (x then y).
-    subroutine emit_node(node)
-      integer, intent(in) :: node
-      integer :: c, f
-      do c = 1, 2
-        f = sys%free_of(2*(node - 1) + c)
-        if (f <= 0) cycle
-        if (f > sys%n) then
-          bad_map = .true.
-          cycle
-        end if
-        if (skip(f)) cycle
-        pos = pos + 1
-        if (pos <= size(perm)) perm(pos) = f
-      end do
-    end subroutine emit_node
+  end subroutine grid_dissection
 
-    !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
-    logical function general_system_ok() result(ok)
-      ok = .false.
-      if (mesh%nnode < 1 .or. sys%ndof /= 2*mesh%nnode .or. .not. allocated(mesh%xy)) then
-        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', sys%ndof, &
-          ' DOFs) does not belong to a mesh of ', mesh%nnode, ' nodes.'
-      else if (size(mesh%xy, 2) /= mesh%nnode) then
-        emsg = 'nested dissection: the mesh has the wrong number of node coordinates.'
-      else if (.not. allocated(sys%free_of) .or. .not. allocated(sys%dof_of) .or. &
-               .not. allocated(sys%colptr) .or. .not. allocated(sys%rowind)) then
-        emsg = 'nested dissection: the system has no DOF maps or no stiffness pattern.'
-      else if (size(sys%free_of) /= sys%ndof) then
-        emsg = 'nested dissection: the free-DOF map has the wrong size.'
-      else if (size(sys%dof_of) /= sys%n .or. size(sys%colptr) /= sys%n + 1) then
-        emsg = 'nested dissection: the DOF map or the column pointers have the wrong size.'
-      else if (sys%colptr(sys%n + 1) > size(sys%rowind)) then
-        emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
+  !> Nested-dissection permutation of the free DOFs not in `last` of a body on any mesh, by
+  !! recursive coordinate bisection of the node graph of the stiffness pattern (cost
+  !! O(nnz log n)). perm as grid_dissection's.
+  subroutine coordinate_bisection(xy, free_of, dof_of, colptr, rowind, last, perm, info, msg)
+    real(wp), intent(in) :: xy(:, :)                  !< (2, nnode) node coordinates [length]
+    integer, intent(in) :: free_of(:)                 !< (2*nnode) free index of each DOF, 0 if prescribed
+    integer, intent(in) :: dof_of(:)                  !< (n) global DOF of each free index
+    integer, intent(in) :: colptr(:)                  !< (n+1) 0-based CSC column pointers of the stiffness
+    integer, intent(in) :: rowind(:)                  !< 0-based row indices (free DOFs)
+    integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
+    integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
+    integer, intent(out) :: info                      !< ND_OK or an error code
+    character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
+    type(order_t) :: order
+    type(node_graph_t) :: graph
+    integer :: n, stamp
+    character(len=200) :: emsg
+
+    emsg = ''
+    n = size(dof_of)
+    info = ND_BAD_SYSTEM
+    if (general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg)) call start_order(n, last, order, info, emsg)
+    if (info == ND_OK) then
+      if (build_node_graph(xy, free_of, dof_of, colptr, rowind, n, order%skip, graph, emsg)) then
+        stamp = 0
+        call bisect(1, size(graph%sorted, 1))
+        call finish_order(order, info, emsg)
       else
-        ok = .true.
+        info = ND_BAD_SYSTEM
       end if
-    end function general_system_ok
+    end if
+    call hand_over(order, info, emsg, perm, msg)
 
-    !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
-    !! `last`) renumbered 1..na by increasing x (glob: local -> mesh node, so that the
-    !! graph sweeps touch memory in order), their coordinates xyl, their neighbours
-    !! through the stiffness (xadj, adj; both DOFs merged, DOFs in `last` left out), the
-    !! largest edge extents emax, the nodes sorted by x (srt(:,1)) and by y (srt(:,2)).
-    !! .false. with a sentence in emsg on a pattern or DOF map out of range.
-    logical function node_graph() result(ok)
-      integer, allocatable :: mark(:), loc(:)
-      integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
-      logical, allocatable :: active(:)
+  contains
 
-      ok = .false.
-      nn = mesh%nnode
-      allocate (active(nn), loc(nn))
-      active = .false.
-      do p = 1, sys%n
-        if (sys%dof_of(p) < 1 .or. sys%dof_of(p) > sys%ndof) then
-          write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
-            sys%dof_of(p), ', out of range.'
-          return
-        end if
-        if (.not. skip(p)) active((sys%dof_of(p) + 1)/2) = .true.
-      end do
-      na = count(active)
-      allocate (srt(na, 2), tmp(na), lab(na), mark(na), xadj(na + 1), xyl(2, na), rank(na, 2))
-      glob = pack([(node, node=1, nn)], active)
-      call sort_nodes(glob, 1, mesh%xy)
-      loc = 0
-      loc(glob) = [(i, i=1, na)]
-      xyl = mesh%xy(:, glob)
-      lab = 0
-
-      do pass = 1, 2            ! 1: count the neighbours, 2: store them
-        mark = 0
-        xadj(1) = 0
-        do i = 1, na
-          node = glob(i)
-          cnt = xadj(i)
-          do c = 1, 2
-            p = sys%free_of(2*(node - 1) + c)
-            if (p < 1 .or. p > sys%n) cycle
-            if (skip(p)) cycle
-            do kk = sys%colptr(p) + 1, sys%colptr(p + 1)
-              q = sys%rowind(kk) + 1
-              if (q < 1 .or. q > sys%n) then
-                write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
-                  ' of free DOF ', p, ' is out of range.'
-                return
-              end if
-              if (skip(q)) cycle
-              nb = loc((sys%dof_of(q) + 1)/2)
-              if (nb == i .or. nb == 0) cycle
-              if (mark(nb) == i) cycle
-              mark(nb) = i
-              cnt = cnt + 1
-              if (pass == 2) adj(cnt) = nb
-            end do
-          end do
-          if (pass == 1) then
-            xadj(i + 1) = cnt
-          else if (cnt /= xadj(i + 1)) then
-            emsg = 'nested dissection: internal error building the node graph.'
-            return
-          end if
-        end do
-        if (pass == 1) allocate (adj(xadj(na + 1)))
-      end do
-
-      emax = 0.0_wp
-      do i = 1, na
-        do kk = xadj(i) + 1, xadj(i + 1)
-          emax = max(emax, abs(xyl(:, adj(kk)) - xyl(:, i)))
-        end do
-      end do
-      emax = emax*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
-      srt(:, 1) = [(i, i=1, na)]
-      srt(:, 2) = srt(:, 1)
-      call sort_nodes(srt(:, 2), 2, xyl)
-      ok = .true.
-    end function node_graph
-
-    !> Stable merge sort of the points ids by coordinate `axis` of xyc, then by the other.
-    subroutine sort_nodes(ids, axis, xyc)
-      integer, intent(inout) :: ids(:)
-      integer, intent(in) :: axis
-      real(wp), intent(in) :: xyc(:, :)
-      integer, allocatable :: buf(:)
-      integer :: width, lo, mid, hi, i, j, k, n
-      logical :: first
-      n = size(ids)
-      allocate (buf(n))
-      width = 1
-      do while (width < n)
-        lo = 1
-        do while (lo <= n - width)
-          mid = lo + width - 1
-          hi = min(lo + 2*width - 1, n)
-          i = lo
-          j = mid + 1
-          k = lo
-          do while (i <= mid .and. j <= hi)
-            ! point ids(j) strictly before ids(i)?
-            if (xyc(axis, ids(j)) /= xyc(axis, ids(i))) then
-              first = xyc(axis, ids(j)) < xyc(axis, ids(i))
-            else
-              first = xyc(3 - axis, ids(j)) < xyc(3 - axis, ids(i))
-            end if
-            if (first) then
-              buf(k) = ids(j)
-              j = j + 1
-            else
-              buf(k) = ids(i)
-              i = i + 1
-            end if
-            k = k + 1
-          end do
-          if (i <= mid) buf(k:hi) = ids(i:mid)
-          if (j <= hi) buf(k:hi) = ids(j:hi)
-          ids(lo:hi) = buf(lo:hi)
-          lo = lo + 2*width
-        end do
-        width = 2*width
-      end do
-    end subroutine sort_nodes
-
-    !> Order the (local) nodes srt(lo:hi, :) (the same set in both columns) by recursive
+    !> Order the (local) nodes graph%sorted(lo:hi, :) (the same set in both columns) by recursive
     !! coordinate bisection: cut across x or y (both are tried when neither extent is
     !! below half the other) at the median or at 40, 45, 55 or 60% of the nodes, keeping
     !! the cut with the smallest separator (the smaller set of nodes of one side with a
@@ -357,14 +195,14 @@ contains
 
       m = hi - lo + 1
       if (m <= 0) return
-      ext(1) = xyl(1, srt(hi, 1)) - xyl(1, srt(lo, 1))
-      ext(2) = xyl(2, srt(hi, 2)) - xyl(2, srt(lo, 2))
+      ext(1) = graph%xy_local(1, graph%sorted(hi, 1)) - graph%xy_local(1, graph%sorted(lo, 1))
+      ext(2) = graph%xy_local(2, graph%sorted(hi, 2)) - graph%xy_local(2, graph%sorted(lo, 2))
       axis = 1
       if (ext(2) > ext(1)) axis = 2
       if (m < RCB_LEAF_NODES .or. .not. ext(axis) > 0.0_wp) then
         ! a leaf: along the longer extent, the shorter one varying fastest
         do i = lo, hi
-          call emit_node(glob(srt(i, axis)))
+          call emit_node(order, free_of, n, graph%mesh_node(graph%sorted(i, axis)))
         end do
         return
       end if
@@ -375,10 +213,10 @@ contains
       rset = stamp + 3
       sset = stamp + 4
       stamp = stamp + 4
-      lab(srt(lo:hi, 1)) = seg
+      graph%label(graph%sorted(lo:hi, 1)) = seg
       do a = 1, 2
         do i = lo, hi
-          rank(srt(i, a), a) = i
+          graph%position(graph%sorted(i, a), a) = i
         end do
       end do
       best = huge(1)
@@ -386,7 +224,7 @@ contains
       best_p = 0
       best_side = 1
       do k = 0, 1
-        ax = merge(axis, 3 - axis, k == 0)
+        ax = merge(axis, other_axis(axis), k == 0)
         if (k == 1 .and. .not. ext(ax) >= 0.5_wp*ext(axis)) exit
         do f = 1, size(fracs)
           p = cut_at(lo, hi, ax, lo + int((int(m, i8)*fracs(f))/100))
@@ -404,14 +242,14 @@ contains
       end do
       if (best_p == 0) then                  ! no cut possible (cannot happen: ext > 0)
         do i = lo, hi
-          call emit_node(glob(srt(i, axis)))
+          call emit_node(order, free_of, n, graph%mesh_node(graph%sorted(i, axis)))
         end do
         return
       end if
       axis = best_ax
       p = best_p
-      lab(srt(lo:p - 1, axis)) = lset
-      lab(srt(p:hi, axis)) = rset
+      graph%label(graph%sorted(lo:p - 1, axis)) = lset
+      graph%label(graph%sorted(p:hi, axis)) = rset
       if (best_side < 0) then
         ns = touching(p - 1, lo, -1, axis, p, sset)
       else
@@ -423,47 +261,47 @@ contains
         k = lo - 1
         do lbl = lset, sset
           do i = lo, hi
-            if (lab(srt(i, a)) == lbl) then
+            if (graph%label(graph%sorted(i, a)) == lbl) then
               k = k + 1
-              tmp(k) = srt(i, a)
+              graph%work(k) = graph%sorted(i, a)
             end if
           end do
           if (a == 1 .and. lbl == lset) nl = k - lo + 1
           if (a == 1 .and. lbl == rset) nr = k - lo + 1 - nl
         end do
-        srt(lo:hi, a) = tmp(lo:hi)
+        graph%sorted(lo:hi, a) = graph%work(lo:hi)
       end do
 
       call bisect(lo, lo + nl - 1)
       call bisect(lo + nl, lo + nl + nr - 1)
       ! the separator, along its length (sorted by the other coordinate)
       do i = lo + nl + nr, hi
-        call emit_node(glob(srt(i, 3 - axis)))
+        call emit_node(order, free_of, n, graph%mesh_node(graph%sorted(i, other_axis(axis))))
       end do
     end subroutine bisect
 
-    !> The first position of the right side of a cut of srt(lo:hi, axis) near position
-    !! mid: right = coordinate >= v = that of srt(mid), or > v when v is the least.
+    !> The first position of the right side of a cut of graph%sorted(lo:hi, axis) near position
+    !! mid: right = coordinate >= v = that of graph%sorted(mid), or > v when v is the least.
     integer function cut_at(lo, hi, axis, mid) result(p)
       integer, intent(in) :: lo, hi, axis, mid
       real(wp) :: v
-      v = xyl(axis, srt(mid, axis))
+      v = graph%xy_local(axis, graph%sorted(mid, axis))
       p = mid
       do while (p > lo)
-        if (xyl(axis, srt(p - 1, axis)) < v) exit
+        if (graph%xy_local(axis, graph%sorted(p - 1, axis)) < v) exit
         p = p - 1
       end do
       if (p == lo) then
         p = mid + 1
         do while (p <= hi)
-          if (xyl(axis, srt(p, axis)) > v) exit
+          if (graph%xy_local(axis, graph%sorted(p, axis)) > v) exit
           p = p + 1
         end do
       end if
     end function cut_at
 
-    !> For the cut of the current set (label seg) before position p of srt(:, axis): how
-    !! many of the nodes srt(i0, axis), srt(i0 + step, axis), ... (towards i1, from the
+    !> For the cut of the current set (label seg) before position p of graph%sorted(:, axis): how
+    !! many of the nodes graph%sorted(i0, axis), graph%sorted(i0 + step, axis), ... (towards i1, from the
     !! cut outwards, stopping one edge extent away from it) have a neighbour on the other
     !! side; with sep > 0 those nodes are labelled sep (the separator).
     integer function touching(i0, i1, step, axis, p, sep) result(cnt)
@@ -472,24 +310,24 @@ contains
       real(wp) :: cut
       cnt = 0
       if ((i1 - i0)*step < 0) return
-      seg = lab(srt(i0, axis))
+      seg = graph%label(graph%sorted(i0, axis))
       if (sep > 0) seg = -1                  ! labels already split: the other side is lset/rset
-      cut = xyl(axis, srt(i0, axis))
+      cut = graph%xy_local(axis, graph%sorted(i0, axis))
       do i = i0, i1, step
-        node = srt(i, axis)
-        if (abs(xyl(axis, node) - cut) > emax(axis)) exit
-        do kk = xadj(node) + 1, xadj(node + 1)
-          nb = adj(kk)
+        node = graph%sorted(i, axis)
+        if (abs(graph%xy_local(axis, node) - cut) > graph%edge_extent(axis)) exit
+        do kk = graph%xadj(node) + 1, graph%xadj(node + 1)
+          nb = graph%adj(kk)
           if (sep > 0) then
-            if (lab(nb) /= sep - 2 .and. lab(nb) /= sep - 1) cycle   ! not in this set
-            if (lab(nb) == sep - 2 .eqv. step > 0) then
+            if (graph%label(nb) /= sep - 2 .and. graph%label(nb) /= sep - 1) cycle   ! not in this set
+            if (graph%label(nb) == sep - 2 .eqv. step > 0) then
               cnt = cnt + 1
-              lab(node) = sep
+              graph%label(node) = sep
               exit
             end if
           else
-            if (lab(nb) /= seg) cycle
-            if ((rank(nb, axis) < p) .eqv. step > 0) then
+            if (graph%label(nb) /= seg) cycle
+            if ((graph%position(nb, axis) < p) .eqv. step > 0) then
               cnt = cnt + 1
               exit
             end if
@@ -498,6 +336,239 @@ contains
       end do
     end function touching
 
-  end subroutine nested_dissection
+  end subroutine coordinate_bisection
+
+  !> Check `last` (in 1..n, no repeats: else ND_BAD_LAST with a sentence) and start an
+  !! empty order of n - size(last) DOFs.
+  subroutine start_order(n, last, order, info, emsg)
+    integer, intent(in) :: n, last(:)
+    type(order_t), intent(out) :: order
+    integer, intent(out) :: info
+    character(len=*), intent(inout) :: emsg
+    integer :: k
+    info = ND_OK
+    allocate (order%skip(max(n, 0)))
+    order%skip = .false.
+    do k = 1, size(last)
+      if (last(k) < 1 .or. last(k) > n) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
+        info = ND_BAD_LAST
+        return
+      else if (order%skip(last(k))) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
+        info = ND_BAD_LAST
+        return
+      end if
+      order%skip(last(k)) = .true.
+    end do
+    allocate (order%perm(n - size(last)))
+  end subroutine start_order
+
+  !> Every DOF placed exactly once, else free_of is not a bijection onto 1..n: ND_BAD_SYSTEM.
+  subroutine finish_order(order, info, emsg)
+    type(order_t), intent(in) :: order
+    integer, intent(inout) :: info
+    character(len=*), intent(inout) :: emsg
+    if (order%bad_map .or. order%pos /= size(order%perm)) then
+      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', order%pos, ' DOFs but expected ', size(order%perm), &
+        ' (inconsistent free-DOF map).'
+      info = ND_BAD_SYSTEM
+    end if
+  end subroutine finish_order
+
+  !> The result: the order, or on failure an empty perm and the sentence in msg.
+  subroutine hand_over(order, info, emsg, perm, msg)
+    type(order_t), intent(inout) :: order
+    integer, intent(in) :: info
+    character(len=*), intent(in) :: emsg
+    integer, allocatable, intent(out) :: perm(:)
+    character(len=*), intent(out), optional :: msg
+    if (present(msg)) msg = ''
+    if (info == ND_OK) then
+      call move_alloc(order%perm, perm)
+    else
+      allocate (perm(0))
+      if (present(msg)) msg = emsg
+    end if
+  end subroutine hand_over
+
+  !> The other coordinate axis: 2 for 1 (x), 1 for 2 (y).
+  pure integer function other_axis(axis)
+    integer, intent(in) :: axis
+    other_axis = 3 - axis
+  end function other_axis
+
+  !> Append the free, non-skipped DOFs of one node (x then y).
+  subroutine emit_node(order, free_of, n, node)
+    type(order_t), intent(inout) :: order
+    integer, intent(in) :: free_of(:), n, node
+    integer :: c, f
+    do c = 1, 2
+      f = free_of(2*(node - 1) + c)
+      if (f <= 0) cycle
+      if (f > n) then
+        order%bad_map = .true.
+        cycle
+      end if
+      if (order%skip(f)) cycle
+      order%pos = order%pos + 1
+      if (order%pos <= size(order%perm)) order%perm(order%pos) = f
+    end do
+  end subroutine emit_node
+
+  !> The arrays a general mesh needs are there and agree in size (else a sentence in emsg).
+  logical function general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg) result(ok)
+    real(wp), intent(in) :: xy(:, :)
+    integer, intent(in) :: free_of(:), dof_of(:), colptr(:), rowind(:)
+    character(len=*), intent(inout) :: emsg
+    integer :: ndof, nnode, n
+    ndof = size(free_of)
+    nnode = size(xy, 2)
+    n = size(dof_of)             ! the free DOFs
+    ok = .false.
+    if (nnode < 1 .or. ndof /= 2*nnode) then
+      write (emsg, '(a,i0,a,i0,a)') 'nested dissection: the system (', ndof, &
+        ' DOFs) does not belong to a mesh of ', nnode, ' nodes.'
+    else if (size(xy, 1) /= 2) then
+      emsg = 'nested dissection: the node coordinates are not (x, y) pairs.'
+    else if (size(colptr) /= n + 1) then
+      emsg = 'nested dissection: the column pointers do not match the DOF map (size n + 1).'
+    else if (colptr(n + 1) > size(rowind)) then
+      emsg = 'nested dissection: the stiffness pattern has fewer row indices than its column pointers say.'
+    else
+      ok = .true.
+    end if
+  end function general_arrays_ok
+
+  !> The node graph of a general mesh: the ordered nodes (those with a free DOF not in
+  !! `last`) renumbered 1..na by increasing x (graph%mesh_node: local -> mesh node, so that the
+  !! graph sweeps touch memory in order), their coordinates graph%xy_local, their neighbours
+  !! through the stiffness (graph%xadj, graph%adj; both DOFs merged, DOFs in `last` left out), the
+  !! largest edge extents graph%edge_extent, the nodes sorted by x (graph%sorted(:,1)) and by y (graph%sorted(:,2)).
+  !! .false. with a sentence in emsg on a pattern or DOF map out of range.
+  logical function build_node_graph(xy, free_of, dof_of, colptr, rowind, n, skip, graph, emsg) result(ok)
+    real(wp), intent(in) :: xy(:, :)
+    integer, intent(in) :: free_of(:), dof_of(:), colptr(:), rowind(:), n
+    logical, intent(in) :: skip(:)
+    type(node_graph_t), intent(out) :: graph
+    character(len=*), intent(inout) :: emsg
+    integer, allocatable :: mark(:), loc(:)
+    integer :: nn, node, c, p, q, kk, nb, cnt, na, pass, i
+    logical, allocatable :: active(:)
+
+    ok = .false.
+    nn = size(xy, 2)
+    allocate (active(nn), loc(nn))
+    active = .false.
+    do p = 1, n
+      if (dof_of(p) < 1 .or. dof_of(p) > size(free_of)) then
+        write (emsg, '(a,i0,a,i0,a)') 'nested dissection: free DOF ', p, ' maps to global DOF ', &
+          dof_of(p), ', out of range.'
+        return
+      end if
+      if (.not. skip(p)) active((dof_of(p) + 1)/2) = .true.
+    end do
+    na = count(active)
+    allocate (graph%sorted(na, 2), graph%work(na), graph%label(na), mark(na), graph%xadj(na + 1), &
+              graph%xy_local(2, na), graph%position(na, 2))
+    graph%mesh_node = pack([(node, node=1, nn)], active)
+    call sort_nodes(graph%mesh_node, 1, xy)
+    loc = 0
+    loc(graph%mesh_node) = [(i, i=1, na)]
+    graph%xy_local = xy(:, graph%mesh_node)
+    graph%label = 0
+
+    do pass = 1, 2            ! 1: count the neighbours, 2: store them
+      mark = 0
+      graph%xadj(1) = 0
+      do i = 1, na
+        node = graph%mesh_node(i)
+        cnt = graph%xadj(i)
+        do c = 1, 2
+          p = free_of(2*(node - 1) + c)
+          if (p < 1 .or. p > n) cycle
+          if (skip(p)) cycle
+          do kk = colptr(p) + 1, colptr(p + 1)
+            q = rowind(kk) + 1
+            if (q < 1 .or. q > n) then
+              write (emsg, '(a,i0,a,i0,a)') 'nested dissection: row index ', q - 1, &
+                ' of free DOF ', p, ' is out of range.'
+              return
+            end if
+            if (skip(q)) cycle
+            nb = loc((dof_of(q) + 1)/2)
+            if (nb == i .or. nb == 0) cycle
+            if (mark(nb) == i) cycle
+            mark(nb) = i
+            cnt = cnt + 1
+            if (pass == 2) graph%adj(cnt) = nb
+          end do
+        end do
+        if (pass == 1) then
+          graph%xadj(i + 1) = cnt
+        else if (cnt /= graph%xadj(i + 1)) then
+          emsg = 'nested dissection: internal error building the node graph.'
+          return
+        end if
+      end do
+      if (pass == 1) allocate (graph%adj(graph%xadj(na + 1)))
+    end do
+
+    graph%edge_extent = 0.0_wp
+    do i = 1, na
+      do kk = graph%xadj(i) + 1, graph%xadj(i + 1)
+        graph%edge_extent = max(graph%edge_extent, abs(graph%xy_local(:, graph%adj(kk)) - graph%xy_local(:, i)))
+      end do
+    end do
+    graph%edge_extent = graph%edge_extent*(1.0_wp + 1.0e-10_wp)        ! no node lost to rounding at the band's edge
+    graph%sorted(:, 1) = [(i, i=1, na)]
+    graph%sorted(:, 2) = graph%sorted(:, 1)
+    call sort_nodes(graph%sorted(:, 2), 2, graph%xy_local)
+    ok = .true.
+  end function build_node_graph
+
+  !> Stable merge sort of the points ids by coordinate `axis` of xyc, then by the other.
+  subroutine sort_nodes(ids, axis, xyc)
+    integer, intent(inout) :: ids(:)
+    integer, intent(in) :: axis
+    real(wp), intent(in) :: xyc(:, :)
+    integer, allocatable :: buf(:)
+    integer :: width, lo, mid, hi, i, j, k, n
+    logical :: first
+    n = size(ids)
+    allocate (buf(n))
+    width = 1
+    do while (width < n)
+      lo = 1
+      do while (lo <= n - width)
+        mid = lo + width - 1
+        hi = min(lo + 2*width - 1, n)
+        i = lo
+        j = mid + 1
+        k = lo
+        do while (i <= mid .and. j <= hi)
+          ! point ids(j) strictly before ids(i)?
+          if (xyc(axis, ids(j)) /= xyc(axis, ids(i))) then
+            first = xyc(axis, ids(j)) < xyc(axis, ids(i))
+          else
+            first = xyc(other_axis(axis), ids(j)) < xyc(other_axis(axis), ids(i))
+          end if
+          if (first) then
+            buf(k) = ids(j)
+            j = j + 1
+          else
+            buf(k) = ids(i)
+            i = i + 1
+          end if
+          k = k + 1
+        end do
+        if (i <= mid) buf(k:hi) = ids(i:mid)
+        if (j <= hi) buf(k:hi) = ids(j:hi)
+        ids(lo:hi) = buf(lo:hi)
+        lo = lo + 2*width
+      end do
+      width = 2*width
+    end do
+  end subroutine sort_nodes
 
 end module ordering

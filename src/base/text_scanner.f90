@@ -1,0 +1,340 @@
+!> A text scanner over a whole file held in memory: blank-separated tokens, integers and
+!! reals converted by hand (a list-directed READ costs about 1.7 us a number, several
+!! seconds for the millions of numbers of a large mesh file), the current line for
+!! messages, and the first error met (code, line, sentence). After an error every read
+!! returns at once (0 for a number), so a reader checks the status only where it must
+!! stop.
+module text_scanner
+  use kinds, only: wp, i8
+  use strings, only: i2s, fpstate_t, fp_read_begin, fp_read_end
+  implicit none (type, external)
+  private
+
+  public :: scanner_load, scan_fail, next_token, bad_token, get_int, get_real, read_count, bytes_left, &
+            expect, skip_past, parse_int, parse_real
+
+  integer, parameter, public :: SCAN_BAD_INPUT = 1       !< info: the text is not what was expected
+  integer, parameter, public :: SCAN_OTHER_FAILURE = 3   !< info: anything else (memory)
+
+  real(wp), parameter :: p10(0:22) = [ &   ! the powers of ten that doubles hold exactly
+    1.0e0_wp, 1.0e1_wp, 1.0e2_wp, 1.0e3_wp, 1.0e4_wp, 1.0e5_wp, 1.0e6_wp, 1.0e7_wp, 1.0e8_wp, &
+    1.0e9_wp, 1.0e10_wp, 1.0e11_wp, 1.0e12_wp, 1.0e13_wp, 1.0e14_wp, 1.0e15_wp, 1.0e16_wp, &
+    1.0e17_wp, 1.0e18_wp, 1.0e19_wp, 1.0e20_wp, 1.0e21_wp, 1.0e22_wp]
+
+  !> The file's text and a reading position, with the first error met.
+  type, public :: scanner_t
+    character(len=:), allocatable :: text     !< the whole file
+    integer(i8) :: n = 0                      !< its length
+    integer(i8) :: pos = 1                    !< next character
+    integer :: line = 1                       !< the line of pos
+    character(len=:), allocatable :: path     !< the file
+    character(len=:), allocatable :: section  !< the part being read, for messages
+    integer :: info = 0                       !< first error: code (0: none)
+    integer :: err_line = 0                   !< its line (0: none)
+    character(len=:), allocatable :: err      !< its text
+  end type scanner_t
+
+contains
+
+  ! ---- errors ---------------------------------------------------------------------------
+
+  !> Record an error (the first one only) at the current line, or with no line (at_line false).
+  subroutine scan_fail(scanner, text, code, at_line)
+    type(scanner_t), intent(inout) :: scanner
+    character(len=*), intent(in) :: text
+    integer, intent(in), optional :: code
+    logical, intent(in), optional :: at_line
+    if (scanner%info /= 0) return
+    scanner%info = SCAN_BAD_INPUT
+    if (present(code)) scanner%info = code
+    scanner%err_line = scanner%line
+    if (present(at_line)) then
+      if (.not. at_line) scanner%err_line = 0
+    end if
+    scanner%err = text
+  end subroutine scan_fail
+
+  ! ---- the text -------------------------------------------------------------------------
+
+  !> Read the whole file `path` into scanner%text (scanner%path names it in messages).
+  subroutine scanner_load(scanner, path)
+    type(scanner_t), intent(inout) :: scanner   !< the scanner, at the file's start on return
+    character(len=*), intent(in) :: path    !< the file
+    integer :: u, ios, st
+    integer(i8) :: size_bytes
+    character(len=256) :: iom
+
+    scanner%path = path
+    scanner%section = ''
+    open (newunit=u, file=path, access='stream', form='unformatted', status='old', &
+          action='read', iostat=ios, iomsg=iom)
+    if (ios /= 0) then
+      call scan_fail(scanner, 'cannot be opened ('//trim(iom)//')', at_line=.false.)
+      return
+    end if
+    inquire (unit=u, size=size_bytes)
+    if (size_bytes <= 0) then
+      close (u)
+      call scan_fail(scanner, 'is empty or not a regular file', at_line=.false.)
+      return
+    end if
+    allocate (character(len=size_bytes) :: scanner%text, stat=st)
+    if (st /= 0) then
+      close (u)
+      call scan_fail(scanner, 'needs '//i2s(int(size_bytes/2**20))//' MB of memory to be read', &
+                SCAN_OTHER_FAILURE, .false.)
+      return
+    end if
+    read (u, iostat=ios, iomsg=iom) scanner%text
+    close (u)
+    if (ios /= 0) then
+      call scan_fail(scanner, 'cannot be read ('//trim(iom)//')', at_line=.false.)
+      return
+    end if
+    scanner%n = size_bytes
+  end subroutine scanner_load
+
+  !> The next token (characters above the blank) as text(s:e); s > scanner%n at the end of the
+  !! file. Blanks, tabs, carriage returns and other control characters separate tokens.
+  subroutine next_token(scanner, s, e)
+    type(scanner_t), intent(inout) :: scanner
+    integer(i8), intent(out) :: s, e
+    integer :: code
+    do while (scanner%pos <= scanner%n)
+      code = iachar(scanner%text(scanner%pos:scanner%pos))
+      if (code > 32) exit
+      if (code == 10) scanner%line = scanner%line + 1
+      scanner%pos = scanner%pos + 1
+    end do
+    s = scanner%pos
+    do while (scanner%pos <= scanner%n)
+      if (iachar(scanner%text(scanner%pos:scanner%pos)) <= 32) exit
+      scanner%pos = scanner%pos + 1
+    end do
+    e = scanner%pos - 1
+  end subroutine next_token
+
+  !> Report the end of the file inside a section, or a token that is not `what`.
+  subroutine bad_token(scanner, s, e, what)
+    type(scanner_t), intent(inout) :: scanner
+    integer(i8), intent(in) :: s, e
+    character(len=*), intent(in) :: what
+    if (s > scanner%n) then
+      call scan_fail(scanner, 'the file ends inside '//scanner%section//' where '//what// &
+                ' was expected (truncated file?)')
+    else
+      call scan_fail(scanner, 'expected '//what//' in '//scanner%section//", found '"// &
+                scanner%text(s:min(e, s + 40))//"'")
+    end if
+  end subroutine bad_token
+
+  !> The next token as an integer (0 after an error).
+  integer function get_int(scanner, what) result(v)
+    type(scanner_t), intent(inout) :: scanner
+    character(len=*), intent(in) :: what   ! what the number is, for messages
+    integer(i8) :: s, e
+    logical :: ok
+    v = 0
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
+    ok = s <= e
+    if (ok) call parse_int(scanner%text(s:e), v, ok)
+    if (.not. ok) call bad_token(scanner, s, e, what//' (an integer)')
+  end function get_int
+
+  !> The next token as a real (0 after an error).
+  real(wp) function get_real(scanner, what) result(v)
+    type(scanner_t), intent(inout) :: scanner
+    character(len=*), intent(in) :: what
+    integer(i8) :: s, e
+    logical :: ok
+    v = 0.0_wp
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
+    ok = s <= e
+    if (ok) call parse_real(scanner%text(s:e), v, ok)
+    if (.not. ok) call bad_token(scanner, s, e, what//' (a finite real)')
+  end function get_real
+
+  !> The next token as a count of items that follow in the file (0 after an error): a
+  !! non-negative integer. Every count that sizes an allocation is read here, so that the
+  !! checks of a count against the file (the bytes left, bytes_left) have one place.
+  integer function read_count(scanner, what) result(v)
+    type(scanner_t), intent(inout) :: scanner
+    character(len=*), intent(in) :: what   ! what is counted, for messages
+    integer(i8) :: s, e
+    logical :: ok
+    v = 0
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
+    ok = s <= e
+    if (ok) call parse_int(scanner%text(s:e), v, ok)
+    if (ok) ok = v >= 0
+    if (.not. ok) then
+      v = 0
+      call bad_token(scanner, s, e, what//' (an integer >= 0)')
+    end if
+  end function read_count
+
+  !> The characters from the position to the end of the file.
+  pure integer(i8) function bytes_left(scanner)
+    type(scanner_t), intent(in) :: scanner
+    bytes_left = max(scanner%n - scanner%pos + 1, 0_i8)
+  end function bytes_left
+
+  !> The next token must be `word` (a section's end marker).
+  subroutine expect(scanner, word)
+    type(scanner_t), intent(inout) :: scanner
+    character(len=*), intent(in) :: word
+    integer(i8) :: s, e
+    if (scanner%info /= 0) return
+    call next_token(scanner, s, e)
+    if (s > scanner%n) then
+      call scan_fail(scanner, 'the file ends before '//word//' (truncated file?)')
+    else if (scanner%text(s:e) /= word) then
+      call scan_fail(scanner, 'expected '//word//" to close "//scanner%section//", found '"// &
+                scanner%text(s:min(e, s + 40))//"'")
+    end if
+  end subroutine expect
+
+  !> Move past the first `marker` at or after the position (the end of a section that is
+  !! not read).
+  subroutine skip_past(scanner, marker)
+    type(scanner_t), intent(inout) :: scanner
+    character(len=*), intent(in) :: marker   !< e.g. '$EndComments'
+    integer(i8) :: k, stop_at
+    k = index(scanner%text(scanner%pos:scanner%n), marker, kind=i8)
+    if (k == 0) then
+      call scan_fail(scanner, 'the file ends before '//marker//' (truncated file?)')
+      return
+    end if
+    stop_at = scanner%pos + k - 1
+    do while (scanner%pos < stop_at)
+      if (scanner%text(scanner%pos:scanner%pos) == achar(10)) scanner%line = scanner%line + 1
+      scanner%pos = scanner%pos + 1
+    end do
+    scanner%pos = stop_at + len(marker)
+  end subroutine skip_past
+
+  !> A decimal integer with an optional sign, in the default integer range.
+  pure subroutine parse_int(t, v, ok)
+    character(len=*), intent(in) :: t
+    integer, intent(out) :: v
+    logical, intent(out) :: ok
+    integer :: i, i0, d
+    integer(i8) :: m
+    v = 0
+    i0 = 1
+    if (t(1:1) == '-' .or. t(1:1) == '+') i0 = 2
+    ok = len(t) >= i0 .and. len(t) - i0 < 18
+    if (.not. ok) return
+    m = 0
+    do i = i0, len(t)
+      d = iachar(t(i:i)) - iachar('0')
+      if (d < 0 .or. d > 9) then
+        ok = .false.
+        return
+      end if
+      m = 10*m + d
+    end do
+    if (t(1:1) == '-') m = -m
+    ok = abs(m) <= huge(v)
+    if (ok) v = int(m)
+  end subroutine parse_int
+
+  !> A decimal real. Exact (correctly rounded) in the common case of at most 18 significant
+  !! digits with a mantissa below 2**53 and a power of ten up to 22 (one multiplication or
+  !! division of two exact doubles); other forms go through a formatted READ.
+  subroutine parse_real(t, v, ok)
+    character(len=*), intent(in) :: t
+    real(wp), intent(out) :: v
+    logical, intent(out) :: ok
+    integer :: i, d, nsig, e10, ex, esign
+    integer(i8) :: m
+    logical :: digits, neg
+    type(fpstate_t) :: fp
+    integer :: ios
+
+    v = 0.0_wp
+    i = 1
+    neg = t(1:1) == '-'
+    if (t(1:1) == '-' .or. t(1:1) == '+') i = 2
+    m = 0
+    nsig = 0
+    e10 = 0
+    digits = .false.
+    ok = .true.
+    do while (i <= len(t))                       ! integer part
+      d = iachar(t(i:i)) - iachar('0')
+      if (d < 0 .or. d > 9) exit
+      digits = .true.
+      if (nsig >= 18) then
+        ok = .false.
+      else
+        m = 10*m + d
+        if (m > 0) nsig = nsig + 1
+      end if
+      i = i + 1
+    end do
+    if (i <= len(t)) then                        ! fraction
+      if (t(i:i) == '.') then
+        i = i + 1
+        do while (i <= len(t))
+          d = iachar(t(i:i)) - iachar('0')
+          if (d < 0 .or. d > 9) exit
+          digits = .true.
+          if (nsig >= 18) then
+            ok = .false.
+          else
+            m = 10*m + d
+            if (m > 0) nsig = nsig + 1
+            e10 = e10 - 1
+          end if
+          i = i + 1
+        end do
+      end if
+    end if
+    if (i <= len(t)) then                        ! exponent
+      if (t(i:i) == 'e' .or. t(i:i) == 'E') then
+        i = i + 1
+        esign = 1
+        if (i <= len(t)) then
+          if (t(i:i) == '-') esign = -1
+          if (t(i:i) == '-' .or. t(i:i) == '+') i = i + 1
+        end if
+        ex = 0
+        digits = digits .and. i <= len(t)
+        do while (i <= len(t))
+          d = iachar(t(i:i)) - iachar('0')
+          if (d < 0 .or. d > 9) exit
+          if (ex < 100000) ex = 10*ex + d
+          i = i + 1
+        end do
+        e10 = e10 + esign*ex
+      end if
+    end if
+    ok = ok .and. digits .and. i > len(t)
+    if (ok .and. m == 0) then
+      v = 0.0_wp
+    else if (ok .and. m <= 2_i8**53 .and. abs(e10) <= 22) then
+      v = real(m, wp)
+      if (e10 >= 0) then
+        v = v*p10(e10)
+      else
+        v = v/p10(-e10)
+      end if
+    else
+      ! Rare forms (17+ digits, large exponents, 'D' exponents): a formatted READ, only of
+      ! number characters (a list-directed READ would take '/' or ',' as separators).
+      ok = len(t) <= 64 .and. verify(t, '0123456789+-.eEdD') == 0
+      if (.not. ok) return
+      call fp_read_begin(fp)
+      read (t, '(f64.0)', iostat=ios) v
+      call fp_read_end(fp)
+      ok = ios == 0 .and. abs(v) <= huge(v)
+      return
+    end if
+    if (neg) v = -v
+  end subroutine parse_real
+
+end module text_scanner

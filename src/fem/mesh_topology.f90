@@ -1,0 +1,495 @@
+!> One body's mesh from what a mesh file holds (physical groups, entities, nodes, cells,
+!! lines and points, in file order; module gmsh_msh reads them): the cells of the body's
+!! physical surface, its nodes renumbered 1..nnode in increasing tag order, its cells
+!! counter-clockwise (degenerate cells and non-convex quadrangles refused), and its groups.
+!! A group keeps the line elements of its physical curve that are boundary edges of the body
+!! (edges of exactly one body cell), oriented as that cell traverses them; the nodes of its
+!! lines inside the body (edges of two body cells) are kept as single nodes. A physical point
+!! is a group of single nodes: those of its points that are nodes of the body. A point's
+!! node in no cell of the file (a free geometry point) is the body's node at the same place,
+!! within 1e-9 times the body's size, if it has one.
+module mesh_topology
+  use kinds, only: wp, i8
+  use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
+  use strings, only: i2s
+  use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
+  use mesh, only: mesh_t
+  implicit none (type, external)
+  private
+
+  public :: body_from_file, add_physical, entity_index
+
+  integer, parameter :: BAD_INPUT = 1, OTHER_FAILURE = 3
+  real(wp), parameter :: AREA_TOL = 1.0e-12_wp       ! degenerate: |area| < AREA_TOL * (longest edge)^2
+
+  !> A text of its own length (an array of names).
+  type, public :: name_t
+    character(len=:), allocatable :: s
+  end type name_t
+
+  !> A point, curve or surface entity and its physical tags.
+  type, public :: entity_t
+    integer :: dim = 0, tag = 0
+    integer, allocatable :: phys(:)
+  end type entity_t
+
+  !> What a mesh file holds, before a body is chosen. Nodes, cells, lines and points are
+  !! numbered in file order; elements refer to nodes by that number, to entities by their
+  !! index in `ent` (0: the file has no entity for them).
+  type, public :: file_mesh_t
+    integer :: nphys = 0                       !< physical groups (named or not)
+    integer, allocatable :: phys_dim(:), phys_tag(:)
+    type(name_t), allocatable :: phys_name(:)
+    integer :: nent = 0                        !< point, curve and surface entities
+    type(entity_t), allocatable :: ent(:)
+    integer :: nnode = 0                       !< nodes
+    integer, allocatable :: node_tag(:)
+    real(wp), allocatable :: node_xy(:, :)
+    integer :: ncell = 0                       !< triangles and quadrangles
+    integer, allocatable :: cell_tag(:), cell_entity(:)
+    integer, allocatable :: cell_node(:, :)    !< (4, ncell) nodes; a triangle's 4th is 0
+    integer :: nline = 0                       !< 2-node lines
+    integer, allocatable :: line_entity(:), line_node(:, :)
+    integer :: npoint = 0                      !< point elements
+    integer, allocatable :: point_entity(:), point_node(:)
+  end type file_mesh_t
+
+contains
+
+  !> Add a physical group (dim, tag) named `name` unless it is there already.
+  subroutine add_physical(file_mesh, dim, tag, name)
+    type(file_mesh_t), intent(inout) :: file_mesh
+    integer, intent(in) :: dim, tag
+    character(len=*), intent(in) :: name
+    integer, allocatable :: idim(:), itag(:)
+    type(name_t), allocatable :: nm(:)
+    integer :: k
+    if (.not. allocated(file_mesh%phys_dim)) &
+      allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
+    do k = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(k) == dim .and. file_mesh%phys_tag(k) == tag) return
+    end do
+    if (file_mesh%nphys == size(file_mesh%phys_dim)) then
+      allocate (idim(2*file_mesh%nphys), itag(2*file_mesh%nphys), nm(2*file_mesh%nphys))
+      idim(1:file_mesh%nphys) = file_mesh%phys_dim
+      itag(1:file_mesh%nphys) = file_mesh%phys_tag
+      do k = 1, file_mesh%nphys
+        call move_alloc(file_mesh%phys_name(k)%s, nm(k)%s)
+      end do
+      call move_alloc(idim, file_mesh%phys_dim)
+      call move_alloc(itag, file_mesh%phys_tag)
+      call move_alloc(nm, file_mesh%phys_name)
+    end if
+    file_mesh%nphys = file_mesh%nphys + 1
+    file_mesh%phys_dim(file_mesh%nphys) = dim
+    file_mesh%phys_tag(file_mesh%nphys) = tag
+    file_mesh%phys_name(file_mesh%nphys)%s = name
+  end subroutine add_physical
+
+  !> The index in file_mesh%ent of entity (dim, tag), 0 if it has none.
+  integer function entity_index(file_mesh, dim, tag) result(k)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: dim, tag
+    do k = 1, file_mesh%nent
+      if (file_mesh%ent(k)%dim == dim .and. file_mesh%ent(k)%tag == tag) return
+    end do
+    k = 0
+  end function entity_index
+
+  !> Record a failure (the first one only).
+  subroutine refuse(info, err, text, code)
+    integer, intent(inout) :: info
+    character(len=:), allocatable, intent(inout) :: err
+    character(len=*), intent(in) :: text
+    integer, intent(in), optional :: code
+    if (info /= 0) return
+    info = BAD_INPUT
+    if (present(code)) info = code
+    err = text
+  end subroutine refuse
+
+  !> One body from what a mesh file holds: choose the body's cells (those of the physical
+  !! surface `region`), renumber its nodes, orient and check its cells, find its groups.
+  !! On failure info = 1 (bad input) or 3 (memory) and err is a phrase about the file
+  !! (its subject the file: 'has no physical surface ...').
+  subroutine body_from_file(file_mesh, region, path, mesh, info, err)
+    type(file_mesh_t), intent(in) :: file_mesh          !< the file's groups, entities, nodes, elements
+    character(len=*), intent(in) :: region              !< physical surface name of the body, or ''
+    character(len=*), intent(in) :: path                !< the file, kept as mesh%source
+    type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
+    integer, intent(out) :: info                        !< 0; 1 bad input; 3 other failure
+    character(len=:), allocatable, intent(out) :: err   !< the failure, when info /= 0
+    integer :: surface, k, c, nsurf, ncell, st, nquad
+    logical, allocatable :: in_entity(:)
+    integer, allocatable :: file_cell(:), body_node(:), order(:)
+    character(len=:), allocatable :: surfaces
+
+    info = 0
+    ! the physical surface of the body
+    surfaces = ''
+    nsurf = 0
+    surface = 0
+    do k = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(k) /= 2) cycle
+      nsurf = nsurf + 1
+      surfaces = surfaces//merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'"
+      if (len(region) > 0 .and. file_mesh%phys_name(k)%s == region) surface = k
+    end do
+    surfaces = trim(adjustl(surfaces))
+    if (len(region) > 0 .and. surface == 0) then
+      if (nsurf == 0) then
+        call refuse(info, err, "has no physical surface '"//region//"' (it has no physical surfaces)")
+      else
+        call refuse(info, err, "has no physical surface '"//region//"' (its physical surfaces: "//surfaces//')')
+      end if
+      return
+    end if
+    if (len(region) == 0 .and. nsurf > 1) then
+      call refuse(info, err, 'holds '//i2s(nsurf)//' physical surfaces ('//surfaces// &
+                '); name the body''s one as its region')
+      return
+    end if
+    if (len(region) == 0 .and. nsurf == 1) then
+      do k = 1, file_mesh%nphys
+        if (file_mesh%phys_dim(k) == 2) surface = k
+      end do
+    end if
+
+    ! its cells: those of the surface entities in the group (every one without a group)
+    allocate (in_entity(0:file_mesh%nent))
+    in_entity = surface == 0
+    do k = 1, file_mesh%nent
+      if (surface > 0) in_entity(k) = file_mesh%ent(k)%dim == 2 .and. &
+                                      any(file_mesh%ent(k)%phys == file_mesh%phys_tag(surface))
+    end do
+    file_cell = pack([(c, c=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
+    ncell = size(file_cell)
+    if (ncell == 0) then
+      if (surface > 0) then
+        call refuse(info, err, "physical surface '"//file_mesh%phys_name(surface)%s// &
+                    "' has no triangles or quadrangles")
+      else
+        call refuse(info, err, 'has no triangles or quadrangles')
+      end if
+      return
+    end if
+
+    ! its nodes, in increasing tag order
+    allocate (body_node(file_mesh%nnode), stat=st)
+    if (st /= 0) then
+      call refuse(info, err, 'not enough memory', OTHER_FAILURE)
+      return
+    end if
+    body_node = 0
+    do k = 1, ncell
+      do c = 1, 4
+        if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
+      end do
+    end do
+    order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
+    call sort_by_tag(order, file_mesh%node_tag)
+    mesh%nnode = size(order)
+    allocate (mesh%xy(2, mesh%nnode), mesh%node_tag(mesh%nnode))
+    do k = 1, mesh%nnode
+      body_node(order(k)) = k
+      mesh%xy(:, k) = file_mesh%node_xy(:, order(k))
+      mesh%node_tag(k) = file_mesh%node_tag(order(k))
+    end do
+
+    ! its cells
+    nquad = count(file_mesh%cell_node(4, file_cell) > 0)
+    mesh%ncell = ncell
+    mesh%nvert = merge(4, 3, nquad > 0)
+    if (nquad == ncell) then
+      mesh%element = ELEM_Q1
+    else if (nquad == 0) then
+      mesh%element = ELEM_P1
+    else
+      mesh%element = ELEM_MIXED
+    end if
+    allocate (mesh%cells(mesh%nvert, ncell), mesh%cell_type(ncell), mesh%cell_tag(ncell))
+    mesh%cells = 0
+    do k = 1, ncell
+      c = file_cell(k)
+      mesh%cell_tag(k) = file_mesh%cell_tag(c)
+      if (file_mesh%cell_node(4, c) > 0) then
+        mesh%cell_type(k) = ELEM_Q1
+        mesh%cells(1:4, k) = body_node(file_mesh%cell_node(1:4, c))
+      else
+        mesh%cell_type(k) = ELEM_P1
+        mesh%cells(1:3, k) = body_node(file_mesh%cell_node(1:3, c))
+      end if
+      call orient_cell(mesh, k, info, err)
+      if (info /= 0) return
+    end do
+
+    mesh%structured = .false.
+    mesh%source = path
+    mesh%nx = 0
+    mesh%ny = 0
+    mesh%x0 = minval(mesh%xy(1, :))
+    mesh%y0 = minval(mesh%xy(2, :))
+    mesh%width = maxval(mesh%xy(1, :)) - mesh%x0
+    mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
+
+    call boundary_groups(file_mesh, body_node, mesh, info, err)
+    if (info == 0) call point_groups(file_mesh, body_node, mesh)
+  end subroutine body_from_file
+
+  !> Put cell k counter-clockwise; refuse it if degenerate or (a quadrangle) not convex.
+  subroutine orient_cell(mesh, k, info, err)
+    type(mesh_t), intent(inout) :: mesh
+    integer, intent(in) :: k
+    integer, intent(inout) :: info
+    character(len=:), allocatable, intent(inout) :: err
+    real(wp) :: p(2, 4), area2, h2, turn
+    integer :: nv, i, i1, i2
+    character(len=*), parameter :: what(2) = ['quadrangle', 'triangle  ']
+
+    nv = merge(4, 3, mesh%cell_type(k) == ELEM_Q1)
+    p(:, 1:nv) = mesh%xy(:, mesh%cells(1:nv, k))
+    area2 = 0.0_wp
+    h2 = 0.0_wp
+    do i = 1, nv
+      i1 = modulo(i, nv) + 1
+      area2 = area2 + p(1, i)*p(2, i1) - p(1, i1)*p(2, i)
+      h2 = max(h2, sum((p(:, i1) - p(:, i))**2))
+    end do
+    if (.not. abs(area2) > 2.0_wp*AREA_TOL*h2) then
+      call refuse(info, err, 'element '//i2s(mesh%cell_tag(k))//' (a '//trim(what(mesh%cell_type(k)))// &
+                ') is degenerate: its area is zero or nearly so')
+      return
+    end if
+    if (area2 < 0.0_wp) then      ! clockwise: reverse, keeping the first vertex
+      mesh%cells(2:nv, k) = mesh%cells(nv:2:-1, k)
+      p(:, 2:nv) = p(:, nv:2:-1)
+    end if
+    if (nv == 4) then
+      do i = 1, 4
+        i1 = modulo(i, 4) + 1
+        i2 = modulo(i + 1, 4) + 1
+        turn = (p(1, i1) - p(1, i))*(p(2, i2) - p(2, i1)) - (p(2, i1) - p(2, i))*(p(1, i2) - p(1, i1))
+        if (.not. turn > AREA_TOL*h2) then
+          call refuse(info, err, 'element '//i2s(mesh%cell_tag(k))//' is not a convex quadrangle '// &
+                    '(inverted, self-crossing or with a re-entrant or straight corner at node '// &
+                    i2s(mesh%node_tag(mesh%cells(i1, k)))//')')
+          return
+        end if
+      end do
+    end if
+  end subroutine orient_cell
+
+  !> One edge group per physical curve: its lines that are boundary edges of the body, and
+  !! the nodes of its lines inside the body as single nodes (a curve inside the body gives
+  !! a group of nodes only). The lines' edges are hashed (a small table), then every cell
+  !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
+  !! oriented as that cell has it; one met in two is inside the body.
+  subroutine boundary_groups(file_mesh, body_node, mesh, info, err)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
+    type(mesh_t), intent(inout) :: mesh
+    integer, intent(inout) :: info
+    character(len=:), allocatable, intent(inout) :: err
+    type(int_hash_t) :: edge_hash
+    integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
+    logical, allocatable :: marked(:)
+    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner
+    integer(i8) :: key, key_base
+
+    ! the body's line edges, keyed by their two nodes (line_slot = -1: not a body edge)
+    call hash_init(edge_hash, file_mesh%nline, st)
+    if (st == 0) allocate (line_slot(file_mesh%nline), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
+                           edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
+                           inner(2*file_mesh%nline), marked(mesh%nnode), stat=st)
+    if (st /= 0) then
+      call refuse(info, err, 'not enough memory for the boundary edges', OTHER_FAILURE)
+      return
+    end if
+    line_slot = -1
+    edge_count = 0
+    marked = .false.
+    key_base = mesh%nnode + 1
+    do line = 1, file_mesh%nline
+      if (file_mesh%line_entity(line) == 0) cycle
+      a = body_node(file_mesh%line_node(1, line))
+      b = body_node(file_mesh%line_node(2, line))
+      if (a == 0 .or. b == 0 .or. a == b) cycle
+      key = min(a, b)*key_base + max(a, b)
+      slot = hash_slot(edge_hash, key)
+      edge_hash%key(slot) = key
+      line_slot(line) = slot
+    end do
+
+    ! how many cells have each of them, and the last one
+    do c = 1, mesh%ncell
+      nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+      do i = 1, nv
+        a = mesh%cells(i, c)
+        b = mesh%cells(modulo(i, nv) + 1, c)
+        key = min(a, b)*key_base + max(a, b)
+        slot = hash_slot(edge_hash, key)
+        if (edge_hash%key(slot) /= key) cycle
+        edge_count(slot) = edge_count(slot) + 1
+        edge_cell(slot) = c
+        edge_local(slot) = i
+      end do
+    end do
+
+    mesh%file_groups = ''
+    ! room for the curves' and the points' groups
+    allocate (mesh%group(count(file_mesh%phys_dim(1:file_mesh%nphys) == 1 .or. file_mesh%phys_dim(1:file_mesh%nphys) == 0)))
+    ngroup = 0
+    do phys = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(phys) /= 1) cycle
+      mesh%file_groups = trim(mesh%file_groups//' '//file_mesh%phys_name(phys)%s)
+      nedge = 0
+      ninner = 0
+      do line = 1, file_mesh%nline
+        if (line_slot(line) < 0) cycle
+        if (.not. any(file_mesh%ent(file_mesh%line_entity(line))%phys == file_mesh%phys_tag(phys))) cycle
+        slot = line_slot(line)
+        if (edge_count(slot) == 0) cycle          ! not an edge of the body's cells
+        if (edge_count(slot) > 1) then            ! inside the body: its nodes, once each
+          do i = 1, 2
+            a = body_node(file_mesh%line_node(i, line))
+            if (marked(a)) cycle
+            marked(a) = .true.
+            ninner = ninner + 1
+            inner(ninner) = a
+          end do
+          cycle
+        end if
+        c = edge_cell(slot)
+        nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+        nedge = nedge + 1
+        edges(:, nedge) = [mesh%cells(edge_local(slot), c), mesh%cells(modulo(edge_local(slot), nv) + 1, c)]
+        cells(nedge) = c
+      end do
+      marked(inner(1:ninner)) = .false.
+      if (nedge == 0 .and. ninner == 0) cycle
+      ngroup = ngroup + 1
+      mesh%group(ngroup)%name = file_mesh%phys_name(phys)%s
+      mesh%group(ngroup)%nedge = nedge
+      mesh%group(ngroup)%edge = edges(:, 1:nedge)
+      mesh%group(ngroup)%cell = cells(1:nedge)
+      mesh%group(ngroup)%nnode = ninner
+      mesh%group(ngroup)%node = inner(1:ninner)
+    end do
+    mesh%file_groups = trim(adjustl(mesh%file_groups))
+    mesh%ngroup = ngroup
+  end subroutine boundary_groups
+
+  !> One node group per physical point with nodes in the body, after the edge groups (a
+  !! physical point named as a physical curve adds its nodes to the curve's group); the
+  !! points' names go to file_groups. A point's node is the body's if the body's cells have
+  !! it; a node in no cell of the file is matched to the body's node at its place.
+  subroutine point_groups(file_mesh, body_node, mesh)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
+    type(mesh_t), intent(inout) :: mesh
+    logical, allocatable :: in_cell(:)
+    integer, allocatable :: nodes(:)
+    integer :: phys, point, n, nfound, group, c, i
+    real(wp) :: tol
+    character(len=:), allocatable :: names
+
+    names = ''
+    allocate (nodes(file_mesh%npoint))
+    tol = 1.0e-9_wp*max(mesh%width, mesh%height)
+    do phys = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(phys) /= 0) cycle
+      names = names//' '//file_mesh%phys_name(phys)%s
+      nfound = 0
+      do point = 1, file_mesh%npoint
+        if (file_mesh%point_entity(point) == 0) cycle
+        if (.not. any(file_mesh%ent(file_mesh%point_entity(point))%phys == file_mesh%phys_tag(phys))) cycle
+        n = body_node(file_mesh%point_node(point))
+        if (n == 0) then
+          if (.not. allocated(in_cell)) then
+            allocate (in_cell(file_mesh%nnode))
+            in_cell = .false.
+            do c = 1, file_mesh%ncell
+              do i = 1, 4
+                if (file_mesh%cell_node(i, c) > 0) in_cell(file_mesh%cell_node(i, c)) = .true.
+              end do
+            end do
+          end if
+          if (.not. in_cell(file_mesh%point_node(point))) &
+            n = node_at(mesh, file_mesh%node_xy(:, file_mesh%point_node(point)), tol)
+        end if
+        if (n == 0) cycle
+        if (any(nodes(1:nfound) == n)) cycle
+        nfound = nfound + 1
+        nodes(nfound) = n
+      end do
+      if (nfound == 0) cycle
+      group = 0
+      do c = 1, mesh%ngroup
+        if (mesh%group(c)%name == file_mesh%phys_name(phys)%s) group = c
+      end do
+      if (group == 0) then
+        mesh%ngroup = mesh%ngroup + 1
+        group = mesh%ngroup
+        mesh%group(group)%name = file_mesh%phys_name(phys)%s
+        mesh%group(group)%point = .true.
+        allocate (mesh%group(group)%edge(2, 0), mesh%group(group)%cell(0))
+      end if
+      if (.not. allocated(mesh%group(group)%node)) allocate (mesh%group(group)%node(0))
+      mesh%group(group)%node = [mesh%group(group)%node, nodes(1:nfound)]
+      mesh%group(group)%nnode = size(mesh%group(group)%node)
+    end do
+    if (len(names) == 0) return
+    if (len(mesh%file_groups) == 0) mesh%file_groups = '(none)'
+    mesh%file_groups = mesh%file_groups//'; physical points:'//names
+  end subroutine point_groups
+
+  !> The body node within tol of xy (the nearest), 0 if none.
+  integer function node_at(mesh, xy, tol) result(n)
+    type(mesh_t), intent(in) :: mesh
+    real(wp), intent(in) :: xy(2), tol
+    real(wp) :: dist, best
+    integer :: k
+    n = 0
+    best = tol
+    do k = 1, mesh%nnode
+      dist = maxval(abs(mesh%xy(:, k) - xy))
+      if (dist <= best) then
+        n = k
+        best = dist
+      end if
+    end do
+  end function node_at
+
+  !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
+  subroutine sort_by_tag(idx, tag)
+    integer, intent(inout) :: idx(:)
+    integer, intent(in) :: tag(:)
+    integer, allocatable :: work(:)
+    integer :: n, width, lo, mid, hi, i, j, k
+    n = size(idx)
+    if (n < 2) return
+    if (all(tag(idx(2:n)) > tag(idx(1:n - 1)))) return     ! the usual case: already sorted
+    allocate (work(n))
+    width = 1
+    do while (width < n)
+      do lo = 1, n, 2*width
+        mid = min(lo + width, n + 1)
+        hi = min(lo + 2*width, n + 1)
+        i = lo
+        j = mid
+        do k = lo, hi - 1
+          if (i < mid .and. (j >= hi .or. tag(idx(min(i, n))) <= tag(idx(min(j, n))))) then
+            work(k) = idx(i)
+            i = i + 1
+          else
+            work(k) = idx(j)
+            j = j + 1
+          end if
+        end do
+      end do
+      idx = work
+      width = 2*width
+    end do
+  end subroutine sort_by_tag
+
+end module mesh_topology

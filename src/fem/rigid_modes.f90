@@ -1,0 +1,253 @@
+!> The rigid motions of one body that its prescribed displacements leave free (a body
+!! held only by contact): the kernel of its stiffness, spanned by combinations of the
+!! three rigid modes (1,0), (0,1) and the rotation about the body's centre, and the fixing
+!! DOFs that make the factorized system nonsingular (a generalized inverse, module
+!! floating's use). Fills the rigid-motion fields of body_system_t.
+module rigid_modes
+  use kinds, only: wp
+  use config, only: body_cfg_t, BC_CONTACT
+  use mesh, only: mesh_t, side_nodes, group_index, group_nodes
+  use lapack, only: dsyev
+  use body_system, only: body_system_t
+  implicit none (type, external)
+  private
+
+  public :: rigid_kernel, choose_fixing, rigid_motion_name
+
+contains
+
+  !> The rigid motions that the prescribed DOFs leave free: the null space of the three
+  !! rigid modes (1,0), (0,1), (-(y-yc), x-xc)/h restricted to the prescribed DOFs (the
+  !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
+  !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
+  !! sys%rig (ndof x nrig, zero at prescribed DOFs).
+  subroutine rigid_kernel(mesh, prescribed, sys, info)
+    type(mesh_t), intent(in) :: mesh           !< the body's mesh
+    logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys  !< gets nrig, rig, rig_coef, rig_xc, rig_h
+    integer, intent(out) :: info               !< /= 0: dsyev failed
+    real(wp) :: g(3, 3), r(3), ev(3), work(64), top
+    integer :: k, cc, j, lapinfo, nk
+
+    sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
+    sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
+    g = 0.0_wp
+    do k = 1, mesh%nnode
+      do cc = 1, 2
+        if (.not. prescribed(2*(k - 1) + cc)) cycle
+        r = rigid_row(sys, mesh%xy(:, k), cc)
+        do j = 1, 3
+          g(:, j) = g(:, j) + r*r(j)
+        end do
+      end do
+    end do
+    call dsyev('V', 'U', 3, g, 3, ev, work, size(work), lapinfo)
+    top = max(ev(3), 0.0_wp)
+    nk = 0
+    info = lapinfo
+    if (lapinfo /= 0) return
+    nk = count(ev <= 1.0e-10_wp*top)
+    if (top <= 0.0_wp) nk = 3
+    sys%nrig = nk
+    if (nk == 0) return
+    ! ascending eigenvalues: the kernel is the first nk columns (nothing prescribed: identity)
+    allocate (sys%rig_coef(3, nk), sys%rig(sys%ndof, nk))
+    if (top <= 0.0_wp) then
+      sys%rig_coef = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+    else
+      sys%rig_coef = g(:, 1:nk)
+      call tidy_basis(sys%rig_coef)
+    end if
+    do j = 1, nk
+      do k = 1, mesh%nnode
+        do cc = 1, 2
+          if (prescribed(2*(k - 1) + cc)) then
+            sys%rig(2*(k - 1) + cc, j) = 0.0_wp
+          else
+            sys%rig(2*(k - 1) + cc, j) = dot_product(rigid_row(sys, mesh%xy(:, k), cc), sys%rig_coef(:, j))
+          end if
+        end do
+      end do
+    end do
+  end subroutine rigid_kernel
+
+  !> Component cc of the three basis rigid modes at the point x.
+  pure function rigid_row(sys, x, cc) result(r)
+    type(body_system_t), intent(in) :: sys
+    real(wp), intent(in) :: x(2)
+    integer, intent(in) :: cc
+    real(wp) :: r(3)
+    r = 0.0_wp
+    r(cc) = 1.0_wp
+    if (cc == 1) r(3) = -(x(2) - sys%rig_xc(2))/sys%rig_h
+    if (cc == 2) r(3) = (x(1) - sys%rig_xc(1))/sys%rig_h
+  end function rigid_row
+
+  !> Round a kernel basis to its simplest form: entries below 1e-12 become 0 and each
+  !! column gets a positive largest entry (a pure translation reads (0, 1, 0)).
+  pure subroutine tidy_basis(c)
+    real(wp), intent(inout) :: c(:, :)
+    integer :: j
+    do j = 1, size(c, 2)
+      if (c(maxloc(abs(c(:, j)), dim=1), j) < 0.0_wp) c(:, j) = -c(:, j)
+      where (abs(c(:, j)) < 1.0e-12_wp) c(:, j) = 0.0_wp
+      c(:, j) = c(:, j)/norm2(c(:, j))
+    end do
+  end subroutine tidy_basis
+
+  !> The rigid motion with coefficients c (basis of rigid_kernel) in words: 'translation
+  !! along x', 'translation along (0.6, 0.8)', 'rotation about (x0, y0)'.
+  function rigid_motion_name(sys, c) result(s)
+    type(body_system_t), intent(in) :: sys  !< the body's system (rig_xc, rig_h)
+    real(wp), intent(in) :: c(3)            !< coefficients in the basis of rigid_kernel
+    character(len=:), allocatable :: s
+    character(len=64) :: buf
+    real(wp) :: w, t(2)
+    w = c(3)/sys%rig_h
+    t = c(1:2)
+    if (abs(c(3)) <= 1.0e-8_wp*norm2(c)) then
+      if (abs(t(2)) <= 1.0e-8_wp*norm2(t)) then
+        s = 'translation along x'
+      else if (abs(t(1)) <= 1.0e-8_wp*norm2(t)) then
+        s = 'translation along y'
+      else
+        write (buf, '(a,f7.4,a,f7.4,a)') 'translation along (', t(1)/norm2(t), ', ', t(2)/norm2(t), ')'
+        s = trim(buf)
+      end if
+    else
+      ! the centre, its coordinates below 1e-9 of the body's size shown as 0
+      t = [sys%rig_xc(1) - t(2)/w, sys%rig_xc(2) + t(1)/w]
+      where (abs(t) < 1.0e-9_wp*sys%rig_h) t = 0.0_wp
+      write (buf, '(a,g0.6,a,g0.6,a)') 'rotation about (', t(1), ', ', t(2), ')'
+      s = trim(buf)
+    end if
+  end function rigid_motion_name
+
+  !> The fixing DOFs of a floating body: sys%nrig DOFs that are not prescribed, not on the
+  !! contact (the contact group, or a rectangle's 'contact' side), on which the kernel is
+  !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
+  !! and the node farthest from that one) for the largest |det| of the kernel restricted to
+  !! them. They are prescribed to 0 (prescribed) for the factorization only.
+  subroutine choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
+    type(mesh_t), intent(in) :: mesh                         !< the body's mesh
+    type(body_cfg_t), intent(in) :: body                     !< its id and side conditions
+    logical, intent(inout) :: prescribed(:)                  !< (ndof) the fixing DOFs are added
+    type(body_system_t), intent(inout) :: sys                !< gets fixing; its u_fixed is 0 there
+    integer, intent(out) :: info                             !< 0, or 1 when no fixing DOFs are found
+    character(len=*), intent(out) :: msg                     !< the failure, naming the body
+    character(len=*), intent(in), optional :: contact_group  !< the body's contact group, kept clear
+    logical, allocatable :: avoid(:)
+    integer, allocatable :: nodes(:)
+    integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
+    real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
+
+    info = 0
+    msg = ''
+    r = sys%nrig
+    allocate (avoid(mesh%nnode))
+    avoid = .false.
+    do side = 1, 4
+      if (body%bc(side) /= BC_CONTACT) cycle
+      call side_nodes(mesh, side, nodes)
+      avoid(nodes) = .true.
+    end do
+    if (present(contact_group)) then
+      g = 0
+      if (len_trim(contact_group) > 0) g = group_index(mesh, contact_group)
+      if (g > 0) then
+        call group_nodes(mesh, g, nodes)
+        avoid(nodes) = .true.
+      end if
+    end if
+    ! the first node: the closest to the contact's centroid off the contact (the centre when
+    ! there is none), so that K^+'s contact displacements are measured from a near point and
+    ! stay small (the rigid part R alpha then does not cancel a large pinned deformation)
+    ctr = sys%rig_xc
+    if (any(avoid)) then
+      ctr(1) = sum(mesh%xy(1, :), mask=avoid)/count(avoid)
+      ctr(2) = sum(mesh%xy(2, :), mask=avoid)/count(avoid)
+    end if
+    p = 0
+    dbest = huge(1.0_wp)
+    do k = 1, mesh%nnode
+      if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
+      d = norm2(mesh%xy(:, k) - ctr)
+      if (d < dbest) then
+        dbest = d
+        p(1) = k
+      end if
+    end do
+    if (p(1) == 0) then
+      info = 1
+      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
+        'contact or prescribed: no node is left to fix its rigid motion for the factorization; '// &
+        'refine the mesh or support the body'
+      return
+    end if
+    dbest = -1.0_wp
+    do k = 1, mesh%nnode
+      if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
+      d = norm2(mesh%xy(:, k) - mesh%xy(:, p(1)))
+      if (d > dbest) then
+        dbest = d
+        p(2) = k
+      end if
+    end do
+    nc = 0
+    do i = 1, 2
+      do j = 1, 2
+        k = 2*(p(i) - 1) + j
+        if (.not. prescribed(k) .and. .not. any(cand(1:nc) == k)) then
+          nc = nc + 1
+          cand(nc) = k
+        end if
+      end do
+    end do
+    ! the r candidates with the largest |det R(fix, :)| (at most 4 choose 3 tries)
+    detbest = 0.0_wp
+    best = 0
+    do i = 1, nc
+      do j = merge(i + 1, i, r > 1), merge(nc, i, r > 1)
+        do l = merge(j + 1, j, r > 2), merge(nc, j, r > 2)
+          if (r > 1 .and. j == i) cycle
+          if (r > 2 .and. l == j) cycle
+          sub = 0.0_wp
+          sub(1, 1:r) = sys%rig(cand(i), 1:r)
+          if (r > 1) sub(2, 1:r) = sys%rig(cand(j), 1:r)
+          if (r > 2) sub(3, 1:r) = sys%rig(cand(l), 1:r)
+          det = abs(small_det(sub, r))
+          if (det > detbest) then
+            detbest = det
+            best = [cand(i), cand(j), cand(l)]
+          end if
+        end do
+      end do
+    end do
+    if (.not. detbest > 1.0e-6_wp) then
+      info = 1
+      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
+        'from the contact fixes its free rigid motion for the factorization; support the body'
+      return
+    end if
+    allocate (sys%fixing(r))
+    sys%fixing = best(1:r)
+    prescribed(sys%fixing) = .true.
+    sys%u_fixed(sys%fixing) = 0.0_wp
+  end subroutine choose_fixing
+
+  !> Determinant of the leading r x r block (r = 1..3).
+  pure real(wp) function small_det(a, r) result(d)
+    real(wp), intent(in) :: a(3, 3)
+    integer, intent(in) :: r
+    select case (r)
+    case (1)
+      d = a(1, 1)
+    case (2)
+      d = a(1, 1)*a(2, 2) - a(1, 2)*a(2, 1)
+    case default
+      d = a(1, 1)*(a(2, 2)*a(3, 3) - a(2, 3)*a(3, 2)) - a(1, 2)*(a(2, 1)*a(3, 3) - a(2, 3)*a(3, 1)) + &
+          a(1, 3)*(a(2, 1)*a(3, 2) - a(2, 2)*a(3, 1))
+    end select
+  end function small_det
+
+end module rigid_modes

@@ -1,0 +1,142 @@
+!> The supports of one body: which DOFs its side conditions (a rectangle's sides) and its
+!! &boundary conditions (named groups) prescribe, with their values, and the numbering of
+!! the DOFs left free (body_system_t's ndof, u_fixed, n, free_of, dof_of).
+module supports
+  use kinds, only: wp
+  use config, only: body_cfg_t, boundary_cfg_t, SIDE_BOTTOM, SIDE_TOP, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
+  use mesh, only: mesh_t, side_nodes, group_index, group_names, group_nodes
+  use body_system, only: body_system_t
+  implicit none (type, external)
+  private
+
+  public :: prescribed_dofs, group_conditions, unknown_group, number_free_dofs
+
+contains
+
+  !> Which DOFs the side conditions prescribe (`prescribed`), and their values (sys%ndof,
+  !! sys%u_fixed). Sides are visited in SIDE_* order; a corner shared by two sides gets
+  !! the union of their constraints, and where both prescribe the same component with
+  !! different values the later side in SIDE_* order (left, right, bottom, top) wins.
+  !! `u_prescribed`, where given, replaces the values at every prescribed DOF.
+  subroutine prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
+    type(mesh_t), intent(in) :: mesh                    !< the body's mesh
+    type(body_cfg_t), intent(in) :: body                !< its side conditions (bc, u_side)
+    logical, allocatable, intent(out) :: prescribed(:)  !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys           !< gets ndof and u_fixed
+    real(wp), intent(in), optional :: u_prescribed(:)   !< (ndof) values replacing the side values [length]
+    integer, allocatable :: nodes(:)
+    integer :: side, k, cc
+
+    sys%ndof = 2*mesh%nnode
+    allocate (prescribed(sys%ndof), sys%u_fixed(sys%ndof))
+    prescribed = .false.
+    sys%u_fixed = 0.0_wp
+    do side = 1, 4
+      call side_nodes(mesh, side, nodes)
+      select case (body%bc(side))
+      case (BC_CLAMPED)
+        do k = 1, size(nodes)
+          do cc = 1, 2
+            prescribed(2*(nodes(k) - 1) + cc) = .true.
+            sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
+          end do
+        end do
+      case (BC_ROLLER)
+        cc = 1
+        if (side == SIDE_BOTTOM .or. side == SIDE_TOP) cc = 2
+        do k = 1, size(nodes)
+          prescribed(2*(nodes(k) - 1) + cc) = .true.
+          sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
+        end do
+      case (BC_DISPLACEMENT)
+        do k = 1, size(nodes)
+          do cc = 1, 2
+            prescribed(2*(nodes(k) - 1) + cc) = .true.
+            sys%u_fixed(2*(nodes(k) - 1) + cc) = body%u_side(cc, side)
+          end do
+        end do
+      case default   ! BC_FREE, BC_CONTACT: nothing
+      end select
+    end do
+    if (present(u_prescribed)) then
+      where (prescribed) sys%u_fixed = u_prescribed
+    end if
+  end subroutine prescribed_dofs
+
+  !> The &boundary conditions of this body: the components given are prescribed on every
+  !! node of the group (a later condition overrides an earlier value). info = 1 when the
+  !! group is not one of the body's.
+  subroutine group_conditions(mesh, body_id, boundaries, prescribed, sys, info, msg)
+    type(mesh_t), intent(in) :: mesh                   !< the body's mesh
+    integer, intent(in) :: body_id                     !< the body (conditions of the other are skipped)
+    type(boundary_cfg_t), intent(in) :: boundaries(:)  !< the deck's &boundary conditions
+    logical, intent(inout) :: prescribed(:)            !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys          !< its u_fixed gets the values
+    integer, intent(out) :: info                       !< 0, or 1 on an unknown group
+    character(len=*), intent(out) :: msg               !< the failure, naming the condition
+    integer :: i, g, k, cc, dof
+    integer, allocatable :: nodes(:)
+
+    info = 0
+    msg = ''
+    do i = 1, size(boundaries)
+      if (boundaries(i)%body /= body_id) cycle
+      g = group_index(mesh, boundaries(i)%group)
+      if (g == 0) then
+        info = 1
+        msg = trim(boundaries(i)%origin)//': '//unknown_group(mesh, boundaries(i)%group)
+        return
+      end if
+      call group_nodes(mesh, g, nodes)
+      do k = 1, size(nodes)
+        do cc = 1, 2
+          if (.not. boundaries(i)%fix(cc)) cycle
+          dof = 2*(nodes(k) - 1) + cc
+          prescribed(dof) = .true.
+          sys%u_fixed(dof) = boundaries(i)%u(cc)
+        end do
+      end do
+    end do
+  end subroutine group_conditions
+
+  !> The sentence for a group name the body's mesh does not have.
+  function unknown_group(mesh, name) result(s)
+    type(mesh_t), intent(in) :: mesh      !< the body's mesh
+    character(len=*), intent(in) :: name  !< the group name it lacks
+    character(len=:), allocatable :: s, src
+    src = 'the rectangle'
+    if (allocated(mesh%source)) then
+      if (len(mesh%source) > 0) src = mesh%source
+    end if
+    s = 'group '''//trim(name)//''' has no edge on the boundary of this body ('//src// &
+        '); its groups are '//group_names(mesh)
+    if (allocated(mesh%file_groups) .and. .not. mesh%structured) then
+      if (len_trim(mesh%file_groups) > 0) s = s//' (physical curves of the file: '//trim(mesh%file_groups)//')'
+    end if
+  end function unknown_group
+
+  !> Number the DOFs that are not prescribed 1..n in increasing global order
+  !! (sys%n, sys%free_of, sys%dof_of).
+  subroutine number_free_dofs(prescribed, sys)
+    logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
+    type(body_system_t), intent(inout) :: sys  !< gets n, free_of, dof_of
+    integer :: k, n
+
+    allocate (sys%free_of(sys%ndof))
+    n = 0
+    do k = 1, sys%ndof
+      if (prescribed(k)) then
+        sys%free_of(k) = 0
+      else
+        n = n + 1
+        sys%free_of(k) = n
+      end if
+    end do
+    sys%n = n
+    allocate (sys%dof_of(n))
+    do k = 1, sys%ndof
+      if (sys%free_of(k) > 0) sys%dof_of(sys%free_of(k)) = k
+    end do
+  end subroutine number_free_dofs
+
+end module supports
