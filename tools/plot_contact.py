@@ -7,7 +7,7 @@ Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [-o contact.png] [-
 Top panel: /contact/pressure (nodal force / tributary length) against /contact/s (arc length along the contact curve); the
 legend gives each run's total normal force P = sum of /contact/normal_force (force per
 unit thickness); dotted vertical lines mark the edges of each run's contact zone (the zero
-of p^2 extrapolated from the two outermost active nodes, rc_common.contact_edges).
+of p^2 extrapolated from the two outermost active nodes, rc_results.contact_edges).
 Middle panel: the gap /contact/gap = B1u1 + B2u2 - g0 (<= 0; < 0 where the bodies are apart).
 Units from the result file (root attributes unit_length/unit_force/unit_stress and the
 datasets' `units` attributes; SI m, N, Pa when absent), values scaled to an SI prefix
@@ -47,9 +47,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from rc_common import axis_label, contact_edges, dataset_unit, hertz_pressure, hertz_zone, num_attr, \
-    plain_axis, result_units, run_label, save_figure, si_scale, strip_comments, text_attr, \
-    text_dataset, tool_main  # noqa: E402
+from rc_figures import axis_label, plain_axis, run_label, save_figure, si_scale, tool_main  # noqa: E402
+from rc_results import contact_edges, dataset_unit, hertz_pressure, hertz_zone, num_attr, result_units, text_attr, text_dataset  # noqa: E402
+from rc_run import strip_comments  # noqa: E402
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)"
 

@@ -4,7 +4,7 @@
   tools/regression.py --store  [--bin bin/robin_contact] [--ref tests/data/regression.json]
   tools/regression.py [--bin bin/robin_contact] [--ref ...] [--only SUBSTRING] [--quick]
 
---store runs every deck of inputs/, inputs/hard/, inputs/table1/ and tests/decks/ with its own
+--store runs every deck of inputs/, inputs/hard/, inputs/table1/ and tests/data/decks/ with its own
 settings, again with method='monolithic' and with the harmonic operator at delta 0.5, and stores, per deck: the exit code, the status, the outer iteration count and the
 nodal contact forces (/contact/normal_force). Without --store it runs them again and compares:
 same exit code, status and outer count, and max |f - f_ref| <= 1e-12 max |f_ref| (scale-aware;
@@ -13,7 +13,6 @@ Exit 0 when every deck agrees, 1 otherwise (each difference printed). Runs with
 OMP_NUM_THREADS=2 unless set; results go to a temporary folder, nothing in the tree is written
 but the reference file (--store).
 """
-import argparse
 import glob
 import json
 import os
@@ -25,9 +24,11 @@ import time
 import h5py
 import numpy as np
 
+from rc_run import tool_parser
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-DECK_DIRS = ("inputs", "inputs/hard", "inputs/table1", "tests/decks")
+DECK_DIRS = ("inputs", "inputs/hard", "inputs/table1", "tests/data/decks")
 RTOL = 1.0e-12
 
 
@@ -87,8 +88,7 @@ def compare(ref, new):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin", default="bin/robin_contact")
+    ap = tool_parser(__doc__)
     ap.add_argument("--ref", default="tests/data/regression.json")
     ap.add_argument("--store", action="store_true")
     ap.add_argument("--only", default="")
