@@ -38,6 +38,24 @@ def si_scale(values, unit):
     return 10.0 ** k, f"1e{k} {unit}".strip()
 
 
+def format_quantity(values, unit, digits=4):
+    """A value (or a sequence of values, written '(a, b)') with its unit as text for a legend or
+    an annotation: an SI prefix for the SI units m, N, Pa, N/m ('3.2 MPa', '(1.5, -2) kN/m'),
+    else the plain number in the given unit ('3000 N/mm', '1.235e5 N/mm'; never a power of
+    ten beside the number). `digits` significant digits."""
+    v = np.atleast_1d(np.asarray(values, dtype=float))
+    factor, label = si_scale(v, unit) if unit in _PREFIXABLE else (1.0, unit)
+
+    def num(x):
+        t = f"{x / factor:.{digits}g}"
+        if "e" in t:                      # 1.235e+05 -> 1.235e5
+            mant, exp = t.split("e")
+            t = f"{mant}e{int(exp)}"
+        return t
+    text = num(v[0]) if np.ndim(values) == 0 else "(" + ", ".join(num(x) for x in v) + ")"
+    return f"{text} {label}".strip()
+
+
 def plain_axis(ax, axis="both"):
     """No offset text and no scientific multiplier on the linear axes of ax (they would hide
     the unit: values are scaled explicitly with si_scale). Log axes are left alone."""

@@ -14,10 +14,15 @@ instead of swamping the machine, and checks:
   - plot_contact --hertz prints the errors against Hertz (err_a, err_p0, err_L2);
   - failures end with a message and exit 1: a result without /body2, a file that is not
     HDF5, and running out of memory (--pixels 8000 under the cap);
-  - rc_results' and rc_figures' unit helpers (SI defaults, stored units, SI-prefix scaling, labels).
+  - rc_results' and rc_figures' unit helpers (SI defaults, stored units, SI-prefix scaling, labels,
+    numbers with units);
+  - plot_contact names the force it shows: the sum of the nodal normal forces as one number
+    with its unit ('1.579e9 N/mm', not '1.579 1e9 N/mm'), or the resultant vector when the
+    result file stores one.
 Wall times are printed (TIME lines), never asserted.
 """
 import os
+import re
 import resource
 import shutil
 import subprocess
@@ -30,7 +35,7 @@ import numpy as np
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_checks import Checks  # noqa: E402
-from rc_figures import axis_label, si_scale  # noqa: E402
+from rc_figures import axis_label, format_quantity, si_scale  # noqa: E402
 from rc_results import result_units  # noqa: E402
 from rc_run import run_solver  # noqa: E402
 
@@ -153,6 +158,7 @@ shutil.copy(hz, withu)
 with h5py.File(withu, "a") as f:
     f.attrs["unit_length"], f.attrs["unit_force"], f.attrs["unit_stress"] = np.bytes_("mm"), np.bytes_("N"), np.bytes_("MPa")
     f["contact/pressure"].attrs["units"] = np.bytes_("MPa")
+    f["contact/normal_force"].attrs["units"] = np.bytes_("N/mm")
     u = result_units(f)
 check(u["length"] == "mm" and u["stress"] == "MPa" and u["line_force"] == "N/mm" and u["from_file"],
       "result_units: stored units read", str(u))
@@ -161,9 +167,30 @@ check(si_scale([3.2e7], "Pa") == (1e6, "MPa") and si_scale([-1.5e-6], "m") == (1
       and si_scale([2e4], "MPa") == (1e3, "1e3 MPa") and si_scale([0.0], "Pa") == (1.0, "Pa"),
       "si_scale: SI prefixes, explicit power of ten for other units")
 check(axis_label("x", "m") == "x [m]" and axis_label("p/p0", "") == "p/p0 [-]", "axis_label")
+check(format_quantity(3000.0, "N/mm") == "3000 N/mm" and format_quantity(3.2e7, "Pa") == "32 MPa"
+      and format_quantity(1.23456e5, "N/mm") == "1.235e5 N/mm" and format_quantity([1.5e3, -2e3], "N/m")
+      == "(1.5, -2) kN/m" and format_quantity(2.5e-5, "m") == "25 µm",
+      "format_quantity: one number (or vector) and its unit, SI prefix or plain number")
+force_line = {}
 for name, args in (("plot_contact.py", ["--hertz"]), ("plot_solution.py", []), ("plot_history.py", [])):
     rc, out, _, _ = tool(name, withu, *args, "-o", f"{OUT}/units_{name[:-3]}.png")
     check(rc == 0, f"{name} on a result with stored units (mm, MPa): exit 0", f"exit {rc} {out.strip()[-200:]}")
+    if name == "plot_contact.py":
+        force_line = [ln for ln in out.splitlines() if ln.startswith("plot_contact: units: ")]
+with h5py.File(withu, "r") as f:
+    total = float(np.sum(f["contact/normal_force"][()]))
+m = re.search(r": sum of nodal normal forces = (\S+) N/mm$", force_line[0]) if force_line else None
+check(m is not None and abs(float(m.group(1)) / total - 1.0) < 1e-3,
+      "plot_contact: the sum of the nodal normal forces as one number in N/mm",
+      f"{force_line} against {total:.6g}")
+res_file = f"{OUT}/resultant.h5"
+shutil.copy(withu, res_file)
+with h5py.File(res_file, "a") as f:
+    f["contact"].attrs["resultant"] = np.array([-250.0, 1.5e5])
+rc, out, _, _ = tool("plot_contact.py", res_file, "-o", f"{OUT}/resultant.png")
+check(rc == 0 and "plot_contact: resultant: resultant = (-250, 1.5e5) N/mm" in out
+      and "sum of nodal normal forces" not in out,
+      "plot_contact: the stored resultant vector instead of the sum", out.strip()[-300:])
 
 print(f"{len(check.failed)} failed checks")
 sys.exit(1 if check.failed else 0)
