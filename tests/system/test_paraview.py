@@ -7,8 +7,12 @@ missing array exits 1 listing the available ones, that --list works, and that ce
 and a polyline grid without displacement (the XDMF layout being added: body id, contact
 line) are handled, that the bodies are coloured (not grey: the fraction of saturated pixels
 in the drawn region), and that a dead display from xvfb-run is retried once and any other
-abnormal end of the re-run is one line and exit 1. Without pvpython the test is skipped,
-and says so (exit 0)."""
+abnormal end of the re-run is one line and exit 1. Without pvpython the rendering is
+skipped, and says so; the tool's geometry, which needs no ParaView, is checked always: the
+contact line of each body warped by its displacement (on the Hertz deck: the normal distance
+between the two warped lines, over the magnification, minus the initial gap g0 is the gap
+the program wrote) and the box of --zoom contact (it holds the active contact nodes and is
+much smaller than the contact line)."""
 import os
 import re
 import shutil
@@ -25,17 +29,63 @@ OUT = os.path.abspath(os.path.join(os.environ.get("BUILD", "build/release"), "te
 TOOL = os.path.join(ROOT, "tools", "paraview_view.py")
 check = Checks()
 
+shutil.rmtree(OUT, ignore_errors=True)
+os.makedirs(OUT)
+
+# 0. the contact lines and the zoom box, without ParaView
+import numpy as np  # noqa: E402
+import h5py  # noqa: E402
+import paraview_view  # noqa: E402
+hz = f"{OUT}/hertz.h5"
+p, _ = run_solver(BIN, os.path.join(ROOT, "inputs/hard/hertz.nml"), f"&output file='{hz}' /")
+if not check(p.returncode == 0, "Hertz deck solved", f"exit {p.returncode}"):
+    sys.exit(1)
+with h5py.File(hz, "r") as f:
+    xy = f["contact/coordinates"][()].T
+    normal = f["contact/normal"][()].T
+    gap, g0 = f["contact/gap"][()], f["contact/g0"][()]
+    active = f["contact/normal_force"][()] > 0
+for mag in (0.0, 25.0):
+    lines, _, _ = paraview_view.contact_lines(hz, mag)
+    check(sorted(b for b, _ in lines) == [1, 2] and all(q.shape == xy.shape for _, q in lines),
+          f"contact_lines x{mag:g}: one line per body through every contact node", str([(b, q.shape) for b, q in lines]))
+    if len(lines) != 2 or any(q.shape != xy.shape for _, q in lines):
+        continue
+    (_, p1), (_, p2) = sorted(lines, key=lambda t: t[0])
+    if mag == 0.0:
+        check(np.array_equal(p1, xy) and np.array_equal(p2, xy), "contact_lines x0: the undeformed contact nodes")
+    else:
+        dn = np.sum((p1 - p2) * normal, axis=1) / mag - g0
+        err = float(np.max(np.abs(dn - gap)) / np.max(np.abs(g0)))
+        check(err < 1e-9, "contact_lines x25: normal distance of the warped lines / 25 - g0 = the written gap",
+              f"max deviation {err:.2e} of max g0")
+box = paraview_view.zoom_box("contact", hz, 25.0)
+(b1, p1), (b2, p2) = sorted(paraview_view.contact_lines(hz, 25.0)[0], key=lambda t: t[0])
+inside = all(box[0] <= x <= box[1] and box[2] <= y <= box[3] for q in (p1, p2) for x, y in q[active])
+span = float(xy[:, 0].max() - xy[:, 0].min())
+check(inside and box[1] - box[0] < 0.25 * span,
+      "zoom_box contact: holds the active contact nodes of both warped lines, narrower than a quarter of the line",
+      f"box {tuple(round(v, 3) for v in box)}, line {span:.3g} long, {int(active.sum())} active nodes")
+check(paraview_view.zoom_box("1,2.5,-3,4e-1") == (1.0, 2.5, -3.0, 0.4), "zoom_box: an explicit X0,X1,Y0,Y1 box")
+for bad in ("1,2,3", "2,1,0,1", "a,b,c,d"):
+    try:
+        paraview_view.zoom_box(bad)
+        check(False, f"zoom_box {bad!r}: rejected")
+    except ValueError as e:
+        check("--zoom" in str(e), f"zoom_box {bad!r}: rejected with a message", str(e))
+check(paraview_view.camera_box((0.0, 4.0, 0.0, 1.0), 1.5) == (2.0, 0.5, 4.0 / 3.0)
+      and paraview_view.camera_box((0.0, 1.0, 0.0, 4.0), 1.5) == (0.5, 2.0, 2.0),
+      "camera_box: the whole box in view, wide or tall")
+
 pv = shutil.which("pvpython")
 if pv is None:
     print("SKIP  pvpython not found: ParaView is optional (Debian: apt-get install paraview xvfb); "
-          "tools/paraview_view.py not tested")
-    sys.exit(0)
+          "rendering by tools/paraview_view.py not tested")
+    sys.exit(1 if check.failed else 0)
 if not (os.environ.get("DISPLAY") or os.environ.get("RC_PV_OFFSCREEN") or shutil.which("xvfb-run")):
     print("SKIP  pvpython found but no DISPLAY and no xvfb-run (apt-get install xvfb): cannot render here")
-    sys.exit(0)
+    sys.exit(1 if check.failed else 0)
 
-shutil.rmtree(OUT, ignore_errors=True)
-os.makedirs(OUT)
 p, res = run_solver(BIN, os.path.join(ROOT, "inputs/default.nml"), f"&output file='{OUT}/r.h5' /")
 if not check(p.returncode == 0 and os.path.isfile(f"{OUT}/r.xdmf"), "default deck solved, r.xdmf written",
              f"exit {p.returncode}"):
@@ -91,6 +141,14 @@ picture(f"{OUT}/v.png", "von_mises")
 rc, so, se = view(f"{OUT}/r.h5", "--field", "displacement:Y", "--edges", "-o", f"{OUT}/uy.png", cwd=ROOT)
 check(rc == 0, "paraview_view.py r.h5 --field displacement:Y --edges exits 0", f"exit {rc} {se.strip()[-300:]}")
 picture(f"{OUT}/uy.png", "displacement:Y")
+# 2b. zoom on the contact zone, the contact lines drawn
+rc, so, se = view(hz, "--zoom", "contact", "-o", f"{OUT}/zoom.png", cwd=ROOT)
+check(rc == 0 and "2 contact lines" in so and ", zoom x " in so, "--zoom contact exits 0, draws 2 contact lines and says so",
+      f"exit {rc} {so.strip()} {se.strip()[-300:]}")
+picture(f"{OUT}/zoom.png", "zoom on the contact")
+rc, so, se = view("r.xdmf", "--zoom", "1,2", "-o", "zbad.png")
+check(rc == 1 and "--zoom" in se and not os.path.exists(f"{OUT}/zbad.png"), "--zoom 1,2: exit 1 with a message",
+      f"exit {rc} {se.strip()[-200:]}")
 # 3. a missing array: exit 1 and the list of arrays
 rc, so, se = view("r.xdmf", "--field", "no_such_field", "-o", "x.png")
 check(rc == 1 and "no array 'no_such_field'" in se and "point arrays:" in se and "von_mises" in se
@@ -104,7 +162,6 @@ check(rc == 1 and "no XDMF file" in se, "a missing file: exit 1 with a message",
 # 4. the XDMF layout being added: a cell array (body id) and a polyline grid without displacement
 with open(f"{OUT}/r.xdmf") as f:
     s = f.read()
-import h5py  # noqa: E402
 with h5py.File(f"{OUT}/r.h5", "r") as f:
     ncell = [f[f"body{b}/cells"].shape[0] for b in (1, 2)]
     c = f["contact/coordinates"][()]
