@@ -74,7 +74,7 @@ OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $
 TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_floating
 BENCH_F := bench_mprgp bench_ordering
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
-BENCH_BINS := $(addprefix $(BUILD)/tests/,$(BENCH_F))
+BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
 
 DEPS_STAMP := build/.deps-ok
 ifeq ($(MPI),1)
@@ -190,18 +190,26 @@ $(PROG): $(BUILD)/robin_contact FORCE
 	@mkdir -p $(BIN)
 	@cmp -s $< $@ || { cp $< $@.tmp && mv -f $@.tmp $@; }
 
-# Test programs; tests/testing.f90 is a module of helpers shared by them.
+# Unit test programs (tests/unit/test_*.f90, built into $(BUILD)/tests) share the helper
+# module tests/unit/testing.f90; the benchmark programs (bench/*.f90) go to $(BUILD)/bench.
 TEST_SUPPORT := $(BUILD)/tests/testing.o
 
-$(TEST_SUPPORT): tests/testing.f90 $(OBJS)
+$(TEST_SUPPORT): tests/unit/testing.f90 $(OBJS)
 	@mkdir -p $(BUILD)/tests
 	$(FC) $(FFLAGS) -c $< -o $@
 
-$(BUILD)/tests/%.o: tests/%.f90 $(OBJS) $(TEST_SUPPORT)
+$(BUILD)/tests/%.o: tests/unit/%.f90 $(OBJS) $(TEST_SUPPORT)
 	@mkdir -p $(BUILD)/tests
+	$(FC) $(FFLAGS) -c $< -o $@
+
+$(BUILD)/bench/%.o: bench/%.f90 $(OBJS) $(TEST_SUPPORT)
+	@mkdir -p $(BUILD)/bench
 	$(FC) $(FFLAGS) -c $< -o $@
 
 $(BUILD)/tests/%: $(BUILD)/tests/%.o $(OBJS) $(TEST_SUPPORT)
+	$(FC) $(FFLAGS) -o $@ $< $(OBJS) $(TEST_SUPPORT) $(LDLIBS)
+
+$(BUILD)/bench/%: $(BUILD)/bench/%.o $(OBJS) $(TEST_SUPPORT)
 	$(FC) $(FFLAGS) -o $@ $< $(OBJS) $(TEST_SUPPORT) $(LDLIBS)
 
 # ---- user targets ----------------------------------------------------------------
@@ -211,6 +219,8 @@ run: $(PROG)
 
 # make check runs the MPI tests too: it installs OpenMPI and MUMPS first where they are missing
 # (tools/install-deps.sh; without root it prints the command and test_mpi skips)
+# test_regression compares with a reference stored by the release build: to 1e-12; the checked
+# build (-O0 rounds differently) within ten times each run's a posteriori bound
 check: $(PROG) $(TEST_BINS) mpi-deps
 	@if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then $(MAKE) MPI=1 all; fi
 	@BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
@@ -223,11 +233,11 @@ mpi:
 	$(MAKE) MPI=1 all
 
 bench-mprgp: $(BENCH_BINS)
-	$(BUILD)/tests/bench_mprgp
+	$(BUILD)/bench/bench_mprgp
 
 # the ordering ladder: metis / amd / nd, 128x64 ... 1024x512, 1 and 2 threads (about 6 min)
 bench-ordering: $(PROG) $(BENCH_BINS)
-	$(PYTHON) tools/bench_ordering.py --bin $(PROG) --bench $(BUILD)/tests/bench_ordering
+	$(PYTHON) bench/bench_ordering.py --bin $(PROG) --bench $(BUILD)/bench/bench_ordering
 
 table1: $(PROG)
 	$(PYTHON) tools/table1.py --bin $(PROG) --csv results/table1.csv
@@ -236,22 +246,22 @@ hard: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/hard.py --bin $(PROG)
 
 bench: $(PROG)
-	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/bench.py --bin $(PROG)
-	$(PYTHON) tools/plot_bench.py results/bench.csv
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench.py --bin $(PROG)
+	$(PYTHON) bench/plot_bench.py results/bench.csv
 
 # The Gmsh ladder beside the structured one: the paper's scene as unstructured triangles
 # (inputs/gmsh/bench_paper_tri.geo, meshed by gmsh into results/bench_gmsh/, h = 0.02 ...
 # 0.0025: 20k ... 1.27M DOFs per body), time per phase; results/bench_gmsh.csv
 bench-gmsh: $(PROG)
-	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/bench_gmsh.py --bin $(PROG) --gmsh $(GMSH) --structured
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_gmsh.py --bin $(PROG) --gmsh $(GMSH) --structured
 
-# The MPI binary beside the serial one (issue 16): the paper's scene at 1024x512 per body,
+# The MPI binary beside the serial one: the paper's scene at 1024x512 per body,
 # serial CHOLMOD and MUMPS at -np 2, 4, 8 (oversubscribed here), time per phase and the
 # largest per-rank peak memory; then the largest body per path (CHOLMOD, -np 2, -np 4) by a
 # ladder (about 25 min); results/bench_mpi.csv and Markdown tables
 bench-mpi: $(PROG)
 	$(MAKE) MPI=1 all
-	$(PYTHON) tools/bench_mpi.py --bin $(PROG) --mpi-bin bin/robin_contact_mpi --ladder
+	$(PYTHON) bench/bench_mpi.py --bin $(PROG) --mpi-bin bin/robin_contact_mpi --ladder
 
 plots: $(PROG)
 	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Runs every test of `make check`: the Fortran test programs in $BUILD/tests, the
-# shell tests tests/test_*.sh and the Python tests tests/test_*.py. Each is one test;
-# it passes when it exits 0. Logs go to $BUILD/test-logs. Last line: N passed, M failed.
+# Runs every test of `make check`: the Fortran unit test programs built from
+# tests/unit/test_*.f90 into $BUILD/tests, then the whole-program tests tests/system/test_*.sh
+# and tests/system/test_*.py (tests/test_*.sh and tests/test_*.py too, for a test not yet
+# sorted into a folder). Each is one test; it passes when it exits 0. Logs go to
+# $BUILD/test-logs. Last line: N passed, M failed.
 set -u
 BUILD=${BUILD:-build/release}
 PYTHON=${PYTHON:-/usr/bin/python3}
@@ -33,11 +35,11 @@ for t in "$BUILD"/tests/test_*; do
   [ -x "$t" ] || continue
   run_one "$(basename "$t")" "$t"
 done
-for t in tests/test_*.sh; do
+for t in tests/system/test_*.sh tests/test_*.sh; do
   [ -f "$t" ] || continue
   run_one "$(basename "$t" .sh)" bash "$t"
 done
-for t in tests/test_*.py; do
+for t in tests/system/test_*.py tests/test_*.py; do
   [ -f "$t" ] || continue
   run_one "$(basename "$t" .py)" "$PYTHON" "$t"
 done

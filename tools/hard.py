@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Hard cases of robin_contact (issue "numerical stability on hard cases").
+"""Hard cases of robin_contact: numerical stability on badly scaled, nearly incompressible,
+curved and floating scenes.
 
 Runs every deck of inputs/hard/ (and inputs/table1/q1_24x16.nml as the unscaled reference
 of the scale cases): each Robin variant of a deck plus the monolithic reference of the same
@@ -26,7 +27,6 @@ printed), hard.md (the tables in Markdown), hard.csv (the main table).
 Usage: tools/hard.py [--bin bin/robin_contact] [--out results/hard] [--only SUBSTRING]
 Runs with OMP_NUM_THREADS=2 unless set. About 40 s on 2 cores.
 """
-import argparse
 import math
 import os
 import re
@@ -37,7 +37,8 @@ import time
 import h5py
 import numpy as np
 
-from rc_common import contact_edges, hertz_pressure, hertz_zone, md_header, md_row, rel_err, run_solver, solver_env
+from rc_results import contact_edges, hertz_pressure, hertz_zone, md_header, md_row, rel_err
+from rc_run import run_solver, solver_env, tool_parser
 
 BUG_TOL = 1.0e-5          # largest error against monolithic accepted from a 'converged' run
 
@@ -94,7 +95,7 @@ CASES += [
     ("loads x1e-6", f"{HARD}/scale_1em6.nml", [], [(S95, CONV), (S50, CONV), (H50, CONV), (H50R, CONV)]),
     ("loads x1e6", f"{HARD}/scale_1e6.nml", [], [(S95, CONV), (S50, CONV), (H50, CONV), (H50R, CONV)]),
     ("paper scene in mm/N/MPa", f"{HARD}/paper_mm.nml", [], [(S95, CONV), (S50, CONV), (H50, CONV), (H50R, CONV)]),
-    # bodies held only by contact (issue 15): SMALBE-M subproblems, the projected inverse in the
+    # bodies held only by contact: SMALBE-M subproblems, the projected inverse in the
     # harmonic operator. A soft floating body on a stiff one (E1/E2 = 1e-6) stalls near a
     # residual of 2e-7: the penalty-augmented Hessian's rounding, amplified by the contrast
     ("floating, contrast 1e6", f"{HARD}/floating_contrast_1e6.nml", [], [(S50, ANY), (H50, CONV), (H50R, ANY)]),
@@ -325,7 +326,7 @@ def hertz_analysis(r):
     i0, i1 = act[0], act[-1]
     h = float(np.median(np.diff(x)))
     # edge of the contact zone: zero of p^2 extrapolated from the two outermost active
-    # nodes, kept between the last active and the first open node (rc_common.contact_edges)
+    # nodes, kept between the last active and the first open node (rc_results.contact_edges)
     xl, xr = contact_edges(x, p, lam)
     a_num = 0.5 * (xr - xl)
     ph = hertz_pressure(x, xc, a_h, p0)
@@ -491,8 +492,7 @@ def locking_study(R):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin", default="bin/robin_contact")
+    ap = tool_parser(__doc__)
     ap.add_argument("--out", default="results/hard")
     ap.add_argument("--only", default="", help="run only the main-table cases whose label or deck contains this")
     a = ap.parse_args()

@@ -5,6 +5,7 @@ colour by a chosen point or cell array, write a PNG. Runs headless.
 Usage:
   pvpython tools/paraview_view.py RESULT [-o view.png] [--field NAME] [--scale S|auto]
                                   [--clip P] [--range MIN MAX] [--edges] [--size WxH]
+                                  [--zoom contact|X0,X1,Y0,Y1]
   pvpython tools/paraview_view.py RESULT --list      (the point and cell arrays, then exit)
 RESULT is results/x.xdmf or results/x.h5 (then its sibling results/x.xdmf is opened).
 It also runs with pvbatch, or with /usr/bin/python3 when ParaView's Python modules are
@@ -20,6 +21,15 @@ installed (Debian's `paraview` package puts them in dist-packages).
                  MIN MAX sets it explicitly. The scalar bar title says which.
   --edges        draw the element edges (Surface With Edges).
   --size WxH     image size in pixels (default 1200x800).
+  --zoom Z       frame a part of the picture instead of the whole scene: 'contact' frames
+                 the contact zone (the contact nodes with a positive normal force, all
+                 contact nodes when none has one), warped like the bodies, with a margin of
+                 half its size (at least two contact segments) on every side;
+                 X0,X1,Y0,Y1 frames that box (model coordinates, undeformed).
+The contact line is drawn on top of the bodies as a black polyline per body, through the
+contact nodes of that body (/contact/coordinates matched to the body's nodes) warped by the
+body's displacement with the same magnification as the bodies: where the bodies touch the
+two lines lie on each other, where they are apart the gap is seen between them.
 
 Headless nodes: rendering needs an X display, or an offscreen (EGL/OSMesa) ParaView build.
 Without DISPLAY the tool re-runs itself as `xvfb-run -a pvbatch tools/paraview_view.py ...`
@@ -66,6 +76,8 @@ def parse(argv):
     ap.add_argument("--edges", action="store_true", help="draw the element edges")
     ap.add_argument("--size", default="1200x800", help="image size WxH in pixels (default 1200x800)")
     ap.add_argument("--list", action="store_true", help="list the point and cell arrays and exit")
+    ap.add_argument("--zoom", default=None, metavar="contact|X0,X1,Y0,Y1",
+                    help="frame the contact zone ('contact') or a box X0,X1,Y0,Y1")
     return ap.parse_args(argv)
 
 
@@ -217,6 +229,76 @@ def values(src, name, assoc, comp):
     return v if v.size else None
 
 
+# ---- the contact line and the zoom box (numpy and h5py only: no ParaView needed) ----------
+def contact_lines(h5path, scale):
+    """The contact line of each body warped by that body's displacement times scale: a list of
+    (body, points) with points an (n, 2) array in contact-line order, n >= 2. The contact
+    nodes (/contact/coordinates) are matched to a body's nodes by identical coordinates;
+    a body with fewer than two matching nodes (a non-matching mortar side) has no line.
+    Also returns the boolean mask of the active contact nodes (normal force > 0)."""
+    import h5py
+    import numpy as np
+    with h5py.File(h5path, "r") as f:
+        c = np.asarray(f["contact/coordinates"][()], dtype=float)
+        lam = np.asarray(f["contact/normal_force"][()], dtype=float).reshape(-1)
+        bodies = []
+        for b in (1, 2):
+            g = f.get(f"body{b}")
+            if g is None or "coordinates" not in g or "displacement" not in g:
+                continue
+            bodies.append((b, np.asarray(g["coordinates"][()], dtype=float),
+                           np.asarray(g["displacement"][()], dtype=float)))
+    c = c.T if c.shape[0] == 2 and c.shape[-1] != 2 else c          # (m, 2)
+    lines = []
+    for b, xy, u in bodies:
+        xy = xy.T if xy.shape[0] == 2 and xy.shape[-1] != 2 else xy
+        u = u.T if u.shape[0] == 2 and u.shape[-1] != 2 else u
+        index = {(float(x), float(y)): k for k, (x, y) in enumerate(xy)}
+        rows = [(i, index.get((float(x), float(y)))) for i, (x, y) in enumerate(c)]
+        rows = [(i, k) for i, k in rows if k is not None]
+        if len(rows) < 2:
+            continue
+        ci, bi = (np.array(t) for t in zip(*rows))
+        lines.append((b, c[ci] + scale * u[bi]))
+    return lines, c, lam > 0.0
+
+
+def zoom_box(spec, h5path=None, scale=0.0):
+    """(x0, x1, y0, y1) to frame: spec 'X0,X1,Y0,Y1' as given, or 'contact': the active contact
+    nodes (all contact nodes when none is active) of both bodies' warped contact lines, with
+    a margin of half the box's larger side, at least two contact segments, on every side.
+    ValueError for a bad spec or a result without a contact line."""
+    import numpy as np
+    if spec != "contact":
+        try:
+            x0, x1, y0, y1 = (float(t) for t in spec.split(","))
+        except ValueError:
+            raise ValueError(f"--zoom takes 'contact' or X0,X1,Y0,Y1 (four numbers), not {spec!r}") from None
+        if not (x1 > x0 and y1 > y0):
+            raise ValueError(f"--zoom box {spec!r}: needs X0 < X1 and Y0 < Y1")
+        return x0, x1, y0, y1
+    lines, c, active = contact_lines(h5path, scale)
+    if c.shape[0] < 2:
+        raise ValueError(f"{h5path}: no contact line to zoom on")
+    pick = active if active.any() else np.ones(c.shape[0], dtype=bool)
+    pts = [c[pick]]
+    for _, p in lines:
+        if p.shape[0] == c.shape[0]:
+            pts.append(p[pick])
+    pts = np.vstack(pts)
+    seg = float(np.median(np.hypot(*np.diff(c, axis=0).T)))
+    (x0, y0), (x1, y1) = pts.min(axis=0), pts.max(axis=0)
+    margin = max(0.5 * max(x1 - x0, y1 - y0), 2.0 * seg)
+    return x0 - margin, x1 + margin, y0 - margin, y1 + margin
+
+
+def camera_box(box, aspect):
+    """(centre x, centre y, parallel scale) of a 2D camera that shows the box whole in a
+    picture of width/height = aspect (parallel scale: half the visible height)."""
+    x0, x1, y0, y1 = box
+    return 0.5 * (x0 + x1), 0.5 * (y0 + y1), max(0.5 * (y1 - y0), 0.5 * (x1 - x0) / aspect)
+
+
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
     a = parse(argv)
@@ -230,6 +312,12 @@ def main(argv=None):
     except (ValueError, AssertionError):
         return fail(f"--size must be WxH in pixels (16-8000), not {a.size!r}")
     field, _, compname = a.field.partition(":")
+    h5 = xdmf[:-5] + ".h5"
+    if a.zoom not in (None, "contact"):
+        try:
+            zoom_box(a.zoom)
+        except ValueError as e:
+            return fail(str(e))
     rc = headless_reexec(argv)
     if rc is not None:
         return rc
@@ -336,18 +424,44 @@ def main(argv=None):
     td.FontSize = 14
     if hasattr(td, "Color"):
         td.Color = [0.0, 0.0, 0.0]
+    # the contact line of each body, warped like the bodies, drawn over them
+    try:
+        lines, _, _ = contact_lines(h5, scale)
+    except (OSError, KeyError) as e:
+        lines = []
+        print(f"{TOOL}: note: no contact line drawn ({e})", file=sys.stderr)
+    for _, pts in lines:
+        pl = pvs.PolyLineSource(Points=[v for x, y in pts for v in (float(x), float(y), 0.0)])
+        ld = pvs.Show(pl, view)
+        ld.Representation = "Surface"
+        pvs.ColorBy(ld, None)
+        ld.AmbientColor = ld.DiffuseColor = [0.0, 0.0, 0.0]
+        if hasattr(ld, "LineWidth"):
+            ld.LineWidth = 2.0
     view.InteractionMode = "2D"
     view.CameraPosition = [0.0, 0.0, 1.0]
     view.CameraFocalPoint = [0.0, 0.0, 0.0]
     view.CameraViewUp = [0.0, 1.0, 0.0]
     view.ResetCamera()
+    zoom_note = ""
+    if a.zoom is not None:
+        try:
+            box = zoom_box(a.zoom, h5, scale)
+        except (ValueError, OSError, KeyError) as e:
+            return fail(f"--zoom {a.zoom}: {e}")
+        cx, cy, half = camera_box(box, w / h)
+        view.CameraParallelProjection = 1
+        view.CameraFocalPoint = [cx, cy, 0.0]
+        view.CameraPosition = [cx, cy, 1.0]
+        view.CameraParallelScale = half
+        zoom_note = f", zoom x {box[0]:.4g} to {box[1]:.4g}, y {box[2]:.4g} to {box[3]:.4g}"
     out = os.path.abspath(a.output)
     os.makedirs(os.path.dirname(out), exist_ok=True)
     pvs.SaveScreenshot(out, view, ImageResolution=[w, h])
     if not os.path.isfile(out):
         return fail(f"ParaView wrote no {out}")
     print(f"{TOOL}: wrote {a.output} ({label}, {assoc.lower()[:-1]} data, colour {lo:.4g} to {hi:.4g}{' ' + unit if unit else ''}, "
-          f"{rng_note}, magnification {scale:g})")
+          f"{rng_note}, magnification {scale:g}, {len(lines)} contact lines{zoom_note})")
     return 0
 
 

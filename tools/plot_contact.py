@@ -4,14 +4,19 @@ runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-ga
 
 Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [-o contact.png] [--title TEXT]
 
-Top panel: /contact/pressure (nodal force / tributary length) against /contact/s (arc length along the contact curve); the
-legend gives each run's total normal force P = sum of /contact/normal_force (force per
-unit thickness); dotted vertical lines mark the edges of each run's contact zone (the zero
-of p^2 extrapolated from the two outermost active nodes, rc_common.contact_edges).
+Top panel: /contact/pressure (nodal force / tributary length) against the arc length s along
+the contact curve (/contact/s). The legend gives each run's contact force per unit thickness:
+the resultant vector when the result file stores one (attribute `resultant` of /contact or
+of the root, two components), else the sum of the nodal normal forces (sum of
+/contact/normal_force; a scalar, not a resultant: the normals vary along a curved contact);
+the same is printed, one line per run ('plot_contact: NAME: ...'). Dotted vertical lines
+mark the edges of each run's contact zone (the zero of p^2 extrapolated from the two
+outermost active nodes, rc_results.contact_edges).
 Middle panel: the gap /contact/gap = B1u1 + B2u2 - g0 (<= 0; < 0 where the bodies are apart).
 Units from the result file (root attributes unit_length/unit_force/unit_stress and the
 datasets' `units` attributes; SI m, N, Pa when absent), values scaled to an SI prefix
-(MPa, µm, MN/m) written in the axis labels: no matplotlib offset text.
+(MPa, µm, MN/m) written in the axis labels: no matplotlib offset text; numbers in the
+legends are written with their unit ('3000 N/mm', '32 MPa', never a power of ten beside them).
 With --hertz, for each run with a parabolic initial gap g0 = (x - xc)^2 / (2 R):
   P  = sum of /contact/normal_force             (total force per unit thickness)
   R, xc from the root attributes gap_radius/gap_center if present, else from the
@@ -20,8 +25,8 @@ With --hertz, for each run with a parabolic initial gap g0 = (x - xc)^2 / (2 R):
   1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2  (plane strain; 1/E1 + 1/E2 in plane stress),
         E, nu from the young/poisson attributes of /body1 and /body2
   a  = sqrt(4 P R / (pi E*)),  p0 = 2 P / (pi a),  p(x) = p0 sqrt(1 - (x - xc)^2 / a^2)
-the Hertz curve is added to the top panel and a bottom panel shows p/p0 against (x - xc)/a
-(zoomed on the contact zone, |x - xc| <= 1.6 a) with sqrt(1 - s^2); the errors against
+the Hertz curve is added to the top panel and a bottom panel shows p/p0 against (s - xc)/a
+(zoomed on the contact zone, |s - xc| <= 1.6 a) with sqrt(1 - t^2); the errors against
 Hertz are printed (stdout line 'plot_contact: Hertz for NAME: ... err_a=... err_p0=...
 err_L2=...') and written in that panel's legend:
   err_a   |a_num - a| / a, a_num half the distance between the contact-zone edges
@@ -35,7 +40,6 @@ Runs that are identical for Hertz (same P, R, xc, E*) share one curve.
 Exit 0 on success, 1 (with a message) on a missing or unreadable file or any other failure.
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
 """
-import argparse
 import os
 import re
 import sys
@@ -47,9 +51,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from rc_common import axis_label, contact_edges, dataset_unit, hertz_pressure, hertz_zone, num_attr, \
-    plain_axis, result_units, run_label, save_figure, si_scale, strip_comments, text_attr, \
-    text_dataset, tool_main  # noqa: E402
+from rc_figures import (axis_label, format_quantity, plain_axis, plot_parser, run_label,  # noqa: E402
+                        save_figure, si_scale, tool_main)
+from rc_results import (contact_edges, dataset_unit, hertz_pressure, hertz_zone, num_attr,  # noqa: E402
+                        result_units, text_attr, text_dataset)
+from rc_run import strip_comments  # noqa: E402
 
 NUM = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?)"
 
@@ -148,6 +154,13 @@ def read_run(path, want_hertz):
         # rectangle's side); files of older versions have only /contact/x
         sname = "/contact/s" if "/contact/s" in f else "/contact/x"
         x = np.array(f[sname], dtype=float)
+        resultant = None
+        for obj in (f["/contact"], f):
+            if "resultant" in obj.attrs:
+                v = np.asarray(obj.attrs["resultant"], dtype=float).reshape(-1)
+                if v.size >= 2:
+                    resultant = v[:2]
+                    break
         order = np.argsort(x, kind="stable")
         lam = np.array(f["/contact/normal_force"], dtype=float)
         r = dict(x=x[order], p=np.array(f["/contact/pressure"], dtype=float)[order], lam=lam[order],
@@ -155,7 +168,8 @@ def read_run(path, want_hertz):
                  trib=np.array(f["/contact/tributary_length"], dtype=float)[order]
                  if "/contact/tributary_length" in f else np.zeros(0),
                  method=text_attr(f, "method", "?"), status=text_attr(f, "status", "?"),
-                 delta=num_attr(f, "delta", float("nan")),
+                 delta=num_attr(f, "delta", float("nan")), resultant=resultant,
+                 sname="s" if sname == "/contact/s" else "x",
                  ux=dataset_unit(f[sname], u["length"]),
                  up=dataset_unit(f["/contact/pressure"], u["stress"]),
                  uf=dataset_unit(f["/contact/normal_force"], u["line_force"]),
@@ -167,11 +181,8 @@ def read_run(path, want_hertz):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("files", nargs="+", metavar="FILE.h5", help="robin_contact result files")
+    ap = plot_parser(__doc__, "contact.png")
     ap.add_argument("--hertz", action="store_true", help="add the Hertz line-contact pressure and p/p0 panel")
-    ap.add_argument("-o", "--output", default="contact.png", help="output image (default contact.png)")
-    ap.add_argument("--title", default=None, help="figure title")
     a = ap.parse_args(argv)
 
     runs = []
@@ -208,6 +219,13 @@ def main(argv=None):
                   f"p0={h['p0']:.6g} (R, xc from {h['src']}) a_num={e['a_num']:.6g} err_a={e['err_a']:.3g} "
                   f"err_p0={e['err_p0']:.3g} err_L2={e['err_L2']:.3g}")
     with_hertz = bool(seen)
+    for r in runs:
+        if r["resultant"] is not None:
+            r["force_text"] = f"resultant = {format_quantity(r['resultant'], uf)}"
+        else:
+            r["force_text"] = f"sum of nodal normal forces = {format_quantity(r['P'], uf)}"
+        print(f"plot_contact: {r['name']}: {r['force_text']}")
+    sn = runs[0]["sname"]
 
     nrow = 3 if with_hertz else 2
     fig = plt.figure(figsize=(8.0, 9.5 if with_hertz else 7.0), dpi=120)
@@ -223,10 +241,8 @@ def main(argv=None):
     xmax = max((r["x"].max() for r in runs if r["x"].size), default=1.0)
     for k, r in enumerate(runs):
         c = r["colour"] = colours[k % len(colours)]
-        fP, lP = si_scale([r["P"]], uf)
         mk = "o-" if r["x"].size <= 150 else "-"
-        ax.plot(r["x"] / fx, r["p"] / fp, mk, color=c, ms=3.0, lw=1.3,
-                label=f"{r['label']}: P = Σλ = {r['P'] / fP:.4g} {lP}")
+        ax.plot(r["x"] / fx, r["p"] / fp, mk, color=c, ms=3.0, lw=1.3, label=f"{r['label']}: {r['force_text']}")
         if r["gap"] is not None:
             axg.plot(r["x"] / fx, r["gap"] / fg, mk, color=c, ms=2.5, lw=1.1)
         if r["edges"] is not None:
@@ -234,22 +250,23 @@ def main(argv=None):
             for i, xe in enumerate((xl, xr)):
                 for axx in (ax, axg):
                     axx.axvline(xe / fx, color=c, ls=":", lw=1.0,
-                                label=(f"contact zone edges x = {xl / fx:.4g}, {xr / fx:.4g} {lx}"
+                                label=(f"contact zone edges {sn} = {format_quantity([xl, xr], ux)}"
                                        if i == 0 and axx is ax else None))
         h = r.get("h")
         if h is not None and r.get("new_curve"):
             hx, hp = hertz_curve(h, xmin, xmax, 801)
             ax.plot(hx / fx, hp / fp, "--",
                     color=c if len(runs) > 1 else "k", lw=1.3,
-                    label=f"Hertz for {r['name']}: R = {h['R']:.4g} {ux}, a = {h['a'] / fx:.4g} {lx}, "
-                          f"p0 = {h['p0'] / fp:.4g} {lp}")
+                    label=f"Hertz for {r['name']}: P = {format_quantity(h['P'], uf)}, "
+                          f"R = {format_quantity(h['R'], ux)}, a = {format_quantity(h['a'], ux)}, "
+                          f"p0 = {format_quantity(h['p0'], up)}")
     ax.axhline(0.0, color="0.5", lw=0.6)
     axg.axhline(0.0, color="0.5", lw=0.6)
     ax.grid(True, alpha=0.4)
     axg.grid(True, alpha=0.4)
     ax.set_ylabel(axis_label("contact pressure p", lp))
     axg.set_ylabel(axis_label("gap", lg))
-    axg.set_xlabel(axis_label("s, position along the contact curve", lx))
+    axg.set_xlabel(axis_label("arc length s along the contact curve" if sn == "s" else "x", lx))
     ax.tick_params(labelbottom=False)
     ax.set_title(a.title or "contact pressure (top) and gap (below; < 0: apart)"
                  + (", Hertz line contact" if with_hertz else ""), fontsize=10)
@@ -260,7 +277,7 @@ def main(argv=None):
     if with_hertz:
         axh = fig.add_subplot(gs[2])
         s = np.linspace(-1.6, 1.6, 641)
-        axh.plot(s, np.sqrt(np.clip(1.0 - s * s, 0.0, None)), "k--", lw=1.3, label="Hertz sqrt(1 - s²)")
+        axh.plot(s, np.sqrt(np.clip(1.0 - s * s, 0.0, None)), "k--", lw=1.3, label="Hertz sqrt(1 - t²)")
         for r in runs:
             h = r.get("h")
             if h is None:
@@ -279,7 +296,7 @@ def main(argv=None):
         axh.set_ylim(-0.05, 1.45)
         axh.axhline(0.0, color="0.5", lw=0.6)
         axh.grid(True, alpha=0.4)
-        axh.set_xlabel("s = (x - xc) / a  (a: Hertz half-width)")
+        axh.set_xlabel(f"t = ({sn} - xc) / a  [-]  (a: Hertz half-width)")
         axh.set_ylabel("p / p0 [-]")
         axh.set_title("zoom on the contact zone, normalised by Hertz (dotted: contact-zone edges; "
                       "errors against Hertz in the legend)",

@@ -23,7 +23,6 @@ legend with a note and no curve. Exit 0 on success, 1 (with a message) on a miss
 unreadable file or any other failure.
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
 """
-import argparse
 import re
 import sys
 
@@ -34,8 +33,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from rc_common import num_attr, plain_axis, run_label, save_figure, text_attr, text_dataset, \
-    tool_main  # noqa: E402
+from rc_figures import plain_axis, plot_parser, run_label, save_figure, tool_main  # noqa: E402
+from rc_results import num_attr, text_attr, text_dataset  # noqa: E402
 
 CRITERION = {"increment": "relative obstacle increment Σ|ΔG_a|/|G_a|",
              "residual": "residual max(imbalance, penetration, complementarity)"}
@@ -66,10 +65,7 @@ def read_run(path):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("files", nargs="+", metavar="FILE.h5", help="robin_contact result files")
-    ap.add_argument("-o", "--output", default="history.png", help="output image (default history.png)")
-    ap.add_argument("--title", default=None, help="figure title")
+    ap = plot_parser(__doc__, "history.png")
     a = ap.parse_args(argv)
 
     runs = []

@@ -48,8 +48,8 @@ from matplotlib.cm import ScalarMappable  # noqa: E402
 from matplotlib.collections import LineCollection, PolyCollection  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
 
-from rc_common import axis_label, clip_limits, dataset_unit, plain_axis, result_units, save_figure, \
-    si_scale, text_attr, tool_main  # noqa: E402
+from rc_figures import axis_label, clip_limits, plain_axis, save_figure, si_scale, tool_main  # noqa: E402
+from rc_results import dataset_unit, result_units, text_attr  # noqa: E402
 
 STRESS_ROWS = {"sxx": 0, "syy": 1, "sxy": 2, "szz": 3}
 FIELDS = ["von_mises", "sxx", "syy", "sxy", "szz", "contact_pressure", "ux", "uy", "u"]

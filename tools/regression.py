@@ -4,7 +4,7 @@
   tools/regression.py --store  [--bin bin/robin_contact] [--ref tests/data/regression.json]
   tools/regression.py [--bin bin/robin_contact] [--ref ...] [--only SUBSTRING] [--quick]
 
---store runs every deck of inputs/, inputs/hard/, inputs/table1/ and tests/decks/ with its own
+--store runs every deck of inputs/, inputs/hard/, inputs/table1/ and tests/data/decks/ with its own
 settings, again with method='monolithic' and with the harmonic operator at delta 0.5, and stores, per deck: the exit code, the status, the outer iteration count and the
 nodal contact forces (/contact/normal_force). Without --store it runs them again and compares:
 same exit code, status and outer count, and max |f - f_ref| <= 1e-12 max |f_ref| (scale-aware;
@@ -28,7 +28,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-DECK_DIRS = ("inputs", "inputs/hard", "inputs/table1", "tests/decks")
+DECK_DIRS = ("inputs", "inputs/hard", "inputs/table1", "tests/data/decks")
 RTOL = 1.0e-12
 
 

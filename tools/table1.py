@@ -8,13 +8,13 @@ Usage: tools/table1.py [--bin bin/robin_contact] [--out results/table1] [--csv F
                        [--meshes 3x1,6x2,16x8,24x16] [--deltas 0.1,0.5,0.7,0.95,1]
                        [--extra '&solver ... /']
 """
-import argparse
 import os
 import sys
 
 import numpy as np
 
-from rc_common import read_lam, run_solver
+from rc_results import read_lam
+from rc_run import run_solver, tool_parser
 
 PAPER = {  # n/m -> {delta: (outer, inner) or None}
     "3x1": ("12/3", {0.1: (287, 903), 0.5: (76, 243), 0.7: (62, 208), 0.95: (47, 160), 1.0: None}),
@@ -33,8 +33,7 @@ def run(binary, deck, overrides):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--bin", default="bin/robin_contact")
+    ap = tool_parser(__doc__)
     ap.add_argument("--decks", default="inputs/table1")
     ap.add_argument("--out", default="results/table1")
     ap.add_argument("--csv", default=None)

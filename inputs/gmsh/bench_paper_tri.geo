@@ -1,12 +1,12 @@
 // bench_paper_tri.geo: the paper's two-body scene (inputs/gmsh/paper.geo) as UNSTRUCTURED
-// linear triangles, for tools/bench_gmsh.py (make bench-gmsh). Body 1 "upper" = (0,3)x(1,2),
+// linear triangles, for bench/bench_gmsh.py (make bench-gmsh). Body 1 "upper" = (0,3)x(1,2),
 // body 2 "lower" = (0,3)x(0,1); uniform size h in the upper body and ratio*h in the lower one
 // (default ratio 1.07: the contact lines do not match, the mortar coupling is a real one).
 // About 4/h^2 nodes in the upper body (measured, gmsh 4.8): h = 0.02 10k nodes (20k DOFs),
 // 0.01 40k (80k DOFs), 0.005 159k (318k DOFs), 0.0025 636k (1.27M DOFs); the lower body 13% fewer. The bodies share no point. Physical names as in paper.geo:
 // surfaces "upper", "lower"; curves <body>_left/right/top/bottom.
 //   gmsh -2 -format msh41 -setnumber h 0.01 bench_paper_tri.geo -o bench_paper_tri_h0.01.msh
-// Large meshes are not shipped: tools/bench_gmsh.py generates them in its work folder.
+// Large meshes are not shipped: bench/bench_gmsh.py generates them in its work folder.
 Geometry.AutoCoherence = 0;
 If (!Exists(h))
   h = 0.02;

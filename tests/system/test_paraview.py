@@ -1,0 +1,252 @@
+#!/usr/bin/python3
+"""tools/paraview_view.py (run by `make check`): when ParaView's pvpython is installed
+(Debian package `paraview`; headless it also needs xvfb-run, package `xvfb`), render a
+solved result by its bare file name from the result folder (the case Debian's Xdmf3 readers
+abort on without an absolute path), check the PNG is a real picture (not blank), that a
+missing array exits 1 listing the available ones, that --list works, and that cell arrays
+and a polyline grid without displacement (the XDMF layout being added: body id, contact
+line) are handled, that the bodies are coloured (not grey: the fraction of saturated pixels
+in the drawn region), and that a dead display from xvfb-run is retried once and any other
+abnormal end of the re-run is one line and exit 1. Without pvpython the rendering is
+skipped, and says so; the tool's geometry, which needs no ParaView, is checked always: the
+contact line of each body warped by its displacement (on the Hertz deck: the normal distance
+between the two warped lines, over the magnification, minus the initial gap g0 is the gap
+the program wrote) and the box of --zoom contact (it holds the active contact nodes and is
+much smaller than the contact line)."""
+import os
+import re
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
+from rc_checks import Checks  # noqa: E402
+from rc_run import run_solver  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+BIN = os.path.abspath(os.environ.get("BIN", "bin/robin_contact"))
+OUT = os.path.abspath(os.path.join(os.environ.get("BUILD", "build/release"), "test-out", "paraview"))
+TOOL = os.path.join(ROOT, "tools", "paraview_view.py")
+check = Checks()
+
+shutil.rmtree(OUT, ignore_errors=True)
+os.makedirs(OUT)
+
+# 0. the contact lines and the zoom box, without ParaView
+import numpy as np  # noqa: E402
+import h5py  # noqa: E402
+import paraview_view  # noqa: E402
+hz = f"{OUT}/hertz.h5"
+p, _ = run_solver(BIN, os.path.join(ROOT, "inputs/hard/hertz.nml"), f"&output file='{hz}' /")
+if not check(p.returncode == 0, "Hertz deck solved", f"exit {p.returncode}"):
+    sys.exit(1)
+with h5py.File(hz, "r") as f:
+    xy = f["contact/coordinates"][()].T
+    normal = f["contact/normal"][()].T
+    gap, g0 = f["contact/gap"][()], f["contact/g0"][()]
+    active = f["contact/normal_force"][()] > 0
+for mag in (0.0, 25.0):
+    lines, _, _ = paraview_view.contact_lines(hz, mag)
+    check(sorted(b for b, _ in lines) == [1, 2] and all(q.shape == xy.shape for _, q in lines),
+          f"contact_lines x{mag:g}: one line per body through every contact node", str([(b, q.shape) for b, q in lines]))
+    if len(lines) != 2 or any(q.shape != xy.shape for _, q in lines):
+        continue
+    (_, p1), (_, p2) = sorted(lines, key=lambda t: t[0])
+    if mag == 0.0:
+        check(np.array_equal(p1, xy) and np.array_equal(p2, xy), "contact_lines x0: the undeformed contact nodes")
+    else:
+        dn = np.sum((p1 - p2) * normal, axis=1) / mag - g0
+        err = float(np.max(np.abs(dn - gap)) / np.max(np.abs(g0)))
+        check(err < 1e-9, "contact_lines x25: normal distance of the warped lines / 25 - g0 = the written gap",
+              f"max deviation {err:.2e} of max g0")
+box = paraview_view.zoom_box("contact", hz, 25.0)
+(b1, p1), (b2, p2) = sorted(paraview_view.contact_lines(hz, 25.0)[0], key=lambda t: t[0])
+inside = all(box[0] <= x <= box[1] and box[2] <= y <= box[3] for q in (p1, p2) for x, y in q[active])
+span = float(xy[:, 0].max() - xy[:, 0].min())
+check(inside and box[1] - box[0] < 0.25 * span,
+      "zoom_box contact: holds the active contact nodes of both warped lines, narrower than a quarter of the line",
+      f"box {tuple(round(v, 3) for v in box)}, line {span:.3g} long, {int(active.sum())} active nodes")
+check(paraview_view.zoom_box("1,2.5,-3,4e-1") == (1.0, 2.5, -3.0, 0.4), "zoom_box: an explicit X0,X1,Y0,Y1 box")
+for bad in ("1,2,3", "2,1,0,1", "a,b,c,d"):
+    try:
+        paraview_view.zoom_box(bad)
+        check(False, f"zoom_box {bad!r}: rejected")
+    except ValueError as e:
+        check("--zoom" in str(e), f"zoom_box {bad!r}: rejected with a message", str(e))
+check(paraview_view.camera_box((0.0, 4.0, 0.0, 1.0), 1.5) == (2.0, 0.5, 4.0 / 3.0)
+      and paraview_view.camera_box((0.0, 1.0, 0.0, 4.0), 1.5) == (0.5, 2.0, 2.0),
+      "camera_box: the whole box in view, wide or tall")
+
+pv = shutil.which("pvpython")
+if pv is None:
+    print("SKIP  pvpython not found: ParaView is optional (Debian: apt-get install paraview xvfb); "
+          "rendering by tools/paraview_view.py not tested")
+    sys.exit(1 if check.failed else 0)
+if not (os.environ.get("DISPLAY") or os.environ.get("RC_PV_OFFSCREEN") or shutil.which("xvfb-run")):
+    print("SKIP  pvpython found but no DISPLAY and no xvfb-run (apt-get install xvfb): cannot render here")
+    sys.exit(1 if check.failed else 0)
+
+p, res = run_solver(BIN, os.path.join(ROOT, "inputs/default.nml"), f"&output file='{OUT}/r.h5' /")
+if not check(p.returncode == 0 and os.path.isfile(f"{OUT}/r.xdmf"), "default deck solved, r.xdmf written",
+             f"exit {p.returncode}"):
+    sys.exit(1)
+
+
+def view(*args, cwd=OUT):
+    q = subprocess.run([pv, TOOL, *args], cwd=cwd, capture_output=True, text=True, timeout=300)
+    return q.returncode, q.stdout, q.stderr
+
+
+def picture(path, what, coloured=True):
+    """PNG exists and is not (almost) uniform: pixel standard deviation of the grey levels;
+    coloured: the drawn bodies are coloured by the colour map, not left grey (ParaView's
+    solid colour when the rendered geometry lost the array, as Xdmf3ReaderS does on the
+    Collection): of the non-background pixels (not near-white, the scalar bar strip at the
+    right edge left out), at least MIN_SATURATED carry an HSV saturation above 0.3. Every
+    colour of the default map (Viridis) has saturation 0.7-1; ParaView's grey 0.06, the
+    black text 0."""
+    if not check(os.path.isfile(path), f"{what}: {os.path.basename(path)} written"):
+        return
+    import matplotlib.image as mpimg
+    import matplotlib.colors as mcolors
+    import numpy as np
+    img = mpimg.imread(path)
+    grey = img[..., :3].mean(axis=2) if img.ndim == 3 else img
+    check(grey.std() > 0.05, f"{what}: picture is not blank (grey-level std {grey.std():.3f} > 0.05)",
+          f"{img.shape[1]}x{img.shape[0]}")
+    if not coloured:
+        return
+    rgb = np.asarray(img[..., :3], dtype=float) if img.ndim == 3 else np.repeat(img[..., None], 3, axis=2)
+    if rgb.max() > 1.0:                                   # 8-bit PNG read as integers
+        rgb = rgb / 255.0
+    rgb = rgb[:, : int(rgb.shape[1] * 0.88)]              # the scalar bar sits at the right edge
+    sat = mcolors.rgb_to_hsv(np.clip(rgb, 0.0, 1.0))[..., 1]
+    drawn = rgb.min(axis=2) < 0.9                         # not the white background
+    frac = float((sat[drawn] > 0.3).mean()) if drawn.any() else 0.0
+    check(frac >= MIN_SATURATED, f"{what}: bodies coloured, not grey ({100 * frac:.1f}% of the "
+          f"{int(drawn.sum())} drawn pixels saturated, at least {100 * MIN_SATURATED:.0f}%)")
+
+
+MIN_SATURATED = 0.5   # measured (default deck): coloured 96-98%; the grey bodies of Xdmf3ReaderS 0% (14% with
+#                       the dark blue element edges of --edges)
+
+
+# 1. bare file name from the result folder (absolute path passed to the reader)
+rc, so, se = view("r.xdmf", "-o", "v.png")
+check(rc == 0, "paraview_view.py r.xdmf (bare name, cwd = result folder) exits 0", f"exit {rc} {se.strip()[-300:]}")
+check(re.search(r"wrote v.png \(von_mises, point data, colour .* Pa", so), "reports field, colour range and unit",
+      so.strip())
+picture(f"{OUT}/v.png", "von_mises")
+# 2. the .h5 name, a vector component, element edges
+rc, so, se = view(f"{OUT}/r.h5", "--field", "displacement:Y", "--edges", "-o", f"{OUT}/uy.png", cwd=ROOT)
+check(rc == 0, "paraview_view.py r.h5 --field displacement:Y --edges exits 0", f"exit {rc} {se.strip()[-300:]}")
+picture(f"{OUT}/uy.png", "displacement:Y")
+# 2b. zoom on the contact zone, the contact lines drawn
+rc, so, se = view(hz, "--zoom", "contact", "-o", f"{OUT}/zoom.png", cwd=ROOT)
+check(rc == 0 and "2 contact lines" in so and ", zoom x " in so, "--zoom contact exits 0, draws 2 contact lines and says so",
+      f"exit {rc} {so.strip()} {se.strip()[-300:]}")
+picture(f"{OUT}/zoom.png", "zoom on the contact")
+rc, so, se = view("r.xdmf", "--zoom", "1,2", "-o", "zbad.png")
+check(rc == 1 and "--zoom" in se and not os.path.exists(f"{OUT}/zbad.png"), "--zoom 1,2: exit 1 with a message",
+      f"exit {rc} {se.strip()[-200:]}")
+# 3. a missing array: exit 1 and the list of arrays
+rc, so, se = view("r.xdmf", "--field", "no_such_field", "-o", "x.png")
+check(rc == 1 and "no array 'no_such_field'" in se and "point arrays:" in se and "von_mises" in se
+      and "displacement" in se, "a missing array: exit 1, the available arrays listed", f"exit {rc}")
+check(not os.path.exists(f"{OUT}/x.png"), "a missing array writes no picture")
+rc, so, se = view("r.xdmf", "--list")
+check(rc == 0 and "von_mises" in so and "cell arrays:" in so, "--list exits 0 and lists the arrays", so.strip())
+rc, so, se = view("missing.xdmf")
+check(rc == 1 and "no XDMF file" in se, "a missing file: exit 1 with a message", se.strip())
+
+# 4. the XDMF layout being added: a cell array (body id) and a polyline grid without displacement
+with open(f"{OUT}/r.xdmf") as f:
+    s = f.read()
+with h5py.File(f"{OUT}/r.h5", "r") as f:
+    ncell = [f[f"body{b}/cells"].shape[0] for b in (1, 2)]
+    c = f["contact/coordinates"][()]
+    pr = f["contact/pressure"][()]
+for b in (1, 2):
+    i = s.index(f'<Grid Name="body{b}"')
+    j = s.index("</Grid>", i)
+    s = s[:j] + (f'  <Attribute Name="body_id" AttributeType="Scalar" Center="Cell">\n'
+                 f'          <DataItem Dimensions="{ncell[b - 1]}" NumberType="Int" Format="XML">'
+                 f'{" ".join([str(b)] * ncell[b - 1])}</DataItem>\n        </Attribute>\n      ') + s[j:]
+m = c.shape[1]
+line = (f'  <Grid Name="contact_line" GridType="Uniform">\n'
+        f'        <Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="{m - 1}">\n'
+        f'          <DataItem Dimensions="{m - 1} 2" NumberType="Int" Format="XML">'
+        f'{" ".join(f"{k} {k + 1}" for k in range(m - 1))}</DataItem>\n        </Topology>\n'
+        f'        <Geometry GeometryType="XYZ">\n          <DataItem Dimensions="{m} 3" NumberType="Float" '
+        f'Precision="8" Format="XML">{" ".join(f"{c[0, k]!r} {c[1, k]!r} 0" for k in range(m))}</DataItem>\n'
+        f'        </Geometry>\n        <Attribute Name="line_pressure" AttributeType="Scalar" Center="Node">\n'
+        f'          <DataItem Dimensions="{m}" NumberType="Float" Precision="8" Format="XML">'
+        f'{" ".join(repr(float(v)) for v in pr)}</DataItem>\n        </Attribute>\n      </Grid>\n    ')
+k = s.rindex("</Grid>\n  </Domain>")
+s = s[:k] + line + s[k:]
+with open(f"{OUT}/future.xdmf", "w") as f:
+    f.write(s)
+rc, so, se = view("future.xdmf", "--list")
+check(rc == 0 and re.search(r"cell arrays: .*body_id", so) and "line_pressure" in so,
+      "future layout: body_id listed as a cell array, the contact-line array as a point array", so.strip())
+rc, so, se = view("future.xdmf", "--field", "body_id", "-o", "body.png")
+check(rc == 0 and "cell data" in so, "future layout: --field body_id (cell array) exits 0", f"exit {rc} {se.strip()[-300:]}")
+picture(f"{OUT}/body.png", "body_id")
+rc, so, se = view("future.xdmf", "--field", "line_pressure", "-o", "line.png")
+check(rc == 0, "future layout: --field line_pressure (on the polyline grid only) exits 0",
+      f"exit {rc} {se.strip()[-300:]}")
+picture(f"{OUT}/line.png", "line_pressure", coloured=False)   # the bodies lack it: grey by design
+
+# 5. a dead display from xvfb-run -a (seen in 2 of 36 headless runs: ParaView says "bad X
+# server connection" and aborts, exit 134): a stand-in xvfb-run on PATH hands out a display
+# no X server listens on, the first time only (then the real xvfb-run: the retry renders)
+# or every time (exit 1 with a one-line message, no stack trace)
+dead = next(n for n in range(473, 600) if not os.path.exists(f"/tmp/.X11-unix/X{n}"))
+env = {k: v for k, v in os.environ.items()
+       if k not in ("DISPLAY", "WAYLAND_DISPLAY", "RC_PV_OFFSCREEN", "RC_PV_WRAPPED")}
+
+
+def fake_xvfb(name, body):
+    d = os.path.join(OUT, name)
+    os.makedirs(d, exist_ok=True)
+    with open(os.path.join(d, "xvfb-run"), "w") as f:
+        f.write("#!/bin/sh\n" + body)
+    os.chmod(os.path.join(d, "xvfb-run"), 0o755)
+    return dict(env, PATH=d + os.pathsep + env.get("PATH", ""))
+
+
+def headless(env_, *args):
+    q = subprocess.run([pv, TOOL, "r.xdmf", "--size", "320x240", *args], cwd=OUT, env=env_,
+                       capture_output=True, text=True, timeout=300)
+    return q.returncode, q.stdout, q.stderr
+
+
+real_xvfb = shutil.which("xvfb-run")
+if real_xvfb:
+    once = (f'if [ ! -e "$(dirname "$0")/used" ]; then : > "$(dirname "$0")/used"; '
+            f'shift; DISPLAY=:{dead} exec "$@"; fi\nexec {real_xvfb} "$@"\n')
+    rc, so, se = headless(fake_xvfb("once_dead", once), "-o", "retry.png")
+    if rc == 1 and "retrying once" in se and "on the retry: " in se and "bad X server connection" in se:
+        # the real xvfb-run -a handed out a dead display too (what this guards against, rare)
+        print(f"INFO  the real xvfb-run also gave a dead display on the retry: {se.strip().splitlines()[-1]}")
+        check(len(se.strip().splitlines()) == 2, "a dead display the first time: retried once, then one line",
+              se.strip()[-300:])
+    else:
+        check(rc == 0 and "retrying once" in se and os.path.isfile(f"{OUT}/retry.png"),
+              "a dead display the first time: one retry under xvfb-run, the picture written",
+              f"exit {rc} {se.strip()[-300:]}")
+else:
+    print("SKIP  the dead-display retry that renders: no xvfb-run")
+rc, so, se = headless(fake_xvfb("always_dead", f'shift; DISPLAY=:{dead} exec "$@"\n'), "-o", "dead.png")
+last = se.strip().splitlines()[-1] if se.strip() else ""
+check(rc == 1 and last.startswith("paraview_view: rendering under xvfb-run ended abnormally")
+      and "bad X server connection" in last and "Stack trace" not in se
+      and not os.path.exists(f"{OUT}/dead.png"),
+      "a dead display twice: exit 1, a one-line message, no stack trace", f"exit {rc} {se.strip()[-300:]}")
+rc, so, se = headless(fake_xvfb("crash", 'echo "some failure" >&2\nkill -SEGV $$\n'), "-o", "crash.png")
+check(rc == 1 and se.strip().splitlines() == ["paraview_view: rendering under xvfb-run ended abnormally, "
+                                               "signal 11 (SIGSEGV): some failure"],
+      "any other abnormal end of the re-run (SIGSEGV): exit 1 and one line", f"exit {rc} {se.strip()[-300:]}")
+
+print(f"{len(check.failed)} failed checks")
+sys.exit(1 if check.failed else 0)

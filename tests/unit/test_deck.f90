@@ -1,0 +1,256 @@
+!> Tests of module deck on good input: the default deck's values, the round trip
+!! (print_deck output read back gives identical values), override precedence and
+!! semantics, defaults, a few namelist forms (case, repeat counts, quotes, comments), and
+!! the Markdown reference table of a group (cells, required, forms, escaping).
+!! Bad input is tested by tests/system/test_bad_input.sh (fatal errors end the process).
+program test_deck
+  use kinds, only: wp
+  use config
+  use deck, only: read_deck, print_deck, deck_text
+  use namelist_input, only: vars_t, str_t, reference_table
+  use testing, only: report, test_summary
+  implicit none (type, external)
+  type(deck_t) :: d, e
+  character(len=512) :: tmp
+  character(len=200) :: none(0)
+  character(len=200) :: ov(6)
+  character(len=:), allocatable :: t1, t2
+  character(len=*), parameter :: NL = achar(10)
+  real(wp) :: r
+
+  call random_number(r)
+  write (tmp, '(a,i0)') '/tmp/test_deck_', int(r * 1.0e9_wp)
+
+  ! ---- the default deck (the seed's scene) ---------------------------------------------
+  call read_deck('inputs/default.nml', none, d)
+  call check(d%body(1)%id == 1 .and. d%body(2)%id == 2, 'default: body ids 1 and 2')
+  call check(d%body(1)%nx == 24 .and. d%body(1)%ny == 16 .and. d%body(2)%nx == 24 .and. &
+             d%body(2)%ny == 16, 'default: 24x16 cells per body')
+  call check(d%body(1)%young == 2.1e11_wp .and. d%body(2)%poisson == 0.277_wp, &
+             'default: young = 2.1e11, poisson = 0.277 exactly')
+  call check(d%body(1)%y0 == 1.0_wp .and. d%body(2)%y0 == 0.0_wp .and. d%body(1)%width == 3.0_wp, &
+             'default: geometry (0,3)x(1,2) over (0,3)x(0,1)')
+  call check(all(d%body(1)%bc == [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), &
+             'default: body 1 sides clamped/free/contact/free (left,right,bottom,top)')
+  call check(all(d%body(2)%bc == [BC_CLAMPED, BC_FREE, BC_FREE, BC_CONTACT]), &
+             'default: body 2 sides clamped/free/free/contact')
+  call check(d%ntraction == 2, 'default: two tractions')
+  if (d%ntraction == 2) then
+    call check(d%traction(1)%body == 1 .and. d%traction(1)%side == SIDE_TOP .and. &
+               all(d%traction(1)%t0 == [0.0_wp, -3.0e6_wp]) .and. &
+               all(d%traction(1)%t1 == [0.0_wp, -1.0e6_wp]), 'default: top traction t0, t1')
+    call check(d%traction(2)%side == SIDE_RIGHT .and. all(d%traction(2)%t0 == [0.0_wp, 2.0e6_wp]) &
+               .and. all(d%traction(2)%t1 == 0.0_wp), 'default: right traction, t1 defaults to 0')
+  end if
+  call check(d%plane_strain, 'default: plane strain')
+  call check(d%solver%method == METHOD_ROBIN .and. d%solver%delta == 0.95_wp .and. &
+             d%solver%tol == 1.0e-8_wp .and. d%solver%max_outer == 800, 'default: solver values')
+  call check(d%output%file == 'results/default.h5', 'default: output file')
+  call check(allocated(d%effective), 'default: effective deck text stored')
+
+  ! ---- round trip of the default deck ----------------------------------------------------
+  call round_trip(d, 'default deck')
+
+  ! ---- overrides -----------------------------------------------------------------------------
+  ov(1) = '&solver delta=0.5 /'
+  ov(2) = '&body id=2, young=1e9 /'
+  ov(3) = '&solver delta=0.7, robin_operator=''constant'', alpha=2.5e-12 /'
+  ov(4) = '&traction body=2, side=''bottom'', t0=0.0, 1.0e5 /'
+  ov(5) = '&displacement body=2, side=''right'', u=0.0, -1.0e-4 /  &scene plane=''stress'' /'
+  ov(6) = '&body id=1, element=''p1'' /'
+  call read_deck('inputs/default.nml', ov, e)
+  call check(e%solver%delta == 0.7_wp, 'override: later override wins (delta = 0.7)')
+  call check(e%solver%robin_operator == ROBIN_CONSTANT .and. e%solver%alpha == 2.5e-12_wp, &
+             'override: robin_operator and alpha')
+  call check(e%body(2)%young == 1.0e9_wp .and. e%body(1)%young == 2.1e11_wp, &
+             'override: &body id=2 changes body 2 only')
+  call check(e%body(2)%nx == 24 .and. e%body(2)%poisson == 0.277_wp .and. &
+             e%body(2)%bc(SIDE_TOP) == BC_CONTACT, 'override: other values of body 2 kept')
+  call check(e%ntraction == 3, 'override: &traction appends (3 tractions)')
+  if (e%ntraction == 3) call check(e%traction(3)%body == 2 .and. e%traction(3)%side == SIDE_BOTTOM &
+                                   .and. e%traction(3)%t0(2) == 1.0e5_wp, 'override: appended traction')
+  call check(e%body(2)%bc(SIDE_RIGHT) == BC_DISPLACEMENT .and. &
+             all(e%body(2)%u_side(:, SIDE_RIGHT) == [0.0_wp, -1.0e-4_wp]), &
+             'override: &displacement sets the side and its vector')
+  call check(.not. e%plane_strain, 'override: two groups in one override (plane stress)')
+  call check(e%body(1)%element == ELEM_P1 .and. e%body(2)%element == ELEM_Q1, &
+             'override: element, case-insensitive')
+  call round_trip(e, 'deck with overrides')
+
+  ! ---- defaults, namelist forms ----------------------------------------------------------
+  call write_file(trim(tmp)//'_my_case.nml', [character(len=120) :: &
+    '! minimal deck: only the bodies', &
+    '&BODY ID=1, Y0=1.0, NX=4, NY=2, LEFT=''Clamped'', Bottom="contact" / &body id=2,', &
+    '  nx=4, ny=2, left=''roller'', bottom=''roller'', top=''contact'', young=1.5e9 /', &
+    '&scene title=''a!b, it''''s "quoted" / here'' /  ! comment with a quote '' and a /', &
+    '&traction body=1, side=''top'', t0=2*-1.0e6 /', &
+    '&traction body=1, side=''top'', t0(2)=5.0, t1=, 3.0 /'])
+  call read_deck(trim(tmp)//'_my_case.nml', none, e)
+  call check(e%output%file == 'results/'//trim(tmp(6:))//'_my_case.h5', &
+             'defaults: output file results/<deck basename>.h5 ('//trim(e%output%file)//')')
+  call check(e%body(1)%width == 1.0_wp .and. e%body(1)%poisson == 0.3_wp .and. &
+             e%solver%delta == 0.5_wp .and. e%solver%robin_operator == ROBIN_HARMONIC .and. &
+             e%contact%gap_radius == 0.0_wp, 'defaults: config.f90 values (harmonic at delta 0.5)')
+  call check(all(e%body(2)%bc == [BC_ROLLER, BC_FREE, BC_ROLLER, BC_CONTACT]), &
+             'forms: upper-case names, mixed-case values, double quotes, two groups on a line')
+  call check(e%title == 'a!b, it''s "quoted" / here', 'forms: quotes, ! and / inside a string')
+  call check(all(e%traction(1)%t0 == -1.0e6_wp), 'forms: repeat count 2*-1.0e6')
+  call check(all(e%traction(2)%t0 == [0.0_wp, 5.0_wp]) .and. all(e%traction(2)%t1 == [0.0_wp, 3.0_wp]), &
+             'forms: subscript t0(2)= and a null value t1=, 3.0')
+  call round_trip(e, 'minimal deck')
+  call delete_file(trim(tmp)//'_my_case.nml')
+
+  ! ---- exact round trip of awkward reals -----------------------------------------------------
+  call write_file(trim(tmp)//'_reals.nml', [character(len=200) :: &
+    '&body id=1, x0=-0.1, y0=0.30000000000000004, width=1.2345678901234567e11, height=7e-300,', &
+    '  nx=1, ny=1, left=''clamped'', bottom=''contact'', young=1.7976931348623157e308, poisson=-0.999999 /', &
+    '&body id=2, x0=-0.1, y0=-1.0, width=1.2345678901234567e11, height=1.0, nx=1, ny=1,', &
+    '  left=''clamped'', top=''contact'', poisson=0.49999999999999994 /', &
+    '&contact gap_radius=123456.7, gap_center=-2.5e-5 /'])
+  call read_deck(trim(tmp)//'_reals.nml', none, e)
+  call check(e%body(1)%y0 == 0.30000000000000004_wp .and. e%body(1)%young == huge(1.0_wp) .and. &
+             e%body(2)%poisson == 0.49999999999999994_wp, 'reals: read exactly')
+  call round_trip(e, 'awkward reals')
+  call delete_file(trim(tmp)//'_reals.nml')
+
+  call deck_text(d, t1)
+  call deck_text(d, t2)
+  call check(t1 == t2 .and. t1 == d%effective, 'deck_text is deterministic and equals d%effective')
+
+  ! ---- the reference table of a group (namelist_input%reference_table) -----------------------
+  block
+    type(vars_t) :: v, forms(2)
+    integer, target :: n, code
+    real(wp), target :: x, p(2)
+    character(len=8), target :: s
+    character(len=:), allocatable :: tab
+    n = 3
+    code = 0
+    x = 2.5e11_wp
+    p = [1.0_wp, -0.5_wp]
+    s = 'ab'
+    call v%int('n', n, doc='count', range='>= 1', required=.true.)
+    call v%real('x', x, unit='[stress]', range='> 0', doc='a | b')
+    call v%pair('p', p, unit='[length]', doc='position')
+    call v%str('s', s)
+    call v%enum('c', code, 'one two')
+    call forms(1)%int('n', n)
+    call forms(1)%real('x', x)
+    call forms(2)%int('n', n)
+    call forms(2)%pair('p', p)
+    tab = reference_table(v, forms, [str_t('A'), str_t('B')])
+    call check(index(tab, '| variable | type | default | unit | allowed values | description |'//NL// &
+                     '| --- | --- | --- | --- | --- | --- |'//NL) == 1, 'reference table: header')
+    call check(index(tab, NL//'| `n` | integer | required | | >= 1 | count |'//NL) > 0, &
+               'reference table: a required integer with its range')
+    call check(index(tab, NL//'| `x` | real | `2.5e11` | [stress] | > 0 | *A only:* a \| b |'//NL) > 0, &
+               'reference table: a real with its unit, form and an escaped bar')
+    call check(index(tab, NL//'| `p` | real pair (x, y) | `1.0, -0.5` | [length] | | *B only:* position |'//NL) > 0, &
+               'reference table: a pair')
+    call check(index(tab, NL//'| `s` | string (at most 8 characters) | `''ab''` | | | |'//NL) > 0, &
+               'reference table: a string without a description')
+    call check(index(tab, NL//'| `c` | choice | none | | `''one''`, `''two''` | |'//NL) > 0, &
+               'reference table: a choice without a value')
+    code = 2
+    tab = reference_table(v)
+    call check(index(tab, NL//'| `c` | choice | `''two''` | | `''one''`, `''two''` | |'//NL) > 0 .and. &
+               index(tab, 'only:') == 0, 'reference table: the current value is the default; no forms, no notes')
+  end block
+
+  call test_summary()
+
+contains
+
+  subroutine check(ok, what)
+    logical, intent(in) :: ok
+    character(len=*), intent(in) :: what
+    call report(ok, what)
+  end subroutine check
+
+  !> print_deck -> file -> read_deck must give identical values and identical text.
+  subroutine round_trip(a, what)
+    type(deck_t), intent(in) :: a
+    character(len=*), intent(in) :: what
+    type(deck_t) :: b
+    integer :: u
+    character(len=:), allocatable :: f, diff
+    f = trim(tmp)//'_roundtrip.nml'
+    open (newunit=u, file=f, status='replace', action='write')
+    call print_deck(a, u)
+    close (u)
+    call read_deck(f, none, b)
+    call compare(a, b, diff)
+    call check(len(diff) == 0, 'round trip of the '//what//': identical values'//diff)
+    call check(after_first_line(a%effective) == after_first_line(b%effective), &
+               'round trip of the '//what//': identical effective text')
+    call delete_file(f)
+  end subroutine round_trip
+
+  function after_first_line(s) result(r)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: r
+    r = s(index(s, achar(10)) + 1:)
+  end function after_first_line
+
+  subroutine compare(a, b, diff)
+    type(deck_t), intent(in) :: a, b
+    character(len=:), allocatable, intent(out) :: diff
+    integer :: k, i
+    diff = ''
+    if (a%title /= b%title) diff = diff//' title'
+    if (a%plane_strain .neqv. b%plane_strain) diff = diff//' plane'
+    do k = 1, 2
+      associate (x => a%body(k), y => b%body(k))
+        if (x%id /= y%id .or. x%nx /= y%nx .or. x%ny /= y%ny .or. x%element /= y%element) &
+          diff = diff//' body-integers'
+        if (x%x0 /= y%x0 .or. x%y0 /= y%y0 .or. x%width /= y%width .or. x%height /= y%height) &
+          diff = diff//' body-geometry'
+        if (x%young /= y%young .or. x%poisson /= y%poisson) diff = diff//' body-material'
+        if (any(x%bc /= y%bc)) diff = diff//' body-bc'
+        if (any(x%u_side /= y%u_side)) diff = diff//' body-u_side'
+      end associate
+    end do
+    if (a%ntraction /= b%ntraction) then
+      diff = diff//' ntraction'
+    else
+      do i = 1, a%ntraction
+        if (a%traction(i)%body /= b%traction(i)%body .or. a%traction(i)%side /= b%traction(i)%side &
+            .or. any(a%traction(i)%t0 /= b%traction(i)%t0) .or. any(a%traction(i)%t1 /= b%traction(i)%t1)) &
+          diff = diff//' traction'
+      end do
+    end if
+    if (a%contact%gap_radius /= b%contact%gap_radius .or. a%contact%gap_center /= b%contact%gap_center) diff = diff//' contact'
+    associate (x => a%solver, y => b%solver)
+      if (x%method /= y%method .or. x%robin_operator /= y%robin_operator .or. x%stop /= y%stop .or. &
+          x%factor%factorization /= y%factor%factorization .or. x%factor%ordering /= y%factor%ordering .or. &
+          x%acceleration /= y%acceleration) diff = diff//' solver-enumerations'
+      if (x%alpha /= y%alpha .or. x%delta /= y%delta .or. x%tol /= y%tol .or. &
+          x%inner_factor /= y%inner_factor .or. x%inner_rtol_min /= y%inner_rtol_min .or. &
+          x%inner_rtol_max /= y%inner_rtol_max .or. x%monolithic_rtol /= y%monolithic_rtol) &
+        diff = diff//' solver-reals'
+      if (x%max_outer /= y%max_outer .or. x%inner_max_it /= y%inner_max_it) diff = diff//' solver-integers'
+    end associate
+    if (a%output%file /= b%output%file .or. a%output%checkpoint_every /= b%output%checkpoint_every &
+        .or. a%output%progress_lines /= b%output%progress_lines) diff = diff//' output'
+    if (len(diff) > 0) diff = ' (differ:'//diff//')'
+  end subroutine compare
+
+  subroutine write_file(path, lines)
+    character(len=*), intent(in) :: path
+    character(len=*), intent(in) :: lines(:)
+    integer :: u, i
+    open (newunit=u, file=path, status='replace', action='write')
+    do i = 1, size(lines)
+      write (u, '(a)') trim(lines(i))
+    end do
+    close (u)
+  end subroutine write_file
+
+  subroutine delete_file(path)
+    character(len=*), intent(in) :: path
+    integer :: u, ios
+    open (newunit=u, file=path, status='old', iostat=ios)
+    if (ios == 0) close (u, status='delete')
+  end subroutine delete_file
+
+end program test_deck
