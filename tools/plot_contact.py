@@ -6,8 +6,8 @@ Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [-o contact.png] [-
 
 Top panel: /contact/pressure (nodal force / tributary length) against the arc length s along
 the contact curve (/contact/s). The legend gives each run's contact force per unit thickness:
-the resultant vector when the result file stores one (attribute `resultant` of /contact or
-of the root, two components), else the sum of the nodal normal forces (sum of
+the resultant vector on body 1 (/contact/resultant_body1, two components) when the result
+file has it, else the sum of the nodal normal forces (sum of
 /contact/normal_force; a scalar, not a resultant: the normals vary along a curved contact);
 the same is printed, one line per run ('plot_contact: NAME: ...'). Dotted vertical lines
 mark the edges of each run's contact zone (the zero of p^2 extrapolated from the two
@@ -150,17 +150,13 @@ def hertz_errors(r, h):
 def read_run(path, want_hertz):
     with h5py.File(path, "r") as f:
         u = result_units(f)
-        # position along the contact curve: /contact/s (arc length, or the coordinate along a
-        # rectangle's side); files of older versions have only /contact/x
+        # position along the contact curve: /contact/s (arc length along the slave's curve;
+        # in older files the coordinate along a rectangle's side); the oldest have only /contact/x
         sname = "/contact/s" if "/contact/s" in f else "/contact/x"
         x = np.array(f[sname], dtype=float)
         resultant = None
-        for obj in (f["/contact"], f):
-            if "resultant" in obj.attrs:
-                v = np.asarray(obj.attrs["resultant"], dtype=float).reshape(-1)
-                if v.size >= 2:
-                    resultant = v[:2]
-                    break
+        if "/contact/resultant_body1" in f:
+            resultant = np.asarray(f["/contact/resultant_body1"], dtype=float).reshape(-1)[:2]
         order = np.argsort(x, kind="stable")
         lam = np.array(f["/contact/normal_force"], dtype=float)
         r = dict(x=x[order], p=np.array(f["/contact/pressure"], dtype=float)[order], lam=lam[order],
