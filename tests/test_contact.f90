@@ -11,12 +11,14 @@ program test_contact
   use assembly, only: body_system_t, assemble_body, expand, residual_full
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement, apply_b, apply_bt
-  use contact_types, only: contact_result_t
+  use contact_types, only: contact_result_t, status_name, STATUS_CONVERGED, STATUS_NONE, STATUS_MAX_OUTER, &
+                           STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   use contact, only: solve_robin, solve_monolithic, error_bound
   use testing, only: report, test_summary
   implicit none (type, external)
   character(len=4096) :: none(0)
 
+  call status_words()
   call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.95, tol=1e-10 /"], .false.)
   call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.5, tol=1e-10 /"], .false.)
   call scene('tests/decks/gap.nml', none, .true.)
@@ -38,6 +40,16 @@ program test_contact
   call test_summary()
 
 contains
+
+  !> The words a run's status is written as (results file, `result:` line; scripts parse them).
+  subroutine status_words()
+    call check(status_name(STATUS_NONE) == 'none', 'status word none', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_CONVERGED) == 'converged', 'status word converged', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_MAX_OUTER) == 'max_outer', 'status word max_outer', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_DIVERGED) == 'diverged', 'status word diverged', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_FAILED) == 'failed', 'status word failed', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_INTERRUPTED) == 'interrupted', 'status word interrupted', 0.0_wp, 0.0_wp)
+  end subroutine status_words
 
   subroutine check(ok, what, val, tol)
     logical, intent(in) :: ok
@@ -87,7 +99,7 @@ contains
 
     ! ---- monolithic: KKT conditions -------------------------------------------------
     call solve_monolithic(d%solver, itf, bc, mono)
-    call check(mono%status == 'converged', 'monolithic converged', 0.0_wp, 0.0_wp)
+    call check(mono%status == STATUS_CONVERGED, 'monolithic converged', 0.0_wp, 0.0_wp)
     lnorm = maxval(abs(mono%lam))
     uscale = max(maxval(abs(bc(1)%b)), maxval(abs(bc(2)%b)), maxval(abs(itf%g0)))
     call check(minval(mono%lam) >= 0.0_wp, 'lam >= 0', -minval(mono%lam), 0.0_wp)
@@ -152,13 +164,13 @@ contains
                e/max(norm2(rob%lam), tiny(1.0_wp)), rob%error_bound)
     if (present(expect_converged)) then
       if (.not. expect_converged) then
-        call check(rob%status /= 'converged', 'robin reports not converged ('//trim(rob%status)//')', &
+        call check(rob%status /= STATUS_CONVERGED, 'robin reports not converged ('//status_name(rob%status)//')', &
                    rob%residual, huge(1.0_wp))
         write (*, '(a,i0,a,i0)') '      robin outer ', rob%outer, ' inner ', rob%inner
         return
       end if
     end if
-    call check(rob%status == 'converged', 'robin converged ('//trim(rob%status)//')', real(rob%outer, wp), &
+    call check(rob%status == STATUS_CONVERGED, 'robin converged ('//status_name(rob%status)//')', real(rob%outer, wp), &
                real(d%solver%max_outer, wp))
     if (present(max_outer_expected)) call check(rob%outer <= max_outer_expected, 'robin outer iterations', &
                                                 real(rob%outer, wp), real(max_outer_expected, wp))

@@ -16,7 +16,8 @@ module contact
   use strings, only: itoa
   use condense, only: interface_t, body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, ANDERSON_DEPTH, &
-                           state_init, alloc_result, grow_history
+                           state_init, alloc_result, grow_history, STATUS_CONVERGED, &
+                           STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   implicit none (type, external)
   private
 
@@ -122,17 +123,17 @@ contains
       end if
       res%inner = st%n_matvec
       if (st%status == MPRGP_STOPPED) then
-        res%status = 'interrupted'
+        res%status = STATUS_INTERRUPTED
         res%message = 'monolithic MPRGP stopped by a signal after '//trim(itoa(st%n_cg + st%n_exp + st%n_prop))// &
                       ' steps (no checkpoint: the monolithic solve is one step)'
       else if (st%status /= MPRGP_CONVERGED) then
-        res%status = merge('max_outer', 'failed   ', st%status == MPRGP_MAX_IT)
+        res%status = merge(STATUS_MAX_OUTER, STATUS_FAILED, st%status == MPRGP_MAX_IT)
         res%message = 'monolithic MPRGP: '//trim(mprgp_status_name(st%status))//': '//trim(st%message)
       else
-        res%status = 'converged'
+        res%status = STATUS_CONVERGED
       end if
     else
-      res%status = 'converged'
+      res%status = STATUS_CONVERGED
     end if
     res%outer = 1
     res%lam = lam
@@ -151,8 +152,8 @@ contains
     res%h_inner(1) = res%inner
     res%h_active(1) = res%active
     res%h_wall(1) = wtime() - t0
-    if (res%status == 'converged' .and. .not. all_finite(lam)) then
-      res%status = 'failed'
+    if (res%status == STATUS_CONVERGED .and. .not. all_finite(lam)) then
+      res%status = STATUS_FAILED
       res%message = 'monolithic solution has non-finite values'
     end if
   end subroutine solve_monolithic
@@ -215,13 +216,13 @@ contains
     end do
     call robin_correction_init(corr_op, s, itf, bc, op, opc, info)
     if (info /= 0 .and. bc(1)%nrig + bc(2)%nrig > 0 .and. (bc(1)%rank < m .or. bc(2)%rank < m)) then
-      res%status = 'failed'
+      res%status = STATUS_FAILED
       res%message = 'harmonic operator: a body held only by contact is a mortar master coarser than the '// &
                     'slave (singular F): make it the slave (&contact slave), or use steklov or monolithic'
       call corr_op%free()
       return
     else if (info /= 0) then
-      res%status = 'failed'
+      res%status = STATUS_FAILED
       write (res%message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
       call corr_op%free()
       return
@@ -229,7 +230,7 @@ contains
     every = 30
     if (present(progress_lines)) every = progress_lines
     every = max(1, maxout/max(1, every))
-    res%status = 'max_outer'
+    res%status = STATUS_MAX_OUTER
     printed = .false.
     if (resumed .and. st_%it >= maxout) then
       call restore_iterate(itf, bc, op, st_, res)
@@ -246,11 +247,11 @@ contains
       rtol_in = inner_tolerance(s, it, m, st_%progress, lmax)
       call solve_subproblems(s, bc, opsub, pin, eq, lsub, rtol_in, it, st_, w, res)
       if (m == 0) then
-        res%status = 'converged'
+        res%status = STATUS_CONVERGED
         res%outer = it
         exit
       end if
-      if (res%status == 'failed') then
+      if (res%status == STATUS_FAILED) then
         res%outer = it
         exit
       end if
@@ -263,7 +264,7 @@ contains
       call accelerate(s%acceleration, s%delta, st_, Gnew)
       ! a non-finite iterate is not kept: the result holds the last finite one
       if (.not. (all_finite(Gnew) .and. all_finite(st_%lam) .and. all_finite(w))) then
-        res%status = 'diverged'
+        res%status = STATUS_DIVERGED
         write (res%message, '(a,i0)') 'non-finite values in the outer iteration at iteration ', it
         exit
       end if
@@ -276,7 +277,7 @@ contains
       if (check_termination(s, it, uref, st_, res)) exit
       if (present(stop_requested)) then
         if (stop_requested()) then
-          res%status = 'interrupted'
+          res%status = STATUS_INTERRUPTED
           write (res%message, '(a,i0)') 'stopped by a signal after outer iteration ', it
           if (present(ckpt)) call ckpt%save(st_, res)
           exit
@@ -290,7 +291,7 @@ contains
     end do
     if (present(progress_unit) .and. res%outer > 0 .and. .not. printed) &
       write (progress_unit, '(i7,2es12.3,i8,i12)') res%outer, res%criterion, res%residual, res%active, res%inner
-    if (res%status == 'max_outer') write (res%message, '(a,i0,a,es10.3)') 'max_outer = ', maxout, &
+    if (res%status == STATUS_MAX_OUTER) write (res%message, '(a,i0,a,es10.3)') 'max_outer = ', maxout, &
       ' reached; last criterion ', res%criterion
     call corr_op%free()
     if (present(state)) state = st_
@@ -752,7 +753,7 @@ contains
       if (ms(a)%status == MPRGP_MAX_IT) then
         res%inner_maxit_hits = res%inner_maxit_hits + 1
       else if (ms(a)%status /= MPRGP_CONVERGED) then
-        res%status = 'failed'
+        res%status = STATUS_FAILED
         write (res%message, '(a,i0,a,i0,a)') 'MPRGP failed on body ', a, ' at outer iteration ', it, &
           ': '//trim(mprgp_status_name(ms(a)%status))//': '//trim(ms(a)%message)
         return
@@ -846,20 +847,20 @@ contains
     type(contact_result_t), intent(inout) :: res
     done = .true.
     if (.not. ieee_is_finite(st%crit)) then
-      res%status = 'diverged'
+      res%status = STATUS_DIVERGED
       write (res%message, '(a,i0)') 'non-finite criterion at iteration ', it
       return
     end if
     st%best = min(st%best, st%crit)
     if (it > 10 .and. st%crit > 1.0e4_wp*st%best .and. st%crit > 1.0_wp) then
-      res%status = 'diverged'
+      res%status = STATUS_DIVERGED
       write (res%message, '(a,es10.3,a,es10.3)') 'criterion grew to ', st%crit, ' from its best ', st%best
       return
     end if
     ! a relative increment stays bounded while the iterates blow up geometrically:
     ! watch the size of the obstacles against the displacements the loads cause
     if (maxval(abs(st%G)) > 1.0e6_wp*uref) then
-      res%status = 'diverged'
+      res%status = STATUS_DIVERGED
       write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(st%G)), &
         ' (1e6 times the load displacement scale ', uref, ')'
       return
@@ -871,7 +872,7 @@ contains
       st%it_best = it
     end if
     if (s%stop == STOP_RESIDUAL .and. st%crit > s%tol .and. it - st%it_best >= FLAT_LIMIT) then
-      res%status = 'diverged'
+      res%status = STATUS_DIVERGED
       write (res%message, '(a,es10.3,a,i0,a,es10.3,a)') 'stagnated: the residual has stayed near ', &
         st%res_best, ' for ', FLAT_LIMIT, ' iterations; tol = ', s%tol, ' is out of reach'
       return
@@ -883,14 +884,14 @@ contains
         ! smaller increment); if it persists, the iteration has stagnated.
         st%stalled = st%stalled + 1
         if (st%stalled >= STALL_LIMIT) then
-          res%status = 'diverged'
+          res%status = STATUS_DIVERGED
           write (res%message, '(a,es10.3,a,es10.3,a,i0,a)') 'stagnated: increment ', st%crit, &
             ' below tol but residual ', res%residual, ' above 100 tol for ', STALL_LIMIT, &
             ' iterations (the bodies do not agree)'
           return
         end if
       else
-        res%status = 'converged'
+        res%status = STATUS_CONVERGED
         return
       end if
     else
