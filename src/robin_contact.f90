@@ -25,7 +25,9 @@ program robin_contact
                       recover_displacement
   use contact_types, only: contact_result_t, robin_state_t, status_name, STATUS_CONVERGED, STATUS_FAILED, &
                            STATUS_INTERRUPTED
-  use contact, only: solve_robin, solve_monolithic, error_bound
+  use robin_iteration, only: solve_robin
+  use monolithic, only: solve_monolithic
+  use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, free_list, fixing_list
   use results, only: timing_t, write_results, program_version
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file

@@ -13,7 +13,9 @@ program test_contact
                       recover_displacement, apply_b, apply_bt
   use contact_types, only: contact_result_t, status_name, STATUS_CONVERGED, STATUS_NONE, STATUS_MAX_OUTER, &
                            STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
-  use contact, only: solve_robin, solve_monolithic, error_bound
+  use robin_iteration, only: solve_robin
+  use monolithic, only: solve_monolithic
+  use error_estimate, only: error_bound
   use testing, only: report, test_summary
   implicit none (type, external)
   character(len=4096) :: none(0)
