@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings sorting sysinfo signals mpi_env config namelist_input deck budget mesh gmsh_msh elements lapack linop assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp smalbe mortar condense condense_mumps floating contact_types contact_common equality_rows \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar condense condense_mumps floating contact_types contact_common equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
@@ -100,9 +100,9 @@ $(DEPS_STAMP): tools/install-deps.sh
 deps: $(DEPS_STAMP)
 
 # ---- compile -------------------------------------------------------------------
-# Sources are grouped by stage (src/base, input, fem, linalg, contact, io; the driver at
+# Sources are grouped by stage (src/base, input, fem, linalg, qp, contact, io; the driver at
 # the top); objects and modules go flat into $(BUILD).
-SRC_DIRS := src src/base src/input src/fem src/linalg src/contact src/io src/parallel
+SRC_DIRS := src src/base src/input src/fem src/linalg src/qp src/contact src/io src/parallel
 vpath %.f90 $(SRC_DIRS)
 vpath %.c $(SRC_DIRS)
 
@@ -141,7 +141,10 @@ $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o
-$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
+$(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o
+$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
+                           $(BUILD)/mprgp_support.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
 $(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \

@@ -18,7 +18,7 @@ program test_floating
   use assembly, only: body_system_t, assemble_body, residual_full, rigid_motion_name
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
   use linop, only: dense_op_t, dense_op_init
-  use mprgp, only: mprgp_opts_t, MPRGP_CONVERGED
+  use mprgp, only: mprgp_t, MPRGP_CONVERGED
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use floating, only: nnls
   use lapack, only: dgesv, dsyev
@@ -396,7 +396,7 @@ contains
     end do
   end subroutine qp_enumerate
 
-  !> SMALBE as the contact solver sets it up (contact.f90 eq_init/eq_add): rho = 10
+  !> SMALBE as the contact solver sets it up (equality_rows: equality_init and equality_add_penalty): rho = 10
   !! lambda_max(H)/lambda_max(GG'), A = H + rho G'G, M0 = lambda_max/sqrt(|GG'|).
   subroutine run_smalbe(h, c, gm, e, l, x, mu, g, st, rho)
     real(wp), intent(in) :: h(:, :), c(:), gm(:, :), e(:), l(:)
@@ -404,7 +404,7 @@ contains
     type(smalbe_stats_t), intent(out) :: st
     real(wp), intent(out) :: rho
     type(dense_op_t) :: op
-    type(mprgp_opts_t) :: opts
+    type(mprgp_t) :: solver
     real(wp), allocatable :: gg(:, :)
     real(wp) :: ev(8), work(64), lmax
     integer :: r, info
@@ -415,11 +415,14 @@ contains
     lmax = maxval(sum(abs(h), dim=1))
     rho = 10.0_wp*lmax/ev(r)
     call dense_op_init(op, h + rho*matmul(transpose(gm), gm))
-    opts%rtol = 1.0e-14_wp
-    opts%lambda_max = lmax + rho*ev(r)
+    solver%opts%rtol = 1.0e-14_wp
+    solver%opts%lambda_max = lmax + rho*ev(r)
+    solver%opts%eq_m = lmax/sqrt(ev(r))           ! SMALBE's initial M
+    solver%opts%eq_feas = 1.0e-14_wp*norm2(e)     ! |Gx - e| that counts as feasible
     x = max(l, 0.0_wp)
     mu = 0.0_wp
-    call smalbe_solve(op, c, gm, e, rho, l, x, mu, opts, lmax/sqrt(ev(r)), 1.0e-14_wp*norm2(e), st, g)
+    call smalbe_solve(solver, op, c, gm, e, rho, l, x, mu, st)
+    g = solver%g
   end subroutine run_smalbe
 
   !> A QP with a known solution: x* with nact entries at the bound l, the rest above it;

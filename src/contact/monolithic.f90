@@ -6,7 +6,7 @@ module monolithic
   use config, only: solver_cfg_t
   use linop, only: dense_op_t, dense_op_init
   use clock, only: wtime
-  use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, &
+  use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, &
                    mprgp_status_name
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
@@ -30,11 +30,11 @@ contains
     type(contact_result_t), intent(out) :: res           !< solution and status
     procedure(stop_iface), optional :: stop_requested    !< true when the run must stop (signal)
     type(dense_op_t) :: hessian
-    type(mprgp_opts_t) :: opts
+    type(mprgp_t) :: mprgp
     type(mprgp_stats_t) :: inner
     type(smalbe_stats_t) :: outer
     type(equality_t) :: equality
-    real(wp), allocatable :: c(:), lb(:), g(:), lam(:), rows(:, :), rhs(:), mu(:)
+    real(wp), allocatable :: c(:), lb(:), lam(:), rows(:, :), rhs(:), mu(:)
     integer :: m, a, r1
     real(wp) :: t0
 
@@ -42,35 +42,37 @@ contains
     t0 = wtime()
     res%method = 'monolithic'
     call alloc_result(res, m, 1)
-    allocate (c(m), lb(m), g(m), lam(m))
+    allocate (c(m), lb(m), lam(m))
     call dense_op_init(hessian, bodies(1)%flex + bodies(2)%flex)
     c = bodies(1)%b + bodies(2)%b - contact_line%g0
     lb = 0.0_wp
     lam = 0.0_wp
-    opts%rtol = solver%monolithic_rtol
-    opts%max_it = solver%inner_max_it
-    if (present(stop_requested)) opts%stop => stop_requested
+    mprgp%opts%rtol = solver%monolithic_rtol
+    mprgp%opts%max_it = solver%inner_max_it
+    if (present(stop_requested)) mprgp%opts%stop => stop_requested
     ! floating bodies: both bodies' equilibrium rows, stacked
     r1 = bodies(1)%nrig
     if (r1 + bodies(2)%nrig > 0 .and. m > 0) then
       call stacked_rows(bodies, rows, rhs)
       allocate (mu(size(rhs)))
-      opts%lambda_max = maxval(sum(abs(hessian%a), dim=1))
-      call equality_init(equality, rows, rhs, opts%lambda_max)
-      call equality_add_penalty(equality, hessian, opts%lambda_max)
+      mprgp%opts%lambda_max = maxval(sum(abs(hessian%a), dim=1))
+      call equality_init(equality, rows, rhs, mprgp%opts%lambda_max)
+      call equality_add_penalty(equality, hessian, mprgp%opts%lambda_max)
       mu = 0.0_wp
     end if
     if (m > 0) then
       if (equality%r > 0) then
-        call smalbe_solve(hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, opts, equality%m0, &
-                          equality%feas, outer, g)
+        mprgp%opts%eq_m = equality%m0
+        mprgp%opts%eq_feas = equality%feas
+        call smalbe_solve(mprgp, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
         inner = outer%inner
         inner%n_matvec = outer%n_matvec
         res%eq_updates = outer%updates
         if (r1 > 0) res%rigid(1:r1, 1) = -mu(1:r1)
         if (bodies(2)%nrig > 0) res%rigid(1:bodies(2)%nrig, 2) = -mu(r1 + 1:)
       else
-        call mprgp_solve(hessian, c, lb, lam, opts, inner, g)
+        call mprgp%solve(hessian, c, lb, lam)
+        inner = mprgp%stats
       end if
       res%inner = inner%n_matvec
       if (inner%status == MPRGP_STOPPED) then

@@ -7,7 +7,7 @@ module robin_subproblems
   use kinds, only: wp
   use config, only: solver_cfg_t, ACCEL_NONE
   use linop, only: dense_op_t, dense_op_init
-  use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
+  use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED
@@ -154,11 +154,10 @@ contains
     real(wp), intent(out) :: grad(:)              !< the Hessian's gradient at the solution
     type(mprgp_stats_t), intent(out) :: inner     !< the inner solve's outcome
     integer, intent(out) :: updates               !< SMALBE multiplier updates
-    type(mprgp_opts_t) :: opts
-    type(smalbe_stats_t) :: ss
+    type(mprgp_t) :: mprgp
+    type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), lam0(:), flam0(:)
-    real(wp) :: feas
-    integer :: m, k, r
+    integer :: m, k, r, first, last
     m = size(rhs)
     allocate (lb(m))
     lb = 0.0_wp
@@ -172,52 +171,54 @@ contains
     ! (previous iterate), not against |b_a - G_a|: with a large material contrast the stiff
     ! body's b_a - G_a is a small difference of the soft body's large displacements.
     if (state%flam(a) > 0.0_wp) then
-      opts%rtol = 0.0_wp
-      opts%atol = max(rtol_in*state%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs))
+      mprgp%opts%rtol = 0.0_wp
+      mprgp%opts%atol = max(rtol_in*state%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs))
     else
-      opts%rtol = rtol_in
-      opts%atol = 0.0_wp
+      mprgp%opts%rtol = rtol_in
+      mprgp%opts%atol = 0.0_wp
     end if
-    opts%max_it = solver%inner_max_it
-    opts%lambda_max = sub%lmax_hessian(a)
+    mprgp%opts%max_it = solver%inner_max_it
+    mprgp%opts%lambda_max = sub%lmax_hessian(a)
     ! F_a is the same in every iteration and the warm start is the last solution: its
     ! gradient comes from F_a lam_a of the last solve (no initial product)
-    opts%use_ax = state%reuse == 1
+    mprgp%opts%use_ax = state%reuse == 1
+    mprgp%ax = state%flam_v(:, a)
     lam0 = state%lam(:, a)
     flam0 = state%flam_v(:, a)
     ! Krylov recycling, not with Aitken or Anderson acceleration, whose updates difference
     ! past iterates and so amplify the (smaller but differently placed) inner errors
-    opts%recycle = solver%acceleration == ACCEL_NONE
+    mprgp%opts%recycle = solver%acceleration == ACCEL_NONE
+    if (search) then
+      mprgp%s = state%srch(:, a)
+      mprgp%as = state%fsrch(:, a)
+    end if
+    ! body a's columns of the stored directions
     k = size(state%rw, 2)/2
+    first = (a - 1)*k + 1
+    last = a*k
     r = sub%equality(a)%r
-    ss%updates = 0
+    updates = 0
     if (m > 0 .and. r > 0) then
       ! a floating body: its equilibrium to the accuracy asked of its forces, down to the
       ! rounding of G lam
-      feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(sub%equality(a)%e)
       associate (eq => sub%equality(a))
-        if (search) then
-          call smalbe_solve(sub%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, state%lam(:, a), state%mu(1:r, a), &
-                            opts, eq%m0, feas, ss, grad, state%flam_v(:, a), &
-                            state%srch(:, a), state%fsrch(:, a), state%rw(:, (a - 1)*k + 1:a*k), &
-                            state%raw(:, (a - 1)*k + 1:a*k), state%nrw(:, a))
-        else
-          call smalbe_solve(sub%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, state%lam(:, a), state%mu(1:r, a), &
-                            opts, eq%m0, feas, ss, grad, state%flam_v(:, a), &
-                            rw=state%rw(:, (a - 1)*k + 1:a*k), raw=state%raw(:, (a - 1)*k + 1:a*k), nrw=state%nrw(:, a))
-        end if
+        mprgp%opts%eq_m = eq%m0
+        mprgp%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
+        call smalbe_solve(mprgp, sub%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, state%lam(:, a), state%mu(1:r, a), &
+                          smalbe_stats, state%rw(:, first:last), state%raw(:, first:last), state%nrw(:, a))
       end associate
-      inner = ss%inner
-      inner%n_matvec = ss%n_matvec
-    else if (m > 0 .and. search) then
-      call mprgp_solve(sub%hessian(a), rhs, lb, state%lam(:, a), opts, inner, grad, state%flam_v(:, a), &
-                       state%srch(:, a), state%fsrch(:, a), state%rw(:, (a - 1)*k + 1:a*k), &
-                       state%raw(:, (a - 1)*k + 1:a*k), state%nrw(:, a))
+      inner = smalbe_stats%inner
+      inner%n_matvec = smalbe_stats%n_matvec
+      updates = smalbe_stats%updates
     else if (m > 0) then
-      call mprgp_solve(sub%hessian(a), rhs, lb, state%lam(:, a), opts, inner, grad, state%flam_v(:, a), &
-                       rw=state%rw(:, (a - 1)*k + 1:a*k), raw=state%raw(:, (a - 1)*k + 1:a*k), nrw=state%nrw(:, a))
+      call mprgp%solve(sub%hessian(a), rhs, lb, state%lam(:, a), state%rw(:, first:last), &
+                       state%raw(:, first:last), state%nrw(:, a))
+      inner = mprgp%stats
     end if
-    updates = ss%updates
+    if (m > 0) then
+      grad = mprgp%g
+      state%flam_v(:, a) = mprgp%ax
+    end if
     state%srch(:, a) = state%lam(:, a) - lam0
     state%fsrch(:, a) = state%flam_v(:, a) - flam0
   end subroutine solve_body
