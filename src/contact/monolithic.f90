@@ -30,7 +30,7 @@ contains
     type(contact_result_t), intent(out) :: res           !< solution and status
     procedure(stop_iface), optional :: stop_requested    !< true when the run must stop (signal)
     type(dense_op_t) :: hessian
-    type(mprgp_t) :: mprgp
+    type(mprgp_t) :: inner_solver
     type(mprgp_stats_t) :: inner
     type(smalbe_stats_t) :: outer
     type(equality_t) :: equality
@@ -47,32 +47,32 @@ contains
     c = bodies(1)%b + bodies(2)%b - contact_line%g0
     lb = 0.0_wp
     lam = 0.0_wp
-    mprgp%opts%rtol = solver%monolithic_rtol
-    mprgp%opts%max_it = solver%inner_max_it
-    if (present(stop_requested)) mprgp%opts%stop => stop_requested
+    inner_solver%opts%rtol = solver%monolithic_rtol
+    inner_solver%opts%max_it = solver%inner_max_it
+    if (present(stop_requested)) inner_solver%opts%stop => stop_requested
     ! floating bodies: both bodies' equilibrium rows, stacked
     r1 = bodies(1)%nrig
     if (r1 + bodies(2)%nrig > 0 .and. m > 0) then
       call stacked_rows(bodies, rows, rhs)
       allocate (mu(size(rhs)))
-      mprgp%opts%lambda_max = maxval(sum(abs(hessian%a), dim=1))
-      call equality_init(equality, rows, rhs, mprgp%opts%lambda_max)
-      call equality_add_penalty(equality, hessian, mprgp%opts%lambda_max)
+      inner_solver%opts%lambda_max = maxval(sum(abs(hessian%a), dim=1))
+      call equality_init(equality, rows, rhs, inner_solver%opts%lambda_max)
+      call equality_add_penalty(equality, hessian, inner_solver%opts%lambda_max)
       mu = 0.0_wp
     end if
     if (m > 0) then
       if (equality%r > 0) then
-        mprgp%opts%eq_m = equality%m0
-        mprgp%opts%eq_feas = equality%feas
-        call smalbe_solve(mprgp, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
+        inner_solver%opts%eq_m = equality%m0
+        inner_solver%opts%eq_feas = equality%feas
+        call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
         inner = outer%inner
         inner%n_matvec = outer%n_matvec
         res%eq_updates = outer%updates
         if (r1 > 0) res%rigid(1:r1, 1) = -mu(1:r1)
         if (bodies(2)%nrig > 0) res%rigid(1:bodies(2)%nrig, 2) = -mu(r1 + 1:)
       else
-        call mprgp%solve(hessian, c, lb, lam)
-        inner = mprgp%stats
+        call inner_solver%solve(hessian, c, lb, lam)
+        inner = inner_solver%stats
       end if
       res%inner = inner%n_matvec
       if (inner%status == MPRGP_STOPPED) then

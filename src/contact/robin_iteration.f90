@@ -40,7 +40,7 @@ contains
     class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     type(robin_state_t) :: run_state
-    type(subproblems_t), target :: sub
+    type(subproblems_t), target :: subproblems
     class(robin_operator_t), allocatable :: robin_op
     real(wp) :: t0
     integer :: m, every, info
@@ -61,8 +61,8 @@ contains
     res%method = 'robin'
 
     robin_op = new_robin_operator(solver%robin_operator)
-    call subproblems_init(sub, bodies, robin_op, run_state, resumed)
-    call robin_op%setup(solver, contact_line, bodies, sub%flexibility, info, res%message)
+    call subproblems_init(subproblems, bodies, robin_op, run_state, resumed)
+    call robin_op%setup(solver, contact_line, bodies, subproblems%flexibility, info, res%message)
     if (info /= 0) then
       res%status = STATUS_FAILED
       return
@@ -72,7 +72,7 @@ contains
     every = max(1, solver%max_outer/max(1, every))
     res%status = STATUS_MAX_OUTER
     if (resumed .and. run_state%it >= solver%max_outer) then
-      call restore_iterate(contact_line, bodies, sub, run_state, res)
+      call restore_iterate(contact_line, bodies, subproblems, run_state, res)
       if (present(progress_unit)) write (progress_unit, '(a,i0,a)') 'the checkpoint is at outer iteration ', &
         run_state%it, ' = max_outer: nothing left to do, its result is written again (raise max_outer to go on)'
     end if
@@ -80,19 +80,19 @@ contains
       if (resumed) write (progress_unit, '(a,i0)') 'resuming after outer iteration ', run_state%it
       write (progress_unit, '(a)') '  outer   criterion    residual  active       inner'
     end if
-    call outer_loop(solver, contact_line, bodies, sub, robin_op, t0, every, run_state, res, &
+    call outer_loop(solver, contact_line, bodies, subproblems, robin_op, t0, every, run_state, res, &
                     progress_unit, ckpt, stop_requested)
     if (present(state)) state = run_state
   end subroutine solve_robin
 
   !> The outer iterations from run_state%it + 1 to max_outer: subproblems, correction,
   !! update, record, termination test, progress line, checkpoint.
-  subroutine outer_loop(solver, contact_line, bodies, sub, robin_op, t0, every, run_state, res, &
+  subroutine outer_loop(solver, contact_line, bodies, subproblems, robin_op, t0, every, run_state, res, &
                         progress_unit, ckpt, stop_requested)
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(2)
-    type(subproblems_t), target, intent(inout) :: sub     !< (the Robin operator may refer to its F_a)
+    type(subproblems_t), target, intent(inout) :: subproblems     !< (the Robin operator may refer to its F_a)
     class(robin_operator_t), intent(inout) :: robin_op
     real(wp), intent(in) :: t0                              !< wall time the iteration started at
     integer, intent(in) :: every                            !< a progress line every this many iterations
@@ -112,8 +112,8 @@ contains
     printed = .false.
     do it = run_state%it + 1, solver%max_outer
       ! 1. each body against its obstacle, in parallel
-      rtol_in = robin_op%inner_tolerance(solver, it, m, run_state%progress, sub%lmax_body)
-      call solve_subproblems(sub, solver, bodies, rtol_in, it, run_state, w, res)
+      rtol_in = robin_op%inner_tolerance(solver, it, m, run_state%progress, subproblems%lmax_body)
+      call solve_subproblems(subproblems, solver, bodies, rtol_in, it, run_state, w, res)
       if (m == 0) then
         res%status = STATUS_CONVERGED
         res%outer = it
@@ -166,10 +166,10 @@ contains
   !> A run resumed from a checkpoint taken at max_outer has nothing left to do: its result
   !! is the checkpointed iterate (contact forces, obstacles, history), with the normal
   !! displacements B_a u_a = b_a - F_a lam_a and the residuals recomputed.
-  subroutine restore_iterate(contact_line, bodies, sub, run_state, res)
+  subroutine restore_iterate(contact_line, bodies, subproblems, run_state, res)
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(2)
-    type(subproblems_t), intent(inout) :: sub
+    type(subproblems_t), intent(inout) :: subproblems
     type(robin_state_t), intent(in) :: run_state
     type(contact_result_t), intent(inout) :: res
     real(wp), allocatable :: flam(:)
@@ -177,7 +177,7 @@ contains
     allocate (flam(contact_line%m))
     res%lam_body = run_state%lam
     do a = 1, 2
-      if (contact_line%m > 0) call sub%flexibility(a)%apply(run_state%lam(:, a), flam)
+      if (contact_line%m > 0) call subproblems%flexibility(a)%apply(run_state%lam(:, a), flam)
       res%w(:, a) = bodies(a)%b - flam
       if (bodies(a)%nrig > 0) res%w(:, a) = res%w(:, a) - matmul(run_state%mu(1:bodies(a)%nrig, a), bodies(a)%rg)
     end do

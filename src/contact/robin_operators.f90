@@ -271,7 +271,7 @@ contains
   !> The linearised outer map is nilpotent at delta = 0.5: the outer iteration is as exact
   !! as its subproblems, so they are solved tightly, scaled by the contrast of the bodies,
   !! down to what rounding lets the projected gradient reach (about sqrt(m) eps: asking for
-  !! less only spins MPRGP up to inner_max_it) (doc/method.md, "Why 'harmonic'").
+  !! less only spins MPRGP up to inner_max_it) (doc/method.md, "Method as implemented", why 'harmonic').
   real(wp) function harmonic_tolerance(self, solver, it, m, progress, lmax) result(rtol_in)
     class(harmonic_operator_t), intent(in) :: self
     type(solver_cfg_t), intent(in) :: solver
@@ -293,7 +293,8 @@ contains
 
   !> Pi_a = Z R Z' on ker F_a only (Z its basis, R = Z' F_o Z floored): S annihilates
   !! ker F_a, so only the kernel needs pinning, and the body stays exact on range F_a.
-  !! Without a kernel basis, F_o (doc/method.md, "Non-matching and curved contact surfaces").
+  !! Without a kernel basis, F_o (doc/method.md, "Non-matching and curved contact surfaces:
+  !! dual mortar").
   subroutine kernel_proximal(self, bodies, a, p)
     class(harmonic_operator_t), intent(in) :: self
     type(body_condensed_t), intent(in) :: bodies(2)

@@ -42,8 +42,8 @@ contains
   !! undetermined; the fixed point stays the monolithic solution for every Pi_a >= 0
   !! (doc/method.md, "Non-matching and curved contact surfaces: dual mortar"). A floating
   !! body's Hessian carries the penalty of its equilibrium rows.
-  subroutine subproblems_init(sub, bodies, robin_op, state, resumed)
-    type(subproblems_t), intent(out) :: sub             !< the subproblems
+  subroutine subproblems_init(subproblems, bodies, robin_op, state, resumed)
+    type(subproblems_t), intent(out) :: subproblems     !< the subproblems
     type(body_condensed_t), intent(in) :: bodies(2)     !< condensed bodies
     class(robin_operator_t), intent(in) :: robin_op     !< the Robin operator
     type(robin_state_t), intent(inout) :: state         !< outer state (inner count)
@@ -54,36 +54,36 @@ contains
     nmv = 0
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
-      call dense_op_init(sub%flexibility(a), bodies(a)%flex)
-      if (m > 0) sub%lmax_body(a) = robin_op%body_lambda_max(sub%flexibility(a), bodies(a)%flex, nmv(a))
+      call dense_op_init(subproblems%flexibility(a), bodies(a)%flex)
+      if (m > 0) subproblems%lmax_body(a) = robin_op%body_lambda_max(subproblems%flexibility(a), bodies(a)%flex, nmv(a))
     end do
     !$omp end parallel do
     if (.not. resumed) state%inner = sum(nmv)
-    sub%lmax_hessian = sub%lmax_body
+    subproblems%lmax_hessian = subproblems%lmax_body
     do a = 1, 2
-      sub%hessian(a) = sub%flexibility(a)
-      sub%proximal(a)%n = 0
+      subproblems%hessian(a) = subproblems%flexibility(a)
+      subproblems%proximal(a)%n = 0
       if (.not. bodies(a)%prox > 0.0_wp) cycle
       allocate (p(m, m))
       call robin_op%proximal_term(bodies, a, p)
-      call dense_op_init(sub%proximal(a), p)
-      sub%hessian(a)%a = sub%hessian(a)%a + p
+      call dense_op_init(subproblems%proximal(a), p)
+      subproblems%hessian(a)%a = subproblems%hessian(a)%a + p
       ! lambda_max(F_a + Pi_a) <= lambda_max(F_a) + |Pi_a|_inf
-      sub%lmax_hessian(a) = sub%lmax_body(a) + maxval(sum(abs(p), dim=1))
+      subproblems%lmax_hessian(a) = subproblems%lmax_body(a) + maxval(sum(abs(p), dim=1))
       deallocate (p)
     end do
     do a = 1, 2
       if (bodies(a)%nrig == 0 .or. m == 0) cycle
-      call equality_init(sub%equality(a), bodies(a)%rg, bodies(a)%re, sub%lmax_hessian(a))
-      call equality_add_penalty(sub%equality(a), sub%hessian(a), sub%lmax_hessian(a))
+      call equality_init(subproblems%equality(a), bodies(a)%rg, bodies(a)%re, subproblems%lmax_hessian(a))
+      call equality_add_penalty(subproblems%equality(a), subproblems%hessian(a), subproblems%lmax_hessian(a))
     end do
   end subroutine subproblems_init
 
   !> Both bodies' subproblems at outer iteration `it` to the inner tolerance rtol_in. On
   !! return state%lam holds the forces, w(:, a) = B_a u_a, and res%status is STATUS_FAILED if
   !! an inner solve broke down.
-  subroutine solve_subproblems(sub, solver, bodies, rtol_in, it, state, w, res)
-    type(subproblems_t), intent(inout) :: sub           !< the subproblems
+  subroutine solve_subproblems(subproblems, solver, bodies, rtol_in, it, state, w, res)
+    type(subproblems_t), intent(inout) :: subproblems   !< the subproblems
     type(solver_cfg_t), intent(in) :: solver            !< solver settings
     type(body_condensed_t), intent(in) :: bodies(2)     !< condensed bodies
     real(wp), intent(in) :: rtol_in                     !< inner tolerance
@@ -106,7 +106,7 @@ contains
     search = state%nsrch == 1 .and. smooth_outer(res, it)
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) if (m > 64)
     do a = 1, 2
-      call solve_body(sub, solver, bodies(a), a, rtol_in, search, lam_last(:, other_body(a)), state, &
+      call solve_body(subproblems, solver, bodies(a), a, rtol_in, search, lam_last(:, other_body(a)), state, &
                       rhs(:, a), grad(:, a), inner(a), updates(a))
     end do
     !$omp end parallel do
@@ -124,8 +124,8 @@ contains
       end if
       ! B_a u_a = b_a - F_a lam_a = G_a - grad_a (with a proximal term: F_a lam_a is the
       ! Hessian's image grad_a + rhs_a less the proximal part)
-      if (sub%proximal(a)%n > 0) then
-        call sub%proximal(a)%apply(state%lam(:, a), flam(:, a))
+      if (subproblems%proximal(a)%n > 0) then
+        call subproblems%proximal(a)%apply(state%lam(:, a), flam(:, a))
         flam(:, a) = grad(:, a) + rhs(:, a) - flam(:, a)
         w(:, a) = bodies(a)%b - flam(:, a)
         state%flam(a) = norm2(flam(:, a))
@@ -141,8 +141,8 @@ contains
   !> Body a's subproblem: MPRGP (SMALBE-M for a floating body), warm-started from
   !! state%lam(:, a) with its known product F_a lam_a, optionally a first line search along
   !! the last change of lam_a, and the Krylov recycling of its stored directions.
-  subroutine solve_body(sub, solver, body, a, rtol_in, search, lam_other, state, rhs, grad, inner, updates)
-    type(subproblems_t), intent(inout) :: sub
+  subroutine solve_body(subproblems, solver, body, a, rtol_in, search, lam_other, state, rhs, grad, inner, updates)
+    type(subproblems_t), intent(inout) :: subproblems
     type(solver_cfg_t), intent(in) :: solver
     type(body_condensed_t), intent(in) :: body
     integer, intent(in) :: a
@@ -154,7 +154,7 @@ contains
     real(wp), intent(out) :: grad(:)              !< the Hessian's gradient at the solution
     type(mprgp_stats_t), intent(out) :: inner     !< the inner solve's outcome
     integer, intent(out) :: updates               !< SMALBE multiplier updates
-    type(mprgp_t) :: mprgp
+    type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), lam0(:), flam0(:)
     integer :: m, k, r, first, last
@@ -162,62 +162,62 @@ contains
     allocate (lb(m))
     lb = 0.0_wp
     rhs = body%b - state%G(:, a)
-    if (sub%proximal(a)%n > 0) then
+    if (subproblems%proximal(a)%n > 0) then
       ! a singular body is pinned to the other body's last force
-      call sub%proximal(a)%apply(lam_other, grad)
+      call subproblems%proximal(a)%apply(lam_other, grad)
       rhs = rhs + grad
     end if
     ! The tolerance is measured against the body's own contact displacement |F_a lam_a|
     ! (previous iterate), not against |b_a - G_a|: with a large material contrast the stiff
     ! body's b_a - G_a is a small difference of the soft body's large displacements.
     if (state%flam(a) > 0.0_wp) then
-      mprgp%opts%rtol = 0.0_wp
-      mprgp%opts%atol = max(rtol_in*state%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs))
+      inner_solver%opts%rtol = 0.0_wp
+      inner_solver%opts%atol = max(rtol_in*state%flam(a), 4.0_wp*epsilon(1.0_wp)*norm2(rhs))
     else
-      mprgp%opts%rtol = rtol_in
-      mprgp%opts%atol = 0.0_wp
+      inner_solver%opts%rtol = rtol_in
+      inner_solver%opts%atol = 0.0_wp
     end if
-    mprgp%opts%max_it = solver%inner_max_it
-    mprgp%opts%lambda_max = sub%lmax_hessian(a)
+    inner_solver%opts%max_it = solver%inner_max_it
+    inner_solver%opts%lambda_max = subproblems%lmax_hessian(a)
     ! F_a is the same in every iteration and the warm start is the last solution: its
     ! gradient comes from F_a lam_a of the last solve (no initial product)
-    mprgp%opts%use_ax = state%reuse == 1
-    mprgp%ax = state%flam_v(:, a)
+    inner_solver%opts%use_ax = state%reuse == 1
+    inner_solver%ax = state%flam_v(:, a)
     lam0 = state%lam(:, a)
     flam0 = state%flam_v(:, a)
     ! Krylov recycling, not with Aitken or Anderson acceleration, whose updates difference
     ! past iterates and so amplify the (smaller but differently placed) inner errors
-    mprgp%opts%recycle = solver%acceleration == ACCEL_NONE
+    inner_solver%opts%recycle = solver%acceleration == ACCEL_NONE
     if (search) then
-      mprgp%s = state%srch(:, a)
-      mprgp%as = state%fsrch(:, a)
+      inner_solver%s = state%srch(:, a)
+      inner_solver%as = state%fsrch(:, a)
     end if
     ! body a's columns of the stored directions
     k = size(state%rw, 2)/2
     first = (a - 1)*k + 1
     last = a*k
-    r = sub%equality(a)%r
+    r = subproblems%equality(a)%r
     updates = 0
     if (m > 0 .and. r > 0) then
       ! a floating body: its equilibrium to the accuracy asked of its forces, down to the
       ! rounding of G lam
-      associate (eq => sub%equality(a))
-        mprgp%opts%eq_m = eq%m0
-        mprgp%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
-        call smalbe_solve(mprgp, sub%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, state%lam(:, a), state%mu(1:r, a), &
+      associate (eq => subproblems%equality(a))
+        inner_solver%opts%eq_m = eq%m0
+        inner_solver%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
+        call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, state%lam(:, a), state%mu(1:r, a), &
                           smalbe_stats, state%rw(:, first:last), state%raw(:, first:last), state%nrw(:, a))
       end associate
       inner = smalbe_stats%inner
       inner%n_matvec = smalbe_stats%n_matvec
       updates = smalbe_stats%updates
     else if (m > 0) then
-      call mprgp%solve(sub%hessian(a), rhs, lb, state%lam(:, a), state%rw(:, first:last), &
+      call inner_solver%solve(subproblems%hessian(a), rhs, lb, state%lam(:, a), state%rw(:, first:last), &
                        state%raw(:, first:last), state%nrw(:, a))
-      inner = mprgp%stats
+      inner = inner_solver%stats
     end if
     if (m > 0) then
-      grad = mprgp%g
-      state%flam_v(:, a) = mprgp%ax
+      grad = inner_solver%g
+      state%flam_v(:, a) = inner_solver%ax
     end if
     state%srch(:, a) = state%lam(:, a) - lam0
     state%fsrch(:, a) = state%flam_v(:, a) - flam0

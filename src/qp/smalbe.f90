@@ -65,7 +65,7 @@ contains
     integer, intent(inout), optional :: nrw(2)
     type(mprgp_opts_t) :: opts
     real(wp), allocatable :: rhs(:), r(:)
-    real(wp) :: lag_old, lag_new, rr, mm, feas
+    real(wp) :: lag_old, lag_new, rr, m_control, feas
     integer :: n, k
     logical :: have_ax
 
@@ -73,7 +73,7 @@ contains
     allocate (rhs(n), r(size(e)))
     opts = solver%opts
     feas = opts%eq_feas
-    mm = opts%eq_m
+    m_control = opts%eq_m
     have_ax = opts%use_ax .and. allocated(solver%ax)
     if (have_ax) call multiplier_estimate(gm, e, rho, lb, x, c, solver%ax, mu)
     solver%eq_g = gm
@@ -82,7 +82,7 @@ contains
     stats%updates = 0
     do k = 1, SMALBE_MAX_UPDATES
       solver%opts = opts
-      solver%opts%eq_m = mm
+      solver%opts%eq_m = m_control
       solver%opts%use_ax = have_ax
       ! a projected gradient below the rounding of a product with A cannot be reached (A
       ! holds rho G'G, about RHO_FACTOR times the Hessian's own scale): floor the tolerance
@@ -110,10 +110,10 @@ contains
                 dot_product(mu, r) + 0.5_wp*rho*rr*rr
       stats%updates = k
       if (rr <= feas) exit
-      if (lag_new < lag_old + 0.5_wp*rho*rr*rr) mm = BETA*mm
+      if (lag_new < lag_old + 0.5_wp*rho*rr*rr) m_control = BETA*m_control
       lag_old = lag_new
     end do
-    stats%m_final = mm
+    stats%m_final = m_control
     if (stats%inner%status == MPRGP_CONVERGED .and. stats%feas > feas) then
       stats%inner%status = MPRGP_MAX_IT
       write (stats%inner%message, '(a,i0,a,es10.3,a,es10.3)') 'SMALBE: ', SMALBE_MAX_UPDATES, &
