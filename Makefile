@@ -66,7 +66,8 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings int_hash text_scanner sorting sysinfo signals mpi_env config namelist_input deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp smalbe mortar condense condense_mumps floating contact_types contact h5io files history_io \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar condense condense_mumps floating contact_types contact_common equality_rows \
+        robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
@@ -99,9 +100,9 @@ $(DEPS_STAMP): tools/install-deps.sh
 deps: $(DEPS_STAMP)
 
 # ---- compile -------------------------------------------------------------------
-# Sources are grouped by stage (src/base, input, fem, linalg, contact, io; the driver at
+# Sources are grouped by stage (src/base, input, fem, linalg, qp, contact, io; the driver at
 # the top); objects and modules go flat into $(BUILD).
-SRC_DIRS := src src/base src/input src/fem src/linalg src/contact src/io src/parallel
+SRC_DIRS := src src/base src/input src/fem src/linalg src/qp src/contact src/io src/parallel
 vpath %.f90 $(SRC_DIRS)
 vpath %.c $(SRC_DIRS)
 
@@ -149,7 +150,10 @@ $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o
-$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o
+$(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o
+$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
+                           $(BUILD)/mprgp_support.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
 $(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
@@ -159,9 +163,25 @@ $(BUILD)/condense_mumps.o: $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o
 $(BUILD)/floating.o:       $(BUILD)/kinds.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/lapack.o \
                            $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
-$(BUILD)/contact.o:        $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/strings.o $(BUILD)/config.o \
-                           $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o $(BUILD)/condense.o \
-                           $(BUILD)/contact_types.o
+$(BUILD)/contact_common.o: $(BUILD)/kinds.o $(BUILD)/condense.o $(BUILD)/contact_types.o
+$(BUILD)/equality_rows.o:  $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/condense.o
+# the Robin operators implement one interface: not every operator needs every argument
+$(BUILD)/robin_operators.o: FFLAGS += -Wno-unused-dummy-argument
+$(BUILD)/robin_operators.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
+                           $(BUILD)/condense.o $(BUILD)/contact_common.o
+$(BUILD)/robin_subproblems.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
+                           $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/contact_common.o \
+                           $(BUILD)/equality_rows.o $(BUILD)/robin_operators.o
+$(BUILD)/acceleration.o:   $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/lapack.o $(BUILD)/contact_types.o \
+                           $(BUILD)/contact_common.o
+$(BUILD)/robin_iteration.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/clock.o $(BUILD)/condense.o \
+                           $(BUILD)/contact_types.o $(BUILD)/contact_common.o $(BUILD)/robin_operators.o \
+                           $(BUILD)/robin_subproblems.o $(BUILD)/acceleration.o
+$(BUILD)/monolithic.o:     $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/clock.o $(BUILD)/mprgp.o \
+                           $(BUILD)/smalbe.o $(BUILD)/strings.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
+                           $(BUILD)/contact_common.o $(BUILD)/equality_rows.o
+$(BUILD)/error_estimate.o: $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
+                           $(BUILD)/equality_rows.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o
 $(BUILD)/files.o:
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5io.o

@@ -1,4 +1,4 @@
-!> Benchmark of mprgp_solve (prints, asserts nothing).
+!> Benchmark of the MPRGP solver (prints, asserts nothing).
 !!
 !! 1. The 1D obstacle problem -u'' = -15 on (0,1), u(0) = u(1) = 0, u >= -1, by
 !!    finite differences: A = tridiag(-1,2,-1)*(n+1)^2 (scaled form, sparse CSC),
@@ -15,7 +15,7 @@
 program bench_mprgp
   use kinds, only: wp
   use linop, only: csc_op_t, dense_op_t, dense_op_init, linop_t
-  use mprgp, only: mprgp_solve, mprgp_opts_t, mprgp_stats_t, mprgp_status_name
+  use mprgp, only: mprgp_t, mprgp_status_name
   use clock, only: wtime
   use testing, only: obstacle_problem
   implicit none (type, external)
@@ -85,27 +85,28 @@ contains
     real(wp), intent(in) :: b(:), l(:)
     integer, intent(in) :: n
     real(wp), intent(in) :: rtol
-    type(mprgp_opts_t) :: opts
-    type(mprgp_stats_t) :: st
+    type(mprgp_t) :: solver
     real(wp), allocatable :: x(:)
     integer :: reps
     real(wp) :: t0, elapsed
     allocate (x(n))
-    opts%rtol = rtol
-    opts%max_it = 1000000
+    solver%opts%rtol = rtol
+    solver%opts%max_it = 1000000
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)   ! warm-up, not timed
+    call solver%solve(op, b, l, x)   ! warm-up, not timed
     reps = 0
     t0 = wtime()
     do
       x = 0.0_wp
-      call mprgp_solve(op, b, l, x, opts, st)
+      call solver%solve(op, b, l, x)
       reps = reps + 1
       elapsed = wtime() - t0
       if (elapsed >= 0.5_wp .or. reps >= 1000) exit
     end do
-    write (*, '(i6,es10.1,i13,3i8,es18.3,es11.2,3x,a)') n, rtol, st%n_matvec, st%n_cg, st%n_exp, &
-      st%n_prop, elapsed / reps, st%gp_norm / st%b_norm, mprgp_status_name(st%status)
+    associate (st => solver%stats)
+      write (*, '(i6,es10.1,i13,3i8,es18.3,es11.2,3x,a)') n, rtol, st%n_matvec, st%n_cg, st%n_exp, &
+        st%n_prop, elapsed / reps, st%gp_norm / st%b_norm, mprgp_status_name(st%status)
+    end associate
   end subroutine timed
 
 end program bench_mprgp

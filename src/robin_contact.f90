@@ -24,8 +24,11 @@ program robin_contact
   use assembly, only: body_system_t, assemble_body, expand, cell_triplets
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, contact_resultant, &
                       recover_displacement
-  use contact_types, only: contact_result_t, robin_state_t
-  use contact, only: solve_robin, solve_monolithic, error_bound
+  use contact_types, only: contact_result_t, robin_state_t, status_name, STATUS_CONVERGED, STATUS_FAILED, &
+                           STATUS_INTERRUPTED
+  use robin_iteration, only: solve_robin
+  use monolithic, only: solve_monolithic
+  use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, free_list, fixing_list
   use results, only: timing_t, write_results, program_version
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
@@ -258,8 +261,8 @@ program robin_contact
     call solve_robin(d%solver, itf, cb, res, output_unit, d%output%progress_lines, state, ckpt, stop_requested)
     if (ckpt%failed) call warn(ckpt%message)
   end if
-  if (me == 0 .and. res%status /= 'failed') call error_bound(itf, cb, res)
-  if (me == 0 .and. res%status /= 'failed' .and. itf%m > 0) then
+  if (me == 0 .and. res%status /= STATUS_FAILED) call error_bound(itf, cb, res)
+  if (me == 0 .and. res%status /= STATUS_FAILED .and. itf%m > 0) then
     ! a floating body's load against its contact force: the equality the solver enforced
     do a = 1, 2
       if (sys(a)%nrig == 0) cycle
@@ -275,9 +278,9 @@ program robin_contact
   maxndof = max(sys(1)%ndof, sys(2)%ndof)
   allocate (u(maxndof, 2))
   u = 0.0_wp
-  if (use_mumps .and. res%status /= 'failed') then
+  if (use_mumps .and. res%status /= STATUS_FAILED) then
     call recover_mumps()
-  else if (res%status /= 'failed') then
+  else if (res%status /= STATUS_FAILED) then
     !$omp parallel do num_threads(nthr) schedule(static, 1) private(ufree)
     do a = 1, 2
       allocate (ufree(sys(a)%n))
@@ -288,29 +291,29 @@ program robin_contact
     !$omp end parallel do
   end if
   ! a floating body's rigid part: u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a (rank 0 writes)
-  if (res%status /= 'failed' .and. me == 0) then
+  if (res%status /= STATUS_FAILED .and. me == 0) then
     do a = 1, 2
       if (sys(a)%nrig > 0) u(1:sys(a)%ndof, a) = u(1:sys(a)%ndof, a) + matmul(sys(a)%rig, res%rigid(1:sys(a)%nrig, a))
     end do
   end if
-  if (res%status /= 'failed' .and. .not. all(ieee_is_finite(u))) then
+  if (res%status /= STATUS_FAILED .and. .not. all(ieee_is_finite(u))) then
     ! a derived field that is not finite is a failure, never a result
-    res%status = 'failed'
+    res%status = STATUS_FAILED
     res%message = 'the displacements are not finite: the problem is beyond double precision; rescale the units'
   end if
   tm%iterate = wtime() - t0
 
-  select case (trim(res%status))
-  case ('converged')
+  select case (res%status)
+  case (STATUS_CONVERGED)
     code = EXIT_OK
-  case ('failed')
+  case (STATUS_FAILED)
     code = EXIT_NUMERICAL
-  case ('interrupted')
+  case (STATUS_INTERRUPTED)
     code = EXIT_INTERRUPTED
   case default
     code = EXIT_NOT_CONVERGED
   end select
-  if (res%status /= 'converged') write (error_unit, '(a)') 'robin_contact: '//trim(res%status)//': '//trim(res%message)
+  if (res%status /= STATUS_CONVERGED) write (error_unit, '(a)') 'robin_contact: '//status_name(res%status)//': '//trim(res%message)
   if (code == EXIT_NOT_CONVERGED) write (error_unit, '(a)') 'robin_contact: next: '//next_setting(d%solver)
 
   ! ---- output -------------------------------------------------------------------------
@@ -509,25 +512,14 @@ contains
   !! body's displacement, and the status to end alike).
   subroutine share_contact_forces()
     integer :: iv(1)
-    iv(1) = 0
-    if (me == 0) then
-      select case (trim(res%status))
-      case ('failed')
-        iv(1) = 1
-      case ('converged')
-        iv(1) = 0
-      case default
-        iv(1) = 2
-      end select
-    end if
+    iv(1) = res%status
     call par_bcast_ints(iv, 1, 0)
     if (me /= 0) then
-      res%status = merge('failed   ', 'converged', iv(1) == 1)
-      if (iv(1) == 2) res%status = 'other'
+      res%status = iv(1)
       if (allocated(res%lam_body)) deallocate (res%lam_body)
       allocate (res%lam_body(itf%m, 2))
     end if
-    if (iv(1) /= 1) call par_bcast_reals(res%lam_body, 2*itf%m, 0)
+    if (iv(1) /= STATUS_FAILED) call par_bcast_reals(res%lam_body, 2*itf%m, 0)
   end subroutine share_contact_forces
 
   !> Each group solves its body under its contact forces; the hosts send the displacements
@@ -580,7 +572,7 @@ contains
   subroutine check_interrupt(phase)
     character(len=*), intent(in) :: phase
     if (.not. par_any(stop_requested())) return
-    res%status = 'interrupted'
+    res%status = STATUS_INTERRUPTED
     res%method = merge('robin     ', 'monolithic', d%solver%method == METHOD_ROBIN)
     code = EXIT_INTERRUPTED
     write (error_unit, '(a)') 'robin_contact: interrupted: signal '//i2s(pending_signal())//' during the '// &
@@ -617,7 +609,7 @@ contains
     write (line(3), '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', tm%assemble, ' factor=', tm%factor, &
       ' condense=', tm%condense, ' iterate=', tm%iterate, ' output=', tm%output, ' total=', tm%total, &
       ' peak_mb=', tm%peak_rss_mb, ' factor_mb=', tm%factor_mb
-    write (line(4), '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', trim(res%status), &
+    write (line(4), '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', status_name(res%status), &
       ' method=', trim(res%method), ' outer=', res%outer, ' inner=', res%inner, ' n1=', sys(1)%n, &
       ' n2=', sys(2)%n, ' m=', itf%m, ' delta=', fmt_real(d%solver%delta, '(f0.6)'), ' residual=', res%residual, &
       ' wall_s=', fmt_real(tm%total, '(f0.3)')
@@ -630,7 +622,7 @@ contains
     end do
     if (any(err /= 0)) then
       write (error_unit, '(a)') 'robin_contact: error: cannot write the summary to standard output '// &
-        '(full disk or closed pipe?); the run''s status was '//trim(res%status)
+        '(full disk or closed pipe?); the run''s status was '//status_name(res%status)
       code = EXIT_NUMERICAL
     end if
   end subroutine summary

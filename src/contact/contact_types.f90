@@ -8,9 +8,18 @@ module contact_types
   implicit none (type, external)
   private
 
+  !> How a contact solve ended (contact_result_t%status); `status_name` gives the word the
+  !! results file and the `result:` line print.
+  integer, parameter, public :: STATUS_NONE = 0         !< not solved (yet)
+  integer, parameter, public :: STATUS_CONVERGED = 1    !< the stopping criterion was met
+  integer, parameter, public :: STATUS_MAX_OUTER = 2    !< max_outer iterations without convergence
+  integer, parameter, public :: STATUS_DIVERGED = 3     !< diverged or stagnated (the message says which)
+  integer, parameter, public :: STATUS_FAILED = 4       !< a numerical failure (factorization, inner solve)
+  integer, parameter, public :: STATUS_INTERRUPTED = 5  !< stopped by a signal
+
   !> Outcome of a contact solve, with the outer history.
   type, public :: contact_result_t
-    character(len=16) :: status = 'none'       !< converged | max_outer | diverged | failed | interrupted
+    integer :: status = STATUS_NONE            !< STATUS_*
     character(len=16) :: method = ''           !< robin | monolithic
     character(len=256) :: message = ''         !< why it failed, if it did
     integer :: outer = 0                       !< outer iterations (1 for monolithic)
@@ -101,9 +110,32 @@ module contact_types
     end function stop_iface
   end interface
 
-  public :: state_init, alloc_result, grow_history, stop_iface, recycle_size
+  public :: state_init, alloc_result, grow_history, stop_iface, recycle_size, status_name
 
 contains
+
+  !> The word for a STATUS_* code: 'none', 'converged', 'max_outer', 'diverged', 'failed',
+  !! 'interrupted' (what the results file and the `result:` line hold).
+  function status_name(status) result(name)
+    integer, intent(in) :: status   !< a STATUS_* code
+    character(len=:), allocatable :: name
+    select case (status)
+    case (STATUS_NONE)
+      name = 'none'
+    case (STATUS_CONVERGED)
+      name = 'converged'
+    case (STATUS_MAX_OUTER)
+      name = 'max_outer'
+    case (STATUS_DIVERGED)
+      name = 'diverged'
+    case (STATUS_FAILED)
+      name = 'failed'
+    case (STATUS_INTERRUPTED)
+      name = 'interrupted'
+    case default
+      name = 'unknown'
+    end select
+  end function status_name
 
   !> Fresh outer state: obstacles at the initial gap, no contact force.
   subroutine state_init(st, m, g0)

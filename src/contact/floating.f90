@@ -1,4 +1,4 @@
-!> Bodies held only by contact (README, "Bodies held only by contact"): the equilibrium
+!> Bodies held only by contact (doc/method.md, "Bodies held only by contact"): the equilibrium
 !! rows of a floating body, G_a = R_a' B_a' and e_a = R_a' f_a (its load balanced by its
 !! contact forces: G_a lam = e_a), and the checks that the contact can hold it: every
 !! free rigid motion has a contact normal component (else the body slides or turns
@@ -21,36 +21,36 @@ module floating
 
 contains
 
-  !> bc%rg = R_a' B_a' (row k: B_a applied to kernel vector k, from the interface's rows
-  !! over global DOFs; B_a never touches a fixing DOF) and bc%re = R_a' f_a (the applied
+  !> body%rg = R_a' B_a' (row k: B_a applied to kernel vector k, from the interface's rows
+  !! over global DOFs; B_a never touches a fixing DOF) and body%re = R_a' f_a (the applied
   !! load along each free motion: the lifting of prescribed displacements has no part
   !! along R_a, since K R_a = 0). Needs no factorization: the checks run before it.
-  subroutine rigid_rows(itf, a, sys, bc)
-    type(interface_t), intent(in) :: itf
+  subroutine rigid_rows(contact_line, a, system, body)
+    type(interface_t), intent(in) :: contact_line
     integer, intent(in) :: a
-    type(body_system_t), intent(in) :: sys
-    type(body_condensed_t), intent(inout) :: bc
+    type(body_system_t), intent(in) :: system
+    type(body_condensed_t), intent(inout) :: body
     integer :: k, i, e
     integer :: l, nd
-    bc%nrig = sys%nrig
-    if (allocated(bc%rg)) deallocate (bc%rg, bc%re)
-    if (allocated(bc%rreach)) deallocate (bc%rreach)
-    allocate (bc%rg(sys%nrig, itf%m), bc%re(sys%nrig), bc%rreach(sys%nrig, sys%nrig))
-    bc%rreach = 0.0_wp
-    do k = 1, sys%nrig
-      do i = 1, itf%m
-        bc%rg(k, i) = 0.0_wp
-        do e = itf%b(a)%ptr(i), itf%b(a)%ptr(i + 1) - 1
-          bc%rg(k, i) = bc%rg(k, i) + itf%b(a)%val(e)*sys%rig(itf%b(a)%dof(e), k)
+    body%nrig = system%nrig
+    if (allocated(body%rg)) deallocate (body%rg, body%re)
+    if (allocated(body%rreach)) deallocate (body%rreach)
+    allocate (body%rg(system%nrig, contact_line%m), body%re(system%nrig), body%rreach(system%nrig, system%nrig))
+    body%rreach = 0.0_wp
+    do k = 1, system%nrig
+      do i = 1, contact_line%m
+        body%rg(k, i) = 0.0_wp
+        do e = contact_line%b(a)%ptr(i), contact_line%b(a)%ptr(i + 1) - 1
+          body%rg(k, i) = body%rg(k, i) + contact_line%b(a)%val(e)*system%rig(contact_line%b(a)%dof(e), k)
           ! the motions' vectors at the entry's node, against the coefficient's weight
-          nd = (itf%b(a)%dof(e) + 1)/2
-          do l = 1, sys%nrig
-            bc%rreach(k, l) = bc%rreach(k, l) + itf%b(a)%val(e)**2* &
-                              (sys%rig(2*nd - 1, k)*sys%rig(2*nd - 1, l) + sys%rig(2*nd, k)*sys%rig(2*nd, l))
+          nd = (contact_line%b(a)%dof(e) + 1)/2
+          do l = 1, system%nrig
+            body%rreach(k, l) = body%rreach(k, l) + contact_line%b(a)%val(e)**2* &
+                              (system%rig(2*nd - 1, k)*system%rig(2*nd - 1, l) + system%rig(2*nd, k)*system%rig(2*nd, l))
           end do
         end do
       end do
-      bc%re(k) = dot_product(sys%rig(:, k), sys%f_applied)
+      body%re(k) = dot_product(system%rig(:, k), system%f_applied)
     end do
   end subroutine rigid_rows
 
@@ -58,9 +58,9 @@ contains
   !! when a free motion has no contact normal component, when the load cannot be balanced
   !! by compressive contact forces, when nothing presses the body into the contact, or
   !! when two floating bodies are free together.
-  subroutine check_held(sys, bc, info, msg)
-    type(body_system_t), intent(in) :: sys(2)
-    type(body_condensed_t), intent(in) :: bc(2)
+  subroutine check_held(systems, bodies, info, msg)
+    type(body_system_t), intent(in) :: systems(2)
+    type(body_condensed_t), intent(in) :: bodies(2)
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
     real(wp), allocatable :: gg(:, :), lam(:), gs(:, :), es(:), sr(:, :)
@@ -71,26 +71,26 @@ contains
 
     info = 0
     msg = ''
-    m = size(bc(1)%rg, 2)
+    m = size(bodies(1)%rg, 2)
     do a = 1, 2
-      r = bc(a)%nrig
+      r = bodies(a)%nrig
       if (r == 0) cycle
-      fx = sum(sys(a)%f_applied(1::2))
-      fy = sum(sys(a)%f_applied(2::2))
+      fx = sum(systems(a)%f_applied(1::2))
+      fy = sum(systems(a)%f_applied(2::2))
       ! 1. every free motion must meet the contact normals: min over motions v of
       ! |G'v|^2 / (v'S v), the part of the motion's reach on the contact that is normal to it
       ! (generalized eigenproblem G G' v = mu S v), at least HOLD_MIN. A disc on a flat
       ! surface turning about its centre has normals through the centre: mu is only the
       ! discretisation's error of the normals (1e-6), not a hold
       allocate (gg(r, r))
-      gg = matmul(bc(a)%rg, transpose(bc(a)%rg))
-      call held_motions(gg, bc(a)%rreach, r, ev, lapinfo)
+      gg = matmul(bodies(a)%rg, transpose(bodies(a)%rg))
+      call held_motions(gg, bodies(a)%rreach, r, ev, lapinfo)
       if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
-        c = matmul(sys(a)%rig_coef, gg(:, 1))
-        along = dot_product(gg(:, 1), bc(a)%re)
+        c = matmul(systems(a)%rig_coef, gg(:, 1))
+        along = dot_product(gg(:, 1), bodies(a)%re)
         info = 1
         msg = 'body '//i2s(a)//' is held only by contact (its supports leave rigid motion free), '// &
-              'but the contact cannot hold its '//rigid_motion_name(sys(a), c)//': the contact normals '// &
+              'but the contact cannot hold its '//rigid_motion_name(systems(a), c)//': the contact normals '// &
               'have (almost) no component along it (frictionless contact lets the body slide or turn)'
         if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = trim(msg)// &
           '; its load has a component '//r2s(along)//' along that motion, which no contact force balances'
@@ -99,20 +99,20 @@ contains
       end if
       deallocate (gg)
       ! 2. something must press it into the contact
-      enorm = norm2(bc(a)%re)
-      if (.not. enorm > 1.0e-12_wp*max(sum(abs(sys(a)%f_applied)), tiny(1.0_wp)) .or. m == 0) then
+      enorm = norm2(bodies(a)%re)
+      if (.not. enorm > 1.0e-12_wp*max(sum(abs(systems(a)%f_applied)), tiny(1.0_wp)) .or. m == 0) then
         info = 1
-        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(sys(a))//'), but no load '// &
+        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact (load resultant ('//r2s(fx)//', '//r2s(fy)//')): its position '// &
               'is undetermined; load it towards the other body, or '//hold
         return
       end if
       ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
       allocate (lam(m))
-      call nnls(bc(a)%rg, bc(a)%re, lam, res)
+      call nnls(bodies(a)%rg, bodies(a)%re, lam, res)
       if (res > 1.0e-8_wp*enorm) then
         info = 1
-        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(sys(a))//'), but its load '// &
+        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but its load '// &
               '(resultant ('//r2s(fx)//', '//r2s(fy)//')) pulls it away from the contact: no compressive '// &
               'contact force balances it (an unbalanced part '//r2s(res)//' remains); reverse the load '// &
               'or '//hold
@@ -121,26 +121,26 @@ contains
       deallocate (lam)
     end do
     ! 4. both floating: the pair together must be held too (stacked rows of full rank)
-    if (bc(1)%nrig > 0 .and. bc(2)%nrig > 0) then
-      r = bc(1)%nrig + bc(2)%nrig
+    if (bodies(1)%nrig > 0 .and. bodies(2)%nrig > 0) then
+      r = bodies(1)%nrig + bodies(2)%nrig
       allocate (gs(r, m), es(r), gg(r, r))
-      gs(1:bc(1)%nrig, :) = bc(1)%rg
-      gs(bc(1)%nrig + 1:, :) = bc(2)%rg
-      es(1:bc(1)%nrig) = bc(1)%re
-      es(bc(1)%nrig + 1:) = bc(2)%re
+      gs(1:bodies(1)%nrig, :) = bodies(1)%rg
+      gs(bodies(1)%nrig + 1:, :) = bodies(2)%rg
+      es(1:bodies(1)%nrig) = bodies(1)%re
+      es(bodies(1)%nrig + 1:) = bodies(2)%re
       gg = matmul(gs, transpose(gs))
       allocate (sr(r, r))
       sr = 0.0_wp
-      sr(1:bc(1)%nrig, 1:bc(1)%nrig) = bc(1)%rreach
-      sr(bc(1)%nrig + 1:, bc(1)%nrig + 1:) = bc(2)%rreach
+      sr(1:bodies(1)%nrig, 1:bodies(1)%nrig) = bodies(1)%rreach
+      sr(bodies(1)%nrig + 1:, bodies(1)%nrig + 1:) = bodies(2)%rreach
       call held_motions(gg, sr, r, ev, lapinfo)
       if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
         ! the free motion of the pair, as body 1's part of it
-        k = bc(1)%nrig
-        c = matmul(sys(1)%rig_coef, gg(1:k, 1))
+        k = bodies(1)%nrig
+        c = matmul(systems(1)%rig_coef, gg(1:k, 1))
         info = 1
         msg = 'bodies 1 and 2 are both held only by contact, and together they are free: the pair can '// &
-              'move as a whole ('//rigid_motion_name(sys(1), c)//' of both) and nothing holds it; '// &
+              'move as a whole ('//rigid_motion_name(systems(1), c)//' of both) and nothing holds it; '// &
               'support one of the bodies against that rigid motion'
         return
       end if
@@ -177,26 +177,26 @@ contains
   end subroutine held_motions
 
   !> The rigid motions a body's supports leave free, in words.
-  function free_list(sys) result(s)
-    type(body_system_t), intent(in) :: sys
+  function free_list(system) result(s)
+    type(body_system_t), intent(in) :: system
     character(len=:), allocatable :: s
     integer :: k
     s = ''
-    do k = 1, sys%nrig
+    do k = 1, system%nrig
       if (k > 1) s = s//', '
-      s = s//rigid_motion_name(sys, sys%rig_coef(:, k))
+      s = s//rigid_motion_name(system, system%rig_coef(:, k))
     end do
   end function free_list
 
   !> The fixing DOFs in words: 'node 12 uy, node 40 ux' (node numbers of the body's mesh).
-  function fixing_list(sys) result(s)
-    type(body_system_t), intent(in) :: sys
+  function fixing_list(system) result(s)
+    type(body_system_t), intent(in) :: system
     character(len=:), allocatable :: s
     integer :: k
     s = ''
-    do k = 1, sys%nrig
+    do k = 1, system%nrig
       if (k > 1) s = s//', '
-      s = s//'node '//i2s((sys%fixing(k) + 1)/2)//merge(' ux', ' uy', mod(sys%fixing(k), 2) == 1)
+      s = s//'node '//i2s((system%fixing(k) + 1)/2)//merge(' ux', ' uy', mod(system%fixing(k), 2) == 1)
     end do
   end function fixing_list
 

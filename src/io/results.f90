@@ -18,7 +18,7 @@ module results
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t, contact_resultant
-  use contact_types, only: contact_result_t
+  use contact_types, only: contact_result_t, status_name
   use floating, only: free_list
   implicit none (type, external)
   private
@@ -141,7 +141,7 @@ contains
     uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
     call file_open(path, fid, st, create=.true.)
     ! root attributes
-    call write_attr(fid, 'status', trim(res%status), st)
+    call write_attr(fid, 'status', status_name(res%status), st)
     call write_attr(fid, 'method', trim(res%method), st)
     call write_attr(fid, 'message', trim(res%message), st)
     call write_attr(fid, 'version', program_version, st)

@@ -1,5 +1,5 @@
 !> Contact solver tests: the monolithic solution satisfies the KKT conditions of
-!! the README (Method as implemented) and the equilibrium of each body (reactions + loads + contact forces);
+!! doc/method.md ("Method as implemented") and the equilibrium of each body (reactions + loads + contact forces);
 !! the Robin iterate equals the monolithic solution on the paper's scene, on a
 !! partial-contact scene (parabolic gap) and on a scene whose load lifts part of the
 !! interface; the recovered displacements reproduce the condensed ones.
@@ -11,12 +11,16 @@ program test_contact
   use assembly, only: body_system_t, assemble_body, expand, residual_full
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
                       recover_displacement, apply_b, apply_bt
-  use contact_types, only: contact_result_t
-  use contact, only: solve_robin, solve_monolithic, error_bound
+  use contact_types, only: contact_result_t, status_name, STATUS_CONVERGED, STATUS_NONE, STATUS_MAX_OUTER, &
+                           STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
+  use robin_iteration, only: solve_robin
+  use monolithic, only: solve_monolithic
+  use error_estimate, only: error_bound
   use testing, only: report, test_summary
   implicit none (type, external)
   character(len=4096) :: none(0)
 
+  call status_words()
   call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.95, tol=1e-10 /"], .false.)
   call scene('inputs/table1/q1_16x8.nml', [character(len=64) :: "&solver delta=0.5, tol=1e-10 /"], .false.)
   call scene('tests/data/decks/gap.nml', none, .true.)
@@ -39,6 +43,16 @@ program test_contact
 
 contains
 
+  !> The words a run's status is written as (results file, `result:` line; scripts parse them).
+  subroutine status_words()
+    call check(status_name(STATUS_NONE) == 'none', 'status word none', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_CONVERGED) == 'converged', 'status word converged', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_MAX_OUTER) == 'max_outer', 'status word max_outer', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_DIVERGED) == 'diverged', 'status word diverged', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_FAILED) == 'failed', 'status word failed', 0.0_wp, 0.0_wp)
+    call check(status_name(STATUS_INTERRUPTED) == 'interrupted', 'status word interrupted', 0.0_wp, 0.0_wp)
+  end subroutine status_words
+
   subroutine check(ok, what, val, tol)
     logical, intent(in) :: ok
     character(len=*), intent(in) :: what
@@ -53,9 +67,9 @@ contains
     integer, intent(in), optional :: max_outer_expected
     type(deck_t) :: d
     type(mesh_t) :: msh(2)
-    type(body_system_t) :: sys(2)
-    type(interface_t) :: itf
-    type(body_condensed_t) :: bc(2)
+    type(body_system_t) :: systems(2)
+    type(interface_t) :: contact_line
+    type(body_condensed_t) :: bodies(2)
     type(contact_result_t) :: mono, rob
     integer :: a, info, i, k, c
     character(len=512) :: msg
@@ -73,23 +87,23 @@ contains
     write (*, '(a)') '--- '//trim(tag)
     do a = 1, 2
       call mesh_build(msh(a), d%body(a))
-      call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, sys(a), info, msg)
+      call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, systems(a), info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%contact, msh, sys, itf, info, msg)
+    call build_interface(d%body, d%contact, msh, systems, contact_line, info, msg)
     if (info /= 0) error stop 'interface failed'
     do a = 1, 2
-      call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a), info, msg)
+      call factor_body(d%solver%factor, contact_line, a, msh(a), systems(a), bodies(a), info, msg)
       if (info /= 0) error stop 'factor failed'
-      call condense_body(sys(a), bc(a), info, msg)
+      call condense_body(systems(a), bodies(a), info, msg)
       if (info /= 0) error stop 'condense failed'
     end do
 
     ! ---- monolithic: KKT conditions -------------------------------------------------
-    call solve_monolithic(d%solver, itf, bc, mono)
-    call check(mono%status == 'converged', 'monolithic converged', 0.0_wp, 0.0_wp)
+    call solve_monolithic(d%solver, contact_line, bodies, mono)
+    call check(mono%status == STATUS_CONVERGED, 'monolithic converged', 0.0_wp, 0.0_wp)
     lnorm = maxval(abs(mono%lam))
-    uscale = max(maxval(abs(bc(1)%b)), maxval(abs(bc(2)%b)), maxval(abs(itf%g0)))
+    uscale = max(maxval(abs(bodies(1)%b)), maxval(abs(bodies(2)%b)), maxval(abs(contact_line%g0)))
     call check(minval(mono%lam) >= 0.0_wp, 'lam >= 0', -minval(mono%lam), 0.0_wp)
     call check(maxval(mono%gap) <= 1.0e-9_wp*uscale, 'no penetration', maxval(mono%gap)/uscale, 1.0e-9_wp)
     e = maxval(mono%lam*abs(mono%gap))/(lnorm*uscale)
@@ -97,8 +111,8 @@ contains
     call check(lnorm > 0.0_wp, 'some contact force', 0.0_wp, 0.0_wp)
     if (expect_partial) then
       k = count(mono%lam > 1.0e-8_wp*lnorm)
-      call check(k > 0 .and. k < itf%m, 'partial contact (some nodes separate)', real(itf%m - k, wp), &
-                 real(itf%m, wp))
+      call check(k > 0 .and. k < contact_line%m, 'partial contact (some nodes separate)', real(contact_line%m - k, wp), &
+                 real(contact_line%m, wp))
       e = maxval(mono%gap, mask=mono%lam <= 1.0e-8_wp*lnorm)
       call check(e < 0.0_wp, 'separated nodes have a negative gap', e/uscale, 0.0_wp)
     end if
@@ -106,59 +120,59 @@ contains
     ! ---- equilibrium of each body: reactions + applied loads + contact forces = 0 ------
     fscale = 0.0_wp
     do a = 1, 2
-      allocate (ufree(sys(a)%n), ufull(sys(a)%ndof), r(sys(a)%ndof))
-      call recover_displacement(sys(a), bc(a), mono%lam, ufree)
-      call expand(sys(a), ufree, ufull)
+      allocate (ufree(systems(a)%n), ufull(systems(a)%ndof), r(systems(a)%ndof))
+      call recover_displacement(systems(a), bodies(a), mono%lam, ufree)
+      call expand(systems(a), ufree, ufull)
       ! recovered B_a u_a equals the condensed b_a - F_a lam
-      allocate (bu(itf%m))
-      call apply_b(bc(a), ufree, bu)
+      allocate (bu(contact_line%m))
+      call apply_b(bodies(a), ufree, bu)
       e = maxval(abs(bu - mono%w(:, a)))
       deallocate (bu)
       call check(e <= 1.0e-10_wp*uscale, 'body '//achar(48 + a)//': recovered B u = b - F lam', e/uscale, 1.0e-10_wp)
-      call residual_full(msh(a), d%body(a), d%plane_strain, ufull, sys(a)%f_applied, r)
+      call residual_full(msh(a), d%body(a), d%plane_strain, ufull, systems(a)%f_applied, r)
       ! r = K u - f: at free DOFs it must be -B' lam, at prescribed DOFs it is the support force
-      load = [sum(sys(a)%f_applied(1::2)), sum(sys(a)%f_applied(2::2))]
+      load = [sum(systems(a)%f_applied(1::2)), sum(systems(a)%f_applied(2::2))]
       react = 0.0_wp
-      do i = 1, sys(a)%ndof
+      do i = 1, systems(a)%ndof
         c = 2 - mod(i, 2)
-        if (sys(a)%free_of(i) == 0) react(c) = react(c) + r(i)
+        if (systems(a)%free_of(i) == 0) react(c) = react(c) + r(i)
       end do
       ! force exerted on body a by the contact: -B_a' lam, summed by component
       r = 0.0_wp
-      call apply_bt(bc(a), mono%lam, r)
+      call apply_bt(bodies(a), mono%lam, r)
       cont = 0.0_wp
-      do i = 1, sys(a)%n
-        c = 2 - mod(sys(a)%dof_of(i), 2)
+      do i = 1, systems(a)%n
+        c = 2 - mod(systems(a)%dof_of(i), 2)
         cont(c) = cont(c) - r(i)
       end do
       ! scale of the terms summed (not of their sum): with a stiff body pushed by a prescribed
       ! displacement the nodal forces K u are large and cancel to a small contact force
-      fscale = max(sum(abs(sys(a)%f_applied)), sum(mono%lam), maxval(abs(react)), &
-                   sys(a)%k_norm*maxval(abs(ufull)), tiny(1.0_wp))
+      fscale = max(sum(abs(systems(a)%f_applied)), sum(mono%lam), maxval(abs(react)), &
+                   systems(a)%k_norm*maxval(abs(ufull)), tiny(1.0_wp))
       ! K u = f + support + contact, so at prescribed DOFs r = support force; balance:
       ! applied load + contact force + support forces = 0
       e = maxval(abs(load + cont + react))/fscale
       call check(e <= 1.0e-9_wp, 'body '//achar(48 + a)//': reactions + loads + contact balance', e, 1.0e-9_wp)
       deallocate (ufree, ufull, r)
     end do
-    write (*, '(a,es14.6,a,i0,a,i0)') '      total contact force ', sum(mono%lam), ' active ', mono%active, ' of ', itf%m
+    write (*, '(a,es14.6,a,i0,a,i0)') '      total contact force ', sum(mono%lam), ' active ', mono%active, ' of ', contact_line%m
 
     ! ---- Robin equals monolithic --------------------------------------------------------
-    call solve_robin(d%solver, itf, bc, rob)
-    call error_bound(itf, bc, rob)
+    call solve_robin(d%solver, contact_line, bodies, rob)
+    call error_bound(contact_line, bodies, rob)
     ! the a posteriori bound holds whatever the outcome
     e = norm2(rob%lam - mono%lam)
     call check(e <= rob%error_bound*norm2(rob%lam)*(1.0_wp + 1.0e-9_wp), 'robin error within its reported bound', &
                e/max(norm2(rob%lam), tiny(1.0_wp)), rob%error_bound)
     if (present(expect_converged)) then
       if (.not. expect_converged) then
-        call check(rob%status /= 'converged', 'robin reports not converged ('//trim(rob%status)//')', &
+        call check(rob%status /= STATUS_CONVERGED, 'robin reports not converged ('//status_name(rob%status)//')', &
                    rob%residual, huge(1.0_wp))
         write (*, '(a,i0,a,i0)') '      robin outer ', rob%outer, ' inner ', rob%inner
         return
       end if
     end if
-    call check(rob%status == 'converged', 'robin converged ('//trim(rob%status)//')', real(rob%outer, wp), &
+    call check(rob%status == STATUS_CONVERGED, 'robin converged ('//status_name(rob%status)//')', real(rob%outer, wp), &
                real(d%solver%max_outer, wp))
     if (present(max_outer_expected)) call check(rob%outer <= max_outer_expected, 'robin outer iterations', &
                                                 real(rob%outer, wp), real(max_outer_expected, wp))

@@ -1,4 +1,4 @@
-!> Bodies held only by contact (README, "Bodies held only by contact"), unit level:
+!> Bodies held only by contact (doc/method.md, "Bodies held only by contact"), unit level:
 !! (a) the rigid kernel a body's supports leave free: its dimension, its span against the
 !!     rigid motions written out by hand, its names, |K R| at rounding level, and fixing
 !!     DOFs that make the kernel's restriction nonsingular and keep off the contact;
@@ -18,7 +18,7 @@ program test_floating
   use assembly, only: body_system_t, assemble_body, residual_full, rigid_motion_name
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
   use linop, only: dense_op_t, dense_op_init
-  use mprgp, only: mprgp_opts_t, MPRGP_CONVERGED
+  use mprgp, only: mprgp_t, MPRGP_CONVERGED
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use floating, only: nnls
   use lapack, only: dgesv, dsyev
@@ -151,11 +151,11 @@ contains
 
   !> Checks (a) and (b) on one assembled body; expect(1:nexp) the kinds of the rigid
   !! motions that must span the kernel (rotations about rot_at).
-  subroutine check_body(tag, msh, body, sys, expect, nexp, rot_at, contact, check_inverse)
+  subroutine check_body(tag, msh, body, system, expect, nexp, rot_at, contact, check_inverse)
     character(len=*), intent(in) :: tag
     type(mesh_t), intent(in) :: msh
     type(body_cfg_t), intent(in) :: body
-    type(body_system_t), intent(in) :: sys
+    type(body_system_t), intent(in) :: system
     integer, intent(in) :: expect(:), nexp
     real(wp), intent(in) :: rot_at(2)
     character(len=*), intent(in) :: contact
@@ -170,41 +170,41 @@ contains
     character(len=256) :: msg
     type(chol_t) :: ch
 
-    call report(sys%nrig == nexp, tag//': kernel dimension', real(sys%nrig, wp), real(nexp, wp))
-    if (sys%nrig /= nexp) return
+    call report(system%nrig == nexp, tag//': kernel dimension', real(system%nrig, wp), real(nexp, wp))
+    if (system%nrig /= nexp) return
     if (nexp == 0) then
       names_ok = .true.   ! (no short-circuit .or. in Fortran)
-      if (allocated(sys%fixing)) names_ok = size(sys%fixing) == 0
+      if (allocated(system%fixing)) names_ok = size(system%fixing) == 0
       call report(names_ok, tag//': no fixing DOFs')
       return
     end if
-    allocate (v(sys%ndof), kr(sys%ndof), live(sys%ndof), pres(sys%ndof))
-    live = sys%free_of > 0
-    live(sys%fixing) = .true.
+    allocate (v(system%ndof), kr(system%ndof), live(system%ndof), pres(system%ndof))
+    live = system%free_of > 0
+    live(system%fixing) = .true.
     pres = .not. live
     ! span: every expected motion lies in span(R), and R has full column rank (dimension equal)
     worst = 0.0_wp
     do k = 1, nexp
       call rigid_field(msh, expect(k), rot_at, v)
-      worst = max(worst, off_span(sys%rig, v))
+      worst = max(worst, off_span(system%rig, v))
     end do
     call report_le(worst, 1.0e-12_wp, tag//': expected rigid motions lie in span(R)')
-    sub(1:nexp, 1:nexp) = matmul(transpose(sys%rig), sys%rig)
+    sub(1:nexp, 1:nexp) = matmul(transpose(system%rig), system%rig)
     call dsyev('N', 'U', nexp, sub, 3, ev, work, size(work), info)
     call report(info == 0 .and. ev(1) > 1.0e-8_wp*ev(nexp), tag//': R has full column rank', ev(1)/ev(nexp))
-    call report_le(max(0.0_wp, maxval(abs(sys%rig), mask=spread(pres, 2, nexp))), 0.0_wp, tag//': R is 0 at prescribed DOFs')
+    call report_le(max(0.0_wp, maxval(abs(system%rig), mask=spread(pres, 2, nexp))), 0.0_wp, tag//': R is 0 at prescribed DOFs')
     ! |K R| (element loop) over the live DOFs
     worst = 0.0_wp
     do j = 1, nexp
-      call kmul(msh, body, live, sys%rig(:, j), kr)
-      worst = max(worst, maxval(abs(kr))/(sys%k_norm*maxval(abs(sys%rig(:, j)))))
+      call kmul(msh, body, live, system%rig(:, j), kr)
+      worst = max(worst, maxval(abs(kr))/(system%k_norm*maxval(abs(system%rig(:, j)))))
     end do
     call report_le(worst, 1.0e-12_wp, tag//': |K R|/(|K| |R|)')
     ! names: translations along the expected axis, rotations about a point that the
     ! expected rotation's centre shares (on the line ux=0: same y; a free body: anything)
     names_ok = .true.
     do j = 1, nexp
-      nm = rigid_motion_name(sys, sys%rig_coef(:, j))
+      nm = rigid_motion_name(system, system%rig_coef(:, j))
       if (nm(1:min(len(nm), 16)) == 'rotation about (') then
         names_ok = names_ok .and. any(expect(1:nexp) == ROT)
         if (any(expect(1:nexp) == ROT) .and. nexp == 2) then
@@ -220,36 +220,36 @@ contains
       end if
       if (.not. names_ok) write (*, '(a)') '      name of motion: '//nm
     end do
-    call report(names_ok, tag//': rigid motion names ('//rigid_motion_name(sys, sys%rig_coef(:, 1))//', ...)')
+    call report(names_ok, tag//': rigid motion names ('//rigid_motion_name(system, system%rig_coef(:, 1))//', ...)')
     ! fixing DOFs: as many as motions, the kernel nonsingular on them, off the contact
-    call report(size(sys%fixing) == nexp, tag//': one fixing DOF per free motion')
+    call report(size(system%fixing) == nexp, tag//': one fixing DOF per free motion')
     sub = 0.0_wp
-    sub(1:nexp, 1:nexp) = sys%rig(sys%fixing, :)
+    sub(1:nexp, 1:nexp) = system%rig(system%fixing, :)
     sub(1:nexp, 1:nexp) = matmul(transpose(sub(1:nexp, 1:nexp)), sub(1:nexp, 1:nexp))
     call dsyev('N', 'U', nexp, sub, 3, ev, work, size(work), info)
-    call report(info == 0 .and. ev(1) > 1.0e-6_wp*maxval(abs(sys%rig))**2, &
+    call report(info == 0 .and. ev(1) > 1.0e-6_wp*maxval(abs(system%rig))**2, &
                 tag//': R restricted to the fixing DOFs is nonsingular', ev(1))
     if (len(contact) > 0) then
       g = group_index(msh, contact)
       call group_nodes(msh, g, nodes)
-      call report(g > 0 .and. .not. any([(any(nodes == (sys%fixing(k) + 1)/2), k=1, nexp)]), &
+      call report(g > 0 .and. .not. any([(any(nodes == (system%fixing(k) + 1)/2), k=1, nexp)]), &
                   tag//': no fixing DOF on the contact group '''//contact//'''')
     end if
     if (.not. check_inverse) return
     ! (b) K K^+ K = K on random vectors: K^+ y solves the reduced system, 0 at the fixing DOFs
-    call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg)
+    call ch%factor(system%n, system%colptr, system%rowind, system%val, FACT_CHOLMOD, ORD_AMD, info, msg)
     call report(info == 0, tag//': factor with the fixing DOFs removed is positive definite')
     if (info /= 0) return
-    allocate (x(sys%ndof), y(sys%ndof), z(sys%ndof), w(sys%ndof), zf(sys%n))
+    allocate (x(system%ndof), y(system%ndof), z(system%ndof), w(system%ndof), zf(system%n))
     err = 0.0_wp
     do it = 1, 3
       call uniform(x, -1.0_wp, 1.0_wp)
       x = merge(x, 0.0_wp, live)
       call kmul(msh, body, live, x, y)
-      zf = y(sys%dof_of)
+      zf = y(system%dof_of)
       call ch%solve(zf, info, msg)
       z = 0.0_wp
-      z(sys%dof_of) = zf
+      z(system%dof_of) = zf
       call kmul(msh, body, live, z, w)
       err = max(err, norm2(w - y)/norm2(y))
     end do
@@ -265,7 +265,7 @@ contains
     type(traction_cfg_t) :: notr(1)
     type(boundary_cfg_t), allocatable :: bnd(:)
     type(mesh_t) :: msh
-    type(body_system_t) :: sys
+    type(body_system_t) :: system
     integer :: info
     character(len=256) :: msg
     real(wp) :: rot_at(2)
@@ -291,11 +291,11 @@ contains
       if (group == 'bottom') rot_at = [0.7_wp, 0.0_wp]   ! ux = 0 on y = 0: rotations about points of it
     end if
     call mesh_build(msh, body, info, msg)
-    if (info == 0) call assemble_body(msh, body, .true., notr, 0, sys, info, msg, boundaries=bnd, &
+    if (info == 0) call assemble_body(msh, body, .true., notr, 0, system, info, msg, boundaries=bnd, &
                                       contact_group=contact)
     call report(info == 0, tag//': assembled ('//trim(msg)//')')
     if (info /= 0) return
-    call check_body(tag, msh, body, sys, expect, nexp, rot_at, contact, check_inverse)
+    call check_body(tag, msh, body, system, expect, nexp, rot_at, contact, check_inverse)
   end subroutine kernel_case
 
   !> The force-controlled Hertz disc (inputs/hertz_force.nml, h = 0.02): ux = 0 on its
@@ -305,7 +305,7 @@ contains
     type(traction_cfg_t) :: notr(1)
     type(boundary_cfg_t) :: bnd(1)
     type(mesh_t) :: msh
-    type(body_system_t) :: sys
+    type(body_system_t) :: system
     integer :: info
     character(len=256) :: msg
     body%id = 1
@@ -317,11 +317,11 @@ contains
     bnd(1)%fix = [.true., .false.]
     bnd(1)%origin = 'test'
     call msh_read('inputs/gmsh/hertz_force_h0.02.msh', 'disc', 1, msh, info, msg)
-    if (info == 0) call assemble_body(msh, body, .true., notr, 0, sys, info, msg, boundaries=bnd, &
+    if (info == 0) call assemble_body(msh, body, .true., notr, 0, system, info, msg, boundaries=bnd, &
                                       contact_group='disc_arc')
     call report(info == 0, 'Hertz disc, ux=0 on its axis: assembled ('//trim(msg)//')')
     if (info /= 0) return
-    call check_body('Hertz disc, ux=0 on its axis', msh, body, sys, [TY], 1, [0.0_wp, 0.0_wp], 'disc_arc', .true.)
+    call check_body('Hertz disc, ux=0 on its axis', msh, body, system, [TY], 1, [0.0_wp, 0.0_wp], 'disc_arc', .true.)
   end subroutine disc_case
 
   ! ---------------------------------------------------------------------------------------
@@ -396,7 +396,7 @@ contains
     end do
   end subroutine qp_enumerate
 
-  !> SMALBE as the contact solver sets it up (contact.f90 eq_init/eq_add): rho = 10
+  !> SMALBE as the contact solver sets it up (equality_rows: equality_init and equality_add_penalty): rho = 10
   !! lambda_max(H)/lambda_max(GG'), A = H + rho G'G, M0 = lambda_max/sqrt(|GG'|).
   subroutine run_smalbe(h, c, gm, e, l, x, mu, g, st, rho)
     real(wp), intent(in) :: h(:, :), c(:), gm(:, :), e(:), l(:)
@@ -404,7 +404,7 @@ contains
     type(smalbe_stats_t), intent(out) :: st
     real(wp), intent(out) :: rho
     type(dense_op_t) :: op
-    type(mprgp_opts_t) :: opts
+    type(mprgp_t) :: solver
     real(wp), allocatable :: gg(:, :)
     real(wp) :: ev(8), work(64), lmax
     integer :: r, info
@@ -415,11 +415,14 @@ contains
     lmax = maxval(sum(abs(h), dim=1))
     rho = 10.0_wp*lmax/ev(r)
     call dense_op_init(op, h + rho*matmul(transpose(gm), gm))
-    opts%rtol = 1.0e-14_wp
-    opts%lambda_max = lmax + rho*ev(r)
+    solver%opts%rtol = 1.0e-14_wp
+    solver%opts%lambda_max = lmax + rho*ev(r)
+    solver%opts%eq_m = lmax/sqrt(ev(r))           ! SMALBE's initial M
+    solver%opts%eq_feas = 1.0e-14_wp*norm2(e)     ! |Gx - e| that counts as feasible
     x = max(l, 0.0_wp)
     mu = 0.0_wp
-    call smalbe_solve(op, c, gm, e, rho, l, x, mu, opts, lmax/sqrt(ev(r)), 1.0e-14_wp*norm2(e), st, g)
+    call smalbe_solve(solver, op, c, gm, e, rho, l, x, mu, st)
+    g = solver%g
   end subroutine run_smalbe
 
   !> A QP with a known solution: x* with nact entries at the bound l, the rest above it;

@@ -5,7 +5,7 @@ program test_mprgp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
   use linop, only: linop_t, dense_op_t, csc_op_t, dense_op_init
-  use mprgp, only: mprgp_solve, lambda_max_estimate, mprgp_status_name, mprgp_opts_t, mprgp_stats_t, &
+  use mprgp, only: mprgp_t, lambda_max_estimate, mprgp_status_name, mprgp_opts_t, mprgp_stats_t, &
                    MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, &
                    MPRGP_STOPPED
   use lapack, only: dposv
@@ -28,10 +28,80 @@ program test_mprgp
   call test_threads()
   call test_stop_hook()
   call test_recycle()
+  call test_solver_reuse()
 
   call test_summary()
 
 contains
+
+  !> One solve by a fresh solver with the options opts: x in/out, st its outcome; g = A x - b
+  !! and ax = A x at the returned x when asked for (ax in: A x at the warm start, with
+  !! opts%use_ax); the ring of stored directions rw, raw, nrw when given.
+  subroutine solve_once(op, b, l, x, opts, st, g, ax, rw, raw, nrw)
+    class(linop_t), intent(inout) :: op
+    real(wp), intent(in) :: b(:), l(:)
+    real(wp), intent(inout) :: x(:)
+    type(mprgp_opts_t), intent(in) :: opts
+    type(mprgp_stats_t), intent(out) :: st
+    real(wp), intent(out), optional :: g(:)
+    real(wp), intent(inout), optional :: ax(:)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
+    integer, intent(inout), optional :: nrw(2)
+    type(mprgp_t) :: solver
+    solver%opts = opts
+    if (present(ax)) solver%ax = ax
+    call solver%solve(op, b, l, x, rw, raw, nrw)
+    st = solver%stats
+    if (st%status == MPRGP_BAD_ARG) return
+    if (present(g)) g = solver%g
+    if (present(ax)) ax = solver%ax
+  end subroutine solve_once
+
+  !> One solver for a sequence of solves of different sizes returns what a fresh solver
+  !! returns, bit for bit, with g = A x - b and ax = A x at the returned x (to rounding);
+  !! its search direction serves one solve only.
+  subroutine test_solver_reuse()
+    integer, parameter :: n1 = 30, n2 = 17
+    real(wp) :: a1(n1, n1), a2(n2, n2), b1(n1), b2(n2), l1(n1), l2(n2), lmin, lmax
+    real(wp) :: x1(n1), x2(n2), y1(n1), y2(n2), err
+    type(dense_op_t) :: op1, op2
+    type(mprgp_t) :: reused, fresh1, fresh2
+    integer :: i
+    call random_spd(n1, 2.0_wp, a1, lmin, lmax)
+    call random_spd(n2, 2.0_wp, a2, lmin, lmax)
+    call dense_op_init(op1, a1)
+    call dense_op_init(op2, a2)
+    do i = 1, n1
+      b1(i) = urand(-1.0_wp, 1.0_wp)
+    end do
+    do i = 1, n2
+      b2(i) = urand(-1.0_wp, 1.0_wp)
+    end do
+    l1 = 0.0_wp
+    l2 = 0.0_wp
+    reused%opts%rtol = 1.0e-10_wp
+    fresh1%opts = reused%opts
+    fresh2%opts = reused%opts
+    x1 = 0.0_wp
+    y1 = 0.0_wp
+    call reused%solve(op1, b1, l1, x1)
+    call fresh1%solve(op1, b1, l1, y1)
+    err = maxval(abs(reused%g - (matmul(a1, x1) - b1))) + maxval(abs(reused%ax - matmul(a1, x1)))
+    call report(reused%stats%status == MPRGP_CONVERGED .and. err <= 1.0e-12_wp*lmax*maxval(abs(x1)), &
+                'solver: g = A x - b and ax = A x at the returned x', err)
+    x2 = 0.0_wp
+    y2 = 0.0_wp
+    reused%s = b2
+    reused%as = matmul(a2, b2)
+    fresh2%s = reused%s
+    fresh2%as = reused%as
+    call reused%solve(op2, b2, l2, x2)
+    call fresh2%solve(op2, b2, l2, y2)
+    call report(all(x1 == y1) .and. all(x2 == y2) .and. reused%stats%n_matvec == fresh2%stats%n_matvec .and. &
+                reused%stats%n_recycled == fresh2%stats%n_recycled, &
+                'solver: a reused solver (sizes 30, 17) returns a fresh one''s iterates bit for bit')
+    call report(.not. (allocated(reused%s) .or. allocated(reused%as)), 'solver: a search direction serves one solve')
+  end subroutine test_solver_reuse
 
   !> The stop hook: a solve asked to stop returns MPRGP_STOPPED at once with a feasible
   !! iterate, after fewer steps than it needs to converge.
@@ -48,7 +118,7 @@ contains
     opts%rtol = 1.0e-10_wp
     opts%stop => stop_after_five
     calls = 0
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_STOPPED .and. st%n_cg + st%n_exp + st%n_prop == 5 .and. all(x >= l), &
                 'stop hook: stops after the step it turned true at (5 steps), iterate feasible', &
                 real(st%n_cg + st%n_exp + st%n_prop, wp))
@@ -93,9 +163,9 @@ contains
       do v = 1, 2
         opts%recycle = v == 1
         if (v == 1) then
-          call mprgp_solve(op, b, l, x(:, v), opts, st, g, ax(:, v), rw=rw, raw=raw, nrw=nrw)
+          call solve_once(op, b, l, x(:, v), opts, st, g, ax(:, v), rw=rw, raw=raw, nrw=nrw)
         else
-          call mprgp_solve(op, b, l, x(:, v), opts, st, g, ax(:, v))
+          call solve_once(op, b, l, x(:, v), opts, st, g, ax(:, v))
         end if
         nmv(v) = nmv(v) + st%n_matvec
         ! the stopping test on the true gradient A x - b
@@ -117,14 +187,14 @@ contains
     call report(nrw(1) == kr .and. err <= 1.0e-12_wp, 'recycle: ring full ('//i2s(nrw(1))// &
                 '), raw = A rw and rw''A rw = 1 to rounding', err, 1.0e-12_wp)
     ! the same problem again: the warm start meets the tolerance, no product
-    call mprgp_solve(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, raw=raw, nrw=nrw)
+    call solve_once(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, raw=raw, nrw=nrw)
     call report(st%status == MPRGP_CONVERGED .and. st%n_matvec == 0, &
                 'recycle: a warm start that meets the tolerance costs no product', real(st%n_matvec, wp), 0.0_wp)
-    call mprgp_solve(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, nrw=nrw)
+    call solve_once(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, nrw=nrw)
     call report(st%status == MPRGP_BAD_ARG, 'recycle: rw without raw refused ('// &
                 mprgp_status_name(st%status)//')')
     nrw = [kr + 1, 1]
-    call mprgp_solve(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, raw=raw, nrw=nrw)
+    call solve_once(op, b, l, x(:, 1), opts, st, g, ax(:, 1), rw=rw, raw=raw, nrw=nrw)
     call report(st%status == MPRGP_BAD_ARG, 'recycle: nrw out of range refused ('// &
                 mprgp_status_name(st%status)//')')
   end subroutine test_recycle
@@ -344,7 +414,7 @@ contains
         end do
       end if
       call dense_op_init(op, a)
-      call mprgp_solve(op, b, l, x, opts, st, g)
+      call solve_once(op, b, l, x, opts, st, g)
       if (st%status == MPRGP_CONVERGED) nconv = nconv + 1
       if (st%status == MPRGP_MAX_IT) nmax_it = nmax_it + 1
       ! error bound: |x - x*| <= |gP| / lambda_min up to a modest constant
@@ -431,7 +501,7 @@ contains
     do k = 1, kcg - 1
       opts%max_it = k
       x = 0.0_wp
-      call mprgp_solve(op, b, l, x, opts, st)
+      call solve_once(op, b, l, x, opts, st)
       diff = norm2(x - xhist(:, k)) / norm2(xhist(:, kcg))
       worst = max(worst, diff)
       if (st%status /= MPRGP_MAX_IT .or. st%n_cg /= k .or. st%n_exp /= 0 .or. st%n_prop /= 0 .or. st%n_matvec /= k + 2) &
@@ -443,7 +513,7 @@ contains
                'n_matvec = k+2 (initial + final true gradient, no power its)')
     opts%max_it = 10000
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_CONVERGED .and. st%n_cg == kcg, &
                'plain CG: converged with the same step count as CG ('//i2s(kcg)//')', real(st%n_cg, wp))
     call report(st%n_exp == 0 .and. st%n_prop == 0 .and. st%n_matvec == st%n_cg + 2, &
@@ -467,7 +537,7 @@ contains
       x = 0.0_wp
       opts%rtol = 1.0e-8_wp
       opts%max_it = 500000
-      call mprgp_solve(op, b, l, x, opts, st, g)
+      call solve_once(op, b, l, x, opts, st, g)
       write (line, '(a,i0,a,i0,a,i0,a,i0,a,i0,a,es9.2)') 'obstacle n = ', n, ': ', st%n_matvec, &
         ' products (cg ', st%n_cg, ', exp ', st%n_exp, ', prop ', st%n_prop, '), |gP|/|b| = ', &
         st%gp_norm / st%b_norm
@@ -494,7 +564,7 @@ contains
   !> Bad arguments, non-finite input, indefinite matrices: a status and a message.
   subroutine test_bad_arguments()
     integer, parameter :: n = 20
-    real(wp) :: a(n, n), b(n), l(n), x(n), lmin, lmax, d(n), xs(n - 1), gsmall(n - 1)
+    real(wp) :: a(n, n), b(n), l(n), x(n), lmin, lmax, d(n), xs(n - 1), axsmall(n - 1)
     type(dense_op_t) :: op
     type(mprgp_opts_t) :: opts, bad
     type(mprgp_stats_t) :: st
@@ -507,27 +577,32 @@ contains
     l = 0.0_wp
     x = 0.0_wp
     xs = 0.0_wp
-    call mprgp_solve(op, b, l, xs, opts, st)
+    call solve_once(op, b, l, xs, opts, st)
     call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: size(x) /= n -> bad argument: "'//trim(st%message)//'"')
-    call mprgp_solve(op, b(1:n - 1), l, x, opts, st)
+    call solve_once(op, b(1:n - 1), l, x, opts, st)
     call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: size(b) /= n -> bad argument')
-    call mprgp_solve(op, b, l, x, opts, st, gsmall)
+    bad = opts
+    bad%use_ax = .true.
+    call solve_once(op, b, l, x, bad, st)
     call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
-               'bad args: size(g) /= n -> bad argument')
+               'bad args: use_ax without ax -> bad argument: "'//trim(st%message)//'"')
+    call solve_once(op, b, l, x, bad, st, ax=axsmall)
+    call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
+               'bad args: size(ax) /= n -> bad argument: "'//trim(st%message)//'"')
     bad = opts
     bad%rtol = -1.0e-6_wp
-    call mprgp_solve(op, b, l, x, bad, st)
+    call solve_once(op, b, l, x, bad, st)
     call report(st%status == MPRGP_BAD_ARG .and. len_trim(st%message) > 0, &
                'bad args: rtol < 0 -> bad argument: "'//trim(st%message)//'"')
     bad = opts
     bad%max_it = -3
-    call mprgp_solve(op, b, l, x, bad, st)
+    call solve_once(op, b, l, x, bad, st)
     call report(st%status == MPRGP_BAD_ARG, 'bad args: max_it < 0 -> bad argument')
     bad = opts
     bad%gamma = 0.0_wp
-    call mprgp_solve(op, b, l, x, bad, st)
+    call solve_once(op, b, l, x, bad, st)
     call report(st%status == MPRGP_BAD_ARG, 'bad args: gamma = 0 -> bad argument')
     call report(mprgp_status_name(MPRGP_BAD_ARG) == 'bad argument' .and. &
                mprgp_status_name(MPRGP_NOT_SPD) == 'not SPD' .and. &
@@ -536,19 +611,19 @@ contains
                mprgp_status_name(MPRGP_CONVERGED) == 'converged', 'status names')
     ! NaN in b, NaN in lb
     b(3) = ieee_value(1.0_wp, ieee_quiet_nan)
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_NONFINITE .and. len_trim(st%message) > 0, &
                'NaN in b -> non-finite: "'//trim(st%message)//'"')
     b(3) = 0.5_wp
     l(5) = ieee_value(1.0_wp, ieee_quiet_nan)
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_NONFINITE, 'NaN in lb -> non-finite')
     l(5) = 0.0_wp
     ! max_it reached is reported, not silent
     bad = opts
     bad%max_it = 2
     x = 0.0_wp
-    call mprgp_solve(op, b, -b * 0.0_wp - 1.0_wp, x, bad, st)
+    call solve_once(op, b, -b * 0.0_wp - 1.0_wp, x, bad, st)
     call report(st%status == MPRGP_MAX_IT .and. len_trim(st%message) > 0, &
                'max_it = 2 -> max_it: "'//trim(st%message)//'"')
     ! indefinite matrix (eigenvalues of both signs), no bounds, generic b
@@ -559,25 +634,25 @@ contains
     call dense_op_init(op, a)
     l = nobound
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_NOT_SPD, 'indefinite A, no bounds -> not SPD: "'//trim(st%message)//'"')
     ! negative definite with bounds: every direction has p'Ap < 0
     call spd_from_eigs(n, -abs(d), a)
     call dense_op_init(op, a)
     l = -1.0_wp
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status /= MPRGP_CONVERGED .and. st%status /= MPRGP_BAD_ARG, &
                'negative definite A with bounds -> not converged ('//mprgp_status_name(st%status)//')')
     ! zero matrix
     a = 0.0_wp
     call dense_op_init(op, a)
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_NOT_SPD, 'zero A -> not SPD ('//mprgp_status_name(st%status)//')')
     ! empty problem
     call dense_op_init(op, a(1:0, 1:0))
-    call mprgp_solve(op, b(1:0), l(1:0), x(1:0), opts, st)
+    call solve_once(op, b(1:0), l(1:0), x(1:0), opts, st)
     call report(st%status == MPRGP_CONVERGED, 'n = 0 -> converged')
   end subroutine test_bad_arguments
 
@@ -619,14 +694,14 @@ contains
     b = 0.0_wp
     l = -1.0_wp
     x = 0.3_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_CONVERGED .and. maxval(abs(x)) <= 1.0e3_wp * eps, &
                'b = 0, l < 0: converged to x = 0 ('//trim(st%message)//')', maxval(abs(x)))
     do i = 1, n
       l(i) = merge(0.5_wp, nobound, mod(i, 2) == 0)
     end do
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call enumerate_qp(n, a, b, l, xs, ok)
     gt = matmul(a, x) - b
     tolg = 100.0_wp * n * eps * lmax * norm2(x)
@@ -636,7 +711,7 @@ contains
                norm2(x - xs) / norm2(xs))
     opts%atol = 1.0e-6_wp
     x = 0.0_wp
-    call mprgp_solve(op, b, l, x, opts, st)
+    call solve_once(op, b, l, x, opts, st)
     call report(st%status == MPRGP_CONVERGED .and. st%gp_norm <= 1.0e-6_wp, &
                'b = 0 with atol = 1e-6: converged on the absolute floor', st%gp_norm, 1.0e-6_wp)
   end subroutine test_zero_rhs
@@ -683,14 +758,14 @@ contains
     opts%rtol = 1.0e-8_wp
     opts%max_it = 100000
     x0 = 0.0_wp
-    call mprgp_solve(op, b, l, x0, opts, st0)
+    call solve_once(op, b, l, x0, opts, st0)
     opts%lambda_max = 0.1_wp * lam_true
     x1 = 0.0_wp
-    call mprgp_solve(op, b, l, x1, opts, st1)
+    call solve_once(op, b, l, x1, opts, st1)
     opts%lambda_max = 0.0_wp
     opts%alpha_bar = 20.0_wp / lam_true
     x2 = 0.0_wp
-    call mprgp_solve(op, b, l, x2, opts, st2)
+    call solve_once(op, b, l, x2, opts, st2)
     tolx = 10.0_wp * opts%rtol * norm2(b) / lam_min
     d = max(norm2(x1 - x0), norm2(x2 - x0))
     call report(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. &
@@ -731,9 +806,9 @@ contains
     opts%rtol = 1.0e-8_wp
     opts%max_it = 100000
     x0 = 0.0_wp
-    call mprgp_solve(op0, b, l, x0, opts, st0)
+    call solve_once(op0, b, l, x0, opts, st0)
     x1 = 0.0_wp
-    call mprgp_solve(op1, 1.0e6_wp * b, 1.0e-5_wp * l, x1, opts, st1)
+    call solve_once(op1, 1.0e6_wp * b, 1.0e-5_wp * l, x1, opts, st1)
     tolx = 10.0_wp * opts%rtol * norm2(b) / (acos(-1.0_wp)**2)
     d = norm2(1.0e5_wp * x1 - x0)
     call report(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. d <= tolx, &
@@ -748,9 +823,9 @@ contains
     call dense_op_init(dop0, a)
     call dense_op_init(dop1, 1.0e11_wp * a)
     xr0 = 0.0_wp
-    call mprgp_solve(dop0, br, lr, xr0, opts, st0)
+    call solve_once(dop0, br, lr, xr0, opts, st0)
     xr1 = 0.0_wp
-    call mprgp_solve(dop1, 1.0e6_wp * br, 1.0e-5_wp * lr, xr1, opts, st1)
+    call solve_once(dop1, 1.0e6_wp * br, 1.0e-5_wp * lr, xr1, opts, st1)
     tolx = 10.0_wp * opts%rtol * norm2(br) / lmin
     d = norm2(1.0e5_wp * xr1 - xr0)
     call report(st0%status == MPRGP_CONVERGED .and. st1%status == MPRGP_CONVERGED .and. d <= tolx .and. &
@@ -782,8 +857,8 @@ contains
     opts%rtol = 1.0e-10_wp
     xs1 = 0.0_wp
     xs2 = 0.0_wp
-    call mprgp_solve(op1, b1, l1, xs1, opts, s1)
-    call mprgp_solve(op2, b2, l2, xs2, opts, s2)
+    call solve_once(op1, b1, l1, xs1, opts, s1)
+    call solve_once(op2, b2, l2, xs2, opts, s2)
     ok = .true.
     d = 0.0_wp
     do rep = 1, 20
@@ -791,9 +866,9 @@ contains
       xp2 = 0.0_wp
       !$omp parallel sections num_threads(2)
       !$omp section
-      call mprgp_solve(op1, b1, l1, xp1, opts, t1)
+      call solve_once(op1, b1, l1, xp1, opts, t1)
       !$omp section
-      call mprgp_solve(op2, b2, l2, xp2, opts, t2)
+      call solve_once(op2, b2, l2, xp2, opts, t2)
       !$omp end parallel sections
       d = max(d, norm2(xp1 - xs1) / norm2(xs1), norm2(xp2 - xs2) / norm2(xs2))
       ok = ok .and. t1%status == MPRGP_CONVERGED .and. t2%status == MPRGP_CONVERGED .and. &

@@ -3,8 +3,8 @@
 !!     minimise 1/2 x'Hx - c'x   subject to   x >= l,   G x = e      (G: r x n, r small)
 !!
 !! with MPRGP (module mprgp) as its inner solver. Z. Dostal, "Optimal Quadratic
-!! Programming Algorithms", Springer 2009, ch. 9; the form used here (README, "Bodies
-!! held only by contact"): for a fixed penalty rho and multipliers mu,
+!! Programming Algorithms", Springer 2009, ch. 9; the form used here (doc/method.md,
+!! "Bodies held only by contact"): for a fixed penalty rho and multipliers mu,
 !!
 !!     L(x, mu, rho) = 1/2 x'Hx - c'x + mu'(Gx - e) + rho/2 |Gx - e|^2
 !!
@@ -22,7 +22,7 @@ module smalbe
   use kinds, only: wp
   use linop, only: linop_t
   use lapack, only: dposv
-  use mprgp, only: mprgp_opts_t, mprgp_stats_t, mprgp_solve, MPRGP_CONVERGED, MPRGP_MAX_IT
+  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT
   implicit none (type, external)
   private
 
@@ -42,12 +42,16 @@ module smalbe
 
 contains
 
-  !> Solve the bound- and equality-constrained QP (module header). opts is MPRGP's
-  !! options for every inner solve (rtol/atol give eta; use_ax, recycle as in mprgp_solve,
-  !! the first solve only for use_ax); m0 > 0 the initial M. mu holds the warm start of
-  !! the multipliers and returns them. stats%inner%status is MPRGP_CONVERGED only when
-  !! both the projected gradient and |Gx - e| met their tolerances.
-  subroutine smalbe_solve(A, c, gm, e, rho, lb, x, mu, opts, m0, feas, stats, g, ax, s, as, rw, raw, nrw)
+  !> Solve the bound- and equality-constrained QP (module header) with the MPRGP solver
+  !! `solver` for every inner solve: its options give eta (rtol/atol), max_it, lambda_max of
+  !! A, use_ax (its ax: A x at the warm start, first solve only), recycle, and SMALBE's
+  !! initial M (opts%eq_m > 0) and the |Gx - e| that counts as feasible (opts%eq_feas); its
+  !! search direction s, as (if any) serves the first solve. On return solver%g holds
+  !! Hx - c + G'mu and solver%ax A x. mu holds the warm start of the multipliers and returns
+  !! them. stats%inner%status is MPRGP_CONVERGED only when both the projected gradient and
+  !! |Gx - e| met their tolerances.
+  subroutine smalbe_solve(solver, A, c, gm, e, rho, lb, x, mu, stats, rw, raw, nrw)
+    type(mprgp_t), intent(inout) :: solver      !< inner solver (options; ax, g as above)
     class(linop_t), intent(inout) :: A          !< H + rho G'G
     real(wp), intent(in) :: c(:)                !< (n) linear term
     real(wp), intent(in) :: gm(:, :)            !< (r, n) equality rows G
@@ -56,52 +60,41 @@ contains
     real(wp), intent(in) :: lb(:)               !< (n) lower bounds
     real(wp), intent(inout) :: x(:)             !< in: warm start; out: solution
     real(wp), intent(inout) :: mu(:)            !< (r) in: warm start; out: multipliers
-    type(mprgp_opts_t), intent(in) :: opts      !< inner options (tolerance eta, max_it, lambda_max of A...)
-    real(wp), intent(in) :: m0                  !< initial M (units of c per unit of e)
-    real(wp), intent(in) :: feas                !< |Gx - e| that counts as feasible (units of e)
     type(smalbe_stats_t), intent(out) :: stats
-    real(wp), intent(out) :: g(:)               !< (n) Hx - c + G'mu at the returned x, mu
-    real(wp), intent(inout), optional :: ax(:)  !< as in mprgp_solve (A x)
-    real(wp), intent(in), optional :: s(:), as(:)             !< first line search (first solve only)
-    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_solve)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_t%solve)
     integer, intent(inout), optional :: nrw(2)
-    type(mprgp_opts_t) :: o
-    real(wp), allocatable :: rhs(:), r(:), axl(:)
-    real(wp) :: lag_old, lag_new, rr, mm
+    type(mprgp_opts_t) :: opts
+    real(wp), allocatable :: rhs(:), r(:)
+    real(wp) :: lag_old, lag_new, rr, m_control, feas
     integer :: n, k
     logical :: have_ax
 
     n = size(x)
-    allocate (rhs(n), r(size(e)), axl(n))
-    o = opts
-    o%eq_feas = feas
-    mm = m0
-    have_ax = opts%use_ax .and. present(ax)
-    if (have_ax) then
-      axl = ax
-      call multiplier_estimate(gm, e, rho, lb, x, c, axl, mu)
-    end if
+    allocate (rhs(n), r(size(e)))
+    opts = solver%opts
+    feas = opts%eq_feas
+    m_control = opts%eq_m
+    have_ax = opts%use_ax .and. allocated(solver%ax)
+    if (have_ax) call multiplier_estimate(gm, e, rho, lb, x, c, solver%ax, mu)
+    solver%eq_g = gm
+    solver%eq_e = e
     lag_old = -huge(1.0_wp)
     stats%updates = 0
     do k = 1, SMALBE_MAX_UPDATES
-      o%eq_m = mm
-      o%use_ax = have_ax
+      solver%opts = opts
+      solver%opts%eq_m = m_control
+      solver%opts%use_ax = have_ax
       ! a projected gradient below the rounding of a product with A cannot be reached (A
       ! holds rho G'G, about RHO_FACTOR times the Hessian's own scale): floor the tolerance
       ! there, sqrt(n) eps lambda_max(A) |x|, instead of spinning MPRGP up to max_it (measured:
       ! a floating body under the harmonic tolerance, 1.2 M products for m = 25 without it; a
       ! floor 10 times higher costs a soft floating body's contrast case its last digits)
       if (opts%lambda_max > 0.0_wp) &
-        o%atol = max(opts%atol, sqrt(real(n, wp))*epsilon(1.0_wp)*opts%lambda_max*norm2(x))
+        solver%opts%atol = max(opts%atol, sqrt(real(n, wp))*epsilon(1.0_wp)*opts%lambda_max*norm2(x))
       ! linear term of L(., mu, rho) with the penalty's part: c - G'mu + rho G'e
       rhs = c - matmul(mu - rho*e, gm)
-      if (k == 1 .and. present(s) .and. present(rw)) then
-        call mprgp_solve(A, rhs, lb, x, o, stats%inner, g, axl, s, as, rw, raw, nrw, eq_g=gm, eq_e=e)
-      else if (present(rw)) then
-        call mprgp_solve(A, rhs, lb, x, o, stats%inner, g, axl, rw=rw, raw=raw, nrw=nrw, eq_g=gm, eq_e=e)
-      else
-        call mprgp_solve(A, rhs, lb, x, o, stats%inner, g, axl, eq_g=gm, eq_e=e)
-      end if
+      call solver%solve(A, rhs, lb, x, rw, raw, nrw)
+      stats%inner = solver%stats
       have_ax = .true.
       stats%n_matvec = stats%n_matvec + stats%inner%n_matvec
       r = matmul(gm, x) - e
@@ -113,20 +106,21 @@ contains
       if (stats%inner%status /= MPRGP_CONVERGED) exit
       ! L(x, mu_new, rho) = 1/2 x'Ax - x'rhs(mu_old) + mu_old'(Gx - e)... written out:
       ! 1/2 x'Hx - c'x + mu_new'(Gx - e) + rho/2 |Gx - e|^2, with x'Hx = x'Ax - rho |Gx|^2
-      lag_new = 0.5_wp*(dot_product(x, axl) - rho*sum(matmul(gm, x)**2)) - dot_product(c, x) + &
+      lag_new = 0.5_wp*(dot_product(x, solver%ax) - rho*sum(matmul(gm, x)**2)) - dot_product(c, x) + &
                 dot_product(mu, r) + 0.5_wp*rho*rr*rr
       stats%updates = k
       if (rr <= feas) exit
-      if (lag_new < lag_old + 0.5_wp*rho*rr*rr) mm = BETA*mm
+      if (lag_new < lag_old + 0.5_wp*rho*rr*rr) m_control = BETA*m_control
       lag_old = lag_new
     end do
-    stats%m_final = mm
+    stats%m_final = m_control
     if (stats%inner%status == MPRGP_CONVERGED .and. stats%feas > feas) then
       stats%inner%status = MPRGP_MAX_IT
       write (stats%inner%message, '(a,i0,a,es10.3,a,es10.3)') 'SMALBE: ', SMALBE_MAX_UPDATES, &
         ' multiplier updates without |Gx - e| = ', stats%feas, ' <= ', feas
     end if
-    if (present(ax)) ax = axl
+    solver%opts = opts
+    deallocate (solver%eq_g, solver%eq_e)
   end subroutine smalbe_solve
 
   !> A better start for the multipliers when the warm start mu is far off: the least-squares

@@ -1,0 +1,92 @@
+!> The equality rows G lam = e of bodies held only by contact (module floating), as the
+!! QP solvers see them: each floating body's equilibrium, with the SMALBE settings that go
+!! with the Hessian H they are added to (A = H + rho G'G).
+module equality_rows
+  use kinds, only: wp
+  use lapack, only: dgemm, dsyev
+  use linop, only: dense_op_t
+  use condense, only: body_condensed_t
+  implicit none (type, external)
+  private
+
+  real(wp), parameter :: RHO_FACTOR = 10.0_wp       !< SMALBE penalty rho = RHO_FACTOR lambda_max(H) / |G G'|
+  real(wp), parameter :: FEAS_RTOL = 1.0e-12_wp     !< equilibrium: |G lam - e| <= FEAS_RTOL |e| (monolithic)
+
+  !> Equality rows G lam = e and the SMALBE settings for a Hessian H.
+  type, public :: equality_t
+    integer :: r = 0                          !< rows (0: no equality, plain MPRGP)
+    real(wp), allocatable :: g(:, :)          !< (r, m) G [-]
+    real(wp), allocatable :: e(:)             !< (r) e [force]
+    real(wp) :: rho = 0.0_wp                  !< penalty [length/force]
+    real(wp) :: gg = 0.0_wp                   !< lambda_max(G G') [-]
+    real(wp) :: m0 = 0.0_wp                   !< SMALBE's initial M [length/force]
+    real(wp) :: feas = 0.0_wp                 !< |G lam - e| that counts as equilibrium [force]
+  end type equality_t
+
+  public :: equality_init, equality_add_penalty, gram_eigenvalues, stacked_rows
+
+contains
+
+  !> The equality rows G lam = e for a QP whose Hessian H has its largest eigenvalue below
+  !! lmax: the penalty rho = RHO_FACTOR lmax / lambda_max(G G') (A = H + rho G'G stays within
+  !! (1 + RHO_FACTOR) lmax, and a multiplier update reduces |G lam - e| by about
+  !! 1 / (1 + RHO_FACTOR)), SMALBE's initial M = lmax / sqrt(lambda_max(G G')) (a gradient per
+  !! unit of force imbalance), and the equilibrium tolerance FEAS_RTOL |e|.
+  subroutine equality_init(q, g, e, lmax)
+    type(equality_t), intent(out) :: q      !< the rows and their settings
+    real(wp), intent(in) :: g(:, :)         !< (r, m) G
+    real(wp), intent(in) :: e(:)            !< (r) e
+    real(wp), intent(in) :: lmax            !< bound of lambda_max(H)
+    q%r = size(g, 1)
+    q%g = g
+    q%e = e
+    q%gg = max(maxval(gram_eigenvalues(g)), tiny(1.0_wp))
+    q%rho = RHO_FACTOR*lmax/q%gg
+    q%m0 = lmax/sqrt(q%gg)
+    q%feas = FEAS_RTOL*max(norm2(e), tiny(1.0_wp))
+  end subroutine equality_init
+
+  !> Add the penalty rho G'G to the dense Hessian and its bound to lmax.
+  subroutine equality_add_penalty(q, hessian, lmax)
+    type(equality_t), intent(in) :: q              !< the rows (equality_init)
+    type(dense_op_t), intent(inout) :: hessian     !< H in, H + rho G'G out
+    real(wp), intent(inout) :: lmax                !< bound of lambda_max(H) in, of the sum out
+    integer :: m
+    m = size(q%g, 2)
+    call dgemm('T', 'N', m, m, q%r, q%rho, q%g, q%r, q%g, q%r, 1.0_wp, hessian%a, m)
+    lmax = lmax + q%rho*q%gg
+  end subroutine equality_add_penalty
+
+  !> Both bodies' equilibrium rows stacked, body 1's first: g (r1 + r2, m), e (r1 + r2).
+  subroutine stacked_rows(bodies, g, e)
+    type(body_condensed_t), intent(in) :: bodies(2)      !< condensed bodies
+    real(wp), allocatable, intent(out) :: g(:, :)        !< stacked G_a
+    real(wp), allocatable, intent(out) :: e(:)           !< stacked e_a
+    integer :: r1
+    r1 = bodies(1)%nrig
+    allocate (g(r1 + bodies(2)%nrig, bodies(1)%m), e(r1 + bodies(2)%nrig))
+    if (r1 > 0) g(1:r1, :) = bodies(1)%rg
+    if (r1 > 0) e(1:r1) = bodies(1)%re
+    if (bodies(2)%nrig > 0) g(r1 + 1:, :) = bodies(2)%rg
+    if (bodies(2)%nrig > 0) e(r1 + 1:) = bodies(2)%re
+  end subroutine stacked_rows
+
+  !> The eigenvalues of G G' (r <= 6 rows), ascending; if LAPACK fails, 0 and, last, the
+  !! row-sum bound of the largest (what the penalty and the error bound's projection can
+  !! still use safely).
+  function gram_eigenvalues(g) result(ev)
+    real(wp), intent(in) :: g(:, :)   !< (r, m) rows
+    real(wp) :: ev(size(g, 1))
+    real(wp) :: work(64), gg(size(g, 1), size(g, 1))
+    integer :: r, info
+    r = size(g, 1)
+    gg = matmul(g, transpose(g))
+    call dsyev('N', 'U', r, gg, r, ev, work, size(work), info)
+    if (info /= 0) then
+      gg = matmul(g, transpose(g))
+      ev = 0.0_wp
+      ev(r) = maxval(sum(abs(gg), dim=1))
+    end if
+  end function gram_eigenvalues
+
+end module equality_rows

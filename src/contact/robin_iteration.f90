@@ -1,0 +1,304 @@
+!> The Robin domain-decomposition iteration (doc/method.md, "Method as implemented"):
+!! each body's contact problem against its obstacle (module robin_subproblems), the force
+!! imbalance d = lam_1 - lam_2, its Robin correction (module robin_operators), and the
+!! relaxed or accelerated update of the obstacles (module acceleration), until the bodies
+!! agree. Everything here is interface-sized: O(m^2) per Hessian product.
+module robin_iteration
+  use kinds, only: wp
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use config, only: solver_cfg_t, STOP_RESIDUAL
+  use clock, only: wtime
+  use condense, only: interface_t, body_condensed_t
+  use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
+                           grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
+                           STATUS_INTERRUPTED
+  use contact_common, only: interface_residual, maxabs, all_finite
+  use robin_operators, only: robin_operator_t, new_robin_operator
+  use robin_subproblems, only: subproblems_t, subproblems_init, solve_subproblems
+  use acceleration, only: accelerate
+  implicit none (type, external)
+  private
+
+  integer, parameter :: STALL_LIMIT = 25      !< iterations of small increment / large residual before 'diverged'
+  integer, parameter :: HISTORY_CHUNK = 256   !< initial history entries (grown by doubling)
+  integer, parameter :: FLAT_LIMIT = 50       !< iterations without a 1% better residual before 'diverged' (stop='residual')
+
+  public :: solve_robin
+
+contains
+
+  !> The Robin iteration. With `state` the iteration resumes from a checkpoint; `ckpt%save`
+  !! is called every ckpt%every iterations and when `stop_requested` turns true.
+  subroutine solve_robin(solver, contact_line, bodies, res, progress_unit, progress_lines, state, ckpt, stop_requested)
+    type(solver_cfg_t), intent(in) :: solver                !< solver settings
+    type(interface_t), intent(in) :: contact_line           !< contact line
+    type(body_condensed_t), intent(in) :: bodies(2)         !< condensed bodies
+    type(contact_result_t), intent(inout) :: res            !< solution, status and history (in: history of a restart)
+    integer, intent(in), optional :: progress_unit          !< unit for progress lines (none if absent)
+    integer, intent(in), optional :: progress_lines         !< at most about this many progress lines (default 30)
+    type(robin_state_t), intent(inout), optional :: state   !< in: state to resume from (state%it > 0)
+    class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
+    procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
+    type(robin_state_t) :: run_state
+    type(subproblems_t), target :: subproblems
+    class(robin_operator_t), allocatable :: robin_op
+    real(wp) :: t0
+    integer :: m, every, info
+    logical :: resumed
+
+    m = contact_line%m
+    t0 = wtime()
+    resumed = .false.
+    if (present(state)) resumed = state%it > 0
+    if (resumed) then
+      run_state = state
+      t0 = t0 - run_state%wall
+    else
+      ! the history grows as the run goes (max_outer may be huge)
+      call alloc_result(res, m, min(solver%max_outer, HISTORY_CHUNK))
+      call state_init(run_state, m, contact_line%g0)
+    end if
+    res%method = 'robin'
+
+    robin_op = new_robin_operator(solver%robin_operator)
+    call subproblems_init(subproblems, bodies, robin_op, run_state, resumed)
+    call robin_op%setup(solver, contact_line, bodies, subproblems%flexibility, info, res%message)
+    if (info /= 0) then
+      res%status = STATUS_FAILED
+      return
+    end if
+    every = 30
+    if (present(progress_lines)) every = progress_lines
+    every = max(1, solver%max_outer/max(1, every))
+    res%status = STATUS_MAX_OUTER
+    if (resumed .and. run_state%it >= solver%max_outer) then
+      call restore_iterate(contact_line, bodies, subproblems, run_state, res)
+      if (present(progress_unit)) write (progress_unit, '(a,i0,a)') 'the checkpoint is at outer iteration ', &
+        run_state%it, ' = max_outer: nothing left to do, its result is written again (raise max_outer to go on)'
+    end if
+    if (present(progress_unit)) then
+      if (resumed) write (progress_unit, '(a,i0)') 'resuming after outer iteration ', run_state%it
+      write (progress_unit, '(a)') '  outer   criterion    residual  active       inner'
+    end if
+    call outer_loop(solver, contact_line, bodies, subproblems, robin_op, t0, every, run_state, res, &
+                    progress_unit, ckpt, stop_requested)
+    if (present(state)) state = run_state
+  end subroutine solve_robin
+
+  !> The outer iterations from run_state%it + 1 to max_outer: subproblems, correction,
+  !! update, record, termination test, progress line, checkpoint.
+  subroutine outer_loop(solver, contact_line, bodies, subproblems, robin_op, t0, every, run_state, res, &
+                        progress_unit, ckpt, stop_requested)
+    type(solver_cfg_t), intent(in) :: solver
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(2)
+    type(subproblems_t), target, intent(inout) :: subproblems     !< (the Robin operator may refer to its F_a)
+    class(robin_operator_t), intent(inout) :: robin_op
+    real(wp), intent(in) :: t0                              !< wall time the iteration started at
+    integer, intent(in) :: every                            !< a progress line every this many iterations
+    type(robin_state_t), intent(inout) :: run_state
+    type(contact_result_t), intent(inout) :: res
+    integer, intent(in), optional :: progress_unit
+    class(checkpointer_t), intent(inout), optional :: ckpt
+    procedure(stop_iface), optional :: stop_requested
+    real(wp), allocatable :: g_new(:, :), w(:, :), dlam(:), corr(:, :)
+    real(wp) :: rtol_in, uref
+    integer :: m, it
+    logical :: printed
+
+    m = contact_line%m
+    allocate (g_new(m, 2), w(m, 2), dlam(m), corr(m, 2))
+    uref = max(maxabs(bodies(1)%b), maxabs(bodies(2)%b), maxabs(contact_line%g0), tiny(1.0_wp))
+    printed = .false.
+    do it = run_state%it + 1, solver%max_outer
+      ! 1. each body against its obstacle, in parallel
+      rtol_in = robin_op%inner_tolerance(solver, it, m, run_state%progress, subproblems%lmax_body)
+      call solve_subproblems(subproblems, solver, bodies, rtol_in, it, run_state, w, res)
+      if (m == 0) then
+        res%status = STATUS_CONVERGED
+        res%outer = it
+        exit
+      end if
+      if (res%status == STATUS_FAILED) then
+        res%outer = it
+        exit
+      end if
+      ! 2. force imbalance and its Robin correction
+      dlam = run_state%lam(:, 1) - run_state%lam(:, 2)
+      call robin_op%apply(dlam, corr, run_state%inner)
+      ! 3. the fixed-point map T(G) and the relaxed or accelerated update
+      g_new(:, 1) = contact_line%g0 - w(:, 2) + corr(:, 1)
+      g_new(:, 2) = contact_line%g0 - w(:, 1) - corr(:, 2)
+      call accelerate(solver%acceleration, solver%delta, run_state, g_new)
+      ! a non-finite iterate is not kept: the result holds the last finite one
+      if (.not. (all_finite(g_new) .and. all_finite(run_state%lam) .and. all_finite(w))) then
+        res%status = STATUS_DIVERGED
+        write (res%message, '(a,i0)') 'non-finite values in the outer iteration at iteration ', it
+        exit
+      end if
+      call record_iteration(solver, contact_line, bodies, it, g_new, w, t0, run_state, res)
+      printed = .false.
+      if (present(progress_unit) .and. (it <= 5 .or. mod(it, every) == 0)) then
+        write (progress_unit, '(i7,2es12.3,i8,i12)') it, run_state%crit, res%residual, res%active, run_state%inner
+        printed = .true.
+      end if
+      if (check_termination(solver, it, uref, run_state, res)) exit
+      if (present(stop_requested)) then
+        if (stop_requested()) then
+          res%status = STATUS_INTERRUPTED
+          write (res%message, '(a,i0)') 'stopped by a signal after outer iteration ', it
+          if (present(ckpt)) call ckpt%save(run_state, res)
+          exit
+        end if
+      end if
+      if (present(ckpt)) then
+        if (ckpt%every > 0) then
+          if (mod(it, ckpt%every) == 0) call ckpt%save(run_state, res)
+        end if
+      end if
+    end do
+    if (present(progress_unit) .and. res%outer > 0 .and. .not. printed) &
+      write (progress_unit, '(i7,2es12.3,i8,i12)') res%outer, res%criterion, res%residual, res%active, res%inner
+    if (res%status == STATUS_MAX_OUTER) write (res%message, '(a,i0,a,es10.3)') 'max_outer = ', solver%max_outer, &
+      ' reached; last criterion ', res%criterion
+  end subroutine outer_loop
+
+  !> A run resumed from a checkpoint taken at max_outer has nothing left to do: its result
+  !! is the checkpointed iterate (contact forces, obstacles, history), with the normal
+  !! displacements B_a u_a = b_a - F_a lam_a and the residuals recomputed.
+  subroutine restore_iterate(contact_line, bodies, subproblems, run_state, res)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(2)
+    type(subproblems_t), intent(inout) :: subproblems
+    type(robin_state_t), intent(in) :: run_state
+    type(contact_result_t), intent(inout) :: res
+    real(wp), allocatable :: flam(:)
+    integer :: a
+    allocate (flam(contact_line%m))
+    res%lam_body = run_state%lam
+    do a = 1, 2
+      if (contact_line%m > 0) call subproblems%flexibility(a)%apply(run_state%lam(:, a), flam)
+      res%w(:, a) = bodies(a)%b - flam
+      if (bodies(a)%nrig > 0) res%w(:, a) = res%w(:, a) - matmul(run_state%mu(1:bodies(a)%nrig, a), bodies(a)%rg)
+    end do
+    res%rigid = -run_state%mu
+    call interface_residual(contact_line, bodies, res)
+    res%obstacle = run_state%G
+    res%outer = run_state%it
+    res%inner = run_state%inner
+    res%criterion = run_state%crit
+    res%nhist = run_state%it
+  end subroutine restore_iterate
+
+  !> The true residual of the iterate, the increment of the obstacles (the paper's
+  !! criterion), the stopping criterion, the new state and one history entry.
+  subroutine record_iteration(solver, contact_line, bodies, it, g_new, w, t0, run_state, res)
+    type(solver_cfg_t), intent(in) :: solver
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(2)
+    integer, intent(in) :: it
+    real(wp), intent(in) :: g_new(:, :), w(:, :), t0
+    type(robin_state_t), intent(inout) :: run_state
+    type(contact_result_t), intent(inout) :: res
+    real(wp) :: denom(2), ref, incr
+    integer :: a
+    res%lam_body = run_state%lam
+    res%w = w
+    res%rigid = -run_state%mu
+    call interface_residual(contact_line, bodies, res)
+    ref = tiny(1.0_wp) + 1.0e-14_wp*(maxabs(bodies(1)%b) + maxabs(bodies(2)%b) + maxabs(contact_line%g0))
+    do a = 1, 2
+      denom(a) = max(norm2(g_new(:, a)), ref)
+    end do
+    incr = norm2(g_new(:, 1) - run_state%G(:, 1))/denom(1) + norm2(g_new(:, 2) - run_state%G(:, 2))/denom(2)
+    if (solver%stop == STOP_RESIDUAL) then
+      run_state%crit = res%residual
+    else
+      run_state%crit = incr
+    end if
+    ! the inner tolerance follows the outer progress: both the increment and the residual
+    ! must shrink before the subproblems are solved tightly (a tolerance tied to the
+    ! residual alone can freeze the obstacles and stall the iteration)
+    run_state%progress = min(incr, res%residual)
+    run_state%G = g_new
+    run_state%it = it
+    run_state%wall = wtime() - t0
+    res%obstacle = run_state%G
+    res%outer = it
+    res%inner = run_state%inner
+    res%criterion = run_state%crit
+    if (it > size(res%h_criterion)) call grow_history(res, min(solver%max_outer, 2*size(res%h_criterion) + HISTORY_CHUNK))
+    res%nhist = it
+    res%h_criterion(it) = run_state%crit
+    res%h_residual(it) = res%residual
+    res%h_inner(it) = run_state%inner
+    res%h_active(it) = res%active
+    res%h_wall(it) = run_state%wall
+  end subroutine record_iteration
+
+  !> True when the iteration ends after iteration `it`: converged, or diverged (a
+  !! non-finite or exploding criterion, obstacles beyond 1e6 times the load displacement
+  !! scale `uref`, a residual stop that stagnates, a small increment with a large residual
+  !! for too long). Sets res%status and res%message.
+  logical function check_termination(solver, it, uref, run_state, res) result(done)
+    type(solver_cfg_t), intent(in) :: solver
+    integer, intent(in) :: it
+    real(wp), intent(in) :: uref
+    type(robin_state_t), intent(inout) :: run_state
+    type(contact_result_t), intent(inout) :: res
+    done = .true.
+    if (.not. ieee_is_finite(run_state%crit)) then
+      res%status = STATUS_DIVERGED
+      write (res%message, '(a,i0)') 'non-finite criterion at iteration ', it
+      return
+    end if
+    run_state%best = min(run_state%best, run_state%crit)
+    if (it > 10 .and. run_state%crit > 1.0e4_wp*run_state%best .and. run_state%crit > 1.0_wp) then
+      res%status = STATUS_DIVERGED
+      write (res%message, '(a,es10.3,a,es10.3)') 'criterion grew to ', run_state%crit, ' from its best ', run_state%best
+      return
+    end if
+    ! a relative increment stays bounded while the iterates blow up geometrically: watch
+    ! the size of the obstacles against the displacements the loads cause
+    if (maxval(abs(run_state%G)) > 1.0e6_wp*uref) then
+      res%status = STATUS_DIVERGED
+      write (res%message, '(a,es10.3,a,es10.3,a)') 'obstacles grew to ', maxval(abs(run_state%G)), &
+        ' (1e6 times the load displacement scale ', uref, ')'
+      return
+    end if
+    ! the residual stop: a residual that has not improved by 1% in FLAT_LIMIT iterations
+    ! has reached the floor that rounding and conditioning allow; tol is out of reach
+    if (res%residual < 0.99_wp*run_state%res_best) then
+      run_state%res_best = res%residual
+      run_state%it_best = it
+    end if
+    if (solver%stop == STOP_RESIDUAL .and. run_state%crit > solver%tol .and. it - run_state%it_best >= FLAT_LIMIT) then
+      res%status = STATUS_DIVERGED
+      write (res%message, '(a,es10.3,a,i0,a,es10.3,a)') 'stagnated: the residual has stayed near ', &
+        run_state%res_best, ' for ', FLAT_LIMIT, ' iterations; tol = ', solver%tol, ' is out of reach'
+      return
+    end if
+    if (run_state%crit <= solver%tol) then
+      if (solver%stop /= STOP_RESIDUAL .and. res%residual > 1.0e2_wp*solver%tol) then
+        ! the obstacles stopped moving but the bodies do not agree yet: a small increment
+        ! is not a small error. Go on (the inner tolerance follows the smaller increment);
+        ! if it persists, the iteration has stagnated.
+        run_state%stalled = run_state%stalled + 1
+        if (run_state%stalled >= STALL_LIMIT) then
+          res%status = STATUS_DIVERGED
+          write (res%message, '(a,es10.3,a,es10.3,a,i0,a)') 'stagnated: increment ', run_state%crit, &
+            ' below tol but residual ', res%residual, ' above 100 tol for ', STALL_LIMIT, &
+            ' iterations (the bodies do not agree)'
+          return
+        end if
+      else
+        res%status = STATUS_CONVERGED
+        return
+      end if
+    else
+      run_state%stalled = 0
+    end if
+    done = .false.
+  end function check_termination
+
+end module robin_iteration

@@ -1,0 +1,725 @@
+!> MPRGP: modified proportioning with reduced gradient projection, for the
+!! bound-constrained convex quadratic program
+!!
+!!     minimise 1/2 x'Ax - b'x   subject to   x >= l
+!!
+!! with A symmetric positive definite, given as a `class(linop_t)` (dense, sparse or
+!! implicit). Z. Dostal and J. Schoberl, "Minimizing quadratic functions subject to
+!! bound constraints with the rate of convergence and finite termination",
+!! Comput. Optim. Appl. 30 (2005) 23-43.
+!!
+!! Notation (g = Ax - b, free set F = {i : x_i > l_i}, active set its complement):
+!!   free gradient        phi_i  = g_i on F, 0 else
+!!   chopped gradient     beta_i = min(g_i, 0) off F, 0 else
+!!   projected gradient   gP     = phi + beta            (stopping criterion)
+!!   reduced free grad.   phit_i = min((x_i - l_i)/alpha_bar, phi_i) on F, 0 else
+!! x is *proportional* when |beta|^2 <= Gamma^2 phit'phi. Then a conjugate gradient
+!! step along p is tried; if it stays feasible it is taken (CG step), otherwise the
+!! feasible part of it is taken and followed by a projected step of length alpha_bar
+!! along the free gradient, after which CG restarts (expansion step). A
+!! non-proportional x gets an exact line search along -beta (proportioning step),
+!! which releases variables from their bounds.
+!!
+!! Bounds equal to -huge(1.0_wp) mean "no bound". All other bounds must be finite.
+!!
+!! Thread safety: no module variables, no SAVE, work arrays are local to each call.
+!! Two threads may solve concurrently with two different operators.
+module mprgp
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use kinds, only: wp
+  use linop, only: linop_t
+  use strings, only: itoa
+  use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
+                           MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
+  use mprgp_support, only: lambda_max_estimate, power_iteration, projected_gradient_norm, line_search, &
+                           recycled_subspace, store_direction
+  implicit none (type, external)
+  private
+
+  public :: lambda_max_estimate, mprgp_status_name
+  public :: mprgp_t, mprgp_opts_t, mprgp_stats_t
+  public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
+
+  !> Safety factor: default alpha_bar = ALPHA_FACTOR / lambda_max (theory: (0, 2/|A|]).
+  real(wp), parameter :: ALPHA_FACTOR = 1.9_wp
+  !> At most this many retries of one expansion step with a reduced alpha_bar.
+  integer, parameter :: MAX_RETRY = 60
+
+  !> An MPRGP solver: its options, what its last solve did, and the vectors a sequence of
+  !! solves with one operator hands on from one solve to the next. One solver per thread.
+  type :: mprgp_t
+    type(mprgp_opts_t) :: opts             !< options
+    type(mprgp_stats_t) :: stats           !< outcome of the last solve
+    real(wp), allocatable :: g(:)          !< A x - b at the returned x (units of b)
+    !> in (opts%use_ax): A x at the warm start; out: A x at the returned x, the start of the
+    !! next solve from it
+    real(wp), allocatable :: ax(:)
+    real(wp), allocatable :: s(:)          !< direction of a first line search (next solve only; needs as)
+    real(wp), allocatable :: as(:)         !< A s
+    real(wp), allocatable :: eq_g(:, :)    !< (r, n) equality rows (SMALBE; with eq_e, opts%eq_m)
+    real(wp), allocatable :: eq_e(:)       !< (r) their right-hand side
+    ! the iteration's state
+    integer, private :: n = 0              ! unknowns
+    integer, private :: it = 0             ! steps taken
+    logical, private :: fresh = .false.    ! g was computed as A x - b, not by recurrence
+    logical, private :: zero_tol = .false. ! no tolerance given: stop at the rounding floor
+    real(wp), private :: tol = 0.0_wp      ! max(rtol |b|, atol)
+    real(wp), private :: ab = 0.0_wp       ! alpha_bar in use (0: not yet needed)
+    real(wp), private :: lam_lo = 0.0_wp   ! largest known lower bound of lambda_max
+    real(wp), private :: xscale0 = 0.0_wp  ! |x| of the projected start
+    real(wp), allocatable, private :: p(:), ap(:), w(:), v(:), av(:)
+  contains
+    procedure :: solve => mprgp_solve
+  end type mprgp_t
+
+  !> What the stopping test asks the main loop to do.
+  integer, parameter :: GO_ON = 0, DONE = 1, RETEST = 2
+
+contains
+
+  !> Solve min 1/2 x'Ax - b'x subject to x >= lb by MPRGP.
+  !!
+  !! x is a warm start on entry (projected onto the bounds first) and the solution
+  !! on exit (the last iterate on failure); self%g holds A x - b and self%ax A x there.
+  !! The run stops when |gP| <= max(rtol |b|, atol); if both are zero (b = 0 and atol = 0),
+  !! at the rounding-level floor 10 sqrt(n) eps lambda_max max(|x|, |x_0|), x_0 the projected
+  !! start. Convergence is always confirmed on a freshly computed gradient Ax - b (one extra
+  !! product); if the recurrence drifted, the iteration continues from the true one.
+  !!
+  !! Guard on alpha_bar. The power iteration underestimates lambda_max, so
+  !! 1.9/estimate may exceed the admissible 2/lambda_max. Every product with A made
+  !! by the iteration (CG direction, proportioning direction, expansion step) yields
+  !! a Rayleigh quotient d'Ad/d'd <= lambda_max; the largest one raises the
+  !! lambda_max used, and whenever alpha_bar * (that value) > 2, alpha_bar is cut to
+  !! 1.9/(that value). In an expansion step the projected step d costs
+  !! g'd + 1/2 d'Ad; since g'd <= -|d|^2/alpha_bar, it can only increase the cost if
+  !! d'Ad/d'd > 2/alpha_bar, i.e. exactly when the cut above happens: the step is then
+  !! recomputed from the half step with the reduced alpha_bar (at most 60 times, each
+  !! one product). A cost increase without such a curvature (rounding) is accepted.
+  !! A user-given alpha_bar is subject to the same guard.
+  !!
+  !! Cost per step: one product with A (two for an expansion) and O(n) work.
+  !!
+  !! Reuse across a sequence of solves with the same A (the outer contact iteration):
+  !! with opts%use_ax, self%ax holds A x at the warm start and the initial product is
+  !! skipped; on exit it holds A x at the returned x (the confirming product, so the next
+  !! solve, warm-started from x, starts from it). With a direction self%s and self%as = A s
+  !! (e.g. the change of x in the previous solve and of A x), the iteration starts with an
+  !! exact line search along s, cut at the bounds, which costs no product; the solve
+  !! consumes s and as.
+  !! Krylov recycling: with rw, raw, nrw (a ring of A-normalised directions and their
+  !! images, filled by every conjugate gradient step of the solves that share it) and
+  !! opts%recycle, the iteration starts from the minimum over x plus the span of s and of
+  !! the stored directions that vanish where x is at its bound (A-orthogonalised; a
+  !! direction with less than 1% of its A-norm left is dropped, so the recurrence gradient
+  !! stays accurate), taken only if the whole step is feasible and leaves a proportional
+  !! iterate with a smaller projected gradient: again no product.
+  !! A warm start whose projected gradient (from opts%use_ax) already meets the tolerance
+  !! is returned without a search or a product.
+  subroutine mprgp_solve(self, A, b, lb, x, rw, raw, nrw)
+    class(mprgp_t), intent(inout) :: self           !< the solver (options in, outcome out)
+    class(linop_t), intent(inout) :: A              !< SPD operator (size A%n)
+    real(wp), intent(in) :: b(:)                    !< linear term (size n)
+    real(wp), intent(in) :: lb(:)                   !< lower bounds (size n); -huge(1.0_wp): none
+    real(wp), intent(inout) :: x(:)                 !< in: warm start; out: solution
+    real(wp), intent(inout), optional :: rw(:, :)   !< (n, k) stored directions, A-normalised (needs raw, nrw)
+    real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
+    integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
+    real(wp) :: betabeta, phitphi
+    logical :: ok
+
+    self%stats = mprgp_stats_t()
+    if (.not. valid_arguments(self, A%n, b, lb, x, rw, raw, nrw)) then
+      call consume_search(self)
+      return
+    end if
+    self%stats%b_norm = norm2(b)
+    if (self%n == 0) then
+      self%stats%status = MPRGP_CONVERGED
+      self%stats%message = 'converged: empty problem'
+      call consume_search(self)
+      return
+    end if
+    call start(self, A, b, lb, x, rw, raw, nrw)
+    main: do
+      select case (stopping_test(self, A, b, lb, x, betabeta, phitphi))
+      case (DONE)
+        exit main
+      case (RETEST)
+        cycle main
+      end select
+      self%it = self%it + 1
+      if (proportional(self, A, lb, x, betabeta, phitphi, ok)) then
+        if (ok) ok = cg_or_expansion_step(self, A, lb, x, rw, raw, nrw)
+      else if (ok) then
+        ok = proportioning_step(self, A, lb, x, betabeta)
+      end if
+      if (.not. ok) exit main
+    end do main
+    self%stats%lambda_max = self%lam_lo
+    self%stats%alpha_bar = self%ab
+    ! Report the true gradient (and |gP| from it) unless the iteration broke down.
+    if (.not. self%fresh .and. (self%stats%status == MPRGP_MAX_IT .or. self%stats%status == MPRGP_NOT_SPD)) then
+      call true_gradient(self, A, b, x)
+      self%stats%gp_norm = proj_grad_norm(self, lb, x)
+    end if
+    if (.not. self%fresh) self%ax = self%g + b
+    call consume_search(self)
+  end subroutine mprgp_solve
+
+  !> A solve uses its search direction once.
+  subroutine consume_search(self)
+    type(mprgp_t), intent(inout) :: self
+    if (allocated(self%s)) deallocate (self%s)
+    if (allocated(self%as)) deallocate (self%as)
+  end subroutine consume_search
+
+  !> Check sizes, options and finiteness before any work; sets self%n, allocates the
+  !! solver's vectors. False (with the status and message) when the solve cannot start.
+  logical function valid_arguments(self, n, b, lb, x, rw, raw, nrw) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    integer, intent(in) :: n
+    real(wp), intent(in) :: b(:), lb(:), x(:)
+    real(wp), intent(in), optional :: rw(:, :), raw(:, :)
+    integer, intent(in), optional :: nrw(2)
+    integer :: i
+    ok = .false.
+    self%n = n
+    if (n < 0) then
+      call fail(self, MPRGP_BAD_ARG, 'operator size A%n is negative')
+      return
+    end if
+    if (allocated(self%g)) then
+      if (size(self%g) /= n) deallocate (self%g)
+    end if
+    if (.not. allocated(self%g)) allocate (self%g(n))
+    if (size(b) /= n .or. size(lb) /= n .or. size(x) /= n) then
+      write (self%stats%message, '(a,i0,a,i0,a,i0,a,i0)') 'size mismatch: A%n = ', n, &
+        ', size(b) = ', size(b), ', size(lb) = ', size(lb), ', size(x) = ', size(x)
+      self%stats%status = MPRGP_BAD_ARG
+      return
+    end if
+    if (self%opts%use_ax) then
+      if (.not. allocated(self%ax)) then
+        call fail(self, MPRGP_BAD_ARG, 'opts%use_ax without ax')
+        return
+      else if (size(self%ax) /= n) then
+        call fail(self, MPRGP_BAD_ARG, 'size mismatch: size(ax) /= A%n')
+        return
+      end if
+    end if
+    if (allocated(self%s) .neqv. allocated(self%as)) then
+      call fail(self, MPRGP_BAD_ARG, 's and as must be given together')
+      return
+    end if
+    if (allocated(self%s)) then
+      if (size(self%s) /= n .or. size(self%as) /= n) then
+        call fail(self, MPRGP_BAD_ARG, 'size mismatch: size(s) or size(as) /= A%n')
+        return
+      end if
+    end if
+    if ((present(rw) .neqv. present(raw)) .or. (present(rw) .neqv. present(nrw))) then
+      call fail(self, MPRGP_BAD_ARG, 'rw, raw and nrw must be given together')
+      return
+    end if
+    if (present(rw)) then
+      if (size(rw, 1) /= n .or. size(raw, 1) /= n .or. size(raw, 2) /= size(rw, 2)) then
+        call fail(self, MPRGP_BAD_ARG, 'size mismatch: rw or raw is not (A%n, k)')
+        return
+      end if
+      if (nrw(1) < 0 .or. nrw(1) > size(rw, 2) .or. nrw(2) < 1 .or. nrw(2) > max(1, size(rw, 2))) then
+        call fail(self, MPRGP_BAD_ARG, 'nrw out of range')
+        return
+      end if
+    end if
+    if (allocated(self%eq_g) .neqv. allocated(self%eq_e)) then
+      call fail(self, MPRGP_BAD_ARG, 'eq_g and eq_e must be given together')
+      return
+    end if
+    if (allocated(self%eq_g)) then
+      if (size(self%eq_g, 2) /= n .or. size(self%eq_g, 1) /= size(self%eq_e)) then
+        call fail(self, MPRGP_BAD_ARG, 'size mismatch: eq_g is not (size(eq_e), A%n)')
+        return
+      end if
+    end if
+    if (.not. valid_options(self)) return
+    do i = 1, n
+      if (.not. ieee_is_finite(b(i))) then
+        call fail(self, MPRGP_NONFINITE, 'b('//trim(itoa(i))//') is not finite')
+        return
+      end if
+      if (.not. ieee_is_finite(lb(i))) then
+        call fail(self, MPRGP_NONFINITE, 'lb('//trim(itoa(i))//') is not finite (use -huge(1.0_wp) for no bound)')
+        return
+      end if
+      if (.not. ieee_is_finite(x(i))) then
+        call fail(self, MPRGP_NONFINITE, 'initial x('//trim(itoa(i))//') is not finite')
+        return
+      end if
+    end do
+    if (allocated(self%ax)) then
+      if (size(self%ax) /= n) deallocate (self%ax)
+    end if
+    if (.not. allocated(self%ax)) allocate (self%ax(n))
+    ok = .true.
+  end function valid_arguments
+
+  !> The options are finite and in range (else a bad-argument failure).
+  logical function valid_options(self) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    character(len=:), allocatable :: why
+    why = options_error(self%opts)
+    ok = len(why) == 0
+    if (.not. ok) call fail(self, MPRGP_BAD_ARG, why)
+  end function valid_options
+
+  !> Project the warm start, take its gradient (from ax with opts%use_ax), and unless it
+  !! already meets the tolerance, the recycled subspace step or the first line search.
+  subroutine start(self, A, b, lb, x, rw, raw, nrw)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:), lb(:)
+    real(wp), intent(inout) :: x(:)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
+    integer, intent(inout), optional :: nrw(2)
+    integer :: n
+    logical :: moved
+    n = self%n
+    moved = .false.
+    self%tol = max(self%opts%rtol * self%stats%b_norm, self%opts%atol)
+    self%zero_tol = (self%tol <= 0.0_wp)
+    if (allocated(self%p)) then
+      if (size(self%p) /= n) deallocate (self%p, self%ap, self%w, self%v, self%av)
+    end if
+    if (.not. allocated(self%p)) allocate (self%p(n), self%ap(n), self%w(n), self%v(n), self%av(n))
+    self%ab = 0.0_wp
+    self%lam_lo = 0.0_wp
+    if (self%opts%lambda_max > 0.0_wp) self%lam_lo = self%opts%lambda_max
+    x = max(x, lb)
+    self%xscale0 = norm2(x)
+    if (self%opts%use_ax) then
+      self%g = self%ax - b
+    else
+      call A%apply(x, self%g)
+      self%stats%n_matvec = 1
+      self%ax = self%g
+      self%g = self%g - b
+    end if
+    self%fresh = .true.
+    ! a warm start that already meets the tolerance is returned as it is (no product)
+    if (self%zero_tol .or. proj_grad_norm(self, lb, x) > self%tol) then
+      if (present(rw) .and. self%opts%recycle) then
+        if (allocated(self%s)) then
+          moved = recycled_subspace(x, self%g, lb, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
+                                    self%p, self%ap, self%s, self%as)
+        else
+          moved = recycled_subspace(x, self%g, lb, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
+                                    self%p, self%ap)
+        end if
+      else if (allocated(self%s)) then
+        moved = line_search(x, self%g, lb, self%s, self%as, .false., self%opts%gamma, self%p, self%ap)
+      end if
+      if (moved) then
+        self%stats%n_recycled = self%stats%n_recycled + 1
+        self%fresh = .false.
+      end if
+    end if
+    call set_p_to_phi(self, lb, x)
+    self%it = 0
+  end subroutine start
+
+  !> Split the gradient, test convergence (confirmed on the true gradient), max_it and the
+  !! stop hook. DONE: the solve ends; RETEST: the true gradient was taken, test again;
+  !! GO_ON: take a step (betabeta = |chopped gradient|^2, phitphi = phit'phi).
+  integer function stopping_test(self, A, b, lb, x, betabeta, phitphi) result(action)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:), lb(:), x(:)
+    real(wp), intent(out) :: betabeta, phitphi
+    real(wp), parameter :: big = huge(1.0_wp)
+    real(wp) :: phiphi, gp2, phi, phit, beta, slack, tol_now, feas, floor_eq
+    character(len=24) :: s1, s2
+    integer :: i, n
+    n = self%n
+    action = DONE
+    ! Split the gradient (one pass).
+    phiphi = 0.0_wp
+    phitphi = 0.0_wp
+    betabeta = 0.0_wp
+    do i = 1, n
+      if (x(i) > lb(i)) then
+        phi = self%g(i)
+        phiphi = phiphi + phi * phi
+        phit = phi
+        if (self%ab > 0.0_wp .and. lb(i) > -big) then
+          slack = x(i) - lb(i)
+          if (slack < self%ab * phi) phit = slack / self%ab
+        end if
+        phitphi = phitphi + phit * phi
+      else
+        beta = min(self%g(i), 0.0_wp)
+        betabeta = betabeta + beta * beta
+      end if
+    end do
+    gp2 = phiphi + betabeta
+    self%stats%gp_norm = sqrt(gp2)
+    if (.not. ieee_is_finite(gp2)) then
+      call fail(self, MPRGP_NONFINITE, 'the projected gradient became non-finite after '// &
+                trim(itoa(self%it))//' steps')
+      return
+    end if
+
+    ! Stopping test, confirmed on the true gradient.
+    tol_now = self%tol
+    if (self%zero_tol .and. gp2 > 0.0_wp) then
+      if (.not. ensure_alpha(self, A)) return
+      tol_now = 10.0_wp * sqrt(real(n, wp)) * epsilon(1.0_wp) * max(self%lam_lo, ALPHA_FACTOR / self%ab) * &
+                max(norm2(x), self%xscale0)
+    end if
+    if (allocated(self%eq_g) .and. self%stats%gp_norm <= tol_now .and. self%opts%eq_m > 0.0_wp) then
+      ! SMALBE-M: solve more precisely while the equality is far from holding
+      feas = norm2(matmul(self%eq_g, x) - self%eq_e)
+      if (feas > self%opts%eq_feas) then
+        floor_eq = 10.0_wp*sqrt(real(n, wp))*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)
+        tol_now = max(min(tol_now, self%opts%eq_m*feas), floor_eq)
+      end if
+    end if
+    if (self%stats%gp_norm <= tol_now) then
+      if (self%fresh) then
+        self%stats%status = MPRGP_CONVERGED
+        write (s1, '(es10.3)') self%stats%gp_norm
+        write (s2, '(es10.3)') tol_now
+        self%stats%message = 'converged: |gP| = '//trim(adjustl(s1))//' <= '//trim(adjustl(s2))// &
+                             ' after '//trim(itoa(self%it))//' steps, '//trim(itoa(self%stats%n_matvec))// &
+                             ' products with A'
+        return
+      end if
+      call true_gradient(self, A, b, x)
+      call set_p_to_phi(self, lb, x)
+      action = RETEST
+      return
+    end if
+    if (self%it >= self%opts%max_it) then
+      self%stats%status = MPRGP_MAX_IT
+      write (s1, '(es10.3)') self%stats%gp_norm
+      write (s2, '(es10.3)') tol_now
+      self%stats%message = 'not converged: |gP| = '//trim(adjustl(s1))//' > '//trim(adjustl(s2))// &
+                           ' after max_it = '//trim(itoa(self%opts%max_it))//' steps'
+      return
+    end if
+    if (associated(self%opts%stop)) then
+      if (self%opts%stop()) then
+        self%stats%status = MPRGP_STOPPED
+        self%stats%message = 'stopped on request after '//trim(itoa(self%it))//' steps'
+        return
+      end if
+    end if
+    action = GO_ON
+  end function stopping_test
+
+  !> The proportionality test |beta|^2 <= Gamma^2 phit'phi (alpha_bar is needed only when
+  !! some bound is active). ok = .false. when alpha_bar could not be had.
+  logical function proportional(self, A, lb, x, betabeta, phitphi, ok) result(prop)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: lb(:), x(:), betabeta
+    real(wp), intent(inout) :: phitphi       !< phit'phi (recomputed once alpha_bar is known)
+    logical, intent(out) :: ok
+    real(wp), parameter :: big = huge(1.0_wp)
+    real(wp) :: phi, phit, slack
+    integer :: i
+    prop = .false.
+    ok = .true.
+    if (betabeta > 0.0_wp .and. self%ab <= 0.0_wp) then
+      ok = ensure_alpha(self, A)
+      if (.not. ok) return
+      phitphi = 0.0_wp
+      do i = 1, self%n
+        if (x(i) > lb(i)) then
+          phi = self%g(i)
+          phit = phi
+          if (lb(i) > -big) then
+            slack = x(i) - lb(i)
+            if (slack < self%ab * phi) phit = slack / self%ab
+          end if
+          phitphi = phitphi + phit * phi
+        end if
+      end do
+    end if
+    prop = (betabeta <= self%opts%gamma**2 * phitphi)
+  end function proportional
+
+  !> Trial conjugate gradient step along -p: taken when it stays feasible (CG step),
+  !! otherwise its feasible part followed by an expansion step. False on a breakdown.
+  logical function cg_or_expansion_step(self, A, lb, x, rw, raw, nrw) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: lb(:)
+    real(wp), intent(inout) :: x(:)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
+    integer, intent(inout), optional :: nrw(2)
+    real(wp), parameter :: big = huge(1.0_wp)
+    real(wp) :: pap, pp, gtp, acg, af, num, gam, slack
+    integer :: i, n, blk
+    n = self%n
+    associate (p => self%p, ap => self%ap, gr => self%g)
+      call A%apply(p, ap)
+      self%stats%n_matvec = self%stats%n_matvec + 1
+      pap = 0.0_wp
+      pp = 0.0_wp
+      gtp = 0.0_wp
+      do i = 1, n
+        pap = pap + p(i) * ap(i)
+        pp = pp + p(i) * p(i)
+        gtp = gtp + gr(i) * p(i)
+      end do
+      ok = check_curvature(self, pap, pp, 'conjugate gradient direction')
+      if (.not. ok) return
+      if (present(rw)) call store_direction(p, ap, rw, raw, nrw)
+      acg = gtp / pap
+      ! Largest feasible step along -p, capped at acg (no division can overflow).
+      af = acg
+      blk = 0
+      do i = 1, n
+        if (p(i) > 0.0_wp .and. lb(i) > -big) then
+          slack = x(i) - lb(i)
+          if (slack < af * p(i)) then
+            af = slack / p(i)
+            blk = i
+          end if
+        end if
+      end do
+      if (blk == 0) then
+        ! CG step.
+        num = 0.0_wp
+        do i = 1, n
+          x(i) = max(x(i) - acg * p(i), lb(i))
+          gr(i) = gr(i) - acg * ap(i)
+          if (x(i) > lb(i)) num = num + gr(i) * ap(i)
+        end do
+        gam = num / pap
+        do i = 1, n
+          if (x(i) > lb(i)) then
+            p(i) = gr(i) - gam * p(i)
+          else
+            p(i) = -gam * p(i)
+          end if
+        end do
+        self%stats%n_cg = self%stats%n_cg + 1
+        self%fresh = .false.
+        return
+      end if
+      ! the feasible half step
+      af = max(af, 0.0_wp)
+      do i = 1, n
+        x(i) = max(x(i) - af * p(i), lb(i))
+        gr(i) = gr(i) - af * ap(i)
+      end do
+      x(blk) = lb(blk)
+    end associate
+    ok = expansion_step(self, A, lb, x)
+  end function cg_or_expansion_step
+
+  !> Projected step of length alpha_bar along the free gradient, recomputed with a cut
+  !! alpha_bar while it increases the cost (the guard above); then CG restarts.
+  logical function expansion_step(self, A, lb, x) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: lb(:)
+    real(wp), intent(inout) :: x(:)
+    real(wp) :: dd, dad, df, ab_prev
+    integer :: i, n, retry
+    n = self%n
+    ok = ensure_alpha(self, A)
+    if (.not. ok) return
+    retry = 0
+    associate (p => self%p, ap => self%ap, gr => self%g)
+      expand: do
+        ! Candidate step d = P(x - ab*phi) - x = -ab*phit, stored in p (reset afterwards).
+        dd = 0.0_wp
+        do i = 1, n
+          if (x(i) > lb(i)) then
+            p(i) = max(lb(i) - x(i), -self%ab * gr(i))
+          else
+            p(i) = 0.0_wp
+          end if
+          dd = dd + p(i) * p(i)
+        end do
+        if (dd <= 0.0_wp) exit expand
+        call A%apply(p, ap)
+        self%stats%n_matvec = self%stats%n_matvec + 1
+        dad = 0.0_wp
+        df = 0.0_wp
+        do i = 1, n
+          dad = dad + p(i) * ap(i)
+          df = df + gr(i) * p(i)
+        end do
+        df = df + 0.5_wp * dad
+        ab_prev = self%ab
+        ok = check_curvature(self, dad, dd, 'expansion step')
+        if (.not. ok) return
+        if (df > 0.0_wp .and. self%ab < ab_prev .and. retry < MAX_RETRY) then
+          ! The step increased the cost: alpha_bar exceeded 2/lambda_max. Cut and retry.
+          retry = retry + 1
+          cycle expand
+        end if
+        do i = 1, n
+          x(i) = max(x(i) + p(i), lb(i))
+          gr(i) = gr(i) + ap(i)
+        end do
+        exit expand
+      end do expand
+    end associate
+    call set_p_to_phi(self, lb, x)
+    self%stats%n_exp = self%stats%n_exp + 1
+    self%fresh = .false.
+  end function expansion_step
+
+  !> Exact line search along -beta (the chopped gradient), which releases variables from
+  !! their bounds. False on a breakdown.
+  logical function proportioning_step(self, A, lb, x, betabeta) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: lb(:), betabeta
+    real(wp), intent(inout) :: x(:)
+    real(wp) :: pap, pp, acg
+    integer :: i, n
+    n = self%n
+    associate (p => self%p, ap => self%ap, gr => self%g)
+      do i = 1, n
+        if (x(i) > lb(i)) then
+          p(i) = 0.0_wp
+        else
+          p(i) = min(gr(i), 0.0_wp)
+        end if
+      end do
+      call A%apply(p, ap)
+      self%stats%n_matvec = self%stats%n_matvec + 1
+      pap = 0.0_wp
+      pp = 0.0_wp
+      do i = 1, n
+        pap = pap + p(i) * ap(i)
+        pp = pp + p(i) * p(i)
+      end do
+      ok = check_curvature(self, pap, pp, 'proportioning direction')
+      if (.not. ok) return
+      acg = betabeta / pap
+      do i = 1, n
+        x(i) = max(x(i) - acg * p(i), lb(i))
+        gr(i) = gr(i) - acg * ap(i)
+      end do
+    end associate
+    call set_p_to_phi(self, lb, x)
+    self%stats%n_prop = self%stats%n_prop + 1
+    self%fresh = .false.
+  end function proportioning_step
+
+  !> Record a failure.
+  subroutine fail(self, code, msg)
+    type(mprgp_t), intent(inout) :: self
+    integer, intent(in) :: code
+    character(len=*), intent(in) :: msg
+    self%stats%status = code
+    self%stats%message = msg
+  end subroutine fail
+
+  !> p = phi(x).
+  subroutine set_p_to_phi(self, lb, x)
+    type(mprgp_t), intent(inout) :: self
+    real(wp), intent(in) :: lb(:), x(:)
+    integer :: j
+    do j = 1, self%n
+      if (x(j) > lb(j)) then
+        self%p(j) = self%g(j)
+      else
+        self%p(j) = 0.0_wp
+      end if
+    end do
+  end subroutine set_p_to_phi
+
+  !> |gP| for the current x and g.
+  real(wp) function proj_grad_norm(self, lb, x) result(r)
+    type(mprgp_t), intent(in) :: self
+    real(wp), intent(in) :: lb(:), x(:)
+    r = projected_gradient_norm(self%g, x, lb)
+  end function proj_grad_norm
+
+  !> g = A x - b computed directly.
+  subroutine true_gradient(self, A, b, x)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:), x(:)
+    call A%apply(x, self%g)
+    self%stats%n_matvec = self%stats%n_matvec + 1
+    self%ax = self%g
+    self%g = self%g - b
+    self%fresh = .true.
+  end subroutine true_gradient
+
+  !> Make alpha_bar available (power iteration on first need). False on failure.
+  logical function ensure_alpha(self, A) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp) :: lam_pow
+    integer :: nmv_pow
+    ok = .true.
+    if (self%ab > 0.0_wp) return
+    if (self%opts%alpha_bar > 0.0_wp) then
+      self%ab = self%opts%alpha_bar
+      if (self%lam_lo * self%ab > 2.0_wp) self%ab = ALPHA_FACTOR / self%lam_lo
+      return
+    end if
+    if (self%opts%lambda_max <= 0.0_wp) then
+      ! ap and w are free whenever this is called.
+      call power_iteration(A, self%opts%power_its, self%ap, self%w, lam_pow, nmv_pow)
+      self%stats%n_matvec = self%stats%n_matvec + nmv_pow
+      if (.not. ieee_is_finite(lam_pow)) then
+        call fail(self, MPRGP_NONFINITE, 'A produced a non-finite value in the power iteration')
+        ok = .false.
+        return
+      end if
+      if (lam_pow <= 0.0_wp) then
+        call fail(self, MPRGP_NOT_SPD, 'A v = 0 for the power-iteration vector: A is not SPD')
+        ok = .false.
+        return
+      end if
+      self%lam_lo = max(self%lam_lo, lam_pow)
+    end if
+    self%ab = ALPHA_FACTOR / self%lam_lo
+  end function ensure_alpha
+
+  !> Check d'Ad > 0 and finite; update the lambda_max bound and the alpha_bar guard.
+  logical function check_curvature(self, dad_, dd_, what) result(ok)
+    type(mprgp_t), intent(inout) :: self
+    real(wp), intent(in) :: dad_, dd_
+    character(len=*), intent(in) :: what
+    real(wp) :: rq_
+    character(len=24) :: s1
+    ok = .false.
+    if (.not. (ieee_is_finite(dad_) .and. ieee_is_finite(dd_))) then
+      call fail(self, MPRGP_NONFINITE, 'non-finite curvature along the '//what//' after '// &
+                trim(itoa(self%it))//' steps')
+      return
+    end if
+    if (dad_ <= 0.0_wp .and. dd_ <= tiny(1.0_wp)) then
+      ! the direction has vanished (underflowed): the iterate is exact to working
+      ! precision and a tolerance below that cannot be reached; not a curvature failure
+      self%stats%status = MPRGP_CONVERGED
+      write (s1, '(es10.3)') self%stats%gp_norm
+      self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
+                           ' (the tolerance asked for is below what double precision resolves)'
+      return
+    end if
+    if (dad_ <= 0.0_wp) then
+      write (s1, '(es10.3)') dad_
+      call fail(self, MPRGP_NOT_SPD, 'p''Ap = '//trim(adjustl(s1))//' <= 0 along the '//what// &
+                ' at step '//trim(itoa(self%it))//': A is not SPD')
+      return
+    end if
+    ok = .true.
+    rq_ = dad_ / dd_
+    if (rq_ > self%lam_lo) self%lam_lo = rq_
+    if (self%ab > 0.0_wp .and. self%ab * self%lam_lo > 2.0_wp) self%ab = ALPHA_FACTOR / self%lam_lo
+  end function check_curvature
+
+end module mprgp

@@ -1,0 +1,125 @@
+!> The options of an MPRGP solve (module mprgp), what a solve reports, and the status
+!! codes with their names.
+module mprgp_options
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use kinds, only: wp
+  use strings, only: rtoa
+  implicit none (type, external)
+  private
+
+  public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, mprgp_stop_iface
+  public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
+
+  integer, parameter :: MPRGP_CONVERGED = 0  !< |gP| <= max(rtol |b|, atol) at the true gradient
+  integer, parameter :: MPRGP_MAX_IT = 1     !< max_it steps done without convergence
+  integer, parameter :: MPRGP_NONFINITE = 2  !< NaN/Inf in the input or during the iteration
+  integer, parameter :: MPRGP_NOT_SPD = 3    !< a direction with p'Ap <= 0 was met (A not SPD)
+  integer, parameter :: MPRGP_BAD_ARG = 4    !< inconsistent sizes or invalid options
+  integer, parameter :: MPRGP_STOPPED = 5    !< opts%stop turned true (a signal): x is the current iterate
+
+  abstract interface
+    !> True when the solve must stop now (polled once per step).
+    logical function mprgp_stop_iface()
+    end function mprgp_stop_iface
+  end interface
+
+  !> Options of an MPRGP solve. Tolerances are in the units of b (for contact: a displacement).
+  type :: mprgp_opts_t
+    real(wp) :: rtol = 1.0e-8_wp     !< stop when |gP| <= max(rtol*|b|, atol)
+    real(wp) :: atol = 0.0_wp        !< absolute floor of the stopping test (units of b)
+    integer :: max_it = 10000        !< maximum number of CG + expansion + proportioning steps
+    real(wp) :: gamma = 1.0_wp       !< proportioning constant Gamma > 0
+    real(wp) :: alpha_bar = 0.0_wp   !< expansion step length; <= 0: 1.9/lambda_max (units 1/[A])
+    real(wp) :: lambda_max = 0.0_wp  !< > 0: use this largest eigenvalue of A instead of estimating
+    integer :: power_its = 20        !< power iterations for the lambda_max estimate
+    logical :: use_ax = .false.      !< warm start: the solver's `ax` holds A x at x, no initial product
+    logical :: recycle = .false.     !< start with exact line searches along the stored directions `rw` (no product)
+    !> With equality rows (the solver's eq_g, eq_e: SMALBE's inner solve) a projected gradient
+    !! below the tolerance stops only when it is also below eq_m |eq_g x - eq_e| or the
+    !! equality already holds to eq_feas (Dostal's SMALBE-M precision control; SMALBE takes
+    !! eq_m as its initial M)
+    real(wp) :: eq_m = 0.0_wp        !< M of SMALBE-M (units of b per unit of eq_e)
+    real(wp) :: eq_feas = 0.0_wp     !< |eq_g x - eq_e| that counts as feasible (units of eq_e)
+    procedure(mprgp_stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
+  end type mprgp_opts_t
+
+  !> What an MPRGP solve did.
+  type :: mprgp_stats_t
+    integer :: status = MPRGP_BAD_ARG  !< one of the MPRGP_* codes
+    integer :: n_cg = 0                !< conjugate gradient steps
+    integer :: n_exp = 0               !< expansion steps
+    integer :: n_prop = 0              !< proportioning steps
+    integer :: n_matvec = 0            !< products with A, power iterations included
+    integer :: n_recycled = 0          !< line searches along s and the stored directions that moved x (no product)
+    real(wp) :: gp_norm = 0.0_wp       !< |gP| at the returned x (units of b)
+    real(wp) :: b_norm = 0.0_wp        !< |b|
+    real(wp) :: lambda_max = 0.0_wp    !< lambda_max used (largest of estimate and observed Rayleigh quotients); 0: not needed
+    real(wp) :: alpha_bar = 0.0_wp     !< final expansion step length; 0: not needed
+    character(len=160) :: message = '' !< one sentence on the outcome
+  end type mprgp_stats_t
+
+contains
+
+  !> Name of a status code: 'converged', 'max_it', 'non-finite', 'not SPD', 'bad argument'.
+  function mprgp_status_name(status) result(name)
+    integer, intent(in) :: status  !< an MPRGP_* code
+    character(len=:), allocatable :: name
+    select case (status)
+    case (MPRGP_CONVERGED)
+      name = 'converged'
+    case (MPRGP_MAX_IT)
+      name = 'max_it'
+    case (MPRGP_NONFINITE)
+      name = 'non-finite'
+    case (MPRGP_NOT_SPD)
+      name = 'not SPD'
+    case (MPRGP_BAD_ARG)
+      name = 'bad argument'
+    case (MPRGP_STOPPED)
+      name = 'stopped'
+    case default
+      name = 'unknown status'
+    end select
+  end function mprgp_status_name
+
+  !> Why the options cannot be used: '' when they are finite and in range.
+  function options_error(o) result(why)
+    type(mprgp_opts_t), intent(in) :: o   !< options
+    character(len=:), allocatable :: why
+    why = ''
+    if (.not. ieee_is_finite(o%rtol)) then
+      why = 'opts%rtol is not finite'
+      return
+    else if (o%rtol < 0.0_wp) then
+      why = 'opts%rtol is negative: '//trim(rtoa(o%rtol))
+      return
+    end if
+    if (.not. ieee_is_finite(o%atol)) then
+      why = 'opts%atol is not finite'
+      return
+    else if (o%atol < 0.0_wp) then
+      why = 'opts%atol is negative: '//trim(rtoa(o%atol))
+      return
+    end if
+    if (o%max_it < 0) then
+      why = 'opts%max_it is negative'
+      return
+    end if
+    if (.not. ieee_is_finite(o%gamma)) then
+      why = 'opts%gamma is not finite'
+      return
+    else if (o%gamma <= 0.0_wp) then
+      why = 'opts%gamma must be positive: '//trim(rtoa(o%gamma))
+      return
+    end if
+    if (.not. (ieee_is_finite(o%alpha_bar) .and. ieee_is_finite(o%lambda_max))) then
+      why = 'opts%alpha_bar or opts%lambda_max is not finite'
+      return
+    end if
+    if (o%alpha_bar <= 0.0_wp .and. o%lambda_max <= 0.0_wp .and. o%power_its < 1) then
+      why = 'opts%power_its must be >= 1 when neither alpha_bar nor lambda_max is given'
+      return
+    end if
+  end function options_error
+
+end module mprgp_options
