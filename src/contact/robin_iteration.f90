@@ -113,6 +113,10 @@ contains
     do it = run_state%it + 1, solver%max_outer
       ! 1. each body against its obstacle, in parallel
       rtol_in = robin_op%inner_tolerance(solver, it, m, run_state%progress, subproblems%lmax_body)
+      ! the obstacles stopped moving but the bodies do not agree: the subproblems' own error
+      ! is what is left, so each such iteration solves them ten times tighter, down to rounding
+      if (run_state%stalled > 0) rtol_in = max(sqrt(real(m, wp))*epsilon(1.0_wp), &
+                                               rtol_in*0.1_wp**min(run_state%stalled, 12))
       call solve_subproblems(subproblems, solver, bodies, rtol_in, it, run_state, w, res)
       if (m == 0) then
         res%status = STATUS_CONVERGED
