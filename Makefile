@@ -149,7 +149,7 @@ $(BUILD)/ordering.o:       $(BUILD)/kinds.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
-$(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o
+$(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/lapack.o
 $(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \

@@ -14,7 +14,7 @@ module results
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES
-  use strings, only: word
+  use strings, only: word, body_label
   use mesh, only: mesh_t
   use assembly, only: body_system_t, nodal_stress
   use condense, only: interface_t, contact_resultant
@@ -254,7 +254,7 @@ contains
       if (.not. (all(ieee_is_finite(sig)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed) then
         ! a derived field that is not finite is a failure, never part of a result
         st%failed = .true.
-        st%what = 'the stresses of body '//achar(48 + a)//' are not finite: beyond double precision, rescale the units'
+        st%what = 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units'
       end if
       sigt = transpose(sig)
       call write_dset(gid, 'stress', sigt, st, us)
@@ -396,8 +396,8 @@ contains
     write (nn, '(i0)') msh%nnode
     write (nc, '(i0)') msh%ncell
     write (nv, '(i0)') msh%nvert
-    g = h5//':/body'//achar(48 + a)
-    t = line('      <Grid Name="body'//achar(48 + a)//'" GridType="Uniform">')
+    g = h5//':/body'//body_label(a)
+    t = line('      <Grid Name="body'//body_label(a)//'" GridType="Uniform">')
     t = t//line('        <Topology TopologyType="'//trim(topo)//'" NumberOfElements="'//trim(nc)//'">')
     if (msh%element == ELEM_MIXED) then
       write (nv, '(i0)') 5*count(msh%cell_type == ELEM_Q1) + 4*count(msh%cell_type /= ELEM_Q1)

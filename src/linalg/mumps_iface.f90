@@ -10,6 +10,7 @@
 !! compiles mumps_iface_none.f90 (same API, every call an error) instead.
 module mumps_iface
   use kinds, only: wp
+  use strings, only: body_label
   use lapack, only: dpotrf, dpotri
   use mpi, only: MPI_Bcast, MPI_INTEGER
   implicit none (type, external)
@@ -143,7 +144,7 @@ contains
     subroutine fail(what)
       character(len=*), intent(in) :: what
       info = 3
-      msg = 'MUMPS '//what//' of body '//achar(48 + body)//' failed: '// &
+      msg = 'MUMPS '//what//' of body '//body_label(body)//' failed: '// &
             trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body))
     end subroutine fail
 
@@ -211,7 +212,7 @@ contains
   contains
     subroutine fail()
       info = 3
-      msg = 'MUMPS solve with body '//achar(48 + body)//' failed: '// &
+      msg = 'MUMPS solve with body '//body_label(body)//' failed: '// &
             trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body))
       if (associated(mt%id%RHS)) deallocate (mt%id%RHS)
       if (associated(mt%id%REDRHS)) deallocate (mt%id%REDRHS)
@@ -239,7 +240,7 @@ contains
     write (c, '(a,i0,a,i0,a)') '(INFO(1) = ', info1, ', INFO(2) = ', info2, ')'
     select case (info1)
     case (-10)
-      s = 'the stiffness of body '//achar(48 + body)//' is singular (not held against rigid motion?) '//trim(c)
+      s = 'the stiffness of body '//body_label(body)//' is singular (not held against rigid motion?) '//trim(c)
     case (-19)
       s = 'the working memory cap per rank (ROBIN_MUMPS_MAX_MB, ICNTL(23)) is too small for the factor '//trim(c)
     case (-9, -8, -14, -15, -17, -20)
@@ -249,7 +250,7 @@ contains
     case (-5, -7)
       s = 'out of memory in the MUMPS analysis: use more ranks per body or a coarser mesh '//trim(c)
     case (-6)
-      s = 'the stiffness of body '//achar(48 + body)//' is structurally singular '//trim(c)
+      s = 'the stiffness of body '//body_label(body)//' is structurally singular '//trim(c)
     case default
       s = 'MUMPS error '//trim(c)//' (see the MUMPS user guide, section "Error diagnostics")'
     end select
