@@ -55,12 +55,12 @@ module condense
     real(wp), allocatable :: flex(:, :)     !< (m,m) F_a [length/force]
     !> > 0 when F_a is singular (mortar: a master surface coarser than the slave has fewer
     !! normal DOFs than the slave has rows): then the body's subproblem gets a proximal term
-    !! that pins its multipliers to the other body's (contact.f90 `subproblem_operators`);
+    !! that pins its multipliers to the other body's (robin_operators `proximal_term`);
     !! its value, 1e-2 max diag F_a, is the scale of F_a
     real(wp) :: prox = 0.0_wp             !< [length/force]
     integer :: rank = 0                   !< numerical rank of F_a
     !> (m, m - rank) orthonormal basis Z of the numerical kernel of F_a (unallocated when F_a
-    !! is nonsingular): the proximal term and the obstacle act on Z Z' only (contact.f90)
+    !! is nonsingular): the proximal term and the obstacle act on Z Z' only (robin_operators)
     real(wp), allocatable :: kern(:, :)
     !> A body held only by contact (assembly: sys%nrig > 0): K_a^-1 above is the generalized
     !! inverse K_a^+ of the factor with the fixing DOFs removed, and the equilibrium of the
@@ -478,7 +478,7 @@ contains
     deallocate (work)
     allocate (work(lwork))
     call dsyev('V', 'L', bc%m, f, bc%m, ev, work, lwork, lapinfo)
-    ! no eigenvectors (dsyev did not converge): contact.f90 then uses the other body's F
+    ! no eigenvectors (dsyev did not converge): robin_operators then uses the other body's F
     if (lapinfo == 0) bc%kern = f(:, 1:bc%m - r)
   end subroutine flex_rank
 

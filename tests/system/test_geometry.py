@@ -232,7 +232,7 @@ for k, (what, deck, words) in enumerate(bad):
 
 # 7. the paper's operator on a singular master flexibility: the slave (the finer surface) has
 # more rows than the coarser master has normal DOFs, F_master is singular, and the master's
-# subproblem carries a proximal term (contact.f90 `subproblem_operators`)
+# subproblem carries a proximal term (robin_operators `proximal_term`)
 E2e, n2e = 200.0, 0.3
 p_eq = delta / (h1 / modulus(E1, n1) + h2 / modulus(E2e, n2e))
 EQ = (f"&body id=2, young={E2e}, poisson={n2e} /",)
