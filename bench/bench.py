@@ -13,7 +13,7 @@ Runs (each a separate process of bin/robin_contact, OMP_NUM_THREADS=2 unless sai
            operators, plus monolithic with monolithic_rtol 1e-2 ... 1e-10;
   floating the paper's size (24x16) and the finest level, contact by groups, body 1 clamped
            on its left side (supported) against body 1 with ux = 0 only there (held only
-           by contact, floating vertically: README "Bodies held only by contact"), Robin
+           by contact, floating vertically: doc/method.md, "Bodies held only by contact"), Robin
            harmonic delta 0.5 and monolithic: the extra cost of a floating body.
 
 Error columns:

@@ -7,7 +7,7 @@ result file (label from the file name and the method/delta attributes):
   bottom:          the active-set count (contact nodes with lam > 0) of each iteration,
                    out of the m contact nodes.
 
-What they are (README, "Stopping"; the run's `stop` setting is read from /input_deck):
+What they are (doc/method.md, "Stopping"; the run's `stop` setting is read from /input_deck):
   criterion  the quantity the run tests against tol: with stop='increment' (default) the
              relative obstacle increment |G1^k - G1^k-1|/|G1^k| + |G2^k - G2^k-1|/|G2^k|;
              with stop='residual' the residual below;

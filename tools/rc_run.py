@@ -1,6 +1,6 @@
 """Running robin_contact and reading its console output.
 
-The program's console output ends with key=value lines (see README, "Output"):
+The program's console output ends with key=value lines (see doc/running.md, "What a run prints"):
   result: status=converged method=robin outer=189 inner=2491 n1=816 n2=816 m=24 delta=0.5 residual=... wall_s=0.036
   time: assemble=... factor=... condense=... iterate=... output=... total=... peak_mb=... factor_mb=...
   contact: total normal force= ...

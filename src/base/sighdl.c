@@ -4,7 +4,7 @@
  * 4. Only async-signal-safe work in the handler. SIGUSR1 is there for OpenMPI's mpirun,
  * which forwards SIGUSR1 and SIGUSR2 to its ranks but answers SIGTERM by killing them
  * (SIGTERM, then SIGKILL a second later): `kill -USR1 <mpirun>` is the checkpoint request
- * of an MPI run (README, "MPI and MUMPS").
+ * of an MPI run (doc/batch.md, "MPI and MUMPS").
  *
  * METIS (GKlib, bundled in Debian's libmetis) installs its own SIGTERM handler with
  * signal() around every ordering and restores ours afterwards: a SIGTERM from the

@@ -1,4 +1,4 @@
-!> Interface condensation of one body through MUMPS (README, "MPI and MUMPS"), the
+!> Interface condensation of one body through MUMPS (doc/batch.md, "MPI and MUMPS"), the
 !! distributed counterpart of condense%factor_body/condense_body: the body's interface
 !! DOFs (condense%interface_dofs) are MUMPS's Schur variables, X = S^-1 = (K_a^-1) on them
 !! gives F_a = B_a X B_a' (condense%flex_from_x), b_a = B_a K_a^-1 f_a comes from a MUMPS

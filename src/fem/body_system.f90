@@ -24,7 +24,7 @@ module body_system
     real(wp), allocatable :: f_applied(:)
     real(wp) :: k_norm = 0.0_wp               !< max abs row sum of K (infinity norm) [stress]
     !> A body whose prescribed displacements leave rigid motions free (held only by
-    !! contact, README "Bodies held only by contact"): nrig > 0 kernel vectors R of K, and
+    !! contact, doc/method.md, "Bodies held only by contact"): nrig > 0 kernel vectors R of K, and
     !! as many fixing DOFs, prescribed to 0 in the factorized system only, so that the
     !! factor is a generalized inverse K^+ (K K^+ K = K) and u = K^+ (f - B'lam) + R alpha
     integer :: nrig = 0                       !< rigid motions left free (0..3)

@@ -5,7 +5,7 @@
 !! bad input (exit 1) with the estimate and the limit in the message: a run must not
 !! allocate until the kernel's OOM killer ends it.
 !!
-!! The factor estimate is calibrated on measured runs (README, "Performance"): nested
+!! The factor estimate is calibrated on measured runs (doc/performance.md): nested
 !! dissection orderings (metis, nd, amd) of a structured 2D body of n DOFs fill about
 !! 8 n log2(n) entries; the banded factorization and the natural order fill n times the
 !! half-bandwidth. Counts are computed in double precision, so no integer overflows.

@@ -1,5 +1,5 @@
 !> One body's stiffness factorized by MUMPS (Debian's MPI build, libdmumps) over a group of
-!! ranks, with the body's interface DOFs as Schur variables (README, "MPI and MUMPS"):
+!! ranks, with the body's interface DOFs as Schur variables (doc/batch.md, "MPI and MUMPS"):
 !! MUMPS factors the interior and returns S = K_GG - K_GI K_II^-1 K_IG on the group's host,
 !! and X = S^-1 = (K^-1)_GG follows by LAPACK (dpotrf/dpotri), as the CHOLMOD path's trailing
 !! block. A solve K u = r reduces the right-hand side (ICNTL(26) = 1: r_G - K_GI K_II^-1 r_I),

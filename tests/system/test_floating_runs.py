@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Bodies held only by contact, whole program (run by `make check`; README, "Bodies held only
+"""Bodies held only by contact, whole program (run by `make check`; doc/method.md, "Bodies held only
 by contact"):
 
 (a) force-controlled Hertz (inputs/hertz_force.nml on the h = 0.01 mesh): the vertical

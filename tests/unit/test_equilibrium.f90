@@ -1,4 +1,4 @@
-!> Global equilibrium of the seed's upper body (README, "The paper's Table 1") solved alone, its contact side
+!> Global equilibrium of the seed's upper body (doc/performance.md, "The paper's Table 1") solved alone, its contact side
 !! left free: the applied loads have the right resultant, and the reactions at the
 !! clamped side balance them in force and moment; the same scene in mm, N, MPa gives
 !! the same displacements. Q1 and P1, plane strain and plane stress. Solves use LAPACK's
