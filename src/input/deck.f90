@@ -19,9 +19,9 @@ module deck
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
   use strings, only: i2s, r2s, quoted_list, index_of, word, text_buffer_t
-  use namelist_input, only: str_t, src_t, grp_t, vars_t, load_file, text_source, parse_source, &
-                            read_group, render_group, reference_table, find_asg, find_int, die_at, bad_value, &
-                            unknown_group
+  use namelist_vars, only: str_t, vars_t, render_group, reference_table
+  use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, read_group, find_asg, find_int, &
+                            die_at, bad_value, unknown_group
   use config, only: deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
