@@ -38,34 +38,38 @@ module deck_checks
 
 contains
 
+  !> A group that appears at most once (&scene, &contact, &solver, &output): read into its
+  !! settings through its table, then its values checked.
   subroutine apply_single(g, src, d)
-    type(grp_t), intent(in) :: g
-    type(src_t), intent(in) :: src
-    type(deck_t), target, intent(inout) :: d
-    select case (g%name)
-    case ('scene')
-      call apply_scene(g, src, d)
-    case ('contact')
-      call apply_contact(g, src, d%contact)
-    case ('solver')
-      call apply_solver(g, src, d%solver)
-    case ('output')
-      call apply_output(g, src, d%output)
-    end select
-  end subroutine apply_single
-
-  subroutine apply_scene(g, src, d)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(deck_t), target, intent(inout) :: d
     type(scene_in_t), target :: sc
     type(vars_t) :: v
-    sc%plane = merge(1, 2, d%plane_strain)
-    call scene_vars(d, sc, v)
+    select case (g%name)
+    case ('scene')
+      sc%plane = merge(1, 2, d%plane_strain)
+      call scene_vars(d, sc, v)
+    case ('contact')
+      call contact_vars(d%contact, v)
+    case ('solver')
+      call solver_vars(d%solver, v)
+    case ('output')
+      call output_vars(d%output, v)
+    end select
     call read_group(g, src, v)
-    d%plane_strain = (sc%plane == 1)
-    call check_units(g, src, d%units)
-  end subroutine apply_scene
+    select case (g%name)
+    case ('scene')
+      d%plane_strain = (sc%plane == 1)
+      call check_units(g, src, d%units)
+    case ('contact')
+      call check_contact(g, src, d%contact)
+    case ('solver')
+      call check_solver(g, src, d%solver)
+    case ('output')
+      call check_output(g, src, d%output)
+    end select
+  end subroutine apply_single
 
   !> The unit names of a named system are fixed (given ones must agree); 'custom' needs all three.
   subroutine check_units(g, src, u)
@@ -112,26 +116,20 @@ contains
     end select
   end function unit_name
 
-  subroutine apply_contact(g, src, c)
+  subroutine check_contact(g, src, c)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
-    type(contact_cfg_t), target, intent(inout) :: c
-    type(vars_t) :: v
-    call contact_vars(c, v)
-    call read_group(g, src, v)
+    type(contact_cfg_t), intent(inout) :: c
     if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
       'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
     if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
       'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')
-  end subroutine apply_contact
+  end subroutine check_contact
 
-  subroutine apply_solver(g, src, s)
+  subroutine check_solver(g, src, s)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
-    type(solver_cfg_t), target, intent(inout) :: s
-    type(vars_t) :: v
-    call solver_vars(s, v)
-    call read_group(g, src, v)
+    type(solver_cfg_t), intent(inout) :: s
     if (s%alpha < 0.0_wp) call bad_value(g, src, 'alpha', r2s(s%alpha), 'must be >= 0')
     if (s%robin_operator == ROBIN_CONSTANT .and. .not. s%alpha > 0.0_wp) call bad_value(g, src, &
       'alpha', r2s(s%alpha), 'must be > 0 when robin_operator=''constant''')
@@ -150,21 +148,18 @@ contains
     if (s%inner_max_it < 1) call bad_value(g, src, 'inner_max_it', i2s(s%inner_max_it), 'must be >= 1')
     if (.not. (s%monolithic_rtol > 0.0_wp .and. s%monolithic_rtol < 1.0_wp)) call bad_value(g, src, &
       'monolithic_rtol', r2s(s%monolithic_rtol), 'must satisfy 0 < monolithic_rtol < 1')
-  end subroutine apply_solver
+  end subroutine check_solver
 
-  subroutine apply_output(g, src, o)
+  subroutine check_output(g, src, o)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
-    type(output_cfg_t), target, intent(inout) :: o
-    type(vars_t) :: v
-    call output_vars(o, v)
-    call read_group(g, src, v)
+    type(output_cfg_t), intent(inout) :: o
     o%file = adjustl(o%file)
     if (o%checkpoint_every < 0) call bad_value(g, src, 'checkpoint_every', i2s(o%checkpoint_every), &
       'must be >= 0 (0: no checkpoints)')
     if (o%progress_lines < 0) call bad_value(g, src, 'progress_lines', i2s(o%progress_lines), &
       'must be >= 0')
-  end subroutine apply_output
+  end subroutine check_output
 
   !> A &body in the deck file: a new body.
   subroutine new_body(g, src, d, st)
@@ -173,22 +168,17 @@ contains
     type(deck_t), intent(inout) :: d
     type(state_t), intent(inout) :: st
     integer :: id
-    logical :: found
     type(body_cfg_t) :: fresh
 
     if (st%nbody == 2) call die_at(src, g%line, 'in group &body: a third &body group; a deck '// &
       'has exactly two bodies, with ids 1 and 2 (the others are at lines '// &
       i2s(st%body_line(1))//' and '//i2s(st%body_line(2))//')')
-    call find_int(g, 'id', id, found)
-    if (.not. found) call die_at(src, g%line, 'in group &body: no id; give id=1 or id=2')
-    if (id /= 1 .and. id /= 2) call bad_value(g, src, 'id', i2s(id), &
-      'is not a body id: the two bodies have ids 1 and 2')
+    call body_id(g, src, 'no id; give id=1 or id=2', id)
     if (d%body(id)%id /= 0) call bad_value(g, src, 'id', i2s(id), &
       'is used twice (also by the &body at line '//i2s(st%body_line(id))// &
       '); the two bodies must have ids 1 and 2')
     fresh%id = id
-    call apply_body(g, src, fresh, d%body(id), st%path)
-    st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
+    call apply_body(g, src, fresh, id, d, st)
     st%nbody = st%nbody + 1
     st%body_line(id) = g%line
     st%body_at(id)%s = '&body at line '//i2s(g%line)
@@ -201,27 +191,37 @@ contains
     type(deck_t), intent(inout) :: d
     type(state_t), intent(inout) :: st
     integer :: id
-    logical :: found
     type(body_cfg_t) :: copy
 
-    call find_int(g, 'id', id, found)
-    if (.not. found) call die_at(src, g%line, 'in group &body: an override of &body must name '// &
-      'the body it changes with id=1 or id=2, e.g. ''&body id=2, young=1e9 /''')
-    if (id /= 1 .and. id /= 2) call bad_value(g, src, 'id', i2s(id), &
-      'is not a body id: the two bodies have ids 1 and 2')
+    call body_id(g, src, 'an override of &body must name the body it changes with id=1 or id=2, '// &
+                 'e.g. ''&body id=2, young=1e9 /''', id)
     copy = d%body(id)
-    call apply_body(g, src, copy, d%body(id), st%path)
-    st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
+    call apply_body(g, src, copy, id, d, st)
     st%body_at(id)%s = st%body_at(id)%s//', changed by '//src%label
   end subroutine override_body
 
-  !> Read a &body group into a copy of `b0` (its current values) and store it in `b`.
-  subroutine apply_body(g, src, b0, b, deck_path)
+  !> The id= of a &body: given (else the message `missing`), and 1 or 2.
+  subroutine body_id(g, src, missing, id)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    character(len=*), intent(in) :: missing
+    integer, intent(out) :: id
+    logical :: found
+    call find_int(g, 'id', id, found)
+    if (.not. found) call die_at(src, g%line, 'in group &body: '//missing)
+    if (id /= 1 .and. id /= 2) call bad_value(g, src, 'id', i2s(id), &
+      'is not a body id: the two bodies have ids 1 and 2')
+  end subroutine body_id
+
+  !> Read a &body group into a copy of `b0` (its current values) and store it as body `id`
+  !! of `d`; a side no longer declared 'displacement' drops its &displacement.
+  subroutine apply_body(g, src, b0, id, d, st)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(body_cfg_t), intent(in) :: b0
-    type(body_cfg_t), intent(inout) :: b
-    character(len=*), intent(in) :: deck_path
+    integer, intent(in) :: id
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
     type(body_cfg_t), target :: c
     type(vars_t) :: v
     integer :: s
@@ -229,7 +229,7 @@ contains
     c = b0
     call body_vars(c, v, ALL_FORMS)
     call read_group(g, src, v)
-    if (len_trim(c%mesh) > 0 .and. find_asg(g, 'mesh') > 0) call mesh_body(g, src, c, deck_path)
+    if (len_trim(c%mesh) > 0 .and. find_asg(g, 'mesh') > 0) call mesh_body(g, src, c, st%path)
     if (.not. c%width > 0.0_wp) call bad_value(g, src, 'width', r2s(c%width), 'must be > 0')
     if (.not. c%height > 0.0_wp) call bad_value(g, src, 'height', r2s(c%height), 'must be > 0')
     if (c%nx < 1) call bad_value(g, src, 'nx', i2s(c%nx), 'must be >= 1 (cells along x)')
@@ -245,7 +245,8 @@ contains
     do s = 1, 4
       if (c%bc(s) /= BC_DISPLACEMENT) c%u_side(:, s) = 0.0_wp
     end do
-    b = c
+    d%body(id) = c
+    st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
   end subroutine apply_body
 
   !> A &traction group (deck or override): appends a traction.
@@ -349,12 +350,11 @@ contains
     type(src_t), intent(in) :: src
     integer, intent(in) :: body
     integer :: k
+    logical :: missing
     k = find_asg(g, 'body')
-    if (k == 0) then
-      call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
-    else if (len_trim(g%a(k)%value) == 0) then
-      call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
-    end if
+    missing = k == 0
+    if (.not. missing) missing = len_trim(g%a(k)%value) == 0
+    if (missing) call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
     if (body /= 1 .and. body /= 2) call bad_value(g, src, 'body', i2s(body), &
       'does not exist: the bodies have ids 1 and 2')
   end subroutine body_given
@@ -492,12 +492,7 @@ contains
     ! leave free is held only by contact, and module floating checks that the contact can)
 
     do b = 1, 2
-      do s = 1, 4
-        if (d%body(b)%bc(s) == BC_DISPLACEMENT .and. .not. st%disp_given(s, b)) call fatal(EXIT_INPUT, &
-          p//'body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '//trim(side_names(s))//' side '// &
-          '''displacement'' but no &displacement group gives that displacement; add &displacement '// &
-          'body='//i2s(b)//', side='''//trim(side_names(s))//''', u=ux, uy /')
-      end do
+      call check_disp_given(d, st, b, .true.)
     end do
 
     call check_loads(d, st)
@@ -534,7 +529,7 @@ contains
   subroutine check_groups(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
-    integer :: b, s
+    integer :: b
     character(len=:), allocatable :: p
     p = st%path//': '
     do b = 1, 2
@@ -544,14 +539,28 @@ contains
         st%body_at(b)%s//') declares a ''contact'' side, but &contact names the contact groups; '// &
         'use one or the other (a rectangle''s sides are the groups ''left'', ''right'', '// &
         '''bottom'', ''top'')')
-      do s = 1, 4
-        if (d%body(b)%bc(s) == BC_DISPLACEMENT .and. .not. st%disp_given(s, b)) call fatal(EXIT_INPUT, &
-          p//'body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '//trim(side_names(s))//' side '// &
-          '''displacement'' but no &displacement group gives that displacement')
-      end do
+      call check_disp_given(d, st, b, .false.)
     end do
     call check_loads(d, st)
   end subroutine check_groups
+
+  !> Every side of body b declared 'displacement' has its &displacement (with `hint`, the
+  !! message shows the group to add).
+  subroutine check_disp_given(d, st, b, hint)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer, intent(in) :: b
+    logical, intent(in) :: hint
+    integer :: s
+    character(len=:), allocatable :: add
+    do s = 1, 4
+      if (d%body(b)%bc(s) /= BC_DISPLACEMENT .or. st%disp_given(s, b)) cycle
+      add = ''
+      if (hint) add = '; add &displacement body='//i2s(b)//', side='''//trim(side_names(s))//''', u=ux, uy /'
+      call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '// &
+        trim(side_names(s))//' side ''displacement'' but no &displacement group gives that displacement'//add)
+    end do
+  end subroutine check_disp_given
 
   function side_list(b) result(s)
     type(body_cfg_t), intent(in) :: b
