@@ -8,7 +8,8 @@
 !!
 !! with D_jj = int N_j ds (tributary length), N_k the slave hat functions, Phi_j their dual
 !! functions (Phi_1 = (1 - 3 xi)/2, Phi_2 = (1 + 3 xi)/2 on a segment, xi in [-1, 1]) and pi
-!! the projection along the slave normal onto the master curve. Rules as implemented:
+!! the projection along the slave normal onto the master curve. Rules as implemented (the
+!! chains and the projection of master nodes in module mortar_chains):
 !!
 !! - Chains. Each side's edges must form one open chain or one closed loop (a rim, a bore;
 !!   linked by shared nodes through a node -> edge map, O(n)); a branching node, inconsistent

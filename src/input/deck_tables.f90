@@ -19,7 +19,7 @@ module deck_tables
   public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
             solver_vars, output_vars
 
-
+  ! the documentation shared by the three unit names of &scene
   character(len=*), parameter :: UNIT_NAME_DOC = &
     'With `units=''SI''` or `''mm-N-MPa''` it is set by `units` (a different name given is bad '// &
     'input); with `''custom''` it is free but not empty'
