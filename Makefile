@@ -65,8 +65,8 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings int_hash text_scanner sorting sysinfo signals mpi_env config namelist_input deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar condense condense_mumps floating contact_types contact_common equality_rows \
+MODS := kinds errors clock strings int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar condense condense_mumps floating contact_types contact_common equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
@@ -127,9 +127,14 @@ $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
 $(BUILD)/mpi_env.o:        $(BUILD)/kinds.o
 $(BUILD)/config.o:         $(BUILD)/kinds.o
-$(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
-$(BUILD)/deck.o:           $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/config.o \
-                           $(BUILD)/namelist_input.o
+$(BUILD)/namelist_vars.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o
+$(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o
+$(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o \
+                           $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
+$(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
+$(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
+                           $(BUILD)/deck_checks.o $(BUILD)/deck_render.o
 $(BUILD)/budget.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
@@ -155,7 +160,8 @@ $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
                            $(BUILD)/mprgp_support.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
-$(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/mortar_chains.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
 $(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o
 $(BUILD)/condense_mumps.o: $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o $(BUILD)/condense.o \

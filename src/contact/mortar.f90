@@ -8,7 +8,8 @@
 !!
 !! with D_jj = int N_j ds (tributary length), N_k the slave hat functions, Phi_j their dual
 !! functions (Phi_1 = (1 - 3 xi)/2, Phi_2 = (1 + 3 xi)/2 on a segment, xi in [-1, 1]) and pi
-!! the projection along the slave normal onto the master curve. Rules as implemented:
+!! the projection along the slave normal onto the master curve. Rules as implemented (the
+!! chains and the projection of master nodes in module mortar_chains):
 !!
 !! - Chains. Each side's edges must form one open chain or one closed loop (a rim, a bore;
 !!   linked by shared nodes through a node -> edge map, O(n)); a branching node, inconsistent
@@ -61,9 +62,9 @@
 !!   weight sum: h where the row is the plain one, more next to a removed node, less at a
 !!   partly covered end.
 module mortar
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use strings, only: i2s
+  use mortar_chains, only: chain_order, project_master_nodes, edge_normal, cross, UNPLACED
   implicit none (type, external)
   private
 
@@ -97,7 +98,27 @@ module mortar
   real(wp), parameter :: TOL_FULL = 1.0e-12_wp     ! relative shortfall of a segment still counted as covered
   real(wp), parameter :: MIN_FACING = 1.0e-3_wp    ! cosine between n_s and -n_m below which a piece is dropped
   real(wp), parameter :: MIN_WEIGHT = 1.0e-3_wp    ! a row whose master weights sum below this is dropped
-  integer, parameter :: UNPLACED = 2               ! mstat of a master node no slave normal line reaches
+
+  !> The work of one mortar_build: the two chains, the slave geometry, where the master
+  !! nodes fall on the slave chain, the clipped pieces and which slave nodes carry rows.
+  type :: mortar_work_t
+    integer :: nes = 0, nem = 0                 ! slave and master edges
+    integer, allocatable :: cs(:), cm(:)        ! (0:ne) slave and master nodes in chain order
+    logical :: closed = .false.                 ! the slave chain is a closed loop
+    real(wp), allocatable :: slen(:)            ! (nes) slave segment lengths
+    real(wp), allocatable :: arc(:)             ! (0:nes) arc length of the slave chain nodes
+    real(wp), allocatable :: nn(:, :)           ! (2, 0:nes) slave nodal unit normals
+    integer, allocatable :: mstat(:), mseg(:)   ! (0:nem) master node place: status, slave segment
+    real(wp), allocatable :: mxi(:)             ! (0:nem) and xi on it
+    integer :: np = 0, nrej = 0                 ! pieces kept, pieces dropped as not facing
+    integer, allocatable :: pk(:), pq(:)        ! piece: slave segment, master segment
+    real(wp), allocatable :: plo(:), phi(:)     ! piece: xi interval on its slave segment
+    integer, allocatable :: kptr(:), ord(:)     ! pieces grouped by slave segment
+    real(wp), allocatable :: covlen(:)          ! (nes) covered length of each segment, in xi
+    logical, allocatable :: full(:)             ! (nes) segment covered whole
+    logical, allocatable :: covered(:)          ! (0:nes) slave node reached by a piece
+    logical, allocatable :: isrow(:)            ! (0:nes) slave node carries a row
+  end type mortar_work_t
 
 contains
 
@@ -113,12 +134,9 @@ contains
     type(mortar_t), intent(out) :: mt       !< the constraint rows
     integer, intent(out) :: info            !< 0 ok, 1 bad input
     character(len=*), intent(out) :: msg    !< why, when info /= 0
-    integer, allocatable :: cs(:), cm(:), mstat(:), mseg(:), pk(:), pq(:), kptr(:), ord(:)
-    real(wp), allocatable :: slen(:), nn(:, :), arc(:), mxi(:), plo(:), phi(:), covlen(:)
-    logical, allocatable :: covered(:), full(:), isrow(:)
-    logical :: closed, mclosed
-    integer :: nes, nem, i, k, q, np, nrej, klo, khi, iter, nbad
-    real(wp) :: lo, hi, xlo, xhi, sa, sb
+    type(mortar_work_t) :: w
+    logical :: mclosed
+    integer :: i, iter, nbad
 
     info = 0
     msg = ''
@@ -132,85 +150,139 @@ contains
       msg = 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes'
       return
     end if
-    call chain_order(xs, es, 'slave', cs, closed, info, msg)
+    call chain_order(xs, es, 'slave', w%cs, w%closed, info, msg)
     if (info /= 0) return
-    call chain_order(xm, em, 'master', cm, mclosed, info, msg)
+    call chain_order(xm, em, 'master', w%cm, mclosed, info, msg)
     if (info /= 0) return
-    nes = size(es, 2)
-    nem = size(em, 2)
+    w%nes = size(es, 2)
+    w%nem = size(em, 2)
 
-    ! Slave segment lengths, arc length and nodal normals (inverse-length weighted).
-    allocate (slen(nes), arc(0:nes), nn(2, 0:nes))
-    arc(0) = 0.0_wp
-    nn = 0.0_wp
-    do k = 1, nes
-      slen(k) = norm2(xs(:, cs(k)) - xs(:, cs(k - 1)))
-      arc(k) = arc(k - 1) + slen(k)
-      nn(:, k - 1) = nn(:, k - 1) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
-      nn(:, k) = nn(:, k) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
-    end do
-    if (closed) then
-      ! the loop's first and last chain nodes are one node, with both its edges
-      nn(:, 0) = nn(:, 0) + nn(:, nes)
-      nn(:, nes) = nn(:, 0)
-    end if
-    do i = 0, nes
-      lo = 0.0_wp
-      if (i > 0 .or. closed) lo = lo + 1.0_wp / slen(merge(i, nes, i > 0))
-      if (i < nes .or. closed) lo = lo + 1.0_wp / slen(merge(i + 1, 1, i < nes))
-      hi = norm2(nn(:, i))
-      if (hi <= 1.0e-8_wp * lo) then
-        info = 1
-        msg = 'mortar: the slave chain folds back on itself at node '//i2s(cs(i))//' (its two edges are opposite)'
-        return
-      end if
-      nn(:, i) = nn(:, i) / hi
-    end do
+    call slave_normals(w, xs, info, msg)
+    if (info /= 0) return
 
     ! Each master node's place on the slave chain: segment mseg and xi (mstat 0), or before
     ! the chain's start (mstat -1) or beyond its end (+1).
-    allocate (mstat(0:nem), mseg(0:nem), mxi(0:nem))
-    call project_master_nodes(xs, cs, nn, closed, xm, cm, mstat, mseg, mxi)
+    allocate (w%mstat(0:w%nem), w%mseg(0:w%nem), w%mxi(0:w%nem))
+    call project_master_nodes(xs, w%cs, w%nn, w%closed, xm, w%cm, w%mstat, w%mseg, w%mxi)
 
-    ! Clip: each master segment covers a slave interval; its pieces per slave segment.
-    np = 0
-    nrej = 0
-    allocate (pk(nes + nem + 8), pq(nes + nem + 8), plo(nes + nem + 8), phi(nes + nem + 8))
+    call clip_pieces(w, xm)
+    call sort_pieces(w)
+
+    allocate (w%isrow(0:w%nes))
+    do i = 0, w%nes
+      w%isrow(i) = w%covered(i) .and. .not. removable(w%cs(i))
+    end do
+    do iter = 1, w%nes + 2
+      call build_rows(w, xs, xm, mt, nbad)
+      if (nbad == 0) exit
+    end do
+
+    if (mt%m == 0) then
+      info = 1
+      if (w%np == 0 .and. w%nrej > 0) then
+        msg = 'mortar: every master edge over the slave faces away from it (n_s.n_m >= 0): both bodies must lie '// &
+              'on the left of their edges; is one edge list reversed?'
+      else if (w%np == 0) then
+        msg = 'mortar: the master curve does not overlap the slave curve along the slave normals'
+      else
+        msg = 'mortar: no slave node carries a multiplier (every covered slave node is removable)'
+      end if
+    end if
+  end subroutine mortar_build
+
+  !> Slave segment lengths, arc length and nodal normals (inverse-length weighted);
+  !! info = 1 where the chain folds back on itself.
+  subroutine slave_normals(w, xs, info, msg)
+    type(mortar_work_t), intent(inout) :: w
+    real(wp), intent(in) :: xs(:, :)
+    integer, intent(inout) :: info
+    character(len=*), intent(inout) :: msg
+    integer :: i, k, nes
+    real(wp) :: lo, hi
+    nes = w%nes
+    allocate (w%slen(nes), w%arc(0:nes), w%nn(2, 0:nes))
+    associate (cs => w%cs, slen => w%slen, arc => w%arc, nn => w%nn, closed => w%closed)
+      arc(0) = 0.0_wp
+      nn = 0.0_wp
+      do k = 1, nes
+        slen(k) = norm2(xs(:, cs(k)) - xs(:, cs(k - 1)))
+        arc(k) = arc(k - 1) + slen(k)
+        nn(:, k - 1) = nn(:, k - 1) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
+        nn(:, k) = nn(:, k) + edge_normal(xs(:, cs(k - 1)), xs(:, cs(k))) / slen(k)
+      end do
+      if (closed) then
+        ! the loop's first and last chain nodes are one node, with both its edges
+        nn(:, 0) = nn(:, 0) + nn(:, nes)
+        nn(:, nes) = nn(:, 0)
+      end if
+      do i = 0, nes
+        lo = 0.0_wp
+        if (i > 0 .or. closed) lo = lo + 1.0_wp / slen(merge(i, nes, i > 0))
+        if (i < nes .or. closed) lo = lo + 1.0_wp / slen(merge(i + 1, 1, i < nes))
+        hi = norm2(nn(:, i))
+        if (hi <= 1.0e-8_wp * lo) then
+          info = 1
+          msg = 'mortar: the slave chain folds back on itself at node '//i2s(cs(i))//' (its two edges are opposite)'
+          return
+        end if
+        nn(:, i) = nn(:, i) / hi
+      end do
+    end associate
+  end subroutine slave_normals
+
+  !> Clip: each master segment covers a slave interval; its pieces per slave segment.
+  subroutine clip_pieces(w, xm)
+    type(mortar_work_t), intent(inout) :: w
+    real(wp), intent(in) :: xm(:, :)
+    integer :: q, k, i, klo, khi, nes, nem
+    real(wp) :: lo, hi, xlo, xhi, sa, sb
+    nes = w%nes
+    nem = w%nem
+    w%np = 0
+    w%nrej = 0
+    allocate (w%pk(nes + nem + 8), w%pq(nes + nem + 8), w%plo(nes + nem + 8), w%phi(nes + nem + 8))
     do q = 1, nem
-      if (mstat(q - 1) /= 0 .and. mstat(q - 1) == mstat(q)) cycle
-      if (mstat(q - 1) == UNPLACED .or. mstat(q) == UNPLACED) cycle
-      call place(q - 1, k, lo)
-      call place(q, i, hi)
+      if (w%mstat(q - 1) /= 0 .and. w%mstat(q - 1) == w%mstat(q)) cycle
+      if (w%mstat(q - 1) == UNPLACED .or. w%mstat(q) == UNPLACED) cycle
+      call place(w, q - 1, k, lo)
+      call place(w, q, i, hi)
       if (i < k .or. (i == k .and. hi < lo)) then
         klo = i; xlo = hi; khi = k; xhi = lo
       else
         klo = k; xlo = lo; khi = i; xhi = hi
       end if
-      sa = arc(klo - 1) + 0.5_wp * (xlo + 1.0_wp) * slen(klo)
-      sb = arc(khi - 1) + 0.5_wp * (xhi + 1.0_wp) * slen(khi)
-      if (closed .and. sb - sa > 0.5_wp * arc(nes)) then
+      sa = w%arc(klo - 1) + 0.5_wp * (xlo + 1.0_wp) * w%slen(klo)
+      sb = w%arc(khi - 1) + 0.5_wp * (xhi + 1.0_wp) * w%slen(khi)
+      if (w%closed .and. sb - sa > 0.5_wp * w%arc(nes)) then
         ! the segment straddles the loop's first node: its two ends of the loop
-        call add_pieces(q, khi, xhi, nes, 1.0_wp)
-        call add_pieces(q, 1, -1.0_wp, klo, xlo)
+        call add_pieces(w, xm, q, khi, xhi, nes, 1.0_wp)
+        call add_pieces(w, xm, q, 1, -1.0_wp, klo, xlo)
       else
-        call add_pieces(q, klo, xlo, khi, xhi)
+        call add_pieces(w, xm, q, klo, xlo, khi, xhi)
       end if
     end do
+  end subroutine clip_pieces
 
-    ! Pieces grouped by slave segment (counting sort), coverage of segments and nodes.
-    allocate (kptr(nes + 1), ord(np), covlen(nes), full(nes), covered(0:nes))
-    kptr = 0
-    do i = 1, np
-      kptr(pk(i) + 1) = kptr(pk(i) + 1) + 1
-    end do
-    kptr(1) = 1
-    do k = 1, nes
-      kptr(k + 1) = kptr(k + 1) + kptr(k)
-    end do
-    covlen = 0.0_wp
-    covered = .false.
-    block
-      integer, allocatable :: fill(:)
+  !> Pieces grouped by slave segment (counting sort), coverage of segments and nodes.
+  subroutine sort_pieces(w)
+    type(mortar_work_t), intent(inout) :: w
+    integer, allocatable :: fill(:)
+    integer :: i, k, nes, np
+    nes = w%nes
+    np = w%np
+    allocate (w%kptr(nes + 1), w%ord(np), w%covlen(nes), w%full(nes), w%covered(0:nes))
+    associate (kptr => w%kptr, ord => w%ord, covlen => w%covlen, covered => w%covered, pk => w%pk, &
+               plo => w%plo, phi => w%phi)
+      kptr = 0
+      do i = 1, np
+        kptr(pk(i) + 1) = kptr(pk(i) + 1) + 1
+      end do
+      kptr(1) = 1
+      do k = 1, nes
+        kptr(k + 1) = kptr(k + 1) + kptr(k)
+      end do
+      covlen = 0.0_wp
+      covered = .false.
       allocate (fill(nes))
       fill = kptr(1:nes)
       do i = 1, np
@@ -221,119 +293,111 @@ contains
         if (plo(i) <= -1.0_wp + TOL_COVER) covered(k - 1) = .true.
         if (phi(i) >= 1.0_wp - TOL_COVER) covered(k) = .true.
       end do
-    end block
-    full = covlen >= 2.0_wp * (1.0_wp - TOL_FULL)
-    if (closed) then
-      covered(0) = covered(0) .or. covered(nes)
-      covered(nes) = covered(0)
-    end if
-
-    allocate (isrow(0:nes))
-    do i = 0, nes
-      isrow(i) = covered(i) .and. .not. removable(cs(i))
-    end do
-    do iter = 1, nes + 2
-      call build_rows(nbad)
-      if (nbad == 0) exit
-    end do
-
-    if (mt%m == 0) then
-      info = 1
-      if (np == 0 .and. nrej > 0) then
-        msg = 'mortar: every master edge over the slave faces away from it (n_s.n_m >= 0): both bodies must lie '// &
-              'on the left of their edges; is one edge list reversed?'
-      else if (np == 0) then
-        msg = 'mortar: the master curve does not overlap the slave curve along the slave normals'
-      else
-        msg = 'mortar: no slave node carries a multiplier (every covered slave node is removable)'
+      w%full = covlen >= 2.0_wp * (1.0_wp - TOL_FULL)
+      if (w%closed) then
+        covered(0) = covered(0) .or. covered(nes)
+        covered(nes) = covered(0)
       end if
-    end if
+    end associate
+  end subroutine sort_pieces
 
-  contains
+  !> The pieces of master segment qq on the slave chain from (k1, x1) to (k2, x2), one per
+  !! slave segment, those that face the slave normal.
+  subroutine add_pieces(w, xm, qq, k1, x1, k2, x2)
+    type(mortar_work_t), intent(inout) :: w
+    real(wp), intent(in) :: xm(:, :)
+    integer, intent(in) :: qq, k1, k2
+    real(wp), intent(in) :: x1, x2
+    integer :: kk
+    real(wp) :: a, b
+    do kk = k1, k2
+      a = -1.0_wp
+      b = 1.0_wp
+      if (kk == k1) a = x1
+      if (kk == k2) b = x2
+      if (b <= a) cycle
+      if (.not. facing(w, xm, kk, qq, 0.5_wp * (a + b))) then
+        w%nrej = w%nrej + 1
+        cycle
+      end if
+      if (w%np == size(w%pk)) call grow(w)
+      w%np = w%np + 1
+      w%pk(w%np) = kk; w%pq(w%np) = qq; w%plo(w%np) = a; w%phi(w%np) = b
+    end do
+  end subroutine add_pieces
 
-    !> The pieces of master segment qq on the slave chain from (k1, x1) to (k2, x2), one per
-    !! slave segment, those that face the slave normal.
-    subroutine add_pieces(qq, k1, x1, k2, x2)
-      integer, intent(in) :: qq, k1, k2
-      real(wp), intent(in) :: x1, x2
-      integer :: kk
-      real(wp) :: a, b
-      do kk = k1, k2
-        a = -1.0_wp
-        b = 1.0_wp
-        if (kk == k1) a = x1
-        if (kk == k2) b = x2
-        if (b <= a) cycle
-        if (.not. facing(kk, qq, 0.5_wp * (a + b))) then
-          nrej = nrej + 1
-          cycle
-        end if
-        if (np == size(pk)) call grow()
-        np = np + 1
-        pk(np) = kk; pq(np) = qq; plo(np) = a; phi(np) = b
-      end do
-    end subroutine add_pieces
+  !> The slave segment before chain node ii (0: none), across the first node of a loop.
+  pure integer function seg_before(w, ii)
+    type(mortar_work_t), intent(in) :: w
+    integer, intent(in) :: ii
+    seg_before = ii
+    if (ii == 0 .and. w%closed) seg_before = w%nes
+  end function seg_before
 
-    !> The slave segment before chain node ii (0: none), across the first node of a loop.
-    pure integer function seg_before(ii)
-      integer, intent(in) :: ii
-      seg_before = ii
-      if (ii == 0 .and. closed) seg_before = nes
-    end function seg_before
+  !> Where master chain node p sits on the slave chain, as (segment, xi), ends clamped.
+  subroutine place(w, p, kk, xx)
+    type(mortar_work_t), intent(in) :: w
+    integer, intent(in) :: p
+    integer, intent(out) :: kk
+    real(wp), intent(out) :: xx
+    select case (w%mstat(p))
+    case (-1)
+      kk = 1; xx = -1.0_wp
+    case (1)
+      kk = w%nes; xx = 1.0_wp
+    case default
+      kk = w%mseg(p); xx = w%mxi(p)
+    end select
+  end subroutine place
 
-    !> Where master chain node p sits on the slave chain, as (segment, xi), ends clamped.
-    subroutine place(p, kk, xx)
-      integer, intent(in) :: p
-      integer, intent(out) :: kk
-      real(wp), intent(out) :: xx
-      select case (mstat(p))
-      case (-1)
-        kk = 1; xx = -1.0_wp
-      case (1)
-        kk = nes; xx = 1.0_wp
-      case default
-        kk = mseg(p); xx = mxi(p)
-      end select
-    end subroutine place
+  !> Does master segment qq face the slave normal of segment kk at xi?
+  logical function facing(w, xm, kk, qq, xi)
+    type(mortar_work_t), intent(in) :: w
+    real(wp), intent(in) :: xm(:, :)
+    integer, intent(in) :: kk, qq
+    real(wp), intent(in) :: xi
+    real(wp) :: ns(2), nm(2)
+    ns = 0.5_wp * (1.0_wp - xi) * w%nn(:, kk - 1) + 0.5_wp * (1.0_wp + xi) * w%nn(:, kk)
+    nm = edge_normal(xm(:, w%cm(qq - 1)), xm(:, w%cm(qq)))
+    facing = dot_product(ns, nm) < -MIN_FACING * norm2(ns) * norm2(nm)
+  end function facing
 
-    !> Does master segment qq face the slave normal of segment kk at xi?
-    logical function facing(kk, qq, xi)
-      integer, intent(in) :: kk, qq
-      real(wp), intent(in) :: xi
-      real(wp) :: ns(2), nm(2)
-      ns = 0.5_wp * (1.0_wp - xi) * nn(:, kk - 1) + 0.5_wp * (1.0_wp + xi) * nn(:, kk)
-      nm = edge_normal(xm(:, cm(qq - 1)), xm(:, cm(qq)))
-      facing = dot_product(ns, nm) < -MIN_FACING * norm2(ns) * norm2(nm)
-    end function facing
+  !> Double the capacity of the piece arrays.
+  subroutine grow(w)
+    type(mortar_work_t), intent(inout) :: w
+    integer, allocatable :: ti(:)
+    real(wp), allocatable :: tr(:)
+    integer :: nw, np
+    np = w%np
+    nw = 2 * size(w%pk)
+    allocate (ti(nw)); ti(1:np) = w%pk(1:np); call move_alloc(ti, w%pk)
+    allocate (ti(nw)); ti(1:np) = w%pq(1:np); call move_alloc(ti, w%pq)
+    allocate (tr(nw)); tr(1:np) = w%plo(1:np); call move_alloc(tr, w%plo)
+    allocate (tr(nw)); tr(1:np) = w%phi(1:np); call move_alloc(tr, w%phi)
+  end subroutine grow
 
-    !> Double the capacity of the piece arrays.
-    subroutine grow()
-      integer, allocatable :: ti(:)
-      real(wp), allocatable :: tr(:)
-      integer :: nw
-      nw = 2 * size(pk)
-      allocate (ti(nw)); ti(1:np) = pk(1:np); call move_alloc(ti, pk)
-      allocate (ti(nw)); ti(1:np) = pq(1:np); call move_alloc(ti, pq)
-      allocate (tr(nw)); tr(1:np) = plo(1:np); call move_alloc(tr, plo)
-      allocate (tr(nw)); tr(1:np) = phi(1:np); call move_alloc(tr, phi)
-    end subroutine grow
+  !> Fill mt from isrow; rows whose master weights sum below MIN_WEIGHT are switched off
+  !! (nbad of them), in which case the caller builds again.
+  subroutine build_rows(wk, xs, xm, mt, nbad)
+    type(mortar_work_t), intent(inout) :: wk   !< the chains, normals and pieces; isrow is updated
+    real(wp), intent(in) :: xs(:, :), xm(:, :)
+    type(mortar_t), intent(inout) :: mt
+    integer, intent(out) :: nbad
+    integer :: j, m, cap, ns_, nm_, side, kk, other, ii, g, l, l1, l2, e, e2, pc, s0, m0_, nlast
+    integer, allocatable :: pos(:)
+    real(wp) :: dj, ws(-1:1), xa(2), xb(2), c0(2), c1(2), mm0(2), mm1(2), p1(2), dq(2), half, mid, xi, w, &
+                ph, p(2), ng(2), den, t, sw, g0
+    logical :: dual, isb
 
-    !> Fill mt from isrow; rows whose master weights sum below MIN_WEIGHT are switched off
-    !! (nbad of them), in which case the caller builds again.
-    subroutine build_rows(nbad)
-      integer, intent(out) :: nbad
-      integer :: j, m, cap, ns_, nm_, side, kk, other, ii, g, l, l1, l2, e, e2, pc, s0, m0_, nlast
-      integer, allocatable :: pos(:)
-      real(wp) :: dj, ws(-1:1), xa(2), xb(2), c0(2), c1(2), mm0(2), mm1(2), p1(2), dq(2), half, mid, xi, w, &
-                  ph, p(2), ng(2), den, t, sw, g0
-      logical :: dual, isb
-
+    associate (nes => wk%nes, closed => wk%closed, cs => wk%cs, cm => wk%cm, nn => wk%nn, slen => wk%slen, &
+               arc => wk%arc, kptr => wk%kptr, ord => wk%ord, pq => wk%pq, plo => wk%plo, phi => wk%phi, &
+               full => wk%full, isrow => wk%isrow)
       nlast = merge(nes - 1, nes, closed)      ! a loop's last chain node is its first
       m = count(isrow(0:nlast))
       cap = 0
       do ii = 0, nlast
         if (.not. isrow(ii)) cycle
-        kk = seg_before(ii)
+        kk = seg_before(wk, ii)
         if (kk > 0) cap = cap + 2 * (kptr(kk + 1) - kptr(kk))
         if (ii < nes) cap = cap + 2 * (kptr(ii + 2) - kptr(ii + 1))
       end do
@@ -362,7 +426,7 @@ contains
         do side = -1, 1, 2
           ! side -1: segment ii (nodes ii-1, ii; this node is its end b); +1: segment ii+1 (node a).
           if (side == -1) then
-            kk = seg_before(ii)
+            kk = seg_before(wk, ii)
             if (kk == 0) cycle
           else
             if (ii == nes) cycle
@@ -476,265 +540,7 @@ contains
         mt%mnod = mt%mnod(1:nm_)
         mt%mval = mt%mval(1:nm_)
       end if
-    end subroutine build_rows
-
-  end subroutine mortar_build
-
-  !> Order the edges of one side into a single chain: c(0:ne) are its nodes from the start
-  !! (the node no edge ends at), edge k joining c(k-1) -> c(k). A closed loop (a rim, a bore)
-  !! starts at the first edge's first node and has c(ne) = c(0).
-  subroutine chain_order(x, e, what, c, closed, info, msg)
-    real(wp), intent(in) :: x(:, :)            !< (2, nnode) coordinates
-    integer, intent(in) :: e(:, :)             !< (2, ne) edges
-    character(len=*), intent(in) :: what       !< 'slave' or 'master', for messages
-    integer, allocatable, intent(out) :: c(:)  !< (0:ne) nodes in chain order
-    logical, intent(out) :: closed             !< the edges form one closed loop
-    integer, intent(inout) :: info             !< set to 1 on bad input
-    character(len=*), intent(inout) :: msg     !< why
-    integer, allocatable :: eout(:), ein(:), deg(:)
-    integer :: ne, nnode, k, a, b, nstart, start, n
-    real(wp) :: lo(2), hi(2), diag
-
-    closed = .false.
-    ne = size(e, 2)
-    nnode = size(x, 2)
-    if (size(e, 1) /= 2) then
-      info = 1
-      msg = 'mortar: the '//what//' edges must be a (2, ne) array'
-      return
-    end if
-    if (ne == 0) then
-      info = 1
-      msg = 'mortar: no '//what//' contact edges'
-      return
-    end if
-    do k = 1, ne
-      if (any(e(:, k) < 1) .or. any(e(:, k) > nnode)) then
-        info = 1
-        msg = 'mortar: '//what//' edge '//i2s(k)//' refers to node '//i2s(merge(e(1, k), e(2, k), &
-              e(1, k) < 1 .or. e(1, k) > nnode))//', outside 1..'//i2s(nnode)
-        return
-      end if
-      if (.not. all(ieee_is_finite(x(:, e(:, k))))) then
-        info = 1
-        msg = 'mortar: '//what//' edge '//i2s(k)//' has a node with a non-finite coordinate'
-        return
-      end if
-    end do
-    lo = huge(1.0_wp)
-    hi = -huge(1.0_wp)
-    do k = 1, ne
-      do a = 1, 2
-        lo = min(lo, x(:, e(a, k)))
-        hi = max(hi, x(:, e(a, k)))
-      end do
-    end do
-    diag = norm2(hi - lo)
-    do k = 1, ne
-      if (e(1, k) == e(2, k) .or. norm2(x(:, e(2, k)) - x(:, e(1, k))) <= 1.0e-12_wp * diag) then
-        info = 1
-        msg = 'mortar: '//what//' edge '//i2s(k)//' (nodes '//i2s(e(1, k))//', '//i2s(e(2, k))//') has zero length'
-        return
-      end if
-    end do
-    allocate (eout(nnode), ein(nnode), deg(nnode))
-    eout = 0
-    ein = 0
-    deg = 0
-    do k = 1, ne
-      deg(e(:, k)) = deg(e(:, k)) + 1
-    end do
-    do k = 1, ne
-      do a = 1, 2
-        if (deg(e(a, k)) > 2) then
-          info = 1
-          msg = 'mortar: the '//what//' edges branch at node '//i2s(e(a, k))//' ('//i2s(deg(e(a, k)))// &
-                ' edges meet there); one chain is required'
-          return
-        end if
-      end do
-    end do
-    do k = 1, ne
-      a = e(1, k)
-      b = e(2, k)
-      if (eout(a) /= 0) then
-        info = 1
-        msg = 'mortar: '//what//' edges '//i2s(eout(a))//' and '//i2s(k)//' both start at node '//i2s(a)// &
-              ': they are not consistently oriented (the body must lie on the left of every edge)'
-        return
-      end if
-      if (ein(b) /= 0) then
-        info = 1
-        msg = 'mortar: '//what//' edges '//i2s(ein(b))//' and '//i2s(k)//' both end at node '//i2s(b)// &
-              ': they are not consistently oriented (the body must lie on the left of every edge)'
-        return
-      end if
-      eout(a) = k
-      ein(b) = k
-    end do
-    nstart = 0
-    start = 0
-    do k = 1, ne
-      a = e(1, k)
-      if (ein(a) == 0) then
-        nstart = nstart + 1
-        start = a
-      end if
-    end do
-    if (nstart == 0) then
-      closed = .true.
-      start = e(1, 1)
-    end if
-    if (nstart > 1) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form '//i2s(nstart)//' separate chains; one chain or one loop is required'
-      return
-    end if
-    allocate (c(0:ne))
-    c(0) = start
-    n = 0
-    do while (eout(c(n)) /= 0)
-      if (n == ne) exit
-      k = eout(c(n))
-      n = n + 1
-      c(n) = e(2, k)
-      if (closed .and. c(n) == start) exit
-    end do
-    if (closed .and. n /= ne) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form more than one closed loop (one of '//i2s(n)//' edges, the '// &
-            'other '//i2s(ne - n)//'); one chain or one loop is required'
-      return
-    end if
-    if (n /= ne) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form more than one chain (a chain of '//i2s(n)//' edges and a closed '// &
-            'loop of the other '//i2s(ne - n)//'); one chain is required'
-      return
-    end if
-  end subroutine chain_order
-
-  !> Place every master chain node on the slave chain along the interpolated slave normal:
-  !! the segment k where sigma_i = (x - x_i) x n_i changes sign from <= 0 at node k-1 to
-  !! >= 0 at node k, found by walking from the previous node's segment. Along the slave
-  !! curve sigma grows through the point x projects to (d sigma/ds = 1 + d kappa > 0 while
-  !! x is nearer than the centre of curvature), so on a closed slave loop, where the walk
-  !! wraps around, the rising sign change is the projection; a node with none is UNPLACED.
-  subroutine project_master_nodes(xs, cs, nn, closed, xm, cm, mstat, mseg, mxi)
-    real(wp), intent(in) :: xs(:, :), nn(:, 0:), xm(:, :)
-    integer, intent(in) :: cs(0:), cm(0:)
-    logical, intent(in) :: closed
-    integer, intent(out) :: mstat(0:), mseg(0:)
-    real(wp), intent(out) :: mxi(0:)
-    integer :: nes, k, p, steps
-    real(wp) :: x(2)
-    nes = size(cs) - 1
-    k = nes
-    do p = 0, size(cm) - 1
-      x = xm(:, cm(p))
-      mseg(p) = 0
-      mxi(p) = 0.0_wp
-      steps = 0
-      do
-        steps = steps + 1
-        if (steps > nes + 2) then
-          mstat(p) = UNPLACED
-          k = nes
-          exit
-        end if
-        if (cross(x - xs(:, cs(k - 1)), nn(:, k - 1)) > 0.0_wp) then
-          if (k == 1) then
-            if (closed) then
-              k = nes
-              cycle
-            end if
-            mstat(p) = -1
-            exit
-          end if
-          k = k - 1
-        else if (cross(x - xs(:, cs(k)), nn(:, k)) < 0.0_wp) then
-          if (k == nes) then
-            if (closed) then
-              k = 1
-              cycle
-            end if
-            mstat(p) = 1
-            exit
-          end if
-          k = k + 1
-        else
-          mstat(p) = 0
-          mseg(p) = k
-          mxi(p) = project_on_segment(x, xs(:, cs(k - 1)), xs(:, cs(k)), nn(:, k - 1), nn(:, k))
-          exit
-        end if
-      end do
-    end do
-  end subroutine project_master_nodes
-
-  !> The xi in [-1, 1] where (x - x_s(xi)) x n(xi) = 0 on the segment xa -> xb with nodal
-  !! normals na, nb interpolated linearly (a quadratic; the caller has checked the sign
-  !! change between the ends).
-  pure real(wp) function project_on_segment(x, xa, xb, na, nb) result(xi)
-    real(wp), intent(in) :: x(2), xa(2), xb(2), na(2), nb(2)
-    real(wp) :: c0(2), c1(2), m0(2), m1(2), d(2), a, b, c, disc, q, r(2), fl, fm, lo, hi
-    integer :: it, i
-    c0 = 0.5_wp * (xa + xb)
-    c1 = 0.5_wp * (xb - xa)
-    m0 = 0.5_wp * (na + nb)
-    m1 = 0.5_wp * (nb - na)
-    d = x - c0
-    a = -cross(c1, m1)
-    b = cross(d, m1) - cross(c1, m0)
-    c = cross(d, m0)
-    ! f(xi) = c + b xi + a xi^2
-    if (a == 0.0_wp) then
-      if (b /= 0.0_wp) then
-        xi = min(1.0_wp, max(-1.0_wp, -c / b))
-        return
-      end if
-    else
-      disc = b * b - 4.0_wp * a * c
-      if (disc >= 0.0_wp) then
-        q = -0.5_wp * (b + sign(sqrt(disc), b))
-        r = huge(1.0_wp)
-        r(1) = q / a
-        if (q /= 0.0_wp) r(2) = c / q
-        i = minloc(abs(r), 1)
-        if (abs(r(i)) <= 1.0_wp + 1.0e-8_wp) then
-          xi = min(1.0_wp, max(-1.0_wp, r(i)))
-          return
-        end if
-      end if
-    end if
-    ! Fallback: bisection on the bracket.
-    lo = -1.0_wp
-    hi = 1.0_wp
-    fl = c - b + a
-    do it = 1, 60
-      xi = 0.5_wp * (lo + hi)
-      fm = c + xi * (b + xi * a)
-      if ((fm <= 0.0_wp) .eqv. (fl <= 0.0_wp)) then
-        lo = xi
-        fl = fm
-      else
-        hi = xi
-      end if
-    end do
-  end function project_on_segment
-
-  !> Outward normal (dy, -dx)/len of the edge xa -> xb (body on the left).
-  pure function edge_normal(xa, xb) result(n)
-    real(wp), intent(in) :: xa(2), xb(2)
-    real(wp) :: n(2)
-    n = [xb(2) - xa(2), xa(1) - xb(1)]
-    n = n / norm2(n)
-  end function edge_normal
-
-  !> The 2D cross product a x b = a1 b2 - a2 b1.
-  pure real(wp) function cross(a, b)
-    real(wp), intent(in) :: a(2), b(2)
-    cross = a(1) * b(2) - a(2) * b(1)
-  end function cross
+    end associate
+  end subroutine build_rows
 
 end module mortar

@@ -29,6 +29,26 @@ module checkpoint
 
   public :: checkpoint_read, checkpoint_file
 
+  integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
+  character(len=*), parameter :: INT_ATTRS(6) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
+                                                 'it_best', 'inner_maxit_hits']
+  character(len=*), parameter :: REAL_ATTRS(6) = [character(len=16) :: 'res_best', 'crit', 'progress', &
+                                                  'best', 'omega', 'wall']
+
+  !> A checkpoint being read: the open file and groups, what this run implies of it, what
+  !! it was found to hold, and the first thing wrong with it (msg, '' while all is well).
+  type :: ckpt_reader_t
+    character(len=:), allocatable :: src       ! 'restart file <path>', for messages
+    character(len=:), allocatable :: msg       ! why it cannot be used
+    integer(hid_t) :: fid = -1, gid = -1, hid = -1   ! the file, /state, /history
+    type(h5_status_t) :: hs
+    integer :: m = 0                           ! interface size of this run
+    integer :: maxout = 0                      ! max_outer of this run
+    integer :: nh = 0                          ! entries of /history
+    integer :: kr = 0                          ! stored directions per body
+    logical :: has_products = .false., has_search = .false., has_recycle = .false., has_mu = .false.
+  end type ckpt_reader_t
+
 contains
 
   !> The checkpoint path of a result file: `<file>.ckpt.h5`.
@@ -114,310 +134,312 @@ contains
     type(contact_result_t), intent(inout) :: res  !< receives the history
     logical, intent(out) :: ok                    !< success
     character(len=*), intent(out) :: msg          !< why not
-    integer(hid_t) :: fid, gid, hid
-    type(h5_status_t) :: hs
-    integer :: n, nh, kr
-    character(len=:), allocatable :: k, src
-    real(wp), allocatable :: r(:), rmu(:, :)
-    integer, allocatable :: ir(:)
-    logical :: exists_, has_products, has_search, has_recycle, has_mu
-    integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
-    character(len=*), parameter :: INT_ATTRS(6) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
-                                                   'it_best', 'inner_maxit_hits']
-    character(len=*), parameter :: REAL_ATTRS(6) = [character(len=16) :: 'res_best', 'crit', 'progress', &
-                                                    'best', 'omega', 'wall']
-    integer :: j
+    type(ckpt_reader_t) :: r
+    character(len=:), allocatable :: k
+    logical :: exists_
 
     ok = .false.
     msg = ''
-    src = 'restart file '//trim(file)
-    gid = -1
-    hid = -1
+    r%msg = ''
+    r%src = 'restart file '//trim(file)
+    r%m = m
+    r%maxout = maxout
     inquire (file=file, exist=exists_)
     if (.not. exists_) then
-      msg = src//' does not exist'
+      msg = r%src//' does not exist'
       return
     end if
-    call file_open(file, fid, hs)
-    if (hs%failed) then
-      msg = src//' is not an HDF5 file'
+    call file_open(file, r%fid, r%hs)
+    if (r%hs%failed) then
+      msg = r%src//' is not an HDF5 file'
       return
     end if
-    if (.not. exists(fid, 'key', .false.)) then
-      msg = src//' is not a robin_contact checkpoint (it has no dataset /key)'
+    if (.not. exists(r%fid, 'key', .false.)) then
+      r%msg = r%src//' is not a robin_contact checkpoint (it has no dataset /key)'
     else
-      call need(fid, '/', 'key', .false., CLASS_STRING, SCALAR, 'a scalar string')
+      call need(r, r%fid, '/', 'key', .false., CLASS_STRING, SCALAR, 'a scalar string')
     end if
-    if (len_trim(msg) == 0) then
-      call read_dset(fid, 'key', k, hs)
-      if (hs%failed) then
-        msg = src//' is not a robin_contact checkpoint ('//hs%what//')'
+    if (len_trim(r%msg) == 0) then
+      call read_dset(r%fid, 'key', k, r%hs)
+      if (r%hs%failed) then
+        r%msg = r%src//' is not a robin_contact checkpoint ('//r%hs%what//')'
       else if (trim(k) /= trim(key)) then
-        msg = src//' was made from a different deck or mesh '// &
-              '(its bodies, loads, contact or solver settings differ from this run''s)'
+        r%msg = r%src//' was made from a different deck or mesh '// &
+                '(its bodies, loads, contact or solver settings differ from this run''s)'
       end if
     end if
-    if (len_trim(msg) == 0) call check_layout()
-    if (len_trim(msg) == 0) call read_state()
-    call group_close(hid, hs)
-    call group_close(gid, hs)
-    call file_close(fid, hs)
+    if (len_trim(r%msg) == 0) call check_layout(r)
+    if (len_trim(r%msg) == 0) call read_state(r, st, res)
+    call group_close(r%hid, r%hs)
+    call group_close(r%gid, r%hs)
+    call file_close(r%fid, r%hs)
+    msg = r%msg
     ok = len_trim(msg) == 0
-
-  contains
-
-    !> Every object the state is read from, checked for class and shape before reading.
-    subroutine check_layout()
-      integer(hsize_t) :: m2, hdims(1)
-      integer(hsize_t), allocatable :: dims(:)
-      integer :: cls
-      character(len=*), parameter :: hist(5) = [character(len=9) :: 'criterion', 'residual', 'wall_s', &
-                                                'inner', 'active']
-      m2 = int(m, hsize_t)
-      call group(fid, 'state', gid)
-      call group(fid, 'history', hid)
-      if (len_trim(msg) > 0) return
-      do j = 1, size(INT_ATTRS)
-        call need(gid, '/state', trim(INT_ATTRS(j)), .true., CLASS_INTEGER, SCALAR, 'a scalar')
-      end do
-      do j = 1, size(REAL_ATTRS)
-        call need(gid, '/state', trim(REAL_ATTRS(j)), .true., CLASS_REAL, SCALAR, 'a scalar')
-      end do
-      call need(gid, '/state', 'flam', .false., CLASS_REAL, [2_hsize_t], 'the two bodies')
-      call need(gid, '/state', 'G', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
-      call need(gid, '/state', 'lam', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
-      call need(gid, '/state', 'r_prev', .false., CLASS_REAL, [2*m2], contact_nodes())
-      call need(gid, '/state', 'x_prev', .false., CLASS_REAL, [2*m2], contact_nodes())
-      call need(gid, '/state', 'dX', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
-                contact_nodes()//' and Anderson depth '//i2s(ANDERSON_DEPTH))
-      call need(gid, '/state', 'dR', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
-                contact_nodes()//' and Anderson depth '//i2s(ANDERSON_DEPTH))
-      ! F_a lam_a of the last solves: absent from older checkpoints, checked when present
-      has_products = exists(gid, 'reuse', .true.) .or. exists(gid, 'flam_v', .false.)
-      if (has_products) then
-        call need(gid, '/state', 'reuse', .true., CLASS_INTEGER, SCALAR, 'a scalar')
-        call need(gid, '/state', 'flam_v', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
-      end if
-      ! the last change of lam_a and F_a times it: absent from older checkpoints, checked when present
-      has_search = exists(gid, 'nsrch', .true.) .or. exists(gid, 'srch', .false.) .or. exists(gid, 'fsrch', .false.)
-      if (has_search) then
-        call need(gid, '/state', 'nsrch', .true., CLASS_INTEGER, SCALAR, 'a scalar')
-        call need(gid, '/state', 'srch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
-        call need(gid, '/state', 'fsrch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes())
-      end if
-      ! the stored directions of the bodies' solves and their images: absent from older
-      ! checkpoints, checked when present
-      kr = recycle_size(m)
-      has_recycle = exists(gid, 'nrw', .false.) .or. exists(gid, 'rw', .false.) .or. exists(gid, 'raw', .false.)
-      if (has_recycle) then
-        call need(gid, '/state', 'nrw', .false., CLASS_INTEGER, [4_hsize_t], 'two counters per body')
-        call need(gid, '/state', 'rw', .false., CLASS_REAL, [m2, int(2*kr, hsize_t)], &
-                  contact_nodes()//' and '//i2s(kr)//' directions per body')
-        call need(gid, '/state', 'raw', .false., CLASS_REAL, [m2, int(2*kr, hsize_t)], &
-                  contact_nodes()//' and '//i2s(kr)//' directions per body')
-      end if
-      ! the equality multipliers of floating bodies: absent from older checkpoints
-      has_mu = exists(gid, 'mu', .false.)
-      if (has_mu) call need(gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, 2_hsize_t], &
-                            'three multipliers per body')
-      if (len_trim(msg) > 0) return
-      ! the history: five arrays of one length nh, it <= nh <= max_outer (checked after reading it)
-      call need(hid, '/history', 'criterion', .false., CLASS_REAL, [-1_hsize_t], 'one entry per outer iteration')
-      if (len_trim(msg) > 0) return
-      call describe(hid, 'criterion', .false., cls, dims, hs)
-      hdims = dims
-      do j = 1, size(hist)
-        call need(hid, '/history', trim(hist(j)), .false., merge(CLASS_INTEGER, CLASS_REAL, j > 3), hdims, &
-                  'one entry per outer iteration, as /history/criterion')
-      end do
-      nh = int(hdims(1))
-      if (len_trim(msg) == 0 .and. nh > maxout) &
-        msg = src//': dataset /history/criterion has '//i2s(nh)//' entries, more than max_outer = '//i2s(maxout)
-    end subroutine check_layout
-
-    !> Open group `name` of the file into g; msg when it is not there.
-    subroutine group(loc, name, g)
-      integer(hid_t), intent(in) :: loc
-      character(len=*), intent(in) :: name
-      integer(hid_t), intent(out) :: g
-      g = -1
-      if (len_trim(msg) > 0) return
-      if (.not. exists(loc, name, .false.)) then
-        msg = src//' has no group /'//name
-        return
-      end if
-      call group_open(loc, name, g, hs)
-      if (hs%failed) msg = src//': '//hs%what
-    end subroutine group
-
-    !> Check that `name` in `loc` (path `path`) is a dataset, or an attribute when `attr`, of
-    !! class `cls` and shape `dims` (Fortran order; -1: any extent); `what` says what the
-    !! shape stands for. On the first mismatch msg names the file and the object.
-    subroutine need(loc, path, name, attr, cls, dims, what)
-      integer(hid_t), intent(in) :: loc
-      character(len=*), intent(in) :: path, name, what
-      logical, intent(in) :: attr
-      integer, intent(in) :: cls
-      integer(hsize_t), intent(in) :: dims(:)
-      integer(hsize_t), allocatable :: got(:)
-      integer :: c
-      character(len=:), allocatable :: obj
-      type(h5_status_t) :: ds
-      if (len_trim(msg) > 0) return
-      if (attr) then
-        obj = 'attribute '//trim(name)//' of '//path
-      else
-        obj = 'dataset '//path//'/'//name
-        if (path == '/') obj = 'dataset /'//name
-      end if
-      if (.not. exists(loc, name, attr)) then
-        msg = src//' has no '//obj
-        return
-      end if
-      call describe(loc, name, attr, c, got, ds)
-      if (ds%failed) then
-        msg = src//': '//ds%what
-      else if (c /= cls) then
-        msg = src//': '//obj//' holds '//class_name(c)//', expected '//class_name(cls)
-      else if (size(got) /= size(dims)) then
-        msg = src//': '//obj//' has shape '//shape_text(got)//', expected '//shape_text(dims)//' ('//what//')'
-      else if (any(got /= dims .and. dims >= 0)) then
-        msg = src//': '//obj//' has shape '//shape_text(got)//', expected '//shape_text(dims)//' ('//what//')'
-      end if
-    end subroutine need
-
-    function contact_nodes() result(t)
-      character(len=:), allocatable :: t
-      t = 'this deck has '//i2s(m)//' contact nodes'
-    end function contact_nodes
-
-    subroutine read_state()
-      call read_attr(gid, 'it', st%it, hs)
-      call read_attr(gid, 'inner', st%inner, hs)
-      call read_attr(gid, 'nacc', st%nacc, hs)
-      call read_attr(gid, 'inner_maxit_hits', res%inner_maxit_hits, hs)
-      call read_attr(gid, 'stalled', st%stalled, hs)
-      call read_attr(gid, 'it_best', st%it_best, hs)
-      call read_attr(gid, 'res_best', st%res_best, hs)
-      call read_attr(gid, 'crit', st%crit, hs)
-      call read_attr(gid, 'progress', st%progress, hs)
-      call read_attr(gid, 'best', st%best, hs)
-      call read_attr(gid, 'omega', st%omega, hs)
-      call read_attr(gid, 'wall', st%wall, hs)
-      call read_dset(gid, 'flam', r, hs)
-      if (.not. hs%failed) st%flam = r
-      call read_dset(gid, 'G', st%G, hs)
-      call read_dset(gid, 'lam', st%lam, hs)
-      call read_dset(gid, 'r_prev', st%r_prev, hs)
-      call read_dset(gid, 'x_prev', st%x_prev, hs)
-      call read_dset(gid, 'dX', st%dX, hs)
-      call read_dset(gid, 'dR', st%dR, hs)
-      if (has_products) then
-        call read_attr(gid, 'reuse', st%reuse, hs)
-        call read_dset(gid, 'flam_v', st%flam_v, hs)
-      else
-        ! an older checkpoint: the first solve after the restart computes F_a lam_a
-        st%reuse = 0
-        allocate (st%flam_v(m, 2))
-        st%flam_v = 0.0_wp
-      end if
-      if (has_search) then
-        call read_attr(gid, 'nsrch', st%nsrch, hs)
-        call read_dset(gid, 'srch', st%srch, hs)
-        call read_dset(gid, 'fsrch', st%fsrch, hs)
-      else
-        ! an older checkpoint: no line search in the first iteration after the restart
-        st%nsrch = 0
-        allocate (st%srch(m, 2), st%fsrch(m, 2))
-        st%srch = 0.0_wp
-        st%fsrch = 0.0_wp
-      end if
-      st%mu = 0.0_wp
-      if (has_mu) then
-        call read_dset(gid, 'mu', rmu, hs)
-        if (.not. hs%failed) st%mu = rmu
-      end if
-      if (has_recycle) then
-        call read_dset(gid, 'nrw', ir, hs)
-        if (.not. hs%failed) st%nrw = reshape(ir, [2, 2])
-        call read_dset(gid, 'rw', st%rw, hs)
-        call read_dset(gid, 'raw', st%raw, hs)
-      else
-        ! an older checkpoint: the bodies' solves start again without stored directions
-        st%nrw = reshape([0, 1, 0, 1], [2, 2])
-        allocate (st%rw(m, 2*kr), st%raw(m, 2*kr))
-        st%rw = 0.0_wp
-        st%raw = 0.0_wp
-      end if
-      if (hs%failed) then
-        msg = src//' cannot be read ('//hs%what//')'
-        return
-      end if
-      ! ranges of the counters, finite values
-      n = st%it
-      if (n < 1 .or. n > maxout) then
-        msg = src//': attribute it of /state is '//i2s(n)//', outside 1 .. max_outer = '//i2s(maxout)
-      else if (n > nh) then
-        msg = src//': attribute it of /state is '//i2s(n)//', beyond the '//i2s(nh)// &
-              ' entries of /history/criterion'
-      else if (min(st%inner, st%nacc, st%stalled, res%inner_maxit_hits) < 0) then
-        msg = src//': a counter of /state (inner, nacc, stalled, inner_maxit_hits) is negative'
-      else if (st%it_best < 0 .or. st%it_best > n) then
-        msg = src//': attribute it_best of /state is '//i2s(st%it_best)//', outside 0 .. it = '//i2s(n)
-      else if (st%reuse /= 0 .and. st%reuse /= 1) then
-        msg = src//': attribute reuse of /state is '//i2s(st%reuse)//', not 0 or 1'
-      else if (.not. all(ieee_is_finite(st%G))) then
-        msg = src//': dataset /state/G holds values that are not finite'
-      else if (.not. all(ieee_is_finite(st%lam))) then
-        msg = src//': dataset /state/lam holds values that are not finite'
-      else if (any(st%lam < 0.0_wp)) then
-        msg = src//': dataset /state/lam holds negative contact forces'
-      else if (.not. (all(ieee_is_finite(st%srch)) .and. all(ieee_is_finite(st%fsrch)))) then
-        msg = src//': dataset /state/srch or fsrch holds values that are not finite'
-      else if (any(st%nrw(1, :) < 0 .or. st%nrw(1, :) > kr .or. st%nrw(2, :) < 1 .or. st%nrw(2, :) > max(1, kr))) then
-        msg = src//': dataset /state/nrw holds counters outside 0 .. '//i2s(kr)//' (held) or 1 .. '// &
-              i2s(max(1, kr))//' (next slot)'
-      else if (.not. (all(ieee_is_finite(st%rw)) .and. all(ieee_is_finite(st%raw)))) then
-        msg = src//': dataset /state/rw or raw holds values that are not finite'
-      else if (st%nsrch /= 0 .and. st%nsrch /= 1) then
-        msg = src//': attribute nsrch of /state is '//i2s(st%nsrch)//', not 0 or 1'
-      else if (.not. (all(ieee_is_finite(st%r_prev)) .and. all(ieee_is_finite(st%x_prev)) .and. &
-                      all(ieee_is_finite(st%dX)) .and. all(ieee_is_finite(st%dR)) .and. &
-                      all(ieee_is_finite(st%flam)) .and. all(ieee_is_finite(st%flam_v)))) then
-        msg = src//': a dataset of /state (flam, r_prev, x_prev, dX, dR, flam_v) holds values that are not finite'
-      else if (.not. all(ieee_is_finite([st%res_best, st%crit, st%progress, st%best, st%omega, st%wall]))) then
-        msg = src//': an attribute of /state (res_best, crit, progress, best, omega, wall) is not finite'
-      end if
-      if (len_trim(msg) > 0) return
-      ! history
-      if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, &
-                                                  res%h_active)
-      ! the history grows as the run goes on: room for what the checkpoint holds
-      allocate (res%h_criterion(n), res%h_residual(n), res%h_wall(n), res%h_inner(n), res%h_active(n))
-      res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
-      if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
-      allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
-      res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = st%G
-      call read_history(fid, n, res, hs)
-      if (hs%failed) then
-        msg = src//' has an incomplete history ('//hs%what//')'
-        return
-      end if
-      if (.not. (all(ieee_is_finite(res%h_criterion(1:n))) .and. all(ieee_is_finite(res%h_residual(1:n))) .and. &
-                 all(ieee_is_finite(res%h_wall(1:n))))) then
-        msg = src//': a dataset of /history (criterion, residual, wall_s) holds values that are not finite'
-        return
-      end if
-      if (any(res%h_inner(1:n) < 0) .or. any(res%h_active(1:n) < 0) .or. any(res%h_active(1:n) > m)) then
-        msg = src//': dataset /history/inner or /history/active holds counts out of range'
-        return
-      end if
-      res%nhist = n
-      res%outer = n
-      res%inner = st%inner
-    end subroutine read_state
-
   end subroutine checkpoint_read
+
+  !> Every object the state is read from, checked for class and shape before reading.
+  subroutine check_layout(r)
+    type(ckpt_reader_t), intent(inout) :: r
+    integer(hsize_t) :: m2, hdims(1)
+    integer(hsize_t), allocatable :: dims(:)
+    integer :: cls, j
+    integer(hid_t) :: g
+    character(len=*), parameter :: hist(5) = [character(len=9) :: 'criterion', 'residual', 'wall_s', &
+                                              'inner', 'active']
+    m2 = int(r%m, hsize_t)
+    call open_group(r, 'state', g)
+    r%gid = g
+    call open_group(r, 'history', g)
+    r%hid = g
+    if (len_trim(r%msg) > 0) return
+    do j = 1, size(INT_ATTRS)
+      call need(r, r%gid, '/state', trim(INT_ATTRS(j)), .true., CLASS_INTEGER, SCALAR, 'a scalar')
+    end do
+    do j = 1, size(REAL_ATTRS)
+      call need(r, r%gid, '/state', trim(REAL_ATTRS(j)), .true., CLASS_REAL, SCALAR, 'a scalar')
+    end do
+    call need(r, r%gid, '/state', 'flam', .false., CLASS_REAL, [2_hsize_t], 'the two bodies')
+    call need(r, r%gid, '/state', 'G', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
+    call need(r, r%gid, '/state', 'lam', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
+    call need(r, r%gid, '/state', 'r_prev', .false., CLASS_REAL, [2*m2], contact_nodes(r%m))
+    call need(r, r%gid, '/state', 'x_prev', .false., CLASS_REAL, [2*m2], contact_nodes(r%m))
+    call need(r, r%gid, '/state', 'dX', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
+              contact_nodes(r%m)//' and Anderson depth '//i2s(ANDERSON_DEPTH))
+    call need(r, r%gid, '/state', 'dR', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
+              contact_nodes(r%m)//' and Anderson depth '//i2s(ANDERSON_DEPTH))
+    ! F_a lam_a of the last solves: absent from older checkpoints, checked when present
+    r%has_products = exists(r%gid, 'reuse', .true.) .or. exists(r%gid, 'flam_v', .false.)
+    if (r%has_products) then
+      call need(r, r%gid, '/state', 'reuse', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+      call need(r, r%gid, '/state', 'flam_v', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
+    end if
+    ! the last change of lam_a and F_a times it: absent from older checkpoints, checked when present
+    r%has_search = exists(r%gid, 'nsrch', .true.) .or. exists(r%gid, 'srch', .false.) .or. exists(r%gid, 'fsrch', .false.)
+    if (r%has_search) then
+      call need(r, r%gid, '/state', 'nsrch', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+      call need(r, r%gid, '/state', 'srch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
+      call need(r, r%gid, '/state', 'fsrch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
+    end if
+    ! the stored directions of the bodies' solves and their images: absent from older
+    ! checkpoints, checked when present
+    r%kr = recycle_size(r%m)
+    r%has_recycle = exists(r%gid, 'nrw', .false.) .or. exists(r%gid, 'rw', .false.) .or. exists(r%gid, 'raw', .false.)
+    if (r%has_recycle) then
+      call need(r, r%gid, '/state', 'nrw', .false., CLASS_INTEGER, [4_hsize_t], 'two counters per body')
+      call need(r, r%gid, '/state', 'rw', .false., CLASS_REAL, [m2, int(2*r%kr, hsize_t)], &
+                contact_nodes(r%m)//' and '//i2s(r%kr)//' directions per body')
+      call need(r, r%gid, '/state', 'raw', .false., CLASS_REAL, [m2, int(2*r%kr, hsize_t)], &
+                contact_nodes(r%m)//' and '//i2s(r%kr)//' directions per body')
+    end if
+    ! the equality multipliers of floating bodies: absent from older checkpoints
+    r%has_mu = exists(r%gid, 'mu', .false.)
+    if (r%has_mu) call need(r, r%gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, 2_hsize_t], &
+                          'three multipliers per body')
+    if (len_trim(r%msg) > 0) return
+    ! the history: five arrays of one length r%nh, it <= r%nh <= max_outer (checked after reading it)
+    call need(r, r%hid, '/history', 'criterion', .false., CLASS_REAL, [-1_hsize_t], 'one entry per outer iteration')
+    if (len_trim(r%msg) > 0) return
+    call describe(r%hid, 'criterion', .false., cls, dims, r%hs)
+    hdims = dims
+    do j = 1, size(hist)
+      call need(r, r%hid, '/history', trim(hist(j)), .false., merge(CLASS_INTEGER, CLASS_REAL, j > 3), hdims, &
+                'one entry per outer iteration, as /history/criterion')
+    end do
+    r%nh = int(hdims(1))
+    if (len_trim(r%msg) == 0 .and. r%nh > r%maxout) &
+      r%msg = r%src//': dataset /history/criterion has '//i2s(r%nh)//' entries, more than max_outer = '//i2s(r%maxout)
+  end subroutine check_layout
+
+  !> Open group `name` of the file into g; r%msg when it is not there.
+  subroutine open_group(r, name, g)
+    type(ckpt_reader_t), intent(inout) :: r
+    character(len=*), intent(in) :: name
+    integer(hid_t), intent(out) :: g
+    g = -1
+    if (len_trim(r%msg) > 0) return
+    if (.not. exists(r%fid, name, .false.)) then
+      r%msg = r%src//' has no group /'//name
+      return
+    end if
+    call group_open(r%fid, name, g, r%hs)
+    if (r%hs%failed) r%msg = r%src//': '//r%hs%what
+  end subroutine open_group
+
+  !> Check that `name` in `loc` (path `path`) is a dataset, or an attribute when `attr`, of
+  !! class `cls` and shape `dims` (Fortran order; -1: any extent); `what` says what the
+  !! shape stands for. On the first mismatch r%msg names the file and the object.
+  subroutine need(r, loc, path, name, attr, cls, dims, what)
+    type(ckpt_reader_t), intent(inout) :: r
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: path, name, what
+    logical, intent(in) :: attr
+    integer, intent(in) :: cls
+    integer(hsize_t), intent(in) :: dims(:)
+    integer(hsize_t), allocatable :: got(:)
+    integer :: c
+    character(len=:), allocatable :: obj
+    type(h5_status_t) :: ds
+    if (len_trim(r%msg) > 0) return
+    if (attr) then
+      obj = 'attribute '//trim(name)//' of '//path
+    else
+      obj = 'dataset '//path//'/'//name
+      if (path == '/') obj = 'dataset /'//name
+    end if
+    if (.not. exists(loc, name, attr)) then
+      r%msg = r%src//' has no '//obj
+      return
+    end if
+    call describe(loc, name, attr, c, got, ds)
+    if (ds%failed) then
+      r%msg = r%src//': '//ds%what
+    else if (c /= cls) then
+      r%msg = r%src//': '//obj//' holds '//class_name(c)//', expected '//class_name(cls)
+    else if (size(got) /= size(dims)) then
+      r%msg = r%src//': '//obj//' has shape '//shape_text(got)//', expected '//shape_text(dims)//' ('//what//')'
+    else if (any(got /= dims .and. dims >= 0)) then
+      r%msg = r%src//': '//obj//' has shape '//shape_text(got)//', expected '//shape_text(dims)//' ('//what//')'
+    end if
+  end subroutine need
+
+  function contact_nodes(m) result(t)
+    integer, intent(in) :: m
+    character(len=:), allocatable :: t
+    t = 'this deck has '//i2s(m)//' contact nodes'
+  end function contact_nodes
+
+  subroutine read_state(r, st, res)
+    type(ckpt_reader_t), intent(inout) :: r
+    type(robin_state_t), intent(inout) :: st
+    type(contact_result_t), intent(inout) :: res
+    real(wp), allocatable :: rv(:), rmu(:, :)
+    integer, allocatable :: ir(:)
+    integer :: n, m
+    m = r%m
+    call read_attr(r%gid, 'it', st%it, r%hs)
+    call read_attr(r%gid, 'inner', st%inner, r%hs)
+    call read_attr(r%gid, 'nacc', st%nacc, r%hs)
+    call read_attr(r%gid, 'inner_maxit_hits', res%inner_maxit_hits, r%hs)
+    call read_attr(r%gid, 'stalled', st%stalled, r%hs)
+    call read_attr(r%gid, 'it_best', st%it_best, r%hs)
+    call read_attr(r%gid, 'res_best', st%res_best, r%hs)
+    call read_attr(r%gid, 'crit', st%crit, r%hs)
+    call read_attr(r%gid, 'progress', st%progress, r%hs)
+    call read_attr(r%gid, 'best', st%best, r%hs)
+    call read_attr(r%gid, 'omega', st%omega, r%hs)
+    call read_attr(r%gid, 'wall', st%wall, r%hs)
+    call read_dset(r%gid, 'flam', rv, r%hs)
+    if (.not. r%hs%failed) st%flam = rv
+    call read_dset(r%gid, 'G', st%G, r%hs)
+    call read_dset(r%gid, 'lam', st%lam, r%hs)
+    call read_dset(r%gid, 'r_prev', st%r_prev, r%hs)
+    call read_dset(r%gid, 'x_prev', st%x_prev, r%hs)
+    call read_dset(r%gid, 'dX', st%dX, r%hs)
+    call read_dset(r%gid, 'dR', st%dR, r%hs)
+    if (r%has_products) then
+      call read_attr(r%gid, 'reuse', st%reuse, r%hs)
+      call read_dset(r%gid, 'flam_v', st%flam_v, r%hs)
+    else
+      ! an older checkpoint: the first solve after the restart computes F_a lam_a
+      st%reuse = 0
+      allocate (st%flam_v(m, 2))
+      st%flam_v = 0.0_wp
+    end if
+    if (r%has_search) then
+      call read_attr(r%gid, 'nsrch', st%nsrch, r%hs)
+      call read_dset(r%gid, 'srch', st%srch, r%hs)
+      call read_dset(r%gid, 'fsrch', st%fsrch, r%hs)
+    else
+      ! an older checkpoint: no line search in the first iteration after the restart
+      st%nsrch = 0
+      allocate (st%srch(m, 2), st%fsrch(m, 2))
+      st%srch = 0.0_wp
+      st%fsrch = 0.0_wp
+    end if
+    st%mu = 0.0_wp
+    if (r%has_mu) then
+      call read_dset(r%gid, 'mu', rmu, r%hs)
+      if (.not. r%hs%failed) st%mu = rmu
+    end if
+    if (r%has_recycle) then
+      call read_dset(r%gid, 'nrw', ir, r%hs)
+      if (.not. r%hs%failed) st%nrw = reshape(ir, [2, 2])
+      call read_dset(r%gid, 'rw', st%rw, r%hs)
+      call read_dset(r%gid, 'raw', st%raw, r%hs)
+    else
+      ! an older checkpoint: the bodies' solves start again without stored directions
+      st%nrw = reshape([0, 1, 0, 1], [2, 2])
+      allocate (st%rw(m, 2*r%kr), st%raw(m, 2*r%kr))
+      st%rw = 0.0_wp
+      st%raw = 0.0_wp
+    end if
+    if (r%hs%failed) then
+      r%msg = r%src//' cannot be read ('//r%hs%what//')'
+      return
+    end if
+    ! ranges of the counters, finite values
+    n = st%it
+    if (n < 1 .or. n > r%maxout) then
+      r%msg = r%src//': attribute it of /state is '//i2s(n)//', outside 1 .. max_outer = '//i2s(r%maxout)
+    else if (n > r%nh) then
+      r%msg = r%src//': attribute it of /state is '//i2s(n)//', beyond the '//i2s(r%nh)// &
+            ' entries of /history/criterion'
+    else if (min(st%inner, st%nacc, st%stalled, res%inner_maxit_hits) < 0) then
+      r%msg = r%src//': a counter of /state (inner, nacc, stalled, inner_maxit_hits) is negative'
+    else if (st%it_best < 0 .or. st%it_best > n) then
+      r%msg = r%src//': attribute it_best of /state is '//i2s(st%it_best)//', outside 0 .. it = '//i2s(n)
+    else if (st%reuse /= 0 .and. st%reuse /= 1) then
+      r%msg = r%src//': attribute reuse of /state is '//i2s(st%reuse)//', not 0 or 1'
+    else if (.not. all(ieee_is_finite(st%G))) then
+      r%msg = r%src//': dataset /state/G holds values that are not finite'
+    else if (.not. all(ieee_is_finite(st%lam))) then
+      r%msg = r%src//': dataset /state/lam holds values that are not finite'
+    else if (any(st%lam < 0.0_wp)) then
+      r%msg = r%src//': dataset /state/lam holds negative contact forces'
+    else if (.not. (all(ieee_is_finite(st%srch)) .and. all(ieee_is_finite(st%fsrch)))) then
+      r%msg = r%src//': dataset /state/srch or fsrch holds values that are not finite'
+    else if (any(st%nrw(1, :) < 0 .or. st%nrw(1, :) > r%kr .or. st%nrw(2, :) < 1 .or. st%nrw(2, :) > max(1, r%kr))) then
+      r%msg = r%src//': dataset /state/nrw holds counters outside 0 .. '//i2s(r%kr)//' (held) or 1 .. '// &
+            i2s(max(1, r%kr))//' (next slot)'
+    else if (.not. (all(ieee_is_finite(st%rw)) .and. all(ieee_is_finite(st%raw)))) then
+      r%msg = r%src//': dataset /state/rw or raw holds values that are not finite'
+    else if (st%nsrch /= 0 .and. st%nsrch /= 1) then
+      r%msg = r%src//': attribute nsrch of /state is '//i2s(st%nsrch)//', not 0 or 1'
+    else if (.not. (all(ieee_is_finite(st%r_prev)) .and. all(ieee_is_finite(st%x_prev)) .and. &
+                    all(ieee_is_finite(st%dX)) .and. all(ieee_is_finite(st%dR)) .and. &
+                    all(ieee_is_finite(st%flam)) .and. all(ieee_is_finite(st%flam_v)))) then
+      r%msg = r%src//': a dataset of /state (flam, r_prev, x_prev, dX, dR, flam_v) holds values that are not finite'
+    else if (.not. all(ieee_is_finite([st%res_best, st%crit, st%progress, st%best, st%omega, st%wall]))) then
+      r%msg = r%src//': an attribute of /state (res_best, crit, progress, best, omega, wall) is not finite'
+    end if
+    if (len_trim(r%msg) > 0) return
+    ! history
+    if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, &
+                                                res%h_active)
+    ! the history grows as the run goes on: room for what the checkpoint holds
+    allocate (res%h_criterion(n), res%h_residual(n), res%h_wall(n), res%h_inner(n), res%h_active(n))
+    res%h_criterion = 0.0_wp; res%h_residual = 0.0_wp; res%h_wall = 0.0_wp; res%h_inner = 0; res%h_active = 0
+    if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
+    allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
+    res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = st%G
+    call read_history(r%fid, n, res, r%hs)
+    if (r%hs%failed) then
+      r%msg = r%src//' has an incomplete history ('//r%hs%what//')'
+      return
+    end if
+    if (.not. (all(ieee_is_finite(res%h_criterion(1:n))) .and. all(ieee_is_finite(res%h_residual(1:n))) .and. &
+               all(ieee_is_finite(res%h_wall(1:n))))) then
+      r%msg = r%src//': a dataset of /history (criterion, residual, wall_s) holds values that are not finite'
+      return
+    end if
+    if (any(res%h_inner(1:n) < 0) .or. any(res%h_active(1:n) < 0) .or. any(res%h_active(1:n) > m)) then
+      r%msg = r%src//': dataset /history/inner or /history/active holds counts out of range'
+      return
+    end if
+    res%nhist = n
+    res%outer = n
+    res%inner = st%inner
+  end subroutine read_state
 
   !> The name of a type class, for messages.
   function class_name(c) result(t)

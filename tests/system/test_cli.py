@@ -2,7 +2,7 @@
 """Command-line tests of bin/robin_contact (run by `make check` with /usr/bin/python3;
 binary from BIN): --help, --version and --deck-reference exit 0 and write to standard output
 only; the deck reference equals doc/deck-reference.md byte for byte and lists every variable
-the deck reader declares (read from src/input/deck.f90's tables), with the defaults of
+the deck reader declares (read from the tables of src/input/deck_tables.f90), with the defaults of
 src/input/config.f90's type declarations; the ranges it states are the ones the reader
 enforces (a value outside is exit 1, a value on a closed bound is accepted); an unknown option
 is exit 1."""
@@ -121,12 +121,12 @@ ref_tables = tables(ref)
 check(list(ref_tables) == GROUPS, "one section per group, in deck order", ", ".join(ref_tables))
 
 # ---- every variable the reader declares is in the reference (and nothing else) ----------
-deck_src = source("src/input/deck.f90")
+deck_src = source("src/input/deck_tables.f90")
 kinds = {"int": "integer", "real": "real", "pair": "real pair (x, y)", "str": "string", "enum": "choice"}
 declared = {}
 for g in GROUPS:
     body = re.search(rf"subroutine {g}_vars\(.*?end subroutine {g}_vars", deck_src, re.S)
-    check(body is not None, f"src/input/deck.f90 has {g}_vars")
+    check(body is not None, f"src/input/deck_tables.f90 has {g}_vars")
     if body:
         declared[g] = dict((n, k) for k, n in re.findall(r"call v%(int|real|pair|str|enum)\('(\w+)'", body.group(0)))
 nvar = 0

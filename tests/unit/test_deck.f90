@@ -7,7 +7,7 @@ program test_deck
   use kinds, only: wp
   use config
   use deck, only: read_deck, print_deck, deck_text
-  use namelist_input, only: vars_t, str_t, reference_table
+  use namelist_vars, only: vars_t, str_t, reference_table
   use testing, only: report, test_summary
   implicit none (type, external)
   type(deck_t) :: d, e

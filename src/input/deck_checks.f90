@@ -1,0 +1,572 @@
+!> The checks of the deck's groups as they are read: each group read into its settings
+!! through its table (`deck_tables`), its values checked (`apply_*`, `new_body`,
+!! `add_traction`, ...), then, once the deck and its overrides are read, the checks across
+!! groups (`check_cross`: contact sides or groups, prescribed displacements, loads).
+!! Every bad input ends in `fatal(EXIT_INPUT, msg)` naming the source, group, variable
+!! and value.
+module deck_checks
+  use kinds, only: wp
+  use errors, only: fatal, warn, EXIT_INPUT
+  use strings, only: i2s, r2s, quoted_list, word
+  use namelist_vars, only: str_t, vars_t
+  use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
+
+  use config, only: deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+                    SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
+                    ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t
+  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, scene_vars, body_vars, traction_vars, &
+                         boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
+  implicit none (type, external)
+  private
+
+  public :: state_t, apply_single, new_body, override_body, add_traction, add_boundary, &
+            apply_displacement, check_cross
+
+
+  !> Where things came from, for cross-field messages.
+  type :: state_t
+    character(len=:), allocatable :: path
+    integer :: nbody = 0
+    integer :: body_line(2) = 0                 ! line of each &body in the deck file
+    type(str_t) :: body_at(2)                   ! 'line N' or 'command-line override k'
+    type(str_t), allocatable :: trac_at(:)      ! per traction
+    integer :: disp_line(4, 2) = 0              ! deck line of the &displacement per side, body
+    logical :: disp_given(4, 2) = .false.       ! a &displacement gives the side's vector
+    integer :: once_line(8) = 0                 ! deck line of each singleton group
+  end type state_t
+
+contains
+
+  !> A group that appears at most once (&scene, &contact, &solver, &output): read into its
+  !! settings through its table, then its values checked.
+  subroutine apply_single(g, src, d)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), target, intent(inout) :: d
+    type(scene_in_t), target :: sc
+    type(vars_t) :: v
+    select case (g%name)
+    case ('scene')
+      sc%plane = merge(1, 2, d%plane_strain)
+      call scene_vars(d, sc, v)
+    case ('contact')
+      call contact_vars(d%contact, v)
+    case ('solver')
+      call solver_vars(d%solver, v)
+    case ('output')
+      call output_vars(d%output, v)
+    end select
+    call read_group(g, src, v)
+    select case (g%name)
+    case ('scene')
+      d%plane_strain = (sc%plane == 1)
+      call check_units(g, src, d%units)
+    case ('contact')
+      call check_contact(g, src, d%contact)
+    case ('solver')
+      call check_solver(g, src, d%solver)
+    case ('output')
+      call check_output(g, src, d%output)
+    end select
+  end subroutine apply_single
+
+  !> The unit names of a named system are fixed (given ones must agree); 'custom' needs all three.
+  subroutine check_units(g, src, u)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(units_cfg_t), intent(inout) :: u
+    character(len=16) :: names(3)
+    character(len=*), parameter :: vars(3) = ['length_unit', 'force_unit ', 'stress_unit']
+    integer :: k
+    select case (u%system)
+    case (UNITS_SI)
+      names = [character(len=16) :: 'm', 'N', 'Pa']
+    case (UNITS_MM)
+      names = [character(len=16) :: 'mm', 'N', 'MPa']
+    case default
+      do k = 1, 3
+        if (len_trim(unit_name(u, k)) == 0) call bad_value(g, src, trim(vars(k)), "''", &
+          'is empty: with units=''custom'' give length_unit, force_unit and stress_unit')
+      end do
+      return
+    end select
+    do k = 1, 3
+      if (find_asg(g, trim(vars(k))) > 0 .and. unit_name(u, k) /= names(k)) call bad_value(g, src, &
+        trim(vars(k)), "'"//trim(unit_name(u, k))//"'", 'does not belong to units='''// &
+        word(UNITS_CHOICES, u%system)//''' (whose '//trim(vars(k))//' is '''//trim(names(k))// &
+        '''); use units=''custom'' to name your own')
+    end do
+    u%length = names(1)
+    u%force = names(2)
+    u%stress = names(3)
+  end subroutine check_units
+
+  function unit_name(u, k) result(s)
+    type(units_cfg_t), intent(in) :: u
+    integer, intent(in) :: k
+    character(len=16) :: s
+    select case (k)
+    case (1)
+      s = u%length
+    case (2)
+      s = u%force
+    case default
+      s = u%stress
+    end select
+  end function unit_name
+
+  subroutine check_contact(g, src, c)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(contact_cfg_t), intent(inout) :: c
+    if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
+      'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
+    if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
+      'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')
+  end subroutine check_contact
+
+  subroutine check_solver(g, src, s)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(solver_cfg_t), intent(inout) :: s
+    if (s%alpha < 0.0_wp) call bad_value(g, src, 'alpha', r2s(s%alpha), 'must be >= 0')
+    if (s%robin_operator == ROBIN_CONSTANT .and. .not. s%alpha > 0.0_wp) call bad_value(g, src, &
+      'alpha', r2s(s%alpha), 'must be > 0 when robin_operator=''constant''')
+    if (.not. (s%delta > 0.0_wp .and. s%delta <= 1.0_wp)) call bad_value(g, src, 'delta', &
+      r2s(s%delta), 'is out of range: the relaxation must satisfy 0 < delta <= 1')
+    if (.not. s%tol > 0.0_wp) call bad_value(g, src, 'tol', r2s(s%tol), 'must be > 0')
+    if (s%max_outer < 1) call bad_value(g, src, 'max_outer', i2s(s%max_outer), 'must be >= 1')
+    if (.not. s%inner_factor > 0.0_wp) call bad_value(g, src, 'inner_factor', r2s(s%inner_factor), &
+      'must be > 0')
+    if (.not. (s%inner_rtol_min > 0.0_wp .and. s%inner_rtol_min < 1.0_wp)) call bad_value(g, src, &
+      'inner_rtol_min', r2s(s%inner_rtol_min), 'must satisfy 0 < inner_rtol_min < 1')
+    if (.not. (s%inner_rtol_max > 0.0_wp .and. s%inner_rtol_max < 1.0_wp)) call bad_value(g, src, &
+      'inner_rtol_max', r2s(s%inner_rtol_max), 'must satisfy 0 < inner_rtol_max < 1')
+    if (s%inner_rtol_max < s%inner_rtol_min) call bad_value(g, src, 'inner_rtol_max', &
+      r2s(s%inner_rtol_max), 'must be >= inner_rtol_min = '//r2s(s%inner_rtol_min))
+    if (s%inner_max_it < 1) call bad_value(g, src, 'inner_max_it', i2s(s%inner_max_it), 'must be >= 1')
+    if (.not. (s%monolithic_rtol > 0.0_wp .and. s%monolithic_rtol < 1.0_wp)) call bad_value(g, src, &
+      'monolithic_rtol', r2s(s%monolithic_rtol), 'must satisfy 0 < monolithic_rtol < 1')
+  end subroutine check_solver
+
+  subroutine check_output(g, src, o)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(output_cfg_t), intent(inout) :: o
+    o%file = adjustl(o%file)
+    if (o%checkpoint_every < 0) call bad_value(g, src, 'checkpoint_every', i2s(o%checkpoint_every), &
+      'must be >= 0 (0: no checkpoints)')
+    if (o%progress_lines < 0) call bad_value(g, src, 'progress_lines', i2s(o%progress_lines), &
+      'must be >= 0')
+  end subroutine check_output
+
+  !> A &body in the deck file: a new body.
+  subroutine new_body(g, src, d, st)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    integer :: id
+    type(body_cfg_t) :: fresh
+
+    if (st%nbody == 2) call die_at(src, g%line, 'in group &body: a third &body group; a deck '// &
+      'has exactly two bodies, with ids 1 and 2 (the others are at lines '// &
+      i2s(st%body_line(1))//' and '//i2s(st%body_line(2))//')')
+    call body_id(g, src, 'no id; give id=1 or id=2', id)
+    if (d%body(id)%id /= 0) call bad_value(g, src, 'id', i2s(id), &
+      'is used twice (also by the &body at line '//i2s(st%body_line(id))// &
+      '); the two bodies must have ids 1 and 2')
+    fresh%id = id
+    call apply_body(g, src, fresh, id, d, st)
+    st%nbody = st%nbody + 1
+    st%body_line(id) = g%line
+    st%body_at(id)%s = '&body at line '//i2s(g%line)
+  end subroutine new_body
+
+  !> A &body on the command line: changes the existing body with that id.
+  subroutine override_body(g, src, d, st)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    integer :: id
+    type(body_cfg_t) :: copy
+
+    call body_id(g, src, 'an override of &body must name the body it changes with id=1 or id=2, '// &
+                 'e.g. ''&body id=2, young=1e9 /''', id)
+    copy = d%body(id)
+    call apply_body(g, src, copy, id, d, st)
+    st%body_at(id)%s = st%body_at(id)%s//', changed by '//src%label
+  end subroutine override_body
+
+  !> The id= of a &body: given (else the message `missing`), and 1 or 2.
+  subroutine body_id(g, src, missing, id)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    character(len=*), intent(in) :: missing
+    integer, intent(out) :: id
+    logical :: found
+    call find_int(g, 'id', id, found)
+    if (.not. found) call die_at(src, g%line, 'in group &body: '//missing)
+    if (id /= 1 .and. id /= 2) call bad_value(g, src, 'id', i2s(id), &
+      'is not a body id: the two bodies have ids 1 and 2')
+  end subroutine body_id
+
+  !> Read a &body group into a copy of `b0` (its current values) and store it as body `id`
+  !! of `d`; a side no longer declared 'displacement' drops its &displacement.
+  subroutine apply_body(g, src, b0, id, d, st)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(body_cfg_t), intent(in) :: b0
+    integer, intent(in) :: id
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    type(body_cfg_t), target :: c
+    type(vars_t) :: v
+    integer :: s
+
+    c = b0
+    call body_vars(c, v, ALL_FORMS)
+    call read_group(g, src, v)
+    if (len_trim(c%mesh) > 0 .and. find_asg(g, 'mesh') > 0) call mesh_body(g, src, c, st%path)
+    if (.not. c%width > 0.0_wp) call bad_value(g, src, 'width', r2s(c%width), 'must be > 0')
+    if (.not. c%height > 0.0_wp) call bad_value(g, src, 'height', r2s(c%height), 'must be > 0')
+    if (c%nx < 1) call bad_value(g, src, 'nx', i2s(c%nx), 'must be >= 1 (cells along x)')
+    if (c%ny < 1) call bad_value(g, src, 'ny', i2s(c%ny), 'must be >= 1 (cells along y)')
+    if (.not. c%young > 0.0_wp) call bad_value(g, src, 'young', r2s(c%young), &
+      'must be > 0 (Young''s modulus)')
+    if (c%poisson >= 0.5_wp) call bad_value(g, src, 'poisson', r2s(c%poisson), 'is out of range: '// &
+      'it must satisfy -1 < poisson < 0.5; poisson >= 0.5 (an incompressible material) is '// &
+      'rejected: this displacement formulation cannot model it')
+    if (c%poisson <= -1.0_wp) call bad_value(g, src, 'poisson', r2s(c%poisson), 'is out of range: '// &
+      'it must satisfy -1 < poisson < 0.5')
+    c%id = b0%id
+    do s = 1, 4
+      if (c%bc(s) /= BC_DISPLACEMENT) c%u_side(:, s) = 0.0_wp
+    end do
+    d%body(id) = c
+    st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
+  end subroutine apply_body
+
+  !> A &traction group (deck or override): appends a traction.
+  subroutine add_traction(g, src, d, st, origin)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    character(len=*), intent(in) :: origin
+    type(load_in_t), target :: t
+    type(vars_t) :: v
+    type(traction_cfg_t), allocatable :: tmp(:)
+    type(str_t), allocatable :: wtmp(:)
+    integer :: n
+
+    call traction_vars(t, v, ALL_FORMS)
+    call read_group(g, src, v)
+    call traction_form(g, src, t)
+    n = d%ntraction
+    if (n == size(d%traction)) then   ! grow geometrically: many tractions stay linear
+      allocate (tmp(max(4, 2*n)), wtmp(max(4, 2*n)))
+      tmp(1:n) = d%traction(1:n)
+      wtmp(1:n) = st%trac_at(1:n)
+      call move_alloc(tmp, d%traction)
+      call move_alloc(wtmp, st%trac_at)
+    end if
+    n = n + 1
+    d%ntraction = n
+    d%traction(n)%body = t%body
+    d%traction(n)%side = t%side
+    d%traction(n)%group = t%group
+    d%traction(n)%t0 = t%t0
+    d%traction(n)%t1 = t%t1
+    d%traction(n)%tx = t%tx
+    d%traction(n)%ty = t%ty
+    d%traction(n)%pressure = t%pressure
+    d%traction(n)%origin = '&traction at '//origin
+    st%trac_at(n)%s = origin
+  end subroutine add_traction
+
+  !> A traction is on a side (side=, t0, t1) or on a group (group=, t0, tx, ty, pressure).
+  subroutine traction_form(g, src, t)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(load_in_t), intent(inout) :: t
+    integer :: k
+    if (len_trim(t%group) > 0) then
+      if (find_asg(g, 'side') > 0) call die_at(src, g%line, 'in group &traction: give side= '// &
+        '(a rectangle''s side) or group= (a named edge group), not both')
+      if (find_asg(g, 't1') > 0) call die_at(src, g%line, 'in group &traction: t1 belongs to a '// &
+        'side traction; on a group the traction is t0 + tx*x + ty*y - pressure*n')
+      call body_given(g, src, t%body)
+    else
+      do k = 1, 3
+        if (find_asg(g, trim(word('tx ty pressure', k))) > 0) call die_at(src, g%line, &
+          'in group &traction: '//trim(word('tx ty pressure', k))//' belongs to a group traction '// &
+          '(group=''NAME''); on a side the traction is t0 + t1*s')
+      end do
+      call body_and_side(g, src, t)
+    end if
+  end subroutine traction_form
+
+  !> A &boundary group (deck or override): prescribed components on a named edge group.
+  subroutine add_boundary(g, src, d, origin)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    character(len=*), intent(in) :: origin
+    type(load_in_t), target :: t
+    type(vars_t) :: v
+    type(boundary_cfg_t), allocatable :: tmp(:)
+    integer :: n
+
+    call boundary_vars(t, v, ALL_FORMS)
+    call read_group(g, src, v)
+    call body_given(g, src, t%body)
+    if (len_trim(t%group) == 0) call die_at(src, g%line, 'in group &boundary: no group; give '// &
+      'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
+      '''bottom'', ''top'')')
+    if (find_asg(g, 'ux') == 0 .and. find_asg(g, 'uy') == 0) call die_at(src, g%line, &
+      'in group &boundary: neither ux nor uy is given; give the components to prescribe '// &
+      '(ux=0.0 for a roller on a vertical wall, ux=0.0, uy=0.0 to clamp)')
+    n = d%nboundary
+    if (n == size(d%boundary)) then
+      allocate (tmp(max(4, 2*n)))
+      tmp(1:n) = d%boundary(1:n)
+      call move_alloc(tmp, d%boundary)
+    end if
+    n = n + 1
+    d%nboundary = n
+    d%boundary(n)%body = t%body
+    d%boundary(n)%group = t%group
+    d%boundary(n)%fix = [find_asg(g, 'ux') > 0, find_asg(g, 'uy') > 0]
+    d%boundary(n)%u = [t%ux, t%uy]
+    d%boundary(n)%origin = '&boundary at '//origin
+  end subroutine add_boundary
+
+  !> The body= of a &traction, &displacement or &boundary: given, and 1 or 2.
+  subroutine body_given(g, src, body)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    integer, intent(in) :: body
+    integer :: k
+    logical :: missing
+    k = find_asg(g, 'body')
+    missing = k == 0
+    if (.not. missing) missing = len_trim(g%a(k)%value) == 0
+    if (missing) call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
+    if (body /= 1 .and. body /= 2) call bad_value(g, src, 'body', i2s(body), &
+      'does not exist: the bodies have ids 1 and 2')
+  end subroutine body_given
+
+  !> A body read from a mesh file: the rectangle's variables have no meaning; the path is
+  !! made absolute, relative to the deck's folder (for a command-line override too).
+  subroutine mesh_body(g, src, c, deck_path)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(body_cfg_t), intent(inout) :: c
+    character(len=*), intent(in) :: deck_path
+    character(len=*), parameter :: RECT = 'x0 y0 width height nx ny element left right top bottom'
+    integer :: k
+    do k = 1, 11
+      if (find_asg(g, trim(word(RECT, k))) > 0) call die_at(src, g%line, 'in group &body: '// &
+        trim(word(RECT, k))//' describes a built-in rectangle, but this body comes from mesh='''// &
+        trim(c%mesh)//'''; give its conditions with &boundary and &traction on the mesh''s groups')
+    end do
+    if (c%mesh(1:1) /= '/') c%mesh = deck_folder(deck_path)//trim(c%mesh)
+    c%bc = BC_FREE
+  end subroutine mesh_body
+
+  !> The absolute folder of the deck file, with a trailing '/' (the working folder for a
+  !! deck read from /dev/, e.g. a pipe).
+  function deck_folder(path) result(f)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: f
+    character(len=4096) :: cwd
+    integer :: k, stat
+    call getcwd(cwd, stat)
+    if (stat /= 0) cwd = '.'
+    f = ''
+    if (path(1:min(5, len(path))) /= '/dev/') then
+      k = index(path, '/', back=.true.)
+      if (k > 0) f = path(1:k)
+    end if
+    if (len(f) == 0) then
+      f = trim(cwd)//'/'
+    else if (f(1:1) /= '/') then
+      f = trim(cwd)//'/'//f
+    end if
+  end function deck_folder
+
+  !> A &displacement group (deck or override): prescribes a displacement on a side.
+  subroutine apply_displacement(g, src, d, st)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    type(load_in_t), target :: t
+    type(vars_t) :: v
+    integer :: s, body
+    character(len=:), allocatable :: side
+
+    call displacement_vars(t, v)
+    call read_group(g, src, v)
+    call body_and_side(g, src, t)
+    if (len_trim(d%body(t%body)%mesh) > 0) call die_at(src, g%line, 'in group &displacement: body '// &
+      i2s(t%body)//' comes from a mesh file and has no sides; prescribe its displacement with '// &
+      '&boundary body='//i2s(t%body)//', group=''NAME'', ux=..., uy=... /')
+    body = t%body
+    s = t%side
+    side = trim(side_names(s))
+    if (d%body(body)%bc(s) == BC_CONTACT) call bad_value(g, src, 'side', "'"//side//"'", &
+      'is the contact side of body '//i2s(body)//'; a contact side cannot have a '// &
+      'prescribed displacement')
+    if (d%body(body)%bc(s) == BC_CLAMPED .or. d%body(body)%bc(s) == BC_ROLLER) call bad_value(g, src, &
+      'side', "'"//side//"'", 'is '''//trim(bc_names(d%body(body)%bc(s)))//''' on body '//i2s(body)// &
+      '; a side is either '''//trim(bc_names(d%body(body)%bc(s)))//''' or has a prescribed '// &
+      'displacement: declare it '//side//'=''displacement'' (or ''free'') in its &body')
+    if (src%is_file) then
+      if (st%disp_line(s, body) > 0) call die_at(src, g%line, 'in group &displacement: side '''// &
+        side//''' of body '//i2s(body)//' already has a prescribed displacement (line '// &
+        i2s(st%disp_line(s, body))//')')
+      st%disp_line(s, body) = g%line
+    end if
+    d%body(body)%bc(s) = BC_DISPLACEMENT
+    d%body(body)%u_side(:, s) = t%u
+    st%disp_given(s, body) = .true.
+  end subroutine apply_displacement
+
+  !> Check the body= and side= of a &traction or &displacement.
+  subroutine body_and_side(g, src, t)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(load_in_t), intent(in) :: t
+    call body_given(g, src, t%body)
+    if (t%side == 0) call die_at(src, g%line, 'in group &'//g%name//': no side; give '// &
+      'side='//quoted_list(SIDE_CHOICES, ''))
+  end subroutine body_and_side
+
+  ! ============================================================================================
+  ! Cross-field checks
+  ! ============================================================================================
+
+  subroutine check_cross(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: b, s, nc
+    character(len=:), allocatable :: p, lst
+    logical :: groups
+
+    p = st%path//': '
+    groups = len_trim(d%contact%body_group(1)) > 0 .or. len_trim(d%contact%body_group(2)) > 0
+    if (groups) then
+      call check_groups(d, st)
+      return
+    end if
+    do b = 1, 2
+      if (len_trim(d%body(b)%mesh) > 0) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
+        st%body_at(b)%s//') comes from a mesh file: name the contact surfaces with &contact '// &
+        'body1_group=''NAME1'', body2_group=''NAME2'' /')
+    end do
+    do b = 1, 2
+      nc = count(d%body(b)%bc == BC_CONTACT)
+      if (nc /= 1) then
+        lst = ''
+        do s = 1, 4
+          if (d%body(b)%bc(s) == BC_CONTACT) lst = lst//merge(', ', '  ', len(lst) > 0)//trim(side_names(s))
+        end do
+        if (nc == 0) then
+          call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('//st%body_at(b)%s//') has no '// &
+            '''contact'' side; each body needs exactly one ('//side_list(d%body(b))//')')
+        else
+          call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('//st%body_at(b)%s//') has '//i2s(nc)// &
+            ' ''contact'' sides ('//trim(adjustl(lst))//'); each body needs exactly one')
+        end if
+      end if
+    end do
+
+    ! whether the two sides face each other, overlap and how their nodes pair is the mortar
+    ! interface's business, as for named groups (condense: build_interface)
+
+    ! support against rigid motion is the mesh's business (assembly: a body the supports
+    ! leave free is held only by contact, and module floating checks that the contact can)
+
+    do b = 1, 2
+      call check_disp_given(d, st, b, .true.)
+    end do
+
+    call check_loads(d, st)
+  end subroutine check_cross
+
+  !> Side tractions on rectangles: not on a contact side; no effect on a prescribed side.
+  subroutine check_loads(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: i, s
+    character(len=:), allocatable :: p
+    p = st%path//': '
+    do i = 1, d%ntraction
+      associate (t => d%traction(i))
+        if (len_trim(t%group) > 0) cycle
+        if (len_trim(d%body(t%body)%mesh) > 0) call fatal(EXIT_INPUT, p//'the &traction at '// &
+          st%trac_at(i)%s//' loads side '''//trim(side_names(t%side))//''' of body '//i2s(t%body)// &
+          ', which comes from a mesh file and has no sides; load a group: group=''NAME''')
+        s = d%body(t%body)%bc(t%side)
+        if (s == BC_CONTACT) call fatal(EXIT_INPUT, p//'the &traction at '//st%trac_at(i)%s// &
+          ' loads side '''//trim(side_names(t%side))//''' of body '//i2s(t%body)//', which is '// &
+          'its contact side; a contact side carries only contact forces')
+        if (s == BC_CLAMPED .or. s == BC_DISPLACEMENT) call warn(p// &
+          'the &traction at '//st%trac_at(i)%s//' loads side '''//trim(side_names(t%side))// &
+          ''' of body '//i2s(t%body)//', which has a prescribed displacement ('''// &
+          trim(bc_names(s))//'''); that traction has no effect')
+      end associate
+    end do
+  end subroutine check_loads
+
+  !> Contact on named groups (mortar): both groups given, no rectangle side declared
+  !! 'contact', sides with 'displacement' given. Supports and group names are checked on
+  !! the meshes (module assembly, condense).
+  subroutine check_groups(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: b
+    character(len=:), allocatable :: p
+    p = st%path//': '
+    do b = 1, 2
+      if (len_trim(d%contact%body_group(b)) == 0) call fatal(EXIT_INPUT, p//'&contact names '// &
+        'the contact group of one body only; give both, body1_group=''NAME1'', body2_group=''NAME2''')
+      if (any(d%body(b)%bc == BC_CONTACT)) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
+        st%body_at(b)%s//') declares a ''contact'' side, but &contact names the contact groups; '// &
+        'use one or the other (a rectangle''s sides are the groups ''left'', ''right'', '// &
+        '''bottom'', ''top'')')
+      call check_disp_given(d, st, b, .false.)
+    end do
+    call check_loads(d, st)
+  end subroutine check_groups
+
+  !> Every side of body b declared 'displacement' has its &displacement (with `hint`, the
+  !! message shows the group to add).
+  subroutine check_disp_given(d, st, b, hint)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer, intent(in) :: b
+    logical, intent(in) :: hint
+    integer :: s
+    character(len=:), allocatable :: add
+    do s = 1, 4
+      if (d%body(b)%bc(s) /= BC_DISPLACEMENT .or. st%disp_given(s, b)) cycle
+      add = ''
+      if (hint) add = '; add &displacement body='//i2s(b)//', side='''//trim(side_names(s))//''', u=ux, uy /'
+      call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '// &
+        trim(side_names(s))//' side ''displacement'' but no &displacement group gives that displacement'//add)
+    end do
+  end subroutine check_disp_given
+
+  function side_list(b) result(s)
+    type(body_cfg_t), intent(in) :: b
+    character(len=:), allocatable :: s
+    s = 'left='''//trim(bc_names(b%bc(SIDE_LEFT)))//''', right='''//trim(bc_names(b%bc(SIDE_RIGHT)))// &
+      ''', top='''//trim(bc_names(b%bc(SIDE_TOP)))//''', bottom='''//trim(bc_names(b%bc(SIDE_BOTTOM)))//''''
+  end function side_list
+
+end module deck_checks

@@ -1,0 +1,228 @@
+!> The variable tables of the deck's groups: one `*_vars` routine per group binds each
+!! variable the group may set to its place in `config`'s settings (or in a `scene_in_t` /
+!! `load_in_t` holding what is read before it is checked), with its description, unit and
+!! range. The same table reads the group, renders it back and documents it: a new setting
+!! is its field in `config` and one line here.
+module deck_tables
+  use kinds, only: wp
+  use namelist_vars, only: vars_t
+  use config, only: deck_t, body_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+                    SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
+                    METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
+                    ORDER_CHOICES, ACCEL_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
+                    UNITS_CHOICES
+  implicit none (type, external)
+  private
+
+  public :: scene_in_t, load_in_t
+  public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY
+  public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
+            solver_vars, output_vars
+
+  ! the documentation shared by the three unit names of &scene
+  character(len=*), parameter :: UNIT_NAME_DOC = &
+    'With `units=''SI''` or `''mm-N-MPa''` it is set by `units` (a different name given is bad '// &
+    'input); with `''custom''` it is free but not empty'
+
+  !> The variables of &scene that are not stored as they are read.
+  type :: scene_in_t
+    integer :: plane = 1                        ! PLANE_CHOICES code
+  end type scene_in_t
+
+  !> A &traction, &displacement or &boundary as read, before it is checked and stored.
+  type :: load_in_t
+    integer :: body = 0
+    integer :: side = 0                         ! SIDE_*; 0 = not given
+    character(len=128) :: group = ''            ! edge group ('' = not given)
+    real(wp) :: t0(2) = 0.0_wp, t1(2) = 0.0_wp  ! traction
+    real(wp) :: tx(2) = 0.0_wp, ty(2) = 0.0_wp  ! traction gradient (group)
+    real(wp) :: pressure = 0.0_wp               ! normal pressure (group)
+    real(wp) :: u(2) = 0.0_wp                   ! displacement
+    real(wp) :: ux = 0.0_wp, uy = 0.0_wp        ! &boundary components
+  end type load_in_t
+
+  ! which variables a table holds: all (reading), or those of one form (rendering)
+  integer, parameter :: ALL_FORMS = 0, SIDE_FORM = 1, GROUP_FORM = 2, UX_ONLY = 3, UY_ONLY = 4, UXY = 5
+
+contains
+
+
+  !> &scene. The units named here are the ones the other tables' unit column refers to.
+  subroutine scene_vars(d, sc, v)
+    type(deck_t), target, intent(inout) :: d
+    type(scene_in_t), target, intent(inout) :: sc
+    type(vars_t), intent(out) :: v
+    call v%str('title', d%title, doc='free text, stored in the result file')
+    call v%enum('plane', sc%plane, PLANE_CHOICES, doc='plane strain or plane stress')
+    call v%enum('units', d%units%system, UNITS_CHOICES, doc='the units of the deck''s numbers, '// &
+      'named in the result file, the plots and the summary (the solver is unit-free): `''SI''` (m, '// &
+      'N, Pa), `''mm-N-MPa''` (mm, N, MPa: consistent, N/mm^2 = MPa) or `''custom''` (the names '// &
+      'given by `length_unit`, `force_unit`, `stress_unit`)')
+    call v%str('length_unit', d%units%length, doc='name of the length unit. '//UNIT_NAME_DOC)
+    call v%str('force_unit', d%units%force, doc='name of the force unit. '//UNIT_NAME_DOC)
+    call v%str('stress_unit', d%units%stress, doc='name of the stress unit (force/length^2). '// &
+      UNIT_NAME_DOC)
+  end subroutine scene_vars
+
+  !> &body: `form` ALL_FORMS reads every variable; SIDE_FORM renders a rectangle,
+  !! GROUP_FORM a body from a mesh file.
+  subroutine body_vars(b, v, form)
+    type(body_cfg_t), target, intent(inout) :: b
+    type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
+    call v%int('id', b%id, range='1 or 2', required=.true., doc='which body; each id once in '// &
+      'the deck. An override of `&body` changes the body it names: `''&body id=2, young=1e9 /''`')
+    if (form /= SIDE_FORM) then
+      call v%str('mesh', b%mesh, doc='a Gmsh mesh file, MSH 4.1 ASCII, holding the body''s '// &
+        'cells (3-node triangles and 4-node quadrilaterals, mixed allowed); a path relative to '// &
+        'the deck''s folder (for an override too); `''''`: the built-in rectangle')
+      call v%str('region', b%region, doc='the physical surface of the file that is this body '// &
+        '(one file may hold both bodies); `''''`: the file''s only physical surface, or every 2D '// &
+        'cell if the file has none')
+    end if
+    if (form /= GROUP_FORM) then
+      call v%real('x0', b%x0, unit='[length]', doc='x of the lower-left corner')
+      call v%real('y0', b%y0, unit='[length]', doc='y of the lower-left corner')
+      call v%real('width', b%width, unit='[length]', range='> 0', doc='extent in x')
+      call v%real('height', b%height, unit='[length]', range='> 0', doc='extent in y')
+      call v%int('nx', b%nx, range='>= 1', doc='cells along x')
+      call v%int('ny', b%ny, range='>= 1', doc='cells along y')
+      call v%enum('element', b%element, ELEMENT_CHOICES, doc='`''Q1''`: bilinear quadrilaterals '// &
+        '(2x2 Gauss); `''P1''`: linear triangles, each cell split along its lower-left/upper-right '// &
+        'diagonal')
+    end if
+    call v%real('young', b%young, unit='[stress]', range='> 0', doc='Young''s modulus')
+    call v%real('poisson', b%poisson, unit='[-]', range='-1 < poisson < 0.5', doc='Poisson''s '// &
+      'ratio; 0.5 (an incompressible material) is rejected: this displacement formulation '// &
+      'cannot model it')
+    if (form /= GROUP_FORM) then
+      call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE, doc='condition on the side '// &
+        'x = x0: `''free''` (traction-free unless a `&traction` loads it), `''clamped''` (u = 0), '// &
+        '`''roller''` (normal displacement 0), `''contact''` (exactly one side per body, paired '// &
+        'with the other body''s contact side by dual mortar), `''displacement''` (given by '// &
+        'a `&displacement`)')
+      call v%enum('right', b%bc(SIDE_RIGHT), BC_CHOICES, base=BC_FREE, doc='condition on the '// &
+        'side x = x0 + width, as `left`')
+      call v%enum('top', b%bc(SIDE_TOP), BC_CHOICES, base=BC_FREE, doc='condition on the side '// &
+        'y = y0 + height, as `left`')
+      call v%enum('bottom', b%bc(SIDE_BOTTOM), BC_CHOICES, base=BC_FREE, doc='condition on the '// &
+        'side y = y0, as `left`')
+    end if
+  end subroutine body_vars
+
+  !> &traction: on a side (t0, t1) or on a group (t0, tx, ty, pressure).
+  subroutine traction_vars(t, v, form)
+    type(load_in_t), target, intent(inout) :: t
+    type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
+    call v%int('body', t%body, range='1 or 2', required=.true., doc='the body loaded')
+    if (form /= GROUP_FORM) call v%enum('side', t%side, SIDE_CHOICES, doc='the side of the '// &
+      'rectangle loaded (not its contact side)')
+    if (form /= SIDE_FORM) call v%str('group', t%group, doc='the edge group loaded: a physical '// &
+      'curve of the body''s mesh (a rectangle has `''left''`, `''right''`, `''bottom''`, `''top''`)')
+    call v%pair('t0', t%t0, unit='[stress]', doc='the constant part of the traction vector')
+    if (form /= GROUP_FORM) call v%pair('t1', t%t1, unit='[stress/length]', doc='its rate along '// &
+      'the side: t(s) = t0 + t1*s, s the global coordinate along the side (x on top and bottom, '// &
+      'y on left and right)')
+    if (form /= SIDE_FORM) then
+      call v%pair('tx', t%tx, unit='[stress/length]', doc='its rate along x: t(x,y) = t0 + tx*x + '// &
+        'ty*y - pressure*n')
+      call v%pair('ty', t%ty, unit='[stress/length]', doc='its rate along y')
+      call v%real('pressure', t%pressure, unit='[stress]', doc='a normal pressure, positive '// &
+        'pushing into the body (n is the outward unit normal of each edge)')
+    end if
+  end subroutine traction_vars
+
+  !> &boundary: prescribed components on a group; rendered with the components given.
+  subroutine boundary_vars(t, v, form)
+    type(load_in_t), target, intent(inout) :: t
+    type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
+    call v%int('body', t%body, range='1 or 2', required=.true., doc='the body')
+    call v%str('group', t%group, required=.true., doc='the group: a physical curve or point of '// &
+      'the body''s mesh, or a rectangle''s side (`''left''`, `''right''`, `''bottom''`, `''top''`)')
+    if (form /= UY_ONLY) call v%real('ux', t%ux, unit='[length]', doc='the x displacement of '// &
+      'every node of the group; not given: free')
+    if (form /= UX_ONLY) call v%real('uy', t%uy, unit='[length]', doc='the y displacement of '// &
+      'every node of the group; not given: free')
+  end subroutine boundary_vars
+
+  subroutine displacement_vars(t, v)
+    type(load_in_t), target, intent(inout) :: t
+    type(vars_t), intent(out) :: v
+    call v%int('body', t%body, range='1 or 2', required=.true., doc='the body')
+    call v%enum('side', t%side, SIDE_CHOICES, required=.true., doc='the side, declared '// &
+      '`''displacement''` in the body''s `&body`')
+    call v%pair('u', t%u, unit='[length]', doc='the displacement vector of every node of the side')
+  end subroutine displacement_vars
+
+  subroutine contact_vars(c, v)
+    type(contact_cfg_t), target, intent(inout) :: c
+    type(vars_t), intent(out) :: v
+    call v%str('body1_group', c%body_group(1), doc='body 1''s contact surface as an edge group '// &
+      '(give both groups or neither); `''''`: the side its `&body` declares `''contact''`')
+    call v%str('body2_group', c%body_group(2), doc='body 2''s contact surface, as `body1_group`')
+    call v%int('slave', c%slave, range='0, 1 or 2', doc='the body whose contact nodes carry the '// &
+      'multipliers (mortar); 0: the one whose contact group has the shorter mean edge (the '// &
+      'finer), body 1 on a tie')
+    call v%real('gap_radius', c%gap_radius, unit='[length]', range='>= 0', doc='0: no initial '// &
+      'gap; R > 0: an initial normal gap g0(s) = (s - gap_center)^2/(2R) on top of the '// &
+      'geometry''s (with groups: s is the slave node''s x)')
+    call v%real('gap_center', c%gap_center, unit='[length]', doc='s of the vertex of that parabola')
+  end subroutine contact_vars
+
+  subroutine solver_vars(s, v)
+    type(solver_cfg_t), target, intent(inout) :: s
+    type(vars_t), intent(out) :: v
+    call v%enum('method', s%method, METHOD_CHOICES, doc='`''robin''`: the Robin domain '// &
+      'decomposition; `''monolithic''`: the same discrete problem in one piece (MPRGP on the '// &
+      'condensed interface problem), the reference')
+    call v%enum('robin_operator', s%robin_operator, ROBIN_CHOICES, doc='the Robin operator: '// &
+      '`''steklov''` (the paper''s: the other body''s flexibility), `''constant''` (alpha M^-1), '// &
+      '`''harmonic''` (2 F1 (F1+F2)^-1 F2, robust to a stiffness contrast and to a body held '// &
+      'only by contact)')
+    call v%real('alpha', s%alpha, unit='[length/stress]', range='>= 0; > 0 with '// &
+      '`robin_operator=''constant''`', doc='the constant Robin parameter')
+    call v%real('delta', s%delta, unit='[-]', range='0 < delta <= 1', doc='relaxation of the '// &
+      'outer iteration (0.5 is the best choice for `''harmonic''`, and for `''steklov''` on equal '// &
+      'bodies)')
+    call v%real('tol', s%tol, unit='[-]', range='> 0', doc='outer tolerance, on the criterion '// &
+      'of `stop`')
+    call v%enum('stop', s%stop, STOP_CHOICES, doc='`''increment''`: the paper''s relative '// &
+      'increment of the obstacles; `''residual''`: the true residual of the iterate')
+    call v%int('max_outer', s%max_outer, range='>= 1', doc='outer iteration limit (reached: exit 2)')
+    call v%enum('factorization', s%factor%factorization, FACTOR_CHOICES, doc='`''cholmod''`: '// &
+      'sparse Cholesky (CHOLMOD), the interface ordered last; `''banded''`: reverse '// &
+      'Cuthill-McKee and LAPACK dpbtrf; `''mumps''`: MUMPS over MPI ranks with the interface as '// &
+      'Schur variables (`bin/robin_contact_mpi` only)')
+    call v%enum('ordering', s%factor%ordering, ORDER_CHOICES, doc='fill-reducing ordering of '// &
+      'each body for `''cholmod''`, the interface always last: `''metis''`, `''amd''` (CAMD), '// &
+      '`''natural''` or `''nd''` (the program''s geometric nested dissection)')
+    call v%enum('acceleration', s%acceleration, ACCEL_CHOICES, doc='outer fixed-point '// &
+      'acceleration: `''none''`, `''aitken''` (dynamic relaxation) or `''anderson''` (depth 5, '// &
+      'mixing delta)')
+    call v%real('inner_factor', s%inner_factor, unit='[-]', range='> 0', doc='inner tolerance = '// &
+      'inner_factor x min(increment, residual) of the previous outer iteration, clamped to '// &
+      '[inner_rtol_min, inner_rtol_max]')
+    call v%real('inner_rtol_min', s%inner_rtol_min, unit='[-]', range='0 < inner_rtol_min < 1', &
+      doc='floor of the adaptive inner tolerance')
+    call v%real('inner_rtol_max', s%inner_rtol_max, unit='[-]', range='0 < inner_rtol_max < 1; '// &
+      '>= inner_rtol_min', doc='ceiling of the adaptive inner tolerance')
+    call v%int('inner_max_it', s%inner_max_it, range='>= 1', doc='MPRGP iteration limit per '// &
+      'subproblem')
+    call v%real('monolithic_rtol', s%monolithic_rtol, unit='[-]', range='0 < monolithic_rtol < 1', &
+      doc='MPRGP tolerance of `method=''monolithic''`')
+  end subroutine solver_vars
+
+  subroutine output_vars(o, v)
+    type(output_cfg_t), target, intent(inout) :: o
+    type(vars_t), intent(out) :: v
+    call v%str('file', o%file, doc='the result file (HDF5; its folders are created); `''''`: '// &
+      '`results/<deck name>.h5`')
+    call v%int('checkpoint_every', o%checkpoint_every, range='>= 0', doc='outer iterations '// &
+      'between checkpoints to `<file>.ckpt.h5`; 0: only on SIGTERM or SIGINT')
+    call v%int('progress_lines', o%progress_lines, range='>= 0', doc='at most about this many '// &
+      'progress lines')
+  end subroutine output_vars
+
+end module deck_tables
