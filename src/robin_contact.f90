@@ -42,6 +42,8 @@ program robin_contact
   call parse_arguments(run%rank, deck_path, overrides, run%restart_file)
   call read_deck(deck_path, overrides, run%deck)
   call choose_backend(run, backend)
+  if (len(run%restart_file) > 0 .and. run%deck%solver%method /= METHOD_ROBIN) call fatal(EXIT_INPUT, &
+    'deck '//trim(run%deck%source)//': --restart applies to method=''robin'' only')
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
   call backend%check_memory(run, run%deck)
   call check_load_range(run%deck, ok, budget_msg)

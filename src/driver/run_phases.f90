@@ -59,8 +59,6 @@ contains
           i2s(run%ranks)//'; use factorization=''mumps'' or mpirun -np 1')
         allocate (serial_backend_t :: backend)
       end if
-      if (len(run%restart_file) > 0 .and. deck%solver%method /= METHOD_ROBIN) &
-        call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//': --restart applies to method=''robin'' only')
     end associate
   end subroutine choose_backend
 
