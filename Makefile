@@ -68,7 +68,7 @@ endif
 MODS := kinds errors clock strings int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar condense condense_mumps floating contact_types contact_common equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
-        results checkpoint
+        results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
@@ -102,7 +102,7 @@ deps: $(DEPS_STAMP)
 # ---- compile -------------------------------------------------------------------
 # Sources are grouped by stage (src/base, input, fem, linalg, qp, contact, io; the driver at
 # the top); objects and modules go flat into $(BUILD).
-SRC_DIRS := src src/base src/input src/fem src/linalg src/qp src/contact src/io src/parallel
+SRC_DIRS := src src/base src/input src/fem src/linalg src/qp src/contact src/io src/parallel src/driver
 vpath %.f90 $(SRC_DIRS)
 vpath %.c $(SRC_DIRS)
 
@@ -196,6 +196,30 @@ $(BUILD)/results.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(
                            $(BUILD)/history_io.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o
+# the driver's modules (src/driver): the run's data, its two back-ends, its phases
+$(BUILD)/run_state.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/deck.o $(BUILD)/mesh.o \
+                           $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/results.o \
+                           $(BUILD)/strings.o $(BUILD)/clock.o $(BUILD)/mpi_env.o
+$(BUILD)/run_backend.o:    $(BUILD)/config.o $(BUILD)/run_state.o
+# a back-end implements every phase of the interface: not every phase needs every argument
+$(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o: FFLAGS += -Wno-unused-dummy-argument
+$(BUILD)/serial_backend.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/assembly.o \
+                           $(BUILD)/condense.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/mpi_env.o \
+                           $(BUILD)/run_state.o $(BUILD)/run_backend.o
+$(BUILD)/mpi_backend.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/assembly.o \
+                           $(BUILD)/contact_types.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/strings.o \
+                           $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/condense_mumps.o \
+                           $(BUILD)/run_state.o $(BUILD)/run_backend.o
+$(BUILD)/run_summary.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/condense.o \
+                           $(BUILD)/contact_types.o $(BUILD)/sysinfo.o $(BUILD)/strings.o $(BUILD)/run_state.o
+$(BUILD)/run_phases.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/gmsh_msh.o \
+                           $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
+                           $(BUILD)/robin_iteration.o $(BUILD)/monolithic.o $(BUILD)/error_estimate.o \
+                           $(BUILD)/floating.o $(BUILD)/results.o $(BUILD)/checkpoint.o $(BUILD)/files.o \
+                           $(BUILD)/signals.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/strings.o \
+                           $(BUILD)/clock.o $(BUILD)/mpi_env.o $(BUILD)/run_state.o $(BUILD)/run_backend.o \
+                           $(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o $(BUILD)/run_summary.o
+$(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/deck.o $(BUILD)/results.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
 $(BUILD)/files_shim.o:     include/files_shim.h
 $(BUILD)/robin_contact.o:  $(OBJS)

@@ -1,0 +1,310 @@
+!> The phases both back-ends share, in the driver's order: the back-end's choice, the
+!! meshes and the assembly of both bodies, the contact line, the restart, the finiteness of
+!! the condensed data, the contact solve (rank 0), the displacements' rigid part, the
+!! result file; and the check for a signal between the phases.
+module run_phases
+  use kinds, only: wp
+  use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use errors, only: fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED
+  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
+  use mesh, only: mesh_build
+  use gmsh_msh, only: msh_read, msh_read_pair
+  use assembly, only: assemble_body
+  use condense, only: build_interface
+  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED
+  use robin_iteration, only: solve_robin
+  use monolithic, only: solve_monolithic
+  use error_estimate, only: error_bound
+  use floating, only: rigid_rows, check_held, free_list, fixing_list
+  use results, only: write_results
+  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
+  use files, only: remove_file
+  use signals, only: stop_requested, pending_signal
+  use sysinfo, only: peak_rss_mb
+  use budget, only: body_memory_mb
+  use strings, only: sci, i2s, word
+  use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
+  use clock, only: wtime
+  use mpi_env, only: par_built, par_any
+  use run_state, only: run_t
+  use run_backend, only: backend_t
+  use serial_backend, only: serial_backend_t
+  use mpi_backend, only: mpi_backend_t
+  use run_summary, only: summary
+  implicit none (type, external)
+  private
+
+  public :: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, read_restart, &
+            factor_estimate, check_condensed, solve_contact, complete_displacements, write_output, &
+            check_interrupt
+
+contains
+
+  !> The MPI back-end for factorization='mumps' (the MPI binary only), the serial one
+  !! otherwise (one rank only).
+  subroutine choose_backend(run, backend)
+    type(run_t), intent(in) :: run                            !< the run: its deck and ranks
+    class(backend_t), allocatable, intent(out) :: backend     !< the chosen back-end
+    associate (deck => run%deck)
+      if (deck%solver%factor%factorization == FACTOR_MUMPS) then
+        if (.not. par_built) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)// &
+          ': factorization=''mumps'' needs the MPI binary: run mpirun -np N bin/robin_contact_mpi '// &
+          trim(deck%source)//' (built by make MPI=1); this binary has no MPI or MUMPS')
+        allocate (mpi_backend_t :: backend)
+        backend%assembles_matrix = .false.
+      else
+        if (run%ranks > 1) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//': factorization='''// &
+          word(FACTOR_CHOICES, deck%solver%factor%factorization)//''' runs on one rank, and this run has '// &
+          i2s(run%ranks)//'; use factorization=''mumps'' or mpirun -np 1')
+        allocate (serial_backend_t :: backend)
+      end if
+    end associate
+  end subroutine choose_backend
+
+  !> One thread per body, at most two. CHOLMOD opens OpenMP regions of its own with a
+  !! fixed num_threads(4); inside our 2-thread region they are nested and run serially, but
+  !! with one thread our region is inactive and CHOLMOD's would start 4 threads on the
+  !! cores we use (measured: 10x slower factorization). So no region below ours is active.
+  subroutine choose_threads(run)
+    type(run_t), intent(inout) :: run   !< the run: its threads
+    run%threads = max(1, min(2, omp_get_max_threads()))
+    if (run%threads == 1) then
+      call omp_set_max_active_levels(0)
+    else
+      call omp_set_max_active_levels(1)
+    end if
+  end subroutine choose_threads
+
+  !> Both bodies' meshes: from one file holding both (read and parsed once), from a file
+  !! each, or structured from the deck. A body from a mesh file is sized by its node count
+  !! (run%sized), and the memory is checked again with it.
+  subroutine read_meshes(run, backend)
+    type(run_t), intent(inout) :: run                  !< the run: its meshes
+    class(backend_t), intent(inout) :: backend         !< checks the memory
+    integer :: info(2), a
+    character(len=512) :: msg(2)
+    associate (deck => run%deck)
+      if (len_trim(deck%body(1)%mesh) > 0 .and. deck%body(1)%mesh == deck%body(2)%mesh) then
+        call msh_read_pair(trim(deck%body(1)%mesh), [deck%body(1)%region, deck%body(2)%region], run%meshes, info, msg, &
+                           run%threads)
+      else
+        !$omp parallel do num_threads(run%threads) schedule(static, 1)
+        do a = 1, 2
+          if (len_trim(deck%body(a)%mesh) > 0) then
+            call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), info(a), msg(a))
+          else
+            call mesh_build(run%meshes(a), deck%body(a))
+            info(a) = 0
+          end if
+        end do
+        !$omp end parallel do
+      end if
+      do a = 1, 2   ! the mesh reader's message names the body
+        if (info(a) == 1) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//': '//trim(msg(a)))
+        if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'deck '//trim(deck%source)//': '//trim(msg(a)))
+      end do
+      run%sized = deck
+      if (len_trim(deck%body(1)%mesh) > 0 .or. len_trim(deck%body(2)%mesh) > 0) then
+        do a = 1, 2
+          if (len_trim(deck%body(a)%mesh) == 0) cycle
+          run%sized%body(a)%nx = max(1, nint(sqrt(real(run%meshes(a)%nnode, wp))) - 1)
+          run%sized%body(a)%ny = max(1, run%meshes(a)%nnode/(run%sized%body(a)%nx + 1) - 1)
+        end do
+        call backend%check_memory(run, run%sized)
+      end if
+    end associate
+  end subroutine read_meshes
+
+  !> Both bodies' DOF numbering and loads, one thread each; the stiffness too unless each
+  !! rank assembles its cells' share later (MUMPS).
+  subroutine assemble_bodies(run, matrix)
+    type(run_t), intent(inout) :: run   !< the run: its systems
+    logical, intent(in) :: matrix       !< assemble the stiffness
+    integer :: info(2), a
+    character(len=512) :: msg(2)
+    associate (deck => run%deck)
+      !$omp parallel do num_threads(run%threads) schedule(static, 1)
+      do a = 1, 2
+        call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
+                           run%systems(a), info(a), msg(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
+                           contact_group=deck%contact%body_group(a))
+      end do
+      !$omp end parallel do
+      do a = 1, 2
+        if (info(a) /= 0) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', body '//achar(48 + a)//': '// &
+                                     trim(msg(a)))
+      end do
+    end associate
+  end subroutine assemble_bodies
+
+  !> The contact line between the bodies; for a body held only by contact, its
+  !! equilibrium rows, and whether the contact can hold it (exit 1 if not).
+  subroutine build_contact_line(run)
+    type(run_t), intent(inout) :: run   !< the run: its contact line and bodies' rigid rows
+    integer :: info, a
+    character(len=512) :: msg
+    call build_interface(run%deck%body, run%deck%contact, run%meshes, run%systems, run%contact_line, info, msg)
+    if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
+    do a = 1, 2
+      call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
+    end do
+    if (run%systems(1)%nrig + run%systems(2)%nrig == 0) return
+    call check_held(run%systems, run%bodies, info, msg)
+    if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
+    do a = 1, 2
+      associate (system => run%systems(a))
+        if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//achar(48 + a)//' is held only by '// &
+          'contact (free: '//free_list(system)//'); fixing DOFs for its generalized inverse: '//fixing_list(system)// &
+          '; kernel check |K R|/(|K| |R|) = '//sci(system%rig_residual)
+      end associate
+    end do
+  end subroutine build_contact_line
+
+  !> The checkpoint to restart from is input too: read and checked before any file is touched.
+  subroutine read_restart(run)
+    type(run_t), intent(inout) :: run   !< the run: its Robin state and result
+    logical :: ok
+    character(len=512) :: msg
+    if (len(run%restart_file) == 0) return
+    call checkpoint_read(run%restart_file, run%key, run%contact_line%m, run%deck%solver%max_outer, &
+                         run%robin_state, run%result, ok, msg)
+    if (.not. ok) call fatal(EXIT_INPUT, trim(msg))
+  end subroutine read_restart
+
+  !> The budget's estimate of body a's Cholesky factor, '123 MiB' or '1.2 GiB'.
+  function factor_estimate(run, a) result(s)
+    type(run_t), intent(in) :: run   !< the run: its sized deck
+    integer, intent(in) :: a         !< the body
+    character(len=:), allocatable :: s
+    real(wp) :: nm, nf, mib
+    character(len=24) :: buf
+    mib = body_memory_mb(run%sized%body(a), run%deck%solver%factor, nm, nf)   ! the body's total; the factor's part:
+    mib = 8.5_wp*nf/1048576.0_wp                                              ! values and supernodal indices
+    if (mib >= 1024.0_wp) then
+      write (buf, '(f0.1,a)') mib/1024.0_wp, ' GiB'
+    else
+      write (buf, '(i0,a)') nint(mib), ' MiB'
+    end if
+    s = trim(buf)
+  end function factor_estimate
+
+  !> A flexibility that is not finite is a stiffness out of double precision's range (exit 3).
+  subroutine check_condensed(run)
+    type(run_t), intent(in) :: run   !< the run: its condensed bodies
+    integer :: a
+    character(len=512) :: msg
+    do a = 1, 2
+      if (.not. (all(ieee_is_finite(run%bodies(a)%flex)) .and. all(ieee_is_finite(run%bodies(a)%b)))) then
+        write (msg, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
+          run%deck%body(a)%young, '): the stiffness is out of the range of double precision; rescale the units'
+        call fatal(EXIT_NUMERICAL, trim(msg))
+      end if
+    end do
+  end subroutine check_condensed
+
+  !> The contact forces (rank 0; the other ranks wait for them): the Robin iteration with
+  !! its checkpoints, or the monolithic QP; then the a posteriori error bound and, for a
+  !! floating body, its load against its contact force.
+  subroutine solve_contact(run)
+    type(run_t), intent(inout) :: run   !< the run: its contact result
+    type(h5_checkpointer_t) :: ckpt
+    integer :: a
+    if (run%rank /= 0) return
+    associate (deck => run%deck, result => run%result, contact_line => run%contact_line, bodies => run%bodies)
+      if (deck%solver%method == METHOD_MONOLITHIC) then
+        call solve_monolithic(deck%solver, contact_line, bodies, result, stop_requested)
+      else
+        ckpt%file = checkpoint_file(deck%output%file)
+        ckpt%key = run%key
+        ckpt%every = deck%output%checkpoint_every
+        call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
+                         run%robin_state, ckpt, stop_requested)
+        if (ckpt%failed) call warn(ckpt%message)
+      end if
+      if (result%status == STATUS_FAILED) return
+      call error_bound(contact_line, bodies, result)
+      if (contact_line%m == 0) return
+      do a = 1, 2
+        if (run%systems(a)%nrig == 0) cycle
+        associate (g => bodies(a)%rg, e => bodies(a)%re)
+          write (output_unit, '(a)') 'equilibrium: body '//achar(48 + a)//' |G lam - e|/|e| = '// &
+            sci(norm2(matmul(g, result%lam_body(:, a)) - e)/norm2(e))//' (its own force), '// &
+            sci(norm2(matmul(g, result%lam) - e)/norm2(e))//' (mean force); rigid motion '// &
+            'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates (this run''s solves) '// &
+            i2s(result%eq_updates)
+        end associate
+      end do
+    end associate
+  end subroutine solve_contact
+
+  !> Body a's rigid motion amplitudes (the displacement of its fixing DOFs), space-separated.
+  function amplitudes(run, a) result(t)
+    type(run_t), intent(in) :: run
+    integer, intent(in) :: a
+    character(len=64) :: t
+    integer :: k
+    t = ''
+    do k = 1, run%systems(a)%nrig
+      t = trim(t)//' '//sci(run%result%rigid(k, a))
+    end do
+    t = adjustl(t)
+  end function amplitudes
+
+  !> A floating body's rigid part, u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a (rank 0,
+  !! which writes); displacements that are not finite are a failure, never a result.
+  subroutine complete_displacements(run)
+    type(run_t), intent(inout) :: run   !< the run: its displacements and status
+    integer :: a
+    if (run%result%status == STATUS_FAILED) return
+    if (run%rank == 0) then
+      do a = 1, 2
+        associate (system => run%systems(a))
+          if (system%nrig > 0) run%displacement(1:system%ndof, a) = run%displacement(1:system%ndof, a) + &
+                                                              matmul(system%rig, run%result%rigid(1:system%nrig, a))
+        end associate
+      end do
+    end if
+    if (.not. all(ieee_is_finite(run%displacement))) then
+      run%result%status = STATUS_FAILED
+      run%result%message = 'the displacements are not finite: the problem is beyond double precision; rescale the units'
+    end if
+  end subroutine complete_displacements
+
+  !> The result file (rank 0, unless the run failed). A converged run has no use for its
+  !! checkpoint; a run that stopped keeps it. An earlier result at this path stays until
+  !! this one replaces it whole; a run that fails leaves it untouched.
+  subroutine write_output(run)
+    type(run_t), intent(inout) :: run   !< the run: whether its result was written
+    logical :: ok
+    character(len=512) :: msg
+    if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
+    run%timing%peak_rss_mb = peak_rss_mb()
+    run%timing%total = wtime() - run%t_start
+    call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
+                       run%displacement, run%timing, ok, msg)
+    run%written = ok
+    if (.not. ok) call fatal(EXIT_NUMERICAL, 'output: '//trim(msg))
+    if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
+  end subroutine write_output
+
+  !> A signal before the outer iteration (during assembly, ordering, factorization or
+  !! condensation, where the libraries cannot be interrupted safely): stop at the end of
+  !! the phase with exit 4. There is nothing to checkpoint yet and nothing is written.
+  subroutine check_interrupt(run, backend, phase)
+    type(run_t), intent(inout) :: run              !< the run
+    class(backend_t), intent(inout) :: backend     !< ends the run
+    character(len=*), intent(in) :: phase          !< the phase just ended
+    if (.not. par_any(stop_requested())) return
+    run%result%status = STATUS_INTERRUPTED
+    run%result%method = merge('robin     ', 'monolithic', run%deck%solver%method == METHOD_ROBIN)
+    run%code = EXIT_INTERRUPTED
+    write (error_unit, '(a)') 'robin_contact: interrupted: signal '//i2s(pending_signal())//' during the '// &
+      phase//'; stopped before the first outer iteration, so there is no checkpoint and nothing was written'
+    run%timing%total = wtime() - run%t_start
+    run%timing%peak_rss_mb = peak_rss_mb()
+    call summary(run)
+    call backend%finish(run)
+  end subroutine check_interrupt
+
+end module run_phases

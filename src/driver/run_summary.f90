@@ -1,0 +1,104 @@
+!> How a run ends: its exit code from the contact status (with the reason and the next
+!! setting to try on standard error) and the closing summary lines on standard output.
+module run_summary
+  use kinds, only: wp
+  use, intrinsic :: iso_fortran_env, only: error_unit
+  use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED
+  use config, only: solver_cfg_t, ROBIN_HARMONIC
+  use condense, only: contact_resultant
+  use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED
+  use sysinfo, only: write_stdout_checked
+  use strings, only: sci, fmt_real
+  use run_state, only: run_t
+  implicit none (type, external)
+  private
+
+  public :: set_exit_code, summary
+
+contains
+
+  !> The exit code of the contact status; a run that did not converge says why, and what
+  !! to try next, on standard error.
+  subroutine set_exit_code(run)
+    type(run_t), intent(inout) :: run   !< the run: its result's status, its code
+    select case (run%result%status)
+    case (STATUS_CONVERGED)
+      run%code = EXIT_OK
+    case (STATUS_FAILED)
+      run%code = EXIT_NUMERICAL
+    case (STATUS_INTERRUPTED)
+      run%code = EXIT_INTERRUPTED
+    case default
+      run%code = EXIT_NOT_CONVERGED
+    end select
+    if (run%result%status /= STATUS_CONVERGED) write (error_unit, '(a)') 'robin_contact: '// &
+      status_name(run%result%status)//': '//trim(run%result%message)
+    if (run%code == EXIT_NOT_CONVERGED) write (error_unit, '(a)') 'robin_contact: next: '// &
+      next_setting(run%deck%solver)
+  end subroutine set_exit_code
+
+  !> The closing lines (rank 0). A summary that cannot be written (standard output on a
+  !! full disk or a closed pipe) is a failure, exit 3: scripts read the result: line.
+  subroutine summary(run)
+    type(run_t), intent(inout) :: run   !< the run: its result and timing; its code on failure
+    real(wp) :: ftot, fres(2)
+    character(len=1024) :: line(5)
+    integer :: err(5), k
+    if (run%rank /= 0) return
+    associate (result => run%result, timing => run%timing)
+      err = 0
+      ftot = 0.0_wp
+      fres = 0.0_wp
+      if (allocated(result%lam)) then
+        ftot = sum(result%lam)
+        fres = contact_resultant(run%contact_line, 1, result%lam)
+      end if
+      write (line(1), '(a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: resultant_on_body1='// &
+        sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', result%active, &
+        ' imbalance=', result%imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity
+      if (result%outer > 0) then
+        line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(result%error_bound)// &
+          ' (a posteriori bound, cond(F1+F2) ~ '//sci(result%kappa)//')'
+      else
+        line(2) = 'accuracy: none (stopped before the first outer iteration: no contact forces to bound)'
+      end if
+      write (line(3), '(a,6(a,f0.3),a,f0.1,a,f0.1)') 'time:', ' assemble=', timing%assemble, ' factor=', timing%factor, &
+        ' condense=', timing%condense, ' iterate=', timing%iterate, ' output=', timing%output, ' total=', timing%total, &
+        ' peak_mb=', timing%peak_rss_mb, ' factor_mb=', timing%factor_mb
+      write (line(4), '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', &
+        status_name(result%status), ' method=', trim(result%method), ' outer=', result%outer, ' inner=', result%inner, &
+        ' n1=', run%systems(1)%n, ' n2=', run%systems(2)%n, ' m=', run%contact_line%m, &
+        ' delta=', fmt_real(run%deck%solver%delta, '(f0.6)'), ' residual=', result%residual, &
+        ' wall_s=', fmt_real(timing%total, '(f0.3)')
+      ! the output line sits before the time line when a result file was written
+      do k = 1, 4
+        if (k == 3 .and. run%written) then
+          call write_stdout_checked('output: '//trim(run%deck%output%file), err(5))
+        end if
+        call write_stdout_checked(trim(line(k)), err(k))
+      end do
+      if (any(err /= 0)) then
+        write (error_unit, '(a)') 'robin_contact: error: cannot write the summary to standard output '// &
+          '(full disk or closed pipe?); the run''s status was '//status_name(result%status)
+        run%code = EXIT_NUMERICAL
+      end if
+    end associate
+  end subroutine summary
+
+  !> What a user whose Robin run did not converge should try next, in order: the robust
+  !! operator and relaxation (the defaults), then the monolithic reference.
+  function next_setting(solver) result(t)
+    type(solver_cfg_t), intent(in) :: solver
+    character(len=:), allocatable :: t
+    if (solver%robin_operator /= ROBIN_HARMONIC) then
+      t = "try &solver robin_operator='harmonic', delta=0.5 / (robust to material contrast), "// &
+          "or method='monolithic'"
+    else if (abs(solver%delta - 0.5_wp) > 0.01_wp) then
+      t = "try &solver delta=0.5 / (the harmonic operator's best relaxation), or method='monolithic'"
+    else
+      t = "try &solver method='monolithic' / (one QP over both bodies, no outer iteration), "// &
+          "or a larger max_outer"
+    end if
+  end function next_setting
+
+end module run_summary

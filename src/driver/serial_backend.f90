@@ -1,0 +1,119 @@
+!> The serial back-end: both bodies in this process, one OpenMP thread each, factorized
+!! by CHOLMOD or the banded Cholesky (condense::factor_body).
+module serial_backend
+  use kinds, only: wp
+  use errors, only: fatal, terminate, EXIT_INPUT, EXIT_NUMERICAL
+  use config, only: deck_t
+  use assembly, only: expand
+  use condense, only: factor_body, condense_body, recover_displacement
+  use sysinfo, only: memory_limit_mb
+  use budget, only: check_budget
+  use mpi_env, only: par_finalize
+  use run_state, only: run_t
+  use run_backend, only: backend_t
+  implicit none (type, external)
+  private
+
+  !> Both bodies here, one thread each.
+  type, extends(backend_t), public :: serial_backend_t
+  contains
+    procedure :: check_memory, factor, condense, record_factor_memory, share_contact_forces, recover, &
+                 agree_code, report_ranks, finish
+  end type serial_backend_t
+
+contains
+
+  !> The whole run against this process's memory (exit 1, nothing allocated yet).
+  subroutine check_memory(self, run, the_deck)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(in) :: run          !< the run
+    type(deck_t), intent(in) :: the_deck    !< the deck to size
+    logical :: ok
+    character(len=:), allocatable :: budget_msg
+    call check_budget(the_deck, memory_limit_mb(), ok, budget_msg)
+    if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+  end subroutine check_memory
+
+  !> Order and factorize both bodies, one thread each.
+  subroutine factor(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its systems factorized into its bodies
+    integer :: info(2), a
+    character(len=512) :: msg(2)
+    !$omp parallel do num_threads(run%threads) schedule(static, 1)
+    do a = 1, 2
+      call factor_body(run%deck%solver%factor, run%contact_line, a, run%meshes(a), run%systems(a), run%bodies(a), &
+                       info(a), msg(a))
+    end do
+    !$omp end parallel do
+    do a = 1, 2
+      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': factorization failed: '//trim(msg(a)))
+    end do
+  end subroutine factor
+
+  !> Both bodies' interface flexibilities F_a and b_a, one thread each.
+  subroutine condense(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its bodies condensed
+    integer :: info(2), a
+    character(len=512) :: msg(2)
+    !$omp parallel do num_threads(run%threads) schedule(static, 1)
+    do a = 1, 2
+      call condense_body(run%systems(a), run%bodies(a), info(a), msg(a))
+    end do
+    !$omp end parallel do
+    do a = 1, 2
+      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': condensation failed: '//trim(msg(a)))
+    end do
+  end subroutine condense
+
+  !> The two Cholesky factors' memory [MiB].
+  subroutine record_factor_memory(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its timing
+    run%timing%factor_mb = (run%bodies(1)%chol%mem_bytes + run%bodies(2)%chol%mem_bytes)/1048576.0_wp
+  end subroutine record_factor_memory
+
+  !> The contact forces are here already.
+  subroutine share_contact_forces(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run
+  end subroutine share_contact_forces
+
+  !> Both bodies' displacements under their own contact forces, one thread each.
+  subroutine recover(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its displacements
+    real(wp), allocatable :: ufree(:)
+    integer :: a
+    !$omp parallel do num_threads(run%threads) schedule(static, 1) private(ufree)
+    do a = 1, 2
+      allocate (ufree(run%systems(a)%n))
+      call recover_displacement(run%systems(a), run%bodies(a), run%result%lam_body(:, a), ufree)
+      call expand(run%systems(a), ufree, run%displacement(1:run%systems(a)%ndof, a))
+      deallocate (ufree)
+    end do
+    !$omp end parallel do
+  end subroutine recover
+
+  !> One process decides its exit code alone.
+  subroutine agree_code(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run
+  end subroutine agree_code
+
+  !> No ranks to report.
+  subroutine report_ranks(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run
+  end subroutine report_ranks
+
+  !> End the run with its code.
+  subroutine finish(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its exit code
+    call par_finalize()
+    call terminate(run%code)
+  end subroutine finish
+
+end module serial_backend
