@@ -10,7 +10,7 @@ module run_phases
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
   use mesh, only: mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
-  use assembly, only: assemble_body
+  use assembly, only: assemble_body, nodal_stress, stress_field_t
   use condense, only: build_interface
   use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED
   use robin_iteration, only: solve_robin
@@ -282,11 +282,24 @@ contains
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
     call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                       run%displacement, run%timing, ok, msg)
+                       run%displacement, body_stresses(run), run%timing, ok, msg)
     run%written = ok
     if (.not. ok) call fatal(EXIT_NUMERICAL, 'output: '//trim(msg))
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
+
+  !> Each body's nodal stresses from its displacement (what the result file shows).
+  function body_stresses(run) result(stress)
+    type(run_t), intent(in) :: run
+    type(stress_field_t) :: stress(2)
+    integer :: a, nnode
+    do a = 1, 2
+      nnode = run%meshes(a)%nnode
+      allocate (stress(a)%sigma(4, nnode), stress(a)%von_mises(nnode))
+      call nodal_stress(run%meshes(a), run%deck%body(a), run%deck%plane_strain, &
+                        run%displacement(1:run%systems(a)%ndof, a), stress(a)%sigma, stress(a)%von_mises)
+    end do
+  end function body_stresses
 
   !> A signal before the outer iteration (during assembly, ordering, factorization or
   !! condensation, where the libraries cannot be interrupted safely): stop at the end of

@@ -16,7 +16,7 @@ module results
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES
   use strings, only: word, body_label
   use mesh, only: mesh_t
-  use assembly, only: body_system_t, nodal_stress
+  use assembly, only: body_system_t, stress_field_t
   use condense, only: interface_t, contact_resultant
   use contact_types, only: contact_result_t, status_name
   use floating, only: free_list
@@ -49,7 +49,7 @@ contains
   !! last) only when all are complete. ok = .false. and msg (naming the file and what
   !! failed) otherwise; then the files of an earlier result at these names are as they
   !! were, and no temporary file is left.
-  subroutine write_results(file, d, msh, sys, itf, res, u, tm, ok, msg)
+  subroutine write_results(file, d, msh, sys, itf, res, u, stress, tm, ok, msg)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(2)                 !< meshes
@@ -57,6 +57,7 @@ contains
     type(interface_t), intent(in) :: itf               !< contact line
     type(contact_result_t), intent(in) :: res          !< contact solution
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, 2) full displacements
+    type(stress_field_t), intent(in) :: stress(2)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     logical, intent(out) :: ok                         !< success
     character(len=*), intent(out) :: msg               !< failure description
@@ -73,7 +74,7 @@ contains
     do k = 1, NFILES
       tmp(k) = temp_name(name(k))
     end do
-    call write_h5(tmp(1), d, msh, sys, itf, res, u, tm, run_id(), st)
+    call write_h5(tmp(1), d, msh, sys, itf, res, u, stress, tm, run_id(), st)
     if (st%failed) then
       msg = 'cannot write '//trim(file)//' ('//st%what//')'
       call remove_temps()
@@ -118,7 +119,7 @@ contains
   end subroutine result_files
 
   !> The HDF5 result file `path`, whole; st records the first failure.
-  subroutine write_h5(path, d, msh, sys, itf, res, u, tm, run_id, st)
+  subroutine write_h5(path, d, msh, sys, itf, res, u, stress, tm, run_id, st)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(2)
@@ -126,12 +127,13 @@ contains
     type(interface_t), intent(in) :: itf
     type(contact_result_t), intent(in) :: res
     real(wp), intent(in) :: u(:, :)
+    type(stress_field_t), intent(in) :: stress(2)
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
     type(h5_status_t), intent(inout) :: st
     integer(hid_t) :: fid, gid
     integer :: a, k
-    real(wp), allocatable :: sig(:, :), vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
+    real(wp), allocatable :: vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
     character(len=8) :: bname
     character(len=:), allocatable :: ul, us, uf
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
@@ -249,14 +251,14 @@ contains
       call write_dset(gid, 'cells', msh(a)%cells - 1, st, '1')
       if (msh(a)%element == ELEM_MIXED) call write_dset(gid, 'topology', mixed_topology(msh(a)), st, '1')
       call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
-      allocate (sig(4, msh(a)%nnode), vm(msh(a)%nnode), sigt(msh(a)%nnode, 4))
-      call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sig, vm)
-      if (.not. (all(ieee_is_finite(sig)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed) then
+      allocate (sigt(msh(a)%nnode, 4))
+      vm = stress(a)%von_mises
+      if (.not. (all(ieee_is_finite(stress(a)%sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed) then
         ! a derived field that is not finite is a failure, never part of a result
         st%failed = .true.
         st%what = 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units'
       end if
-      sigt = transpose(sig)
+      sigt = transpose(stress(a)%sigma)
       call write_dset(gid, 'stress', sigt, st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
       do k = 1, 4
@@ -266,7 +268,7 @@ contains
       ! contact pressure as a nodal field of the body (0 off the contact line)
       call nodal_pressure(itf, a, pres, vm)
       call write_dset(gid, 'contact_pressure', vm, st, us)
-      deallocate (w2, w3, ua, sigt, sig, vm)
+      deallocate (w2, w3, ua, sigt, vm)
       call group_close(gid, st)
     end do
     call file_close(fid, st)
