@@ -24,7 +24,7 @@ program test_ordering
   use clock, only: wtime
   use strings, only: body_label
   use testing, only: report, report_le, test_summary, rectangle_body, structured_body, general_body, &
-                     side_free_dofs, order_body
+                     side_free_dofs, order_body, factor_ordered
   implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -189,15 +189,7 @@ contains
     write (output_unit, '(a,i0,a,i0)') '      '//name//': n = ', sys%n, ', interface m = ', m
     do o = 1, 3
       tag = name//' '//trim(onames(o))
-      select case (o)
-      case (1)
-        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
-      case (2)
-        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
-      case default
-        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
-                       interior_perm=perm)
-      end select
+      call factor_ordered(ch, sys, o, last, perm, info, msg)
       call report(info == 0, trim(tag)//': factor info = 0 '//trim(msg))
       if (info /= 0) cycle
       write (output_unit, '(a)') '      '//ch%summary()
@@ -383,15 +375,7 @@ contains
     u = 0.0_wp
     do o = 1, 3
       tag = name//' '//trim(onames(o))
-      select case (o)
-      case (1)
-        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
-      case (2)
-        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
-      case default
-        call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
-                       interior_perm=perm)
-      end select
+      call factor_ordered(ch, sys, o, last, perm, info, msg)
       call report(info == 0 .and. ch%interface_last_ok, trim(tag)//': factor ok, interface last '//trim(msg))
       if (info /= 0) cycle
       write (output_unit, '(a)') '      '//ch%summary()

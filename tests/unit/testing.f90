@@ -15,6 +15,7 @@ module testing
   use linop, only: csc_op_t, csc_op_init
   use lapack, only: dpbsv
   use ordering, only: grid_dissection, coordinate_bisection
+  use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
   implicit none (type, external)
   private
 
@@ -22,7 +23,7 @@ module testing
   integer, public, protected :: nfail = 0   !< checks failed so far
 
   public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem
-  public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body
+  public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
 
 contains
 
@@ -341,5 +342,25 @@ contains
 
 
   end subroutine general_body
+
+  !> Factor a body's stiffness by CHOLMOD with its interface DOFs `last` ordered last, in
+  !! ordering o: 1 METIS, 2 AMD, 3 the given interior permutation `perm` (order_body).
+  subroutine factor_ordered(ch, sys, o, last, perm, info, msg)
+    type(chol_t), intent(inout) :: ch
+    type(body_system_t), intent(in) :: sys
+    integer, intent(in) :: o
+    integer, intent(in) :: last(:), perm(:)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    select case (o)
+    case (1)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
+    case (2)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
+    case default
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+                     interior_perm=perm)
+    end select
+  end subroutine factor_ordered
 
 end module testing
