@@ -205,7 +205,7 @@ $(BUILD)/run_backend.o:    $(BUILD)/config.o $(BUILD)/run_state.o
 $(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/serial_backend.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/assembly.o \
                            $(BUILD)/condense.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/mpi_env.o \
-                           $(BUILD)/run_state.o $(BUILD)/run_backend.o
+                           $(BUILD)/run_state.o $(BUILD)/run_backend.o $(BUILD)/strings.o
 $(BUILD)/mpi_backend.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/assembly.o \
                            $(BUILD)/contact_types.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/strings.o \
                            $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/condense_mumps.o \

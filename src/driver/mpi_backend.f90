@@ -11,7 +11,7 @@ module mpi_backend
   use contact_types, only: STATUS_FAILED
   use sysinfo, only: peak_rss_mb, node_memory_limit_mb, process_memory_limit_mb
   use budget, only: rank_memory_mb, check_budget_ranks
-  use strings, only: i2s
+  use strings, only: i2s, body_label
   use mpi_env, only: par_finalize, par_split, par_bcast_reals, par_bcast_ints, par_agree, par_max_real, &
                      par_sum_real, par_node_sum
   use mumps_iface, only: mumps_t, mumps_end
@@ -109,7 +109,7 @@ contains
     self%group_rank = [run%rank, run%rank - g1]
     do b = 1, 2
       if (self%group_size(b) > run%meshes(b)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)// &
-        ': '//i2s(self%group_size(b))//' ranks for body '//achar(48 + b)//', which has '// &
+        ': '//i2s(self%group_size(b))//' ranks for body '//body_label(b)//', which has '// &
         i2s(run%meshes(b)%ncell)//' cells: use at most '// &
         i2s(2*min(run%meshes(1)%ncell, run%meshes(2)%ncell))//' ranks')
     end do
@@ -259,7 +259,7 @@ contains
     do b = 2, 1, -1
       if (self%info(b) /= 0) then
         st = EXIT_NUMERICAL
-        m1 = 'body '//achar(48 + b)//': '//what//': '//trim(self%msg(b))
+        m1 = 'body '//body_label(b)//': '//what//': '//trim(self%msg(b))
       end if
     end do
     call par_agree(st, m1)

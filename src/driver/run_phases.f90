@@ -23,7 +23,7 @@ module run_phases
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
-  use strings, only: sci, i2s, word
+  use strings, only: sci, i2s, word, body_label
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
   use mpi_env, only: par_built, par_any
@@ -132,8 +132,13 @@ contains
       end do
       !$omp end parallel do
       do a = 1, 2
-        if (info(a) /= 0) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', body '//achar(48 + a)//': '// &
-                                     trim(msg(a)))
+        if (info(a) == 0) cycle
+        ! a message that names its body already gets the deck only
+        if (index(msg(a), 'body '//body_label(a)//':') == 1) then
+          call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', '//trim(msg(a)))
+        else
+          call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', body '//body_label(a)//': '//trim(msg(a)))
+        end if
       end do
     end associate
   end subroutine assemble_bodies
@@ -154,7 +159,7 @@ contains
     if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
     do a = 1, 2
       associate (system => run%systems(a))
-        if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//achar(48 + a)//' is held only by '// &
+        if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
           'contact (free: '//free_list(system)//'); fixing DOFs for its generalized inverse: '//fixing_list(system)// &
           '; kernel check |K R|/(|K| |R|) = '//sci(system%rig_residual)
       end associate
@@ -228,7 +233,7 @@ contains
       do a = 1, 2
         if (run%systems(a)%nrig == 0) cycle
         associate (g => bodies(a)%rg, e => bodies(a)%re)
-          write (output_unit, '(a)') 'equilibrium: body '//achar(48 + a)//' |G lam - e|/|e| = '// &
+          write (output_unit, '(a)') 'equilibrium: body '//body_label(a)//' |G lam - e|/|e| = '// &
             sci(norm2(matmul(g, result%lam_body(:, a)) - e)/norm2(e))//' (its own force), '// &
             sci(norm2(matmul(g, result%lam) - e)/norm2(e))//' (mean force); rigid motion '// &
             'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates (this run''s solves) '// &

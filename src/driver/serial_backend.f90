@@ -11,6 +11,7 @@ module serial_backend
   use mpi_env, only: par_finalize
   use run_state, only: run_t
   use run_backend, only: backend_t
+  use strings, only: body_label
   implicit none (type, external)
   private
 
@@ -47,7 +48,7 @@ contains
     end do
     !$omp end parallel do
     do a = 1, 2
-      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': factorization failed: '//trim(msg(a)))
+      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//body_label(a)//': factorization failed: '//trim(msg(a)))
     end do
   end subroutine factor
 
@@ -63,7 +64,7 @@ contains
     end do
     !$omp end parallel do
     do a = 1, 2
-      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//achar(48 + a)//': condensation failed: '//trim(msg(a)))
+      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//body_label(a)//': condensation failed: '//trim(msg(a)))
     end do
   end subroutine condense
 
