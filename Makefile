@@ -144,12 +144,12 @@ $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/body_system.o:    $(BUILD)/kinds.o
-$(BUILD)/supports.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
+$(BUILD)/supports.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o $(BUILD)/strings.o
 $(BUILD)/stiffness_pattern.o: $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
 $(BUILD)/rigid_modes.o:    $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
 $(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/body_system.o $(BUILD)/supports.o \
-                           $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o
+                           $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o
 $(BUILD)/ordering.o:       $(BUILD)/kinds.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o

@@ -132,13 +132,8 @@ contains
       end do
       !$omp end parallel do
       do a = 1, 2
-        if (info(a) == 0) cycle
-        ! a message that names its body already gets the deck only
-        if (index(msg(a), 'body '//body_label(a)//':') == 1) then
-          call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', '//trim(msg(a)))
-        else
-          call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', body '//body_label(a)//': '//trim(msg(a)))
-        end if
+        ! assembly's messages name their body
+        if (info(a) /= 0) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', '//trim(msg(a)))
       end do
     end associate
   end subroutine assemble_bodies

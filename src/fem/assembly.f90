@@ -14,6 +14,7 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp
+  use strings, only: body_label
   use sorting, only: sort_by_key
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
@@ -315,12 +316,14 @@ contains
         g = group_index(mesh, tractions(t)%group)
         if (g == 0) then
           info = 1
-          msg = trim(tractions(t)%origin)//': '//unknown_group(mesh, tractions(t)%group)
+          msg = 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
+                unknown_group(mesh, tractions(t)%group)
           return
         end if
         if (nodes_only(mesh, g)) then
           info = 1
-          msg = trim(tractions(t)%origin)//': '//nodes_only_refusal(mesh, g, 'a traction needs')
+          msg = 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
+                nodes_only_refusal(mesh, g, 'a traction needs')
           return
         end if
         call add_group_traction(mesh, g, tractions(t), sys%f_applied)

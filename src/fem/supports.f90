@@ -3,6 +3,7 @@
 !! the DOFs left free (body_system_t's ndof, u_fixed, n, free_of, dof_of).
 module supports
   use kinds, only: wp
+  use strings, only: body_label
   use config, only: body_cfg_t, boundary_cfg_t, SIDE_BOTTOM, SIDE_TOP, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, side_nodes, group_index, group_names, group_nodes
   use body_system, only: body_system_t
@@ -84,7 +85,8 @@ contains
       g = group_index(mesh, boundaries(i)%group)
       if (g == 0) then
         info = 1
-        msg = trim(boundaries(i)%origin)//': '//unknown_group(mesh, boundaries(i)%group)
+        msg = 'body '//body_label(body_id)//': '//trim(boundaries(i)%origin)//': '// &
+              unknown_group(mesh, boundaries(i)%group)
         return
       end if
       call group_nodes(mesh, g, nodes)
