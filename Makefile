@@ -65,14 +65,14 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
+MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar condense condense_mumps floating contact_types contact_common equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_floating
+TESTS_F := test_deck test_mprgp test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_floating test_digest
 BENCH_F := bench_mprgp bench_ordering
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -120,6 +120,7 @@ $(BUILD)/kinds.o:
 $(BUILD)/errors.o:
 $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
+$(BUILD)/digest.o:         $(BUILD)/errors.o
 $(BUILD)/int_hash.o:       $(BUILD)/kinds.o
 $(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
