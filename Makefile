@@ -195,7 +195,7 @@ $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5
 $(BUILD)/results.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
                            $(BUILD)/condense.o $(BUILD)/floating.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
                            $(BUILD)/history_io.o $(BUILD)/strings.o
-$(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
+$(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o
 # the driver's modules (src/driver): the run's data, its two back-ends, its phases
 $(BUILD)/run_state.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/deck.o $(BUILD)/mesh.o \

@@ -6,7 +6,7 @@ module run_phases
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use errors, only: fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED
+  use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
   use mesh, only: mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
@@ -18,7 +18,7 @@ module run_phases
   use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, free_list, fixing_list
   use results, only: write_results
-  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file
+  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file, mesh_identity
   use files, only: remove_file
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
@@ -161,15 +161,17 @@ contains
     end do
   end subroutine build_contact_line
 
-  !> The checkpoint to restart from is input too: read and checked before any file is touched.
+  !> The content hashes of the mesh files just read, which a checkpoint records; the
+  !! checkpoint to restart from is input too: read and checked before any file is touched.
   subroutine read_restart(run)
-    type(run_t), intent(inout) :: run   !< the run: its Robin state and result
-    logical :: ok
-    character(len=512) :: msg
+    type(run_t), intent(inout) :: run   !< the run: its mesh hashes, Robin state and result
+    type(error_t) :: err
+    call mesh_identity([run%deck%body(1)%mesh, run%deck%body(2)%mesh], run%mesh_ids, err)
+    call fail_on(err, 'deck '//trim(run%deck%source))
     if (len(run%restart_file) == 0) return
-    call checkpoint_read(run%restart_file, run%key, run%contact_line%m, run%deck%solver%max_outer, &
-                         run%robin_state, run%result, ok, msg)
-    if (.not. ok) call fatal(EXIT_INPUT, trim(msg))
+    call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%deck%solver%max_outer, &
+                         run%robin_state, run%result, err)
+    call fail_on(err)
   end subroutine read_restart
 
   !> The budget's estimate of body a's Cholesky factor, '123 MiB' or '1.2 GiB'.
@@ -217,10 +219,11 @@ contains
       else
         ckpt%file = checkpoint_file(deck%output%file)
         ckpt%key = run%key
+        ckpt%meshes = run%mesh_ids
         ckpt%every = deck%output%checkpoint_every
         call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
                          run%robin_state, ckpt, stop_requested)
-        if (ckpt%failed) call warn(ckpt%message)
+        if (ckpt%err%failed()) call warn(ckpt%err%text())
       end if
       if (result%status == STATUS_FAILED) return
       call error_bound(contact_line, bodies, result)
@@ -231,7 +234,7 @@ contains
           write (output_unit, '(a)') 'equilibrium: body '//body_label(a)//' |G lam - e|/|e| = '// &
             sci(norm2(matmul(g, result%lam_body(:, a)) - e)/norm2(e))//' (its own force), '// &
             sci(norm2(matmul(g, result%lam) - e)/norm2(e))//' (mean force); rigid motion '// &
-            'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates (this run''s solves) '// &
+            'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates '// &
             i2s(result%eq_updates)
         end associate
       end do

@@ -29,6 +29,7 @@ module run_state
     type(deck_t) :: sized                              !< the deck with mesh-file bodies sized by their node counts
     character(len=:), allocatable :: restart_file      !< checkpoint to restart from ('' none)
     character(len=:), allocatable :: key               !< the deck's physics, which a checkpoint must match
+    character(len=:), allocatable :: mesh_ids          !< content hashes of the mesh files, which a checkpoint must match
     integer :: threads = 1                             !< OpenMP threads over the two bodies
     type(mesh_t) :: meshes(2)                          !< the bodies' meshes
     type(body_system_t) :: systems(2)                  !< their DOF maps, stiffnesses and loads

@@ -1,7 +1,9 @@
 !> Checkpoint and restart of the outer Robin iteration: the whole outer state
 !! (obstacles, contact forces, acceleration history, counters) and the history so
 !! far, written atomically to `<result file>.ckpt.h5`. A restart resumes bitwise
-!! identically and refuses a checkpoint made from a different deck or mesh.
+!! identically and refuses a checkpoint made from a different deck, from a mesh file
+!! whose content has changed since (FNV-1a 64 hash of its bytes), or holding anything
+!! that is not what this deck implies (shapes, ranges, NaN or Inf).
 module checkpoint
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
@@ -9,7 +11,9 @@ module checkpoint
   use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, &
                   write_dset, write_attr, read_dset, read_attr, describe, exists, &
                   CLASS_INTEGER, CLASS_REAL, CLASS_STRING, CLASS_VSTRING
+  use errors, only: error_t, ERR_INPUT, ERR_IO
   use strings, only: i2s
+  use digest, only: file_digest
   use history_io, only: write_history, read_history
   use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
   use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, ANDERSON_DEPTH, recycle_size
@@ -20,18 +24,18 @@ module checkpoint
   !! that cannot be written whole leaves the previous one in place.
   type, extends(checkpointer_t), public :: h5_checkpointer_t
     character(len=:), allocatable :: file     !< where checkpoints go
-    character(len=:), allocatable :: key      !< fingerprint of the deck and mesh
-    logical :: failed = .false.               !< a checkpoint could not be written
-    character(len=:), allocatable :: message  !< why the first failed one failed, naming the file
+    character(len=:), allocatable :: key      !< fingerprint of the deck
+    character(len=:), allocatable :: meshes   !< content hashes of the mesh files (mesh_identity; '' none)
+    type(error_t) :: err                      !< why the first checkpoint that failed failed (ERR_IO), naming the file
   contains
     procedure :: save => checkpoint_write
   end type h5_checkpointer_t
 
-  public :: checkpoint_read, checkpoint_file
+  public :: checkpoint_read, checkpoint_file, mesh_identity
 
   integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
-  character(len=*), parameter :: INT_ATTRS(6) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
-                                                 'it_best', 'inner_maxit_hits']
+  character(len=*), parameter :: INT_ATTRS(7) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
+                                                 'it_best', 'inner_maxit_hits', 'equality_updates']
   character(len=*), parameter :: REAL_ATTRS(6) = [character(len=16) :: 'res_best', 'crit', 'progress', &
                                                   'best', 'omega', 'wall']
 
@@ -58,6 +62,26 @@ contains
     p = trim(result_file)//'.ckpt.h5'
   end function checkpoint_file
 
+  !> The identity of the mesh files a deck reads: one line `<hash>  <path>` per distinct
+  !! file (hash: FNV-1a 64 of its bytes, 16 hex digits), lines joined by a newline; ''
+  !! when the deck reads none. err (ERR_IO) when a file cannot be read whole.
+  subroutine mesh_identity(paths, text, err)
+    character(len=*), intent(in) :: paths(:)            !< each body's mesh file ('' none)
+    character(len=:), allocatable, intent(out) :: text  !< the identity
+    type(error_t), intent(out) :: err                   !< why a file could not be hashed
+    character(len=16) :: hex
+    integer :: a
+    text = ''
+    do a = 1, size(paths)
+      if (len_trim(paths(a)) == 0) cycle
+      if (any(paths(1:a - 1) == paths(a))) cycle
+      call file_digest(trim(paths(a)), hex, err)
+      if (err%failed()) return
+      if (len(text) > 0) text = text//achar(10)
+      text = text//hex//'  '//trim(paths(a))
+    end do
+  end subroutine mesh_identity
+
   !> Write the outer state and history to a temporary file and rename it over the
   !! previous checkpoint only when complete; on failure remove it and record why.
   subroutine checkpoint_write(self, st, res)
@@ -73,6 +97,9 @@ contains
     tmp = temp_name(self%file)
     call file_open(tmp, fid, hs, create=.true.)
     call write_dset(fid, 'key', self%key, hs)
+    if (allocated(self%meshes)) then
+      if (len(self%meshes) > 0) call write_dset(fid, 'mesh_files', self%meshes, hs)
+    end if
     call write_attr(fid, 'kind', 'robin_contact checkpoint', hs)
     call group_open(fid, 'state', gid, hs, create=.true.)
     call write_attr(gid, 'it', st%it, hs)
@@ -82,6 +109,7 @@ contains
     call write_attr(gid, 'it_best', st%it_best, hs)
     call write_attr(gid, 'res_best', st%res_best, hs)
     call write_attr(gid, 'inner_maxit_hits', res%inner_maxit_hits, hs)
+    call write_attr(gid, 'equality_updates', res%eq_updates, hs)
     call write_attr(gid, 'crit', st%crit, hs)
     call write_attr(gid, 'progress', st%progress, hs)
     call write_attr(gid, 'best', st%best, hs)
@@ -113,45 +141,44 @@ contains
     end if
     if (.not. ok) then
       call remove_file(tmp)
-      if (.not. self%failed) self%message = 'a checkpoint could not be written to '//self%file// &
-                                            ' ('//hs%what//'); the previous one, if any, is kept'
-      self%failed = .true.
+      if (.not. self%err%failed()) call self%err%set(ERR_IO, 'a checkpoint could not be written to '//self%file// &
+                                                     ' ('//hs%what//'); the previous one, if any, is kept')
     end if
   end subroutine checkpoint_write
 
-  !> Read a checkpoint. ok = .false. with msg if it cannot be read, was made from another
-  !! deck or mesh (its key differs from `key`), or does not hold what this deck implies.
-  !! Nothing in the file is trusted: before anything is read, every dataset and attribute
-  !! is checked for its type class and shape (m contact nodes, ANDERSON_DEPTH, a history
-  !! of at least `it` and at most max_outer entries), and after reading, the counters for
-  !! their ranges and the arrays for finite values; msg names the file and the object.
-  subroutine checkpoint_read(file, key, m, maxout, st, res, ok, msg)
+  !> Read a checkpoint. err (ERR_INPUT) if it cannot be read, was made from another deck
+  !! (its key differs from `key`) or from mesh files whose content has changed since
+  !! (`meshes`, from mesh_identity), or does not hold what this deck implies. Nothing in
+  !! the file is trusted: before anything is read, every dataset and attribute is checked
+  !! for its type class and shape (m contact nodes, ANDERSON_DEPTH, a history of at least
+  !! `it` and at most max_outer entries), and after reading, the counters for their ranges
+  !! and every real dataset and attribute for finite values; the message names the file
+  !! and the object.
+  subroutine checkpoint_read(file, key, meshes, m, maxout, st, res, err)
     character(len=*), intent(in) :: file          !< checkpoint path
     character(len=*), intent(in) :: key           !< fingerprint of this run
+    character(len=*), intent(in) :: meshes        !< this run's mesh_identity
     integer, intent(in) :: m                      !< interface size of this run
     integer, intent(in) :: maxout                 !< max_outer of this run (history size)
     type(robin_state_t), intent(out) :: st        !< the outer state
-    type(contact_result_t), intent(inout) :: res  !< receives the history
-    logical, intent(out) :: ok                    !< success
-    character(len=*), intent(out) :: msg          !< why not
+    type(contact_result_t), intent(inout) :: res  !< receives the history and the counters
+    type(error_t), intent(out) :: err             !< why it cannot be used
     type(ckpt_reader_t) :: r
     character(len=:), allocatable :: k
     logical :: exists_
 
-    ok = .false.
-    msg = ''
     r%msg = ''
     r%src = 'restart file '//trim(file)
     r%m = m
     r%maxout = maxout
     inquire (file=file, exist=exists_)
     if (.not. exists_) then
-      msg = r%src//' does not exist'
+      call err%set(ERR_INPUT, r%src//' does not exist')
       return
     end if
     call file_open(file, r%fid, r%hs)
     if (r%hs%failed) then
-      msg = r%src//' is not an HDF5 file'
+      call err%set(ERR_INPUT, r%src//' is not an HDF5 file')
       return
     end if
     if (.not. exists(r%fid, 'key', .false.)) then
@@ -168,14 +195,92 @@ contains
                 '(its bodies, loads, contact or solver settings differ from this run''s)'
       end if
     end if
+    if (len_trim(r%msg) == 0) call check_meshes(r, meshes)
     if (len_trim(r%msg) == 0) call check_layout(r)
     if (len_trim(r%msg) == 0) call read_state(r, st, res)
     call group_close(r%hid, r%hs)
     call group_close(r%gid, r%hs)
     call file_close(r%fid, r%hs)
-    msg = r%msg
-    ok = len_trim(msg) == 0
+    if (len_trim(r%msg) > 0) call err%set(ERR_INPUT, r%msg)
   end subroutine checkpoint_read
+
+  !> Each mesh file of this run (a line `<hash>  <path>` of `meshes`) must have the hash
+  !! the checkpoint's /mesh_files records for its path: the file has not changed since.
+  !! (Its path is in the key, compared before.)
+  subroutine check_meshes(r, meshes)
+    type(ckpt_reader_t), intent(inout) :: r
+    character(len=*), intent(in) :: meshes
+    character(len=:), allocatable :: stored, line, path, had
+    integer :: i0, i1
+    if (len(meshes) == 0) return
+    if (.not. exists(r%fid, 'mesh_files', .false.)) then
+      r%msg = r%src//' has no dataset /mesh_files (the content hashes of the mesh files it was made from), '// &
+              'so it cannot be checked against mesh file '//first_path(meshes)//'; start the run afresh'
+      return
+    end if
+    call need(r, r%fid, '/', 'mesh_files', .false., CLASS_STRING, SCALAR, 'a scalar string')
+    if (len_trim(r%msg) > 0) return
+    call read_dset(r%fid, 'mesh_files', stored, r%hs)
+    if (r%hs%failed) then
+      r%msg = r%src//': dataset /mesh_files cannot be read ('//r%hs%what//')'
+      return
+    end if
+    i0 = 1
+    do while (i0 <= len(meshes))
+      i1 = index(meshes(i0:), achar(10))
+      if (i1 == 0) then
+        i1 = len(meshes) + 1
+      else
+        i1 = i0 + i1 - 1
+      end if
+      line = meshes(i0:i1 - 1)
+      path = line(19:)
+      had = stored_hash(stored, path)
+      if (len(had) == 0) then
+        r%msg = r%src//': dataset /mesh_files has no content hash for mesh file '//path
+        return
+      else if (had /= line(1:16)) then
+        r%msg = 'mesh file '//path//' changed since the checkpoint was written (content hash '//line(1:16)// &
+                ', the checkpoint''s '//had//'): '//r%src//' belongs to the mesh it replaced; start the run afresh'
+        return
+      end if
+      i0 = i1 + 1
+    end do
+  end subroutine check_meshes
+
+  !> The hash that the /mesh_files text `stored` records for `path` ('' none).
+  function stored_hash(stored, path) result(h)
+    character(len=*), intent(in) :: stored, path
+    character(len=:), allocatable :: h
+    integer :: i0, i1
+    h = ''
+    i0 = 1
+    do while (i0 <= len(stored))
+      i1 = index(stored(i0:), achar(10))
+      if (i1 == 0) then
+        i1 = len(stored) + 1
+      else
+        i1 = i0 + i1 - 1
+      end if
+      if (i1 - i0 >= 18) then
+        if (stored(i0 + 18:i1 - 1) == path) then
+          h = stored(i0:i0 + 15)
+          return
+        end if
+      end if
+      i0 = i1 + 1
+    end do
+  end function stored_hash
+
+  !> The path of the first line of a mesh_identity text.
+  function first_path(meshes) result(p)
+    character(len=*), intent(in) :: meshes
+    character(len=:), allocatable :: p
+    integer :: i1
+    i1 = index(meshes, achar(10))
+    if (i1 == 0) i1 = len(meshes) + 1
+    p = meshes(19:i1 - 1)
+  end function first_path
 
   !> Every object the state is read from, checked for class and shape before reading.
   subroutine check_layout(r)
@@ -320,6 +425,7 @@ contains
     call read_attr(r%gid, 'inner', st%inner, r%hs)
     call read_attr(r%gid, 'nacc', st%nacc, r%hs)
     call read_attr(r%gid, 'inner_maxit_hits', res%inner_maxit_hits, r%hs)
+    call read_attr(r%gid, 'equality_updates', res%eq_updates, r%hs)
     call read_attr(r%gid, 'stalled', st%stalled, r%hs)
     call read_attr(r%gid, 'it_best', st%it_best, r%hs)
     call read_attr(r%gid, 'res_best', st%res_best, r%hs)
@@ -384,34 +490,41 @@ contains
     else if (n > r%nh) then
       r%msg = r%src//': attribute it of /state is '//i2s(n)//', beyond the '//i2s(r%nh)// &
             ' entries of /history/criterion'
-    else if (min(st%inner, st%nacc, st%stalled, res%inner_maxit_hits) < 0) then
-      r%msg = r%src//': a counter of /state (inner, nacc, stalled, inner_maxit_hits) is negative'
+    else if (min(st%inner, st%nacc, st%stalled, res%inner_maxit_hits, res%eq_updates) < 0) then
+      r%msg = r%src//': a counter of /state (inner, nacc, stalled, inner_maxit_hits, equality_updates) is negative'
     else if (st%it_best < 0 .or. st%it_best > n) then
       r%msg = r%src//': attribute it_best of /state is '//i2s(st%it_best)//', outside 0 .. it = '//i2s(n)
     else if (st%reuse /= 0 .and. st%reuse /= 1) then
       r%msg = r%src//': attribute reuse of /state is '//i2s(st%reuse)//', not 0 or 1'
-    else if (.not. all(ieee_is_finite(st%G))) then
-      r%msg = r%src//': dataset /state/G holds values that are not finite'
-    else if (.not. all(ieee_is_finite(st%lam))) then
-      r%msg = r%src//': dataset /state/lam holds values that are not finite'
     else if (any(st%lam < 0.0_wp)) then
       r%msg = r%src//': dataset /state/lam holds negative contact forces'
-    else if (.not. (all(ieee_is_finite(st%srch)) .and. all(ieee_is_finite(st%fsrch)))) then
-      r%msg = r%src//': dataset /state/srch or fsrch holds values that are not finite'
     else if (any(st%nrw(1, :) < 0 .or. st%nrw(1, :) > r%kr .or. st%nrw(2, :) < 1 .or. st%nrw(2, :) > max(1, r%kr))) then
       r%msg = r%src//': dataset /state/nrw holds counters outside 0 .. '//i2s(r%kr)//' (held) or 1 .. '// &
             i2s(max(1, r%kr))//' (next slot)'
-    else if (.not. (all(ieee_is_finite(st%rw)) .and. all(ieee_is_finite(st%raw)))) then
-      r%msg = r%src//': dataset /state/rw or raw holds values that are not finite'
     else if (st%nsrch /= 0 .and. st%nsrch /= 1) then
       r%msg = r%src//': attribute nsrch of /state is '//i2s(st%nsrch)//', not 0 or 1'
-    else if (.not. (all(ieee_is_finite(st%r_prev)) .and. all(ieee_is_finite(st%x_prev)) .and. &
-                    all(ieee_is_finite(st%dX)) .and. all(ieee_is_finite(st%dR)) .and. &
-                    all(ieee_is_finite(st%flam)) .and. all(ieee_is_finite(st%flam_v)))) then
-      r%msg = r%src//': a dataset of /state (flam, r_prev, x_prev, dX, dR, flam_v) holds values that are not finite'
-    else if (.not. all(ieee_is_finite([st%res_best, st%crit, st%progress, st%best, st%omega, st%wall]))) then
-      r%msg = r%src//': an attribute of /state (res_best, crit, progress, best, omega, wall) is not finite'
     end if
+    if (len_trim(r%msg) > 0) return
+    ! every real dataset and attribute of /state: NaN or Inf in any of them is refused by name
+    call need_finite(r, 'dataset /state/G', st%G)
+    call need_finite(r, 'dataset /state/lam', st%lam)
+    call need_finite(r, 'dataset /state/flam', st%flam)
+    call need_finite(r, 'dataset /state/r_prev', st%r_prev)
+    call need_finite(r, 'dataset /state/x_prev', st%x_prev)
+    call need_finite(r, 'dataset /state/dX', st%dX)
+    call need_finite(r, 'dataset /state/dR', st%dR)
+    call need_finite(r, 'dataset /state/flam_v', st%flam_v)
+    call need_finite(r, 'dataset /state/srch', st%srch)
+    call need_finite(r, 'dataset /state/fsrch', st%fsrch)
+    call need_finite(r, 'dataset /state/rw', st%rw)
+    call need_finite(r, 'dataset /state/raw', st%raw)
+    call need_finite(r, 'dataset /state/mu', st%mu)
+    call need_finite(r, 'attribute res_best of /state', [st%res_best])
+    call need_finite(r, 'attribute crit of /state', [st%crit])
+    call need_finite(r, 'attribute progress of /state', [st%progress])
+    call need_finite(r, 'attribute best of /state', [st%best])
+    call need_finite(r, 'attribute omega of /state', [st%omega])
+    call need_finite(r, 'attribute wall of /state', [st%wall])
     if (len_trim(r%msg) > 0) return
     ! history
     if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, &
@@ -427,11 +540,10 @@ contains
       r%msg = r%src//' has an incomplete history ('//r%hs%what//')'
       return
     end if
-    if (.not. (all(ieee_is_finite(res%h_criterion(1:n))) .and. all(ieee_is_finite(res%h_residual(1:n))) .and. &
-               all(ieee_is_finite(res%h_wall(1:n))))) then
-      r%msg = r%src//': a dataset of /history (criterion, residual, wall_s) holds values that are not finite'
-      return
-    end if
+    call need_finite(r, 'dataset /history/criterion', res%h_criterion(1:n))
+    call need_finite(r, 'dataset /history/residual', res%h_residual(1:n))
+    call need_finite(r, 'dataset /history/wall_s', res%h_wall(1:n))
+    if (len_trim(r%msg) > 0) return
     if (any(res%h_inner(1:n) < 0) .or. any(res%h_active(1:n) < 0) .or. any(res%h_active(1:n) > m)) then
       r%msg = r%src//': dataset /history/inner or /history/active holds counts out of range'
       return
@@ -440,6 +552,25 @@ contains
     res%outer = n
     res%inner = st%inner
   end subroutine read_state
+
+  !> r%msg naming the file and `obj` when `v` holds a NaN or an infinity.
+  subroutine need_finite(r, obj, v)
+    type(ckpt_reader_t), intent(inout) :: r
+    character(len=*), intent(in) :: obj   !< 'dataset /state/mu', for the message
+    real(wp), intent(in) :: v(..)
+    integer :: bad
+    if (len_trim(r%msg) > 0) return
+    select rank (v)
+    rank (1)
+      bad = count(.not. ieee_is_finite(v))
+    rank (2)
+      bad = count(.not. ieee_is_finite(v))
+    rank default
+      bad = 0
+    end select
+    if (bad == 1) r%msg = r%src//': '//obj//' holds a value that is not finite (NaN or Inf)'
+    if (bad > 1) r%msg = r%src//': '//obj//' holds '//i2s(bad)//' values that are not finite (NaN or Inf)'
+  end subroutine need_finite
 
   !> The name of a type class, for messages.
   function class_name(c) result(t)
