@@ -496,8 +496,6 @@ contains
       r%msg = r%src//': attribute it_best of /state is '//i2s(st%it_best)//', outside 0 .. it = '//i2s(n)
     else if (st%reuse /= 0 .and. st%reuse /= 1) then
       r%msg = r%src//': attribute reuse of /state is '//i2s(st%reuse)//', not 0 or 1'
-    else if (any(st%lam < 0.0_wp)) then
-      r%msg = r%src//': dataset /state/lam holds negative contact forces'
     else if (any(st%nrw(1, :) < 0 .or. st%nrw(1, :) > r%kr .or. st%nrw(2, :) < 1 .or. st%nrw(2, :) > max(1, r%kr))) then
       r%msg = r%src//': dataset /state/nrw holds counters outside 0 .. '//i2s(r%kr)//' (held) or 1 .. '// &
             i2s(max(1, r%kr))//' (next slot)'
@@ -526,6 +524,11 @@ contains
     call need_finite(r, 'attribute omega of /state', [st%omega])
     call need_finite(r, 'attribute wall of /state', [st%wall])
     if (len_trim(r%msg) > 0) return
+    ! after the finite check: comparing a NaN traps in the checked build
+    if (any(st%lam < 0.0_wp)) then
+      r%msg = r%src//': dataset /state/lam holds negative contact forces'
+      return
+    end if
     ! history
     if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, &
                                                 res%h_active)
