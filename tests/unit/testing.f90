@@ -1,10 +1,10 @@
 !> Helpers shared by the Fortran test programs: PASS/FAIL reporting with counters and
-!! the closing line; an independent direct solve of an assembled body (LAPACK band
-!! Cholesky in the natural order) so the FE tests do not depend on the Cholesky module
-!! that other tests check; the bodies of the ordering test and benchmark (a rectangle on
-!! its structured mesh, the same on a general, unstructured-looking mesh, the ordering of
-!! either); for the MPRGP tests and benchmark, the 1D obstacle problem, seeded random SPD
-!! matrices and one solve by a fresh solver.
+!! the closing line; writing a test's input file; an independent direct solve of an
+!! assembled body (LAPACK band Cholesky in the natural order) so the FE tests do not
+!! depend on the Cholesky module that other tests check; the bodies of the ordering test
+!! and benchmark (a rectangle on its structured mesh, the same on a general,
+!! unstructured-looking mesh, the ordering of either); for the MPRGP tests and benchmark,
+!! the 1D obstacle problem, seeded random SPD matrices and one solve by a fresh solver.
 module testing
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use kinds, only: wp
@@ -24,7 +24,7 @@ module testing
   integer, public, protected :: npass = 0   !< checks passed so far
   integer, public, protected :: nfail = 0   !< checks failed so far
 
-  public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem
+  public :: report, report_le, test_summary, write_file, band_solve, solve_full, obstacle_problem
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
 
@@ -64,6 +64,18 @@ contains
     write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
     if (nfail > 0) error stop 1
   end subroutine test_summary
+
+  !> Write `lines` to the file `path` (replacing it), one trimmed line each.
+  subroutine write_file(path, lines)
+    character(len=*), intent(in) :: path          !< file to write
+    character(len=*), intent(in) :: lines(:)      !< its lines
+    integer :: u, k
+    open (newunit=u, file=path, status='replace', action='write')
+    do k = 1, size(lines)
+      write (u, '(a)') trim(lines(k))
+    end do
+    close (u)
+  end subroutine write_file
 
   !> Solve K u = f on the free DOFs with LAPACK's banded Cholesky (natural order);
   !! stops the test program if the matrix is not positive definite.
