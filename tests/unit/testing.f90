@@ -179,6 +179,17 @@ contains
     b%bc = bcs
   end function rectangle_body
 
+  !> The load of the ordering bodies: on b's top side the traction t0 + t1 x, (1, -3) MPa
+  !! at x = 0 and (0, -1) MPa more per metre.
+  function top_traction(b) result(tr)
+    type(body_cfg_t), intent(in) :: b   !< the body
+    type(traction_cfg_t) :: tr
+    tr%body = b%id
+    tr%side = SIDE_TOP
+    tr%t0 = [1.0e6_wp, -3.0e6_wp]
+    tr%t1 = [0.0_wp, -1.0e6_wp]
+  end function top_traction
+
   !> The structured mesh of `b` and its system, its top loaded by a linear traction (that
   !! of general_body); `last` = the free normal (y) DOFs of the bottom side. Stops the test
   !! program on failure.
@@ -190,10 +201,7 @@ contains
     type(traction_cfg_t) :: tr(1)
     integer :: info
     character(len=256) :: msg
-    tr(1)%body = b%id
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
-    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
+    tr(1) = top_traction(b)
     call mesh_build(msh, b, info, msg)
     if (info /= 0) error stop 'structured_body: mesh_build failed'
     call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
@@ -260,10 +268,7 @@ contains
     real(wp) :: hx, hy
     character(len=256) :: msg
 
-    tr(1)%body = b%id
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
-    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
+    tr(1) = top_traction(b)
     call mesh_build(grid, b, info, msg)
     if (info /= 0) error stop 'general_body: mesh_build failed'
     nn = grid%nnode
