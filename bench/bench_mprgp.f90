@@ -20,32 +20,35 @@ program bench_mprgp
   use testing, only: obstacle_problem
   implicit none (type, external)
 
-  integer :: ns(3) = [100, 1000, 5000], ms(3) = [500, 1000, 2000]
-  real(wp) :: rtols(2) = [1.0e-4_wp, 1.0e-8_wp]
-  integer :: i, j
-
   write (*, '(a)') 'MPRGP benchmark (Gamma = 1, alpha_bar = 1.9/lambda_max from 20 power iterations)'
-  write (*, '(a)') '1D obstacle: -u'''' = -15, u >= -1, A = tridiag(-1,2,-1)*(n+1)^2 (CSC), x0 = 0'
-  call header()
-  do j = 1, size(rtols)
-    do i = 1, size(ns)
-      call run_obstacle(ns(i), rtols(j))
-    end do
-  end do
+  call table('1D obstacle: -u'''' = -15, u >= -1, A = tridiag(-1,2,-1)*(n+1)^2 (CSC), x0 = 0', &
+             [100, 1000, 5000], .false.)
   write (*, '(a)') ''
-  write (*, '(a)') 'dense Green''s function (inverse FD Laplacian), b = sin(3 pi x), l = 0, dsymv, x0 = 0'
-  call header()
-  do j = 1, size(rtols)
-    do i = 1, size(ms)
-      call run_dense(ms(i), rtols(j))
-    end do
-  end do
+  call table('dense Green''s function (inverse FD Laplacian), b = sin(3 pi x), l = 0, dsymv, x0 = 0', &
+             [500, 1000, 2000], .true.)
 
 contains
 
-  subroutine header()
+  !> One table: its title, the header, a row for each rtol and size, of the dense problem
+  !! or of the obstacle problem.
+  subroutine table(title, sizes, dense)
+    character(len=*), intent(in) :: title
+    integer, intent(in) :: sizes(:)
+    logical, intent(in) :: dense
+    real(wp), parameter :: rtols(2) = [1.0e-4_wp, 1.0e-8_wp]
+    integer :: i, j
+    write (*, '(a)') title
     write (*, '(a)') '     n      rtol   A-products      cg     exp    prop    time/solve [s]   |gP|/|b|   status'
-  end subroutine header
+    do j = 1, size(rtols)
+      do i = 1, size(sizes)
+        if (dense) then
+          call run_dense(sizes(i), rtols(j))
+        else
+          call run_obstacle(sizes(i), rtols(j))
+        end if
+      end do
+    end do
+  end subroutine table
 
   subroutine run_obstacle(n, rtol)
     integer, intent(in) :: n

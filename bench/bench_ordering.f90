@@ -21,9 +21,9 @@ program bench_ordering
   use mesh, only: mesh_t
   use assembly, only: body_system_t
   use ordering, only: ND_OK
-  use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
+  use cholesky, only: chol_t
   use clock, only: wtime
-  use testing, only: rectangle_body, structured_body, general_body, order_body
+  use testing, only: rectangle_body, structured_body, general_body, order_body, factor_ordered
   use omp_lib, only: omp_set_max_active_levels
   implicit none (type, external)
 
@@ -89,12 +89,7 @@ contains
 
     m = size(last)
     t_order = 0.0_wp
-    select case (o)
-    case (1)
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
-    case (2)
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
-    case default
+    if (o == 3) then
       t0 = wtime()
       call order_body(msh, sys, last, perm, info, msg)
       t_order = wtime() - t0
@@ -102,9 +97,10 @@ contains
         write (output_unit, '(a)') 'nested dissection failed: '//trim(msg)
         return
       end if
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
-                     interior_perm=perm)
-    end select
+    else
+      allocate (perm(0))
+    end if
+    call factor_ordered(ch, sys, o, last, perm, info, msg)
     if (info /= 0) then
       write (output_unit, '(a)') 'factor failed: '//trim(msg)
       return

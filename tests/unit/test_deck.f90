@@ -8,7 +8,7 @@ program test_deck
   use config
   use deck, only: read_deck, print_deck, deck_text
   use namelist_vars, only: vars_t, str_t, reference_table
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, write_file
   implicit none (type, external)
   type(deck_t) :: d, e
   character(len=512) :: tmp
@@ -234,17 +234,6 @@ contains
         .or. a%output%progress_lines /= b%output%progress_lines) diff = diff//' output'
     if (len(diff) > 0) diff = ' (differ:'//diff//')'
   end subroutine compare
-
-  subroutine write_file(path, lines)
-    character(len=*), intent(in) :: path
-    character(len=*), intent(in) :: lines(:)
-    integer :: u, i
-    open (newunit=u, file=path, status='replace', action='write')
-    do i = 1, size(lines)
-      write (u, '(a)') trim(lines(i))
-    end do
-    close (u)
-  end subroutine write_file
 
   subroutine delete_file(path)
     character(len=*), intent(in) :: path

@@ -116,6 +116,23 @@ contains
     if (present(poisson)) body%poisson = poisson
   end function rect_body
 
+  !> The body of the assembly tests and its mesh: id 1, (-0.4, 0.3) + 2.5 x 1.2 on nx x ny
+  !! cells of `element`, E = 70, nu = 0.33; left clamped, right moved by (0.01, -0.02),
+  !! bottom on rollers, top free and loaded by t0 = (0.3, -1).
+  subroutine loaded_rect(element, nx, ny, body, tr, m)
+    integer, intent(in) :: element, nx, ny
+    type(body_cfg_t), intent(out) :: body
+    type(traction_cfg_t), intent(out) :: tr
+    type(mesh_t), intent(out) :: m
+    body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, nx, ny, element, young=70.0_wp, poisson=0.33_wp)
+    body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
+    body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
+    tr%body = 1
+    tr%side = SIDE_TOP
+    tr%t0 = [0.3_wp, -1.0_wp]
+    call mesh_build(m, body)
+  end subroutine loaded_rect
+
   !> Deterministic pseudo-random number in [-0.5, 0.5) for integer pair (i, j).
   pure real(wp) function hash01(i, j)
     integer, intent(in) :: i, j
@@ -161,13 +178,7 @@ contains
     character(len=32) :: what
 
     write (what, '(a,a,i0,a)') trim(element_names(element)), ' ', nparts, ' shares:'
-    body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, 7, 4, element, young=70.0_wp, poisson=0.33_wp)
-    body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
-    body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
-    tr(1)%body = 1
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [0.3_wp, -1.0_wp]
-    call mesh_build(m, body)
+    call loaded_rect(element, 7, 4, body, tr(1), m)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
     call assemble_body(m, body, .true., tr, 1, sys0, info, msg, matrix=.false.)
     call report(info == 0 .and. .not. allocated(sys0%val) .and. sys0%n == sys%n .and. &
@@ -209,14 +220,8 @@ contains
     real(wp), allocatable :: uf(:), r(:), u(:)
 
     en = element_names(element)
-    body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, 5, 3, element, young=70.0_wp, poisson=0.33_wp)
-    body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
-    body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
-    tr(1)%body = 1
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [0.3_wp, -1.0_wp]
+    call loaded_rect(element, 5, 3, body, tr(1), m)
     tr(1)%t1 = [0.0_wp, 0.5_wp]
-    call mesh_build(m, body)
     call assemble_body(m, body, .true., tr, 1, sys, info, msg)
     call report(info == 0, trim(en)//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
 

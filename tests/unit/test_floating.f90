@@ -22,13 +22,13 @@ program test_floating
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use floating, only: nnls
   use lapack, only: dgesv, dsyev
-  use testing, only: report, report_le, test_summary
+  use testing, only: report, report_le, test_summary, set_seed
   implicit none (type, external)
 
   integer, parameter :: TY = 1, TX = 2, ROT = 3   ! kinds of expected rigid motions
   integer :: i
 
-  call seed(12345)
+  call set_seed(12345)
 
   ! (a), (b) kernels of structured rectangles (0,2)x(0,1) and the force-controlled Hertz disc
   call kernel_case('no support', ELEM_Q1, [BC_FREE, BC_FREE, BC_FREE, BC_FREE], '', [.false., .false.], &
@@ -70,16 +70,6 @@ program test_floating
 contains
 
   ! ---------------------------------------------------------------------------------------
-  subroutine seed(s)
-    integer, intent(in) :: s
-    integer :: n, k
-    integer, allocatable :: put(:)
-    call random_seed(size=n)
-    allocate (put(n))
-    put = [(s + 7919*k, k=1, n)]
-    call random_seed(put=put)
-  end subroutine seed
-
   !> Uniform random numbers in [a, b).
   subroutine uniform(x, a, b)
     real(wp), intent(out) :: x(..)

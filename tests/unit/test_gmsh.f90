@@ -13,7 +13,7 @@ program test_gmsh
   use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal
   use gmsh_msh, only: msh_read
   use strings, only: i2s, word
-  use testing, only: report, report_le, test_summary
+  use testing, only: report, report_le, test_summary, write_file
   implicit none (type, external)
 
   real(wp), parameter :: pi = acos(-1.0_wp), eps = epsilon(1.0_wp)
@@ -145,17 +145,6 @@ contains
     allocate (x(0))
     if (g > 0) x = [m%xy(1, m%group(g)%edge(1, :)), m%xy(1, m%group(g)%edge(2, :))]
   end function group_x
-
-  subroutine write_file(path, lines)
-    character(len=*), intent(in) :: path
-    character(len=*), intent(in) :: lines(:)
-    integer :: u, k
-    open (newunit=u, file=path, status='replace', action='write')
-    do k = 1, size(lines)
-      write (u, '(a)') trim(lines(k))
-    end do
-    close (u)
-  end subroutine write_file
 
   !> Write `lines` to a temporary file, read it, and check info and that msg holds every
   !! key word (the file name is always one).

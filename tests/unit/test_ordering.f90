@@ -18,6 +18,7 @@ program test_ordering
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT
   use mesh, only: mesh_t, mesh_build, node_id
   use assembly, only: body_system_t, assemble_body, csc_matvec
+  use supports, only: number_free_dofs
   use ordering, only: grid_dissection, coordinate_bisection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
@@ -70,40 +71,28 @@ program test_ordering
 
 contains
 
-  !> The ND permutation is exactly the free DOFs not in `last`, node DOFs adjacent,
-  !! and the top-level separator line comes last.
-  subroutine check_perm(name, nx, ny, elem, bcs, last_side, last_comp)
-    character(len=*), intent(in) :: name
-    integer, intent(in) :: nx, ny, elem, bcs(4), last_side, last_comp
-    type(mesh_t) :: msh
-    type(body_system_t) :: sys
-    integer, allocatable :: last(:), perm(:), cnt(:)
-    logical, allocatable :: is_last(:)
-    integer :: info, k, f, g, node, nsep, mid, i, j
-    logical :: ok
-    character(len=256) :: msg
-
-    call structured_body(rectangle_body(nx, ny, elem, bcs), msh, sys, last)
-    last = side_free_dofs(msh, sys, last_side, last_comp)
-    call order_body(msh, sys, last, perm, info, msg)
-    call report(info == ND_OK, name//': nested dissection info = 0 '//trim(msg))
-    if (info /= ND_OK) return
-    call report(size(perm) == sys%n - size(last), name//': size = n - size(last)')
-    allocate (cnt(sys%n), is_last(sys%n))
-    cnt = 0
-    is_last = .false.
-    is_last(last) = .true.
-    ok = all(perm >= 1 .and. perm <= sys%n)
-    if (ok) then
-      do k = 1, size(perm)
-        cnt(perm(k)) = cnt(perm(k)) + 1
-      end do
-      ok = all(merge(cnt == 0, cnt == 1, is_last))
-    end if
-    call report(ok, name//': a permutation of exactly the free non-interface DOFs')
+  !> Whether perm holds each free DOF 1..n not marked in is_last exactly once, and nothing else.
+  logical function covers_rest(perm, is_last) result(ok)
+    integer, intent(in) :: perm(:)        !< an interior order
+    logical, intent(in) :: is_last(:)     !< (n) the DOFs ordered last by the caller
+    integer, allocatable :: cnt(:)
+    integer :: k
+    ok = all(perm >= 1 .and. perm <= size(is_last))
     if (.not. ok) return
+    allocate (cnt(size(is_last)))
+    cnt = 0
+    do k = 1, size(perm)
+      cnt(perm(k)) = cnt(perm(k)) + 1
+    end do
+    ok = all(merge(cnt == 0, cnt == 1, is_last))
+  end function covers_rest
 
-    ! both DOFs of a node consecutive (x then y) when both are in the permutation
+  !> Whether both DOFs of a node are consecutive in perm, x then y, wherever both are in it.
+  logical function node_dofs_adjacent(sys, perm, is_last) result(ok)
+    type(body_system_t), intent(in) :: sys    !< the body's numbering
+    integer, intent(in) :: perm(:)            !< an interior order (covers_rest)
+    logical, intent(in) :: is_last(:)         !< the DOFs ordered last by the caller
+    integer :: k, f, g
     ok = .true.
     do k = 1, size(perm)
       g = sys%dof_of(perm(k))
@@ -131,7 +120,34 @@ contains
         end if
       end if
     end do
-    call report(ok, name//': the two DOFs of a node are adjacent, x first')
+  end function node_dofs_adjacent
+
+  !> The ND permutation is exactly the free DOFs not in `last`, node DOFs adjacent,
+  !! and the top-level separator line comes last.
+  subroutine check_perm(name, nx, ny, elem, bcs, last_side, last_comp)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: nx, ny, elem, bcs(4), last_side, last_comp
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    integer, allocatable :: last(:), perm(:)
+    logical, allocatable :: is_last(:)
+    integer :: info, k, node, nsep, mid, i, j
+    logical :: ok
+    character(len=256) :: msg
+
+    call structured_body(rectangle_body(nx, ny, elem, bcs), msh, sys, last)
+    last = side_free_dofs(msh, sys, last_side, last_comp)
+    call order_body(msh, sys, last, perm, info, msg)
+    call report(info == ND_OK, name//': nested dissection info = 0 '//trim(msg))
+    if (info /= ND_OK) return
+    call report(size(perm) == sys%n - size(last), name//': size = n - size(last)')
+    allocate (is_last(sys%n))
+    is_last = .false.
+    is_last(last) = .true.
+    ok = covers_rest(perm, is_last)
+    call report(ok, name//': a permutation of exactly the free non-interface DOFs')
+    if (.not. ok) return
+    call report(node_dofs_adjacent(sys, perm, is_last), name//': the two DOFs of a node are adjacent, x first')
 
     ! the top-level separator: the middle grid line across the longer side, last
     if ((nx + 1)*(ny + 1) >= ND_LEAF_NODES) then
@@ -327,11 +343,11 @@ contains
     type(mesh_t) :: msh
     type(body_system_t) :: sys
     type(chol_t) :: ch
-    integer, allocatable :: last(:), perm(:), cnt(:)
+    integer, allocatable :: last(:), perm(:)
     logical, allocatable :: is_last(:)
     real(wp), allocatable :: u(:, :), r(:), sgn(:), flex(:, :, :)
     real(wp) :: res, d, nnz(3), t0, t_nd
-    integer :: o, info, m, k, f, g
+    integer :: o, info, m
     logical :: ok, used
     character(len=256) :: msg
     character(len=64) :: tag
@@ -344,30 +360,14 @@ contains
     t_nd = wtime() - t0
     call report(info == ND_OK, name//': nested dissection info = 0 '//trim(msg))
     if (info /= ND_OK) return
-    allocate (cnt(sys%n), is_last(sys%n))
-    cnt = 0
+    allocate (is_last(sys%n))
     is_last = .false.
     is_last(last) = .true.
-    ok = size(perm) == sys%n - m .and. all(perm >= 1 .and. perm <= sys%n)
-    if (ok) then
-      do k = 1, size(perm)
-        cnt(perm(k)) = cnt(perm(k)) + 1
-      end do
-      ok = all(merge(cnt == 0, cnt == 1, is_last))
-    end if
+    ok = size(perm) == sys%n - m
+    if (ok) ok = covers_rest(perm, is_last)
     call report(ok, name//': a permutation of exactly the free non-interface DOFs')
     if (.not. ok) return
-    ok = .true.
-    do k = 1, size(perm)
-      g = sys%dof_of(perm(k))
-      if (mod(g, 2) == 0) cycle
-      f = sys%free_of(g + 1)               ! the node's y DOF follows its x DOF
-      if (f > 0) then
-        if (.not. is_last(f)) ok = ok .and. k < size(perm)
-        if (.not. is_last(f) .and. k < size(perm)) ok = ok .and. perm(k + 1) == f
-      end if
-    end do
-    call report(ok, name//': the two DOFs of a node are adjacent, x first')
+    call report(node_dofs_adjacent(sys, perm, is_last), name//': the two DOFs of a node are adjacent, x first')
 
     allocate (u(sys%n, 3), r(sys%n), sgn(m), flex(m, m, 3))
     sgn = -1.0_wp
@@ -440,18 +440,9 @@ contains
     msh%ny = 512
     msh%nnode = (msh%nx + 1)*(msh%ny + 1)
     sys%ndof = 2*msh%nnode
-    allocate (sys%free_of(sys%ndof))
     ! left side clamped: the nodes with i = 0 have no free DOFs
-    n = 0
-    do k = 1, sys%ndof
-      if (mod((k - 1)/2, msh%nx + 1) == 0) then
-        sys%free_of(k) = 0
-      else
-        n = n + 1
-        sys%free_of(k) = n
-      end if
-    end do
-    sys%n = n
+    call number_free_dofs([(mod((k - 1)/2, msh%nx + 1) == 0, k=1, sys%ndof)], sys)
+    n = sys%n
     last = [(sys%free_of(2*(node_id(msh, k, 0) - 1) + 2), k=1, msh%nx)]
     t0 = wtime()
     call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, last, perm, info, msg)

@@ -1,9 +1,10 @@
 !> Helpers shared by the Fortran test programs: PASS/FAIL reporting with counters and
-!! the closing line, the 1D obstacle problem of the MPRGP test and benchmark, and an independent direct solve of an assembled body
-!! (LAPACK band Cholesky in the natural order) so the FE tests do not depend on the
-!! Cholesky module that other tests check, and the bodies of the ordering test and
-!! benchmark: a rectangle on its structured mesh, the same on a general
-!! (unstructured-looking) mesh, and the ordering of either.
+!! the closing line; writing a test's input file; an independent direct solve of an
+!! assembled body (LAPACK band Cholesky in the natural order) so the FE tests do not
+!! depend on the Cholesky module that other tests check; the bodies of the ordering test
+!! and benchmark (a rectangle on its structured mesh, the same on a general,
+!! unstructured-looking mesh, the ordering of either); for the MPRGP tests and benchmark,
+!! the 1D obstacle problem, seeded random SPD matrices and one solve by a fresh solver.
 module testing
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use kinds, only: wp
@@ -12,7 +13,8 @@ module testing
   use mesh, only: mesh_t, mesh_build, side_nodes
   use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness
   use assembly, only: body_system_t, expand, assemble_body, lame_parameters
-  use linop, only: csc_op_t, csc_op_init
+  use linop, only: linop_t, csc_op_t, csc_op_init
+  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_BAD_ARG
   use lapack, only: dpbsv
   use ordering, only: grid_dissection, coordinate_bisection
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
@@ -22,8 +24,9 @@ module testing
   integer, public, protected :: npass = 0   !< checks passed so far
   integer, public, protected :: nfail = 0   !< checks failed so far
 
-  public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem
+  public :: report, report_le, test_summary, write_file, band_solve, solve_full, obstacle_problem
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
+  public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
 
 contains
 
@@ -61,6 +64,18 @@ contains
     write (output_unit, '(i0,a,i0,a)') npass, ' checks passed, ', nfail, ' failed'
     if (nfail > 0) error stop 1
   end subroutine test_summary
+
+  !> Write `lines` to the file `path` (replacing it), one trimmed line each.
+  subroutine write_file(path, lines)
+    character(len=*), intent(in) :: path          !< file to write
+    character(len=*), intent(in) :: lines(:)      !< its lines
+    integer :: u, k
+    open (newunit=u, file=path, status='replace', action='write')
+    do k = 1, size(lines)
+      write (u, '(a)') trim(lines(k))
+    end do
+    close (u)
+  end subroutine write_file
 
   !> Solve K u = f on the free DOFs with LAPACK's banded Cholesky (natural order);
   !! stops the test program if the matrix is not positive definite.
@@ -164,6 +179,17 @@ contains
     b%bc = bcs
   end function rectangle_body
 
+  !> The load of the ordering bodies: on b's top side the traction t0 + t1 x, (1, -3) MPa
+  !! at x = 0 and (0, -1) MPa more per metre.
+  function top_traction(b) result(tr)
+    type(body_cfg_t), intent(in) :: b   !< the body
+    type(traction_cfg_t) :: tr
+    tr%body = b%id
+    tr%side = SIDE_TOP
+    tr%t0 = [1.0e6_wp, -3.0e6_wp]
+    tr%t1 = [0.0_wp, -1.0e6_wp]
+  end function top_traction
+
   !> The structured mesh of `b` and its system, its top loaded by a linear traction (that
   !! of general_body); `last` = the free normal (y) DOFs of the bottom side. Stops the test
   !! program on failure.
@@ -175,10 +201,7 @@ contains
     type(traction_cfg_t) :: tr(1)
     integer :: info
     character(len=256) :: msg
-    tr(1)%body = b%id
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
-    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
+    tr(1) = top_traction(b)
     call mesh_build(msh, b, info, msg)
     if (info /= 0) error stop 'structured_body: mesh_build failed'
     call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
@@ -245,10 +268,7 @@ contains
     real(wp) :: hx, hy
     character(len=256) :: msg
 
-    tr(1)%body = b%id
-    tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
-    tr(1)%t1 = [0.0_wp, -1.0e6_wp]
+    tr(1) = top_traction(b)
     call mesh_build(grid, b, info, msg)
     if (info /= 0) error stop 'general_body: mesh_build failed'
     nn = grid%nnode
@@ -362,5 +382,99 @@ contains
                      interior_perm=perm)
     end select
   end subroutine factor_ordered
+
+  ! ---- random dense QPs and one MPRGP solve (the MPRGP tests)
+
+  !> Seed the intrinsic generator with s, s + 7919, s + 2*7919, ... so that a test's random
+  !! problems are the same on every run.
+  subroutine set_seed(s)
+    integer, intent(in) :: s    !< the seed
+    integer :: n, k
+    integer, allocatable :: put(:)
+    call random_seed(size=n)
+    allocate (put(n))
+    put = [(s + 7919*k, k=1, n)]
+    call random_seed(put=put)
+  end subroutine set_seed
+
+  !> A uniform random number in [lo, hi).
+  real(wp) function urand(lo, hi)
+    real(wp), intent(in) :: lo, hi  !< the interval
+    real(wp) :: r
+    call random_number(r)
+    urand = lo + (hi - lo) * r
+  end function urand
+
+  !> Random SPD matrix Q diag(d) Q' with log-uniform eigenvalues in [1, 10**cexp]
+  !! (the extremes 1 and 10**cexp included when n >= 2).
+  subroutine random_spd(n, cexp, a, lmin, lmax)
+    integer, intent(in) :: n                          !< order
+    real(wp), intent(in) :: cexp                      !< log10 of the condition number
+    real(wp), intent(out) :: a(n, n), lmin, lmax      !< the matrix, its extreme eigenvalues
+    real(wp) :: d(n)
+    integer :: i
+    do i = 1, n
+      d(i) = 10.0_wp**(cexp * urand(0.0_wp, 1.0_wp))
+    end do
+    if (n >= 2) then
+      d(1) = 1.0_wp
+      d(2) = 10.0_wp**cexp
+    end if
+    call spd_from_eigs(n, d, a)
+    lmin = minval(d)
+    lmax = maxval(d)
+  end subroutine random_spd
+
+  !> Symmetric matrix Q diag(d) Q' with given eigenvalues d; Q is a product of three
+  !! random Householder reflectors.
+  subroutine spd_from_eigs(n, d, a)
+    integer, intent(in) :: n            !< order
+    real(wp), intent(in) :: d(n)        !< eigenvalues
+    real(wp), intent(out) :: a(n, n)    !< the matrix
+    real(wp) :: q(n, n), v(n), qv(n), vv
+    integer :: i, j, k
+    q = 0.0_wp
+    do i = 1, n
+      q(i, i) = 1.0_wp
+    end do
+    do k = 1, 3
+      do i = 1, n
+        v(i) = urand(-1.0_wp, 1.0_wp)
+      end do
+      ! q := q (I - 2 v v'/v'v)
+      qv = matmul(q, v)
+      vv = dot_product(v, v)
+      do j = 1, n
+        q(:, j) = q(:, j) - (2.0_wp * v(j) / vv) * qv
+      end do
+    end do
+    do i = 1, n
+      a(:, i) = matmul(q, d * q(i, :))
+    end do
+    a = 0.5_wp * (a + transpose(a))
+  end subroutine spd_from_eigs
+
+  !> One solve by a fresh solver with the options opts: x in/out, st its outcome; g = A x - b
+  !! and ax = A x at the returned x when asked for (ax in: A x at the warm start, with
+  !! opts%use_ax); the ring of stored directions rw, raw, nrw when given.
+  subroutine solve_once(op, b, l, x, opts, st, g, ax, rw, raw, nrw)
+    class(linop_t), intent(inout) :: op                 !< the matrix A
+    real(wp), intent(in) :: b(:), l(:)                  !< right-hand side, lower bounds
+    real(wp), intent(inout) :: x(:)                     !< start in, solution out
+    type(mprgp_opts_t), intent(in) :: opts              !< solver options
+    type(mprgp_stats_t), intent(out) :: st              !< the solve's outcome
+    real(wp), intent(out), optional :: g(:)             !< gradient at the returned x
+    real(wp), intent(inout), optional :: ax(:)          !< A x at the start in, at the end out
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions, their images
+    integer, intent(inout), optional :: nrw(2)          !< ring count and position
+    type(mprgp_t) :: solver
+    solver%opts = opts
+    if (present(ax)) solver%ax = ax
+    call solver%solve(op, b, l, x, rw, raw, nrw)
+    st = solver%stats
+    if (st%status == MPRGP_BAD_ARG) return
+    if (present(g)) g = solver%g
+    if (present(ax)) ax = solver%ax
+  end subroutine solve_once
 
 end module testing
