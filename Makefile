@@ -213,7 +213,7 @@ $(BUILD)/mpi_backend.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o 
                            $(BUILD)/run_state.o $(BUILD)/run_backend.o
 $(BUILD)/run_summary.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/condense.o \
                            $(BUILD)/contact_types.o $(BUILD)/sysinfo.o $(BUILD)/strings.o $(BUILD)/run_state.o
-$(BUILD)/run_phases.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/gmsh_msh.o \
+$(BUILD)/run_phases.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_common.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/gmsh_msh.o \
                            $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
                            $(BUILD)/robin_iteration.o $(BUILD)/monolithic.o $(BUILD)/error_estimate.o \
                            $(BUILD)/floating.o $(BUILD)/results.o $(BUILD)/checkpoint.o $(BUILD)/files.o \

@@ -453,6 +453,8 @@ contains
   !! 1e-10 max diag stop it); when it is rank deficient, `prox` is a hundredth of its
   !! largest diagonal entry and `kern` an orthonormal basis of the kernel:
   !! the eigenvectors of the m - rank smallest eigenvalues (LAPACK dsyev, once, O(m^3)).
+  !! F_a = 0 (all its contact DOFs prescribed): rank 0, no `kern` (the proximal term is then
+  !! the other body's F).
   subroutine flex_rank(bc)
     type(body_condensed_t), intent(inout) :: bc
     real(wp), allocatable :: f(:, :), work(:), ev(:)
@@ -464,6 +466,14 @@ contains
     do i = 1, bc%m
       dmax = max(dmax, bc%flex(i, i))
     end do
+    if (.not. dmax > 0.0_wp) then
+      ! every contact DOF of the body is prescribed (a foundation drawn as a body): F_a = 0,
+      ! its kernel is everything, and the proximal term alone (the other body's F) carries
+      ! its subproblem: the other body then solves the obstacle problem against it
+      bc%rank = 0
+      bc%prox = 1.0_wp
+      return
+    end if
     allocate (f(bc%m, bc%m), work(2*bc%m), piv(bc%m))
     f = bc%flex
     call dpstrf('L', bc%m, f, bc%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)

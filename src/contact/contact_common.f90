@@ -54,7 +54,8 @@ contains
     do i = 1, 2
       if (bodies(i)%nrig == 0) cycle
       res%equilibrium = max(res%equilibrium, norm2(matmul(bodies(i)%rg, res%lam_body(:, i)) - bodies(i)%re)/ &
-                            max(norm2(bodies(i)%re), tiny(1.0_wp)))
+                            max(norm2(bodies(i)%re), merge(norm2(bodies(i)%rg)*norm2(res%lam_body(:, i)), 0.0_wp, &
+                                all(bodies(i)%re == 0.0_wp)), tiny(1.0_wp)))
     end do
     res%residual = max(res%imbalance, res%penetration, res%complementarity, res%equilibrium)
     res%active = count(res%lam > 0.0_wp)

@@ -21,6 +21,7 @@ module equality_rows
     real(wp) :: gg = 0.0_wp                   !< lambda_max(G G') [-]
     real(wp) :: m0 = 0.0_wp                   !< SMALBE's initial M [length/force]
     real(wp) :: feas = 0.0_wp                 !< |G lam - e| that counts as equilibrium [force]
+    real(wp) :: feas_x = 0.0_wp               !< e = 0: per unit of |lam| instead (FEAS_RTOL |G|) [-]
   end type equality_t
 
   public :: equality_init, equality_add_penalty, gram_eigenvalues, stacked_rows
@@ -31,7 +32,9 @@ contains
   !! lmax: the penalty rho = RHO_FACTOR lmax / lambda_max(G G') (A = H + rho G'G stays within
   !! (1 + RHO_FACTOR) lmax, and a multiplier update reduces |G lam - e| by about
   !! 1 / (1 + RHO_FACTOR)), SMALBE's initial M = lmax / sqrt(lambda_max(G G')) (a gradient per
-  !! unit of force imbalance), and the equilibrium tolerance FEAS_RTOL |e|.
+  !! unit of force imbalance), and the equilibrium tolerance FEAS_RTOL |e|, or FEAS_RTOL |G| |lam|
+  !! when e = 0 (nothing loads the body along its free motions, a deformation presses it
+  !! into the contact: the contact forces' size is the scale then).
   subroutine equality_init(q, g, e, lmax)
     type(equality_t), intent(out) :: q      !< the rows and their settings
     real(wp), intent(in) :: g(:, :)         !< (r, m) G
@@ -44,6 +47,7 @@ contains
     q%rho = RHO_FACTOR*lmax/q%gg
     q%m0 = lmax/sqrt(q%gg)
     q%feas = FEAS_RTOL*max(norm2(e), tiny(1.0_wp))
+    if (all(e == 0.0_wp)) q%feas_x = FEAS_RTOL*sqrt(q%gg)
   end subroutine equality_init
 
   !> Add the penalty rho G'G to the dense Hessian and its bound to lmax.

@@ -13,7 +13,7 @@ module floating
   implicit none (type, external)
   private
 
-  public :: rigid_rows, check_held, nnls, free_list, fixing_list
+  public :: rigid_rows, check_held, check_pressed, nnls, free_list, fixing_list
 
   !> a free motion counts as held by the contact when at least this fraction of its reach on the
   !! contact (squared) is normal to it (1%: mu >= 1e-4)
@@ -52,6 +52,9 @@ contains
       end do
       body%re(k) = dot_product(system%rig(:, k), system%f_applied)
     end do
+    ! a load with no part along the free motions (to rounding) has none: e = 0 exactly, the
+    ! sign that only a deformation can press the body into the contact (check_pressed)
+    if (.not. norm2(body%re) > 1.0e-12_wp*max(sum(abs(system%f_applied)), tiny(1.0_wp))) body%re = 0.0_wp
   end subroutine rigid_rows
 
   !> Can the contact hold the floating bodies? info = 1 (bad input) with the sentence
@@ -98,9 +101,12 @@ contains
         return
       end if
       deallocate (gg)
-      ! 2. something must press it into the contact
+      ! 2. something must press it into the contact: a load along its free motions, or (e = 0,
+      ! decided after condensation by check_pressed) a deformation, by loads or prescribed
+      ! displacements, that no rigid motion of the body can undo
       enorm = norm2(bodies(a)%re)
-      if (.not. enorm > 1.0e-12_wp*max(sum(abs(systems(a)%f_applied)), tiny(1.0_wp)) .or. m == 0) then
+      if (enorm == 0.0_wp .and. m > 0) cycle
+      if (m == 0) then
         info = 1
         msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact (load resultant ('//r2s(fx)//', '//r2s(fy)//')): its position '// &
@@ -154,6 +160,50 @@ contains
       end if
     end if
   end subroutine check_held
+
+  !> A floating body with e = 0 (no load along its free motions) is pressed into the contact
+  !! only when its deformation under the loads and prescribed displacements (the particular
+  !! solutions, b_1 + b_2) closes the gap in a way no rigid motion can open again: the gaps
+  !! h = g0 - b_1 - b_2 admit no motion alpha with G' alpha <= h (else the body can move off
+  !! the contact and its position is undetermined). By Farkas: there is lam >= 0 with
+  !! G lam = 0 and h' lam < 0, found by NNLS on the rows [G; h'/|h|] against (0, -1).
+  !! info = 1 with the sentence when the body is not pressed.
+  subroutine check_pressed(systems, contact_line, bodies, info, msg)
+    type(body_system_t), intent(in) :: systems(2)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(2)
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    real(wp), allocatable :: rows(:, :), target(:), lam(:), h(:)
+    real(wp) :: res
+    integer :: a, r, m
+    info = 0
+    msg = ''
+    m = contact_line%m
+    if (m == 0) return
+    h = contact_line%g0 - bodies(1)%b - bodies(2)%b
+    do a = 1, 2
+      r = bodies(a)%nrig
+      if (r == 0) cycle
+      if (any(bodies(a)%re /= 0.0_wp)) cycle
+      allocate (rows(r + 1, m), target(r + 1), lam(m))
+      rows(1:r, :) = bodies(a)%rg
+      rows(r + 1, :) = h/max(maxval(abs(h)), tiny(1.0_wp))
+      target = 0.0_wp
+      target(r + 1) = -1.0_wp
+      call nnls(rows, target, lam, res)
+      if (.not. res <= 1.0e-8_wp) then
+        info = 1
+        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but nothing '// &
+              'presses it into the contact: its loads have no part along that motion, and its deformation '// &
+              'under the loads and prescribed displacements leaves a rigid motion that lifts it off the '// &
+              'contact, so its position is undetermined; load it towards the other body, or hold that '// &
+              'rigid motion with a support: a ''clamped'' side, a ''roller'', or ux/uy on a group (&boundary)'
+        return
+      end if
+      deallocate (rows, target, lam)
+    end do
+  end subroutine check_pressed
 
   !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of
   !! each motion's reach on the contact is normal to it. S singular (a motion that does not

@@ -64,6 +64,7 @@ contains
       if (equality%r > 0) then
         inner_solver%opts%eq_m = equality%m0
         inner_solver%opts%eq_feas = equality%feas
+        inner_solver%opts%eq_feas_x = equality%feas_x
         call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
         inner = outer%inner
         inner%n_matvec = outer%n_matvec

@@ -204,6 +204,8 @@ contains
       associate (eq => subproblems%equality(a))
         inner_solver%opts%eq_m = eq%m0
         inner_solver%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
+        inner_solver%opts%eq_feas_x = merge(max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*sqrt(eq%gg), &
+                                            0.0_wp, all(eq%e == 0.0_wp))
         call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, state%lam(:, a), state%mu(1:r, a), &
                           smalbe_stats, state%rw(:, first:last), state%raw(:, first:last), state%nrw(:, a))
       end associate

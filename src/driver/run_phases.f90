@@ -16,7 +16,8 @@ module run_phases
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
-  use floating, only: rigid_rows, check_held, free_list, fixing_list
+  use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
+  use contact_common, only: other_body
   use results, only: write_results
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file, mesh_identity
   use files, only: remove_file
@@ -194,8 +195,8 @@ contains
   !> A flexibility that is not finite is a stiffness out of double precision's range (exit 3).
   subroutine check_condensed(run)
     type(run_t), intent(in) :: run   !< the run: its condensed bodies
-    integer :: a
-    character(len=512) :: msg
+    integer :: a, info
+    character(len=1024) :: msg
     do a = 1, 2
       if (.not. (all(ieee_is_finite(run%bodies(a)%flex)) .and. all(ieee_is_finite(run%bodies(a)%b)))) then
         write (msg, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
@@ -203,6 +204,10 @@ contains
         call fatal(EXIT_NUMERICAL, trim(msg))
       end if
     end do
+    ! a floating body with no load along its free motions: is it pressed by a deformation?
+    if (run%systems(1)%nrig + run%systems(2)%nrig == 0 .or. run%rank /= 0) return
+    call check_pressed(run%systems, run%contact_line, run%bodies, info, msg)
+    if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
   end subroutine check_condensed
 
   !> The contact forces (rank 0; the other ranks wait for them): the Robin iteration with
@@ -211,10 +216,24 @@ contains
   subroutine solve_contact(run)
     type(run_t), intent(inout) :: run   !< the run: its contact result
     type(h5_checkpointer_t) :: ckpt
-    integer :: a
+    integer :: a, rigid
+    real(wp) :: scale
+    character(len=:), allocatable :: ratio
     if (run%rank /= 0) return
     associate (deck => run%deck, result => run%result, contact_line => run%contact_line, bodies => run%bodies)
+      rigid = 0
+      do a = 1, 2
+        if (contact_line%m > 0 .and. all(bodies(a)%flex == 0.0_wp)) rigid = a
+      end do
       if (deck%solver%method == METHOD_MONOLITHIC) then
+        call solve_monolithic(deck%solver, contact_line, bodies, result, stop_requested)
+      else if (rigid > 0) then
+        ! a body whose contact DOFs are all prescribed does not move on the contact: the
+        ! problem is the other body's obstacle problem, one QP, which is also the Robin
+        ! iteration's fixed point (doc/method.md, "A body rigid on the contact")
+        write (output_unit, '(a)') 'robin: body '//body_label(rigid)//' does not move on the contact (every '// &
+          'contact DOF prescribed): the contact problem is body '//body_label(other_body(rigid))// &
+          '''s obstacle problem, solved as one QP (method monolithic)'
         call solve_monolithic(deck%solver, contact_line, bodies, result, stop_requested)
       else
         ckpt%file = checkpoint_file(deck%output%file)
@@ -231,9 +250,17 @@ contains
       do a = 1, 2
         if (run%systems(a)%nrig == 0) cycle
         associate (g => bodies(a)%rg, e => bodies(a)%re)
-          write (output_unit, '(a)') 'equilibrium: body '//body_label(a)//' |G lam - e|/|e| = '// &
-            sci(norm2(matmul(g, result%lam_body(:, a)) - e)/norm2(e))//' (its own force), '// &
-            sci(norm2(matmul(g, result%lam) - e)/norm2(e))//' (mean force); rigid motion '// &
+          ! e = 0 (pressed by a deformation only): judged against the contact forces' size
+          if (all(e == 0.0_wp)) then
+            scale = max(norm2(g)*norm2(result%lam), tiny(1.0_wp))
+            ratio = '|G lam|/(|G| |lam|) = '
+          else
+            scale = norm2(e)
+            ratio = '|G lam - e|/|e| = '
+          end if
+          write (output_unit, '(a)') 'equilibrium: body '//body_label(a)//' '//ratio// &
+            sci(norm2(matmul(g, result%lam_body(:, a)) - e)/scale)//' (its own force), '// &
+            sci(norm2(matmul(g, result%lam) - e)/scale)//' (mean force); rigid motion '// &
             'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates '// &
             i2s(result%eq_updates)
         end associate

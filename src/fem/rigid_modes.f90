@@ -7,7 +7,7 @@ module rigid_modes
   use kinds, only: wp
   use config, only: body_cfg_t, BC_CONTACT
   use mesh, only: mesh_t, side_nodes, group_index, group_nodes
-  use lapack, only: dsyev
+  use lapack, only: dgesvd
   use body_system, only: body_system_t
   implicit none (type, external)
   private
@@ -17,16 +17,20 @@ module rigid_modes
 contains
 
   !> The rigid motions that the prescribed DOFs leave free: the null space of the three
-  !! rigid modes (1,0), (0,1), (-(y-yc), x-xc)/h restricted to the prescribed DOFs (the
-  !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
-  !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
+  !! rigid modes (1,0), (0,1), (-(y-yc), x-xc)/h restricted to the prescribed DOFs: the right
+  !! singular vectors of that (prescribed DOFs x 3) matrix A with singular values below 1e-10
+  !! of the largest (all three when nothing is prescribed). A is reduced to its 3 x 3
+  !! triangle R by Givens rotations row by row (no Gram matrix: squaring would put a thin
+  !! clamp, the short side of a 1e5:1 strip, below the rounding of a true kernel), then R's
+  !! SVD. A true kernel has singular value ~ eps; a support of length l on a body of size h
+  !! has ~ l/h, so the test is scale-free and holds to aspect ratios of about 1e9. Sets sys%nrig, rig_coef, rig_xc, rig_h and
   !! sys%rig (ndof x nrig, zero at prescribed DOFs).
   subroutine rigid_kernel(mesh, prescribed, sys, info)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
     type(body_system_t), intent(inout) :: sys  !< gets nrig, rig, rig_coef, rig_xc, rig_h
     integer, intent(out) :: info               !< /= 0: dsyev failed
-    real(wp) :: g(3, 3), r(3), ev(3), work(64), top
+    real(wp) :: g(3, 3), r(3), ev(3), work(64), top, vt(3, 3), dummy(1, 1)
     integer :: k, cc, j, lapinfo, nk
 
     sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
@@ -36,18 +40,20 @@ contains
       do cc = 1, 2
         if (.not. prescribed(2*(k - 1) + cc)) cycle
         r = rigid_row(sys, mesh%xy(:, k), cc)
-        do j = 1, 3
-          g(:, j) = g(:, j) + r*r(j)
-        end do
+        call givens_add_row(g, r)
       end do
     end do
-    call dsyev('V', 'U', 3, g, 3, ev, work, size(work), lapinfo)
-    top = max(ev(3), 0.0_wp)
+    call dgesvd('N', 'A', 3, 3, g, 3, ev, dummy, 1, vt, 3, work, size(work), lapinfo)
+    top = max(ev(1), 0.0_wp)
     nk = 0
     info = lapinfo
     if (lapinfo /= 0) return
     nk = count(ev <= 1.0e-10_wp*top)
     if (top <= 0.0_wp) nk = 3
+    ! the kernel, smallest singular value first (the order the Gram eigenvectors had)
+    do j = 1, 3
+      g(:, j) = vt(4 - j, :)
+    end do
     sys%nrig = nk
     if (nk == 0) return
     ! ascending eigenvalues: the kernel is the first nk columns (nothing prescribed: identity)
@@ -70,6 +76,31 @@ contains
       end do
     end do
   end subroutine rigid_kernel
+
+  !> Add the row r to the upper triangle rt of a QR factorization by three Givens rotations.
+  pure subroutine givens_add_row(rt, r)
+    real(wp), intent(inout) :: rt(3, 3)   !< upper triangular R (below the diagonal: zero)
+    real(wp), intent(in) :: r(3)          !< the new row
+    real(wp) :: w(3), c, s, rho
+    integer :: i
+    w = r
+    do i = 1, 3
+      if (w(i) == 0.0_wp) cycle
+      rho = hypot(rt(i, i), w(i))
+      c = rt(i, i)/rho
+      s = w(i)/rho
+      rt(i, i) = rho
+      w(i) = 0.0_wp
+      if (i < 3) then
+        block
+          real(wp) :: row(3 - i)
+          row = rt(i, i + 1:3)
+          rt(i, i + 1:3) = c*row + s*w(i + 1:3)
+          w(i + 1:3) = -s*row + c*w(i + 1:3)
+        end block
+      end if
+    end do
+  end subroutine givens_add_row
 
   !> Component cc of the three basis rigid modes at the point x.
   pure function rigid_row(sys, x, cc) result(r)

@@ -12,7 +12,7 @@ module lapack
   public :: dsymv, dgemm
   public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev
   public :: dpbtrf, dpbtrs, dpbsv
-  public :: dgels, dgesv, dsygv
+  public :: dgels, dgesv, dsygv, dgesvd
 
   interface
 
@@ -83,6 +83,24 @@ module lapack
       real(wp), intent(out) :: work(*)      !< (2n) workspace
       integer, intent(out) :: info          !< status
     end subroutine dpstrf
+
+    !> Singular values (descending) of a general A and, as asked, its left (U) and right (VT)
+    !! singular vectors. lwork = -1: workspace query. info > 0: no convergence.
+    subroutine dgesvd(jobu, jobvt, m, n, a, lda, s, u, ldu, vt, ldvt, work, lwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: jobu   !< 'N': no U, 'A': all of U
+      character(len=1), intent(in) :: jobvt  !< 'N': no VT, 'A': all of VT
+      integer, intent(in) :: m, n            !< rows and columns of A
+      integer, intent(in) :: lda, ldu, ldvt  !< leading dimensions
+      real(wp), intent(inout) :: a(lda, *)   !< A on entry, destroyed
+      real(wp), intent(out) :: s(*)          !< (min(m, n)) singular values, descending
+      real(wp), intent(out) :: u(ldu, *)     !< left singular vectors (jobu = 'A')
+      real(wp), intent(out) :: vt(ldvt, *)   !< right singular vectors as rows (jobvt = 'A')
+      real(wp), intent(out) :: work(*)       !< (lwork) workspace
+      integer, intent(in) :: lwork           !< size of work (-1: query)
+      integer, intent(out) :: info           !< status
+    end subroutine dgesvd
 
     !> Eigenvalues (ascending) and, with jobz = 'V', orthonormal eigenvectors of a symmetric A.
     !! lwork = -1: workspace query (the optimal size in work(1)). info > 0: no convergence.

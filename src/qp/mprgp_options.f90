@@ -40,6 +40,9 @@ module mprgp_options
     !! eq_m as its initial M)
     real(wp) :: eq_m = 0.0_wp        !< M of SMALBE-M (units of b per unit of eq_e)
     real(wp) :: eq_feas = 0.0_wp     !< |eq_g x - eq_e| that counts as feasible (units of eq_e)
+    !> SMALBE: |eq_g x - eq_e| <= max(eq_feas, eq_feas_x |x|) counts as feasible, so rows whose
+    !! right side vanishes (a body pressed only by a deformation) are judged against the size of x
+    real(wp) :: eq_feas_x = 0.0_wp   !< (units of eq_e per unit of x)
     procedure(mprgp_stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
   end type mprgp_opts_t
 

@@ -93,6 +93,8 @@ contains
         solver%opts%atol = max(opts%atol, sqrt(real(n, wp))*epsilon(1.0_wp)*opts%lambda_max*norm2(x))
       ! linear term of L(., mu, rho) with the penalty's part: c - G'mu + rho G'e
       rhs = c - matmul(mu - rho*e, gm)
+      feas = max(opts%eq_feas, opts%eq_feas_x*norm2(x))
+      solver%opts%eq_feas = feas
       call solver%solve(A, rhs, lb, x, rw, raw, nrw)
       stats%inner = solver%stats
       have_ax = .true.
@@ -109,6 +111,7 @@ contains
       lag_new = 0.5_wp*(dot_product(x, solver%ax) - rho*sum(matmul(gm, x)**2)) - dot_product(c, x) + &
                 dot_product(mu, r) + 0.5_wp*rho*rr*rr
       stats%updates = k
+      feas = max(opts%eq_feas, opts%eq_feas_x*norm2(x))
       if (rr <= feas) exit
       if (lag_new < lag_old + 0.5_wp*rho*rr*rr) m_control = BETA*m_control
       lag_old = lag_new
