@@ -194,7 +194,7 @@ contains
       call nnls(rows, target, lam, res)
       if (.not. res <= 1.0e-8_wp) then
         info = 1
-        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but nothing '// &
+        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact: its loads have no part along that motion, and its deformation '// &
               'under the loads and prescribed displacements leaves a rigid motion that lifts it off the '// &
               'contact, so its position is undetermined; load it towards the other body, or hold that '// &

@@ -125,8 +125,8 @@ with tempfile.TemporaryDirectory() as tmp:
             check(False, "rocker: twice the displacement solves", f"exit {rc2}")
     for uy in ("1e-3", "0"):
         rc_u, text_u, _, out = run(tmp, f"rocker_up{uy}", ROCKER.format(uy=uy))
-        check(rc_u == 1 and "body 1 is held only by contact" in text_u and "nothing presses it" in text_u
-              and "rotation about" in text_u, f"rocker with uy = {uy}: exit 1, nothing presses it",
+        check(rc_u == 1 and "body 1 is held only by contact" in text_u and "no load presses it" in text_u
+              and "rotation about" in text_u, f"rocker with uy = {uy}: exit 1, no load presses it",
               f"exit {rc_u}: {text_u[-300:]}")
         check(not os.path.exists(out), f"rocker with uy = {uy}: no result file")
         check("Traceback" not in text_u and "Error termination" not in text_u, f"rocker with uy = {uy}: no backtrace")
