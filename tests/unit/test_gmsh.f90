@@ -11,7 +11,8 @@ program test_gmsh
   use kinds, only: wp
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal
-  use gmsh_msh, only: msh_read
+  use gmsh_msh, only: msh_read_err => msh_read
+  use errors, only: error_t, exit_code
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary
   implicit none (type, external)
@@ -43,6 +44,19 @@ program test_gmsh
 contains
 
   ! ---- helpers --------------------------------------------------------------------------
+
+  !> msh_read with its error as an exit code (0; 1 bad input; 3 other) and a message.
+  subroutine msh_read(path, region, body_id, m, info, msg)
+    character(len=*), intent(in) :: path, region
+    integer, intent(in) :: body_id
+    type(mesh_t), intent(out) :: m
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    type(error_t) :: err
+    call msh_read_err(path, region, body_id, m, err)
+    info = exit_code(err)
+    msg = err%text()
+  end subroutine msh_read
 
   subroutine read_ok(path, region, m)
     character(len=*), intent(in) :: path, region
