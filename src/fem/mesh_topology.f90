@@ -12,7 +12,7 @@ module mesh_topology
   use kinds, only: wp, i8
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
-  use strings, only: i2s, text_buffer_t
+  use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use mesh, only: mesh_t
   implicit none (type, external)
@@ -247,7 +247,7 @@ contains
     do k = 1, mesh%nnode
       if (maxval(abs(mesh%xy(:, k))) > COORD_MAX) then
         call err%set(ERR_INPUT, 'node '//i2s(mesh%node_tag(k))//' has a coordinate of magnitude '// &
-                     trim(real_text(maxval(abs(mesh%xy(:, k)))))//': beyond '//trim(real_text(COORD_MAX))// &
+                     sci(maxval(abs(mesh%xy(:, k))))//': beyond '//sci(COORD_MAX)// &
                      ' the cells'' areas overflow double precision; scale the mesh')
         return
       end if
@@ -610,14 +610,6 @@ contains
       end do
     end subroutine sort4
   end subroutine check_duplicate_cells
-
-  !> A real for messages.
-  function real_text(x) result(s)
-    real(wp), intent(in) :: x
-    character(len=24) :: s
-    write (s, '(es12.5)') x
-    s = adjustl(s)
-  end function real_text
 
   !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
   subroutine sort_by_tag(idx, tag)

@@ -78,6 +78,7 @@ def bad(name, mesh_text, patterns, **kw):
              "Error termination" not in p.stderr and len(err.splitlines()) == 1)
     check(p.returncode == 1 and clean, f"{name}: exit 1 with one clean line",
           f"exit {p.returncode}: {err[-300:]}")
+    print(f"       message: {err[-400:]}")
     for pat in patterns:
         check(re.search(pat, err) is not None, f"{name}: the message says /{pat}/", err[-300:])
     check(written(folder) == [], f"{name}: nothing written", str(written(folder)))
