@@ -292,7 +292,7 @@ contains
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
     call boundary_groups(file_mesh, body_node, mesh, err)
-    if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh)
+    if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh, err)
   end subroutine body_from_file
 
   !> Put cell k counter-clockwise; refuse it if degenerate or (a quadrangle) not convex.
@@ -349,9 +349,9 @@ contains
     type(error_t), intent(inout) :: err
     type(int_hash_t) :: edge_hash
     integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
-    integer, allocatable :: seen_group(:), seen_line(:)
+    integer, allocatable :: seen_group(:), seen_line(:), first(:), members(:)
     logical, allocatable :: marked(:)
-    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner
+    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m
     integer(i8) :: key, key_base
     type(text_buffer_t) :: names
 
@@ -361,6 +361,7 @@ contains
                            edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
                            inner(2*file_mesh%nline), marked(mesh%nnode), seen_group(0:edge_hash%mask), &
                            seen_line(0:edge_hash%mask), stat=st)
+    if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory for the boundary edges')
       return
@@ -405,9 +406,9 @@ contains
       names%n = len_trim(names%buf(1:names%n))
       nedge = 0
       ninner = 0
-      do line = 1, file_mesh%nline
+      do m = first(phys), first(phys + 1) - 1
+        line = members(m)
         if (line_slot(line) < 0) cycle
-        if (.not. any(file_mesh%ent(file_mesh%line_entity(line))%phys == file_mesh%phys_tag(phys))) cycle
         slot = line_slot(line)
         if (seen_group(slot) == phys) then      ! the same edge twice: its load would count twice
           call err%set(ERR_INPUT, 'elements '//i2s(file_mesh%line_tag(seen_line(slot)))//' and '// &
@@ -455,26 +456,32 @@ contains
   !! physical point named as a physical curve adds its nodes to the curve's group); the
   !! points' names go to file_groups. A point's node is the body's if the body's cells have
   !! it; a node in no cell of the file is matched to the body's node at its place.
-  subroutine point_groups(file_mesh, body_node, mesh)
+  subroutine point_groups(file_mesh, body_node, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
-    logical, allocatable :: in_cell(:)
-    integer, allocatable :: nodes(:)
-    integer :: phys, point, n, nfound, group, c, i
+    type(error_t), intent(inout) :: err
+    logical, allocatable :: in_cell(:), taken(:)
+    integer, allocatable :: nodes(:), first(:), members(:)
+    integer :: phys, point, n, nfound, group, c, i, m, st
     real(wp) :: tol
     character(len=:), allocatable :: names
     type(text_buffer_t) :: list
 
-    allocate (nodes(file_mesh%npoint))
+    allocate (nodes(file_mesh%npoint), taken(mesh%nnode), stat=st)
+    if (st == 0) call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), first, members, st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for the physical points')
+      return
+    end if
+    taken = .false.
     tol = 1.0e-9_wp*max(mesh%width, mesh%height)
     do phys = 1, file_mesh%nphys
       if (file_mesh%phys_dim(phys) /= 0) cycle
       call list%add(' '//file_mesh%phys_name(phys)%s)
       nfound = 0
-      do point = 1, file_mesh%npoint
-        if (file_mesh%point_entity(point) == 0) cycle
-        if (.not. any(file_mesh%ent(file_mesh%point_entity(point))%phys == file_mesh%phys_tag(phys))) cycle
+      do m = first(phys), first(phys + 1) - 1
+        point = members(m)
         n = body_node(file_mesh%point_node(point))
         if (n == 0) then
           if (.not. allocated(in_cell)) then
@@ -490,10 +497,12 @@ contains
             n = node_at(mesh, file_mesh%node_xy(:, file_mesh%point_node(point)), tol)
         end if
         if (n == 0) cycle
-        if (any(nodes(1:nfound) == n)) cycle
+        if (taken(n)) cycle
+        taken(n) = .true.
         nfound = nfound + 1
         nodes(nfound) = n
       end do
+      taken(nodes(1:nfound)) = .false.
       if (nfound == 0) cycle
       group = 0
       do c = 1, mesh%ngroup
@@ -532,6 +541,59 @@ contains
       end if
     end do
   end function node_at
+
+  !> The physical group (dim, tag), 0 if the file has none.
+  integer function phys_index(file_mesh, dim, tag) result(p)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: dim, tag
+    integer :: slot
+    integer(i8) :: key
+    p = 0
+    if (file_mesh%nphys == 0) return
+    key = group_key(dim, tag)
+    slot = hash_slot(file_mesh%phys_hash, key)
+    if (file_mesh%phys_hash%key(slot) == key) p = file_mesh%phys_of_slot(slot)
+  end function phys_index
+
+  !> The items (lines or points, by their entities `item_entity`, 0: none) of every physical
+  !! group of dimension `dim`: those of group p are members(first(p):first(p + 1) - 1), in
+  !! file order, each once. One pass over the items, so many groups cost linear time.
+  subroutine group_members(file_mesh, dim, item_entity, first, members, stat)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: dim, item_entity(:)
+    integer, allocatable, intent(out) :: first(:), members(:)
+    integer, intent(out) :: stat
+    integer, allocatable :: fill(:), last_item(:)
+    integer :: pass, item, j, p
+    allocate (first(file_mesh%nphys + 1), fill(file_mesh%nphys), last_item(file_mesh%nphys), stat=stat)
+    if (stat /= 0) return
+    fill = 0
+    do pass = 1, 2            ! count, then place
+      last_item = 0
+      do item = 1, size(item_entity)
+        if (item_entity(item) == 0) cycle
+        associate (phys => file_mesh%ent(item_entity(item))%phys)
+          do j = 1, size(phys)
+            p = phys_index(file_mesh, dim, phys(j))
+            if (p == 0) cycle
+            if (last_item(p) == item) cycle     ! a tag listed twice counts once
+            last_item(p) = item
+            fill(p) = fill(p) + 1
+            if (pass == 2) members(first(p) + fill(p) - 1) = item
+          end do
+        end associate
+      end do
+      if (pass == 1) then
+        first(1) = 1
+        do p = 1, file_mesh%nphys
+          first(p + 1) = first(p) + fill(p)
+        end do
+        allocate (members(first(file_mesh%nphys + 1) - 1), stat=stat)
+        if (stat /= 0) return
+        fill = 0
+      end if
+    end do
+  end subroutine group_members
 
   !> Refuse two cells with the same nodes (in any order): a cell listed twice would count
   !! its stiffness twice. The cells are sorted by their sorted node lists, so duplicates
