@@ -138,8 +138,8 @@ $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelis
                            $(BUILD)/deck_checks.o $(BUILD)/deck_render.o
 $(BUILD)/budget.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
-$(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
-$(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/text_scanner.o \
+$(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
+$(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/text_scanner.o \
                            $(BUILD)/mesh.o $(BUILD)/mesh_topology.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o

@@ -13,6 +13,9 @@ void rc_unlock_dir(int fd);
 /* What is at path (not following a final symbolic link): 0 nothing, 1 a regular file or a
    symbolic link, 2 a folder, 3 something else (device, fifo, socket), -1 cannot tell. */
 int rc_path_kind(const char *path);
+/* What path names, following symbolic links: 0 nothing, 1 a regular file, 2 a folder,
+   3 something else (fifo, device, socket), -1 cannot tell. */
+int rc_file_kind(const char *path);
 /* 1 when the folder dir can take new entries (write and search permission), else 0. */
 int rc_dir_writable(const char *dir);
 #endif

@@ -92,6 +92,11 @@ contains
       return
     end if
     scanner%n = size_bytes
+    ! a UTF-8 byte-order mark (written by some editors) is not part of the text
+    if (size_bytes >= 3) then
+      if (iachar(scanner%text(1:1)) == 239 .and. iachar(scanner%text(2:2)) == 187 .and. &
+          iachar(scanner%text(3:3)) == 191) scanner%pos = 4
+    end if
   end subroutine scanner_load
 
   !> The next token (characters above the blank) as text(s:e); s > scanner%n at the end of the
@@ -157,11 +162,15 @@ contains
   end function get_real
 
   !> The next token as a count of items that follow in the file (0 after an error): a
-  !! non-negative integer. Every count that sizes an allocation is read here, so that the
-  !! checks of a count against the file (the bytes left, bytes_left) have one place.
-  integer function read_count(scanner, what) result(v)
+  !! non-negative integer. Every count that sizes an allocation is read here. With
+  !! `min_bytes` (the fewest characters one item takes in the file, its separators included)
+  !! and `items` (the items' name, plural), the count is checked in 64-bit arithmetic
+  !! against the characters left, so that no count the file cannot hold sizes an allocation.
+  integer function read_count(scanner, what, min_bytes, items) result(v)
     type(scanner_t), intent(inout) :: scanner
-    character(len=*), intent(in) :: what   ! what is counted, for messages
+    character(len=*), intent(in) :: what                 ! what is counted, for messages
+    integer, intent(in), optional :: min_bytes           ! the fewest characters of one item
+    character(len=*), intent(in), optional :: items      ! the items, plural ('nodes')
     integer(i8) :: s, e
     logical :: ok
     v = 0
@@ -173,8 +182,32 @@ contains
     if (.not. ok) then
       v = 0
       call bad_token(scanner, s, e, what//' (an integer >= 0)')
+      return
+    end if
+    if (present(min_bytes)) then
+      if (int(v, i8)*min_bytes > bytes_left(scanner)) then
+        if (present(items)) then
+          call scan_fail(scanner, scanner%section//' announces '//i2s(v)//' '//items// &
+                         ', but the rest of the file holds at most '//i8s(bytes_left(scanner))// &
+                         ' bytes, room for at most '//i8s(bytes_left(scanner)/min_bytes)// &
+                         ' (one takes at least '//i2s(min_bytes)//' bytes; truncated file?)')
+        else
+          call scan_fail(scanner, what//' in '//scanner%section//' is '//i2s(v)// &
+                         ', but the rest of the file holds at most '//i8s(bytes_left(scanner))//' bytes')
+        end if
+        v = 0
+      end if
     end if
   end function read_count
+
+  !> A 64-bit integer as text.
+  pure function i8s(k) result(t)
+    integer(i8), intent(in) :: k
+    character(len=:), allocatable :: t
+    character(len=24) :: buf
+    write (buf, '(i0)') k
+    t = trim(buf)
+  end function i8s
 
   !> The characters from the position to the end of the file.
   pure integer(i8) function bytes_left(scanner)

@@ -6,7 +6,7 @@ module run_phases
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED
+  use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
   use mesh, only: mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
@@ -20,7 +20,7 @@ module run_phases
   use contact_common, only: other_body
   use results, only: write_results
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file, mesh_identity
-  use files, only: remove_file
+  use files, only: remove_file, special_file
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
@@ -83,27 +83,31 @@ contains
   subroutine read_meshes(run, backend)
     type(run_t), intent(inout) :: run                  !< the run: its meshes
     class(backend_t), intent(inout) :: backend         !< checks the memory
-    integer :: info(2), a
-    character(len=512) :: msg(2)
+    integer :: a
+    type(error_t) :: err(2)
     associate (deck => run%deck)
+      do a = 1, 2   ! opening a FIFO or device would wait or read forever
+        if (len_trim(deck%body(a)%mesh) == 0) cycle
+        if (special_file(trim(deck%body(a)%mesh))) call fail_on(error_t(ERR_INPUT, 'body '//i2s(a)// &
+          ": mesh file '"//trim(deck%body(a)%mesh)//"': is not a regular file (a folder, FIFO or device)"), &
+          'deck '//trim(deck%source))
+      end do
       if (len_trim(deck%body(1)%mesh) > 0 .and. deck%body(1)%mesh == deck%body(2)%mesh) then
-        call msh_read_pair(trim(deck%body(1)%mesh), [deck%body(1)%region, deck%body(2)%region], run%meshes, info, msg, &
+        call msh_read_pair(trim(deck%body(1)%mesh), [deck%body(1)%region, deck%body(2)%region], run%meshes, err, &
                            run%threads)
       else
         !$omp parallel do num_threads(run%threads) schedule(static, 1)
         do a = 1, 2
           if (len_trim(deck%body(a)%mesh) > 0) then
-            call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), info(a), msg(a))
+            call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a))
           else
             call mesh_build(run%meshes(a), deck%body(a))
-            info(a) = 0
           end if
         end do
         !$omp end parallel do
       end if
       do a = 1, 2   ! the mesh reader's message names the body
-        if (info(a) == 1) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//': '//trim(msg(a)))
-        if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'deck '//trim(deck%source)//': '//trim(msg(a)))
+        call fail_on(err(a), 'deck '//trim(deck%source))
       end do
       run%sized = deck
       if (len_trim(deck%body(1)%mesh) > 0 .or. len_trim(deck%body(2)%mesh) > 0) then

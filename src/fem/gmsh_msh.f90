@@ -10,19 +10,22 @@
 !! the surface's mesh.
 !!
 !! Every count that sizes an allocation is read by read_count (module text_scanner), the
-!! one place for checks of counts against the file.
+!! one place for checks of counts against the file: each is checked, in 64-bit arithmetic,
+!! against the characters left in the file (an item takes at least a few of them) before
+!! anything is allocated. Tags must be >= 1, as the format says.
 !!
-!! Errors: info = 1 for bad input (msg names the body, the file and the line or element
-!! tag), 3 for other failures (memory). Only first-order elements (2-node lines, 3-node
-!! triangles, 4-node quadrangles, points) in the plane z = 0 are read.
+!! Errors: an error_t, ERR_INPUT for bad input (the message names the body, the file and
+!! the line or element tag), ERR_MEMORY otherwise. Only first-order elements (2-node
+!! lines, 3-node triangles, 4-node quadrangles, points) in the plane z = 0 are read.
 module gmsh_msh
   use kinds, only: wp, i8
+  use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use text_scanner, only: scanner_t, scanner_load, scan_fail, next_token, get_int, get_real, read_count, &
-                          expect, skip_past, SCAN_OTHER_FAILURE
+                          expect, skip_past, bytes_left, SCAN_OTHER_FAILURE
   use mesh, only: mesh_t
-  use mesh_topology, only: file_mesh_t, body_from_file, add_physical, entity_index
+  use mesh_topology, only: file_mesh_t, body_from_file, add_physical, index_entities, entity_index
   implicit none (type, external)
   private
 
@@ -46,13 +49,12 @@ contains
   !! group per physical curve with edges on the body's boundary, then one node group per
   !! physical point with nodes of the body (`file_groups` lists every physical curve and
   !! point name of the file).
-  subroutine msh_read(path, region, body_id, mesh, info, msg)
+  subroutine msh_read(path, region, body_id, mesh, err)
     character(len=*), intent(in) :: path     !< the .msh file
     character(len=*), intent(in) :: region   !< physical surface name of the body, or ''
     integer, intent(in) :: body_id           !< the body's number, for messages
     type(mesh_t), intent(out) :: mesh        !< the body's mesh
-    integer, intent(out) :: info             !< 0; 1 bad input; 3 other failure
-    character(len=*), intent(out) :: msg     !< one sentence when info /= 0
+    type(error_t), intent(out) :: err        !< ERR_INPUT (bad file) or ERR_MEMORY, one sentence
     type(scanner_t) :: scanner
     type(file_mesh_t) :: file_mesh
 
@@ -61,18 +63,17 @@ contains
     if (scanner%info == 0) call parse(scanner, file_mesh)
     if (scanner%info == 0) call build(scanner, file_mesh, trim(region), mesh)
     if (allocated(scanner%text)) deallocate (scanner%text)
-    call outcome(scanner, path, body_id, mesh, info, msg)
+    call outcome(scanner, path, body_id, mesh, err)
   end subroutine msh_read
 
   !> Both bodies from one .msh file (the same path for both): the file is read and parsed
   !! once, then each body is built from it (the bodies in parallel on two threads when
   !! `nthr` is 2). Arguments as msh_read's, one per body.
-  subroutine msh_read_pair(path, region, mesh, info, msg, nthr)
+  subroutine msh_read_pair(path, region, mesh, err, nthr)
     character(len=*), intent(in) :: path          !< the .msh file of both bodies
     character(len=*), intent(in) :: region(2)     !< physical surface name of each body
     type(mesh_t), intent(out) :: mesh(2)          !< the bodies' meshes
-    integer, intent(out) :: info(2)               !< 0; 1 bad input; 3 other failure
-    character(len=*), intent(out) :: msg(2)       !< one sentence when info /= 0
+    type(error_t), intent(out) :: err(2)          !< each body's error, as msh_read's
     integer, intent(in) :: nthr                   !< threads for the two builds (1 or 2)
     type(scanner_t) :: scanner, body_scanner(2)
     type(file_mesh_t) :: file_mesh
@@ -91,25 +92,24 @@ contains
     end do
     !$omp end parallel do
     do a = 1, 2
-      call outcome(body_scanner(a), path, a, mesh(a), info(a), msg(a))
+      call outcome(body_scanner(a), path, a, mesh(a), err(a))
     end do
   end subroutine msh_read_pair
 
-  !> The status of a read: info from the scanner and, on failure, one sentence naming the body,
-  !! the file and the line, and an empty mesh.
-  subroutine outcome(scanner, path, body_id, mesh, info, msg)
+  !> The status of a read: on failure, one sentence naming the body, the file and the line,
+  !! and an empty mesh.
+  subroutine outcome(scanner, path, body_id, mesh, err)
     type(scanner_t), intent(in) :: scanner
     character(len=*), intent(in) :: path
     integer, intent(in) :: body_id
     type(mesh_t), intent(inout) :: mesh
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
-    info = scanner%info
-    msg = ''
-    if (info == 0) return
-    msg = 'body '//i2s(body_id)//": mesh file '"//trim(path)//"'"
-    if (scanner%err_line > 0) msg = trim(msg)//', line '//i2s(scanner%err_line)
-    msg = trim(msg)//': '//scanner%err//'.'
+    type(error_t), intent(out) :: err
+    character(len=:), allocatable :: msg
+    if (scanner%info == 0) return
+    msg = 'body '//i2s(body_id)//": mesh file '"//path//"'"
+    if (scanner%err_line > 0) msg = msg//', line '//i2s(scanner%err_line)
+    msg = msg//': '//scanner%err//'.'
+    call err%set(merge(ERR_MEMORY, ERR_INPUT, scanner%info == SCAN_OTHER_FAILURE), msg)
     mesh%nnode = 0
     mesh%ncell = 0
   end subroutine outcome
@@ -120,10 +120,10 @@ contains
     type(file_mesh_t), intent(in) :: file_mesh
     character(len=*), intent(in) :: region
     type(mesh_t), intent(inout) :: mesh
-    integer :: info
-    character(len=:), allocatable :: err
-    call body_from_file(file_mesh, region, scanner%path, mesh, info, err)
-    if (info /= 0) call scan_fail(scanner, err, info, .false.)
+    type(error_t) :: err
+    call body_from_file(file_mesh, region, scanner%path, mesh, err)
+    if (err%failed()) call scan_fail(scanner, err%text(), merge(SCAN_OTHER_FAILURE, 1, err%category == ERR_MEMORY), &
+                                     .false.)
   end subroutine build
 
   ! ---- parsing ----------------------------------------------------------------------------
@@ -215,18 +215,24 @@ contains
     call expect(scanner, '$EndMeshFormat')
   end subroutine read_format
 
-  !> $PhysicalNames: dimension, tag and quoted name of each physical group.
+  !> $PhysicalNames: dimension, tag and quoted name of each physical group (a name of any
+  !! length, on one line).
   subroutine read_physical_names(scanner, file_mesh)
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
-    integer :: n, k, dim, tag
+    integer :: n, k, dim, tag, st
     integer(i8) :: q
-    n = read_count(scanner, 'the number of physical names')
+    ! a name takes at least 7 characters: '1 2 ""' and a line end
+    n = read_count(scanner, 'the number of physical names', 7, 'physical names')
     if (scanner%info /= 0) return
     do k = 1, n
       dim = get_int(scanner, 'a physical dimension')
       tag = get_int(scanner, 'a physical tag')
       if (scanner%info /= 0) return
+      if (dim < 0 .or. dim > 3) then
+        call scan_fail(scanner, 'physical group '//i2s(tag)//' has dimension '//i2s(dim)//', not 0, 1, 2 or 3')
+        return
+      end if
       ! the name: from the opening quote to the closing one on the same line
       do while (scanner%pos <= scanner%n)
         if (scanner%text(scanner%pos:scanner%pos) /= ' ' .and. scanner%text(scanner%pos:scanner%pos) /= achar(9)) exit
@@ -238,7 +244,7 @@ contains
       end if
       q = 0
       if (scanner%text(scanner%pos:scanner%pos) == '"') &
-        q = scan(scanner%text(scanner%pos + 1:min(scanner%n, scanner%pos + 1024)), '"'//achar(10))
+        q = scan(scanner%text(scanner%pos + 1:scanner%n), '"'//achar(10), kind=i8)
       if (q == 0) then
         call scan_fail(scanner, 'a physical name must be in double quotes on one line')
         return
@@ -247,7 +253,11 @@ contains
         call scan_fail(scanner, 'a physical name must be in double quotes on one line')
         return
       end if
-      call add_physical(file_mesh, dim, tag, scanner%text(scanner%pos + 1:scanner%pos + q - 1))
+      call add_physical(file_mesh, dim, tag, scanner%text(scanner%pos + 1:scanner%pos + q - 1), st)
+      if (st /= 0) then
+        call scan_fail(scanner, 'not enough memory for '//i2s(k)//' physical groups', SCAN_OTHER_FAILURE)
+        return
+      end if
       scanner%pos = scanner%pos + q + 1
     end do
     call expect(scanner, '$EndPhysicalNames')
@@ -257,28 +267,52 @@ contains
   subroutine read_entities(scanner, file_mesh)
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
-    integer :: nents(0:3), dim, k, j, nb, tag, np, bound
+    ! the fewest characters of a point (tag, x, y, z, no physical tag) and of a curve,
+    ! surface or volume (tag, a box of 6, no physical tag, no bounding entity)
+    integer, parameter :: POINT_BYTES = 10, OTHER_BYTES = 18
+    character(len=*), parameter :: KIND(0:3) = ['points  ', 'curves  ', 'surfaces', 'volumes ']
+    integer :: nents(0:3), dim, k, j, nb, tag, np, bound, st
+    integer(i8) :: need
     real(wp) :: r
     integer, allocatable :: phys(:)
     do dim = 0, 3
-      nents(dim) = read_count(scanner, 'the number of entities')
+      nents(dim) = read_count(scanner, 'the number of '//trim(KIND(dim)), merge(POINT_BYTES, OTHER_BYTES, dim == 0), &
+                              trim(KIND(dim)))
     end do
     if (scanner%info /= 0) return
-    allocate (file_mesh%ent(nents(0) + nents(1) + nents(2)))
+    need = POINT_BYTES*int(nents(0), i8) + OTHER_BYTES*(int(nents(1), i8) + nents(2) + nents(3))
+    if (need > bytes_left(scanner)) then
+      call scan_fail(scanner, '$Entities announces '//i2s(nents(0))//' points, '//i2s(nents(1))//' curves, '// &
+                     i2s(nents(2))//' surfaces and '//i2s(nents(3))//' volumes, but the rest of the file '// &
+                     'is too short for them')
+      return
+    end if
+    allocate (file_mesh%ent(nents(0) + nents(1) + nents(2)), stat=st)
+    if (st /= 0) then
+      call scan_fail(scanner, 'not enough memory for '//i2s(nents(0) + nents(1) + nents(2))//' entities', &
+                     SCAN_OTHER_FAILURE)
+      return
+    end if
     do dim = 0, 3
       do k = 1, nents(dim)
         tag = get_int(scanner, 'an entity tag')
         do j = 1, merge(3, 6, dim == 0)
           r = get_real(scanner, 'an entity coordinate')
         end do
-        np = read_count(scanner, 'the number of physical tags')
+        np = read_count(scanner, 'the number of physical tags', 2, &
+                        'physical tags for '//KIND(dim)(1:len_trim(KIND(dim)) - 1)//' '//i2s(tag))
         if (scanner%info /= 0) return
-        allocate (phys(np))
+        allocate (phys(np), stat=st)
+        if (st /= 0) then
+          call scan_fail(scanner, 'not enough memory for '//i2s(np)//' physical tags', SCAN_OTHER_FAILURE)
+          return
+        end if
         do j = 1, np     ! negative when the entity is reversed in the group
           phys(j) = abs(get_int(scanner, 'a physical tag'))
         end do
         if (dim > 0) then
-          nb = read_count(scanner, 'the number of bounding entities')
+          nb = read_count(scanner, 'the number of bounding entities', 2, &
+                          'bounding entities for '//KIND(dim)(1:len_trim(KIND(dim)) - 1)//' '//i2s(tag))
           do j = 1, nb
             bound = get_int(scanner, 'a bounding entity tag')
           end do
@@ -291,13 +325,22 @@ contains
           call move_alloc(phys, file_mesh%ent(file_mesh%nent)%phys)
           do j = 1, np        ! physical groups without a name are named by their tag
             call add_physical(file_mesh, dim, file_mesh%ent(file_mesh%nent)%phys(j), &
-                              i2s(file_mesh%ent(file_mesh%nent)%phys(j)))
+                              i2s(file_mesh%ent(file_mesh%nent)%phys(j)), st)
+            if (st /= 0) then
+              call scan_fail(scanner, 'not enough memory for the physical groups', SCAN_OTHER_FAILURE)
+              return
+            end if
           end do
         else
           deallocate (phys)
         end if
       end do
     end do
+    call index_entities(file_mesh, st)
+    if (st /= 0) then
+      call scan_fail(scanner, 'not enough memory for the entities', SCAN_OTHER_FAILURE)
+      return
+    end if
     call expect(scanner, '$EndEntities')
   end subroutine read_entities
 
@@ -306,11 +349,13 @@ contains
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
     type(node_index_t), intent(inout) :: by_tag
+    ! the fewest characters of a node (tag and x, y, z) and of a block's header
+    integer, parameter :: NODE_BYTES = 8, BLOCK_BYTES = 8
     integer :: nblock, ntotal, b, edim, etag, param, nb, k, j, st, slot, first
     real(wp) :: z, r
 
-    nblock = read_count(scanner, 'the number of node blocks')
-    ntotal = read_count(scanner, 'the number of nodes')
+    nblock = read_count(scanner, 'the number of node blocks', BLOCK_BYTES, 'node blocks')
+    ntotal = read_count(scanner, 'the number of nodes', NODE_BYTES, 'nodes')
     k = get_int(scanner, 'the smallest node tag')
     k = get_int(scanner, 'the largest node tag')
     if (scanner%info /= 0) return
@@ -326,9 +371,9 @@ contains
       edim = get_int(scanner, 'an entity dimension')
       etag = get_int(scanner, 'an entity tag')
       param = get_int(scanner, 'the parametric flag')
-      nb = read_count(scanner, 'the number of nodes in the block')
+      nb = read_count(scanner, 'the number of nodes in the block', NODE_BYTES, 'nodes in a block')
       if (scanner%info /= 0) return
-      if (file_mesh%nnode + nb > ntotal) then
+      if (int(file_mesh%nnode, i8) + nb > ntotal) then
         call scan_fail(scanner, 'the node blocks hold more nodes than the '//i2s(ntotal)//' announced')
         return
       end if
@@ -336,6 +381,10 @@ contains
       do k = first + 1, first + nb
         file_mesh%node_tag(k) = get_int(scanner, 'a node tag')
         if (scanner%info /= 0) return
+        if (file_mesh%node_tag(k) < 1) then
+          call scan_fail(scanner, 'node tag '//i2s(file_mesh%node_tag(k))//' in $Nodes: tags must be >= 1')
+          return
+        end if
         slot = hash_slot(by_tag%hash, int(file_mesh%node_tag(k), i8))
         if (by_tag%hash%key(slot) /= HASH_EMPTY) then
           call scan_fail(scanner, 'node tag '//i2s(file_mesh%node_tag(k))//' appears twice')
@@ -375,17 +424,19 @@ contains
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
     type(node_index_t), intent(in) :: by_tag
+    ! the fewest characters of an element (a point: tag and node) and of a block's header
+    integer, parameter :: ELEMENT_BYTES = 4, BLOCK_BYTES = 8
     integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, st, t, slot
 
-    nblock = read_count(scanner, 'the number of element blocks')
-    ntotal = read_count(scanner, 'the number of elements')
+    nblock = read_count(scanner, 'the number of element blocks', BLOCK_BYTES, 'element blocks')
+    ntotal = read_count(scanner, 'the number of elements', ELEMENT_BYTES, 'elements')
     k = get_int(scanner, 'the smallest element tag')
     k = get_int(scanner, 'the largest element tag')
     if (scanner%info /= 0) return
     ! sized for the worst case; the lines are a small part of a 2D mesh but bounded by ntotal too
     allocate (file_mesh%cell_tag(ntotal), file_mesh%cell_entity(ntotal), file_mesh%cell_node(4, ntotal), &
-              file_mesh%line_entity(ntotal), file_mesh%line_node(2, ntotal), file_mesh%point_entity(ntotal), &
-              file_mesh%point_node(ntotal), stat=st)
+              file_mesh%line_tag(ntotal), file_mesh%line_entity(ntotal), file_mesh%line_node(2, ntotal), &
+              file_mesh%point_entity(ntotal), file_mesh%point_node(ntotal), stat=st)
     if (st /= 0) then
       call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
       return
@@ -395,18 +446,6 @@ contains
       edim = get_int(scanner, 'an entity dimension')
       etag = get_int(scanner, 'an entity tag')
       etype = get_int(scanner, 'an element type')
-      nb = read_count(scanner, 'the number of elements in the block')
-      if (scanner%info /= 0) return
-      if (t + nb > ntotal) then
-        call scan_fail(scanner, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
-        return
-      end if
-      t = t + nb
-      if (edim == 3) then
-        call scan_fail(scanner, 'has elements of type '//i2s(etype)//' on volume '//i2s(etag)// &
-                  ': a 3D mesh, and only 2D meshes are read')
-        return
-      end if
       select case (etype)
       case (1)
         nv = 2
@@ -417,14 +456,36 @@ contains
       case (15)
         nv = 1
       case default
+        nv = 1
+      end select
+      ! an element takes at least its tag and nodes, each a digit and a separator
+      nb = read_count(scanner, 'the number of elements in the block', 2*(nv + 1), 'elements in a block')
+      if (scanner%info /= 0) return
+      if (int(t, i8) + nb > ntotal) then
+        call scan_fail(scanner, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
+        return
+      end if
+      t = t + nb
+      if (edim == 3) then
+        call scan_fail(scanner, 'has elements of type '//i2s(etype)//' on volume '//i2s(etag)// &
+                  ': a 3D mesh, and only 2D meshes are read')
+        return
+      end if
+      if (all(etype /= [1, 2, 3, 15])) then
         call scan_fail(scanner, unsupported_type(etype))
         return
-      end select
+      end if
       ent = entity_index(file_mesh, edim, etag)
       do k = 1, nb
         tag = get_int(scanner, 'an element tag')
+        if (scanner%info /= 0) return
+        if (tag < 1) then
+          call scan_fail(scanner, 'element tag '//i2s(tag)//' in $Elements: tags must be >= 1')
+          return
+        end if
         if (etype == 1) then
           file_mesh%nline = file_mesh%nline + 1
+          file_mesh%line_tag(file_mesh%nline) = tag
           file_mesh%line_entity(file_mesh%nline) = ent
         else if (etype == 15) then
           file_mesh%npoint = file_mesh%npoint + 1
@@ -438,6 +499,10 @@ contains
         do j = 1, nv
           ntg = get_int(scanner, 'a node tag')
           if (scanner%info /= 0) return
+          if (ntg < 1) then
+            call scan_fail(scanner, 'element '//i2s(tag)//' refers to node tag '//i2s(ntg)//': tags must be >= 1')
+            return
+          end if
           slot = hash_slot(by_tag%hash, int(ntg, i8))
           if (by_tag%hash%key(slot) == HASH_EMPTY) then
             call scan_fail(scanner, 'element '//i2s(tag)//' refers to node '//i2s(ntg)//', which is not in $Nodes')

@@ -11,16 +11,18 @@
 module mesh_topology
   use kinds, only: wp, i8
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
-  use strings, only: i2s
+  use errors, only: error_t, ERR_INPUT, ERR_MEMORY
+  use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use mesh, only: mesh_t
   implicit none (type, external)
   private
 
-  public :: body_from_file, add_physical, entity_index
+  public :: body_from_file, add_physical, index_entities, entity_index
 
-  integer, parameter :: BAD_INPUT = 1, OTHER_FAILURE = 3
   real(wp), parameter :: AREA_TOL = 1.0e-12_wp       ! degenerate: |area| < AREA_TOL * (longest edge)^2
+  ! the largest coordinate whose cell areas and squared edges stay finite (8 x^2 <= huge)
+  real(wp), parameter :: COORD_MAX = 0.25_wp*sqrt(huge(1.0_wp))
 
   !> A text of its own length (an array of names).
   type, public :: name_t
@@ -38,10 +40,14 @@ module mesh_topology
   !! index in `ent` (0: the file has no entity for them).
   type, public :: file_mesh_t
     integer :: nphys = 0                       !< physical groups (named or not)
-    integer, allocatable :: phys_dim(:), phys_tag(:)
+    integer, allocatable :: phys_dim(:), phys_tag(:)  !< dimension 0..3 and tag of each
     type(name_t), allocatable :: phys_name(:)
+    type(int_hash_t) :: phys_hash              !< the groups' keys (group_key)
+    integer, allocatable :: phys_of_slot(:)    !< (0:phys_hash%mask) the group in each slot
     integer :: nent = 0                        !< point, curve and surface entities
     type(entity_t), allocatable :: ent(:)
+    type(int_hash_t) :: ent_hash               !< the entities' keys (group_key), by index_entities
+    integer, allocatable :: ent_of_slot(:)     !< (0:ent_hash%mask) the entity in each slot
     integer :: nnode = 0                       !< nodes
     integer, allocatable :: node_tag(:)
     real(wp), allocatable :: node_xy(:, :)
@@ -49,28 +55,55 @@ module mesh_topology
     integer, allocatable :: cell_tag(:), cell_entity(:)
     integer, allocatable :: cell_node(:, :)    !< (4, ncell) nodes; a triangle's 4th is 0
     integer :: nline = 0                       !< 2-node lines
-    integer, allocatable :: line_entity(:), line_node(:, :)
+    integer, allocatable :: line_tag(:), line_entity(:), line_node(:, :)
     integer :: npoint = 0                      !< point elements
     integer, allocatable :: point_entity(:), point_node(:)
   end type file_mesh_t
 
 contains
 
-  !> Add a physical group (dim, tag) named `name` unless it is there already.
-  subroutine add_physical(file_mesh, dim, tag, name)
+  !> The hash key of a physical group or entity (dim, tag), dim 0..3: non-negative.
+  pure integer(i8) function group_key(dim, tag)
+    integer, intent(in) :: dim, tag
+    group_key = int(dim, i8)*2_i8**32 + (int(tag, i8) + 2_i8**31)
+  end function group_key
+
+  !> Add a physical group (dim, tag), dim 0..3, named `name` unless it is there already
+  !! (looked up through a hash table, so many groups cost linear time). stat /= 0: out of
+  !! memory.
+  subroutine add_physical(file_mesh, dim, tag, name, stat)
     type(file_mesh_t), intent(inout) :: file_mesh
     integer, intent(in) :: dim, tag
     character(len=*), intent(in) :: name
+    integer, intent(out) :: stat
     integer, allocatable :: idim(:), itag(:)
     type(name_t), allocatable :: nm(:)
-    integer :: k
+    integer :: k, slot
+    integer(i8) :: key
+    stat = 0
     if (.not. allocated(file_mesh%phys_dim)) &
-      allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
-    do k = 1, file_mesh%nphys
-      if (file_mesh%phys_dim(k) == dim .and. file_mesh%phys_tag(k) == tag) return
-    end do
+      allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), stat=stat)
+    if (stat /= 0) return
+    if (2_i8*(file_mesh%nphys + 1) > file_mesh%phys_hash%mask + 1) then   ! keep the table at most half full
+      call hash_init(file_mesh%phys_hash, 2*(file_mesh%nphys + 1), stat)
+      if (stat == 0) then
+        if (allocated(file_mesh%phys_of_slot)) deallocate (file_mesh%phys_of_slot)
+        allocate (file_mesh%phys_of_slot(0:file_mesh%phys_hash%mask), stat=stat)
+      end if
+      if (stat /= 0) return
+      do k = 1, file_mesh%nphys
+        key = group_key(file_mesh%phys_dim(k), file_mesh%phys_tag(k))
+        slot = hash_slot(file_mesh%phys_hash, key)
+        file_mesh%phys_hash%key(slot) = key
+        file_mesh%phys_of_slot(slot) = k
+      end do
+    end if
+    key = group_key(dim, tag)
+    slot = hash_slot(file_mesh%phys_hash, key)
+    if (file_mesh%phys_hash%key(slot) == key) return
     if (file_mesh%nphys == size(file_mesh%phys_dim)) then
-      allocate (idim(2*file_mesh%nphys), itag(2*file_mesh%nphys), nm(2*file_mesh%nphys))
+      allocate (idim(2*file_mesh%nphys), itag(2*file_mesh%nphys), nm(2*file_mesh%nphys), stat=stat)
+      if (stat /= 0) return
       idim(1:file_mesh%nphys) = file_mesh%phys_dim
       itag(1:file_mesh%nphys) = file_mesh%phys_tag
       do k = 1, file_mesh%nphys
@@ -84,68 +117,79 @@ contains
     file_mesh%phys_dim(file_mesh%nphys) = dim
     file_mesh%phys_tag(file_mesh%nphys) = tag
     file_mesh%phys_name(file_mesh%nphys)%s = name
+    file_mesh%phys_hash%key(slot) = key
+    file_mesh%phys_of_slot(slot) = file_mesh%nphys
   end subroutine add_physical
 
-  !> The index in file_mesh%ent of entity (dim, tag), 0 if it has none.
+  !> Hash the entities (dim 0..2) for entity_index; of two with the same dimension and tag
+  !! the first is found. stat /= 0: out of memory.
+  subroutine index_entities(file_mesh, stat)
+    type(file_mesh_t), intent(inout) :: file_mesh
+    integer, intent(out) :: stat
+    integer :: k, slot
+    integer(i8) :: key
+    call hash_init(file_mesh%ent_hash, file_mesh%nent, stat)
+    if (stat == 0) allocate (file_mesh%ent_of_slot(0:file_mesh%ent_hash%mask), stat=stat)
+    if (stat /= 0) return
+    do k = 1, file_mesh%nent
+      key = group_key(file_mesh%ent(k)%dim, file_mesh%ent(k)%tag)
+      slot = hash_slot(file_mesh%ent_hash, key)
+      if (file_mesh%ent_hash%key(slot) == key) cycle
+      file_mesh%ent_hash%key(slot) = key
+      file_mesh%ent_of_slot(slot) = k
+    end do
+  end subroutine index_entities
+
+  !> The index in file_mesh%ent of entity (dim, tag), 0 if it has none (or dim is not 0..2).
   integer function entity_index(file_mesh, dim, tag) result(k)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: dim, tag
-    do k = 1, file_mesh%nent
-      if (file_mesh%ent(k)%dim == dim .and. file_mesh%ent(k)%tag == tag) return
-    end do
+    integer :: slot
+    integer(i8) :: key
     k = 0
+    if (.not. allocated(file_mesh%ent_of_slot) .or. dim < 0 .or. dim > 2) return
+    key = group_key(dim, tag)
+    slot = hash_slot(file_mesh%ent_hash, key)
+    if (file_mesh%ent_hash%key(slot) == key) k = file_mesh%ent_of_slot(slot)
   end function entity_index
-
-  !> Record a failure (the first one only).
-  subroutine refuse(info, err, text, code)
-    integer, intent(inout) :: info
-    character(len=:), allocatable, intent(inout) :: err
-    character(len=*), intent(in) :: text
-    integer, intent(in), optional :: code
-    if (info /= 0) return
-    info = BAD_INPUT
-    if (present(code)) info = code
-    err = text
-  end subroutine refuse
 
   !> One body from what a mesh file holds: choose the body's cells (those of the physical
   !! surface `region`), renumber its nodes, orient and check its cells, find its groups.
-  !! On failure info = 1 (bad input) or 3 (memory) and err is a phrase about the file
+  !! On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
   !! (its subject the file: 'has no physical surface ...').
-  subroutine body_from_file(file_mesh, region, path, mesh, info, err)
+  subroutine body_from_file(file_mesh, region, path, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh          !< the file's groups, entities, nodes, elements
     character(len=*), intent(in) :: region              !< physical surface name of the body, or ''
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
-    integer, intent(out) :: info                        !< 0; 1 bad input; 3 other failure
-    character(len=:), allocatable, intent(out) :: err   !< the failure, when info /= 0
+    type(error_t), intent(out) :: err                   !< the failure, if any
     integer :: surface, k, c, nsurf, ncell, st, nquad
     logical, allocatable :: in_entity(:)
     integer, allocatable :: file_cell(:), body_node(:), order(:)
     character(len=:), allocatable :: surfaces
+    type(text_buffer_t) :: list
 
-    info = 0
     ! the physical surface of the body
-    surfaces = ''
     nsurf = 0
     surface = 0
     do k = 1, file_mesh%nphys
       if (file_mesh%phys_dim(k) /= 2) cycle
       nsurf = nsurf + 1
-      surfaces = surfaces//merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'"
+      call list%add(merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'")
       if (len(region) > 0 .and. file_mesh%phys_name(k)%s == region) surface = k
     end do
+    surfaces = list%text()
     surfaces = trim(adjustl(surfaces))
     if (len(region) > 0 .and. surface == 0) then
       if (nsurf == 0) then
-        call refuse(info, err, "has no physical surface '"//region//"' (it has no physical surfaces)")
+        call err%set(ERR_INPUT, "has no physical surface '"//region//"' (it has no physical surfaces)")
       else
-        call refuse(info, err, "has no physical surface '"//region//"' (its physical surfaces: "//surfaces//')')
+        call err%set(ERR_INPUT, "has no physical surface '"//region//"' (its physical surfaces: "//surfaces//')')
       end if
       return
     end if
     if (len(region) == 0 .and. nsurf > 1) then
-      call refuse(info, err, 'holds '//i2s(nsurf)//' physical surfaces ('//surfaces// &
+      call err%set(ERR_INPUT, 'holds '//i2s(nsurf)//' physical surfaces ('//surfaces// &
                 '); name the body''s one as its region')
       return
     end if
@@ -166,10 +210,15 @@ contains
     ncell = size(file_cell)
     if (ncell == 0) then
       if (surface > 0) then
-        call refuse(info, err, "physical surface '"//file_mesh%phys_name(surface)%s// &
-                    "' has no triangles or quadrangles")
+        if (file_mesh%nent == 0) then
+          call err%set(ERR_INPUT, "names physical surface '"//file_mesh%phys_name(surface)%s// &
+                       "' but has no $Entities section, which ties elements to physical groups")
+        else
+          call err%set(ERR_INPUT, "physical surface '"//file_mesh%phys_name(surface)%s// &
+                       "' has no triangles or quadrangles")
+        end if
       else
-        call refuse(info, err, 'has no triangles or quadrangles')
+        call err%set(ERR_INPUT, 'has no triangles or quadrangles')
       end if
       return
     end if
@@ -177,7 +226,7 @@ contains
     ! its nodes, in increasing tag order
     allocate (body_node(file_mesh%nnode), stat=st)
     if (st /= 0) then
-      call refuse(info, err, 'not enough memory', OTHER_FAILURE)
+      call err%set(ERR_MEMORY, 'not enough memory for '//i2s(file_mesh%nnode)//' nodes')
       return
     end if
     body_node = 0
@@ -194,6 +243,14 @@ contains
       body_node(order(k)) = k
       mesh%xy(:, k) = file_mesh%node_xy(:, order(k))
       mesh%node_tag(k) = file_mesh%node_tag(order(k))
+    end do
+    do k = 1, mesh%nnode
+      if (maxval(abs(mesh%xy(:, k))) > COORD_MAX) then
+        call err%set(ERR_INPUT, 'node '//i2s(mesh%node_tag(k))//' has a coordinate of magnitude '// &
+                     sci(maxval(abs(mesh%xy(:, k))))//': beyond '//sci(COORD_MAX)// &
+                     ' the cells'' areas overflow double precision; scale the mesh')
+        return
+      end if
     end do
 
     ! its cells
@@ -219,9 +276,11 @@ contains
         mesh%cell_type(k) = ELEM_P1
         mesh%cells(1:3, k) = body_node(file_mesh%cell_node(1:3, c))
       end if
-      call orient_cell(mesh, k, info, err)
-      if (info /= 0) return
+      call orient_cell(mesh, k, err)
+      if (err%failed()) return
     end do
+    call check_duplicate_cells(mesh, err)
+    if (err%failed()) return
 
     mesh%structured = .false.
     mesh%source = path
@@ -232,16 +291,15 @@ contains
     mesh%width = maxval(mesh%xy(1, :)) - mesh%x0
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
-    call boundary_groups(file_mesh, body_node, mesh, info, err)
-    if (info == 0) call point_groups(file_mesh, body_node, mesh)
+    call boundary_groups(file_mesh, body_node, mesh, err)
+    if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh, err)
   end subroutine body_from_file
 
   !> Put cell k counter-clockwise; refuse it if degenerate or (a quadrangle) not convex.
-  subroutine orient_cell(mesh, k, info, err)
+  subroutine orient_cell(mesh, k, err)
     type(mesh_t), intent(inout) :: mesh
     integer, intent(in) :: k
-    integer, intent(inout) :: info
-    character(len=:), allocatable, intent(inout) :: err
+    type(error_t), intent(inout) :: err
     real(wp) :: p(2, 4), area2, h2, turn
     integer :: nv, i, i1, i2
     character(len=*), parameter :: what(2) = ['quadrangle', 'triangle  ']
@@ -256,7 +314,7 @@ contains
       h2 = max(h2, sum((p(:, i1) - p(:, i))**2))
     end do
     if (.not. abs(area2) > 2.0_wp*AREA_TOL*h2) then
-      call refuse(info, err, 'element '//i2s(mesh%cell_tag(k))//' (a '//trim(what(mesh%cell_type(k)))// &
+      call err%set(ERR_INPUT, 'element '//i2s(mesh%cell_tag(k))//' (a '//trim(what(mesh%cell_type(k)))// &
                 ') is degenerate: its area is zero or nearly so')
       return
     end if
@@ -270,7 +328,7 @@ contains
         i2 = modulo(i + 1, 4) + 1
         turn = (p(1, i1) - p(1, i))*(p(2, i2) - p(2, i1)) - (p(2, i1) - p(2, i))*(p(1, i2) - p(1, i1))
         if (.not. turn > AREA_TOL*h2) then
-          call refuse(info, err, 'element '//i2s(mesh%cell_tag(k))//' is not a convex quadrangle '// &
+          call err%set(ERR_INPUT, 'element '//i2s(mesh%cell_tag(k))//' is not a convex quadrangle '// &
                     '(inverted, self-crossing or with a re-entrant or straight corner at node '// &
                     i2s(mesh%node_tag(mesh%cells(i1, k)))//')')
           return
@@ -284,29 +342,33 @@ contains
   !! a group of nodes only). The lines' edges are hashed (a small table), then every cell
   !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
   !! oriented as that cell has it; one met in two is inside the body.
-  subroutine boundary_groups(file_mesh, body_node, mesh, info, err)
+  subroutine boundary_groups(file_mesh, body_node, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
-    integer, intent(inout) :: info
-    character(len=:), allocatable, intent(inout) :: err
+    type(error_t), intent(inout) :: err
     type(int_hash_t) :: edge_hash
     integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
+    integer, allocatable :: seen_group(:), seen_line(:), first(:), members(:)
     logical, allocatable :: marked(:)
-    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner
+    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m
     integer(i8) :: key, key_base
+    type(text_buffer_t) :: names
 
     ! the body's line edges, keyed by their two nodes (line_slot = -1: not a body edge)
     call hash_init(edge_hash, file_mesh%nline, st)
     if (st == 0) allocate (line_slot(file_mesh%nline), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
                            edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
-                           inner(2*file_mesh%nline), marked(mesh%nnode), stat=st)
+                           inner(2*file_mesh%nline), marked(mesh%nnode), seen_group(0:edge_hash%mask), &
+                           seen_line(0:edge_hash%mask), stat=st)
+    if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, st)
     if (st /= 0) then
-      call refuse(info, err, 'not enough memory for the boundary edges', OTHER_FAILURE)
+      call err%set(ERR_MEMORY, 'not enough memory for the boundary edges')
       return
     end if
     line_slot = -1
     edge_count = 0
+    seen_group = 0
     marked = .false.
     key_base = mesh%nnode + 1
     do line = 1, file_mesh%nline
@@ -335,19 +397,29 @@ contains
       end do
     end do
 
-    mesh%file_groups = ''
     ! room for the curves' and the points' groups
     allocate (mesh%group(count(file_mesh%phys_dim(1:file_mesh%nphys) == 1 .or. file_mesh%phys_dim(1:file_mesh%nphys) == 0)))
     ngroup = 0
     do phys = 1, file_mesh%nphys
       if (file_mesh%phys_dim(phys) /= 1) cycle
-      mesh%file_groups = trim(mesh%file_groups//' '//file_mesh%phys_name(phys)%s)
+      call names%add(' '//file_mesh%phys_name(phys)%s)
+      names%n = len_trim(names%buf(1:names%n))
       nedge = 0
       ninner = 0
-      do line = 1, file_mesh%nline
+      do m = first(phys), first(phys + 1) - 1
+        line = members(m)
         if (line_slot(line) < 0) cycle
-        if (.not. any(file_mesh%ent(file_mesh%line_entity(line))%phys == file_mesh%phys_tag(phys))) cycle
         slot = line_slot(line)
+        if (seen_group(slot) == phys) then      ! the same edge twice: its load would count twice
+          call err%set(ERR_INPUT, 'elements '//i2s(file_mesh%line_tag(seen_line(slot)))//' and '// &
+                       i2s(file_mesh%line_tag(line))//" of physical curve '"//file_mesh%phys_name(phys)%s// &
+                       "' are the same edge (nodes "//i2s(mesh%node_tag(body_node(file_mesh%line_node(1, line))))// &
+                       ' and '//i2s(mesh%node_tag(body_node(file_mesh%line_node(2, line))))// &
+                       '): a line listed twice would apply its load twice')
+          return
+        end if
+        seen_group(slot) = phys
+        seen_line(slot) = line
         if (edge_count(slot) == 0) cycle          ! not an edge of the body's cells
         if (edge_count(slot) > 1) then            ! inside the body: its nodes, once each
           do i = 1, 2
@@ -375,6 +447,7 @@ contains
       mesh%group(ngroup)%nnode = ninner
       mesh%group(ngroup)%node = inner(1:ninner)
     end do
+    mesh%file_groups = names%text()
     mesh%file_groups = trim(adjustl(mesh%file_groups))
     mesh%ngroup = ngroup
   end subroutine boundary_groups
@@ -383,26 +456,32 @@ contains
   !! physical point named as a physical curve adds its nodes to the curve's group); the
   !! points' names go to file_groups. A point's node is the body's if the body's cells have
   !! it; a node in no cell of the file is matched to the body's node at its place.
-  subroutine point_groups(file_mesh, body_node, mesh)
+  subroutine point_groups(file_mesh, body_node, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
-    logical, allocatable :: in_cell(:)
-    integer, allocatable :: nodes(:)
-    integer :: phys, point, n, nfound, group, c, i
+    type(error_t), intent(inout) :: err
+    logical, allocatable :: in_cell(:), taken(:)
+    integer, allocatable :: nodes(:), first(:), members(:)
+    integer :: phys, point, n, nfound, group, c, i, m, st
     real(wp) :: tol
     character(len=:), allocatable :: names
+    type(text_buffer_t) :: list
 
-    names = ''
-    allocate (nodes(file_mesh%npoint))
+    allocate (nodes(file_mesh%npoint), taken(mesh%nnode), stat=st)
+    if (st == 0) call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), first, members, st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for the physical points')
+      return
+    end if
+    taken = .false.
     tol = 1.0e-9_wp*max(mesh%width, mesh%height)
     do phys = 1, file_mesh%nphys
       if (file_mesh%phys_dim(phys) /= 0) cycle
-      names = names//' '//file_mesh%phys_name(phys)%s
+      call list%add(' '//file_mesh%phys_name(phys)%s)
       nfound = 0
-      do point = 1, file_mesh%npoint
-        if (file_mesh%point_entity(point) == 0) cycle
-        if (.not. any(file_mesh%ent(file_mesh%point_entity(point))%phys == file_mesh%phys_tag(phys))) cycle
+      do m = first(phys), first(phys + 1) - 1
+        point = members(m)
         n = body_node(file_mesh%point_node(point))
         if (n == 0) then
           if (.not. allocated(in_cell)) then
@@ -418,10 +497,12 @@ contains
             n = node_at(mesh, file_mesh%node_xy(:, file_mesh%point_node(point)), tol)
         end if
         if (n == 0) cycle
-        if (any(nodes(1:nfound) == n)) cycle
+        if (taken(n)) cycle
+        taken(n) = .true.
         nfound = nfound + 1
         nodes(nfound) = n
       end do
+      taken(nodes(1:nfound)) = .false.
       if (nfound == 0) cycle
       group = 0
       do c = 1, mesh%ngroup
@@ -438,6 +519,7 @@ contains
       mesh%group(group)%node = [mesh%group(group)%node, nodes(1:nfound)]
       mesh%group(group)%nnode = size(mesh%group(group)%node)
     end do
+    names = list%text()
     if (len(names) == 0) return
     if (len(mesh%file_groups) == 0) mesh%file_groups = '(none)'
     mesh%file_groups = mesh%file_groups//'; physical points:'//names
@@ -459,6 +541,137 @@ contains
       end if
     end do
   end function node_at
+
+  !> The physical group (dim, tag), 0 if the file has none.
+  integer function phys_index(file_mesh, dim, tag) result(p)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: dim, tag
+    integer :: slot
+    integer(i8) :: key
+    p = 0
+    if (file_mesh%nphys == 0) return
+    key = group_key(dim, tag)
+    slot = hash_slot(file_mesh%phys_hash, key)
+    if (file_mesh%phys_hash%key(slot) == key) p = file_mesh%phys_of_slot(slot)
+  end function phys_index
+
+  !> The items (lines or points, by their entities `item_entity`, 0: none) of every physical
+  !! group of dimension `dim`: those of group p are members(first(p):first(p + 1) - 1), in
+  !! file order, each once. One pass over the items, so many groups cost linear time.
+  subroutine group_members(file_mesh, dim, item_entity, first, members, stat)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: dim, item_entity(:)
+    integer, allocatable, intent(out) :: first(:), members(:)
+    integer, intent(out) :: stat
+    integer, allocatable :: fill(:), last_item(:)
+    integer :: pass, item, j, p
+    allocate (first(file_mesh%nphys + 1), fill(file_mesh%nphys), last_item(file_mesh%nphys), stat=stat)
+    if (stat /= 0) return
+    fill = 0
+    do pass = 1, 2            ! count, then place
+      last_item = 0
+      do item = 1, size(item_entity)
+        if (item_entity(item) == 0) cycle
+        associate (phys => file_mesh%ent(item_entity(item))%phys)
+          do j = 1, size(phys)
+            p = phys_index(file_mesh, dim, phys(j))
+            if (p == 0) cycle
+            if (last_item(p) == item) cycle     ! a tag listed twice counts once
+            last_item(p) = item
+            fill(p) = fill(p) + 1
+            if (pass == 2) members(first(p) + fill(p) - 1) = item
+          end do
+        end associate
+      end do
+      if (pass == 1) then
+        first(1) = 1
+        do p = 1, file_mesh%nphys
+          first(p + 1) = first(p) + fill(p)
+        end do
+        allocate (members(first(file_mesh%nphys + 1) - 1), stat=stat)
+        if (stat /= 0) return
+        fill = 0
+      end if
+    end do
+  end subroutine group_members
+
+  !> Refuse two cells with the same nodes (in any order): a cell listed twice would count
+  !! its stiffness twice. The cells are sorted by their sorted node lists, so duplicates
+  !! are neighbours (n log n).
+  subroutine check_duplicate_cells(mesh, err)
+    type(mesh_t), intent(in) :: mesh
+    type(error_t), intent(inout) :: err
+    integer, allocatable :: key(:, :), idx(:), work(:)
+    integer :: c, n, st, width, lo, mid, hi, i, j, k
+    n = mesh%ncell
+    if (n < 2) return
+    allocate (key(4, n), idx(n), work(n), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory to check '//i2s(n)//' cells for duplicates')
+      return
+    end if
+    key = 0
+    do c = 1, n
+      key(1:mesh%nvert, c) = mesh%cells(:, c)       ! a triangle's 4th node is 0 (or absent)
+      call sort4(key(:, c))
+      idx(c) = c
+    end do
+    width = 1
+    do while (width < n)                                ! bottom-up merge sort of idx by key
+      do lo = 1, n, 2*width
+        mid = min(lo + width, n + 1)
+        hi = min(lo + 2*width, n + 1)
+        i = lo
+        j = mid
+        do k = lo, hi - 1
+          if (i < mid .and. (j >= hi .or. .not. key_less(key(:, idx(min(j, n))), key(:, idx(min(i, n)))))) then
+            work(k) = idx(i)
+            i = i + 1
+          else
+            work(k) = idx(j)
+            j = j + 1
+          end if
+        end do
+      end do
+      idx = work
+      width = 2*width
+    end do
+    do k = 2, n
+      if (all(key(:, idx(k)) == key(:, idx(k - 1)))) then
+        i = min(idx(k - 1), idx(k))
+        j = max(idx(k - 1), idx(k))
+        call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(i))//' and '//i2s(mesh%cell_tag(j))// &
+                     ' have the same nodes: a cell listed twice would count its stiffness twice')
+        return
+      end if
+    end do
+  contains
+    pure logical function key_less(a, b)
+      integer, intent(in) :: a(4), b(4)
+      integer :: m
+      key_less = .false.
+      do m = 1, 4
+        if (a(m) /= b(m)) then
+          key_less = a(m) < b(m)
+          return
+        end if
+      end do
+    end function key_less
+    pure subroutine sort4(v)
+      integer, intent(inout) :: v(4)
+      integer :: p, q, t
+      do p = 2, 4
+        t = v(p)
+        q = p - 1
+        do while (q >= 1)
+          if (v(q) <= t) exit
+          v(q + 1) = v(q)
+          q = q - 1
+        end do
+        v(q + 1) = t
+      end do
+    end subroutine sort4
+  end subroutine check_duplicate_cells
 
   !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
   subroutine sort_by_tag(idx, tag)

@@ -10,6 +10,9 @@ module config
   implicit none (type, external)
   private
 
+  !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
+  !! are held in variables of this length, and a longer one is refused with its length.
+  integer, parameter, public :: PATH_LEN = 4096
   integer, parameter, public :: SIDE_LEFT = 1    !< x = x0
   integer, parameter, public :: SIDE_RIGHT = 2   !< x = x0 + width
   integer, parameter, public :: SIDE_BOTTOM = 3  !< y = y0
@@ -80,7 +83,7 @@ module config
   !> One elastic body: a rectangle meshed by nx x ny cells, or the cells of a Gmsh file.
   type, public :: body_cfg_t
     integer :: id = 0                 !< 1 or 2
-    character(len=512) :: mesh = ''   !< Gmsh MSH 4.1 file ('' : the rectangle below); absolute after reading
+    character(len=PATH_LEN) :: mesh = ''   !< Gmsh MSH 4.1 file ('' : the rectangle below); absolute after reading
     character(len=128) :: region = '' !< physical surface of the file that is this body ('' : the only one)
     real(wp) :: x0 = 0.0_wp           !< lower-left corner x [length]
     real(wp) :: y0 = 0.0_wp           !< lower-left corner y [length]
@@ -154,14 +157,14 @@ module config
 
   !> Output settings.
   type, public :: output_cfg_t
-    character(len=512) :: file = ''                   !< result file ('' -> results/<deck name>.h5)
+    character(len=PATH_LEN) :: file = ''              !< result file ('' -> results/<deck name>.h5)
     integer :: checkpoint_every = 0                   !< outer iterations between checkpoints (0: none)
     integer :: progress_lines = 30                    !< at most about this many progress lines
   end type output_cfg_t
 
   !> A whole input deck, defaults included.
   type, public :: deck_t
-    character(len=512) :: source = ''                 !< deck path as given
+    character(len=PATH_LEN) :: source = ''            !< deck path as given
     character(len=256) :: title = ''                  !< free text
     logical :: plane_strain = .true.                  !< .true.: plane strain, .false.: plane stress
     type(units_cfg_t) :: units                        !< unit names (&scene units=...)

@@ -72,6 +72,8 @@ contains
     integer :: i, k, ig
     character(len=:), allocatable :: olabel
 
+    if (len(path) > len(d%source)) call fatal(EXIT_INPUT, 'the deck path is '//i2s(len(path))// &
+      ' characters long, longer than the system''s limit of '//i2s(len(d%source))//' (PATH_MAX)')
     d%source = path
     st%path = path
     allocate (d%traction(4), st%trac_at(4), d%boundary(4))

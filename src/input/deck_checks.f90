@@ -373,7 +373,13 @@ contains
         trim(word(RECT, k))//' describes a built-in rectangle, but this body comes from mesh='''// &
         trim(c%mesh)//'''; give its conditions with &boundary and &traction on the mesh''s groups')
     end do
-    if (c%mesh(1:1) /= '/') c%mesh = deck_folder(deck_path)//trim(c%mesh)
+    if (c%mesh(1:1) /= '/') then
+      if (len(deck_folder(deck_path)) + len_trim(c%mesh) > len(c%mesh)) call die_at(src, g%line, &
+        'in group &body: the mesh path '''//trim(c%mesh)//''' in the deck''s folder '''//deck_folder(deck_path)// &
+        ''' is '//i2s(len(deck_folder(deck_path)) + len_trim(c%mesh))//' characters long, longer than the '// &
+        'system''s limit of '//i2s(len(c%mesh))//' (PATH_MAX)')
+      c%mesh = deck_folder(deck_path)//trim(c%mesh)
+    end if
     c%bc = BC_FREE
   end subroutine mesh_body
 

@@ -14,7 +14,7 @@ module files
   private
 
   public :: temp_name, run_id, replace_suffix, base_name, dir_name, ensure_parent_dir, atomic_rename, &
-            remove_file, write_text, commit_files
+            remove_file, write_text, commit_files, special_file
 
   interface
     integer(c_int) function c_rename(old, new) bind(c, name='rename')
@@ -59,6 +59,11 @@ module files
       implicit none (type, external)
       character(kind=c_char), intent(in) :: path(*)
     end function rc_path_kind
+    integer(c_int) function rc_file_kind(path) bind(c, name='rc_file_kind')
+      import :: c_int, c_char
+      implicit none (type, external)
+      character(kind=c_char), intent(in) :: path(*)
+    end function rc_file_kind
     integer(c_int) function rc_dir_writable(dir) bind(c, name='rc_dir_writable')
       import :: c_int, c_char
       implicit none (type, external)
@@ -181,6 +186,16 @@ contains
     logical, intent(out) :: ok            !< success
     ok = c_rename(trim(old)//c_null_char, trim(new)//c_null_char) == 0
   end subroutine atomic_rename
+
+  !> True when `path` names something that exists and is not a regular file (after
+  !! symbolic links): a folder, FIFO, device or socket. Opening a FIFO to read waits for a
+  !! writer, so a reader checks its input file here first.
+  logical function special_file(path)
+    character(len=*), intent(in) :: path   !< the file
+    integer :: kind
+    kind = rc_file_kind(path//c_null_char)
+    special_file = kind == 2 .or. kind == 3
+  end function special_file
 
   !> unlink(2) `path` if it exists (a symbolic link is removed, not its target).
   subroutine remove_file(path)

@@ -52,6 +52,15 @@ int rc_path_kind(const char *path)
     return 3;
 }
 
+int rc_file_kind(const char *path)
+{
+    struct stat s;
+    if (stat(path, &s) != 0) return errno == ENOENT ? 0 : -1;
+    if (S_ISREG(s.st_mode)) return 1;
+    if (S_ISDIR(s.st_mode)) return 2;
+    return 3;
+}
+
 int rc_dir_writable(const char *dir)
 {
     return access(dir, W_OK | X_OK) == 0;

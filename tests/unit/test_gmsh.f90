@@ -2,7 +2,8 @@
 !! coordinates, boundary groups and their outward normals, refinement), and small bad or
 !! unusual MSH files written here (binary, version 2.2, missing node, 3D, second order,
 !! unknown region, clockwise cells, degenerate and non-convex cells, sparse unordered tags,
-!! truncation, unknown sections, numbers in every form), and groups of nodes (physical
+!! truncation, unknown sections, numbers in every form, cells and boundary lines listed
+!! twice, tags < 1, counts the file cannot hold), and groups of nodes (physical
 !! points, a physical curve inside a body).
 !!
 !! With arguments, `test_gmsh file.msh [region]` only reads that file and prints the time
@@ -11,7 +12,8 @@ program test_gmsh
   use kinds, only: wp
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal
-  use gmsh_msh, only: msh_read
+  use gmsh_msh, only: msh_read_err => msh_read
+  use errors, only: error_t, exit_code
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary, write_file
   implicit none (type, external)
@@ -43,6 +45,19 @@ program test_gmsh
 contains
 
   ! ---- helpers --------------------------------------------------------------------------
+
+  !> msh_read with its error as an exit code (0; 1 bad input; 3 other) and a message.
+  subroutine msh_read(path, region, body_id, m, info, msg)
+    character(len=*), intent(in) :: path, region
+    integer, intent(in) :: body_id
+    type(mesh_t), intent(out) :: m
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    type(error_t) :: err
+    call msh_read_err(path, region, body_id, m, err)
+    info = exit_code(err)
+    msg = err%text()
+  end subroutine msh_read
 
   subroutine read_ok(path, region, m)
     character(len=*), intent(in) :: path, region
@@ -586,6 +601,27 @@ contains
                       'a second $Nodes section is refused')
     call expect_error('notmsh.msh', [character(len=20) :: 'hello', 'world'], 'sq', 1, &
                       [character(len=20) :: 'not a Gmsh MSH', 'line 1'], 'a file that is not MSH is refused')
+    ! duplicates, tags and counts the file cannot hold
+    call expect_error('dup_tri.msh', square(element_lines=[character(len=60) :: '$Elements', '1 3 1 9', &
+                      '2 1 2 3', '7 1 2 3', '8 1 3 4', '9 3 1 2', '$EndElements']), 'sq', 1, &
+                      [character(len=24) :: 'elements 7 and 9', 'same nodes'], 'a triangle listed twice (rotated) is refused')
+    call expect_error('dup_line.msh', square(element_lines=[character(len=60) :: '$Elements', '2 3 1 9', &
+                      '1 1 1 2', '8 1 2', '9 2 1', '2 1 3 1', '7 1 2 3 4', '$EndElements']), 'sq', 1, &
+                      [character(len=24) :: 'elements 8 and 9', "curve 'base'"], 'a boundary line listed twice is refused')
+    call expect_error('tag0.msh', square(element_lines=[character(len=60) :: '$Elements', '2 2 1 8', &
+                      '1 1 1 1', '8 1 2', '2 1 3 1', '0 1 2 3 4', '$EndElements']), 'sq', 1, &
+                      [character(len=24) :: 'element tag 0', 'must be >= 1'], 'an element tag 0 is refused')
+    call expect_error('ref0.msh', square(element_lines=[character(len=60) :: '$Elements', '2 2 1 8', &
+                      '1 1 1 1', '8 1 -1', '2 1 3 1', '7 1 2 3 4', '$EndElements']), 'sq', 1, &
+                      [character(len=24) :: 'node tag -1', 'must be >= 1'], 'a node reference -1 is refused')
+    l = square()
+    l(10) = '0 1 99999 0'
+    call expect_error('many_ents.msh', l, 'sq', 1, [character(len=24) :: 'announces 99999 surfaces', 'at most'], &
+                      'more surfaces than the file can hold are refused before allocating')
+    l = square()
+    l(11) = '1 0 0 0 1 0 0 1 10 2000000000'
+    call expect_error('many_bounds.msh', l, 'sq', 1, [character(len=24) :: '2000000000 bounding', 'curve 1'], &
+                      'more bounding entities than the file can hold are refused')
   end subroutine test_bad_inputs
 
   subroutine test_unusual_inputs()
