@@ -9,6 +9,7 @@ module rigid_modes
   use mesh, only: mesh_t, side_nodes, group_index, group_nodes
   use lapack, only: dsyev
   use body_system, only: body_system_t
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -21,13 +22,14 @@ contains
   !! eigenvectors of their 3 x 3 Gram matrix with eigenvalues below 1e-10 of the largest;
   !! all three when nothing is prescribed). Sets sys%nrig, rig_coef, rig_xc, rig_h and
   !! sys%rig (ndof x nrig, zero at prescribed DOFs).
-  subroutine rigid_kernel(mesh, prescribed, sys, info)
+  subroutine rigid_kernel(mesh, prescribed, sys, err)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
     type(body_system_t), intent(inout) :: sys  !< gets nrig, rig, rig_coef, rig_xc, rig_h
-    integer, intent(out) :: info               !< /= 0: dsyev failed
+    type(error_t), intent(out) :: err          !< ERR_NUMERICAL when dsyev fails
     real(wp) :: g(3, 3), r(3), ev(3), work(64), top
     integer :: k, cc, j, lapinfo, nk
+    character(len=512) :: emsg
 
     sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
     sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
@@ -44,8 +46,12 @@ contains
     call dsyev('V', 'U', 3, g, 3, ev, work, size(work), lapinfo)
     top = max(ev(3), 0.0_wp)
     nk = 0
-    info = lapinfo
-    if (lapinfo /= 0) return
+    if (lapinfo /= 0) then
+      write (emsg, '(a,i0,a)') 'body ', sys%id, ': LAPACK dsyev failed on the 3 x 3 Gram matrix of its '// &
+        'rigid modes (the kernel of its supports is unknown)'
+      call err%set(ERR_NUMERICAL, emsg)
+      return
+    end if
     nk = count(ev <= 1.0e-10_wp*top)
     if (top <= 0.0_wp) nk = 3
     sys%nrig = nk
@@ -128,21 +134,19 @@ contains
   !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
   !! and the node farthest from that one) for the largest |det| of the kernel restricted to
   !! them. They are prescribed to 0 (prescribed) for the factorization only.
-  subroutine choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
+  subroutine choose_fixing(mesh, body, prescribed, sys, err, contact_group)
     type(mesh_t), intent(in) :: mesh                         !< the body's mesh
     type(body_cfg_t), intent(in) :: body                     !< its id and side conditions
     logical, intent(inout) :: prescribed(:)                  !< (ndof) the fixing DOFs are added
     type(body_system_t), intent(inout) :: sys                !< gets fixing; its u_fixed is 0 there
-    integer, intent(out) :: info                             !< 0, or 1 when no fixing DOFs are found
-    character(len=*), intent(out) :: msg                     !< the failure, naming the body
+    type(error_t), intent(out) :: err                        !< ERR_INPUT when no fixing DOFs are found
     character(len=*), intent(in), optional :: contact_group  !< the body's contact group, kept clear
     logical, allocatable :: avoid(:)
     integer, allocatable :: nodes(:)
     integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
     real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
+    character(len=512) :: emsg
 
-    info = 0
-    msg = ''
     r = sys%nrig
     allocate (avoid(mesh%nnode))
     avoid = .false.
@@ -178,10 +182,10 @@ contains
       end if
     end do
     if (p(1) == 0) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
+      write (emsg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
         'contact or prescribed: no node is left to fix its rigid motion for the factorization; '// &
         'refine the mesh or support the body'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     dbest = -1.0_wp
@@ -224,9 +228,9 @@ contains
       end do
     end do
     if (.not. detbest > 1.0e-6_wp) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
+      write (emsg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
         'from the contact fixes its free rigid motion for the factorization; support the body'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     allocate (sys%fixing(r))

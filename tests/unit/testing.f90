@@ -16,6 +16,7 @@ module testing
   use lapack, only: dpbsv
   use ordering, only: grid_dissection, coordinate_bisection
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
+  use errors, only: error_t
   implicit none (type, external)
   private
 
@@ -24,6 +25,7 @@ module testing
 
   public :: report, report_le, test_summary, band_solve, solve_full, obstacle_problem
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
+  public :: error_parts
 
 contains
 
@@ -175,14 +177,15 @@ contains
     type(traction_cfg_t) :: tr(1)
     integer :: info
     character(len=256) :: msg
+    type(error_t) :: err
     tr(1)%body = b%id
     tr(1)%side = SIDE_TOP
     tr(1)%t0 = [1.0e6_wp, -3.0e6_wp]
     tr(1)%t1 = [0.0_wp, -1.0e6_wp]
     call mesh_build(msh, b, info, msg)
     if (info /= 0) error stop 'structured_body: mesh_build failed'
-    call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
-    if (info /= 0) error stop 'structured_body: assemble_body failed'
+    call assemble_body(msh, b, .true., tr, 1, sys, err)
+    if (err%failed()) error stop 'structured_body: assemble_body failed'
     last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
   end subroutine structured_body
 
@@ -244,6 +247,7 @@ contains
     integer(int64) :: state
     real(wp) :: hx, hy
     character(len=256) :: msg
+    type(error_t) :: err
 
     tr(1)%body = b%id
     tr(1)%side = SIDE_TOP
@@ -319,8 +323,8 @@ contains
     tr(1)%group = 'top'
     tr(1)%tx = tr(1)%t1
     tr(1)%t1 = 0.0_wp
-    call assemble_body(msh, free, .true., tr, 1, sys, info, msg, boundaries=bd(1:nbd))
-    if (info /= 0) error stop 'general_body: assemble_body failed on the general mesh'
+    call assemble_body(msh, free, .true., tr, 1, sys, err, boundaries=bd(1:nbd))
+    if (err%failed()) error stop 'general_body: assemble_body failed on the general mesh'
 
     call side_nodes(grid, SIDE_BOTTOM, bottom)
     allocate (last(0))
@@ -352,15 +356,27 @@ contains
     integer, intent(in) :: last(:), perm(:)
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
+    type(error_t) :: err
     select case (o)
     case (1)
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, err, last=last)
     case (2)
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, err, last=last)
     case default
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, last=last, &
                      interior_perm=perm)
     end select
+    info = merge(1, 0, err%failed())
+    msg = err%text()
   end subroutine factor_ordered
+
+  !> An error_t as the tests read it: info its category (0 when none), msg its message.
+  subroutine error_parts(err, info, msg)
+    type(error_t), intent(in) :: err       !< the error, possibly none
+    integer, intent(out) :: info           !< err%category
+    character(len=*), intent(out) :: msg   !< err%text()
+    info = err%category
+    msg = err%text()
+  end subroutine error_parts
 
 end module testing
