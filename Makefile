@@ -172,8 +172,8 @@ $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact_common.o: $(BUILD)/kinds.o $(BUILD)/condense.o $(BUILD)/contact_types.o
 $(BUILD)/equality_rows.o:  $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/condense.o
 # the Robin operators implement one interface: not every operator needs every argument
-$(BUILD)/robin_operators.o: $(BUILD)/errors.o FFLAGS += -Wno-unused-dummy-argument
-$(BUILD)/robin_operators.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
+$(BUILD)/robin_operators.o: FFLAGS += -Wno-unused-dummy-argument
+$(BUILD)/robin_operators.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
                            $(BUILD)/condense.o $(BUILD)/contact_common.o
 $(BUILD)/robin_subproblems.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
                            $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/contact_common.o \
