@@ -72,7 +72,7 @@ MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo 
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_deck test_mprgp test_mprgp_options test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_floating test_digest
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_floating test_digest
 BENCH_F := bench_mprgp bench_ordering
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -136,7 +136,7 @@ $(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
                            $(BUILD)/deck_checks.o $(BUILD)/deck_render.o
-$(BUILD)/budget.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
+$(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
 $(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/text_scanner.o \
@@ -146,42 +146,42 @@ $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/body_system.o:    $(BUILD)/kinds.o
 $(BUILD)/supports.o:       $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o $(BUILD)/strings.o
-$(BUILD)/stiffness_pattern.o: $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
-$(BUILD)/rigid_modes.o:    $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
-$(BUILD)/assembly.o:       $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
+$(BUILD)/stiffness_pattern.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
+$(BUILD)/rigid_modes.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
+$(BUILD)/assembly.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/body_system.o $(BUILD)/supports.o \
                            $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o
 $(BUILD)/ordering.o:       $(BUILD)/kinds.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
-$(BUILD)/banded.o:         $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
-$(BUILD)/cholesky.o:       $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
-$(BUILD)/mumps_iface.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/lapack.o
+$(BUILD)/banded.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
+$(BUILD)/cholesky.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/mumps_iface.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/lapack.o
 $(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
                            $(BUILD)/mprgp_support.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
-$(BUILD)/mortar_chains.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
-$(BUILD)/mortar.o:         $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
-$(BUILD)/condense.o:       $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
+$(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
+$(BUILD)/condense.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o
-$(BUILD)/condense_mumps.o: $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o $(BUILD)/condense.o \
+$(BUILD)/condense_mumps.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o $(BUILD)/condense.o \
                            $(BUILD)/mumps_iface.o
-$(BUILD)/floating.o:       $(BUILD)/kinds.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/lapack.o \
+$(BUILD)/floating.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/lapack.o \
                            $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact_common.o: $(BUILD)/kinds.o $(BUILD)/condense.o $(BUILD)/contact_types.o
 $(BUILD)/equality_rows.o:  $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/condense.o
 # the Robin operators implement one interface: not every operator needs every argument
 $(BUILD)/robin_operators.o: FFLAGS += -Wno-unused-dummy-argument
-$(BUILD)/robin_operators.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
+$(BUILD)/robin_operators.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
                            $(BUILD)/condense.o $(BUILD)/contact_common.o
 $(BUILD)/robin_subproblems.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
                            $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/contact_common.o \
                            $(BUILD)/equality_rows.o $(BUILD)/robin_operators.o
 $(BUILD)/acceleration.o:   $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/lapack.o $(BUILD)/contact_types.o \
                            $(BUILD)/contact_common.o
-$(BUILD)/robin_iteration.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/clock.o $(BUILD)/condense.o \
+$(BUILD)/robin_iteration.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/clock.o $(BUILD)/condense.o \
                            $(BUILD)/contact_types.o $(BUILD)/contact_common.o $(BUILD)/robin_operators.o \
                            $(BUILD)/robin_subproblems.o $(BUILD)/acceleration.o
 $(BUILD)/monolithic.o:     $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/clock.o $(BUILD)/mprgp.o \
@@ -192,7 +192,7 @@ $(BUILD)/error_estimate.o: $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/condense.
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o
 $(BUILD)/files.o:
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
-$(BUILD)/results.o:        $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
+$(BUILD)/results.o:        $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
                            $(BUILD)/condense.o $(BUILD)/floating.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
                            $(BUILD)/history_io.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \

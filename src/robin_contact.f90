@@ -12,7 +12,7 @@
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use errors, only: fatal, warn, EXIT_INPUT
+  use errors, only: fatal, warn, error_t, fail_on, EXIT_INPUT
   use config, only: METHOD_ROBIN
   use deck, only: read_deck, print_deck
   use results, only: program_version
@@ -32,10 +32,10 @@ program robin_contact
 
   type(run_t) :: run
   class(backend_t), allocatable :: backend
-  character(len=:), allocatable :: deck_path, budget_msg
+  character(len=:), allocatable :: deck_path
   character(len=4096), allocatable :: overrides(:)
   real(wp) :: t0
-  logical :: ok
+  type(error_t) :: err
 
   ! ---- the deck, and a deck that cannot fit this machine refused before anything is allocated
   call start_ranks(run)
@@ -46,8 +46,8 @@ program robin_contact
     'deck '//trim(run%deck%source)//': --restart applies to method=''robin'' only')
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
   call backend%check_memory(run, run%deck)
-  call check_load_range(run%deck, ok, budget_msg)
-  if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+  call check_load_range(run%deck, err)
+  call fail_on(err, 'deck '//trim(run%deck%source))
   run%key = physics_key(run%deck)
   write (output_unit, '(a)') 'robin_contact '//program_version//': effective input'
   call print_deck(run%deck, output_unit)

@@ -18,6 +18,7 @@ module condense
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL, ERR_MEMORY
   use lapack, only: dpstrf, dsyev
   implicit none (type, external)
   private
@@ -105,68 +106,59 @@ contains
   !! groups of &contact, or a rectangle's side declared 'contact' (its mesh has the sides
   !! as groups 'left', 'right', 'bottom', 'top'). On matching lines the mortar rows are the
   !! node-to-node ones to rounding, so one path serves every scene.
-  subroutine build_interface(body, cc, msh, sys, itf, info, msg)
+  subroutine build_interface(body, cc, msh, sys, itf, err)
     type(body_cfg_t), intent(in) :: body(2)          !< the two bodies (their contact sides)
     type(contact_cfg_t), intent(in) :: cc            !< the interface settings (groups, slave, initial gap)
     type(mesh_t), intent(in) :: msh(2)               !< meshes of body 1 and 2
     type(body_system_t), intent(in) :: sys(2)        !< assembled systems
     type(interface_t), intent(out) :: itf            !< the contact line
-    integer, intent(out) :: info                     !< 0 ok, 1 bad input
-    character(len=*), intent(out) :: msg             !< description of a failure
+    type(error_t), intent(out) :: err                !< the bad input (ERR_INPUT), if any
     type(contact_cfg_t) :: ccg
     integer :: a, side
 
-    info = 0
-    msg = ''
     ccg = cc
     if (len_trim(cc%body_group(1)) == 0) then
       do a = 1, 2
         side = findloc(body(a)%bc, BC_CONTACT, dim=1)
         if (side == 0) then
-          info = 1
-          msg = 'body '//i2s(a)//' has no contact side'
+          call err%set(ERR_INPUT, 'body '//i2s(a)//' has no contact side')
           return
         end if
         ccg%body_group(a) = side_names(side)
       end do
     end if
-    call mortar_interface(ccg, msh, sys, itf, info, msg)
+    call mortar_interface(ccg, msh, sys, itf, err)
   end subroutine build_interface
 
   !> The interface of two named edge groups by dual mortar (module mortar): the slave is
   !! cc%slave, or the body whose contact group has the shorter mean edge (body 1 on a tie).
   !! A slave node carries no row when its normal displacement and that of every master node
   !! its row involves are prescribed (the constraint would only repeat the supports): found
-  !! by a first build, then the rows are built again without those nodes. info = 1 (bad
-  !! input) for an unknown group, a group facing nothing, or an initial overlap.
-  subroutine mortar_interface(cc, msh, sys, itf, info, msg)
+  !! by a first build, then the rows are built again without those nodes. err = ERR_INPUT
+  !! for an unknown group, a group facing nothing, or an initial overlap.
+  subroutine mortar_interface(cc, msh, sys, itf, err)
     type(contact_cfg_t), intent(in) :: cc
     type(mesh_t), intent(in) :: msh(2)
     type(body_system_t), intent(in) :: sys(2)
     type(interface_t), intent(out) :: itf
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
     integer :: g(2), a, sl, ma, j, e, k, ne
     real(wp) :: hmean(2), tol, gmin
     logical, allocatable :: removable(:)
     real(wp), allocatable :: gdist(:)
     type(mortar_t) :: mt
-    character(len=512) :: why
+    type(error_t) :: why
 
-    info = 0
-    msg = ''
     do a = 1, 2
       g(a) = group_index(msh(a), cc%body_group(a))
       if (g(a) == 0) then
-        info = 1
-        msg = '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)// &
-              ' has no such group with edges on its boundary; its groups are '//group_names(msh(a))
+        call err%set(ERR_INPUT, '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)// &
+              ' has no such group with edges on its boundary; its groups are '//group_names(msh(a)))
         return
       end if
       if (nodes_only(msh(a), g(a))) then
-        info = 1
-        msg = '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)//': '// &
-              nodes_only_refusal(msh(a), g(a), 'contact needs')
+        call err%set(ERR_INPUT, '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)//': '// &
+              nodes_only_refusal(msh(a), g(a), 'contact needs'))
         return
       end if
       associate (gr => msh(a)%group(g(a)))
@@ -186,8 +178,8 @@ contains
     allocate (removable(msh(sl)%nnode))
     removable = .false.
     call mortar_build(msh(sl)%xy, msh(sl)%group(g(sl))%edge, removable, msh(ma)%xy, &
-                      msh(ma)%group(g(ma))%edge, mt, info, why)
-    if (info == 0) then
+                      msh(ma)%group(g(ma))%edge, mt, why)
+    if (.not. why%failed()) then
       do j = 1, mt%m
         removable(mt%snode(j)) = normal_fixed(sys(sl), mt%snode(j), mt%normal(:, j))
         do k = mt%mptr(j), mt%mptr(j + 1) - 1
@@ -196,12 +188,11 @@ contains
         end do
       end do
       if (any(removable)) call mortar_build(msh(sl)%xy, msh(sl)%group(g(sl))%edge, removable, msh(ma)%xy, &
-                                            msh(ma)%group(g(ma))%edge, mt, info, why)
+                                            msh(ma)%group(g(ma))%edge, mt, why)
     end if
-    if (info /= 0) then
-      info = 1
-      msg = 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(sl)//' (slave) and '''// &
-            trim(cc%body_group(ma))//''' of body '//i2s(ma)//' (master): '//trim(why)
+    if (why%failed()) then
+      call err%set(ERR_INPUT, 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(sl)//' (slave) and '''// &
+                   trim(cc%body_group(ma))//''' of body '//i2s(ma)//' (master): '//why%text())
       return
     end if
 
@@ -216,11 +207,10 @@ contains
     gmin = minval(gdist)
     if (gmin < -tol) then
       j = minloc(gdist, dim=1)
-      info = 1
-      msg = 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
+      call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
             ''' overlap in the initial configuration: the gap at slave node '//i2s(msh(sl)%node_tag(mt%snode(j)))// &
             ' of body '//i2s(sl)//' at ('//r2s(msh(sl)%xy(1, mt%snode(j)))//', '//r2s(msh(sl)%xy(2, mt%snode(j)))// &
-            ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart'
+            ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart')
       return
     end if
 
@@ -330,17 +320,17 @@ contains
   !> Factorize K_a with the interface DOFs ordered last. ordering='nd' orders the
   !! other DOFs by geometric nested dissection of the body's grid (module ordering);
   !! its time is part of t_factor.
-  subroutine factor_body(fc, itf, a, msh, sys, bc, info, msg)
+  subroutine factor_body(fc, itf, a, msh, sys, bc, err)
     type(factor_cfg_t), intent(in) :: fc             !< factorization and ordering
     type(interface_t), intent(in) :: itf             !< the contact line
     integer, intent(in) :: a                         !< body number
     type(mesh_t), intent(in) :: msh                  !< mesh of body a
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
     type(body_condensed_t), intent(inout) :: bc      !< receives the factorization
-    integer, intent(out) :: info                     !< 0 ok, else failure (see chol_factor)
-    character(len=*), intent(out) :: msg             !< description of a failure
-    integer :: method, iord
+    type(error_t), intent(out) :: err                !< the failure (see chol_factor), if any
+    integer :: method, iord, info
     integer, allocatable :: perm(:)
+    character(len=200) :: msg
     real(wp) :: t0
 
     t0 = wtime()
@@ -365,23 +355,23 @@ contains
         call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, bc%idx, perm, info, msg)
       end if
       if (info /= 0) then
+        call err%set(ERR_NUMERICAL, msg)
         bc%t_factor = wtime() - t0
         return
       end if
-      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, info, msg, last=bc%idx, &
+      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, err, last=bc%idx, &
                           interior_perm=perm)
     else
-      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, info, msg, last=bc%idx)
+      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, err, last=bc%idx)
     end if
     bc%t_factor = wtime() - t0
   end subroutine factor_body
 
   !> Form F_a and b_a (and u0 = K_a^-1 f_a) from the factorization.
-  subroutine condense_body(sys, bc, info, msg)
+  subroutine condense_body(sys, bc, err)
     type(body_system_t), intent(in) :: sys           !< assembled system of the body
     type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives flex, b, u0
-    integer, intent(out) :: info                     !< 0 ok
-    character(len=*), intent(out) :: msg             !< description of a failure
+    type(error_t), intent(out) :: err                !< the failure, if any
     real(wp) :: t0
     integer :: k, st
     real(wp), allocatable :: x(:, :)
@@ -390,25 +380,22 @@ contains
     if (allocated(bc%b)) deallocate (bc%b)
     if (allocated(bc%u0)) deallocate (bc%u0)
     allocate (bc%b(bc%m), bc%u0(sys%n))
-    info = 0
-    msg = ''
     k = size(bc%idx)
     if (bc%m > 0 .and. k > 0) then
       ! X = (K^-1) on the interface DOFs, then F = B X B' over the few entries of each row
       allocate (x(k, k), stat=st)
       if (st /= 0) then
-        info = 2
-        msg = 'out of memory for the interface block of K^-1'
+        call err%set(ERR_MEMORY, 'out of memory for the interface block of K^-1')
         return
       end if
-      call bc%chol%flexibility(bc%idx, spread(1.0_wp, 1, k), x, info, msg)
-      if (info /= 0) return
+      call bc%chol%flexibility(bc%idx, spread(1.0_wp, 1, k), x, err)
+      if (err%failed()) return
     end if
     if (.not. allocated(x)) allocate (x(0, 0))
     call flex_from_x(bc, x)
     bc%u0 = sys%f
-    call bc%chol%solve(bc%u0, info, msg)
-    if (info /= 0) return
+    call bc%chol%solve(bc%u0, err)
+    if (err%failed()) return
     call apply_b(bc, bc%u0, bc%b)
     bc%t_condense = wtime() - t0
   end subroutine condense_body
@@ -528,12 +515,12 @@ contains
     real(wp), intent(in) :: lam(:)                   !< (m) contact force on this body [force]
     real(wp), intent(out) :: u_free(:)               !< (n) displacement at free DOFs [length]
     real(wp), allocatable :: r(:)
-    integer :: info
+    type(error_t) :: err
     allocate (r(sys%n))
     r = 0.0_wp
     call apply_bt(bc, lam, r)
-    call bc%chol%solve(r, info)
-    if (info /= 0) r = ieee_value(1.0_wp, ieee_quiet_nan)
+    call bc%chol%solve(r, err)
+    if (err%failed()) r = ieee_value(1.0_wp, ieee_quiet_nan)
     u_free = bc%u0 - r
   end subroutine recover_displacement
 

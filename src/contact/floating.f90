@@ -10,6 +10,7 @@ module floating
   use condense, only: body_condensed_t, interface_t
   use lapack, only: dsyev, dgels, dsygv
   use strings, only: i2s, r2s
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
@@ -57,23 +58,21 @@ contains
     if (.not. norm2(body%re) > 1.0e-12_wp*max(sum(abs(system%f_applied)), tiny(1.0_wp))) body%re = 0.0_wp
   end subroutine rigid_rows
 
-  !> Can the contact hold the floating bodies? info = 1 (bad input) with the sentence
-  !! when a free motion has no contact normal component, when the load cannot be balanced
-  !! by compressive contact forces, when nothing presses the body into the contact, or
-  !! when two floating bodies are free together.
-  subroutine check_held(systems, bodies, info, msg)
+  !> Can the contact hold the floating bodies? err = ERR_INPUT with the sentence when a
+  !! free motion has no contact normal component, when the load cannot be balanced by
+  !! compressive contact forces, when nothing presses the body into the contact, or when
+  !! two floating bodies are free together.
+  subroutine check_held(systems, bodies, err)
     type(body_system_t), intent(in) :: systems(2)
     type(body_condensed_t), intent(in) :: bodies(2)
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
+    character(len=:), allocatable :: msg
     real(wp), allocatable :: gg(:, :), lam(:), gs(:, :), es(:), sr(:, :)
     real(wp) :: ev(6), c(3), fx, fy, along, res, enorm
     integer :: a, r, m, lapinfo, k
     character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
       'a ''roller'', or ux/uy on a group (&boundary)'
 
-    info = 0
-    msg = ''
     m = size(bodies(1)%rg, 2)
     do a = 1, 2
       r = bodies(a)%nrig
@@ -91,13 +90,12 @@ contains
       if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
         c = matmul(systems(a)%rig_coef, gg(:, 1))
         along = dot_product(gg(:, 1), bodies(a)%re)
-        info = 1
         msg = 'body '//i2s(a)//' is held only by contact (its supports leave rigid motion free), '// &
               'but the contact cannot hold its '//rigid_motion_name(systems(a), c)//': the contact normals '// &
               'have (almost) no component along it (frictionless contact lets the body slide or turn)'
-        if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = trim(msg)// &
+        if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = msg// &
           '; its load has a component '//r2s(along)//' along that motion, which no contact force balances'
-        msg = trim(msg)//'; '//hold
+        call err%set(ERR_INPUT, msg//'; '//hold)
         return
       end if
       deallocate (gg)
@@ -107,21 +105,19 @@ contains
       enorm = norm2(bodies(a)%re)
       if (enorm == 0.0_wp .and. m > 0) cycle
       if (m == 0) then
-        info = 1
-        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
+        call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact (load resultant ('//r2s(fx)//', '//r2s(fy)//')): its position '// &
-              'is undetermined; load it towards the other body, or '//hold
+              'is undetermined; load it towards the other body, or '//hold)
         return
       end if
       ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
       allocate (lam(m))
       call nnls(bodies(a)%rg, bodies(a)%re, lam, res)
       if (res > 1.0e-8_wp*enorm) then
-        info = 1
-        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but its load '// &
+        call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but its load '// &
               '(resultant ('//r2s(fx)//', '//r2s(fy)//')) pulls it away from the contact: no compressive '// &
               'contact force balances it (an unbalanced part '//r2s(res)//' remains); reverse the load '// &
-              'or '//hold
+              'or '//hold)
         return
       end if
       deallocate (lam)
@@ -144,18 +140,16 @@ contains
         ! the free motion of the pair, as body 1's part of it
         k = bodies(1)%nrig
         c = matmul(systems(1)%rig_coef, gg(1:k, 1))
-        info = 1
-        msg = 'bodies 1 and 2 are both held only by contact, and together they are free: the pair can '// &
+        call err%set(ERR_INPUT, 'bodies 1 and 2 are both held only by contact, and together they are free: the pair can '// &
               'move as a whole ('//rigid_motion_name(systems(1), c)//' of both) and nothing holds it; '// &
-              'support one of the bodies against that rigid motion'
+              'support one of the bodies against that rigid motion')
         return
       end if
       allocate (lam(m))
       call nnls(gs, es, lam, res)
       if (res > 1.0e-8_wp*norm2(es)) then
-        info = 1
-        msg = 'bodies 1 and 2 are both held only by contact, and their loads cannot be balanced by '// &
-              'compressive contact forces between them (unbalanced part '//r2s(res)//'); support one of them'
+        call err%set(ERR_INPUT, 'bodies 1 and 2 are both held only by contact, and their loads cannot be balanced by '// &
+              'compressive contact forces between them (unbalanced part '//r2s(res)//'); support one of them')
         return
       end if
     end if
@@ -167,18 +161,15 @@ contains
   !! h = g0 - b_1 - b_2 admit no motion alpha with G' alpha <= h (else the body can move off
   !! the contact and its position is undetermined). By Farkas: there is lam >= 0 with
   !! G lam = 0 and h' lam < 0, found by NNLS on the rows [G; h'/|h|] against (0, -1).
-  !! info = 1 with the sentence when the body is not pressed.
-  subroutine check_pressed(systems, contact_line, bodies, info, msg)
+  !! ERR_INPUT with the sentence when the body is not pressed.
+  subroutine check_pressed(systems, contact_line, bodies, err)
     type(body_system_t), intent(in) :: systems(2)
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(2)
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err                  !< ERR_INPUT when a body is not pressed
     real(wp), allocatable :: rows(:, :), target(:), lam(:), h(:)
     real(wp) :: res
     integer :: a, r, m
-    info = 0
-    msg = ''
     m = contact_line%m
     if (m == 0) return
     h = contact_line%g0 - bodies(1)%b - bodies(2)%b
@@ -193,12 +184,11 @@ contains
       target(r + 1) = -1.0_wp
       call nnls(rows, target, lam, res)
       if (.not. res <= 1.0e-8_wp) then
-        info = 1
-        msg = 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
+        call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact: its loads have no part along that motion, and its deformation '// &
               'under the loads and prescribed displacements leaves a rigid motion that lifts it off the '// &
               'contact, so its position is undetermined; load it towards the other body, or hold that '// &
-              'rigid motion with a support: a ''clamped'' side, a ''roller'', or ux/uy on a group (&boundary)'
+              'rigid motion with a support: a ''clamped'' side, a ''roller'', or ux/uy on a group (&boundary)')
         return
       end if
       deallocate (rows, target, lam)

@@ -64,6 +64,7 @@
 module mortar
   use kinds, only: wp
   use strings, only: i2s
+  use errors, only: error_t, ERR_INPUT
   use mortar_chains, only: chain_order, project_master_nodes, edge_normal, cross, UNPLACED
   implicit none (type, external)
   private
@@ -123,42 +124,37 @@ module mortar
 contains
 
   !> Build the dual mortar rows of a slave contact chain against a master chain.
-  !! info = 1 with msg (which side, which edge or node) on bad input, or when no slave
+  !! err (ERR_INPUT, naming the side and the edge or node) on bad input, or when no slave
   !! node ends up with a row (no overlap, master edges facing away, all removable).
-  subroutine mortar_build(xs, es, removable, xm, em, mt, info, msg)
+  subroutine mortar_build(xs, es, removable, xm, em, mt, err)
     real(wp), intent(in) :: xs(:, :)        !< (2, nnode_s) slave body node coordinates [length]
     integer, intent(in) :: es(:, :)         !< (2, ne_s) slave contact edges (node ids), slave body on the left of es(1)->es(2)
     logical, intent(in) :: removable(:)     !< (nnode_s) the slave node may carry no multiplier (normal displacement prescribed on both bodies)
     real(wp), intent(in) :: xm(:, :)        !< (2, nnode_m) master body node coordinates [length]
     integer, intent(in) :: em(:, :)         !< (2, ne_m) master contact edges, master body on the left
     type(mortar_t), intent(out) :: mt       !< the constraint rows
-    integer, intent(out) :: info            !< 0 ok, 1 bad input
-    character(len=*), intent(out) :: msg    !< why, when info /= 0
+    type(error_t), intent(out) :: err       !< the bad input, if any
     type(mortar_work_t) :: w
     logical :: mclosed
     integer :: i, iter, nbad
 
-    info = 0
-    msg = ''
     if (size(xs, 1) /= 2 .or. size(xm, 1) /= 2) then
-      info = 1
-      msg = 'mortar: node coordinates must be (2, nnode) arrays'
+      call err%set(ERR_INPUT, 'mortar: node coordinates must be (2, nnode) arrays')
       return
     end if
     if (size(removable) /= size(xs, 2)) then
-      info = 1
-      msg = 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes'
+      call err%set(ERR_INPUT, 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes')
       return
     end if
-    call chain_order(xs, es, 'slave', w%cs, w%closed, info, msg)
-    if (info /= 0) return
-    call chain_order(xm, em, 'master', w%cm, mclosed, info, msg)
-    if (info /= 0) return
+    call chain_order(xs, es, 'slave', w%cs, w%closed, err)
+    if (err%failed()) return
+    call chain_order(xm, em, 'master', w%cm, mclosed, err)
+    if (err%failed()) return
     w%nes = size(es, 2)
     w%nem = size(em, 2)
 
-    call slave_normals(w, xs, info, msg)
-    if (info /= 0) return
+    call slave_normals(w, xs, err)
+    if (err%failed()) return
 
     ! Each master node's place on the slave chain: segment mseg and xi (mstat 0), or before
     ! the chain's start (mstat -1) or beyond its end (+1).
@@ -178,25 +174,23 @@ contains
     end do
 
     if (mt%m == 0) then
-      info = 1
       if (w%np == 0 .and. w%nrej > 0) then
-        msg = 'mortar: every master edge over the slave faces away from it (n_s.n_m >= 0): both bodies must lie '// &
-              'on the left of their edges; is one edge list reversed?'
+        call err%set(ERR_INPUT, 'mortar: every master edge over the slave faces away from it (n_s.n_m >= 0): '// &
+                     'both bodies must lie on the left of their edges; is one edge list reversed?')
       else if (w%np == 0) then
-        msg = 'mortar: the master curve does not overlap the slave curve along the slave normals'
+        call err%set(ERR_INPUT, 'mortar: the master curve does not overlap the slave curve along the slave normals')
       else
-        msg = 'mortar: no slave node carries a multiplier (every covered slave node is removable)'
+        call err%set(ERR_INPUT, 'mortar: no slave node carries a multiplier (every covered slave node is removable)')
       end if
     end if
   end subroutine mortar_build
 
   !> Slave segment lengths, arc length and nodal normals (inverse-length weighted);
-  !! info = 1 where the chain folds back on itself.
-  subroutine slave_normals(w, xs, info, msg)
+  !! err (ERR_INPUT) where the chain folds back on itself.
+  subroutine slave_normals(w, xs, err)
     type(mortar_work_t), intent(inout) :: w
     real(wp), intent(in) :: xs(:, :)
-    integer, intent(inout) :: info
-    character(len=*), intent(inout) :: msg
+    type(error_t), intent(inout) :: err
     integer :: i, k, nes
     real(wp) :: lo, hi
     nes = w%nes
@@ -221,8 +215,7 @@ contains
         if (i < nes .or. closed) lo = lo + 1.0_wp / slen(merge(i + 1, 1, i < nes))
         hi = norm2(nn(:, i))
         if (hi <= 1.0e-8_wp * lo) then
-          info = 1
-          msg = 'mortar: the slave chain folds back on itself at node '//i2s(cs(i))//' (its two edges are opposite)'
+          call err%set(ERR_INPUT, 'mortar: the slave chain folds back on itself at node '//i2s(cs(i))//' (its two edges are opposite)')
           return
         end if
         nn(:, i) = nn(:, i) / hi

@@ -6,6 +6,7 @@ module mortar_chains
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use strings, only: i2s
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
@@ -19,14 +20,13 @@ contains
   !> Order the edges of one side into a single chain: c(0:ne) are its nodes from the start
   !! (the node no edge ends at), edge k joining c(k-1) -> c(k). A closed loop (a rim, a bore)
   !! starts at the first edge's first node and has c(ne) = c(0).
-  subroutine chain_order(x, e, what, c, closed, info, msg)
+  subroutine chain_order(x, e, what, c, closed, err)
     real(wp), intent(in) :: x(:, :)            !< (2, nnode) coordinates
     integer, intent(in) :: e(:, :)             !< (2, ne) edges
     character(len=*), intent(in) :: what       !< 'slave' or 'master', for messages
     integer, allocatable, intent(out) :: c(:)  !< (0:ne) nodes in chain order
     logical, intent(out) :: closed             !< the edges form one closed loop
-    integer, intent(inout) :: info             !< set to 1 on bad input
-    character(len=*), intent(inout) :: msg     !< why
+    type(error_t), intent(inout) :: err        !< set (ERR_INPUT) on bad input
     integer, allocatable :: eout(:), ein(:), deg(:)
     integer :: ne, nnode, k, a, b, nstart, start, n
     real(wp) :: lo(2), hi(2), diag
@@ -35,25 +35,21 @@ contains
     ne = size(e, 2)
     nnode = size(x, 2)
     if (size(e, 1) /= 2) then
-      info = 1
-      msg = 'mortar: the '//what//' edges must be a (2, ne) array'
+      call err%set(ERR_INPUT, 'mortar: the '//what//' edges must be a (2, ne) array')
       return
     end if
     if (ne == 0) then
-      info = 1
-      msg = 'mortar: no '//what//' contact edges'
+      call err%set(ERR_INPUT, 'mortar: no '//what//' contact edges')
       return
     end if
     do k = 1, ne
       if (any(e(:, k) < 1) .or. any(e(:, k) > nnode)) then
-        info = 1
-        msg = 'mortar: '//what//' edge '//i2s(k)//' refers to node '//i2s(merge(e(1, k), e(2, k), &
-              e(1, k) < 1 .or. e(1, k) > nnode))//', outside 1..'//i2s(nnode)
+        call err%set(ERR_INPUT, 'mortar: '//what//' edge '//i2s(k)//' refers to node '//i2s(merge(e(1, k), e(2, k), &
+              e(1, k) < 1 .or. e(1, k) > nnode))//', outside 1..'//i2s(nnode))
         return
       end if
       if (.not. all(ieee_is_finite(x(:, e(:, k))))) then
-        info = 1
-        msg = 'mortar: '//what//' edge '//i2s(k)//' has a node with a non-finite coordinate'
+        call err%set(ERR_INPUT, 'mortar: '//what//' edge '//i2s(k)//' has a node with a non-finite coordinate')
         return
       end if
     end do
@@ -68,8 +64,7 @@ contains
     diag = norm2(hi - lo)
     do k = 1, ne
       if (e(1, k) == e(2, k) .or. norm2(x(:, e(2, k)) - x(:, e(1, k))) <= 1.0e-12_wp * diag) then
-        info = 1
-        msg = 'mortar: '//what//' edge '//i2s(k)//' (nodes '//i2s(e(1, k))//', '//i2s(e(2, k))//') has zero length'
+        call err%set(ERR_INPUT, 'mortar: '//what//' edge '//i2s(k)//' (nodes '//i2s(e(1, k))//', '//i2s(e(2, k))//') has zero length')
         return
       end if
     end do
@@ -83,9 +78,8 @@ contains
     do k = 1, ne
       do a = 1, 2
         if (deg(e(a, k)) > 2) then
-          info = 1
-          msg = 'mortar: the '//what//' edges branch at node '//i2s(e(a, k))//' ('//i2s(deg(e(a, k)))// &
-                ' edges meet there); one chain is required'
+          call err%set(ERR_INPUT, 'mortar: the '//what//' edges branch at node '//i2s(e(a, k))//' ('//i2s(deg(e(a, k)))// &
+                ' edges meet there); one chain is required')
           return
         end if
       end do
@@ -94,15 +88,13 @@ contains
       a = e(1, k)
       b = e(2, k)
       if (eout(a) /= 0) then
-        info = 1
-        msg = 'mortar: '//what//' edges '//i2s(eout(a))//' and '//i2s(k)//' both start at node '//i2s(a)// &
-              ': they are not consistently oriented (the body must lie on the left of every edge)'
+        call err%set(ERR_INPUT, 'mortar: '//what//' edges '//i2s(eout(a))//' and '//i2s(k)//' both start at node '//i2s(a)// &
+              ': they are not consistently oriented (the body must lie on the left of every edge)')
         return
       end if
       if (ein(b) /= 0) then
-        info = 1
-        msg = 'mortar: '//what//' edges '//i2s(ein(b))//' and '//i2s(k)//' both end at node '//i2s(b)// &
-              ': they are not consistently oriented (the body must lie on the left of every edge)'
+        call err%set(ERR_INPUT, 'mortar: '//what//' edges '//i2s(ein(b))//' and '//i2s(k)//' both end at node '//i2s(b)// &
+              ': they are not consistently oriented (the body must lie on the left of every edge)')
         return
       end if
       eout(a) = k
@@ -122,8 +114,7 @@ contains
       start = e(1, 1)
     end if
     if (nstart > 1) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form '//i2s(nstart)//' separate chains; one chain or one loop is required'
+      call err%set(ERR_INPUT, 'mortar: the '//what//' edges form '//i2s(nstart)//' separate chains; one chain or one loop is required')
       return
     end if
     allocate (c(0:ne))
@@ -137,15 +128,13 @@ contains
       if (closed .and. c(n) == start) exit
     end do
     if (closed .and. n /= ne) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form more than one closed loop (one of '//i2s(n)//' edges, the '// &
-            'other '//i2s(ne - n)//'); one chain or one loop is required'
+      call err%set(ERR_INPUT, 'mortar: the '//what//' edges form more than one closed loop (one of '//i2s(n)//' edges, the '// &
+            'other '//i2s(ne - n)//'); one chain or one loop is required')
       return
     end if
     if (n /= ne) then
-      info = 1
-      msg = 'mortar: the '//what//' edges form more than one chain (a chain of '//i2s(n)//' edges and a closed '// &
-            'loop of the other '//i2s(ne - n)//'); one chain is required'
+      call err%set(ERR_INPUT, 'mortar: the '//what//' edges form more than one chain (a chain of '//i2s(n)//' edges and a closed '// &
+            'loop of the other '//i2s(ne - n)//'); one chain is required')
       return
     end if
   end subroutine chain_order

@@ -13,6 +13,7 @@ module robin_iteration
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
                            STATUS_INTERRUPTED
   use contact_common, only: interface_residual, maxabs, all_finite
+  use errors, only: error_t
   use robin_operators, only: robin_operator_t, new_robin_operator
   use robin_subproblems, only: subproblems_t, subproblems_init, solve_subproblems
   use acceleration, only: accelerate
@@ -43,7 +44,8 @@ contains
     type(subproblems_t), target :: subproblems
     class(robin_operator_t), allocatable :: robin_op
     real(wp) :: t0
-    integer :: m, every, info
+    integer :: m, every
+    type(error_t) :: err
     logical :: resumed
 
     m = contact_line%m
@@ -62,8 +64,9 @@ contains
 
     robin_op = new_robin_operator(solver%robin_operator)
     call subproblems_init(subproblems, bodies, robin_op, run_state, resumed)
-    call robin_op%setup(solver, contact_line, bodies, subproblems%flexibility, info, res%message)
-    if (info /= 0) then
+    call robin_op%setup(solver, contact_line, bodies, subproblems%flexibility, err)
+    if (err%failed()) then
+      res%message = err%text()
       res%status = STATUS_FAILED
       return
     end if

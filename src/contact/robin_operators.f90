@@ -13,6 +13,7 @@ module robin_operators
   use mprgp, only: lambda_max_estimate
   use condense, only: interface_t, body_condensed_t
   use contact_common, only: other_body
+  use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -34,16 +35,15 @@ module robin_operators
   end type robin_operator_t
 
   abstract interface
-    !> Build the correction. info /= 0 and a message when it cannot be built.
-    subroutine setup_iface(self, solver, contact_line, bodies, flexibility, info, message)
-      import :: robin_operator_t, solver_cfg_t, interface_t, body_condensed_t, dense_op_t
+    !> Build the correction; err (ERR_NUMERICAL) when it cannot be built.
+    subroutine setup_iface(self, solver, contact_line, bodies, flexibility, err)
+      import :: robin_operator_t, solver_cfg_t, interface_t, body_condensed_t, dense_op_t, error_t
       class(robin_operator_t), intent(inout) :: self
       type(solver_cfg_t), intent(in) :: solver
       type(interface_t), intent(in) :: contact_line
       type(body_condensed_t), intent(in) :: bodies(2)
       type(dense_op_t), target, intent(in) :: flexibility(2)    !< F_a as operators (kept by reference)
-      integer, intent(out) :: info
-      character(len=*), intent(inout) :: message
+      type(error_t), intent(out) :: err
     end subroutine setup_iface
 
     !> corr(:, 1) = S_1 d, corr(:, 2) = S_2 d.
@@ -146,16 +146,14 @@ contains
 
   ! ---- steklov ---------------------------------------------------------------------------
 
-  subroutine steklov_setup(self, solver, contact_line, bodies, flexibility, info, message)
+  subroutine steklov_setup(self, solver, contact_line, bodies, flexibility, err)
     class(steklov_operator_t), intent(inout) :: self
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(2)
     type(dense_op_t), target, intent(in) :: flexibility(2)
-    integer, intent(out) :: info
-    character(len=*), intent(inout) :: message
+    type(error_t), intent(out) :: err
     integer :: a
-    info = 0
     do a = 1, 2
       self%projected(a)%n = 0
       if (bodies(a)%nrig > 0 .and. contact_line%m > 0) &
@@ -205,15 +203,13 @@ contains
 
   ! ---- constant --------------------------------------------------------------------------
 
-  subroutine constant_setup(self, solver, contact_line, bodies, flexibility, info, message)
+  subroutine constant_setup(self, solver, contact_line, bodies, flexibility, err)
     class(constant_operator_t), intent(inout) :: self
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(2)
     type(dense_op_t), target, intent(in) :: flexibility(2)
-    integer, intent(out) :: info
-    character(len=*), intent(inout) :: message
-    info = 0
+    type(error_t), intent(out) :: err
     self%alpha = solver%alpha
     self%w = contact_line%trib
   end subroutine constant_setup
@@ -230,16 +226,16 @@ contains
 
   ! ---- harmonic --------------------------------------------------------------------------
 
-  subroutine harmonic_setup(self, solver, contact_line, bodies, flexibility, info, message)
+  subroutine harmonic_setup(self, solver, contact_line, bodies, flexibility, err)
     class(harmonic_operator_t), intent(inout) :: self
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(2)
     type(dense_op_t), target, intent(in) :: flexibility(2)
-    integer, intent(out) :: info
-    character(len=*), intent(inout) :: message
+    type(error_t), intent(out) :: err
     real(wp), allocatable :: s(:, :)
-    integer :: m
+    integer :: m, info
+    character(len=100) :: emsg
     info = 0
     m = contact_line%m
     if (m == 0) return
@@ -249,10 +245,11 @@ contains
       call harmonic_matrix(bodies(1)%flex, bodies(2)%flex, s, info)
     end if
     if (info /= 0 .and. bodies(1)%nrig + bodies(2)%nrig > 0 .and. (bodies(1)%rank < m .or. bodies(2)%rank < m)) then
-      message = 'harmonic operator: a body held only by contact is a mortar master coarser than the '// &
-                'slave (singular F): make it the slave (&contact slave), or use steklov or monolithic'
+      call err%set(ERR_NUMERICAL, 'harmonic operator: a body held only by contact is a mortar master coarser than '// &
+                   'the slave (singular F): make it the slave (&contact slave), or use steklov or monolithic')
     else if (info /= 0) then
-      write (message, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
+      write (emsg, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
+      call err%set(ERR_NUMERICAL, emsg)
     else
       call dense_op_init(self%s, s)
     end if

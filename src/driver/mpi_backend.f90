@@ -5,7 +5,7 @@
 module mpi_backend
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use errors, only: fatal, terminate, EXIT_INPUT, EXIT_NUMERICAL
+  use errors, only: fatal, terminate, error_t, exit_code, EXIT_INPUT
   use config, only: deck_t
   use assembly, only: expand, cell_triplets
   use contact_types, only: STATUS_FAILED
@@ -30,8 +30,7 @@ module mpi_backend
     logical :: mine(2) = .true.             !< this rank works on the body
     real(wp) :: assembly_peak_mb = 0.0_wp   !< this rank's peak RSS when the factorization starts [MiB]
     type(mumps_t) :: solver(2)              !< each body's MUMPS instance
-    integer :: info(2) = 0                  !< each body's status in the current phase
-    character(len=512) :: msg(2) = ''       !< and its message
+    type(error_t) :: err(2)                 !< each body's failure in the current phase, if any
   contains
     procedure :: check_memory, factor, condense, record_factor_memory, share_contact_forces, recover, &
                  agree_code, report_ranks, finish
@@ -49,17 +48,17 @@ contains
     type(deck_t), intent(in) :: the_deck    !< the deck to size
     real(wp) :: est, node_est
     integer :: st, node_ranks
-    logical :: ok
-    character(len=:), allocatable :: budget_msg
+    type(error_t) :: err
     character(len=1024) :: m1
     est = rank_memory_mb(the_deck, run%ranks, run%rank)
     call par_node_sum(est, node_est, node_ranks)
     call check_budget_ranks(the_deck, run%ranks, run%rank, est, node_est, node_ranks, node_memory_limit_mb(), &
-                            process_memory_limit_mb(), ok, budget_msg)
-    st = merge(0, EXIT_INPUT, ok)
-    m1 = budget_msg
+                            process_memory_limit_mb(), err)
+    st = exit_code(err)
+    m1 = ''
+    if (err%failed()) m1 = 'deck '//trim(the_deck%source)//': '//err%text()
     call par_agree(st, m1)
-    if (st /= 0) call fatal(EXIT_INPUT, trim(m1))
+    if (st /= 0) call fatal(st, trim(m1))
   end subroutine check_memory
 
   !> Split the ranks into their groups, then each group assembles its share of its body's
@@ -72,16 +71,14 @@ contains
     integer :: a, first, last
     call self%split_groups(run)
     do a = 1, 2
-      self%info(a) = 0
-      self%msg(a) = ''
+      call self%err(a)%clear()
       if (.not. self%mine(a)) cycle
       first = self%group_rank(a)*run%meshes(a)%ncell/self%group_size(a) + 1
       last = (self%group_rank(a) + 1)*run%meshes(a)%ncell/self%group_size(a)
       call cell_triplets(run%meshes(a), run%deck%body(a), run%deck%plane_strain, run%systems(a), first, last, &
-                         irn, jcn, kval, self%info(a), self%msg(a))
-      if (self%info(a) == 0) call factor_body_mumps(run%contact_line, a, run%systems(a), irn, jcn, kval, &
-                                                    self%group_comm, run%bodies(a), self%solver(a), self%info(a), &
-                                                    self%msg(a))
+                         irn, jcn, kval, self%err(a))
+      if (.not. self%err(a)%failed()) call factor_body_mumps(run%contact_line, a, run%systems(a), irn, jcn, kval, &
+                                                             self%group_comm, run%bodies(a), self%solver(a), self%err(a))
       if (allocated(irn)) deallocate (irn, jcn, kval)
     end do
     call self%agree_fatal('factorization failed')
@@ -123,8 +120,7 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its bodies condensed
     integer :: a
     do a = 1, 2
-      if (self%mine(a)) call condense_body_mumps(run%systems(a), run%bodies(a), self%solver(a), a, self%info(a), &
-                                                 self%msg(a))
+      if (self%mine(a)) call condense_body_mumps(run%systems(a), run%bodies(a), self%solver(a), a, self%err(a))
     end do
     call self%agree_fatal('condensation failed')
     call share_condensed(self, run)
@@ -168,7 +164,7 @@ contains
           if (iv(1) > 0) call par_bcast_reals(body%kern, m*iv(1), self%host(b))
         end if
       end associate
-      self%info(b) = 0
+      call self%err(b)%clear()
     end do
     write (output_unit, '(a,2(f0.1,a))') 'mumps: largest rank''s factorization memory: body 1 ', &
       self%solver(1)%max_rank_mb, ' MB, body 2 ', self%solver(2)%max_rank_mb, ' MB'
@@ -205,13 +201,12 @@ contains
     integer :: b
     real(wp), allocatable :: uf(:)
     do b = 1, 2
-      self%info(b) = 0
-      self%msg(b) = ''
+      call self%err(b)%clear()
       if (.not. self%mine(b)) cycle
       allocate (uf(run%systems(b)%n))
       uf = 0.0_wp
       call recover_displacement_mumps(run%systems(b), run%bodies(b), self%solver(b), b, run%result%lam_body(:, b), &
-                                      uf, self%info(b), self%msg(b))
+                                      uf, self%err(b))
       if (self%solver(b)%host) call expand(run%systems(b), uf, run%displacement(1:run%systems(b)%ndof, b))
       deallocate (uf)
     end do
@@ -247,8 +242,8 @@ contains
     flush (output_unit)
   end subroutine report_ranks
 
-  !> Every rank learns the worst status of the bodies' groups; a failure is fatal (exit 3)
-  !! on all ranks with the message of the lowest failing rank.
+  !> Every rank learns the worst status of the bodies' groups; a failure is fatal on all
+  !! ranks, with the exit code of its category and the message of the lowest failing rank.
   subroutine agree_fatal(self, what)
     class(mpi_backend_t), intent(inout) :: self
     character(len=*), intent(in) :: what
@@ -257,9 +252,9 @@ contains
     st = 0
     m1 = ''
     do b = 2, 1, -1
-      if (self%info(b) /= 0) then
-        st = EXIT_NUMERICAL
-        m1 = 'body '//body_label(b)//': '//what//': '//trim(self%msg(b))
+      if (self%err(b)%failed()) then
+        st = exit_code(self%err(b))
+        m1 = 'body '//body_label(b)//': '//what//': '//self%err(b)%text()
       end if
     end do
     call par_agree(st, m1)

@@ -126,19 +126,19 @@ contains
   subroutine assemble_bodies(run, matrix)
     type(run_t), intent(inout) :: run   !< the run: its systems
     logical, intent(in) :: matrix       !< assemble the stiffness
-    integer :: info(2), a
-    character(len=512) :: msg(2)
+    type(error_t) :: err(2)
+    integer :: a
     associate (deck => run%deck)
       !$omp parallel do num_threads(run%threads) schedule(static, 1)
       do a = 1, 2
         call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
-                           run%systems(a), info(a), msg(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
+                           run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
                            contact_group=deck%contact%body_group(a))
       end do
       !$omp end parallel do
       do a = 1, 2
         ! assembly's messages name their body
-        if (info(a) /= 0) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//', '//trim(msg(a)))
+        call fail_on(err(a), 'deck '//trim(deck%source))
       end do
     end associate
   end subroutine assemble_bodies
@@ -147,16 +147,16 @@ contains
   !! equilibrium rows, and whether the contact can hold it (exit 1 if not).
   subroutine build_contact_line(run)
     type(run_t), intent(inout) :: run   !< the run: its contact line and bodies' rigid rows
-    integer :: info, a
-    character(len=512) :: msg
-    call build_interface(run%deck%body, run%deck%contact, run%meshes, run%systems, run%contact_line, info, msg)
-    if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
+    type(error_t) :: err
+    integer :: a
+    call build_interface(run%deck%body, run%deck%contact, run%meshes, run%systems, run%contact_line, err)
+    call fail_on(err, 'deck '//trim(run%deck%source))
     do a = 1, 2
       call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
     end do
     if (run%systems(1)%nrig + run%systems(2)%nrig == 0) return
-    call check_held(run%systems, run%bodies, info, msg)
-    if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
+    call check_held(run%systems, run%bodies, err)
+    call fail_on(err, 'deck '//trim(run%deck%source))
     do a = 1, 2
       associate (system => run%systems(a))
         if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
@@ -199,7 +199,8 @@ contains
   !> A flexibility that is not finite is a stiffness out of double precision's range (exit 3).
   subroutine check_condensed(run)
     type(run_t), intent(in) :: run   !< the run: its condensed bodies
-    integer :: a, info
+    integer :: a
+    type(error_t) :: err
     character(len=1024) :: msg
     do a = 1, 2
       if (.not. (all(ieee_is_finite(run%bodies(a)%flex)) .and. all(ieee_is_finite(run%bodies(a)%b)))) then
@@ -210,8 +211,8 @@ contains
     end do
     ! a floating body with no load along its free motions: is it pressed by a deformation?
     if (run%systems(1)%nrig + run%systems(2)%nrig == 0 .or. run%rank /= 0) return
-    call check_pressed(run%systems, run%contact_line, run%bodies, info, msg)
-    if (info /= 0) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)//': '//trim(msg))
+    call check_pressed(run%systems, run%contact_line, run%bodies, err)
+    call fail_on(err, 'deck '//trim(run%deck%source))
   end subroutine check_condensed
 
   !> The contact forces (rank 0; the other ranks wait for them): the Robin iteration with
@@ -310,15 +311,14 @@ contains
   !! this one replaces it whole; a run that fails leaves it untouched.
   subroutine write_output(run)
     type(run_t), intent(inout) :: run   !< the run: whether its result was written
-    logical :: ok
-    character(len=512) :: msg
+    type(error_t) :: err
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
     call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                       run%displacement, body_stresses(run), run%timing, ok, msg)
-    run%written = ok
-    if (.not. ok) call fatal(EXIT_NUMERICAL, 'output: '//trim(msg))
+                       run%displacement, body_stresses(run), run%timing, err)
+    run%written = .not. err%failed()
+    call fail_on(err, 'output')
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
 

@@ -2,7 +2,7 @@
 !! by CHOLMOD or the banded Cholesky (condense::factor_body).
 module serial_backend
   use kinds, only: wp
-  use errors, only: fatal, terminate, EXIT_INPUT, EXIT_NUMERICAL
+  use errors, only: terminate, error_t, fail_on
   use config, only: deck_t
   use assembly, only: expand
   use condense, only: factor_body, condense_body, recover_displacement
@@ -29,26 +29,25 @@ contains
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(in) :: run          !< the run
     type(deck_t), intent(in) :: the_deck    !< the deck to size
-    logical :: ok
-    character(len=:), allocatable :: budget_msg
-    call check_budget(the_deck, memory_limit_mb(), ok, budget_msg)
-    if (.not. ok) call fatal(EXIT_INPUT, budget_msg)
+    type(error_t) :: err
+    call check_budget(the_deck, memory_limit_mb(), err)
+    call fail_on(err, 'deck '//trim(the_deck%source))
   end subroutine check_memory
 
   !> Order and factorize both bodies, one thread each.
   subroutine factor(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its systems factorized into its bodies
-    integer :: info(2), a
-    character(len=512) :: msg(2)
+    type(error_t) :: err(2)
+    integer :: a
     !$omp parallel do num_threads(run%threads) schedule(static, 1)
     do a = 1, 2
       call factor_body(run%deck%solver%factor, run%contact_line, a, run%meshes(a), run%systems(a), run%bodies(a), &
-                       info(a), msg(a))
+                       err(a))
     end do
     !$omp end parallel do
     do a = 1, 2
-      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//body_label(a)//': factorization failed: '//trim(msg(a)))
+      call fail_on(err(a), 'body '//body_label(a)//': factorization failed')
     end do
   end subroutine factor
 
@@ -56,15 +55,15 @@ contains
   subroutine condense(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies condensed
-    integer :: info(2), a
-    character(len=512) :: msg(2)
+    type(error_t) :: err(2)
+    integer :: a
     !$omp parallel do num_threads(run%threads) schedule(static, 1)
     do a = 1, 2
-      call condense_body(run%systems(a), run%bodies(a), info(a), msg(a))
+      call condense_body(run%systems(a), run%bodies(a), err(a))
     end do
     !$omp end parallel do
     do a = 1, 2
-      if (info(a) /= 0) call fatal(EXIT_NUMERICAL, 'body '//body_label(a)//': condensation failed: '//trim(msg(a)))
+      call fail_on(err(a), 'body '//body_label(a)//': condensation failed')
     end do
   end subroutine condense
 

@@ -26,6 +26,7 @@ module assembly
   use supports, only: prescribed_dofs, group_conditions, unknown_group, number_free_dofs
   use stiffness_pattern, only: build_pattern
   use rigid_modes, only: rigid_kernel, choose_fixing, rigid_motion_name
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -63,8 +64,9 @@ contains
   !! roller (normal component 0), displacement (both components = body%u_side(:,side)),
   !! free and contact (nothing). Prescribed DOFs are eliminated with the lifting
   !! f -= K_fd u_d. Tractions with %body == body%id are integrated exactly on the side.
-  !! On an impossible input `info` is non-zero, `msg` says why, and `sys` is incomplete.
-  subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, info, msg, &
+  !! On an impossible input `err` says why (ERR_INPUT; ERR_NUMERICAL for a LAPACK or
+  !! internal failure), naming the body, and `sys` is incomplete.
+  subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, err, &
                            u_prescribed, body_force, boundaries, matrix, contact_group)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
@@ -72,8 +74,7 @@ contains
     type(traction_cfg_t), intent(in) :: tractions(:)     !< tractions of the deck (any body)
     integer, intent(in) :: ntraction                     !< how many of `tractions` are in use
     type(body_system_t), intent(out) :: sys              !< the assembled system
-    integer, intent(out) :: info                         !< 0 on success
-    character(len=*), intent(out) :: msg                 !< error sentence when info /= 0
+    type(error_t), intent(out) :: err                    !< the failure, if any
     !> (ndof) optional per-dof prescribed values [length]: where given, they replace the
     !! side values at every DOF that the side conditions prescribe (which DOFs are
     !! prescribed is still decided by body%bc).
@@ -93,52 +94,52 @@ contains
     logical, allocatable :: prescribed(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
+    integer :: info
+    character(len=512) :: msg
 
     with_k = .true.
     if (present(matrix)) with_k = matrix
 
     sys%id = body%id
-    call check_input(mesh, body, tractions, ntraction, info, msg, u_prescribed)
-    if (info /= 0) return
+    call check_input(mesh, body, tractions, ntraction, err, u_prescribed)
+    if (err%failed()) return
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
 
     call prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
     if (present(boundaries)) then
       call group_conditions(mesh, body%id, boundaries, prescribed, sys, info, msg)
-      if (info /= 0) return
+      if (info /= 0) then
+        call err%set(ERR_INPUT, msg)
+        return
+      end if
     end if
     ! rigid motions the supports leave free: a body held only by contact
-    call rigid_kernel(mesh, prescribed, sys, info)
-    if (info /= 0) then
-      info = 3
-      write (msg, '(a,i0,a)') 'body ', body%id, ': LAPACK dsyev failed on the 3 x 3 Gram matrix of its '// &
-        'rigid modes (the kernel of its supports is unknown)'
-      return
-    end if
+    call rigid_kernel(mesh, prescribed, sys, err)
+    if (err%failed()) return
     if (sys%nrig > 0) then
-      call choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
-      if (info /= 0) return
+      call choose_fixing(mesh, body, prescribed, sys, err, contact_group)
+      if (err%failed()) return
     end if
     call number_free_dofs(prescribed, sys)
     if (with_k) then
-      call build_pattern(mesh, sys, info, msg)
-      if (info /= 0) return
+      call build_pattern(mesh, sys, err)
+      if (err%failed()) return
     end if
-    call applied_loads(mesh, body%id, tractions(1:ntraction), sys, info, msg, body_force)
-    if (info /= 0) return
-    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg, with_k)
-    if (info /= 0) return
+    call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
+    if (err%failed()) return
+    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k)
+    if (err%failed()) return
     call add_applied_loads(sys)
     if (with_k) sys%k_norm = stiffness_norm(sys)
-    if (sys%nrig > 0) call check_kernel(mesh, body, plane_strain, sys, info, msg)
+    if (sys%nrig > 0) call check_kernel(mesh, body, plane_strain, sys, err)
   end subroutine assemble_body
 
   !> The stiffness entries of cells c1..c2 on the free DOFs as coordinate triplets of the
   !! lower triangle (1-based free indices, row >= column; a DOF pair shared by cells
   !! appears once per cell, to be summed): one rank's share of the matrix, MUMPS's
   !! distributed assembled input (ICNTL(18) = 3). sys needs its DOF numbering only
-  !! (assemble_body with matrix=.false.). info = 7 on a cell with a non-positive Jacobian.
-  subroutine cell_triplets(mesh, body, plane_strain, sys, c1, c2, irn, jcn, a, info, msg)
+  !! (assemble_body with matrix=.false.). err = ERR_INPUT on a cell with a non-positive Jacobian.
+  subroutine cell_triplets(mesh, body, plane_strain, sys, c1, c2, irn, jcn, a, err)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh
     type(body_cfg_t), intent(in) :: body                 !< material
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -146,24 +147,21 @@ contains
     integer, intent(in) :: c1, c2                        !< the cells, c1..c2 (none if c2 < c1)
     integer, allocatable, intent(out) :: irn(:), jcn(:)  !< row and column of each entry (free, 1-based)
     real(wp), allocatable, intent(out) :: a(:)           !< the entries [stress]
-    integer, intent(out) :: info                         !< 0 ok, 7 bad cell
-    character(len=*), intent(out) :: msg                 !< error sentence when info /= 0
+    type(error_t), intent(out) :: err                    !< the bad cell, if any
     integer :: c, nd, i, j, q, fi, fj, ldof(MAX_NDOF)
     real(wp) :: ke(MAX_NDOF, MAX_NDOF), lame_lambda, lame_mu
     type(ke_cache_t) :: cache
     integer, allocatable :: ti(:), tj(:)
     real(wp), allocatable :: ta(:)
 
-    info = 0
-    msg = ''
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     q = max(0, c2 - c1 + 1)*(MAX_NDOF*(MAX_NDOF + 1))/2
     allocate (ti(q), tj(q), ta(q))
     q = 0
     do c = max(1, c1), min(mesh%ncell, c2)
-      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, info, msg)
-      if (info /= 0) return
+      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
+      if (err%failed()) return
       do j = 1, nd
         fj = sys%free_of(ldof(j))
         if (fj == 0) cycle
@@ -184,94 +182,90 @@ contains
 
   !> Check the arguments of assemble_body: a built mesh of a known element, a valid
   !! material, known side conditions, tractions on sides 1..4, u_prescribed of size ndof.
-  subroutine check_input(mesh, body, tractions, ntraction, info, msg, u_prescribed)
+  subroutine check_input(mesh, body, tractions, ntraction, err, u_prescribed)
     type(mesh_t), intent(in) :: mesh
     type(body_cfg_t), intent(in) :: body
     type(traction_cfg_t), intent(in) :: tractions(:)
     integer, intent(in) :: ntraction
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
     real(wp), intent(in), optional :: u_prescribed(:)
     integer :: side, t
+    character(len=512) :: emsg
 
-    info = 0
-    msg = ''
     if (mesh%nnode < 1 .or. .not. allocated(mesh%xy) .or. .not. allocated(mesh%cells)) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ': the mesh is empty (call mesh_build first)'
+      write (emsg, '(a,i0,a)') 'body ', body%id, ': the mesh is empty (call mesh_build first)'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     if (mesh%element /= ELEM_Q1 .and. mesh%element /= ELEM_P1 .and. mesh%element /= ELEM_MIXED) then
-      info = 1
-      write (msg, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', mesh%element
+      write (emsg, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', mesh%element
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     if (.not. (body%young > 0.0_wp)) then
-      info = 2
-      write (msg, '(a,i0,a,es12.4)') 'body ', body%id, ': Young''s modulus must be positive, got ', body%young
+      write (emsg, '(a,i0,a,es12.4)') 'body ', body%id, ': Young''s modulus must be positive, got ', body%young
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     if (.not. (body%poisson > -1.0_wp .and. body%poisson < 0.5_wp)) then
-      info = 2
-      write (msg, '(a,i0,a,es12.4)') 'body ', body%id, ': Poisson''s ratio must lie in (-1, 0.5), got ', &
+      write (emsg, '(a,i0,a,es12.4)') 'body ', body%id, ': Poisson''s ratio must lie in (-1, 0.5), got ', &
         body%poisson
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     do side = 1, 4
       if (body%bc(side) < BC_FREE .or. body%bc(side) > BC_DISPLACEMENT) then
-        info = 3
-        write (msg, '(a,i0,a,a,a,i0)') 'body ', body%id, ': unknown condition code on side ', &
+        write (emsg, '(a,i0,a,a,a,i0)') 'body ', body%id, ': unknown condition code on side ', &
           trim(side_names(side)), ': ', body%bc(side)
+        call err%set(ERR_INPUT, emsg)
         return
       end if
     end do
     if (ntraction < 0 .or. ntraction > size(tractions)) then
-      info = 4
-      write (msg, '(a,i0,a,i0,a)') 'ntraction = ', ntraction, ' but only ', size(tractions), &
+      write (emsg, '(a,i0,a,i0,a)') 'ntraction = ', ntraction, ' but only ', size(tractions), &
         ' tractions were passed'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     do t = 1, ntraction
       if (tractions(t)%body /= body%id) cycle
       if (len_trim(tractions(t)%group) > 0) cycle
       if (.not. mesh%structured) then
-        info = 4
-        write (msg, '(a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
+        write (emsg, '(a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
           ' is on a side, but the body comes from a mesh file: load a group'
+        call err%set(ERR_INPUT, emsg)
         return
       end if
       if (tractions(t)%side < SIDE_LEFT .or. tractions(t)%side > SIDE_TOP) then
-        info = 4
-        write (msg, '(a,i0,a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
+        write (emsg, '(a,i0,a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
           ' has side index ', tractions(t)%side, ', outside 1..4'
+        call err%set(ERR_INPUT, emsg)
         return
       end if
     end do
     if (present(u_prescribed)) then
       if (size(u_prescribed) /= 2*mesh%nnode) then
-        info = 5
-        write (msg, '(a,i0,a,i0,a,i0)') 'body ', body%id, ': u_prescribed has ', size(u_prescribed), &
+        write (emsg, '(a,i0,a,i0,a,i0)') 'body ', body%id, ': u_prescribed has ', size(u_prescribed), &
           ' values, expected ndof = ', 2*mesh%nnode
+        call err%set(ERR_INPUT, emsg)
         return
       end if
     end if
   end subroutine check_input
 
   !> The kernel is computed, not guessed: |K R| over the DOFs that are not prescribed
-  !! (fixing DOFs included) must be at rounding level, 1e-9 |K| |R|. info = 3 otherwise.
-  subroutine check_kernel(mesh, body, plane_strain, sys, info, msg)
+  !! (fixing DOFs included) must be at rounding level, 1e-9 |K| |R|. err = ERR_INPUT otherwise.
+  subroutine check_kernel(mesh, body, plane_strain, sys, err)
     type(mesh_t), intent(in) :: mesh
     type(body_cfg_t), intent(in) :: body
     logical, intent(in) :: plane_strain
     type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
+    character(len=512) :: emsg
     real(wp), allocatable :: kr(:), zero(:)
     real(wp) :: worst, knorm
     integer :: j
     logical, allocatable :: live(:)
-    info = 0
-    msg = ''
     allocate (kr(sys%ndof), zero(sys%ndof), live(sys%ndof))
     zero = 0.0_wp
     live = sys%free_of > 0
@@ -286,27 +280,24 @@ contains
     end do
     sys%rig_residual = worst
     if (worst > 1.0e-9_wp) then
-      info = 3
-      write (msg, '(a,i0,a,es10.3,a)') 'body ', body%id, ': its rigid-motion kernel fails the check |K R| = ', &
+      write (emsg, '(a,i0,a,es10.3,a)') 'body ', body%id, ': its rigid-motion kernel fails the check |K R| = ', &
         worst, ' |K| |R| (expected rounding level)'
+      call err%set(ERR_INPUT, emsg)
     end if
   end subroutine check_kernel
 
   !> The applied nodal loads on all DOFs (sys%f_applied): the tractions on this body,
-  !! then the body force if any; sys%f = 0. info = 1 when a traction names a group the
-  !! body does not have.
-  subroutine applied_loads(mesh, body_id, tractions, sys, info, msg, body_force)
+  !! then the body force if any; sys%f = 0. err = ERR_INPUT when a traction names a group
+  !! the body does not have.
+  subroutine applied_loads(mesh, body_id, tractions, sys, err, body_force)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id
     type(traction_cfg_t), intent(in) :: tractions(:)
     type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
     procedure(body_force_fn), optional :: body_force
     integer :: t, g
 
-    info = 0
-    msg = ''
     allocate (sys%f(sys%n), sys%f_applied(sys%ndof))
     sys%f = 0.0_wp
     sys%f_applied = 0.0_wp
@@ -315,15 +306,13 @@ contains
       if (len_trim(tractions(t)%group) > 0) then
         g = group_index(mesh, tractions(t)%group)
         if (g == 0) then
-          info = 1
-          msg = 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
-                unknown_group(mesh, tractions(t)%group)
+          call err%set(ERR_INPUT, 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
+                unknown_group(mesh, tractions(t)%group))
           return
         end if
         if (nodes_only(mesh, g)) then
-          info = 1
-          msg = 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
-                nodes_only_refusal(mesh, g, 'a traction needs')
+          call err%set(ERR_INPUT, 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
+                nodes_only_refusal(mesh, g, 'a traction needs'))
           return
         end if
         call add_group_traction(mesh, g, tractions(t), sys%f_applied)
@@ -335,54 +324,55 @@ contains
   end subroutine applied_loads
 
   !> The element loop: each cell's stiffness into the CSC values, and the lifting
-  !! f -= K_fd u_d of its prescribed values. info = 7 on a cell with a non-positive
-  !! Jacobian, 8 on a coupling outside the pattern (an internal error).
-  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, info, msg, with_k)
+  !! f -= K_fd u_d of its prescribed values. err = ERR_INPUT on a cell with a non-positive
+  !! Jacobian, ERR_NUMERICAL on a coupling outside the pattern (an internal error).
+  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k)
     type(mesh_t), intent(in) :: mesh
     real(wp), intent(in) :: lame_lambda, lame_mu
     type(body_system_t), intent(inout) :: sys
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
     integer :: c, nd, ldof(MAX_NDOF)
     real(wp) :: ke(MAX_NDOF, MAX_NDOF)
     type(ke_cache_t) :: cache
+    logical :: inside
+    character(len=512) :: emsg
 
-    info = 0
-    msg = ''
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
-      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, info, msg)
-      if (info /= 0) return
-      if (with_k) call scatter_element(sys, ldof(1:nd), ke, info)
-      if (info /= 0) then
-        write (msg, '(a,i0,a,i0,a)') 'body ', sys%id, ': internal error, cell ', c, &
+      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
+      if (err%failed()) return
+      inside = .true.
+      if (with_k) call scatter_element(sys, ldof(1:nd), ke, inside)
+      if (.not. inside) then
+        write (emsg, '(a,i0,a,i0,a)') 'body ', sys%id, ': internal error, cell ', c, &
           ' couples DOFs outside the stiffness pattern'
+        call err%set(ERR_NUMERICAL, emsg)
         return
       end if
       call lift_prescribed(sys, ldof(1:nd), ke)
     end do
   end subroutine stiffness_and_lifting
 
-  !> The stiffness of cell c (nd = its DOF count, ldof its global DOFs); info = 7 with a
-  !! message naming the cell's tag when its Jacobian is not positive (inverted or degenerate).
-  subroutine cell_stiffness(mesh, body_id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, info, msg)
+  !> The stiffness of cell c (nd = its DOF count, ldof its global DOFs); err = ERR_INPUT,
+  !! naming the cell's tag, when its Jacobian is not positive (inverted or degenerate).
+  subroutine cell_stiffness(mesh, body_id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id, c
     real(wp), intent(in) :: lame_lambda, lame_mu
     type(ke_cache_t), intent(inout) :: cache
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)
-    integer, intent(out) :: nd, ldof(MAX_NDOF), info
-    character(len=*), intent(inout) :: msg
+    integer, intent(out) :: nd, ldof(MAX_NDOF)
+    type(error_t), intent(inout) :: err
     real(wp) :: xe(2, MAX_NVERT), minjac
-    info = 0
+    character(len=512) :: emsg
     nd = 2*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
     call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
     if (.not. (minjac > 0.0_wp)) then
-      info = 7
-      write (msg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
+      write (emsg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
         ' has a non-positive Jacobian (inverted or degenerate element)'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     call cell_dofs(mesh, c, ldof)
@@ -390,15 +380,15 @@ contains
 
   !> Add the free-free block of an element stiffness to the CSC values. The element's
   !! DOFs are merged in increasing global (hence free) order with the sorted rows of
-  !! each column. info = 8 when a coupling is missing from the pattern.
-  subroutine scatter_element(sys, ldof, ke, info)
+  !! each column. inside = .false. when a coupling is missing from the pattern.
+  subroutine scatter_element(sys, ldof, ke, inside)
     type(body_system_t), intent(inout) :: sys
     integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
     real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
-    integer, intent(out) :: info
+    logical, intent(out) :: inside
     integer :: nd, a, b, kk, fc, pos, pend, lfree(MAX_NDOF), perm(MAX_NDOF)
 
-    info = 0
+    inside = .true.
     nd = size(ldof)
     ! Local dofs in increasing global order (insertion sort).
     do a = 1, nd
@@ -419,7 +409,7 @@ contains
         do while (sys%rowind(pos) /= lfree(a) - 1)
           pos = pos + 1
           if (pos > pend) then
-            info = 8
+            inside = .false.
             return
           end if
         end do

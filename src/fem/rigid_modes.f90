@@ -9,6 +9,7 @@ module rigid_modes
   use mesh, only: mesh_t, side_nodes, group_index, group_nodes
   use lapack, only: dgesvd
   use body_system, only: body_system_t
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -25,13 +26,14 @@ contains
   !! SVD. A true kernel has singular value ~ eps; a support of length l on a body of size h
   !! has ~ l/h, so the test is scale-free and holds to aspect ratios of about 1e9. Sets sys%nrig, rig_coef, rig_xc, rig_h and
   !! sys%rig (ndof x nrig, zero at prescribed DOFs).
-  subroutine rigid_kernel(mesh, prescribed, sys, info)
+  subroutine rigid_kernel(mesh, prescribed, sys, err)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
     type(body_system_t), intent(inout) :: sys  !< gets nrig, rig, rig_coef, rig_xc, rig_h
-    integer, intent(out) :: info               !< /= 0: dsyev failed
+    type(error_t), intent(out) :: err          !< ERR_NUMERICAL when the SVD fails
     real(wp) :: g(3, 3), r(3), ev(3), work(64), top, vt(3, 3), dummy(1, 1)
     integer :: k, cc, j, lapinfo, nk
+    character(len=512) :: emsg
 
     sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
     sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
@@ -46,8 +48,12 @@ contains
     call dgesvd('N', 'A', 3, 3, g, 3, ev, dummy, 1, vt, 3, work, size(work), lapinfo)
     top = max(ev(1), 0.0_wp)
     nk = 0
-    info = lapinfo
-    if (lapinfo /= 0) return
+    if (lapinfo /= 0) then
+      write (emsg, '(a,i0,a)') 'body ', sys%id, ': LAPACK dgesvd failed on the 3 x 3 triangle of its '// &
+        'rigid modes (the kernel of its supports is unknown)'
+      call err%set(ERR_NUMERICAL, emsg)
+      return
+    end if
     nk = count(ev <= 1.0e-10_wp*top)
     if (top <= 0.0_wp) nk = 3
     ! the kernel, smallest singular value first (the order the Gram eigenvectors had)
@@ -159,21 +165,19 @@ contains
   !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
   !! and the node farthest from that one) for the largest |det| of the kernel restricted to
   !! them. They are prescribed to 0 (prescribed) for the factorization only.
-  subroutine choose_fixing(mesh, body, prescribed, sys, info, msg, contact_group)
+  subroutine choose_fixing(mesh, body, prescribed, sys, err, contact_group)
     type(mesh_t), intent(in) :: mesh                         !< the body's mesh
     type(body_cfg_t), intent(in) :: body                     !< its id and side conditions
     logical, intent(inout) :: prescribed(:)                  !< (ndof) the fixing DOFs are added
     type(body_system_t), intent(inout) :: sys                !< gets fixing; its u_fixed is 0 there
-    integer, intent(out) :: info                             !< 0, or 1 when no fixing DOFs are found
-    character(len=*), intent(out) :: msg                     !< the failure, naming the body
+    type(error_t), intent(out) :: err                        !< ERR_INPUT when no fixing DOFs are found
     character(len=*), intent(in), optional :: contact_group  !< the body's contact group, kept clear
     logical, allocatable :: avoid(:)
     integer, allocatable :: nodes(:)
     integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
     real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
+    character(len=512) :: emsg
 
-    info = 0
-    msg = ''
     r = sys%nrig
     allocate (avoid(mesh%nnode))
     avoid = .false.
@@ -209,10 +213,10 @@ contains
       end if
     end do
     if (p(1) == 0) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
+      write (emsg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but every node is on the '// &
         'contact or prescribed: no node is left to fix its rigid motion for the factorization; '// &
         'refine the mesh or support the body'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     dbest = -1.0_wp
@@ -255,9 +259,9 @@ contains
       end do
     end do
     if (.not. detbest > 1.0e-6_wp) then
-      info = 1
-      write (msg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
+      write (emsg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no pair of nodes away '// &
         'from the contact fixes its free rigid motion for the factorization; support the body'
+      call err%set(ERR_INPUT, emsg)
       return
     end if
     allocate (sys%fixing(r))

@@ -6,6 +6,7 @@ module stiffness_pattern
   use config, only: ELEM_Q1
   use mesh, only: mesh_t, node_id, cell_vertices
   use body_system, only: body_system_t
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
@@ -45,19 +46,17 @@ contains
   end subroutine node_stencil
 
   !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
-  !! rows sorted in every column, from the node stencil of the grid. info = 6 when the
-  !! number of entries does not fit 32-bit indices.
-  subroutine build_pattern(mesh, sys, info, msg)
+  !! rows sorted in every column, from the node stencil of the grid. err = ERR_INPUT when
+  !! the number of entries does not fit 32-bit indices.
+  subroutine build_pattern(mesh, sys, err)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     type(body_system_t), intent(inout) :: sys  !< with its DOF numbering; gets colptr, rowind, val = 0
-    integer, intent(out) :: info               !< 0, or 6 when the pattern is too large
-    character(len=*), intent(out) :: msg       !< the failure, naming the body
+    type(error_t), intent(out) :: err          !< ERR_INPUT when the pattern is too large
     integer :: p, s, cc, q, pos, nnbr
     integer(i8) :: nnz
     integer, allocatable :: aptr(:), adj(:), nbr(:)
+    character(len=512) :: emsg
 
-    info = 0
-    msg = ''
     if (mesh%structured) then
       allocate (nbr(9))
     else
@@ -75,9 +74,9 @@ contains
         end do
       end do
       if (nnz > int(huge(1), i8)) then
-        info = 6
-        write (msg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
+        write (emsg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
           'the mesh is too large for 32-bit CSC indices'
+        call err%set(ERR_INPUT, emsg)
         return
       end if
       sys%colptr(p + 1) = int(nnz)

@@ -20,6 +20,7 @@ module budget
   use kinds, only: wp
   use config, only: deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
   use strings, only: i2s, sci, fmt_real
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
@@ -77,37 +78,32 @@ contains
   end function run_memory_mb
 
   !> Refuse a deck that cannot run here: a body whose matrix or factor overflows 32-bit
-  !! indices, or a run whose estimate exceeds `limit_mb` (0: no limit known). ok = .false.
-  !! with msg naming the deck, the estimate and the limit.
-  subroutine check_budget(d, limit_mb, ok, msg)
+  !! indices, or a run whose estimate exceeds `limit_mb` (0: no limit known): err
+  !! (ERR_INPUT) naming the body, the estimate and the limit; the caller adds the deck.
+  subroutine check_budget(d, limit_mb, err)
     type(deck_t), intent(in) :: d                       !< the deck
     real(wp), intent(in) :: limit_mb                    !< memory this process may use [MiB]
-    logical, intent(out) :: ok                          !< the run fits
-    character(len=:), allocatable, intent(out) :: msg   !< why not
+    type(error_t), intent(out) :: err                   !< why the run does not fit, if so
     real(wp) :: nm, nf, mb, est
     integer :: a
-    ok = .true.
-    msg = ''
     do a = 1, 2
       mb = body_memory_mb(d%body(a), d%solver%factor, nm, nf)
       if (nm > INDEX_MAX .or. nf > INDEX_MAX) then
-        ok = .false.
-        msg = 'deck '//trim(d%source)//': body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
+        call err%set(ERR_INPUT, 'body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
               i2s(d%body(a)%ny)//') needs about '//fmt_real(nm/1.0e9_wp, '(f0.2)')//'e9 matrix and '//fmt_real(nf/1.0e9_wp, '(f0.2)')// &
               'e9 factor entries, beyond the 2^31 (2.1e9) that the 32-bit indices of this build hold; '// &
-              'use fewer cells'
+              'use fewer cells')
         return
       end if
     end do
     est = run_memory_mb(d)
     if (limit_mb > 0.0_wp .and. est > limit_mb) then
-      ok = .false.
-      msg = 'deck '//trim(d%source)//': the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
+      call err%set(ERR_INPUT, 'the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
             ' GiB (body 1: '//fmt_real(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB, body 2: '//fmt_real(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
             fmt_real(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
-            'use fewer cells or a machine with more memory'
+            'use fewer cells or a machine with more memory')
     end if
   end subroutine check_budget
 
@@ -163,10 +159,10 @@ contains
   !> Refuse an MPI run with factorization='mumps' that cannot run on these ranks: a rank's
   !! share beyond 32-bit indices, a rank whose estimate `rank_mb` exceeds the address-space
   !! limit `process_limit_mb`, or ranks of a node whose estimates `node_mb` (summed over the
-  !! node's `node_ranks` ranks) exceed `node_limit_mb` (0: no limit known). ok = .false.
-  !! with msg naming the deck, the estimate per rank and the limit.
+  !! node's `node_ranks` ranks) exceed `node_limit_mb` (0: no limit known): err (ERR_INPUT)
+  !! naming the estimate per rank and the limit; the caller adds the deck.
   subroutine check_budget_ranks(d, ranks, rank, rank_mb, node_mb, node_ranks, node_limit_mb, process_limit_mb, &
-                                ok, msg)
+                                err)
     type(deck_t), intent(in) :: d                       !< the deck
     integer, intent(in) :: ranks, rank                  !< ranks in the world, this rank
     real(wp), intent(in) :: rank_mb                     !< this rank's estimate (rank_memory_mb) [MiB]
@@ -174,20 +170,16 @@ contains
     integer, intent(in) :: node_ranks                   !< ranks on this node
     real(wp), intent(in) :: node_limit_mb               !< memory of the node (available, cgroup) [MiB]
     real(wp), intent(in) :: process_limit_mb            !< ulimit -v of a process [MiB]
-    logical, intent(out) :: ok                          !< the run fits
-    character(len=:), allocatable, intent(out) :: msg   !< why not
+    type(error_t), intent(out) :: err                   !< why the run does not fit, if so
     real(wp) :: fs, x
     integer :: a, g(2)
     character(len=:), allocatable :: what
-    ok = .true.
-    msg = ''
     g = mumps_group_sizes(d, ranks)
     do a = 1, 2
       if (dofs(d%body(a)) > INDEX_MAX .or. 9.0_wp*dofs(d%body(a))/real(g(a), wp) > INDEX_MAX) then
-        ok = .false.
-        msg = 'deck '//trim(d%source)//': body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
+        call err%set(ERR_INPUT, 'body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
               i2s(d%body(a)%ny)//') has too many DOFs or element entries per rank for the 32-bit indices '// &
-              'of this build with '//i2s(g(a))//' rank(s) on it; use more ranks or fewer cells'
+              'of this build with '//i2s(g(a))//' rank(s) on it; use more ranks or fewer cells')
         return
       end if
     end do
@@ -197,15 +189,13 @@ contains
            ': its share of the MUMPS factor '//fmt_real(fs/1024.0_wp, '(f0.2)')//' GiB, the meshes and loads of '// &
            'both bodies and its element entries the rest)'
     if (process_limit_mb > 0.0_wp .and. rank_mb > process_limit_mb) then
-      ok = .false.
-      msg = 'deck '//trim(d%source)//': '//what//' but a process may use only '// &
-            fmt_real(process_limit_mb/1024.0_wp, '(f0.2)')//' GiB (ulimit -v); use more ranks per body or fewer cells'
+      call err%set(ERR_INPUT, ''//what//' but a process may use only '// &
+            fmt_real(process_limit_mb/1024.0_wp, '(f0.2)')//' GiB (ulimit -v); use more ranks per body or fewer cells')
     else if (node_limit_mb > 0.0_wp .and. node_mb > node_limit_mb) then
-      ok = .false.
-      msg = 'deck '//trim(d%source)//': '//what//', and the '//i2s(node_ranks)//' rank(s) on its node about '// &
+      call err%set(ERR_INPUT, ''//what//', and the '//i2s(node_ranks)//' rank(s) on its node about '// &
             fmt_real(node_mb/1024.0_wp, '(f0.2)')//' GiB together, but that node may use only '// &
             fmt_real(node_limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ROBIN_MEMORY_LIMIT_MB); '// &
-            'spread the ranks over more nodes (fewer per node), use more ranks per body, or fewer cells'
+            'spread the ranks over more nodes (fewer per node), use more ranks per body, or fewer cells')
     end if
   end subroutine check_budget_ranks
 
@@ -217,16 +207,14 @@ contains
 
   !> Loads within double precision: a traction or prescribed displacement whose stresses
   !! would overflow (1e308 Pa) is refused, with a margin of 1e6 for the products of
-  !! assembly and stress recovery. ok = .false. with msg naming the group and the value.
-  subroutine check_load_range(d, ok, msg)
+  !! assembly and stress recovery: err (ERR_INPUT) naming the load and the value; the
+  !! caller adds the deck.
+  subroutine check_load_range(d, err)
     type(deck_t), intent(in) :: d                       !< the deck
-    logical, intent(out) :: ok                          !< the loads are representable
-    character(len=:), allocatable, intent(out) :: msg   !< why not
+    type(error_t), intent(out) :: err                   !< why the loads are not representable, if so
     real(wp), parameter :: MARGIN = 1.0e6_wp
     real(wp) :: ext, t, h, u, cap
     integer :: i, a, s
-    ok = .true.
-    msg = ''
     ext = 1.0_wp
     do a = 1, 2
       ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
@@ -242,10 +230,9 @@ contains
         t = huge(1.0_wp)
       end if
       if (.not. t < cap) then
-        ok = .false.
-        msg = 'deck '//trim(d%source)//': &traction '//i2s(i)//' (body '//i2s(d%traction(i)%body)// &
+        call err%set(ERR_INPUT, '&traction '//i2s(i)//' (body '//i2s(d%traction(i)%body)// &
               ') reaches '//sci(t)//' [stress]: its stresses would overflow double precision; '// &
-              'rescale the units (e.g. &scene units=''mm-N-MPa'')'
+              'rescale the units (e.g. &scene units=''mm-N-MPa'')')
         return
       end if
     end do
@@ -255,10 +242,9 @@ contains
         u = maxval(abs(d%body(a)%u_side(:, s)))
         if (.not. u > 0.0_wp) cycle   ! (no short-circuit in Fortran: log(0) must not be evaluated)
         if (.not. log(u) + log(d%body(a)%young) - log(h) + log(MARGIN) < log(huge(1.0_wp))) then
-          ok = .false.
-          msg = 'deck '//trim(d%source)//': the &displacement of body '//i2s(a)//' ('//sci(u)// &
+          call err%set(ERR_INPUT, 'the &displacement of body '//i2s(a)//' ('//sci(u)// &
                 ' [length]) with young = '//sci(d%body(a)%young)//' gives stresses beyond double '// &
-                'precision; rescale the units'
+                'precision; rescale the units')
           return
         end if
       end do

@@ -20,6 +20,7 @@ module results
   use condense, only: interface_t, contact_resultant
   use contact_types, only: contact_result_t, status_name
   use floating, only: free_list
+  use errors, only: error_t, ERR_IO
   implicit none (type, external)
   private
 
@@ -46,10 +47,10 @@ contains
 
   !> Write the HDF5 result and its XDMF companions, each under a temporary name of this
   !! run first, and commit them together (`commit_files`: companions first, the HDF5 file
-  !! last) only when all are complete. ok = .false. and msg (naming the file and what
-  !! failed) otherwise; then the files of an earlier result at these names are as they
-  !! were, and no temporary file is left.
-  subroutine write_results(file, d, msh, sys, itf, res, u, stress, tm, ok, msg)
+  !! last) only when all are complete. Otherwise err (ERR_IO, naming the file and what
+  !! failed); then the files of an earlier result at these names are as they were, and no
+  !! temporary file is left.
+  subroutine write_results(file, d, msh, sys, itf, res, u, stress, tm, err)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(2)                 !< meshes
@@ -59,16 +60,14 @@ contains
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, 2) full displacements
     type(stress_field_t), intent(in) :: stress(2)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
-    logical, intent(out) :: ok                         !< success
-    character(len=*), intent(out) :: msg               !< failure description
+    type(error_t), intent(out) :: err                  !< the failure, if any
     character(len=len_trim(file) + 16) :: name(NFILES)
     character(len=len_trim(file) + 128) :: tmp(NFILES)
     character(len=:), allocatable :: why, h5
     type(h5_status_t) :: st
     integer :: k, a
+    logical :: ok
 
-    ok = .false.
-    msg = ''
     call ensure_parent_dir(file)
     call result_files(file, name)
     do k = 1, NFILES
@@ -76,7 +75,7 @@ contains
     end do
     call write_h5(tmp(1), d, msh, sys, itf, res, u, stress, tm, run_id(), st)
     if (st%failed) then
-      msg = 'cannot write '//trim(file)//' ('//st%what//')'
+      call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%what//')')
       call remove_temps()
       return
     end if
@@ -87,13 +86,13 @@ contains
       if (ok) call write_text(tmp(2 + a), xdmf_text([a], h5, msh, itf%m, run_id()), ok)
     end do
     if (.not. ok) then
-      msg = 'cannot write the XDMF files beside '//trim(file)
+      call err%set(ERR_IO, 'cannot write the XDMF files beside '//trim(file))
       call remove_temps()
       return
     end if
     ! companions first, the HDF5 file last: it appears only with its XDMF files
     call commit_files(tmp(NFILES:1:-1), name(NFILES:1:-1), ok, why)
-    if (.not. ok) msg = 'cannot write '//trim(file)//': '//why
+    if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
 
   contains
 

@@ -6,6 +6,7 @@ module banded
   use clock, only: wtime
   use sorting, only: sort_by_key
   use lapack, only: dpbtrf, dpbtrs
+  use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
   implicit none (type, external)
   private
 
@@ -171,29 +172,25 @@ contains
   end function band_width
 
   !> RCM-order, store in band form and factorize with `dpbtrf`.
-  !! info: 0 ok; 1 not positive definite; 2 out of memory; 3 other failure.
-  subroutine band_factor(self, n, colptr, rowind, val, info, msg)
+  !! err: ERR_NUMERICAL (not positive definite, LAPACK failure) or ERR_MEMORY.
+  subroutine band_factor(self, n, colptr, rowind, val, err)
     class(band_t), intent(inout) :: self
     integer, intent(in) :: n              !< matrix order
     integer, intent(in) :: colptr(:)      !< column pointers, size n+1, 0-based (full symmetric)
     integer, intent(in) :: rowind(:)      !< row indices, 0-based
     real(wp), intent(in) :: val(:)        !< values
-    integer, intent(out) :: info          !< status code
-    character(len=*), intent(out) :: msg  !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err     !< the failure, if any
     integer, allocatable :: iperm(:)
     integer :: j, p, ni, nj, st, lapinfo
     real(wp) :: t0
     character(len=160) :: emsg
 
     call self%free()
-    info = 0
-    msg = ''
     t0 = wtime()
     self%n = n
     allocate (self%perm(n), iperm(n), stat=st)
     if (st /= 0) then
-      info = 2
-      msg = 'banded Cholesky: out of memory for the RCM permutation.'
+      call err%set(ERR_MEMORY, 'banded Cholesky: out of memory for the RCM permutation.')
       return
     end if
     call rcm_order(n, colptr, rowind, self%perm)
@@ -202,18 +199,16 @@ contains
     end do
     self%kd = band_width(n, colptr, rowind, self%perm)
     if (int(self%kd + 1, i8) * int(n, i8) > int(huge(1), i8)) then
-      info = 2
       write (emsg, '(a,i0,a,i0,a)') 'banded Cholesky: band storage (', self%kd + 1, ' x ', n, &
         ') is too large for 32-bit LAPACK indexing.'
-      msg = emsg
+      call err%set(ERR_MEMORY, emsg)
       return
     end if
     allocate (self%ab(self%kd + 1, n), stat=st)
     if (st /= 0) then
-      info = 2
       write (emsg, '(a,i0,a,i0,a)') 'banded Cholesky: out of memory for band storage (', &
         self%kd + 1, ' x ', n, ').'
-      msg = emsg
+      call err%set(ERR_MEMORY, emsg)
       return
     end if
     self%ab = 0.0_wp
@@ -230,47 +225,39 @@ contains
     call dpbtrf('L', n, self%kd, self%ab, self%kd + 1, lapinfo)
     self%t_factor = wtime() - t0
     if (lapinfo > 0) then
-      info = 1
       write (emsg, '(a,i0,a,i0,a)') 'banded Cholesky: matrix is not positive definite (leading minor ', &
         lapinfo, ', DOF ', self%perm(lapinfo), ').'
-      msg = emsg
+      call err%set(ERR_NUMERICAL, emsg)
       deallocate (self%ab)
       return
     else if (lapinfo < 0) then
-      info = 3
       write (emsg, '(a,i0,a)') 'banded Cholesky: dpbtrf rejected argument ', -lapinfo, '.'
-      msg = emsg
+      call err%set(ERR_NUMERICAL, emsg)
       deallocate (self%ab)
       return
     end if
     self%factored = .true.
   end subroutine band_factor
 
-  !> Solve K X = B in place (b is n x nrhs). info: 0 ok, 2 out of memory, 3 failure.
-  subroutine band_solve(self, b, info, msg)
+  !> Solve K X = B in place (b is n x nrhs). err: ERR_MEMORY or ERR_NUMERICAL.
+  subroutine band_solve(self, b, err)
     class(band_t), intent(in) :: self
     real(wp), intent(inout) :: b(:, :)    !< right-hand sides in, solutions out
-    integer, intent(out) :: info          !< status code
-    character(len=*), intent(out) :: msg  !< one sentence on failure
+    type(error_t), intent(out) :: err     !< the failure, if any
     real(wp), allocatable :: w(:, :)
     integer :: k, st, lapinfo
-    info = 0
-    msg = ''
     if (.not. self%factored) then
-      info = 3
-      msg = 'banded Cholesky: solve called without a valid factorization.'
+      call err%set(ERR_NUMERICAL, 'banded Cholesky: solve called without a valid factorization.')
       return
     end if
     if (size(b, 1) /= self%n) then
-      info = 3
-      msg = 'banded Cholesky: right-hand side length differs from the matrix order.'
+      call err%set(ERR_NUMERICAL, 'banded Cholesky: right-hand side length differs from the matrix order.')
       return
     end if
     if (size(b, 2) == 0) return
     allocate (w(self%n, size(b, 2)), stat=st)
     if (st /= 0) then
-      info = 2
-      msg = 'banded Cholesky: out of memory for the solve workspace.'
+      call err%set(ERR_MEMORY, 'banded Cholesky: out of memory for the solve workspace.')
       return
     end if
     do k = 1, self%n
@@ -278,8 +265,7 @@ contains
     end do
     call dpbtrs('L', self%n, self%kd, size(b, 2), self%ab, self%kd + 1, w, self%n, lapinfo)
     if (lapinfo /= 0) then
-      info = 3
-      msg = 'banded Cholesky: dpbtrs failed.'
+      call err%set(ERR_NUMERICAL, 'banded Cholesky: dpbtrs failed.')
       return
     end if
     do k = 1, self%n

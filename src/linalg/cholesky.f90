@@ -16,9 +16,10 @@ module cholesky
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
-                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN
+                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN, CM_OK, CM_OUT_OF_MEMORY
   use banded, only: band_t
   use lapack, only: dpotri
+  use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
   implicit none (type, external)
   private
 
@@ -29,11 +30,6 @@ module cholesky
   integer, parameter, public :: ORD_AMD = 2        !< AMD, or CAMD when an interface is given
   integer, parameter, public :: ORD_NATURAL = 3    !< natural order (interface last if given)
   integer, parameter, public :: ORD_GIVEN = 4      !< caller's interior order (interior_perm), interface last
-
-  integer, parameter, public :: CHOL_OK = 0          !< info: success
-  integer, parameter, public :: CHOL_NOT_POSDEF = 1  !< info: matrix not positive definite
-  integer, parameter, public :: CHOL_NO_MEMORY = 2   !< info: out of memory / too large
-  integer, parameter, public :: CHOL_FAILURE = 3     !< info: any other failure
 
   !> One factorization of one symmetric positive definite matrix K (n x n).
   type, public :: chol_t
@@ -67,8 +63,8 @@ contains
   !! increasingly in each column, K symmetric).
   !! With ORD_GIVEN (CHOLMOD), interior_perm is the elimination order of every DOF not in
   !! `last` (e.g. module ordering's nested dissection), followed by `last`.
-  !! info: 0 ok; 1 not positive definite; 2 out of memory; 3 other failure (msg says which).
-  subroutine chol_factor(self, n, colptr, rowind, val, method, ordering, info, msg, last, interior_perm)
+  !! err: ERR_NUMERICAL (not positive definite, bad arguments, CHOLMOD failure) or ERR_MEMORY.
+  subroutine chol_factor(self, n, colptr, rowind, val, method, ordering, err, last, interior_perm)
     class(chol_t), intent(inout) :: self
     integer, intent(in) :: n                    !< matrix order
     integer(ip), intent(in) :: colptr(:)        !< column pointers, size n+1, 0-based
@@ -76,8 +72,7 @@ contains
     real(wp), intent(in) :: val(:)              !< values, size >= colptr(n+1)
     integer, intent(in) :: method               !< FACT_CHOLMOD or FACT_BANDED
     integer, intent(in) :: ordering             !< ORD_METIS, ORD_AMD, ORD_NATURAL or ORD_GIVEN (CHOLMOD)
-    integer, intent(out) :: info                !< status code (see above)
-    character(len=*), intent(out) :: msg        !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err           !< the failure, if any
     integer, intent(in), optional :: last(:)    !< 1-based DOFs to order last (interface), CHOLMOD
     integer, intent(in), optional :: interior_perm(:)  !< ORD_GIVEN: 1-based order of the DOFs not in `last`
     integer :: j, p, nnz, k
@@ -85,46 +80,46 @@ contains
     integer(c_int), allocatable :: last0(:), inter0(:)
     type(cm_stats_t) :: st
     character(len=200) :: emsg
+    character(len=512) :: cmsg
+    integer :: code
 
     call self%free()
-    info = CHOL_OK
-    msg = ''
 
     ! ---- check arguments ----
     if (n < 1) then
       write (emsg, '(a,i0,a)') 'Cholesky: matrix order n = ', n, ' must be positive.'
-      call fail(CHOL_FAILURE, emsg)
+      call err%set(ERR_NUMERICAL, emsg)
       return
     end if
     if (size(colptr) < n + 1) then
-      call fail(CHOL_FAILURE, 'Cholesky: colptr is shorter than n+1.')
+      call err%set(ERR_NUMERICAL, 'Cholesky: colptr is shorter than n+1.')
       return
     end if
     if (colptr(1) /= 0) then
-      call fail(CHOL_FAILURE, 'Cholesky: colptr(1) must be 0 (0-based CSC).')
+      call err%set(ERR_NUMERICAL, 'Cholesky: colptr(1) must be 0 (0-based CSC).')
       return
     end if
     nnz = colptr(n + 1)
     if (size(rowind) < nnz .or. size(val) < nnz) then
-      call fail(CHOL_FAILURE, 'Cholesky: rowind or val is shorter than colptr(n+1).')
+      call err%set(ERR_NUMERICAL, 'Cholesky: rowind or val is shorter than colptr(n+1).')
       return
     end if
     do j = 1, n
       if (colptr(j + 1) < colptr(j)) then
         write (emsg, '(a,i0,a)') 'Cholesky: colptr decreases at column ', j, '.'
-        call fail(CHOL_FAILURE, emsg)
+        call err%set(ERR_NUMERICAL, emsg)
         return
       end if
       do p = colptr(j) + 1, colptr(j + 1)
         if (rowind(p) < 0 .or. rowind(p) >= n) then
           write (emsg, '(a,i0,a,i0,a)') 'Cholesky: row index ', rowind(p), ' out of range in column ', j, '.'
-          call fail(CHOL_FAILURE, emsg)
+          call err%set(ERR_NUMERICAL, emsg)
           return
         end if
         if (p > colptr(j) + 1) then
           if (rowind(p) <= rowind(p - 1)) then
             write (emsg, '(a,i0,a)') 'Cholesky: row indices not strictly increasing in column ', j, '.'
-            call fail(CHOL_FAILURE, emsg)
+            call err%set(ERR_NUMERICAL, emsg)
             return
           end if
         end if
@@ -132,12 +127,12 @@ contains
     end do
     if (method /= FACT_CHOLMOD .and. method /= FACT_BANDED) then
       write (emsg, '(a,i0,a)') 'Cholesky: unknown factorization method ', method, '.'
-      call fail(CHOL_FAILURE, emsg)
+      call err%set(ERR_NUMERICAL, emsg)
       return
     end if
     if (method == FACT_CHOLMOD .and. (ordering < ORD_METIS .or. ordering > ORD_GIVEN)) then
       write (emsg, '(a,i0,a)') 'Cholesky: unknown ordering ', ordering, '.'
-      call fail(CHOL_FAILURE, emsg)
+      call err%set(ERR_NUMERICAL, emsg)
       return
     end if
     allocate (seen(n))
@@ -146,12 +141,12 @@ contains
       do k = 1, size(last)
         if (last(k) < 1 .or. last(k) > n) then
           write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
-          call fail(CHOL_FAILURE, emsg)
+          call err%set(ERR_NUMERICAL, emsg)
           return
         end if
         if (seen(last(k))) then
           write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
-          call fail(CHOL_FAILURE, emsg)
+          call err%set(ERR_NUMERICAL, emsg)
           return
         end if
         seen(last(k)) = .true.
@@ -163,26 +158,26 @@ contains
     if (method == FACT_CHOLMOD .and. ordering == ORD_GIVEN) then
       ! interior_perm: every DOF not in `last`, once (seen marks `last` so far)
       if (.not. present(interior_perm)) then
-        call fail(CHOL_FAILURE, 'Cholesky: ordering GIVEN needs interior_perm.')
+        call err%set(ERR_NUMERICAL, 'Cholesky: ordering GIVEN needs interior_perm.')
         return
       end if
       if (size(interior_perm) /= n - size(self%last)) then
         write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interior_perm has ', size(interior_perm), &
           ' entries, expected n - size(last) = ', n - size(self%last), '.'
-        call fail(CHOL_FAILURE, emsg)
+        call err%set(ERR_NUMERICAL, emsg)
         return
       end if
       do k = 1, size(interior_perm)
         if (interior_perm(k) < 1 .or. interior_perm(k) > n) then
           write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interior_perm entry ', k, ' = ', interior_perm(k), &
             ' is out of range.'
-          call fail(CHOL_FAILURE, emsg)
+          call err%set(ERR_NUMERICAL, emsg)
           return
         end if
         if (seen(interior_perm(k))) then
           write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interior_perm entry ', k, ' = ', interior_perm(k), &
             ' is repeated or an interface DOF.'
-          call fail(CHOL_FAILURE, emsg)
+          call err%set(ERR_NUMERICAL, emsg)
           return
         end if
         seen(interior_perm(k)) = .true.
@@ -197,18 +192,21 @@ contains
     call cm_init()    ! BLAS single-threaded, for the banded path too
     select case (method)
     case (FACT_CHOLMOD)
-      call cm_create(self%handle, info, msg)
-      if (info /= CHOL_OK) return
+      call cm_create(self%handle, code, cmsg)
+      if (code /= CM_OK) then
+        call set_cm_error(code, cmsg, err)
+        return
+      end if
       allocate (last0(self%m_last))
       last0 = int(self%last - 1, c_int)
       if (ordering == ORD_GIVEN) then
         allocate (inter0(size(interior_perm)))
         inter0 = int(interior_perm - 1, c_int)
-        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, info, msg, &
+        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, code, cmsg, &
                           interior0=inter0)
         deallocate (inter0)
       else
-        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, info, msg)
+        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, code, cmsg)
       end if
       st = cm_get_stats(self%handle)
       self%t_analyze = st%t_analyze
@@ -217,16 +215,17 @@ contains
       self%flops = st%flops
       self%mem_bytes = int(st%mem_peak, i8)
       self%interface_last_ok = (st%last_ok == 1 .and. self%m_last > 0)
-      if (info /= CHOL_OK) then
+      if (code /= CM_OK) then
+        call set_cm_error(code, cmsg, err)
         call cm_free(self%handle)
         return
       end if
     case (FACT_BANDED)
-      call self%band%factor(n, colptr, rowind, val, info, msg)
+      call self%band%factor(n, colptr, rowind, val, err)
       self%t_analyze = self%band%t_order
       self%t_factor = self%band%t_factor
       self%bandwidth = self%band%kd
-      if (info /= CHOL_OK) return
+      if (err%failed()) return
       self%nnz_factor = int(n, i8) * int(self%band%kd + 1, i8) &
                         - int(self%band%kd, i8) * int(self%band%kd + 1, i8) / 2
       self%flops = real(n, wp) * real(self%band%kd, wp) * real(self%band%kd + 3, wp)
@@ -234,16 +233,19 @@ contains
     end select
     self%method = method
 
-  contains
-
-    subroutine fail(code, text)
-      integer, intent(in) :: code
-      character(len=*), intent(in) :: text
-      info = code
-      msg = text
-    end subroutine fail
-
   end subroutine chol_factor
+
+  !> The error for a CHOLMOD shim status: out of memory, or any other failure.
+  subroutine set_cm_error(code, text, err)
+    integer, intent(in) :: code              !< CM_* status, not CM_OK
+    character(len=*), intent(in) :: text     !< the shim's sentence
+    type(error_t), intent(inout) :: err      !< receives the error
+    if (code == CM_OUT_OF_MEMORY) then
+      call err%set(ERR_MEMORY, text)
+    else
+      call err%set(ERR_NUMERICAL, text)
+    end if
+  end subroutine set_cm_error
 
   !> Map ORD_* to the shim's codes.
   pure integer function cm_ordering(ordering)
@@ -260,53 +262,48 @@ contains
     end select
   end function cm_ordering
 
-  !> Solve K x = b in place (one right-hand side). info: 0 ok, 2 out of memory, 3 failure.
-  subroutine chol_solve_vec(self, b, info, msg)
+  !> Solve K x = b in place (one right-hand side). err: ERR_MEMORY or ERR_NUMERICAL.
+  subroutine chol_solve_vec(self, b, err)
     class(chol_t), intent(in) :: self
     real(wp), intent(inout), target, contiguous :: b(:)   !< right-hand side in, solution out
-    integer, intent(out) :: info                          !< status code
-    character(len=*), intent(out), optional :: msg        !< one sentence on failure
+    type(error_t), intent(out) :: err                     !< the failure, if any
     real(wp), pointer, contiguous :: b2(:, :)
     b2(1:size(b), 1:1) => b
-    call chol_solve_mat(self, b2, info, msg)
+    call chol_solve_mat(self, b2, err)
   end subroutine chol_solve_vec
 
-  !> Solve K X = B in place (columns of b). info: 0 ok, 2 out of memory, 3 failure.
-  subroutine chol_solve_mat(self, b, info, msg)
+  !> Solve K X = B in place (columns of b). err: ERR_MEMORY or ERR_NUMERICAL.
+  subroutine chol_solve_mat(self, b, err)
     class(chol_t), intent(in) :: self
     real(wp), intent(inout), contiguous :: b(:, :)   !< right-hand sides in, solutions out (n x nrhs)
-    integer, intent(out) :: info                     !< status code
-    character(len=*), intent(out), optional :: msg   !< one sentence on failure
+    type(error_t), intent(out) :: err                !< the failure, if any
     character(len=512) :: emsg
-    emsg = ''
-    info = CHOL_OK
+    integer :: code
     if (self%method == 0) then
-      info = CHOL_FAILURE
-      emsg = 'Cholesky: solve called without a valid factorization.'
+      call err%set(ERR_NUMERICAL, 'Cholesky: solve called without a valid factorization.')
     else if (size(b, 1) /= self%n) then
-      info = CHOL_FAILURE
       write (emsg, '(a,i0,a,i0,a)') 'Cholesky: right-hand side length ', size(b, 1), &
         ' differs from the matrix order ', self%n, '.'
+      call err%set(ERR_NUMERICAL, emsg)
     else if (self%method == FACT_CHOLMOD) then
-      call cm_solve(self%handle, b, info, emsg)
+      call cm_solve(self%handle, b, code, emsg)
+      if (code /= CM_OK) call set_cm_error(code, emsg, err)
     else
-      call self%band%solve(b, info, emsg)
+      call self%band%solve(b, err)
     end if
-    if (present(msg)) msg = emsg
   end subroutine chol_solve_mat
 
   !> Interface flexibility F(i,j) = sgn(i) sgn(j) (K^-1)(idx(i), idx(j)), m = size(idx),
   !! symmetric, full storage. Uses the trailing block of L when the factorization
   !! is CHOLMOD with every idx(i) among the DOFs ordered last and the ordering check
   !! passed; otherwise blocked solves with unit right-hand sides.
-  !! info: 0 ok; 1 Schur complement not positive definite; 2 out of memory; 3 failure.
-  subroutine chol_flexibility(self, idx, sgn, F, info, msg, use_solves, used_block)
+  !! err: ERR_NUMERICAL (Schur complement not positive definite, failure) or ERR_MEMORY.
+  subroutine chol_flexibility(self, idx, sgn, F, err, use_solves, used_block)
     class(chol_t), intent(in) :: self
     integer, intent(in) :: idx(:)                 !< 1-based DOFs of the interface rows
     real(wp), intent(in) :: sgn(:)                !< row scaling (the +-1 signs of E), size(idx)
     real(wp), intent(out) :: F(:, :)              !< m x m flexibility [K^-1 units]
-    integer, intent(out) :: info                  !< status code
-    character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err             !< the failure, if any
     logical, intent(in), optional :: use_solves   !< force the solve-based path (default false)
     logical, intent(out), optional :: used_block  !< true if the trailing-block path was used
     integer :: m, i, j, k, st
@@ -314,27 +311,22 @@ contains
     logical :: try_block
     character(len=200) :: emsg
 
-    info = CHOL_OK
-    msg = ''
     if (present(used_block)) used_block = .false.
     m = size(idx)
     if (self%method == 0) then
-      info = CHOL_FAILURE
-      msg = 'Cholesky: flexibility requested without a valid factorization.'
+      call err%set(ERR_NUMERICAL, 'Cholesky: flexibility requested without a valid factorization.')
       return
     end if
     if (size(sgn) /= m .or. size(F, 1) /= m .or. size(F, 2) /= m) then
-      info = CHOL_FAILURE
       write (emsg, '(a,i0,a)') 'Cholesky: flexibility needs sgn(', m, ') and F(m,m) for m = size(idx).'
-      msg = emsg
+      call err%set(ERR_NUMERICAL, emsg)
       return
     end if
     if (m == 0) return
     do i = 1, m
       if (idx(i) < 1 .or. idx(i) > self%n) then
-        info = CHOL_FAILURE
         write (emsg, '(a,i0,a,i0,a)') 'Cholesky: interface DOF ', idx(i), ' (entry ', i, ') is out of range.'
-        msg = emsg
+        call err%set(ERR_NUMERICAL, emsg)
         return
       end if
     end do
@@ -356,7 +348,7 @@ contains
 
     if (try_block) then
       call flex_block()
-      if (present(used_block)) used_block = (info == CHOL_OK)
+      if (present(used_block)) used_block = .not. err%failed()
     else
       call flex_solves()
     end if
@@ -366,25 +358,26 @@ contains
     !> F from the trailing block L_G: (K^-1)_GG = (L_G L_G')^-1 via dpotri.
     subroutine flex_block()
       real(wp), allocatable :: lg(:, :)
-      integer :: ml, lapinfo, a, b
+      integer :: ml, lapinfo, a, b, code
+      character(len=512) :: cmsg
       ml = self%m_last
       allocate (lg(ml, ml), stat=st)
       if (st /= 0) then
-        info = CHOL_NO_MEMORY
-        msg = 'Cholesky: out of memory for the trailing block of L.'
+        call err%set(ERR_MEMORY, 'Cholesky: out of memory for the trailing block of L.')
         return
       end if
-      call cm_trailing_block(self%handle, lg, info, msg)
-      if (info /= CHOL_OK) return
+      call cm_trailing_block(self%handle, lg, code, cmsg)
+      if (code /= CM_OK) then
+        call set_cm_error(code, cmsg, err)
+        return
+      end if
       call dpotri('L', ml, lg, ml, lapinfo)
       if (lapinfo > 0) then
-        info = CHOL_NOT_POSDEF
         write (emsg, '(a,i0,a)') 'Cholesky: trailing block of L is singular (dpotri info ', lapinfo, ').'
-        msg = emsg
+        call err%set(ERR_NUMERICAL, emsg)
         return
       else if (lapinfo < 0) then
-        info = CHOL_FAILURE
-        msg = 'Cholesky: dpotri rejected its arguments.'
+        call err%set(ERR_NUMERICAL, 'Cholesky: dpotri rejected its arguments.')
         return
       end if
       do j = 1, m
@@ -405,8 +398,7 @@ contains
       nb = min(nb, m)
       allocate (w(self%n, nb), stat=st)
       if (st /= 0) then
-        info = CHOL_NO_MEMORY
-        msg = 'Cholesky: out of memory for the flexibility solve block.'
+        call err%set(ERR_MEMORY, 'Cholesky: out of memory for the flexibility solve block.')
         return
       end if
       do j0 = 1, m, nb
@@ -415,8 +407,8 @@ contains
         do jj = 1, nc
           w(idx(j0 + jj - 1), jj) = 1.0_wp
         end do
-        call chol_solve_mat(self, w(:, 1:nc), info, msg)
-        if (info /= CHOL_OK) exit
+        call chol_solve_mat(self, w(:, 1:nc), err)
+        if (err%failed()) exit
         do jj = 1, nc
           j = j0 + jj - 1
           do i = 1, m
@@ -425,7 +417,7 @@ contains
         end do
       end do
       if (self%method == FACT_CHOLMOD) call cm_release_workspace(self%handle)
-      if (info /= CHOL_OK) return
+      if (err%failed()) return
       do j = 1, m
         do i = j + 1, m
           F(i, j) = 0.5_wp * (F(i, j) + F(j, i))

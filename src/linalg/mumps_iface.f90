@@ -13,6 +13,7 @@ module mumps_iface
   use strings, only: body_label
   use lapack, only: dpotrf, dpotri
   use mpi, only: MPI_Bcast, MPI_INTEGER
+  use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -41,8 +42,8 @@ contains
   !> Analyse and factorize K (n x n, symmetric positive definite; each rank gives its
   !! entries of the lower triangle, summed over ranks) with the DOFs schur(:) (1-based) as
   !! Schur variables; on the host, X = S^-1.
-  !! info: 0 ok, 3 MUMPS failed or S is not positive definite (msg says which and why).
-  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, info, msg)
+  !! err: ERR_NUMERICAL when MUMPS failed or S is not positive definite (which and why).
+  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, err)
     type(mumps_t), intent(inout) :: mt        !< receives the instance
     integer, intent(in) :: comm               !< the group's communicator (host: its rank 0)
     integer, intent(in) :: n                  !< unknowns (same on every rank)
@@ -50,10 +51,10 @@ contains
     real(wp), intent(in) :: val(:)            !< this rank's entries [stress]
     integer, intent(in) :: schur(:)           !< (k) host: the Schur variables, 1-based
     integer, intent(in) :: body               !< body number, for messages
-    integer, intent(out) :: info              !< 0 ok, 3 failure
-    character(len=*), intent(out) :: msg      !< description of a failure
-    integer :: j, lap, k, i, cap, st
+    type(error_t), intent(out) :: err         !< the failure, if any
+    integer :: j, lap, k, i, cap, st, info
     character(len=32) :: env
+    character(len=512) :: msg
 
     info = 0
     msg = ''
@@ -138,14 +139,14 @@ contains
     call bcast_int(info)
     if (info /= 0 .and. .not. mt%host) write (msg, '(a,i0,a)') 'the stiffness of body ', body, &
       ' is singular (not held against rigid motion?)'
+    if (info /= 0) call err%set(ERR_NUMERICAL, msg)
 
   contains
 
     subroutine fail(what)
       character(len=*), intent(in) :: what
-      info = 3
-      msg = 'MUMPS '//what//' of body '//body_label(body)//' failed: '// &
-            trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body))
+      call err%set(ERR_NUMERICAL, 'MUMPS '//what//' of body '//body_label(body)//' failed: '// &
+                   trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body)))
     end subroutine fail
 
     subroutine bcast_int(v)
@@ -161,15 +162,12 @@ contains
   !> Solve K u = r in place (r given and u returned on the host): the reduced right-hand
   !! side r_G - K_GI K_II^-1 r_I (ICNTL(26) = 1), u_G = X times it, the interior by
   !! expansion (ICNTL(26) = 2). Collective over the group.
-  subroutine mumps_solve(mt, r, body, info, msg)
+  subroutine mumps_solve(mt, r, body, err)
     type(mumps_t), intent(inout) :: mt          !< factorized body
     real(wp), intent(inout) :: r(:)             !< host: (n) in r [force], out u [length]
     integer, intent(in) :: body                 !< body number, for messages
-    integer, intent(out) :: info                !< 0 ok, 3 MUMPS failed
-    character(len=*), intent(out) :: msg        !< description of a failure
+    type(error_t), intent(out) :: err           !< the failure (ERR_NUMERICAL), if any
     real(wp), allocatable :: ug(:)
-    info = 0
-    msg = ''
     if (mt%host) then
       allocate (mt%id%RHS(mt%n))
       mt%id%RHS = r
@@ -211,9 +209,8 @@ contains
     end if
   contains
     subroutine fail()
-      info = 3
-      msg = 'MUMPS solve with body '//body_label(body)//' failed: '// &
-            trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body))
+      call err%set(ERR_NUMERICAL, 'MUMPS solve with body '//body_label(body)//' failed: '// &
+                   trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body)))
       if (associated(mt%id%RHS)) deallocate (mt%id%RHS)
       if (associated(mt%id%REDRHS)) deallocate (mt%id%REDRHS)
     end subroutine fail

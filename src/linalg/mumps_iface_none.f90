@@ -3,6 +3,7 @@
 !! binaries. The driver refuses factorization='mumps' before any call reaches here.
 module mumps_iface
   use kinds, only: wp
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
@@ -24,28 +25,24 @@ module mumps_iface
 
 contains
 
-  !> Not available: info = 1.
-  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, info, msg)
+  !> Not available: ERR_INPUT (the deck asks for what this binary lacks).
+  subroutine mumps_schur_factor(mt, comm, n, irn, jcn, val, schur, body, err)
     type(mumps_t), intent(inout) :: mt
     integer, intent(in) :: comm, n, irn(:), jcn(:), schur(:), body
     real(wp), intent(in) :: val(:)
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
     mt%n = n + 0*(comm + body + size(irn) + size(jcn) + size(val) + size(schur))
-    info = 1
-    msg = NONE
+    call err%set(ERR_INPUT, NONE)
   end subroutine mumps_schur_factor
 
-  !> Not available: info = 1.
-  subroutine mumps_solve(mt, r, body, info, msg)
+  !> Not available: ERR_INPUT (the deck asks for what this binary lacks).
+  subroutine mumps_solve(mt, r, body, err)
     type(mumps_t), intent(inout) :: mt
     real(wp), intent(inout) :: r(:)
     integer, intent(in) :: body
-    integer, intent(out) :: info
-    character(len=*), intent(out) :: msg
+    type(error_t), intent(out) :: err
     mt%k = mt%k + 0*(size(r) + body)
-    info = 1
-    msg = NONE
+    call err%set(ERR_INPUT, NONE)
   end subroutine mumps_solve
 
   !> Nothing to free.

@@ -8,12 +8,12 @@ program test_cholesky
   use, intrinsic :: iso_fortran_env, only: output_unit
   use omp_lib, only: omp_get_max_threads
   use kinds, only: wp
-  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, &
-                      CHOL_NOT_POSDEF, CHOL_FAILURE
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL
   use banded, only: rcm_order, band_width
   use lapack, only: dpotrf, dpotri, dposv, dpocon
   use clock, only: wtime
-  use testing, only: report, report_le, test_summary
+  use testing, only: report, report_le, test_summary, error_parts
+  use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
 
   !> A sparse symmetric matrix in full 0-based CSC.
@@ -366,6 +366,7 @@ contains
     integer, allocatable :: iwork(:)
     real(wp) :: anorm, rcond, kappa, tol_sol, tol_flex, t
     integer :: n, mi, info, i, j, o, meth
+    type(error_t) :: err
     logical :: used
     character(len=256) :: msg
     character(len=80) :: tag
@@ -414,17 +415,20 @@ contains
         o = meth
         tag = name//' cholmod/'//trim(onames(o))
         t = wtime()
-        call ch%factor(n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg, last=iface)
+        call ch%factor(n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, err, last=iface)
+        call error_parts(err, info, msg)
       else
         tag = name//' banded'
-        call ch%factor(n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, info, msg)
+        call ch%factor(n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, err)
+        call error_parts(err, info, msg)
       end if
       call report(info == 0, trim(tag)//': factor info = 0 '//trim(msg))
       if (info /= 0) cycle
       write (output_unit, '(a)') '      '//ch%summary()
       if (meth <= 3) call report(ch%interface_last_ok, trim(tag)//': interface DOFs ordered last, in the given order')
       u = f
-      call ch%solve(u, info, msg)
+      call ch%solve(u, err)
+      call error_parts(err, info, msg)
       call report(info == 0, trim(tag)//': solve info = 0')
       call report_le(scaled_residual(M, u, f), RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)')
       call report_le(rel_diff(u, ud), tol_sol, trim(tag)//': |u - u_dposv|/|u_dposv|')
@@ -433,10 +437,12 @@ contains
       allocate (F3(n, 3), U3(n, 3))
       call random_number(F3)
       U3 = F3
-      call ch%solve(U3, info, msg)
+      call ch%solve(U3, err)
+      call error_parts(err, info, msg)
       do j = 1, 3
         u = F3(:, j)
-        call ch%solve(u, info, msg)
+        call ch%solve(u, err)
+        call error_parts(err, info, msg)
         F3(:, j) = u
       end do
       call report_le(rel_diff2(U3, F3), tol_sol, trim(tag)//': 3 right-hand sides at once = one by one')
@@ -444,10 +450,12 @@ contains
 
       ! flexibility
       if (meth <= 3) then
-        call ch%flexibility(iface, sgn, Fb, info, msg, used_block=used)
+        call ch%flexibility(iface, sgn, Fb, err, used_block=used)
+        call error_parts(err, info, msg)
         call report(info == 0 .and. used, trim(tag)//': flexibility via trailing block of L used')
         call report_le(rel_diff2(Fb, Fd), tol_flex, trim(tag)//': F (trailing block) vs dense inverse block')
-        call ch%flexibility(iface, sgn, Fs, info, msg, use_solves=.true., used_block=used)
+        call ch%flexibility(iface, sgn, Fs, err, use_solves=.true., used_block=used)
+        call error_parts(err, info, msg)
         call report(info == 0 .and. .not. used, trim(tag)//': flexibility via solves ran')
         call report_le(rel_diff2(Fs, Fd), tol_flex, trim(tag)//': F (solves) vs dense inverse block')
         call report_le(rel_diff2(Fb, Fs), tol_flex, trim(tag)//': F (trailing block) vs F (solves)')
@@ -457,11 +465,13 @@ contains
         sub = [(mi + 1 - 2 * i, i = 1, ms)]          ! positions mi-1, mi-3, ... (reversed)
         if (allocated(Fsub)) deallocate (Fsub)
         allocate (Fsub(ms, ms))
-        call ch%flexibility(iface(sub), sgn(sub), Fsub, info, msg, used_block=used)
+        call ch%flexibility(iface(sub), sgn(sub), Fsub, err, used_block=used)
+        call error_parts(err, info, msg)
         call report(info == 0 .and. used .and. rel_diff2(Fsub, Fd(sub, sub)) <= tol_flex, &
                     trim(tag)//': F of a reordered interface subset (trailing block)')
       else
-        call ch%flexibility(iface, sgn, Fs, info, msg, used_block=used)
+        call ch%flexibility(iface, sgn, Fs, err, used_block=used)
+        call error_parts(err, info, msg)
         call report(info == 0 .and. .not. used, trim(tag)//': flexibility via solves ran')
         call report_le(rel_diff2(Fs, Fd), tol_flex, trim(tag)//': F (solves) vs dense inverse block')
       end if
@@ -503,12 +513,13 @@ contains
     call report_le(real(kd_rcm, wp), real(2 * k, wp), 'RCM bandwidth of a k x k grid <= 2k')
   end subroutine check_rcm
 
-  !> Indefinite matrices give info = 1 and a message, for every method; no crash after.
+  !> Indefinite matrices give ERR_NUMERICAL and a message, for every method; no crash after.
   subroutine check_not_posdef()
     type(csc_t) :: M
     type(chol_t) :: ch
     real(wp) :: lmin, u(144), F(3, 3)
     integer :: info, o, j, p
+    type(error_t) :: err
     character(len=256) :: msg
     character(len=*), parameter :: onames(3) = [character(len=7) :: 'metis', 'amd', 'natural']
     ! (a) one diagonal entry made strongly negative
@@ -519,55 +530,67 @@ contains
       end do
     end do
     do o = 1, 3
-      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg, last=[1, 2, 3])
-      call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, &
-                  'negative diagonal: cholmod/'//trim(onames(o))//' info = 1: '//trim(msg))
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, err, last=[1, 2, 3])
+      call error_parts(err, info, msg)
+      call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, &
+                  'negative diagonal: cholmod/'//trim(onames(o))//' ERR_NUMERICAL: '//trim(msg))
     end do
-    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, info, msg)
-    call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, 'negative diagonal: banded info = 1: '//trim(msg))
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'negative diagonal: banded ERR_NUMERICAL: '//trim(msg))
     ! (b) shift just below the smallest eigenvalue: one slightly negative eigenvalue
     lmin = 8.0_wp * sin(acos(-1.0_wp) / 26.0_wp)**2
     call laplace2d(12, -1.05_wp * lmin, M)
     do o = 1, 3
-      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg)
-      call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, &
-                  'lambda_min = -0.05 lambda_1: cholmod/'//trim(onames(o))//' info = 1: '//trim(msg))
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, err)
+      call error_parts(err, info, msg)
+      call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, &
+                  'lambda_min = -0.05 lambda_1: cholmod/'//trim(onames(o))//' ERR_NUMERICAL: '//trim(msg))
     end do
-    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, info, msg)
-    call report(info == CHOL_NOT_POSDEF .and. len_trim(msg) > 0, &
-                'lambda_min = -0.05 lambda_1: banded info = 1: '//trim(msg))
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, &
+                'lambda_min = -0.05 lambda_1: banded ERR_NUMERICAL: '//trim(msg))
     ! using the failed factorization is an error, not a crash
     u = 1.0_wp
-    call ch%solve(u, info, msg)
-    call report(info == CHOL_FAILURE, 'solve after a failed factorization returns info = 3')
-    call ch%flexibility([1, 2, 3], [1.0_wp, 1.0_wp, 1.0_wp], F, info, msg)
-    call report(info == CHOL_FAILURE, 'flexibility after a failed factorization returns info = 3')
+    call ch%solve(u, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL, 'solve after a failed factorization returns ERR_NUMERICAL')
+    call ch%flexibility([1, 2, 3], [1.0_wp, 1.0_wp, 1.0_wp], F, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL, 'flexibility after a failed factorization returns ERR_NUMERICAL')
     ! and the same object factorizes a good matrix afterwards
     call laplace2d(12, 1.0_wp, M)
-    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_AMD, info, msg)
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_AMD, err)
+    call error_parts(err, info, msg)
     u = 1.0_wp
-    call ch%solve(u, info, msg)
+    call ch%solve(u, err)
+    call error_parts(err, info, msg)
     call report(info == 0 .and. scaled_residual(M, u, [(1.0_wp, j = 1, 144)]) <= RES_TOL, &
                 'the same chol_t is reusable after a failure')
     call ch%free()
   end subroutine check_not_posdef
 
-  !> Invalid arguments give info = 3 with a message.
+  !> Invalid arguments give ERR_NUMERICAL with a message.
   subroutine check_bad_input()
     type(csc_t) :: M
     type(chol_t) :: ch
     integer :: info, tmp
+    type(error_t) :: err
     character(len=256) :: msg
     call laplace2d(6, 1.0_wp, M)
-    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=[3, 5, 3])
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'repeated interface DOF: info = 3: '//trim(msg))
-    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=[0])
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interface DOF 0: info = 3: '//trim(msg))
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, err, last=[3, 5, 3])
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'repeated interface DOF: ERR_NUMERICAL: '//trim(msg))
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, err, last=[0])
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'interface DOF 0: ERR_NUMERICAL: '//trim(msg))
     tmp = M%rowind(1)
     M%rowind(1) = M%rowind(2)
     M%rowind(2) = tmp
-    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_METIS, info, msg)
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'unsorted row indices: info = 3: '//trim(msg))
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_METIS, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'unsorted row indices: ERR_NUMERICAL: '//trim(msg))
     call ch%free()
   end subroutine check_bad_input
 
@@ -621,13 +644,17 @@ contains
       real(wp), intent(out) :: F(:, :)
       real(wp), intent(out), contiguous :: u(:)
       integer, intent(out) :: info
+      type(error_t) :: err
       character(len=*), intent(out) :: msg
-      call c%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ord, info, msg, last=g)
+      call c%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ord, err, last=g)
+      call error_parts(err, info, msg)
       if (info /= 0) return
-      call c%flexibility(g, s, F, info, msg)
+      call c%flexibility(g, s, F, err)
+      call error_parts(err, info, msg)
       if (info /= 0) return
       u = 1.0_wp
-      call c%solve(u, info, msg)
+      call c%solve(u, err)
+      call error_parts(err, info, msg)
   end subroutine conc_work
 
   !> A larger lattice (200 x 200 cells, ~80k DOFs, 200 interface DOFs): print timings.
@@ -637,6 +664,7 @@ contains
     integer, allocatable :: g(:)
     real(wp), allocatable :: Fb(:, :), Fs(:, :), s(:), u(:), f(:)
     integer :: info, o, i, nc
+    type(error_t) :: err
     real(wp) :: t0, tb, ts
     logical :: used
     character(len=256) :: msg
@@ -651,23 +679,27 @@ contains
     allocate (Fb(nc, nc), Fs(nc, nc), f(M%n))
     call random_number(f)
     do o = 1, 2
-      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, info, msg, last=g)
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, o, err, last=g)
+      call error_parts(err, info, msg)
       call report(info == 0 .and. ch%interface_last_ok, &
                   'timing lattice cholmod/'//trim(onames(o))//': factor ok, interface last')
       if (info /= 0) cycle
       write (output_unit, '(a)') '      '//ch%summary()
       t0 = wtime()
-      call ch%flexibility(g, s, Fb, info, msg, used_block=used)
+      call ch%flexibility(g, s, Fb, err, used_block=used)
+      call error_parts(err, info, msg)
       tb = wtime() - t0
       t0 = wtime()
-      call ch%flexibility(g, s, Fs, info, msg, use_solves=.true.)
+      call ch%flexibility(g, s, Fs, err, use_solves=.true.)
+      call error_parts(err, info, msg)
       ts = wtime() - t0
       write (output_unit, '(a,f0.4,a,f0.4,a)') '      flexibility (m = 200): trailing block + dpotri ', tb, &
         ' s, blocked solves ', ts, ' s'
       call report_le(rel_diff2(Fb, Fs), 1.0e-10_wp, 'timing lattice cholmod/'//trim(onames(o))// &
                      ': F (trailing block) vs F (solves)')
       u = f
-      call ch%solve(u, info, msg)
+      call ch%solve(u, err)
+      call error_parts(err, info, msg)
       call report_le(scaled_residual(M, u, f), RES_TOL, 'timing lattice cholmod/'//trim(onames(o))// &
                      ': scaled residual')
     end do

@@ -16,7 +16,8 @@ program test_contact
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, error_parts
+  use errors, only: error_t
   implicit none (type, external)
   character(len=4096) :: none(0)
 
@@ -72,6 +73,7 @@ contains
     type(body_condensed_t) :: bodies(2)
     type(contact_result_t) :: mono, rob
     integer :: a, info, i, k, c
+    type(error_t) :: err
     character(len=512) :: msg
     real(wp), allocatable :: ufree(:), ufull(:), r(:)
     real(wp) :: fscale, uscale, lnorm, e, load(2), react(2), cont(2)
@@ -87,15 +89,19 @@ contains
     write (*, '(a)') '--- '//trim(tag)
     do a = 1, 2
       call mesh_build(msh(a), d%body(a))
-      call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, systems(a), info, msg)
+      call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, systems(a), err)
+      call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%contact, msh, systems, contact_line, info, msg)
+    call build_interface(d%body, d%contact, msh, systems, contact_line, err)
+    call error_parts(err, info, msg)
     if (info /= 0) error stop 'interface failed'
     do a = 1, 2
-      call factor_body(d%solver%factor, contact_line, a, msh(a), systems(a), bodies(a), info, msg)
+      call factor_body(d%solver%factor, contact_line, a, msh(a), systems(a), bodies(a), err)
+      call error_parts(err, info, msg)
       if (info /= 0) error stop 'factor failed'
-      call condense_body(systems(a), bodies(a), info, msg)
+      call condense_body(systems(a), bodies(a), err)
+      call error_parts(err, info, msg)
       if (info /= 0) error stop 'condense failed'
     end do
 

@@ -9,7 +9,8 @@ program test_equilibrium
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, BC_CLAMPED, BC_CONTACT
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, residual_full
-  use testing, only: report, test_summary, solve_full
+  use testing, only: report, test_summary, solve_full, error_parts
+  use errors, only: error_t
   implicit none (type, external)
 
   real(wp), parameter :: load_y = -11.5e6_wp   ! total applied vertical load [N/m]
@@ -64,9 +65,13 @@ contains
     type(body_system_t), intent(out) :: sys
     real(wp), allocatable, intent(out) :: u(:)
     integer :: info
+    type(error_t) :: err
     character(len=256) :: msg
     call mesh_build(m, body, info, msg)
-    if (info == 0) call assemble_body(m, body, plane_strain, tr, size(tr), sys, info, msg)
+    if (info == 0) then
+      call assemble_body(m, body, plane_strain, tr, size(tr), sys, err)
+      call error_parts(err, info, msg)
+    end if
     call solve_full(sys, info, msg, 'mesh/assembly', u)
   end subroutine solve
 
@@ -147,12 +152,14 @@ contains
     type(mesh_t) :: m
     type(body_system_t) :: sys
     integer :: i, info
+    type(error_t) :: err
     character(len=256) :: msg
     character(len=64) :: what
     do i = 1, 4
       call seed_body(ELEM_Q1, nxs(i), nys(i), .false., body, tr)
       call mesh_build(m, body)
-      call assemble_body(m, body, .true., tr, 2, sys, info, msg)
+      call assemble_body(m, body, .true., tr, 2, sys, err)
+      call error_parts(err, info, msg)
       write (what, '(a,i0,a,i0,a,i0,a)') 'seed mesh ', nxs(i), 'x', nys(i), ': n = ', nexp(i), ' free DOFs'
       call report(info == 0 .and. sys%n == nexp(i), trim(what), real(sys%n, wp), real(nexp(i), wp))
     end do

@@ -53,7 +53,8 @@ program test_fem
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
                       body_force_fn, cell_triplets
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
-  use testing, only: report, test_summary, solve_full
+  use testing, only: report, test_summary, solve_full, error_parts
+  use errors, only: error_t
   implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -91,9 +92,11 @@ contains
     real(wp), intent(in), optional :: u_prescribed(:)
     procedure(body_force_fn), optional :: body_force
     integer :: info
+    type(error_t) :: err
     character(len=256) :: msg
-    call assemble_body(m, body, plane_strain, tr, ntr, sys, info, msg, u_prescribed=u_prescribed, &
+    call assemble_body(m, body, plane_strain, tr, ntr, sys, err, u_prescribed=u_prescribed, &
                        body_force=body_force)
+    call error_parts(err, info, msg)
     call solve_full(sys, info, msg, 'assemble_body', u_full)
   end subroutine solve_body
 
@@ -172,6 +175,7 @@ contains
     type(body_system_t) :: sys, sys0
     type(traction_cfg_t) :: tr(1)
     integer :: info, r, q, j, p
+    type(error_t) :: err
     integer, allocatable :: irn(:), jcn(:)
     real(wp), allocatable :: a(:), dense(:, :), ref(:, :)
     character(len=256) :: msg
@@ -179,8 +183,10 @@ contains
 
     write (what, '(a,a,i0,a)') trim(element_names(element)), ' ', nparts, ' shares:'
     call loaded_rect(element, 7, 4, body, tr(1), m)
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
-    call assemble_body(m, body, .true., tr, 1, sys0, info, msg, matrix=.false.)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys0, err, matrix=.false.)
+    call error_parts(err, info, msg)
     call report(info == 0 .and. .not. allocated(sys0%val) .and. sys0%n == sys%n .and. &
                 all(sys0%free_of == sys%free_of) .and. maxval(abs(sys0%f - sys%f)) <= 1.0e-14_wp*maxval(abs(sys%f)), &
                 trim(what)//' assemble_body(matrix=.false.): same numbering and load, no matrix')
@@ -193,7 +199,8 @@ contains
       end do
     end do
     do r = 0, nparts - 1
-      call cell_triplets(m, body, .true., sys0, r*m%ncell/nparts + 1, (r + 1)*m%ncell/nparts, irn, jcn, a, info, msg)
+      call cell_triplets(m, body, .true., sys0, r*m%ncell/nparts + 1, (r + 1)*m%ncell/nparts, irn, jcn, a, err)
+      call error_parts(err, info, msg)
       if (info /= 0 .or. any(irn < jcn)) then
         call report(.false., trim(what)//' cell_triplets info = 0, lower triangle only')
         return
@@ -213,6 +220,7 @@ contains
     type(body_system_t) :: sys
     type(traction_cfg_t) :: tr(1)
     integer :: info, i, j, p, q, nnz_expect, k
+    type(error_t) :: err
     character(len=256) :: msg
     character(len=5) :: en
     logical :: sorted, found
@@ -222,7 +230,8 @@ contains
     en = element_names(element)
     call loaded_rect(element, 5, 3, body, tr(1), m)
     tr(1)%t1 = [0.0_wp, 0.5_wp]
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
     call report(info == 0, trim(en)//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
 
     ! 6 x 4 nodes = 48 dofs; left clamped 8, bottom roller 5 more y's, right both 8
@@ -553,6 +562,7 @@ contains
     type(traction_cfg_t) :: tr(2)
     integer, allocatable :: nodes(:)
     integer :: side, info, k, coord, kase
+    type(error_t) :: status
     character(len=256) :: msg
     character(len=80) :: what
     real(wp) :: sa, sb, fsum(2), fmom(2), fex(2), mex(2), err, scale, other
@@ -578,7 +588,8 @@ contains
         tr(2)%body = 1
         tr(2)%side = SIDE_TOP
         tr(2)%t0 = [100.0_wp, 100.0_wp]
-        call assemble_body(m, body, .false., tr, 2, sys, info, msg)
+        call assemble_body(m, body, .false., tr, 2, sys, status)
+        call error_parts(status, info, msg)
         if (info /= 0) then
           write (*, '(a,a)') 'FAIL  assemble_body: ', trim(msg)
           error stop 1
@@ -662,13 +673,14 @@ contains
   end subroutine test_units
 
   ! ---------------------------------------------------------------------------------
-  !> Impossible inputs are reported through info/msg, not by stopping.
+  !> Impossible inputs are reported through an error_t, not by stopping.
   subroutine test_errors()
     type(body_cfg_t) :: body
     type(mesh_t) :: m
     type(body_system_t) :: sys
     type(traction_cfg_t) :: tr(1)
     integer :: info
+    type(error_t) :: err
     character(len=256) :: msg
     real(wp) :: up(3)
 
@@ -679,33 +691,40 @@ contains
     call mesh_build(m, body)
     tr(1)%body = 1
     tr(1)%side = 7
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
     write (*, '(a,a)') '      message: ', trim(msg)
     call report(info /= 0 .and. len_trim(msg) > 0, &
                 'errors: traction side 7 gives info /= 0 and a message', real(info, wp), 0.0_wp)
-    call assemble_body(m, body, .true., tr, 2, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 2, sys, err)
+    call error_parts(err, info, msg)
     call report(info /= 0, 'errors: ntraction > size(tractions) gives info /= 0', real(info, wp), 0.0_wp)
     tr(1)%side = SIDE_TOP
     body%poisson = 0.5_wp
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
     call report(info /= 0, 'errors: Poisson ratio 0.5 gives info /= 0', real(info, wp), 0.0_wp)
     body%poisson = 0.3_wp
     body%bc(SIDE_TOP) = 9
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
     call report(info /= 0, 'errors: unknown side condition gives info /= 0', real(info, wp), 0.0_wp)
     body%bc(SIDE_TOP) = BC_FREE
     up = 0.0_wp
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg, u_prescribed=up)
+    call assemble_body(m, body, .true., tr, 1, sys, err, u_prescribed=up)
+    call error_parts(err, info, msg)
     call report(info /= 0, 'errors: u_prescribed of the wrong size gives info /= 0', real(info, wp), 0.0_wp)
     m%xy(1, 2) = m%xy(1, 2) + 2*body%width    ! fold a cell over
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
     write (*, '(a,a)') '      message: ', trim(msg)
     call report(info /= 0, 'errors: an inverted cell gives info /= 0', real(info, wp), 0.0_wp)
     body%nx = 0
     call mesh_build(m, body, info, msg)
     call report(info /= 0 .and. m%nnode == 0, &
                 'errors: mesh_build with nx = 0 gives info /= 0', real(info, wp), 0.0_wp)
-    call assemble_body(m, body, .true., tr, 1, sys, info, msg)
+    call assemble_body(m, body, .true., tr, 1, sys, err)
+    call error_parts(err, info, msg)
     call report(info /= 0, 'errors: assemble_body on an empty mesh gives info /= 0', real(info, wp), 0.0_wp)
   end subroutine test_errors
 

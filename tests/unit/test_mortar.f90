@@ -5,7 +5,8 @@
 program test_mortar
   use kinds, only: wp
   use mortar, only: mortar_t, mortar_build
-  use testing, only: report, report_le, test_summary
+  use testing, only: report, report_le, test_summary, error_parts
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
 
   real(wp), parameter :: tol = 1.0e-13_wp
@@ -159,8 +160,10 @@ contains
     type(mortar_t), intent(out) :: mt
     character(len=*), intent(in) :: what
     integer :: info
+    type(error_t) :: err
     character(len=256) :: msg
-    call mortar_build(xs, es, removable, xm, em, mt, info, msg)
+    call mortar_build(xs, es, removable, xm, em, mt, err)
+    call error_parts(err, info, msg)
     call report(info == 0 .and. msg == '', what//': mortar_build succeeds')
     if (info /= 0) then
       write (*, '(a)') 'FAIL  '//what//': '//trim(msg)
@@ -613,7 +616,7 @@ contains
     end do
   end subroutine rim
 
-  !> Each bad input gives info = 1 and a message.
+  !> Each bad input gives ERR_INPUT and a message.
   subroutine test_bad_input()
     real(wp) :: xs(2, 6), xm(2, 3)
     integer :: ok_em(2, 2)
@@ -648,7 +651,7 @@ contains
     call expect_bad(xs, xm, rem, reshape([3, 2, 2, 1], [2, 2]), ok_em, 'master beside the slave', 'does not overlap')
   end subroutine test_bad_input
 
-  !> One bad input: info = 1 and a message containing word.
+  !> One bad input: ERR_INPUT and a message containing word.
   subroutine expect_bad(xs, xm, rem, es, em_, what, word, all_removable, short_removable)
     real(wp), intent(in) :: xs(:, :), xm(:, :)
     logical, intent(in) :: rem(6)
@@ -657,16 +660,19 @@ contains
     logical, intent(in), optional :: all_removable, short_removable
     type(mortar_t) :: mt
     integer :: info
+    type(error_t) :: err
     character(len=256) :: msg
     logical :: r(6)
     r = rem
     if (present(all_removable)) r = all_removable
     if (present(short_removable)) then
-      call mortar_build(xs, es, r(1:5), xm, em_, mt, info, msg)
+      call mortar_build(xs, es, r(1:5), xm, em_, mt, err)
+      call error_parts(err, info, msg)
     else
-      call mortar_build(xs, es, r, xm, em_, mt, info, msg)
+      call mortar_build(xs, es, r, xm, em_, mt, err)
+      call error_parts(err, info, msg)
     end if
-    call report(info == 1 .and. index(msg, word) > 0, 'bad input, '//what//': info = '//itoa(info)//', "'// &
+    call report(info == ERR_INPUT .and. index(msg, word) > 0, 'bad input, '//what//': category = '//itoa(info)//', "'// &
                 trim(msg)//'"')
   end subroutine expect_bad
 
@@ -680,6 +686,7 @@ contains
     logical, allocatable :: rem(:)
     type(mortar_t) :: mt
     integer :: k, info, j
+    type(error_t) :: err
     integer(8) :: t0, t1, rate
     real(wp) :: phi, e_pu
     character(len=256) :: msg
@@ -702,7 +709,8 @@ contains
     end do
     rem = .false.
     call system_clock(t0, rate)
-    call mortar_build(xs, es, rem, xm, em, mt, info, msg)
+    call mortar_build(xs, es, rem, xm, em, mt, err)
+    call error_parts(err, info, msg)
     call system_clock(t1)
     call report(info == 0 .and. mt%m == ns + 1, 'timing case: 100k x 130k segments built, a row per slave node')
     e_pu = 0.0_wp

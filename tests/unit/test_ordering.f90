@@ -20,12 +20,13 @@ program test_ordering
   use assembly, only: body_system_t, assemble_body, csc_matvec
   use supports, only: number_free_dofs
   use ordering, only: grid_dissection, coordinate_bisection, ND_OK, ND_BAD_LAST, ND_LEAF_NODES
-  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, CHOL_FAILURE
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN
   use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
   use clock, only: wtime
   use strings, only: body_label
   use testing, only: report, report_le, test_summary, rectangle_body, structured_body, general_body, &
-                     side_free_dofs, order_body, factor_ordered
+                     side_free_dofs, order_body, factor_ordered, error_parts
+  use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
 
   real(wp), parameter :: eps = epsilon(1.0_wp)
@@ -190,6 +191,7 @@ contains
     real(wp), allocatable :: u(:), r(:), sgn(:), flex(:, :, :)
     real(wp) :: res, d, nnz(3)
     integer :: o, info, m
+    type(error_t) :: err
     logical :: used
     character(len=256) :: msg
     character(len=64) :: tag
@@ -212,11 +214,13 @@ contains
       nnz(o) = real(ch%nnz_factor, wp)
       call report(ch%interface_last_ok, trim(tag)//': interface DOFs ordered last, in the given order')
       u = sys%f
-      call ch%solve(u, info, msg)
+      call ch%solve(u, err)
+      call error_parts(err, info, msg)
       call csc_matvec(sys, u, r)
       res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u))*eps)
       call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
-      call ch%flexibility(last, sgn, flex(:, :, o), info, msg, used_block=used)
+      call ch%flexibility(last, sgn, flex(:, :, o), err, used_block=used)
+      call error_parts(err, info, msg)
       call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
       call ch%free()
     end do
@@ -237,6 +241,7 @@ contains
     type(chol_t) :: ch
     integer, allocatable :: last(:), perm(:), bad(:)
     integer :: info, n
+    type(error_t) :: err
     character(len=256) :: msg
 
     call structured_body(rectangle_body(10, 6, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys, last)
@@ -254,28 +259,34 @@ contains
                 'nested dissection: mesh of another size rejected: '//trim(msg))
 
     call order_body(msh, sys, last, perm, info, msg)
-    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last)
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'ORD_GIVEN without interior_perm: info = 3: '//trim(msg))
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, last=last)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'ORD_GIVEN without interior_perm: ERR_NUMERICAL: '//trim(msg))
     bad = perm(1:size(perm) - 1)
-    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, last=last, &
                    interior_perm=bad)
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interior_perm too short: info = 3: '//trim(msg))
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'interior_perm too short: ERR_NUMERICAL: '//trim(msg))
     bad = perm
     bad(2) = bad(1)
-    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, last=last, &
                    interior_perm=bad)
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interior_perm repeated entry: info = 3: '//trim(msg))
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'interior_perm repeated entry: ERR_NUMERICAL: '//trim(msg))
     bad = perm
     bad(1) = last(1)
-    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, last=last, &
                    interior_perm=bad)
-    call report(info == CHOL_FAILURE .and. len_trim(msg) > 0, 'interior_perm holds an interface DOF: info = 3: '//trim(msg))
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'interior_perm holds an interface DOF: ERR_NUMERICAL: '//trim(msg))
     ! the banded factorization ignores the ordering
-    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_BANDED, ORD_GIVEN, info, msg)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_BANDED, ORD_GIVEN, err)
+    call error_parts(err, info, msg)
     call report(info == 0, 'banded with ORD_GIVEN (ordering ignored): info = 0')
     ! ORD_GIVEN without an interface: the whole order is given
     call order_body(msh, sys, [integer ::], perm, info, msg)
-    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, interior_perm=perm)
+    call ch%factor(n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, interior_perm=perm)
+    call error_parts(err, info, msg)
     call report(info == 0, 'ORD_GIVEN with no interface DOFs: info = 0 '//trim(msg))
     call ch%free()
   end subroutine check_bad_input
@@ -291,6 +302,7 @@ contains
     character(len=5), parameter :: ords(2) = ['metis', 'nd   ']
     integer, parameter :: ord_codes(2) = [ORDER_METIS, ORDER_ND]
     integer :: a, o, info
+    type(error_t) :: err
     character(len=256) :: msg
     real(wp) :: dflex, db
 
@@ -306,20 +318,24 @@ contains
     tr(2)%t0 = [5.0e5_wp, 1.0e6_wp]
     do a = 1, 2
       call mesh_build(msh(a), d%body(a))
-      call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), info, msg)
+      call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), err)
+      call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%contact, msh, sys, itf, info, msg)
+    call build_interface(d%body, d%contact, msh, sys, itf, err)
+    call error_parts(err, info, msg)
     call report(info == 0 .and. itf%m > 0, 'two-body scene: interface built '//trim(msg))
     if (info /= 0) return
     do o = 1, 2
       d%solver%factor%ordering = ord_codes(o)
       do a = 1, 2
-        call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a, o), info, msg)
+        call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a, o), err)
+        call error_parts(err, info, msg)
         call report(info == 0 .and. bc(a, o)%chol%interface_last_ok, &
                     'factor_body ordering='''//trim(ords(o))//''', body '//body_label(a)//': ok, interface last '//trim(msg))
         if (info /= 0) return
-        call condense_body(sys(a), bc(a, o), info, msg)
+        call condense_body(sys(a), bc(a, o), err)
+        call error_parts(err, info, msg)
         if (info /= 0) error stop 'condense_body failed'
       end do
     end do
@@ -347,7 +363,8 @@ contains
     logical, allocatable :: is_last(:)
     real(wp), allocatable :: u(:, :), r(:), sgn(:), flex(:, :, :)
     real(wp) :: res, d, nnz(3), t0, t_nd
-    integer :: o, info, m
+    integer :: o, info, m, k, f, g
+    type(error_t) :: err
     logical :: ok, used
     character(len=256) :: msg
     character(len=64) :: tag
@@ -381,12 +398,14 @@ contains
       write (output_unit, '(a)') '      '//ch%summary()
       nnz(o) = real(ch%nnz_factor, wp)
       u(:, o) = sys%f
-      call ch%solve(u(:, o), info, msg)
+      call ch%solve(u(:, o), err)
+      call error_parts(err, info, msg)
       call csc_matvec(sys, u(:, o), r)
       res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u(:, o)))*eps)
       call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
       if (m > 0) then
-        call ch%flexibility(last, sgn, flex(:, :, o), info, msg, used_block=used)
+        call ch%flexibility(last, sgn, flex(:, :, o), err, used_block=used)
+        call error_parts(err, info, msg)
         call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
       end if
       call ch%free()

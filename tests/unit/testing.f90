@@ -18,6 +18,7 @@ module testing
   use lapack, only: dpbsv
   use ordering, only: grid_dissection, coordinate_bisection
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
+  use errors, only: error_t
   implicit none (type, external)
   private
 
@@ -27,6 +28,7 @@ module testing
   public :: report, report_le, test_summary, write_file, band_solve, solve_full, obstacle_problem
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
+  public :: error_parts
 
 contains
 
@@ -201,11 +203,12 @@ contains
     type(traction_cfg_t) :: tr(1)
     integer :: info
     character(len=256) :: msg
+    type(error_t) :: err
     tr(1) = top_traction(b)
     call mesh_build(msh, b, info, msg)
     if (info /= 0) error stop 'structured_body: mesh_build failed'
-    call assemble_body(msh, b, .true., tr, 1, sys, info, msg)
-    if (info /= 0) error stop 'structured_body: assemble_body failed'
+    call assemble_body(msh, b, .true., tr, 1, sys, err)
+    if (err%failed()) error stop 'structured_body: assemble_body failed'
     last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
   end subroutine structured_body
 
@@ -267,6 +270,7 @@ contains
     integer(int64) :: state
     real(wp) :: hx, hy
     character(len=256) :: msg
+    type(error_t) :: err
 
     tr(1) = top_traction(b)
     call mesh_build(grid, b, info, msg)
@@ -339,8 +343,8 @@ contains
     tr(1)%group = 'top'
     tr(1)%tx = tr(1)%t1
     tr(1)%t1 = 0.0_wp
-    call assemble_body(msh, free, .true., tr, 1, sys, info, msg, boundaries=bd(1:nbd))
-    if (info /= 0) error stop 'general_body: assemble_body failed on the general mesh'
+    call assemble_body(msh, free, .true., tr, 1, sys, err, boundaries=bd(1:nbd))
+    if (err%failed()) error stop 'general_body: assemble_body failed on the general mesh'
 
     call side_nodes(grid, SIDE_BOTTOM, bottom)
     allocate (last(0))
@@ -372,15 +376,18 @@ contains
     integer, intent(in) :: last(:), perm(:)
     integer, intent(out) :: info
     character(len=*), intent(out) :: msg
+    type(error_t) :: err
     select case (o)
     case (1)
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, info, msg, last=last)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_METIS, err, last=last)
     case (2)
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, info, msg, last=last)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AMD, err, last=last)
     case default
-      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, info, msg, last=last, &
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_GIVEN, err, last=last, &
                      interior_perm=perm)
     end select
+    info = merge(1, 0, err%failed())
+    msg = err%text()
   end subroutine factor_ordered
 
   ! ---- random dense QPs and one MPRGP solve (the MPRGP tests)
@@ -476,5 +483,14 @@ contains
     if (present(g)) g = solver%g
     if (present(ax)) ax = solver%ax
   end subroutine solve_once
+
+  !> An error_t as the tests read it: info its category (0 when none), msg its message.
+  subroutine error_parts(err, info, msg)
+    type(error_t), intent(in) :: err       !< the error, possibly none
+    integer, intent(out) :: info           !< err%category
+    character(len=*), intent(out) :: msg   !< err%text()
+    info = err%category
+    msg = err%text()
+  end subroutine error_parts
 
 end module testing
