@@ -189,9 +189,9 @@ $(BUILD)/monolithic.o:     $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $
                            $(BUILD)/contact_common.o $(BUILD)/equality_rows.o
 $(BUILD)/error_estimate.o: $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
                            $(BUILD)/equality_rows.o
-$(BUILD)/h5io.o:           $(BUILD)/kinds.o
+$(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/files.o:
-$(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
+$(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
                            $(BUILD)/condense.o $(BUILD)/floating.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
                            $(BUILD)/history_io.o $(BUILD)/strings.o

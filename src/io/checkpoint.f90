@@ -8,7 +8,7 @@ module checkpoint
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use hdf5, only: hid_t, hsize_t
-  use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, &
+  use h5io, only: file_open, file_close, group_open, group_close, &
                   write_dset, write_attr, read_dset, read_attr, describe, exists, &
                   CLASS_INTEGER, CLASS_REAL, CLASS_STRING, CLASS_VSTRING
   use errors, only: error_t, ERR_INPUT, ERR_IO
@@ -45,7 +45,7 @@ module checkpoint
     character(len=:), allocatable :: src       ! 'restart file <path>', for messages
     character(len=:), allocatable :: msg       ! why it cannot be used
     integer(hid_t) :: fid = -1, gid = -1, hid = -1   ! the file, /state, /history
-    type(h5_status_t) :: hs
+    type(error_t) :: hs
     integer :: m = 0                           ! interface size of this run
     integer :: maxout = 0                      ! max_outer of this run
     integer :: nh = 0                          ! entries of /history
@@ -89,7 +89,7 @@ contains
     type(robin_state_t), intent(in) :: st       !< outer state after iteration st%it
     type(contact_result_t), intent(in) :: res   !< history so far
     integer(hid_t) :: fid, gid
-    type(h5_status_t) :: hs
+    type(error_t) :: hs
     character(len=:), allocatable :: tmp
     logical :: ok
     if (.not. allocated(self%file)) return
@@ -134,15 +134,15 @@ contains
     call group_close(gid, hs)
     call write_history(fid, res, hs)
     call file_close(fid, hs)
-    ok = .not. hs%failed
+    ok = .not. hs%failed()
     if (ok) then
       call atomic_rename(tmp, self%file, ok)
-      if (.not. ok) hs%what = 'failed to rename '//tmp//' to it'
+      if (.not. ok) call hs%set(ERR_IO, 'failed to rename '//tmp//' to it')
     end if
     if (.not. ok) then
       call remove_file(tmp)
       if (.not. self%err%failed()) call self%err%set(ERR_IO, 'a checkpoint could not be written to '//self%file// &
-                                                     ' ('//hs%what//'); the previous one, if any, is kept')
+                                                     ' ('//hs%text()//'); the previous one, if any, is kept')
     end if
   end subroutine checkpoint_write
 
@@ -177,7 +177,7 @@ contains
       return
     end if
     call file_open(file, r%fid, r%hs)
-    if (r%hs%failed) then
+    if (r%hs%failed()) then
       call err%set(ERR_INPUT, r%src//' is not an HDF5 file')
       return
     end if
@@ -188,8 +188,8 @@ contains
     end if
     if (len_trim(r%msg) == 0) then
       call read_dset(r%fid, 'key', k, r%hs)
-      if (r%hs%failed) then
-        r%msg = r%src//' is not a robin_contact checkpoint ('//r%hs%what//')'
+      if (r%hs%failed()) then
+        r%msg = r%src//' is not a robin_contact checkpoint ('//r%hs%text()//')'
       else if (trim(k) /= trim(key)) then
         r%msg = r%src//' was made from a different deck or mesh '// &
                 '(its bodies, loads, contact or solver settings differ from this run''s)'
@@ -221,8 +221,8 @@ contains
     call need(r, r%fid, '/', 'mesh_files', .false., CLASS_STRING, SCALAR, 'a scalar string')
     if (len_trim(r%msg) > 0) return
     call read_dset(r%fid, 'mesh_files', stored, r%hs)
-    if (r%hs%failed) then
-      r%msg = r%src//': dataset /mesh_files cannot be read ('//r%hs%what//')'
+    if (r%hs%failed()) then
+      r%msg = r%src//': dataset /mesh_files cannot be read ('//r%hs%text()//')'
       return
     end if
     i0 = 1
@@ -367,7 +367,7 @@ contains
       return
     end if
     call group_open(r%fid, name, g, r%hs)
-    if (r%hs%failed) r%msg = r%src//': '//r%hs%what
+    if (r%hs%failed()) r%msg = r%src//': '//r%hs%text()
   end subroutine open_group
 
   !> Check that `name` in `loc` (path `path`) is a dataset, or an attribute when `attr`, of
@@ -383,7 +383,7 @@ contains
     integer(hsize_t), allocatable :: got(:)
     integer :: c
     character(len=:), allocatable :: obj
-    type(h5_status_t) :: ds
+    type(error_t) :: ds
     if (len_trim(r%msg) > 0) return
     if (attr) then
       obj = 'attribute '//trim(name)//' of '//path
@@ -396,8 +396,8 @@ contains
       return
     end if
     call describe(loc, name, attr, c, got, ds)
-    if (ds%failed) then
-      r%msg = r%src//': '//ds%what
+    if (ds%failed()) then
+      r%msg = r%src//': '//ds%text()
     else if (c /= cls) then
       r%msg = r%src//': '//obj//' holds '//class_name(c)//', expected '//class_name(cls)
     else if (size(got) /= size(dims)) then
@@ -435,7 +435,7 @@ contains
     call read_attr(r%gid, 'omega', st%omega, r%hs)
     call read_attr(r%gid, 'wall', st%wall, r%hs)
     call read_dset(r%gid, 'flam', rv, r%hs)
-    if (.not. r%hs%failed) st%flam = rv
+    if (.not. r%hs%failed()) st%flam = rv
     call read_dset(r%gid, 'G', st%G, r%hs)
     call read_dset(r%gid, 'lam', st%lam, r%hs)
     call read_dset(r%gid, 'r_prev', st%r_prev, r%hs)
@@ -465,11 +465,11 @@ contains
     st%mu = 0.0_wp
     if (r%has_mu) then
       call read_dset(r%gid, 'mu', rmu, r%hs)
-      if (.not. r%hs%failed) st%mu = rmu
+      if (.not. r%hs%failed()) st%mu = rmu
     end if
     if (r%has_recycle) then
       call read_dset(r%gid, 'nrw', ir, r%hs)
-      if (.not. r%hs%failed) st%nrw = reshape(ir, [2, 2])
+      if (.not. r%hs%failed()) st%nrw = reshape(ir, [2, 2])
       call read_dset(r%gid, 'rw', st%rw, r%hs)
       call read_dset(r%gid, 'raw', st%raw, r%hs)
     else
@@ -479,8 +479,8 @@ contains
       st%rw = 0.0_wp
       st%raw = 0.0_wp
     end if
-    if (r%hs%failed) then
-      r%msg = r%src//' cannot be read ('//r%hs%what//')'
+    if (r%hs%failed()) then
+      r%msg = r%src//' cannot be read ('//r%hs%text()//')'
       return
     end if
     ! ranges of the counters, finite values
@@ -539,8 +539,8 @@ contains
     allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))
     res%lam = 0.0_wp; res%lam_body = 0.0_wp; res%w = 0.0_wp; res%gap = 0.0_wp; res%obstacle = st%G
     call read_history(r%fid, n, res, r%hs)
-    if (r%hs%failed) then
-      r%msg = r%src//' has an incomplete history ('//r%hs%what//')'
+    if (r%hs%failed()) then
+      r%msg = r%src//' has an incomplete history ('//r%hs%text()//')'
       return
     end if
     call need_finite(r, 'dataset /history/criterion', res%h_criterion(1:n))

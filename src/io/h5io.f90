@@ -2,7 +2,7 @@
 !! to write and to read a dataset or an attribute of the kinds the files hold (real and
 !! integer arrays of any rank, real and integer scalars, text).
 !!
-!! Every call takes an `h5_status_t` that keeps the first failure (what could not be done
+!! Every call takes an `error_t` (ERR_IO) that keeps the first failure (what could not be done
 !! to which object); once it is set, writes and reads do nothing and only closing still
 !! happens, so a caller checks the status once, at the end. HDF5's own error printing is
 !! switched off: failures reach the user only through the caller's message.
@@ -17,6 +17,7 @@
 !! datasets are fixed-length.
 module h5io
   use kinds, only: wp
+  use errors, only: error_t, ERR_IO
   use, intrinsic :: iso_c_binding, only: c_ptr, c_loc, c_null_ptr, c_char, c_null_char
   use hdf5, only: hid_t, hsize_t, size_t, H5F_ACC_TRUNC_F, H5F_ACC_RDONLY_F, H5S_SCALAR_F, &
                   H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_FORTRAN_S1, H5T_C_S1, H5T_CSET_UTF8_F, &
@@ -31,12 +32,6 @@ module h5io
                   h5awrite_f, h5aread_f, h5tcopy_f, h5tset_size_f, h5tget_size_f, h5tclose_f
   implicit none (type, external)
   private
-
-  !> Outcome of a sequence of HDF5 calls: set by the first call that fails, then kept.
-  type, public :: h5_status_t
-    logical :: failed = .false.                 !< some call has failed
-    character(len=:), allocatable :: what       !< the first failure, e.g. 'failed to write dataset /contact/gap'
-  end type h5_status_t
 
   public :: file_open, file_close, group_open, group_close
   public :: write_dset, write_attr, read_dset, read_attr, describe, exists
@@ -71,7 +66,7 @@ contains
   subroutine file_open(path, fid, st, create)
     character(len=*), intent(in) :: path        !< file path
     integer(hid_t), intent(out) :: fid          !< the open file
-    type(h5_status_t), intent(inout) :: st      !< status
+    type(error_t), intent(inout) :: st      !< status
     logical, intent(in), optional :: create     !< create the file (default: read it)
     logical :: new
     integer :: e
@@ -79,7 +74,7 @@ contains
     new = .false.
     if (present(create)) new = create
     call library_init(st)
-    if (st%failed) return
+    if (st%failed()) return
     if (new) then
       call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, e)
     else
@@ -95,7 +90,7 @@ contains
   !! full disk may show only here. Nothing happens for fid < 0.
   subroutine file_close(fid, st)
     integer(hid_t), intent(inout) :: fid        !< the file; -1 on return
-    type(h5_status_t), intent(inout) :: st      !< status
+    type(error_t), intent(inout) :: st      !< status
     integer :: e
     if (fid < 0) return
     call h5fclose_f(fid, e)
@@ -109,12 +104,12 @@ contains
     integer(hid_t), intent(in) :: loc           !< file or group
     character(len=*), intent(in) :: name        !< group name
     integer(hid_t), intent(out) :: gid          !< the open group
-    type(h5_status_t), intent(inout) :: st      !< status
+    type(error_t), intent(inout) :: st      !< status
     logical, intent(in), optional :: create     !< create the group (default: open it)
     logical :: new
     integer :: e
     gid = -1
-    if (st%failed) return
+    if (st%failed()) return
     new = .false.
     if (present(create)) new = create
     if (new) then
@@ -131,7 +126,7 @@ contains
   !> Close a group (whatever the status). Nothing happens for gid < 0.
   subroutine group_close(gid, st)
     integer(hid_t), intent(inout) :: gid        !< the group; -1 on return
-    type(h5_status_t), intent(inout) :: st      !< status
+    type(error_t), intent(inout) :: st      !< status
     integer :: e
     if (gid < 0) return
     call h5gclose_f(gid, e)
@@ -148,7 +143,7 @@ contains
     real(wp), intent(in), target, contiguous :: v(..)       !< the data
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     character(len=*), intent(in), optional :: units         !< unit of the values
     call put_data(loc, name, H5T_NATIVE_DOUBLE, v, st, units)
   end subroutine dset_real
@@ -159,7 +154,7 @@ contains
     integer, intent(in), target, contiguous :: v(..)        !< the data
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     character(len=*), intent(in), optional :: units         !< unit of the values
     call put_data(loc, name, H5T_NATIVE_INTEGER, v, st, units)
   end subroutine dset_int
@@ -169,7 +164,7 @@ contains
     integer(hid_t), intent(in) :: loc, mtype
     character(len=*), intent(in) :: name
     type(*), intent(in), target, contiguous :: v(..)
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     character(len=*), intent(in), optional :: units
     type(c_ptr) :: p
     p = c_null_ptr
@@ -182,7 +177,7 @@ contains
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
     character(len=*), intent(in) :: s                       !< the text
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     call put_string(loc, name, .false., s, st)
   end subroutine dset_text
 
@@ -191,7 +186,7 @@ contains
     integer(hid_t), intent(in) :: loc                   !< file, group or dataset
     character(len=*), intent(in) :: name                !< attribute name
     class(*), intent(in), target :: v                   !< its value
-    type(h5_status_t), intent(inout) :: st              !< status
+    type(error_t), intent(inout) :: st              !< status
     select type (v)
     type is (real(wp))
       call put(loc, name, .true., H5T_NATIVE_DOUBLE, SCALAR, c_loc(v), st)
@@ -210,12 +205,12 @@ contains
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name, s
     logical, intent(in) :: attr
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     character(kind=c_char), allocatable, target :: c(:)
     type(c_ptr), target :: pv(1)
     integer(hid_t) :: ty
     integer :: n, e, ec
-    if (st%failed) return
+    if (st%failed()) return
     if (attr) then
       n = len(s) + 1
       c = transfer(s//c_null_char, 'a', n)
@@ -257,11 +252,11 @@ contains
     logical, intent(in) :: attr
     integer(hsize_t), intent(in) :: dims(:)
     type(c_ptr), intent(in) :: buf
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     character(len=*), intent(in), optional :: units
     integer(hid_t) :: sp, obj
     integer :: e, ec
-    if (st%failed) return
+    if (st%failed()) return
     if (size(dims) == 0) then
       call h5screate_f(H5S_SCALAR_F, sp, e)
     else
@@ -319,14 +314,14 @@ contains
     logical, intent(in) :: attr                             !< an attribute (else a dataset)
     integer, intent(out) :: cls                             !< CLASS_*
     integer(hsize_t), allocatable, intent(out) :: dims(:)   !< stored shape
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     integer(hid_t) :: obj, ty, sp
     integer(hsize_t), allocatable :: maxd(:)
     integer :: e, ec, r, tc
     logical :: vl
     cls = CLASS_OTHER
     allocate (dims(0))
-    if (st%failed) return
+    if (st%failed()) return
     if (attr) then
       call h5aopen_f(loc, name, obj, e)
     else
@@ -383,12 +378,12 @@ contains
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
     real(wp), allocatable, target, intent(out) :: v(..)     !< the data
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     integer(hsize_t) :: d(2)
     if (rank(v) > 2) call fail(st, 'cannot read an array of rank above 2 from dataset', loc, name)
-    if (st%failed) return
+    if (st%failed()) return
     call extent(loc, name, CLASS_REAL, d(1:rank(v)), st)
-    if (st%failed) return
+    if (st%failed()) return
     select rank (v)
     rank (1)
       allocate (v(d(1)))
@@ -403,10 +398,10 @@ contains
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
     integer, allocatable, target, intent(out) :: v(:)       !< the data
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     integer(hsize_t) :: d(1)
     call extent(loc, name, CLASS_INTEGER, d, st)
-    if (st%failed) return
+    if (st%failed()) return
     allocate (v(d(1)))
     if (d(1) > 0) call get(loc, name, .false., H5T_NATIVE_INTEGER, c_loc(v), st)
   end subroutine read_int
@@ -416,7 +411,7 @@ contains
     integer(hid_t), intent(in) :: loc                       !< file or group
     character(len=*), intent(in) :: name                    !< dataset name
     character(len=:), allocatable, intent(out) :: s         !< the text
-    type(h5_status_t), intent(inout) :: st                  !< status
+    type(error_t), intent(inout) :: st                  !< status
     character(kind=c_char), allocatable, target :: c(:)
     integer(hsize_t), allocatable :: dims(:)
     integer(hid_t) :: ds, ty
@@ -424,7 +419,7 @@ contains
     integer :: e, ec, cls
     s = ''
     call describe(loc, name, .false., cls, dims, st)
-    if (st%failed) return
+    if (st%failed()) return
     if (cls /= CLASS_STRING .or. size(dims) /= 0) then
       call fail(st, 'not a scalar fixed-length string:', loc, name)
       return
@@ -454,7 +449,7 @@ contains
     integer(hid_t), intent(in) :: loc                   !< file, group or dataset
     character(len=*), intent(in) :: name                !< attribute name
     class(*), intent(inout), target :: v                !< receives the value
-    type(h5_status_t), intent(inout) :: st              !< status
+    type(error_t), intent(inout) :: st              !< status
     integer(hsize_t), allocatable :: dims(:)
     integer :: cls, want
     select type (v)
@@ -467,7 +462,7 @@ contains
       return
     end select
     call describe(loc, name, .true., cls, dims, st)
-    if (st%failed) return
+    if (st%failed()) return
     if (cls /= want .or. product(dims) /= 1) then
       call fail(st, 'not a single '//merge('real   ', 'integer', want == CLASS_REAL)//' value: attribute', loc, name)
       return
@@ -488,11 +483,11 @@ contains
     character(len=*), intent(in) :: name
     logical, intent(in) :: attr
     type(c_ptr), intent(in) :: buf
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     integer(hid_t) :: obj
     type(c_ptr) :: p
     integer :: e, eo
-    if (st%failed) return
+    if (st%failed()) return
     p = buf   ! HDF5 declares the buffer intent(inout)
     if (attr) then
       call h5aopen_f(loc, name, obj, eo)
@@ -513,12 +508,12 @@ contains
     character(len=*), intent(in) :: name
     integer, intent(in) :: cls
     integer(hsize_t), intent(out) :: dims(:)
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     integer(hsize_t), allocatable :: d(:)
     integer :: c
     dims = 0
     call describe(loc, name, .false., c, d, st)
-    if (st%failed) return
+    if (st%failed()) return
     if (c /= cls) then
       call fail(st, 'dataset does not hold '//merge('real numbers', 'integers    ', cls == CLASS_REAL)//':', loc, name)
     else if (size(d) /= size(dims)) then
@@ -533,7 +528,7 @@ contains
   !> Open the library once: no HDF5 error printing, and no HDF5 clean-up at exit (a file
   !! whose flush failed would make it loop; every file is closed explicitly).
   subroutine library_init(st)
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     integer :: e
     if (initialised) return
     call h5dont_atexit_f(e)
@@ -550,7 +545,7 @@ contains
     logical, intent(in) :: attr
     integer(hid_t), intent(in) :: obj, loc
     character(len=*), intent(in) :: name
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     integer :: e
     if (attr) then
       call h5aclose_f(obj, e)
@@ -569,14 +564,16 @@ contains
 
   !> Record the first failure: `text`, followed by the path of `name` in `loc` if given.
   subroutine fail(st, text, loc, name)
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     character(len=*), intent(in) :: text
     integer(hid_t), intent(in), optional :: loc
     character(len=*), intent(in), optional :: name
-    if (st%failed) return
-    st%failed = .true.
-    st%what = trim(text)
-    if (present(loc) .and. present(name)) st%what = st%what//' '//object_path(loc, name)
+    if (st%failed()) return
+    if (present(loc) .and. present(name)) then
+      call st%set(ERR_IO, trim(text)//' '//object_path(loc, name))
+    else
+      call st%set(ERR_IO, trim(text))
+    end if
   end subroutine fail
 
   !> The path of `name` in the object `loc` ('/contact/gap'), for messages.

@@ -3,7 +3,8 @@
 module history_io
   use kinds, only: wp
   use hdf5, only: hid_t
-  use h5io, only: h5_status_t, group_open, group_close, write_dset, read_dset
+  use h5io, only: group_open, group_close, write_dset, read_dset
+  use errors, only: error_t, ERR_IO
   use contact_types, only: contact_result_t
   implicit none (type, external)
   private
@@ -17,7 +18,7 @@ contains
   subroutine write_history(fid, res, st)
     integer(hid_t), intent(in) :: fid              !< open file
     type(contact_result_t), intent(in) :: res      !< history source
-    type(h5_status_t), intent(inout) :: st         !< status (first failure kept)
+    type(error_t), intent(inout) :: st         !< status (first failure kept)
     integer(hid_t) :: gid
     call group_open(fid, 'history', gid, st, create=.true.)
     call write_dset(gid, 'criterion', res%h_criterion(1:res%nhist), st, '1')
@@ -34,7 +35,7 @@ contains
     integer(hid_t), intent(in) :: fid              !< open file
     integer, intent(in) :: n                       !< entries to read
     type(contact_result_t), intent(inout) :: res   !< receives the history
-    type(h5_status_t), intent(inout) :: st         !< status (first failure kept)
+    type(error_t), intent(inout) :: st         !< status (first failure kept)
     integer(hid_t) :: gid
     real(wp), allocatable :: crit(:), resid(:), wall(:)
     integer, allocatable :: inner(:), active(:)
@@ -45,10 +46,9 @@ contains
     call read_dset(gid, 'inner', inner, st)
     call read_dset(gid, 'active', active, st)
     call group_close(gid, st)
-    if (st%failed) return
+    if (st%failed()) return
     if (min(size(crit), size(resid), size(wall), size(inner), size(active)) < n) then
-      st%failed = .true.
-      st%what = 'the history is shorter than the outer iterations done'
+      call st%set(ERR_IO, 'the history is shorter than the outer iterations done')
       return
     end if
     res%h_criterion(1:n) = crit(1:n)

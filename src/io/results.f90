@@ -9,7 +9,7 @@ module results
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use hdf5, only: hid_t
-  use h5io, only: h5_status_t, file_open, file_close, group_open, group_close, write_dset, write_attr
+  use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
@@ -64,7 +64,7 @@ contains
     character(len=len_trim(file) + 16) :: name(NFILES)
     character(len=len_trim(file) + 128) :: tmp(NFILES)
     character(len=:), allocatable :: why, h5
-    type(h5_status_t) :: st
+    type(error_t) :: st
     integer :: k, a
     logical :: ok
 
@@ -74,8 +74,8 @@ contains
       tmp(k) = temp_name(name(k))
     end do
     call write_h5(tmp(1), d, msh, sys, itf, res, u, stress, tm, run_id(), st)
-    if (st%failed) then
-      call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%what//')')
+    if (st%failed()) then
+      call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%text()//')')
       call remove_temps()
       return
     end if
@@ -129,7 +129,7 @@ contains
     type(stress_field_t), intent(in) :: stress(2)
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
-    type(h5_status_t), intent(inout) :: st
+    type(error_t), intent(inout) :: st
     integer(hid_t) :: fid, gid
     integer :: a, k
     real(wp), allocatable :: vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
@@ -252,10 +252,9 @@ contains
       call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
       allocate (sigt(msh(a)%nnode, 4))
       vm = stress(a)%von_mises
-      if (.not. (all(ieee_is_finite(stress(a)%sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed) then
+      if (.not. (all(ieee_is_finite(stress(a)%sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) then
         ! a derived field that is not finite is a failure, never part of a result
-        st%failed = .true.
-        st%what = 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units'
+        call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
       end if
       sigt = transpose(stress(a)%sigma)
       call write_dset(gid, 'stress', sigt, st, us)
