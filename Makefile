@@ -138,7 +138,7 @@ $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelis
                            $(BUILD)/deck_checks.o $(BUILD)/deck_render.o
 $(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
-$(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
+$(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
 $(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/text_scanner.o \
                            $(BUILD)/mesh.o $(BUILD)/mesh_topology.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o

@@ -1,10 +1,10 @@
-!> Sorting of small index lists: an element's DOFs, a level of the Cuthill-McKee ordering, a
-!! node's neighbours.
+!> Sorting of index lists: insertion sorts for the short ones (an element's DOFs, a level of
+!! the Cuthill-McKee ordering, a node's neighbours), a merge sort for a mesh's long ones.
 module sorting
   implicit none (type, external)
   private
 
-  public :: sort_by_key, sort_ints
+  public :: sort_by_key, sort_ints, merge_sort_by_keys
 
 contains
 
@@ -43,5 +43,51 @@ contains
       v(j + 1) = x
     end do
   end subroutine sort_ints
+
+  !> Stable bottom-up merge sort of the indices `idx` by the columns `keys(:, idx(i))`,
+  !! compared lexicographically (first row first): n log n for the long lists of a mesh
+  !! (its node tags, its cells' sorted node sets).
+  subroutine merge_sort_by_keys(idx, keys)
+    integer, intent(inout) :: idx(:)        !< indices into the columns of keys, sorted on return
+    integer, intent(in) :: keys(:, :)       !< (k, *) the keys
+    integer, allocatable :: work(:)
+    integer :: n, width, lo, mid, hi, i, j, k
+    n = size(idx)
+    if (n < 2) return
+    allocate (work(n))
+    width = 1
+    do while (width < n)
+      do lo = 1, n, 2*width
+        mid = min(lo + width, n + 1)
+        hi = min(lo + 2*width, n + 1)
+        i = lo
+        j = mid
+        do k = lo, hi - 1
+          if (i < mid .and. (j >= hi .or. .not. keys_less(keys(:, idx(min(j, n))), keys(:, idx(min(i, n)))))) then
+            work(k) = idx(i)
+            i = i + 1
+          else
+            work(k) = idx(j)
+            j = j + 1
+          end if
+        end do
+      end do
+      idx = work
+      width = 2*width
+    end do
+  end subroutine merge_sort_by_keys
+
+  !> a < b, lexicographically.
+  pure logical function keys_less(a, b)
+    integer, intent(in) :: a(:), b(:)
+    integer :: m
+    keys_less = .false.
+    do m = 1, size(a)
+      if (a(m) /= b(m)) then
+        keys_less = a(m) < b(m)
+        return
+      end if
+    end do
+  end function keys_less
 
 end module sorting

@@ -14,6 +14,7 @@ module mesh_topology
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
+  use sorting, only: sort_ints, merge_sort_by_keys
   use mesh, only: mesh_t
   implicit none (type, external)
   private
@@ -601,11 +602,11 @@ contains
   subroutine check_duplicate_cells(mesh, err)
     type(mesh_t), intent(in) :: mesh
     type(error_t), intent(inout) :: err
-    integer, allocatable :: key(:, :), idx(:), work(:)
-    integer :: c, n, st, width, lo, mid, hi, i, j, k
+    integer, allocatable :: key(:, :), idx(:)
+    integer :: c, n, st, i, j, k
     n = mesh%ncell
     if (n < 2) return
-    allocate (key(4, n), idx(n), work(n), stat=st)
+    allocate (key(4, n), idx(n), stat=st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory to check '//i2s(n)//' cells for duplicates')
       return
@@ -613,29 +614,10 @@ contains
     key = 0
     do c = 1, n
       key(1:mesh%nvert, c) = mesh%cells(:, c)       ! a triangle's 4th node is 0 (or absent)
-      call sort4(key(:, c))
+      call sort_ints(key(:, c))
       idx(c) = c
     end do
-    width = 1
-    do while (width < n)                                ! bottom-up merge sort of idx by key
-      do lo = 1, n, 2*width
-        mid = min(lo + width, n + 1)
-        hi = min(lo + 2*width, n + 1)
-        i = lo
-        j = mid
-        do k = lo, hi - 1
-          if (i < mid .and. (j >= hi .or. .not. key_less(key(:, idx(min(j, n))), key(:, idx(min(i, n)))))) then
-            work(k) = idx(i)
-            i = i + 1
-          else
-            work(k) = idx(j)
-            j = j + 1
-          end if
-        end do
-      end do
-      idx = work
-      width = 2*width
-    end do
+    call merge_sort_by_keys(idx, key)
     do k = 2, n
       if (all(key(:, idx(k)) == key(:, idx(k - 1)))) then
         i = min(idx(k - 1), idx(k))
@@ -645,64 +627,17 @@ contains
         return
       end if
     end do
-  contains
-    pure logical function key_less(a, b)
-      integer, intent(in) :: a(4), b(4)
-      integer :: m
-      key_less = .false.
-      do m = 1, 4
-        if (a(m) /= b(m)) then
-          key_less = a(m) < b(m)
-          return
-        end if
-      end do
-    end function key_less
-    pure subroutine sort4(v)
-      integer, intent(inout) :: v(4)
-      integer :: p, q, t
-      do p = 2, 4
-        t = v(p)
-        q = p - 1
-        do while (q >= 1)
-          if (v(q) <= t) exit
-          v(q + 1) = v(q)
-          q = q - 1
-        end do
-        v(q + 1) = t
-      end do
-    end subroutine sort4
   end subroutine check_duplicate_cells
 
   !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
   subroutine sort_by_tag(idx, tag)
     integer, intent(inout) :: idx(:)
     integer, intent(in) :: tag(:)
-    integer, allocatable :: work(:)
-    integer :: n, width, lo, mid, hi, i, j, k
+    integer :: n
     n = size(idx)
     if (n < 2) return
     if (all(tag(idx(2:n)) > tag(idx(1:n - 1)))) return     ! the usual case: already sorted
-    allocate (work(n))
-    width = 1
-    do while (width < n)
-      do lo = 1, n, 2*width
-        mid = min(lo + width, n + 1)
-        hi = min(lo + 2*width, n + 1)
-        i = lo
-        j = mid
-        do k = lo, hi - 1
-          if (i < mid .and. (j >= hi .or. tag(idx(min(i, n))) <= tag(idx(min(j, n))))) then
-            work(k) = idx(i)
-            i = i + 1
-          else
-            work(k) = idx(j)
-            j = j + 1
-          end if
-        end do
-      end do
-      idx = work
-      width = 2*width
-    end do
+    call merge_sort_by_keys(idx, reshape(tag, [1, size(tag)]))
   end subroutine sort_by_tag
 
 end module mesh_topology
