@@ -20,8 +20,8 @@ program bench_ordering
   use config, only: body_cfg_t, ELEM_Q1, BC_FREE, BC_CLAMPED, BC_CONTACT
   use mesh, only: mesh_t
   use assembly, only: body_system_t
-  use ordering, only: ND_OK
   use cholesky, only: chol_t
+  use errors, only: error_t
   use clock, only: wtime
   use testing, only: rectangle_body, structured_body, general_body, order_body, factor_ordered
   use omp_lib, only: omp_set_max_active_levels
@@ -86,6 +86,7 @@ contains
     real(wp) :: t0, t_order, t_cond
     integer :: info, m
     character(len=256) :: msg
+    type(error_t) :: err
 
     m = size(last)
     t_order = 0.0_wp
@@ -93,7 +94,7 @@ contains
       t0 = wtime()
       call order_body(msh, sys, last, perm, info, msg)
       t_order = wtime() - t0
-      if (info /= ND_OK) then
+      if (info /= 0) then
         write (output_unit, '(a)') 'nested dissection failed: '//trim(msg)
         return
       end if
@@ -108,8 +109,12 @@ contains
     allocate (flex(m, m), sgn(m))
     sgn = -1.0_wp
     t0 = wtime()
-    call ch%flexibility(last, sgn, flex, info, msg)
+    call ch%flexibility(last, sgn, flex, err)
     t_cond = wtime() - t0
+    if (err%failed()) then
+      write (output_unit, '(a)') 'flexibility failed: '//err%text()
+      return
+    end if
     write (output_unit, '(a,i0,a,i0,a,a,a,a,a,i0,a,i0,5(a,f0.3),a,es9.2,a,es9.2,a,f0.0,a)') &
       '| ', nx, 'x', nx/2, ' | ', trim(kinds(kind)), ' | ', trim(onames(o)), ' | ', sys%n, ' | ', m, &
       ' | ', t_order, ' | ', ch%t_analyze, ' | ', ch%t_factor, ' | ', t_cond, ' | ', &

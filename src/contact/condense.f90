@@ -350,12 +350,11 @@ contains
     end select
     if (iord == ORD_GIVEN .and. method == FACT_CHOLMOD) then
       if (msh%structured) then
-        call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, bc%idx, perm, info, msg)
+        call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, bc%idx, perm, err)
       else
-        call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, bc%idx, perm, info, msg)
+        call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, bc%idx, perm, err)
       end if
-      if (info /= 0) then
-        call err%set(ERR_NUMERICAL, msg)
+      if (err%failed()) then
         bc%t_factor = wtime() - t0
         return
       end if

@@ -28,6 +28,7 @@
 !! DOF to its free index (0: prescribed), dof_of a free index to its global DOF.
 module ordering
   use kinds, only: wp, i8
+  use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -37,9 +38,10 @@ module ordering
   !! factor's size depends little on it (within 12% from 4 to 64 on 512 x 256 Q1 cells).
   integer, parameter, public :: ND_LEAF_NODES = 16
 
-  integer, parameter, public :: ND_OK = 0            !< info: success
-  integer, parameter, public :: ND_BAD_SYSTEM = 1    !< info: mesh and system do not match
-  integer, parameter, public :: ND_BAD_LAST = 2      !< info: an entry of `last` is out of range or repeated
+  ! internal status of an ordering; the exported procedures return an error_t
+  integer, parameter :: ND_OK = 0            !< success
+  integer, parameter :: ND_BAD_SYSTEM = 1    !< mesh and system do not match
+  integer, parameter :: ND_BAD_LAST = 2      !< an entry of `last` is out of range or repeated
 
   !> Unstructured meshes: node sets with fewer nodes than this are not bisected further.
   integer, parameter, public :: RCB_LEAF_NODES = 16
@@ -71,18 +73,17 @@ contains
   !! (cost O(number of nodes)). perm(k) is the free DOF (1-based, 1..n) placed k-th; size
   !! n - size(last). Both DOFs of a node are consecutive; prescribed DOFs and DOFs in
   !! `last` are skipped. The caller appends `last` to obtain a full ordering with the
-  !! interface last. info: ND_OK, or ND_BAD_SYSTEM / ND_BAD_LAST with a sentence in msg
-  !! (perm empty).
-  subroutine grid_dissection(nx, ny, free_of, n, last, perm, info, msg)
+  !! interface last. On failure (the system does not belong to the mesh, `last` out of range
+  !! or repeated) ERR_NUMERICAL with a sentence, perm empty.
+  subroutine grid_dissection(nx, ny, free_of, n, last, perm, err)
     integer, intent(in) :: nx, ny                     !< grid cells along x and y
     integer, intent(in) :: free_of(:)                 !< (2*(nx+1)*(ny+1)) free index of each DOF, 0 if prescribed
     integer, intent(in) :: n                          !< the number of free DOFs
     integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
-    integer, intent(out) :: info                      !< ND_OK or an error code
-    character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err                 !< ERR_NUMERICAL with one sentence (perm empty)
     type(order_t) :: order
-    integer :: nx1
+    integer :: nx1, info
     character(len=200) :: emsg
 
     emsg = ''
@@ -98,7 +99,7 @@ contains
       call dissect(0, nx, 0, ny)
       call finish_order(order, info, emsg)
     end if
-    call hand_over(order, info, emsg, perm, msg)
+    call hand_over(order, info, emsg, perm, err)
 
   contains
 
@@ -149,7 +150,7 @@ contains
   !> Nested-dissection permutation of the free DOFs not in `last` of a body on any mesh, by
   !! recursive coordinate bisection of the node graph of the stiffness pattern (cost
   !! O(nnz log n)). perm as grid_dissection's.
-  subroutine coordinate_bisection(xy, free_of, dof_of, colptr, rowind, last, perm, info, msg)
+  subroutine coordinate_bisection(xy, free_of, dof_of, colptr, rowind, last, perm, err)
     real(wp), intent(in) :: xy(:, :)                  !< (2, nnode) node coordinates [length]
     integer, intent(in) :: free_of(:)                 !< (2*nnode) free index of each DOF, 0 if prescribed
     integer, intent(in) :: dof_of(:)                  !< (n) global DOF of each free index
@@ -157,11 +158,10 @@ contains
     integer, intent(in) :: rowind(:)                  !< 0-based row indices (free DOFs)
     integer, intent(in) :: last(:)                    !< 1-based free DOFs to leave out (ordered last by the caller)
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
-    integer, intent(out) :: info                      !< ND_OK or an error code
-    character(len=*), intent(out), optional :: msg    !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err                 !< ERR_NUMERICAL with one sentence (perm empty)
     type(order_t) :: order
     type(node_graph_t) :: graph
-    integer :: n, stamp
+    integer :: n, stamp, info
     character(len=200) :: emsg
 
     emsg = ''
@@ -177,7 +177,7 @@ contains
         info = ND_BAD_SYSTEM
       end if
     end if
-    call hand_over(order, info, emsg, perm, msg)
+    call hand_over(order, info, emsg, perm, err)
 
   contains
 
@@ -376,19 +376,18 @@ contains
     end if
   end subroutine finish_order
 
-  !> The result: the order, or on failure an empty perm and the sentence in msg.
-  subroutine hand_over(order, info, emsg, perm, msg)
+  !> The result: the order, or on failure an empty perm and the sentence in err.
+  subroutine hand_over(order, info, emsg, perm, err)
     type(order_t), intent(inout) :: order
     integer, intent(in) :: info
     character(len=*), intent(in) :: emsg
     integer, allocatable, intent(out) :: perm(:)
-    character(len=*), intent(out), optional :: msg
-    if (present(msg)) msg = ''
+    type(error_t), intent(out) :: err
     if (info == ND_OK) then
       call move_alloc(order%perm, perm)
     else
       allocate (perm(0))
-      if (present(msg)) msg = emsg
+      call err%set(ERR_NUMERICAL, emsg)
     end if
   end subroutine hand_over
 

@@ -239,13 +239,15 @@ contains
     type(body_system_t), intent(in) :: sys            !< its system (with its pattern on a general mesh)
     integer, intent(in) :: last(:)                    !< free DOFs ordered last by the caller
     integer, allocatable, intent(out) :: perm(:)      !< the interior order
-    integer, intent(out) :: info                      !< ND_OK or an error code
+    integer, intent(out) :: info                      !< 0, or the error's category
     character(len=*), intent(out) :: msg              !< the failure, else blank
+    type(error_t) :: err
     if (msh%structured) then
-      call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, last, perm, info, msg)
+      call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, last, perm, err)
     else
-      call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, last, perm, info, msg)
+      call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, last, perm, err)
     end if
+    call error_parts(err, info, msg)
   end subroutine order_body
 
   !> A body on a general mesh, as a mesh file would give it: the structured mesh of `b`
