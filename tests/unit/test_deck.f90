@@ -90,7 +90,7 @@ program test_deck
              'defaults: output file results/<deck basename>.h5 ('//trim(e%output%file)//')')
   call check(e%body(1)%width == 1.0_wp .and. e%body(1)%poisson == 0.3_wp .and. &
              e%solver%delta == 0.5_wp .and. e%solver%robin_operator == ROBIN_HARMONIC .and. &
-             e%contact%gap_radius == 0.0_wp, 'defaults: config.f90 values (harmonic at delta 0.5)')
+             e%pair(1)%gap_radius == 0.0_wp, 'defaults: config.f90 values (harmonic at delta 0.5)')
   call check(all(e%body(2)%bc == [BC_ROLLER, BC_FREE, BC_ROLLER, BC_CONTACT]), &
              'forms: upper-case names, mixed-case values, double quotes, two groups on a line')
   call check(e%title == 'a!b, it''s "quoted" / here', 'forms: quotes, ! and / inside a string')
@@ -219,7 +219,7 @@ contains
           diff = diff//' traction'
       end do
     end if
-    if (a%contact%gap_radius /= b%contact%gap_radius .or. a%contact%gap_center /= b%contact%gap_center) diff = diff//' contact'
+    if (a%pair(1)%gap_radius /= b%pair(1)%gap_radius .or. a%pair(1)%gap_center /= b%pair(1)%gap_center) diff = diff//' contact'
     associate (x => a%solver, y => b%solver)
       if (x%method /= y%method .or. x%robin_operator /= y%robin_operator .or. x%stop /= y%stop .or. &
           x%factor%factorization /= y%factor%factorization .or. x%factor%ordering /= y%factor%ordering .or. &
