@@ -131,7 +131,7 @@ contains
       return
     end if
     if (st%contact_form /= 0 .and. st%contact_form /= form) call die_at(src, g%line, 'in group '// &
-      '&contact: '//form_words(form)//', but the &contact at line '//i2s(st%contact_line)// &
+      '&contact: this group has '//form_words(form)//', but the &contact at line '//i2s(st%contact_line)// &
       ' has '//form_words(st%contact_form)//'; a deck uses one form: the two-body form '// &
       '(&contact body1_group=..., body2_group=... /, bodies 1 and 2) or a &contact bodies=A,B, '// &
       'groups=''GA'',''GB'' / per pair')
