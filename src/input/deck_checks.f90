@@ -11,7 +11,7 @@ module deck_checks
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
-  use config, only: deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: pair_oriented, deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t
@@ -207,6 +207,7 @@ contains
     call contact_vars(c, v, ALL_FORMS)
     call read_group(g, src, v)
     call check_contact(g, src, c, merge(PAIR_FORM, TWO_BODY_FORM, d%pairs_named), d%nbody)
+    if (.not. d%pairs_named) c = pair_oriented(c)   ! the two-body form: body 1's group first
     d%pair(p) = c
     st%pair_at(p)%s = st%pair_at(p)%s//', changed by '//src%label
   end subroutine override_contact

@@ -219,6 +219,11 @@ contains
     call read_deck(trim(tmp)//'_two.nml', o(1:1), p)
     call check(p%pair(1)%gap_radius == 1.0_wp .and. p%pair(1)%slave == 2, &
                'pairs: an override in the two-body form changes the pair (1, 2)')
+    o(1) = '&contact bodies=2,1, groups=''top'',''rim'', slave=1 /'
+    call read_deck(trim(tmp)//'_two.nml', o(1:1), p)
+    call check(all(p%pair(1)%bodies == [1, 2]) .and. p%pair(1)%body_group(1) == 'rim' .and. &
+               p%pair(1)%body_group(2) == 'top' .and. p%pair(1)%slave == 1 .and. .not. p%pairs_named, &
+               'pairs: an override naming the pair (2, 1) of a two-body deck keeps body 1''s group first')
     call delete_file(trim(tmp)//'_two.nml')
 
     ! the pair form, bodies out of order and a pair given as (3, 2)
