@@ -9,7 +9,7 @@ program test_deck
   use kinds, only: wp
   use config
   use deck, only: read_deck, print_deck, deck_text
-  use namelist_vars, only: vars_t, str_t, reference_table
+  use namelist_vars, only: vars_t, str_t, reference_table, render_group
   use testing, only: report, test_summary, write_file
   implicit none (type, external)
   type(deck_t) :: d, e
@@ -138,6 +138,8 @@ program test_deck
     integer, target :: n, code
     real(wp), target :: x, p(2)
     character(len=8), target :: s
+    integer, target :: ip(2)
+    character(len=6), target :: sp(2)
     character(len=:), allocatable :: tab
     n = 3
     code = 0
@@ -149,6 +151,10 @@ program test_deck
     call v%pair('p', p, unit='[length]', doc='position')
     call v%str('s', s)
     call v%enum('c', code, 'one two')
+    ip = [3, 1]
+    sp = ['top   ', 'rim   ']
+    call v%ints('ip', ip, range='two ids', doc='bodies')
+    call v%strs('sp', sp, doc='groups')
     call forms(1)%int('n', n)
     call forms(1)%real('x', x)
     call forms(2)%int('n', n)
@@ -166,6 +172,12 @@ program test_deck
                'reference table: a string without a description')
     call check(index(tab, NL//'| `c` | choice | none | | `''one''`, `''two''` | |'//NL) > 0, &
                'reference table: a choice without a value')
+    call check(index(tab, NL//'| `ip` | integer pair | `3, 1` | | two ids | bodies |'//NL) > 0, &
+               'reference table: an integer pair')
+    call check(index(tab, NL//'| `sp` | string pair (at most 6 characters each) | `''top'', ''rim''` | | | '// &
+               'groups |'//NL) > 0, 'reference table: a string pair')
+    call check(index(render_group('g', v, 200), 'ip=3, 1, sp=''top'', ''rim'' /') > 0, &
+               'render_group: an integer pair and a string pair')
     code = 2
     tab = reference_table(v)
     call check(index(tab, NL//'| `c` | choice | `''two''` | | `''one''`, `''two''` | |'//NL) > 0 .and. &
