@@ -4,9 +4,10 @@
 !!
 !! Groups: `&scene`, `&body` (N of them, ids 1 to N), `&traction`, `&displacement` and
 !! `&boundary` (any number, any order), `&contact` (the two-body form once, or one per
-!! contact pair), `&solver`, `&output` (each at most once; all optional). Command-line overrides are namelist fragments applied after the deck:
-!! `&body id=2, young=1e9 /` changes body 2, `&traction ... /` adds a traction, other
-!! groups change the values given. Every bad input ends in `fatal(EXIT_INPUT, msg)` with
+!! contact pair), `&solver`, `&output` (each at most once; all optional). Command-line
+!! overrides are namelist fragments applied after the deck: `&body id=2, young=1e9 /`
+!! changes body 2, `&contact bodies=2,3, slave=3 /` the pair of bodies 2 and 3,
+!! `&traction ... /` adds a traction, other groups change the values given. Every bad input ends in `fatal(EXIT_INPUT, msg)` with
 !! a message naming the source (deck file and line, or command-line override k), the
 !! group, the variable and the value, followed by the offending line.
 !!

@@ -1,7 +1,8 @@
 !> The checks of the deck's groups as they are read: each group read into its settings
 !! through its table (`deck_tables`), its values checked (`apply_*`, `new_body`,
 !! `add_traction`, ...), then, once the deck and its overrides are read, the checks across
-!! groups (`check_cross`: contact sides or groups, prescribed displacements, loads).
+!! groups (`check_cross`: the contact pairs, their sides or groups, prescribed
+!! displacements, loads).
 !! Every bad input ends in `fatal(EXIT_INPUT, msg)` naming the source, group, variable
 !! and value.
 module deck_checks
@@ -41,7 +42,7 @@ module deck_checks
 
 contains
 
-  !> A group that appears at most once (&scene, &contact, &solver, &output): read into its
+  !> A group that appears at most once (&scene, &solver, &output): read into its
   !! settings through its table, then its values checked.
   subroutine apply_single(g, src, d)
     type(grp_t), intent(in) :: g
