@@ -7,7 +7,7 @@ module run_phases
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
-  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES
+  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, contact_cfg_t, pair_oriented
   use mesh, only: mesh_build
   use gmsh_msh, only: msh_read, msh_read_pair
   use assembly, only: assemble_body, nodal_stress, stress_field_t
@@ -128,12 +128,14 @@ contains
     logical, intent(in) :: matrix       !< assemble the stiffness
     type(error_t) :: err(2)
     integer :: a
+    type(contact_cfg_t) :: pair   ! the pair of bodies 1 and 2, in that order
+    pair = pair_oriented(run%deck%pair(1))
     associate (deck => run%deck)
       !$omp parallel do num_threads(run%threads) schedule(static, 1)
       do a = 1, 2
         call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
                            run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
-                           contact_group=deck%contact%body_group(a))
+                           contact_group=pair%body_group(a))
       end do
       !$omp end parallel do
       do a = 1, 2
@@ -149,7 +151,7 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its contact line and bodies' rigid rows
     type(error_t) :: err
     integer :: a
-    call build_interface(run%deck%body, run%deck%contact, run%meshes, run%systems, run%contact_line, err)
+    call build_interface(run%deck%body, pair_oriented(run%deck%pair(1)), run%meshes, run%systems, run%contact_line, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
     do a = 1, 2
       call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))

@@ -10,6 +10,8 @@ module config
   implicit none (type, external)
   private
 
+  public :: deck_init, pair_oriented
+
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
   integer, parameter, public :: PATH_LEN = 4096
@@ -82,7 +84,7 @@ module config
 
   !> One elastic body: a rectangle meshed by nx x ny cells, or the cells of a Gmsh file.
   type, public :: body_cfg_t
-    integer :: id = 0                 !< 1 or 2
+    integer :: id = 0                 !< 1 .. nbody
     character(len=PATH_LEN) :: mesh = ''   !< Gmsh MSH 4.1 file ('' : the rectangle below); absolute after reading
     character(len=128) :: region = '' !< physical surface of the file that is this body ('' : the only one)
     real(wp) :: x0 = 0.0_wp           !< lower-left corner x [length]
@@ -128,11 +130,13 @@ module config
     integer :: ordering = ORDER_ND                    !< ORDER_* (cholmod only)
   end type factor_cfg_t
 
-  !> The contact interface: the two contact surfaces (rectangle sides declared 'contact', or
-  !! named edge groups, then paired by mortar), and an initial gap on top of the geometry's.
+  !> One contact pair: two bodies, the contact surface of each (a named edge group, or ''
+  !! for a rectangle's side declared 'contact'), paired by mortar, and an initial gap on top
+  !! of the geometry's.
   type, public :: contact_cfg_t
-    character(len=128) :: body_group(2) = ''          !< contact edge group of each body ('' : sides)
-    integer :: slave = 0                              !< mortar slave body, 0: the finer surface
+    integer :: bodies(2) = [1, 2]                     !< the two body ids, in the order given
+    character(len=128) :: body_group(2) = ''          !< contact edge group of each ('' : the 'contact' side)
+    integer :: slave = 0                              !< mortar slave: a body id of the pair, 0: the finer surface
     real(wp) :: gap_radius = 0.0_wp                   !< R of the parabolic initial gap, 0: none [length]
     real(wp) :: gap_center = 0.0_wp                   !< xc of the parabolic gap [length]
   end type contact_cfg_t
@@ -168,15 +172,49 @@ module config
     character(len=256) :: title = ''                  !< free text
     logical :: plane_strain = .true.                  !< .true.: plane strain, .false.: plane stress
     type(units_cfg_t) :: units                        !< unit names (&scene units=...)
-    type(body_cfg_t) :: body(2)                       !< indexed by id
+    integer :: nbody = 0                              !< number of bodies
+    type(body_cfg_t), allocatable :: body(:)          !< the bodies, indexed by id (1 .. nbody)
     integer :: ntraction = 0                          !< number of tractions in use
     type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)
     integer :: nboundary = 0                          !< number of &boundary groups
     type(boundary_cfg_t), allocatable :: boundary(:)  !< prescribed components on groups (size >= nboundary)
-    type(contact_cfg_t) :: contact                    !< the contact interface (&contact)
+    integer :: npair = 0                              !< number of contact pairs
+    type(contact_cfg_t), allocatable :: pair(:)       !< the contact pairs (&contact; size >= npair)
+    logical :: pairs_named = .false.                  !< given as &contact bodies=A,B (else the two-body form)
     type(solver_cfg_t) :: solver
     type(output_cfg_t) :: output
     character(len=:), allocatable :: effective        !< effective deck as namelist text
   end type deck_t
+
+contains
+
+  !> A deck of `nbody` default bodies (ids 1 .. nbody) and `npair` default pairs (bodies
+  !! 1 and 2, each on its 'contact' side): the start of a deck built in code.
+  subroutine deck_init(d, nbody, npair)
+    type(deck_t), intent(inout) :: d   !< the deck; its bodies and pairs are replaced
+    integer, intent(in) :: nbody       !< number of bodies
+    integer, intent(in) :: npair       !< number of pairs
+    integer :: b
+    if (allocated(d%body)) deallocate (d%body)
+    if (allocated(d%pair)) deallocate (d%pair)
+    allocate (d%body(nbody), d%pair(npair))
+    d%nbody = nbody
+    d%npair = npair
+    do b = 1, nbody
+      d%body(b)%id = b
+    end do
+  end subroutine deck_init
+
+  !> The pair with its bodies in ascending order of id (groups swapped along): entry a of
+  !! `body_group` is then the group of the pair's a-th smallest body.
+  pure function pair_oriented(p) result(q)
+    type(contact_cfg_t), intent(in) :: p   !< the pair as given
+    type(contact_cfg_t) :: q
+    q = p
+    if (p%bodies(1) > p%bodies(2)) then
+      q%bodies = p%bodies(2:1:-1)
+      q%body_group = p%body_group(2:1:-1)
+    end if
+  end function pair_oriented
 
 end module config

@@ -2,11 +2,12 @@
 !! value by value and across fields, with clear messages on bad input, and rendered back as
 !! namelist text.
 !!
-!! Groups: `&scene`, `&body` (exactly two, ids 1 and 2), `&traction` and `&displacement`
-!! (any number, any order), `&contact`, `&solver`, `&output` (each at most once; all
-!! optional). Command-line overrides are namelist fragments applied after the deck:
-!! `&body id=2, young=1e9 /` changes body 2, `&traction ... /` adds a traction, other
-!! groups change the values given. Every bad input ends in `fatal(EXIT_INPUT, msg)` with
+!! Groups: `&scene`, `&body` (N of them, ids 1 to N), `&traction`, `&displacement` and
+!! `&boundary` (any number, any order), `&contact` (the two-body form once, or one per
+!! contact pair), `&solver`, `&output` (each at most once; all optional). Command-line
+!! overrides are namelist fragments applied after the deck: `&body id=2, young=1e9 /`
+!! changes body 2, `&contact bodies=2,3, slave=3 /` the pair of bodies 2 and 3,
+!! `&traction ... /` adds a traction, other groups change the values given. Every bad input ends in `fatal(EXIT_INPUT, msg)` with
 !! a message naming the source (deck file and line, or command-line override k), the
 !! group, the variable and the value, followed by the offending line.
 !!
@@ -20,8 +21,8 @@ module deck
   use strings, only: i2s, index_of
   use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, die_at, unknown_group
   use config, only: deck_t
-  use deck_checks, only: state_t, apply_single, new_body, override_body, add_traction, add_boundary, &
-                         apply_displacement, check_cross
+  use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, &
+                         add_boundary, apply_displacement, add_contact, check_cross
   use deck_render, only: deck_text, print_deck, deck_reference
   implicit none (type, external)
   private
@@ -61,31 +62,34 @@ contains
 
   !> Read the deck file `path`, then apply the command-line `overrides` in order, validate
   !! everything and fill `d` (with `d%effective`, the effective deck as namelist text).
-  !! On any bad input: `fatal(EXIT_INPUT, message)`.
-  subroutine read_deck(path, overrides, d)
+  !! On any bad input: `fatal(EXIT_INPUT, message)`. The solver handles two bodies in one
+  !! pair: a deck beyond that is refused after its checks, unless `assembly` is true.
+  subroutine read_deck(path, overrides, d, assembly)
     character(len=*), intent(in) :: path          !< deck file path
     character(len=*), intent(in) :: overrides(:)  !< namelist fragments from the command line
     type(deck_t), intent(out) :: d                !< the effective deck
+    logical, intent(in), optional :: assembly     !< accept any number of bodies and pairs
     type(state_t) :: st
     type(src_t) :: src
     type(grp_t), allocatable :: gs(:)
     integer :: i, k, ig
     character(len=:), allocatable :: olabel
+    logical :: any_size
 
+    any_size = .false.
+    if (present(assembly)) any_size = assembly
     if (len(path) > len(d%source)) call fatal(EXIT_INPUT, 'the deck path is '//i2s(len(path))// &
       ' characters long, longer than the system''s limit of '//i2s(len(d%source))//' (PATH_MAX)')
     d%source = path
-    st%path = path
-    allocate (d%traction(4), st%trac_at(4), d%boundary(4))
-    d%ntraction = 0
-    d%nboundary = 0
-    do k = 1, 2
-      d%body(k)%id = 0
-    end do
-
     if (len_trim(path) == 0) call fatal(EXIT_INPUT, 'no deck file given'//NL//deck_usage)
     call load_file(path, src)
     call parse_source(src, GROUP_NAMES, gs)
+    ! the &body groups, counted first: the ids are 1 to their number
+    k = 0
+    do i = 1, size(gs)
+      if (gs(i)%name == 'body') k = k + 1
+    end do
+    call start_state(path, k, d, st)
 
     ! Pass 1: everything but the loads, which refer to the bodies.
     do i = 1, size(gs)
@@ -96,6 +100,8 @@ contains
         cycle
       case ('body')
         call new_body(gs(i), src, d, st)
+      case ('contact')
+        call add_contact(gs(i), src, d, st)
       case default
         if (st%once_line(ig) > 0) call die_at(src, gs(i)%line, 'group &'//gs(i)%name// &
           ' appears twice in the deck (first at line '//i2s(st%once_line(ig))// &
@@ -105,11 +111,12 @@ contains
       end select
     end do
     if (st%nbody == 0) call fatal(EXIT_INPUT, path//': the deck has no &body group; it needs '// &
-      'exactly two, &body id=1 ... / and &body id=2 ... /')
-    if (st%nbody == 1) then
-      k = merge(1, 2, d%body(1)%id == 1)
-      call fatal(EXIT_INPUT, path//': the deck has only one &body group (id='//i2s(k)// &
-        ', line '//i2s(st%body_line(k))//'); it needs exactly two, with ids 1 and 2')
+      'at least two, &body id=1 ... / and &body id=2 ... /')
+    if (st%nbody == 1) call fatal(EXIT_INPUT, path//': the deck has only one &body group (id=1, '// &
+      'line '//i2s(st%body_line(1))//'); it needs at least two, in contact')
+    if (d%npair == 0 .and. d%nbody == 2) then   ! no &contact: bodies 1 and 2 on their 'contact' sides
+      d%npair = 1
+      st%pair_at(1)%s = 'two-body contact'
     end if
 
     ! Pass 2: loads, in deck order.
@@ -132,6 +139,8 @@ contains
         select case (gs(i)%name)
         case ('body')
           call override_body(gs(i), src, d, st)
+        case ('contact')
+          call add_contact(gs(i), src, d, st)
         case ('traction')
           call add_traction(gs(i), src, d, st, olabel)
         case ('displacement')
@@ -146,6 +155,9 @@ contains
 
     if (len_trim(d%output%file) == 0) d%output%file = default_output(path)
     call check_cross(d, st)
+    if (.not. any_size .and. (d%nbody > 2 .or. d%npair > 1)) call fatal(EXIT_INPUT, path// &
+      ': this version solves two bodies in one contact pair; the deck has '//i2s(d%nbody)// &
+      ' bodies and '//i2s(d%npair)//' pairs')
     call deck_text(d, d%effective)
   end subroutine read_deck
 

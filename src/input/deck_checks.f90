@@ -1,44 +1,48 @@
 !> The checks of the deck's groups as they are read: each group read into its settings
 !! through its table (`deck_tables`), its values checked (`apply_*`, `new_body`,
 !! `add_traction`, ...), then, once the deck and its overrides are read, the checks across
-!! groups (`check_cross`: contact sides or groups, prescribed displacements, loads).
+!! groups (`check_cross`: the contact pairs, their sides or groups, prescribed
+!! displacements, loads).
 !! Every bad input ends in `fatal(EXIT_INPUT, msg)` naming the source, group, variable
 !! and value.
 module deck_checks
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
-  use strings, only: i2s, r2s, quoted_list, word
+  use strings, only: i2s, r2s, quote, quoted_list, word
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
-  use config, only: deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: pair_oriented, deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t
-  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, scene_vars, body_vars, traction_vars, &
-                         boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
+  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, &
+                         traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
   implicit none (type, external)
   private
 
-  public :: state_t, apply_single, new_body, override_body, add_traction, add_boundary, &
-            apply_displacement, check_cross
+  public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, &
+            apply_displacement, add_contact, check_cross
 
 
   !> Where things came from, for cross-field messages.
   type :: state_t
     character(len=:), allocatable :: path
-    integer :: nbody = 0
-    integer :: body_line(2) = 0                 ! line of each &body in the deck file
-    type(str_t) :: body_at(2)                   ! 'line N' or 'command-line override k'
+    integer :: nbody = 0                        ! &body groups read so far
+    integer, allocatable :: body_line(:)        ! line of each &body in the deck file, per id
+    type(str_t), allocatable :: body_at(:)      ! '&body at line N' (and its overrides), per id
     type(str_t), allocatable :: trac_at(:)      ! per traction
-    integer :: disp_line(4, 2) = 0              ! deck line of the &displacement per side, body
-    logical :: disp_given(4, 2) = .false.       ! a &displacement gives the side's vector
+    integer, allocatable :: disp_line(:, :)     ! deck line of the &displacement per side, body
+    logical, allocatable :: disp_given(:, :)    ! a &displacement gives the side's vector
     integer :: once_line(8) = 0                 ! deck line of each singleton group
+    integer :: contact_form = 0                 ! the deck's &contact form (TWO_BODY_FORM, PAIR_FORM; 0: none)
+    integer :: contact_line = 0                 ! line of the deck's first &contact
+    type(str_t), allocatable :: pair_at(:)      ! '&contact at line N' (and its overrides), per pair
   end type state_t
 
 contains
 
-  !> A group that appears at most once (&scene, &contact, &solver, &output): read into its
+  !> A group that appears at most once (&scene, &solver, &output): read into its
   !! settings through its table, then its values checked.
   subroutine apply_single(g, src, d)
     type(grp_t), intent(in) :: g
@@ -50,8 +54,6 @@ contains
     case ('scene')
       sc%plane = merge(1, 2, d%plane_strain)
       call scene_vars(d, sc, v)
-    case ('contact')
-      call contact_vars(d%contact, v)
     case ('solver')
       call solver_vars(d%solver, v)
     case ('output')
@@ -62,14 +64,164 @@ contains
     case ('scene')
       d%plane_strain = (sc%plane == 1)
       call check_units(g, src, d%units)
-    case ('contact')
-      call check_contact(g, src, d%contact)
     case ('solver')
       call check_solver(g, src, d%solver)
     case ('output')
       call check_output(g, src, d%output)
     end select
   end subroutine apply_single
+
+  !> The deck `d` of `nbody` bodies (the &body groups of the file, counted before they are
+  !! read: the ids are then 1 to nbody) before its groups are read, and the state `st`.
+  subroutine start_state(path, nbody, d, st)
+    character(len=*), intent(in) :: path   !< the deck file
+    integer, intent(in) :: nbody           !< its number of &body groups
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(out) :: st
+    integer :: b
+    st%path = path
+    allocate (d%body(nbody), d%pair(4), d%traction(4), d%boundary(4), st%trac_at(4), st%pair_at(4))
+    allocate (st%body_line(nbody), st%body_at(nbody), st%disp_line(4, nbody), st%disp_given(4, nbody))
+    st%body_line = 0
+    st%disp_line = 0
+    st%disp_given = .false.
+    do b = 1, nbody
+      d%body(b)%id = 0
+      st%body_at(b)%s = ''
+    end do
+    d%nbody = nbody
+    d%npair = 0
+    d%ntraction = 0
+    d%nboundary = 0
+  end subroutine start_state
+
+  !> The ids of the deck's bodies, in words.
+  function ids_text(n) result(s)
+    integer, intent(in) :: n
+    character(len=:), allocatable :: s
+    if (n == 2) then
+      s = 'ids 1 and 2'
+    else
+      s = 'ids 1 to '//i2s(n)
+    end if
+  end function ids_text
+
+  !> A &contact group. The two-body form (body1_group, body2_group, or neither) is the pair
+  !! of bodies 1 and 2, at most once; the pair form (bodies=A,B, groups='GA','GB') adds a
+  !! pair, any number of times. A deck uses one form. An override changes a pair: the
+  !! two-body one, or the one its bodies= names.
+  subroutine add_contact(g, src, d, st)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    type(contact_cfg_t), target :: c
+    type(contact_cfg_t), allocatable :: tmp(:)
+    type(str_t), allocatable :: wtmp(:)
+    type(vars_t) :: v
+    integer :: form, n
+    logical :: named, legacy
+
+    named = find_asg(g, 'bodies') > 0 .or. find_asg(g, 'groups') > 0
+    legacy = find_asg(g, 'body1_group') > 0 .or. find_asg(g, 'body2_group') > 0
+    if (named .and. legacy) call die_at(src, g%line, 'in group &contact: body1_group and '// &
+      'body2_group belong to the two-body form, bodies and groups to the pair form; give one form')
+    form = merge(PAIR_FORM, TWO_BODY_FORM, named)
+    if (.not. src%is_file) then
+      call override_contact(g, src, d, st, form)
+      return
+    end if
+    if (st%contact_form /= 0 .and. st%contact_form /= form) call die_at(src, g%line, 'in group '// &
+      '&contact: this group has '//form_words(form)//', but the &contact at line '//i2s(st%contact_line)// &
+      ' has '//form_words(st%contact_form)//'; a deck uses one form: the two-body form '// &
+      '(&contact body1_group=..., body2_group=... /, bodies 1 and 2) or a &contact bodies=A,B, '// &
+      'groups=''GA'',''GB'' / per pair')
+    if (st%contact_form == 0) st%contact_line = g%line
+    st%contact_form = form
+    if (form == TWO_BODY_FORM) then
+      if (d%npair > 0) call die_at(src, g%line, 'group &contact appears twice in the deck (first '// &
+        'at line '//i2s(st%contact_line)//'); give each of its variables in one group')
+      c%bodies = [1, 2]
+    else
+      c%bodies = 0
+    end if
+    call contact_vars(c, v, ALL_FORMS)
+    call read_group(g, src, v)
+    call check_contact(g, src, c, form, d%nbody)
+    n = d%npair
+    if (n == size(d%pair)) then   ! grow geometrically: many pairs stay linear
+      allocate (tmp(2*n), wtmp(2*n))
+      tmp(1:n) = d%pair(1:n)
+      wtmp(1:n) = st%pair_at(1:n)
+      call move_alloc(tmp, d%pair)
+      call move_alloc(wtmp, st%pair_at)
+    end if
+    n = n + 1
+    d%npair = n
+    d%pair(n) = c
+    d%pairs_named = form == PAIR_FORM
+    st%pair_at(n)%s = '&contact at line '//i2s(g%line)
+  end subroutine add_contact
+
+  !> A &contact on the command line: the pair form changes the pair of the bodies it names
+  !! (in the order it gives them); the two-body form the pair of bodies 1 and 2 of a
+  !! two-body deck.
+  subroutine override_contact(g, src, d, st, form)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(inout) :: st
+    integer, intent(in) :: form
+    type(contact_cfg_t), target :: c, probe
+    type(vars_t) :: v
+    integer :: k, p
+
+    if (form == TWO_BODY_FORM) then
+      if (d%pairs_named) call die_at(src, g%line, 'in group &contact: the deck names its pairs '// &
+        '(&contact bodies=A,B at line '//i2s(st%contact_line)//'); an override of &contact names '// &
+        'the pair it changes, e.g. ''&contact bodies=1,2, gap_radius=0.5 /''')
+      if (d%npair == 0) call die_at(src, g%line, 'in group &contact: the deck has no pair of '// &
+        'bodies 1 and 2 to change')
+      p = 1
+      c = d%pair(1)
+    else
+      probe%bodies = 0
+      call contact_vars(probe, v, ALL_FORMS)
+      call read_group(g, src, v)
+      if (find_asg(g, 'bodies') == 0) call die_at(src, g%line, 'in group &contact: an override '// &
+        'in the pair form names the pair it changes: bodies=A,B')
+      p = 0
+      do k = 1, d%npair
+        if (all(d%pair(k)%bodies == probe%bodies) .or. all(d%pair(k)%bodies == probe%bodies(2:1:-1))) then
+          p = k
+          exit
+        end if
+      end do
+      if (p == 0) call bad_value(g, src, 'bodies', i2s(probe%bodies(1))//', '//i2s(probe%bodies(2)), &
+        'is no pair of the deck; an override changes a pair the deck gives')
+      c = d%pair(p)
+      if (any(c%bodies /= probe%bodies)) then   ! given in the other order: the groups follow
+        c%bodies = probe%bodies
+        c%body_group = c%body_group(2:1:-1)
+      end if
+    end if
+    call contact_vars(c, v, ALL_FORMS)
+    call read_group(g, src, v)
+    call check_contact(g, src, c, merge(PAIR_FORM, TWO_BODY_FORM, d%pairs_named), d%nbody)
+    if (.not. d%pairs_named) c = pair_oriented(c)   ! the two-body form: body 1's group first
+    d%pair(p) = c
+    st%pair_at(p)%s = st%pair_at(p)%s//', changed by '//src%label
+  end subroutine override_contact
+
+  function form_words(form) result(s)
+    integer, intent(in) :: form
+    character(len=:), allocatable :: s
+    if (form == PAIR_FORM) then
+      s = 'the pair form (bodies=A,B, groups=...)'
+    else
+      s = 'the two-body form (body1_group, body2_group, or neither)'
+    end if
+  end function form_words
 
   !> The unit names of a named system are fixed (given ones must agree); 'custom' needs all three.
   subroutine check_units(g, src, u)
@@ -116,14 +268,41 @@ contains
     end select
   end function unit_name
 
-  subroutine check_contact(g, src, c)
+  !> The values of one pair: the gap; in the pair form its bodies (two different ids of the
+  !! deck), its groups (both given) and a slave of the pair.
+  subroutine check_contact(g, src, c, form, nbody)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(contact_cfg_t), intent(inout) :: c
+    integer, intent(in) :: form, nbody
+    integer :: k
+    character(len=:), allocatable :: shown
     if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
       'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
-    if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
-      'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')
+    if (form == TWO_BODY_FORM) then
+      if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
+        'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')
+      return
+    end if
+    shown = i2s(c%bodies(1))//', '//i2s(c%bodies(2))
+    if (find_asg(g, 'bodies') == 0) call die_at(src, g%line, 'in group &contact: '// &
+      'no bodies; a pair names its two bodies and their groups: bodies=A,B, groups=''GA'',''GB''')
+    do k = 1, 2
+      if (c%bodies(k) < 1 .or. c%bodies(k) > nbody) call bad_value(g, src, 'bodies', shown, &
+        'names body '//i2s(c%bodies(k))//', which does not exist: the deck''s '//i2s(nbody)// &
+        ' bodies have '//ids_text(nbody))
+    end do
+    if (c%bodies(1) == c%bodies(2)) call bad_value(g, src, 'bodies', shown, 'pairs body '// &
+      i2s(c%bodies(1))//' with itself; a contact pair is two different bodies')
+    do k = 1, 2
+      if (len_trim(c%body_group(k)) == 0) call bad_value(g, src, 'groups', quote(trim(c%body_group(1)))// &
+        ', '//quote(trim(c%body_group(2))), 'names no group for body '//i2s(c%bodies(k))// &
+        '; give the contact surface of each body, in the order of bodies: groups=''GA'',''GB'' (a '// &
+        'rectangle''s sides are the groups ''left'', ''right'', ''bottom'', ''top'')')
+    end do
+    if (c%slave /= 0 .and. all(c%bodies /= c%slave)) call bad_value(g, src, 'slave', i2s(c%slave), &
+      'is not a body of the pair (bodies='//shown//'): give '//i2s(c%bodies(1))//' or '// &
+      i2s(c%bodies(2))//', or 0 for the finer surface')
   end subroutine check_contact
 
   subroutine check_solver(g, src, s)
@@ -170,13 +349,10 @@ contains
     integer :: id
     type(body_cfg_t) :: fresh
 
-    if (st%nbody == 2) call die_at(src, g%line, 'in group &body: a third &body group; a deck '// &
-      'has exactly two bodies, with ids 1 and 2 (the others are at lines '// &
-      i2s(st%body_line(1))//' and '//i2s(st%body_line(2))//')')
-    call body_id(g, src, 'no id; give id=1 or id=2', id)
+    call body_id(g, src, 'no id; give id=1 to id=N, N the number of &body groups', d%nbody, id)
     if (d%body(id)%id /= 0) call bad_value(g, src, 'id', i2s(id), &
       'is used twice (also by the &body at line '//i2s(st%body_line(id))// &
-      '); the two bodies must have ids 1 and 2')
+      '); the deck''s '//i2s(d%nbody)//' bodies must have '//ids_text(d%nbody)//', each once')
     fresh%id = id
     call apply_body(g, src, fresh, id, d, st)
     st%nbody = st%nbody + 1
@@ -194,23 +370,24 @@ contains
     type(body_cfg_t) :: copy
 
     call body_id(g, src, 'an override of &body must name the body it changes with id=1 or id=2, '// &
-                 'e.g. ''&body id=2, young=1e9 /''', id)
+                 'e.g. ''&body id=2, young=1e9 /''', d%nbody, id)
     copy = d%body(id)
     call apply_body(g, src, copy, id, d, st)
     st%body_at(id)%s = st%body_at(id)%s//', changed by '//src%label
   end subroutine override_body
 
-  !> The id= of a &body: given (else the message `missing`), and 1 or 2.
-  subroutine body_id(g, src, missing, id)
+  !> The id= of a &body: given (else the message `missing`), and 1 to nbody.
+  subroutine body_id(g, src, missing, nbody, id)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     character(len=*), intent(in) :: missing
+    integer, intent(in) :: nbody
     integer, intent(out) :: id
     logical :: found
     call find_int(g, 'id', id, found)
     if (.not. found) call die_at(src, g%line, 'in group &body: '//missing)
-    if (id /= 1 .and. id /= 2) call bad_value(g, src, 'id', i2s(id), &
-      'is not a body id: the two bodies have ids 1 and 2')
+    if (id < 1 .or. id > nbody) call bad_value(g, src, 'id', i2s(id), 'is not a body id: the '// &
+      'deck''s '//i2s(nbody)//' bodies have '//ids_text(nbody)//' (each once, without gaps)')
   end subroutine body_id
 
   !> Read a &body group into a copy of `b0` (its current values) and store it as body `id`
@@ -264,7 +441,7 @@ contains
 
     call traction_vars(t, v, ALL_FORMS)
     call read_group(g, src, v)
-    call traction_form(g, src, t)
+    call traction_form(g, src, t, d%nbody)
     n = d%ntraction
     if (n == size(d%traction)) then   ! grow geometrically: many tractions stay linear
       allocate (tmp(max(4, 2*n)), wtmp(max(4, 2*n)))
@@ -288,24 +465,25 @@ contains
   end subroutine add_traction
 
   !> A traction is on a side (side=, t0, t1) or on a group (group=, t0, tx, ty, pressure).
-  subroutine traction_form(g, src, t)
+  subroutine traction_form(g, src, t, nbody)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(load_in_t), intent(inout) :: t
+    integer, intent(in) :: nbody
     integer :: k
     if (len_trim(t%group) > 0) then
       if (find_asg(g, 'side') > 0) call die_at(src, g%line, 'in group &traction: give side= '// &
         '(a rectangle''s side) or group= (a named edge group), not both')
       if (find_asg(g, 't1') > 0) call die_at(src, g%line, 'in group &traction: t1 belongs to a '// &
         'side traction; on a group the traction is t0 + tx*x + ty*y - pressure*n')
-      call body_given(g, src, t%body)
+      call body_given(g, src, t%body, nbody)
     else
       do k = 1, 3
         if (find_asg(g, trim(word('tx ty pressure', k))) > 0) call die_at(src, g%line, &
           'in group &traction: '//trim(word('tx ty pressure', k))//' belongs to a group traction '// &
           '(group=''NAME''); on a side the traction is t0 + t1*s')
       end do
-      call body_and_side(g, src, t)
+      call body_and_side(g, src, t, nbody)
     end if
   end subroutine traction_form
 
@@ -322,7 +500,7 @@ contains
 
     call boundary_vars(t, v, ALL_FORMS)
     call read_group(g, src, v)
-    call body_given(g, src, t%body)
+    call body_given(g, src, t%body, d%nbody)
     if (len_trim(t%group) == 0) call die_at(src, g%line, 'in group &boundary: no group; give '// &
       'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
       '''bottom'', ''top'')')
@@ -344,19 +522,19 @@ contains
     d%boundary(n)%origin = '&boundary at '//origin
   end subroutine add_boundary
 
-  !> The body= of a &traction, &displacement or &boundary: given, and 1 or 2.
-  subroutine body_given(g, src, body)
+  !> The body= of a &traction, &displacement or &boundary: given, and 1 to nbody.
+  subroutine body_given(g, src, body, nbody)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
-    integer, intent(in) :: body
+    integer, intent(in) :: body, nbody
     integer :: k
     logical :: missing
     k = find_asg(g, 'body')
     missing = k == 0
     if (.not. missing) missing = len_trim(g%a(k)%value) == 0
     if (missing) call die_at(src, g%line, 'in group &'//g%name//': no body; give body=1 or body=2')
-    if (body /= 1 .and. body /= 2) call bad_value(g, src, 'body', i2s(body), &
-      'does not exist: the bodies have ids 1 and 2')
+    if (body < 1 .or. body > nbody) call bad_value(g, src, 'body', i2s(body), &
+      'does not exist: the bodies have '//ids_text(nbody))
   end subroutine body_given
 
   !> A body read from a mesh file: the rectangle's variables have no meaning; the path is
@@ -417,7 +595,7 @@ contains
 
     call displacement_vars(t, v)
     call read_group(g, src, v)
-    call body_and_side(g, src, t)
+    call body_and_side(g, src, t, d%nbody)
     if (len_trim(d%body(t%body)%mesh) > 0) call die_at(src, g%line, 'in group &displacement: body '// &
       i2s(t%body)//' comes from a mesh file and has no sides; prescribe its displacement with '// &
       '&boundary body='//i2s(t%body)//', group=''NAME'', ux=..., uy=... /')
@@ -443,11 +621,12 @@ contains
   end subroutine apply_displacement
 
   !> Check the body= and side= of a &traction or &displacement.
-  subroutine body_and_side(g, src, t)
+  subroutine body_and_side(g, src, t, nbody)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(load_in_t), intent(in) :: t
-    call body_given(g, src, t%body)
+    integer, intent(in) :: nbody
+    call body_given(g, src, t%body, nbody)
     if (t%side == 0) call die_at(src, g%line, 'in group &'//g%name//': no side; give '// &
       'side='//quoted_list(SIDE_CHOICES, ''))
   end subroutine body_and_side
@@ -456,6 +635,9 @@ contains
   ! Cross-field checks
   ! ============================================================================================
 
+  !> The checks across groups, once the deck and its overrides are read: every body in a
+  !! pair, a group of a body in one pair at most; then the two-body form's contact sides or
+  !! groups, or the pair form's groups; prescribed displacements and loads.
   subroutine check_cross(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
@@ -464,7 +646,14 @@ contains
     logical :: groups
 
     p = st%path//': '
-    groups = len_trim(d%contact%body_group(1)) > 0 .or. len_trim(d%contact%body_group(2)) > 0
+    if (d%npair == 0) call fatal(EXIT_INPUT, p//'the deck has '//i2s(d%nbody)//' bodies and no '// &
+      '&contact; name each contact pair with &contact bodies=A,B, groups=''GA'',''GB'' /')
+    call check_pairs(d, st)
+    if (d%pairs_named) then
+      call check_named(d, st)
+      return
+    end if
+    groups = len_trim(d%pair(1)%body_group(1)) > 0 .or. len_trim(d%pair(1)%body_group(2)) > 0
     if (groups) then
       call check_groups(d, st)
       return
@@ -539,7 +728,7 @@ contains
     character(len=:), allocatable :: p
     p = st%path//': '
     do b = 1, 2
-      if (len_trim(d%contact%body_group(b)) == 0) call fatal(EXIT_INPUT, p//'&contact names '// &
+      if (len_trim(d%pair(1)%body_group(b)) == 0) call fatal(EXIT_INPUT, p//'&contact names '// &
         'the contact group of one body only; give both, body1_group=''NAME1'', body2_group=''NAME2''')
       if (any(d%body(b)%bc == BC_CONTACT)) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
         st%body_at(b)%s//') declares a ''contact'' side, but &contact names the contact groups; '// &
@@ -549,6 +738,117 @@ contains
     end do
     call check_loads(d, st)
   end subroutine check_groups
+
+  !> Every body is in a pair, and no group of a body is in two pairs: the pairs' ends
+  !! bucketed by body, each bucket sorted by group name (linear in the pairs but for the
+  !! sort of a body's own ends).
+  subroutine check_pairs(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer, allocatable :: first(:), ends(:), fill(:), ebody(:)
+    character(len=128), allocatable :: gname(:)
+    integer :: k, j, e, b, n, i1, i2
+    n = 2*d%npair
+    allocate (first(d%nbody + 1), fill(d%nbody), ends(n), ebody(n), gname(n))
+    first = 0
+    do k = 1, d%npair
+      do j = 1, 2
+        e = 2*(k - 1) + j
+        ebody(e) = d%pair(k)%bodies(j)
+        gname(e) = d%pair(k)%body_group(j)
+        first(ebody(e) + 1) = first(ebody(e) + 1) + 1
+      end do
+    end do
+    do b = 1, d%nbody
+      if (first(b + 1) == 0) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('// &
+        st%body_at(b)%s//') is in no contact pair; every body touches another: add &contact '// &
+        'bodies='//i2s(b)//',B, groups=''GA'',''GB'' / for it')
+    end do
+    first(1) = 1
+    do b = 1, d%nbody
+      first(b + 1) = first(b + 1) + first(b)
+    end do
+    fill = first(1:d%nbody)
+    do e = 1, n
+      ends(fill(ebody(e))) = e
+      fill(ebody(e)) = fill(ebody(e)) + 1
+    end do
+    do b = 1, d%nbody
+      if (first(b + 1) - first(b) < 2) cycle
+      call sort_names(ends(first(b):first(b + 1) - 1), gname)
+      do j = first(b), first(b + 1) - 2
+        i1 = ends(j)
+        i2 = ends(j + 1)
+        if (gname(i1) /= gname(i2) .or. len_trim(gname(i1)) == 0) cycle
+        call fatal(EXIT_INPUT, st%path//': the '//st%pair_at((min(i1, i2) + 1)/2)%s//' and the '// &
+          st%pair_at((max(i1, i2) + 1)/2)%s//' both name group '''//trim(gname(i1))//''' of body '// &
+          i2s(b)//'; a group of a body is in one contact pair at most')
+      end do
+    end do
+  end subroutine check_pairs
+
+  !> Sort the indices `idx` by `key(idx(i))`, ascending (bottom-up merge sort).
+  subroutine sort_names(idx, key)
+    integer, intent(inout) :: idx(:)          !< indices into key, sorted on return
+    character(len=*), intent(in) :: key(:)    !< the names
+    integer, allocatable :: tmp(:)
+    integer :: n, w, lo, mid, hi, i, j, k
+    n = size(idx)
+    allocate (tmp(n))
+    w = 1
+    do while (w < n)
+      lo = 1
+      do while (lo <= n)
+        mid = min(lo + w - 1, n)
+        hi = min(lo + 2*w - 1, n)
+        i = lo
+        j = mid + 1
+        do k = lo, hi
+          if (j > hi) then
+            tmp(k) = idx(i)
+            i = i + 1
+          else if (i > mid) then
+            tmp(k) = idx(j)
+            j = j + 1
+          else if (key(idx(j)) < key(idx(i))) then
+            tmp(k) = idx(j)
+            j = j + 1
+          else
+            tmp(k) = idx(i)
+            i = i + 1
+          end if
+        end do
+        lo = lo + 2*w
+      end do
+      idx = tmp
+      w = 2*w
+    end do
+  end subroutine sort_names
+
+  !> The pair form: a rectangle's groups are its sides, none of them declared 'contact'
+  !! (the pairs name them); sides with 'displacement' given; loads.
+  subroutine check_named(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: k, j, b
+    do k = 1, d%npair
+      do j = 1, 2
+        b = d%pair(k)%bodies(j)
+        if (len_trim(d%body(b)%mesh) > 0) cycle
+        if (.not. any(side_names == d%pair(k)%body_group(j))) call fatal(EXIT_INPUT, st%path// &
+          ': the '//st%pair_at(k)%s//' names group '''//trim(d%pair(k)%body_group(j))//''' of body '// &
+          i2s(b)//', a rectangle, whose groups are its sides ''left'', ''right'', ''bottom'', ''top''')
+      end do
+    end do
+    do b = 1, d%nbody
+      if (any(d%body(b)%bc == BC_CONTACT)) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('// &
+        st%body_at(b)%s//') declares a ''contact'' side, but the deck names its pairs with &contact '// &
+        'bodies=A,B, groups=...; a pair names a rectangle''s contact side as its group (''left'', '// &
+        '''right'', ''bottom'', ''top''), declared ''free''')
+      call check_disp_given(d, st, b, len_trim(d%body(b)%mesh) == 0)
+    end do
+    call check_loads(d, st)
+  end subroutine check_named
 
   !> Every side of body b declared 'displacement' has its &displacement (with `hint`, the
   !! message shows the group to add).

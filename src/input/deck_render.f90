@@ -4,8 +4,9 @@
 module deck_render
   use strings, only: text_buffer_t
   use namelist_vars, only: str_t, vars_t, render_group, reference_table
-  use config, only: deck_t, BC_DISPLACEMENT
+  use config, only: deck_t, body_cfg_t, contact_cfg_t, BC_DISPLACEMENT
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, &
+                         TWO_BODY_FORM, PAIR_FORM, &
                          scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, &
                          contact_vars, solver_vars, output_vars
   implicit none (type, external)
@@ -24,7 +25,7 @@ module deck_render
     '# Input deck reference'//NL//NL// &
     'An input deck is a text file of Fortran namelist groups, `&name var=value, ... /`, read by '// &
     'the program''s own reader with its own checks; `inputs/default.nml` is the paper''s scene, '// &
-    'commented. Every group but the two `&body` is optional, and a variable left out keeps the '// &
+    'commented. Every group but `&body` is optional, and a variable left out keeps the '// &
     'default shown here (this program''s own). A variable given twice in one group is bad input. '// &
     'Strings are quoted; a choice is one of the quoted strings listed, in any case; a pair takes '// &
     'two values, the x and y components (`t0 = 0.0, -1.0e6`). Comments start with `!`. The deck '// &
@@ -41,7 +42,8 @@ module deck_render
     'The scene: a title, plane strain or stress, and the names of the units. Optional, at '// &
     'most once.'
   character(len=*), parameter :: REF_BODY = &
-    'One elastic body. Required: exactly two, `id=1` and `id=2`. Either a built-in **rectangle** '// &
+    'One elastic body. Required: at least two, with the ids 1 to N (N the number of `&body` '// &
+    'groups), each once; this version''s solver takes two. Either a built-in **rectangle** '// &
     '[x0, x0+width] x [y0, y0+height] meshed by nx x ny cells, whose sides get their conditions '// &
     'here (`left`, `right`, `bottom`, `top`) and are its groups `''left''`, `''right''`, '// &
     '`''bottom''`, `''top''`; or the cells of a **mesh file** (`mesh`, `region`), whose '// &
@@ -67,10 +69,16 @@ module deck_render
     'least one) are prescribed on every node of the group, a component not given stays free: '// &
     '`ux` alone is a roller on a vertical wall, both clamp or prescribe.'
   character(len=*), parameter :: REF_CONTACT = &
-    'The contact interface. Optional, at most once; needed for a body from a mesh file. The two '// &
-    'contact surfaces are the groups `body1_group` and `body2_group` (a rectangle''s sides are '// &
-    'the groups `''left''`, `''right''`, `''bottom''`, `''top''`), or without groups the two '// &
-    'sides declared `''contact''`; either way they are paired by dual mortar: matching or not, '// &
+    'A contact pair: two bodies and the contact surface of each. Two forms, one per deck. The '// &
+    '**pair form**, one group per pair, any number: `&contact bodies=A,B, groups=''GA'',''GB'' /` '// &
+    'names the two bodies and their groups, in that order; a body may be in several pairs, each '// &
+    'on its own group, and every body is in one at least. The **two-body form**, at most once, '// &
+    'is the pair of bodies 1 and 2: their groups are `body1_group` and `body2_group`, or without '// &
+    'groups the two sides declared `''contact''` (then `&contact` is optional; it is needed for a '// &
+    'body from a mesh file). A rectangle''s sides are the groups `''left''`, `''right''`, '// &
+    '`''bottom''`, `''top''`. An override changes a pair: the two-body one, or the one its '// &
+    '`bodies` names. This version''s solver takes two bodies in one pair (a deck beyond that is '// &
+    'refused after its checks). The two surfaces of a pair are paired by dual mortar: matching or not, '// &
     'overlapping in whole or in part, flat or curved, an open chain of edges or a closed curve '// &
     '(a rim, a bore). Pairing and normals are computed once, on the initial configuration '// &
     '(small deformation).'
@@ -100,7 +108,7 @@ contains
     sc%plane = merge(1, 2, c%plane_strain)
     call scene_vars(c, sc, v)
     call tb%add(render_group('scene', v, WIDTH))
-    do b = 1, 2
+    do b = 1, c%nbody
       call body_vars(c%body(b), v, merge(GROUP_FORM, SIDE_FORM, len_trim(c%body(b)%mesh) > 0))
       call tb%add(render_group('body', v, WIDTH))
     end do
@@ -128,7 +136,7 @@ contains
       end if
       call tb%add(render_group('boundary', v, WIDTH))
     end do
-    do b = 1, 2
+    do b = 1, c%nbody
       do s = 1, 4
         if (c%body(b)%bc(s) /= BC_DISPLACEMENT) cycle
         t%body = b
@@ -138,8 +146,10 @@ contains
         call tb%add(render_group('displacement', v, WIDTH))
       end do
     end do
-    call contact_vars(c%contact, v)
-    call tb%add(render_group('contact', v, WIDTH))
+    do i = 1, c%npair
+      call contact_vars(c%pair(i), v, merge(PAIR_FORM, TWO_BODY_FORM, c%pairs_named))
+      call tb%add(render_group('contact', v, WIDTH))
+    end do
     call solver_vars(c%solver, v)
     call tb%add(render_group('solver', v, WIDTH))
     call output_vars(c%output, v)
@@ -181,14 +191,15 @@ contains
     type(load_in_t), target :: t
     type(vars_t) :: v, forms(2)
     type(text_buffer_t) :: tb
+    type(body_cfg_t), target :: b
 
     call tb%add(REF_INTRO)
     sc%plane = merge(1, 2, c%plane_strain)
     call scene_vars(c, sc, v)
     call section('scene', REF_SCENE, reference_table(v))
-    call body_vars(c%body(1), v, ALL_FORMS)
-    call body_vars(c%body(1), forms(1), SIDE_FORM)
-    call body_vars(c%body(1), forms(2), GROUP_FORM)
+    call body_vars(b, v, ALL_FORMS)
+    call body_vars(b, forms(1), SIDE_FORM)
+    call body_vars(b, forms(2), GROUP_FORM)
     call section('body', REF_BODY, reference_table(v, forms, [str_t('rectangle'), str_t('mesh file')]))
     call traction_vars(t, v, ALL_FORMS)
     call traction_vars(t, forms(1), SIDE_FORM)
@@ -198,8 +209,13 @@ contains
     call section('displacement', REF_DISPLACEMENT, reference_table(v))
     call boundary_vars(t, v, ALL_FORMS)
     call section('boundary', REF_BOUNDARY, reference_table(v))
-    call contact_vars(c%contact, v)
-    call section('contact', REF_CONTACT, reference_table(v))
+    block
+      type(contact_cfg_t), target :: cc
+      call contact_vars(cc, v, ALL_FORMS)
+      call contact_vars(cc, forms(1), PAIR_FORM)
+      call contact_vars(cc, forms(2), TWO_BODY_FORM)
+      call section('contact', REF_CONTACT, reference_table(v, forms, [str_t('pair form'), str_t('two-body form')]))
+    end block
     call solver_vars(c%solver, v)
     call section('solver', REF_SOLVER, reference_table(v))
     call output_vars(c%output, v)

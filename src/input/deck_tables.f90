@@ -15,7 +15,7 @@ module deck_tables
   private
 
   public :: scene_in_t, load_in_t
-  public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY
+  public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, TWO_BODY_FORM, PAIR_FORM
   public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
             solver_vars, output_vars
 
@@ -43,6 +43,8 @@ module deck_tables
 
   ! which variables a table holds: all (reading), or those of one form (rendering)
   integer, parameter :: ALL_FORMS = 0, SIDE_FORM = 1, GROUP_FORM = 2, UX_ONLY = 3, UY_ONLY = 4, UXY = 5
+  ! the two forms of &contact: bodies 1 and 2 (body1_group, body2_group), or a named pair
+  integer, parameter :: TWO_BODY_FORM = 6, PAIR_FORM = 7
 
 contains
 
@@ -70,8 +72,9 @@ contains
     type(body_cfg_t), target, intent(inout) :: b
     type(vars_t), intent(out) :: v
     integer, intent(in) :: form
-    call v%int('id', b%id, range='1 or 2', required=.true., doc='which body; each id once in '// &
-      'the deck. An override of `&body` changes the body it names: `''&body id=2, young=1e9 /''`')
+    call v%int('id', b%id, range='1 to N', required=.true., doc='which body; the N bodies of '// &
+      'the deck have the ids 1 to N, each once. An override of `&body` changes the body it '// &
+      'names: `''&body id=2, young=1e9 /''`')
     if (form /= SIDE_FORM) then
       call v%str('mesh', b%mesh, doc='a Gmsh mesh file, MSH 4.1 ASCII, holding the body''s '// &
         'cells (3-node triangles and 4-node quadrilaterals, mixed allowed); a path relative to '// &
@@ -98,8 +101,9 @@ contains
     if (form /= GROUP_FORM) then
       call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE, doc='condition on the side '// &
         'x = x0: `''free''` (traction-free unless a `&traction` loads it), `''clamped''` (u = 0), '// &
-        '`''roller''` (normal displacement 0), `''contact''` (exactly one side per body, paired '// &
-        'with the other body''s contact side by dual mortar), `''displacement''` (given by '// &
+        '`''roller''` (normal displacement 0), `''contact''` (two-body form of `&contact`: '// &
+        'exactly one side per body, paired with the other body''s contact side by dual mortar), '// &
+        '`''displacement''` (given by '// &
         'a `&displacement`)')
       call v%enum('right', b%bc(SIDE_RIGHT), BC_CHOICES, base=BC_FREE, doc='condition on the '// &
         'side x = x0 + width, as `left`')
@@ -115,7 +119,7 @@ contains
     type(load_in_t), target, intent(inout) :: t
     type(vars_t), intent(out) :: v
     integer, intent(in) :: form
-    call v%int('body', t%body, range='1 or 2', required=.true., doc='the body loaded')
+    call v%int('body', t%body, range='1 to N', required=.true., doc='the body loaded')
     if (form /= GROUP_FORM) call v%enum('side', t%side, SIDE_CHOICES, doc='the side of the '// &
       'rectangle loaded (not its contact side)')
     if (form /= SIDE_FORM) call v%str('group', t%group, doc='the edge group loaded: a physical '// &
@@ -138,7 +142,7 @@ contains
     type(load_in_t), target, intent(inout) :: t
     type(vars_t), intent(out) :: v
     integer, intent(in) :: form
-    call v%int('body', t%body, range='1 or 2', required=.true., doc='the body')
+    call v%int('body', t%body, range='1 to N', required=.true., doc='the body')
     call v%str('group', t%group, required=.true., doc='the group: a physical curve or point of '// &
       'the body''s mesh, or a rectangle''s side (`''left''`, `''right''`, `''bottom''`, `''top''`)')
     if (form /= UY_ONLY) call v%real('ux', t%ux, unit='[length]', doc='the x displacement of '// &
@@ -150,21 +154,33 @@ contains
   subroutine displacement_vars(t, v)
     type(load_in_t), target, intent(inout) :: t
     type(vars_t), intent(out) :: v
-    call v%int('body', t%body, range='1 or 2', required=.true., doc='the body')
+    call v%int('body', t%body, range='1 to N', required=.true., doc='the body')
     call v%enum('side', t%side, SIDE_CHOICES, required=.true., doc='the side, declared '// &
       '`''displacement''` in the body''s `&body`')
     call v%pair('u', t%u, unit='[length]', doc='the displacement vector of every node of the side')
   end subroutine displacement_vars
 
-  subroutine contact_vars(c, v)
+  !> &contact: `form` ALL_FORMS reads every variable; TWO_BODY_FORM renders the pair of
+  !! bodies 1 and 2 (body1_group, body2_group), PAIR_FORM a pair named by its bodies.
+  subroutine contact_vars(c, v, form)
     type(contact_cfg_t), target, intent(inout) :: c
     type(vars_t), intent(out) :: v
-    call v%str('body1_group', c%body_group(1), doc='body 1''s contact surface as an edge group '// &
-      '(give both groups or neither); `''''`: the side its `&body` declares `''contact''`')
-    call v%str('body2_group', c%body_group(2), doc='body 2''s contact surface, as `body1_group`')
-    call v%int('slave', c%slave, range='0, 1 or 2', doc='the body whose contact nodes carry the '// &
-      'multipliers (mortar); 0: the one whose contact group has the shorter mean edge (the '// &
-      'finer), body 1 on a tie')
+    integer, intent(in) :: form
+    if (form /= TWO_BODY_FORM) then
+      call v%ints('bodies', c%bodies, range='two different ids, 1 to N', required=.true., &
+        doc='the two bodies of the pair, `bodies=A,B`')
+      call v%strs('groups', c%body_group, required=.true., doc='the contact surface of each, '// &
+        'in the order of `bodies`: an edge group of its mesh, or a rectangle''s side (`''left''`, '// &
+        '`''right''`, `''bottom''`, `''top''`); a group of a body is in at most one pair')
+    end if
+    if (form /= PAIR_FORM) then
+      call v%str('body1_group', c%body_group(1), doc='body 1''s contact surface as an edge group '// &
+        '(give both groups or neither); `''''`: the side its `&body` declares `''contact''`')
+      call v%str('body2_group', c%body_group(2), doc='body 2''s contact surface, as `body1_group`')
+    end if
+    call v%int('slave', c%slave, range='0 or a body of the pair', doc='the body whose contact '// &
+      'nodes carry the multipliers (mortar); 0: the one whose contact group has the shorter mean '// &
+      'edge (the finer), the one with the smaller id on a tie')
     call v%real('gap_radius', c%gap_radius, unit='[length]', range='>= 0', doc='0: no initial '// &
       'gap; R > 0: an initial normal gap g0(s) = (s - gap_center)^2/(2R) on top of the '// &
       'geometry''s (with groups: s is the slave node''s x)')

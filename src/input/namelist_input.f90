@@ -412,9 +412,12 @@ contains
           if (nitem > merge(1, v%nval, a%sub > 0)) then
             if (v%nval == 1 .or. a%sub > 0) then
               call die_at(src, a%line, head//': too many values ('//a%name//' takes one value)')
-            else
+            else if (v%typ == T_REAL) then
               call die_at(src, a%line, head//': too many values ('//a%name//' takes '// &
                 i2s(v%nval)//': the x and y components)')
+            else
+              call die_at(src, a%line, head//': too many values ('//a%name//' takes '// &
+                i2s(v%nval)//')')
             end if
           end if
           pos = max(a%sub, 1)
@@ -432,7 +435,11 @@ contains
                 ': expected an integer, e.g. '//a%name//'=24, found '//tok)
               read (tok, *, iostat=ios) m
               if (ios /= 0) call die_at(src, a%line, head//': the integer '//tok//' is out of range')
-              v%ip = m
+              if (v%nval == 1) then
+                v%ip = m
+              else
+                v%iv(pos:pos + rep - 1) = m
+              end if
             case (T_REAL)
               call fp_read_begin(fps)
               read (tok, *, iostat=ios) x
@@ -455,7 +462,13 @@ contains
               if (.not. is_quoted(tok)) call die_at(src, a%line, head// &
                 ': expected a quoted character string, e.g. '//a%name//'=''...'', found '//tok)
               txt = unquote(tok)
-              if (v%typ == T_STR) then
+              if (v%typ == T_STR .and. v%nval > 1) then
+                if (len_trim(txt) > len(v%sv(pos)%p)) call die_at(src, a%line, head//': '''//txt// &
+                  ''' is too long (at most '//i2s(len(v%sv(pos)%p))//' characters)')
+                do m = pos, pos + rep - 1
+                  v%sv(m)%p = txt
+                end do
+              else if (v%typ == T_STR) then
                 if (len_trim(txt) > len(v%sp)) call die_at(src, a%line, head//': is too long (at most '// &
                   i2s(len(v%sp))//' characters)')
                 v%sp = txt

@@ -19,15 +19,22 @@ module namelist_vars
     character(len=:), allocatable :: s
   end type str_t
 
+  !> A pointer to one string (an element of a string pair's storage).
+  type :: strp_t
+    character(len=:), pointer :: p => null()
+  end type strp_t
+
   !> One variable of a group, bound to the place its value lives.
   type, public :: var_t
     character(len=:), allocatable :: name
     integer :: typ = 0                          ! T_*
-    integer :: nval = 1                         ! values it takes (1, or 2 for x/y pairs)
+    integer :: nval = 1                         ! values it takes (1, or 2 for pairs)
     integer, pointer :: ip => null()            ! T_INT, T_ENUM (the code)
+    integer, pointer :: iv(:) => null()         ! T_INT, nval values
     real(wp), pointer :: rs => null()           ! T_REAL, one value
     real(wp), pointer :: rv(:) => null()        ! T_REAL, nval values
-    character(len=:), pointer :: sp => null()   ! T_STR
+    character(len=:), pointer :: sp => null()   ! T_STR, one value
+    type(strp_t), allocatable :: sv(:)          ! T_STR, nval values
     character(len=:), allocatable :: choices    ! T_ENUM: allowed spellings, in code order
     integer :: base = 1                         ! T_ENUM: code of the first choice
     character(len=:), allocatable :: doc        ! description (Markdown), for the reference
@@ -44,7 +51,9 @@ module namelist_vars
     procedure :: int => add_int       !< an integer
     procedure :: real => add_real     !< a real
     procedure :: pair => add_pair     !< two reals (x and y components)
+    procedure :: ints => add_ints     !< two integers
     procedure :: str => add_str       !< a quoted string
+    procedure :: strs => add_strs     !< two quoted strings
     procedure :: enum => add_enum     !< a quoted string from a list, stored as its code
     procedure :: has => has_var       !< whether the table holds a variable of that name
   end type vars_t
@@ -128,6 +137,35 @@ contains
     call describe(self%v(self%n), doc=doc, unit=unit)
   end subroutine add_pair
 
+  subroutine add_ints(self, name, x, doc, range, required)
+    class(vars_t), intent(inout) :: self
+    character(len=*), intent(in) :: name      !< variable name (lower case)
+    integer, target, intent(inout) :: x(2)    !< its storage
+    character(len=*), intent(in), optional :: doc       !< description
+    character(len=*), intent(in), optional :: range     !< accepted values
+    logical, intent(in), optional :: required           !< no default: the group needs it
+    call push(self, name, T_INT)
+    self%v(self%n)%nval = 2
+    self%v(self%n)%iv => x
+    call describe(self%v(self%n), doc=doc, range=range, required=required)
+  end subroutine add_ints
+
+  subroutine add_strs(self, name, x, doc, required)
+    class(vars_t), intent(inout) :: self
+    character(len=*), intent(in) :: name                 !< variable name (lower case)
+    character(len=*), target, intent(inout) :: x(2)      !< its storage (its length is the limit)
+    character(len=*), intent(in), optional :: doc        !< description
+    logical, intent(in), optional :: required            !< no default: the group needs it
+    integer :: k
+    call push(self, name, T_STR)
+    self%v(self%n)%nval = 2
+    allocate (self%v(self%n)%sv(2))
+    do k = 1, 2
+      self%v(self%n)%sv(k)%p => x(k)
+    end do
+    call describe(self%v(self%n), doc=doc, required=required)
+  end subroutine add_strs
+
   subroutine add_str(self, name, x, doc, required)
     class(vars_t), intent(inout) :: self
     character(len=*), intent(in) :: name              !< variable name (lower case)
@@ -199,7 +237,11 @@ contains
       associate (v => vars%v(k))
         select case (v%typ)
         case (T_INT)
-          item = v%name//'='//i2s(v%ip)
+          if (v%nval == 1) then
+            item = v%name//'='//i2s(v%ip)
+          else
+            item = v%name//'='//i2s(v%iv(1))//', '//i2s(v%iv(2))
+          end if
         case (T_REAL)
           if (v%nval == 1) then
             item = v%name//'='//r2s(v%rs)
@@ -207,7 +249,11 @@ contains
             item = v%name//'='//r2s(v%rv(1))//', '//r2s(v%rv(2))
           end if
         case (T_STR)
-          item = v%name//'='//quote(trim(v%sp))
+          if (v%nval == 1) then
+            item = v%name//'='//quote(trim(v%sp))
+          else
+            item = v%name//'='//quote(trim(v%sv(1)%p))//', '//quote(trim(v%sv(2)%p))
+          end if
         case default
           item = v%name//'='//quote(word(v%choices, v%ip - v%base + 1))
         end select
@@ -241,8 +287,13 @@ contains
         allowed = text_of(v%range)
         select case (v%typ)
         case (T_INT)
-          typ = 'integer'
-          def = '`'//i2s(v%ip)//'`'
+          if (v%nval == 1) then
+            typ = 'integer'
+            def = '`'//i2s(v%ip)//'`'
+          else
+            typ = 'integer pair'
+            def = '`'//i2s(v%iv(1))//', '//i2s(v%iv(2))//'`'
+          end if
         case (T_REAL)
           if (v%nval == 1) then
             typ = 'real'
@@ -252,8 +303,13 @@ contains
             def = '`'//r2s(v%rv(1))//', '//r2s(v%rv(2))//'`'
           end if
         case (T_STR)
-          typ = 'string (at most '//i2s(len(v%sp))//' characters)'
-          def = '`'//quote(trim(v%sp))//'`'
+          if (v%nval == 1) then
+            typ = 'string (at most '//i2s(len(v%sp))//' characters)'
+            def = '`'//quote(trim(v%sp))//'`'
+          else
+            typ = 'string pair (at most '//i2s(len(v%sv(1)%p))//' characters each)'
+            def = '`'//quote(trim(v%sv(1)%p))//', '//quote(trim(v%sv(2)%p))//'`'
+          end if
         case default
           typ = 'choice'
           j = v%ip - v%base + 1

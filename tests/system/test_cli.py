@@ -122,13 +122,14 @@ check(list(ref_tables) == GROUPS, "one section per group, in deck order", ", ".j
 
 # ---- every variable the reader declares is in the reference (and nothing else) ----------
 deck_src = source("src/input/deck_tables.f90")
-kinds = {"int": "integer", "real": "real", "pair": "real pair (x, y)", "str": "string", "enum": "choice"}
+kinds = {"int": "integer", "real": "real", "pair": "real pair (x, y)", "str": "string", "enum": "choice",
+         "ints": "integer pair", "strs": "string pair"}
 declared = {}
 for g in GROUPS:
     body = re.search(rf"subroutine {g}_vars\(.*?end subroutine {g}_vars", deck_src, re.S)
     check(body is not None, f"src/input/deck_tables.f90 has {g}_vars")
     if body:
-        declared[g] = dict((n, k) for k, n in re.findall(r"call v%(int|real|pair|str|enum)\('(\w+)'", body.group(0)))
+        declared[g] = dict((n, k) for k, n in re.findall(r"call v%(ints|int|real|pair|strs|str|enum)\('(\w+)'", body.group(0)))
 nvar = 0
 for g, names in declared.items():
     got = ref_tables.get(g, {})
@@ -244,6 +245,10 @@ for group, rows in ref_tables.items():
             (good if m.group(2) == "<=" else bad).append(a)
             (good if m.group(3) == "<=" else bad).append(b)
             bad.append(b + max(1.0, abs(b)))
+        elif rule == "1 to N":   # a body id; DECK has two bodies
+            bad += [0, 3]
+        elif rule == "0 or a body of the pair":   # DECK's pair is bodies 1 and 2
+            bad += [-1, 3]
         elif m := re.fullmatch(r"(-?\d+)(?:, (-?\d+))* or (-?\d+)", rule):
             vals = [int(v) for v in re.findall(r"-?\d+", rule)]
             bad += [min(vals) - 1, max(vals) + 1]

@@ -93,7 +93,7 @@ contains
       call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%contact, msh, systems, contact_line, err)
+    call build_interface(d%body, d%pair(1), msh, systems, contact_line, err)
     call error_parts(err, info, msg)
     if (info /= 0) error stop 'interface failed'
     do a = 1, 2

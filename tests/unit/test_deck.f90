@@ -1,13 +1,15 @@
 !> Tests of module deck on good input: the default deck's values, the round trip
 !! (print_deck output read back gives identical values), override precedence and
 !! semantics, defaults, a few namelist forms (case, repeat counts, quotes, comments), and
-!! the Markdown reference table of a group (cells, required, forms, escaping).
-!! Bad input is tested by tests/system/test_bad_input.sh (fatal errors end the process).
+!! the Markdown reference table of a group (cells, required, forms, escaping); the contact
+!! pairs in both forms and their bad input. A fatal error ends the process: a bad deck is
+!! read by this program run again as `test_deck --read DECK`, its exit code and message
+!! checked (tests/system/test_bad_input.sh runs the whole program on more).
 program test_deck
   use kinds, only: wp
   use config
   use deck, only: read_deck, print_deck, deck_text
-  use namelist_vars, only: vars_t, str_t, reference_table
+  use namelist_vars, only: vars_t, str_t, reference_table, render_group
   use testing, only: report, test_summary, write_file
   implicit none (type, external)
   type(deck_t) :: d, e
@@ -17,6 +19,17 @@ program test_deck
   character(len=:), allocatable :: t1, t2
   character(len=*), parameter :: NL = achar(10)
   real(wp) :: r
+  character(len=4096) :: arg
+
+  ! `test_deck --read DECK [assembly]`: read one deck and stop (the bad-input cases below)
+  if (command_argument_count() >= 2) then
+    call get_command_argument(1, arg)
+    if (arg == '--read') then
+      call get_command_argument(2, arg)
+      call read_deck(trim(arg), none, d, assembly=command_argument_count() >= 3)
+      stop 0
+    end if
+  end if
 
   call random_number(r)
   write (tmp, '(a,i0)') '/tmp/test_deck_', int(r * 1.0e9_wp)
@@ -90,7 +103,7 @@ program test_deck
              'defaults: output file results/<deck basename>.h5 ('//trim(e%output%file)//')')
   call check(e%body(1)%width == 1.0_wp .and. e%body(1)%poisson == 0.3_wp .and. &
              e%solver%delta == 0.5_wp .and. e%solver%robin_operator == ROBIN_HARMONIC .and. &
-             e%contact%gap_radius == 0.0_wp, 'defaults: config.f90 values (harmonic at delta 0.5)')
+             e%pair(1)%gap_radius == 0.0_wp, 'defaults: config.f90 values (harmonic at delta 0.5)')
   call check(all(e%body(2)%bc == [BC_ROLLER, BC_FREE, BC_ROLLER, BC_CONTACT]), &
              'forms: upper-case names, mixed-case values, double quotes, two groups on a line')
   call check(e%title == 'a!b, it''s "quoted" / here', 'forms: quotes, ! and / inside a string')
@@ -113,6 +126,8 @@ program test_deck
   call round_trip(e, 'awkward reals')
   call delete_file(trim(tmp)//'_reals.nml')
 
+  call test_pairs()
+
   call deck_text(d, t1)
   call deck_text(d, t2)
   call check(t1 == t2 .and. t1 == d%effective, 'deck_text is deterministic and equals d%effective')
@@ -123,6 +138,8 @@ program test_deck
     integer, target :: n, code
     real(wp), target :: x, p(2)
     character(len=8), target :: s
+    integer, target :: ip(2)
+    character(len=6), target :: sp(2)
     character(len=:), allocatable :: tab
     n = 3
     code = 0
@@ -134,6 +151,10 @@ program test_deck
     call v%pair('p', p, unit='[length]', doc='position')
     call v%str('s', s)
     call v%enum('c', code, 'one two')
+    ip = [3, 1]
+    sp = ['top   ', 'rim   ']
+    call v%ints('ip', ip, range='two ids', doc='bodies')
+    call v%strs('sp', sp, doc='groups')
     call forms(1)%int('n', n)
     call forms(1)%real('x', x)
     call forms(2)%int('n', n)
@@ -151,6 +172,12 @@ program test_deck
                'reference table: a string without a description')
     call check(index(tab, NL//'| `c` | choice | none | | `''one''`, `''two''` | |'//NL) > 0, &
                'reference table: a choice without a value')
+    call check(index(tab, NL//'| `ip` | integer pair | `3, 1` | | two ids | bodies |'//NL) > 0, &
+               'reference table: an integer pair')
+    call check(index(tab, NL//'| `sp` | string pair (at most 6 characters each) | `''top'', ''rim''` | | | '// &
+               'groups |'//NL) > 0, 'reference table: a string pair')
+    call check(index(render_group('g', v, 200), 'ip=3, 1, sp=''top'', ''rim'' /') > 0, &
+               'render_group: an integer pair and a string pair')
     code = 2
     tab = reference_table(v)
     call check(index(tab, NL//'| `c` | choice | `''two''` | | `''one''`, `''two''` | |'//NL) > 0 .and. &
@@ -167,6 +194,144 @@ contains
     call report(ok, what)
   end subroutine check
 
+  !> The contact pairs: the two-body form is the pair (1, 2); the pair form in any order of
+  !! ids, with its overrides; each bad deck refused with its message (the solver's two-body
+  !! limit only after the checks).
+  subroutine test_pairs()
+    type(deck_t) :: p
+    type(contact_cfg_t) :: q
+    character(len=200) :: o(2)
+    character(len=100), parameter :: B1 = '&body id=1, y0=2.0, nx=2, ny=2 /', &
+      B2 = '&body id=2, y0=1.0, nx=2, ny=2, left=''roller'' /', &
+      B3 = '&body id=3, y0=0.0, nx=2, ny=2, bottom=''clamped'' /', &
+      T1 = '&traction body=1, side=''top'', t0=0.0, -1.0e6 /', &
+      P12 = '&contact bodies=1,2, groups=''bottom'',''top'' /', &
+      P23 = '&contact bodies=2,3, groups=''bottom'',''top'' /'
+
+    ! the default deck: no &contact, the pair of bodies 1 and 2 on their 'contact' sides
+    call check(d%nbody == 2 .and. d%npair == 1 .and. .not. d%pairs_named, &
+               'pairs: the default deck has two bodies in one pair, the two-body form')
+    call check(all(d%pair(1)%bodies == [1, 2]) .and. all(d%pair(1)%body_group == ''), &
+               'pairs: without &contact the pair is bodies 1, 2 on their contact sides')
+
+    ! the two-body form with groups
+    call write_file(trim(tmp)//'_two.nml', [character(len=120) :: &
+      '&body id=1, y0=1.0, nx=2, ny=2, left=''clamped'' /', &
+      '&body id=2, y0=0.0, nx=2, ny=2, bottom=''clamped'' /', T1, &
+      '&contact body1_group=''bottom'', body2_group=''top'', slave=2, gap_radius=4.0 /'])
+    call read_deck(trim(tmp)//'_two.nml', none, p)
+    call check(p%npair == 1 .and. all(p%pair(1)%bodies == [1, 2]) .and. &
+               p%pair(1)%body_group(1) == 'bottom' .and. p%pair(1)%body_group(2) == 'top' .and. &
+               p%pair(1)%slave == 2 .and. p%pair(1)%gap_radius == 4.0_wp .and. .not. p%pairs_named, &
+               'pairs: the two-body form is the pair (1, 2) with its groups')
+    call check(index(p%effective, '&contact body1_group=''bottom'', body2_group=''top''') > 0, &
+               'pairs: the two-body form is rendered in the two-body form')
+    call round_trip(p, 'two-body form')
+    o(1) = '&contact body2_group=''top'', gap_radius=1.0 /'
+    call read_deck(trim(tmp)//'_two.nml', o(1:1), p)
+    call check(p%pair(1)%gap_radius == 1.0_wp .and. p%pair(1)%slave == 2, &
+               'pairs: an override in the two-body form changes the pair (1, 2)')
+    o(1) = '&contact bodies=2,1, groups=''top'',''rim'', slave=1 /'
+    call read_deck(trim(tmp)//'_two.nml', o(1:1), p)
+    call check(all(p%pair(1)%bodies == [1, 2]) .and. p%pair(1)%body_group(1) == 'rim' .and. &
+               p%pair(1)%body_group(2) == 'top' .and. p%pair(1)%slave == 1 .and. .not. p%pairs_named, &
+               'pairs: an override naming the pair (2, 1) of a two-body deck keeps body 1''s group first')
+    call delete_file(trim(tmp)//'_two.nml')
+
+    ! the pair form, bodies out of order and a pair given as (3, 2)
+    call write_file(trim(tmp)//'_stack.nml', [character(len=120) :: B3, B1, B2, T1, P12, &
+      '&contact bodies=3,2, groups=''top'',''bottom'', slave=2, gap_radius=2.5, gap_center=0.5 /'])
+    call read_deck(trim(tmp)//'_stack.nml', none, p, assembly=.true.)
+    call check(p%nbody == 3 .and. p%npair == 2 .and. p%pairs_named, 'pairs: three bodies, two named pairs')
+    call check(p%body(1)%y0 == 2.0_wp .and. p%body(3)%y0 == 0.0_wp .and. p%body(3)%id == 3 .and. &
+               p%body(3)%bc(SIDE_BOTTOM) == BC_CLAMPED, 'pairs: bodies stored by id, whatever their order')
+    call check(all(p%pair(1)%bodies == [1, 2]) .and. p%pair(1)%body_group(1) == 'bottom' .and. &
+               p%pair(1)%body_group(2) == 'top' .and. p%pair(1)%slave == 0, 'pairs: pair 1 as given')
+    call check(all(p%pair(2)%bodies == [3, 2]) .and. p%pair(2)%body_group(1) == 'top' .and. &
+               p%pair(2)%body_group(2) == 'bottom' .and. p%pair(2)%slave == 2 .and. &
+               p%pair(2)%gap_radius == 2.5_wp .and. p%pair(2)%gap_center == 0.5_wp, &
+               'pairs: pair 2 keeps the order of its bodies, groups, slave and gap')
+    q = pair_oriented(p%pair(2))
+    call check(all(q%bodies == [2, 3]) .and. q%body_group(1) == 'bottom' .and. q%body_group(2) == 'top', &
+               'pairs: pair_oriented swaps bodies and groups')
+    call round_trip(p, 'pair form')
+    o(1) = '&contact bodies=2,3, groups=''bottom'',''top'', slave=3 /'
+    o(2) = '&body id=3, young=1e9 /'
+    call read_deck(trim(tmp)//'_stack.nml', o, p, assembly=.true.)
+    call check(all(p%pair(2)%bodies == [2, 3]) .and. p%pair(2)%body_group(1) == 'bottom' .and. &
+               p%pair(2)%slave == 3 .and. p%pair(2)%gap_radius == 2.5_wp .and. p%body(3)%young == 1.0e9_wp, &
+               'pairs: an override names its pair by its bodies, in either order')
+    o(1) = '&contact bodies=3,2, slave=3 /'
+    call read_deck(trim(tmp)//'_stack.nml', o(1:1), p, assembly=.true.)
+    call check(all(p%pair(2)%bodies == [3, 2]) .and. p%pair(2)%body_group(1) == 'top' .and. &
+               p%pair(2)%slave == 3, 'pairs: an override in the deck''s order keeps the groups')
+    call delete_file(trim(tmp)//'_stack.nml')
+
+    ! bad decks: each refused with its message (exit code 1)
+    call refused('self', [character(len=120) :: B1, B2, B3, P12, &
+      '&contact bodies=2,2, groups=''bottom'',''top'' /', T1], &
+      ':5: in group &contact: bodies = 2,2 pairs body 2 with itself')
+    call refused('unknown', [character(len=120) :: B1, B2, B3, P12, &
+      '&contact bodies=2,4, groups=''bottom'',''top'' /', T1], &
+      ':5: in group &contact: bodies = 2,4 names body 4, which does not exist')
+    call refused('same_group', [character(len=120) :: B1, B2, B3, P12, &
+      '&contact bodies=3,1, groups=''top'',''bottom'' /', T1], &
+      'the &contact at line 4 and the &contact at line 5 both name group ''bottom'' of body 1')
+    call refused('gap', [character(len=120) :: B1, B2, '&body id=4, nx=2, ny=2 /', P12, P23, T1], &
+      ':3: in group &body: id = 4 is not a body id: the deck''s 3 bodies have ids 1 to 3')
+    call refused('duplicate', [character(len=120) :: B1, B2, '&body id=2, nx=2, ny=2 /', P12, P23, T1], &
+      ':3: in group &body: id = 2 is used twice (also by the &body at line 2)')
+    call refused('no_pair', [character(len=120) :: B1, B2, B3, P12, T1], &
+      'body 3 (&body at line 3) is in no contact pair')
+    call refused('none', [character(len=120) :: B1, B2, B3, T1], 'the deck has 3 bodies and no &contact')
+    call refused('slave', [character(len=120) :: B1, B2, B3, P12, &
+      '&contact bodies=2,3, groups=''bottom'',''top'', slave=1 /', T1], &
+      ':5: in group &contact: slave = 1 is not a body of the pair (bodies=2, 3)')
+    call refused('mixed', [character(len=120) :: B1, B2, &
+      '&contact body1_group=''bottom'', body2_group=''top'' /', P12, T1], &
+      ':4: in group &contact: this group has the pair form')
+    call refused('mixed_group', [character(len=120) :: B1, B2, &
+      '&contact bodies=1,2, groups=''bottom'',''top'', body1_group=''bottom'' /', T1], &
+      ':3: in group &contact: body1_group and body2_group belong to the two-body form')
+    call refused('no_groups', [character(len=120) :: B1, B2, '&contact bodies=1,2 /', T1], &
+      'names no group for body 1')
+    call refused('no_bodies', [character(len=120) :: B1, B2, '&contact groups=''bottom'',''top'' /', T1], &
+      ':3: in group &contact: no bodies')
+    call refused('not_a_side', [character(len=120) :: B1, B2, &
+      '&contact bodies=1,2, groups=''bottom'',''rim'' /', T1], &
+      'the &contact at line 3 names group ''rim'' of body 2, a rectangle')
+    call refused('stack', [character(len=120) :: B1, B2, B3, P12, P23, T1], &
+      'this version solves two bodies in one contact pair; the deck has 3 bodies and 2 pairs')
+  end subroutine test_pairs
+
+  !> The deck of `lines` read by `test_deck --read`: exit code 1 and `expect` in its message.
+  subroutine refused(name, lines, expect)
+    character(len=*), intent(in) :: name, lines(:), expect
+    character(len=4096) :: self
+    character(len=:), allocatable :: f, out, msg
+    integer :: rc, u, ios
+    character(len=1000) :: line
+    f = trim(tmp)//'_bad_'//name//'.nml'
+    out = trim(tmp)//'_bad_'//name//'.out'
+    call write_file(f, lines)
+    call get_command_argument(0, self)
+    call execute_command_line(trim(self)//' --read '//f//' > '//out//' 2>&1', exitstat=rc)
+    msg = ''
+    open (newunit=u, file=out, status='old', action='read', iostat=ios)
+    do while (ios == 0)
+      read (u, '(a)', iostat=ios) line
+      if (ios == 0) msg = msg//trim(line)//NL
+    end do
+    close (u, status='delete')
+    if (rc == 1 .and. index(msg, expect) > 0) then
+      call check(.true., 'bad deck '''//name//''': exit 1 and "'//expect//'"')
+    else
+      call check(.false., 'bad deck '''//name//''': exit 1 and "'//expect//'" (exit '// &
+                 achar(48 + min(max(rc, 0), 9))//': '//msg//')')
+    end if
+    call delete_file(f)
+  end subroutine refused
+
   !> print_deck -> file -> read_deck must give identical values and identical text.
   subroutine round_trip(a, what)
     type(deck_t), intent(in) :: a
@@ -178,7 +343,7 @@ contains
     open (newunit=u, file=f, status='replace', action='write')
     call print_deck(a, u)
     close (u)
-    call read_deck(f, none, b)
+    call read_deck(f, none, b, assembly=.true.)
     call compare(a, b, diff)
     call check(len(diff) == 0, 'round trip of the '//what//': identical values'//diff)
     call check(after_first_line(a%effective) == after_first_line(b%effective), &
@@ -199,7 +364,17 @@ contains
     diff = ''
     if (a%title /= b%title) diff = diff//' title'
     if (a%plane_strain .neqv. b%plane_strain) diff = diff//' plane'
-    do k = 1, 2
+    if (a%nbody /= b%nbody .or. a%npair /= b%npair .or. (a%pairs_named .neqv. b%pairs_named)) then
+      diff = diff//' nbody-npair-form'
+      return
+    end if
+    do k = 1, a%npair
+      associate (x => a%pair(k), y => b%pair(k))
+        if (any(x%bodies /= y%bodies) .or. any(x%body_group /= y%body_group) .or. x%slave /= y%slave &
+            .or. x%gap_radius /= y%gap_radius .or. x%gap_center /= y%gap_center) diff = diff//' pair'
+      end associate
+    end do
+    do k = 1, a%nbody
       associate (x => a%body(k), y => b%body(k))
         if (x%id /= y%id .or. x%nx /= y%nx .or. x%ny /= y%ny .or. x%element /= y%element) &
           diff = diff//' body-integers'
@@ -219,7 +394,6 @@ contains
           diff = diff//' traction'
       end do
     end if
-    if (a%contact%gap_radius /= b%contact%gap_radius .or. a%contact%gap_center /= b%contact%gap_center) diff = diff//' contact'
     associate (x => a%solver, y => b%solver)
       if (x%method /= y%method .or. x%robin_operator /= y%robin_operator .or. x%stop /= y%stop .or. &
           x%factor%factorization /= y%factor%factorization .or. x%factor%ordering /= y%factor%ordering .or. &

@@ -5,7 +5,7 @@ program test_errors
   use kinds, only: wp, ip
   use errors, only: error_t, exit_code, fail_on, ERR_NONE, ERR_INPUT, ERR_NUMERICAL, ERR_IO, ERR_MEMORY, &
                     EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL
-  use config, only: body_cfg_t, traction_cfg_t, deck_t, SIDE_LEFT, BC_CLAMPED
+  use config, only: body_cfg_t, traction_cfg_t, deck_t, deck_init, SIDE_LEFT, BC_CLAMPED
   use mesh, only: mesh_t, mesh_build
   use assembly, only: assemble_body, body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_AMD, ORD_NATURAL
@@ -121,6 +121,7 @@ contains
     type(deck_t) :: d
     type(error_t) :: err
     integer :: a
+    call deck_init(d, 2, 1)
     do a = 1, 2
       d%body(a)%nx = 4
       d%body(a)%ny = 4

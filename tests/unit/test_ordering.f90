@@ -13,7 +13,7 @@
 program test_ordering
   use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
-  use config, only: deck_t, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, ORDER_METIS, ORDER_ND, &
+  use config, only: deck_t, deck_init, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, ORDER_METIS, ORDER_ND, &
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT
   use mesh, only: mesh_t, mesh_build, node_id
@@ -306,6 +306,7 @@ contains
     character(len=256) :: msg
     real(wp) :: dflex, db
 
+    call deck_init(d, 2, 1)
     d%body(1) = rectangle_body(30, 12, ELEM_Q1, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE])
     d%body(1)%y0 = 1.0_wp
     d%body(2) = rectangle_body(30, 10, ELEM_P1, [BC_CLAMPED, BC_FREE, BC_FREE, BC_CONTACT])
@@ -322,7 +323,7 @@ contains
       call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%contact, msh, sys, itf, err)
+    call build_interface(d%body, d%pair(1), msh, sys, itf, err)
     call error_parts(err, info, msg)
     call report(info == 0 .and. itf%m > 0, 'two-body scene: interface built '//trim(msg))
     if (info /= 0) return

@@ -1,0 +1,91 @@
+#!/usr/bin/python3
+"""A deck of many bodies and contact pairs, whole program (run by `make check`; the
+`&contact bodies=A,B, groups=...` form of doc/deck-reference.md):
+
+(a) a stack of 1,000 small rectangles and 999 pairs, written by this script, is read and
+    checked, then refused with exit 1 and the one message of this version's limit (two
+    bodies in one pair), nothing written; the time of that run is printed (INFO), never
+    asserted (the machine may be shared);
+(b) the same stack with a fault far down the deck gets its own message before that limit:
+    a group of a body in two pairs (naming both pairs' lines), a body in no pair, a pair
+    naming a body the deck does not have.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.abspath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from rc_checks import Checks  # noqa: E402
+
+check = Checks()
+BIN = os.path.abspath(os.path.join(ROOT, os.environ.get("BIN", "bin/robin_contact")))
+N = 1000
+
+
+def stack(n, pairs=None):
+    """Deck lines of n unit blocks stacked downwards (body 1 on top, body n clamped below),
+    the top one loaded, and the pairs (k, k+1) of block k's bottom on block k+1's top."""
+    lines = [f"&body id={k}, x0=0.0, y0={float(n - k)}, width=1.0, height=1.0, nx=2, ny=2"
+             + (", bottom='clamped'" if k == n else ", left='roller'") + " /" for k in range(1, n + 1)]
+    lines.append("&traction body=1, side='top', t0=0.0, -1.0e6 /")
+    if pairs is None:
+        pairs = [(k, k + 1, "bottom", "top") for k in range(1, n)]
+    lines += [f"&contact bodies={a},{b}, groups='{ga}','{gb}' /" for a, b, ga, gb in pairs]
+    return lines
+
+
+def run_deck(work, name, lines):
+    """Run the program on the deck in an empty folder: exit code, output, seconds, files made."""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    cwd = os.path.join(work, name)
+    os.mkdir(cwd)
+    t0 = time.perf_counter()
+    p = subprocess.run([BIN, deck], cwd=cwd, capture_output=True, timeout=120)
+    dt = time.perf_counter() - t0
+    return p.returncode, (p.stdout + p.stderr).decode(errors="replace"), dt, os.listdir(cwd)
+
+
+work = tempfile.mkdtemp(prefix="rc_many_bodies_")
+try:
+    # (a) the whole stack: read, checked, refused by the solver's limit
+    code, out, dt, made = run_deck(work, "stack", stack(N))
+    want = f"this version solves two bodies in one contact pair; the deck has {N} bodies and {N - 1} pairs"
+    check(code == 1, f"a stack of {N} bodies and {N - 1} pairs exits 1", f"exit {code}")
+    check(want in out, "its message is the two-body limit", out.strip()[-300:])
+    check(out.count("error:") == 1, "one message", str(out.count("error:")))
+    check(not made, "nothing is written", " ".join(made))
+    print(f"INFO  reading and checking {N} bodies and {N - 1} pairs up to the two-body refusal: "
+          f"{dt:.3f} s (whole process)")
+
+    # (b) faults deep in the deck get their own message first
+    pairs = [(k, k + 1, "bottom", "top") for k in range(1, N)]
+    twice = pairs + [(N - 1, 1, "left", "bottom")]
+    code, out, _, made = run_deck(work, "twice", stack(N, twice))
+    first = N + 1 + 1          # line of the first pair: after the bodies and the traction
+    last = first + len(twice) - 1
+    check(code == 1 and f"the &contact at line {first} and the &contact at line {last} both name group "
+          "'bottom' of body 1" in out and "two bodies" not in out,
+          "a group in two pairs is named with both pairs' lines", out.strip()[-300:])
+    check(not made, "nothing is written (group in two pairs)", " ".join(made))
+
+    code, out, _, _ = run_deck(work, "lonely", stack(N, pairs[:-1]))
+    check(code == 1 and f"body {N} (&body at line {N}) is in no contact pair" in out
+          and "two bodies" not in out, "a body in no pair is named", out.strip()[-300:])
+
+    unknown = pairs[:500] + [(501, N + 1, "bottom", "top")] + pairs[501:]
+    code, out, _, _ = run_deck(work, "unknown", stack(N, unknown))
+    check(code == 1 and f"unknown.nml:{first + 500}: in group &contact: bodies = 501,{N + 1} names body "
+          f"{N + 1}, which does not exist" in out, "a pair naming a body the deck lacks is named at its line",
+          out.strip()[-300:])
+finally:
+    shutil.rmtree(work, ignore_errors=True)
+
+print(f"{len(check.failed)} failed checks")
+sys.exit(1 if check.failed else 0)
