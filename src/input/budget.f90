@@ -216,7 +216,7 @@ contains
     type(deck_t), intent(in) :: d                       !< the deck
     type(error_t), intent(out) :: err                   !< why the loads are not representable, if so
     real(wp), parameter :: MARGIN = 1.0e6_wp
-    real(wp) :: ext, t, h, u, cap
+    real(wp) :: ext, t, h, u, cap, ymin
     integer :: i, a, s
     ext = 1.0_wp
     do a = 1, 2
@@ -234,6 +234,16 @@ contains
     do a = 1, 2
       ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
     end do
+    ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
+    do a = 1, 2
+      if (.not. (d%body(a)%young < LOAD_MAX/MARGIN .and. d%body(a)%young > MARGIN/LOAD_MAX)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': young = '//sci(d%body(a)%young)//' is outside ['// &
+              sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
+              'stay within double precision; rescale the units')
+        return
+      end if
+    end do
+    ymin = min(d%body(1)%young, d%body(2)%young)
     ! every product below stays finite (no overflow trap in the checked build): ext is a
     ! coordinate extent, at most COORD_MAX, far below huge/MARGIN
     cap = LOAD_MAX/(ext*MARGIN)
@@ -249,6 +259,15 @@ contains
               ') reaches '//sci(t)//' [stress]: its stresses would overflow double precision; '// &
               'rescale the units (e.g. &scene units=''mm-N-MPa'')')
         return
+      end if
+      ! the displacements it causes, of the order of t ext / young in the softer body
+      if (t > 0.0_wp) then
+        if (.not. log(t) + log(ext) - log(ymin) + log(MARGIN) < log(LOAD_MAX)) then
+          call err%set(ERR_INPUT, '&traction '//i2s(i)//' (body '//i2s(d%traction(i)%body)// &
+                ') reaches '//sci(t)//' [stress] with young = '//sci(ymin)//': its displacements '// &
+                'would overflow double precision; rescale the units')
+          return
+        end if
       end if
     end do
     do a = 1, 2

@@ -12,10 +12,10 @@ that promise on every case:
 - decks (the small shipped decks): a line dropped or duplicated, a value replaced by a wrong
   type or an extreme number, a quote cut, a group's '/' deleted, a byte changed;
 - fixed cases: the unmutated inputs (exit 0) and reproducers of failures the fuzzing found.
-A case passes when it exits 0 or 1 (2 only for a deck mutation inside &solver, where a setting
-may stop convergence, or in a deck with the paper's 'steklov' operator, which a changed material
-or geometry may stop converging; 3 only with an error message), within 20 s, with no runtime
-error text on stderr, and, on exit 1, with an error message naming the file and nothing written.
+A case passes when it exits 0 or 1 (2, not converged, only for a deck mutation: a changed
+setting, load or material may stop the iteration, which must say why; 3 only with an error
+message), within 20 s, with no runtime error text on stderr, and, on exit 1, with an error
+message naming the file and nothing written.
 A summary table of the cases by mutation kind and outcome ends the output.
 Environment: BIN (the program), FUZZ_SEED (default 20261125), FUZZ_JOBS (parallel runs, 2),
 FUZZ_SCALE (a factor on the number of mutated cases, 1), FUZZ_VERBOSE=1 (print every case's exit
@@ -47,7 +47,6 @@ OUTPUT = "&output file='out.h5' /"   # every run writes (if at all) into its own
 # the mesh cases solve with the default Robin operator, which converges on any valid mesh
 # (the paper's 'steklov' at delta 0.95 of gmsh_paper.nml may not on a changed one)
 ROBUST = "&solver robin_operator='harmonic', delta=0.5 /"
-STEKLOV = re.compile(r"robin_operator\s*=\s*['\"]steklov['\"]", re.I)
 RUNTIME_TEXT = ("Fortran runtime", "Backtrace", "Error termination", "SIGSEGV", "SIGFPE",
                 "SIGBUS", "SIGABRT", "Segmentation fault", "Program received signal")
 check = Checks()
@@ -148,14 +147,8 @@ BAD_VALUES = ["'text'", "abc", ".true.", "1.5", "-1", "0", "-0.0", "1e308", "-1e
               "1.0d400", "''", "'" + "x" * 5000 + "'", "3*", "1,2,3", "&", "/", "%", "1 2"]
 
 
-def in_group(text, pos, group):
-    """True when position pos of the deck lies inside a &group ... / of that name."""
-    start = text.rfind("&", 0, pos + 1)
-    return start >= 0 and re.match(r"&" + group + r"\b", text[start:], re.I) is not None
-
-
 def mutate_deck(rng, text):
-    """One random mutation of the deck: (kind, detail, mutated text, touches &solver)."""
+    """One random mutation of the deck: (kind, detail, mutated text)."""
     kind = rng.choice(["drop_line", "duplicate_line", "value", "value", "value", "cut_quote",
                        "drop_slash", "flip_byte"])
     spans = code_spans(text)
@@ -164,16 +157,16 @@ def mutate_deck(rng, text):
         s, e = rng.choice(code)
         ln = text[s:e + 1]
         new = text[:s] + text[e + 1:] if kind == "drop_line" else text[:s] + ln + text[s:]
-        return kind, ln.strip()[:60], new, in_group(text, s, "solver") or "&solver" in ln
+        return kind, ln.strip()[:60], new
     if kind == "value":
         cands = [m.span() for s, e in code for m in VALUE.finditer(text, s, e)]
         s, e = rng.choice(cands)
         v = rng.choice(BAD_VALUES)
-        return kind, f"{text[s:e][:40]} -> {v[:40]}", text[:s] + v + text[e:], in_group(text, s, "solver")
+        return kind, f"{text[s:e][:40]} -> {v[:40]}", text[:s] + v + text[e:]
     if kind == "cut_quote":
         cands = [i for s, e in code for i in range(s, e) if text[i] in "'\""]
         k = rng.choice(cands)
-        return kind, f"quote at {k}", text[:k] + text[k + 1:], in_group(text, k, "solver")
+        return kind, f"quote at {k}", text[:k] + text[k + 1:]
     if kind == "drop_slash":
         cands = []
         for s, e in code:
@@ -187,12 +180,12 @@ def mutate_deck(rng, text):
                 elif c == "/":
                     cands.append(i)
         k = rng.choice(cands)
-        return kind, f"'/' at {k}", text[:k] + text[k + 1:], True   # the next group's settings join it
+        return kind, f"'/' at {k}", text[:k] + text[k + 1:]
     raw = text.encode("latin-1")                         # flip_byte
     k = rng.randrange(len(raw))
     v = rng.randrange(256)
     new = (raw[:k] + bytes([v]) + raw[k + 1:]).decode("latin-1")
-    return kind, f"byte {k}: {raw[k]} -> {v}", new, in_group(text, k, "solver")
+    return kind, f"byte {k}: {raw[k]} -> {v}", new
 
 
 # ---- running a case -----------------------------------------------------------------------
@@ -235,6 +228,8 @@ def run_case(case):
     if rc not in allowed and not (rc < 0 or rc >= 128):
         problems.append(f"exit {rc}")
     if rc in (1, 3) and not re.search(r"^robin_contact: (error|failed): ", err, re.M):
+        problems.append("no error message")
+    if rc == 2 and not re.search(r"^robin_contact: \w+: ", err, re.M):
         problems.append("no error message")
     if rc == 1:
         names = ["d.nml", "override"] + ([case.mesh_file] if case.mesh_file else [])
@@ -295,6 +290,10 @@ def fixed_cases():
     out.append((Case("deck default.nml", "fixed", "x0 = -1e308", {"d.nml": default.replace(
         b"x0 = 0.0, y0 = 1.0", b"x0 = -1e308, y0 = 1.0", 1)}), "1",
         r"d\.nml: body 1: its rectangle reaches a coordinate of magnitude 1\.000E\+308"))
+    # young = 1e-308: its flexibility overflows (the checked build trapped in the condensation)
+    out.append((Case("deck default.nml", "fixed", "young = 1e-308", {"d.nml": default.replace(
+        b"young = 2.1e11", b"young = 1e-308", 1)}), "1",
+        r"d\.nml: body 1: young = 1\.000E-308 is outside"))
     # a pressure of 1e308 on a group (the checked build trapped), a displacement of 1e250
     # (the squares of its loads overflow in the solver: the checked build trapped), and one
     # of 1e130, within the bound, which runs
@@ -319,9 +318,8 @@ def random_cases(rng):
     for deck, n in DECK_BASES:
         text = read(os.path.join(INPUTS, deck)).decode("latin-1")
         for _ in range(round(SCALE * n)):
-            kind, detail, new, solver = mutate_deck(rng, text)
-            cases.append(Case("deck " + deck, kind, detail, {"d.nml": new.encode("latin-1")},
-                              allow2=solver or STEKLOV.search(new) is not None))
+            kind, detail, new = mutate_deck(rng, text)
+            cases.append(Case("deck " + deck, kind, detail, {"d.nml": new.encode("latin-1")}, allow2=True))
     return cases
 
 
