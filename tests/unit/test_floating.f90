@@ -306,7 +306,6 @@ contains
     type(body_system_t) :: system
     type(error_t) :: err
     integer :: info
-    type(error_t) :: err
     character(len=256) :: msg
     body%id = 1
     body%young = 1000.0_wp
