@@ -216,8 +216,17 @@ contains
     type(deck_t), intent(in) :: d                       !< the deck
     type(error_t), intent(out) :: err                   !< why the loads are not representable, if so
     real(wp), parameter :: MARGIN = 1.0e6_wp
-    real(wp) :: ext, t, h, u, cap, ymin
+    real(wp) :: ext, t, h, u, cap, ymin, hx, hy
     integer :: i, a, s
+    ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
+    do a = 1, 2
+      if (.not. (d%body(a)%young < LOAD_MAX/MARGIN .and. d%body(a)%young > MARGIN/LOAD_MAX)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': young = '//sci(d%body(a)%young)//' is outside ['// &
+              sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
+              'stay within double precision; rescale the units')
+        return
+      end if
+    end do
     ext = 1.0_wp
     do a = 1, 2
       if (len_trim(d%body(a)%mesh) > 0) cycle
@@ -229,19 +238,20 @@ contains
               'scale the geometry')
         return
       end if
+      ! an element's stiffness holds young/h and young (longer side)/(shorter side)
+      hx = d%body(a)%width/real(d%body(a)%nx, wp)
+      hy = d%body(a)%height/real(d%body(a)%ny, wp)
+      if (.not. log(d%body(a)%young) + log(max(1.0_wp, hx, hy)) - log(min(hx, hy)) + log(MARGIN) &
+          < log(LOAD_MAX)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': its cells of '//sci(hx)//' x '//sci(hy)// &
+              ' [length] with young = '//sci(d%body(a)%young)//' have a stiffness beyond double '// &
+              'precision; rescale the geometry or the units')
+        return
+      end if
     end do
     ext = 1.0_wp
     do a = 1, 2
       ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
-    end do
-    ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
-    do a = 1, 2
-      if (.not. (d%body(a)%young < LOAD_MAX/MARGIN .and. d%body(a)%young > MARGIN/LOAD_MAX)) then
-        call err%set(ERR_INPUT, 'body '//i2s(a)//': young = '//sci(d%body(a)%young)//' is outside ['// &
-              sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
-              'stay within double precision; rescale the units')
-        return
-      end if
     end do
     ymin = min(d%body(1)%young, d%body(2)%young)
     ! every product below stays finite (no overflow trap in the checked build): ext is a

@@ -290,6 +290,10 @@ def fixed_cases():
     out.append((Case("deck default.nml", "fixed", "x0 = -1e308", {"d.nml": default.replace(
         b"x0 = 0.0, y0 = 1.0", b"x0 = -1e308, y0 = 1.0", 1)}), "1",
         r"d\.nml: body 1: its rectangle reaches a coordinate of magnitude 1\.000E\+308"))
+    # a rectangle 1e-308 wide: its cells' stiffness overflows (the checked build trapped)
+    out.append((Case("deck default.nml", "fixed", "width = 1e-308", {"d.nml": default.replace(
+        b"width = 3.0", b"width = 1e-308", 1)}), "1",
+        r"d\.nml: body 1: its cells of 4\.167E-310 x 6\.250E-02 \[length\]"))
     # young = 1e-308: its flexibility overflows (the checked build trapped in the condensation)
     out.append((Case("deck default.nml", "fixed", "young = 1e-308", {"d.nml": default.replace(
         b"young = 2.1e11", b"young = 1e-308", 1)}), "1",
