@@ -72,7 +72,7 @@ DECK_BASES = [("default.nml", 60), ("gmsh_paper.nml", 50), ("patch.nml", 50),
 NUMBER = re.compile(rb"(?<![\w.+\-\"])[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?(?![\w.\"])")
 BAD_NUMBERS = [b"2147483648", b"9223372036854775808", b"99999999999999999999999", b"1e308",
                b"1e400", b"-1", b"-2147483648", b"0", b"-0", b"nan", b"NaN", b"inf", b"-Infinity",
-               b"1.5", b"0.5e-300", b"abc", b"1x", b"0x10", b"", b"1e", b"+"]
+               b"1.5", b"0.5e-300", b"abc", b"1x", b"0x10", b"", b"1e", b"+", b"-", b".", b"1-2", b"+e5"]
 GARBAGE = [b"", b" ", b"\t", b"garbage line", b"1 2 3 4 5 6 7 8 9", b"$Nodes", b"$EndElements",
            b"\x00\x01\x02", b"\xff\xfe", b"-1 -1 -1", b"\"unterminated", b"0"]
 
@@ -278,6 +278,13 @@ def fixed_cases():
     pin[2738], pin[2933] = pin[2933], pin[2738]
     out.append((mesh_case(MESH_BASES[2], "fixed", "two nodes' coordinates swapped", join(pin)), "1",
                 r"m\.msh.*elements \d+ and \d+ overlap"))
+    # a coordinate '+' or '.' (no digit): the reader took it for 0
+    mixed = lines_of(read(os.path.join(INPUTS, "gmsh/patch_mixed.msh")))
+    for token in (b"+", b"."):
+        bad_z = mixed[:137] + [b"0 0.400000000001665 " + token] + mixed[138:]
+        out.append((mesh_case(MESH_BASES[1], "fixed", f"z = {token.decode()}", join(bad_z)), "1",
+                    r"m\.msh', line 138: expected a node z coordinate \(a finite real\) in \$Nodes, found '"
+                    + re.escape(token.decode()) + "'"))
     # a prescribed displacement of -1e308 on a group: its loads K u overflow (the checked
     # build trapped in the assembly; the run's message blamed the stiffness)
     patch = read(os.path.join(INPUTS, "patch.nml"))
