@@ -275,7 +275,8 @@ contains
     if (ok) v = int(m)
   end subroutine parse_int
 
-  !> A decimal real. Exact (correctly rounded) in the common case of at most 18 significant
+  !> A decimal real: an optional sign, digits with an optional fraction (one digit at least)
+  !! and an optional exponent (e, E, d or D). Exact (correctly rounded) in the common case of at most 18 significant
   !! digits with a mantissa below 2**53 and a power of ten up to 22 (one multiplication or
   !! division of two exact doubles); other forms go through a formatted READ.
   subroutine parse_real(t, v, ok)
@@ -328,7 +329,7 @@ contains
       end if
     end if
     if (i <= len(t)) then                        ! exponent
-      if (t(i:i) == 'e' .or. t(i:i) == 'E') then
+      if (t(i:i) == 'e' .or. t(i:i) == 'E' .or. t(i:i) == 'd' .or. t(i:i) == 'D') then
         i = i + 1
         esign = 1
         if (i <= len(t)) then
@@ -346,7 +347,11 @@ contains
         e10 = e10 + esign*ex
       end if
     end if
-    ok = ok .and. digits .and. i > len(t)
+    ! the form: digits, and nothing after the exponent ('+', '.', '1-2' are no numbers)
+    if (.not. (digits .and. i > len(t))) then
+      ok = .false.
+      return
+    end if
     if (ok .and. m == 0) then
       v = 0.0_wp
     else if (ok .and. m <= 2_i8**53 .and. abs(e10) <= 22) then
@@ -357,8 +362,8 @@ contains
         v = v/p10(-e10)
       end if
     else
-      ! Rare forms (17+ digits, large exponents, 'D' exponents): a formatted READ, only of
-      ! number characters (a list-directed READ would take '/' or ',' as separators).
+      ! Rare forms (17+ digits, large exponents): a formatted READ, only of number
+      ! characters (a list-directed READ would take '/' or ',' as separators).
       ok = len(t) <= 64 .and. verify(t, '0123456789+-.eEdD') == 0
       if (.not. ok) return
       call fp_read_begin(fp)

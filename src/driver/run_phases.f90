@@ -198,16 +198,21 @@ contains
     s = trim(buf)
   end function factor_estimate
 
-  !> A flexibility that is not finite is a stiffness out of double precision's range (exit 3).
+  !> A flexibility that is not finite is a stiffness out of double precision's range, an
+  !! interface load that is not finite a prescribed displacement or load out of it (exit 3).
   subroutine check_condensed(run)
     type(run_t), intent(in) :: run   !< the run: its condensed bodies
     integer :: a
     type(error_t) :: err
     character(len=1024) :: msg
     do a = 1, 2
-      if (.not. (all(ieee_is_finite(run%bodies(a)%flex)) .and. all(ieee_is_finite(run%bodies(a)%b)))) then
+      if (.not. all(ieee_is_finite(run%bodies(a)%flex))) then
         write (msg, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
           run%deck%body(a)%young, '): the stiffness is out of the range of double precision; rescale the units'
+        call fatal(EXIT_NUMERICAL, trim(msg))
+      else if (.not. all(ieee_is_finite(run%bodies(a)%b))) then
+        write (msg, '(a,i0,a)') 'body ', a, ': its interface load is not finite: its prescribed displacements '// &
+          'or loads are out of the range of double precision; rescale the units'
         call fatal(EXIT_NUMERICAL, trim(msg))
       end if
     end do

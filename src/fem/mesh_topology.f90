@@ -282,6 +282,8 @@ contains
     end do
     call check_duplicate_cells(mesh, err)
     if (err%failed()) return
+    call check_overlapping_cells(mesh, err)
+    if (err%failed()) return
 
     mesh%structured = .false.
     mesh%source = path
@@ -595,6 +597,44 @@ contains
       end if
     end do
   end subroutine group_members
+
+  !> Refuse cells that overlap across an edge: with every cell counter-clockwise, the two
+  !! cells of an inner edge run along it in opposite directions, so an edge run twice in
+  !! the same direction has two cells on one side (a node moved or swapped, or a wrong
+  !! node in a cell; an edge shared by three cells too). The directed edges are hashed.
+  subroutine check_overlapping_cells(mesh, err)
+    type(mesh_t), intent(in) :: mesh
+    type(error_t), intent(inout) :: err
+    type(int_hash_t) :: edge_hash
+    integer, allocatable :: edge_cell(:)
+    integer :: c, i, nv, a, b, slot, st
+    integer(i8) :: key, key_base
+    call hash_init(edge_hash, mesh%nvert*mesh%ncell, st)
+    if (st == 0) allocate (edge_cell(0:edge_hash%mask), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory to check '//i2s(mesh%ncell)//' cells for overlaps')
+      return
+    end if
+    key_base = mesh%nnode + 1
+    do c = 1, mesh%ncell
+      nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+      do i = 1, nv
+        a = mesh%cells(i, c)
+        b = mesh%cells(modulo(i, nv) + 1, c)
+        key = a*key_base + b
+        slot = hash_slot(edge_hash, key)
+        if (edge_hash%key(slot) == key) then
+          call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(edge_cell(slot)))//' and '// &
+                       i2s(mesh%cell_tag(c))//' overlap: both lie on the same side of their edge from node '// &
+                       i2s(mesh%node_tag(a))//' to node '//i2s(mesh%node_tag(b))// &
+                       ' (a node misplaced or a wrong node in a cell)')
+          return
+        end if
+        edge_hash%key(slot) = key
+        edge_cell(slot) = c
+      end do
+    end do
+  end subroutine check_overlapping_cells
 
   !> Refuse two cells with the same nodes (in any order): a cell listed twice would count
   !! its stiffness twice. The cells are sorted by their sorted node lists, so duplicates

@@ -28,6 +28,8 @@ module budget
   real(wp), parameter :: INDEX_MAX = 2147483647.0_wp   ! largest 32-bit index
   real(wp), parameter :: BASE_MB = 64.0_wp             ! the program, libraries and small arrays
   real(wp), parameter :: MUMPS_OVERHEAD = 1.1_wp       ! MUMPS's working space beyond the factor
+  real(wp), parameter :: COORD_MAX = 0.25_wp*sqrt(huge(1.0_wp))   ! as in mesh_topology
+  real(wp), parameter :: LOAD_MAX = sqrt(huge(1.0_wp))   ! stresses and loads whose squares stay finite
 
   public :: body_memory_mb, run_memory_mb, check_budget, check_load_range, mumps_group_sizes, rank_memory_mb, &
             check_budget_ranks
@@ -205,25 +207,58 @@ contains
     dofs = 2.0_wp*(real(b%nx, wp) + 1.0_wp)*(real(b%ny, wp) + 1.0_wp)
   end function dofs
 
-  !> Loads within double precision: a traction or prescribed displacement whose stresses
-  !! would overflow (1e308 Pa) is refused, with a margin of 1e6 for the products of
+  !> Loads within double precision: a traction (pressure included) or prescribed displacement
+  !! whose stresses or loads would reach LOAD_MAX (1.3e154 Pa, beyond which their squares in
+  !! the solvers' norms overflow) is refused, with a margin of 1e6 for the products of
   !! assembly and stress recovery: err (ERR_INPUT) naming the load and the value; the
   !! caller adds the deck.
   subroutine check_load_range(d, err)
     type(deck_t), intent(in) :: d                       !< the deck
     type(error_t), intent(out) :: err                   !< why the loads are not representable, if so
     real(wp), parameter :: MARGIN = 1.0e6_wp
-    real(wp) :: ext, t, h, u, cap
+    real(wp) :: ext, t, h, u, cap, ymin, hx, hy
     integer :: i, a, s
+    ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
+    do a = 1, 2
+      if (.not. (d%body(a)%young < LOAD_MAX/MARGIN .and. d%body(a)%young > MARGIN/LOAD_MAX)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': young = '//sci(d%body(a)%young)//' is outside ['// &
+              sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
+              'stay within double precision; rescale the units')
+        return
+      end if
+    end do
+    ext = 1.0_wp
+    do a = 1, 2
+      if (len_trim(d%body(a)%mesh) > 0) cycle
+      ! the Gmsh reader's bound on coordinates (mesh_topology), here for a rectangle
+      ext = max(abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
+      if (.not. ext <= COORD_MAX) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': its rectangle reaches a coordinate of magnitude '// &
+              sci(ext)//': beyond '//sci(COORD_MAX)//' the cells'' areas overflow double precision; '// &
+              'scale the geometry')
+        return
+      end if
+      ! an element's stiffness holds young/h and young (longer side)/(shorter side)
+      hx = d%body(a)%width/real(d%body(a)%nx, wp)
+      hy = d%body(a)%height/real(d%body(a)%ny, wp)
+      if (.not. log(d%body(a)%young) + log(max(1.0_wp, hx, hy)) - log(min(hx, hy)) + log(MARGIN) &
+          < log(LOAD_MAX)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': its cells of '//sci(hx)//' x '//sci(hy)// &
+              ' [length] with young = '//sci(d%body(a)%young)//' have a stiffness beyond double '// &
+              'precision; rescale the geometry or the units')
+        return
+      end if
+    end do
     ext = 1.0_wp
     do a = 1, 2
       ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
     end do
+    ymin = min(d%body(1)%young, d%body(2)%young)
     ! every product below stays finite (no overflow trap in the checked build): ext is a
-    ! coordinate extent, far below huge/MARGIN for any deck that passed its own checks
-    cap = huge(1.0_wp)/(ext*MARGIN)
+    ! coordinate extent, at most COORD_MAX, far below huge/MARGIN
+    cap = LOAD_MAX/(ext*MARGIN)
     do i = 1, d%ntraction
-      t = maxval(abs(d%traction(i)%t0))
+      t = maxval(abs(d%traction(i)%t0)) + abs(d%traction(i)%pressure)
       if (maxval(abs(d%traction(i)%t1)) < cap/ext) then
         t = t + maxval(abs(d%traction(i)%t1))*ext
       else
@@ -235,19 +270,42 @@ contains
               'rescale the units (e.g. &scene units=''mm-N-MPa'')')
         return
       end if
+      ! the displacements it causes, of the order of t ext / young in the softer body
+      if (t > 0.0_wp) then
+        if (.not. log(t) + log(ext) - log(ymin) + log(MARGIN) < log(LOAD_MAX)) then
+          call err%set(ERR_INPUT, '&traction '//i2s(i)//' (body '//i2s(d%traction(i)%body)// &
+                ') reaches '//sci(t)//' [stress] with young = '//sci(ymin)//': its displacements '// &
+                'would overflow double precision; rescale the units')
+          return
+        end if
+      end if
     end do
     do a = 1, 2
       h = min(d%body(a)%width/real(d%body(a)%nx, wp), d%body(a)%height/real(d%body(a)%ny, wp))
       do s = 1, 4
         u = maxval(abs(d%body(a)%u_side(:, s)))
         if (.not. u > 0.0_wp) cycle   ! (no short-circuit in Fortran: log(0) must not be evaluated)
-        if (.not. log(u) + log(d%body(a)%young) - log(h) + log(MARGIN) < log(huge(1.0_wp))) then
+        if (.not. log(u) + log(d%body(a)%young) - log(h) + log(MARGIN) < log(LOAD_MAX)) then
           call err%set(ERR_INPUT, 'the &displacement of body '//i2s(a)//' ('//sci(u)// &
                 ' [length]) with young = '//sci(d%body(a)%young)//' gives stresses beyond double '// &
                 'precision; rescale the units')
           return
         end if
       end do
+    end do
+    ! on a group the mesh size is not known yet, but the loads K u of a plane element's
+    ! stiffness K (entries of the order of young) must stay finite
+    do i = 1, d%nboundary
+      a = d%boundary(i)%body
+      if (a < 1 .or. a > 2) cycle
+      u = maxval(abs(d%boundary(i)%u), mask=d%boundary(i)%fix)
+      if (.not. u > 0.0_wp) cycle
+      if (.not. log(u) + log(d%body(a)%young) + log(MARGIN) < log(LOAD_MAX)) then
+        call err%set(ERR_INPUT, '&boundary '//i2s(i)//' (body '//i2s(a)//", group '"// &
+              trim(d%boundary(i)%group)//"') prescribes "//sci(u)//' [length] with young = '// &
+              sci(d%body(a)%young)//': its loads would overflow double precision; rescale the units')
+        return
+      end if
     end do
   end subroutine check_load_range
 
