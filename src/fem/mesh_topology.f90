@@ -342,7 +342,8 @@ contains
 
   !> One edge group per physical curve: its lines that are boundary edges of the body, and
   !! the nodes of its lines inside the body as single nodes (a curve inside the body gives
-  !! a group of nodes only). The lines' edges are hashed (a small table), then every cell
+  !! a group of nodes only). A line whose two nodes are in the body but are not an edge of
+  !! any of its cells (a corrupted node number) is bad input: its condition would be lost. The lines' edges are hashed (a small table), then every cell
   !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
   !! oriented as that cell has it; one met in two is inside the body.
   subroutine boundary_groups(file_mesh, body_node, mesh, err)
@@ -423,7 +424,14 @@ contains
         end if
         seen_group(slot) = phys
         seen_line(slot) = line
-        if (edge_count(slot) == 0) cycle          ! not an edge of the body's cells
+        if (edge_count(slot) == 0) then           ! both nodes in the body, but no cell has that edge
+          call err%set(ERR_INPUT, 'element '//i2s(file_mesh%line_tag(line))//" of physical curve '"// &
+                       file_mesh%phys_name(phys)%s//"' joins nodes "// &
+                       i2s(mesh%node_tag(body_node(file_mesh%line_node(1, line))))//' and '// &
+                       i2s(mesh%node_tag(body_node(file_mesh%line_node(2, line))))// &
+                       ', which are not an edge of any cell of the body: its condition or load would be lost')
+          return
+        end if
         if (edge_count(slot) > 1) then            ! inside the body: its nodes, once each
           do i = 1, 2
             a = body_node(file_mesh%line_node(i, line))

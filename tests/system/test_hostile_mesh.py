@@ -182,6 +182,10 @@ bad("duplicate_quad", elements_with([(2, 5, 3, [[900001] + rot])]),
 line = first_element(1, 2)          # a line of upper_top (curve entity 2)
 bad("duplicate_line", elements_with([(1, 2, 1, [[900002, line[2], line[1]]])]),
     [r"m\.msh", rf"\b{line[0]}\b", r"\b900002\b", r"same nodes|twice|duplicate"])
+# a line of upper_top across a cell's diagonal: both nodes in the body, no cell has that edge
+# (a corrupted node number); its load would be lost without a word
+bad("line_not_an_edge", elements_with([(1, 2, 1, [[900003, quad[1], quad[3]]])]),
+    [r"m\.msh", r"\b900003\b", r"upper_top", r"not an edge"])
 
 # ---- 5. many physical groups -------------------------------------------------------------
 s, e = section(PAPER_MSH, "PhysicalNames")
