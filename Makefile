@@ -131,7 +131,7 @@ $(BUILD)/config.o:         $(BUILD)/kinds.o
 $(BUILD)/namelist_vars.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o
 $(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o
-$(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o \
+$(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/namelist_vars.o \
                            $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \

@@ -4,7 +4,14 @@ module sorting
   implicit none (type, external)
   private
 
-  public :: sort_by_key, sort_ints, merge_sort_by_keys
+  public :: sort_by_key, sort_ints, merge_sort, merge_sort_by_keys, index_less
+
+  abstract interface
+    !> The order of merge_sort: true when index a goes before index b.
+    logical function index_less(a, b)
+      integer, intent(in) :: a, b
+    end function index_less
+  end interface
 
 contains
 
@@ -44,12 +51,12 @@ contains
     end do
   end subroutine sort_ints
 
-  !> Stable bottom-up merge sort of the indices `idx` by the columns `keys(:, idx(i))`,
-  !! compared lexicographically (first row first): n log n for the long lists of a mesh
-  !! (its node tags, its cells' sorted node sets).
-  subroutine merge_sort_by_keys(idx, keys)
-    integer, intent(inout) :: idx(:)        !< indices into the columns of keys, sorted on return
-    integer, intent(in) :: keys(:, :)       !< (k, *) the keys
+  !> Stable bottom-up merge sort of the indices `idx`: `less(a, b)` is true when index a
+  !! goes before index b. n log n comparisons, for the long lists (a mesh's node tags, its
+  !! cells' node sets, a deck's group names).
+  subroutine merge_sort(idx, less)
+    integer, intent(inout) :: idx(:)        !< the indices, sorted on return
+    procedure(index_less) :: less           !< the order
     integer, allocatable :: work(:)
     integer :: n, width, lo, mid, hi, i, j, k
     n = size(idx)
@@ -63,7 +70,7 @@ contains
         i = lo
         j = mid
         do k = lo, hi - 1
-          if (i < mid .and. (j >= hi .or. .not. keys_less(keys(:, idx(min(j, n))), keys(:, idx(min(i, n)))))) then
+          if (i < mid .and. (j >= hi .or. .not. less(idx(min(j, n)), idx(min(i, n))))) then
             work(k) = idx(i)
             i = i + 1
           else
@@ -75,19 +82,26 @@ contains
       idx = work
       width = 2*width
     end do
-  end subroutine merge_sort_by_keys
+  end subroutine merge_sort
 
-  !> a < b, lexicographically.
-  pure logical function keys_less(a, b)
-    integer, intent(in) :: a(:), b(:)
-    integer :: m
-    keys_less = .false.
-    do m = 1, size(a)
-      if (a(m) /= b(m)) then
-        keys_less = a(m) < b(m)
-        return
-      end if
-    end do
-  end function keys_less
+  !> Stable merge sort of the indices `idx` by the columns `keys(:, idx(i))`, compared
+  !! lexicographically (first row first).
+  subroutine merge_sort_by_keys(idx, keys)
+    integer, intent(inout) :: idx(:)        !< indices into the columns of keys, sorted on return
+    integer, intent(in) :: keys(:, :)       !< (k, *) the keys
+    call merge_sort(idx, column_less)
+  contains
+    logical function column_less(a, b)
+      integer, intent(in) :: a, b
+      integer :: m
+      column_less = .false.
+      do m = 1, size(keys, 1)
+        if (keys(m, a) /= keys(m, b)) then
+          column_less = keys(m, a) < keys(m, b)
+          return
+        end if
+      end do
+    end function column_less
+  end subroutine merge_sort_by_keys
 
 end module sorting

@@ -328,9 +328,8 @@ contains
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
     type(body_condensed_t), intent(inout) :: bc      !< receives the factorization
     type(error_t), intent(out) :: err                !< the failure (see chol_factor), if any
-    integer :: method, iord, info
+    integer :: method, iord
     integer, allocatable :: perm(:)
-    character(len=200) :: msg
     real(wp) :: t0
 
     t0 = wtime()

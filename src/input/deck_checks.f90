@@ -9,6 +9,7 @@ module deck_checks
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
   use strings, only: i2s, r2s, quote, quoted_list, word
+  use sorting, only: merge_sort
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
@@ -787,42 +788,16 @@ contains
     end do
   end subroutine check_pairs
 
-  !> Sort the indices `idx` by `key(idx(i))`, ascending (bottom-up merge sort).
+  !> Sort the indices `idx` by `key(idx(i))`, ascending (stable merge sort).
   subroutine sort_names(idx, key)
     integer, intent(inout) :: idx(:)          !< indices into key, sorted on return
     character(len=*), intent(in) :: key(:)    !< the names
-    integer, allocatable :: tmp(:)
-    integer :: n, w, lo, mid, hi, i, j, k
-    n = size(idx)
-    allocate (tmp(n))
-    w = 1
-    do while (w < n)
-      lo = 1
-      do while (lo <= n)
-        mid = min(lo + w - 1, n)
-        hi = min(lo + 2*w - 1, n)
-        i = lo
-        j = mid + 1
-        do k = lo, hi
-          if (j > hi) then
-            tmp(k) = idx(i)
-            i = i + 1
-          else if (i > mid) then
-            tmp(k) = idx(j)
-            j = j + 1
-          else if (key(idx(j)) < key(idx(i))) then
-            tmp(k) = idx(j)
-            j = j + 1
-          else
-            tmp(k) = idx(i)
-            i = i + 1
-          end if
-        end do
-        lo = lo + 2*w
-      end do
-      idx = tmp
-      w = 2*w
-    end do
+    call merge_sort(idx, name_less)
+  contains
+    logical function name_less(a, b)
+      integer, intent(in) :: a, b
+      name_less = key(a) < key(b)
+    end function name_less
   end subroutine sort_names
 
   !> The pair form: a rectangle's groups are its sides, none of them declared 'contact'
