@@ -65,7 +65,7 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
+MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar condense condense_mumps floating contact_types contact_common equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
@@ -131,11 +131,12 @@ $(BUILD)/config.o:         $(BUILD)/kinds.o
 $(BUILD)/namelist_vars.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o
 $(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o
-$(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/namelist_vars.o \
+$(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o \
                            $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
+$(BUILD)/deck_cross.o:     $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
-                           $(BUILD)/deck_checks.o $(BUILD)/deck_render.o
+                           $(BUILD)/deck_checks.o $(BUILD)/deck_cross.o $(BUILD)/deck_render.o
 $(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o

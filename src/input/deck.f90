@@ -22,7 +22,8 @@ module deck
   use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, die_at, unknown_group
   use config, only: deck_t
   use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, &
-                         add_boundary, apply_displacement, add_contact, check_cross
+                         add_boundary, apply_displacement, add_contact
+  use deck_cross, only: check_cross
   use deck_render, only: deck_text, print_deck, deck_reference
   implicit none (type, external)
   private

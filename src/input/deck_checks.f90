@@ -1,20 +1,17 @@
 !> The checks of the deck's groups as they are read: each group read into its settings
 !! through its table (`deck_tables`), its values checked (`apply_*`, `new_body`,
-!! `add_traction`, ...), then, once the deck and its overrides are read, the checks across
-!! groups (`check_cross`: the contact pairs, their sides or groups, prescribed
-!! displacements, loads).
+!! `add_traction`, ...); the checks across groups, once the deck and its overrides are read,
+!! are in `deck_cross`.
 !! Every bad input ends in `fatal(EXIT_INPUT, msg)` naming the source, group, variable
 !! and value.
 module deck_checks
   use kinds, only: wp
-  use errors, only: fatal, warn, EXIT_INPUT
   use strings, only: i2s, r2s, quote, quoted_list, word
-  use sorting, only: merge_sort
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
   use config, only: pair_oriented, deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
-                    SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, &
+                    side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, &
@@ -23,7 +20,7 @@ module deck_checks
   private
 
   public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, &
-            apply_displacement, add_contact, check_cross
+            apply_displacement, add_contact
 
 
   !> Where things came from, for cross-field messages.
@@ -631,223 +628,5 @@ contains
     if (t%side == 0) call die_at(src, g%line, 'in group &'//g%name//': no side; give '// &
       'side='//quoted_list(SIDE_CHOICES, ''))
   end subroutine body_and_side
-
-  ! ============================================================================================
-  ! Cross-field checks
-  ! ============================================================================================
-
-  !> The checks across groups, once the deck and its overrides are read: every body in a
-  !! pair, a group of a body in one pair at most; then the two-body form's contact sides or
-  !! groups, or the pair form's groups; prescribed displacements and loads.
-  subroutine check_cross(d, st)
-    type(deck_t), intent(in) :: d
-    type(state_t), intent(in) :: st
-    integer :: b, s, nc
-    character(len=:), allocatable :: p, lst
-    logical :: groups
-
-    p = st%path//': '
-    if (d%npair == 0) call fatal(EXIT_INPUT, p//'the deck has '//i2s(d%nbody)//' bodies and no '// &
-      '&contact; name each contact pair with &contact bodies=A,B, groups=''GA'',''GB'' /')
-    call check_pairs(d, st)
-    if (d%pairs_named) then
-      call check_named(d, st)
-      return
-    end if
-    groups = len_trim(d%pair(1)%body_group(1)) > 0 .or. len_trim(d%pair(1)%body_group(2)) > 0
-    if (groups) then
-      call check_groups(d, st)
-      return
-    end if
-    do b = 1, 2
-      if (len_trim(d%body(b)%mesh) > 0) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
-        st%body_at(b)%s//') comes from a mesh file: name the contact surfaces with &contact '// &
-        'body1_group=''NAME1'', body2_group=''NAME2'' /')
-    end do
-    do b = 1, 2
-      nc = count(d%body(b)%bc == BC_CONTACT)
-      if (nc /= 1) then
-        lst = ''
-        do s = 1, 4
-          if (d%body(b)%bc(s) == BC_CONTACT) lst = lst//merge(', ', '  ', len(lst) > 0)//trim(side_names(s))
-        end do
-        if (nc == 0) then
-          call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('//st%body_at(b)%s//') has no '// &
-            '''contact'' side; each body needs exactly one ('//side_list(d%body(b))//')')
-        else
-          call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('//st%body_at(b)%s//') has '//i2s(nc)// &
-            ' ''contact'' sides ('//trim(adjustl(lst))//'); each body needs exactly one')
-        end if
-      end if
-    end do
-
-    ! whether the two sides face each other, overlap and how their nodes pair is the mortar
-    ! interface's business, as for named groups (condense: build_interface)
-
-    ! support against rigid motion is the mesh's business (assembly: a body the supports
-    ! leave free is held only by contact, and module floating checks that the contact can)
-
-    do b = 1, 2
-      call check_disp_given(d, st, b, .true.)
-    end do
-
-    call check_loads(d, st)
-  end subroutine check_cross
-
-  !> Side tractions on rectangles: not on a contact side; no effect on a prescribed side.
-  subroutine check_loads(d, st)
-    type(deck_t), intent(in) :: d
-    type(state_t), intent(in) :: st
-    integer :: i, s
-    character(len=:), allocatable :: p
-    p = st%path//': '
-    do i = 1, d%ntraction
-      associate (t => d%traction(i))
-        if (len_trim(t%group) > 0) cycle
-        if (len_trim(d%body(t%body)%mesh) > 0) call fatal(EXIT_INPUT, p//'the &traction at '// &
-          st%trac_at(i)%s//' loads side '''//trim(side_names(t%side))//''' of body '//i2s(t%body)// &
-          ', which comes from a mesh file and has no sides; load a group: group=''NAME''')
-        s = d%body(t%body)%bc(t%side)
-        if (s == BC_CONTACT) call fatal(EXIT_INPUT, p//'the &traction at '//st%trac_at(i)%s// &
-          ' loads side '''//trim(side_names(t%side))//''' of body '//i2s(t%body)//', which is '// &
-          'its contact side; a contact side carries only contact forces')
-        if (s == BC_CLAMPED .or. s == BC_DISPLACEMENT) call warn(p// &
-          'the &traction at '//st%trac_at(i)%s//' loads side '''//trim(side_names(t%side))// &
-          ''' of body '//i2s(t%body)//', which has a prescribed displacement ('''// &
-          trim(bc_names(s))//'''); that traction has no effect')
-      end associate
-    end do
-  end subroutine check_loads
-
-  !> Contact on named groups (mortar): both groups given, no rectangle side declared
-  !! 'contact', sides with 'displacement' given. Supports and group names are checked on
-  !! the meshes (module assembly, condense).
-  subroutine check_groups(d, st)
-    type(deck_t), intent(in) :: d
-    type(state_t), intent(in) :: st
-    integer :: b
-    character(len=:), allocatable :: p
-    p = st%path//': '
-    do b = 1, 2
-      if (len_trim(d%pair(1)%body_group(b)) == 0) call fatal(EXIT_INPUT, p//'&contact names '// &
-        'the contact group of one body only; give both, body1_group=''NAME1'', body2_group=''NAME2''')
-      if (any(d%body(b)%bc == BC_CONTACT)) call fatal(EXIT_INPUT, p//'body '//i2s(b)//' ('// &
-        st%body_at(b)%s//') declares a ''contact'' side, but &contact names the contact groups; '// &
-        'use one or the other (a rectangle''s sides are the groups ''left'', ''right'', '// &
-        '''bottom'', ''top'')')
-      call check_disp_given(d, st, b, .false.)
-    end do
-    call check_loads(d, st)
-  end subroutine check_groups
-
-  !> Every body is in a pair, and no group of a body is in two pairs: the pairs' ends
-  !! bucketed by body, each bucket sorted by group name (linear in the pairs but for the
-  !! sort of a body's own ends).
-  subroutine check_pairs(d, st)
-    type(deck_t), intent(in) :: d
-    type(state_t), intent(in) :: st
-    integer, allocatable :: first(:), ends(:), fill(:), ebody(:)
-    character(len=128), allocatable :: gname(:)
-    integer :: k, j, e, b, n, i1, i2
-    n = 2*d%npair
-    allocate (first(d%nbody + 1), fill(d%nbody), ends(n), ebody(n), gname(n))
-    first = 0
-    do k = 1, d%npair
-      do j = 1, 2
-        e = 2*(k - 1) + j
-        ebody(e) = d%pair(k)%bodies(j)
-        gname(e) = d%pair(k)%body_group(j)
-        first(ebody(e) + 1) = first(ebody(e) + 1) + 1
-      end do
-    end do
-    do b = 1, d%nbody
-      if (first(b + 1) == 0) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('// &
-        st%body_at(b)%s//') is in no contact pair; every body touches another: add &contact '// &
-        'bodies='//i2s(b)//',B, groups=''GA'',''GB'' / for it')
-    end do
-    first(1) = 1
-    do b = 1, d%nbody
-      first(b + 1) = first(b + 1) + first(b)
-    end do
-    fill = first(1:d%nbody)
-    do e = 1, n
-      ends(fill(ebody(e))) = e
-      fill(ebody(e)) = fill(ebody(e)) + 1
-    end do
-    do b = 1, d%nbody
-      if (first(b + 1) - first(b) < 2) cycle
-      call sort_names(ends(first(b):first(b + 1) - 1), gname)
-      do j = first(b), first(b + 1) - 2
-        i1 = ends(j)
-        i2 = ends(j + 1)
-        if (gname(i1) /= gname(i2) .or. len_trim(gname(i1)) == 0) cycle
-        call fatal(EXIT_INPUT, st%path//': the '//st%pair_at((min(i1, i2) + 1)/2)%s//' and the '// &
-          st%pair_at((max(i1, i2) + 1)/2)%s//' both name group '''//trim(gname(i1))//''' of body '// &
-          i2s(b)//'; a group of a body is in one contact pair at most')
-      end do
-    end do
-  end subroutine check_pairs
-
-  !> Sort the indices `idx` by `key(idx(i))`, ascending (stable merge sort).
-  subroutine sort_names(idx, key)
-    integer, intent(inout) :: idx(:)          !< indices into key, sorted on return
-    character(len=*), intent(in) :: key(:)    !< the names
-    call merge_sort(idx, name_less)
-  contains
-    logical function name_less(a, b)
-      integer, intent(in) :: a, b
-      name_less = key(a) < key(b)
-    end function name_less
-  end subroutine sort_names
-
-  !> The pair form: a rectangle's groups are its sides, none of them declared 'contact'
-  !! (the pairs name them); sides with 'displacement' given; loads.
-  subroutine check_named(d, st)
-    type(deck_t), intent(in) :: d
-    type(state_t), intent(in) :: st
-    integer :: k, j, b
-    do k = 1, d%npair
-      do j = 1, 2
-        b = d%pair(k)%bodies(j)
-        if (len_trim(d%body(b)%mesh) > 0) cycle
-        if (.not. any(side_names == d%pair(k)%body_group(j))) call fatal(EXIT_INPUT, st%path// &
-          ': the '//st%pair_at(k)%s//' names group '''//trim(d%pair(k)%body_group(j))//''' of body '// &
-          i2s(b)//', a rectangle, whose groups are its sides ''left'', ''right'', ''bottom'', ''top''')
-      end do
-    end do
-    do b = 1, d%nbody
-      if (any(d%body(b)%bc == BC_CONTACT)) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('// &
-        st%body_at(b)%s//') declares a ''contact'' side, but the deck names its pairs with &contact '// &
-        'bodies=A,B, groups=...; a pair names a rectangle''s contact side as its group (''left'', '// &
-        '''right'', ''bottom'', ''top''), declared ''free''')
-      call check_disp_given(d, st, b, len_trim(d%body(b)%mesh) == 0)
-    end do
-    call check_loads(d, st)
-  end subroutine check_named
-
-  !> Every side of body b declared 'displacement' has its &displacement (with `hint`, the
-  !! message shows the group to add).
-  subroutine check_disp_given(d, st, b, hint)
-    type(deck_t), intent(in) :: d
-    type(state_t), intent(in) :: st
-    integer, intent(in) :: b
-    logical, intent(in) :: hint
-    integer :: s
-    character(len=:), allocatable :: add
-    do s = 1, 4
-      if (d%body(b)%bc(s) /= BC_DISPLACEMENT .or. st%disp_given(s, b)) cycle
-      add = ''
-      if (hint) add = '; add &displacement body='//i2s(b)//', side='''//trim(side_names(s))//''', u=ux, uy /'
-      call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('//st%body_at(b)%s//') declares its '// &
-        trim(side_names(s))//' side ''displacement'' but no &displacement group gives that displacement'//add)
-    end do
-  end subroutine check_disp_given
-
-  function side_list(b) result(s)
-    type(body_cfg_t), intent(in) :: b
-    character(len=:), allocatable :: s
-    s = 'left='''//trim(bc_names(b%bc(SIDE_LEFT)))//''', right='''//trim(bc_names(b%bc(SIDE_RIGHT)))// &
-      ''', top='''//trim(bc_names(b%bc(SIDE_TOP)))//''', bottom='''//trim(bc_names(b%bc(SIDE_BOTTOM)))//''''
-  end function side_list
 
 end module deck_checks
