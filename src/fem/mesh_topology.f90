@@ -284,6 +284,8 @@ contains
     if (err%failed()) return
     call check_overlapping_cells(mesh, err)
     if (err%failed()) return
+    call check_one_piece(mesh, err)
+    if (err%failed()) return
 
     mesh%structured = .false.
     mesh%source = path
@@ -676,6 +678,51 @@ contains
       end if
     end do
   end subroutine check_duplicate_cells
+
+  !> A body is one connected piece of cells (cells connected through shared nodes): its rigid
+  !! motions, supports and floating checks are those of one body. Two pieces in one region
+  !! (a region drawn as two parts, or a cell whose node numbers were corrupted into another
+  !! part) are bad input naming one cell of each.
+  subroutine check_one_piece(mesh, err)
+    type(mesh_t), intent(in) :: mesh
+    type(error_t), intent(inout) :: err
+    integer, allocatable :: parent(:)
+    integer :: c, i, nv, r, root, other, st
+    if (mesh%ncell < 2) return
+    allocate (parent(mesh%nnode), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory to check that the cells form one piece')
+      return
+    end if
+    parent = [(i, i=1, mesh%nnode)]
+    do c = 1, mesh%ncell
+      nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+      root = find(mesh%cells(1, c))
+      do i = 2, nv
+        r = find(mesh%cells(i, c))
+        if (r /= root) parent(r) = root
+      end do
+    end do
+    root = find(mesh%cells(1, 1))
+    do c = 2, mesh%ncell
+      if (find(mesh%cells(1, c)) == root) cycle
+      other = c
+      call err%set(ERR_INPUT, 'its cells form more than one piece (element '//i2s(mesh%cell_tag(1))// &
+                   ' and element '//i2s(mesh%cell_tag(other))//' share no chain of nodes): a body is one '// &
+                   'connected piece; give each piece its own physical surface and &body')
+      return
+    end do
+  contains
+    !> The root of node k's piece, halving the path on the way.
+    integer function find(k)
+      integer, intent(in) :: k
+      find = k
+      do while (parent(find) /= find)
+        parent(find) = parent(parent(find))
+        find = parent(find)
+      end do
+    end function find
+  end subroutine check_one_piece
 
   !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
   subroutine sort_by_tag(idx, tag)

@@ -184,6 +184,11 @@ bad("duplicate_line", elements_with([(1, 2, 1, [[900002, line[2], line[1]]])]),
     [r"m\.msh", rf"\b{line[0]}\b", r"\b900002\b", r"same nodes|twice|duplicate"])
 # a line of upper_top across a cell's diagonal: both nodes in the body, no cell has that edge
 # (a corrupted node number); its load would be lost without a word
+# a cell of the upper body whose nodes were corrupted into the lower body's: the upper region
+# is then two pieces (it solved to exit 3 "not positive definite", a numerical failure)
+lower = first_element(2, 10)        # a quadrangle of the lower body (surface entity 10)
+bad("two_pieces", elements_with([(2, 5, 3, [[900004] + lower[1:]])]),
+    [r"m\.msh", r"\b900004\b", r"more than one piece"])
 bad("line_not_an_edge", elements_with([(1, 2, 1, [[900003, quad[1], quad[3]]])]),
     [r"m\.msh", r"\b900003\b", r"upper_top", r"not an edge"])
 
