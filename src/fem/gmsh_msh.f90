@@ -5,9 +5,9 @@
 !! The file is read whole into memory and scanned once, token by token (module
 !! text_scanner: a 500k-node mesh, 4 million numbers, in about 1 s; peak memory about 2.8
 !! times the file). Its sections fill a file_mesh_t (module mesh_topology), which then
-!! gives the body. Node tags are looked up through a hash table, so tags may be sparse and
-!! unordered. Gmsh gives a point that bounds or is embedded in a meshed surface the node of
-!! the surface's mesh.
+!! gives the body. Node tags are looked up in an array indexed by tag when they are dense,
+!! through a hash table otherwise, so tags may be sparse and unordered. Gmsh gives a point
+!! that bounds or is embedded in a meshed surface the node of the surface's mesh.
 !!
 !! Every count that sizes an allocation is read by read_count (module text_scanner), the
 !! one place for checks of counts against the file: each is checked, in 64-bit arithmetic,
@@ -31,11 +31,19 @@ module gmsh_msh
 
   public :: msh_read, msh_read_pair
 
-  !> Node tag -> file node number, while the elements are read.
+  !> Node tag -> file node number, while the elements are read: an array indexed by tag
+  !! when the tags $Nodes announces are dense (Gmsh writes 1..N), else a hash table. A tag
+  !! outside the announced range moves the index to the hash table.
   type :: node_index_t
-    type(int_hash_t) :: hash                   ! the tags
+    logical :: direct = .false.                ! node_of_tag holds the index
+    integer :: lo = 1, hi = 0                  ! the range of node_of_tag
+    integer, allocatable :: node_of_tag(:)     ! (lo:hi) the node of each tag, 0: none
+    type(int_hash_t) :: hash                   ! the tags, when not direct
     integer, allocatable :: node_of_slot(:)    ! (0:hash%mask) the node of each tag's slot
   end type node_index_t
+
+  ! the direct index is used when the announced tag range is at most this many times the node count
+  integer, parameter :: DIRECT_SPAN = 4
 
 contains
 
@@ -351,17 +359,24 @@ contains
     type(node_index_t), intent(inout) :: by_tag
     ! the fewest characters of a node (tag and x, y, z) and of a block's header
     integer, parameter :: NODE_BYTES = 8, BLOCK_BYTES = 8
-    integer :: nblock, ntotal, b, edim, etag, param, nb, k, j, st, slot, first
+    integer :: nblock, ntotal, b, edim, etag, param, nb, k, j, st, slot, first, tag, tag_lo, tag_hi
     real(wp) :: z, r
 
     nblock = read_count(scanner, 'the number of node blocks', BLOCK_BYTES, 'node blocks')
     ntotal = read_count(scanner, 'the number of nodes', NODE_BYTES, 'nodes')
-    k = get_int(scanner, 'the smallest node tag')
-    k = get_int(scanner, 'the largest node tag')
+    tag_lo = get_int(scanner, 'the smallest node tag')
+    tag_hi = get_int(scanner, 'the largest node tag')
     if (scanner%info /= 0) return
     allocate (file_mesh%node_tag(ntotal), file_mesh%node_xy(2, ntotal), stat=st)
-    if (st == 0) call hash_init(by_tag%hash, ntotal, st)
-    if (st == 0) allocate (by_tag%node_of_slot(0:by_tag%hash%mask), stat=st)
+    by_tag%direct = tag_lo >= 1 .and. tag_hi >= tag_lo .and. &
+                    int(tag_hi, i8) - tag_lo + 1 <= DIRECT_SPAN*(int(ntotal, i8) + 1)
+    if (by_tag%direct) then
+      by_tag%lo = tag_lo
+      by_tag%hi = tag_hi
+      if (st == 0) allocate (by_tag%node_of_tag(tag_lo:tag_hi), source=0, stat=st)
+    else
+      if (st == 0) call index_to_hash(by_tag, file_mesh%node_tag, 0, ntotal, st)
+    end if
     if (st /= 0) then
       call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
       return
@@ -385,13 +400,25 @@ contains
           call scan_fail(scanner, 'node tag '//i2s(file_mesh%node_tag(k))//' in $Nodes: tags must be >= 1')
           return
         end if
-        slot = hash_slot(by_tag%hash, int(file_mesh%node_tag(k), i8))
-        if (by_tag%hash%key(slot) /= HASH_EMPTY) then
-          call scan_fail(scanner, 'node tag '//i2s(file_mesh%node_tag(k))//' appears twice')
+        tag = file_mesh%node_tag(k)
+        if (by_tag%direct .and. (tag < by_tag%lo .or. tag > by_tag%hi)) then
+          call index_to_hash(by_tag, file_mesh%node_tag, k - 1, ntotal, st)
+          if (st /= 0) then
+            call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
+            return
+          end if
+        end if
+        if (node_of(by_tag, tag) /= 0) then
+          call scan_fail(scanner, 'node tag '//i2s(tag)//' appears twice')
           return
         end if
-        by_tag%hash%key(slot) = file_mesh%node_tag(k)
-        by_tag%node_of_slot(slot) = k
+        if (by_tag%direct) then
+          by_tag%node_of_tag(tag) = k
+        else
+          slot = hash_slot(by_tag%hash, int(tag, i8))
+          by_tag%hash%key(slot) = tag
+          by_tag%node_of_slot(slot) = k
+        end if
       end do
       do k = first + 1, first + nb
         file_mesh%node_xy(1, k) = get_real(scanner, 'a node x coordinate')
@@ -426,7 +453,7 @@ contains
     type(node_index_t), intent(in) :: by_tag
     ! the fewest characters of an element (a point: tag and node) and of a block's header
     integer, parameter :: ELEMENT_BYTES = 4, BLOCK_BYTES = 8
-    integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, st, t, slot
+    integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, st, t, node
 
     nblock = read_count(scanner, 'the number of element blocks', BLOCK_BYTES, 'element blocks')
     ntotal = read_count(scanner, 'the number of elements', ELEMENT_BYTES, 'elements')
@@ -503,17 +530,17 @@ contains
             call scan_fail(scanner, 'element '//i2s(tag)//' refers to node tag '//i2s(ntg)//': tags must be >= 1')
             return
           end if
-          slot = hash_slot(by_tag%hash, int(ntg, i8))
-          if (by_tag%hash%key(slot) == HASH_EMPTY) then
+          node = node_of(by_tag, ntg)
+          if (node == 0) then
             call scan_fail(scanner, 'element '//i2s(tag)//' refers to node '//i2s(ntg)//', which is not in $Nodes')
             return
           end if
           if (etype == 1) then
-            file_mesh%line_node(j, file_mesh%nline) = by_tag%node_of_slot(slot)
+            file_mesh%line_node(j, file_mesh%nline) = node
           else if (etype == 15) then
-            file_mesh%point_node(file_mesh%npoint) = by_tag%node_of_slot(slot)
+            file_mesh%point_node(file_mesh%npoint) = node
           else
-            file_mesh%cell_node(j, file_mesh%ncell) = by_tag%node_of_slot(slot)
+            file_mesh%cell_node(j, file_mesh%ncell) = node
           end if
         end do
       end do
@@ -524,6 +551,39 @@ contains
     end if
     call expect(scanner, '$EndElements')
   end subroutine read_elements
+
+  !> The file node of tag `tag`, 0 if no node has it.
+  integer function node_of(by_tag, tag) result(node)
+    type(node_index_t), intent(in) :: by_tag
+    integer, intent(in) :: tag
+    integer :: slot
+    node = 0
+    if (by_tag%direct) then
+      if (tag >= by_tag%lo .and. tag <= by_tag%hi) node = by_tag%node_of_tag(tag)
+    else
+      slot = hash_slot(by_tag%hash, int(tag, i8))
+      if (by_tag%hash%key(slot) /= HASH_EMPTY) node = by_tag%node_of_slot(slot)
+    end if
+  end function node_of
+
+  !> Move the index to a hash table sized for ntotal tags, holding the nnode tags read so far.
+  subroutine index_to_hash(by_tag, node_tag, nnode, ntotal, stat)
+    type(node_index_t), intent(inout) :: by_tag
+    integer, intent(in) :: node_tag(:)
+    integer, intent(in) :: nnode, ntotal
+    integer, intent(out) :: stat
+    integer :: k, slot
+    by_tag%direct = .false.
+    if (allocated(by_tag%node_of_tag)) deallocate (by_tag%node_of_tag)
+    call hash_init(by_tag%hash, ntotal, stat)
+    if (stat == 0) allocate (by_tag%node_of_slot(0:by_tag%hash%mask), stat=stat)
+    if (stat /= 0) return
+    do k = 1, nnode
+      slot = hash_slot(by_tag%hash, int(node_tag(k), i8))
+      by_tag%hash%key(slot) = node_tag(k)
+      by_tag%node_of_slot(slot) = k
+    end do
+  end subroutine index_to_hash
 
   !> The sentence refusing an element type.
   function unsupported_type(etype) result(s)

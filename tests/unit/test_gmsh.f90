@@ -593,6 +593,9 @@ contains
     call expect_error('dup.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
                       '1', '2', '2', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']), 'sq', 1, &
                       [character(len=20) :: 'node tag 2', 'twice'], 'a repeated node tag is refused')
+    call expect_error('absent.msh', square(element_lines=[character(len=60) :: '$Elements', '2 2 1 8', &
+                      '1 1 1 1', '8 1 2', '2 1 3 1', '7 1 2 3 5', '$EndElements']), 'sq', 1, &
+                      [character(len=20) :: 'node 5', 'not in $Nodes'], 'a reference to an absent node tag is refused')
     call expect_error('negative.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 -4 1 4', '2 1 0 4', &
                       '1', '2', '3', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes']), 'sq', 1, &
                       [character(len=20) :: 'number of nodes', '>= 0', "'-4'"], 'a negative count is refused')
@@ -669,7 +672,16 @@ contains
                               'the base edge oriented with the body on its left')
     end if
 
-    ! a line after a skipped section keeps its line number
+    ! a node tag outside the range $Nodes announces (1..4 here, tag 9) is still found
+    call write_file(tmp//'range.msh', square(node_lines=[character(len=60) :: '$Nodes', '1 4 1 4', '2 1 0 4', &
+                    '1', '2', '9', '4', '0 0 0', '1 0 0', '1 1 0', '0 1 0', '$EndNodes'], &
+                    element_lines=[character(len=60) :: '$Elements', '2 2 1 8', '1 1 1 1', '8 1 2', &
+                    '2 1 3 1', '7 1 2 9 4', '$EndElements']))
+    call msh_read(tmp//'range.msh', 'sq', 1, m, info, msg)
+    call report(info == 0, 'a node tag beyond the announced range is read')
+    if (info == 0) call report(all(m%node_tag == [1, 2, 4, 9]) .and. all(m%xy(:, 4) == [1.0_wp, 1.0_wp]) .and. &
+                               abs(total_area(m) - 1) < 1e-15_wp, 'the node of tag 9 has its coordinates')
+
     call expect_error('skipline.msh', [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', &
       '$Comments', 'a', 'b', '$EndComments', '$Nodes', '1 1 1 1', '2 1 0 1', '1', '0 0 0', '$EndNodes', &
       '$Elements', '1 1 1 1', '2 1 2 1', '1 1 1 5', '$EndElements'], '', 1, &
