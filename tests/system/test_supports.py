@@ -19,7 +19,9 @@ are written by the test (tests/system/msh_blocks.py), no gmsh needed.
 (c) A contact group that is also clamped (a foundation drawn as a body): every Robin operator
     and the monolithic solve converge; the vertical resultant on the upper body equals its
     load, 2 (a traction of 1 on a top of length 2; its support, ux = 0, carries no vertical
-    force), to 1e-9.
+    force), to 1e-9. Clamped at two of its contact nodes only (F_2 singular, not zero): the
+    default operator converges to the monolithic forces; 'steklov' and 'constant' either do
+    too or stop with exit 2, never with other forces.
 """
 import os
 import sys
@@ -144,6 +146,29 @@ with tempfile.TemporaryDirectory() as tmp:
                 err = np.abs(lam_f - lam_m).max() / np.abs(lam_m).max()
                 check(err <= 1e-10, f"foundation, {op}: = monolithic", f"{err:.2e}")
             check(result_fields(text_f)["status"] == "converged", f"foundation, {op}: status converged")
+
+    # (d) the same foundation clamped at two of its contact nodes only: F_2 singular, not zero
+    write_msh(os.path.join(tmp, "part.msh"),
+              [block("rocker", 0.0, 1.0, 2.0, 0.5, 20, 5),
+               block("base", 0.0, 0.0, 2.0, 1.0, 20, 10, [("mid", 10, 10), ("q", 5, 10)])])
+    part = FOUNDATION.replace("rocker.msh", "part.msh").replace(
+        "&boundary body=2, group='base_top', ux=0, uy=0 /",
+        "&boundary body=2, group='mid', ux=0, uy=0 /\n&boundary body=2, group='q', ux=0, uy=0 /")
+    rc_m, _, lam_m, _ = run(tmp, "part_mono", part, MONO)
+    check(rc_m == 0, "foundation clamped at two contact nodes: monolithic converges", f"exit {rc_m}")
+    rc_h, text_h, lam_h, _ = run(tmp, "part_harmonic", part)
+    check(rc_h == 0, "foundation clamped at two contact nodes: the default (harmonic) converges", f"exit {rc_h}")
+    if rc_h == 0 and lam_m is not None:
+        fy = float(line_fields(text_h, "contact")["resultant_on_body1"].split(",")[1])
+        check(abs(fy - 2.0) <= 1e-9 * 2.0, "foundation clamped at two nodes: vertical resultant = the load 2", f"{fy!r}")
+        err = np.abs(lam_h - lam_m).max() / np.abs(lam_m).max()
+        check(err <= 1e-8, "foundation clamped at two nodes, harmonic: = monolithic", f"{err:.2e}")
+    for op in ("'steklov'", "'constant', alpha=1e-3"):
+        rc_o, _, lam_o, _ = run(tmp, "part_other", part, f"&solver robin_operator={op} /")
+        agree = rc_o == 2 or (rc_o == 0 and lam_m is not None and
+                              np.abs(lam_o - lam_m).max() <= 1e-8 * np.abs(lam_m).max())
+        check(agree, f"foundation clamped at two nodes, {op}: converged to the monolithic forces or exit 2",
+              f"exit {rc_o}")
 
 print(f"{len(check.failed)} failed" if check.failed else "all passed")
 sys.exit(1 if check.failed else 0)
