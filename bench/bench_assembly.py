@@ -21,32 +21,13 @@ import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))
 from rc_run import result_fields, solver_env, time_fields  # noqa: E402
+from bench_gmsh import DECK as GMSH_DECK, make_mesh  # noqa: E402  (the same scene and meshes)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-GEO = os.path.join(ROOT, "inputs", "gmsh", "bench_paper_tri.geo")
 DEFAULT_DECK = os.path.join(ROOT, "inputs", "default.nml")
 
-GMSH_DECK = """\
-&scene title = 'bench_assembly: paper scene, unstructured P1', plane = 'strain', units = 'SI' /
-&body id = 1, mesh = '{msh}', region = 'upper', young = 2.1e11, poisson = 0.277 /
-&body id = 2, mesh = '{msh}', region = 'lower', young = 2.1e11, poisson = 0.277 /
-&boundary body = 1, group = 'upper_left', ux = 0.0, uy = 0.0 /
-&boundary body = 2, group = 'lower_left', ux = 0.0, uy = 0.0 /
-&traction body = 1, group = 'upper_top', t0 = 0.0, -3.0e6, tx = 0.0, -1.0e6 /
-&traction body = 1, group = 'upper_right', t0 = 0.0, 2.0e6 /
-&contact body1_group = 'upper_bottom', body2_group = 'lower_top' /
-"""
 SOLVER = "&solver method='robin', robin_operator='harmonic', delta=0.5, max_outer=1 /"
-
-
-def mesh_file(h, workdir):
-    path = os.path.join(workdir, f"bench_paper_tri_h{h:g}.msh")
-    if not (os.path.exists(path) and os.path.getmtime(path) >= os.path.getmtime(GEO)):
-        sys.stderr.write(f"bench_assembly: gmsh h={h:g} -> {path}\n")
-        subprocess.run(["gmsh", "-2", "-format", "msh41", "-v", "2", "-setnumber", "h", repr(h), GEO,
-                        "-o", path], check=True)
-    return path
 
 
 def run(binary, args, threads, workdir):
@@ -68,10 +49,10 @@ def main():
     ap.add_argument("--workdir", default=os.path.join(ROOT, "results", "bench_assembly"))
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
-    msh = mesh_file(a.h, a.workdir)
+    msh, _, _ = make_mesh(a.h, 1.07, a.workdir, "gmsh")   # bench_paper_tri.geo's default ratio
     deck = os.path.join(a.workdir, "gmsh.nml")
     with open(deck, "w") as f:
-        f.write(GMSH_DECK.format(msh=msh))
+        f.write(GMSH_DECK.format(h=f"{a.h:g}", msh=msh))
     bins = [os.path.abspath(b) for b in a.bin.split(",") if b]
     # the structured meshes: nx = 2 ny per body, the DOF count of the Gmsh scene
     _, ndof = run(bins[0], [deck], a.threads, a.workdir)
