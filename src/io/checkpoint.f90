@@ -227,12 +227,7 @@ contains
     end if
     i0 = 1
     do while (i0 <= len(meshes))
-      i1 = index(meshes(i0:), achar(10))
-      if (i1 == 0) then
-        i1 = len(meshes) + 1
-      else
-        i1 = i0 + i1 - 1
-      end if
+      i1 = line_end(meshes, i0)
       line = meshes(i0:i1 - 1)
       path = line(19:)
       had = stored_hash(stored, path)
@@ -248,6 +243,19 @@ contains
     end do
   end subroutine check_meshes
 
+  !> The position of the newline ending the line that starts at i0 of `text` (len + 1 on
+  !! the last line without one).
+  pure integer function line_end(text, i0)
+    character(len=*), intent(in) :: text
+    integer, intent(in) :: i0
+    line_end = index(text(i0:), achar(10))
+    if (line_end == 0) then
+      line_end = len(text) + 1
+    else
+      line_end = i0 + line_end - 1
+    end if
+  end function line_end
+
   !> The hash that the /mesh_files text `stored` records for `path` ('' none).
   function stored_hash(stored, path) result(h)
     character(len=*), intent(in) :: stored, path
@@ -256,12 +264,7 @@ contains
     h = ''
     i0 = 1
     do while (i0 <= len(stored))
-      i1 = index(stored(i0:), achar(10))
-      if (i1 == 0) then
-        i1 = len(stored) + 1
-      else
-        i1 = i0 + i1 - 1
-      end if
+      i1 = line_end(stored, i0)
       if (i1 - i0 >= 18) then
         if (stored(i0 + 18:i1 - 1) == path) then
           h = stored(i0:i0 + 15)
