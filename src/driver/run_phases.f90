@@ -217,7 +217,8 @@ contains
       end if
     end do
     ! a floating body with no load along its free motions: is it pressed by a deformation?
-    if (run%systems(1)%nrig + run%systems(2)%nrig == 0 .or. run%rank /= 0) return
+    ! (every rank decides, from the broadcast F_a and b_a, so that all stop together)
+    if (run%systems(1)%nrig + run%systems(2)%nrig == 0) return
     call check_pressed(run%systems, run%contact_line, run%bodies, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
   end subroutine check_condensed

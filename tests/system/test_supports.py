@@ -24,6 +24,8 @@ are written by the test (tests/system/msh_blocks.py), no gmsh needed.
     too or stop with exit 2, never with other forces.
 """
 import os
+import shutil
+import subprocess
 import sys
 import tempfile
 
@@ -132,6 +134,28 @@ with tempfile.TemporaryDirectory() as tmp:
               f"exit {rc_u}: {text_u[-300:]}")
         check(not os.path.exists(out), f"rocker with uy = {uy}: no result file")
         check("Traceback" not in text_u and "Error termination" not in text_u, f"rocker with uy = {uy}: no backtrace")
+
+    # the same refusal under MPI: every rank decides and all stop together (a rank that waits
+    # for the others is a hang, which the timeout turns into a failure)
+    mpi_bin = os.path.join(ROOT, "bin", "robin_contact_mpi")
+    if os.path.exists(mpi_bin) and shutil.which("mpirun"):
+        deck = os.path.join(tmp, "rocker_up_mpi.nml")
+        out = os.path.join(tmp, "rocker_up_mpi.h5")
+        with open(deck, "w") as f:
+            f.write(ROCKER.format(uy="1e-3"))
+        env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+                   OMPI_MCA_mpi_yield_when_idle="1", OMP_NUM_THREADS="1")
+        try:
+            p = subprocess.run(["mpirun", "--oversubscribe", "-np", "3", mpi_bin, deck,
+                                "&solver factorization='mumps' /", f"&output file='{out}' /"],
+                               capture_output=True, text=True, cwd=tmp, env=env, timeout=120)
+            check(p.returncode == 1 and "no load presses it" in p.stderr and not os.path.exists(out),
+                  "rocker pulled up, mpirun -np 3: exit 1 on every rank, nothing written",
+                  f"exit {p.returncode}: {p.stderr[-300:]}")
+        except subprocess.TimeoutExpired:
+            check(False, "rocker pulled up, mpirun -np 3: exit 1 on every rank", "timed out (a rank waited)")
+    else:
+        print("SKIP  rocker under MPI: no MPI binary or mpirun")
 
     # (c) foundation
     rc_m, _, lam_m, _ = run(tmp, "found_mono", FOUNDATION, MONO)
