@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar condense condense_mumps floating contact_types contact_common equality_rows \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar contact_interface condense condense_mumps floating contact_types contact_common equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
@@ -164,63 +164,72 @@ $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o 
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
 $(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
-$(BUILD)/condense.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                           $(BUILD)/assembly.o $(BUILD)/ordering.o $(BUILD)/cholesky.o $(BUILD)/mortar.o $(BUILD)/strings.o $(BUILD)/lapack.o
-$(BUILD)/condense_mumps.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/assembly.o $(BUILD)/condense.o \
-                           $(BUILD)/mumps_iface.o
-$(BUILD)/floating.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/lapack.o \
-                           $(BUILD)/strings.o
+$(BUILD)/contact_interface.o: $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
+                           $(BUILD)/mortar.o $(BUILD)/strings.o
+$(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/cholesky.o $(BUILD)/clock.o $(BUILD)/config.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
+                           $(BUILD)/mesh.o $(BUILD)/ordering.o
+$(BUILD)/condense_mumps.o: $(BUILD)/assembly.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/contact_interface.o \
+                           $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mumps_iface.o
+$(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/errors.o \
+                           $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
-$(BUILD)/contact_common.o: $(BUILD)/kinds.o $(BUILD)/condense.o $(BUILD)/contact_types.o
+$(BUILD)/contact_common.o: $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
 $(BUILD)/equality_rows.o:  $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/condense.o
 # the Robin operators implement one interface: not every operator needs every argument
-$(BUILD)/robin_operators.o: FFLAGS += -Wno-unused-dummy-argument
+$(BUILD)/robin_operators.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
+                           $(BUILD)/linop.o $(BUILD)/mprgp.o
 $(BUILD)/robin_operators.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
                            $(BUILD)/condense.o $(BUILD)/contact_common.o
-$(BUILD)/robin_subproblems.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
-                           $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/contact_common.o \
-                           $(BUILD)/equality_rows.o $(BUILD)/robin_operators.o
+$(BUILD)/robin_subproblems.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
+                           $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/robin_operators.o \
+                           $(BUILD)/smalbe.o $(BUILD)/sorting.o
 $(BUILD)/acceleration.o:   $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/lapack.o $(BUILD)/contact_types.o \
                            $(BUILD)/contact_common.o
-$(BUILD)/robin_iteration.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/clock.o $(BUILD)/condense.o \
-                           $(BUILD)/contact_types.o $(BUILD)/contact_common.o $(BUILD)/robin_operators.o \
-                           $(BUILD)/robin_subproblems.o $(BUILD)/acceleration.o
-$(BUILD)/monolithic.o:     $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/clock.o $(BUILD)/mprgp.o \
-                           $(BUILD)/smalbe.o $(BUILD)/strings.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
-                           $(BUILD)/contact_common.o $(BUILD)/equality_rows.o
-$(BUILD)/error_estimate.o: $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
-                           $(BUILD)/equality_rows.o
+$(BUILD)/robin_iteration.o: $(BUILD)/acceleration.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \
+                           $(BUILD)/contact_common.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
+                           $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/robin_operators.o $(BUILD)/robin_subproblems.o
+$(BUILD)/monolithic.o:     $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
+                           $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
+                           $(BUILD)/strings.o
+$(BUILD)/error_estimate.o: $(BUILD)/condense.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
+                           $(BUILD)/contact_types.o $(BUILD)/equality_rows.o $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/files.o:
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
-$(BUILD)/results.o:        $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/assembly.o \
-                           $(BUILD)/condense.o $(BUILD)/floating.o $(BUILD)/contact_types.o $(BUILD)/h5io.o $(BUILD)/files.o \
-                           $(BUILD)/history_io.o $(BUILD)/strings.o
+$(BUILD)/results.o:        $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
+                           $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/h5io.o \
+                           $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o
 # the driver's modules (src/driver): the run's data, its two back-ends, its phases
-$(BUILD)/run_state.o:      $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/deck.o $(BUILD)/mesh.o \
-                           $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_types.o $(BUILD)/results.o \
-                           $(BUILD)/strings.o $(BUILD)/clock.o $(BUILD)/mpi_env.o
+$(BUILD)/run_state.o:      $(BUILD)/assembly.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/deck.o $(BUILD)/errors.o \
+                           $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/mpi_env.o $(BUILD)/results.o $(BUILD)/strings.o
 $(BUILD)/run_backend.o:    $(BUILD)/config.o $(BUILD)/run_state.o
 # a back-end implements every phase of the interface: not every phase needs every argument
 $(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o: FFLAGS += -Wno-unused-dummy-argument
-$(BUILD)/serial_backend.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/assembly.o \
-                           $(BUILD)/condense.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/mpi_env.o \
-                           $(BUILD)/run_state.o $(BUILD)/run_backend.o $(BUILD)/strings.o
-$(BUILD)/mpi_backend.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/assembly.o \
-                           $(BUILD)/contact_types.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/strings.o \
-                           $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/condense_mumps.o \
-                           $(BUILD)/run_state.o $(BUILD)/run_backend.o
-$(BUILD)/run_summary.o:    $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/condense.o \
-                           $(BUILD)/contact_types.o $(BUILD)/sysinfo.o $(BUILD)/strings.o $(BUILD)/run_state.o
-$(BUILD)/run_phases.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_common.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/gmsh_msh.o \
-                           $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_types.o \
-                           $(BUILD)/robin_iteration.o $(BUILD)/monolithic.o $(BUILD)/error_estimate.o \
-                           $(BUILD)/floating.o $(BUILD)/results.o $(BUILD)/checkpoint.o $(BUILD)/files.o \
-                           $(BUILD)/signals.o $(BUILD)/sysinfo.o $(BUILD)/budget.o $(BUILD)/strings.o \
-                           $(BUILD)/clock.o $(BUILD)/mpi_env.o $(BUILD)/run_state.o $(BUILD)/run_backend.o \
-                           $(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o $(BUILD)/run_summary.o
+$(BUILD)/serial_backend.o: $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense.o $(BUILD)/config.o \
+                           $(BUILD)/contact_common.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mpi_env.o \
+                           $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/sorting.o $(BUILD)/strings.o \
+                           $(BUILD)/sysinfo.o
+$(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense_mumps.o $(BUILD)/config.o \
+                           $(BUILD)/contact_common.o $(BUILD)/contact_types.o $(BUILD)/errors.o $(BUILD)/kinds.o \
+                           $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
+                           $(BUILD)/strings.o $(BUILD)/sysinfo.o
+$(BUILD)/run_summary.o:    $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
+                           $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
+$(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/clock.o \
+                           $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
+                           $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/files.o \
+                           $(BUILD)/floating.o $(BUILD)/gmsh_msh.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
+                           $(BUILD)/monolithic.o $(BUILD)/mpi_backend.o $(BUILD)/mpi_env.o $(BUILD)/results.o \
+                           $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
+                           $(BUILD)/run_summary.o $(BUILD)/serial_backend.o $(BUILD)/signals.o $(BUILD)/strings.o \
+                           $(BUILD)/sysinfo.o
 $(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/deck.o $(BUILD)/results.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
 $(BUILD)/files_shim.o:     include/files_shim.h

@@ -1,5 +1,6 @@
-!> robin_contact: frictionless contact between two elastic bodies by a Robin
-!! (Lions-type) nonoverlapping domain decomposition (Sassi, Ipopa, Roux).
+!> robin_contact: frictionless contact between elastic bodies (any number of bodies and
+!! contact pairs) by a Robin (Lions-type) nonoverlapping domain decomposition (Sassi,
+!! Ipopa, Roux).
 !!
 !! Usage: robin_contact DECK.nml ['&group var=value ... /' ...]
 !!        mpirun -np N robin_contact_mpi DECK.nml ... (factorization='mumps')
@@ -21,6 +22,7 @@ program robin_contact
   use budget, only: check_load_range
   use contact_types, only: STATUS_FAILED
   use clock, only: wtime
+  use strings, only: i2s
   use command_line, only: parse_arguments
   use run_state, only: run_t, start_ranks, set_collective, phase, physics_key
   use run_backend, only: backend_t
@@ -53,8 +55,8 @@ program robin_contact
   call print_deck(run%deck, output_unit)
   call choose_threads(run)
 
-  ! ---- assemble both bodies, the contact line between them ----------------------------
-  call phase(run, 'assembly of both bodies')
+  ! ---- assemble the bodies, the contact rows of all pairs ------------------------------
+  call phase(run, merge('assembly of both bodies', 'assembly of the bodies ', run%deck%nbody == 2))
   t0 = wtime()
   call read_meshes(run, backend)
   call assemble_bodies(run, matrix=backend%assembles_matrix)
@@ -66,8 +68,13 @@ program robin_contact
     ' m=', run%contact_line%m, ' threads=', run%threads
 
   ! ---- factorize and condense on the contact line -------------------------------------
-  call phase(run, 'ordering and factorization (estimated factors: body 1 '//factor_estimate(run, 1)// &
-             ', body 2 '//factor_estimate(run, 2)//')')
+  if (run%nbody == 2) then
+    call phase(run, 'ordering and factorization (estimated factors: body 1 '//factor_estimate(run, 1)// &
+               ', body 2 '//factor_estimate(run, 2)//')')
+  else
+    call phase(run, 'ordering and factorization ('//i2s(run%nbody)//' bodies, estimated factors '// &
+               factor_estimate(run)//' in all)')
+  end if
   t0 = wtime()
   call backend%factor(run)
   run%timing%factor = wtime() - t0
@@ -79,14 +86,14 @@ program robin_contact
   call check_interrupt(run, backend, 'condensation')
   call backend%record_factor_memory(run)
 
-  ! ---- contact forces (rank 0 alone), then both bodies' displacements -------------------
+  ! ---- contact forces (rank 0 alone), then the bodies' displacements ----------------------
   call phase(run, merge('Robin iteration  ', 'monolithic solve ', run%deck%solver%method == METHOD_ROBIN))
   t0 = wtime()
   call set_collective(.false.)
   call solve_contact(run)
   call set_collective(.true.)
   call backend%share_contact_forces(run)
-  allocate (run%displacement(max(run%systems(1)%ndof, run%systems(2)%ndof), 2))
+  allocate (run%displacement(maxval(run%systems(:)%ndof), run%nbody))
   run%displacement = 0.0_wp
   if (run%result%status /= STATUS_FAILED) call backend%recover(run)
   call complete_displacements(run)

@@ -1,19 +1,15 @@
-!> Interface condensation: the contact interface of the two bodies (its m constraint rows
-!! B_1 u_1 + B_2 u_2 <= g0), and for each body its factorization, normal flexibility
+!> Interface condensation: for each body, on its contact rows of every pair it takes part
+!! in (module contact_interface), its factorization, its normal flexibility
 !! F_a = B_a K_a^-1 B_a' and the normal interface displacement under the load alone
-!! b_a = B_a K_a^-1 f_a (plus B_a's part on prescribed DOFs) (doc/method.md). The rows come
-!! from two edge groups (named groups, or the rectangle sides declared 'contact') paired by
-!! dual mortar (module mortar; row j = the weighted normal gap at slave node j). The free DOFs
+!! b_a = B_a K_a^-1 f_a (plus B_a's part on prescribed DOFs) (doc/method.md). The free DOFs
 !! that B_a touches are ordered last in the Cholesky factorization, so F_a comes from the
 !! trailing block of the factor at a cost of O(k^3) (k those DOFs), not m solves.
 module condense
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-  use config, only: body_cfg_t, contact_cfg_t, factor_cfg_t, BC_CONTACT, side_names, &
-                    FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
-  use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
-  use mortar, only: mortar_t, mortar_build
-  use strings, only: i2s, r2s
+  use config, only: factor_cfg_t, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
+  use mesh, only: mesh_t
+  use contact_interface, only: interface_t, body_slots
   use assembly, only: body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: grid_dissection, coordinate_bisection
@@ -23,30 +19,12 @@ module condense
   implicit none (type, external)
   private
 
-  !> The m rows of one body's B_a (compressed rows over global DOFs 2*(node-1)+c).
-  type, public :: brows_t
-    integer, allocatable :: ptr(:)          !< (m+1) row k is entries ptr(k) .. ptr(k+1)-1
-    integer, allocatable :: dof(:)          !< global DOF of each entry
-    real(wp), allocatable :: val(:)         !< coefficient of each entry [-]
-  end type brows_t
-
-  !> The contact interface: m constraint rows, one per contact node of the slave side.
-  type, public :: interface_t
-    integer :: m = 0                        !< contact constraints (slave nodes with a multiplier)
-    logical :: mortar = .false.             !< rows from dual mortar on named groups
-    integer :: slave = 1                    !< body whose nodes carry the rows
-    real(wp), allocatable :: s(:)           !< (m) arc length along the slave contact chain [length]
-    real(wp), allocatable :: xy(:, :)       !< (2,m) slave node coordinates [length]
-    real(wp), allocatable :: normal(:, :)   !< (2,m) unit normal, outward from the slave body
-    real(wp), allocatable :: g0(:)          !< (m) initial normal gap [length]
-    real(wp), allocatable :: trib(:)        !< (m) tributary length D_jj [length]
-    integer, allocatable :: node(:, :)      !< (m,2) mesh node of each body (0: none, mortar master)
-    type(brows_t) :: b(2)                   !< B_1, B_2
-  end type interface_t
-
   !> One body reduced to the interface.
   type, public :: body_condensed_t
-    integer :: m = 0                        !< interface size
+    integer :: m = 0                        !< the body's contact rows, over all its pairs
+    !> (m) where the body's rows sit in the (M, 2) side layout of the contact vectors
+    !! (contact_interface `body_slots`): the body's own vector is x(slots) of such an x
+    integer, allocatable :: slots(:)
     integer :: n = 0                        !< free DOFs of the body
     integer, allocatable :: idx(:)          !< (k) the free DOFs B_a touches, ordered last
     integer, allocatable :: bptr(:)         !< (m+1) B_a on them: row i is entries bptr(i)..bptr(i+1)-1,
@@ -79,223 +57,44 @@ module condense
     real(wp) :: t_condense = 0.0_wp         !< wall time of F_a and b_a [s]
   end type body_condensed_t
 
-  public :: build_interface, factor_body, condense_body, recover_displacement, apply_bt, apply_b, &
-            interface_dofs, flex_from_x, contact_resultant
+  public :: factor_body, condense_body, recover_displacement, apply_bt, apply_b, interface_dofs, flex_from_x
 
 contains
 
-  !> The resultant of the contact forces on body a, -sum of B_a' lam by component [force]:
-  !! what balances the body's applied load when contact alone holds it (the sum of the
-  !! nodal normal forces is not a resultant on a curved contact line).
-  pure function contact_resultant(itf, a, lam) result(f)
-    type(interface_t), intent(in) :: itf
-    integer, intent(in) :: a                  !< body
-    real(wp), intent(in) :: lam(:)            !< (m) contact forces [force]
-    real(wp) :: f(2)
-    integer :: k, e, c
-    f = 0.0_wp
-    do k = 1, itf%m
-      do e = itf%b(a)%ptr(k), itf%b(a)%ptr(k + 1) - 1
-        c = 2 - mod(itf%b(a)%dof(e), 2)
-        f(c) = f(c) - itf%b(a)%val(e)*lam(k)
-      end do
-    end do
-  end function contact_resultant
-
-  !> The contact interface of the two bodies, by dual mortar on two edge groups: the named
-  !! groups of &contact, or a rectangle's side declared 'contact' (its mesh has the sides
-  !! as groups 'left', 'right', 'bottom', 'top'). On matching lines the mortar rows are the
-  !! node-to-node ones to rounding, so one path serves every scene.
-  subroutine build_interface(body, cc, msh, sys, itf, err)
-    type(body_cfg_t), intent(in) :: body(2)          !< the two bodies (their contact sides)
-    type(contact_cfg_t), intent(in) :: cc            !< the interface settings (groups, slave, initial gap)
-    type(mesh_t), intent(in) :: msh(2)               !< meshes of body 1 and 2
-    type(body_system_t), intent(in) :: sys(2)        !< assembled systems
-    type(interface_t), intent(out) :: itf            !< the contact line
-    type(error_t), intent(out) :: err                !< the bad input (ERR_INPUT), if any
-    type(contact_cfg_t) :: ccg
-    integer :: a, side
-
-    ccg = cc
-    if (len_trim(cc%body_group(1)) == 0) then
-      do a = 1, 2
-        side = findloc(body(a)%bc, BC_CONTACT, dim=1)
-        if (side == 0) then
-          call err%set(ERR_INPUT, 'body '//i2s(a)//' has no contact side')
-          return
-        end if
-        ccg%body_group(a) = side_names(side)
-      end do
-    end if
-    call mortar_interface(ccg, msh, sys, itf, err)
-  end subroutine build_interface
-
-  !> The interface of two named edge groups by dual mortar (module mortar): the slave is
-  !! cc%slave, or the body whose contact group has the shorter mean edge (body 1 on a tie).
-  !! A slave node carries no row when its normal displacement and that of every master node
-  !! its row involves are prescribed (the constraint would only repeat the supports): found
-  !! by a first build, then the rows are built again without those nodes. err = ERR_INPUT
-  !! for an unknown group, a group facing nothing, or an initial overlap.
-  subroutine mortar_interface(cc, msh, sys, itf, err)
-    type(contact_cfg_t), intent(in) :: cc
-    type(mesh_t), intent(in) :: msh(2)
-    type(body_system_t), intent(in) :: sys(2)
-    type(interface_t), intent(out) :: itf
-    type(error_t), intent(out) :: err
-    integer :: g(2), a, sl, ma, j, e, k, ne
-    real(wp) :: hmean(2), tol, gmin
-    logical, allocatable :: removable(:)
-    real(wp), allocatable :: gdist(:)
-    type(mortar_t) :: mt
-    type(error_t) :: why
-
-    do a = 1, 2
-      g(a) = group_index(msh(a), cc%body_group(a))
-      if (g(a) == 0) then
-        call err%set(ERR_INPUT, '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)// &
-              ' has no such group with edges on its boundary; its groups are '//group_names(msh(a)))
-        return
-      end if
-      if (nodes_only(msh(a), g(a))) then
-        call err%set(ERR_INPUT, '&contact body'//i2s(a)//'_group='''//trim(cc%body_group(a))//''': body '//i2s(a)//': '// &
-              nodes_only_refusal(msh(a), g(a), 'contact needs'))
-        return
-      end if
-      associate (gr => msh(a)%group(g(a)))
-        hmean(a) = 0.0_wp
-        do e = 1, gr%nedge
-          hmean(a) = hmean(a) + norm2(msh(a)%xy(:, gr%edge(2, e)) - msh(a)%xy(:, gr%edge(1, e)))
-        end do
-        hmean(a) = hmean(a)/max(1, gr%nedge)
-      end associate
-    end do
-    sl = cc%slave
-    if (sl == 0) sl = merge(2, 1, hmean(2) < hmean(1)*(1.0_wp - 1.0e-12_wp))
-    ma = 3 - sl
-    itf%mortar = .true.
-    itf%slave = sl
-
-    allocate (removable(msh(sl)%nnode))
-    removable = .false.
-    call mortar_build(msh(sl)%xy, msh(sl)%group(g(sl))%edge, removable, msh(ma)%xy, &
-                      msh(ma)%group(g(ma))%edge, mt, why)
-    if (.not. why%failed()) then
-      do j = 1, mt%m
-        removable(mt%snode(j)) = normal_fixed(sys(sl), mt%snode(j), mt%normal(:, j))
-        do k = mt%mptr(j), mt%mptr(j + 1) - 1
-          if (abs(mt%mval(k)) > 1.0e-12_wp) removable(mt%snode(j)) = removable(mt%snode(j)) .and. &
-            normal_fixed(sys(ma), mt%mnod(k), mt%normal(:, j))
-        end do
-      end do
-      if (any(removable)) call mortar_build(msh(sl)%xy, msh(sl)%group(g(sl))%edge, removable, msh(ma)%xy, &
-                                            msh(ma)%group(g(ma))%edge, mt, why)
-    end if
-    if (why%failed()) then
-      call err%set(ERR_INPUT, 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(sl)//' (slave) and '''// &
-                   trim(cc%body_group(ma))//''' of body '//i2s(ma)//' (master): '//why%text())
-      return
-    end if
-
-    ! an initial overlap beyond a thousandth of the slave's mean edge is bad input
-    ! (the gap of a row divided by its slave weight sum: the distance, where the row's
-    ! weights sum to more or less than one next to a removed node or at a partly covered end)
-    tol = 1.0e-3_wp*hmean(sl)
-    allocate (gdist(mt%m))
-    do j = 1, mt%m
-      gdist(j) = mt%g0(j)/sum(mt%sval(mt%sptr(j):mt%sptr(j + 1) - 1))
-    end do
-    gmin = minval(gdist)
-    if (gmin < -tol) then
-      j = minloc(gdist, dim=1)
-      call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
-            ''' overlap in the initial configuration: the gap at slave node '//i2s(msh(sl)%node_tag(mt%snode(j)))// &
-            ' of body '//i2s(sl)//' at ('//r2s(msh(sl)%xy(1, mt%snode(j)))//', '//r2s(msh(sl)%xy(2, mt%snode(j)))// &
-            ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart')
-      return
-    end if
-
-    itf%m = mt%m
-    allocate (itf%s(mt%m), itf%xy(2, mt%m), itf%g0(mt%m), itf%trib(mt%m), itf%node(mt%m, 2), &
-              itf%normal(2, mt%m))
-    itf%s = mt%s
-    itf%xy = msh(sl)%xy(:, mt%snode)
-    itf%normal = mt%normal
-    itf%trib = mt%d
-    itf%node(:, sl) = mt%snode
-    itf%node(:, ma) = 0
-    itf%g0 = mt%g0
-    if (cc%gap_radius > 0.0_wp) itf%g0 = itf%g0 + (itf%xy(1, :) - cc%gap_center)**2/(2.0_wp*cc%gap_radius)
-    ! B_s: + sum_k ws_k n_j.u_k ; B_m: - sum_l wm_l n_j.u_l (both components of each node)
-    ne = 2*(mt%sptr(mt%m + 1) - 1)
-    allocate (itf%b(sl)%ptr(mt%m + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
-    ne = 2*(mt%mptr(mt%m + 1) - 1)
-    allocate (itf%b(ma)%ptr(mt%m + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
-    call fill_rows(mt%sptr, mt%snod, mt%sval, 1.0_wp, itf%b(sl))
-    call fill_rows(mt%mptr, mt%mnod, mt%mval, -1.0_wp, itf%b(ma))
-
-  contains
-
-    !> Rows of one body: each node entry (weight w) gives sgn*w*n_j on both its DOFs.
-    subroutine fill_rows(ptr, nod, val, sgn, b)
-      integer, intent(in) :: ptr(:), nod(:)
-      real(wp), intent(in) :: val(:), sgn
-      type(brows_t), intent(inout) :: b
-      integer :: jj, kk, q, c
-      q = 0
-      b%ptr(1) = 1
-      do jj = 1, mt%m
-        do kk = ptr(jj), ptr(jj + 1) - 1
-          do c = 1, 2
-            q = q + 1
-            b%dof(q) = 2*(nod(kk) - 1) + c
-            b%val(q) = sgn*val(kk)*mt%normal(c, jj)
-          end do
-        end do
-        b%ptr(jj + 1) = q + 1
-      end do
-    end subroutine fill_rows
-
-  end subroutine mortar_interface
-
-  !> Whether the displacement of node k along nrm is prescribed in the body: every
-  !! component that nrm has is a prescribed DOF.
-  pure logical function normal_fixed(sys, k, nrm)
-    type(body_system_t), intent(in) :: sys
-    integer, intent(in) :: k
-    real(wp), intent(in) :: nrm(2)
-    integer :: c
-    normal_fixed = .true.
-    do c = 1, 2
-      if (abs(nrm(c)) > 1.0e-12_wp .and. sys%free_of(2*(k - 1) + c) > 0) normal_fixed = .false.
-    end do
-  end function normal_fixed
-
-
-  !> B_a on the free DOFs of body a: the DOFs it touches with a non-zero coefficient, in the
-  !! order the rows first touch them (these are ordered last in the factorization), the
-  !! rows over their positions, and the constant part on prescribed DOFs.
+  !> B_a on the free DOFs of body a (its sides of the rows of every pair it is in, in the
+  !! order of `body_slots`): the DOFs it touches with a non-zero coefficient, in the order
+  !! the rows first touch them (these are ordered last in the factorization), the rows over
+  !! their positions, and the constant part on prescribed DOFs.
   subroutine interface_dofs(itf, a, sys, bc)
-    type(interface_t), intent(in) :: itf             !< the contact line
+    type(interface_t), intent(in) :: itf             !< the contact rows of all pairs
     integer, intent(in) :: a                         !< body number
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
-    type(body_condensed_t), intent(inout) :: bc      !< receives m, n, idx and the rows on it
-    integer :: i, e, p, k, ne
+    type(body_condensed_t), intent(inout) :: bc      !< receives m, n, slots, idx and the rows on it
+    integer :: i, e, p, k, ne, row, side, total
     integer, allocatable :: pos_of(:), idx(:)
 
-    bc%m = itf%m
+    bc%slots = body_slots(itf, a)
+    bc%m = size(bc%slots)
     bc%n = sys%n
     if (allocated(bc%idx)) deallocate (bc%idx)
     if (allocated(bc%bptr)) deallocate (bc%bptr, bc%bpos, bc%bval, bc%bfix)
-    associate (b => itf%b(a))
-      ne = b%ptr(itf%m + 1) - 1
-      allocate (pos_of(sys%n), idx(ne), bc%bptr(itf%m + 1), bc%bpos(ne), bc%bval(ne), bc%bfix(itf%m))
-      pos_of = 0
-      k = 0
-      ne = 0
-      bc%bptr(1) = 1
-      do i = 1, itf%m
-        bc%bfix(i) = 0.0_wp
-        do e = b%ptr(i), b%ptr(i + 1) - 1
+    total = 0
+    do i = 1, bc%m
+      row = bc%slots(i) - ((bc%slots(i) - 1)/itf%m)*itf%m
+      side = (bc%slots(i) - 1)/itf%m + 1
+      total = total + itf%b(side)%ptr(row + 1) - itf%b(side)%ptr(row)
+    end do
+    allocate (pos_of(sys%n), idx(total), bc%bptr(bc%m + 1), bc%bpos(total), bc%bval(total), bc%bfix(bc%m))
+    pos_of = 0
+    k = 0
+    ne = 0
+    bc%bptr(1) = 1
+    do i = 1, bc%m
+      row = bc%slots(i) - ((bc%slots(i) - 1)/itf%m)*itf%m
+      side = (bc%slots(i) - 1)/itf%m + 1
+      bc%bfix(i) = 0.0_wp
+      associate (b => itf%b(side))
+        do e = b%ptr(row), b%ptr(row + 1) - 1
           if (b%val(e) == 0.0_wp) cycle
           p = sys%free_of(b%dof(e))
           if (p == 0) then
@@ -311,9 +110,9 @@ contains
           bc%bpos(ne) = pos_of(p)
           bc%bval(ne) = b%val(e)
         end do
-        bc%bptr(i + 1) = ne + 1
-      end do
-    end associate
+      end associate
+      bc%bptr(i + 1) = ne + 1
+    end do
     bc%idx = idx(1:k)
   end subroutine interface_dofs
 
@@ -322,7 +121,7 @@ contains
   !! its time is part of t_factor.
   subroutine factor_body(fc, itf, a, msh, sys, bc, err)
     type(factor_cfg_t), intent(in) :: fc             !< factorization and ordering
-    type(interface_t), intent(in) :: itf             !< the contact line
+    type(interface_t), intent(in) :: itf             !< the contact rows of all pairs
     integer, intent(in) :: a                         !< body number
     type(mesh_t), intent(in) :: msh                  !< mesh of body a
     type(body_system_t), intent(in) :: sys           !< assembled system of body a

@@ -8,7 +8,8 @@ module condense_mumps
   use kinds, only: wp
   use clock, only: wtime
   use assembly, only: body_system_t
-  use condense, only: interface_t, body_condensed_t, interface_dofs, flex_from_x, apply_b, apply_bt
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t, interface_dofs, flex_from_x, apply_b, apply_bt
   use mumps_iface, only: mumps_t, mumps_schur_factor, mumps_solve
   use errors, only: error_t
   implicit none (type, external)

@@ -1,27 +1,79 @@
 !> Small pieces every contact solver shares: the residual of an iterate on the contact
-!! line, the other body's index, finiteness tests and the thread count for the two bodies.
+!! rows, a body's own vector out of the side layout and back (gather, scatter),
+!! finiteness tests and the thread count over the bodies.
 module contact_common
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use condense, only: interface_t, body_condensed_t
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t
   use contact_types, only: contact_result_t
   implicit none (type, external)
   private
 
-  public :: interface_residual, other_body, maxabs, all_finite, body_threads
+  public :: interface_residual, gather, scatter, partner_slots, pair_positions, maxabs, all_finite, body_threads
 
 contains
 
-  !> The body facing body a (1 <-> 2).
-  pure integer function other_body(a)
-    integer, intent(in) :: a   !< a body, 1 or 2
-    other_body = 3 - a
-  end function other_body
+  !> A body's own vector x(slots) of a side-layout array x (m, 2) (body_condensed_t%slots).
+  pure function gather(x, slots) result(y)
+    real(wp), intent(in) :: x(:, :)         !< (m, 2) side layout
+    integer, intent(in) :: slots(:)         !< the body's positions, row + (side - 1) m
+    real(wp) :: y(size(slots))
+    integer :: k, m
+    m = size(x, 1)
+    do k = 1, size(slots)
+      y(k) = x(slots(k) - ((slots(k) - 1)/m)*m, (slots(k) - 1)/m + 1)
+    end do
+  end function gather
+
+  !> x(slots) = y: a body's own vector into the side-layout array x (m, 2).
+  pure subroutine scatter(y, slots, x)
+    real(wp), intent(in) :: y(:)            !< the body's vector
+    integer, intent(in) :: slots(:)         !< the body's positions, row + (side - 1) m
+    real(wp), intent(inout) :: x(:, :)      !< (m, 2) side layout
+    integer :: k, m
+    m = size(x, 1)
+    do k = 1, size(slots)
+      x(slots(k) - ((slots(k) - 1)/m)*m, (slots(k) - 1)/m + 1) = y(k)
+    end do
+  end subroutine scatter
+
+  !> The slots of the other side of the same rows: (row, s) -> (row, 3 - s).
+  pure function partner_slots(slots, m) result(q)
+    integer, intent(in) :: slots(:)         !< a body's positions, row + (side - 1) m
+    integer, intent(in) :: m                !< contact rows of all pairs
+    integer :: q(size(slots))
+    integer :: k
+    do k = 1, size(slots)
+      if (slots(k) > m) then
+        q(k) = slots(k) - m
+      else
+        q(k) = slots(k) + m
+      end if
+    end do
+  end function partner_slots
+
+  !> The positions in body's own vectors of the rows of pair p (contiguous: a body's rows
+  !! go pair by pair), as first and last (last < first: the body is not in the pair).
+  pure function pair_positions(body, contact_line, p) result(r)
+    type(body_condensed_t), intent(in) :: body
+    type(interface_t), intent(in) :: contact_line
+    integer, intent(in) :: p                !< pair
+    integer :: r(2)
+    integer :: k, row
+    r = [1, 0]
+    do k = 1, body%m
+      row = body%slots(k) - ((body%slots(k) - 1)/contact_line%m)*contact_line%m
+      if (contact_line%pair_of(row) /= p) cycle
+      if (r(2) < r(1)) r(1) = k
+      r(2) = k
+    end do
+  end function pair_positions
 
   !> Gap, imbalance, penetration, complementarity and equilibrium of res%lam_body, res%w.
   subroutine interface_residual(contact_line, bodies, res)
-    type(interface_t), intent(in) :: contact_line         !< contact line
-    type(body_condensed_t), intent(in) :: bodies(2)       !< condensed bodies (scales)
+    type(interface_t), intent(in) :: contact_line         !< contact rows of all pairs
+    type(body_condensed_t), intent(in) :: bodies(:)       !< condensed bodies (scales)
     type(contact_result_t), intent(inout) :: res          !< lam_body, w in; residuals out
     real(wp) :: uscale, lnorm, lmax
     integer :: i
@@ -31,8 +83,10 @@ contains
     end if
     res%lam = 0.5_wp*(res%lam_body(:, 1) + res%lam_body(:, 2))
     res%gap = res%w(:, 1) + res%w(:, 2) - contact_line%g0
-    uscale = max(maxabs(bodies(1)%b), maxabs(bodies(2)%b), maxabs(contact_line%g0), maxabs(res%w(:, 1)), &
-                 maxabs(res%w(:, 2)), tiny(1.0_wp))
+    uscale = max(maxabs(contact_line%g0), maxabs(res%w(:, 1)), maxabs(res%w(:, 2)), tiny(1.0_wp))
+    do i = 1, size(bodies)
+      uscale = max(uscale, maxabs(bodies(i)%b))
+    end do
     lnorm = norm2(res%lam)
     lmax = maxval(res%lam)
     if (lnorm > 0.0_wp) then
@@ -51,11 +105,13 @@ contains
     ! a floating body's equilibrium (its load against its own contact force): an inner
     ! solve that stopped on inner_max_it may leave it unmet, and then no run converges
     res%equilibrium = 0.0_wp
-    do i = 1, 2
+    do i = 1, size(bodies)
       if (bodies(i)%nrig == 0) cycle
-      res%equilibrium = max(res%equilibrium, norm2(matmul(bodies(i)%rg, res%lam_body(:, i)) - bodies(i)%re)/ &
-                            max(norm2(bodies(i)%re), merge(norm2(bodies(i)%rg)*norm2(res%lam_body(:, i)), 0.0_wp, &
-                                all(bodies(i)%re == 0.0_wp)), tiny(1.0_wp)))
+      associate (lam_i => gather(res%lam_body, bodies(i)%slots))
+        res%equilibrium = max(res%equilibrium, norm2(matmul(bodies(i)%rg, lam_i) - bodies(i)%re)/ &
+                              max(norm2(bodies(i)%re), merge(norm2(bodies(i)%rg)*norm2(lam_i), 0.0_wp, &
+                                  all(bodies(i)%re == 0.0_wp)), tiny(1.0_wp)))
+      end associate
     end do
     res%residual = max(res%imbalance, res%penetration, res%complementarity, res%equilibrium)
     res%active = count(res%lam > 0.0_wp)
@@ -81,7 +137,7 @@ contains
     end select
   end function all_finite
 
-  !> Threads for the two bodies: min(2, OMP max threads).
+  !> Threads over the bodies: min(2, OMP max threads).
   integer function body_threads()
     use omp_lib, only: omp_get_max_threads
     body_threads = max(1, min(2, omp_get_max_threads()))

@@ -25,11 +25,14 @@ module contact_types
     integer :: outer = 0                       !< outer iterations (1 for monolithic)
     integer :: inner = 0                       !< Hessian multiplications, all subproblems (IT_inner)
     integer :: inner_maxit_hits = 0            !< subproblems that stopped on inner_max_it
-    real(wp), allocatable :: lam(:)            !< (m) normal contact force, mean of the bodies' [force]
-    real(wp), allocatable :: lam_body(:, :)    !< (m,2) each body's contact force [force]
-    real(wp), allocatable :: w(:, :)           !< (m,2) B_a u_a, normal interface displacement [length]
-    real(wp), allocatable :: gap(:)            !< (m) B_1u_1 + B_2u_2 - g0 [length]
-    real(wp), allocatable :: obstacle(:, :)    !< (m,2) final obstacles G_a [length]
+    !! The contact vectors are over the rows of all pairs (m), in the side layout (m, 2):
+    !! column s holds, for each row, the value of the body on side s of the row's pair
+    !! (contact_interface); a body's own vector is x(slots) (body_condensed_t%slots).
+    real(wp), allocatable :: lam(:)            !< (m) normal contact force, mean of the two sides' [force]
+    real(wp), allocatable :: lam_body(:, :)    !< (m,2) each side's contact force [force]
+    real(wp), allocatable :: w(:, :)           !< (m,2) B u of each side, normal interface displacement [length]
+    real(wp), allocatable :: gap(:)            !< (m) w(:, 1) + w(:, 2) - g0 [length]
+    real(wp), allocatable :: obstacle(:, :)    !< (m,2) final obstacles of each side [length]
     real(wp) :: criterion = 0.0_wp             !< last value of the stopping criterion
     real(wp) :: residual = 0.0_wp              !< max(imbalance, penetration, complementarity, equilibrium)
     real(wp) :: imbalance = 0.0_wp             !< |lam_1 - lam_2| / |lam|
@@ -37,11 +40,11 @@ module contact_types
     real(wp) :: complementarity = 0.0_wp       !< max lam_i |gap_i| / (max lam * displacement scale)
     real(wp) :: equilibrium = 0.0_wp           !< floating bodies: max_a |G_a lam_a - e_a| / |e_a| (0: none)
     real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
-    real(wp) :: kappa = 0.0_wp                 !< condition number estimate of F_1 + F_2
+    real(wp) :: kappa = 0.0_wp                 !< condition number estimate of the monolithic Hessian
     integer :: active = 0                      !< nodes with lam > 0
     !> bodies held only by contact: the amplitudes alpha_a of their rigid motions R_a
     !! (u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a; alpha_a = -mu_a, the equality multipliers)
-    real(wp) :: rigid(3, 2) = 0.0_wp           !< [length] (R_a's columns are dimensionless)
+    real(wp), allocatable :: rigid(:, :)       !< (3, bodies) [length] (R_a's columns are dimensionless)
     integer :: eq_updates = 0                  !< SMALBE multiplier updates, all solves
     integer :: nhist = 0                       !< entries in the history
     real(wp), allocatable :: h_criterion(:)    !< per outer iteration
@@ -68,8 +71,10 @@ module contact_types
     real(wp) :: best = huge(1.0_wp)            !< best criterion so far
     real(wp) :: omega = 0.0_wp                 !< Aitken relaxation
     real(wp) :: wall = 0.0_wp                  !< wall time spent in the iteration so far [s]
-    real(wp) :: flam(2) = 0.0_wp               !< |F_a lam_a| of the last iterate [length]
-    real(wp) :: mu(3, 2) = 0.0_wp              !< equality multipliers of floating bodies (SMALBE warm start) [length]
+    !! Per body: (bodies) and (3, bodies); on the contact rows: the side layout (m, 2) of
+    !! contact_result_t.
+    real(wp), allocatable :: flam(:)           !< (bodies) |F_a lam_a| of the last iterate [length]
+    real(wp), allocatable :: mu(:, :)          !< (3, bodies) equality multipliers of floating bodies (SMALBE warm start) [length]
     real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
     real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
     integer :: reuse = 0                       !< 1: flam_v holds F_a lam_a (0: not known, e.g. an older checkpoint)
@@ -77,9 +82,11 @@ module contact_types
     integer :: nsrch = 0                       !< 1: srch, fsrch hold the last change of lam_a and F_a times it
     real(wp), allocatable :: srch(:, :)        !< (m,2) lam_a after its last solve minus before it [force]
     real(wp), allocatable :: fsrch(:, :)       !< (m,2) F_a srch (difference of the two products F_a lam_a) [length]
-    integer :: nrw(2, 2) = reshape([0, 1, 0, 1], [2, 2])  !< per body: directions held in rw, next slot to fill
-    real(wp), allocatable :: rw(:, :)          !< (m, 2 k) per body k F_a-orthonormal directions of its solves [1/sqrt(length force)]
-    real(wp), allocatable :: raw(:, :)         !< (m, 2 k) F_a rw, body 1 in columns 1..k, body 2 in k+1..2k
+    integer, allocatable :: nrw(:, :)          !< (2, bodies) per body: directions held in rw, next slot to fill
+    !> (m, 2 k) per body up to k F_a-orthonormal directions of its solves, in the side layout:
+    !! direction j of a body is in column j on its side-1 rows and k + j on its side-2 rows
+    real(wp), allocatable :: rw(:, :)          !< [1/sqrt(length force)]
+    real(wp), allocatable :: raw(:, :)         !< (m, 2 k) F_a rw, the same layout
     real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
     real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
     real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
@@ -138,17 +145,22 @@ contains
   end function status_name
 
   !> Fresh outer state: obstacles at the initial gap, no contact force.
-  subroutine state_init(st, m, g0)
+  subroutine state_init(st, m, g0, nbody)
     type(robin_state_t), intent(out) :: st   !< state to initialise
-    integer, intent(in) :: m                 !< interface size
+    integer, intent(in) :: m                 !< contact rows of all pairs
     real(wp), intent(in) :: g0(:)            !< initial gap
+    integer, intent(in) :: nbody             !< bodies
+    allocate (st%flam(nbody), st%mu(3, nbody), st%nrw(2, nbody))
+    st%flam = 0.0_wp
+    st%mu = 0.0_wp
+    st%nrw(1, :) = 0
+    st%nrw(2, :) = 1
     allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
     allocate (st%dX(2*m, ANDERSON_DEPTH), st%dR(2*m, ANDERSON_DEPTH))
     allocate (st%flam_v(m, 2), st%srch(m, 2), st%fsrch(m, 2))
     allocate (st%rw(m, 2*recycle_size(m)), st%raw(m, 2*recycle_size(m)))
     st%rw = 0.0_wp
     st%raw = 0.0_wp
-    st%nrw = reshape([0, 1, 0, 1], [2, 2])
     st%srch = 0.0_wp
     st%fsrch = 0.0_wp
     st%flam_v = 0.0_wp   ! F_a 0 with lam = 0: exact
@@ -168,10 +180,13 @@ contains
     recycle_size = max(0, min(RECYCLE_DEPTH, m))
   end function recycle_size
 
-  !> Allocate the result for m contact nodes and a history of nh entries, all zero.
-  subroutine alloc_result(res, m, nh)
+  !> Allocate the result for m contact rows, nbody bodies and a history of nh entries, all zero.
+  subroutine alloc_result(res, m, nh, nbody)
     type(contact_result_t), intent(inout) :: res
-    integer, intent(in) :: m, nh
+    integer, intent(in) :: m, nh, nbody
+    if (allocated(res%rigid)) deallocate (res%rigid)
+    allocate (res%rigid(3, nbody))
+    res%rigid = 0.0_wp
     if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
     if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, res%h_active)
     allocate (res%lam(m), res%lam_body(m, 2), res%w(m, 2), res%gap(m), res%obstacle(m, 2))

@@ -61,18 +61,29 @@ contains
     lmax = lmax + q%rho*q%gg
   end subroutine equality_add_penalty
 
-  !> Both bodies' equilibrium rows stacked, body 1's first: g (r1 + r2, m), e (r1 + r2).
-  subroutine stacked_rows(bodies, g, e)
-    type(body_condensed_t), intent(in) :: bodies(2)      !< condensed bodies
+  !> The floating bodies' equilibrium rows stacked in body order over the m contact rows of
+  !! all pairs: g (sum r_a, m), each body's G_a on the rows it takes part in, e (sum r_a).
+  subroutine stacked_rows(bodies, m, g, e)
+    type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
+    integer, intent(in) :: m                             !< contact rows of all pairs
     real(wp), allocatable, intent(out) :: g(:, :)        !< stacked G_a
     real(wp), allocatable, intent(out) :: e(:)           !< stacked e_a
-    integer :: r1
-    r1 = bodies(1)%nrig
-    allocate (g(r1 + bodies(2)%nrig, bodies(1)%m), e(r1 + bodies(2)%nrig))
-    if (r1 > 0) g(1:r1, :) = bodies(1)%rg
-    if (r1 > 0) e(1:r1) = bodies(1)%re
-    if (bodies(2)%nrig > 0) g(r1 + 1:, :) = bodies(2)%rg
-    if (bodies(2)%nrig > 0) e(r1 + 1:) = bodies(2)%re
+    integer :: a, r, i
+    r = 0
+    do a = 1, size(bodies)
+      r = r + bodies(a)%nrig
+    end do
+    allocate (g(r, m), e(r))
+    g = 0.0_wp
+    r = 0
+    do a = 1, size(bodies)
+      if (bodies(a)%nrig == 0) cycle
+      do i = 1, bodies(a)%m
+        g(r + 1:r + bodies(a)%nrig, bodies(a)%slots(i) - ((bodies(a)%slots(i) - 1)/m)*m) = bodies(a)%rg(:, i)
+      end do
+      e(r + 1:r + bodies(a)%nrig) = bodies(a)%re
+      r = r + bodies(a)%nrig
+    end do
   end subroutine stacked_rows
 
   !> The eigenvalues of G G' (r <= 6 rows), ascending; if LAPACK fails, 0 and, last, the

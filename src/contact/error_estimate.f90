@@ -4,12 +4,16 @@
 module error_estimate
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use lapack, only: dsymv, dpotrf, dpotrs, dposv
-  use condense, only: interface_t, body_condensed_t
+  use lapack, only: dsymv, dpotrf, dpotrs, dposv, dsyev
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t
+  use contact_common, only: scatter
   use contact_types, only: contact_result_t
-  use equality_rows, only: gram_eigenvalues, stacked_rows
+  use equality_rows, only: stacked_rows
   implicit none (type, external)
   private
+
+  integer, parameter :: DENSE_MAX = 6000   !< contact rows beyond which no bound is computed
 
   public :: error_bound
 
@@ -17,23 +21,41 @@ contains
 
   !> A posteriori bound of the error of res%lam against the monolithic solution lam* of
   !! the same discrete problem: for the strongly convex QP min 1/2 l'Hl - c'l, l >= 0
-  !! (H = F_1 + F_2, c = b_1 + b_2 - g0) and the natural residual
+  !! (H = sum_a E_a' F_a E_a, c = sum_a E_a' b_a - g0) and the natural residual
   !! r = l - max(0, l - (Hl - c)/L), |l - lam*| <= 2 (L/mu) |r| with L, mu the extreme
   !! eigenvalues of H (estimated by power and inverse iteration, kappa enlarged by 10%).
-  !! Sets res%error_bound (relative to |lam|) and res%kappa.
+  !! Sets res%error_bound (relative to |lam|) and res%kappa; both are -1 (not computed)
+  !! beyond DENSE_MAX contact rows, where the dense H and its factor would not pay.
   subroutine error_bound(contact_line, bodies, res)
-    type(interface_t), intent(in) :: contact_line        !< contact line
-    type(body_condensed_t), intent(in) :: bodies(2)      !< condensed bodies
+    type(interface_t), intent(in) :: contact_line        !< contact rows of all pairs
+    type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
     type(contact_result_t), intent(inout) :: res         !< lam in; error_bound, kappa out
-    real(wp), allocatable :: H(:, :), A(:, :), g(:), r(:), x(:), y(:)
+    real(wp), allocatable :: H(:, :), A(:, :), g(:), r(:), x(:), y(:), bs(:, :)
     real(wp) :: lmax, lmin, nl, perr
-    integer :: m, i, k, info
+    integer :: m, i, j, k, info, ib
+    integer, allocatable :: rows(:)
     m = contact_line%m
     res%error_bound = 0.0_wp
     res%kappa = 1.0_wp
     if (m == 0) return
-    allocate (H(m, m), A(m, m), g(m), r(m), x(m), y(m))
-    H = bodies(1)%flex + bodies(2)%flex
+    if (m > DENSE_MAX) then
+      res%error_bound = -1.0_wp
+      res%kappa = -1.0_wp
+      return
+    end if
+    allocate (H(m, m), A(m, m), g(m), r(m), x(m), y(m), bs(m, 2))
+    ! H = sum_a E_a' F_a E_a (two bodies in one pair: F_1 + F_2)
+    H = 0.0_wp
+    bs = 0.0_wp
+    do ib = 1, size(bodies)
+      rows = bodies(ib)%slots - ((bodies(ib)%slots - 1)/m)*m
+      do j = 1, bodies(ib)%m
+        do i = 1, bodies(ib)%m
+          H(rows(i), rows(j)) = H(rows(i), rows(j)) + bodies(ib)%flex(i, j)
+        end do
+      end do
+      call scatter(bodies(ib)%b, bodies(ib)%slots, bs)
+    end do
     ! largest eigenvalue: power iteration (a lower estimate, enlarged below)
     do i = 1, m
       x(i) = 1.0_wp + 0.5_wp*sin(real(i, wp))
@@ -74,12 +96,12 @@ contains
     end if
     ! natural residual of the mean contact force
     call dsymv('U', m, 1.0_wp, H, m, res%lam, 1, 0.0_wp, g, 1)
-    g = g - (bodies(1)%b + bodies(2)%b - contact_line%g0)
-    if (bodies(1)%nrig + bodies(2)%nrig > 0) then
+    g = g - (bs(:, 1) + bs(:, 2) - contact_line%g0)
+    if (sum(bodies(:)%nrig) > 0) then
       ! floating bodies: the feasible set is {l >= 0, G l = e}, and the bound holds with the
       ! projection on it (the proof only uses the projection's variational inequality and
       ! the strong convexity of the objective on R^m); the projection's own inaccuracy is added
-      call project_feasible(bodies, res%lam - g/lmax, y, perr)
+      call project_feasible(bodies, m, res%lam - g/lmax, y, perr)
       r = res%lam - y
     else
       r = res%lam - max(0.0_wp, res%lam - g/lmax)
@@ -97,34 +119,47 @@ contains
     end if
   end subroutine error_bound
 
-  !> z = the Euclidean projection of y on {l >= 0, G l = e} (G, e: both bodies' equilibrium
-  !! rows, stacked): z = max(0, y - G'nu) with nu the minimiser of the convex, piecewise
-  !! quadratic phi(nu) = 1/2 |max(0, y - G'nu)|^2 + e'nu (r <= 6 unknowns), by Newton steps on
+  !> z = the Euclidean projection of y on {l >= 0, G l = e} (G, e: the floating bodies'
+  !! equilibrium rows, stacked): z = max(0, y - G'nu) with nu the minimiser of the convex,
+  !! piecewise quadratic phi(nu) = 1/2 |max(0, y - G'nu)|^2 + e'nu (r unknowns), by Newton steps on
   !! the current positive set (Hessian G_P G_P', a small ridge when it is singular) with a
   !! backtracking line search on phi: exact once the positive set is right, whatever the
   !! conditioning of G on it. perr bounds |z - exact projection| by the equilibrium left,
   !! |G z - e| / sqrt(lambda_min(G_P G_P')).
-  subroutine project_feasible(bodies, y, z, perr)
-    type(body_condensed_t), intent(in) :: bodies(2)
+  subroutine project_feasible(bodies, m_rows, y, z, perr)
+    type(body_condensed_t), intent(in) :: bodies(:)
+    integer, intent(in) :: m_rows                   !< contact rows of all pairs
     real(wp), intent(in) :: y(:)
     real(wp), allocatable, intent(out) :: z(:)
     real(wp), intent(out) :: perr
-    real(wp), allocatable :: gs(:, :), es(:), nu(:), f(:), h(:, :), d(:), nt(:), gp(:, :)
+    real(wp), allocatable :: gs(:, :), es(:), nu(:), f(:), h(:, :), d(:), nt(:), cval(:, :), ev(:), work(:)
+    integer, allocatable :: crow(:, :), ncol(:)
     real(wp) :: phi, phit, t, ridge, lmin
-    integer :: m, r, it, k, info
+    integer :: m, r, it, k, info, i, nmax
     m = size(y)
-    call stacked_rows(bodies, gs, es)
+    call stacked_rows(bodies, m_rows, gs, es)
     r = size(es)
+    ! G by columns: a column has the rows of the (at most two) floating bodies of its row
+    nmax = 0
+    allocate (ncol(m))
+    do k = 1, m
+      ncol(k) = count(gs(:, k) /= 0.0_wp)
+      nmax = max(nmax, ncol(k))
+    end do
+    allocate (crow(nmax, m), cval(nmax, m))
+    do k = 1, m
+      crow(1:ncol(k), k) = pack([(i, i=1, r)], gs(:, k) /= 0.0_wp)
+      cval(1:ncol(k), k) = gs(crow(1:ncol(k), k), k)
+    end do
     allocate (nu(r), f(r), h(r, r), d(r), nt(r))
     nu = 0.0_wp
-    z = max(y - matmul(nu, gs), 0.0_wp)
+    z = project(nu)
     phi = 0.5_wp*sum(z**2) + dot_product(es, nu)
     ridge = 1.0e-14_wp*maxval(sum(gs**2, dim=2))
     do it = 1, 200
-      f = matmul(gs, z) - es           ! = -grad phi
+      f = gz(z) - es                   ! = -grad phi
       if (norm2(f) <= 1.0e-15_wp*max(norm2(es), tiny(1.0_wp))) exit
-      gp = gs(:, pack([(k, k=1, m)], z > 0.0_wp))
-      h = matmul(gp, transpose(gp))
+      call gram(z, h)
       do k = 1, r
         h(k, k) = h(k, k) + ridge
       end do
@@ -135,21 +170,66 @@ contains
       t = 1.0_wp
       do k = 1, 60
         nt = nu + t*d
-        phit = 0.5_wp*sum(max(y - matmul(nt, gs), 0.0_wp)**2) + dot_product(es, nt)
+        phit = 0.5_wp*sum(project(nt)**2) + dot_product(es, nt)
         if (phit <= phi - 1.0e-4_wp*t*dot_product(f, d)) exit
         t = 0.5_wp*t
       end do
       if (k > 60) exit
       nu = nt
       phi = phit
-      z = max(y - matmul(nu, gs), 0.0_wp)
+      z = project(nu)
     end do
-    f = matmul(gs, z) - es
-    gp = gs(:, pack([(k, k=1, m)], z > 0.0_wp))
+    f = gz(z) - es
     lmin = 0.0_wp
-    if (size(gp, 2) > 0) lmin = minval(gram_eigenvalues(gp))
+    if (any(z > 0.0_wp)) then
+      call gram(z, h)
+      allocate (ev(r), work(max(64, 3*r)))
+      call dsyev('N', 'U', r, h, r, ev, work, size(work), info)
+      if (info == 0) lmin = max(ev(1), 0.0_wp)
+    end if
     perr = norm2(f)/sqrt(max(lmin, tiny(1.0_wp)))
     if (.not. lmin > 0.0_wp) perr = merge(0.0_wp, huge(1.0_wp), norm2(f) == 0.0_wp)
+
+  contains
+
+    !> max(0, y - G' v).
+    function project(v) result(zz)
+      real(wp), intent(in) :: v(:)
+      real(wp) :: zz(m)
+      integer :: kk
+      do kk = 1, m
+        zz(kk) = max(y(kk) - dot_product(cval(1:ncol(kk), kk), v(crow(1:ncol(kk), kk))), 0.0_wp)
+      end do
+    end function project
+
+    !> G x.
+    function gz(x) result(g)
+      real(wp), intent(in) :: x(:)
+      real(wp) :: g(r)
+      integer :: kk
+      g = 0.0_wp
+      do kk = 1, m
+        if (x(kk) == 0.0_wp) cycle
+        g(crow(1:ncol(kk), kk)) = g(crow(1:ncol(kk), kk)) + cval(1:ncol(kk), kk)*x(kk)
+      end do
+    end function gz
+
+    !> G_P G_P', P the columns where x > 0.
+    subroutine gram(x, hh)
+      real(wp), intent(in) :: x(:)
+      real(wp), intent(out) :: hh(:, :)
+      integer :: kk, a, b
+      hh = 0.0_wp
+      do kk = 1, m
+        if (.not. x(kk) > 0.0_wp) cycle
+        do b = 1, ncol(kk)
+          do a = 1, ncol(kk)
+            hh(crow(a, kk), crow(b, kk)) = hh(crow(a, kk), crow(b, kk)) + cval(a, kk)*cval(b, kk)
+          end do
+        end do
+      end do
+    end subroutine gram
+
   end subroutine project_feasible
 
 end module error_estimate

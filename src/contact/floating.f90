@@ -7,7 +7,8 @@
 module floating
   use kinds, only: wp
   use assembly, only: body_system_t, rigid_motion_name
-  use condense, only: body_condensed_t, interface_t
+  use contact_interface, only: interface_t, body_slots
+  use condense, only: body_condensed_t
   use lapack, only: dsyev, dgels, dsygv
   use strings, only: i2s, r2s
   use errors, only: error_t, ERR_INPUT
@@ -27,29 +28,36 @@ contains
   !! load along each free motion: the lifting of prescribed displacements has no part
   !! along R_a, since K R_a = 0). Needs no factorization: the checks run before it.
   subroutine rigid_rows(contact_line, a, system, body)
-    type(interface_t), intent(in) :: contact_line
-    integer, intent(in) :: a
-    type(body_system_t), intent(in) :: system
-    type(body_condensed_t), intent(inout) :: body
-    integer :: k, i, e
+    type(interface_t), intent(in) :: contact_line   !< contact rows of all pairs
+    integer, intent(in) :: a                        !< the body
+    type(body_system_t), intent(in) :: system       !< its system
+    type(body_condensed_t), intent(inout) :: body   !< receives slots, nrig, rg, re, rreach
+    integer :: k, i, e, row, side, m
     integer :: l, nd
+    body%slots = body_slots(contact_line, a)
+    m = size(body%slots)
+    body%m = m
     body%nrig = system%nrig
     if (allocated(body%rg)) deallocate (body%rg, body%re)
     if (allocated(body%rreach)) deallocate (body%rreach)
-    allocate (body%rg(system%nrig, contact_line%m), body%re(system%nrig), body%rreach(system%nrig, system%nrig))
+    allocate (body%rg(system%nrig, m), body%re(system%nrig), body%rreach(system%nrig, system%nrig))
     body%rreach = 0.0_wp
     do k = 1, system%nrig
-      do i = 1, contact_line%m
+      do i = 1, m
+        row = body%slots(i) - ((body%slots(i) - 1)/contact_line%m)*contact_line%m
+        side = (body%slots(i) - 1)/contact_line%m + 1
         body%rg(k, i) = 0.0_wp
-        do e = contact_line%b(a)%ptr(i), contact_line%b(a)%ptr(i + 1) - 1
-          body%rg(k, i) = body%rg(k, i) + contact_line%b(a)%val(e)*system%rig(contact_line%b(a)%dof(e), k)
-          ! the motions' vectors at the entry's node, against the coefficient's weight
-          nd = (contact_line%b(a)%dof(e) + 1)/2
-          do l = 1, system%nrig
-            body%rreach(k, l) = body%rreach(k, l) + contact_line%b(a)%val(e)**2* &
-                              (system%rig(2*nd - 1, k)*system%rig(2*nd - 1, l) + system%rig(2*nd, k)*system%rig(2*nd, l))
+        associate (b => contact_line%b(side))
+          do e = b%ptr(row), b%ptr(row + 1) - 1
+            body%rg(k, i) = body%rg(k, i) + b%val(e)*system%rig(b%dof(e), k)
+            ! the motions' vectors at the entry's node, against the coefficient's weight
+            nd = (b%dof(e) + 1)/2
+            do l = 1, system%nrig
+              body%rreach(k, l) = body%rreach(k, l) + b%val(e)**2* &
+                                (system%rig(2*nd - 1, k)*system%rig(2*nd - 1, l) + system%rig(2*nd, k)*system%rig(2*nd, l))
+            end do
           end do
-        end do
+        end associate
       end do
       body%re(k) = dot_product(system%rig(:, k), system%f_applied)
     end do
@@ -61,22 +69,23 @@ contains
   !> Can the contact hold the floating bodies? err = ERR_INPUT with the sentence when a
   !! free motion has no contact normal component, when the load cannot be balanced by
   !! compressive contact forces, when nothing presses the body into the contact, or when
-  !! two floating bodies are free together.
-  subroutine check_held(systems, bodies, err)
-    type(body_system_t), intent(in) :: systems(2)
-    type(body_condensed_t), intent(in) :: bodies(2)
+  !! floating bodies in contact with each other are free together (a sub-assembly).
+  subroutine check_held(contact_line, systems, bodies, err)
+    type(interface_t), intent(in) :: contact_line
+    type(body_system_t), intent(in) :: systems(:)
+    type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(out) :: err
     character(len=:), allocatable :: msg
-    real(wp), allocatable :: gg(:, :), lam(:), gs(:, :), es(:), sr(:, :)
-    real(wp) :: ev(6), c(3), fx, fy, along, res, enorm
-    integer :: a, r, m, lapinfo, k
+    real(wp), allocatable :: gg(:, :), lam(:), ev(:)
+    real(wp) :: c(3), fx, fy, along, res, enorm
+    integer :: a, r, m, lapinfo
     character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
       'a ''roller'', or ux/uy on a group (&boundary)'
 
-    m = size(bodies(1)%rg, 2)
-    do a = 1, 2
+    do a = 1, size(bodies)
       r = bodies(a)%nrig
       if (r == 0) cycle
+      m = bodies(a)%m
       fx = sum(systems(a)%f_applied(1::2))
       fy = sum(systems(a)%f_applied(2::2))
       ! 1. every free motion must meet the contact normals: min over motions v of
@@ -84,7 +93,7 @@ contains
       ! (generalized eigenproblem G G' v = mu S v), at least HOLD_MIN. A disc on a flat
       ! surface turning about its centre has normals through the centre: mu is only the
       ! discretisation's error of the normals (1e-6), not a hold
-      allocate (gg(r, r))
+      allocate (gg(r, r), ev(r))
       gg = matmul(bodies(a)%rg, transpose(bodies(a)%rg))
       call held_motions(gg, bodies(a)%rreach, r, ev, lapinfo)
       if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
@@ -98,7 +107,7 @@ contains
         call err%set(ERR_INPUT, msg//'; '//hold)
         return
       end if
-      deallocate (gg)
+      deallocate (gg, ev)
       ! 2. something must press it into the contact: a load along its free motions, or (e = 0,
       ! decided after condensation by check_pressed) a deformation, by loads or prescribed
       ! displacements, that no rigid motion of the body can undo
@@ -107,7 +116,7 @@ contains
       if (m == 0) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact (load resultant ('//r2s(fx)//', '//r2s(fy)//')): its position '// &
-              'is undetermined; load it towards the other body, or '//hold)
+              'is undetermined; load it towards the body it touches, or '//hold)
         return
       end if
       ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
@@ -122,64 +131,174 @@ contains
       end if
       deallocate (lam)
     end do
-    ! 4. both floating: the pair together must be held too (stacked rows of full rank)
-    if (bodies(1)%nrig > 0 .and. bodies(2)%nrig > 0) then
-      r = bodies(1)%nrig + bodies(2)%nrig
-      allocate (gs(r, m), es(r), gg(r, r))
-      gs(1:bodies(1)%nrig, :) = bodies(1)%rg
-      gs(bodies(1)%nrig + 1:, :) = bodies(2)%rg
-      es(1:bodies(1)%nrig) = bodies(1)%re
-      es(bodies(1)%nrig + 1:) = bodies(2)%re
-      gg = matmul(gs, transpose(gs))
-      allocate (sr(r, r))
+    ! 4. floating bodies that touch each other: each such group together must be held too
+    call check_groups(contact_line, systems, bodies, err)
+  end subroutine check_held
+
+  !> The groups of floating bodies connected by pairs of two floating bodies (each alone
+  !! passed check_held): their rows stacked over the union of their contact rows must have
+  !! full rank (no joint free motion) and their loads must be balanced by compressive forces.
+  subroutine check_groups(contact_line, systems, bodies, err)
+    type(interface_t), intent(in) :: contact_line
+    type(body_system_t), intent(in) :: systems(:)
+    type(body_condensed_t), intent(in) :: bodies(:)
+    type(error_t), intent(inout) :: err
+    integer, allocatable :: root(:), members(:), col(:)
+    real(wp), allocatable :: gs(:, :), es(:), gg(:, :), sr(:, :), ev(:), lam(:)
+    real(wp) :: c(3), res
+    integer :: a, g, r, nm, ncol, k, i, i0
+    character(len=:), allocatable :: names
+
+    root = floating_groups(contact_line, bodies)
+    allocate (col(2*contact_line%m))
+    do g = 1, size(bodies)
+      if (bodies(g)%nrig == 0 .or. root(g) /= g) cycle
+      members = pack([(a, a=1, size(bodies))], [(root(a) == g .and. bodies(a)%nrig > 0, a=1, size(bodies))])
+      nm = size(members)
+      if (nm < 2) cycle
+      ! the union of the members' rows: column of each row in the stacked rows
+      col = 0
+      ncol = 0
+      r = 0
+      do k = 1, nm
+        associate (bd => bodies(members(k)))
+          r = r + bd%nrig
+          do i = 1, bd%m
+            i0 = bd%slots(i) - ((bd%slots(i) - 1)/contact_line%m)*contact_line%m
+            if (col(i0) == 0) then
+              ncol = ncol + 1
+              col(i0) = ncol
+            end if
+          end do
+        end associate
+      end do
+      allocate (gs(r, ncol), es(r), gg(r, r), sr(r, r), ev(r))
+      gs = 0.0_wp
       sr = 0.0_wp
-      sr(1:bodies(1)%nrig, 1:bodies(1)%nrig) = bodies(1)%rreach
-      sr(bodies(1)%nrig + 1:, bodies(1)%nrig + 1:) = bodies(2)%rreach
-      call held_motions(gg, sr, r, ev, lapinfo)
-      if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
-        ! the free motion of the pair, as body 1's part of it
-        k = bodies(1)%nrig
-        c = matmul(systems(1)%rig_coef, gg(1:k, 1))
-        call err%set(ERR_INPUT, 'bodies 1 and 2 are both held only by contact, and together they are free: the pair can '// &
-              'move as a whole ('//rigid_motion_name(systems(1), c)//' of both) and nothing holds it; '// &
-              'support one of the bodies against that rigid motion')
+      r = 0
+      do k = 1, nm
+        associate (bd => bodies(members(k)))
+          do i = 1, bd%m
+            i0 = bd%slots(i) - ((bd%slots(i) - 1)/contact_line%m)*contact_line%m
+            gs(r + 1:r + bd%nrig, col(i0)) = bd%rg(:, i)
+          end do
+          es(r + 1:r + bd%nrig) = bd%re
+          sr(r + 1:r + bd%nrig, r + 1:r + bd%nrig) = bd%rreach
+          r = r + bd%nrig
+        end associate
+      end do
+      names = group_names(members)
+      gg = matmul(gs, transpose(gs))
+      call held_motions(gg, sr, r, ev, k)
+      if (k == 0 .and. ev(1) <= HOLD_MIN) then
+        ! the free motion of the group, as its first body's part of it
+        c = matmul(systems(members(1))%rig_coef, gg(1:bodies(members(1))%nrig, 1))
+        if (nm == 2) then
+          call err%set(ERR_INPUT, 'bodies '//names//' are both held only by contact, and together they are free: '// &
+                'the pair can move as a whole ('//rigid_motion_name(systems(members(1)), c)//' of both) and nothing '// &
+                'holds it; support one of the bodies against that rigid motion')
+        else
+          call err%set(ERR_INPUT, 'bodies '//names//' are all held only by contact, and together they are free: '// &
+                'they can move as a whole ('//rigid_motion_name(systems(members(1)), c)//' of body '// &
+                i2s(members(1))//') and nothing holds them; support one of the bodies against that rigid motion')
+        end if
         return
       end if
-      allocate (lam(m))
+      allocate (lam(ncol))
       call nnls(gs, es, lam, res)
       if (res > 1.0e-8_wp*norm2(es)) then
-        call err%set(ERR_INPUT, 'bodies 1 and 2 are both held only by contact, and their loads cannot be balanced by '// &
-              'compressive contact forces between them (unbalanced part '//r2s(res)//'); support one of them')
+        call err%set(ERR_INPUT, 'bodies '//names//' are '//merge('both', 'all ', nm == 2)// &
+              ' held only by contact, and their loads cannot be balanced by compressive contact forces '// &
+              'between them (unbalanced part '//r2s(res)//'); support one of them')
         return
       end if
-    end if
-  end subroutine check_held
+      deallocate (gs, es, gg, sr, ev, lam)
+    end do
+  end subroutine check_groups
+
+  !> The groups of floating bodies that touch each other (connected by pairs of two
+  !! floating bodies): root(a) is the lowest id of body a's group (a itself when alone or
+  !! supported).
+  function floating_groups(contact_line, bodies) result(root)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    integer, allocatable :: root(:)
+    integer :: p, a, b, k
+    root = [(a, a=1, size(bodies))]
+    do p = 1, contact_line%npair
+      a = find(contact_line%pair_body(1, p))
+      b = find(contact_line%pair_body(2, p))
+      if (bodies(contact_line%pair_body(1, p))%nrig > 0 .and. bodies(contact_line%pair_body(2, p))%nrig > 0 &
+          .and. a /= b) root(max(a, b)) = min(a, b)
+    end do
+    do k = 1, size(root)
+      root(k) = find(k)
+    end do
+
+  contains
+
+    !> The root of body x's group (path halving).
+    integer function find(x)
+      integer, intent(in) :: x
+      find = x
+      do while (root(find) /= find)
+        root(find) = root(root(find))
+        find = root(find)
+      end do
+    end function find
+
+  end function floating_groups
+
+  !> 'a and b' or 'a, b and c' (the bodies of a group).
+  function group_names(ids) result(t)
+    integer, intent(in) :: ids(:)
+    character(len=:), allocatable :: t
+    integer :: k
+    t = i2s(ids(1))
+    do k = 2, size(ids)
+      t = t//merge(' and ', ',    ', k == size(ids))
+      t = trim(t)//' '//i2s(ids(k))
+    end do
+  end function group_names
 
   !> A floating body with e = 0 (no load along its free motions) is pressed into the contact
   !! only when its deformation under the loads and prescribed displacements (the particular
-  !! solutions, b_1 + b_2) closes the gap in a way no rigid motion can open again: the gaps
-  !! h = g0 - b_1 - b_2 admit no motion alpha with G' alpha <= h (else the body can move off
-  !! the contact and its position is undetermined). By Farkas: there is lam >= 0 with
-  !! G lam = 0 and h' lam < 0, found by NNLS on the rows [G; h'/|h|] against (0, -1).
-  !! ERR_INPUT with the sentence when the body is not pressed.
+  !! solutions: on each row, the b of both sides) closes the gap in a way no rigid motion can
+  !! open again: the gaps h = g0 - b_s1 - b_s2 on its rows admit no motion alpha with
+  !! G' alpha <= h (else the body can move off the contact and its position is undetermined).
+  !! By Farkas: there is lam >= 0 with G lam = 0 and h' lam < 0, found by NNLS on the rows
+  !! [G; h'/|h|] against (0, -1). ERR_INPUT with the sentence when the body is not pressed.
   subroutine check_pressed(systems, contact_line, bodies, err)
-    type(body_system_t), intent(in) :: systems(2)
+    type(body_system_t), intent(in) :: systems(:)
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(out) :: err                  !< ERR_INPUT when a body is not pressed
-    real(wp), allocatable :: rows(:, :), target(:), lam(:), h(:)
+    real(wp), allocatable :: rows(:, :), target(:), lam(:), h(:), bs(:, :), ha(:)
+    integer, allocatable :: root(:)
     real(wp) :: res
-    integer :: a, r, m
-    m = contact_line%m
-    if (m == 0) return
-    h = contact_line%g0 - bodies(1)%b - bodies(2)%b
-    do a = 1, 2
+    integer :: a, r, m, i
+    if (contact_line%m == 0) return
+    allocate (bs(contact_line%m, 2))
+    bs = 0.0_wp
+    do a = 1, size(bodies)
+      call scatter_rows(bodies(a)%b, bodies(a)%slots, bs)
+    end do
+    h = contact_line%g0 - bs(:, 1) - bs(:, 2)
+    root = floating_groups(contact_line, bodies)
+    do a = 1, size(bodies)
       r = bodies(a)%nrig
-      if (r == 0) cycle
+      m = bodies(a)%m
+      if (r == 0 .or. m == 0) cycle
       if (any(bodies(a)%re /= 0.0_wp)) cycle
-      allocate (rows(r + 1, m), target(r + 1), lam(m))
+      ! a member of a group of floating bodies with a load: check_groups found that load
+      ! balanced by compressive forces through the group, which presses its members
+      if (any([(root(i) == root(a) .and. i /= a .and. any(bodies(i)%re /= 0.0_wp), i=1, size(bodies))])) cycle
+      allocate (rows(r + 1, m), target(r + 1), lam(m), ha(m))
+      do i = 1, m
+        ha(i) = h(bodies(a)%slots(i) - ((bodies(a)%slots(i) - 1)/contact_line%m)*contact_line%m)
+      end do
       rows(1:r, :) = bodies(a)%rg
-      rows(r + 1, :) = h/max(maxval(abs(h)), tiny(1.0_wp))
+      rows(r + 1, :) = ha/max(maxval(abs(ha)), tiny(1.0_wp))
       target = 0.0_wp
       target(r + 1) = -1.0_wp
       call nnls(rows, target, lam, res)
@@ -187,12 +306,27 @@ contains
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact: its loads have no part along that motion, and its deformation '// &
               'under the loads and prescribed displacements leaves a rigid motion that lifts it off the '// &
-              'contact, so its position is undetermined; load it towards the other body, or hold that '// &
+              'contact, so its position is undetermined; load it towards the body it touches, or hold that '// &
               'rigid motion with a support: a ''clamped'' side, a ''roller'', or ux/uy on a group (&boundary)')
         return
       end if
-      deallocate (rows, target, lam)
+      deallocate (rows, target, lam, ha)
     end do
+
+  contains
+
+    !> x(slots) = y in the side layout.
+    pure subroutine scatter_rows(y, slots, x)
+      real(wp), intent(in) :: y(:)
+      integer, intent(in) :: slots(:)
+      real(wp), intent(inout) :: x(:, :)
+      integer :: k, mm
+      mm = size(x, 1)
+      do k = 1, size(slots)
+        x(slots(k) - ((slots(k) - 1)/mm)*mm, (slots(k) - 1)/mm + 1) = y(k)
+      end do
+    end subroutine scatter_rows
+
   end subroutine check_pressed
 
   !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of

@@ -1,22 +1,35 @@
-!> The monolithic reference: the discrete contact problem in one piece,
-!! min 1/2 lam'(F_1 + F_2) lam - lam'(b_1 + b_2 - g0), lam >= 0, by MPRGP (SMALBE-M with
-!! the floating bodies' equilibrium rows). Every converged Robin run must match it.
+!> The monolithic reference: the discrete contact problem of all pairs in one piece,
+!! min 1/2 lam'(sum_a E_a' F_a E_a) lam - lam'(sum_a E_a' b_a - g0), lam >= 0, by MPRGP
+!! (SMALBE-M with the floating bodies' equilibrium rows); E_a picks body a's rows. Two
+!! bodies in one pair: the dense F_1 + F_2; more pairs: the sum assembled sparse (pairs
+!! couple only through a shared body). Every converged Robin run must match it.
 module monolithic
   use kinds, only: wp
   use config, only: solver_cfg_t
-  use linop, only: dense_op_t, dense_op_init
+  use linop, only: linop_t, dense_op_t, dense_op_init, csc_op_t, csc_op_init
+  use lapack, only: dgemv, dsyrk, dpotrf, dtrsm, dtrsv
   use clock, only: wtime
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, &
                    mprgp_status_name
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
-  use condense, only: interface_t, body_condensed_t
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
-  use contact_common, only: interface_residual, all_finite
+  use contact_common, only: interface_residual, all_finite, gather, scatter
   use equality_rows, only: equality_t, equality_init, equality_add_penalty, stacked_rows
   implicit none (type, external)
   private
+
+  !> H + rho G'G as an operator: H sparse, G (r, m) dense (the floating bodies' rows).
+  type, extends(linop_t) :: penalized_op_t
+    type(csc_op_t) :: h
+    real(wp) :: rho = 0.0_wp
+    real(wp), allocatable :: g(:, :)
+  contains
+    procedure :: apply => penalized_apply
+  end type penalized_op_t
 
   public :: solve_monolithic
 
@@ -25,39 +38,75 @@ contains
   !> The monolithic solve; res holds the solution, its residuals and one history entry.
   subroutine solve_monolithic(solver, contact_line, bodies, res, stop_requested)
     type(solver_cfg_t), intent(in) :: solver             !< solver settings
-    type(interface_t), intent(in) :: contact_line        !< contact line
-    type(body_condensed_t), intent(in) :: bodies(2)      !< condensed bodies
+    type(interface_t), intent(in) :: contact_line        !< contact rows of all pairs
+    type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
     type(contact_result_t), intent(out) :: res           !< solution and status
     procedure(stop_iface), optional :: stop_requested    !< true when the run must stop (signal)
-    type(dense_op_t) :: hessian
+    class(linop_t), allocatable :: hessian
     type(mprgp_t) :: inner_solver
     type(mprgp_stats_t) :: inner
     type(smalbe_stats_t) :: outer
     type(equality_t) :: equality
-    real(wp), allocatable :: c(:), lb(:), lam(:), rows(:, :), rhs(:), mu(:)
-    integer :: m, a, r1
-    real(wp) :: t0
+    real(wp), allocatable :: c(:), lb(:), lam(:), rows(:, :), rhs(:), mu(:), bs(:, :), wa(:), lfac(:, :)
+    integer :: m, a, r, nrig, info
+    real(wp) :: t0, lmax
 
     m = contact_line%m
     t0 = wtime()
     res%method = 'monolithic'
-    call alloc_result(res, m, 1)
-    allocate (c(m), lb(m), lam(m))
-    call dense_op_init(hessian, bodies(1)%flex + bodies(2)%flex)
-    c = bodies(1)%b + bodies(2)%b - contact_line%g0
+    call alloc_result(res, m, 1, size(bodies))
+    allocate (c(m), lb(m), lam(m), bs(m, 2))
+    ! c = sum_a E_a' b_a - g0: each row has one body on each side
+    bs = 0.0_wp
+    do a = 1, size(bodies)
+      call scatter(bodies(a)%b, bodies(a)%slots, bs)
+    end do
+    c = bs(:, 1) + bs(:, 2) - contact_line%g0
     lb = 0.0_wp
     lam = 0.0_wp
     inner_solver%opts%rtol = solver%monolithic_rtol
     inner_solver%opts%max_it = solver%inner_max_it
     if (present(stop_requested)) inner_solver%opts%stop => stop_requested
-    ! floating bodies: both bodies' equilibrium rows, stacked
-    r1 = bodies(1)%nrig
-    if (r1 + bodies(2)%nrig > 0 .and. m > 0) then
-      call stacked_rows(bodies, rows, rhs)
-      allocate (mu(size(rhs)))
-      inner_solver%opts%lambda_max = maxval(sum(abs(hessian%a), dim=1))
-      call equality_init(equality, rows, rhs, inner_solver%opts%lambda_max)
-      call equality_add_penalty(equality, hessian, inner_solver%opts%lambda_max)
+    nrig = sum(bodies(:)%nrig)
+    if (nrig > 0 .and. m > 0) call stacked_rows(bodies, m, rows, rhs)
+    if (contact_line%npair == 1) then
+      allocate (dense_op_t :: hessian)
+      select type (hessian)
+      type is (dense_op_t)
+        call dense_op_init(hessian, bodies(1)%flex + bodies(2)%flex)
+        ! floating bodies: their equilibrium rows, stacked
+        if (nrig > 0 .and. m > 0) then
+          inner_solver%opts%lambda_max = maxval(sum(abs(hessian%a), dim=1))
+          call equality_init(equality, rows, rhs, inner_solver%opts%lambda_max)
+          call equality_add_penalty(equality, hessian, inner_solver%opts%lambda_max)
+        end if
+      end select
+    else
+      ! several pairs: H sparse; the floating bodies' rows orthonormalized (a chain of
+      ! floating bodies has G G' like a 1D Laplacian, whose conditioning would slow SMALBE's
+      ! multiplier updates as the chain grows), the penalty applied as rho G'(G x)
+      allocate (penalized_op_t :: hessian)
+      select type (hessian)
+      type is (penalized_op_t)
+        call assemble_hessian(contact_line, bodies, hessian%h, lmax)
+        hessian%n = m
+        inner_solver%opts%lambda_max = lmax
+        if (nrig > 0 .and. m > 0) then
+          call orthonormal_rows(rows, rhs, lfac, info)
+          if (info /= 0) then
+            res%status = STATUS_FAILED
+            res%message = 'monolithic: the floating bodies'' equilibrium rows are linearly dependent'
+            return
+          end if
+          call equality_init(equality, rows, rhs, lmax)
+          hessian%rho = equality%rho
+          hessian%g = equality%g
+          inner_solver%opts%lambda_max = lmax + equality%rho*equality%gg
+        end if
+      end select
+    end if
+    if (equality%r > 0) then
+      allocate (mu(equality%r))
       mu = 0.0_wp
     end if
     if (m > 0) then
@@ -69,8 +118,14 @@ contains
         inner = outer%inner
         inner%n_matvec = outer%n_matvec
         res%eq_updates = outer%updates
-        if (r1 > 0) res%rigid(1:r1, 1) = -mu(1:r1)
-        if (bodies(2)%nrig > 0) res%rigid(1:bodies(2)%nrig, 2) = -mu(r1 + 1:)
+        ! multipliers of the orthonormalized rows L^-1 G back to those of G: mu = L^-T mu~
+        if (allocated(lfac)) call dtrsv('L', 'T', 'N', size(mu), lfac, size(mu), mu, 1)
+        r = 0
+        do a = 1, size(bodies)
+          if (bodies(a)%nrig == 0) cycle
+          res%rigid(1:bodies(a)%nrig, a) = -mu(r + 1:r + bodies(a)%nrig)
+          r = r + bodies(a)%nrig
+        end do
       else
         call inner_solver%solve(hessian, c, lb, lam)
         inner = inner_solver%stats
@@ -91,12 +146,14 @@ contains
     end if
     res%outer = 1
     res%lam = lam
-    do a = 1, 2
-      res%lam_body(:, a) = lam
+    res%lam_body(:, 1) = lam
+    res%lam_body(:, 2) = lam
+    res%obstacle = 0.0_wp
+    do a = 1, size(bodies)
       ! B_a u_a with the rigid part B_a R_a alpha_a = G_a' alpha_a of a floating body
-      res%w(:, a) = bodies(a)%b - matmul(bodies(a)%flex, lam)
-      if (bodies(a)%nrig > 0) res%w(:, a) = res%w(:, a) + matmul(res%rigid(1:bodies(a)%nrig, a), bodies(a)%rg)
-      res%obstacle(:, a) = 0.0_wp
+      wa = bodies(a)%b - matmul(bodies(a)%flex, gather(res%lam_body, bodies(a)%slots))
+      if (bodies(a)%nrig > 0) wa = wa + matmul(res%rigid(1:bodies(a)%nrig, a), bodies(a)%rg)
+      call scatter(wa, bodies(a)%slots, res%w)
     end do
     call interface_residual(contact_line, bodies, res)
     res%criterion = res%residual
@@ -111,5 +168,120 @@ contains
       res%message = 'monolithic solution has non-finite values'
     end if
   end subroutine solve_monolithic
+
+  !> H = sum_a E_a' F_a E_a in compressed sparse columns (both triangles, rows in the order
+  !! the blocks list them) and its row-sum bound lmax of lambda_max: each row belongs to the
+  !! two bodies of its pair, so column j gathers their two blocks.
+  subroutine assemble_hessian(contact_line, bodies, op, lmax)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    type(csc_op_t), intent(out) :: op
+    real(wp), intent(out) :: lmax
+    integer, allocatable :: owner(:, :), colptr(:), rowind(:), mark(:), list(:)
+    real(wp), allocatable :: val(:), acc(:), rowsum(:)
+    integer :: m, a, s, i, j, k, nnz, n, row, slot
+    m = contact_line%m
+    ! owner(:, j): (body, position in its rows) of each side of row j
+    allocate (owner(4, m))
+    do a = 1, size(bodies)
+      do i = 1, bodies(a)%m
+        slot = bodies(a)%slots(i)
+        row = slot - ((slot - 1)/m)*m
+        s = (slot - 1)/m + 1
+        owner(2*s - 1:2*s, row) = [a, i]
+      end do
+    end do
+    allocate (colptr(m + 1), mark(m), acc(m), list(m), rowsum(m))
+    mark = 0
+    acc = 0.0_wp
+    ! pass 1: the pattern's size
+    nnz = 0
+    do j = 1, m
+      n = 0
+      call visit(j, .false.)
+      nnz = nnz + n
+      do k = 1, n
+        mark(list(k)) = 0
+      end do
+    end do
+    allocate (rowind(nnz), val(nnz))
+    colptr(1) = 0
+    nnz = 0
+    do j = 1, m
+      n = 0
+      call visit(j, .true.)
+      rowsum(j) = 0.0_wp
+      do k = 1, n
+        nnz = nnz + 1
+        rowind(nnz) = list(k) - 1
+        val(nnz) = acc(list(k))
+        rowsum(j) = rowsum(j) + abs(acc(list(k)))
+        acc(list(k)) = 0.0_wp
+        mark(list(k)) = 0
+      end do
+      colptr(j + 1) = nnz
+    end do
+    lmax = 0.0_wp
+    if (m > 0) lmax = maxval(rowsum)
+    call csc_op_init(op, m, colptr, rowind, val)
+
+  contains
+
+    !> Column j's entries from the blocks of its two bodies: rows into list(1:n), values
+    !! summed into acc (when add).
+    subroutine visit(jj, add)
+      integer, intent(in) :: jj
+      logical, intent(in) :: add
+      integer :: side, b, col, ii, sl, r
+      do side = 1, 2
+        b = owner(2*side - 1, jj)
+        col = owner(2*side, jj)
+        do ii = 1, bodies(b)%m
+          sl = bodies(b)%slots(ii)
+          r = sl - ((sl - 1)/m)*m
+          if (mark(r) == 0) then
+            n = n + 1
+            list(n) = r
+            mark(r) = 1
+          end if
+          if (add) acc(r) = acc(r) + bodies(b)%flex(ii, col)
+        end do
+      end do
+    end subroutine visit
+
+  end subroutine assemble_hessian
+
+  !> y = H x + rho G'(G x).
+  subroutine penalized_apply(self, x, y)
+    class(penalized_op_t), intent(inout) :: self
+    real(wp), intent(in) :: x(:)
+    real(wp), intent(out) :: y(:)
+    real(wp), allocatable :: gx(:)
+    call self%h%apply(x, y)
+    if (.not. allocated(self%g)) return
+    if (size(self%g, 1) == 0) return
+    allocate (gx(size(self%g, 1)))
+    call dgemv('N', size(self%g, 1), size(self%g, 2), 1.0_wp, self%g, size(self%g, 1), x, 1, 0.0_wp, gx, 1)
+    call dgemv('T', size(self%g, 1), size(self%g, 2), self%rho, self%g, size(self%g, 1), gx, 1, 1.0_wp, y, 1)
+  end subroutine penalized_apply
+
+  !> G <- L^-1 G, e <- L^-1 e with G G' = L L' (Cholesky): rows with G G' = I, the same
+  !! constraint. info /= 0: G G' is not definite (dependent rows).
+  subroutine orthonormal_rows(g, e, l, info)
+    real(wp), intent(inout) :: g(:, :), e(:)
+    real(wp), allocatable, intent(out) :: l(:, :)
+    integer, intent(out) :: info
+    integer :: r, i
+    r = size(g, 1)
+    allocate (l(r, r))
+    call dsyrk('L', 'N', r, size(g, 2), 1.0_wp, g, r, 0.0_wp, l, r)
+    call dpotrf('L', r, l, r, info)
+    if (info /= 0) return
+    do i = 1, r - 1
+      l(i, i + 1:) = 0.0_wp
+    end do
+    call dtrsm('L', 'L', 'N', 'N', r, size(g, 2), 1.0_wp, l, r, g, r)
+    call dtrsv('L', 'N', 'N', r, l, r, e, 1)
+  end subroutine orthonormal_rows
 
 end module monolithic

@@ -1,18 +1,20 @@
-!> The Robin domain-decomposition iteration (doc/method.md, "Method as implemented"):
-!! each body's contact problem against its obstacle (module robin_subproblems), the force
-!! imbalance d = lam_1 - lam_2, its Robin correction (module robin_operators), and the
-!! relaxed or accelerated update of the obstacles (module acceleration), until the bodies
-!! agree. Everything here is interface-sized: O(m^2) per Hessian product.
+!> The Robin domain-decomposition iteration (doc/method.md, "Method as implemented",
+!! "Several bodies and contact pairs"): each body's contact problem against its obstacles
+!! on all its contact rows (module robin_subproblems), the force imbalance of every row
+!! d = lam_side1 - lam_side2, its Robin correction (module robin_operators), and the relaxed
+!! or accelerated update of the obstacles (module acceleration), until the bodies agree.
+!! Everything here is interface-sized: O(m_a^2) per body and Hessian product.
 module robin_iteration
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use config, only: solver_cfg_t, STOP_RESIDUAL
   use clock, only: wtime
-  use condense, only: interface_t, body_condensed_t
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
                            STATUS_INTERRUPTED
-  use contact_common, only: interface_residual, maxabs, all_finite
+  use contact_common, only: interface_residual, maxabs, all_finite, gather, scatter
   use errors, only: error_t
   use robin_operators, only: robin_operator_t, new_robin_operator
   use robin_subproblems, only: subproblems_t, subproblems_init, solve_subproblems
@@ -32,8 +34,8 @@ contains
   !! is called every ckpt%every iterations and when `stop_requested` turns true.
   subroutine solve_robin(solver, contact_line, bodies, res, progress_unit, progress_lines, state, ckpt, stop_requested)
     type(solver_cfg_t), intent(in) :: solver                !< solver settings
-    type(interface_t), intent(in) :: contact_line           !< contact line
-    type(body_condensed_t), intent(in) :: bodies(2)         !< condensed bodies
+    type(interface_t), intent(in) :: contact_line           !< contact rows of all pairs
+    type(body_condensed_t), intent(in) :: bodies(:)         !< condensed bodies
     type(contact_result_t), intent(inout) :: res            !< solution, status and history (in: history of a restart)
     integer, intent(in), optional :: progress_unit          !< unit for progress lines (none if absent)
     integer, intent(in), optional :: progress_lines         !< at most about this many progress lines (default 30)
@@ -57,13 +59,13 @@ contains
       t0 = t0 - run_state%wall
     else
       ! the history grows as the run goes (max_outer may be huge)
-      call alloc_result(res, m, min(solver%max_outer, HISTORY_CHUNK))
-      call state_init(run_state, m, contact_line%g0)
+      call alloc_result(res, m, min(solver%max_outer, HISTORY_CHUNK), size(bodies))
+      call state_init(run_state, m, contact_line%g0, size(bodies))
     end if
     res%method = 'robin'
 
     robin_op = new_robin_operator(solver%robin_operator)
-    call subproblems_init(subproblems, bodies, robin_op, run_state, resumed)
+    call subproblems_init(subproblems, contact_line, bodies, robin_op, run_state, resumed)
     call robin_op%setup(solver, contact_line, bodies, subproblems%flexibility, err)
     if (err%failed()) then
       res%message = err%text()
@@ -94,7 +96,7 @@ contains
                         progress_unit, ckpt, stop_requested)
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
     type(subproblems_t), target, intent(inout) :: subproblems     !< (the Robin operator may refer to its F_a)
     class(robin_operator_t), intent(inout) :: robin_op
     real(wp), intent(in) :: t0                              !< wall time the iteration started at
@@ -106,12 +108,15 @@ contains
     procedure(stop_iface), optional :: stop_requested
     real(wp), allocatable :: g_new(:, :), w(:, :), dlam(:), corr(:, :)
     real(wp) :: rtol_in, uref
-    integer :: m, it
+    integer :: m, it, a
     logical :: printed
 
     m = contact_line%m
     allocate (g_new(m, 2), w(m, 2), dlam(m), corr(m, 2))
-    uref = max(maxabs(bodies(1)%b), maxabs(bodies(2)%b), maxabs(contact_line%g0), tiny(1.0_wp))
+    uref = max(maxabs(contact_line%g0), tiny(1.0_wp))
+    do a = 1, size(bodies)
+      uref = max(uref, maxabs(bodies(a)%b))
+    end do
     printed = .false.
     do it = run_state%it + 1, solver%max_outer
       ! 1. each body against its obstacle, in parallel
@@ -175,18 +180,21 @@ contains
   !! displacements B_a u_a = b_a - F_a lam_a and the residuals recomputed.
   subroutine restore_iterate(contact_line, bodies, subproblems, run_state, res)
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
     type(subproblems_t), intent(inout) :: subproblems
     type(robin_state_t), intent(in) :: run_state
     type(contact_result_t), intent(inout) :: res
-    real(wp), allocatable :: flam(:)
+    real(wp), allocatable :: flam(:), wa(:)
     integer :: a
-    allocate (flam(contact_line%m))
     res%lam_body = run_state%lam
-    do a = 1, 2
-      if (contact_line%m > 0) call subproblems%flexibility(a)%apply(run_state%lam(:, a), flam)
-      res%w(:, a) = bodies(a)%b - flam
-      if (bodies(a)%nrig > 0) res%w(:, a) = res%w(:, a) - matmul(run_state%mu(1:bodies(a)%nrig, a), bodies(a)%rg)
+    do a = 1, size(bodies)
+      if (bodies(a)%m == 0) cycle
+      allocate (flam(bodies(a)%m))
+      call subproblems%flexibility(a)%apply(gather(run_state%lam, bodies(a)%slots), flam)
+      wa = bodies(a)%b - flam
+      if (bodies(a)%nrig > 0) wa = wa - matmul(run_state%mu(1:bodies(a)%nrig, a), bodies(a)%rg)
+      call scatter(wa, bodies(a)%slots, res%w)
+      deallocate (flam)
     end do
     res%rigid = -run_state%mu
     call interface_residual(contact_line, bodies, res)
@@ -202,18 +210,22 @@ contains
   subroutine record_iteration(solver, contact_line, bodies, it, g_new, w, t0, run_state, res)
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
     integer, intent(in) :: it
     real(wp), intent(in) :: g_new(:, :), w(:, :), t0
     type(robin_state_t), intent(inout) :: run_state
     type(contact_result_t), intent(inout) :: res
-    real(wp) :: denom(2), ref, incr
+    real(wp) :: denom(2), ref, incr, bsum
     integer :: a
     res%lam_body = run_state%lam
     res%w = w
     res%rigid = -run_state%mu
     call interface_residual(contact_line, bodies, res)
-    ref = tiny(1.0_wp) + 1.0e-14_wp*(maxabs(bodies(1)%b) + maxabs(bodies(2)%b) + maxabs(contact_line%g0))
+    bsum = 0.0_wp
+    do a = 1, size(bodies)
+      bsum = bsum + maxabs(bodies(a)%b)
+    end do
+    ref = tiny(1.0_wp) + 1.0e-14_wp*(bsum + maxabs(contact_line%g0))
     do a = 1, 2
       denom(a) = max(norm2(g_new(:, a)), ref)
     end do

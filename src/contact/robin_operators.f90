@@ -1,18 +1,22 @@
-!> The Robin operators of the outer iteration (doc/method.md, "Method as implemented"):
-!! body 1's obstacle moves by S_1 d, body 2's by -S_2 d (d = lam_1 - lam_2).
-!! 'steklov' (the paper's: S_1 = F_2, S_2 = F_1), 'constant' (S_1 = S_2 = alpha M^-1) and
-!! 'harmonic' (S_1 = S_2 = 2 F_1 (F_1+F_2)^-1 F_2) extend one abstract type; they differ in
-!! the correction itself, the inner tolerance, the bound of lambda_max(F_a) the subproblems
-!! use, and the proximal term of a body with a singular F_a. `new_robin_operator` is the
-!! one place that picks the operator from the decoded setting (config's ROBIN_*).
+!> The Robin operators of the outer iteration (doc/method.md, "Method as implemented",
+!! "Several bodies and contact pairs"): on every contact row, side 1's obstacle moves by
+!! corr(:, 1), side 2's by -corr(:, 2), from the imbalance d = lam_side1 - lam_side2.
+!! 'steklov' (the paper's: each body's flexibility on its own imbalance over all its rows,
+!! moving its partners' obstacles; two bodies: S_1 = F_2, S_2 = F_1), 'constant'
+!! (S = alpha M^-1) and 'harmonic' (per pair, S = 2 (F_A^-1 + F_B^-1)^-1 of the pair's
+!! blocks) extend one abstract type; they differ in the correction itself, the inner
+!! tolerance, the bound of lambda_max(F_a) the subproblems use, and the proximal term of a
+!! body with a singular F_a. `new_robin_operator` is the one place that picks the operator
+!! from the decoded setting (config's ROBIN_*).
 module robin_operators
   use kinds, only: wp
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init
-  use lapack, only: dgemm, dposv, dgesv
+  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd
   use mprgp, only: lambda_max_estimate
-  use condense, only: interface_t, body_condensed_t
-  use contact_common, only: other_body
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t
+  use contact_common, only: pair_positions
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
@@ -24,13 +28,13 @@ module robin_operators
   contains
     !> Build the correction once, before the outer loop.
     procedure(setup_iface), deferred :: setup
-    !> corr(:, 1) = S_1 d, corr(:, 2) = S_2 d; count grows by the Hessian-sized products.
+    !> corr(:, 1), corr(:, 2) from d; count grows by the Hessian-sized products.
     procedure(apply_iface), deferred :: apply
     !> The inner tolerance of outer iteration `it` (default: follows the outer progress).
     procedure :: inner_tolerance => progress_tolerance
     !> A bound of lambda_max(F_a) for MPRGP (default: the row-sum norm, no product).
     procedure :: body_lambda_max => row_sum_bound
-    !> The proximal term Pi_a of a body whose F_a is singular (default: the other body's F).
+    !> The proximal term Pi_a of a body whose F_a is singular (default: its partners' F).
     procedure :: proximal_term => other_flexibility
   end type robin_operator_t
 
@@ -41,12 +45,12 @@ module robin_operators
       class(robin_operator_t), intent(inout) :: self
       type(solver_cfg_t), intent(in) :: solver
       type(interface_t), intent(in) :: contact_line
-      type(body_condensed_t), intent(in) :: bodies(2)
-      type(dense_op_t), target, intent(in) :: flexibility(2)    !< F_a as operators (kept by reference)
+      type(body_condensed_t), intent(in) :: bodies(:)
+      type(dense_op_t), target, intent(in) :: flexibility(:)    !< F_a as operators (kept by reference)
       type(error_t), intent(out) :: err
     end subroutine setup_iface
 
-    !> corr(:, 1) = S_1 d, corr(:, 2) = S_2 d.
+    !> The corrections of both sides of every row from the imbalance d.
     subroutine apply_iface(self, d, corr, count)
       import :: robin_operator_t, wp
       class(robin_operator_t), intent(inout) :: self
@@ -56,11 +60,13 @@ module robin_operators
     end subroutine apply_iface
   end interface
 
-  !> 'steklov': each obstacle corrected by the other body's flexibility (a floating body's
-  !! on self-equilibrated forces only: `projected_flex`).
+  !> 'steklov': each body's flexibility on its own imbalance (its force minus its partners'
+  !! on its rows) corrects its partners' obstacles (a floating body's on self-equilibrated
+  !! forces only: `projected_flex`).
   type, extends(robin_operator_t), public :: steklov_operator_t
     type(dense_op_t), pointer :: flexibility(:) => null()   !< F_a (the subproblems' operators)
-    type(dense_op_t) :: projected(2)             !< P_a F_a P_a of a floating body (n = 0: none)
+    type(dense_op_t), allocatable :: projected(:)  !< P_a F_a P_a of a floating body (n = 0: none)
+    type(slots_t), allocatable :: at(:)            !< each body's slots in the side layout
   contains
     procedure :: setup => steklov_setup
     procedure :: apply => steklov_apply
@@ -75,9 +81,11 @@ module robin_operators
     procedure :: apply => constant_apply
   end type constant_operator_t
 
-  !> 'harmonic': S = 2 F_1 (F_1+F_2)^-1 F_2 for both obstacles (contrast-robust).
+  !> 'harmonic': per pair, S = 2 F_A (F_A+F_B)^-1 F_B of the pair's blocks of its two
+  !! bodies' flexibilities, for both obstacles (contrast-robust).
   type, extends(robin_operator_t), public :: harmonic_operator_t
-    type(dense_op_t) :: s                    !< S, formed once
+    type(dense_op_t), allocatable :: s(:)    !< S of each pair, formed once
+    integer, allocatable :: rows(:, :)       !< (2, pairs) each pair's rows, first and last
   contains
     procedure :: setup => harmonic_setup
     procedure :: apply => harmonic_apply
@@ -85,6 +93,24 @@ module robin_operators
     procedure :: body_lambda_max => power_estimate
     procedure :: proximal_term => kernel_proximal
   end type harmonic_operator_t
+
+  !> A body of a two-body pair: its flexibility and, for a floating body, its equilibrium rows.
+  type :: block_t
+    real(wp), allocatable :: f(:, :)
+    real(wp), allocatable :: g(:, :)
+    integer :: nrig = 0
+  end type block_t
+
+  !> A body's stiffness on its contact rows and its infinitely stiff directions.
+  type :: stiffness_t
+    real(wp), allocatable :: k(:, :)
+    real(wp), allocatable :: inf(:, :)
+  end type stiffness_t
+
+  !> A body's slots in the side layout (body_condensed_t%slots).
+  type :: slots_t
+    integer, allocatable :: v(:)
+  end type slots_t
 
   public :: new_robin_operator
 
@@ -114,7 +140,7 @@ contains
     integer, intent(in) :: it                      !< outer iteration
     integer, intent(in) :: m                       !< contact nodes
     real(wp), intent(in) :: progress               !< min(increment, residual) of iteration it - 1
-    real(wp), intent(in) :: lmax(2)                !< bounds of lambda_max(F_a)
+    real(wp), intent(in) :: lmax(:)                !< bounds of lambda_max(F_a), per body
     if (it == 1) then
       rtol_in = solver%inner_rtol_max
     else
@@ -134,15 +160,37 @@ contains
     nmv = 0
   end function row_sum_bound
 
-  !> Pi_a = F_o, the other body's flexibility: F_a + F_o is the monolithic Hessian, definite
-  !! (doc/method.md, "Non-matching and curved contact surfaces: dual mortar").
-  subroutine other_flexibility(self, bodies, a, p)
+  !> Pi_a = the partners' flexibilities on body a's rows, pair by pair (two bodies: F_o,
+  !! the other body's): F_a + Pi_a is then the monolithic Hessian's part on those rows,
+  !! definite (doc/method.md, "Non-matching and curved contact surfaces: dual mortar").
+  subroutine other_flexibility(self, contact_line, bodies, a, p)
     class(robin_operator_t), intent(in) :: self
-    type(body_condensed_t), intent(in) :: bodies(2)    !< condensed bodies
+    type(interface_t), intent(in) :: contact_line      !< contact rows of all pairs
+    type(body_condensed_t), intent(in) :: bodies(:)    !< condensed bodies
     integer, intent(in) :: a                           !< the body with a singular F_a
     real(wp), intent(out) :: p(:, :)                   !< Pi_a
-    p = bodies(other_body(a))%flex
+    p = partner_flex(contact_line, bodies, a)
   end subroutine other_flexibility
+
+  !> Body a's partners' flexibilities on its rows: for each pair of a, the block of the
+  !! partner's F on the pair's rows, in a's positions; zero between pairs.
+  function partner_flex(contact_line, bodies, a) result(p)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    integer, intent(in) :: a
+    real(wp), allocatable :: p(:, :)
+    integer :: q, o, ra(2), ro(2)
+    allocate (p(bodies(a)%m, bodies(a)%m))
+    p = 0.0_wp
+    do q = 1, contact_line%npair
+      if (all(contact_line%pair_body(:, q) /= a)) cycle
+      o = sum(contact_line%pair_body(:, q)) - a
+      ra = pair_positions(bodies(a), contact_line, q)
+      ro = pair_positions(bodies(o), contact_line, q)
+      if (ra(2) < ra(1)) cycle
+      p(ra(1):ra(2), ra(1):ra(2)) = bodies(o)%flex(ro(1):ro(2), ro(1):ro(2))
+    end do
+  end function partner_flex
 
   ! ---- steklov ---------------------------------------------------------------------------
 
@@ -150,34 +198,61 @@ contains
     class(steklov_operator_t), intent(inout) :: self
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
-    type(dense_op_t), target, intent(in) :: flexibility(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
+    type(dense_op_t), target, intent(in) :: flexibility(:)
     type(error_t), intent(out) :: err
     integer :: a
-    do a = 1, 2
+    allocate (self%projected(size(bodies)), self%at(size(bodies)))
+    do a = 1, size(bodies)
       self%projected(a)%n = 0
-      if (bodies(a)%nrig > 0 .and. contact_line%m > 0) &
-        call dense_op_init(self%projected(a), projected_flex(bodies(a)))
+      self%at(a)%v = bodies(a)%slots
+      if (bodies(a)%nrig > 0 .and. bodies(a)%m > 0) call dense_op_init(self%projected(a), projected_flex(bodies(a)))
     end do
     self%flexibility => flexibility
   end subroutine steklov_setup
 
+  !> Body b's own imbalance d_b (+d on its side-1 rows, -d on its side-2 rows), y = F_b d_b,
+  !! and the partner's obstacle on each of those rows moves by -y (corr(:, 1) = -y where b
+  !! is side 2, corr(:, 2) = y where it is side 1). Two bodies: corr(:, 1) = F_2 d,
+  !! corr(:, 2) = F_1 d.
   subroutine steklov_apply(self, d, corr, count)
     class(steklov_operator_t), intent(inout) :: self
     real(wp), intent(in) :: d(:)
     real(wp), intent(out) :: corr(:, :)
     integer, intent(inout) :: count
-    if (self%projected(2)%n > 0) then
-      call self%projected(2)%apply(d, corr(:, 1))
-    else
-      call self%flexibility(2)%apply(d, corr(:, 1))
-    end if
-    if (self%projected(1)%n > 0) then
-      call self%projected(1)%apply(d, corr(:, 2))
-    else
-      call self%flexibility(1)%apply(d, corr(:, 2))
-    end if
-    count = count + 2
+    real(wp), allocatable :: db(:), y(:)
+    integer :: b, k, m, sl, row
+    m = size(d)
+    do b = 1, size(self%at)
+      associate (slots => self%at(b)%v)
+        if (size(slots) == 0) cycle
+        allocate (db(size(slots)), y(size(slots)))
+        do k = 1, size(slots)
+          sl = slots(k)
+          if (sl > m) then
+            db(k) = -d(sl - m)
+          else
+            db(k) = d(sl)
+          end if
+        end do
+        if (self%projected(b)%n > 0) then
+          call self%projected(b)%apply(db, y)
+        else
+          call self%flexibility(b)%apply(db, y)
+        end if
+        do k = 1, size(slots)
+          sl = slots(k)
+          if (sl > m) then
+            row = sl - m
+            corr(row, 1) = -y(k)
+          else
+            corr(sl, 2) = y(k)
+          end if
+        end do
+        deallocate (db, y)
+        count = count + 1
+      end associate
+    end do
   end subroutine steklov_apply
 
   !> P F_a P with P = I - G_a'(G_a G_a')^-1 G_a, the orthogonal projector on the forces that
@@ -207,8 +282,8 @@ contains
     class(constant_operator_t), intent(inout) :: self
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
-    type(dense_op_t), target, intent(in) :: flexibility(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
+    type(dense_op_t), target, intent(in) :: flexibility(:)
     type(error_t), intent(out) :: err
     self%alpha = solver%alpha
     self%w = contact_line%trib
@@ -226,41 +301,93 @@ contains
 
   ! ---- harmonic --------------------------------------------------------------------------
 
+  !> S of each pair. A pair whose two bodies are in no other pair (two bodies): from their
+  !! whole F (and, for a floating body, its equilibrium rows: `harmonic_floating`). Else
+  !! each body's stiffness on all its rows (`body_stiffness`: its other pairs' rows held,
+  !! which is what holds a floating body in a stack), its block on the pair's rows, and
+  !! S = 2 (Sigma_A + Sigma_B)^-1 of the blocks (`parallel_flex`).
   subroutine harmonic_setup(self, solver, contact_line, bodies, flexibility, err)
     class(harmonic_operator_t), intent(inout) :: self
     type(solver_cfg_t), intent(in) :: solver
     type(interface_t), intent(in) :: contact_line
-    type(body_condensed_t), intent(in) :: bodies(2)
-    type(dense_op_t), target, intent(in) :: flexibility(2)
+    type(body_condensed_t), intent(in) :: bodies(:)
+    type(dense_op_t), target, intent(in) :: flexibility(:)
     type(error_t), intent(out) :: err
     real(wp), allocatable :: s(:, :)
-    integer :: m, info
+    integer :: p, info, side, a, r(2, 2)
+    integer, allocatable :: npairs(:)
+    type(block_t) :: blk(2)
+    type(stiffness_t), allocatable :: stiff(:)
+    logical :: singular
     character(len=100) :: emsg
-    info = 0
-    m = contact_line%m
-    if (m == 0) return
-    if (bodies(1)%nrig + bodies(2)%nrig > 0) then
-      call harmonic_floating(bodies, s, info)
-    else
-      call harmonic_matrix(bodies(1)%flex, bodies(2)%flex, s, info)
-    end if
-    if (info /= 0 .and. bodies(1)%nrig + bodies(2)%nrig > 0 .and. (bodies(1)%rank < m .or. bodies(2)%rank < m)) then
-      call err%set(ERR_NUMERICAL, 'harmonic operator: a body held only by contact is a mortar master coarser than '// &
-                   'the slave (singular F): make it the slave (&contact slave), or use steklov or monolithic')
-    else if (info /= 0) then
-      write (emsg, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
-      call err%set(ERR_NUMERICAL, emsg)
-    else
-      call dense_op_init(self%s, s)
-    end if
+    allocate (self%s(contact_line%npair), self%rows(2, contact_line%npair), npairs(size(bodies)), stiff(size(bodies)))
+    npairs = 0
+    do p = 1, contact_line%npair
+      npairs(contact_line%pair_body(:, p)) = npairs(contact_line%pair_body(:, p)) + 1
+    end do
+    do p = 1, contact_line%npair
+      self%rows(:, p) = [contact_line%pair_ptr(p), contact_line%pair_ptr(p + 1) - 1]
+      self%s(p)%n = 0
+      if (self%rows(2, p) < self%rows(1, p)) cycle
+      singular = any([(bodies(contact_line%pair_body(side, p))%rank < bodies(contact_line%pair_body(side, p))%m, &
+                       side=1, 2)])
+      info = 0
+      if (all(npairs(contact_line%pair_body(:, p)) == 1)) then
+        do side = 1, 2
+          a = contact_line%pair_body(side, p)
+          blk(side)%f = bodies(a)%flex
+          blk(side)%nrig = bodies(a)%nrig
+          if (bodies(a)%nrig > 0) blk(side)%g = bodies(a)%rg
+        end do
+        if (blk(1)%nrig + blk(2)%nrig > 0) then
+          call harmonic_floating(blk, s, info)
+          ! a singular F (a mortar master coarser than the slave): no inverse of it
+          if (info /= 0 .and. singular) call harmonic_singular(blk, s, info)
+        else
+          call harmonic_matrix(blk(1)%f, blk(2)%f, s, info)
+        end if
+      else
+        do side = 1, 2
+          a = contact_line%pair_body(side, p)
+          r(:, side) = pair_positions(bodies(a), contact_line, p)
+          if (.not. allocated(stiff(a)%k)) then
+            call body_stiffness(bodies(a)%flex, bodies(a)%rg, stiff(a)%k, stiff(a)%inf, info)
+            if (info /= 0) exit
+          end if
+        end do
+        if (info == 0) then
+          associate (ka => stiff(contact_line%pair_body(1, p)), kb => stiff(contact_line%pair_body(2, p)))
+            call parallel_flex(ka%k(r(1, 1):r(2, 1), r(1, 1):r(2, 1)), ka%inf(r(1, 1):r(2, 1), :), &
+                               kb%k(r(1, 2):r(2, 2), r(1, 2):r(2, 2)), kb%inf(r(1, 2):r(2, 2), :), s, info)
+          end associate
+        end if
+      end if
+      if (info /= 0 .and. any(bodies(contact_line%pair_body(:, p))%nrig > 0) .and. singular) then
+        call err%set(ERR_NUMERICAL, 'harmonic operator: a body held only by contact is a mortar master coarser than '// &
+                     'the slave (singular F): make it the slave (&contact slave), or use steklov or monolithic')
+        return
+      else if (info /= 0) then
+        write (emsg, '(a,i0)') 'harmonic Robin operator: F_1 + F_2 is not positive definite, info = ', info
+        if (contact_line%npair > 1) write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: pair ', p, &
+          ': F_A + F_B is not positive definite, info = ', info
+        call err%set(ERR_NUMERICAL, emsg)
+        return
+      end if
+      call dense_op_init(self%s(p), s)
+    end do
   end subroutine harmonic_setup
 
+  !> corr(:, 1) = corr(:, 2) = S d, pair by pair.
   subroutine harmonic_apply(self, d, corr, count)
     class(harmonic_operator_t), intent(inout) :: self
     real(wp), intent(in) :: d(:)
     real(wp), intent(out) :: corr(:, :)
     integer, intent(inout) :: count
-    call self%s%apply(d, corr(:, 1))
+    integer :: p
+    do p = 1, size(self%s)
+      if (self%s(p)%n == 0) cycle
+      call self%s(p)%apply(d(self%rows(1, p):self%rows(2, p)), corr(self%rows(1, p):self%rows(2, p), 1))
+    end do
     corr(:, 2) = corr(:, 1)
     count = count + 1
   end subroutine harmonic_apply
@@ -273,7 +400,7 @@ contains
     class(harmonic_operator_t), intent(in) :: self
     type(solver_cfg_t), intent(in) :: solver
     integer, intent(in) :: it, m
-    real(wp), intent(in) :: progress, lmax(2)
+    real(wp), intent(in) :: progress, lmax(:)
     rtol_in = max(sqrt(real(max(m, 1), wp))*epsilon(1.0_wp), &
                   solver%inner_factor*solver%tol*minval(lmax)/max(maxval(lmax), tiny(1.0_wp)))
   end function harmonic_tolerance
@@ -288,34 +415,35 @@ contains
     lmax = lambda_max_estimate(flexibility, POWER_ITS, nmv)
   end function power_estimate
 
-  !> Pi_a = Z R Z' on ker F_a only (Z its basis, R = Z' F_o Z floored): S annihilates
-  !! ker F_a, so only the kernel needs pinning, and the body stays exact on range F_a.
-  !! Without a kernel basis, F_o (doc/method.md, "Non-matching and curved contact surfaces:
+  !> Pi_a = Z R Z' on ker F_a only (Z its basis, R = Z' F_o Z floored, F_o the partners'
+  !! flexibilities on a's rows): S annihilates ker F_a, so only the kernel needs pinning,
+  !! and the body stays exact on range F_a. Without a kernel basis, F_o (doc/method.md, "Non-matching and curved contact surfaces:
   !! dual mortar").
-  subroutine kernel_proximal(self, bodies, a, p)
+  subroutine kernel_proximal(self, contact_line, bodies, a, p)
     class(harmonic_operator_t), intent(in) :: self
-    type(body_condensed_t), intent(in) :: bodies(2)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
     integer, intent(in) :: a
     real(wp), intent(out) :: p(:, :)
-    real(wp), allocatable :: zf(:, :), zr(:, :), r(:, :)
+    real(wp), allocatable :: zf(:, :), zr(:, :), r(:, :), fo(:, :)
     real(wp) :: floor
-    integer :: i, k, m, o
+    integer :: i, k, m
+    fo = partner_flex(contact_line, bodies, a)
     if (.not. allocated(bodies(a)%kern)) then
-      call other_flexibility(self, bodies, a, p)
+      p = fo
       return
     end if
     m = bodies(a)%m
-    o = other_body(a)
     k = size(bodies(a)%kern, 2)
     allocate (zf(k, m), zr(m, k), r(k, k))
-    ! R = Z' F_o Z (k x k), floored so that F_a + Pi_a is definite even if F_o is nearly
-    ! singular on ker F_a
-    call dgemm('T', 'N', k, m, m, 1.0_wp, bodies(a)%kern, m, bodies(o)%flex, m, 0.0_wp, zf, k)
+    ! R = Z' F_o Z (k x k), F_o the partners' flexibilities, floored so that F_a + Pi_a is
+    ! definite even if F_o is nearly singular on ker F_a
+    call dgemm('T', 'N', k, m, m, 1.0_wp, bodies(a)%kern, m, fo, m, 0.0_wp, zf, k)
     call dgemm('N', 'N', k, k, m, 1.0_wp, zf, k, bodies(a)%kern, m, 0.0_wp, r, k)
     r = 0.5_wp*(r + transpose(r))
     floor = 0.0_wp
     do i = 1, m
-      floor = max(floor, 1.0e-10_wp*bodies(o)%flex(i, i))
+      floor = max(floor, 1.0e-10_wp*fo(i, i))
     end do
     do i = 1, k
       r(i, i) = r(i, i) + floor
@@ -342,26 +470,26 @@ contains
     s = 0.5_wp*(s + transpose(s))
   end subroutine harmonic_matrix
 
-  !> The harmonic operator with a floating body: S = 2 (Sigma_1 + Sigma_2)^-1, Sigma_a = F_a^-1
-  !! for a supported body and the projected inverse Q_a (`projected_inverse`) for a floating
-  !! one (doc/method.md, "Bodies held only by contact"). One floating body f, the other o
-  !! supported: S = 2 (I + F_o Q_f)^-1 F_o (no inverse of F_o). Both floating:
-  !! S = 2 (Q_1 + Q_2)^-1. info /= 0: a factorization failed.
-  subroutine harmonic_floating(bodies, s, info)
-    type(body_condensed_t), intent(in) :: bodies(2)
+  !> The harmonic operator of a pair with a floating body: S = 2 (Sigma_A + Sigma_B)^-1,
+  !! Sigma = F^-1 for a supported body's block and the projected inverse Q (`projected_inverse`)
+  !! for a floating one's (doc/method.md, "Bodies held only by contact"). One floating f, the
+  !! other o supported: S = 2 (I + F_o Q_f)^-1 F_o (no inverse of F_o). Both floating:
+  !! S = 2 (Q_A + Q_B)^-1. info /= 0: a factorization failed.
+  subroutine harmonic_floating(blk, s, info)
+    type(block_t), intent(in) :: blk(2)             !< the pair's blocks of its two bodies
     real(wp), allocatable, intent(out) :: s(:, :)
     integer, intent(out) :: info
     real(wp), allocatable :: q(:, :, :), a(:, :)
     integer, allocatable :: ipiv(:)
     integer :: m, f, o, i
-    m = bodies(1)%m
+    m = size(blk(1)%f, 1)
     allocate (q(m, m, 2), s(m, m), a(m, m), ipiv(m))
     do f = 1, 2
-      if (bodies(f)%nrig == 0) cycle
-      call projected_inverse(bodies(f), q(:, :, f), info)
+      if (blk(f)%nrig == 0) cycle
+      call projected_inverse(blk(f)%f, blk(f)%g, q(:, :, f), info)
       if (info /= 0) return
     end do
-    if (bodies(1)%nrig > 0 .and. bodies(2)%nrig > 0) then
+    if (blk(1)%nrig > 0 .and. blk(2)%nrig > 0) then
       a = q(:, :, 1) + q(:, :, 2)
       a = 0.5_wp*(a + transpose(a))
       s = 0.0_wp
@@ -370,30 +498,149 @@ contains
       end do
       call dposv('U', m, m, a, m, s, m, info)
     else
-      f = merge(1, 2, bodies(1)%nrig > 0)
-      o = other_body(f)
+      f = merge(1, 2, blk(1)%nrig > 0)
+      o = 3 - f
       ! (I + F_o Q_f) X = F_o, S = 2 X
-      a = matmul(bodies(o)%flex, q(:, :, f))
+      a = matmul(blk(o)%f, q(:, :, f))
       do i = 1, m
         a(i, i) = a(i, i) + 1.0_wp
       end do
-      s = 2.0_wp*bodies(o)%flex
+      s = 2.0_wp*blk(o)%f
       call dgesv(m, m, a, m, ipiv, s, m, info)
     end if
     s = 0.5_wp*(s + transpose(s))
   end subroutine harmonic_floating
 
-  !> The projected inverse Q = F^-1 - F^-1 G' (G F^-1 G')^-1 G F^-1 of a floating body.
-  subroutine projected_inverse(body, q, info)
-    type(body_condensed_t), intent(in) :: body
+  !> The harmonic operator of a pair of two bodies (in no other pair) with a floating body
+  !! and a singular F (a mortar master coarser than the slave): S = 2 (Sigma_A + Sigma_B)^-1
+  !! of their stiffnesses (`body_stiffness`, `parallel_flex`), no inverse of a singular F.
+  subroutine harmonic_singular(blk, s, info)
+    type(block_t), intent(in) :: blk(2)
+    real(wp), allocatable, intent(out) :: s(:, :)
+    integer, intent(out) :: info
+    type(stiffness_t) :: st(2)
+    integer :: side
+    do side = 1, 2
+      if (blk(side)%nrig > 0) then
+        call body_stiffness(blk(side)%f, blk(side)%g, st(side)%k, st(side)%inf, info)
+      else
+        call body_stiffness(blk(side)%f, reshape([real(wp) ::], [0, size(blk(side)%f, 1)]), st(side)%k, &
+                            st(side)%inf, info)
+      end if
+      if (info /= 0) return
+    end do
+    call parallel_flex(st(1)%k, st(1)%inf, st(2)%k, st(2)%inf, s, info)
+  end subroutine harmonic_singular
+
+  !> A body's stiffness on its contact rows, Sigma = Z (Z' F Z)^+ Z' (Z a basis of the
+  !! forces its equilibrium rows g see as balanced, Z = I without rows: for a nonsingular F
+  !! of a supported body, F^-1; of a floating one, its projected inverse), and the
+  !! directions where Z' F Z is singular, along which the body is infinitely stiff (the
+  !! multipliers a mortar master coarser than the slave cannot feel).
+  subroutine body_stiffness(f, g, k, inf, info)
+    real(wp), intent(in) :: f(:, :)                 !< (m, m) F
+    real(wp), intent(in) :: g(:, :)                 !< (r, m) equilibrium rows (r = 0: none)
+    real(wp), allocatable, intent(out) :: k(:, :)   !< (m, m) Sigma
+    real(wp), allocatable, intent(out) :: inf(:, :) !< (m, *) the infinitely stiff directions
+    integer, intent(out) :: info
+    real(wp), allocatable :: z(:, :), c(:, :), ev(:), work(:), y(:, :)
+    integer :: m, nz, i, lwork
+    m = size(f, 1)
+    z = complement(transpose(g), m)
+    nz = size(z, 2)
+    c = matmul(transpose(z), matmul(f, z))
+    c = 0.5_wp*(c + transpose(c))
+    allocate (ev(nz), work(max(1, 3*nz)), k(m, m))
+    k = 0.0_wp
+    info = 0
+    if (nz == 0) then
+      allocate (inf(m, 0))
+      return
+    end if
+    call dsyev('V', 'U', nz, c, nz, ev, work, -1, info)
+    lwork = max(3*nz, int(work(1)))
+    deallocate (work)
+    allocate (work(lwork))
+    call dsyev('V', 'U', nz, c, nz, ev, work, lwork, info)
+    if (info /= 0) return
+    y = matmul(z, c)   ! the eigenvectors in the rows' space
+    inf = y(:, pack([(i, i=1, nz)], ev <= 1.0e-10_wp*maxval(ev)))
+    do i = 1, nz
+      if (ev(i) <= 1.0e-10_wp*maxval(ev)) cycle
+      k = k + matmul(y(:, i:i), transpose(y(:, i:i)))/ev(i)
+    end do
+  end subroutine body_stiffness
+
+  !> S = 2 (Sigma_A + Sigma_B)^-1 of two stiffnesses on the same rows, zero along their
+  !! infinitely stiff directions: S = 2 V (V' (Sigma_A + Sigma_B) V)^-1 V', V a basis of the
+  !! complement of those directions (the subproblems' proximal term pins them instead, as for
+  !! a supported coarse master). info /= 0: V' (Sigma_A + Sigma_B) V is not definite.
+  subroutine parallel_flex(ka, infa, kb, infb, s, info)
+    real(wp), intent(in) :: ka(:, :), infa(:, :), kb(:, :), infb(:, :)
+    real(wp), allocatable, intent(out) :: s(:, :)
+    integer, intent(out) :: info
+    real(wp), allocatable :: v(:, :), t(:, :), x(:, :), dirs(:, :)
+    integer :: m, nv
+    m = size(ka, 1)
+    allocate (dirs(m, size(infa, 2) + size(infb, 2)), s(m, m))
+    dirs(:, 1:size(infa, 2)) = infa
+    dirs(:, size(infa, 2) + 1:) = infb
+    v = complement(dirs, m)
+    nv = size(v, 2)
+    s = 0.0_wp
+    info = 0
+    if (nv == 0) return
+    t = matmul(transpose(v), matmul(ka + kb, v))
+    t = 0.5_wp*(t + transpose(t))
+    x = transpose(v)
+    call dposv('U', nv, m, t, nv, x, nv, info)
+    if (info /= 0) return
+    s = 2.0_wp*matmul(v, x)
+    s = 0.5_wp*(s + transpose(s))
+  end subroutine parallel_flex
+
+  !> An orthonormal basis of the orthogonal complement of the columns of a (m x n): the
+  !! left singular vectors beyond its numerical rank (1e-10 of its largest singular value).
+  function complement(a, m) result(z)
+    real(wp), intent(in) :: a(:, :)
+    integer, intent(in) :: m
+    real(wp), allocatable :: z(:, :)
+    real(wp), allocatable :: u(:, :), sv(:), vt(:, :), work(:), ac(:, :)
+    integer :: n, r, lwork, info
+    n = size(a, 2)
+    if (n == 0) then
+      allocate (z(m, m))
+      z = 0.0_wp
+      do r = 1, m
+        z(r, r) = 1.0_wp
+      end do
+      return
+    end if
+    ac = a
+    allocate (u(m, m), sv(min(m, n)), vt(1, 1), work(1))
+    call dgesvd('A', 'N', m, n, ac, m, sv, u, m, vt, 1, work, -1, info)
+    lwork = max(1, int(work(1)))
+    deallocate (work)
+    allocate (work(lwork))
+    call dgesvd('A', 'N', m, n, ac, m, sv, u, m, vt, 1, work, lwork, info)
+    r = count(sv > 1.0e-10_wp*maxval(sv))
+    if (info /= 0) r = 0
+    z = u(:, r + 1:m)
+  end function complement
+
+  !> The projected inverse Q = F^-1 - F^-1 G' (G F^-1 G')^-1 G F^-1 of a floating body's
+  !! block F with its equilibrium rows G (full row rank).
+  subroutine projected_inverse(f, g, q, info)
+    real(wp), intent(in) :: f(:, :)
+    real(wp), intent(in) :: g(:, :)
     real(wp), intent(out) :: q(:, :)
     integer, intent(out) :: info
     real(wp), allocatable :: h(:, :), y(:, :), gg(:, :), t(:, :)
     integer :: m, r, i
-    m = body%m
-    r = body%nrig
+    m = size(f, 1)
+    r = size(g, 1)
     allocate (h(m, m), y(m, r), gg(r, r), t(r, m))
-    h = body%flex
+    h = f
     q = 0.0_wp
     do i = 1, m
       q(i, i) = 1.0_wp
@@ -401,8 +648,8 @@ contains
     call dposv('U', m, m, h, m, q, m, info)
     if (info /= 0) return
     ! y = F^-1 G', gg = G F^-1 G': q -= y gg^-1 y'
-    y = matmul(q, transpose(body%rg))
-    gg = matmul(body%rg, y)
+    y = matmul(q, transpose(g))
+    gg = matmul(g, y)
     t = transpose(y)
     call dposv('U', r, m, gg, r, t, r, info)
     if (info /= 0) return

@@ -17,6 +17,7 @@ module mpi_backend
   use mumps_iface, only: mumps_t, mumps_end
   use condense_mumps, only: factor_body_mumps, condense_body_mumps, recover_displacement_mumps
   use run_state, only: run_t
+  use contact_common, only: gather
   use run_backend, only: backend_t
   implicit none (type, external)
   private
@@ -205,7 +206,8 @@ contains
       if (.not. self%mine(b)) cycle
       allocate (uf(run%systems(b)%n))
       uf = 0.0_wp
-      call recover_displacement_mumps(run%systems(b), run%bodies(b), self%solver(b), b, run%result%lam_body(:, b), &
+      call recover_displacement_mumps(run%systems(b), run%bodies(b), self%solver(b), b, &
+                                      gather(run%result%lam_body, run%bodies(b)%slots), &
                                       uf, self%err(b))
       if (self%solver(b)%host) call expand(run%systems(b), uf, run%displacement(1:run%systems(b)%ndof, b))
       deallocate (uf)

@@ -1,5 +1,5 @@
 !> The phases both back-ends share, in the driver's order: the back-end's choice, the
-!! meshes and the assembly of both bodies, the contact line, the restart, the finiteness of
+!! meshes and the assembly of every body, the contact rows, the restart, the finiteness of
 !! the condensed data, the contact solve (rank 0), the displacements' rigid part, the
 !! result file; and the check for a signal between the phases.
 module run_phases
@@ -7,17 +7,17 @@ module run_phases
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
-  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, contact_cfg_t, pair_oriented
-  use mesh, only: mesh_build
-  use gmsh_msh, only: msh_read, msh_read_pair
+  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t
+  use mesh, only: mesh_t, mesh_build
+  use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, nodal_stress, stress_field_t
-  use condense, only: build_interface
+  use contact_interface, only: build_interface
   use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
-  use contact_common, only: other_body
+  use contact_common, only: gather
   use results, only: write_results
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file, mesh_identity
   use files, only: remove_file, special_file
@@ -52,6 +52,8 @@ contains
         if (.not. par_built) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)// &
           ': factorization=''mumps'' needs the MPI binary: run mpirun -np N bin/robin_contact_mpi '// &
           trim(deck%source)//' (built by make MPI=1); this binary has no MPI or MUMPS')
+        if (deck%nbody > 2) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//': factorization=''mumps'' '// &
+          'takes two bodies in this version, and the deck has '//i2s(deck%nbody)//'; use factorization=''cholmod''')
         allocate (mpi_backend_t :: backend)
         backend%assembles_matrix = .false.
       else
@@ -77,41 +79,62 @@ contains
     end if
   end subroutine choose_threads
 
-  !> Both bodies' meshes: from one file holding both (read and parsed once), from a file
-  !! each, or structured from the deck. A body from a mesh file is sized by its node count
-  !! (run%sized), and the memory is checked again with it.
+  !> Every body's mesh: the bodies that share one mesh file from it, read and parsed once;
+  !! a body alone in its file from that file; the others structured from the deck. A body
+  !! from a mesh file is sized by its node count (run%sized), and the memory is checked
+  !! again with it.
   subroutine read_meshes(run, backend)
     type(run_t), intent(inout) :: run                  !< the run: its meshes
     class(backend_t), intent(inout) :: backend         !< checks the memory
-    integer :: a
-    type(error_t) :: err(2)
+    integer :: a, b, k
+    type(error_t), allocatable :: err(:)
+    logical, allocatable :: done(:)
+    integer, allocatable :: ids(:)
     associate (deck => run%deck)
-      do a = 1, 2   ! opening a FIFO or device would wait or read forever
+      run%nbody = deck%nbody
+      allocate (run%meshes(deck%nbody), run%systems(deck%nbody), run%bodies(deck%nbody), err(deck%nbody), &
+                done(deck%nbody))
+      do a = 1, deck%nbody   ! opening a FIFO or device would wait or read forever
         if (len_trim(deck%body(a)%mesh) == 0) cycle
         if (special_file(trim(deck%body(a)%mesh))) call fail_on(error_t(ERR_INPUT, 'body '//i2s(a)// &
           ": mesh file '"//trim(deck%body(a)%mesh)//"': is not a regular file (a folder, FIFO or device)"), &
           'deck '//trim(deck%source))
       end do
-      if (len_trim(deck%body(1)%mesh) > 0 .and. deck%body(1)%mesh == deck%body(2)%mesh) then
-        call msh_read_pair(trim(deck%body(1)%mesh), [deck%body(1)%region, deck%body(2)%region], run%meshes, err, &
-                           run%threads)
-      else
-        !$omp parallel do num_threads(run%threads) schedule(static, 1)
-        do a = 1, 2
-          if (len_trim(deck%body(a)%mesh) > 0) then
-            call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a))
-          else
-            call mesh_build(run%meshes(a), deck%body(a))
-          end if
-        end do
-        !$omp end parallel do
-      end if
-      do a = 1, 2   ! the mesh reader's message names the body
+      ! bodies sharing a mesh file: the file parsed once for all of them
+      done = .false.
+      do a = 1, deck%nbody
+        if (done(a) .or. len_trim(deck%body(a)%mesh) == 0) cycle
+        ids = pack([(b, b=1, deck%nbody)], [(deck%body(b)%mesh == deck%body(a)%mesh, b=1, deck%nbody)])
+        if (size(ids) < 2) cycle
+        block
+          type(mesh_t), allocatable :: shared(:)
+          type(error_t), allocatable :: serr(:)
+          allocate (shared(size(ids)), serr(size(ids)))
+          call msh_read_shared(trim(deck%body(a)%mesh), [(deck%body(ids(k))%region, k=1, size(ids))], ids, shared, &
+                               serr, run%threads)
+          do k = 1, size(ids)
+            call move_mesh(shared(k), run%meshes(ids(k)))
+            err(ids(k)) = serr(k)
+            done(ids(k)) = .true.
+          end do
+        end block
+      end do
+      !$omp parallel do num_threads(run%threads) schedule(dynamic, 1)
+      do a = 1, deck%nbody
+        if (done(a)) cycle
+        if (len_trim(deck%body(a)%mesh) > 0) then
+          call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a))
+        else
+          call mesh_build(run%meshes(a), deck%body(a))
+        end if
+      end do
+      !$omp end parallel do
+      do a = 1, deck%nbody   ! the mesh reader's message names the body
         call fail_on(err(a), 'deck '//trim(deck%source))
       end do
       run%sized = deck
-      if (len_trim(deck%body(1)%mesh) > 0 .or. len_trim(deck%body(2)%mesh) > 0) then
-        do a = 1, 2
+      if (any([(len_trim(deck%body(a)%mesh) > 0, a=1, deck%nbody)])) then
+        do a = 1, deck%nbody
           if (len_trim(deck%body(a)%mesh) == 0) cycle
           run%sized%body(a)%nx = max(1, nint(sqrt(real(run%meshes(a)%nnode, wp))) - 1)
           run%sized%body(a)%ny = max(1, run%meshes(a)%nnode/(run%sized%body(a)%nx + 1) - 1)
@@ -119,47 +142,72 @@ contains
         call backend%check_memory(run, run%sized)
       end if
     end associate
+
+  contains
+
+    !> The mesh built from the shared file into its place (no copy of the arrays kept).
+    subroutine move_mesh(from, to)
+      type(mesh_t), intent(inout) :: from
+      type(mesh_t), intent(out) :: to
+      to = from
+    end subroutine move_mesh
+
   end subroutine read_meshes
 
-  !> Both bodies' DOF numbering and loads, one thread each; the stiffness too unless each
-  !! rank assembles its cells' share later (MUMPS).
+  !> Every body's DOF numbering and loads, the bodies on the threads; the stiffness too
+  !! unless each rank assembles its cells' share later (MUMPS). A body's contact groups
+  !! (one per pair it is in) are the assembly's to check.
   subroutine assemble_bodies(run, matrix)
     type(run_t), intent(inout) :: run   !< the run: its systems
     logical, intent(in) :: matrix       !< assemble the stiffness
-    type(error_t) :: err(2)
+    type(error_t), allocatable :: err(:)
     integer :: a
-    type(contact_cfg_t) :: pair   ! the pair of bodies 1 and 2, in that order
-    pair = pair_oriented(run%deck%pair(1))
     associate (deck => run%deck)
-      !$omp parallel do num_threads(run%threads) schedule(static, 1)
-      do a = 1, 2
+      allocate (err(deck%nbody))
+      !$omp parallel do num_threads(run%threads) schedule(dynamic, 1)
+      do a = 1, deck%nbody
         call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
                            run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
-                           contact_group=pair%body_group(a))
+                           contact_groups=body_groups(deck, a))
       end do
       !$omp end parallel do
-      do a = 1, 2
+      do a = 1, deck%nbody
         ! assembly's messages name their body
         call fail_on(err(a), 'deck '//trim(deck%source))
       end do
     end associate
   end subroutine assemble_bodies
 
-  !> The contact line between the bodies; for a body held only by contact, its
-  !! equilibrium rows, and whether the contact can hold it (exit 1 if not).
+  !> The contact groups of body a, one per pair it takes part in ('' : its 'contact' side).
+  function body_groups(deck, a) result(g)
+    type(deck_t), intent(in) :: deck
+    integer, intent(in) :: a
+    character(len=128), allocatable :: g(:)
+    integer :: p, s
+    allocate (g(0))
+    do p = 1, deck%npair
+      do s = 1, 2
+        if (deck%pair(p)%bodies(s) == a) g = [g, deck%pair(p)%body_group(s)]
+      end do
+    end do
+  end function body_groups
+
+  !> The contact rows of every pair; for a body held only by contact, its equilibrium
+  !! rows, and whether the contact can hold it (exit 1 if not).
   subroutine build_contact_line(run)
-    type(run_t), intent(inout) :: run   !< the run: its contact line and bodies' rigid rows
+    type(run_t), intent(inout) :: run   !< the run: its contact rows and bodies' rigid rows
     type(error_t) :: err
     integer :: a
-    call build_interface(run%deck%body, pair_oriented(run%deck%pair(1)), run%meshes, run%systems, run%contact_line, err)
+    call build_interface(run%deck%body, run%deck%pair(1:run%deck%npair), run%deck%pairs_named, run%meshes, &
+                         run%systems, run%contact_line, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
-    do a = 1, 2
+    do a = 1, run%nbody
       call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
     end do
-    if (run%systems(1)%nrig + run%systems(2)%nrig == 0) return
-    call check_held(run%systems, run%bodies, err)
+    if (sum(run%systems(:)%nrig) == 0) return
+    call check_held(run%contact_line, run%systems, run%bodies, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
-    do a = 1, 2
+    do a = 1, run%nbody
       associate (system => run%systems(a))
         if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
           'contact (free: '//free_list(system)//'); fixing DOFs for its generalized inverse: '//fixing_list(system)// &
@@ -173,23 +221,31 @@ contains
   subroutine read_restart(run)
     type(run_t), intent(inout) :: run   !< the run: its mesh hashes, Robin state and result
     type(error_t) :: err
-    call mesh_identity([run%deck%body(1)%mesh, run%deck%body(2)%mesh], run%mesh_ids, err)
+    call mesh_identity(run%deck%body(1:run%nbody)%mesh, run%mesh_ids, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
     if (len(run%restart_file) == 0) return
-    call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%deck%solver%max_outer, &
-                         run%robin_state, run%result, err)
+    call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%nbody, &
+                         run%deck%solver%max_outer, run%robin_state, run%result, err)
     call fail_on(err)
   end subroutine read_restart
 
-  !> The budget's estimate of body a's Cholesky factor, '123 MiB' or '1.2 GiB'.
+  !> The budget's estimate of body a's Cholesky factor (all bodies' without a), '123 MiB'
+  !! or '1.2 GiB'.
   function factor_estimate(run, a) result(s)
-    type(run_t), intent(in) :: run   !< the run: its sized deck
-    integer, intent(in) :: a         !< the body
+    type(run_t), intent(in) :: run            !< the run: its sized deck
+    integer, intent(in), optional :: a        !< the body
     character(len=:), allocatable :: s
-    real(wp) :: nm, nf, mib
+    real(wp) :: nm, nf, mib, total
+    integer :: b
     character(len=24) :: buf
-    mib = body_memory_mb(run%sized%body(a), run%deck%solver%factor, nm, nf)   ! the body's total; the factor's part:
-    mib = 8.5_wp*nf/1048576.0_wp                                              ! values and supernodal indices
+    mib = 0.0_wp
+    do b = 1, run%nbody
+      if (present(a)) then
+        if (b /= a) cycle
+      end if
+      total = body_memory_mb(run%sized%body(b), run%deck%solver%factor, nm, nf)   ! the body's total; the factor's part:
+      mib = mib + 8.5_wp*nf/1048576.0_wp                                     ! values and supernodal indices
+    end do
     if (mib >= 1024.0_wp) then
       write (buf, '(f0.1,a)') mib/1024.0_wp, ' GiB'
     else
@@ -205,7 +261,7 @@ contains
     integer :: a
     type(error_t) :: err
     character(len=1024) :: msg
-    do a = 1, 2
+    do a = 1, run%nbody
       if (.not. all(ieee_is_finite(run%bodies(a)%flex))) then
         write (msg, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
           run%deck%body(a)%young, '): the stiffness is out of the range of double precision; rescale the units'
@@ -218,7 +274,7 @@ contains
     end do
     ! a floating body with no load along its free motions: is it pressed by a deformation?
     ! (every rank decides, from the broadcast F_a and b_a, so that all stop together)
-    if (run%systems(1)%nrig + run%systems(2)%nrig == 0) return
+    if (sum(run%systems(:)%nrig) == 0) return
     call check_pressed(run%systems, run%contact_line, run%bodies, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
   end subroutine check_condensed
@@ -235,9 +291,11 @@ contains
     if (run%rank /= 0) return
     associate (deck => run%deck, result => run%result, contact_line => run%contact_line, bodies => run%bodies)
       rigid = 0
-      do a = 1, 2
-        if (contact_line%m > 0 .and. all(bodies(a)%flex == 0.0_wp)) rigid = a
-      end do
+      if (contact_line%npair == 1) then
+        do a = 1, 2
+          if (contact_line%m > 0 .and. all(bodies(a)%flex == 0.0_wp)) rigid = a
+        end do
+      end if
       if (deck%solver%method == METHOD_MONOLITHIC) then
         call solve_monolithic(deck%solver, contact_line, bodies, result, stop_requested)
       else if (rigid > 0) then
@@ -245,7 +303,7 @@ contains
         ! problem is the other body's obstacle problem, one QP, which is also the Robin
         ! iteration's fixed point (doc/method.md, "A body rigid on the contact")
         write (output_unit, '(a)') 'robin: body '//body_label(rigid)//' does not move on the contact (every '// &
-          'contact DOF prescribed): the contact problem is body '//body_label(other_body(rigid))// &
+          'contact DOF prescribed): the contact problem is body '//body_label(3 - rigid)// &
           '''s obstacle problem, solved as one QP (method monolithic)'
         call solve_monolithic(deck%solver, contact_line, bodies, result, stop_requested)
       else
@@ -260,20 +318,21 @@ contains
       if (result%status == STATUS_FAILED) return
       call error_bound(contact_line, bodies, result)
       if (contact_line%m == 0) return
-      do a = 1, 2
+      do a = 1, run%nbody
         if (run%systems(a)%nrig == 0) cycle
-        associate (g => bodies(a)%rg, e => bodies(a)%re)
+        associate (g => bodies(a)%rg, e => bodies(a)%re, own => gather(result%lam_body, bodies(a)%slots), &
+                   mean => result%lam(bodies(a)%slots - ((bodies(a)%slots - 1)/contact_line%m)*contact_line%m))
           ! e = 0 (pressed by a deformation only): judged against the contact forces' size
           if (all(e == 0.0_wp)) then
-            scale = max(norm2(g)*norm2(result%lam), tiny(1.0_wp))
+            scale = max(norm2(g)*norm2(mean), tiny(1.0_wp))
             ratio = '|G lam|/(|G| |lam|) = '
           else
             scale = norm2(e)
             ratio = '|G lam - e|/|e| = '
           end if
           write (output_unit, '(a)') 'equilibrium: body '//body_label(a)//' '//ratio// &
-            sci(norm2(matmul(g, result%lam_body(:, a)) - e)/scale)//' (its own force), '// &
-            sci(norm2(matmul(g, result%lam) - e)/scale)//' (mean force); rigid motion '// &
+            sci(norm2(matmul(g, own) - e)/scale)//' (its own force), '// &
+            sci(norm2(matmul(g, mean) - e)/scale)//' (mean force); rigid motion '// &
             'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates '// &
             i2s(result%eq_updates)
         end associate
@@ -301,7 +360,7 @@ contains
     integer :: a
     if (run%result%status == STATUS_FAILED) return
     if (run%rank == 0) then
-      do a = 1, 2
+      do a = 1, run%nbody
         associate (system => run%systems(a))
           if (system%nrig > 0) run%displacement(1:system%ndof, a) = run%displacement(1:system%ndof, a) + &
                                                               matmul(system%rig, run%result%rigid(1:system%nrig, a))
@@ -333,9 +392,10 @@ contains
   !> Each body's nodal stresses from its displacement (what the result file shows).
   function body_stresses(run) result(stress)
     type(run_t), intent(in) :: run
-    type(stress_field_t) :: stress(2)
+    type(stress_field_t), allocatable :: stress(:)
     integer :: a, nnode
-    do a = 1, 2
+    allocate (stress(run%nbody))
+    do a = 1, run%nbody
       nnode = run%meshes(a)%nnode
       allocate (stress(a)%sigma(4, nnode), stress(a)%von_mises(nnode))
       call nodal_stress(run%meshes(a), run%deck%body(a), run%deck%plane_strain, &

@@ -1,5 +1,5 @@
-!> The data of one run, handed from phase to phase by the driver: the deck, both bodies
-!! from their meshes to their condensed flexibilities, the contact line, the contact
+!> The data of one run, handed from phase to phase by the driver: the deck, every body
+!! from its mesh to its condensed flexibility, the contact rows of all pairs, the contact
 !! result, the displacements, the timing and the exit code. Also the rank's role in the
 !! MPI binary: printing is rank 0's, and a fatal error ends every rank alike when all meet
 !! it (collective phases) or aborts them all when one rank meets it alone.
@@ -11,7 +11,8 @@ module run_state
   use deck, only: deck_text
   use mesh, only: mesh_t
   use assembly, only: body_system_t
-  use condense, only: interface_t, body_condensed_t
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t
   use results, only: timing_t
   use strings, only: fmt_real
@@ -30,14 +31,15 @@ module run_state
     character(len=:), allocatable :: restart_file      !< checkpoint to restart from ('' none)
     character(len=:), allocatable :: key               !< the deck's physics, which a checkpoint must match
     character(len=:), allocatable :: mesh_ids          !< content hashes of the mesh files, which a checkpoint must match
-    integer :: threads = 1                             !< OpenMP threads over the two bodies
-    type(mesh_t) :: meshes(2)                          !< the bodies' meshes
-    type(body_system_t) :: systems(2)                  !< their DOF maps, stiffnesses and loads
-    type(interface_t) :: contact_line                  !< the contact line (mortar pairing)
-    type(body_condensed_t) :: bodies(2)                !< the bodies condensed on the contact line
+    integer :: threads = 1                             !< OpenMP threads over the bodies
+    integer :: nbody = 2                               !< bodies
+    type(mesh_t), allocatable :: meshes(:)             !< the bodies' meshes
+    type(body_system_t), allocatable :: systems(:)     !< their DOF maps, stiffnesses and loads
+    type(interface_t) :: contact_line                  !< the contact rows of all pairs (mortar pairing)
+    type(body_condensed_t), allocatable :: bodies(:)   !< the bodies condensed on their contact rows
     type(robin_state_t) :: robin_state                 !< the Robin iteration's state (restart)
     type(contact_result_t) :: result                   !< contact forces, status, counts
-    real(wp), allocatable :: displacement(:, :)        !< (max ndof, 2) both bodies' displacements
+    real(wp), allocatable :: displacement(:, :)        !< (max ndof, bodies) the bodies' displacements
     type(timing_t) :: timing                           !< time per phase, memory
     logical :: written = .false.                       !< this run's result file exists
     integer :: code = 0                                !< the exit code

@@ -5,10 +5,10 @@ module run_summary
   use, intrinsic :: iso_fortran_env, only: error_unit
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED
   use config, only: solver_cfg_t, ROBIN_HARMONIC
-  use condense, only: contact_resultant
+  use contact_interface, only: contact_resultant
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   use sysinfo, only: write_stdout_checked
-  use strings, only: sci, fmt_real
+  use strings, only: sci, fmt_real, i2s
   use run_state, only: run_t
   implicit none (type, external)
   private
@@ -41,24 +41,18 @@ contains
   !! full disk or a closed pipe) is a failure, exit 3: scripts read the result: line.
   subroutine summary(run)
     type(run_t), intent(inout) :: run   !< the run: its result and timing; its code on failure
-    real(wp) :: ftot, fres(2)
     character(len=1024) :: line(5)
+    character(len=1024), allocatable :: pairs(:)
     integer :: err(5), k
     if (run%rank /= 0) return
     associate (result => run%result, timing => run%timing)
       err = 0
-      ftot = 0.0_wp
-      fres = 0.0_wp
-      if (allocated(result%lam)) then
-        ftot = sum(result%lam)
-        fres = contact_resultant(run%contact_line, 1, result%lam)
-      end if
-      write (line(1), '(a,i0,a,es10.3,a,es10.3,a,es10.3)') 'contact: resultant_on_body1='// &
-        sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', result%active, &
-        ' imbalance=', result%imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity
-      if (result%outer > 0) then
+      pairs = pair_lines(run)
+      if (result%outer > 0 .and. result%kappa < 0.0_wp) then
+        line(2) = 'accuracy: no a posteriori bound ('//i2s(run%contact_line%m)//' contact rows: beyond the dense bound''s size)'
+      else if (result%outer > 0) then
         line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(result%error_bound)// &
-          ' (a posteriori bound, cond(F1+F2) ~ '//sci(result%kappa)//')'
+          ' (a posteriori bound, cond('//trim(merge('F1+F2', 'H    ', run%contact_line%npair <= 1))//') ~ '//sci(result%kappa)//')'
       else
         line(2) = 'accuracy: none (stopped before the first outer iteration: no contact forces to bound)'
       end if
@@ -70,8 +64,14 @@ contains
         ' n1=', run%systems(1)%n, ' n2=', run%systems(2)%n, ' m=', run%contact_line%m, &
         ' delta=', fmt_real(run%deck%solver%delta, '(f0.6)'), ' residual=', result%residual, &
         ' wall_s=', fmt_real(timing%total, '(f0.3)')
-      ! the output line sits before the time line when a result file was written
-      do k = 1, 4
+      line(4) = trim(line(4))//' bodies='//i2s(run%nbody)//' pairs='//i2s(run%contact_line%npair)
+      ! one contact line per pair; the output line sits before the time line when a result
+      ! file was written
+      do k = 1, size(pairs)
+        call write_stdout_checked(trim(pairs(k)), err(1))
+        if (err(1) /= 0) exit
+      end do
+      do k = 2, 4
         if (k == 3 .and. run%written) then
           call write_stdout_checked('output: '//trim(run%deck%output%file), err(5))
         end if
@@ -84,6 +84,44 @@ contains
       end if
     end associate
   end subroutine summary
+
+  !> The `contact:` line of each pair: the resultant of its forces on its first body, the sum
+  !! of its nodal normal forces, its active rows and imbalance, and the penetration and
+  !! complementarity of the whole run (one pair: the line without the pair's name).
+  function pair_lines(run) result(lines)
+    type(run_t), intent(in) :: run
+    character(len=1024), allocatable :: lines(:)
+    real(wp) :: ftot, fres(2), imbalance
+    integer :: p, np, r(2), active
+    character(len=:), allocatable :: head
+    np = max(1, run%contact_line%npair)
+    allocate (lines(np))
+    associate (result => run%result, itf => run%contact_line)
+      do p = 1, np
+        ftot = 0.0_wp
+        fres = 0.0_wp
+        active = result%active
+        imbalance = result%imbalance
+        head = 'contact: resultant_on_body1='
+        if (allocated(result%lam) .and. itf%npair > 0) then
+          r = [itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1]
+          ftot = sum(result%lam(r(1):r(2)))
+          fres = contact_resultant(itf, 1, result%lam, r(1), r(2))
+          if (itf%npair > 1) then
+            active = count(result%lam(r(1):r(2)) > 0.0_wp)
+            imbalance = 0.0_wp
+            if (norm2(result%lam(r(1):r(2))) > 0.0_wp) imbalance = norm2(result%lam_body(r(1):r(2), 1) - &
+                                                     result%lam_body(r(1):r(2), 2))/norm2(result%lam(r(1):r(2)))
+            head = 'contact: pair='//i2s(p)//' bodies='//i2s(itf%pair_body(1, p))//','//i2s(itf%pair_body(2, p))// &
+                   ' resultant_on_body'//i2s(itf%pair_body(1, p))//'='
+          end if
+        end if
+        write (lines(p), '(a,i0,a,es10.3,a,es10.3,a,es10.3)') head// &
+          sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', active, &
+          ' imbalance=', imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity
+      end do
+    end associate
+  end function pair_lines
 
   !> What a user whose Robin run did not converge should try next, in order: the robust
   !! operator and relaxation (the defaults), then the monolithic reference.

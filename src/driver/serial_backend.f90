@@ -1,11 +1,14 @@
-!> The serial back-end: both bodies in this process, one OpenMP thread each, factorized
-!! by CHOLMOD or the banded Cholesky (condense::factor_body).
+!> The serial back-end: every body in this process, the bodies on the OpenMP threads
+!! (dynamic schedule, largest first), factorized by CHOLMOD or the banded Cholesky
+!! (condense::factor_body).
 module serial_backend
   use kinds, only: wp
   use errors, only: terminate, error_t, fail_on
   use config, only: deck_t
   use assembly, only: expand
   use condense, only: factor_body, condense_body, recover_displacement
+  use contact_common, only: gather
+  use sorting, only: merge_sort_by_keys
   use sysinfo, only: memory_limit_mb
   use budget, only: check_budget
   use mpi_env, only: par_finalize
@@ -15,7 +18,7 @@ module serial_backend
   implicit none (type, external)
   private
 
-  !> Both bodies here, one thread each.
+  !> Every body here, the bodies on the threads.
   type, extends(backend_t), public :: serial_backend_t
   contains
     procedure :: check_memory, factor, condense, record_factor_memory, share_contact_forces, recover, &
@@ -34,44 +37,56 @@ contains
     call fail_on(err, 'deck '//trim(the_deck%source))
   end subroutine check_memory
 
-  !> Order and factorize both bodies, one thread each.
+  !> Order and factorize every body, the largest first.
   subroutine factor(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its systems factorized into its bodies
-    type(error_t) :: err(2)
-    integer :: a
-    !$omp parallel do num_threads(run%threads) schedule(static, 1)
-    do a = 1, 2
+    type(error_t), allocatable :: err(:)
+    integer, allocatable :: order(:)
+    integer :: a, k
+    allocate (err(run%nbody))
+    order = largest_first(run)
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
+    do k = 1, run%nbody
+      a = order(k)
       call factor_body(run%deck%solver%factor, run%contact_line, a, run%meshes(a), run%systems(a), run%bodies(a), &
                        err(a))
     end do
     !$omp end parallel do
-    do a = 1, 2
+    do a = 1, run%nbody
       call fail_on(err(a), 'body '//body_label(a)//': factorization failed')
     end do
   end subroutine factor
 
-  !> Both bodies' interface flexibilities F_a and b_a, one thread each.
+  !> Every body's interface flexibility F_a and b_a, the largest first.
   subroutine condense(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies condensed
-    type(error_t) :: err(2)
-    integer :: a
-    !$omp parallel do num_threads(run%threads) schedule(static, 1)
-    do a = 1, 2
+    type(error_t), allocatable :: err(:)
+    integer, allocatable :: order(:)
+    integer :: a, k
+    allocate (err(run%nbody))
+    order = largest_first(run)
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
+    do k = 1, run%nbody
+      a = order(k)
       call condense_body(run%systems(a), run%bodies(a), err(a))
     end do
     !$omp end parallel do
-    do a = 1, 2
+    do a = 1, run%nbody
       call fail_on(err(a), 'body '//body_label(a)//': condensation failed')
     end do
   end subroutine condense
 
-  !> The two Cholesky factors' memory [MiB].
+  !> The Cholesky factors' memory [MiB].
   subroutine record_factor_memory(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its timing
-    run%timing%factor_mb = (run%bodies(1)%chol%mem_bytes + run%bodies(2)%chol%mem_bytes)/1048576.0_wp
+    integer :: a
+    run%timing%factor_mb = 0.0_wp
+    do a = 1, run%nbody
+      run%timing%factor_mb = run%timing%factor_mb + run%bodies(a)%chol%mem_bytes/1048576.0_wp
+    end do
   end subroutine record_factor_memory
 
   !> The contact forces are here already.
@@ -80,16 +95,19 @@ contains
     type(run_t), intent(inout) :: run   !< the run
   end subroutine share_contact_forces
 
-  !> Both bodies' displacements under their own contact forces, one thread each.
+  !> Every body's displacement under its own contact forces, the largest first.
   subroutine recover(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its displacements
     real(wp), allocatable :: ufree(:)
-    integer :: a
-    !$omp parallel do num_threads(run%threads) schedule(static, 1) private(ufree)
-    do a = 1, 2
+    integer, allocatable :: order(:)
+    integer :: a, k
+    order = largest_first(run)
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(ufree, a)
+    do k = 1, run%nbody
+      a = order(k)
       allocate (ufree(run%systems(a)%n))
-      call recover_displacement(run%systems(a), run%bodies(a), run%result%lam_body(:, a), ufree)
+      call recover_displacement(run%systems(a), run%bodies(a), gather(run%result%lam_body, run%bodies(a)%slots), ufree)
       call expand(run%systems(a), ufree, run%displacement(1:run%systems(a)%ndof, a))
       deallocate (ufree)
     end do
@@ -107,6 +125,15 @@ contains
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run
   end subroutine report_ranks
+
+  !> The bodies by their unknowns, the largest first (ties by id): the threads' order.
+  function largest_first(run) result(order)
+    type(run_t), intent(in) :: run
+    integer, allocatable :: order(:)
+    integer :: i
+    order = [(i, i=1, run%nbody)]
+    call merge_sort_by_keys(order, reshape([(-run%systems(i)%n, i=1, run%nbody)], [1, run%nbody]))
+  end function largest_first
 
   !> End the run with its code.
   subroutine finish(self, run)

@@ -67,7 +67,7 @@ contains
   !! On an impossible input `err` says why (ERR_INPUT; ERR_NUMERICAL for a LAPACK or
   !! internal failure), naming the body, and `sys` is incomplete.
   subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, err, &
-                           u_prescribed, body_force, boundaries, matrix, contact_group)
+                           u_prescribed, body_force, boundaries, matrix, contact_groups)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -88,9 +88,9 @@ contains
     !! DOF numbering and the load only, for a run whose ranks each assemble their share of
     !! the cells (cell_triplets); default .true.
     logical, intent(in), optional :: matrix
-    !> the body's contact group (&contact body1_group/body2_group), kept clear of fixing
-    !! DOFs when the body is held only by contact (a rectangle's 'contact' side is too)
-    character(len=*), intent(in), optional :: contact_group
+    !> the body's contact groups (one per pair it is in), kept clear of fixing DOFs when the
+    !! body is held only by contact (a rectangle's 'contact' side is too)
+    character(len=*), intent(in), optional :: contact_groups(:)
     logical, allocatable :: prescribed(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
@@ -117,7 +117,7 @@ contains
     call rigid_kernel(mesh, prescribed, sys, err)
     if (err%failed()) return
     if (sys%nrig > 0) then
-      call choose_fixing(mesh, body, prescribed, sys, err, contact_group)
+      call choose_fixing(mesh, body, prescribed, sys, err, contact_groups)
       if (err%failed()) return
     end if
     call number_free_dofs(prescribed, sys)

@@ -29,7 +29,7 @@ module gmsh_msh
   implicit none (type, external)
   private
 
-  public :: msh_read, msh_read_pair
+  public :: msh_read, msh_read_shared
 
   !> Node tag -> file node number, while the elements are read: an array indexed by tag
   !! when the tags $Nodes announces are dense (Gmsh writes 1..N), else a hash table. A tag
@@ -74,35 +74,38 @@ contains
     call outcome(scanner, path, body_id, mesh, err)
   end subroutine msh_read
 
-  !> Both bodies from one .msh file (the same path for both): the file is read and parsed
-  !! once, then each body is built from it (the bodies in parallel on two threads when
-  !! `nthr` is 2). Arguments as msh_read's, one per body.
-  subroutine msh_read_pair(path, region, mesh, err, nthr)
-    character(len=*), intent(in) :: path          !< the .msh file of both bodies
-    character(len=*), intent(in) :: region(2)     !< physical surface name of each body
-    type(mesh_t), intent(out) :: mesh(2)          !< the bodies' meshes
-    type(error_t), intent(out) :: err(2)          !< each body's error, as msh_read's
-    integer, intent(in) :: nthr                   !< threads for the two builds (1 or 2)
-    type(scanner_t) :: scanner, body_scanner(2)
+  !> Several bodies from one .msh file (the same path for all): the file is read and parsed
+  !! once, then each body is built from it (the bodies in parallel on `nthr` threads).
+  !! Arguments as msh_read's, one per body.
+  subroutine msh_read_shared(path, region, ids, mesh, err, nthr)
+    character(len=*), intent(in) :: path          !< the .msh file of these bodies
+    character(len=*), intent(in) :: region(:)     !< physical surface name of each body
+    integer, intent(in) :: ids(:)                 !< each body's id (messages)
+    type(mesh_t), intent(inout) :: mesh(:)        !< the bodies' meshes
+    type(error_t), intent(out) :: err(:)          !< each body's error, as msh_read's
+    integer, intent(in) :: nthr                   !< threads for the builds
+    type(scanner_t) :: scanner
+    type(scanner_t), allocatable :: body_scanner(:)
     type(file_mesh_t) :: file_mesh
-    integer :: a
+    integer :: a, n
 
-    allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
+    n = size(region)
+    allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), body_scanner(n))
     call scanner_load(scanner, path)
     if (scanner%info == 0) call parse(scanner, file_mesh)
     if (allocated(scanner%text)) deallocate (scanner%text)
-    do a = 1, 2
+    do a = 1, n
       body_scanner(a) = scanner
     end do
-    !$omp parallel do num_threads(nthr) schedule(static, 1)
-    do a = 1, 2
+    !$omp parallel do num_threads(nthr) schedule(dynamic, 1)
+    do a = 1, n
       if (body_scanner(a)%info == 0) call build(body_scanner(a), file_mesh, trim(region(a)), mesh(a))
     end do
     !$omp end parallel do
-    do a = 1, 2
-      call outcome(body_scanner(a), path, a, mesh(a), err(a))
+    do a = 1, n
+      call outcome(body_scanner(a), path, ids(a), mesh(a), err(a))
     end do
-  end subroutine msh_read_pair
+  end subroutine msh_read_shared
 
   !> The status of a read: on failure, one sentence naming the body, the file and the line,
   !! and an empty mesh.

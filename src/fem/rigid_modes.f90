@@ -165,13 +165,13 @@ contains
   !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
   !! and the node farthest from that one) for the largest |det| of the kernel restricted to
   !! them. They are prescribed to 0 (prescribed) for the factorization only.
-  subroutine choose_fixing(mesh, body, prescribed, sys, err, contact_group)
+  subroutine choose_fixing(mesh, body, prescribed, sys, err, contact_groups)
     type(mesh_t), intent(in) :: mesh                         !< the body's mesh
     type(body_cfg_t), intent(in) :: body                     !< its id and side conditions
     logical, intent(inout) :: prescribed(:)                  !< (ndof) the fixing DOFs are added
     type(body_system_t), intent(inout) :: sys                !< gets fixing; its u_fixed is 0 there
     type(error_t), intent(out) :: err                        !< ERR_INPUT when no fixing DOFs are found
-    character(len=*), intent(in), optional :: contact_group  !< the body's contact group, kept clear
+    character(len=*), intent(in), optional :: contact_groups(:)  !< the body's contact groups, kept clear
     logical, allocatable :: avoid(:)
     integer, allocatable :: nodes(:)
     integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
@@ -186,13 +186,15 @@ contains
       call side_nodes(mesh, side, nodes)
       avoid(nodes) = .true.
     end do
-    if (present(contact_group)) then
-      g = 0
-      if (len_trim(contact_group) > 0) g = group_index(mesh, contact_group)
-      if (g > 0) then
-        call group_nodes(mesh, g, nodes)
-        avoid(nodes) = .true.
-      end if
+    if (present(contact_groups)) then
+      do k = 1, size(contact_groups)
+        g = 0
+        if (len_trim(contact_groups(k)) > 0) g = group_index(mesh, contact_groups(k))
+        if (g > 0) then
+          call group_nodes(mesh, g, nodes)
+          avoid(nodes) = .true.
+        end if
+      end do
     end if
     ! the first node: the closest to the contact's centroid off the contact (the centre when
     ! there is none), so that K^+'s contact displacements are measured from a near point and

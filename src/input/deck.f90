@@ -63,22 +63,17 @@ contains
 
   !> Read the deck file `path`, then apply the command-line `overrides` in order, validate
   !! everything and fill `d` (with `d%effective`, the effective deck as namelist text).
-  !! On any bad input: `fatal(EXIT_INPUT, message)`. The solver handles two bodies in one
-  !! pair: a deck beyond that is refused after its checks, unless `assembly` is true.
-  subroutine read_deck(path, overrides, d, assembly)
+  !! On any bad input: `fatal(EXIT_INPUT, message)`.
+  subroutine read_deck(path, overrides, d)
     character(len=*), intent(in) :: path          !< deck file path
     character(len=*), intent(in) :: overrides(:)  !< namelist fragments from the command line
     type(deck_t), intent(out) :: d                !< the effective deck
-    logical, intent(in), optional :: assembly     !< accept any number of bodies and pairs
     type(state_t) :: st
     type(src_t) :: src
     type(grp_t), allocatable :: gs(:)
     integer :: i, k, ig
     character(len=:), allocatable :: olabel
-    logical :: any_size
 
-    any_size = .false.
-    if (present(assembly)) any_size = assembly
     if (len(path) > len(d%source)) call fatal(EXIT_INPUT, 'the deck path is '//i2s(len(path))// &
       ' characters long, longer than the system''s limit of '//i2s(len(d%source))//' (PATH_MAX)')
     d%source = path
@@ -156,9 +151,6 @@ contains
 
     if (len_trim(d%output%file) == 0) d%output%file = default_output(path)
     call check_cross(d, st)
-    if (.not. any_size .and. (d%nbody > 2 .or. d%npair > 1)) call fatal(EXIT_INPUT, path// &
-      ': this version solves two bodies in one contact pair; the deck has '//i2s(d%nbody)// &
-      ' bodies and '//i2s(d%npair)//' pairs')
     call deck_text(d, d%effective)
   end subroutine read_deck
 

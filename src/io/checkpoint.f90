@@ -50,6 +50,7 @@ module checkpoint
     integer :: maxout = 0                      ! max_outer of this run
     integer :: nh = 0                          ! entries of /history
     integer :: kr = 0                          ! stored directions per body
+    integer :: nbody = 2                       ! bodies of this run
     logical :: has_products = .false., has_search = .false., has_recycle = .false., has_mu = .false.
   end type ckpt_reader_t
 
@@ -127,7 +128,7 @@ contains
     call write_attr(gid, 'nsrch', st%nsrch, hs)
     call write_dset(gid, 'srch', st%srch, hs)
     call write_dset(gid, 'fsrch', st%fsrch, hs)
-    call write_dset(gid, 'nrw', reshape(st%nrw, [4]), hs)
+    call write_dset(gid, 'nrw', reshape(st%nrw, [size(st%nrw)]), hs)
     call write_dset(gid, 'rw', st%rw, hs)
     call write_dset(gid, 'raw', st%raw, hs)
     call write_dset(gid, 'mu', st%mu, hs)
@@ -154,11 +155,12 @@ contains
   !! `it` and at most max_outer entries), and after reading, the counters for their ranges
   !! and every real dataset and attribute for finite values; the message names the file
   !! and the object.
-  subroutine checkpoint_read(file, key, meshes, m, maxout, st, res, err)
+  subroutine checkpoint_read(file, key, meshes, m, nbody, maxout, st, res, err)
     character(len=*), intent(in) :: file          !< checkpoint path
     character(len=*), intent(in) :: key           !< fingerprint of this run
     character(len=*), intent(in) :: meshes        !< this run's mesh_identity
-    integer, intent(in) :: m                      !< interface size of this run
+    integer, intent(in) :: m                      !< contact rows of this run (all pairs)
+    integer, intent(in) :: nbody                  !< bodies of this run
     integer, intent(in) :: maxout                 !< max_outer of this run (history size)
     type(robin_state_t), intent(out) :: st        !< the outer state
     type(contact_result_t), intent(inout) :: res  !< receives the history and the counters
@@ -170,6 +172,7 @@ contains
     r%msg = ''
     r%src = 'restart file '//trim(file)
     r%m = m
+    r%nbody = nbody
     r%maxout = maxout
     inquire (file=file, exist=exists_)
     if (.not. exists_) then
@@ -306,7 +309,7 @@ contains
     do j = 1, size(REAL_ATTRS)
       call need(r, r%gid, '/state', trim(REAL_ATTRS(j)), .true., CLASS_REAL, SCALAR, 'a scalar')
     end do
-    call need(r, r%gid, '/state', 'flam', .false., CLASS_REAL, [2_hsize_t], 'the two bodies')
+    call need(r, r%gid, '/state', 'flam', .false., CLASS_REAL, [int(r%nbody, hsize_t)], 'one per body')
     call need(r, r%gid, '/state', 'G', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
     call need(r, r%gid, '/state', 'lam', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
     call need(r, r%gid, '/state', 'r_prev', .false., CLASS_REAL, [2*m2], contact_nodes(r%m))
@@ -333,7 +336,7 @@ contains
     r%kr = recycle_size(r%m)
     r%has_recycle = exists(r%gid, 'nrw', .false.) .or. exists(r%gid, 'rw', .false.) .or. exists(r%gid, 'raw', .false.)
     if (r%has_recycle) then
-      call need(r, r%gid, '/state', 'nrw', .false., CLASS_INTEGER, [4_hsize_t], 'two counters per body')
+      call need(r, r%gid, '/state', 'nrw', .false., CLASS_INTEGER, [int(2*r%nbody, hsize_t)], 'two counters per body')
       call need(r, r%gid, '/state', 'rw', .false., CLASS_REAL, [m2, int(2*r%kr, hsize_t)], &
                 contact_nodes(r%m)//' and '//i2s(r%kr)//' directions per body')
       call need(r, r%gid, '/state', 'raw', .false., CLASS_REAL, [m2, int(2*r%kr, hsize_t)], &
@@ -341,7 +344,7 @@ contains
     end if
     ! the equality multipliers of floating bodies: absent from older checkpoints
     r%has_mu = exists(r%gid, 'mu', .false.)
-    if (r%has_mu) call need(r, r%gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, 2_hsize_t], &
+    if (r%has_mu) call need(r, r%gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, int(r%nbody, hsize_t)], &
                           'three multipliers per body')
     if (len_trim(r%msg) > 0) return
     ! the history: five arrays of one length r%nh, it <= r%nh <= max_outer (checked after reading it)
@@ -465,6 +468,7 @@ contains
       st%srch = 0.0_wp
       st%fsrch = 0.0_wp
     end if
+    allocate (st%mu(3, r%nbody), st%nrw(2, r%nbody))
     st%mu = 0.0_wp
     if (r%has_mu) then
       call read_dset(r%gid, 'mu', rmu, r%hs)
@@ -472,12 +476,13 @@ contains
     end if
     if (r%has_recycle) then
       call read_dset(r%gid, 'nrw', ir, r%hs)
-      if (.not. r%hs%failed()) st%nrw = reshape(ir, [2, 2])
+      if (.not. r%hs%failed()) st%nrw = reshape(ir, [2, r%nbody])
       call read_dset(r%gid, 'rw', st%rw, r%hs)
       call read_dset(r%gid, 'raw', st%raw, r%hs)
     else
       ! an older checkpoint: the bodies' solves start again without stored directions
-      st%nrw = reshape([0, 1, 0, 1], [2, 2])
+      st%nrw(1, :) = 0
+      st%nrw(2, :) = 1
       allocate (st%rw(m, 2*r%kr), st%raw(m, 2*r%kr))
       st%rw = 0.0_wp
       st%raw = 0.0_wp

@@ -17,7 +17,7 @@ module results
   use strings, only: word, body_label
   use mesh, only: mesh_t
   use assembly, only: body_system_t, stress_field_t
-  use condense, only: interface_t, contact_resultant
+  use contact_interface, only: interface_t, contact_resultant
   use contact_types, only: contact_result_t, status_name
   use floating, only: free_list
   use errors, only: error_t, ERR_IO
@@ -53,12 +53,12 @@ contains
   subroutine write_results(file, d, msh, sys, itf, res, u, stress, tm, err)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
-    type(mesh_t), intent(in) :: msh(2)                 !< meshes
-    type(body_system_t), intent(in) :: sys(2)          !< systems (DOF maps)
-    type(interface_t), intent(in) :: itf               !< contact line
+    type(mesh_t), intent(in) :: msh(:)                 !< meshes
+    type(body_system_t), intent(in) :: sys(:)          !< systems (DOF maps)
+    type(interface_t), intent(in) :: itf               !< contact rows of all pairs
     type(contact_result_t), intent(in) :: res          !< contact solution
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, 2) full displacements
-    type(stress_field_t), intent(in) :: stress(2)      !< nodal stresses of each body
+    type(stress_field_t), intent(in) :: stress(:)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     type(error_t), intent(out) :: err                  !< the failure, if any
     character(len=len_trim(file) + 16) :: name(NFILES)
@@ -121,12 +121,12 @@ contains
   subroutine write_h5(path, d, msh, sys, itf, res, u, stress, tm, run_id, st)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
-    type(mesh_t), intent(in) :: msh(2)
-    type(body_system_t), intent(in) :: sys(2)
+    type(mesh_t), intent(in) :: msh(:)
+    type(body_system_t), intent(in) :: sys(:)
     type(interface_t), intent(in) :: itf
     type(contact_result_t), intent(in) :: res
     real(wp), intent(in) :: u(:, :)
-    type(stress_field_t), intent(in) :: stress(2)
+    type(stress_field_t), intent(in) :: stress(:)
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
     type(error_t), intent(inout) :: st
@@ -199,7 +199,7 @@ contains
     call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
     call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
     ! the contact forces' resultant on body 1 (x, y): what balances its load
-    call write_dset(gid, 'resultant_body1', contact_resultant(itf, 1, res%lam), st, uf)
+    call write_dset(gid, 'resultant_body1', contact_resultant(itf, 1, res%lam, 1, itf%m), st, uf)
     allocate (pres(itf%m))
     where (itf%trib > 0.0_wp)
       pres = res%lam/itf%trib
@@ -219,7 +219,7 @@ contains
     call group_close(gid, st)
     call write_history(fid, res, st)
     ! bodies
-    do a = 1, 2
+    do a = 1, size(msh)
       write (bname, '(a,i0)') 'body', a
       call group_open(fid, trim(bname), gid, st, create=.true.)
       call write_attr(gid, 'element', trim(element_names(msh(a)%element)), st)
@@ -272,8 +272,8 @@ contains
     call file_close(fid, st)
   end subroutine write_h5
 
-  !> The contact pressure as a nodal field of body a (0 off the contact line): on the slave
-  !! the rows' pressures; on the master the mean of the pressures of the rows that reach a
+  !> The contact pressure as a nodal field of body a (0 off its contact lines): where it is
+  !! a pair's slave the rows' pressures; on the master the mean of the pressures of the rows that reach a
   !! node, weighted by their mortar weight times tributary length (a uniform pressure stays
   !! uniform, and matching lines give the slave's values).
   subroutine nodal_pressure(itf, a, pres, p)
@@ -281,30 +281,39 @@ contains
     integer, intent(in) :: a                  !< body
     real(wp), intent(in) :: pres(:)           !< (m) pressure of each row [stress]
     real(wp), intent(out) :: p(:)             !< (nnode) nodal field [stress]
-    real(wp), allocatable :: den(:)
-    integer :: k, e, i
+    real(wp), allocatable :: den(:), ps(:)
+    logical, allocatable :: on_slave(:)
+    integer :: k, e, i, q, sd
     real(wp) :: w
+    allocate (den(size(p)), ps(size(p)), on_slave(size(p)))
     p = 0.0_wp
-    if (a == itf%slave) then
-      do k = 1, itf%m
-        p(itf%node(k, a)) = pres(k)
-      end do
-      return
-    end if
-    allocate (den(size(p)))
     den = 0.0_wp
-    do k = 1, itf%m
-      ! a node's two entries (x, y) are adjacent: weight |w n| = w
-      do e = itf%b(a)%ptr(k), itf%b(a)%ptr(k + 1) - 2, 2
-        i = (itf%b(a)%dof(e) + 1)/2
-        w = hypot(itf%b(a)%val(e), itf%b(a)%val(e + 1))
-        if (w <= 1.0e-12_wp) cycle             ! a rounding-level weight of a matching line
-        w = w*itf%trib(k)
-        p(i) = p(i) + w*pres(k)
-        den(i) = den(i) + w
+    on_slave = .false.
+    do q = 1, itf%npair
+      do sd = 1, 2
+        if (itf%pair_body(sd, q) /= a) cycle
+        if (sd == itf%pair_slave(q)) then
+          do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 1
+            ps(itf%node(k, sd)) = pres(k)
+            on_slave(itf%node(k, sd)) = .true.
+          end do
+          cycle
+        end if
+        do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 1
+          ! a node's two entries (x, y) are adjacent: weight |w n| = w
+          do e = itf%b(sd)%ptr(k), itf%b(sd)%ptr(k + 1) - 2, 2
+            i = (itf%b(sd)%dof(e) + 1)/2
+            w = hypot(itf%b(sd)%val(e), itf%b(sd)%val(e + 1))
+            if (w <= 1.0e-12_wp) cycle             ! a rounding-level weight of a matching line
+            w = w*itf%trib(k)
+            p(i) = p(i) + w*pres(k)
+            den(i) = den(i) + w
+          end do
+        end do
       end do
     end do
     where (den > 0.0_wp) p = p/den
+    where (on_slave) p = ps
   end subroutine nodal_pressure
 
   !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral)
@@ -354,7 +363,7 @@ contains
   function xdmf_text(grids, h5, msh, m, run_id) result(t)
     integer, intent(in) :: grids(:)
     character(len=*), intent(in) :: h5
-    type(mesh_t), intent(in) :: msh(2)
+    type(mesh_t), intent(in) :: msh(:)
     integer, intent(in) :: m
     character(len=*), intent(in) :: run_id
     character(len=:), allocatable :: t, h

@@ -9,7 +9,7 @@ module lapack
   implicit none (type, external)
   private
 
-  public :: dsymv, dgemm
+  public :: dsymv, dgemm, dgemv, dsyrk, dtrsm, dtrsv
   public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels, dgesv, dsygv, dgesvd
@@ -52,6 +52,55 @@ module lapack
       real(wp), intent(in) :: beta            !< scale of C on entry
       real(wp), intent(inout) :: c(ldc, *)    !< matrix C, m x n
     end subroutine dgemm
+
+    !> y := alpha op(A) x + beta y; A is m x n.
+    subroutine dgemv(trans, m, n, alpha, a, lda, x, incx, beta, y, incy)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: trans   !< 'N' or 'T': op(A) = A or A'
+      integer, intent(in) :: m, n             !< rows and columns of A
+      integer, intent(in) :: lda              !< leading dimension of a
+      integer, intent(in) :: incx, incy       !< strides of x and y
+      real(wp), intent(in) :: alpha, beta     !< scales
+      real(wp), intent(in) :: a(lda, *)       !< matrix A
+      real(wp), intent(in) :: x(*)            !< vector x
+      real(wp), intent(inout) :: y(*)         !< vector y
+    end subroutine dgemv
+
+    !> C := alpha A A' + beta C (trans 'N'), the uplo triangle of the n x n C; A is n x k.
+    subroutine dsyrk(uplo, trans, n, k, alpha, a, lda, beta, c, ldc)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo    !< 'U' or 'L': the triangle of C referenced
+      character(len=1), intent(in) :: trans   !< 'N': A A'; 'T': A' A
+      integer, intent(in) :: n, k             !< order of C, the other dimension of A
+      integer, intent(in) :: lda, ldc         !< leading dimensions
+      real(wp), intent(in) :: alpha, beta     !< scales
+      real(wp), intent(in) :: a(lda, *)       !< matrix A
+      real(wp), intent(inout) :: c(ldc, *)    !< matrix C
+    end subroutine dsyrk
+
+    !> B := alpha op(A)^-1 B (side 'L'), A triangular m x m, B m x n.
+    subroutine dtrsm(side, uplo, transa, diag, m, n, alpha, a, lda, b, ldb)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: side, uplo, transa, diag   !< 'L'/'R', 'U'/'L', 'N'/'T', 'N'/'U'
+      integer, intent(in) :: m, n             !< rows and columns of B
+      integer, intent(in) :: lda, ldb         !< leading dimensions
+      real(wp), intent(in) :: alpha           !< scale
+      real(wp), intent(in) :: a(lda, *)       !< the triangular matrix
+      real(wp), intent(inout) :: b(ldb, *)    !< right-hand sides in, solutions out
+    end subroutine dtrsm
+
+    !> x := op(A)^-1 x, A triangular n x n.
+    subroutine dtrsv(uplo, trans, diag, n, a, lda, x, incx)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo, trans, diag   !< 'U'/'L', 'N'/'T', 'N'/'U'
+      integer, intent(in) :: n, lda, incx     !< order, leading dimension, stride
+      real(wp), intent(in) :: a(lda, *)       !< the triangular matrix
+      real(wp), intent(inout) :: x(*)         !< right-hand side in, solution out
+    end subroutine dtrsv
 
     ! ---- LAPACK: symmetric positive definite, full storage ----
 

@@ -9,8 +9,8 @@ program test_contact
   use deck, only: read_deck
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand, residual_full
-  use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body, &
-                      recover_displacement, apply_b, apply_bt
+  use contact_interface, only: interface_t, build_interface
+  use condense, only: body_condensed_t, factor_body, condense_body, recover_displacement, apply_b, apply_bt
   use contact_types, only: contact_result_t, status_name, STATUS_CONVERGED, STATUS_NONE, STATUS_MAX_OUTER, &
                            STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   use robin_iteration, only: solve_robin
@@ -93,7 +93,7 @@ contains
       call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%pair(1), msh, systems, contact_line, err)
+    call build_interface(d%body, d%pair(1:1), .false., msh, systems, contact_line, err)
     call error_parts(err, info, msg)
     if (info /= 0) error stop 'interface failed'
     do a = 1, 2

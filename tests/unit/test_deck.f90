@@ -21,12 +21,12 @@ program test_deck
   real(wp) :: r
   character(len=4096) :: arg
 
-  ! `test_deck --read DECK [assembly]`: read one deck and stop (the bad-input cases below)
+  ! `test_deck --read DECK`: read one deck and stop (the bad-input cases below)
   if (command_argument_count() >= 2) then
     call get_command_argument(1, arg)
     if (arg == '--read') then
       call get_command_argument(2, arg)
-      call read_deck(trim(arg), none, d, assembly=command_argument_count() >= 3)
+      call read_deck(trim(arg), none, d)
       stop 0
     end if
   end if
@@ -241,7 +241,7 @@ contains
     ! the pair form, bodies out of order and a pair given as (3, 2)
     call write_file(trim(tmp)//'_stack.nml', [character(len=120) :: B3, B1, B2, T1, P12, &
       '&contact bodies=3,2, groups=''top'',''bottom'', slave=2, gap_radius=2.5, gap_center=0.5 /'])
-    call read_deck(trim(tmp)//'_stack.nml', none, p, assembly=.true.)
+    call read_deck(trim(tmp)//'_stack.nml', none, p)
     call check(p%nbody == 3 .and. p%npair == 2 .and. p%pairs_named, 'pairs: three bodies, two named pairs')
     call check(p%body(1)%y0 == 2.0_wp .and. p%body(3)%y0 == 0.0_wp .and. p%body(3)%id == 3 .and. &
                p%body(3)%bc(SIDE_BOTTOM) == BC_CLAMPED, 'pairs: bodies stored by id, whatever their order')
@@ -257,12 +257,12 @@ contains
     call round_trip(p, 'pair form')
     o(1) = '&contact bodies=2,3, groups=''bottom'',''top'', slave=3 /'
     o(2) = '&body id=3, young=1e9 /'
-    call read_deck(trim(tmp)//'_stack.nml', o, p, assembly=.true.)
+    call read_deck(trim(tmp)//'_stack.nml', o, p)
     call check(all(p%pair(2)%bodies == [2, 3]) .and. p%pair(2)%body_group(1) == 'bottom' .and. &
                p%pair(2)%slave == 3 .and. p%pair(2)%gap_radius == 2.5_wp .and. p%body(3)%young == 1.0e9_wp, &
                'pairs: an override names its pair by its bodies, in either order')
     o(1) = '&contact bodies=3,2, slave=3 /'
-    call read_deck(trim(tmp)//'_stack.nml', o(1:1), p, assembly=.true.)
+    call read_deck(trim(tmp)//'_stack.nml', o(1:1), p)
     call check(all(p%pair(2)%bodies == [3, 2]) .and. p%pair(2)%body_group(1) == 'top' .and. &
                p%pair(2)%slave == 3, 'pairs: an override in the deck''s order keeps the groups')
     call delete_file(trim(tmp)//'_stack.nml')
@@ -300,8 +300,6 @@ contains
     call refused('not_a_side', [character(len=120) :: B1, B2, &
       '&contact bodies=1,2, groups=''bottom'',''rim'' /', T1], &
       'the &contact at line 3 names group ''rim'' of body 2, a rectangle')
-    call refused('stack', [character(len=120) :: B1, B2, B3, P12, P23, T1], &
-      'this version solves two bodies in one contact pair; the deck has 3 bodies and 2 pairs')
   end subroutine test_pairs
 
   !> The deck of `lines` read by `test_deck --read`: exit code 1 and `expect` in its message.
@@ -343,7 +341,7 @@ contains
     open (newunit=u, file=f, status='replace', action='write')
     call print_deck(a, u)
     close (u)
-    call read_deck(f, none, b, assembly=.true.)
+    call read_deck(f, none, b)
     call compare(a, b, diff)
     call check(len(diff) == 0, 'round trip of the '//what//': identical values'//diff)
     call check(after_first_line(a%effective) == after_first_line(b%effective), &

@@ -288,7 +288,7 @@ contains
     end if
     call mesh_build(msh, body, info, msg)
     if (info == 0) then
-      call assemble_body(msh, body, .true., notr, 0, system, err, boundaries=bnd, contact_group=contact)
+      call assemble_body(msh, body, .true., notr, 0, system, err, boundaries=bnd, contact_groups=[contact])
       call error_parts(err, info, msg)
     end if
     call report(info == 0, tag//': assembled ('//trim(msg)//')')
@@ -318,7 +318,7 @@ contains
     call msh_read('inputs/gmsh/hertz_force_h0.02.msh', 'disc', 1, msh, err)
     call error_parts(err, info, msg)
     if (info == 0) then
-      call assemble_body(msh, body, .true., notr, 0, system, err, boundaries=bnd, contact_group='disc_arc')
+      call assemble_body(msh, body, .true., notr, 0, system, err, boundaries=bnd, contact_groups=['disc_arc'])
       call error_parts(err, info, msg)
     end if
     call report(info == 0, 'Hertz disc, ux=0 on its axis: assembled ('//trim(msg)//')')

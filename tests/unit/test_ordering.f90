@@ -21,7 +21,8 @@ program test_ordering
   use supports, only: number_free_dofs
   use ordering, only: grid_dissection, coordinate_bisection, ND_LEAF_NODES
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN
-  use condense, only: interface_t, body_condensed_t, build_interface, factor_body, condense_body
+  use contact_interface, only: interface_t, build_interface
+  use condense, only: body_condensed_t, factor_body, condense_body
   use clock, only: wtime
   use strings, only: body_label
   use testing, only: report, report_le, test_summary, rectangle_body, structured_body, general_body, &
@@ -323,7 +324,7 @@ contains
       call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed'
     end do
-    call build_interface(d%body, d%pair(1), msh, sys, itf, err)
+    call build_interface(d%body, d%pair(1:1), .false., msh, sys, itf, err)
     call error_parts(err, info, msg)
     call report(info == 0 .and. itf%m > 0, 'two-body scene: interface built '//trim(msg))
     if (info /= 0) return

@@ -1,0 +1,351 @@
+!> The contact interface of all contact pairs: one constraint row per slave node of each
+!! pair, rows of pair p stacked after those of pairs 1..p-1 (M rows in all), each row with
+!! its two sides: side 1 the pair's body with the lower id, side 2 the other. The gap of a
+!! row is B_s1 u_s1 + B_s2 u_s2 - g0 <= 0, each side's coefficients on its own body's DOFs.
+!! A body's contact rows are its sides of every pair it takes part in (`body_slots`), so a
+!! body in several pairs is condensed on all of them at once. The rows come from two edge
+!! groups per pair (named groups, or the rectangle sides declared 'contact') paired by dual
+!! mortar (module mortar; row j = the weighted normal gap at slave node j).
+module contact_interface
+  use kinds, only: wp
+  use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented
+  use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
+  use mortar, only: mortar_t, mortar_build
+  use strings, only: i2s, r2s
+  use assembly, only: body_system_t
+  use errors, only: error_t, ERR_INPUT
+  implicit none (type, external)
+  private
+
+  !> The rows of one side (compressed rows over the side body's DOFs 2*(node-1)+c).
+  type, public :: brows_t
+    integer, allocatable :: ptr(:)          !< (m+1) row k is entries ptr(k) .. ptr(k+1)-1
+    integer, allocatable :: dof(:)          !< DOF of the side's body of each entry
+    real(wp), allocatable :: val(:)         !< coefficient of each entry [-]
+  end type brows_t
+
+  !> The contact interface: m constraint rows over all pairs, one per contact node of each
+  !! pair's slave side.
+  type, public :: interface_t
+    integer :: m = 0                        !< contact constraints of all pairs
+    integer :: npair = 0                    !< contact pairs
+    logical :: mortar = .false.             !< rows from dual mortar on named groups
+    integer, allocatable :: pair_ptr(:)     !< (npair+1) rows of pair p: pair_ptr(p) .. pair_ptr(p+1)-1
+    integer, allocatable :: pair_body(:, :) !< (2,npair) the body on side 1 and on side 2
+    integer, allocatable :: pair_slave(:)   !< (npair) the side whose nodes carry the rows (1 or 2)
+    integer, allocatable :: pair_of(:)      !< (m) the pair of each row
+    real(wp), allocatable :: s(:)           !< (m) arc length along the pair's slave contact chain [length]
+    real(wp), allocatable :: xy(:, :)       !< (2,m) slave node coordinates [length]
+    real(wp), allocatable :: normal(:, :)   !< (2,m) unit normal, outward from the slave body
+    real(wp), allocatable :: g0(:)          !< (m) initial normal gap [length]
+    real(wp), allocatable :: trib(:)        !< (m) tributary length D_jj [length]
+    integer, allocatable :: node(:, :)      !< (m,2) mesh node of each side's body (0: none, mortar master)
+    type(brows_t) :: b(2)                   !< the rows of side 1 and side 2
+  end type interface_t
+
+  public :: build_interface, contact_resultant, body_slots, pair_rows
+
+contains
+
+  !> The positions of body a's contact rows in the (m, 2) side layout of the contact
+  !! vectors (row + (side - 1) m), pair by pair in the order of the pairs: body a's own
+  !! contact vector is x(slots) of a side-layout array x.
+  function body_slots(itf, a) result(slots)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: a                  !< body
+    integer, allocatable :: slots(:)
+    integer :: p, s, n, i
+    n = 0
+    do p = 1, itf%npair
+      do s = 1, 2
+        if (itf%pair_body(s, p) == a) n = n + itf%pair_ptr(p + 1) - itf%pair_ptr(p)
+      end do
+    end do
+    allocate (slots(n))
+    n = 0
+    do p = 1, itf%npair
+      do s = 1, 2
+        if (itf%pair_body(s, p) /= a) cycle
+        do i = itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1
+          n = n + 1
+          slots(n) = i + (s - 1)*itf%m
+        end do
+      end do
+    end do
+  end function body_slots
+
+  !> The rows of pair p, as a range.
+  pure function pair_rows(itf, p) result(r)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: p                  !< pair
+    integer :: r(2)                           !< first and last row
+    r = [itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1]
+  end function pair_rows
+
+  !> The resultant of the contact forces of `side` on its body over the rows `first..last`,
+  !! -sum of B' lam by component [force]: what balances the body's applied load when contact
+  !! alone holds it (the sum of the nodal normal forces is not a resultant on a curved line).
+  pure function contact_resultant(itf, side, lam, first, last) result(f)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: side               !< side (1 or 2)
+    real(wp), intent(in) :: lam(:)            !< (m) contact forces [force]
+    integer, intent(in) :: first, last        !< rows
+    real(wp) :: f(2)
+    integer :: k, e, c
+    f = 0.0_wp
+    do k = first, last
+      do e = itf%b(side)%ptr(k), itf%b(side)%ptr(k + 1) - 1
+        c = 2 - mod(itf%b(side)%dof(e), 2)
+        f(c) = f(c) - itf%b(side)%val(e)*lam(k)
+      end do
+    end do
+  end function contact_resultant
+
+  !> The contact interface of every pair of the deck, each by dual mortar on two edge
+  !! groups: the named groups of &contact, or a rectangle's side declared 'contact' (its
+  !! mesh has the sides as groups 'left', 'right', 'bottom', 'top'). On matching lines the
+  !! mortar rows are the node-to-node ones to rounding, so one path serves every scene.
+  subroutine build_interface(body, pairs, named, msh, sys, itf, err)
+    type(body_cfg_t), intent(in) :: body(:)          !< the bodies (their contact sides)
+    type(contact_cfg_t), intent(in) :: pairs(:)      !< the pairs (groups, slave, initial gap)
+    logical, intent(in) :: named                     !< the deck names its pairs (&contact bodies=A,B)
+    type(mesh_t), intent(in) :: msh(:)               !< meshes of the bodies
+    type(body_system_t), intent(in) :: sys(:)        !< assembled systems
+    type(interface_t), intent(out) :: itf            !< the contact rows of all pairs
+    type(error_t), intent(out) :: err                !< the bad input (ERR_INPUT), if any
+    type(interface_t), allocatable :: one(:)
+    type(contact_cfg_t) :: cc
+    integer :: p, a, s, side, np
+
+    np = size(pairs)
+    allocate (one(np))
+    itf%npair = np
+    itf%mortar = .true.
+    allocate (itf%pair_ptr(np + 1), itf%pair_body(2, np), itf%pair_slave(np))
+    itf%pair_ptr(1) = 1
+    do p = 1, np
+      cc = pair_oriented(pairs(p))
+      if (len_trim(cc%body_group(1)) == 0) then
+        do s = 1, 2
+          a = cc%bodies(s)
+          side = findloc(body(a)%bc, BC_CONTACT, dim=1)
+          if (side == 0) then
+            call err%set(ERR_INPUT, 'body '//i2s(a)//' has no contact side')
+            return
+          end if
+          cc%body_group(s) = side_names(side)
+        end do
+      end if
+      call mortar_pair(cc, named, msh, sys, one(p), err)
+      if (err%failed()) return
+      itf%pair_body(:, p) = cc%bodies
+      itf%pair_slave(p) = one(p)%pair_slave(1)
+      itf%pair_ptr(p + 1) = itf%pair_ptr(p) + one(p)%m
+    end do
+    call stack_pairs(one, itf)
+  end subroutine build_interface
+
+  !> Stack the pairs' rows (each built with its own rows 1..m_p) into itf, whose pair
+  !! fields are set.
+  subroutine stack_pairs(one, itf)
+    type(interface_t), intent(in) :: one(:)
+    type(interface_t), intent(inout) :: itf
+    integer :: p, s, m, r0, ne(2), k, e0
+    m = itf%pair_ptr(size(one) + 1) - 1
+    itf%m = m
+    allocate (itf%s(m), itf%xy(2, m), itf%g0(m), itf%trib(m), itf%node(m, 2), itf%normal(2, m), itf%pair_of(m))
+    ne = 0
+    do p = 1, size(one)
+      do s = 1, 2
+        ne(s) = ne(s) + one(p)%b(s)%ptr(one(p)%m + 1) - 1
+      end do
+    end do
+    do s = 1, 2
+      allocate (itf%b(s)%ptr(m + 1), itf%b(s)%dof(ne(s)), itf%b(s)%val(ne(s)))
+      itf%b(s)%ptr(1) = 1
+    end do
+    do p = 1, size(one)
+      r0 = itf%pair_ptr(p) - 1
+      associate (o => one(p), rows => [(r0 + k, k=1, one(p)%m)])
+        itf%s(rows) = o%s
+        itf%xy(:, rows) = o%xy
+        itf%normal(:, rows) = o%normal
+        itf%g0(rows) = o%g0
+        itf%trib(rows) = o%trib
+        itf%node(rows, :) = o%node
+        itf%pair_of(rows) = p
+        do s = 1, 2
+          e0 = itf%b(s)%ptr(r0 + 1) - 1
+          itf%b(s)%ptr(r0 + 2:r0 + o%m + 1) = o%b(s)%ptr(2:o%m + 1) + e0
+          ne(s) = o%b(s)%ptr(o%m + 1) - 1
+          itf%b(s)%dof(e0 + 1:e0 + ne(s)) = o%b(s)%dof(1:ne(s))
+          itf%b(s)%val(e0 + 1:e0 + ne(s)) = o%b(s)%val(1:ne(s))
+        end do
+      end associate
+    end do
+  end subroutine stack_pairs
+
+  !> The rows of one pair of two named edge groups by dual mortar (module mortar), side 1
+  !! cc%bodies(1), side 2 cc%bodies(2): the slave is cc%slave, or the side whose contact
+  !! group has the shorter mean edge (side 1 on a tie). A slave node carries no row when its
+  !! normal displacement and that of every master node its row involves are prescribed (the
+  !! constraint would only repeat the supports): found by a first build, then the rows are
+  !! built again without those nodes. err = ERR_INPUT for an unknown group, a group facing
+  !! nothing, or an initial overlap.
+  subroutine mortar_pair(cc, named, msh, sys, itf, err)
+    type(contact_cfg_t), intent(in) :: cc            !< the pair, cc%bodies(1) < cc%bodies(2)
+    logical, intent(in) :: named                     !< the deck names its pairs (messages)
+    type(mesh_t), intent(in) :: msh(:)               !< meshes of all bodies
+    type(body_system_t), intent(in) :: sys(:)        !< systems of all bodies
+    type(interface_t), intent(out) :: itf            !< the pair's rows 1..m_p
+    type(error_t), intent(out) :: err
+    integer :: g(2), s, sl, ma, j, e, k, ne
+    real(wp) :: hmean(2), tol, gmin
+    logical, allocatable :: removable(:)
+    real(wp), allocatable :: gdist(:)
+    character(len=:), allocatable :: what(:)
+    type(mortar_t) :: mt
+    type(error_t) :: why
+
+    allocate (character(len=300) :: what(2))
+    do s = 1, 2
+      if (named) then
+        what(s) = '&contact bodies='//i2s(cc%bodies(1))//','//i2s(cc%bodies(2))//': body '//i2s(cc%bodies(s))
+      else
+        what(s) = '&contact body'//i2s(s)//'_group='''//trim(cc%body_group(s))//''': body '//i2s(cc%bodies(s))
+      end if
+    end do
+    do s = 1, 2
+      associate (m => msh(cc%bodies(s)))
+        g(s) = group_index(m, cc%body_group(s))
+        if (g(s) == 0) then
+          if (named) then
+            call err%set(ERR_INPUT, trim(what(s))//' has no group '''//trim(cc%body_group(s))//''' with edges on '// &
+                         'its boundary; its groups are '//group_names(m))
+          else
+            call err%set(ERR_INPUT, trim(what(s))//' has no such group with edges on its boundary; its groups are '// &
+                         group_names(m))
+          end if
+          return
+        end if
+        if (nodes_only(m, g(s))) then
+          if (named) then
+            call err%set(ERR_INPUT, trim(what(s))//': group '''//trim(cc%body_group(s))//''': '// &
+                         nodes_only_refusal(m, g(s), 'contact needs'))
+          else
+            call err%set(ERR_INPUT, trim(what(s))//': '//nodes_only_refusal(m, g(s), 'contact needs'))
+          end if
+          return
+        end if
+        hmean(s) = 0.0_wp
+        do e = 1, m%group(g(s))%nedge
+          hmean(s) = hmean(s) + norm2(m%xy(:, m%group(g(s))%edge(2, e)) - m%xy(:, m%group(g(s))%edge(1, e)))
+        end do
+        hmean(s) = hmean(s)/max(1, m%group(g(s))%nedge)
+      end associate
+    end do
+    sl = findloc(cc%bodies, cc%slave, dim=1)
+    if (cc%slave == 0 .or. sl == 0) sl = merge(2, 1, hmean(2) < hmean(1)*(1.0_wp - 1.0e-12_wp))
+    ma = 3 - sl
+    itf%mortar = .true.
+    itf%npair = 1
+    itf%pair_slave = [sl]
+
+    associate (ms => msh(cc%bodies(sl)), mm => msh(cc%bodies(ma)))
+      allocate (removable(ms%nnode))
+      removable = .false.
+      call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, mt, why)
+      if (.not. why%failed()) then
+        do j = 1, mt%m
+          removable(mt%snode(j)) = normal_fixed(sys(cc%bodies(sl)), mt%snode(j), mt%normal(:, j))
+          do k = mt%mptr(j), mt%mptr(j + 1) - 1
+            if (abs(mt%mval(k)) > 1.0e-12_wp) removable(mt%snode(j)) = removable(mt%snode(j)) .and. &
+              normal_fixed(sys(cc%bodies(ma)), mt%mnod(k), mt%normal(:, j))
+          end do
+        end do
+        if (any(removable)) call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, &
+                                              mt, why)
+      end if
+      if (why%failed()) then
+        call err%set(ERR_INPUT, 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(cc%bodies(sl))// &
+                     ' (slave) and '''//trim(cc%body_group(ma))//''' of body '//i2s(cc%bodies(ma))//' (master): '// &
+                     why%text())
+        return
+      end if
+
+      ! an initial overlap beyond a thousandth of the slave's mean edge is bad input
+      ! (the gap of a row divided by its slave weight sum: the distance, where the row's
+      ! weights sum to more or less than one next to a removed node or at a partly covered end)
+      tol = 1.0e-3_wp*hmean(sl)
+      allocate (gdist(mt%m))
+      do j = 1, mt%m
+        gdist(j) = mt%g0(j)/sum(mt%sval(mt%sptr(j):mt%sptr(j + 1) - 1))
+      end do
+      gmin = minval(gdist)
+      if (gmin < -tol) then
+        j = minloc(gdist, dim=1)
+        call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
+              ''' overlap in the initial configuration: the gap at slave node '//i2s(ms%node_tag(mt%snode(j)))// &
+              ' of body '//i2s(cc%bodies(sl))//' at ('//r2s(ms%xy(1, mt%snode(j)))//', '//r2s(ms%xy(2, mt%snode(j)))// &
+              ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart')
+        return
+      end if
+
+      itf%m = mt%m
+      allocate (itf%s(mt%m), itf%xy(2, mt%m), itf%g0(mt%m), itf%trib(mt%m), itf%node(mt%m, 2), &
+                itf%normal(2, mt%m))
+      itf%s = mt%s
+      itf%xy = ms%xy(:, mt%snode)
+    end associate
+    itf%normal = mt%normal
+    itf%trib = mt%d
+    itf%node(:, sl) = mt%snode
+    itf%node(:, ma) = 0
+    itf%g0 = mt%g0
+    if (cc%gap_radius > 0.0_wp) itf%g0 = itf%g0 + (itf%xy(1, :) - cc%gap_center)**2/(2.0_wp*cc%gap_radius)
+    ! B_s: + sum_k ws_k n_j.u_k ; B_m: - sum_l wm_l n_j.u_l (both components of each node)
+    ne = 2*(mt%sptr(mt%m + 1) - 1)
+    allocate (itf%b(sl)%ptr(mt%m + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
+    ne = 2*(mt%mptr(mt%m + 1) - 1)
+    allocate (itf%b(ma)%ptr(mt%m + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
+    call fill_rows(mt%sptr, mt%snod, mt%sval, 1.0_wp, itf%b(sl))
+    call fill_rows(mt%mptr, mt%mnod, mt%mval, -1.0_wp, itf%b(ma))
+
+  contains
+
+    !> Rows of one side: each node entry (weight w) gives sgn*w*n_j on both its DOFs.
+    subroutine fill_rows(ptr, nod, val, sgn, b)
+      integer, intent(in) :: ptr(:), nod(:)
+      real(wp), intent(in) :: val(:), sgn
+      type(brows_t), intent(inout) :: b
+      integer :: jj, kk, q, c
+      q = 0
+      b%ptr(1) = 1
+      do jj = 1, mt%m
+        do kk = ptr(jj), ptr(jj + 1) - 1
+          do c = 1, 2
+            q = q + 1
+            b%dof(q) = 2*(nod(kk) - 1) + c
+            b%val(q) = sgn*val(kk)*mt%normal(c, jj)
+          end do
+        end do
+        b%ptr(jj + 1) = q + 1
+      end do
+    end subroutine fill_rows
+
+  end subroutine mortar_pair
+
+  !> Whether the displacement of node k along nrm is prescribed in the body: every
+  !! component that nrm has is a prescribed DOF.
+  pure logical function normal_fixed(sys, k, nrm)
+    type(body_system_t), intent(in) :: sys
+    integer, intent(in) :: k
+    real(wp), intent(in) :: nrm(2)
+    integer :: c
+    normal_fixed = .true.
+    do c = 1, 2
+      if (abs(nrm(c)) > 1.0e-12_wp .and. sys%free_of(2*(k - 1) + c) > 0) normal_fixed = .false.
+    end do
+  end function normal_fixed
+
+end module contact_interface
