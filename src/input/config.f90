@@ -45,7 +45,8 @@ module config
 
   integer, parameter, public :: STOP_INCREMENT = 1   !< the paper's relative increment of the obstacles
   integer, parameter, public :: STOP_RESIDUAL = 2    !< the true residual of the iterate
-  character(len=*), parameter, public :: STOP_CHOICES = 'increment residual'
+  integer, parameter, public :: STOP_AUTO = 3        !< increment for one pair, residual for several (resolved by the deck)
+  character(len=*), parameter, public :: STOP_CHOICES = 'increment residual auto'
 
   integer, parameter, public :: FACTOR_CHOLMOD = 1   !< sparse Cholesky (SuiteSparse CHOLMOD)
   integer, parameter, public :: FACTOR_BANDED = 2    !< banded Cholesky (RCM + LAPACK dpbtrf)
@@ -61,7 +62,8 @@ module config
   integer, parameter, public :: ACCEL_NONE = 1       !< plain relaxation
   integer, parameter, public :: ACCEL_AITKEN = 2     !< Aitken (Irons-Tuck) dynamic relaxation
   integer, parameter, public :: ACCEL_ANDERSON = 3   !< Anderson mixing
-  character(len=*), parameter, public :: ACCEL_CHOICES = 'none aitken anderson'
+  integer, parameter, public :: ACCEL_AUTO = 4       !< none for one pair, anderson for several (resolved by the deck)
+  character(len=*), parameter, public :: ACCEL_CHOICES = 'none aitken anderson auto'
 
   character(len=*), parameter, public :: SIDE_CHOICES = 'left right bottom top'       !< SIDE_* order
   character(len=*), parameter, public :: BC_CHOICES = 'free clamped roller contact displacement'  !< BC_* order, from 0
@@ -148,10 +150,10 @@ module config
     real(wp) :: alpha = 0.0_wp                        !< constant Robin parameter [length/stress]
     real(wp) :: delta = 0.5_wp                        !< relaxation, 0 < delta <= 1
     real(wp) :: tol = 1.0e-8_wp                       !< outer tolerance
-    integer :: stop = STOP_INCREMENT                  !< STOP_*
+    integer :: stop = STOP_AUTO                       !< STOP_* (AUTO is resolved when the deck is read)
     integer :: max_outer = 800                        !< outer iteration limit
     type(factor_cfg_t) :: factor                      !< factorization and ordering
-    integer :: acceleration = ACCEL_NONE              !< ACCEL_*
+    integer :: acceleration = ACCEL_AUTO              !< ACCEL_* (AUTO is resolved when the deck is read)
     real(wp) :: inner_factor = 1.0e-3_wp              !< inner rtol = inner_factor * outer progress (clamped)
     real(wp) :: inner_rtol_min = 1.0e-12_wp           !< floor of the adaptive inner tolerance
     real(wp) :: inner_rtol_max = 1.0e-2_wp            !< ceiling of the adaptive inner tolerance

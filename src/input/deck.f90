@@ -20,7 +20,7 @@ module deck
   use errors, only: fatal, EXIT_INPUT
   use strings, only: i2s, index_of
   use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, die_at, unknown_group
-  use config, only: deck_t
+  use config, only: deck_t, ACCEL_AUTO, ACCEL_NONE, ACCEL_ANDERSON, STOP_AUTO, STOP_INCREMENT, STOP_RESIDUAL
   use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, &
                          add_boundary, apply_displacement, add_contact
   use deck_cross, only: check_cross
@@ -151,6 +151,10 @@ contains
 
     if (len_trim(d%output%file) == 0) d%output%file = default_output(path)
     call check_cross(d, st)
+    ! the defaults that depend on the scene: two bodies in one pair keep the paper's stop and no
+    ! acceleration; a chain of bodies passes its forces one contact per outer iteration
+    if (d%solver%acceleration == ACCEL_AUTO) d%solver%acceleration = merge(ACCEL_NONE, ACCEL_ANDERSON, d%npair <= 1)
+    if (d%solver%stop == STOP_AUTO) d%solver%stop = merge(STOP_INCREMENT, STOP_RESIDUAL, d%npair <= 1)
     call deck_text(d, d%effective)
   end subroutine read_deck
 

@@ -205,7 +205,9 @@ contains
     call v%real('tol', s%tol, unit='[-]', range='> 0', doc='outer tolerance, on the criterion '// &
       'of `stop`')
     call v%enum('stop', s%stop, STOP_CHOICES, doc='`''increment''`: the paper''s relative '// &
-      'increment of the obstacles; `''residual''`: the true residual of the iterate')
+      'increment of the obstacles; `''residual''`: the true residual of the iterate; `''auto''`: '// &
+      'increment for two bodies in one pair, residual for several pairs (a slow chain of bodies has '// &
+      'small increments long before a small error)')
     call v%int('max_outer', s%max_outer, range='>= 1', doc='outer iteration limit (reached: exit 2)')
     call v%enum('factorization', s%factor%factorization, FACTOR_CHOICES, doc='`''cholmod''`: '// &
       'sparse Cholesky (CHOLMOD), the interface ordered last; `''banded''`: reverse '// &
@@ -215,8 +217,9 @@ contains
       'each body for `''cholmod''`, the interface always last: `''metis''`, `''amd''` (CAMD), '// &
       '`''natural''` or `''nd''` (the program''s geometric nested dissection)')
     call v%enum('acceleration', s%acceleration, ACCEL_CHOICES, doc='outer fixed-point '// &
-      'acceleration: `''none''`, `''aitken''` (dynamic relaxation) or `''anderson''` (depth 5, '// &
-      'mixing delta)')
+      'acceleration: `''none''`, `''aitken''` (dynamic relaxation), `''anderson''` (depth 5, '// &
+      'mixing delta) or `''auto''`: none for two bodies in one pair, anderson for several pairs (a chain '// &
+      'of bodies passes its forces one contact per outer iteration)')
     call v%real('inner_factor', s%inner_factor, unit='[-]', range='> 0', doc='inner tolerance = '// &
       'inner_factor x min(increment, residual) of the previous outer iteration, clamped to '// &
       '[inner_rtol_min, inner_rtol_max]')
