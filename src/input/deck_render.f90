@@ -77,8 +77,7 @@ module deck_render
     'groups the two sides declared `''contact''` (then `&contact` is optional; it is needed for a '// &
     'body from a mesh file). A rectangle''s sides are the groups `''left''`, `''right''`, '// &
     '`''bottom''`, `''top''`. An override changes a pair: the two-body one, or the one its '// &
-    '`bodies` names. This version''s solver takes two bodies in one pair (a deck beyond that is '// &
-    'refused after its checks). The two surfaces of a pair are paired by dual mortar: matching or not, '// &
+    '`bodies` names. The two surfaces of a pair are paired by dual mortar: matching or not, '// &
     'overlapping in whole or in part, flat or curved, an open chain of edges or a closed curve '// &
     '(a rim, a bore). Pairing and normals are computed once, on the initial configuration '// &
     '(small deformation).'
