@@ -10,7 +10,7 @@ one contact pair") is a failed check, and so is every check that needs its resul
     'constant' (alpha = 5e-13, about h/E) and with method='monolithic', each pair's vertical
     resultant is the load 6e5 (1e-9, from the result file; the console line to its printed
     digits) and each pair's nodal forces equal the monolithic ones (1e-8 of the largest).
-(2) a disc (R = 1, msh_disc.py) between two plates 2 x 1 (h = 0.005): the upper plate pressed
+(2) inputs/disc_plates.nml, a disc (R = 1, msh_disc.py) between two plates 2 x 1 (h = 0.005): the upper plate pressed
     by 3 on its top (P = 6) and held laterally by a roller, the disc by ux = 0 on its vertical
     axis, the lower plate clamped below; both pairs carry P (1e-9), Robin = monolithic (1e-8),
     and each contact's half-width a and peak pressure p0 are Hertz's for a cylinder on a
@@ -310,18 +310,17 @@ try:
                 hertz_check(f"disc on the lower plate, {m}", d, P2, R, E_D, NU_D, E_P, NU_P)
         check_same("disc on the lower plate", runs["robin"], runs["monolithic"], 1)
 
-    # the N-body scene: upper plate (1), disc (2), lower plate (3), on the fine meshes
-    lines = [f"&body id=1, x0=-1.0, y0=1.0, width={W}, height=1.0, {plate['fine']}, young={E_P}, poisson={NU_P},"
-             " left='roller' /",
-             f"&body id=2, mesh='disc_fine.msh', region='disc', young={E_D}, poisson={NU_D} /",
-             f"&body id=3, x0=-1.0, y0=-2.0, width={W}, height=1.0, {plate['fine']}, young={E_P}, poisson={NU_P},"
-             " bottom='clamped' /",
-             f"&traction body=1, side='top', t0=0.0, {-Q} /",
-             "&boundary body=2, group='disc_axis', ux=0.0 /",
-             "&contact bodies=1,2, groups='bottom','disc_upper' /",
-             "&contact bodies=2,3, groups='disc_lower','top' /",
-             "&solver tol=1e-10 /"]
-    d3 = write(tmp, "disc_plates", lines)
+    # the N-body scene: inputs/disc_plates.nml, upper plate (1), disc (2), lower plate (3)
+    d3 = os.path.join(ROOT, "inputs", "disc_plates.nml")
+    text = open(d3).read()
+    want = [f"width = {W}, height = 1.0, {plate['fine'].replace('=', ' = ')}", f"young = {E_P}, poisson = {NU_P}",
+            f"mesh = 'gmsh/disc_plates.msh', region = 'disc', young = {E_D}, poisson = {NU_D}",
+            f"side = 'top', t0 = 0.0, {-Q}"]
+    check(all(w in text for w in want) and text.count(want[0]) == 2, "disc_plates.nml: the scene of this test",
+          "; ".join(w for w in want if w not in text))
+    with open(os.path.join(tmp, "disc_fine.msh"), "rb") as f1, \
+            open(os.path.join(ROOT, "inputs", "gmsh", "disc_plates.msh"), "rb") as f2:
+        check(f1.read() == f2.read(), "inputs/gmsh/disc_plates.msh is msh_disc.py's disc (R = 1, n = 80, nr = 40)")
     pairs_d = {1: (1, 2), 2: (2, 3)}
     runs = {m: Run(tmp, f"disc_plates_{m}", d3, f"&solver method='{m}' /") for m in ("robin", "monolithic")}
     deck_valid(runs["monolithic"], "disc between plates", 3, 2)
