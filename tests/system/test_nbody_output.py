@@ -19,7 +19,8 @@ pairs (1,2) and (2,3)) and on a two-body deck (inputs/table1/q1_6x2.nml):
 3. tools/plot_solution.py draws every body (its cell count), tools/plot_contact.py one curve
    per pair, labelled 'pair k (bodies A,B)'; on the two-body file no pair label.
 4. Restart: the 3-body run stopped by SIGTERM during the outer iteration and restarted from
-   its checkpoint ends bitwise equal to the uninterrupted run.
+   its checkpoint ends bitwise equal to the uninterrupted run; so does one restarted from a
+   periodic checkpoint (checkpoint_every) of a run stopped by max_outer.
 """
 import filecmp
 import os
@@ -309,6 +310,22 @@ if os.path.isfile(f"{OUT}/s3.h5"):
     os.rmdir(f"{OUT}/s3_contact2.xdmf")
 
 # ---- 4. restart --------------------------------------------------------------------------
+def differences(a, b):
+    """The datasets of every body and pair, the history and the counts that differ between
+    two result files (bitwise)."""
+    diff = []
+    with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+        for k in datasets(fa):
+            if k.startswith(("contact/", "body")) or k in ("history/criterion", "history/residual",
+                                                              "history/inner", "history/active"):
+                if k not in fb or not np.array_equal(np.array(fa[k]), np.array(fb[k])):
+                    diff.append(k)
+        for k in ("outer_iterations", "inner_iterations", "status"):
+            if text_attr(fa, k) != text_attr(fb, k):
+                diff.append(k)
+    return diff
+
+
 # a slow relaxation: some 500 outer iterations, long enough to be stopped part-way
 SLOW = "&solver delta=0.05 /"
 deckr = write_deck("stack3_slow", stack(nx=32))
@@ -334,18 +351,21 @@ if os.path.isfile(ck) and os.path.isfile(f"{OUT}/full.h5"):
     p, _ = run_solver(BIN, deckr, SLOW, out("restart"), "--restart", ck, env=env, timeout=900)
     check(p.returncode == 0, "3 bodies: the restart converges", f"exit {p.returncode} {p.stderr.strip()[-300:]}")
     if p.returncode == 0:
-        diff = []
-        with h5py.File(f"{OUT}/full.h5", "r") as fa, h5py.File(f"{OUT}/restart.h5", "r") as fb:
-            for k in datasets(fa):
-                if k.startswith(("contact/", "body")) or k in ("history/criterion", "history/residual",
-                                                                  "history/inner", "history/active"):
-                    if k not in fb or not np.array_equal(np.array(fa[k]), np.array(fb[k])):
-                        diff.append(k)
-            for k in ("outer_iterations", "inner_iterations", "status"):
-                if text_attr(fa, k) != text_attr(fb, k):
-                    diff.append(k)
+        diff = differences(f"{OUT}/full.h5", f"{OUT}/restart.h5")
         check(not diff, "3 bodies: the restart ends bitwise equal to the uninterrupted run "
               "(every body, every pair, the history)", str(diff[:5]))
+
+# periodic checkpoints: stopped by max_outer, resumed without that limit
+p, _ = run_solver(BIN, deckr, "&solver delta=0.05, max_outer=200 /",
+                  out("part").replace(" /", ", checkpoint_every=100 /"), env=env, timeout=900)
+ck2 = f"{OUT}/part.h5.ckpt.h5"
+check(p.returncode == 2 and os.path.isfile(ck2), "3 bodies: max_outer=200 exits 2 with a periodic checkpoint",
+      f"exit {p.returncode}")
+if os.path.isfile(ck2) and os.path.isfile(f"{OUT}/full.h5"):
+    p, _ = run_solver(BIN, deckr, SLOW, out("part_restart"), "--restart", ck2, env=env, timeout=900)
+    diff = differences(f"{OUT}/full.h5", f"{OUT}/part_restart.h5") if p.returncode == 0 else ["exit"]
+    check(not diff, "3 bodies: the restart from the periodic checkpoint ends bitwise equal to the uninterrupted run",
+          f"exit {p.returncode} {diff[:5]}")
 
 print(f"{len(check.failed)} failed checks")
 sys.exit(1 if check.failed else 0)
