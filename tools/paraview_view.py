@@ -26,8 +26,9 @@ installed (Debian's `paraview` package puts them in dist-packages).
                  contact nodes when none has one), warped like the bodies, with a margin of
                  half its size (at least two contact segments) on every side;
                  X0,X1,Y0,Y1 frames that box (model coordinates, undeformed).
-The contact line is drawn on top of the bodies as a black polyline per body, through the
-contact nodes of that body (/contact/coordinates matched to the body's nodes) warped by the
+The contact line is drawn on top of the bodies as a black polyline per body (and per contact
+pair), through the contact nodes of that body (/contact/coordinates, or a pair's
+/contact/pair_<k>, matched to the body's nodes) warped by the
 body's displacement with the same magnification as the bodies: where the bodies touch the
 two lines lie on each other, where they are apart the gap is seen between them.
 
@@ -39,7 +40,7 @@ would crash in the X window code). When xvfb-run hands out a dead display (ParaV
 "bad X server connection", SIGABRT, exit 134; seen in 2 of 36 runs) the re-run is tried
 once more; any other abnormal end of the re-run becomes a one-line message and exit 1.
 The file is opened with Xdmf3ReaderT, which reads the spatial Collection of x.xdmf
-(body1, body2, contact) as one block per grid. Not Xdmf3ReaderS: it reads the grids of a
+(body1 .. bodyN and the contact lines) as one block per grid. Not Xdmf3ReaderS: it reads the grids of a
 spatial Collection as pieces of one dataset, and ParaView merges the pieces for rendering
 keeping only the arrays every piece has; the contact line shares none with the bodies, so
 the bodies are drawn grey (solid colour) although the scalar bar is shown. The file is
@@ -235,32 +236,57 @@ def contact_lines(h5path, scale):
     (body, points) with points an (n, 2) array in contact-line order, n >= 2. The contact
     nodes (/contact/coordinates) are matched to a body's nodes by identical coordinates;
     a body with fewer than two matching nodes (a non-matching mortar side) has no line.
-    Also returns the boolean mask of the active contact nodes (normal force > 0)."""
+    With several contact pairs each pair's line (/contact/pair_<k>) is matched to its own two
+    bodies: a body in two pairs has two lines.
+    Also returns the contact nodes of all pairs (m, 2) and the boolean mask of the active ones
+    (normal force > 0)."""
+    pieces, c, active = contact_pieces(h5path, scale)
+    return [(b, p) for b, p, _ in pieces], c, active
+
+
+def contact_pieces(h5path, scale):
+    """contact_lines with, for each line, the rows of /contact its points come from."""
     import h5py
     import numpy as np
+
+    def xy_rows(a):
+        a = np.asarray(a, dtype=float)
+        return a.T if a.shape[0] == 2 and a.shape[-1] != 2 else a
+
     with h5py.File(h5path, "r") as f:
-        c = np.asarray(f["contact/coordinates"][()], dtype=float)
+        c = xy_rows(f["contact/coordinates"][()])                     # (m, 2)
         lam = np.asarray(f["contact/normal_force"][()], dtype=float).reshape(-1)
-        bodies = []
-        for b in (1, 2):
+        npair = int(f.attrs.get("pairs", 1))
+        # (first row, last row + 1, bodies) of each pair
+        if npair > 1:
+            spans, first = [], 0
+            for k in range(1, npair + 1):
+                g = f[f"contact/pair_{k}"]
+                n = g["normal_force"].shape[0]
+                spans.append((first, first + n, [int(v) for v in np.asarray(g.attrs["bodies"]).reshape(-1)[:2]]))
+                first += n
+        else:
+            spans = [(0, c.shape[0], [1, 2])]
+        bodies = {}
+        for b in sorted({b for _, _, bs in spans for b in bs}):
             g = f.get(f"body{b}")
             if g is None or "coordinates" not in g or "displacement" not in g:
                 continue
-            bodies.append((b, np.asarray(g["coordinates"][()], dtype=float),
-                           np.asarray(g["displacement"][()], dtype=float)))
-    c = c.T if c.shape[0] == 2 and c.shape[-1] != 2 else c          # (m, 2)
-    lines = []
-    for b, xy, u in bodies:
-        xy = xy.T if xy.shape[0] == 2 and xy.shape[-1] != 2 else xy
-        u = u.T if u.shape[0] == 2 and u.shape[-1] != 2 else u
-        index = {(float(x), float(y)): k for k, (x, y) in enumerate(xy)}
-        rows = [(i, index.get((float(x), float(y)))) for i, (x, y) in enumerate(c)]
-        rows = [(i, k) for i, k in rows if k is not None]
-        if len(rows) < 2:
-            continue
-        ci, bi = (np.array(t) for t in zip(*rows))
-        lines.append((b, c[ci] + scale * u[bi]))
-    return lines, c, lam > 0.0
+            bodies[b] = (xy_rows(g["coordinates"][()]), xy_rows(g["displacement"][()]))
+    pieces = []
+    for r0, r1, bs in spans:
+        for b in bs:
+            if b not in bodies:
+                continue
+            xy, u = bodies[b]
+            index = {(float(x), float(y)): k for k, (x, y) in enumerate(xy)}
+            rows = [(i, index.get((float(x), float(y)))) for i, (x, y) in enumerate(c[r0:r1], start=r0)]
+            rows = [(i, k) for i, k in rows if k is not None]
+            if len(rows) < 2:
+                continue
+            ci, bi = (np.array(t) for t in zip(*rows))
+            pieces.append((b, c[ci] + scale * u[bi], ci))
+    return pieces, c, lam > 0.0
 
 
 def zoom_box(spec, h5path=None, scale=0.0):
@@ -277,14 +303,13 @@ def zoom_box(spec, h5path=None, scale=0.0):
         if not (x1 > x0 and y1 > y0):
             raise ValueError(f"--zoom box {spec!r}: needs X0 < X1 and Y0 < Y1")
         return x0, x1, y0, y1
-    lines, c, active = contact_lines(h5path, scale)
+    pieces, c, active = contact_pieces(h5path, scale)
     if c.shape[0] < 2:
         raise ValueError(f"{h5path}: no contact line to zoom on")
     pick = active if active.any() else np.ones(c.shape[0], dtype=bool)
     pts = [c[pick]]
-    for _, p in lines:
-        if p.shape[0] == c.shape[0]:
-            pts.append(p[pick])
+    for _, p, rows in pieces:
+        pts.append(p[pick[rows]])
     pts = np.vstack(pts)
     seg = float(np.median(np.hypot(*np.diff(c, axis=0).T)))
     (x0, y0), (x1, y1) = pts.min(axis=0), pts.max(axis=0)

@@ -12,6 +12,9 @@ file has it, else the sum of the nodal normal forces (sum of
 the same is printed, one line per run ('plot_contact: NAME: ...'). Dotted vertical lines
 mark the edges of each run's contact zone (the zero of p^2 extrapolated from the two
 outermost active nodes, rc_results.contact_edges).
+A run of several contact pairs (root attribute `pairs` > 1) gives one curve per pair, from
+/contact/pair_<k>, labelled 'pair k (bodies A,B)', its force the resultant on the pair's
+first body (/contact/pair_<k>/resultant_on_first_body).
 Middle panel: the gap /contact/gap = B1u1 + B2u2 - g0 (<= 0; < 0 where the bodies are apart).
 Units from the result file (root attributes unit_length/unit_force/unit_stress and the
 datasets' `units` attributes; SI m, N, Pa when absent), values scaled to an SI prefix
@@ -35,7 +38,8 @@ err_L2=...') and written in that panel's legend:
           w the tributary lengths (/contact/tributary_length)
 Hertz assumes two half-spaces: with finite bodies and a coarse mesh expect agreement
 only when the contact width 2a is small against the bodies and spans several elements.
-A run without a parabolic gap (gap_radius = 0) gets no Hertz curve (a note on stderr).
+A run without a parabolic gap (gap_radius = 0) or of several pairs gets no Hertz curve (a
+note on stderr).
 Runs that are identical for Hertz (same P, R, xc, E*) share one curve.
 Exit 0 on success, 1 (with a message) on a missing or unreadable file or any other failure.
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
@@ -147,33 +151,51 @@ def hertz_errors(r, h):
     return e
 
 
-def read_run(path, want_hertz):
-    with h5py.File(path, "r") as f:
-        u = result_units(f)
-        # position along the contact curve: /contact/s (arc length along the slave's curve;
-        # in older files the coordinate along a rectangle's side); the oldest have only /contact/x
-        sname = "/contact/s" if "/contact/s" in f else "/contact/x"
-        x = np.array(f[sname], dtype=float)
-        resultant = None
-        if "/contact/resultant_body1" in f:
-            resultant = np.asarray(f["/contact/resultant_body1"], dtype=float).reshape(-1)[:2]
-        order = np.argsort(x, kind="stable")
-        lam = np.array(f["/contact/normal_force"], dtype=float)
-        r = dict(x=x[order], p=np.array(f["/contact/pressure"], dtype=float)[order], lam=lam[order],
-                 gap=np.array(f["/contact/gap"], dtype=float)[order] if "/contact/gap" in f else None,
-                 trib=np.array(f["/contact/tributary_length"], dtype=float)[order]
-                 if "/contact/tributary_length" in f else np.zeros(0),
-                 method=text_attr(f, "method", "?"), status=text_attr(f, "status", "?"),
-                 delta=num_attr(f, "delta", float("nan")), resultant=resultant,
-                 sname="s" if sname == "/contact/s" else "x",
-                 ux=dataset_unit(f[sname], u["length"]),
-                 up=dataset_unit(f["/contact/pressure"], u["stress"]),
-                 uf=dataset_unit(f["/contact/normal_force"], u["line_force"]),
-                 ug=dataset_unit(f["/contact/gap"], u["length"]) if "/contact/gap" in f else u["length"])
-        r["h"], r["why"] = hertz(f, path) if want_hertz else (None, None)
+def read_line(f, g, u, resultant_name):
+    """The curve of one contact line (HDF5 group g: /contact or /contact/pair_<k>)."""
+    # position along the contact curve: s (arc length along the slave's curve; in older
+    # files the coordinate along a rectangle's side); the oldest have only x
+    sname = "s" if "s" in g else "x"
+    x = np.array(g[sname], dtype=float)
+    resultant = None
+    if resultant_name in g:
+        resultant = np.asarray(g[resultant_name], dtype=float).reshape(-1)[:2]
+    order = np.argsort(x, kind="stable")
+    lam = np.array(g["normal_force"], dtype=float)
+    r = dict(x=x[order], p=np.array(g["pressure"], dtype=float)[order], lam=lam[order],
+             gap=np.array(g["gap"], dtype=float)[order] if "gap" in g else None,
+             trib=np.array(g["tributary_length"], dtype=float)[order]
+             if "tributary_length" in g else np.zeros(0),
+             method=text_attr(f, "method", "?"), status=text_attr(f, "status", "?"),
+             delta=num_attr(f, "delta", float("nan")), resultant=resultant, sname=sname,
+             ux=dataset_unit(g[sname], u["length"]),
+             up=dataset_unit(g["pressure"], u["stress"]),
+             uf=dataset_unit(g["normal_force"], u["line_force"]),
+             ug=dataset_unit(g["gap"], u["length"]) if "gap" in g else u["length"])
     r["P"] = float(np.sum(lam))
     r["edges"] = contact_edges(r["x"], r["p"], r["lam"])
     return r
+
+
+def read_run(path, want_hertz):
+    """The curves of one result file: one (/contact), or one per pair when it has several."""
+    with h5py.File(path, "r") as f:
+        u = result_units(f)
+        npair = int(f.attrs.get("pairs", 1))
+        if npair <= 1:
+            r = read_line(f, f["contact"], u, "resultant_body1")
+            r["h"], r["why"] = hertz(f, path) if want_hertz else (None, None)
+            r["pair"] = ""
+            return [r]
+        runs = []
+        for k in range(1, npair + 1):
+            g = f[f"contact/pair_{k}"]
+            r = read_line(f, g, u, "resultant_on_first_body")
+            a, b = (int(v) for v in np.asarray(g.attrs["bodies"]).reshape(-1)[:2])
+            r["pair"] = f"pair {k} (bodies {a},{b})"
+            r["h"], r["why"] = (None, f"{npair} contact pairs") if want_hertz else (None, None)
+            runs.append(r)
+        return runs
 
 
 def main(argv=None):
@@ -184,12 +206,16 @@ def main(argv=None):
     runs = []
     for path in a.files:
         try:
-            r = read_run(path, a.hertz)
-        except (OSError, KeyError) as e:
+            curves = read_run(path, a.hertz)
+        except (OSError, KeyError, ValueError) as e:
             print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
             return 1
-        r["name"], r["label"] = run_label(path, r["method"], r["status"], r["delta"])
-        runs.append(r)
+        for r in curves:
+            r["name"], r["label"] = run_label(path, r["method"], r["status"], r["delta"])
+            if r["pair"]:
+                r["name"] += f" {r['pair']}"
+                r["label"] = f"{r['pair']}, {r['label']}"
+            runs.append(r)
     ux, up, uf, ug = (runs[0][k] for k in ("ux", "up", "uf", "ug"))
     for r in runs[1:]:
         if (r["ux"], r["up"], r["uf"], r["ug"]) != (ux, up, uf, ug):
@@ -300,7 +326,8 @@ def main(argv=None):
         axh.legend(fontsize=7, loc="upper right")
         plain_axis(axh)
     save_figure(fig, a.output)
-    print(f"plot_contact: wrote {a.output} ({len(runs)} runs, {len(seen)} Hertz curves)")
+    curves = f", {len(runs)} curves" if len(runs) != len(a.files) else ""
+    print(f"plot_contact: wrote {a.output} ({len(a.files)} runs{curves}, {len(seen)} Hertz curves)")
     return 0
 
 

@@ -1,19 +1,20 @@
 #!/usr/bin/python3
-"""Deformed shape of both bodies of a robin_contact run, coloured by a nodal field (von
-Mises stress by default), with the contact line marked. Cheap at any mesh size: the field
+"""Deformed shape of every body of a robin_contact run, coloured by a nodal field (von
+Mises stress by default), with the contact lines marked. Cheap at any mesh size: the field
 is rasterised, the element edges are drawn only for small meshes.
 
 Usage: tools/plot_solution.py FILE.h5 [-o solution.png] [--field NAME] [--scale S]
                               [--clip P] [--edges N] [--pixels W] [--title TEXT]
 
 Reads /bodyN/coordinates, /bodyN/displacement, /bodyN/cells and the field (results.f90
-layout) and draws x + S u for both bodies on one shared colour scale:
+layout) and draws x + S u for all bodies (N = the root attribute `bodies`, 2 in files
+without it) on one shared colour scale:
   * the field is rasterised: each cell is sampled (bilinear on quadrilaterals, linear on
     triangles) finely enough for every image pixel, the samples are averaged per pixel
     (W pixels along the longer side of the picture, --pixels, default 1000) and drawn as
     one image. Time and memory grow with the cell count only linearly and stay small
     (about 2 s and 150 MB for 512x256 cells per body);
-  * the element edges are drawn when both bodies have at most N cells in all (--edges,
+  * the element edges are drawn when the bodies have at most N cells in all (--edges,
     default 5000); beyond that only the outlines (a million edges make a black picture);
   * the colour scale spans the (100-P)th to the P-th percentile of the nodal values
     (--clip, default 99.5; 100: min to max), so that a stress singularity at a corner does
@@ -26,10 +27,12 @@ attributes; SI m, Pa when absent), written in the axis labels and the colour bar
 values scaled to an SI prefix (MPa, mm); no matplotlib offset text.
 The undeformed outlines are drawn dashed grey, the deformed ones black. The
 magnification S is stated in the title; by default (or --scale auto) it is 10% of the
-larger body size (max of width and height of either body) over the largest nodal
+larger body size (max of width and height of any body) over the largest nodal
 displacement |u|, rounded to 3 significant digits. The contact line (/contact/coordinates)
 is drawn on both deformed bodies; its active nodes (/contact/active = 1) are marked (for at
-most 200 contact nodes; beyond, the active part of the line is drawn thick).
+most 200 contact nodes; beyond, the active part of the line is drawn thick). With several
+contact pairs each pair's line (/contact/pair_<k>) is drawn on its two bodies in a colour
+of its own, its active nodes marked on its first body.
 Exit 0 on success, 1 with a message on a missing or unreadable file or any other failure
 (out of memory included).
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
@@ -137,6 +140,79 @@ def rasterise(bodies, pixels):
     return img, [lo[0], lo[0] + nx * h, lo[1], lo[1] + ny * h]
 
 
+def contact_lines(f):
+    """The contact lines to draw: one per pair, each a dict with the 0-based indices of its
+    two bodies, its node coordinates (2, n), its active flags and its legend labels. One
+    pair (and files without pair groups): /contact, bodies 1 and 2."""
+    npair = int(f.attrs.get("pairs", 1))
+    out = []
+    for k in range(1, npair + 1):
+        g = f[f"contact/pair_{k}"] if npair > 1 else f["contact"]
+        if "coordinates" in g:
+            cxy = np.array(g["coordinates"], dtype=float)
+        elif "x" in g:
+            cxy = np.array([g["x"], g["y"]], dtype=float)
+        else:
+            cxy = np.zeros((2, 0))
+        if cxy.ndim != 2 or cxy.shape[0] != 2:
+            cxy = cxy.reshape(-1, 2).T if cxy.size else np.zeros((2, 0))
+        active = np.array(g["active"]) if "active" in g else np.zeros(cxy.shape[-1])
+        if npair > 1:
+            a, b = (int(v) for v in np.asarray(g.attrs["bodies"]).reshape(-1)[:2])
+            c = f"C{(k - 1) % 10}"
+            styles = [dict(color=c, lw=1.8, label=f"contact line, pair {k} (bodies {a},{b})"),
+                      dict(color=c, lw=1.4, ls="--")]
+            mark, tag = c, f"pair {k}: "
+        else:
+            a, b = 1, 2
+            styles = [dict(color="red", lw=1.8, label="contact line, body 1"),
+                      dict(color="orange", lw=1.4, ls="--", label="contact line, body 2")]
+            mark, tag = "red", ""
+        out.append(dict(bodies=(a - 1, b - 1), cxy=cxy, active=active, styles=styles, mark=mark, tag=tag))
+    return out
+
+
+def draw_contact_line(ax, pair, ln, tol, fl):
+    """One contact line drawn on the deformed boundary of its two bodies `pair` (styles of
+    ln), its active nodes marked on the first; lengths divided by fl."""
+    cxy = ln["cxy"]
+    act_all = np.asarray(ln["active"]).reshape(-1)
+    for b, st in zip(pair, ln["styles"]):
+        if cxy.shape[1] == 0:
+            break
+        bn = b["boundary"]
+        idx = np.empty(cxy.shape[1], dtype=np.int64)
+        ok = np.zeros(cxy.shape[1], dtype=bool)
+        for c0 in range(0, cxy.shape[1], 256):            # (256 x boundary nodes) distances at a time
+            cc = cxy[:, c0:c0 + 256]
+            dist = np.hypot(b["xy"][0][bn][None, :] - cc[0][:, None], b["xy"][1][bn][None, :] - cc[1][:, None])
+            j = np.argmin(dist, axis=1)
+            idx[c0:c0 + cc.shape[1]] = bn[j]
+            ok[c0:c0 + cc.shape[1]] = dist[np.arange(j.size), j] <= tol
+        if not ok.any():
+            continue
+        # the contact nodes come in the order of the contact chain; a closed loop (a rim) is
+        # drawn closed: its ends are as near each other as two neighbours
+        p = b["def"][:, idx[ok]] / fl
+        if p.shape[1] > 2:
+            step = np.hypot(*np.diff(p, axis=1))
+            if np.hypot(*(p[:, -1] - p[:, 0])) <= 1.5 * step.max():
+                p = np.hstack([p, p[:, :1]])
+        ax.plot(p[0], p[1], zorder=4, **st)
+        if b is pair[0]:
+            act = np.zeros(ok.size, dtype=bool)
+            act[:min(ok.size, act_all.size)] = act_all[:ok.size] > 0
+            act &= ok
+            pa = b["def"][:, idx[act]] / fl
+            lab = f"{ln['tag']}active contact nodes ({int(act.sum())} of {ok.size})"
+            if ok.size <= 200:
+                ax.plot(pa[0], pa[1], "o", ms=3.5, mfc=ln["mark"], mec="white", mew=0.5, ls="none", zorder=5,
+                        label=lab)
+            else:
+                o = np.argsort(pa[0], kind="stable")
+                ax.plot(pa[0][o], pa[1][o], ".", color=ln["mark"], ms=1.5, zorder=5, label=lab)
+
+
 def nice(x):
     return float(f"{x:.3g}")
 
@@ -165,20 +241,21 @@ def main(argv=None):
     try:
         with h5py.File(a.file, "r") as f:
             units = result_units(f)
-            read = [read_body(f[f"body{b}"], a.field, units) for b in (1, 2)]
+            nbody = int(f.attrs.get("bodies", 2))
+            read = [read_body(f[f"body{b}"], a.field, units) for b in range(1, nbody + 1)]
             bodies = [r[0] for r in read]
             funit = read[0][1]
             lunit = dataset_unit(f["body1/coordinates"], units["length"])
-            cxy = np.array(f["/contact/coordinates"], dtype=float) if "/contact/coordinates" in f \
-                else np.zeros((2, 0))
-            active = np.array(f["/contact/active"]) if "/contact/active" in f else np.zeros(cxy.shape[-1])
+            lines = contact_lines(f)
             status = text_attr(f, "status", "?")
             method = text_attr(f, "method", "?")
-    except (OSError, KeyError) as e:
+    except (OSError, KeyError, ValueError) as e:
         print(f"plot_solution: cannot read {a.file}: {e}", file=sys.stderr)
         return 1
-    if cxy.ndim != 2 or cxy.shape[0] != 2:
-        cxy = cxy.reshape(-1, 2).T if cxy.size else np.zeros((2, 0))
+    if any(not 0 <= i < len(bodies) for ln in lines for i in ln["bodies"]):
+        print(f"plot_solution: cannot read {a.file}: a contact pair names a body the file does not have",
+              file=sys.stderr)
+        return 1
 
     size = max(max(np.ptp(b["xy"][0]), np.ptp(b["xy"][1])) for b in bodies)
     umax = max(float(np.max(np.hypot(b["u"][0], b["u"][1]), initial=0.0)) for b in bodies)
@@ -225,47 +302,12 @@ def main(argv=None):
     if ncell > a.edges:
         notes.append(f"element edges not drawn ({ncell} cells > {a.edges})")
 
-    # contact line: boundary nodes of each body at the contact coordinates, deformed
+    # contact lines: boundary nodes of each pair's bodies at the contact coordinates, deformed
     tol = 1e-8 * max(size, 1e-300)
-    styles = [dict(color="red", lw=1.8, label="contact line, body 1"),
-              dict(color="orange", lw=1.4, ls="--", label="contact line, body 2")]
-    act_all = np.asarray(active).reshape(-1)
-    for b, st in zip(bodies, styles):
-        if cxy.shape[1] == 0:
-            break
-        bn = b["boundary"]
-        idx = np.empty(cxy.shape[1], dtype=np.int64)
-        ok = np.zeros(cxy.shape[1], dtype=bool)
-        for c0 in range(0, cxy.shape[1], 256):            # (256 x boundary nodes) distances at a time
-            cc = cxy[:, c0:c0 + 256]
-            dist = np.hypot(b["xy"][0][bn][None, :] - cc[0][:, None], b["xy"][1][bn][None, :] - cc[1][:, None])
-            j = np.argmin(dist, axis=1)
-            idx[c0:c0 + cc.shape[1]] = bn[j]
-            ok[c0:c0 + cc.shape[1]] = dist[np.arange(j.size), j] <= tol
-        if not ok.any():
-            continue
-        # the contact nodes come in the order of the contact chain; a closed loop (a rim) is
-        # drawn closed: its ends are as near each other as two neighbours
-        p = b["def"][:, idx[ok]] / fl
-        if p.shape[1] > 2:
-            step = np.hypot(*np.diff(p, axis=1))
-            if np.hypot(*(p[:, -1] - p[:, 0])) <= 1.5 * step.max():
-                p = np.hstack([p, p[:, :1]])
-        ax.plot(p[0], p[1], zorder=4, **st)
-        if b is bodies[0]:
-            act = np.zeros(ok.size, dtype=bool)
-            act[:min(ok.size, act_all.size)] = act_all[:ok.size] > 0
-            act &= ok
-            pa = b["def"][:, idx[act]] / fl
-            lab = f"active contact nodes ({int(act.sum())} of {ok.size})"
-            if ok.size <= 200:
-                ax.plot(pa[0], pa[1], "o", ms=3.5, mfc="red", mec="white", mew=0.5, ls="none", zorder=5,
-                        label=lab)
-            else:
-                o = np.argsort(pa[0], kind="stable")
-                ax.plot(pa[0][o], pa[1][o], ".", color="red", ms=1.5, zorder=5, label=lab)
+    for ln in lines:
+        draw_contact_line(ax, [bodies[i] for i in ln["bodies"]], ln, tol, fl)
 
-    extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}[
+    extend =    extend = {(False, False): "neither", (True, False): "min", (False, True): "max", (True, True): "both"}[
         (vmin < lo, vmax > hi)]
     cb = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.85, extend=extend)
     name = NAMES[a.field]
@@ -287,7 +329,7 @@ def main(argv=None):
     ax.set_ylabel(axis_label("y", ll))
     ax.legend(fontsize=7, loc="best")
     fname = os.path.basename(a.file)
-    first = a.title or f"{fname}: {method}, {status}, {bodies[0]['element']}/{bodies[1]['element']}"
+    first = a.title or f"{fname}: {method}, {status}, {'/'.join(b['element'] for b in bodies)}"
     ax.set_title(f"{first}\ndeformed shape, displacement magnified ×{S:g} ({how})\n"
                  f"colour: {name}, {clip_note}\n" + "; ".join(notes), fontsize=8)
     save_figure(fig, a.output)

@@ -34,7 +34,7 @@ module h5io
   private
 
   public :: file_open, file_close, group_open, group_close
-  public :: write_dset, write_attr, read_dset, read_attr, describe, exists
+  public :: write_dset, write_attr, write_attr_list, read_dset, read_attr, describe, exists
 
   integer, parameter, public :: CLASS_OTHER = 0     !< a type class the files do not use
   integer, parameter, public :: CLASS_INTEGER = 1   !< integer numbers
@@ -198,6 +198,16 @@ contains
       call fail(st, 'cannot write this type as', loc, name)
     end select
   end subroutine write_attr
+
+  !> Write the rank-1 attribute `name` of `loc`: an integer list such as the ids of
+  !! the bodies of a contact pair.
+  subroutine write_attr_list(loc, name, v, st)
+    integer(hid_t), intent(in) :: loc                   !< file, group or dataset
+    character(len=*), intent(in) :: name                !< attribute name
+    integer, intent(in), target, contiguous :: v(:)     !< its values
+    type(error_t), intent(inout) :: st                  !< status
+    call put(loc, name, .true., H5T_NATIVE_INTEGER, [size(v, kind=hsize_t)], c_loc(v), st)
+  end subroutine write_attr_list
 
   !> A scalar string: an attribute as a variable-length UTF-8 string (h5py reads `str`),
   !! a dataset as a fixed-length one (Fortran, space padded; an empty one is stored as ' ').

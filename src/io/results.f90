@@ -1,6 +1,9 @@
 !> Result files: one HDF5 file per run, written whole or not at all (temporary
 !! name in the same folder, then rename), and XDMF 3 files beside it so that
-!! ParaView opens both bodies and the contact line directly, and meshio reads each.
+!! ParaView opens every body and contact line directly, and meshio reads each.
+!!
+!! `/contact` holds the rows of all contact pairs stacked; `/contact/pair_<k>` the rows of
+!! pair k alone, with the ids of its two bodies.
 !!
 !! Every numeric dataset has a string attribute `units` (the deck's unit names: length,
 !! stress, force/length for the nodal contact force in 2D, '1' for pure numbers and
@@ -9,15 +12,15 @@ module results
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use hdf5, only: hid_t
-  use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr
+  use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr, write_attr_list
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES
-  use strings, only: word, body_label
+  use strings, only: word, body_label, i2s
   use mesh, only: mesh_t
   use assembly, only: body_system_t, stress_field_t
-  use contact_interface, only: interface_t, contact_resultant
+  use contact_interface, only: interface_t, contact_resultant, pair_rows
   use contact_types, only: contact_result_t, status_name
   use floating, only: free_list
   use errors, only: error_t, ERR_IO
@@ -41,8 +44,6 @@ module results
 
   public :: write_results
 
-  integer, parameter :: NFILES = 5   ! the HDF5 file and four XDMF files
-
 contains
 
   !> Write the HDF5 result and its XDMF companions, each under a temporary name of this
@@ -57,20 +58,24 @@ contains
     type(body_system_t), intent(in) :: sys(:)          !< systems (DOF maps)
     type(interface_t), intent(in) :: itf               !< contact rows of all pairs
     type(contact_result_t), intent(in) :: res          !< contact solution
-    real(wp), intent(in) :: u(:, :)                    !< (maxndof, 2) full displacements
+    real(wp), intent(in) :: u(:, :)                    !< (maxndof, bodies) full displacements
     type(stress_field_t), intent(in) :: stress(:)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     type(error_t), intent(out) :: err                  !< the failure, if any
-    character(len=len_trim(file) + 16) :: name(NFILES)
-    character(len=len_trim(file) + 128) :: tmp(NFILES)
+    character(len=len_trim(file) + 32), allocatable :: name(:)
+    character(len=len_trim(file) + 160), allocatable :: tmp(:)
     character(len=:), allocatable :: why, h5
     type(error_t) :: st
-    integer :: k, a
+    integer :: k, a, nb, np, nf
     logical :: ok
 
+    nb = size(msh)
+    np = itf%npair
     call ensure_parent_dir(file)
-    call result_files(file, name)
-    do k = 1, NFILES
+    call result_files(file, nb, np, name)
+    nf = size(name)
+    allocate (tmp(nf))
+    do k = 1, nf
       tmp(k) = temp_name(name(k))
     end do
     call write_h5(tmp(1), d, msh, sys, itf, res, u, stress, tm, run_id(), st)
@@ -79,42 +84,63 @@ contains
       call remove_temps()
       return
     end if
-    ! the XDMF files: both bodies and the contact line (ParaView), then one grid each (meshio)
+    ! the XDMF files: every body and contact line (ParaView), then one grid each (meshio);
+    ! one pair: its line is all of /contact, the grid 'contact'
     h5 = base_name(file)
-    call write_text(tmp(2), xdmf_text([1, 2, 3], h5, msh, itf%m, run_id()), ok)
-    do a = 1, 3
-      if (ok) call write_text(tmp(2 + a), xdmf_text([a], h5, msh, itf%m, run_id()), ok)
+    if (np == 1) then
+      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, run_id()), ok)
+    else
+      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(k, k=1, np)], h5, msh, itf, run_id()), ok)
+    end if
+    do a = 1, nb
+      if (ok) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, run_id()), ok)
     end do
+    if (ok) call write_text(tmp(3 + nb), xdmf_text([integer ::], [0], h5, msh, itf, run_id()), ok)
+    if (np > 1) then
+      do k = 1, np
+        if (ok) call write_text(tmp(3 + nb + k), xdmf_text([integer ::], [k], h5, msh, itf, run_id()), ok)
+      end do
+    end if
     if (.not. ok) then
       call err%set(ERR_IO, 'cannot write the XDMF files beside '//trim(file))
       call remove_temps()
       return
     end if
     ! companions first, the HDF5 file last: it appears only with its XDMF files
-    call commit_files(tmp(NFILES:1:-1), name(NFILES:1:-1), ok, why)
+    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why)
     if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
 
   contains
 
     subroutine remove_temps()
       integer :: j
-      do j = 1, NFILES
+      do j = 1, size(tmp)
         call remove_file(tmp(j))
       end do
     end subroutine remove_temps
 
   end subroutine write_results
 
-  !> The files of a result: the HDF5 file, <stem>.xdmf, <stem>_body1.xdmf,
-  !! <stem>_body2.xdmf, <stem>_contact.xdmf.
-  subroutine result_files(file, name)
+  !> The files of a result of nb bodies and np pairs: the HDF5 file, <stem>.xdmf,
+  !! <stem>_body<a>.xdmf for a = 1..nb, <stem>_contact.xdmf, and for np > 1
+  !! <stem>_contact<k>.xdmf for k = 1..np.
+  subroutine result_files(file, nb, np, name)
     character(len=*), intent(in) :: file
-    character(len=*), intent(out) :: name(NFILES)
+    integer, intent(in) :: nb, np
+    character(len=*), allocatable, intent(out) :: name(:)
+    integer :: k
+    allocate (name(3 + nb + merge(np, 0, np > 1)))
     name(1) = file
     name(2) = replace_suffix(file, '.h5', '.xdmf')
-    name(3) = replace_suffix(file, '.h5', '_body1.xdmf')
-    name(4) = replace_suffix(file, '.h5', '_body2.xdmf')
-    name(5) = replace_suffix(file, '.h5', '_contact.xdmf')
+    do k = 1, nb
+      name(2 + k) = replace_suffix(file, '.h5', '_body'//body_label(k)//'.xdmf')
+    end do
+    name(3 + nb) = replace_suffix(file, '.h5', '_contact.xdmf')
+    if (np > 1) then
+      do k = 1, np
+        name(3 + nb + k) = replace_suffix(file, '.h5', '_contact'//i2s(k)//'.xdmf')
+      end do
+    end if
   end subroutine result_files
 
   !> The HDF5 result file `path`, whole; st records the first failure.
@@ -155,6 +181,8 @@ contains
     call write_attr(fid, 'outer_iterations', res%outer, st)
     call write_attr(fid, 'inner_iterations', res%inner, st)
     call write_attr(fid, 'contact_nodes', itf%m, st)
+    call write_attr(fid, 'bodies', size(msh), st)
+    call write_attr(fid, 'pairs', itf%npair, st)
     ! which engine wrote the file: the factorization and the number of MPI processes
     call write_attr(fid, 'factorization', trim(word(FACTOR_CHOICES, d%solver%factor%factorization)), st)
     call write_attr(fid, 'ranks', tm%ranks, st)
@@ -215,7 +243,10 @@ contains
     call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
-    call write_dset(gid, 'segments', line_cells(itf%m), st, '1')
+    call write_dset(gid, 'segments', line_cells(itf, 1, itf%npair), st, '1')
+    do k = 1, itf%npair
+      call write_pair(gid, k, itf, res, pres, ul, us, uf, st)
+    end do
     call group_close(gid, st)
     call write_history(fid, res, st)
     ! bodies
@@ -271,6 +302,49 @@ contains
     end do
     call file_close(fid, st)
   end subroutine write_h5
+
+  !> The group pair_<q> of the contact group gid: pair q's rows alone (segments 0-based
+  !! within the pair), the ids of its bodies (side 1, side 2), its slave body, and the
+  !! resultant of its contact forces on its first body (side 1).
+  subroutine write_pair(gid, q, itf, res, pres, ul, us, uf, st)
+    integer(hid_t), intent(in) :: gid
+    integer, intent(in) :: q
+    type(interface_t), intent(in) :: itf
+    type(contact_result_t), intent(in) :: res
+    real(wp), intent(in) :: pres(:)            !< (m) pressure of each row [stress]
+    character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
+    type(error_t), intent(inout) :: st
+    integer(hid_t) :: pid
+    integer :: r(2), i, j
+    real(wp), allocatable :: w2(:, :)
+    r = pair_rows(itf, q)
+    i = r(1)
+    j = r(2)
+    call group_open(gid, 'pair_'//i2s(q), pid, st, create=.true.)
+    call write_attr_list(pid, 'bodies', itf%pair_body(:, q), st)
+    call write_attr(pid, 'slave_body', itf%pair_body(itf%pair_slave(q), q), st)
+    allocate (w2(j - i + 1, 2))
+    w2 = transpose(itf%xy(:, i:j))
+    call write_dset(pid, 'x', w2(:, 1), st, ul)
+    call write_dset(pid, 'y', w2(:, 2), st, ul)
+    call write_dset(pid, 's', itf%s(i:j), st, ul)
+    w2 = transpose(itf%normal(:, i:j))
+    call write_dset(pid, 'normal', w2, st, '1')
+    call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
+    call write_dset(pid, 'tributary_length', itf%trib(i:j), st, ul)
+    call write_dset(pid, 'normal_force', res%lam(i:j), st, uf)
+    call write_dset(pid, 'normal_force_side1', res%lam_body(i:j, 1), st, uf)
+    call write_dset(pid, 'normal_force_side2', res%lam_body(i:j, 2), st, uf)
+    call write_dset(pid, 'resultant_on_first_body', contact_resultant(itf, 1, res%lam, i, j), st, uf)
+    call write_dset(pid, 'pressure', pres(i:j), st, us)
+    call write_dset(pid, 'gap', res%gap(i:j), st, ul)
+    call write_dset(pid, 'active', merge(1, 0, res%lam(i:j) > 0.0_wp), st, '1')
+    call write_dset(pid, 'normal_displacement_side1', res%w(i:j, 1), st, ul)
+    call write_dset(pid, 'normal_displacement_side2', res%w(i:j, 2), st, ul)
+    call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
+    call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
+    call group_close(pid, st)
+  end subroutine write_pair
 
   !> The contact pressure as a nodal field of body a (0 off its contact lines): where it is
   !! a pair's slave the rows' pressures; on the master the mean of the pressures of the rows that reach a
@@ -339,47 +413,68 @@ contains
     p(3, :) = 0.0_wp
   end function pad3
 
-  !> The cells of the contact line over its m nodes (0-based, h5py shape (cells, n)):
-  !! m - 1 segments (k, k+1), or for m < 2 the m nodes as vertices.
-  function line_cells(m) result(c)
-    integer, intent(in) :: m
+  !> The cells of the contact lines of pairs p1..p2 over their n rows (0-based from the
+  !! first row of p1, h5py shape (cells, 2)): within each pair the segments (k, k+1) of
+  !! neighbouring rows, never one joining two pairs; with no segment at all (each pair
+  !! one row or none) the n rows as vertices (shape (n, 1)).
+  function line_cells(itf, p1, p2) result(c)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: p1, p2              !< first and last pair
     integer, allocatable :: c(:, :)
-    integer :: k
-    if (m >= 2) then
-      allocate (c(2, m - 1))
-      do k = 1, m - 1
-        c(:, k) = [k - 1, k]
+    integer :: k, q, i0, n, nseg
+    i0 = itf%pair_ptr(p1)
+    n = itf%pair_ptr(p2 + 1) - i0
+    nseg = 0
+    do q = p1, p2
+      nseg = nseg + max(0, itf%pair_ptr(q + 1) - itf%pair_ptr(q) - 1)
+    end do
+    if (nseg > 0) then
+      allocate (c(2, nseg))
+      nseg = 0
+      do q = p1, p2
+        do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 2
+          nseg = nseg + 1
+          c(:, nseg) = [k - i0, k + 1 - i0]
+        end do
       end do
     else
-      allocate (c(1, m))
-      c(1, :) = [(k - 1, k = 1, m)]
+      allocate (c(1, n))
+      c(1, :) = [(k - 1, k = 1, n)]
     end if
   end function line_cells
 
-  !> An XDMF 3 file, as text, describing the grids `grids` (1, 2: the bodies, 3: the
-  !! contact line) of the HDF5 file `h5`: one uniform grid directly under Domain for one
-  !! grid (the layout meshio reads), a spatial collection for several (ParaView). A
+  !> An XDMF 3 file, as text, describing the bodies `bodies` and the contact lines `lines`
+  !! (0: all rows, /contact, grid 'contact'; k: pair k, /contact/pair_<k>, grid
+  !! 'contact_pair<k>') of the HDF5 file `h5`: one uniform grid directly under Domain for
+  !! one grid (the layout meshio reads), a spatial collection for several (ParaView). A
   !! comment names the run that wrote it (the HDF5 file's attribute run_id).
-  function xdmf_text(grids, h5, msh, m, run_id) result(t)
-    integer, intent(in) :: grids(:)
+  function xdmf_text(bodies, lines, h5, msh, itf, run_id) result(t)
+    integer, intent(in) :: bodies(:), lines(:)
     character(len=*), intent(in) :: h5
     type(mesh_t), intent(in) :: msh(:)
-    integer, intent(in) :: m
+    type(interface_t), intent(in) :: itf
     character(len=*), intent(in) :: run_id
     character(len=:), allocatable :: t, h
-    integer :: k
+    integer :: k, r(2)
+    logical :: many
     h = xml_escape(h5)
+    many = size(bodies) + size(lines) > 1
     t = line('<?xml version="1.0" ?>')//line('<!-- robin_contact '//program_version//' run_id '//run_id//' -->')// &
         line('<Xdmf Version="3.0">')//line('  <Domain>')
-    if (size(grids) > 1) t = t//line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
-    do k = 1, size(grids)
-      if (grids(k) <= 2) then
-        t = t//grid_text(grids(k), h, msh(grids(k)))
+    if (many) t = t//line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
+    do k = 1, size(bodies)
+      t = t//grid_text(bodies(k), h, msh(bodies(k)))
+    end do
+    do k = 1, size(lines)
+      if (lines(k) == 0) then
+        t = t//contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body')
       else
-        t = t//contact_grid_text(h, m)
+        r = pair_rows(itf, lines(k))
+        t = t//contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
+                                 r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side')
       end if
     end do
-    if (size(grids) > 1) t = t//line('    </Grid>')
+    if (many) t = t//line('    </Grid>')
     t = t//line('  </Domain>')//line('</Xdmf>')
   end function xdmf_text
 
@@ -428,28 +523,30 @@ contains
     t = t//line('      </Grid>')
   end function grid_text
 
-  !> The contact line as an XDMF uniform grid: a polyline over the m contact nodes with
-  !! the contact fields at its nodes.
-  function contact_grid_text(h5, m) result(t)
-    character(len=*), intent(in) :: h5
-    integer, intent(in) :: m
-    character(len=:), allocatable :: t, g
+  !> A contact line as an XDMF uniform grid `name` over the HDF5 group g (file:path): a
+  !! polyline over its n nodes (cells: line_cells of its rows) with the contact fields at its
+  !! nodes; `side` names the columns of the normal displacements ('body': the
+  !! normal_displacement_body1/2 of /contact, 'side': normal_displacement_side1/2 of a pair).
+  function contact_grid_text(name, g, n, cells, side) result(t)
+    character(len=*), intent(in) :: name, g, side
+    integer, intent(in) :: n
+    integer, intent(in) :: cells(:, :)
+    character(len=:), allocatable :: t
     character(len=64) :: nn, nc, nv
-    character(len=25), parameter :: f(5) = [character(len=25) :: 'pressure', 'normal_force', 'gap', &
-                                            'normal_displacement_body1', 'normal_displacement_body2']
+    character(len=32) :: f(5)
     integer :: k
-    write (nn, '(i0)') m
-    if (m >= 2) then
-      write (nc, '(i0)') m - 1
-      nv = '2'
+    f = [character(len=32) :: 'pressure', 'normal_force', 'gap', 'normal_displacement_', 'normal_displacement_']
+    f(4) = trim(f(4))//side//'1'
+    f(5) = trim(f(5))//side//'2'
+    write (nn, '(i0)') n
+    write (nc, '(i0)') size(cells, 2)
+    write (nv, '(i0)') size(cells, 1)
+    if (size(cells, 1) == 2) then
       t = '        <Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="'
     else
-      write (nc, '(i0)') m
-      nv = '1'
       t = '        <Topology TopologyType="Polyvertex" NodesPerElement="1" NumberOfElements="'
     end if
-    g = h5//':/contact'
-    t = line('      <Grid Name="contact" GridType="Uniform">')//line(t//trim(nc)//'">')
+    t = line('      <Grid Name="'//name//'" GridType="Uniform">')//line(t//trim(nc)//'">')
     t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
                 '" NumberType="Int" Precision="4" Format="HDF">'//g//'/segments</DataItem>')
     t = t//line('        </Topology>')

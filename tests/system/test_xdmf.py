@@ -64,6 +64,12 @@ UNITS = {"contact/x": "L", "contact/y": "L", "contact/s": "L", "contact/normal":
          "contact/obstacle_body1": "L", "contact/obstacle_body2": "L", "contact/geometry_xyz": "L",
          "contact/segments": "1", "history/criterion": "1", "history/residual": "1", "history/inner": "1",
          "history/active": "1", "history/wall_s": "s"}
+UNITS.update({f"contact/pair_1/{k}": u for k, u in [
+    ("x", "L"), ("y", "L"), ("s", "L"), ("normal", "1"), ("g0", "L"), ("tributary_length", "L"),
+    ("normal_force", "F/L"), ("normal_force_side1", "F/L"), ("normal_force_side2", "F/L"),
+    ("resultant_on_first_body", "F/L"), ("pressure", "S"), ("gap", "L"), ("active", "1"),
+    ("normal_displacement_side1", "L"), ("normal_displacement_side2", "L"), ("geometry_xyz", "L"),
+    ("segments", "1")]})
 for _b in ("body1", "body2"):
     UNITS.update({f"{_b}/{k}": u for k, u in [
         ("coordinates", "L"), ("displacement", "L"), ("geometry_xyz", "L"), ("displacement_xyz", "L"),
