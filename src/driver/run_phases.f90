@@ -187,7 +187,7 @@ contains
     allocate (g(0))
     do p = 1, deck%npair
       do s = 1, 2
-        if (deck%pair(p)%bodies(s) == a) g = [g, deck%pair(p)%body_group(s)]
+        if (deck%pair(p)%bodies(s) == a) g = [character(len=128) :: g, deck%pair(p)%body_group(s)]
       end do
     end do
   end function body_groups
