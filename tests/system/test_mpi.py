@@ -327,5 +327,16 @@ if 8 in ranks_of:
         check(not bad, "-np 12: a body's factor over its group is about its factor on one rank, and each rank "
               "holds a share of one body's only", f"bodies {bad}: {share} against {size}")
 
+# 8b. a MUMPS failure on one of the ranks that hold several bodies (-np 3, eight bodies,
+# working memory capped at 1 MB per rank, body 3 enlarged so that its factor cannot fit):
+# every rank exits 3, one message, no result file
+q, out = mpirun(3, deck8, "&body id=3, nx=64, ny=128 /", "&solver factorization='mumps' /", name="columns8_memfail",
+                extra_env={"ROBIN_MUMPS_MAX_MB": "1"})
+if check(q is not None, f"8 bodies, -np 3, MUMPS failure: every rank ends within {TIMEOUT} s"):
+    el = error_lines(q)
+    check(q.returncode == 3 and len(el) == 1 and "INFO(1) = -19" in el[0] and not os.path.exists(out),
+          "8 bodies, -np 3, MUMPS failure: exit 3, one message with the code, no result file",
+          f"exit {q.returncode}: {el}")
+
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)
