@@ -118,8 +118,9 @@ contains
         line = line//' '//i2s(self%group_size(a))//' rank(s) on body '//i2s(a)
       end do
     else
-      line = 'mumps: one rank per body, ranks '//i2s(minval(self%host))//' to '//i2s(maxval(self%host))// &
-             ' hosting '//i2s(nb)//' bodies'
+      line = 'mumps: '//i2s(nb)//' bodies on '//i2s(run%ranks)//' ranks, each body on one rank (the largest '// &
+             'first to the least loaded rank), at most '//i2s(maxval([(count(self%host == a - 1), a=1, run%ranks)]))// &
+             ' per rank'
     end if
     write (output_unit, '(a)') line
   end subroutine split_groups
