@@ -109,7 +109,7 @@ contains
     end if
   end subroutine check_budget
 
-  !> The MPI binary's map of bodies to ranks (doc/running.md, "Ranks and bodies"), from
+  !> The MPI binary's map of bodies to ranks (doc/running.md, "MPI: ranks and bodies"), from
   !! each body's estimated factor size w_a (`body_memory_mb`). With at least one rank per
   !! body, each body gets a group of consecutive world ranks, body 1 from rank 0: one rank
   !! each, then every further rank to the body with the largest w_a/(its ranks) (ties: the
@@ -122,11 +122,11 @@ contains
     integer, intent(in) :: ranks               !< ranks in the world
     integer, intent(out) :: host(:)            !< (nbody) the first world rank of each body's group
     integer, intent(out) :: group(:)           !< (nbody) the ranks of each body's group
-    real(wp) :: w(d%nbody), load(max(1, ranks)), nm, best
+    real(wp) :: w(d%nbody), load(max(1, ranks)), nm, total
     logical :: done(d%nbody)
     integer :: a, k, r, pick
     do a = 1, d%nbody
-      best = body_memory_mb(d%body(a), d%solver%factor, nm, w(a))
+      total = body_memory_mb(d%body(a), d%solver%factor, nm, w(a))   ! w(a): its factor entries
     end do
     group = 1
     host = 0
