@@ -24,12 +24,22 @@ MemAvailable); the prediction scales the last measured run by n log2 n (memory) 
 n^1.5 (time). The largest solved level and its measured peaks are reported; a level
 skipped by prediction is marked as such (an extrapolation, not a measurement).
 
-Writes --csv (default results/bench_mpi.csv) and prints Markdown tables.
+Table 4 (--bodies, default 64; 0 skips it): an assembly of many bodies, columns of 8
+blocks of --bodies-size cells each (the bottom block clamped, the others held by a
+roller, a pressure on each column's top), solved by --bodies-method (default monolithic:
+one QP, so that the run is short) with the serial CHOLMOD binary (1 thread) and with the
+MPI binary at -np in --bodies-ranks (default 2,4,8; fewer ranks than bodies: several
+bodies per rank, each on one). Per rank: its bodies, its MUMPS factor share (INFO(9)) and
+its peak RSS (the binary's `mpi: rank=` lines). Memory, not time, is the measure.
+
+Writes --csv (default results/bench_mpi.csv; table 4 to its *_bodies.csv) and prints
+Markdown tables. A benchmark reports; it asserts nothing.
 
 Usage: bench/bench_mpi.py [--bin bin/robin_contact] [--mpi-bin bin/robin_contact_mpi]
          [--size 1024x512] [--ranks 2,4,8] [--ladder] [--levels 1024x512,1448x724,...]
          [--max-run-s 600] [--mem-limit-mb 22528] [--workdir results/bench_mpi] [--quick]
---quick: 128x64, -np 2 and 4, no ladder (a smoke run of a few seconds).
+         [--bodies 64] [--bodies-size 64x32] [--bodies-ranks 2,4,8] [--bodies-method monolithic]
+--quick: 128x64, -np 2 and 4, no ladder, 16 bodies of 16x8 (a smoke run of a few seconds).
 """
 import argparse
 import csv
@@ -48,6 +58,7 @@ from rc_run import line_fields, result_fields, solver_env, time_fields  # noqa: 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 DECK = os.path.join(ROOT, "inputs", "default.nml")
+RANK_LINE = re.compile(r"^mpi: rank=(\d+) bodies=([0-9,]+) factor_mb=([0-9.]+) peak_rss_mb=([0-9.]+)$", re.M)
 MUMPS_MEM = re.compile(r"^mumps: largest rank's factorization memory: body 1 ([0-9.]+) MB, body 2 ([0-9.]+) MB", re.M)
 PHASES = ("assemble", "factor", "condense", "iterate", "output", "total")
 COLUMNS = ["table", "path", "np", "threads", "nx", "ny", "n_per_body", "status", "exit", "outer", "inner"] + \
@@ -240,6 +251,90 @@ def ladder(b, levels, paths):
     return out, summary
 
 
+def columns_deck(path, nbody, nx, ny, rows=8):
+    """Write an assembly of nbody blocks (1 x 1, nx x ny cells) in columns of `rows` (the
+    last column shorter if need be): each block on the one below, the bottom one clamped,
+    the others held by a roller on the left, a pressure on each column's top."""
+    lines, bid = [], 0
+    while bid < nbody:
+        c, top = bid // rows, bid + 1
+        k_max = min(rows, nbody - bid)
+        for k in range(k_max):
+            bid += 1
+            lines.append(f"&body id={bid}, x0={1.2 * c}, y0={float(k_max - 1 - k)}, width=1.0, height=1.0, "
+                         f"nx={nx}, ny={ny}" + (", bottom='clamped'" if k == k_max - 1 else ", left='roller'") + " /")
+        lines.append(f"&traction body={top}, side='top', t0=0.0, -1.0e6 /")
+        lines += [f"&contact bodies={b},{b + 1}, groups='bottom','top' /" for b in range(top, bid)]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def many_bodies(a, nbody, nx, ny, ranks, method):
+    """Table 4: the serial binary and the MPI binary at each -np on the many-body deck;
+    returns (Markdown lines, one row per run, one row per rank)."""
+    deck = os.path.join(a.workdir, f"bodies{nbody}.nml")
+    columns_deck(deck, nbody, nx, ny)
+    runs, per_rank, lam_ref = [], [], None
+    for np_ in [0] + ranks:   # 0: the serial binary
+        h5 = os.path.join(a.workdir, f"bodies{nbody}_np{np_}.h5")
+        over = [f"&solver method='{method}'" + (", factorization='mumps'" if np_ else "") + " /",
+                f"&output file='{h5}', progress_lines=0 /"]
+        if np_:
+            cmd, env = ["mpirun", "--oversubscribe", "-np", str(np_), a.mpi_bin, deck] + over, mpi_env()
+        else:
+            cmd, env = [a.bin, deck] + over, solver_env(1)
+        t0 = time.monotonic()
+        p = subprocess.run(cmd, capture_output=True, text=True, env=env)
+        row = dict(np=np_, bodies=nbody, nx=nx, ny=ny, method=method, exit=p.returncode,
+                   process_wall_s=round(time.monotonic() - t0, 2), status="error", note="")
+        r, t = result_fields(p.stdout), time_fields(p.stdout)
+        if r is None or t is None:
+            row["note"] = (p.stderr.strip().splitlines() or ["no output"])[-1][:200]
+        else:
+            row.update(status=r["status"], total_s=float(t["total"]), factor_s=float(t["factor"]))
+            ranks_here = [(int(k), bs, float(f), float(m)) for k, bs, f, m in RANK_LINE.findall(p.stdout)]
+            if not np_:
+                ranks_here = [(0, "all", float(t["factor_mb"]), float(t["peak_mb"]))]
+            for k, bs, f, m in ranks_here:
+                per_rank.append(dict(np=np_, rank=k, bodies=bs, factor_mb=f, peak_rss_mb=m))
+            peaks = [x[3] for x in ranks_here]
+            facts = [x[2] for x in ranks_here]
+            nb = [len(x[1].split(",")) if x[1] != "all" else nbody for x in ranks_here]
+            row.update(peak_max_rank_mb=max(peaks), peak_min_rank_mb=min(peaks), peak_sum_mb=sum(peaks),
+                       factor_max_rank_mb=max(facts), factor_sum_mb=sum(facts),
+                       bodies_per_rank=f"{min(nb)}-{max(nb)}" if min(nb) != max(nb) else str(nb[0]))
+            if os.path.exists(h5):
+                lam = read_lam(h5)
+                if not np_:
+                    lam_ref = lam
+                e = rel_err(lam, lam_ref) if np_ else None
+                row["lam_rel_err_vs_serial"] = "" if e is None else f"{e:.2e}"
+        for f in (h5, h5 + ".ckpt.h5", os.path.splitext(h5)[0] + ".xdmf"):
+            if os.path.exists(f):
+                os.remove(f)
+        sys.stderr.write(f"  bodies  np={np_} {nbody} x {nx}x{ny}: {row['status']} "
+                         f"largest rank peak {row.get('peak_max_rank_mb', '-')} MB {row['note']}\n")
+        runs.append(row)
+    out = [f"{nbody} bodies of {nx}x{ny} Q1 cells ({2 * (nx + 1) * (ny + 1):,} DOFs each), method {method}, "
+           f"{os.cpu_count()} cores (the runs beyond are oversubscribed: memory is the measure):", ""]
+    out += md_header(["run", "bodies per rank", "largest rank peak MB", "smallest rank peak MB", "sum of ranks MB",
+                      "largest rank factor MB", "factors, all ranks MB", "total s", "lam vs CHOLMOD"])
+    for r in runs:
+        name = "CHOLMOD serial, 1 thread" if not r["np"] else f"MUMPS -np {r['np']}"
+        if r["status"] == "error":
+            out.append(md_row([name, "error", r["note"]] + [""] * 6))
+            continue
+        out.append(md_row([name, r["bodies_per_rank"], f1(r["peak_max_rank_mb"]), f1(r["peak_min_rank_mb"]),
+                           f1(r["peak_sum_mb"]), f1(r["factor_max_rank_mb"]), f1(r["factor_sum_mb"]),
+                           f1(r["total_s"], ".2f"), r.get("lam_rel_err_vs_serial", "") or "-"]))
+    out += ["", "Per rank (bodies, factor MB, peak RSS MB):", ""]
+    for np_ in ranks:
+        rows = [x for x in per_rank if x["np"] == np_]
+        out.append(f"- -np {np_}: " + "; ".join(f"rank {x['rank']}: {len(x['bodies'].split(','))} bodies, "
+                                              f"{x['factor_mb']:.1f} / {x['peak_rss_mb']:.0f}" for x in rows))
+    return out, runs, per_rank
+
+
 def lbl(path, np_, thr):
     return f"CHOLMOD serial ({thr} thr)" if path == "cholmod" else f"MUMPS -np {np_}"
 
@@ -259,9 +354,14 @@ def main():
     ap.add_argument("--workdir", default=os.path.join(ROOT, "results", "bench_mpi"))
     ap.add_argument("--csv", default=os.path.join(ROOT, "results", "bench_mpi.csv"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--bodies", type=int, default=64, help="bodies of table 4 (0: no table 4)")
+    ap.add_argument("--bodies-size", default="64x32", help="cells of each body of table 4")
+    ap.add_argument("--bodies-ranks", default="2,4,8")
+    ap.add_argument("--bodies-method", default="monolithic", choices=("monolithic", "robin"))
     a = ap.parse_args()
     if a.quick:
         a.size, a.ranks, a.ladder = "128x64", "2,4", False
+        a.bodies, a.bodies_size, a.bodies_ranks = min(a.bodies, 16), "16x8", "2,4"
     for exe in (a.bin, a.mpi_bin):
         if not os.access(exe, os.X_OK):
             sys.exit(f"bench_mpi: no executable {exe} (make && make MPI=1)")
@@ -288,13 +388,24 @@ def main():
         lad, summ = ladder(b, levels, paths)
         lines += ["", f"Ladder (limits: {a.max_run_s:.0f} s per run, {a.mem_limit_mb / 1024:.1f} GB "
                       "for all ranks on this machine):", ""] + lad + [""] + summ
+    if a.bodies > 0:
+        bx, by = (int(v) for v in a.bodies_size.split("x"))
+        tab, runs, per_rank = many_bodies(a, a.bodies, bx, by, [int(k) for k in a.bodies_ranks.split(",")],
+                                          a.bodies_method)
+        lines += [""] + tab
+        bodies_csv = os.path.splitext(a.csv)[0] + "_bodies.csv"
+        with open(bodies_csv, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=["np", "rank", "bodies", "factor_mb", "peak_rss_mb"])
+            w.writeheader()
+            for r in per_rank:
+                w.writerow(r)
     with open(a.csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=COLUMNS, extrasaction="ignore")
         w.writeheader()
         for r in b.rows:
             w.writerow(r)
     print("\n".join(lines))
-    print(f"\nbench_mpi: wrote {a.csv}")
+    print(f"\nbench_mpi: wrote {a.csv}" + (f" and {os.path.splitext(a.csv)[0]}_bodies.csv" if a.bodies > 0 else ""))
     bad = [r for r in b.rows if r["table"] == "phases" and r["status"] != "converged"]
     return 1 if bad else 0
 

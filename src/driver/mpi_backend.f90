@@ -1,7 +1,8 @@
-!> The MPI back-end (factorization='mumps'): one group of ranks per body computes its
-!! share of the body's element matrices and factorizes it by MUMPS; the groups' hosts
-!! broadcast the condensed data, rank 0 alone iterates and broadcasts the contact forces,
-!! and every rank ends with rank 0's exit code.
+!> The MPI back-end (factorization='mumps'): the bodies mapped to the ranks
+!! (budget%body_rank_map: a group of ranks per body, or several bodies per rank when the
+!! ranks are fewer); each rank computes its share of its bodies' element matrices and
+!! factorizes them by MUMPS; the bodies' hosts broadcast the condensed data, rank 0 alone
+!! iterates and broadcasts the contact forces, and every rank ends with rank 0's exit code.
 module mpi_backend
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
@@ -10,7 +11,7 @@ module mpi_backend
   use assembly, only: expand, cell_triplets
   use contact_types, only: STATUS_FAILED
   use sysinfo, only: peak_rss_mb, node_memory_limit_mb, process_memory_limit_mb
-  use budget, only: rank_memory_mb, check_budget_ranks
+  use budget, only: rank_memory_mb, check_budget_ranks, body_rank_map
   use strings, only: i2s, body_label
   use mpi_env, only: par_finalize, par_split, par_bcast_reals, par_bcast_ints, par_agree, par_max_real, &
                      par_sum_real, par_node_sum
@@ -24,14 +25,14 @@ module mpi_backend
 
   !> The ranks' groups and each body's MUMPS instance.
   type, extends(backend_t), public :: mpi_backend_t
-    integer :: host(2) = 0                  !< the world rank hosting each body's group
-    integer :: group_comm = 0               !< this rank's group
-    integer :: group_rank(2) = 0            !< this rank within each body's group
-    integer :: group_size(2) = 1            !< ranks of each body's group
-    logical :: mine(2) = .true.             !< this rank works on the body
+    integer, allocatable :: host(:)         !< (nbody) the world rank hosting each body's group
+    integer :: group_comm = 0               !< this rank's group (all its bodies')
+    integer, allocatable :: group_rank(:)   !< (nbody) this rank within each of its bodies' groups
+    integer, allocatable :: group_size(:)   !< (nbody) ranks of each body's group
+    logical, allocatable :: mine(:)         !< (nbody) this rank works on the body
     real(wp) :: assembly_peak_mb = 0.0_wp   !< this rank's peak RSS when the factorization starts [MiB]
-    type(mumps_t) :: solver(2)              !< each body's MUMPS instance
-    type(error_t) :: err(2)                 !< each body's failure in the current phase, if any
+    type(mumps_t), allocatable :: solver(:) !< (nbody) each body's MUMPS instance (its own bodies')
+    type(error_t), allocatable :: err(:)    !< (nbody) each body's failure in the current phase, if any
   contains
     procedure :: check_memory, factor, condense, record_factor_memory, share_contact_forces, recover, &
                  agree_code, report_ranks, finish
@@ -40,7 +41,7 @@ module mpi_backend
 
 contains
 
-  !> Each rank's estimate (its share of its body's factor, the meshes of both bodies)
+  !> Each rank's estimate (its share of its bodies' factors, the meshes of every body)
   !! against ulimit -v, and the sum over the ranks of each node against the node's memory;
   !! every rank agrees (exit 1, nothing allocated yet).
   subroutine check_memory(self, run, the_deck)
@@ -62,8 +63,9 @@ contains
     if (st /= 0) call fatal(st, trim(m1))
   end subroutine check_memory
 
-  !> Split the ranks into their groups, then each group assembles its share of its body's
-  !! cells (rank r of g: cells r*nc/g+1 .. (r+1)*nc/g) and factorizes it by MUMPS.
+  !> Map the bodies to the ranks and split the ranks into their groups, then each rank
+  !! assembles its share of its bodies' cells (rank r of a group of g: cells
+  !! r*nc/g+1 .. (r+1)*nc/g) and factorizes them by MUMPS, the largest body first.
   subroutine factor(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies factorized
@@ -71,7 +73,7 @@ contains
     real(wp), allocatable :: kval(:)
     integer :: a, first, last
     call self%split_groups(run)
-    do a = 1, 2
+    do a = 1, run%nbody
       call self%err(a)%clear()
       if (.not. self%mine(a)) cycle
       first = self%group_rank(a)*run%meshes(a)%ncell/self%group_size(a) + 1
@@ -85,70 +87,80 @@ contains
     call self%agree_fatal('factorization failed')
   end subroutine factor
 
-  !> Split the ranks into one group per body (MPI_Comm_split): one rank does both bodies
-  !! in turn; otherwise half each, an odd one out to the body with more unknowns. The
-  !! lower world ranks form body 1's group, so world rank 0 hosts body 1.
+  !> The body-to-rank map (budget%body_rank_map, on the sized deck, the same on every rank)
+  !! and the ranks' communicators (MPI_Comm_split): with a rank per body at least, one
+  !! group of consecutive ranks per body (world rank 0 hosts body 1); with fewer, each rank
+  !! alone in its communicator, for all its bodies (each body on one rank).
   subroutine split_groups(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(in) :: run
-    integer :: g1, b
-    self%assembly_peak_mb = peak_rss_mb()   ! meshes, numbering and loads of both bodies
-    if (run%ranks == 1) then
-      self%mine = .true.
-      self%host = 0
-      call par_split(0, self%group_comm)
-      return
-    end if
-    g1 = run%ranks/2
-    if (mod(run%ranks, 2) == 1 .and. run%systems(1)%n >= run%systems(2)%n) g1 = g1 + 1
-    self%host = [0, g1]
-    self%mine = [run%rank < g1, run%rank >= g1]
-    self%group_size = [g1, run%ranks - g1]
-    self%group_rank = [run%rank, run%rank - g1]
-    do b = 1, 2
-      if (self%group_size(b) > run%meshes(b)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)// &
-        ': '//i2s(self%group_size(b))//' ranks for body '//body_label(b)//', which has '// &
-        i2s(run%meshes(b)%ncell)//' cells: use at most '// &
-        i2s(2*min(run%meshes(1)%ncell, run%meshes(2)%ncell))//' ranks')
+    integer :: a, nb, color
+    character(len=:), allocatable :: line
+    self%assembly_peak_mb = peak_rss_mb()   ! meshes, numbering and loads of every body
+    nb = run%nbody
+    allocate (self%host(nb), self%group_size(nb), self%group_rank(nb), self%mine(nb), self%solver(nb), self%err(nb))
+    call body_rank_map(run%sized, run%ranks, self%host, self%group_size)
+    self%mine = run%rank >= self%host .and. run%rank < self%host + self%group_size
+    self%group_rank = merge(run%rank - self%host, 0, self%mine)
+    do a = 1, nb
+      if (self%group_size(a) > run%meshes(a)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)// &
+        ': '//i2s(self%group_size(a))//' ranks for body '//body_label(a)//', which has '// &
+        i2s(run%meshes(a)%ncell)//' cells: use fewer ranks (at most one per cell of each body)')
     end do
-    call par_split(merge(1, 2, run%rank < g1), self%group_comm)
-    write (output_unit, '(a,i0,a,i0,a)') 'mumps: ', g1, ' rank(s) on body 1, ', run%ranks - g1, ' on body 2'
+    color = run%rank
+    if (run%ranks >= nb) color = findloc(self%mine, .true., 1)
+    call par_split(color, self%group_comm)
+    if (run%ranks == 1) return
+    if (run%ranks >= nb) then
+      line = 'mumps:'
+      do a = 1, nb
+        if (a > 1) line = line//','
+        line = line//' '//i2s(self%group_size(a))//' rank(s) on body '//i2s(a)
+      end do
+    else
+      line = 'mumps: '//i2s(nb)//' bodies on '//i2s(run%ranks)//' ranks, each body on one rank (the largest '// &
+             'first to the least loaded rank), at most '//i2s(maxval([(count(self%host == a - 1), a=1, run%ranks)]))// &
+             ' per rank'
+    end if
+    write (output_unit, '(a)') line
   end subroutine split_groups
 
-  !> Each group condenses its body; every rank then receives both bodies' condensed data.
+  !> Each group condenses its body; every rank then receives every body's condensed data.
   subroutine condense(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies condensed
     integer :: a
-    do a = 1, 2
+    do a = 1, run%nbody
       if (self%mine(a)) call condense_body_mumps(run%systems(a), run%bodies(a), self%solver(a), a, self%err(a))
     end do
     call self%agree_fatal('condensation failed')
     call share_condensed(self, run)
   end subroutine condense
 
-  !> Each group's host sends its body's F_a, b_a and the proximal weight to every rank.
+  !> Each group's host sends its body's F_a, b_a, the proximal weight, F_a's rank and
+  !! kernel and the factor's size to every rank (the body's m and slots every rank has,
+  !! from floating%rigid_rows).
   subroutine share_condensed(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run
     integer :: b, iv(1), m
-    real(wp) :: rv(3)
-    m = run%contact_line%m
-    do b = 1, 2
+    real(wp) :: rv(4)
+    do b = 1, run%nbody
       associate (body => run%bodies(b), solver => self%solver(b))
+        m = body%m
         if (.not. (self%mine(b) .and. solver%host)) then
           if (allocated(body%flex)) deallocate (body%flex)
           allocate (body%flex(m, m))
-          body%m = m
         end if
         if (.not. allocated(body%b)) allocate (body%b(m))
         call par_bcast_reals(body%flex, m*m, self%host(b))
         call par_bcast_reals(body%b, m, self%host(b))
-        rv = [body%prox, solver%mem_bytes, solver%max_rank_mb]
-        call par_bcast_reals(rv, 3, self%host(b))
+        rv = [body%prox, solver%mem_bytes, solver%max_rank_mb, solver%factor_mb]
+        call par_bcast_reals(rv, 4, self%host(b))
         body%prox = rv(1)
         solver%mem_bytes = rv(2)
         solver%max_rank_mb = rv(3)
+        solver%factor_mb = rv(4)
         iv(1) = body%rank
         call par_bcast_ints(iv, 1, self%host(b))
         body%rank = iv(1)
@@ -167,19 +179,24 @@ contains
       end associate
       call self%err(b)%clear()
     end do
-    write (output_unit, '(a,2(f0.1,a))') 'mumps: largest rank''s factorization memory: body 1 ', &
-      self%solver(1)%max_rank_mb, ' MB, body 2 ', self%solver(2)%max_rank_mb, ' MB'
+    if (run%nbody == 2) then
+      write (output_unit, '(a,2(f0.1,a))') 'mumps: largest rank''s factorization memory: body 1 ', &
+        self%solver(1)%max_rank_mb, ' MB, body 2 ', self%solver(2)%max_rank_mb, ' MB'
+    else
+      write (output_unit, '(a,f0.1,a,i0,a)') 'mumps: largest rank''s factorization memory ', &
+        maxval(self%solver(:)%max_rank_mb), ' MB (body ', maxloc(self%solver(:)%max_rank_mb, 1), ')'
+    end if
   end subroutine share_condensed
 
-  !> The two MUMPS factorizations' memory [MiB].
+  !> The MUMPS factorizations' memory [MiB].
   subroutine record_factor_memory(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its timing
-    run%timing%factor_mb = (self%solver(1)%mem_bytes + self%solver(2)%mem_bytes)/1048576.0_wp
+    run%timing%factor_mb = sum(self%solver(:)%mem_bytes)/1048576.0_wp
   end subroutine record_factor_memory
 
   !> Rank 0's contact forces and status to every rank (the others need lam to recover their
-  !! body's displacement, and the status to end alike).
+  !! bodies' displacements, and the status to end alike).
   subroutine share_contact_forces(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its contact result
@@ -201,7 +218,7 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its displacements
     integer :: b
     real(wp), allocatable :: uf(:)
-    do b = 1, 2
+    do b = 1, run%nbody
       call self%err(b)%clear()
       if (.not. self%mine(b)) cycle
       allocate (uf(run%systems(b)%n))
@@ -213,7 +230,7 @@ contains
       deallocate (uf)
     end do
     call self%agree_fatal('displacement recovery failed')
-    do b = 1, 2
+    do b = 1, run%nbody
       if (self%host(b) /= 0) call par_bcast_reals(run%displacement(1, b), run%systems(b)%ndof, self%host(b))
     end do
   end subroutine recover
@@ -230,17 +247,38 @@ contains
 
   !> One line with the largest peak resident memory (VmHWM, getrusage) of any rank, which
   !! rank, and the sum over the ranks (what the job needs on one node); the largest peak
-  !! at the start of the factorization tells the meshes' and loads' share. Collective.
+  !! at the start of the factorization tells the meshes' and loads' share. Then one line
+  !! per rank: its bodies, its share of their MUMPS factors (INFO(9)) and its peak.
+  !! Collective.
   subroutine report_ranks(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run
-    real(wp) :: pmax, psum, amax
-    integer :: where, awhere
+    real(wp) :: pmax, psum, amax, rv(2)
+    integer :: where, awhere, r, a, iv(run%nbody)
+    character(len=:), allocatable :: list
     call par_max_real(peak_rss_mb(), pmax, where)
     psum = par_sum_real(peak_rss_mb())
     call par_max_real(self%assembly_peak_mb, amax, awhere)
     write (output_unit, '(a,i0,a,f0.1,a,i0,a,f0.1,a,f0.1)') 'mpi: ranks=', run%ranks, ' peak_rss_max_rank_mb=', pmax, &
       ' max_rank=', where, ' peak_rss_sum_mb=', psum, ' assembly_peak_max_rank_mb=', amax
+    if (.not. allocated(self%mine)) return
+    do r = 0, run%ranks - 1
+      rv = [0.0_wp, peak_rss_mb()]
+      do a = 1, run%nbody
+        if (self%mine(a)) rv(1) = rv(1) + self%solver(a)%rank_factor_mb
+      end do
+      iv = merge(1, 0, self%mine)
+      call par_bcast_reals(rv, 2, r)
+      call par_bcast_ints(iv, run%nbody, r)
+      list = ''
+      do a = 1, run%nbody
+        if (iv(a) /= 1) cycle
+        if (len(list) > 0) list = list//','
+        list = list//i2s(a)
+      end do
+      if (run%rank == 0) write (output_unit, '(a,i0,a,a,a,f0.3,a,f0.1)') 'mpi: rank=', r, ' bodies=', &
+        list, ' factor_mb=', rv(1), ' peak_rss_mb=', rv(2)
+    end do
     flush (output_unit)
   end subroutine report_ranks
 
@@ -253,7 +291,7 @@ contains
     character(len=512) :: m1
     st = 0
     m1 = ''
-    do b = 2, 1, -1
+    do b = size(self%err), 1, -1
       if (self%err(b)%failed()) then
         st = exit_code(self%err(b))
         m1 = 'body '//body_label(b)//': '//what//': '//self%err(b)%text()
@@ -268,9 +306,11 @@ contains
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its exit code
     integer :: b
-    do b = 1, 2
-      if (self%mine(b)) call mumps_end(self%solver(b))
-    end do
+    if (allocated(self%mine)) then
+      do b = 1, run%nbody
+        if (self%mine(b)) call mumps_end(self%solver(b))
+      end do
+    end if
     call par_finalize()
     call terminate(run%code)
   end subroutine finish

@@ -52,8 +52,6 @@ contains
         if (.not. par_built) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)// &
           ': factorization=''mumps'' needs the MPI binary: run mpirun -np N bin/robin_contact_mpi '// &
           trim(deck%source)//' (built by make MPI=1); this binary has no MPI or MUMPS')
-        if (deck%nbody > 2) call fatal(EXIT_INPUT, 'deck '//trim(deck%source)//': factorization=''mumps'' '// &
-          'takes two bodies in this version, and the deck has '//i2s(deck%nbody)//'; use factorization=''cholmod''')
         allocate (mpi_backend_t :: backend)
         backend%assembles_matrix = .false.
       else

@@ -11,9 +11,9 @@
 !! half-bandwidth. Counts are computed in double precision, so no integer overflows.
 !!
 !! The MPI binary with factorization='mumps' is sized per rank (`rank_memory_mb`,
-!! `check_budget_ranks`): every rank meshes both bodies and numbers their DOFs and loads,
-!! holds its share of one body's element entries and its share of that body's MUMPS factor
-!! (the factor over the ranks of the body's group, calibrated on bench-mpi at 1024x512:
+!! `check_budget_ranks`) on its bodies (`body_rank_map`): every rank meshes every body and
+!! numbers its DOFs and loads, holds its share of its bodies' element entries and of their
+!! MUMPS factors (a factor over the ranks of the body's group, calibrated on bench-mpi at 1024x512:
 !! largest rank 2083/1188/760 MB at 1/2/4 ranks per body); the estimates of the ranks of a
 !! node are summed against the node's memory, each one against ulimit -v.
 module budget
@@ -31,7 +31,7 @@ module budget
   real(wp), parameter :: COORD_MAX = 0.25_wp*sqrt(huge(1.0_wp))   ! as in mesh_topology
   real(wp), parameter :: LOAD_MAX = sqrt(huge(1.0_wp))   ! stresses and loads whose squares stay finite
 
-  public :: body_memory_mb, run_memory_mb, check_budget, check_load_range, mumps_group_sizes, rank_memory_mb, &
+  public :: body_memory_mb, run_memory_mb, check_budget, check_load_range, body_rank_map, rank_memory_mb, &
             check_budget_ranks
 
 contains
@@ -109,52 +109,90 @@ contains
     end if
   end subroutine check_budget
 
-  !> The ranks of each body's group as the MPI binary splits them: one rank does both
-  !! bodies in turn (g = [1, 1], shared); otherwise half each, an odd one out to the body
-  !! with more unknowns (estimated from nx, ny here).
-  function mumps_group_sizes(d, ranks) result(g)
-    type(deck_t), intent(in) :: d   !< the deck
-    integer, intent(in) :: ranks    !< ranks in the world
-    integer :: g(2)
-    if (ranks <= 1) then
-      g = 1
+  !> The MPI binary's map of bodies to ranks (doc/running.md, "MPI: ranks and bodies"), from
+  !! each body's estimated factor size w_a (`body_memory_mb`). With at least one rank per
+  !! body, each body gets a group of consecutive world ranks, body 1 from rank 0: one rank
+  !! each, then every further rank to the body with the largest w_a/(its ranks) (ties: the
+  !! larger body, then the lower id), so the groups are proportional to the factors; two
+  !! equal bodies get half each, an odd one out to body 1. With fewer ranks than bodies,
+  !! each body is on one rank: the bodies, largest first, each to the least loaded rank
+  !! (ties: the lower rank). `host(a)` is the world rank that leads body a's group.
+  subroutine body_rank_map(d, ranks, host, group)
+    type(deck_t), intent(in) :: d              !< the deck (sized: nx, ny of every body)
+    integer, intent(in) :: ranks               !< ranks in the world
+    integer, intent(out) :: host(:)            !< (nbody) the first world rank of each body's group
+    integer, intent(out) :: group(:)           !< (nbody) the ranks of each body's group
+    real(wp) :: w(d%nbody), load(max(1, ranks)), nm, total
+    logical :: done(d%nbody)
+    integer :: a, k, r, pick
+    do a = 1, d%nbody
+      total = body_memory_mb(d%body(a), d%solver%factor, nm, w(a))   ! w(a): its factor entries
+    end do
+    group = 1
+    host = 0
+    if (ranks >= d%nbody) then
+      do k = d%nbody + 1, ranks
+        pick = 1
+        do a = 2, d%nbody
+          if (w(a)/group(a) > w(pick)/group(pick) .or. &
+              (w(a)/group(a) == w(pick)/group(pick) .and. w(a) > w(pick))) pick = a
+        end do
+        group(pick) = group(pick) + 1
+      end do
+      do a = 2, d%nbody
+        host(a) = host(a - 1) + group(a - 1)
+      end do
       return
     end if
-    g(1) = ranks/2
-    if (mod(ranks, 2) == 1 .and. dofs(d%body(1)) >= dofs(d%body(2))) g(1) = g(1) + 1
-    g(2) = ranks - g(1)
-  end function mumps_group_sizes
+    load = 0.0_wp
+    done = .false.
+    do k = 1, d%nbody
+      pick = 0
+      do a = 1, d%nbody   ! the largest body not placed yet (ties: the lower id)
+        if (done(a)) cycle
+        if (pick == 0) then
+          pick = a
+        else if (w(a) > w(pick)) then
+          pick = a
+        end if
+      end do
+      done(pick) = .true.
+      r = minloc(load, 1)
+      host(pick) = r - 1
+      load(r) = load(r) + w(pick)
+    end do
+  end subroutine body_rank_map
 
   !> Memory of one rank of the MPI binary with factorization='mumps' [MiB]: the meshes,
-  !! DOF numbering and loads of both bodies (every rank has them), its share of its body's
-  !! element entries (triplets, and MUMPS's copy) and of the body's factor (MUMPS's working
-  !! space included), on the group's host the right-hand side and the Schur complement and
-  !! X, on world rank 0 the interface matrices of the contact iteration. With one rank, both
-  !! bodies' shares. `factor_share_mb` returns the factor part alone.
+  !! DOF numbering and loads of every body (every rank has them), its share of its bodies'
+  !! element entries (triplets, and MUMPS's copy) and of their factors (MUMPS's working
+  !! space included), as host of a body the right-hand side and the Schur complement and
+  !! X, on world rank 0 the interface matrices of the contact iteration. The bodies of a
+  !! rank are those of `body_rank_map`. `factor_share_mb` returns the factor part alone.
   real(wp) function rank_memory_mb(d, ranks, rank, factor_share_mb) result(mb)
     type(deck_t), intent(in) :: d                  !< the deck
     integer, intent(in) :: ranks                   !< ranks in the world
     integer, intent(in) :: rank                    !< this rank (0-based)
-    real(wp), intent(out), optional :: factor_share_mb   !< its share of its body's factor [MiB]
-    real(wp) :: nm, nf, m, share, fs
-    integer :: a, g(2), first
-    g = mumps_group_sizes(d, ranks)
+    real(wp), intent(out), optional :: factor_share_mb   !< its share of its bodies' factors [MiB]
+    real(wp) :: nm, nf, ma, share, fs, iface
+    integer :: a, host(d%nbody), group(d%nbody)
+    call body_rank_map(d, max(1, ranks), host, group)
     mb = BASE_MB
-    m = 0.0_wp
     share = 0.0_wp
     fs = 0.0_wp
-    do a = 1, 2
+    iface = 0.0_wp
+    do a = 1, d%nbody
       mb = mb + body_memory_mb(d%body(a), d%solver%factor, nm, nf) &
            - (12.0_wp*nm + 8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB       ! mesh, vectors: every rank
-      m = max(m, real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp)
-      first = merge(0, g(1), a == 1 .or. ranks <= 1)                 ! the group's host
-      if (ranks > 1 .and. (rank < first .or. rank >= first + g(a))) cycle
-      fs = fs + MUMPS_OVERHEAD*(8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB/real(g(a), wp)
-      share = share + MUMPS_OVERHEAD*12.0_wp*nm/MIB/real(g(a), wp)
-      if (rank == first) mb = mb + (24.0_wp*dofs(d%body(a)) + 16.0_wp*(2.0_wp*m)**2)/MIB   ! RHS, S, X
+      ma = real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp       ! the body's contact rows, at most
+      iface = iface + 5.0_wp*8.0_wp*ma*ma/MIB
+      if (rank < host(a) .or. rank >= host(a) + group(a)) cycle
+      fs = fs + MUMPS_OVERHEAD*(8.0_wp*nf + 4.0_wp*nf/16.0_wp)/MIB/real(group(a), wp)
+      share = share + MUMPS_OVERHEAD*12.0_wp*nm/MIB/real(group(a), wp)
+      if (rank == host(a)) mb = mb + (24.0_wp*dofs(d%body(a)) + 16.0_wp*(2.0_wp*ma)**2)/MIB   ! RHS, S, X
     end do
     mb = mb + share + fs
-    if (rank == 0) mb = mb + 10.0_wp*8.0_wp*m*m/MIB   ! F_1, F_2, their operators, the bound's copies
+    if (rank == 0) mb = mb + iface   ! every F_a, their operators, the bound's copies
     if (present(factor_share_mb)) factor_share_mb = fs
   end function rank_memory_mb
 
@@ -174,22 +212,22 @@ contains
     real(wp), intent(in) :: process_limit_mb            !< ulimit -v of a process [MiB]
     type(error_t), intent(out) :: err                   !< why the run does not fit, if so
     real(wp) :: fs, x
-    integer :: a, g(2)
+    integer :: a, host(d%nbody), group(d%nbody)
     character(len=:), allocatable :: what
-    g = mumps_group_sizes(d, ranks)
-    do a = 1, 2
-      if (dofs(d%body(a)) > INDEX_MAX .or. 9.0_wp*dofs(d%body(a))/real(g(a), wp) > INDEX_MAX) then
+    call body_rank_map(d, max(1, ranks), host, group)
+    do a = 1, d%nbody
+      if (dofs(d%body(a)) > INDEX_MAX .or. 9.0_wp*dofs(d%body(a))/real(group(a), wp) > INDEX_MAX) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
               i2s(d%body(a)%ny)//') has too many DOFs or element entries per rank for the 32-bit indices '// &
-              'of this build with '//i2s(g(a))//' rank(s) on it; use more ranks or fewer cells')
+              'of this build with '//i2s(group(a))//' rank(s) on it; use more ranks or fewer cells')
         return
       end if
     end do
     x = rank_memory_mb(d, ranks, rank, fs)
-    what = 'with factorization=''mumps'' on '//i2s(ranks)//' rank(s) ('//i2s(g(1))//' on body 1, '//i2s(g(2))// &
-           ' on body 2) a rank needs about '//fmt_real(rank_mb/1024.0_wp, '(f0.2)')//' GiB (rank '//i2s(rank)// &
+    what = 'with factorization=''mumps'' on '//i2s(ranks)//' rank(s) ('//map_text(d%nbody, ranks, host, group)// &
+           ') a rank needs about '//fmt_real(rank_mb/1024.0_wp, '(f0.2)')//' GiB (rank '//i2s(rank)// &
            ': its share of the MUMPS factor '//fmt_real(fs/1024.0_wp, '(f0.2)')//' GiB, the meshes and loads of '// &
-           'both bodies and its element entries the rest)'
+           'every body and its element entries the rest)'
     if (process_limit_mb > 0.0_wp .and. rank_mb > process_limit_mb) then
       call err%set(ERR_INPUT, ''//what//' but a process may use only '// &
             fmt_real(process_limit_mb/1024.0_wp, '(f0.2)')//' GiB (ulimit -v); use more ranks per body or fewer cells')
@@ -200,6 +238,27 @@ contains
             'spread the ranks over more nodes (fewer per node), use more ranks per body, or fewer cells')
     end if
   end subroutine check_budget_ranks
+
+  !> The map in words: 'g1 on body 1, g2 on body 2, ...' with a rank per body at least,
+  !! otherwise 'at most k bodies per rank'.
+  function map_text(nbody, ranks, host, group) result(t)
+    integer, intent(in) :: nbody, ranks, host(:), group(:)
+    character(len=:), allocatable :: t
+    integer :: a, r, most
+    if (ranks >= nbody) then
+      t = ''
+      do a = 1, nbody
+        if (a > 1) t = t//', '
+        t = t//i2s(group(a))//' on body '//i2s(a)
+      end do
+    else
+      most = 0
+      do r = 0, ranks - 1
+        most = max(most, count(host == r))
+      end do
+      t = 'one rank per body, at most '//i2s(most)//' bodies per rank'
+    end if
+  end function map_text
 
   !> Unknowns of a structured body (both components of every node).
   real(wp) function dofs(b)

@@ -33,6 +33,8 @@ module mumps_iface
     real(wp), allocatable :: x(:, :)          !< (k,k) on the host: S^-1 = (K^-1) on the interface DOFs
     real(wp) :: mem_bytes = 0.0_wp            !< factor memory summed over the group's ranks [byte]
     real(wp) :: max_rank_mb = 0.0_wp          !< the largest rank's factorization memory [MiB]
+    real(wp) :: factor_mb = 0.0_wp            !< the factor's entries over the group (INFOG(9)) [MiB]
+    real(wp) :: rank_factor_mb = 0.0_wp       !< this rank's share of them (INFO(9)) [MiB]
   end type mumps_t
 
   public :: mumps_schur_factor, mumps_solve, mumps_end, mumps_error_text
@@ -110,6 +112,8 @@ contains
     end if
     mt%mem_bytes = max(0.0_wp, real(mt%id%INFOG(22), wp))*1048576.0_wp   ! MB summed over ranks
     mt%max_rank_mb = real(mt%id%INFOG(21), wp)
+    mt%factor_mb = entries_mb(mt%id%INFOG(9))
+    mt%rank_factor_mb = entries_mb(mt%id%INFO(9))
     deallocate (mt%id%IRN_loc, mt%id%JCN_loc, mt%id%A_loc)   ! MUMPS has its own copy now
     if (mt%host .and. k > 0) then
       ! S comes as its upper triangle by columns (the lower by rows) in a k x k array, in
@@ -142,6 +146,12 @@ contains
     if (info /= 0) call err%set(ERR_NUMERICAL, msg)
 
   contains
+
+    !> MUMPS's count of real entries (a negative count is in millions) in MiB.
+    real(wp) function entries_mb(c)
+      integer, intent(in) :: c
+      entries_mb = 8.0_wp*merge(-1.0e6_wp*c, real(c, wp), c < 0)/1048576.0_wp
+    end function entries_mb
 
     subroutine fail(what)
       character(len=*), intent(in) :: what

@@ -17,6 +17,8 @@ module mumps_iface
     real(wp), allocatable :: x(:, :)          !< (k,k) S^-1 (never set here)
     real(wp) :: mem_bytes = 0.0_wp            !< factor memory [byte]
     real(wp) :: max_rank_mb = 0.0_wp          !< the largest rank's factorization memory [MiB]
+    real(wp) :: factor_mb = 0.0_wp            !< the factor's entries over the group [MiB]
+    real(wp) :: rank_factor_mb = 0.0_wp       !< this rank's share of them [MiB]
   end type mumps_t
 
   public :: mumps_schur_factor, mumps_solve, mumps_end, mumps_error_text

@@ -7,7 +7,9 @@ partial-contact scene (a parabolic initial gap); factorization='mumps' in the se
 is bad input naming the MPI binary; bad input and an injected MUMPS failure end every rank
 with exit 1 / 3 and one message, within a timeout (no rank left hanging); SIGTERM to
 the ranks (as srun sends it) in the Robin iteration: exit 4, a checkpoint, and a restart
-that converges as an uninterrupted run."""
+that converges as an uninterrupted run; an eight-body deck at -np 1 to 12 (several bodies
+per rank, one, several ranks per body) gives the serial binary's contact forces, and each
+rank holds the factors of its own bodies only."""
 import os
 import re
 import shutil
@@ -240,6 +242,101 @@ rc, text = signal_in_robin(["bash", "tools/slurm/run_deck_mpi.sbatch", *small,
 check(rc == 4 and "status=interrupted" in text and os.path.exists(ckpt) and "resubmit with --restart" in text,
       "tools/slurm/run_deck_mpi.sbatch under mpirun: SIGTERM to the script gives exit 4 and a checkpoint",
       f"exit {rc}")
+
+# 8. eight bodies (two columns of four blocks of different meshes, the lower ones clamped,
+# the others held by a roller on the left, a pressure on each column's top) at -np 1, 2,
+# 4, 8, 12: fewer ranks than bodies put several bodies on a rank, more give the larger
+# bodies more ranks. The contact forces equal the serial CHOLMOD binary's to 1e-10 of the
+# largest (tol=1e-11: the default 1e-8 leaves both runs 1e-10 from the fixed point); each
+# rank reports its bodies, its share of their MUMPS factors and its peak memory; a rank's
+# factor is the sum of its own bodies' factors (each body's measured at -np 8, one body per
+# rank), never all bodies'
+COLUMNS = [[(8 * (k + 1), 4 * (k + 1)) for k in range(1, 5)], [(6 * (k + 1), 3 * (k + 1)) for k in range(1, 5)]]
+
+
+def columns_deck(path):
+    """Write the eight-body deck (bodies 1-4 the left column top to bottom, 5-8 the right)."""
+    lines, bid = [], 0
+    for c, col in enumerate(COLUMNS):
+        top = bid + 1
+        for k, (nx, ny) in enumerate(col):
+            bid += 1
+            lines.append(f"&body id={bid}, x0={1.2 * c}, y0={3.0 - k}, width=1.0, height=1.0, nx={nx}, ny={ny}"
+                         + (", bottom='clamped'" if k == 3 else ", left='roller'") + " /")
+        lines.append(f"&traction body={top}, side='top', t0=0.0, -1.0e6 /")
+        lines += [f"&contact bodies={b},{b + 1}, groups='bottom','top' /" for b in range(top, top + 3)]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+RANK_LINE = re.compile(r"^mpi: rank=(\d+) bodies=([0-9,]+) factor_mb=([0-9.]+) peak_rss_mb=([0-9.]+)$", re.M)
+deck8 = os.path.join(OUT, "columns8.nml")
+columns_deck(deck8)
+cells = [nx * ny for col in COLUMNS for nx, ny in col]
+ref8 = os.path.join(OUT, "columns8_serial.h5")
+TOL = "tol=1e-11"
+p, r = run_solver(BIN, deck8, f"&solver {TOL} /", f"&output file='{ref8}' /", env=solver_env(1))
+ranks_of = {}
+if check(p.returncode == 0 and r is not None and r["bodies"] == "8", "8 bodies: the serial CHOLMOD reference "
+         "exits 0", f"exit {p.returncode}: {p.stderr.strip()[-200:]}"):
+    lam8 = read_lam(ref8)
+    for np_ in (8, 1, 2, 4, 12):
+        q, out = mpirun(np_, deck8, f"&solver factorization='mumps', {TOL} /", name=f"columns8_np{np_}")
+        what = f"8 bodies, mpirun -np {np_}"
+        if not check(q is not None and q.returncode == 0, f"{what} exits 0",
+                     f"{'timeout' if q is None else q.stderr.strip()[-300:]}"):
+            continue
+        lam = read_lam(out)
+        e = float(np.abs(lam - lam8).max() / np.abs(lam8).max()) if lam.shape == lam8.shape else None
+        check(e is not None and e < 1e-10, f"{what}: contact forces = the serial binary's to 1e-10 of the largest",
+              f"max difference / max force {e}")
+        rows = [(int(a), [int(b) for b in bs.split(",")], float(f), float(m)) for a, bs, f, m in
+                RANK_LINE.findall(q.stdout)]
+        if not check(sorted(x[0] for x in rows) == list(range(np_)) and all(x[3] > 0 for x in rows),
+                     f"{what}: one line per rank with its bodies, factor and peak memory", f"{len(rows)} lines"):
+            continue
+        print(f"INFO  {what}: per-rank peak RSS MB " + " ".join(f"{x[3]:.1f}" for x in rows)
+              + "; factor MB " + " ".join(f"{x[2]:.3f}" for x in rows))
+        ranks_of[np_] = rows
+        hosted = sorted(b for x in rows for b in x[1])
+        if np_ <= 8:
+            check(hosted == list(range(1, 9)), f"{what}: each body on one rank", f"{hosted}")
+        else:
+            per_body = [sum(b in x[1] for x in rows) for b in range(1, 9)]
+            order = sorted(range(8), key=lambda i: cells[i])
+            check(min(per_body) >= 1 and sum(per_body) == np_ and all(
+                per_body[order[i]] <= per_body[order[i + 1]] for i in range(7)) and max(per_body) > 1,
+                f"{what}: every rank on one body, the larger bodies on more ranks", f"ranks per body {per_body}")
+if 8 in ranks_of:
+    size = {x[1][0]: x[2] for x in ranks_of[8]}   # one body per rank: each body's factor
+    total = sum(size.values())
+    check(all(size[b] < 0.5 * total for b in size), "-np 8: no rank holds more than its own body's factor "
+          "(each less than half of all bodies')", f"{size}, all {total:.3f} MB")
+    for np_ in (1, 2, 4):
+        if np_ not in ranks_of:
+            continue
+        bad = [(a, f, sum(size[b] for b in bs)) for a, bs, f, _ in ranks_of[np_]
+               if abs(f - sum(size[b] for b in bs)) > 0.002 + 0.01 * f]
+        check(not bad, f"-np {np_}: each rank's factor = the sum of its own bodies' factors (as measured at -np 8)",
+              f"(rank, factor, its bodies' sum): {bad}")
+    if 12 in ranks_of:
+        share = {}
+        for _, bs, f, _ in ranks_of[12]:
+            share[bs[0]] = share.get(bs[0], 0.0) + f
+        bad = [b for b in share if not 0.5 * size[b] < share[b] < 2.0 * size[b] + 0.002]
+        check(not bad, "-np 12: a body's factor over its group is about its factor on one rank, and each rank "
+              "holds a share of one body's only", f"bodies {bad}: {share} against {size}")
+
+# 8b. a MUMPS failure on one of the ranks that hold several bodies (-np 3, eight bodies,
+# working memory capped at 1 MB per rank, body 3 enlarged so that its factor cannot fit):
+# every rank exits 3, one message, no result file
+q, out = mpirun(3, deck8, "&body id=3, nx=64, ny=128 /", "&solver factorization='mumps' /", name="columns8_memfail",
+                extra_env={"ROBIN_MUMPS_MAX_MB": "1"})
+if check(q is not None, f"8 bodies, -np 3, MUMPS failure: every rank ends within {TIMEOUT} s"):
+    el = error_lines(q)
+    check(q.returncode == 3 and len(el) == 1 and "INFO(1) = -19" in el[0] and not os.path.exists(out),
+          "8 bodies, -np 3, MUMPS failure: exit 3, one message with the code, no result file",
+          f"exit {q.returncode}: {el}")
 
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)
