@@ -65,19 +65,42 @@ contains
           + 8.0_wp*nnz_factor + 4.0_wp*nnz_factor/16.0_wp)/MIB                    ! factor values, indices
   end function body_memory_mb
 
-  !> Memory of the whole run [MiB] (both bodies, interface matrices, a base).
+  !> Memory of the whole run [MiB] (every body, interface matrices, a base).
   real(wp) function run_memory_mb(d) result(mb)
     type(deck_t), intent(in) :: d   !< the deck
-    real(wp) :: nm, nf, m
+    real(wp) :: nm, nf, m, ma, mtot
     integer :: a
     mb = BASE_MB
     m = 0.0_wp
-    do a = 1, 2
+    mtot = 0.0_wp
+    do a = 1, d%nbody
       mb = mb + body_memory_mb(d%body(a), d%solver%factor, nm, nf)
       m = max(m, real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp)
+      ! several pairs: the body's contact rows, at most a side per pair it is in
+      ma = (real(max(d%body(a)%nx, d%body(a)%ny), wp) + 1.0_wp)*real(count_pairs(d, a), wp)
+      if (d%npair > 1) mb = mb + 10.0_wp*8.0_wp*ma*ma/MIB   ! F_a, its operators, S, the bound's copies
+      mtot = mtot + ma
     end do
-    mb = mb + 10.0_wp*8.0_wp*m*m/MIB          ! F_1, F_2, their operators, S, the bound's copies
+    if (d%npair <= 1) then
+      mb = mb + 10.0_wp*8.0_wp*m*m/MIB          ! F_1, F_2, their operators, S, the bound's copies
+    else
+      ! the a posteriori bound's dense H and factor, up to its size (error_estimate)
+      mtot = min(0.5_wp*mtot, 6000.0_wp)
+      mb = mb + 3.0_wp*8.0_wp*mtot*mtot/MIB
+    end if
   end function run_memory_mb
+
+  !> The pairs body a takes part in.
+  pure integer function count_pairs(d, a) result(n)
+    type(deck_t), intent(in) :: d
+    integer, intent(in) :: a
+    integer :: p
+    n = 0
+    do p = 1, d%npair
+      if (any(d%pair(p)%bodies == a)) n = n + 1
+    end do
+    n = max(n, 1)
+  end function count_pairs
 
   !> Refuse a deck that cannot run here: a body whose matrix or factor overflows 32-bit
   !! indices, or a run whose estimate exceeds `limit_mb` (0: no limit known): err
@@ -87,8 +110,11 @@ contains
     real(wp), intent(in) :: limit_mb                    !< memory this process may use [MiB]
     type(error_t), intent(out) :: err                   !< why the run does not fit, if so
     real(wp) :: nm, nf, mb, est
-    integer :: a
-    do a = 1, 2
+    integer :: a, big
+    big = 1
+    do a = 1, d%nbody
+      mb = body_memory_mb(d%body(a), d%solver%factor, nm, nf)
+      if (mb > body_memory_mb(d%body(big), d%solver%factor, nm, nf)) big = a
       mb = body_memory_mb(d%body(a), d%solver%factor, nm, nf)
       if (nm > INDEX_MAX .or. nf > INDEX_MAX) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
@@ -99,10 +125,17 @@ contains
       end if
     end do
     est = run_memory_mb(d)
-    if (limit_mb > 0.0_wp .and. est > limit_mb) then
+    if (limit_mb > 0.0_wp .and. est > limit_mb .and. d%nbody == 2) then
       call err%set(ERR_INPUT, 'the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
             ' GiB (body 1: '//fmt_real(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB, body 2: '//fmt_real(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
+            ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
+            fmt_real(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
+            'use fewer cells or a machine with more memory')
+    else if (limit_mb > 0.0_wp .and. est > limit_mb) then
+      call err%set(ERR_INPUT, 'the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
+            ' GiB for its '//i2s(d%nbody)//' bodies (the largest, body '//i2s(big)//': '// &
+            fmt_real(body_memory_mb(d%body(big), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
             fmt_real(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
             'use fewer cells or a machine with more memory')
@@ -278,7 +311,7 @@ contains
     real(wp) :: ext, t, h, u, cap, ymin, hx, hy
     integer :: i, a, s
     ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
-    do a = 1, 2
+    do a = 1, d%nbody
       if (.not. (d%body(a)%young < LOAD_MAX/MARGIN .and. d%body(a)%young > MARGIN/LOAD_MAX)) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//': young = '//sci(d%body(a)%young)//' is outside ['// &
               sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
@@ -287,7 +320,7 @@ contains
       end if
     end do
     ext = 1.0_wp
-    do a = 1, 2
+    do a = 1, d%nbody
       if (len_trim(d%body(a)%mesh) > 0) cycle
       ! the Gmsh reader's bound on coordinates (mesh_topology), here for a rectangle
       ext = max(abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
@@ -309,10 +342,11 @@ contains
       end if
     end do
     ext = 1.0_wp
-    do a = 1, 2
+    ymin = huge(1.0_wp)
+    do a = 1, d%nbody
       ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
+      ymin = min(ymin, d%body(a)%young)
     end do
-    ymin = min(d%body(1)%young, d%body(2)%young)
     ! every product below stays finite (no overflow trap in the checked build): ext is a
     ! coordinate extent, at most COORD_MAX, far below huge/MARGIN
     cap = LOAD_MAX/(ext*MARGIN)
@@ -339,7 +373,7 @@ contains
         end if
       end if
     end do
-    do a = 1, 2
+    do a = 1, d%nbody
       h = min(d%body(a)%width/real(d%body(a)%nx, wp), d%body(a)%height/real(d%body(a)%ny, wp))
       do s = 1, 4
         u = maxval(abs(d%body(a)%u_side(:, s)))
@@ -356,7 +390,7 @@ contains
     ! stiffness K (entries of the order of young) must stay finite
     do i = 1, d%nboundary
       a = d%boundary(i)%body
-      if (a < 1 .or. a > 2) cycle
+      if (a < 1 .or. a > d%nbody) cycle
       u = maxval(abs(d%boundary(i)%u), mask=d%boundary(i)%fix)
       if (.not. u > 0.0_wp) cycle
       if (.not. log(u) + log(d%body(a)%young) + log(MARGIN) < log(LOAD_MAX)) then
