@@ -311,7 +311,7 @@ contains
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
     type(contact_result_t), intent(in) :: res
-    real(wp), intent(in) :: pres(:)            !< (m) pressure of each row [stress]
+    real(wp), intent(in), contiguous :: pres(:)  !< (m) pressure of each row [stress]
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     type(error_t), intent(inout) :: st
     integer(hid_t) :: pid
