@@ -5,7 +5,7 @@ module acceleration
   use kinds, only: wp
   use config, only: ACCEL_AITKEN, ACCEL_ANDERSON
   use lapack, only: dgels
-  use contact_types, only: robin_state_t, ANDERSON_DEPTH
+  use contact_types, only: robin_state_t
   use contact_common, only: all_finite
   implicit none (type, external)
   private
@@ -64,7 +64,8 @@ contains
     x = x + state%omega*r
   end subroutine aitken
 
-  !> Anderson mixing of depth ANDERSON_DEPTH with mixing parameter delta:
+  !> Anderson mixing of the state's depth (its stored differences, `anderson_history`) with
+  !! mixing parameter delta:
   !! x+ = x + delta r - (dX + delta dR) gamma, gamma = argmin |r - dR gamma|.
   subroutine anderson(delta, state, x, r)
     real(wp), intent(in) :: delta
@@ -72,16 +73,17 @@ contains
     real(wp), intent(inout) :: x(:)
     real(wp), intent(in) :: r(:)
     real(wp), allocatable :: gam(:), qr(:, :), rhs(:), work(:)
-    integer :: n2, k, j, info, lwork
+    integer :: n2, k, j, info, lwork, depth
     n2 = size(x)
+    depth = size(state%dX, 2)
     if (state%nacc > 0) then
-      j = mod(state%nacc - 1, ANDERSON_DEPTH) + 1
+      j = mod(state%nacc - 1, depth) + 1
       state%dX(:, j) = x - state%x_prev
       state%dR(:, j) = r - state%r_prev
     end if
     state%x_prev = x
     state%r_prev = r
-    k = min(state%nacc, ANDERSON_DEPTH)
+    k = min(state%nacc, depth)
     state%nacc = state%nacc + 1
     if (k > 0) then
       allocate (qr(n2, k), rhs(n2), gam(k))

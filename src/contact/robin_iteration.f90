@@ -60,7 +60,7 @@ contains
     else
       ! the history grows as the run goes (max_outer may be huge)
       call alloc_result(res, m, min(solver%max_outer, HISTORY_CHUNK), size(bodies))
-      call state_init(run_state, m, contact_line%g0, size(bodies))
+      call state_init(run_state, m, contact_line%g0, size(bodies), contact_line%npair)
     end if
     res%method = 'robin'
 

@@ -12,7 +12,7 @@ module run_phases
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, nodal_stress, stress_field_t
   use contact_interface, only: build_interface
-  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED
+  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, anderson_history
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
@@ -226,7 +226,8 @@ contains
     call fail_on(err, 'deck '//trim(run%deck%source))
     if (len(run%restart_file) == 0) return
     call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%nbody, &
-                         run%deck%solver%max_outer, run%robin_state, run%result, err)
+                         anderson_history(run%nbody, run%contact_line%npair), run%deck%solver%max_outer, &
+                         run%robin_state, run%result, err)
     call fail_on(err)
   end subroutine read_restart
 

@@ -16,7 +16,7 @@ module checkpoint
   use digest, only: file_digest
   use history_io, only: write_history, read_history
   use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
-  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, ANDERSON_DEPTH, recycle_size
+  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, recycle_size
   implicit none (type, external)
   private
 
@@ -51,6 +51,7 @@ module checkpoint
     integer :: nh = 0                          ! entries of /history
     integer :: kr = 0                          ! stored directions per body
     integer :: nbody = 2                       ! bodies of this run
+    integer :: depth = 5                       ! Anderson depth of this run
     logical :: has_products = .false., has_search = .false., has_recycle = .false., has_mu = .false.
   end type ckpt_reader_t
 
@@ -151,16 +152,17 @@ contains
   !! (its key differs from `key`) or from mesh files whose content has changed since
   !! (`meshes`, from mesh_identity), or does not hold what this deck implies. Nothing in
   !! the file is trusted: before anything is read, every dataset and attribute is checked
-  !! for its type class and shape (m contact nodes, ANDERSON_DEPTH, a history of at least
+  !! for its type class and shape (m contact nodes, the Anderson depth, a history of at least
   !! `it` and at most max_outer entries), and after reading, the counters for their ranges
   !! and every real dataset and attribute for finite values; the message names the file
   !! and the object.
-  subroutine checkpoint_read(file, key, meshes, m, nbody, maxout, st, res, err)
+  subroutine checkpoint_read(file, key, meshes, m, nbody, depth, maxout, st, res, err)
     character(len=*), intent(in) :: file          !< checkpoint path
     character(len=*), intent(in) :: key           !< fingerprint of this run
     character(len=*), intent(in) :: meshes        !< this run's mesh_identity
     integer, intent(in) :: m                      !< contact rows of this run (all pairs)
     integer, intent(in) :: nbody                  !< bodies of this run
+    integer, intent(in) :: depth                  !< Anderson depth of this run (contact_types anderson_history)
     integer, intent(in) :: maxout                 !< max_outer of this run (history size)
     type(robin_state_t), intent(out) :: st        !< the outer state
     type(contact_result_t), intent(inout) :: res  !< receives the history and the counters
@@ -173,6 +175,7 @@ contains
     r%src = 'restart file '//trim(file)
     r%m = m
     r%nbody = nbody
+    r%depth = depth
     r%maxout = maxout
     inquire (file=file, exist=exists_)
     if (.not. exists_) then
@@ -314,10 +317,10 @@ contains
     call need(r, r%gid, '/state', 'lam', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
     call need(r, r%gid, '/state', 'r_prev', .false., CLASS_REAL, [2*m2], contact_nodes(r%m))
     call need(r, r%gid, '/state', 'x_prev', .false., CLASS_REAL, [2*m2], contact_nodes(r%m))
-    call need(r, r%gid, '/state', 'dX', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
-              contact_nodes(r%m)//' and Anderson depth '//i2s(ANDERSON_DEPTH))
-    call need(r, r%gid, '/state', 'dR', .false., CLASS_REAL, [2*m2, int(ANDERSON_DEPTH, hsize_t)], &
-              contact_nodes(r%m)//' and Anderson depth '//i2s(ANDERSON_DEPTH))
+    call need(r, r%gid, '/state', 'dX', .false., CLASS_REAL, [2*m2, int(r%depth, hsize_t)], &
+              contact_nodes(r%m)//' and Anderson depth '//i2s(r%depth))
+    call need(r, r%gid, '/state', 'dR', .false., CLASS_REAL, [2*m2, int(r%depth, hsize_t)], &
+              contact_nodes(r%m)//' and Anderson depth '//i2s(r%depth))
     ! F_a lam_a of the last solves: absent from older checkpoints, checked when present
     r%has_products = exists(r%gid, 'reuse', .true.) .or. exists(r%gid, 'flam_v', .false.)
     if (r%has_products) then
