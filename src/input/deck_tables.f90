@@ -217,9 +217,10 @@ contains
       'each body for `''cholmod''`, the interface always last: `''metis''`, `''amd''` (CAMD), '// &
       '`''natural''` or `''nd''` (the program''s geometric nested dissection)')
     call v%enum('acceleration', s%acceleration, ACCEL_CHOICES, doc='outer fixed-point '// &
-      'acceleration: `''none''`, `''aitken''` (dynamic relaxation), `''anderson''` (depth 5, '// &
-      'mixing delta) or `''auto''`: none for two bodies in one pair, anderson for several pairs (a chain '// &
-      'of bodies passes its forces one contact per outer iteration)')
+      'acceleration: `''none''`, `''aitken''` (dynamic relaxation), `''anderson''` (mixing delta; '// &
+      'history depth 5, for several pairs the number of bodies up to 64) or `''auto''`: none for two '// &
+      'bodies in one pair, anderson for several pairs (a chain of bodies passes its forces one contact '// &
+      'per outer iteration)')
     call v%real('inner_factor', s%inner_factor, unit='[-]', range='> 0', doc='inner tolerance = '// &
       'inner_factor x min(increment, residual) of the previous outer iteration, clamped to '// &
       '[inner_rtol_min, inner_rtol_max]')
