@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar contact_interface condense condense_mumps floating contact_types contact_common equality_rows \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar contact_interface condense condense_mumps contact_types contact_common floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
@@ -171,8 +171,9 @@ $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/cholesky.o $(BUILD)/cloc
                            $(BUILD)/mesh.o $(BUILD)/ordering.o
 $(BUILD)/condense_mumps.o: $(BUILD)/assembly.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/contact_interface.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mumps_iface.o
-$(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/errors.o \
-                           $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/strings.o
+$(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_common.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
+                           $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact_common.o: $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
 $(BUILD)/equality_rows.o:  $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/condense.o

@@ -9,6 +9,7 @@ module floating
   use assembly, only: body_system_t, rigid_motion_name
   use contact_interface, only: interface_t, body_slots
   use condense, only: body_condensed_t
+  use contact_common, only: scatter
   use lapack, only: dsyev, dgels, dsygv
   use strings, only: i2s, r2s
   use errors, only: error_t, ERR_INPUT
@@ -281,7 +282,7 @@ contains
     allocate (bs(contact_line%m, 2))
     bs = 0.0_wp
     do a = 1, size(bodies)
-      call scatter_rows(bodies(a)%b, bodies(a)%slots, bs)
+      call scatter(bodies(a)%b, bodies(a)%slots, bs)
     end do
     h = contact_line%g0 - bs(:, 1) - bs(:, 2)
     root = floating_groups(contact_line, bodies)
@@ -312,20 +313,6 @@ contains
       end if
       deallocate (rows, target, lam, ha)
     end do
-
-  contains
-
-    !> x(slots) = y in the side layout.
-    pure subroutine scatter_rows(y, slots, x)
-      real(wp), intent(in) :: y(:)
-      integer, intent(in) :: slots(:)
-      real(wp), intent(inout) :: x(:, :)
-      integer :: k, mm
-      mm = size(x, 1)
-      do k = 1, size(slots)
-        x(slots(k) - ((slots(k) - 1)/mm)*mm, (slots(k) - 1)/mm + 1) = y(k)
-      end do
-    end subroutine scatter_rows
 
   end subroutine check_pressed
 
