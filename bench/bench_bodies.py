@@ -32,8 +32,8 @@ tables. A benchmark: it reports, it asserts nothing.
 Usage: bench/bench_bodies.py [--bin bin/robin_contact] [--quick] [--skip chain,scale,threads]
                              [--alpha 1e-12] [--repeat 3] [--quiet-wait 30]
 --quick: chain N = 2, 4, 8; scale N = 8, 32 of 16x16; threads 16 bodies of 16x16; one run
-each, no waiting (a smoke run of about half a minute). The full bench takes about 10 minutes
-on 2 cores when the machine is quiet.
+each, no waiting (a smoke run of about 15 s). The full bench takes 11-15 minutes on the
+shared 2-core machine, most of it waiting for a quiet machine (about 3 minutes of runs).
 """
 import argparse
 import os
