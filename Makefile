@@ -326,6 +326,14 @@ bench-mpi: $(PROG)
 	$(MAKE) MPI=1 all
 	$(PYTHON) bench/bench_mpi.py --bin $(PROG) --mpi-bin bin/robin_contact_mpi --ladder
 
+# Many-body assemblies: outer iterations against the length of a stack of N blocks (each Robin
+# operator with and without Anderson, against monolithic), time and memory per phase for 32,
+# 128, 512 blocks of 64x64 cells as columns of 8, and 1 against 2 threads on 64 blocks (11-15
+# min, most of it waiting for a quiet machine); results/bench_bodies.csv and Markdown tables
+.PHONY: bench-bodies
+bench-bodies: $(PROG)
+	$(PYTHON) bench/bench_bodies.py --bin $(PROG)
+
 plots: $(PROG)
 	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh
 
