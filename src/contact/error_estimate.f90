@@ -8,12 +8,29 @@ module error_estimate
   use contact_interface, only: interface_t
   use condense, only: body_condensed_t
   use contact_common, only: scatter
+  use linop, only: csc_op_t
+  use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
+  use monolithic, only: assemble_hessian
+  use errors, only: error_t
   use contact_types, only: contact_result_t
   use equality_rows, only: stacked_rows
   implicit none (type, external)
   private
 
-  integer, parameter :: DENSE_MAX = 6000   !< contact rows beyond which no bound is computed
+  !> H = sum_a E_a' F_a E_a for the bound: its products, its Cholesky factor and solves.
+  type :: hessian_t
+    integer :: m = 0
+    logical :: sparse = .false.              !< several pairs: CSC and CHOLMOD
+    real(wp), allocatable :: h(:, :), a(:, :)  !< dense H and its factor (one pair)
+    type(csc_op_t) :: hc                     !< sparse H (several pairs)
+    real(wp) :: lmax_rows = 0.0_wp           !< its row-sum bound (unused here)
+    type(chol_t) :: chol                     !< its CHOLMOD factor
+  contains
+    procedure :: init => hessian_init
+    procedure :: apply => hessian_apply
+    procedure :: factor => hessian_factor
+    procedure :: solve => hessian_solve
+  end type hessian_t
 
   public :: error_bound
 
@@ -24,36 +41,26 @@ contains
   !! (H = sum_a E_a' F_a E_a, c = sum_a E_a' b_a - g0) and the natural residual
   !! r = l - max(0, l - (Hl - c)/L), |l - lam*| <= 2 (L/mu) |r| with L, mu the extreme
   !! eigenvalues of H (estimated by power and inverse iteration, kappa enlarged by 10%).
-  !! Sets res%error_bound (relative to |lam|) and res%kappa; both are -1 (not computed)
-  !! beyond DENSE_MAX contact rows, where the dense H and its factor would not pay.
+  !! Sets res%error_bound (relative to |lam|) and res%kappa. H is dense for two bodies in one
+  !! pair, sparse (CHOLMOD) for several pairs.
   subroutine error_bound(contact_line, bodies, res)
     type(interface_t), intent(in) :: contact_line        !< contact rows of all pairs
     type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
     type(contact_result_t), intent(inout) :: res         !< lam in; error_bound, kappa out
-    real(wp), allocatable :: H(:, :), A(:, :), g(:), r(:), x(:), y(:), bs(:, :)
+    type(hessian_t) :: hs
+    real(wp), allocatable :: g(:), r(:), x(:), y(:), bs(:, :)
     real(wp) :: lmax, lmin, nl, perr
-    integer :: m, i, j, k, info, ib
-    integer, allocatable :: rows(:)
+    integer :: m, i, k, ib
+    logical :: ok
     m = contact_line%m
     res%error_bound = 0.0_wp
     res%kappa = 1.0_wp
     if (m == 0) return
-    if (m > DENSE_MAX) then
-      res%error_bound = -1.0_wp
-      res%kappa = -1.0_wp
-      return
-    end if
-    allocate (H(m, m), A(m, m), g(m), r(m), x(m), y(m), bs(m, 2))
-    ! H = sum_a E_a' F_a E_a (two bodies in one pair: F_1 + F_2)
-    H = 0.0_wp
+    allocate (g(m), r(m), x(m), y(m), bs(m, 2))
+    ! H = sum_a E_a' F_a E_a: dense for two bodies in one pair (F_1 + F_2), sparse otherwise
+    call hs%init(contact_line, bodies)
     bs = 0.0_wp
     do ib = 1, size(bodies)
-      rows = bodies(ib)%slots - ((bodies(ib)%slots - 1)/m)*m
-      do j = 1, bodies(ib)%m
-        do i = 1, bodies(ib)%m
-          H(rows(i), rows(j)) = H(rows(i), rows(j)) + bodies(ib)%flex(i, j)
-        end do
-      end do
       call scatter(bodies(ib)%b, bodies(ib)%slots, bs)
     end do
     ! largest eigenvalue: power iteration (a lower estimate, enlarged below)
@@ -63,15 +70,14 @@ contains
     x = x/norm2(x)
     lmax = 0.0_wp
     do k = 1, 60
-      call dsymv('U', m, 1.0_wp, H, m, x, 1, 0.0_wp, y, 1)
+      call hs%apply(x, y)
       lmax = norm2(y)
       if (.not. lmax > 0.0_wp) exit
       x = y/lmax
     end do
     ! smallest eigenvalue: inverse iteration on the Cholesky factor of H
-    A = H
-    call dpotrf('U', m, A, m, info)
-    if (info /= 0 .or. .not. lmax > 0.0_wp) then
+    call hs%factor(ok)
+    if (.not. ok .or. .not. lmax > 0.0_wp) then
       res%error_bound = huge(1.0_wp)
       res%kappa = huge(1.0_wp)
       return
@@ -82,10 +88,10 @@ contains
     x = x/norm2(x)
     do k = 1, 60
       y = x
-      call dpotrs('U', m, 1, A, m, y, m, info)
+      call hs%solve(y)
       x = y/norm2(y)
     end do
-    call dsymv('U', m, 1.0_wp, H, m, x, 1, 0.0_wp, y, 1)
+    call hs%apply(x, y)
     lmin = dot_product(x, y)
     res%kappa = 1.1_wp*lmax/max(lmin, tiny(1.0_wp))
     if (.not. (ieee_is_finite(res%kappa) .and. ieee_is_finite(lmax) .and. lmax > 0.0_wp)) then
@@ -95,7 +101,7 @@ contains
       return
     end if
     ! natural residual of the mean contact force
-    call dsymv('U', m, 1.0_wp, H, m, res%lam, 1, 0.0_wp, g, 1)
+    call hs%apply(res%lam, g)
     g = g - (bs(:, 1) + bs(:, 2) - contact_line%g0)
     if (sum(bodies(:)%nrig) > 0) then
       ! floating bodies: the feasible set is {l >= 0, G l = e}, and the bound holds with the
@@ -118,6 +124,73 @@ contains
       res%error_bound = merge(0.0_wp, huge(1.0_wp), norm2(r) == 0.0_wp)
     end if
   end subroutine error_bound
+
+  !> H: dense with LAPACK's Cholesky for one pair, sparse with CHOLMOD's for several.
+  subroutine hessian_init(self, contact_line, bodies)
+    class(hessian_t), intent(inout) :: self
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    integer :: m, i, j, ib
+    integer, allocatable :: rows(:)
+    m = contact_line%m
+    self%m = m
+    self%sparse = contact_line%npair > 1
+    if (self%sparse) then
+      call assemble_hessian(contact_line, bodies, self%hc, self%lmax_rows, sorted=.true.)
+      return
+    end if
+    allocate (self%h(m, m))
+    self%h = 0.0_wp
+    do ib = 1, size(bodies)
+      rows = bodies(ib)%slots - ((bodies(ib)%slots - 1)/m)*m
+      do j = 1, bodies(ib)%m
+        do i = 1, bodies(ib)%m
+          self%h(rows(i), rows(j)) = self%h(rows(i), rows(j)) + bodies(ib)%flex(i, j)
+        end do
+      end do
+    end do
+  end subroutine hessian_init
+
+  !> y = H x.
+  subroutine hessian_apply(self, x, y)
+    class(hessian_t), intent(inout) :: self
+    real(wp), intent(in) :: x(:)
+    real(wp), intent(out) :: y(:)
+    if (self%sparse) then
+      call self%hc%apply(x, y)
+    else
+      call dsymv('U', self%m, 1.0_wp, self%h, self%m, x, 1, 0.0_wp, y, 1)
+    end if
+  end subroutine hessian_apply
+
+  !> The Cholesky factor of H; ok false when H is not positive definite.
+  subroutine hessian_factor(self, ok)
+    class(hessian_t), intent(inout) :: self
+    logical, intent(out) :: ok
+    integer :: info
+    type(error_t) :: err
+    if (self%sparse) then
+      call self%chol%factor(self%m, self%hc%colptr, self%hc%rowind, self%hc%val, FACT_CHOLMOD, ORD_AMD, err)
+      ok = .not. err%failed()
+    else
+      self%a = self%h
+      call dpotrf('U', self%m, self%a, self%m, info)
+      ok = info == 0
+    end if
+  end subroutine hessian_factor
+
+  !> x <- H^-1 x (after hessian_factor).
+  subroutine hessian_solve(self, x)
+    class(hessian_t), intent(inout) :: self
+    real(wp), intent(inout) :: x(:)
+    integer :: info
+    type(error_t) :: err
+    if (self%sparse) then
+      call self%chol%solve(x, err)
+    else
+      call dpotrs('U', self%m, 1, self%a, self%m, x, self%m, info)
+    end if
+  end subroutine hessian_solve
 
   !> z = the Euclidean projection of y on {l >= 0, G l = e} (G, e: the floating bodies'
   !! equilibrium rows, stacked): z = max(0, y - G'nu) with nu the minimiser of the convex,

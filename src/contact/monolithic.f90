@@ -13,6 +13,7 @@ module monolithic
                    mprgp_status_name
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
+  use sorting, only: sort_ints
   use contact_interface, only: interface_t
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
@@ -31,7 +32,7 @@ module monolithic
     procedure :: apply => penalized_apply
   end type penalized_op_t
 
-  public :: solve_monolithic
+  public :: solve_monolithic, assemble_hessian
 
 contains
 
@@ -170,13 +171,15 @@ contains
   end subroutine solve_monolithic
 
   !> H = sum_a E_a' F_a E_a in compressed sparse columns (both triangles, rows in the order
-  !! the blocks list them) and its row-sum bound lmax of lambda_max: each row belongs to the
-  !! two bodies of its pair, so column j gathers their two blocks.
-  subroutine assemble_hessian(contact_line, bodies, op, lmax)
+  !! the blocks list them, or ascending when `sorted`) and its row-sum bound lmax of
+  !! lambda_max: each row belongs to the two bodies of its pair, so column j gathers their
+  !! two blocks.
+  subroutine assemble_hessian(contact_line, bodies, op, lmax, sorted)
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(:)
     type(csc_op_t), intent(out) :: op
     real(wp), intent(out) :: lmax
+    logical, intent(in), optional :: sorted          !< rows ascending in each column (CHOLMOD's input)
     integer, allocatable :: owner(:, :), colptr(:), rowind(:), mark(:), list(:)
     real(wp), allocatable :: val(:), acc(:), rowsum(:)
     integer :: m, a, s, i, j, k, nnz, n, row, slot
@@ -210,6 +213,9 @@ contains
     do j = 1, m
       n = 0
       call visit(j, .true.)
+      if (present(sorted)) then
+        if (sorted) call sort_ints(list(1:n))
+      end if
       rowsum(j) = 0.0_wp
       do k = 1, n
         nnz = nnz + 1

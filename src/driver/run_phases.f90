@@ -219,10 +219,9 @@ contains
   subroutine read_restart(run)
     type(run_t), intent(inout) :: run   !< the run: its mesh hashes, Robin state and result
     type(error_t) :: err
-    character(len=len(run%deck%body(1)%mesh)), allocatable :: paths(:)
     integer :: a
-    paths = [(run%deck%body(a)%mesh, a=1, run%nbody)]   ! contiguous: the checked build warns of a temporary
-    call mesh_identity(paths, run%mesh_ids, err)
+    ! an array constructor, not the section body(:)%mesh, whose temporary the checked build reports
+    call mesh_identity([(run%deck%body(a)%mesh, a=1, run%nbody)], run%mesh_ids, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
     if (len(run%restart_file) == 0) return
     call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%nbody, &
