@@ -176,7 +176,8 @@ $(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/cont
                            $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact_common.o: $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
-$(BUILD)/equality_rows.o:  $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/condense.o
+$(BUILD)/equality_rows.o:  $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
+                           $(BUILD)/linop.o
 # the Robin operators implement one interface: not every operator needs every argument
 $(BUILD)/robin_operators.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \

@@ -9,7 +9,7 @@ module condense
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use config, only: factor_cfg_t, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
   use mesh, only: mesh_t
-  use contact_interface, only: interface_t, body_slots
+  use contact_interface, only: interface_t, body_slots, slot_row, slot_side
   use assembly, only: body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use ordering, only: grid_dissection, coordinate_bisection
@@ -80,8 +80,8 @@ contains
     if (allocated(bc%bptr)) deallocate (bc%bptr, bc%bpos, bc%bval, bc%bfix)
     total = 0
     do i = 1, bc%m
-      row = bc%slots(i) - ((bc%slots(i) - 1)/itf%m)*itf%m
-      side = (bc%slots(i) - 1)/itf%m + 1
+      row = slot_row(bc%slots(i), itf%m)
+      side = slot_side(bc%slots(i), itf%m)
       total = total + itf%b(side)%ptr(row + 1) - itf%b(side)%ptr(row)
     end do
     allocate (pos_of(sys%n), idx(total), bc%bptr(bc%m + 1), bc%bpos(total), bc%bval(total), bc%bfix(bc%m))
@@ -90,8 +90,8 @@ contains
     ne = 0
     bc%bptr(1) = 1
     do i = 1, bc%m
-      row = bc%slots(i) - ((bc%slots(i) - 1)/itf%m)*itf%m
-      side = (bc%slots(i) - 1)/itf%m + 1
+      row = slot_row(bc%slots(i), itf%m)
+      side = slot_side(bc%slots(i), itf%m)
       bc%bfix(i) = 0.0_wp
       associate (b => itf%b(side))
         do e = b%ptr(row), b%ptr(row + 1) - 1

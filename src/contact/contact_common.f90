@@ -4,7 +4,7 @@
 module contact_common
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use contact_interface, only: interface_t
+  use contact_interface, only: interface_t, slot_row, slot_side
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t
   implicit none (type, external)
@@ -22,7 +22,7 @@ contains
     integer :: k, m
     m = size(x, 1)
     do k = 1, size(slots)
-      y(k) = x(slots(k) - ((slots(k) - 1)/m)*m, (slots(k) - 1)/m + 1)
+      y(k) = x(slot_row(slots(k), m), slot_side(slots(k), m))
     end do
   end function gather
 
@@ -34,7 +34,7 @@ contains
     integer :: k, m
     m = size(x, 1)
     do k = 1, size(slots)
-      x(slots(k) - ((slots(k) - 1)/m)*m, (slots(k) - 1)/m + 1) = y(k)
+      x(slot_row(slots(k), m), slot_side(slots(k), m)) = y(k)
     end do
   end subroutine scatter
 
@@ -63,7 +63,7 @@ contains
     integer :: k, row
     r = [1, 0]
     do k = 1, body%m
-      row = body%slots(k) - ((body%slots(k) - 1)/contact_line%m)*contact_line%m
+      row = slot_row(body%slots(k), contact_line%m)
       if (contact_line%pair_of(row) /= p) cycle
       if (r(2) < r(1)) r(1) = k
       r(2) = k

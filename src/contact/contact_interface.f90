@@ -43,7 +43,7 @@ module contact_interface
     type(brows_t) :: b(2)                   !< the rows of side 1 and side 2
   end type interface_t
 
-  public :: build_interface, contact_resultant, body_slots, pair_rows
+  public :: build_interface, contact_resultant, body_slots, pair_rows, slot_row, slot_side
 
 contains
 
@@ -73,6 +73,20 @@ contains
       end do
     end do
   end function body_slots
+
+  !> The contact row of a slot (its position row + (side - 1) m in the side layout).
+  elemental integer function slot_row(slot, m)
+    integer, intent(in) :: slot             !< a position in the side layout
+    integer, intent(in) :: m                !< contact rows of all pairs
+    slot_row = slot - ((slot - 1)/m)*m
+  end function slot_row
+
+  !> The side (1 or 2) of a slot.
+  elemental integer function slot_side(slot, m)
+    integer, intent(in) :: slot             !< a position in the side layout
+    integer, intent(in) :: m                !< contact rows of all pairs
+    slot_side = (slot - 1)/m + 1
+  end function slot_side
 
   !> The rows of pair p, as a range.
   pure function pair_rows(itf, p) result(r)

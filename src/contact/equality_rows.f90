@@ -6,6 +6,7 @@ module equality_rows
   use lapack, only: dgemm, dsyev
   use linop, only: dense_op_t
   use condense, only: body_condensed_t
+  use contact_interface, only: slot_row
   implicit none (type, external)
   private
 
@@ -79,7 +80,7 @@ contains
     do a = 1, size(bodies)
       if (bodies(a)%nrig == 0) cycle
       do i = 1, bodies(a)%m
-        g(r + 1:r + bodies(a)%nrig, bodies(a)%slots(i) - ((bodies(a)%slots(i) - 1)/m)*m) = bodies(a)%rg(:, i)
+        g(r + 1:r + bodies(a)%nrig, slot_row(bodies(a)%slots(i), m)) = bodies(a)%rg(:, i)
       end do
       e(r + 1:r + bodies(a)%nrig) = bodies(a)%re
       r = r + bodies(a)%nrig

@@ -5,7 +5,7 @@ module error_estimate
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use lapack, only: dsymv, dpotrf, dpotrs, dposv, dsyev
-  use contact_interface, only: interface_t
+  use contact_interface, only: interface_t, slot_row
   use condense, only: body_condensed_t
   use contact_common, only: scatter
   use linop, only: csc_op_t
@@ -23,7 +23,6 @@ module error_estimate
     logical :: sparse = .false.              !< several pairs: CSC and CHOLMOD
     real(wp), allocatable :: h(:, :), a(:, :)  !< dense H and its factor (one pair)
     type(csc_op_t) :: hc                     !< sparse H (several pairs)
-    real(wp) :: lmax_rows = 0.0_wp           !< its row-sum bound (unused here)
     type(chol_t) :: chol                     !< its CHOLMOD factor
   contains
     procedure :: init => hessian_init
@@ -132,17 +131,18 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     integer :: m, i, j, ib
     integer, allocatable :: rows(:)
+    real(wp) :: row_sums
     m = contact_line%m
     self%m = m
     self%sparse = contact_line%npair > 1
     if (self%sparse) then
-      call assemble_hessian(contact_line, bodies, self%hc, self%lmax_rows, sorted=.true.)
+      call assemble_hessian(contact_line, bodies, self%hc, row_sums, sorted=.true.)
       return
     end if
     allocate (self%h(m, m))
     self%h = 0.0_wp
     do ib = 1, size(bodies)
-      rows = bodies(ib)%slots - ((bodies(ib)%slots - 1)/m)*m
+      rows = slot_row(bodies(ib)%slots, m)
       do j = 1, bodies(ib)%m
         do i = 1, bodies(ib)%m
           self%h(rows(i), rows(j)) = self%h(rows(i), rows(j)) + bodies(ib)%flex(i, j)

@@ -7,7 +7,7 @@
 module floating
   use kinds, only: wp
   use assembly, only: body_system_t, rigid_motion_name
-  use contact_interface, only: interface_t, body_slots
+  use contact_interface, only: interface_t, body_slots, slot_row, slot_side
   use condense, only: body_condensed_t
   use contact_common, only: scatter
   use lapack, only: dsyev, dgels, dsygv
@@ -45,8 +45,8 @@ contains
     body%rreach = 0.0_wp
     do k = 1, system%nrig
       do i = 1, m
-        row = body%slots(i) - ((body%slots(i) - 1)/contact_line%m)*contact_line%m
-        side = (body%slots(i) - 1)/contact_line%m + 1
+        row = slot_row(body%slots(i), contact_line%m)
+        side = slot_side(body%slots(i), contact_line%m)
         body%rg(k, i) = 0.0_wp
         associate (b => contact_line%b(side))
           do e = b%ptr(row), b%ptr(row + 1) - 1
@@ -165,7 +165,7 @@ contains
         associate (bd => bodies(members(k)))
           r = r + bd%nrig
           do i = 1, bd%m
-            i0 = bd%slots(i) - ((bd%slots(i) - 1)/contact_line%m)*contact_line%m
+            i0 = slot_row(bd%slots(i), contact_line%m)
             if (col(i0) == 0) then
               ncol = ncol + 1
               col(i0) = ncol
@@ -180,7 +180,7 @@ contains
       do k = 1, nm
         associate (bd => bodies(members(k)))
           do i = 1, bd%m
-            i0 = bd%slots(i) - ((bd%slots(i) - 1)/contact_line%m)*contact_line%m
+            i0 = slot_row(bd%slots(i), contact_line%m)
             gs(r + 1:r + bd%nrig, col(i0)) = bd%rg(:, i)
           end do
           es(r + 1:r + bd%nrig) = bd%re
@@ -296,7 +296,7 @@ contains
       if (any([(root(i) == root(a) .and. i /= a .and. any(bodies(i)%re /= 0.0_wp), i=1, size(bodies))])) cycle
       allocate (rows(r + 1, m), target(r + 1), lam(m), ha(m))
       do i = 1, m
-        ha(i) = h(bodies(a)%slots(i) - ((bodies(a)%slots(i) - 1)/contact_line%m)*contact_line%m)
+        ha(i) = h(slot_row(bodies(a)%slots(i), contact_line%m))
       end do
       rows(1:r, :) = bodies(a)%rg
       rows(r + 1, :) = ha/max(maxval(abs(ha)), tiny(1.0_wp))

@@ -14,7 +14,7 @@ module monolithic
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
   use sorting, only: sort_ints
-  use contact_interface, only: interface_t
+  use contact_interface, only: interface_t, slot_row, slot_side
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
@@ -189,8 +189,8 @@ contains
     do a = 1, size(bodies)
       do i = 1, bodies(a)%m
         slot = bodies(a)%slots(i)
-        row = slot - ((slot - 1)/m)*m
-        s = (slot - 1)/m + 1
+        row = slot_row(slot, m)
+        s = slot_side(slot, m)
         owner(2*s - 1:2*s, row) = [a, i]
       end do
     end do
@@ -244,7 +244,7 @@ contains
         col = owner(2*side, jj)
         do ii = 1, bodies(b)%m
           sl = bodies(b)%slots(ii)
-          r = sl - ((sl - 1)/m)*m
+          r = slot_row(sl, m)
           if (mark(r) == 0) then
             n = n + 1
             list(n) = r

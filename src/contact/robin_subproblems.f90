@@ -17,7 +17,7 @@ module robin_subproblems
   use sorting, only: merge_sort_by_keys
   use equality_rows, only: equality_t, equality_init, equality_add_penalty
   use robin_operators, only: robin_operator_t
-  use contact_interface, only: interface_t
+  use contact_interface, only: interface_t, slot_row, slot_side
   implicit none (type, external)
   private
 
@@ -271,7 +271,7 @@ contains
       integer :: i, sl
       do i = 1, m
         sl = body%slots(i)
-        mine(i, :) = all(sl - ((sl - 1)/mm)*mm, ((sl - 1)/mm)*k + 1:((sl - 1)/mm)*k + ka)
+        mine(i, :) = all(slot_row(sl, mm), (slot_side(sl, mm) - 1)*k + 1:(slot_side(sl, mm) - 1)*k + ka)
       end do
     end subroutine directions_out
 
@@ -282,7 +282,7 @@ contains
       integer :: i, sl
       do i = 1, m
         sl = body%slots(i)
-        all(sl - ((sl - 1)/mm)*mm, ((sl - 1)/mm)*k + 1:((sl - 1)/mm)*k + ka) = mine(i, :)
+        all(slot_row(sl, mm), (slot_side(sl, mm) - 1)*k + 1:(slot_side(sl, mm) - 1)*k + ka) = mine(i, :)
       end do
     end subroutine directions_in
 

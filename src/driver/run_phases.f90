@@ -11,7 +11,7 @@ module run_phases
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, nodal_stress, stress_field_t
-  use contact_interface, only: build_interface
+  use contact_interface, only: build_interface, slot_row
   use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, anderson_history
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
@@ -111,7 +111,7 @@ contains
           call msh_read_shared(trim(deck%body(a)%mesh), [(deck%body(ids(k))%region, k=1, size(ids))], ids, shared, &
                                serr, run%threads)
           do k = 1, size(ids)
-            call move_mesh(shared(k), run%meshes(ids(k)))
+            run%meshes(ids(k)) = shared(k)
             err(ids(k)) = serr(k)
             done(ids(k)) = .true.
           end do
@@ -140,16 +140,6 @@ contains
         call backend%check_memory(run, run%sized)
       end if
     end associate
-
-  contains
-
-    !> The mesh built from the shared file into its place (no copy of the arrays kept).
-    subroutine move_mesh(from, to)
-      type(mesh_t), intent(inout) :: from
-      type(mesh_t), intent(out) :: to
-      to = from
-    end subroutine move_mesh
-
   end subroutine read_meshes
 
   !> Every body's DOF numbering and loads, the bodies on the threads; the stiffness too
@@ -322,7 +312,7 @@ contains
       do a = 1, run%nbody
         if (run%systems(a)%nrig == 0) cycle
         associate (g => bodies(a)%rg, e => bodies(a)%re, own => gather(result%lam_body, bodies(a)%slots), &
-                   mean => result%lam(bodies(a)%slots - ((bodies(a)%slots - 1)/contact_line%m)*contact_line%m))
+                   mean => result%lam(slot_row(bodies(a)%slots, contact_line%m)))
           ! e = 0 (pressed by a deformation only): judged against the contact forces' size
           if (all(e == 0.0_wp)) then
             scale = max(norm2(g)*norm2(mean), tiny(1.0_wp))
