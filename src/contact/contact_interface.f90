@@ -217,11 +217,10 @@ contains
     real(wp) :: hmean(2), tol, gmin
     logical, allocatable :: removable(:)
     real(wp), allocatable :: gdist(:)
-    character(len=:), allocatable :: what(:)
+    character(len=300) :: what(2)               ! each side's words for messages
     type(mortar_t) :: mt
     type(error_t) :: why
 
-    allocate (character(len=300) :: what(2))
     do s = 1, 2
       if (named) then
         what(s) = '&contact bodies='//i2s(cc%bodies(1))//','//i2s(cc%bodies(2))//': body '//i2s(cc%bodies(s))

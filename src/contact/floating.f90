@@ -150,6 +150,7 @@ contains
     integer :: a, g, r, nm, ncol, k, i, i0
     character(len=:), allocatable :: names
 
+    allocate (root(size(bodies)))
     root = floating_groups(contact_line, bodies)
     allocate (col(2*contact_line%m))
     do g = 1, size(bodies)
@@ -285,6 +286,7 @@ contains
       call scatter(bodies(a)%b, bodies(a)%slots, bs)
     end do
     h = contact_line%g0 - bs(:, 1) - bs(:, 2)
+    allocate (root(size(bodies)))
     root = floating_groups(contact_line, bodies)
     do a = 1, size(bodies)
       r = bodies(a)%nrig
