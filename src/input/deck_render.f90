@@ -43,7 +43,7 @@ module deck_render
     'most once.'
   character(len=*), parameter :: REF_BODY = &
     'One elastic body. Required: at least two, with the ids 1 to N (N the number of `&body` '// &
-    'groups), each once; this version''s solver takes two. Either a built-in **rectangle** '// &
+    'groups), each once. Either a built-in **rectangle** '// &
     '[x0, x0+width] x [y0, y0+height] meshed by nx x ny cells, whose sides get their conditions '// &
     'here (`left`, `right`, `bottom`, `top`) and are its groups `''left''`, `''right''`, '// &
     '`''bottom''`, `''top''`; or the cells of a **mesh file** (`mesh`, `region`), whose '// &
