@@ -5,10 +5,14 @@
 !! A body's contact rows are its sides of every pair it takes part in (`body_slots`), so a
 !! body in several pairs is condensed on all of them at once. The rows come from two edge
 !! groups per pair (named groups, or the rectangle sides declared 'contact') paired by dual
-!! mortar (module mortar; row j = the weighted normal gap at slave node j).
+!! mortar (module mortar; row j = the weighted normal gap at slave node j). A frictional pair
+!! has, after its normal rows, one tangential row per slave node (the same mortar weights
+!! along the slave tangent: the weighted slip), whose force is bounded by a box (Tresca) or
+!! by mu times the node's normal force (Coulomb): `row_bounds`.
 module contact_interface
   use kinds, only: wp
-  use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented
+  use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented, FRICTION_NONE, FRICTION_TRESCA, &
+                    FRICTION_COULOMB
   use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
   use mortar, only: mortar_t, mortar_build
   use strings, only: i2s, r2s
@@ -36,14 +40,23 @@ module contact_interface
     integer, allocatable :: pair_of(:)      !< (m) the pair of each row
     real(wp), allocatable :: s(:)           !< (m) arc length along the pair's slave contact chain [length]
     real(wp), allocatable :: xy(:, :)       !< (2,m) slave node coordinates [length]
-    real(wp), allocatable :: normal(:, :)   !< (2,m) unit normal, outward from the slave body
+    real(wp), allocatable :: normal(:, :)   !< (2,m) the row's direction: unit normal outward from the slave
+                                            !! body (normal rows), unit tangent (-n_y, n_x) (tangential rows)
+    integer, allocatable :: kind(:)         !< (m) ROW_NORMAL or ROW_TANGENT
+    integer, allocatable :: nrow(:)         !< (m) the normal row of the row's slave node (itself for a normal row)
+    integer, allocatable :: pair_friction(:)   !< (npair) FRICTION_* of the pair (NONE when it has no tangential rows)
+    real(wp), allocatable :: pair_mu(:)        !< (npair) Coulomb coefficient [-]
+    real(wp), allocatable :: pair_slip(:)      !< (npair) Tresca's bound of the shear traction [stress]
     real(wp), allocatable :: g0(:)          !< (m) initial normal gap [length]
     real(wp), allocatable :: trib(:)        !< (m) tributary length D_jj [length]
     integer, allocatable :: node(:, :)      !< (m,2) mesh node of each side's body (0: none, mortar master)
     type(brows_t) :: b(2)                   !< the rows of side 1 and side 2
   end type interface_t
 
-  public :: build_interface, contact_resultant, body_slots, pair_rows, slot_row, slot_side
+  integer, parameter, public :: ROW_NORMAL = 0    !< a row of the normal gap: force >= 0
+  integer, parameter, public :: ROW_TANGENT = 1   !< a row of the slip: force in a box
+
+  public :: build_interface, contact_resultant, body_slots, pair_rows, slot_row, slot_side, row_bounds, has_friction
 
 contains
 
@@ -96,6 +109,38 @@ contains
     r = [itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1]
   end function pair_rows
 
+  !> Whether any pair has tangential rows.
+  pure logical function has_friction(itf)
+    type(interface_t), intent(in) :: itf
+    has_friction = any(itf%kind == ROW_TANGENT)
+  end function has_friction
+
+  !> The bounds of the contact forces on the rows: a normal row's force is >= 0 (no upper
+  !! bound, +huge); a tangential row's lies in [-t, t] with t = slip_bound x tributary length
+  !! (Tresca) or mu x the node's normal force lam_n (Coulomb; lam_n < 0 counts as 0).
+  pure subroutine row_bounds(itf, lam_n, lb, ub)
+    type(interface_t), intent(in) :: itf
+    real(wp), intent(in) :: lam_n(:)          !< (m) normal forces of the rows (read at the normal rows) [force]
+    real(wp), intent(out) :: lb(:), ub(:)     !< (m) [force]
+    integer :: k, p
+    real(wp) :: t
+    do k = 1, itf%m
+      if (itf%kind(k) == ROW_NORMAL) then
+        lb(k) = 0.0_wp
+        ub(k) = huge(1.0_wp)
+      else
+        p = itf%pair_of(k)
+        if (itf%pair_friction(p) == FRICTION_TRESCA) then
+          t = itf%pair_slip(p)*itf%trib(k)
+        else
+          t = itf%pair_mu(p)*max(lam_n(itf%nrow(k)), 0.0_wp)
+        end if
+        lb(k) = -t
+        ub(k) = t
+      end if
+    end do
+  end subroutine row_bounds
+
   !> The resultant of the contact forces of `side` on its body over the rows `first..last`,
   !! -sum of B' lam by component [force]: what balances the body's applied load when contact
   !! alone holds it (the sum of the nodal normal forces is not a resultant on a curved line).
@@ -135,7 +180,8 @@ contains
     allocate (one(np))
     itf%npair = np
     itf%mortar = .true.
-    allocate (itf%pair_ptr(np + 1), itf%pair_body(2, np), itf%pair_slave(np))
+    allocate (itf%pair_ptr(np + 1), itf%pair_body(2, np), itf%pair_slave(np), itf%pair_friction(np), itf%pair_mu(np), &
+              itf%pair_slip(np))
     itf%pair_ptr(1) = 1
     do p = 1, np
       cc = pair_oriented(pairs(p))
@@ -154,6 +200,9 @@ contains
       if (err%failed()) return
       itf%pair_body(:, p) = cc%bodies
       itf%pair_slave(p) = one(p)%pair_slave(1)
+      itf%pair_friction(p) = one(p)%pair_friction(1)
+      itf%pair_mu(p) = cc%mu
+      itf%pair_slip(p) = cc%slip_bound
       itf%pair_ptr(p + 1) = itf%pair_ptr(p) + one(p)%m
     end do
     call stack_pairs(one, itf)
@@ -167,7 +216,8 @@ contains
     integer :: p, s, m, r0, ne(2), k, e0
     m = itf%pair_ptr(size(one) + 1) - 1
     itf%m = m
-    allocate (itf%s(m), itf%xy(2, m), itf%g0(m), itf%trib(m), itf%node(m, 2), itf%normal(2, m), itf%pair_of(m))
+    allocate (itf%s(m), itf%xy(2, m), itf%g0(m), itf%trib(m), itf%node(m, 2), itf%normal(2, m), itf%pair_of(m), &
+              itf%kind(m), itf%nrow(m))
     ne = 0
     do p = 1, size(one)
       do s = 1, 2
@@ -187,6 +237,8 @@ contains
         itf%g0(rows) = o%g0
         itf%trib(rows) = o%trib
         itf%node(rows, :) = o%node
+        itf%kind(rows) = o%kind
+        itf%nrow(rows) = o%nrow + r0
         itf%pair_of(rows) = p
         do s = 1, 2
           e0 = itf%b(s)%ptr(r0 + 1) - 1
@@ -213,7 +265,7 @@ contains
     type(body_system_t), intent(in) :: sys(:)        !< systems of all bodies
     type(interface_t), intent(out) :: itf            !< the pair's rows 1..m_p
     type(error_t), intent(out) :: err
-    integer :: g(2), s, sl, ma, j, e, k, ne
+    integer :: g(2), s, sl, ma, j, e, k, ne, nr
     real(wp) :: hmean(2), tol, gmin
     logical, allocatable :: removable(:)
     real(wp), allocatable :: gdist(:)
@@ -304,45 +356,68 @@ contains
         return
       end if
 
-      itf%m = mt%m
-      allocate (itf%s(mt%m), itf%xy(2, mt%m), itf%g0(mt%m), itf%trib(mt%m), itf%node(mt%m, 2), &
-                itf%normal(2, mt%m))
-      itf%s = mt%s
-      itf%xy = ms%xy(:, mt%snode)
+      ! a pair with friction (a positive bound) has a tangential row per slave node after
+      ! the normal ones: nr = 2 mt%m rows, else mt%m
+      itf%pair_friction = [FRICTION_NONE]
+      if ((cc%friction == FRICTION_TRESCA .and. cc%slip_bound > 0.0_wp) .or. &
+          (cc%friction == FRICTION_COULOMB .and. cc%mu > 0.0_wp)) itf%pair_friction = [cc%friction]
+      nr = merge(2*mt%m, mt%m, itf%pair_friction(1) /= FRICTION_NONE)
+      itf%m = nr
+      allocate (itf%s(nr), itf%xy(2, nr), itf%g0(nr), itf%trib(nr), itf%node(nr, 2), itf%normal(2, nr), &
+                itf%kind(nr), itf%nrow(nr))
+      itf%s(1:mt%m) = mt%s
+      itf%xy(:, 1:mt%m) = ms%xy(:, mt%snode)
     end associate
-    itf%normal = mt%normal
-    itf%trib = mt%d
-    itf%node(:, sl) = mt%snode
+    itf%normal(:, 1:mt%m) = mt%normal
+    itf%trib(1:mt%m) = mt%d
+    itf%node(1:mt%m, sl) = mt%snode
     itf%node(:, ma) = 0
-    itf%g0 = mt%g0
-    if (cc%gap_radius > 0.0_wp) itf%g0 = itf%g0 + (itf%xy(1, :) - cc%gap_center)**2/(2.0_wp*cc%gap_radius)
-    ! B_s: + sum_k ws_k n_j.u_k ; B_m: - sum_l wm_l n_j.u_l (both components of each node)
-    ne = 2*(mt%sptr(mt%m + 1) - 1)
-    allocate (itf%b(sl)%ptr(mt%m + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
-    ne = 2*(mt%mptr(mt%m + 1) - 1)
-    allocate (itf%b(ma)%ptr(mt%m + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
+    itf%g0(1:mt%m) = mt%g0
+    if (cc%gap_radius > 0.0_wp) itf%g0(1:mt%m) = itf%g0(1:mt%m) + (itf%xy(1, 1:mt%m) - cc%gap_center)**2/ &
+                                                  (2.0_wp*cc%gap_radius)
+    itf%kind(1:mt%m) = ROW_NORMAL
+    itf%nrow(1:mt%m) = [(j, j=1, mt%m)]
+    if (nr > mt%m) then
+      itf%s(mt%m + 1:) = itf%s(1:mt%m)
+      itf%xy(:, mt%m + 1:) = itf%xy(:, 1:mt%m)
+      itf%normal(1, mt%m + 1:) = -mt%normal(2, :)
+      itf%normal(2, mt%m + 1:) = mt%normal(1, :)
+      itf%trib(mt%m + 1:) = mt%d
+      itf%node(mt%m + 1:, sl) = mt%snode
+      itf%g0(mt%m + 1:) = 0.0_wp
+      itf%kind(mt%m + 1:) = ROW_TANGENT
+      itf%nrow(mt%m + 1:) = [(j, j=1, mt%m)]
+    end if
+    ! B_s: + sum_k ws_k d_j.u_k ; B_m: - sum_l wm_l d_j.u_l (both components of each node),
+    ! d_j the row's direction (normal, then tangent)
+    ne = (nr/mt%m)*2*(mt%sptr(mt%m + 1) - 1)
+    allocate (itf%b(sl)%ptr(nr + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
+    ne = (nr/mt%m)*2*(mt%mptr(mt%m + 1) - 1)
+    allocate (itf%b(ma)%ptr(nr + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
     call fill_rows(mt%sptr, mt%snod, mt%sval, 1.0_wp, itf%b(sl))
     call fill_rows(mt%mptr, mt%mnod, mt%mval, -1.0_wp, itf%b(ma))
 
   contains
 
-    !> Rows of one side: each node entry (weight w) gives sgn*w*n_j on both its DOFs.
+    !> Rows of one side: each node entry (weight w) of slave node j gives sgn*w*d_r on both
+    !! its DOFs, d_r the direction of row r (j's normal, or its tangent for r = j + mt%m).
     subroutine fill_rows(ptr, nod, val, sgn, b)
       integer, intent(in) :: ptr(:), nod(:)
       real(wp), intent(in) :: val(:), sgn
       type(brows_t), intent(inout) :: b
-      integer :: jj, kk, q, c
+      integer :: r, jj, kk, q, c
       q = 0
       b%ptr(1) = 1
-      do jj = 1, mt%m
+      do r = 1, nr
+        jj = itf%nrow(r)
         do kk = ptr(jj), ptr(jj + 1) - 1
           do c = 1, 2
             q = q + 1
             b%dof(q) = 2*(nod(kk) - 1) + c
-            b%val(q) = sgn*val(kk)*mt%normal(c, jj)
+            b%val(q) = sgn*val(kk)*itf%normal(c, r)
           end do
         end do
-        b%ptr(jj + 1) = q + 1
+        b%ptr(r + 1) = q + 1
       end do
     end subroutine fill_rows
 

@@ -38,6 +38,11 @@ module config
   integer, parameter, public :: METHOD_MONOLITHIC = 2   !< the monolithic reference
   character(len=*), parameter, public :: METHOD_CHOICES = 'robin monolithic'
 
+  integer, parameter, public :: FRICTION_NONE = 1      !< frictionless
+  integer, parameter, public :: FRICTION_TRESCA = 2    !< given slip bound |t| <= slip_bound
+  integer, parameter, public :: FRICTION_COULOMB = 3   !< |t| <= mu p
+  character(len=*), parameter, public :: FRICTION_CHOICES = 'none tresca coulomb'
+
   integer, parameter, public :: ROBIN_STEKLOV = 1    !< the paper's operator: the other body's flexibility
   integer, parameter, public :: ROBIN_CONSTANT = 2   !< alpha M^-1 (constant Robin parameter)
   integer, parameter, public :: ROBIN_HARMONIC = 3   !< 2 F_1 (F_1+F_2)^-1 F_2, contrast-robust
@@ -141,6 +146,9 @@ module config
     integer :: slave = 0                              !< mortar slave: a body id of the pair, 0: the finer surface
     real(wp) :: gap_radius = 0.0_wp                   !< R of the parabolic initial gap, 0: none [length]
     real(wp) :: gap_center = 0.0_wp                   !< xc of the parabolic gap [length]
+    integer :: friction = FRICTION_NONE               !< FRICTION_*
+    real(wp) :: mu = 0.0_wp                           !< Coulomb coefficient [-]
+    real(wp) :: slip_bound = 0.0_wp                   !< Tresca's bound on the shear traction [stress]
   end type contact_cfg_t
 
   !> Outer and inner solver settings (what the contact stage needs, and the factorization).

@@ -13,7 +13,8 @@ module deck_checks
   use config, only: pair_oriented, deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
-                    ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t
+                    ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t, &
+                    FRICTION_TRESCA, FRICTION_COULOMB
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, &
                          traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
   implicit none (type, external)
@@ -277,6 +278,13 @@ contains
     character(len=:), allocatable :: shown
     if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
       'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
+    if (c%mu < 0.0_wp) call bad_value(g, src, 'mu', r2s(c%mu), 'must be >= 0 (the Coulomb friction coefficient)')
+    if (c%slip_bound < 0.0_wp) call bad_value(g, src, 'slip_bound', r2s(c%slip_bound), &
+      'must be >= 0 (Tresca''s bound of the shear traction)')
+    if (c%mu /= 0.0_wp .and. c%friction /= FRICTION_COULOMB) call bad_value(g, src, 'mu', r2s(c%mu), &
+      'is the Coulomb coefficient: give it with friction=''coulomb''')
+    if (c%slip_bound /= 0.0_wp .and. c%friction /= FRICTION_TRESCA) call bad_value(g, src, 'slip_bound', &
+      r2s(c%slip_bound), 'is Tresca''s bound: give it with friction=''tresca''')
     if (form == TWO_BODY_FORM) then
       if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
         'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')

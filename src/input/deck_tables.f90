@@ -10,7 +10,7 @@ module deck_tables
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
                     ORDER_CHOICES, ACCEL_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
-                    UNITS_CHOICES
+                    UNITS_CHOICES, FRICTION_CHOICES
   implicit none (type, external)
   private
 
@@ -185,6 +185,13 @@ contains
       'gap; R > 0: an initial normal gap g0(s) = (s - gap_center)^2/(2R) on top of the '// &
       'geometry''s (with groups: s is the slave node''s x)')
     call v%real('gap_center', c%gap_center, unit='[length]', doc='s of the vertex of that parabola')
+    call v%enum('friction', c%friction, FRICTION_CHOICES, doc='`''none''` (frictionless), '// &
+      '`''tresca''` (the shear traction bounded by `slip_bound`: |t| <= slip_bound) or `''coulomb''` '// &
+      '(|t| <= mu p, p the contact pressure); `mu=0` or `slip_bound=0` is frictionless')
+    call v%real('mu', c%mu, unit='[-]', range='>= 0; with `friction=''coulomb''` only', &
+      doc='*coulomb only:* the friction coefficient')
+    call v%real('slip_bound', c%slip_bound, unit='[stress]', range='>= 0; with `friction=''tresca''` only', &
+      doc='*tresca only:* the bound of the shear traction')
   end subroutine contact_vars
 
   subroutine solver_vars(s, v)
