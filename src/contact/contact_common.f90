@@ -4,7 +4,7 @@
 module contact_common
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use contact_interface, only: interface_t, slot_row, slot_side
+  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, ROW_NORMAL
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t
   implicit none (type, external)
@@ -88,19 +88,23 @@ contains
       uscale = max(uscale, maxabs(bodies(i)%b))
     end do
     lnorm = norm2(res%lam)
-    lmax = maxval(res%lam)
     if (lnorm > 0.0_wp) then
       res%imbalance = norm2(res%lam_body(:, 1) - res%lam_body(:, 2))/lnorm
     else
       res%imbalance = 0.0_wp
     end if
-    res%penetration = max(maxval(res%gap), 0.0_wp)/uscale
-    res%complementarity = 0.0_wp
-    if (lmax > 0.0_wp) then
-      do i = 1, contact_line%m
-        res%complementarity = max(res%complementarity, max(res%lam(i), 0.0_wp)*abs(res%gap(i)))
-      end do
-      res%complementarity = res%complementarity/(lmax*uscale)
+    if (has_friction(contact_line)) then
+      call frictional_residual(contact_line, uscale, res)
+    else
+      lmax = maxval(res%lam)
+      res%penetration = max(maxval(res%gap), 0.0_wp)/uscale
+      res%complementarity = 0.0_wp
+      if (lmax > 0.0_wp) then
+        do i = 1, contact_line%m
+          res%complementarity = max(res%complementarity, max(res%lam(i), 0.0_wp)*abs(res%gap(i)))
+        end do
+        res%complementarity = res%complementarity/(lmax*uscale)
+      end if
     end if
     ! a floating body's equilibrium (its load against its own contact force): an inner
     ! solve that stopped on inner_max_it may leave it unmet, and then no run converges
@@ -114,8 +118,39 @@ contains
       end associate
     end do
     res%residual = max(res%imbalance, res%penetration, res%complementarity, res%equilibrium)
-    res%active = count(res%lam > 0.0_wp)
+    res%active = count(res%lam > 0.0_wp .and. contact_line%kind == ROW_NORMAL)
   end subroutine interface_residual
+
+  !> Penetration and complementarity with tangential rows: the normal rows as without
+  !! friction; on a tangential row with bound t (row_bounds at the mean normal force) the
+  !! force outside [-t, t], a slip where the node sticks ((t - |lam_t|) |slip|) and a slip
+  !! against the force (max(-lam_t slip, 0)) all count, scaled like the normal ones (the
+  !! largest normal force and the displacement scale).
+  subroutine frictional_residual(contact_line, uscale, res)
+    type(interface_t), intent(in) :: contact_line
+    real(wp), intent(in) :: uscale
+    type(contact_result_t), intent(inout) :: res
+    real(wp), allocatable :: lb(:), ub(:)
+    real(wp) :: lmax, pen, comp
+    integer :: i
+    allocate (lb(contact_line%m), ub(contact_line%m))
+    call row_bounds(contact_line, res%lam, lb, ub)
+    lmax = maxval(res%lam, mask=contact_line%kind == ROW_NORMAL)
+    pen = 0.0_wp
+    comp = 0.0_wp
+    do i = 1, contact_line%m
+      if (contact_line%kind(i) == ROW_NORMAL) then
+        pen = max(pen, res%gap(i))
+        comp = max(comp, max(res%lam(i), 0.0_wp)*abs(res%gap(i)))
+      else
+        comp = max(comp, max(ub(i) - abs(res%lam(i)), 0.0_wp)*abs(res%gap(i)), max(-res%lam(i)*res%gap(i), 0.0_wp), &
+                   max(abs(res%lam(i)) - ub(i), 0.0_wp)*uscale)
+      end if
+    end do
+    res%penetration = max(pen, 0.0_wp)/uscale
+    res%complementarity = 0.0_wp
+    if (lmax > 0.0_wp) res%complementarity = comp/(lmax*uscale)
+  end subroutine frictional_residual
 
   !> max |x_i| (0 for an empty x).
   real(wp) function maxabs(x)

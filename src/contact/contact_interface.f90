@@ -118,12 +118,18 @@ contains
   !> The bounds of the contact forces on the rows: a normal row's force is >= 0 (no upper
   !! bound, +huge); a tangential row's lies in [-t, t] with t = slip_bound x tributary length
   !! (Tresca) or mu x the node's normal force lam_n (Coulomb; lam_n < 0 counts as 0).
-  pure subroutine row_bounds(itf, lam_n, lb, ub)
+  !! With `start` (no normal force known yet) a Coulomb row is unbounded: the first solve
+  !! sticks everywhere, and its normal forces give the first bounds.
+  pure subroutine row_bounds(itf, lam_n, lb, ub, start)
     type(interface_t), intent(in) :: itf
     real(wp), intent(in) :: lam_n(:)          !< (m) normal forces of the rows (read at the normal rows) [force]
     real(wp), intent(out) :: lb(:), ub(:)     !< (m) [force]
+    logical, intent(in), optional :: start
     integer :: k, p
     real(wp) :: t
+    logical :: first
+    first = .false.
+    if (present(start)) first = start
     do k = 1, itf%m
       if (itf%kind(k) == ROW_NORMAL) then
         lb(k) = 0.0_wp
@@ -132,6 +138,8 @@ contains
         p = itf%pair_of(k)
         if (itf%pair_friction(p) == FRICTION_TRESCA) then
           t = itf%pair_slip(p)*itf%trib(k)
+        else if (first) then
+          t = huge(1.0_wp)
         else
           t = itf%pair_mu(p)*max(lam_n(itf%nrow(k)), 0.0_wp)
         end if

@@ -5,7 +5,7 @@ module error_estimate
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use lapack, only: dsymv, dpotrf, dpotrs, dposv, dsyev
-  use contact_interface, only: interface_t, slot_row
+  use contact_interface, only: interface_t, slot_row, row_bounds
   use condense, only: body_condensed_t
   use contact_common, only: scatter
   use linop, only: csc_op_t
@@ -47,7 +47,7 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
     type(contact_result_t), intent(inout) :: res         !< lam in; error_bound, kappa out
     type(hessian_t) :: hs
-    real(wp), allocatable :: g(:), r(:), x(:), y(:), bs(:, :)
+    real(wp), allocatable :: g(:), r(:), x(:), y(:), bs(:, :), lo(:), hi(:)
     real(wp) :: lmax, lmin, nl, perr
     integer :: m, i, k, ib
     logical :: ok
@@ -102,14 +102,19 @@ contains
     ! natural residual of the mean contact force
     call hs%apply(res%lam, g)
     g = g - (bs(:, 1) + bs(:, 2) - contact_line%g0)
+    ! the feasible set: l >= 0 on the normal rows, with friction a box on the tangential
+    ! ones (Coulomb: the box of the final normal forces, i.e. the bound is the one of the
+    ! fixed point reached)
+    allocate (lo(m), hi(m))
+    call row_bounds(contact_line, res%lam, lo, hi)
     if (sum(bodies(:)%nrig) > 0) then
-      ! floating bodies: the feasible set is {l >= 0, G l = e}, and the bound holds with the
+      ! floating bodies: the feasible set is {lo <= l <= hi, G l = e}, and the bound holds with the
       ! projection on it (the proof only uses the projection's variational inequality and
       ! the strong convexity of the objective on R^m); the projection's own inaccuracy is added
-      call project_feasible(bodies, m, res%lam - g/lmax, y, perr)
+      call project_feasible(bodies, m, res%lam - g/lmax, lo, hi, y, perr)
       r = res%lam - y
     else
-      r = res%lam - max(0.0_wp, res%lam - g/lmax)
+      r = res%lam - min(max(lo, res%lam - g/lmax), hi)
       perr = 0.0_wp
     end if
     nl = norm2(res%lam)
@@ -192,17 +197,18 @@ contains
     end if
   end subroutine hessian_solve
 
-  !> z = the Euclidean projection of y on {l >= 0, G l = e} (G, e: the floating bodies'
-  !! equilibrium rows, stacked): z = max(0, y - G'nu) with nu the minimiser of the convex,
-  !! piecewise quadratic phi(nu) = 1/2 |max(0, y - G'nu)|^2 + e'nu (r unknowns), by Newton steps on
-  !! the current positive set (Hessian G_P G_P', a small ridge when it is singular) with a
+  !> z = the Euclidean projection of y on {lo <= l <= hi, G l = e} (G, e: the floating bodies'
+  !! equilibrium rows, stacked): z = P(y - G'nu), P the clipping to [lo, hi], with nu the
+  !! minimiser of the convex, piecewise quadratic phi(nu) = 1/2 |P(y - G'nu)|^2 + e'nu (r
+  !! unknowns; lo = 0 makes |P(v)|^2 the usual form), by Newton steps on the current free set (Hessian G_P G_P', a small ridge when it is singular) with a
   !! backtracking line search on phi: exact once the positive set is right, whatever the
   !! conditioning of G on it. perr bounds |z - exact projection| by the equilibrium left,
   !! |G z - e| / sqrt(lambda_min(G_P G_P')).
-  subroutine project_feasible(bodies, m_rows, y, z, perr)
+  subroutine project_feasible(bodies, m_rows, y, lo, hi, z, perr)
     type(body_condensed_t), intent(in) :: bodies(:)
     integer, intent(in) :: m_rows                   !< contact rows of all pairs
     real(wp), intent(in) :: y(:)
+    real(wp), intent(in) :: lo(:), hi(:)            !< the bounds of the forces (row_bounds)
     real(wp), allocatable, intent(out) :: z(:)
     real(wp), intent(out) :: perr
     real(wp), allocatable :: gs(:, :), es(:), nu(:), f(:), h(:, :), d(:), nt(:), cval(:, :), ev(:), work(:)
@@ -254,7 +260,7 @@ contains
     end do
     f = gz(z) - es
     lmin = 0.0_wp
-    if (any(z > 0.0_wp)) then
+    if (any(z > lo .and. z < hi)) then
       call gram(z, h)
       allocate (ev(r), work(max(64, 3*r)))
       call dsyev('N', 'U', r, h, r, ev, work, size(work), info)
@@ -265,13 +271,13 @@ contains
 
   contains
 
-    !> max(0, y - G' v).
+    !> P(y - G' v).
     function project(v) result(zz)
       real(wp), intent(in) :: v(:)
       real(wp) :: zz(m)
       integer :: kk
       do kk = 1, m
-        zz(kk) = max(y(kk) - dot_product(cval(1:ncol(kk), kk), v(crow(1:ncol(kk), kk))), 0.0_wp)
+        zz(kk) = min(max(y(kk) - dot_product(cval(1:ncol(kk), kk), v(crow(1:ncol(kk), kk))), lo(kk)), hi(kk))
       end do
     end function project
 
@@ -287,14 +293,14 @@ contains
       end do
     end function gz
 
-    !> G_P G_P', P the columns where x > 0.
+    !> G_P G_P', P the columns where lo < x < hi.
     subroutine gram(x, hh)
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: hh(:, :)
       integer :: kk, a, b
       hh = 0.0_wp
       do kk = 1, m
-        if (.not. x(kk) > 0.0_wp) cycle
+        if (.not. (x(kk) > lo(kk) .and. x(kk) < hi(kk))) cycle
         do b = 1, ncol(kk)
           do a = 1, ncol(kk)
             hh(crow(a, kk), crow(b, kk)) = hh(crow(a, kk), crow(b, kk)) + cval(a, kk)*cval(b, kk)

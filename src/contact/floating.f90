@@ -3,11 +3,16 @@
 !! contact forces: G_a lam = e_a), and the checks that the contact can hold it: every
 !! free rigid motion has a contact normal component (else the body slides or turns
 !! freely: bad input), the load can be balanced by compressive forces lam >= 0 (else it
-!! pulls the body away: bad input), and two floating bodies are not free as a pair.
+!! pulls the body away: bad input), and two floating bodies are not free as a pair. With
+!! friction the tangential forces take their share within the friction cone (Coulomb:
+!! |lam_t| <= mu lam_n, written as the two generators lam_n (1, +-mu)) or unbounded by the
+!! normal force (Tresca), so a body held by friction alone passes, and one pushed beyond
+!! mu times its normal load does not (it would slide: no static equilibrium).
 module floating
   use kinds, only: wp
   use assembly, only: body_system_t, rigid_motion_name
-  use contact_interface, only: interface_t, body_slots, slot_row, slot_side
+  use contact_interface, only: interface_t, body_slots, slot_row, slot_side, has_friction, ROW_TANGENT
+  use config, only: FRICTION_COULOMB
   use condense, only: body_condensed_t
   use contact_common, only: scatter
   use lapack, only: dsyev, dgels, dsygv
@@ -77,9 +82,9 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(out) :: err
     character(len=:), allocatable :: msg
-    real(wp), allocatable :: gg(:, :), lam(:), ev(:)
+    real(wp), allocatable :: gg(:, :), lam(:), ev(:), gc(:, :)
     real(wp) :: c(3), fx, fy, along, res, enorm
-    integer :: a, r, m, lapinfo
+    integer :: a, r, m, lapinfo, i
     character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
       'a ''roller'', or ux/uy on a group (&boundary)'
 
@@ -121,9 +126,29 @@ contains
         return
       end if
       ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
-      allocate (lam(m))
-      call nnls(bodies(a)%rg, bodies(a)%re, lam, res)
-      if (res > 1.0e-8_wp*enorm) then
+      if (has_friction(contact_line)) then
+        gc = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), bodies(a)%rg)
+      else
+        gc = bodies(a)%rg
+      end if
+      allocate (lam(size(gc, 2)))
+      call nnls(gc, bodies(a)%re, lam, res)
+      if (res > 1.0e-8_wp*enorm .and. has_friction(contact_line)) then
+        ! the direction it would slide in: the load's part along the contact (its
+        ! resultant less its part along the mean normal of the body's contact rows)
+        c = 0.0_wp
+        do i = 1, m
+          if (contact_line%kind(slot_row(bodies(a)%slots(i), contact_line%m)) /= ROW_TANGENT) &
+            c(1:2) = c(1:2) + contact_line%normal(:, slot_row(bodies(a)%slots(i), contact_line%m))
+        end do
+        c(1:2) = [fx, fy] - dot_product([fx, fy], c(1:2))/max(sum(c(1:2)**2), tiny(1.0_wp))*c(1:2)
+        c(1:2) = c(1:2)/max(norm2(c(1:2)), tiny(1.0_wp))
+        call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), and its load '// &
+              '(resultant ('//r2s(fx)//', '//r2s(fy)//')) cannot be balanced by contact forces within the friction '// &
+              'limits (|t| <= mu p, or the Tresca bound): it would slide along ('//r2s(c(1))//', '//r2s(c(2))// &
+              '); no static equilibrium (unbalanced part '//r2s(res)//'): raise mu, lower the tangential load, or '//hold)
+        return
+      else if (res > 1.0e-8_wp*enorm) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but its load '// &
               '(resultant ('//r2s(fx)//', '//r2s(fy)//')) pulls it away from the contact: no compressive '// &
               'contact force balances it (an unbalanced part '//r2s(res)//' remains); reverse the load '// &
@@ -144,7 +169,7 @@ contains
     type(body_system_t), intent(in) :: systems(:)
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(inout) :: err
-    integer, allocatable :: root(:), members(:), col(:)
+    integer, allocatable :: root(:), members(:), col(:), rowof(:)
     real(wp), allocatable :: gs(:, :), es(:), gg(:, :), sr(:, :), ev(:), lam(:)
     real(wp) :: c(3), res
     integer :: a, g, r, nm, ncol, k, i, i0
@@ -206,7 +231,15 @@ contains
         end if
         return
       end if
-      allocate (lam(ncol))
+      if (has_friction(contact_line)) then
+        allocate (rowof(ncol))
+        do i0 = 1, contact_line%m
+          if (col(i0) > 0) rowof(col(i0)) = i0
+        end do
+        gs = cone_columns(contact_line, rowof, gs)
+        deallocate (rowof)
+      end if
+      allocate (lam(size(gs, 2)))
       call nnls(gs, es, lam, res)
       if (res > 1.0e-8_wp*norm2(es)) then
         call err%set(ERR_INPUT, 'bodies '//names//' are '//merge('both', 'all ', nm == 2)// &
@@ -304,6 +337,11 @@ contains
       rows(r + 1, :) = ha/max(maxval(abs(ha)), tiny(1.0_wp))
       target = 0.0_wp
       target(r + 1) = -1.0_wp
+      if (has_friction(contact_line)) then
+        rows = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), rows)
+        deallocate (lam)
+        allocate (lam(size(rows, 2)))
+      end if
       call nnls(rows, target, lam, res)
       if (.not. res <= 1.0e-8_wp) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
@@ -317,6 +355,46 @@ contains
     end do
 
   end subroutine check_pressed
+
+  !> The columns of g (column i on contact row rows(i)) as generators of the admissible
+  !! contact forces, for a non-negative least squares: a normal row without friction keeps
+  !! its column (lam_n >= 0); a Coulomb pair's normal row i with its tangential row j gives
+  !! g_i + mu g_j and g_i - mu g_j (lam_n (1, +-mu): exactly the cone |lam_t| <= mu lam_n);
+  !! a Tresca pair keeps the normal column and gives +g_j and -g_j (the tangential force
+  !! free of the normal one: its bound does not depend on it).
+  function cone_columns(contact_line, rows, g) result(gc)
+    type(interface_t), intent(in) :: contact_line
+    integer, intent(in) :: rows(:)
+    real(wp), intent(in) :: g(:, :)
+    real(wp), allocatable :: gc(:, :)
+    integer, allocatable :: tcol(:)
+    integer :: i, n, k, p
+    allocate (tcol(contact_line%m))
+    tcol = 0
+    do i = 1, size(rows)
+      if (contact_line%kind(rows(i)) == ROW_TANGENT) tcol(contact_line%nrow(rows(i))) = i
+    end do
+    allocate (gc(size(g, 1), 2*size(rows)))
+    n = 0
+    do i = 1, size(rows)
+      k = rows(i)
+      p = contact_line%pair_of(k)
+      if (contact_line%kind(k) == ROW_TANGENT) then
+        if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
+        gc(:, n + 1) = g(:, i)
+        gc(:, n + 2) = -g(:, i)
+        n = n + 2
+      else if (tcol(k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
+        gc(:, n + 1) = g(:, i) + contact_line%pair_mu(p)*g(:, tcol(k))
+        gc(:, n + 2) = g(:, i) - contact_line%pair_mu(p)*g(:, tcol(k))
+        n = n + 2
+      else
+        gc(:, n + 1) = g(:, i)
+        n = n + 1
+      end if
+    end do
+    gc = gc(:, 1:n)
+  end function cone_columns
 
   !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of
   !! each motion's reach on the contact is normal to it. S singular (a motion that does not

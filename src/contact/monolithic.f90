@@ -2,7 +2,9 @@
 !! min 1/2 lam'(sum_a E_a' F_a E_a) lam - lam'(sum_a E_a' b_a - g0), lam >= 0, by MPRGP
 !! (SMALBE-M with the floating bodies' equilibrium rows); E_a picks body a's rows. Two
 !! bodies in one pair: the dense F_1 + F_2; more pairs: the sum assembled sparse (pairs
-!! couple only through a shared body). Every converged Robin run must match it.
+!! couple only through a shared body). Every converged Robin run must match it. With
+!! friction the tangential rows' forces lie in boxes (Tresca); Coulomb's boxes follow the
+!! normal forces, by repeated box solves until the normal forces settle.
 module monolithic
   use kinds, only: wp
   use config, only: solver_cfg_t
@@ -14,7 +16,8 @@ module monolithic
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
   use sorting, only: sort_ints
-  use contact_interface, only: interface_t, slot_row, slot_side
+  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, ROW_TANGENT
+  use config, only: FRICTION_COULOMB
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
@@ -32,6 +35,8 @@ module monolithic
     procedure :: apply => penalized_apply
   end type penalized_op_t
 
+  integer, parameter :: COULOMB_MAX_FIXED = 500   !< box solves of the monolithic Coulomb fixed point
+
   public :: solve_monolithic, assemble_hessian
 
 contains
@@ -48,9 +53,11 @@ contains
     type(mprgp_stats_t) :: inner
     type(smalbe_stats_t) :: outer
     type(equality_t) :: equality
-    real(wp), allocatable :: c(:), lb(:), lam(:), rows(:, :), rhs(:), mu(:), bs(:, :), wa(:), lfac(:, :)
-    integer :: m, a, r, nrig, info
-    real(wp) :: t0, lmax
+    real(wp), allocatable :: c(:), lb(:), ub(:), lam(:), rows(:, :), rhs(:), mu(:), bs(:, :), wa(:), lfac(:, :), ub_new(:)
+    integer :: m, a, r, nrig, info, fixed, nfix, nmv
+    real(wp) :: t0, lmax, change
+    logical :: friction
+    logical, allocatable :: tangent(:)
 
     m = contact_line%m
     t0 = wtime()
@@ -110,15 +117,32 @@ contains
       allocate (mu(equality%r))
       mu = 0.0_wp
     end if
+    ! friction: the boxes of the tangential rows; Coulomb repeats the box solve with the
+    ! boxes of the last normal forces (warm-started) until they change by less than
+    ! monolithic_rtol relative, at most COULOMB_MAX_FIXED times
+    friction = has_friction(contact_line)
+    nfix = 1
+    if (friction) then
+      allocate (ub(m), ub_new(m))
+      call row_bounds(contact_line, lam, lb, ub, start=.true.)
+      tangent = contact_line%kind == ROW_TANGENT
+      if (any(contact_line%pair_friction == FRICTION_COULOMB)) nfix = COULOMB_MAX_FIXED
+    end if
+    nmv = 0
+    do fixed = 1, nfix
     if (m > 0) then
       if (equality%r > 0) then
         inner_solver%opts%eq_m = equality%m0
         inner_solver%opts%eq_feas = equality%feas
         inner_solver%opts%eq_feas_x = equality%feas_x
-        call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
+        if (friction) then
+          call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer, ub=ub)
+        else
+          call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
+        end if
         inner = outer%inner
         inner%n_matvec = outer%n_matvec
-        res%eq_updates = outer%updates
+        res%eq_updates = res%eq_updates + outer%updates
         ! multipliers of the orthonormalized rows L^-1 G back to those of G: mu = L^-T mu~
         if (allocated(lfac)) call dtrsv('L', 'T', 'N', size(mu), lfac, size(mu), mu, 1)
         r = 0
@@ -128,10 +152,15 @@ contains
           r = r + bodies(a)%nrig
         end do
       else
-        call inner_solver%solve(hessian, c, lb, lam)
+        if (friction) then
+          call inner_solver%solve(hessian, c, lb, lam, ub=ub)
+        else
+          call inner_solver%solve(hessian, c, lb, lam)
+        end if
         inner = inner_solver%stats
       end if
-      res%inner = inner%n_matvec
+      nmv = nmv + inner%n_matvec
+      res%inner = nmv
       if (inner%status == MPRGP_STOPPED) then
         res%status = STATUS_INTERRUPTED
         res%message = 'monolithic MPRGP stopped by a signal after '//trim(itoa(inner%n_cg + inner%n_exp + inner%n_prop))// &
@@ -145,7 +174,19 @@ contains
     else
       res%status = STATUS_CONVERGED
     end if
-    res%outer = 1
+    if (nfix == 1 .or. res%status /= STATUS_CONVERGED) exit
+    call row_bounds(contact_line, lam, lb, ub_new)
+    change = norm2(pack(ub_new - ub, tangent))/max(norm2(pack(ub_new, tangent)), tiny(1.0_wp))
+    if (change <= solver%monolithic_rtol) exit
+    if (fixed == nfix) then
+      res%status = STATUS_MAX_OUTER
+      write (res%message, '(a,i0,a,es10.3)') 'monolithic Coulomb: the slip bounds still changed after ', nfix, &
+        ' box solves, by ', change
+      exit
+    end if
+    call row_bounds(contact_line, lam, lb, ub)
+    end do
+    res%outer = min(fixed, nfix)
     res%lam = lam
     res%lam_body(:, 1) = lam
     res%lam_body(:, 2) = lam

@@ -9,7 +9,7 @@ module robin_iteration
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use config, only: solver_cfg_t, STOP_RESIDUAL
   use clock, only: wtime
-  use contact_interface, only: interface_t
+  use contact_interface, only: interface_t, has_friction, row_bounds
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
@@ -125,6 +125,13 @@ contains
       ! is what is left, so each such iteration solves them ten times tighter, down to rounding
       if (run_state%stalled > 0) rtol_in = max(sqrt(real(m, wp))*epsilon(1.0_wp), &
                                                rtol_in*0.1_wp**min(run_state%stalled, 12))
+      ! friction: the bounds of the tangential forces (Coulomb: mu times the mean normal
+      ! force of the last iterate, the same box for both sides of a row)
+      if (has_friction(contact_line)) then
+        if (.not. allocated(subproblems%lb)) allocate (subproblems%lb(m), subproblems%ub(m))
+        call row_bounds(contact_line, 0.5_wp*(run_state%lam(:, 1) + run_state%lam(:, 2)), subproblems%lb, subproblems%ub, &
+                        start=all(run_state%lam == 0.0_wp))
+      end if
       call solve_subproblems(subproblems, solver, bodies, rtol_in, it, run_state, w, res)
       if (m == 0) then
         res%status = STATUS_CONVERGED

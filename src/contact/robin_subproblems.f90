@@ -33,6 +33,9 @@ module robin_subproblems
     real(wp), allocatable :: lmax_body(:)             !< bounds of lambda_max(F_a) [length/force]
     real(wp), allocatable :: lmax_hessian(:)          !< bounds of lambda_max of the Hessians [length/force]
     integer, allocatable :: order(:)                  !< the bodies, largest first (the threads' order)
+    !> with friction: the bounds of the forces on every row (row_bounds), set by the outer
+    !! loop (Coulomb: from the last iterate); not allocated: l >= 0 on every row
+    real(wp), allocatable :: lb(:), ub(:)
   end type subproblems_t
 
   !> A vector per body.
@@ -189,14 +192,20 @@ contains
     integer, intent(out) :: updates               !< SMALBE multiplier updates
     type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
-    real(wp), allocatable :: lb(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
+    real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
     integer :: m, k, ka, r, mm
+    logical :: moved
     m = size(rhs)
     mm = size(state%G, 1)
     updates = 0
     if (m == 0) return
-    allocate (lb(m))
-    lb = 0.0_wp
+    if (allocated(subproblems%lb)) then
+      lb = subproblems%lb(slot_row(body%slots, mm))
+      ub = subproblems%ub(slot_row(body%slots, mm))
+    else
+      allocate (lb(m))
+      lb = 0.0_wp
+    end if
     rhs = body%b - gather(state%G, body%slots)
     if (subproblems%proximal(a)%n > 0) then
       ! a singular body is pinned to its partners' last forces
@@ -222,10 +231,20 @@ contains
     lam0 = gather(state%lam, body%slots)
     lam = lam0
     flam0 = inner_solver%ax
+    ! Coulomb: the box moved with the normal forces; a warm start outside it is projected
+    ! and its product is no longer known
+    moved = .false.
+    if (allocated(ub)) then
+      moved = any(lam < lb .or. lam > ub)
+      if (moved) then
+        lam = min(max(lam, lb), ub)
+        inner_solver%opts%use_ax = .false.
+      end if
+    end if
     ! Krylov recycling, not with Aitken or Anderson acceleration, whose updates difference
     ! past iterates and so amplify the (smaller but differently placed) inner errors
     inner_solver%opts%recycle = solver%acceleration == ACCEL_NONE
-    if (search) then
+    if (search .and. .not. moved) then
       inner_solver%s = gather(state%srch, body%slots)
       inner_solver%as = gather(state%fsrch, body%slots)
     end if
@@ -244,14 +263,23 @@ contains
         inner_solver%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
         inner_solver%opts%eq_feas_x = merge(max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)* &
                                             sqrt(eq%gg), 0.0_wp, all(eq%e == 0.0_wp))
-        call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, lam, state%mu(1:r, a), &
-                          smalbe_stats, rw, raw, state%nrw(:, a))
+        if (allocated(ub)) then
+          call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, lam, state%mu(1:r, a), &
+                            smalbe_stats, rw, raw, state%nrw(:, a), ub=ub)
+        else
+          call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, lam, state%mu(1:r, a), &
+                            smalbe_stats, rw, raw, state%nrw(:, a))
+        end if
       end associate
       inner = smalbe_stats%inner
       inner%n_matvec = smalbe_stats%n_matvec
       updates = smalbe_stats%updates
     else
-      call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a))
+      if (allocated(ub)) then
+        call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a), ub=ub)
+      else
+        call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a))
+      end if
       inner = inner_solver%stats
     end if
     grad = inner_solver%g
