@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar contact_interface condense condense_mumps contact_types contact_common floating equality_rows \
+        ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar contact_interface condense condense_mumps contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
@@ -171,11 +171,12 @@ $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/cholesky.o $(BUILD)/cloc
                            $(BUILD)/mesh.o $(BUILD)/ordering.o
 $(BUILD)/condense_mumps.o: $(BUILD)/assembly.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/contact_interface.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mumps_iface.o
-$(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/contact_common.o \
+$(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact_common.o: $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
+$(BUILD)/friction_view.o:  $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
 $(BUILD)/equality_rows.o:  $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/linop.o
 # the Robin operators implement one interface: not every operator needs every argument
@@ -204,8 +205,8 @@ $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/files.o:
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
-                           $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/h5io.o \
-                           $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
+                           $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/friction_view.o \
+                           $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o
 # the driver's modules (src/driver): the run's data, its two back-ends, its phases
@@ -224,7 +225,8 @@ $(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/conden
                            $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_summary.o:    $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
-                           $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
+                           $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o \
+                           $(BUILD)/sysinfo.o
 $(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/clock.o \
                            $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
                            $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/files.o \

@@ -5,7 +5,9 @@ module run_summary
   use, intrinsic :: iso_fortran_env, only: error_unit
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED
   use config, only: solver_cfg_t, ROBIN_HARMONIC
-  use contact_interface, only: contact_resultant
+  use contact_interface, only: interface_t
+  use contact_types, only: contact_result_t
+  use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   use sysinfo, only: write_stdout_checked
   use strings, only: sci, fmt_real, i2s
@@ -91,34 +93,46 @@ contains
     character(len=1024), allocatable :: lines(:)
     real(wp) :: ftot, fres(2), imbalance
     integer :: p, np, r(2), active
-    character(len=:), allocatable :: head
+    character(len=:), allocatable :: head, tail
+    type(interface_t) :: itf
+    type(contact_result_t) :: result
+    type(tangential_t) :: tg
     np = max(1, run%contact_line%npair)
     allocate (lines(np))
-    associate (result => run%result, itf => run%contact_line)
-      do p = 1, np
-        ftot = 0.0_wp
-        fres = 0.0_wp
-        active = result%active
-        imbalance = result%imbalance
-        head = 'contact: resultant_on_body1='
-        if (allocated(result%lam) .and. itf%npair > 0) then
-          r = [itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1]
-          ftot = sum(result%lam(r(1):r(2)))
-          fres = contact_resultant(itf, 1, result%lam, r(1), r(2))
-          if (itf%npair > 1) then
-            active = count(result%lam(r(1):r(2)) > 0.0_wp)
-            imbalance = 0.0_wp
-            if (norm2(result%lam(r(1):r(2))) > 0.0_wp) imbalance = norm2(result%lam_body(r(1):r(2), 1) - &
-                                                     result%lam_body(r(1):r(2), 2))/norm2(result%lam(r(1):r(2)))
-            head = 'contact: pair='//i2s(p)//' bodies='//i2s(itf%pair_body(1, p))//','//i2s(itf%pair_body(2, p))// &
-                   ' resultant_on_body'//i2s(itf%pair_body(1, p))//'='
-          end if
+    ! one entry per contact node: the normal rows, the tangential part beside them
+    if (allocated(run%contact_line%kind)) then
+      call split_friction(run%contact_line, run%result, itf, result, tg)
+    else
+      result = run%result
+    end if
+    do p = 1, np
+      ftot = 0.0_wp
+      fres = 0.0_wp
+      active = result%active
+      imbalance = result%imbalance
+      head = 'contact: resultant_on_body1='
+      tail = ''
+      if (allocated(result%lam) .and. itf%npair > 0) then
+        r = [itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1]
+        ftot = sum(result%lam(r(1):r(2)))
+        fres = tg%resultant(:, p)
+        if (itf%npair > 1) then
+          active = count(result%lam(r(1):r(2)) > 0.0_wp)
+          imbalance = 0.0_wp
+          if (norm2(result%lam(r(1):r(2))) > 0.0_wp) imbalance = norm2(result%lam_body(r(1):r(2), 1) - &
+                                                   result%lam_body(r(1):r(2), 2))/norm2(result%lam(r(1):r(2)))
+          head = 'contact: pair='//i2s(p)//' bodies='//i2s(itf%pair_body(1, p))//','//i2s(itf%pair_body(2, p))// &
+                 ' resultant_on_body'//i2s(itf%pair_body(1, p))//'='
         end if
-        write (lines(p), '(a,i0,a,es10.3,a,es10.3,a,es10.3)') head// &
-          sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', active, &
-          ' imbalance=', imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity
-      end do
-    end associate
+        if (tg%on) then
+          if (any(tg%state(r(1):r(2)) >= 0)) tail = ' tangential_force_sum='//sci(sum(tg%force(r(1):r(2))), 5)// &
+            ' stick='//i2s(count(tg%state(r(1):r(2)) == NODE_STICK))//' slip='//i2s(count(tg%state(r(1):r(2)) == NODE_SLIP))
+        end if
+      end if
+      write (lines(p), '(a,i0,a,es10.3,a,es10.3,a,es10.3,a)') head// &
+        sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', active, &
+        ' imbalance=', imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity, tail
+    end do
   end function pair_lines
 
   !> What a user whose Robin run did not converge should try next, in order: the robust

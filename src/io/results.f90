@@ -16,12 +16,13 @@ module results
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files
-  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES
+  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE
   use strings, only: word, body_label, i2s
   use mesh, only: mesh_t
   use assembly, only: body_system_t, stress_field_t
-  use contact_interface, only: interface_t, contact_resultant, pair_rows
+  use contact_interface, only: interface_t, pair_rows
   use contact_types, only: contact_result_t, status_name
+  use friction_view, only: tangential_t, split_friction
   use floating, only: free_list
   use errors, only: error_t, ERR_IO
   implicit none (type, external)
@@ -51,13 +52,13 @@ contains
   !! last) only when all are complete. Otherwise err (ERR_IO, naming the file and what
   !! failed); then the files of an earlier result at these names are as they were, and no
   !! temporary file is left.
-  subroutine write_results(file, d, msh, sys, itf, res, u, stress, tm, err)
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, stress, tm, err)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
     type(body_system_t), intent(in) :: sys(:)          !< systems (DOF maps)
-    type(interface_t), intent(in) :: itf               !< contact rows of all pairs
-    type(contact_result_t), intent(in) :: res          !< contact solution
+    type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs
+    type(contact_result_t), intent(in) :: res_all      !< contact solution
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, bodies) full displacements
     type(stress_field_t), intent(in) :: stress(:)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
@@ -68,7 +69,13 @@ contains
     type(error_t) :: st
     integer :: k, a, nb, np, nf
     logical :: ok
+    type(interface_t) :: itf
+    type(contact_result_t) :: res
+    type(tangential_t) :: tg
 
+    ! the file shows one entry per contact node: the normal rows, with friction the
+    ! tangential part of each node beside them
+    call split_friction(itf_all, res_all, itf, res, tg)
     nb = size(msh)
     np = itf%npair
     call ensure_parent_dir(file)
@@ -78,7 +85,7 @@ contains
     do k = 1, nf
       tmp(k) = temp_name(name(k))
     end do
-    call write_h5(tmp(1), d, msh, sys, itf, res, u, stress, tm, run_id(), st)
+    call write_h5(tmp(1), d, msh, sys, itf, res, tg, u, stress, tm, run_id(), st)
     if (st%failed()) then
       call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%text()//')')
       call remove_temps()
@@ -144,13 +151,14 @@ contains
   end subroutine result_files
 
   !> The HDF5 result file `path`, whole; st records the first failure.
-  subroutine write_h5(path, d, msh, sys, itf, res, u, stress, tm, run_id, st)
+  subroutine write_h5(path, d, msh, sys, itf, res, tg, u, stress, tm, run_id, st)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
     type(body_system_t), intent(in) :: sys(:)
     type(interface_t), intent(in) :: itf
     type(contact_result_t), intent(in) :: res
+    type(tangential_t), intent(in) :: tg               !< the tangential part (friction), per node
     real(wp), intent(in) :: u(:, :)
     type(stress_field_t), intent(in) :: stress(:)
     type(timing_t), intent(in) :: tm
@@ -227,7 +235,7 @@ contains
     call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
     call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
     ! the contact forces' resultant on body 1 (x, y): what balances its load
-    call write_dset(gid, 'resultant_body1', contact_resultant(itf, 1, res%lam, 1, itf%m), st, uf)
+    call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
     allocate (pres(itf%m))
     where (itf%trib > 0.0_wp)
       pres = res%lam/itf%trib
@@ -244,8 +252,13 @@ contains
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
     call write_dset(gid, 'segments', line_cells(itf, 1, itf%npair), st, '1')
+    if (tg%on) call write_tangential(gid, tg, 1, itf%m, ul, us, uf, st)
     do k = 1, itf%npair
-      call write_pair(gid, k, itf, res, pres, ul, us, uf, st)
+      call write_pair(gid, k, itf, res, pres, tg%resultant(:, k), ul, us, uf, st)
+      if (tg%on) then
+        if (itf%pair_friction(k) /= FRICTION_NONE) call write_tangential(gid, tg, itf%pair_ptr(k), itf%pair_ptr(k + 1) - 1, ul, us, &
+                                                             uf, st, 'pair_'//i2s(k))
+      end if
     end do
     call group_close(gid, st)
     call write_history(fid, res, st)
@@ -306,12 +319,13 @@ contains
   !> The group pair_<q> of the contact group gid: pair q's rows alone (segments 0-based
   !! within the pair), the ids of its bodies (side 1, side 2), its slave body, and the
   !! resultant of its contact forces on its first body (side 1).
-  subroutine write_pair(gid, q, itf, res, pres, ul, us, uf, st)
+  subroutine write_pair(gid, q, itf, res, pres, resultant, ul, us, uf, st)
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
     type(contact_result_t), intent(in) :: res
     real(wp), intent(in), contiguous :: pres(:)  !< (m) pressure of each row [stress]
+    real(wp), intent(in) :: resultant(2)         !< of all the pair's contact forces on its first body [force]
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     type(error_t), intent(inout) :: st
     integer(hid_t) :: pid
@@ -335,7 +349,7 @@ contains
     call write_dset(pid, 'normal_force', res%lam(i:j), st, uf)
     call write_dset(pid, 'normal_force_side1', res%lam_body(i:j, 1), st, uf)
     call write_dset(pid, 'normal_force_side2', res%lam_body(i:j, 2), st, uf)
-    call write_dset(pid, 'resultant_on_first_body', contact_resultant(itf, 1, res%lam, i, j), st, uf)
+    call write_dset(pid, 'resultant_on_first_body', resultant, st, uf)
     call write_dset(pid, 'pressure', pres(i:j), st, us)
     call write_dset(pid, 'gap', res%gap(i:j), st, ul)
     call write_dset(pid, 'active', merge(1, 0, res%lam(i:j) > 0.0_wp), st, '1')
@@ -345,6 +359,30 @@ contains
     call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
     call group_close(pid, st)
   end subroutine write_pair
+
+  !> The tangential part of the nodes i..j (friction) in the group gid (or its subgroup
+  !! `sub`): tangential_force, shear, tangential_bound (the bound of |tangential_force|), slip,
+  !! slip_increment (the slip of the last load step) and state (0 open, 1 stick, 2 slip,
+  !! -1 a node of a frictionless pair; the names in the attribute state_names).
+  subroutine write_tangential(gid, tg, i, j, ul, us, uf, st, sub)
+    integer(hid_t), intent(in) :: gid
+    type(tangential_t), intent(in) :: tg
+    integer, intent(in) :: i, j
+    character(len=*), intent(in) :: ul, us, uf
+    type(error_t), intent(inout) :: st
+    character(len=*), intent(in), optional :: sub
+    integer(hid_t) :: pid
+    pid = gid
+    if (present(sub)) call group_open(gid, sub, pid, st)
+    call write_dset(pid, 'tangential_force', tg%force(i:j), st, uf)
+    call write_dset(pid, 'shear', tg%shear(i:j), st, us)
+    call write_dset(pid, 'tangential_bound', tg%bound(i:j), st, uf)
+    call write_dset(pid, 'slip', tg%slip(i:j), st, ul)
+    call write_dset(pid, 'slip_increment', tg%slip_increment(i:j), st, ul)
+    call write_dset(pid, 'state', tg%state(i:j), st, '1')
+    call write_attr(pid, 'state_names', 'none=-1 open=0 stick=1 slip=2', st)
+    if (present(sub)) call group_close(pid, st)
+  end subroutine write_tangential
 
   !> The contact pressure as a nodal field of body a (0 off its contact lines): where it is
   !! a pair's slave the rows' pressures; on the master the mean of the pressures of the rows that reach a
