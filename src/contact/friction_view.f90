@@ -15,8 +15,9 @@ module friction_view
   integer, parameter, public :: NODE_NONE = -1   !< a node of a frictionless pair
   character(len=5), parameter, public :: node_state_names(-1:2) = ['none ', 'open ', 'stick', 'slip ']
 
-  !> A relative margin below the bound that still counts as at the bound (slip): the
-  !! inner solvers stop at a tolerance, a projected bound is exact.
+  !> A relative margin below the bound that still counts as at the bound (slip), at least:
+  !! a projected bound is exact, but the Robin iterate's two sides agree only to its
+  !! residual, so the margin is the larger of this and 100 x the residual.
   real(wp), parameter :: AT_BOUND = 1.0e-9_wp
 
   !> The tangential part of a solution, one entry per normal row of the view.
@@ -51,6 +52,7 @@ contains
     integer, allocatable :: keep(:), tan(:)
     real(wp), allocatable :: lb(:), ub(:)
     integer :: k, p, s, n, e, q, mn
+    real(wp) :: margin
     keep = pack([(k, k=1, itf%m)], itf%kind == ROW_NORMAL)
     mn = size(keep)
     itf_n%m = mn
@@ -128,6 +130,7 @@ contains
     if (.not. allocated(res%lam)) return
     allocate (lb(itf%m), ub(itf%m))
     call row_bounds(itf, res%lam, lb, ub)
+    margin = max(AT_BOUND, 100.0_wp*res%residual)
     do k = 1, mn
       q = tan(keep(k))
       if (q == 0) cycle
@@ -136,7 +139,7 @@ contains
       tg%bound(k) = ub(q)
       tg%slip(k) = res%w(q, 1) + res%w(q, 2)
       tg%slip_increment(k) = res%gap(q)
-      if (abs(res%lam(q)) >= (1.0_wp - AT_BOUND)*ub(q) .and. ub(q) > 0.0_wp) then
+      if (abs(res%lam(q)) >= (1.0_wp - margin)*ub(q) .and. ub(q) > 0.0_wp) then
         tg%state(k) = NODE_SLIP
       else if (res%lam(keep(k)) > 0.0_wp) then
         tg%state(k) = NODE_STICK
