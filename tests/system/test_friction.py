@@ -25,9 +25,12 @@ doc/verification.md, "Friction").
     monolithic to 1e-6 (harmonic; steklov without Anderson, which stagnates on the frictional
     stack), the a posteriori bound above the measured error;
     one and two threads bitwise equal.
+(7) MPI: the frictional stack under mpirun -np 1, 2, 4 (factorization='mumps') = the serial run
+    to 1e-10 (skipped without bin/robin_contact_mpi or mpirun).
 """
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -237,6 +240,33 @@ def scenes(tmp):
                       f"{what} ({op}): one and two threads bitwise equal")
 
 
+def mpi(tmp):
+    mpi_bin = os.path.abspath(os.environ.get("MPI_BIN", os.path.join(ROOT, "bin/robin_contact_mpi")))
+    if not (os.path.exists(mpi_bin) and shutil.which("mpirun")):
+        print(f"SKIP  {mpi_bin} or mpirun absent: no MPI check")
+        return
+    stack = os.path.join(ROOT, "inputs/stack3.nml")
+    over = ["&contact bodies=1,2, friction='coulomb', mu=0.3 /", "&contact bodies=2,3, friction='coulomb', mu=0.3 /"]
+    serial = Run(tmp, "mpi_serial", stack, *over)
+    if not converged(serial, "frictional stack, serial"):
+        return
+    env = solver_env(threads=1)
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_mpi_yield_when_idle="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    for np_ in (1, 2, 4):
+        out = os.path.join(tmp, f"mpi_np{np_}.h5")
+        p = subprocess.run(["mpirun", "--oversubscribe", "-np", str(np_), mpi_bin, stack, *over,
+                            "&solver factorization='mumps' /", f"&output file='{out}' /"],
+                           capture_output=True, text=True, env=env, timeout=600)
+        what = f"frictional stack, mpirun -np {np_}"
+        if not check(p.returncode == 0 and os.path.exists(out), f"{what}: exit 0", p.stderr.strip()[-300:]):
+            continue
+        with h5py.File(out, "r") as f:
+            e = max(float(np.max(np.abs(np.array(f["contact"][k]) - serial.c[k])) / np.max(np.abs(serial.c[k])))
+                    for k in ("normal_force", "tangential_force"))
+        check(e <= 1e-10, f"{what}: = serial (1e-10)", f"{e:.2e}")
+
+
 def main():
     with tempfile.TemporaryDirectory(prefix="rc_friction_") as tmp:
         patch_stick(tmp)
@@ -245,6 +275,7 @@ def main():
         threshold(tmp)
         bad_input(tmp)
         scenes(tmp)
+        mpi(tmp)
     print(f"{len(check.failed)} failed")
     return 1 if check.failed else 0
 
