@@ -613,14 +613,17 @@ contains
   end function expansion_step
 
   !> Exact line search along -beta (the chopped gradient), which releases variables from
-  !! their bounds. False on a breakdown.
+  !! their bounds, cut where a released variable reaches its opposite bound (in a box).
+  !! False on a breakdown.
   logical function proportioning_step(self, A, lb, ub, x, betabeta) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
     real(wp), intent(in) :: lb(:), ub(:), betabeta
     real(wp), intent(inout) :: x(:)
-    real(wp) :: pap, pp, acg
-    integer :: i, n
+    real(wp), parameter :: big = huge(1.0_wp)
+    real(wp) :: pap, pp, acg, slack
+    integer :: i, n, blk
+    logical :: blk_up
     n = self%n
     associate (p => self%p, ap => self%ap, gr => self%g)
       do i = 1, n
@@ -641,10 +644,39 @@ contains
       ok = check_curvature(self, pap, pp, 'proportioning direction')
       if (.not. ok) return
       acg = betabeta / pap
+      ! A variable released from l may reach u first (and one from u reach l): the step is
+      ! cut there, so that the recurrence gradient stays that of x. With lower bounds only,
+      ! p <= 0 and no upper bound is finite: no step is cut.
+      blk = 0
+      blk_up = .false.
+      do i = 1, n
+        if (p(i) < 0.0_wp .and. ub(i) < big) then
+          slack = ub(i) - x(i)
+          if (slack < -acg * p(i)) then
+            acg = slack / (-p(i))
+            blk = i
+            blk_up = .true.
+          end if
+        else if (p(i) > 0.0_wp .and. lb(i) > -big) then
+          slack = x(i) - lb(i)
+          if (slack < acg * p(i)) then
+            acg = slack / p(i)
+            blk = i
+            blk_up = .false.
+          end if
+        end if
+      end do
       do i = 1, n
         x(i) = min(max(x(i) - acg * p(i), lb(i)), ub(i))
         gr(i) = gr(i) - acg * ap(i)
       end do
+      if (blk > 0) then
+        if (blk_up) then
+          x(blk) = ub(blk)
+        else
+          x(blk) = lb(blk)
+        end if
+      end if
     end associate
     call set_p_to_phi(self, lb, ub, x)
     self%stats%n_prop = self%stats%n_prop + 1

@@ -22,12 +22,15 @@ program test_mprgp_box
 
   real(wp), parameter :: big = huge(1.0_wp)
   real(wp), parameter :: eps = epsilon(1.0_wp)
+  integer :: calls = 0      ! polls of the stop hook
+  integer :: stop_at = 0    ! the hook stops the solve at this poll
 
   call set_seed(20261125)
   call test_diagonal()
   call test_enumeration()
   call test_upper_only()
   call test_fixed()
+  call test_recurrence()
   call test_line_search()
   call test_recycled_subspace()
   call test_warm_direction()
@@ -382,6 +385,54 @@ contains
     call report(ok .and. st%status == MPRGP_CONVERGED .and. all(x(1:nfix) == l(1:nfix)) .and. err <= 1.0e-10_wp, &
                 'fixed: l = u variables exactly at their value, the rest against the enumeration', err, 1.0e-10_wp)
   end subroutine test_fixed
+
+  logical function stop_now()
+    calls = calls + 1
+    stop_now = calls >= stop_at
+  end function stop_now
+
+  !> The gradient carried by the recurrences stays A x - b in a box: a solve stopped after
+  !! k = 1, 2, ... steps returns the recurrence gradient, compared with A x - b here. First a
+  !! proportioning step that releases x1 from l and would carry it past u (cut at u), then
+  !! random narrow boxes started from l.
+  subroutine test_recurrence()
+    integer, parameter :: n = 30
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), lmin, lmax, err, worst
+    real(wp) :: a2(2, 2), x2(2)
+    type(dense_op_t) :: op
+    type(mprgp_t) :: solver
+    integer :: i, k, nbad
+    a2 = reshape([1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [2, 2])
+    call dense_op_init(op, a2)
+    solver%opts%stop => stop_now
+    calls = 0
+    stop_at = 2
+    x2 = 0.0_wp
+    call solver%solve(op, [10.0_wp, 0.5_wp], [0.0_wp, 0.0_wp], x2, ub=[1.0_wp, 1.0_wp])
+    err = maxval(abs(solver%g - (x2 - [10.0_wp, 0.5_wp])))
+    call report(solver%stats%n_prop == 1 .and. x2(1) == 1.0_wp .and. abs(x2(2) - 0.05_wp) <= 4.0_wp * eps .and. &
+                err <= 16.0_wp * eps, 'proportioning step cut at u: x = (1, 0.05), g = A x - b', err, 16.0_wp * eps)
+    call random_spd(n, 2.0_wp, a, lmin, lmax)
+    call dense_op_init(op, a)
+    do i = 1, n
+      b(i) = urand(-1.0_wp, 1.0_wp)
+      l(i) = urand(-0.02_wp, 0.0_wp)
+      u(i) = l(i) + urand(0.0_wp, 0.02_wp)
+    end do
+    worst = 0.0_wp
+    nbad = 0
+    do k = 1, 40
+      calls = 0
+      stop_at = k + 1
+      x = l
+      call solver%solve(op, b, l, x, ub=u)
+      if (any(x < l) .or. any(x > u)) nbad = nbad + 1
+      err = maxval(abs(solver%g - (matmul(a, x) - b))) / (lmax * maxval(abs(x)) + maxval(abs(b)))
+      worst = max(worst, err)
+    end do
+    call report(nbad == 0 .and. worst <= 1.0e-13_wp, 'recurrence gradient = A x - b after 1..40 box steps', &
+                worst, 1.0e-13_wp)
+  end subroutine test_recurrence
 
   !> The exact line search of mprgp_support cut at an upper bound (A = I).
   subroutine test_line_search()
