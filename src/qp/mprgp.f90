@@ -21,8 +21,8 @@
 !! step along p is tried; if it stays feasible it is taken (CG step), otherwise the
 !! feasible part of it (cut at either bound) is taken and followed by the projected step
 !! P(x - alpha_bar phi) - x, after which CG restarts (expansion step). A non-proportional
-!! x gets an exact line search along -beta (proportioning step), projected onto the box,
-!! which releases variables from their bounds.
+!! x gets an exact line search along -beta (proportioning step), which releases variables
+!! from their bounds; in a box it is cut where a released variable reaches its other bound.
 !!
 !! A lower bound -huge(1.0_wp) or an upper bound +huge(1.0_wp) means "no bound"; the upper
 !! bounds are optional (absent: none). All other bounds must be finite, and l <= u. The

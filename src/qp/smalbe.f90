@@ -8,17 +8,19 @@
 !!
 !!     L(x, mu, rho) = 1/2 x'Hx - c'x + mu'(Gx - e) + rho/2 |Gx - e|^2
 !!
-!! is minimised over the box l <= x <= u by MPRGP with the Hessian A = H + rho G'G (the caller passes
-!! A: its products are the only ones, and since A does not change from one solve to the
-!! next MPRGP's stored directions stay valid) and the linear term c - G'mu + rho G'e, to
-!! a projected gradient below min(M |Gx - e|, eta); then mu <- mu + rho (Gx - e), and
-!! M <- beta M when L did not grow by at least rho/2 |Gx - e|^2. It stops when the
-!! projected gradient is below eta and |Gx - e| below feas. The upper bounds are optional
-!! (absent or +huge(1.0_wp): none) and passed through to MPRGP unchanged.
+!! is minimised over the box l <= x <= u by MPRGP with the Hessian A = H + rho G'G (the
+!! caller passes A: its products are the only ones, and since A does not change from one
+!! solve to the next MPRGP's stored directions stay valid) and the linear term
+!! c - G'mu + rho G'e, to a projected gradient below min(M |Gx - e|, eta); then
+!! mu <- mu + rho (Gx - e), and M <- beta M when L did not grow by at least
+!! rho/2 |Gx - e|^2. It stops when the projected gradient is below eta and |Gx - e| below
+!! feas. The upper bounds are optional (absent or +huge(1.0_wp): none) and passed through
+!! to MPRGP unchanged.
 !!
 !! On return g = Hx - c + G'mu (the gradient of the Lagrangian at the final multipliers,
 !! which is MPRGP's last gradient), so for contact `G_a - g` is still B_a u_a with the
-!! rigid part of u_a = R_a alpha_a, alpha_a = -mu_a.
+!! rigid part of u_a = R_a alpha_a, alpha_a = -mu_a. At the solution g holds the bound
+!! multipliers: g_i >= 0 where x_i = l_i, g_i <= 0 where x_i = u_i, g_i = 0 in between.
 module smalbe
   use kinds, only: wp
   use linop, only: linop_t
