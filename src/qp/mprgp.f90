@@ -1,26 +1,33 @@
 !> MPRGP: modified proportioning with reduced gradient projection, for the
 !! bound-constrained convex quadratic program
 !!
-!!     minimise 1/2 x'Ax - b'x   subject to   x >= l
+!!     minimise 1/2 x'Ax - b'x   subject to   l <= x <= u
 !!
 !! with A symmetric positive definite, given as a `class(linop_t)` (dense, sparse or
 !! implicit). Z. Dostal and J. Schoberl, "Minimizing quadratic functions subject to
 !! bound constraints with the rate of convergence and finite termination",
-!! Comput. Optim. Appl. 30 (2005) 23-43.
+!! Comput. Optim. Appl. 30 (2005) 23-43; for the box, Z. Dostal, "Optimal Quadratic
+!! Programming Algorithms", Springer 2009, ch. 5.
 !!
-!! Notation (g = Ax - b, free set F = {i : x_i > l_i}, active set its complement):
+!! Notation (g = Ax - b, projection P(x) = min(max(x, l), u), free set
+!! F = {i : l_i < x_i < u_i}, active set its complement):
 !!   free gradient        phi_i  = g_i on F, 0 else
-!!   chopped gradient     beta_i = min(g_i, 0) off F, 0 else
+!!   chopped gradient     beta_i = min(g_i, 0) at x_i = l_i, max(g_i, 0) at x_i = u_i,
+!!                                 0 on F and where l_i = u_i (a fixed variable)
 !!   projected gradient   gP     = phi + beta            (stopping criterion)
-!!   reduced free grad.   phit_i = min((x_i - l_i)/alpha_bar, phi_i) on F, 0 else
+!!   reduced free grad.   phit_i = min((x_i - l_i)/alpha_bar, phi_i) on F where phi_i > 0,
+!!                                 max((x_i - u_i)/alpha_bar, phi_i) on F where phi_i < 0
 !! x is *proportional* when |beta|^2 <= Gamma^2 phit'phi. Then a conjugate gradient
 !! step along p is tried; if it stays feasible it is taken (CG step), otherwise the
-!! feasible part of it is taken and followed by a projected step of length alpha_bar
-!! along the free gradient, after which CG restarts (expansion step). A
-!! non-proportional x gets an exact line search along -beta (proportioning step),
-!! which releases variables from their bounds.
+!! feasible part of it (cut at either bound) is taken and followed by the projected step
+!! P(x - alpha_bar phi) - x, after which CG restarts (expansion step). A non-proportional
+!! x gets an exact line search along -beta (proportioning step), which releases variables
+!! from their bounds; in a box it is cut where a released variable reaches its other bound.
 !!
-!! Bounds equal to -huge(1.0_wp) mean "no bound". All other bounds must be finite.
+!! A lower bound -huge(1.0_wp) or an upper bound +huge(1.0_wp) means "no bound"; the upper
+!! bounds are optional (absent: none). All other bounds must be finite, and l <= u. The
+!! upper-bound branches are never taken when u = +huge, so a solve without upper bounds
+!! executes the same floating-point operations, iterate for iterate, with or without ub.
 !!
 !! Thread safety: no module variables, no SAVE, work arrays are local to each call.
 !! Two threads may solve concurrently with two different operators.
@@ -32,11 +39,11 @@ module mprgp
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
   use mprgp_support, only: lambda_max_estimate, power_iteration, projected_gradient_norm, line_search, &
-                           recycled_subspace, store_direction
+                           recycled_subspace, store_direction, chopped
   implicit none (type, external)
   private
 
-  public :: lambda_max_estimate, mprgp_status_name
+  public :: lambda_max_estimate, mprgp_status_name, chopped
   public :: mprgp_t, mprgp_opts_t, mprgp_stats_t
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
 
@@ -77,7 +84,7 @@ module mprgp
 
 contains
 
-  !> Solve min 1/2 x'Ax - b'x subject to x >= lb by MPRGP.
+  !> Solve min 1/2 x'Ax - b'x subject to lb <= x <= ub by MPRGP (without ub: x >= lb).
   !!
   !! x is a warm start on entry (projected onto the bounds first) and the solution
   !! on exit (the last iterate on failure); self%g holds A x - b and self%ax A x there.
@@ -105,18 +112,18 @@ contains
   !! skipped; on exit it holds A x at the returned x (the confirming product, so the next
   !! solve, warm-started from x, starts from it). With a direction self%s and self%as = A s
   !! (e.g. the change of x in the previous solve and of A x), the iteration starts with an
-  !! exact line search along s, cut at the bounds, which costs no product; the solve
+  !! exact line search along s, cut at both bounds, which costs no product; the solve
   !! consumes s and as.
   !! Krylov recycling: with rw, raw, nrw (a ring of A-normalised directions and their
   !! images, filled by every conjugate gradient step of the solves that share it) and
   !! opts%recycle, the iteration starts from the minimum over x plus the span of s and of
-  !! the stored directions that vanish where x is at its bound (A-orthogonalised; a
+  !! the stored directions that vanish where x is at a bound (A-orthogonalised; a
   !! direction with less than 1% of its A-norm left is dropped, so the recurrence gradient
   !! stays accurate), taken only if the whole step is feasible and leaves a proportional
   !! iterate with a smaller projected gradient: again no product.
   !! A warm start whose projected gradient (from opts%use_ax) already meets the tolerance
   !! is returned without a search or a product.
-  subroutine mprgp_solve(self, A, b, lb, x, rw, raw, nrw)
+  subroutine mprgp_solve(self, A, b, lb, x, rw, raw, nrw, ub)
     class(mprgp_t), intent(inout) :: self           !< the solver (options in, outcome out)
     class(linop_t), intent(inout) :: A              !< SPD operator (size A%n)
     real(wp), intent(in) :: b(:)                    !< linear term (size n)
@@ -125,11 +132,13 @@ contains
     real(wp), intent(inout), optional :: rw(:, :)   !< (n, k) stored directions, A-normalised (needs raw, nrw)
     real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
     integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
+    real(wp), intent(in), optional :: ub(:)         !< upper bounds (size n, >= lb); +huge(1.0_wp): none
+    real(wp), allocatable :: u(:)
     real(wp) :: betabeta, phitphi
     logical :: ok
 
     self%stats = mprgp_stats_t()
-    if (.not. valid_arguments(self, A%n, b, lb, x, rw, raw, nrw)) then
+    if (.not. valid_arguments(self, A%n, b, lb, x, rw, raw, nrw, ub)) then
       call consume_search(self)
       return
     end if
@@ -140,19 +149,24 @@ contains
       call consume_search(self)
       return
     end if
-    call start(self, A, b, lb, x, rw, raw, nrw)
+    if (present(ub)) then
+      u = ub
+    else
+      allocate (u(self%n), source=huge(1.0_wp))
+    end if
+    call start(self, A, b, lb, u, x, rw, raw, nrw)
     main: do
-      select case (stopping_test(self, A, b, lb, x, betabeta, phitphi))
+      select case (stopping_test(self, A, b, lb, u, x, betabeta, phitphi))
       case (DONE)
         exit main
       case (RETEST)
         cycle main
       end select
       self%it = self%it + 1
-      if (proportional(self, A, lb, x, betabeta, phitphi, ok)) then
-        if (ok) ok = cg_or_expansion_step(self, A, lb, x, rw, raw, nrw)
+      if (proportional(self, A, lb, u, x, betabeta, phitphi, ok)) then
+        if (ok) ok = cg_or_expansion_step(self, A, lb, u, x, rw, raw, nrw)
       else if (ok) then
-        ok = proportioning_step(self, A, lb, x, betabeta)
+        ok = proportioning_step(self, A, lb, u, x, betabeta)
       end if
       if (.not. ok) exit main
     end do main
@@ -161,7 +175,7 @@ contains
     ! Report the true gradient (and |gP| from it) unless the iteration broke down.
     if (.not. self%fresh .and. (self%stats%status == MPRGP_MAX_IT .or. self%stats%status == MPRGP_NOT_SPD)) then
       call true_gradient(self, A, b, x)
-      self%stats%gp_norm = proj_grad_norm(self, lb, x)
+      self%stats%gp_norm = proj_grad_norm(self, lb, u, x)
     end if
     if (.not. self%fresh) self%ax = self%g + b
     call consume_search(self)
@@ -176,12 +190,13 @@ contains
 
   !> Check sizes, options and finiteness before any work; sets self%n, allocates the
   !! solver's vectors. False (with the status and message) when the solve cannot start.
-  logical function valid_arguments(self, n, b, lb, x, rw, raw, nrw) result(ok)
+  logical function valid_arguments(self, n, b, lb, x, rw, raw, nrw, ub) result(ok)
     type(mprgp_t), intent(inout) :: self
     integer, intent(in) :: n
     real(wp), intent(in) :: b(:), lb(:), x(:)
     real(wp), intent(in), optional :: rw(:, :), raw(:, :)
     integer, intent(in), optional :: nrw(2)
+    real(wp), intent(in), optional :: ub(:)
     integer :: i
     ok = .false.
     self%n = n
@@ -198,6 +213,13 @@ contains
         ', size(b) = ', size(b), ', size(lb) = ', size(lb), ', size(x) = ', size(x)
       self%stats%status = MPRGP_BAD_ARG
       return
+    end if
+    if (present(ub)) then
+      if (size(ub) /= n) then
+        write (self%stats%message, '(a,i0,a,i0)') 'size mismatch: A%n = ', n, ', size(ub) = ', size(ub)
+        self%stats%status = MPRGP_BAD_ARG
+        return
+      end if
     end if
     if (self%opts%use_ax) then
       if (.not. allocated(self%ax)) then
@@ -256,6 +278,16 @@ contains
         call fail(self, MPRGP_NONFINITE, 'initial x('//trim(itoa(i))//') is not finite')
         return
       end if
+      if (present(ub)) then
+        if (.not. ieee_is_finite(ub(i))) then
+          call fail(self, MPRGP_NONFINITE, 'ub('//trim(itoa(i))//') is not finite (use huge(1.0_wp) for no bound)')
+          return
+        end if
+        if (ub(i) < lb(i)) then
+          call fail(self, MPRGP_BAD_ARG, 'ub('//trim(itoa(i))//') < lb('//trim(itoa(i))//'): the box is empty')
+          return
+        end if
+      end if
     end do
     if (allocated(self%ax)) then
       if (size(self%ax) /= n) deallocate (self%ax)
@@ -275,10 +307,10 @@ contains
 
   !> Project the warm start, take its gradient (from ax with opts%use_ax), and unless it
   !! already meets the tolerance, the recycled subspace step or the first line search.
-  subroutine start(self, A, b, lb, x, rw, raw, nrw)
+  subroutine start(self, A, b, lb, ub, x, rw, raw, nrw)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: b(:), lb(:)
+    real(wp), intent(in) :: b(:), lb(:), ub(:)
     real(wp), intent(inout) :: x(:)
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
     integer, intent(inout), optional :: nrw(2)
@@ -295,7 +327,7 @@ contains
     self%ab = 0.0_wp
     self%lam_lo = 0.0_wp
     if (self%opts%lambda_max > 0.0_wp) self%lam_lo = self%opts%lambda_max
-    x = max(x, lb)
+    x = min(max(x, lb), ub)
     self%xscale0 = norm2(x)
     if (self%opts%use_ax) then
       self%g = self%ax - b
@@ -307,37 +339,36 @@ contains
     end if
     self%fresh = .true.
     ! a warm start that already meets the tolerance is returned as it is (no product)
-    if (self%zero_tol .or. proj_grad_norm(self, lb, x) > self%tol) then
+    if (self%zero_tol .or. proj_grad_norm(self, lb, ub, x) > self%tol) then
       if (present(rw) .and. self%opts%recycle) then
         if (allocated(self%s)) then
-          moved = recycled_subspace(x, self%g, lb, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
+          moved = recycled_subspace(x, self%g, lb, ub, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
                                     self%p, self%ap, self%s, self%as)
         else
-          moved = recycled_subspace(x, self%g, lb, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
+          moved = recycled_subspace(x, self%g, lb, ub, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
                                     self%p, self%ap)
         end if
       else if (allocated(self%s)) then
-        moved = line_search(x, self%g, lb, self%s, self%as, .false., self%opts%gamma, self%p, self%ap)
+        moved = line_search(x, self%g, lb, ub, self%s, self%as, .false., self%opts%gamma, self%p, self%ap)
       end if
       if (moved) then
         self%stats%n_recycled = self%stats%n_recycled + 1
         self%fresh = .false.
       end if
     end if
-    call set_p_to_phi(self, lb, x)
+    call set_p_to_phi(self, lb, ub, x)
     self%it = 0
   end subroutine start
 
   !> Split the gradient, test convergence (confirmed on the true gradient), max_it and the
   !! stop hook. DONE: the solve ends; RETEST: the true gradient was taken, test again;
   !! GO_ON: take a step (betabeta = |chopped gradient|^2, phitphi = phit'phi).
-  integer function stopping_test(self, A, b, lb, x, betabeta, phitphi) result(action)
+  integer function stopping_test(self, A, b, lb, ub, x, betabeta, phitphi) result(action)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: b(:), lb(:), x(:)
+    real(wp), intent(in) :: b(:), lb(:), ub(:), x(:)
     real(wp), intent(out) :: betabeta, phitphi
-    real(wp), parameter :: big = huge(1.0_wp)
-    real(wp) :: phiphi, gp2, phi, phit, beta, slack, tol_now, feas, floor_eq
+    real(wp) :: phiphi, gp2, phi, beta, tol_now, feas, floor_eq
     character(len=24) :: s1, s2
     integer :: i, n
     n = self%n
@@ -347,17 +378,12 @@ contains
     phitphi = 0.0_wp
     betabeta = 0.0_wp
     do i = 1, n
-      if (x(i) > lb(i)) then
+      if (x(i) > lb(i) .and. x(i) < ub(i)) then
         phi = self%g(i)
         phiphi = phiphi + phi * phi
-        phit = phi
-        if (self%ab > 0.0_wp .and. lb(i) > -big) then
-          slack = x(i) - lb(i)
-          if (slack < self%ab * phi) phit = slack / self%ab
-        end if
-        phitphi = phitphi + phit * phi
+        phitphi = phitphi + reduced_free(self%ab, phi, x(i), lb(i), ub(i)) * phi
       else
-        beta = min(self%g(i), 0.0_wp)
+        beta = chopped(self%g(i), x(i), lb(i), ub(i))
         betabeta = betabeta + beta * beta
       end if
     end do
@@ -395,7 +421,7 @@ contains
         return
       end if
       call true_gradient(self, A, b, x)
-      call set_p_to_phi(self, lb, x)
+      call set_p_to_phi(self, lb, ub, x)
       action = RETEST
       return
     end if
@@ -419,14 +445,13 @@ contains
 
   !> The proportionality test |beta|^2 <= Gamma^2 phit'phi (alpha_bar is needed only when
   !! some bound is active). ok = .false. when alpha_bar could not be had.
-  logical function proportional(self, A, lb, x, betabeta, phitphi, ok) result(prop)
+  logical function proportional(self, A, lb, ub, x, betabeta, phitphi, ok) result(prop)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:), x(:), betabeta
+    real(wp), intent(in) :: lb(:), ub(:), x(:), betabeta
     real(wp), intent(inout) :: phitphi       !< phit'phi (recomputed once alpha_bar is known)
     logical, intent(out) :: ok
-    real(wp), parameter :: big = huge(1.0_wp)
-    real(wp) :: phi, phit, slack
+    real(wp) :: phi
     integer :: i
     prop = .false.
     ok = .true.
@@ -435,14 +460,9 @@ contains
       if (.not. ok) return
       phitphi = 0.0_wp
       do i = 1, self%n
-        if (x(i) > lb(i)) then
+        if (x(i) > lb(i) .and. x(i) < ub(i)) then
           phi = self%g(i)
-          phit = phi
-          if (lb(i) > -big) then
-            slack = x(i) - lb(i)
-            if (slack < self%ab * phi) phit = slack / self%ab
-          end if
-          phitphi = phitphi + phit * phi
+          phitphi = phitphi + reduced_free(self%ab, phi, x(i), lb(i), ub(i)) * phi
         end if
       end do
     end if
@@ -451,16 +471,17 @@ contains
 
   !> Trial conjugate gradient step along -p: taken when it stays feasible (CG step),
   !! otherwise its feasible part followed by an expansion step. False on a breakdown.
-  logical function cg_or_expansion_step(self, A, lb, x, rw, raw, nrw) result(ok)
+  logical function cg_or_expansion_step(self, A, lb, ub, x, rw, raw, nrw) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:)
+    real(wp), intent(in) :: lb(:), ub(:)
     real(wp), intent(inout) :: x(:)
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
     integer, intent(inout), optional :: nrw(2)
     real(wp), parameter :: big = huge(1.0_wp)
     real(wp) :: pap, pp, gtp, acg, af, num, gam, slack
     integer :: i, n, blk
+    logical :: blk_up
     n = self%n
     associate (p => self%p, ap => self%ap, gr => self%g)
       call A%apply(p, ap)
@@ -477,15 +498,25 @@ contains
       if (.not. ok) return
       if (present(rw)) call store_direction(p, ap, rw, raw, nrw)
       acg = gtp / pap
-      ! Largest feasible step along -p, capped at acg (no division can overflow).
+      ! Largest feasible step along -p, capped at acg (no division can overflow); blk is
+      ! the variable that blocks it, blk_up whether at its upper bound.
       af = acg
       blk = 0
+      blk_up = .false.
       do i = 1, n
         if (p(i) > 0.0_wp .and. lb(i) > -big) then
           slack = x(i) - lb(i)
           if (slack < af * p(i)) then
             af = slack / p(i)
             blk = i
+            blk_up = .false.
+          end if
+        else if (p(i) < 0.0_wp .and. ub(i) < big) then
+          slack = ub(i) - x(i)
+          if (slack < -af * p(i)) then
+            af = slack / (-p(i))
+            blk = i
+            blk_up = .true.
           end if
         end if
       end do
@@ -493,13 +524,13 @@ contains
         ! CG step.
         num = 0.0_wp
         do i = 1, n
-          x(i) = max(x(i) - acg * p(i), lb(i))
+          x(i) = min(max(x(i) - acg * p(i), lb(i)), ub(i))
           gr(i) = gr(i) - acg * ap(i)
-          if (x(i) > lb(i)) num = num + gr(i) * ap(i)
+          if (x(i) > lb(i) .and. x(i) < ub(i)) num = num + gr(i) * ap(i)
         end do
         gam = num / pap
         do i = 1, n
-          if (x(i) > lb(i)) then
+          if (x(i) > lb(i) .and. x(i) < ub(i)) then
             p(i) = gr(i) - gam * p(i)
           else
             p(i) = -gam * p(i)
@@ -512,21 +543,26 @@ contains
       ! the feasible half step
       af = max(af, 0.0_wp)
       do i = 1, n
-        x(i) = max(x(i) - af * p(i), lb(i))
+        x(i) = min(max(x(i) - af * p(i), lb(i)), ub(i))
         gr(i) = gr(i) - af * ap(i)
       end do
-      x(blk) = lb(blk)
+      if (blk_up) then
+        x(blk) = ub(blk)
+      else
+        x(blk) = lb(blk)
+      end if
     end associate
-    ok = expansion_step(self, A, lb, x)
+    ok = expansion_step(self, A, lb, ub, x)
   end function cg_or_expansion_step
 
   !> Projected step of length alpha_bar along the free gradient, recomputed with a cut
   !! alpha_bar while it increases the cost (the guard above); then CG restarts.
-  logical function expansion_step(self, A, lb, x) result(ok)
+  logical function expansion_step(self, A, lb, ub, x) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:)
+    real(wp), intent(in) :: lb(:), ub(:)
     real(wp), intent(inout) :: x(:)
+    real(wp), parameter :: big = huge(1.0_wp)
     real(wp) :: dd, dad, df, ab_prev
     integer :: i, n, retry
     n = self%n
@@ -538,8 +574,9 @@ contains
         ! Candidate step d = P(x - ab*phi) - x = -ab*phit, stored in p (reset afterwards).
         dd = 0.0_wp
         do i = 1, n
-          if (x(i) > lb(i)) then
+          if (x(i) > lb(i) .and. x(i) < ub(i)) then
             p(i) = max(lb(i) - x(i), -self%ab * gr(i))
+            if (ub(i) < big) p(i) = min(p(i), ub(i) - x(i))
           else
             p(i) = 0.0_wp
           end if
@@ -564,33 +601,36 @@ contains
           cycle expand
         end if
         do i = 1, n
-          x(i) = max(x(i) + p(i), lb(i))
+          x(i) = min(max(x(i) + p(i), lb(i)), ub(i))
           gr(i) = gr(i) + ap(i)
         end do
         exit expand
       end do expand
     end associate
-    call set_p_to_phi(self, lb, x)
+    call set_p_to_phi(self, lb, ub, x)
     self%stats%n_exp = self%stats%n_exp + 1
     self%fresh = .false.
   end function expansion_step
 
   !> Exact line search along -beta (the chopped gradient), which releases variables from
-  !! their bounds. False on a breakdown.
-  logical function proportioning_step(self, A, lb, x, betabeta) result(ok)
+  !! their bounds, cut where a released variable reaches its opposite bound (in a box).
+  !! False on a breakdown.
+  logical function proportioning_step(self, A, lb, ub, x, betabeta) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:), betabeta
+    real(wp), intent(in) :: lb(:), ub(:), betabeta
     real(wp), intent(inout) :: x(:)
-    real(wp) :: pap, pp, acg
-    integer :: i, n
+    real(wp), parameter :: big = huge(1.0_wp)
+    real(wp) :: pap, pp, acg, slack
+    integer :: i, n, blk
+    logical :: blk_up
     n = self%n
     associate (p => self%p, ap => self%ap, gr => self%g)
       do i = 1, n
-        if (x(i) > lb(i)) then
+        if (x(i) > lb(i) .and. x(i) < ub(i)) then
           p(i) = 0.0_wp
         else
-          p(i) = min(gr(i), 0.0_wp)
+          p(i) = chopped(gr(i), x(i), lb(i), ub(i))
         end if
       end do
       call A%apply(p, ap)
@@ -604,12 +644,41 @@ contains
       ok = check_curvature(self, pap, pp, 'proportioning direction')
       if (.not. ok) return
       acg = betabeta / pap
+      ! A variable released from l may reach u first (and one from u reach l): the step is
+      ! cut there, so that the recurrence gradient stays that of x. With lower bounds only,
+      ! p <= 0 and no upper bound is finite: no step is cut.
+      blk = 0
+      blk_up = .false.
       do i = 1, n
-        x(i) = max(x(i) - acg * p(i), lb(i))
+        if (p(i) < 0.0_wp .and. ub(i) < big) then
+          slack = ub(i) - x(i)
+          if (slack < -acg * p(i)) then
+            acg = slack / (-p(i))
+            blk = i
+            blk_up = .true.
+          end if
+        else if (p(i) > 0.0_wp .and. lb(i) > -big) then
+          slack = x(i) - lb(i)
+          if (slack < acg * p(i)) then
+            acg = slack / p(i)
+            blk = i
+            blk_up = .false.
+          end if
+        end if
+      end do
+      do i = 1, n
+        x(i) = min(max(x(i) - acg * p(i), lb(i)), ub(i))
         gr(i) = gr(i) - acg * ap(i)
       end do
+      if (blk > 0) then
+        if (blk_up) then
+          x(blk) = ub(blk)
+        else
+          x(blk) = lb(blk)
+        end if
+      end if
     end associate
-    call set_p_to_phi(self, lb, x)
+    call set_p_to_phi(self, lb, ub, x)
     self%stats%n_prop = self%stats%n_prop + 1
     self%fresh = .false.
   end function proportioning_step
@@ -624,12 +693,12 @@ contains
   end subroutine fail
 
   !> p = phi(x).
-  subroutine set_p_to_phi(self, lb, x)
+  subroutine set_p_to_phi(self, lb, ub, x)
     type(mprgp_t), intent(inout) :: self
-    real(wp), intent(in) :: lb(:), x(:)
+    real(wp), intent(in) :: lb(:), ub(:), x(:)
     integer :: j
     do j = 1, self%n
-      if (x(j) > lb(j)) then
+      if (x(j) > lb(j) .and. x(j) < ub(j)) then
         self%p(j) = self%g(j)
       else
         self%p(j) = 0.0_wp
@@ -638,11 +707,29 @@ contains
   end subroutine set_p_to_phi
 
   !> |gP| for the current x and g.
-  real(wp) function proj_grad_norm(self, lb, x) result(r)
+  real(wp) function proj_grad_norm(self, lb, ub, x) result(r)
     type(mprgp_t), intent(in) :: self
-    real(wp), intent(in) :: lb(:), x(:)
-    r = projected_gradient_norm(self%g, x, lb)
+    real(wp), intent(in) :: lb(:), ub(:), x(:)
+    r = projected_gradient_norm(self%g, x, lb, ub)
   end function proj_grad_norm
+
+  !> phit_i of a free variable: phi cut to (x - lb)/ab when phi > 0 and to (x - ub)/ab when
+  !! phi < 0, so that x - ab phit stays in the box; phi itself while ab is not known (0).
+  pure real(wp) function reduced_free(ab, phi, x, lb, ub) result(phit)
+    real(wp), intent(in) :: ab, phi, x, lb, ub
+    real(wp), parameter :: big = huge(1.0_wp)
+    real(wp) :: slack
+    phit = phi
+    if (ab <= 0.0_wp) return
+    if (lb > -big) then
+      slack = x - lb
+      if (slack < ab * phi) phit = slack / ab
+    end if
+    if (ub < big) then
+      slack = ub - x
+      if (slack < -ab * phi) phit = -slack / ab
+    end if
+  end function reduced_free
 
   !> g = A x - b computed directly.
   subroutine true_gradient(self, A, b, x)

@@ -14,7 +14,7 @@ module mprgp_options
   integer, parameter :: MPRGP_MAX_IT = 1     !< max_it steps done without convergence
   integer, parameter :: MPRGP_NONFINITE = 2  !< NaN/Inf in the input or during the iteration
   integer, parameter :: MPRGP_NOT_SPD = 3    !< a direction with p'Ap <= 0 was met (A not SPD)
-  integer, parameter :: MPRGP_BAD_ARG = 4    !< inconsistent sizes or invalid options
+  integer, parameter :: MPRGP_BAD_ARG = 4    !< inconsistent sizes, invalid options or an empty box (ub < lb)
   integer, parameter :: MPRGP_STOPPED = 5    !< opts%stop turned true (a signal): x is the current iterate
 
   abstract interface

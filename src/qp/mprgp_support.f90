@@ -2,7 +2,11 @@
 !! lambda_max, the norm of the projected gradient, and the steps that cost no product with
 !! A because the images of their directions are known: an exact line search, and the
 !! Galerkin step over a ring of stored A-normalised directions (Krylov recycling) with the
-!! ring's upkeep. Bounds equal to -huge(1.0_wp) mean "no bound".
+!! ring's upkeep. Box bounds lb <= x <= ub: a lower bound -huge(1.0_wp) or an upper bound
+!! +huge(1.0_wp) means "no bound"; x_i is free when lb_i < x_i < ub_i, at its lower bound
+!! when x_i <= lb_i < ub_i, at its upper bound when x_i >= ub_i > lb_i, and fixed when
+!! lb_i = ub_i. The upper-bound branches are never taken when ub = +huge, so a lower-bound
+!! problem executes the same floating-point operations as without ub.
 module mprgp_support
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
@@ -11,7 +15,7 @@ module mprgp_support
   private
 
   public :: lambda_max_estimate, power_iteration, projected_gradient_norm, line_search, recycled_subspace, &
-            store_direction
+            store_direction, chopped
 
 contains
 
@@ -69,19 +73,31 @@ contains
   end subroutine power_iteration
 
 
-  !> |gP|: the norm of g on the free variables (x > lb) and of min(g, 0) on the bound ones.
-  real(wp) function projected_gradient_norm(g, x, lb) result(r)
+  !> The chopped gradient of one variable off the free set: min(g, 0) at its lower bound,
+  !! max(g, 0) at its upper bound, 0 when it is fixed (lb = ub); g itself when it is free.
+  elemental real(wp) function chopped(g, x, lb, ub) result(beta)
+    real(wp), intent(in) :: g, x, lb, ub  !< gradient, iterate, bounds
+    if (x > lb .and. x < ub) then
+      beta = g
+    else if (x < ub) then
+      beta = min(g, 0.0_wp)
+    else if (x > lb) then
+      beta = max(g, 0.0_wp)
+    else
+      beta = 0.0_wp
+    end if
+  end function chopped
+
+  !> |gP|: the norm of g on the free variables and of the chopped gradient on the others.
+  real(wp) function projected_gradient_norm(g, x, lb, ub) result(r)
     real(wp), intent(in) :: g(:)    !< gradient
     real(wp), intent(in) :: x(:)    !< iterate
     real(wp), intent(in) :: lb(:)   !< lower bounds
+    real(wp), intent(in) :: ub(:)   !< upper bounds
     integer :: j
     r = 0.0_wp
     do j = 1, size(x)
-      if (x(j) > lb(j)) then
-        r = r + g(j)**2
-      else
-        r = r + min(g(j), 0.0_wp)**2
-      end if
+      r = r + chopped(g(j), x(j), lb(j), ub(j))**2
     end do
     r = sqrt(r)
   end function projected_gradient_norm
@@ -91,10 +107,11 @@ contains
   !! a smaller projected gradient and a proportional iterate (|chopped|^2 <= Gamma^2
   !! |free|^2): otherwise MPRGP would first release bounds and redo what the step did
   !! (delta = 1 cycles). True when x moved.
-  logical function line_search(x, g, lb, d, ad, whole, gamma, p, ap) result(moved)
+  logical function line_search(x, g, lb, ub, d, ad, whole, gamma, p, ap) result(moved)
     real(wp), intent(inout) :: x(:)      !< iterate
     real(wp), intent(inout) :: g(:)      !< A x - b
     real(wp), intent(in) :: lb(:)        !< lower bounds
+    real(wp), intent(in) :: ub(:)        !< upper bounds
     real(wp), intent(in) :: d(:), ad(:)  !< direction and A d
     logical, intent(in) :: whole         !< the whole step or none
     real(wp), intent(in) :: gamma        !< proportioning constant Gamma
@@ -115,22 +132,27 @@ contains
           if (whole) return
           t = t * max(0.0_wp, (x(j) - lb(j)) / (-vj))
         end if
+      else if (vj > 0.0_wp .and. ub(j) < big) then
+        if (x(j) + vj > ub(j)) then
+          if (whole) return
+          t = t * max(0.0_wp, (ub(j) - x(j)) / vj)
+        end if
       end if
     end do
     if (t == 0.0_wp) return
     if (whole) then
-      gp_before = projected_gradient_norm(g, x, lb)
+      gp_before = projected_gradient_norm(g, x, lb, ub)
       do j = 1, n
-        p(j) = max(x(j) + t * d(j), lb(j))
+        p(j) = min(max(x(j) + t * d(j), lb(j)), ub(j))
         ap(j) = g(j) + t * ad(j)
       end do
       gp_after = 0.0_wp
       bb_after = 0.0_wp
       do j = 1, n
-        if (p(j) > lb(j)) then
+        if (p(j) > lb(j) .and. p(j) < ub(j)) then
           gp_after = gp_after + ap(j)**2
         else
-          bb_after = bb_after + min(ap(j), 0.0_wp)**2
+          bb_after = bb_after + chopped(ap(j), p(j), lb(j), ub(j))**2
         end if
       end do
       if (.not. (sqrt(gp_after + bb_after) < gp_before .and. bb_after <= gamma**2 * gp_after)) return
@@ -138,7 +160,7 @@ contains
       g = ap
     else
       do j = 1, n
-        x(j) = max(x(j) + t * d(j), lb(j))
+        x(j) = min(max(x(j) + t * d(j), lb(j)), ub(j))
         g(j) = g(j) + t * ad(j)
       end do
     end if
@@ -146,15 +168,16 @@ contains
   end function line_search
 
   !> The minimum over x plus the span of s and of the first nrw stored directions that
-  !! vanish where x is at its bound (no product: all the images under A are known), taken
+  !! vanish where x is at a bound (no product: all the images under A are known), taken
   !! only if the whole Galerkin step is feasible (a step cut at a bound would fix variables
   !! that belong to the free set) and helps (`line_search`). A direction keeps its place
   !! only if at least 1e-4 of its A-norm squared is left after the A-orthogonalisation: the
   !! rounding of its image then stays within 100 times that of a product. True when x moved.
-  logical function recycled_subspace(x, g, lb, rw, raw, nrw, gamma, v, av, p, ap, s, as) result(moved)
+  logical function recycled_subspace(x, g, lb, ub, rw, raw, nrw, gamma, v, av, p, ap, s, as) result(moved)
     real(wp), intent(inout) :: x(:)             !< iterate
     real(wp), intent(inout) :: g(:)             !< A x - b
     real(wp), intent(in) :: lb(:)               !< lower bounds
+    real(wp), intent(in) :: ub(:)               !< upper bounds
     real(wp), intent(in) :: rw(:, :), raw(:, :) !< stored directions and their images
     integer, intent(in) :: nrw                  !< directions held in rw
     real(wp), intent(in) :: gamma               !< proportioning constant Gamma
@@ -175,7 +198,7 @@ contains
         v = rw(:, j)
         av = raw(:, j)
       end if
-      if (any(v /= 0.0_wp .and. x <= lb)) cycle
+      if (any(v /= 0.0_wp .and. (x <= lb .or. x >= ub))) cycle
       d0 = dot_product(v, av)
       if (.not. (d0 > 0.0_wp .and. ieee_is_finite(d0))) cycle
       do pass = 1, 2
@@ -199,7 +222,7 @@ contains
       v = v + c * q(:, l)
       av = av + c * aq(:, l)
     end do
-    moved = line_search(x, g, lb, v, av, .true., gamma, p, ap)
+    moved = line_search(x, g, lb, ub, v, av, .true., gamma, p, ap)
   end function recycled_subspace
 
   !> Keep the direction d (with A d), A-normalised, in the ring rw, raw (the oldest makes

@@ -1,6 +1,6 @@
 !> SMALBE-M: semi-monotonic augmented Lagrangian for bound and equality constraints,
 !!
-!!     minimise 1/2 x'Hx - c'x   subject to   x >= l,   G x = e      (G: r x n, r small)
+!!     minimise 1/2 x'Hx - c'x   subject to   l <= x <= u,   G x = e      (G: r x n, r small)
 !!
 !! with MPRGP (module mprgp) as its inner solver. Z. Dostal, "Optimal Quadratic
 !! Programming Algorithms", Springer 2009, ch. 9; the form used here (doc/method.md,
@@ -8,21 +8,24 @@
 !!
 !!     L(x, mu, rho) = 1/2 x'Hx - c'x + mu'(Gx - e) + rho/2 |Gx - e|^2
 !!
-!! is minimised over x >= l by MPRGP with the Hessian A = H + rho G'G (the caller passes
-!! A: its products are the only ones, and since A does not change from one solve to the
-!! next MPRGP's stored directions stay valid) and the linear term c - G'mu + rho G'e, to
-!! a projected gradient below min(M |Gx - e|, eta); then mu <- mu + rho (Gx - e), and
-!! M <- beta M when L did not grow by at least rho/2 |Gx - e|^2. It stops when the
-!! projected gradient is below eta and |Gx - e| below feas.
+!! is minimised over the box l <= x <= u by MPRGP with the Hessian A = H + rho G'G (the
+!! caller passes A: its products are the only ones, and since A does not change from one
+!! solve to the next MPRGP's stored directions stay valid) and the linear term
+!! c - G'mu + rho G'e, to a projected gradient below min(M |Gx - e|, eta); then
+!! mu <- mu + rho (Gx - e), and M <- beta M when L did not grow by at least
+!! rho/2 |Gx - e|^2. It stops when the projected gradient is below eta and |Gx - e| below
+!! feas. The upper bounds are optional (absent or +huge(1.0_wp): none) and passed through
+!! to MPRGP unchanged.
 !!
 !! On return g = Hx - c + G'mu (the gradient of the Lagrangian at the final multipliers,
 !! which is MPRGP's last gradient), so for contact `G_a - g` is still B_a u_a with the
-!! rigid part of u_a = R_a alpha_a, alpha_a = -mu_a.
+!! rigid part of u_a = R_a alpha_a, alpha_a = -mu_a. At the solution g holds the bound
+!! multipliers: g_i >= 0 where x_i = l_i, g_i <= 0 where x_i = u_i, g_i = 0 in between.
 module smalbe
   use kinds, only: wp
   use linop, only: linop_t
   use lapack, only: dposv
-  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT
+  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, chopped
   implicit none (type, external)
   private
 
@@ -50,7 +53,7 @@ contains
   !! Hx - c + G'mu and solver%ax A x. mu holds the warm start of the multipliers and returns
   !! them. stats%inner%status is MPRGP_CONVERGED only when both the projected gradient and
   !! |Gx - e| met their tolerances.
-  subroutine smalbe_solve(solver, A, c, gm, e, rho, lb, x, mu, stats, rw, raw, nrw)
+  subroutine smalbe_solve(solver, A, c, gm, e, rho, lb, x, mu, stats, rw, raw, nrw, ub)
     type(mprgp_t), intent(inout) :: solver      !< inner solver (options; ax, g as above)
     class(linop_t), intent(inout) :: A          !< H + rho G'G
     real(wp), intent(in) :: c(:)                !< (n) linear term
@@ -63,6 +66,7 @@ contains
     type(smalbe_stats_t), intent(out) :: stats
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_t%solve)
     integer, intent(inout), optional :: nrw(2)
+    real(wp), intent(in), optional :: ub(:)     !< (n) upper bounds (>= lb); +huge(1.0_wp): none
     type(mprgp_opts_t) :: opts
     real(wp), allocatable :: rhs(:), r(:)
     real(wp) :: lag_old, lag_new, rr, m_control, feas
@@ -75,7 +79,13 @@ contains
     feas = opts%eq_feas
     m_control = opts%eq_m
     have_ax = opts%use_ax .and. allocated(solver%ax)
-    if (have_ax) call multiplier_estimate(gm, e, rho, lb, x, c, solver%ax, mu)
+    if (have_ax) then
+      if (present(ub)) then
+        call multiplier_estimate(gm, e, rho, lb, ub, x, c, solver%ax, mu)
+      else
+        call multiplier_estimate(gm, e, rho, lb, spread(huge(1.0_wp), 1, n), x, c, solver%ax, mu)
+      end if
+    end if
     solver%eq_g = gm
     solver%eq_e = e
     lag_old = -huge(1.0_wp)
@@ -95,7 +105,7 @@ contains
       rhs = c - matmul(mu - rho*e, gm)
       feas = max(opts%eq_feas, opts%eq_feas_x*norm2(x))
       solver%opts%eq_feas = feas
-      call solver%solve(A, rhs, lb, x, rw, raw, nrw)
+      call solver%solve(A, rhs, lb, x, rw, raw, nrw, ub)
       stats%inner = solver%stats
       have_ax = .true.
       stats%n_matvec = stats%n_matvec + stats%inner%n_matvec
@@ -132,15 +142,15 @@ contains
   !! lost contact: mu_ls is then the rigid shift that brings it back to its obstacle on
   !! average, where the warm start would need of order |shift| / (rho |e|) updates to get).
   !! mu_ls replaces mu when the Lagrangian's projected gradient at x is smaller with it.
-  subroutine multiplier_estimate(gm, e, rho, lb, x, c, ax, mu)
-    real(wp), intent(in) :: gm(:, :), e(:), rho, lb(:), x(:), c(:), ax(:)
+  subroutine multiplier_estimate(gm, e, rho, lb, ub, x, c, ax, mu)
+    real(wp), intent(in) :: gm(:, :), e(:), rho, lb(:), ub(:), x(:), c(:), ax(:)
     real(wp), intent(inout) :: mu(:)
     real(wp), allocatable :: g0(:), gf(:, :), a(:, :), b(:), mls(:)
     logical, allocatable :: free(:)
     integer :: r, i, info
     r = size(e)
     g0 = ax - rho*matmul(matmul(gm, x), gm) - c
-    free = x > lb
+    free = x > lb .and. x < ub
     if (count(free) < r) free = .true.
     allocate (a(r, r), b(r))
     gf = gm(:, pack([(i, i=1, size(x))], free))
@@ -149,13 +159,13 @@ contains
     call dposv('U', r, 1, a, r, b, r, info)
     if (info /= 0) return
     mls = b
-    if (proj_norm(g0 + matmul(mls, gm), x, lb) < proj_norm(g0 + matmul(mu, gm), x, lb)) mu = mls
+    if (proj_norm(g0 + matmul(mls, gm), x, lb, ub) < proj_norm(g0 + matmul(mu, gm), x, lb, ub)) mu = mls
   end subroutine multiplier_estimate
 
-  !> Norm of the projected gradient of g at x (bounds lb).
-  pure real(wp) function proj_norm(g, x, lb) result(v)
-    real(wp), intent(in) :: g(:), x(:), lb(:)
-    v = norm2(merge(g, min(g, 0.0_wp), x > lb))
+  !> Norm of the projected gradient of g at x (bounds lb, ub).
+  pure real(wp) function proj_norm(g, x, lb, ub) result(v)
+    real(wp), intent(in) :: g(:), x(:), lb(:), ub(:)
+    v = norm2(chopped(g, x, lb, ub))
   end function proj_norm
 
 
