@@ -25,7 +25,7 @@ module equality_rows
     real(wp) :: feas_x = 0.0_wp               !< e = 0: per unit of |lam| instead (FEAS_RTOL |G|) [-]
   end type equality_t
 
-  public :: equality_init, equality_add_penalty, gram_eigenvalues, stacked_rows
+  public :: equality_init, equality_add_penalty, gram_eigenvalues, stacked_rows, equality_force_scaled
 
 contains
 
@@ -50,6 +50,15 @@ contains
     q%feas = FEAS_RTOL*max(norm2(e), tiny(1.0_wp))
     if (all(e == 0.0_wp)) q%feas_x = FEAS_RTOL*sqrt(q%gg)
   end subroutine equality_init
+
+  !> The equilibrium tolerance counted in the contact forces as well, FEAS_RTOL |G| |lam| when
+  !! that is larger than FEAS_RTOL |e|: with friction a floating body's tangential forces
+  !! can be large and cancel, its load small against them, and |G lam - e| cannot be brought
+  !! below the rounding of the forces.
+  subroutine equality_force_scaled(q)
+    type(equality_t), intent(inout) :: q
+    q%feas_x = max(q%feas_x, FEAS_RTOL*sqrt(q%gg))
+  end subroutine equality_force_scaled
 
   !> Add the penalty rho G'G to the dense Hessian and its bound to lmax.
   subroutine equality_add_penalty(q, hessian, lmax)

@@ -22,7 +22,7 @@ module monolithic
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
   use contact_common, only: interface_residual, all_finite, gather, scatter
-  use equality_rows, only: equality_t, equality_init, equality_add_penalty, stacked_rows
+  use equality_rows, only: equality_t, equality_init, equality_add_penalty, stacked_rows, equality_force_scaled
   implicit none (type, external)
   private
 
@@ -122,6 +122,7 @@ contains
     ! monolithic_rtol relative, at most COULOMB_MAX_FIXED times
     friction = has_friction(contact_line)
     nfix = 1
+    if (friction .and. equality%r > 0) call equality_force_scaled(equality)
     if (friction) then
       allocate (ub(m), ub_new(m))
       call row_bounds(contact_line, lam, lb, ub, start=.true.)
