@@ -175,6 +175,9 @@ contains
     else
       res%status = STATUS_CONVERGED
     end if
+    if (friction .and. equality%r > 0 .and. res%status == STATUS_MAX_OUTER) res%message = trim(res%message)// &
+      '; with friction: a body held along a direction by friction alone cannot be held when its load there '// &
+      'exceeds mu times the normal force its contact carries (no static equilibrium: it slides)'
     if (nfix == 1 .or. res%status /= STATUS_CONVERGED) exit
     call row_bounds(contact_line, lam, lb, ub_new)
     change = norm2(pack(ub_new - ub, tangent))/max(norm2(pack(ub_new, tangent)), tiny(1.0_wp))
