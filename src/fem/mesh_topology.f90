@@ -647,36 +647,82 @@ contains
   end subroutine check_overlapping_cells
 
   !> Refuse two cells with the same nodes (in any order): a cell listed twice would count
-  !! its stiffness twice. The cells are sorted by their sorted node lists, so duplicates
-  !! are neighbours (n log n).
+  !! its stiffness twice. The cells are bucketed by their largest node (a counting sort, in
+  !! cell order), so duplicates share a bucket; a bucket is searched pair by pair, a large
+  !! one sorted. The message names the first two cells of the smallest duplicated node list
+  !! (the lists compared as sorted tuples).
   subroutine check_duplicate_cells(mesh, err)
     type(mesh_t), intent(in) :: mesh
     type(error_t), intent(inout) :: err
-    integer, allocatable :: key(:, :), idx(:)
-    integer :: c, n, st, i, j, k
+    integer, parameter :: PAIRWISE = 32            ! larger buckets are sorted
+    integer, allocatable :: key(:, :), first(:), members(:)
+    integer :: c, n, st, i, j, k, b, lo, hi, best_i, best_j
     n = mesh%ncell
     if (n < 2) return
-    allocate (key(4, n), idx(n), stat=st)
+    allocate (key(4, n), first(mesh%nnode + 2), members(n), stat=st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory to check '//i2s(n)//' cells for duplicates')
       return
     end if
     key = 0
+    first = 0
     do c = 1, n
       key(1:mesh%nvert, c) = mesh%cells(:, c)       ! a triangle's 4th node is 0 (or absent)
       call sort_ints(key(:, c))
-      idx(c) = c
+      first(key(4, c) + 2) = first(key(4, c) + 2) + 1
     end do
-    call merge_sort_by_keys(idx, key)
-    do k = 2, n
-      if (all(key(:, idx(k)) == key(:, idx(k - 1)))) then
-        i = min(idx(k - 1), idx(k))
-        j = max(idx(k - 1), idx(k))
-        call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(i))//' and '//i2s(mesh%cell_tag(j))// &
-                     ' have the same nodes: a cell listed twice would count its stiffness twice')
-        return
+    first(1) = 1
+    do k = 1, mesh%nnode + 1
+      first(k + 1) = first(k + 1) + first(k)
+    end do
+    do c = 1, n                                     ! first(b + 1): the next free place of bucket b
+      b = key(4, c)
+      members(first(b + 1)) = c
+      first(b + 1) = first(b + 1) + 1
+    end do
+    best_i = 0
+    best_j = 0
+    do b = 1, mesh%nnode
+      lo = first(b)
+      hi = first(b + 1) - 1
+      if (hi - lo + 1 > PAIRWISE) then
+        call merge_sort_by_keys(members(lo:hi), key)
+        do i = lo, hi - 1
+          if (all(key(:, members(i)) == key(:, members(i + 1)))) then
+            call keep(members(i), members(i + 1))
+            exit
+          end if
+        end do
+        cycle
       end if
+      do i = lo, hi - 1
+        do j = i + 1, hi
+          if (all(key(:, members(i)) == key(:, members(j)))) then
+            call keep(members(i), members(j))
+            exit
+          end if
+        end do
+      end do
     end do
+    if (best_i > 0) call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(best_i))//' and '// &
+                                 i2s(mesh%cell_tag(best_j))//' have the same nodes: a cell listed twice would '// &
+                                 'count its stiffness twice')
+  contains
+    !> Keep the duplicate pair (ci, cj), ci < cj the first two of their list, if its node
+    !! list is the smallest so far.
+    subroutine keep(ci, cj)
+      integer, intent(in) :: ci, cj
+      integer :: m
+      if (best_i > 0) then
+        do m = 1, 4
+          if (key(m, ci) /= key(m, best_i)) exit
+        end do
+        if (m > 4) return
+        if (key(m, ci) > key(m, best_i)) return
+      end if
+      best_i = ci
+      best_j = cj
+    end subroutine keep
   end subroutine check_duplicate_cells
 
   !> A body is one connected piece of cells (cells connected through shared nodes): its rigid

@@ -523,6 +523,59 @@ contains
     end if
   end function square
 
+  !> A fan of n triangles around node n + 1 (the largest tag) at the origin, nodes 1..n on
+  !! the unit circle (counter-clockwise), triangle k = (k, k+1, n+1) with tag k; then the
+  !! triangles of `extra` (tags n+1, n+2, ...), each given by its first node k.
+  function fan(n, extra) result(l)
+    integer, intent(in) :: n, extra(:)
+    character(len=60), allocatable :: l(:)
+    character(len=60) :: line
+    integer :: k, e
+    real(wp) :: t
+    l = [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', '$PhysicalNames', '1', &
+         '2 20 "sq"', '$EndPhysicalNames', '$Entities', '0 0 1 0', '1 -1 -1 0 1 1 0 1 20 0', '$EndEntities', &
+         '$Nodes']
+    write (line, '(a,i0,a,i0)') '1 ', n + 1, ' 1 ', n + 1
+    l = [l, line]
+    write (line, '(a,i0)') '2 1 0 ', n + 1
+    l = [l, line]
+    do k = 1, n + 1
+      write (line, '(i0)') k
+      l = [l, line]
+    end do
+    do k = 1, n
+      t = 2.0_wp*acos(-1.0_wp)*real(k - 1, wp)/real(n, wp)
+      write (line, '(2(es23.15,1x),a)') cos(t), sin(t), '0'
+      l = [l, line]
+    end do
+    l = [character(len=60) :: l, '0 0 0', '$EndNodes', '$Elements']
+    write (line, '(a,i0,a,i0,a,i0)') '1 ', n + size(extra), ' 1 ', n + size(extra)
+    l = [l, line]
+    write (line, '(a,i0)') '2 1 2 ', n + size(extra)
+    l = [l, line]
+    do k = 1, n
+      write (line, '(4(i0,1x))') k, k, modulo(k, n) + 1, n + 1
+      l = [l, line]
+    end do
+    do e = 1, size(extra)
+      k = extra(e)
+      write (line, '(4(i0,1x))') n + e, k, modulo(k, n) + 1, n + 1
+      l = [l, line]
+    end do
+    l = [character(len=60) :: l, '$EndElements']
+  end function fan
+
+  !> The fan without duplicates is read: its 40 triangles around one node.
+  subroutine read_ok_fan()
+    type(mesh_t) :: m
+    integer :: info
+    character(len=512) :: msg
+    call write_file(tmp//'fan40.msh', fan(40, [integer ::]))
+    call msh_read(tmp//'fan40.msh', 'sq', 1, m, info, msg)
+    call report(info == 0 .and. m%ncell == 40 .and. m%nnode == 41, 'a fan of 40 triangles at one node is read')
+    if (info /= 0) write (*, '(a)') '      msg: '//trim(msg)
+  end subroutine read_ok_fan
+
   subroutine test_bad_inputs()
     character(len=60), allocatable :: l(:)
     type(mesh_t) :: m
@@ -608,6 +661,15 @@ contains
     call expect_error('dup_tri.msh', square(element_lines=[character(len=60) :: '$Elements', '1 3 1 9', &
                       '2 1 2 3', '7 1 2 3', '8 1 3 4', '9 3 1 2', '$EndElements']), 'sq', 1, &
                       [character(len=24) :: 'elements 7 and 9', 'same nodes'], 'a triangle listed twice (rotated) is refused')
+    ! two triangles listed twice: the one of the smaller node list is named, whichever comes
+    ! first in the file; around a node of few cells (compared pair by pair) and of many (sorted)
+    call expect_error('dup_fan8.msh', fan(8, [5, 2]), 'sq', 1, &
+                      [character(len=24) :: 'elements 2 and 10', 'same nodes'], &
+                      'of two triangles listed twice, the smaller node list is named (8 cells at a node)')
+    call expect_error('dup_fan40.msh', fan(40, [30, 7, 30, 7]), 'sq', 1, &
+                      [character(len=24) :: 'elements 7 and 42', 'same nodes'], &
+                      'of two triangles listed twice, the smaller node list is named (40 cells at a node)')
+    call read_ok_fan()
     call expect_error('dup_line.msh', square(element_lines=[character(len=60) :: '$Elements', '2 3 1 9', &
                       '1 1 1 2', '8 1 2', '9 2 1', '2 1 3 1', '7 1 2 3 4', '$EndElements']), 'sq', 1, &
                       [character(len=24) :: 'elements 8 and 9', "curve 'base'"], 'a boundary line listed twice is refused')
