@@ -346,8 +346,8 @@ contains
   !! the nodes of its lines inside the body as single nodes (a curve inside the body gives
   !! a group of nodes only). A line whose two nodes are in the body but are not an edge of
   !! any of its cells (a corrupted node number) is bad input: its condition would be lost. The lines' edges are hashed (a small table), then every cell
-  !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
-  !! oriented as that cell has it; one met in two is inside the body.
+  !! edge between two nodes of lines is looked up in it: a line edge met in exactly one cell
+  !! is a boundary edge, oriented as that cell has it; one met in two is inside the body.
   subroutine boundary_groups(file_mesh, body_node, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
@@ -356,7 +356,7 @@ contains
     type(int_hash_t) :: edge_hash
     integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
     integer, allocatable :: seen_group(:), seen_line(:), first(:), members(:)
-    logical, allocatable :: marked(:)
+    logical, allocatable :: marked(:), on_line(:)
     integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m
     integer(i8) :: key, key_base
     type(text_buffer_t) :: names
@@ -365,7 +365,8 @@ contains
     call hash_init(edge_hash, file_mesh%nline, st)
     if (st == 0) allocate (line_slot(file_mesh%nline), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
                            edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
-                           inner(2*file_mesh%nline), marked(mesh%nnode), seen_group(0:edge_hash%mask), &
+                           inner(2*file_mesh%nline), marked(mesh%nnode), on_line(mesh%nnode), &
+                           seen_group(0:edge_hash%mask), &
                            seen_line(0:edge_hash%mask), stat=st)
     if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, st)
     if (st /= 0) then
@@ -376,6 +377,7 @@ contains
     edge_count = 0
     seen_group = 0
     marked = .false.
+    on_line = .false.
     key_base = mesh%nnode + 1
     do line = 1, file_mesh%nline
       if (file_mesh%line_entity(line) == 0) cycle
@@ -386,6 +388,8 @@ contains
       slot = hash_slot(edge_hash, key)
       edge_hash%key(slot) = key
       line_slot(line) = slot
+      on_line(a) = .true.
+      on_line(b) = .true.
     end do
 
     ! how many cells have each of them, and the last one
@@ -394,6 +398,7 @@ contains
       do i = 1, nv
         a = mesh%cells(i, c)
         b = mesh%cells(modulo(i, nv) + 1, c)
+        if (.not. (on_line(a) .and. on_line(b))) cycle
         key = min(a, b)*key_base + max(a, b)
         slot = hash_slot(edge_hash, key)
         if (edge_hash%key(slot) /= key) cycle
