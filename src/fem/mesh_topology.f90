@@ -346,8 +346,8 @@ contains
   !! the nodes of its lines inside the body as single nodes (a curve inside the body gives
   !! a group of nodes only). A line whose two nodes are in the body but are not an edge of
   !! any of its cells (a corrupted node number) is bad input: its condition would be lost. The lines' edges are hashed (a small table), then every cell
-  !! edge is looked up in it: a line edge met in exactly one cell is a boundary edge,
-  !! oriented as that cell has it; one met in two is inside the body.
+  !! edge between two nodes of lines is looked up in it: a line edge met in exactly one cell
+  !! is a boundary edge, oriented as that cell has it; one met in two is inside the body.
   subroutine boundary_groups(file_mesh, body_node, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
@@ -356,7 +356,7 @@ contains
     type(int_hash_t) :: edge_hash
     integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
     integer, allocatable :: seen_group(:), seen_line(:), first(:), members(:)
-    logical, allocatable :: marked(:)
+    logical, allocatable :: marked(:), on_line(:)
     integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m
     integer(i8) :: key, key_base
     type(text_buffer_t) :: names
@@ -365,7 +365,8 @@ contains
     call hash_init(edge_hash, file_mesh%nline, st)
     if (st == 0) allocate (line_slot(file_mesh%nline), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
                            edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
-                           inner(2*file_mesh%nline), marked(mesh%nnode), seen_group(0:edge_hash%mask), &
+                           inner(2*file_mesh%nline), marked(mesh%nnode), on_line(mesh%nnode), &
+                           seen_group(0:edge_hash%mask), &
                            seen_line(0:edge_hash%mask), stat=st)
     if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, st)
     if (st /= 0) then
@@ -376,6 +377,7 @@ contains
     edge_count = 0
     seen_group = 0
     marked = .false.
+    on_line = .false.
     key_base = mesh%nnode + 1
     do line = 1, file_mesh%nline
       if (file_mesh%line_entity(line) == 0) cycle
@@ -386,6 +388,8 @@ contains
       slot = hash_slot(edge_hash, key)
       edge_hash%key(slot) = key
       line_slot(line) = slot
+      on_line(a) = .true.
+      on_line(b) = .true.
     end do
 
     ! how many cells have each of them, and the last one
@@ -394,6 +398,7 @@ contains
       do i = 1, nv
         a = mesh%cells(i, c)
         b = mesh%cells(modulo(i, nv) + 1, c)
+        if (.not. (on_line(a) .and. on_line(b))) cycle
         key = min(a, b)*key_base + max(a, b)
         slot = hash_slot(edge_hash, key)
         if (edge_hash%key(slot) /= key) cycle
@@ -647,36 +652,82 @@ contains
   end subroutine check_overlapping_cells
 
   !> Refuse two cells with the same nodes (in any order): a cell listed twice would count
-  !! its stiffness twice. The cells are sorted by their sorted node lists, so duplicates
-  !! are neighbours (n log n).
+  !! its stiffness twice. The cells are bucketed by their largest node (a counting sort, in
+  !! cell order), so duplicates share a bucket; a bucket is searched pair by pair, a large
+  !! one sorted. The message names the first two cells of the smallest duplicated node list
+  !! (the lists compared as sorted tuples).
   subroutine check_duplicate_cells(mesh, err)
     type(mesh_t), intent(in) :: mesh
     type(error_t), intent(inout) :: err
-    integer, allocatable :: key(:, :), idx(:)
-    integer :: c, n, st, i, j, k
+    integer, parameter :: PAIRWISE = 32            ! larger buckets are sorted
+    integer, allocatable :: key(:, :), first(:), members(:)
+    integer :: c, n, st, i, j, k, b, lo, hi, best_i, best_j
     n = mesh%ncell
     if (n < 2) return
-    allocate (key(4, n), idx(n), stat=st)
+    allocate (key(4, n), first(mesh%nnode + 2), members(n), stat=st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory to check '//i2s(n)//' cells for duplicates')
       return
     end if
     key = 0
+    first = 0
     do c = 1, n
       key(1:mesh%nvert, c) = mesh%cells(:, c)       ! a triangle's 4th node is 0 (or absent)
       call sort_ints(key(:, c))
-      idx(c) = c
+      first(key(4, c) + 2) = first(key(4, c) + 2) + 1
     end do
-    call merge_sort_by_keys(idx, key)
-    do k = 2, n
-      if (all(key(:, idx(k)) == key(:, idx(k - 1)))) then
-        i = min(idx(k - 1), idx(k))
-        j = max(idx(k - 1), idx(k))
-        call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(i))//' and '//i2s(mesh%cell_tag(j))// &
-                     ' have the same nodes: a cell listed twice would count its stiffness twice')
-        return
+    first(1) = 1
+    do k = 1, mesh%nnode + 1
+      first(k + 1) = first(k + 1) + first(k)
+    end do
+    do c = 1, n                                     ! first(b + 1): the next free place of bucket b
+      b = key(4, c)
+      members(first(b + 1)) = c
+      first(b + 1) = first(b + 1) + 1
+    end do
+    best_i = 0
+    best_j = 0
+    do b = 1, mesh%nnode
+      lo = first(b)
+      hi = first(b + 1) - 1
+      if (hi - lo + 1 > PAIRWISE) then
+        call merge_sort_by_keys(members(lo:hi), key)
+        do i = lo, hi - 1
+          if (all(key(:, members(i)) == key(:, members(i + 1)))) then
+            call keep(members(i), members(i + 1))
+            exit
+          end if
+        end do
+        cycle
       end if
+      do i = lo, hi - 1
+        do j = i + 1, hi
+          if (all(key(:, members(i)) == key(:, members(j)))) then
+            call keep(members(i), members(j))
+            exit
+          end if
+        end do
+      end do
     end do
+    if (best_i > 0) call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(best_i))//' and '// &
+                                 i2s(mesh%cell_tag(best_j))//' have the same nodes: a cell listed twice would '// &
+                                 'count its stiffness twice')
+  contains
+    !> Keep the duplicate pair (ci, cj), ci < cj the first two of their list, if its node
+    !! list is the smallest so far.
+    subroutine keep(ci, cj)
+      integer, intent(in) :: ci, cj
+      integer :: m
+      if (best_i > 0) then
+        do m = 1, 4
+          if (key(m, ci) /= key(m, best_i)) exit
+        end do
+        if (m > 4) return
+        if (key(m, ci) > key(m, best_i)) return
+      end if
+      best_i = ci
+      best_j = cj
+    end subroutine keep
   end subroutine check_duplicate_cells
 
   !> A body is one connected piece of cells (cells connected through shared nodes): its rigid

@@ -4,7 +4,8 @@
 !! unknown region, clockwise cells, degenerate and non-convex cells, sparse unordered tags,
 !! truncation, unknown sections, numbers in every form, cells and boundary lines listed
 !! twice, tags < 1, counts the file cannot hold), and groups of nodes (physical
-!! points, a physical curve inside a body).
+!! points, a physical curve inside a body). The stiffness and lifting of bodies read from
+!! files are those of an element loop in file order, bit for bit.
 !!
 !! With arguments, `test_gmsh file.msh [region]` only reads that file and prints the time
 !! taken (the read benchmark).
@@ -16,6 +17,9 @@ program test_gmsh
   use errors, only: error_t, exit_code
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary, write_file
+  use config, only: body_cfg_t, boundary_cfg_t, traction_cfg_t
+  use elements, only: MAX_NVERT, MAX_NDOF, ke_cache_t, ke_cache_init, element_stiffness
+  use assembly, only: assemble_body, body_system_t, lame_parameters
   implicit none (type, external)
 
   real(wp), parameter :: pi = acos(-1.0_wp), eps = epsilon(1.0_wp)
@@ -40,6 +44,11 @@ program test_gmsh
   call test_bad_inputs()
   call test_point_groups()
   call test_unusual_inputs()
+  call test_file_order(dir//'hertz_h0.02.msh', 'disc', 'disc_top')
+  call test_file_order(dir//'hertz_h0.02.msh', 'block', 'block_bottom')
+  call test_file_order(dir//'paper.msh', 'upper', 'upper_left')
+  call test_file_order(dir//'patch_mixed.msh', 'top', 'top_top')
+  call test_file_order(dir//'pin_hole.msh', 'plate', 'plate_left')
   call test_summary()
 
 contains
@@ -182,6 +191,70 @@ contains
     open (newunit=u, file=tmp//name)
     close (u, status='delete')
   end subroutine expect_error
+
+  ! ---- assembly order ---------------------------------------------------------------------
+
+  !> assemble_body on a body read from a file gives the stiffness and the lifting of the
+  !! element loop in file order (each entry the sum of its cells' terms in cell order,
+  !! with the one-cell stiffness cache), bit for bit: the reference is summed here into
+  !! the same pattern. `group` is held at a non-zero displacement (a lifting).
+  subroutine test_file_order(path, region, group)
+    character(len=*), intent(in) :: path, region, group
+    type(mesh_t) :: m
+    type(body_cfg_t) :: body
+    type(boundary_cfg_t) :: bnd(1)
+    type(traction_cfg_t) :: tr(1)
+    type(body_system_t) :: sys
+    type(error_t) :: err
+    type(ke_cache_t) :: cache
+    real(wp), allocatable :: val(:), f(:)
+    real(wp) :: ke(MAX_NDOF, MAX_NDOF), xe(2, MAX_NVERT), minjac, lame_lambda, lame_mu, ue(MAX_NDOF)
+    integer :: c, nv, a, b, fa, fb, pos, ldof(MAX_NDOF)
+    character(len=:), allocatable :: what
+
+    what = path//' '//region//': '
+    call msh_read_err(path, region, 1, m, err)
+    body%id = 1
+    body%young = 2.1e11_wp
+    body%poisson = 0.277_wp
+    bnd(1)%body = 1
+    bnd(1)%group = group
+    bnd(1)%fix = .true.
+    bnd(1)%u = [1.0e-3_wp, -2.0e-3_wp]
+    if (.not. err%failed()) call assemble_body(m, body, .true., tr, 0, sys, err, boundaries=bnd)
+    if (err%failed()) then
+      call report(.false., what//'read and assembled: '//err%text())
+      return
+    end if
+    call lame_parameters(body, .true., lame_lambda, lame_mu)
+    call ke_cache_init(cache, maxval(abs(m%xy)))
+    allocate (val(size(sys%val)), f(sys%n))
+    val = 0.0_wp
+    f = 0.0_wp
+    do c = 1, m%ncell
+      nv = merge(4, 3, m%cell_type(c) == ELEM_Q1)
+      xe = 0.0_wp
+      do a = 1, nv
+        xe(:, a) = m%xy(:, m%cells(a, c))
+        ldof(2*a - 1:2*a) = 2*m%cells(a, c) - [1, 0]
+      end do
+      call element_stiffness(m%cell_type(c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+      ue(1:2*nv) = sys%u_fixed(ldof(1:2*nv))
+      do b = 1, 2*nv
+        fb = sys%free_of(ldof(b))
+        if (fb == 0) cycle
+        do a = 1, 2*nv
+          fa = sys%free_of(ldof(a))
+          if (fa == 0) cycle
+          pos = sys%colptr(fb) + findloc(sys%rowind(sys%colptr(fb) + 1:sys%colptr(fb + 1)), fa - 1, dim=1)
+          val(pos) = val(pos) + ke(a, b)
+        end do
+        if (any(ue(1:2*nv) /= 0.0_wp)) f(fb) = f(fb) - dot_product(ke(b, 1:2*nv), ue(1:2*nv))
+      end do
+    end do
+    call report(all(sys%val == val), what//'stiffness = the file-order sums, bit for bit')
+    call report(any(f /= 0.0_wp) .and. all(sys%f == f), what//'lifting = the file-order sums, bit for bit')
+  end subroutine test_file_order
 
   ! ---- the shipped meshes ---------------------------------------------------------------
 
@@ -523,6 +596,59 @@ contains
     end if
   end function square
 
+  !> A fan of n triangles around node n + 1 (the largest tag) at the origin, nodes 1..n on
+  !! the unit circle (counter-clockwise), triangle k = (k, k+1, n+1) with tag k; then the
+  !! triangles of `extra` (tags n+1, n+2, ...), each given by its first node k.
+  function fan(n, extra) result(l)
+    integer, intent(in) :: n, extra(:)
+    character(len=60), allocatable :: l(:)
+    character(len=60) :: line
+    integer :: k, e
+    real(wp) :: t
+    l = [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', '$PhysicalNames', '1', &
+         '2 20 "sq"', '$EndPhysicalNames', '$Entities', '0 0 1 0', '1 -1 -1 0 1 1 0 1 20 0', '$EndEntities', &
+         '$Nodes']
+    write (line, '(a,i0,a,i0)') '1 ', n + 1, ' 1 ', n + 1
+    l = [l, line]
+    write (line, '(a,i0)') '2 1 0 ', n + 1
+    l = [l, line]
+    do k = 1, n + 1
+      write (line, '(i0)') k
+      l = [l, line]
+    end do
+    do k = 1, n
+      t = 2.0_wp*acos(-1.0_wp)*real(k - 1, wp)/real(n, wp)
+      write (line, '(2(es23.15,1x),a)') cos(t), sin(t), '0'
+      l = [l, line]
+    end do
+    l = [character(len=60) :: l, '0 0 0', '$EndNodes', '$Elements']
+    write (line, '(a,i0,a,i0,a,i0)') '1 ', n + size(extra), ' 1 ', n + size(extra)
+    l = [l, line]
+    write (line, '(a,i0)') '2 1 2 ', n + size(extra)
+    l = [l, line]
+    do k = 1, n
+      write (line, '(4(i0,1x))') k, k, modulo(k, n) + 1, n + 1
+      l = [l, line]
+    end do
+    do e = 1, size(extra)
+      k = extra(e)
+      write (line, '(4(i0,1x))') n + e, k, modulo(k, n) + 1, n + 1
+      l = [l, line]
+    end do
+    l = [character(len=60) :: l, '$EndElements']
+  end function fan
+
+  !> The fan without duplicates is read: its 40 triangles around one node.
+  subroutine read_ok_fan()
+    type(mesh_t) :: m
+    integer :: info
+    character(len=512) :: msg
+    call write_file(tmp//'fan40.msh', fan(40, [integer ::]))
+    call msh_read(tmp//'fan40.msh', 'sq', 1, m, info, msg)
+    call report(info == 0 .and. m%ncell == 40 .and. m%nnode == 41, 'a fan of 40 triangles at one node is read')
+    if (info /= 0) write (*, '(a)') '      msg: '//trim(msg)
+  end subroutine read_ok_fan
+
   subroutine test_bad_inputs()
     character(len=60), allocatable :: l(:)
     type(mesh_t) :: m
@@ -608,6 +734,15 @@ contains
     call expect_error('dup_tri.msh', square(element_lines=[character(len=60) :: '$Elements', '1 3 1 9', &
                       '2 1 2 3', '7 1 2 3', '8 1 3 4', '9 3 1 2', '$EndElements']), 'sq', 1, &
                       [character(len=24) :: 'elements 7 and 9', 'same nodes'], 'a triangle listed twice (rotated) is refused')
+    ! two triangles listed twice: the one of the smaller node list is named, whichever comes
+    ! first in the file; around a node of few cells (compared pair by pair) and of many (sorted)
+    call expect_error('dup_fan8.msh', fan(8, [5, 2]), 'sq', 1, &
+                      [character(len=24) :: 'elements 2 and 10', 'same nodes'], &
+                      'of two triangles listed twice, the smaller node list is named (8 cells at a node)')
+    call expect_error('dup_fan40.msh', fan(40, [30, 7, 30, 7]), 'sq', 1, &
+                      [character(len=24) :: 'elements 7 and 42', 'same nodes'], &
+                      'of two triangles listed twice, the smaller node list is named (40 cells at a node)')
+    call read_ok_fan()
     call expect_error('dup_line.msh', square(element_lines=[character(len=60) :: '$Elements', '2 3 1 9', &
                       '1 1 1 2', '8 1 2', '9 2 1', '2 1 3 1', '7 1 2 3 4', '$EndElements']), 'sq', 1, &
                       [character(len=24) :: 'elements 8 and 9', "curve 'base'"], 'a boundary line listed twice is refused')
