@@ -22,6 +22,9 @@ and, per mesh and solver, the friction run against the frictionless one: total t
 and outer counts. A Robin setting that does not converge on a mesh is not run on the larger
 meshes (listed as skipped): its runs would only hit max_outer, slowly.
 
+cpu_s is the process's CPU time (user + system, all threads): on a machine shared with other
+work it is a steadier measure of the work done than the wall times of the `time:` line.
+
 Timing hygiene: the machine may be shared. busy_before = cores kept busy (by anything) during
 the second before a run (runs from 512x256 on wait up to --quiet-wait s for < 0.5 busy core);
 busy_during = cores kept busy by other processes during the run; load1 = the 1-minute load
@@ -64,7 +67,7 @@ SOLVERS = {"monolithic": "&solver method='monolithic' /", "deck": "",
            "steklov": "&solver robin_operator='steklov', delta=0.5 /"}
 COLUMNS = ["nx", "ny", "dofs", "m", "friction", "solver", "status", "exit", "outer", "inner", "residual"] + \
           [p + "_s" for p in PHASES] + \
-          ["peak_mb", "factor_mb", "stick", "slip", "tangential_force_sum", "normal_force_sum", "err_n", "err_t",
+          ["cpu_s", "peak_mb", "factor_mb", "stick", "slip", "tangential_force_sum", "normal_force_sum", "err_n", "err_t",
            "repeats", "total_s_all", "process_wall_s", "load1", "busy_before", "busy_during", "cmdline"]
 
 
@@ -135,6 +138,7 @@ class Runner:
         ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
         mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
         hz = os.sysconf("SC_CLK_TCK")
+        row["cpu_s"] = round(mine, 3)
         row["busy_during"] = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
         row["process_wall_s"] = round(wall, 3)
         row["exit"] = p.returncode
@@ -221,11 +225,12 @@ def main():
 
     print(f"\nbench_friction: {len(rows)} rows, {time.monotonic() - t_start:.0f} s; {os.path.relpath(a.csv, ROOT)}\n")
     print("### Runs\n")
-    print(table(["mesh / body", "friction", "solver", "status", "outer/inner", "f / c / i [s]", "total [s]", "peak MB",
+    print(table(["mesh / body", "friction", "solver", "status", "outer/inner", "f / c / i [s]", "total [s]", "cpu [s]",
+                 "peak MB",
                  "stick/slip", "err_n", "err_t", "busy"],
                 [[f"{r['nx']}x{r['ny']}", r["friction"], r["solver"], r["status"],
                   f"{r['outer']}/{r['inner']}" if r["outer"] != "" else "", ph(r), fmt(r["total_s"], ".3g"),
-                  fmt(r["peak_mb"], ".0f"), f"{r['stick']}/{r['slip']}" if r["stick"] != "" else "",
+                  fmt(r["cpu_s"], ".3g"), fmt(r["peak_mb"], ".0f"), f"{r['stick']}/{r['slip']}" if r["stick"] != "" else "",
                   fmt(r["err_n"], ".1e"), fmt(r["err_t"], ".1e"), fmt(r["busy_during"], ".2f")] for r in rows]))
     print("\n### Friction against frictionless (same mesh, same solver)\n")
     key = {(r["nx"], r["ny"], r["friction"], r["solver"]): r for r in rows}
@@ -235,17 +240,18 @@ def main():
             for sv in SOLVERS:
                 r0, r1 = key[(nx, ny, "none", sv)], key[(nx, ny, fr, sv)]
                 if r0["total_s"] == "" or r1["total_s"] == "":
-                    out.append([f"{nx}x{ny}", fr, sv, r0["status"], r1["status"], "", "", "", "", "", ""])
+                    out.append([f"{nx}x{ny}", fr, sv, r0["status"], r1["status"], "", "", "", "", "", "", ""])
                     continue
                 ratio = r1["total_s"] / r0["total_s"] if r0["total_s"] > 0 else float("nan")
                 extra = {p: r1[p + "_s"] - r0[p + "_s"] for p in ("factor", "condense", "iterate")}
                 out.append([f"{nx}x{ny}", fr, sv, f"{r0['outer']}/{r0['inner']}", f"{r1['outer']}/{r1['inner']}",
                             f"{fmt(r0['total_s'], '.3g')} -> {fmt(r1['total_s'], '.3g')}", fmt(ratio, ".2f"),
+                            fmt(r1["cpu_s"] / r0["cpu_s"] if r0["cpu_s"] else float("nan"), ".2f"),
                             " / ".join(f"{extra[p]:+.3g}" for p in ("factor", "condense", "iterate")),
                             f"{r0['m']} -> {r1['m']}", fmt(r1["peak_mb"] - r0["peak_mb"], "+.0f"),
                             r1["status"]])
     print(table(["mesh / body", "friction", "solver", "outer/inner none", "outer/inner friction", "total [s]",
-                 "ratio", "extra f / c / i [s]", "rows m", "extra peak MB", "status"], out))
+                 "ratio", "cpu ratio", "extra f / c / i [s]", "rows m", "extra peak MB", "status"], out))
     return 0
 
 
