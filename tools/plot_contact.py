@@ -49,7 +49,8 @@ note on stderr).
 Runs that are identical for Hertz (same P, R, xc, E*) share one curve.
 With --mindlin (implies --hertz), for each Hertzian run with Coulomb friction (friction =
 'coulomb' and mu > 0 in the input deck), Cattaneo-Mindlin's shear of a tangential load Q < mu P
-applied at constant P over the Hertz contact (a, p0 as above):
+applied at constant P over the Hertz contact (a, p0 as above; bodies of one material, or
+at least of equal Dundurs' beta, so that the normal and the tangential problems uncouple):
   Q  = sum of /contact/tangential_force (the tangential resultant)
   c  = a sqrt(1 - |Q| / (mu P))        (half-width of the stick zone; 0 when |Q| >= mu P)
   q(x) = sign(Q) mu p0 (sqrt(1 - x^2/a^2) - (c/a) sqrt(1 - x^2/c^2)),  x = s - xc
@@ -96,7 +97,7 @@ def plane_stress(text):
 
 def deck_text(f, path):
     """(the effective deck text without comments, where-from) of a result file: /input_deck,
-    else the deck file named by the root attribute 'deck'; ('', None) when neither is there."""
+    else the deck file named by the root attribute 'deck'; ('', 'input_deck') when neither is there."""
     text = text_dataset(f, "input_deck")
     src = "input_deck"
     if text is None:
