@@ -338,6 +338,13 @@ bench-mpi: $(PROG)
 bench-bodies: $(PROG)
 	$(PYTHON) bench/bench_bodies.py --bin $(PROG)
 
+# Friction: the paper's scene at 128x64 ... 1024x512 per body, frictionless against Coulomb
+# (mu 0.3) and Tresca, monolithic and each Robin operator: time per phase, outer/inner counts,
+# memory, error against monolithic (about 20 min); results/bench_friction.csv and Markdown tables
+.PHONY: bench-friction
+bench-friction: $(PROG)
+	$(PYTHON) bench/bench_friction.py --bin $(PROG) --repeat 2
+
 plots: $(PROG)
 	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh
 

@@ -180,7 +180,9 @@ contains
       'exceeds mu times the normal force its contact carries (no static equilibrium: it slides)'
     if (nfix == 1 .or. res%status /= STATUS_CONVERGED) exit
     call row_bounds(contact_line, lam, lb, ub_new)
-    change = norm2(pack(ub_new - ub, tangent))/max(norm2(pack(ub_new, tangent)), tiny(1.0_wp))
+    ! the first solve had no Coulomb bound (row_bounds' start): nothing to compare with
+    change = huge(1.0_wp)
+    if (fixed > 1) change = norm2(pack(ub_new - ub, tangent))/max(norm2(pack(ub_new, tangent)), tiny(1.0_wp))
     if (change <= solver%monolithic_rtol) exit
     if (fixed == nfix) then
       res%status = STATUS_MAX_OUTER

@@ -12,6 +12,14 @@ instead of swamping the machine, and checks:
     fraction of dark pixels in the plot area below 30%;
   - plot_solution says that its colour scale is clipped and that edges are not drawn;
   - plot_contact --hertz prints the errors against Hertz (err_a, err_p0, err_L2);
+  - friction: on a Hertz scene with Coulomb friction and a tangential displacement (Q about
+    0.76 mu P), plot_contact adds the shear panel (a taller picture) and prints the
+    tangential resultant and the stick and slip counts of the file's /contact/state;
+    --mindlin adds Cattaneo-Mindlin's shear: its stick half-width c computed here from the
+    file (Hertz's a from P, R, E*; Q, mu P) is the one printed, and the solution agrees
+    with it (stick half-width within 5% of a, shear L2 error below 8%); on a frictionless
+    result --mindlin says why there is no Mindlin curve and draws the picture --hertz draws,
+    pixel for pixel;
   - failures end with a message and exit 1: a result without /body2, a file that is not
     HDF5, and running out of memory (--pixels 8000 under the cap);
   - rc_results' and rc_figures' unit helpers (SI defaults, stored units, SI-prefix scaling, labels,
@@ -128,6 +136,71 @@ if line:
     err = {k: float(v) for k, v in (w.split("=") for w in line[0].split() if w.startswith("err_"))}
     check(err["err_p0"] < 0.05 and err["err_L2"] < 0.05, "Hertz deck (80x40): p0 and L2 errors below 5%", str(err))
 picture(f"{OUT}/hertz.png", "hertz.png")
+
+# ---- friction: the shear panel and Cattaneo-Mindlin ---------------------------------------
+E, NU, R_GAP, MU = 2.1e11, 0.3, 100.0, 0.3
+cm = f"{OUT}/mindlin.h5"
+cm_deck = f"{OUT}/mindlin.nml"
+with open(cm_deck, "w") as fh:
+    fh.write(f"""&scene title='Hertz line contact with Coulomb friction, sheared', plane='strain' /
+&body id=1, x0=0.0, y0=6.0, width=12.0, height=6.0, nx=240, ny=120, young={E}, poisson={NU},
+      left='free', right='free', top='displacement', bottom='contact' /
+&body id=2, x0=0.0, y0=0.0, width=12.0, height=6.0, nx=240, ny=120, young={E}, poisson={NU},
+      left='free', right='free', top='contact', bottom='clamped' /
+&displacement body=1, side='top', u=0.004, -0.01 /
+&contact gap_radius={R_GAP}, gap_center=6.0, friction='coulomb', mu={MU} /
+&solver method='robin', robin_operator='harmonic', delta=0.5, tol=1e-8 /
+&output file='{cm}' /
+""")
+p, _ = run_solver(BIN, cm_deck)
+if check(p.returncode == 0 and os.path.isfile(cm), "sheared Hertz deck with Coulomb friction solved", f"exit {p.returncode}"):
+    with h5py.File(cm, "r") as f:
+        lam = f["contact/normal_force"][()]
+        tf = f["contact/tangential_force"][()]
+        state = f["contact/state"][()]
+    P, Q = float(lam.sum()), float(tf.sum())
+    a_h = np.sqrt(4.0 * P * R_GAP / (np.pi * E / (2.0 * (1.0 - NU * NU))))
+    c_h = a_h * np.sqrt(1.0 - abs(Q) / (MU * P))
+    nstick, nslip = int(np.sum(state == 1)), int(np.sum(state == 2))
+    check(nstick > 3 and nslip > 3 and 0.5 < abs(Q) / (MU * P) < 0.95,
+          "sheared Hertz deck: partial slip (stick and slip nodes, Q below mu P)",
+          f"stick {nstick}, slip {nslip}, Q/(mu P) {abs(Q) / (MU * P):.3f}")
+
+    rc, out, _, _ = tool("plot_contact.py", cm, "-o", f"{OUT}/friction.png")
+    check(rc == 0 and os.path.getsize(f"{OUT}/friction.png") > 0, "plot_contact on a frictional result: exit 0, picture written",
+          f"exit {rc} {out.strip()[-300:]}")
+    picture(f"{OUT}/friction.png", "friction.png")
+    m = re.search(r"tangential resultant Q = .*, stick (\d+), slip (\d+),", out)
+    check(m is not None and (int(m.group(1)), int(m.group(2))) == (nstick, nslip),
+          "plot_contact: the tangential resultant and the file's stick and slip counts printed",
+          f"{m.group(0) if m else out.strip()[-300:]} against stick {nstick}, slip {nslip}")
+
+    rc, out, _, _ = tool("plot_contact.py", cm, "--mindlin", "-o", f"{OUT}/mindlin.png")
+    check(rc == 0 and "1 Mindlin curves" in out, "plot_contact --mindlin on the sheared Hertz deck: one Mindlin curve",
+          f"exit {rc} {out.strip()[-300:]}")
+    picture(f"{OUT}/mindlin.png", "mindlin.png")
+    line = [ln for ln in out.splitlines() if ln.startswith("plot_contact: Mindlin for mindlin:")]
+    vals = {k: float(v) for k, v in (w.split("=") for w in line[0].split() if "=" in w)} if line else {}
+    check(bool(vals) and abs(vals["c"] / c_h - 1.0) < 1e-4 and abs(vals["mu"] - MU) < 1e-12,
+          "plot_contact --mindlin: c = a sqrt(1 - Q/(mu P)) from the file's forces and the deck's mu",
+          f"{line} against c = {c_h:.6g}")
+    check(bool(vals) and vals["err_c"] < 0.05 and vals["err_q"] < 0.08,
+          "sheared Hertz deck: stick zone and shear agree with Cattaneo-Mindlin (err_c < 5%, err_q < 8%)", str(vals))
+    import matplotlib.image as mpimg
+    if os.path.isfile(f"{OUT}/friction.png") and os.path.isfile(f"{OUT}/contact.png"):
+        tall, plain = mpimg.imread(f"{OUT}/friction.png").shape, mpimg.imread(f"{OUT}/contact.png").shape
+        check(tall[0] > plain[0], "plot_contact with friction: taller than without (the shear panel)", f"{tall} {plain}")
+
+# a frictionless result: --mindlin says why not and changes nothing in the picture
+rc, out, _, _ = tool("plot_contact.py", hz, "--mindlin", "-o", f"{OUT}/hertz_mindlin.png")
+check(rc == 0 and "no Mindlin curve: no friction" in out and "0 Mindlin curves" in out
+      and "tangential resultant" not in out,
+      "plot_contact --mindlin on a frictionless result: exit 0, says why there is no Mindlin curve",
+      f"exit {rc} {out.strip()[-300:]}")
+if os.path.isfile(f"{OUT}/hertz_mindlin.png") and os.path.isfile(f"{OUT}/hertz.png"):
+    import matplotlib.image as mpimg
+    same = np.array_equal(mpimg.imread(f"{OUT}/hertz_mindlin.png"), mpimg.imread(f"{OUT}/hertz.png"))
+    check(same, "plot_contact on a frictionless result: --mindlin draws the picture --hertz draws, pixel for pixel")
 
 # ---- failures end with a message -------------------------------------------------------------
 bad = f"{OUT}/nobody2.h5"
