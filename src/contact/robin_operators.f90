@@ -16,7 +16,8 @@ module robin_operators
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t
   use condense, only: body_condensed_t
-  use contact_common, only: pair_positions
+  use contact_common, only: pair_positions, body_threads
+  use sorting, only: merge_sort_by_keys
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
@@ -314,8 +315,9 @@ contains
     type(dense_op_t), target, intent(in) :: flexibility(:)
     type(error_t), intent(out) :: err
     real(wp), allocatable :: s(:, :)
-    integer :: p, info, side, a, r(2, 2)
-    integer, allocatable :: npairs(:)
+    integer :: p, info, side, a, k, r(2, 2)
+    integer, allocatable :: npairs(:), order(:), stiff_info(:)
+    logical, allocatable :: needs_stiffness(:)
     type(block_t) :: blk(2)
     type(stiffness_t), allocatable :: stiff(:)
     logical :: singular
@@ -325,6 +327,24 @@ contains
     do p = 1, contact_line%npair
       npairs(contact_line%pair_body(:, p)) = npairs(contact_line%pair_body(:, p)) + 1
     end do
+    ! the stiffness of every body in a pair with other pairs, once, before the pairs: the
+    ! bodies on the threads, largest first (an eigendecomposition of its m_a x m_a block each)
+    allocate (needs_stiffness(size(bodies)), stiff_info(size(bodies)))
+    needs_stiffness = .false.
+    stiff_info = 0
+    do p = 1, contact_line%npair
+      if (contact_line%pair_ptr(p + 1) <= contact_line%pair_ptr(p)) cycle
+      if (all(npairs(contact_line%pair_body(:, p)) == 1)) cycle
+      needs_stiffness(contact_line%pair_body(:, p)) = .true.
+    end do
+    order = [(a, a=1, size(bodies))]
+    call merge_sort_by_keys(order, reshape([(-bodies(a)%m, a=1, size(bodies))], [1, size(bodies)]))
+    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a) if (count(needs_stiffness) > 1)
+    do k = 1, size(bodies)
+      a = order(k)
+      if (needs_stiffness(a)) call body_stiffness(bodies(a)%flex, bodies(a)%rg, stiff(a)%k, stiff(a)%inf, stiff_info(a))
+    end do
+    !$omp end parallel do
     do p = 1, contact_line%npair
       self%rows(:, p) = [contact_line%pair_ptr(p), contact_line%pair_ptr(p + 1) - 1]
       self%s(p)%n = 0
@@ -350,10 +370,8 @@ contains
         do side = 1, 2
           a = contact_line%pair_body(side, p)
           r(:, side) = pair_positions(bodies(a), contact_line, p)
-          if (.not. allocated(stiff(a)%k)) then
-            call body_stiffness(bodies(a)%flex, bodies(a)%rg, stiff(a)%k, stiff(a)%inf, info)
-            if (info /= 0) exit
-          end if
+          info = stiff_info(a)
+          if (info /= 0) exit
         end do
         if (info == 0) then
           associate (ka => stiff(contact_line%pair_body(1, p)), kb => stiff(contact_line%pair_body(2, p)))
@@ -544,12 +562,19 @@ contains
     real(wp), allocatable, intent(out) :: inf(:, :) !< (m, *) the infinitely stiff directions
     integer, intent(out) :: info
     real(wp), allocatable :: z(:, :), c(:, :), ev(:), work(:), y(:, :)
-    integer :: m, nz, i, lwork
+    real(wp) :: cut
+    integer :: m, nz, i, j, lwork
     m = size(f, 1)
-    z = complement(transpose(g), m)
-    nz = size(z, 2)
-    c = matmul(transpose(z), matmul(f, z))
-    c = 0.5_wp*(c + transpose(c))
+    if (size(g, 1) == 0) then
+      ! no equilibrium rows: Z = I, so Z' F Z is F and the eigenvectors are y
+      nz = m
+      c = 0.5_wp*(f + transpose(f))
+    else
+      z = complement(transpose(g), m)
+      nz = size(z, 2)
+      c = matmul(transpose(z), matmul(f, z))
+      c = 0.5_wp*(c + transpose(c))
+    end if
     allocate (ev(nz), work(max(1, 3*nz)), k(m, m))
     k = 0.0_wp
     info = 0
@@ -563,11 +588,24 @@ contains
     allocate (work(lwork))
     call dsyev('V', 'U', nz, c, nz, ev, work, lwork, info)
     if (info /= 0) return
-    y = matmul(z, c)   ! the eigenvectors in the rows' space
-    inf = y(:, pack([(i, i=1, nz)], ev <= 1.0e-10_wp*maxval(ev)))
-    do i = 1, nz
-      if (ev(i) <= 1.0e-10_wp*maxval(ev)) cycle
-      k = k + matmul(y(:, i:i), transpose(y(:, i:i)))/ev(i)
+    if (allocated(z)) then
+      y = matmul(z, c)   ! the eigenvectors in the rows' space
+    else
+      call move_alloc(c, y)
+    end if
+    cut = 1.0e-10_wp*maxval(ev)
+    inf = y(:, pack([(i, i=1, nz)], ev <= cut))
+    ! Sigma = sum of y_i y_i' / ev_i over the kept eigenpairs, in that order, column by
+    ! column on the upper triangle, then mirrored (each entry is a product of two numbers:
+    ! the mirror is exact)
+    do j = 1, m
+      do i = 1, nz
+        if (ev(i) <= cut) cycle
+        k(1:j, j) = k(1:j, j) + (y(1:j, i)*y(j, i))/ev(i)
+      end do
+    end do
+    do j = 1, m - 1
+      k(j + 1:m, j) = k(j, j + 1:m)
     end do
   end subroutine body_stiffness
 
