@@ -12,7 +12,7 @@ module robin_operators
   use kinds, only: wp
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init
-  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd
+  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd, dpotrf, dpotri, dpocon
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t
   use condense, only: body_condensed_t
@@ -23,6 +23,10 @@ module robin_operators
   private
 
   integer, parameter :: POWER_ITS = 10   !< power iterations for each body's lambda_max (harmonic operator)
+  !> a body's F with an estimated reciprocal 1-norm condition above this has its stiffness
+  !! from a Cholesky factorization: no eigenvalue of Z' F Z is near body_stiffness's cut of
+  !! 1e-10 of the largest unless the estimate is off by 1e4
+  real(wp), parameter :: RCOND_CHOLESKY = 1.0e-6_wp
 
   !> A Robin operator: the correction of the obstacles and what goes with it.
   type, abstract, public :: robin_operator_t
@@ -564,7 +568,14 @@ contains
     real(wp), allocatable :: z(:, :), c(:, :), ev(:), work(:), y(:, :)
     real(wp) :: cut
     integer :: m, nz, i, j, lwork
+    logical :: ok
     m = size(f, 1)
+    info = 0
+    call cholesky_stiffness(f, g, k, ok)
+    if (ok) then
+      allocate (inf(m, 0))
+      return
+    end if
     if (size(g, 1) == 0) then
       ! no equilibrium rows: Z = I, so Z' F Z is F and the eigenvectors are y
       nz = m
@@ -608,6 +619,48 @@ contains
       k(j + 1:m, j) = k(j, j + 1:m)
     end do
   end subroutine body_stiffness
+
+  !> Sigma of a body whose F is well conditioned (ok; else Sigma is not set): with its
+  !! equilibrium rows g, the projected inverse F^-1 - F^-1 g' (g F^-1 g')^-1 g F^-1, which
+  !! equals Z (Z' F Z)^-1 Z' (eigenvalues of Z' F Z lie within F's: none is infinitely stiff),
+  !! from one Cholesky factorization of F (a few times cheaper than the eigendecomposition).
+  subroutine cholesky_stiffness(f, g, k, ok)
+    real(wp), intent(in) :: f(:, :)                 !< (m, m) F
+    real(wp), intent(in) :: g(:, :)                 !< (r, m) equilibrium rows (r = 0: none)
+    real(wp), allocatable, intent(out) :: k(:, :)   !< (m, m) Sigma
+    logical, intent(out) :: ok
+    real(wp), allocatable :: h(:, :), work(:), y(:, :), gg(:, :), t(:, :)
+    integer, allocatable :: iwork(:)
+    real(wp) :: rcond
+    integer :: m, r, j, info
+    ok = .false.
+    m = size(f, 1)
+    r = size(g, 1)
+    if (m == 0) return
+    h = f
+    call dpotrf('U', m, h, m, info)
+    if (info /= 0) return
+    allocate (work(3*m), iwork(m))
+    call dpocon('U', m, h, m, maxval(sum(abs(f), dim=1)), rcond, work, iwork, info)
+    if (info /= 0 .or. .not. rcond > RCOND_CHOLESKY) return
+    call dpotri('U', m, h, m, info)
+    if (info /= 0) return
+    do j = 1, m - 1
+      h(j + 1:m, j) = h(j, j + 1:m)
+    end do
+    if (r > 0) then
+      ! y = F^-1 g', gg = g F^-1 g', t = gg^-1 y': Sigma = F^-1 - y t
+      y = matmul(h, transpose(g))
+      gg = matmul(g, y)
+      t = transpose(y)
+      call dposv('U', r, m, gg, r, t, r, info)
+      if (info /= 0) return
+      h = h - matmul(y, t)
+      h = 0.5_wp*(h + transpose(h))
+    end if
+    call move_alloc(h, k)
+    ok = .true.
+  end subroutine cholesky_stiffness
 
   !> S = 2 (Sigma_A + Sigma_B)^-1 of two stiffnesses on the same rows, zero along their
   !! infinitely stiff directions: S = 2 V (V' (Sigma_A + Sigma_B) V)^-1 V', V a basis of the
