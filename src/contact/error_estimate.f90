@@ -248,6 +248,8 @@ contains
         t = 0.5_wp*t
       end do
       if (k > 60) exit
+      ! a step that leaves nu as it is: every further iteration would repeat this one exactly
+      if (all(nt == nu)) exit
       nu = nt
       phi = phit
       z = project(nu)
