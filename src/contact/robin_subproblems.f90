@@ -264,14 +264,18 @@ contains
 
   contains
 
-    !> The body's directions out of the side layout.
+    !> The body's directions out of the side layout (column by column: each a contiguous
+    !! column of `all` read at the body's rows).
     subroutine directions_out(all, mine)
       real(wp), intent(in) :: all(:, :)
       real(wp), intent(out) :: mine(:, :)
-      integer :: i, sl
-      do i = 1, m
-        sl = body%slots(i)
-        mine(i, :) = all(slot_row(sl, mm), (slot_side(sl, mm) - 1)*k + 1:(slot_side(sl, mm) - 1)*k + ka)
+      integer :: i, j, row(m), off(m)
+      row = slot_row(body%slots, mm)
+      off = (slot_side(body%slots, mm) - 1)*k
+      do j = 1, ka
+        do i = 1, m
+          mine(i, j) = all(row(i), off(i) + j)
+        end do
       end do
     end subroutine directions_out
 
@@ -279,10 +283,13 @@ contains
     subroutine directions_in(mine, all)
       real(wp), intent(in) :: mine(:, :)
       real(wp), intent(inout) :: all(:, :)
-      integer :: i, sl
-      do i = 1, m
-        sl = body%slots(i)
-        all(slot_row(sl, mm), (slot_side(sl, mm) - 1)*k + 1:(slot_side(sl, mm) - 1)*k + ka) = mine(i, :)
+      integer :: i, j, row(m), off(m)
+      row = slot_row(body%slots, mm)
+      off = (slot_side(body%slots, mm) - 1)*k
+      do j = 1, ka
+        do i = 1, m
+          all(row(i), off(i) + j) = mine(i, j)
+        end do
       end do
     end subroutine directions_in
 
