@@ -229,9 +229,11 @@ contains
       inner_solver%s = gather(state%srch, body%slots)
       inner_solver%as = gather(state%fsrch, body%slots)
     end if
-    ! the body's stored directions: column j on its side-1 rows, k + j on its side-2 rows
+    ! the body's stored directions: column j on its side-1 rows, k + j on its side-2 rows;
+    ! none without recycling (they are only stored then, never used: a quarter of the time)
     k = size(state%rw, 2)/2
     ka = min(k, recycle_size(m))
+    if (.not. inner_solver%opts%recycle) ka = 0
     allocate (rw(m, ka), raw(m, ka))
     call directions_out(state%rw, rw)
     call directions_out(state%raw, raw)
