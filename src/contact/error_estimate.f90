@@ -7,7 +7,7 @@ module error_estimate
   use lapack, only: dsymv, dpotrf, dpotrs, dposv, dsyev
   use contact_interface, only: interface_t, slot_row, row_bounds
   use condense, only: body_condensed_t
-  use contact_common, only: scatter
+  use contact_common, only: scatter, body_threads
   use linop, only: csc_op_t
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
   use monolithic, only: assemble_hessian
@@ -47,49 +47,55 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
     type(contact_result_t), intent(inout) :: res         !< lam in; error_bound, kappa out
     type(hessian_t) :: hs
-    real(wp), allocatable :: g(:), r(:), x(:), y(:), bs(:, :), lo(:), hi(:)
+    real(wp), allocatable :: g(:), r(:), x(:), y(:), xp(:), yp(:), bs(:, :), lo(:), hi(:)
     real(wp) :: lmax, lmin, nl, perr
-    integer :: m, i, k, ib
+    integer :: m, i, k, ki, ib
     logical :: ok
     m = contact_line%m
     res%error_bound = 0.0_wp
     res%kappa = 1.0_wp
     if (m == 0) return
-    allocate (g(m), r(m), x(m), y(m), bs(m, 2))
+    allocate (g(m), r(m), x(m), y(m), xp(m), yp(m), bs(m, 2))
     ! H = sum_a E_a' F_a E_a: dense for two bodies in one pair (F_1 + F_2), sparse otherwise
     call hs%init(contact_line, bodies)
     bs = 0.0_wp
     do ib = 1, size(bodies)
       call scatter(bodies(ib)%b, bodies(ib)%slots, bs)
     end do
-    ! largest eigenvalue: power iteration (a lower estimate, enlarged below)
+    ! the largest eigenvalue (power iteration, a lower estimate, enlarged below) and the
+    ! smallest (inverse iteration on the Cholesky factor of H) on two threads
+    !$omp parallel sections num_threads(body_threads()) private(i, k, ki) if (m > 64)
+    !$omp section
     do i = 1, m
-      x(i) = 1.0_wp + 0.5_wp*sin(real(i, wp))
+      xp(i) = 1.0_wp + 0.5_wp*sin(real(i, wp))
     end do
-    x = x/norm2(x)
+    xp = xp/norm2(xp)
     lmax = 0.0_wp
     do k = 1, 60
-      call hs%apply(x, y)
-      lmax = norm2(y)
+      call hs%apply(xp, yp)
+      lmax = norm2(yp)
       if (.not. lmax > 0.0_wp) exit
-      x = y/lmax
+      xp = yp/lmax
     end do
-    ! smallest eigenvalue: inverse iteration on the Cholesky factor of H
+    !$omp section
     call hs%factor(ok)
+    if (ok) then
+      do i = 1, m
+        x(i) = 1.0_wp + 0.5_wp*cos(real(3*i, wp))
+      end do
+      x = x/norm2(x)
+      do ki = 1, 60
+        y = x
+        call hs%solve(y)
+        x = y/norm2(y)
+      end do
+    end if
+    !$omp end parallel sections
     if (.not. ok .or. .not. lmax > 0.0_wp) then
       res%error_bound = huge(1.0_wp)
       res%kappa = huge(1.0_wp)
       return
     end if
-    do i = 1, m
-      x(i) = 1.0_wp + 0.5_wp*cos(real(3*i, wp))
-    end do
-    x = x/norm2(x)
-    do k = 1, 60
-      y = x
-      call hs%solve(y)
-      x = y/norm2(y)
-    end do
     call hs%apply(x, y)
     lmin = dot_product(x, y)
     res%kappa = 1.1_wp*lmax/max(lmin, tiny(1.0_wp))
@@ -254,6 +260,8 @@ contains
         t = 0.5_wp*t
       end do
       if (k > 60) exit
+      ! a step that leaves nu as it is: every further iteration would repeat this one exactly
+      if (all(nt == nu)) exit
       nu = nt
       phi = phit
       z = project(nu)

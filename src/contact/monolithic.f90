@@ -9,7 +9,7 @@ module monolithic
   use kinds, only: wp
   use config, only: solver_cfg_t
   use linop, only: linop_t, dense_op_t, dense_op_init, csc_op_t, csc_op_init
-  use lapack, only: dgemv, dsyrk, dpotrf, dtrsm, dtrsv
+  use lapack, only: dsyrk, dpotrf, dtrsm, dtrsv
   use clock, only: wtime
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, &
                    mprgp_status_name
@@ -26,11 +26,15 @@ module monolithic
   implicit none (type, external)
   private
 
-  !> H + rho G'G as an operator: H sparse, G (r, m) dense (the floating bodies' rows).
+  !> H + rho G'G as an operator: H sparse, G (r, m) by rows, its nonzeros only (a floating
+  !! body's rows touch its own pairs' rows, and after the orthonormalization those of the
+  !! bodies it is chained to: a small block per chain, not r x m).
   type, extends(linop_t) :: penalized_op_t
     type(csc_op_t) :: h
     real(wp) :: rho = 0.0_wp
-    real(wp), allocatable :: g(:, :)
+    integer :: r = 0                            !< rows of G
+    integer, allocatable :: rowptr(:), col(:)   !< row i's nonzeros: col(rowptr(i):rowptr(i+1)-1)
+    real(wp), allocatable :: val(:)             !< their values
   contains
     procedure :: apply => penalized_apply
   end type penalized_op_t
@@ -108,7 +112,7 @@ contains
           end if
           call equality_init(equality, rows, rhs, lmax)
           hessian%rho = equality%rho
-          hessian%g = equality%g
+          call sparse_rows(equality%g, hessian)
           inner_solver%opts%lambda_max = lmax + equality%rho*equality%gg
         end if
       end select
@@ -309,14 +313,50 @@ contains
     class(penalized_op_t), intent(inout) :: self
     real(wp), intent(in) :: x(:)
     real(wp), intent(out) :: y(:)
-    real(wp), allocatable :: gx(:)
+    real(wp) :: gx
+    integer :: i, k
     call self%h%apply(x, y)
-    if (.not. allocated(self%g)) return
-    if (size(self%g, 1) == 0) return
-    allocate (gx(size(self%g, 1)))
-    call dgemv('N', size(self%g, 1), size(self%g, 2), 1.0_wp, self%g, size(self%g, 1), x, 1, 0.0_wp, gx, 1)
-    call dgemv('T', size(self%g, 1), size(self%g, 2), self%rho, self%g, size(self%g, 1), gx, 1, 1.0_wp, y, 1)
+    do i = 1, self%r
+      gx = 0.0_wp
+      do k = self%rowptr(i), self%rowptr(i + 1) - 1
+        gx = gx + self%val(k)*x(self%col(k))
+      end do
+      gx = self%rho*gx
+      do k = self%rowptr(i), self%rowptr(i + 1) - 1
+        y(self%col(k)) = y(self%col(k)) + self%val(k)*gx
+      end do
+    end do
   end subroutine penalized_apply
+
+  !> The nonzeros of the rows of g (r, m), row by row (columns ascending), into op.
+  subroutine sparse_rows(g, op)
+    real(wp), intent(in) :: g(:, :)
+    type(penalized_op_t), intent(inout) :: op
+    integer, allocatable :: next(:)
+    integer :: i, j
+    op%r = size(g, 1)
+    allocate (op%rowptr(op%r + 1), next(op%r))
+    next = 0
+    do j = 1, size(g, 2)
+      do i = 1, op%r
+        if (g(i, j) /= 0.0_wp) next(i) = next(i) + 1
+      end do
+    end do
+    op%rowptr(1) = 1
+    do i = 1, op%r
+      op%rowptr(i + 1) = op%rowptr(i) + next(i)
+    end do
+    allocate (op%col(op%rowptr(op%r + 1) - 1), op%val(op%rowptr(op%r + 1) - 1))
+    next = op%rowptr(1:op%r)
+    do j = 1, size(g, 2)
+      do i = 1, op%r
+        if (g(i, j) == 0.0_wp) cycle
+        op%col(next(i)) = j
+        op%val(next(i)) = g(i, j)
+        next(i) = next(i) + 1
+      end do
+    end do
+  end subroutine sparse_rows
 
   !> G <- L^-1 G, e <- L^-1 e with G G' = L L' (Cholesky): rows with G G' = I, the same
   !! constraint. info /= 0: G G' is not definite (dependent rows).

@@ -12,16 +12,21 @@ module robin_operators
   use kinds, only: wp
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init
-  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd
+  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd, dpotrf, dpotri, dpocon
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, ROW_NORMAL, ROW_TANGENT
   use condense, only: body_condensed_t
-  use contact_common, only: pair_positions
+  use contact_common, only: pair_positions, body_threads
+  use sorting, only: merge_sort_by_keys
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
 
   integer, parameter :: POWER_ITS = 10   !< power iterations for each body's lambda_max (harmonic operator)
+  !> a body's F with an estimated reciprocal 1-norm condition above this has its stiffness
+  !! from a Cholesky factorization: no eigenvalue of Z' F Z is near body_stiffness's cut of
+  !! 1e-10 of the largest unless the estimate is off by 1e4
+  real(wp), parameter :: RCOND_CHOLESKY = 1.0e-6_wp
 
   !> A Robin operator: the correction of the obstacles and what goes with it.
   type, abstract, public :: robin_operator_t
@@ -314,8 +319,9 @@ contains
     type(dense_op_t), target, intent(in) :: flexibility(:)
     type(error_t), intent(out) :: err
     real(wp), allocatable :: s(:, :)
-    integer :: p, info, side, a, r(2, 2)
-    integer, allocatable :: npairs(:)
+    integer :: p, info, side, a, k, r(2, 2)
+    integer, allocatable :: npairs(:), order(:), stiff_info(:)
+    logical, allocatable :: needs_stiffness(:)
     type(block_t) :: blk(2)
     type(stiffness_t), allocatable :: stiff(:)
     logical :: singular
@@ -325,6 +331,24 @@ contains
     do p = 1, contact_line%npair
       npairs(contact_line%pair_body(:, p)) = npairs(contact_line%pair_body(:, p)) + 1
     end do
+    ! the stiffness of every body in a pair with other pairs, once, before the pairs: the
+    ! bodies on the threads, largest first (an eigendecomposition of its m_a x m_a block each)
+    allocate (needs_stiffness(size(bodies)), stiff_info(size(bodies)))
+    needs_stiffness = .false.
+    stiff_info = 0
+    do p = 1, contact_line%npair
+      if (contact_line%pair_ptr(p + 1) <= contact_line%pair_ptr(p)) cycle
+      if (all(npairs(contact_line%pair_body(:, p)) == 1)) cycle
+      needs_stiffness(contact_line%pair_body(:, p)) = .true.
+    end do
+    order = [(a, a=1, size(bodies))]
+    call merge_sort_by_keys(order, reshape([(-bodies(a)%m, a=1, size(bodies))], [1, size(bodies)]))
+    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a) if (count(needs_stiffness) > 1)
+    do k = 1, size(bodies)
+      a = order(k)
+      if (needs_stiffness(a)) call body_stiffness(bodies(a)%flex, bodies(a)%rg, stiff(a)%k, stiff(a)%inf, stiff_info(a))
+    end do
+    !$omp end parallel do
     do p = 1, contact_line%npair
       self%rows(:, p) = [contact_line%pair_ptr(p), contact_line%pair_ptr(p + 1) - 1]
       self%s(p)%n = 0
@@ -353,10 +377,8 @@ contains
         do side = 1, 2
           a = contact_line%pair_body(side, p)
           r(:, side) = pair_positions(bodies(a), contact_line, p)
-          if (.not. allocated(stiff(a)%k)) then
-            call body_stiffness(bodies(a)%flex, bodies(a)%rg, stiff(a)%k, stiff(a)%inf, info)
-            if (info /= 0) exit
-          end if
+          info = stiff_info(a)
+          if (info /= 0) exit
         end do
         if (info == 0) then
           associate (ka => stiff(contact_line%pair_body(1, p)), kb => stiff(contact_line%pair_body(2, p)))
@@ -575,12 +597,26 @@ contains
     real(wp), allocatable, intent(out) :: inf(:, :) !< (m, *) the infinitely stiff directions
     integer, intent(out) :: info
     real(wp), allocatable :: z(:, :), c(:, :), ev(:), work(:), y(:, :)
-    integer :: m, nz, i, lwork
+    real(wp) :: cut
+    integer :: m, nz, i, j, lwork
+    logical :: ok
     m = size(f, 1)
-    z = complement(transpose(g), m)
-    nz = size(z, 2)
-    c = matmul(transpose(z), matmul(f, z))
-    c = 0.5_wp*(c + transpose(c))
+    info = 0
+    call cholesky_stiffness(f, g, k, ok)
+    if (ok) then
+      allocate (inf(m, 0))
+      return
+    end if
+    if (size(g, 1) == 0) then
+      ! no equilibrium rows: Z = I, so Z' F Z is F and the eigenvectors are y
+      nz = m
+      c = 0.5_wp*(f + transpose(f))
+    else
+      z = complement(transpose(g), m)
+      nz = size(z, 2)
+      c = matmul(transpose(z), matmul(f, z))
+      c = 0.5_wp*(c + transpose(c))
+    end if
     allocate (ev(nz), work(max(1, 3*nz)), k(m, m))
     k = 0.0_wp
     info = 0
@@ -594,13 +630,68 @@ contains
     allocate (work(lwork))
     call dsyev('V', 'U', nz, c, nz, ev, work, lwork, info)
     if (info /= 0) return
-    y = matmul(z, c)   ! the eigenvectors in the rows' space
-    inf = y(:, pack([(i, i=1, nz)], ev <= 1.0e-10_wp*maxval(ev)))
-    do i = 1, nz
-      if (ev(i) <= 1.0e-10_wp*maxval(ev)) cycle
-      k = k + matmul(y(:, i:i), transpose(y(:, i:i)))/ev(i)
+    if (allocated(z)) then
+      y = matmul(z, c)   ! the eigenvectors in the rows' space
+    else
+      call move_alloc(c, y)
+    end if
+    cut = 1.0e-10_wp*maxval(ev)
+    inf = y(:, pack([(i, i=1, nz)], ev <= cut))
+    ! Sigma = sum of y_i y_i' / ev_i over the kept eigenpairs, in that order, column by
+    ! column on the upper triangle, then mirrored (each entry is a product of two numbers:
+    ! the mirror is exact)
+    do j = 1, m
+      do i = 1, nz
+        if (ev(i) <= cut) cycle
+        k(1:j, j) = k(1:j, j) + (y(1:j, i)*y(j, i))/ev(i)
+      end do
+    end do
+    do j = 1, m - 1
+      k(j + 1:m, j) = k(j, j + 1:m)
     end do
   end subroutine body_stiffness
+
+  !> Sigma of a body whose F is well conditioned (ok; else Sigma is not set): with its
+  !! equilibrium rows g, the projected inverse F^-1 - F^-1 g' (g F^-1 g')^-1 g F^-1, which
+  !! equals Z (Z' F Z)^-1 Z' (eigenvalues of Z' F Z lie within F's: none is infinitely stiff),
+  !! from one Cholesky factorization of F (a few times cheaper than the eigendecomposition).
+  subroutine cholesky_stiffness(f, g, k, ok)
+    real(wp), intent(in) :: f(:, :)                 !< (m, m) F
+    real(wp), intent(in) :: g(:, :)                 !< (r, m) equilibrium rows (r = 0: none)
+    real(wp), allocatable, intent(out) :: k(:, :)   !< (m, m) Sigma
+    logical, intent(out) :: ok
+    real(wp), allocatable :: h(:, :), work(:), y(:, :), gg(:, :), t(:, :)
+    integer, allocatable :: iwork(:)
+    real(wp) :: rcond
+    integer :: m, r, j, info
+    ok = .false.
+    m = size(f, 1)
+    r = size(g, 1)
+    if (m == 0) return
+    h = f
+    call dpotrf('U', m, h, m, info)
+    if (info /= 0) return
+    allocate (work(3*m), iwork(m))
+    call dpocon('U', m, h, m, maxval(sum(abs(f), dim=1)), rcond, work, iwork, info)
+    if (info /= 0 .or. .not. rcond > RCOND_CHOLESKY) return
+    call dpotri('U', m, h, m, info)
+    if (info /= 0) return
+    do j = 1, m - 1
+      h(j + 1:m, j) = h(j, j + 1:m)
+    end do
+    if (r > 0) then
+      ! y = F^-1 g', gg = g F^-1 g', t = gg^-1 y': Sigma = F^-1 - y t
+      y = matmul(h, transpose(g))
+      gg = matmul(g, y)
+      t = transpose(y)
+      call dposv('U', r, m, gg, r, t, r, info)
+      if (info /= 0) return
+      h = h - matmul(y, t)
+      h = 0.5_wp*(h + transpose(h))
+    end if
+    call move_alloc(h, k)
+    ok = .true.
+  end subroutine cholesky_stiffness
 
   !> S = 2 (Sigma_A + Sigma_B)^-1 of two stiffnesses on the same rows, zero along their
   !! infinitely stiff directions: S = 2 V (V' (Sigma_A + Sigma_B) V)^-1 V', V a basis of the

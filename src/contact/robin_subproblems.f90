@@ -248,9 +248,11 @@ contains
       inner_solver%s = gather(state%srch, body%slots)
       inner_solver%as = gather(state%fsrch, body%slots)
     end if
-    ! the body's stored directions: column j on its side-1 rows, k + j on its side-2 rows
+    ! the body's stored directions: column j on its side-1 rows, k + j on its side-2 rows;
+    ! none without recycling (they are only stored then, never used: a quarter of the time)
     k = size(state%rw, 2)/2
     ka = min(k, recycle_size(m))
+    if (.not. inner_solver%opts%recycle) ka = 0
     allocate (rw(m, ka), raw(m, ka))
     call directions_out(state%rw, rw)
     call directions_out(state%raw, raw)
@@ -292,14 +294,18 @@ contains
 
   contains
 
-    !> The body's directions out of the side layout.
+    !> The body's directions out of the side layout (column by column: each a contiguous
+    !! column of `all` read at the body's rows).
     subroutine directions_out(all, mine)
       real(wp), intent(in) :: all(:, :)
       real(wp), intent(out) :: mine(:, :)
-      integer :: i, sl
-      do i = 1, m
-        sl = body%slots(i)
-        mine(i, :) = all(slot_row(sl, mm), (slot_side(sl, mm) - 1)*k + 1:(slot_side(sl, mm) - 1)*k + ka)
+      integer :: i, j, row(m), off(m)
+      row = slot_row(body%slots, mm)
+      off = (slot_side(body%slots, mm) - 1)*k
+      do j = 1, ka
+        do i = 1, m
+          mine(i, j) = all(row(i), off(i) + j)
+        end do
       end do
     end subroutine directions_out
 
@@ -307,10 +313,13 @@ contains
     subroutine directions_in(mine, all)
       real(wp), intent(in) :: mine(:, :)
       real(wp), intent(inout) :: all(:, :)
-      integer :: i, sl
-      do i = 1, m
-        sl = body%slots(i)
-        all(slot_row(sl, mm), (slot_side(sl, mm) - 1)*k + 1:(slot_side(sl, mm) - 1)*k + ka) = mine(i, :)
+      integer :: i, j, row(m), off(m)
+      row = slot_row(body%slots, mm)
+      off = (slot_side(body%slots, mm) - 1)*k
+      do j = 1, ka
+        do i = 1, m
+          all(row(i), off(i) + j) = mine(i, j)
+        end do
       end do
     end subroutine directions_in
 
