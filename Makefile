@@ -133,7 +133,7 @@ $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o
 $(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o \
                            $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
-$(BUILD)/deck_cross.o:     $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o
+$(BUILD)/deck_cross.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
                            $(BUILD)/deck_checks.o $(BUILD)/deck_cross.o $(BUILD)/deck_render.o
