@@ -77,8 +77,8 @@ contains
     call check_loads(d, st)
   end subroutine check_cross
 
-  !> The load stages: each of 1 .. the largest stage= has a load (a traction, or a nonzero
-  !! prescribed displacement), and &solver load_steps has one value or one per stage.
+  !> The load stages: with several, each of 1 .. the largest stage= has a load (a traction,
+  !! or a nonzero prescribed displacement); &solver load_steps has one value or one per stage.
   subroutine check_stages(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
@@ -86,7 +86,7 @@ contains
     logical :: loaded
     character(len=:), allocatable :: lst
     nstage = stage_count(d)
-    do s = 1, nstage
+    do s = 1, merge(nstage, 0, nstage > 1)   ! one stage: an unloaded deck is a deck (a gap closed by nothing)
       loaded = any(d%traction(1:d%ntraction)%stage == s)
       do i = 1, d%nboundary
         associate (c => d%boundary(i))
