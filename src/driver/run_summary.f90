@@ -13,7 +13,7 @@ module run_summary
   implicit none (type, external)
   private
 
-  public :: set_exit_code, summary
+  public :: set_exit_code, summary, step_line
 
 contains
 
@@ -82,6 +82,20 @@ contains
       end if
     end associate
   end subroutine summary
+
+  !> The `step:` line of load step k: its stage, load factor, outer iterations, status
+  !! and the sum of the nodal normal contact forces of all pairs.
+  function step_line(run, k) result(t)
+    type(run_t), intent(in) :: run   !< the run: its plan and current result
+    integer, intent(in) :: k         !< the step
+    character(len=:), allocatable :: t
+    real(wp) :: ftot
+    ftot = 0.0_wp
+    if (allocated(run%result%lam)) ftot = sum(run%result%lam)
+    t = 'step: step='//i2s(k)//' of='//i2s(size(run%plan))//' stage='//i2s(run%plan(k)%stage)// &
+        ' load_factor='//fmt_real(run%plan(k)%factor, '(f0.6)')//' outer='//i2s(run%result%outer)// &
+        ' status='//status_name(run%result%status)//' normal_force_sum='//sci(ftot, 5)
+  end function step_line
 
   !> The `contact:` line of each pair: the resultant of its forces on its first body, the sum
   !! of its nodal normal forces, its active rows and imbalance, and the penetration and

@@ -42,6 +42,15 @@ module results
     integer :: ranks = 1                      !< MPI processes of the run (1: the serial binary)
   end type timing_t
 
+  !> One load step's result (&solver load_steps): its stage and load factor, its contact
+  !! solution and the bodies' displacements.
+  type, public :: step_result_t
+    integer :: stage = 1                        !< the stage it ramps
+    real(wp) :: load_factor = 1.0_wp            !< k/N_s of its stage's loads [-]
+    type(contact_result_t) :: res               !< its contact solution, status and counts
+    real(wp), allocatable :: u(:, :)            !< (maxndof, bodies) full displacements [length]
+  end type step_result_t
+
   public :: write_results
 
 contains
