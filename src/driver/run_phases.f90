@@ -474,8 +474,13 @@ contains
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
-    call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                       run%displacement, body_stresses(run), run%timing, err)
+    if (size(run%plan) > 1) then   ! every load step's result too
+      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
+                         run%displacement, body_stresses(run), run%timing, err, run%steps)
+    else
+      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
+                         run%displacement, body_stresses(run), run%timing, err)
+    end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
