@@ -19,7 +19,7 @@ module run_phases
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
   use contact_common, only: gather
   use results, only: write_results
-  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file, mesh_identity
+  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
   use files, only: remove_file, special_file
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
@@ -218,7 +218,8 @@ contains
   subroutine read_restart(run)
     type(run_t), intent(inout) :: run   !< the run: its mesh hashes, Robin state and result
     type(error_t) :: err
-    integer :: a
+    integer :: a, k
+    type(contact_result_t), allocatable :: done(:)
     ! an array constructor, not the section body(:)%mesh, whose temporary the checked build reports
     call mesh_identity([(run%deck%body(a)%mesh, a=1, run%nbody)], run%mesh_ids, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
@@ -227,6 +228,15 @@ contains
                          anderson_history(run%nbody, run%contact_line%npair), run%deck%solver%max_outer, &
                          run%robin_state, run%result, err)
     call fail_on(err)
+    if (size(run%plan) > 1) then   ! in a load history: the step it resumes, and the steps before it
+      call checkpoint_read_steps(run%restart_file, run%contact_line%m, run%nbody, size(run%plan), &
+                                 run%restart_step, done, err)
+      call fail_on(err)
+      allocate (run%steps(size(done)))
+      do k = 1, size(done)
+        run%steps(k)%res = done(k)
+      end do
+    end if
   end subroutine read_restart
 
   !> The budget's estimate of body a's Cholesky factor (all bodies' without a), '123 MiB'
@@ -311,6 +321,13 @@ contains
         ckpt%key = run%key
         ckpt%meshes = run%mesh_ids
         ckpt%every = deck%output%checkpoint_every
+        if (size(run%plan) > 1) then   ! a restart resumes this step, the ones before replayed
+          ckpt%step = run%step
+          allocate (ckpt%done(run%step - 1))
+          do a = 1, run%step - 1
+            ckpt%done(a) = run%steps(a)%res
+          end do
+        end if
         if (run%history%step > 0 .and. run%robin_state%it == 0) then   ! a load step after the first
           call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
                            run%robin_state, ckpt, stop_requested, run%history%obstacle, run%history%lam)
@@ -356,6 +373,7 @@ contains
     class(backend_t), intent(inout) :: backend     !< condenses, shares the forces, recovers
     integer :: k, a
     type(step_result_t), allocatable :: replayed(:)
+    type(contact_result_t) :: resumed
     allocate (run%displacement(maxval(run%systems(:)%ndof), run%nbody))
     if (size(run%plan) == 1) then
       call solve_step(run, backend)
@@ -363,6 +381,7 @@ contains
     end if
     if (allocated(run%steps)) call move_alloc(run%steps, replayed)   ! from the checkpoint
     allocate (run%steps(0))
+    resumed = run%result   ! a checkpoint's result of the step it resumes
     do k = 1, size(run%plan)
       run%step = k
       do a = 1, run%nbody
@@ -372,6 +391,7 @@ contains
       if (k < run%restart_step) then
         call replay_step(run, backend, replayed(k)%res)
       else
+        if (k == run%restart_step .and. k > 1) run%result = resumed
         if (k > run%restart_step) run%robin_state%it = 0   ! a fresh start (warm: run%history)
         call solve_step(run, backend)
       end if

@@ -92,7 +92,7 @@ contains
     end do
     allocate (times(0))
     if (present(steps)) then
-      if (size(steps) > 1) times = [(step_time(steps(k)), k=1, size(steps))]
+      if (size(steps) > 0) times = [(step_time(steps(k)), k=1, size(steps))]
     end if
     if (size(times) > 0) then
       call write_h5(tmp(1), d, msh, sys, itf, res, u, stress, tm, run_id(), st, steps)
