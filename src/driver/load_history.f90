@@ -46,7 +46,8 @@ contains
     type(load_step_t), allocatable :: steps(:)
     integer, allocatable :: n(:)
     integer :: s, j, k
-    n = stage_steps(d%solver, stage_count(d))
+    allocate (n(stage_count(d)))
+    n = stage_steps(d%solver, size(n))
     allocate (steps(sum(n)))
     k = 0
     do s = 1, size(n)

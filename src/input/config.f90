@@ -17,6 +17,8 @@ module config
   integer, parameter, public :: PATH_LEN = 4096
   !> The most load stages a deck may have (`stage=` of a load group, `&solver load_steps`).
   integer, parameter, public :: MAX_STAGES = 16
+  !> The most load steps of one stage.
+  integer, parameter, public :: MAX_STEPS = 10000
   !> An entry of `&solver load_steps` not given.
   integer, parameter, public :: STEPS_UNSET = -huge(1)
   integer, parameter, public :: SIDE_LEFT = 1    !< x = x0

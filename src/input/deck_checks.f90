@@ -14,7 +14,7 @@ module deck_checks
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t, &
-                    MAX_STAGES, STEPS_UNSET
+                    MAX_STAGES, MAX_STEPS, STEPS_UNSET
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, &
                          traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
   implicit none (type, external)
@@ -334,6 +334,9 @@ contains
       'monolithic_rtol', r2s(s%monolithic_rtol), 'must satisfy 0 < monolithic_rtol < 1')
     if (any(s%load_steps < 1 .and. s%load_steps /= STEPS_UNSET)) call bad_value(g, src, 'load_steps', &
       i2s(minval(s%load_steps, mask=s%load_steps /= STEPS_UNSET)), 'must be >= 1 (steps per stage)')
+    ! every step's result is kept for the result file: a bound well above any ramp's need
+    if (any(s%load_steps > MAX_STEPS)) call bad_value(g, src, 'load_steps', i2s(maxval(s%load_steps)), &
+      'is too many: at most '//i2s(MAX_STEPS)//' steps per stage')
     if (s%load_steps(1) == STEPS_UNSET .or. any(s%load_steps(2:) /= STEPS_UNSET .and. &
         s%load_steps(1:MAX_STAGES - 1) == STEPS_UNSET)) call bad_value(g, src, 'load_steps', '(with gaps)', &
       'must be given without gaps: one value, or one per stage from stage 1')

@@ -252,7 +252,7 @@ contains
     call v%real('monolithic_rtol', s%monolithic_rtol, unit='[-]', range='0 < monolithic_rtol < 1', &
       doc='MPRGP tolerance of `method=''monolithic''`')
     if (all_vars .or. s%load_steps(1) /= 1 .or. any(s%load_steps(2:) /= STEPS_UNSET)) &
-      call v%list('load_steps', s%load_steps, STEPS_UNSET, range='>= 1; one value, or one per stage', &
+      call v%list('load_steps', s%load_steps, STEPS_UNSET, range='1 to 10000; one value, or one per stage', &
       doc='load steps per stage: one value for every stage (`load_steps=4`) or one per stage '// &
       '(`load_steps=1,4`). Step k of a stage of N steps applies k/N of that stage''s loads and '// &
       'prescribed displacements; each step is solved in turn, warm-started from the one before; '// &

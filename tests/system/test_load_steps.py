@@ -5,6 +5,7 @@
    contact resultant on the disc is k/4 of the applied load P = 2 (equilibrium, 1e-9);
    the last step equals the one-step run (1e-10 relative: only the warm start differs);
    /steps/step_<k> has stage 1, load_factor k/4, converged; the step: lines say the same.
+   The patch test's prescribed displacement, ramped: step k's pressure is k/4 of the exact.
 2. The XDMF files are a time series: every DataItem names a dataset of the HDF5 file with
    the shape it states; meshio's TimeSeriesReader reads every step with its time.
 3. Two stages: a normal pressure (stage 1, 2 steps), then a tangential traction held by a
@@ -15,7 +16,7 @@
    (converged) and it marked (status max_outer): stage 1 lifts the block off (contact
    open, a few outer iterations), stage 2 presses it (more than max_outer = 100).
 5. Bad input, exit 1, one message naming the variable and value, nothing written: stage=0,
-   load_steps=0, more load_steps values than stages, a stage without a load.
+   load_steps=0 and 10001, more load_steps values than stages, a stage without a load.
 6. SIGTERM in the middle of the history (after the first step: line): exit 4, a checkpoint
    at step 2; --restart continues at step 2 and ends bitwise as the uninterrupted run.
 """
@@ -93,6 +94,20 @@ if four.returncode == 0:
             check(e == 0.0, f"hertz: /steps/step_4/{name} is the last result's")
         check(f.attrs["outer_iterations"] == steps["step_4"].attrs["outer"], "hertz: the root holds the last step")
         check("steps" not in g, "hertz: a one-step run has no /steps")
+
+# ---- 1b. a prescribed displacement ramped: the patch test's uniform pressure ---------------
+# (inputs/patch.nml: the top pressed down by uy = -1e-3 through &boundary; uniaxial strain, so
+# p = delta / (h1/M1 + h2/M2) exactly, M = E(1-nu)/((1+nu)(1-2nu)); step k: k/4 of it)
+p = run("inputs/patch.nml", "&solver load_steps=4 /", out("patch4"))
+check(p.returncode == 0, "patch: load_steps=4 converges", f"exit {p.returncode}")
+if p.returncode == 0:
+    m1, m2 = 200.0 * 0.7 / (1.3 * 0.4), 100.0 * 0.75 / (1.25 * 0.5)
+    p_exact = 1.0e-3 / (0.5 / m1 + 1.0 / m2)
+    with h5py.File(f"{OUT}/patch4.h5", "r") as f:
+        for k in range(1, 5):
+            pr = np.array(f[f"steps/step_{k}/contact/pressure"])
+            e = float(np.max(np.abs(pr / (k / 4 * p_exact) - 1.0)))
+            check(e <= 1e-8, f"patch: step {k}: uniform pressure {k}/4 of the exact one (1e-8)", f"{e:.2e}")
 
 # ---- 2. the XDMF time series ------------------------------------------------------------
 def xdmf_items(path):
@@ -205,6 +220,7 @@ else:
 # ---- 5. bad input ------------------------------------------------------------------------
 BAD = [("stage=0", "&traction body=1, side='top', t0=0.0,-1.0e6, stage=0 /", ["stage", "0"]),
        ("load_steps=0", "&solver load_steps=0 /", ["load_steps", "0"]),
+       ("load_steps=10001", "&solver load_steps=10001 /", ["load_steps", "10001", "10000"]),
        ("more load_steps values than stages", "&solver load_steps=2,3,4 /", ["load_steps", "2,3,4", "stages"]),
        ("a stage without a load", "&traction body=1, side='top', t0=0.0,-1.0e6, stage=4 /", ["stage = 3", "no load"]),
        ("fewer load_steps values than stages (but more than one)",
