@@ -427,8 +427,8 @@ contains
     call complete_displacements(run)
   end subroutine replay_step
 
-  !> Rank 0 keeps step k's result and prints its step: line; every rank hands its forces
-  !! and interface displacements to the next step.
+  !> Rank 0 keeps step k's result, prints its step: line and, for a converged step, hands
+  !! its forces, interface displacements and obstacles to the next (run%history).
   subroutine record_step(run, k)
     type(run_t), intent(inout) :: run
     integer, intent(in) :: k
