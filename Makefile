@@ -68,7 +68,7 @@ endif
 MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface mprgp_options mprgp_support mprgp smalbe mortar_chains mortar contact_interface condense condense_mumps contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
-        results checkpoint run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
+        results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
@@ -133,7 +133,7 @@ $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o
 $(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o \
                            $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
-$(BUILD)/deck_cross.o:     $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o
+$(BUILD)/deck_cross.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
                            $(BUILD)/deck_checks.o $(BUILD)/deck_cross.o $(BUILD)/deck_render.o
@@ -210,24 +210,27 @@ $(BUILD)/results.o:        $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contac
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o
 # the driver's modules (src/driver): the run's data, its two back-ends, its phases
+$(BUILD)/load_history.o:   $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_interface.o \
+                           $(BUILD)/errors.o $(BUILD)/floating.o $(BUILD)/kinds.o
 $(BUILD)/run_state.o:      $(BUILD)/assembly.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/deck.o $(BUILD)/errors.o \
-                           $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/mpi_env.o $(BUILD)/results.o $(BUILD)/strings.o
+                           $(BUILD)/kinds.o $(BUILD)/load_history.o $(BUILD)/mesh.o $(BUILD)/mpi_env.o $(BUILD)/results.o \
+                           $(BUILD)/strings.o
 $(BUILD)/run_backend.o:    $(BUILD)/config.o $(BUILD)/run_state.o
 # a back-end implements every phase of the interface: not every phase needs every argument
 $(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/serial_backend.o: $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense.o $(BUILD)/config.o \
-                           $(BUILD)/contact_common.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mpi_env.o \
-                           $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/sorting.o $(BUILD)/strings.o \
-                           $(BUILD)/sysinfo.o
-$(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense_mumps.o $(BUILD)/config.o \
-                           $(BUILD)/contact_common.o $(BUILD)/contact_types.o $(BUILD)/errors.o $(BUILD)/kinds.o \
-                           $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
+                           $(BUILD)/contact_common.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/load_history.o \
+                           $(BUILD)/mpi_env.o $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/sorting.o \
+                           $(BUILD)/strings.o $(BUILD)/sysinfo.o
+$(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense.o $(BUILD)/condense_mumps.o \
+                           $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
+                           $(BUILD)/floating.o $(BUILD)/kinds.o $(BUILD)/load_history.o $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_summary.o:    $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
                            $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o \
                            $(BUILD)/sysinfo.o
-$(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/clock.o \
+$(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/clock.o $(BUILD)/load_history.o \
                            $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
                            $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/files.o \
                            $(BUILD)/floating.o $(BUILD)/gmsh_msh.o $(BUILD)/kinds.o $(BUILD)/mesh.o \

@@ -20,15 +20,13 @@ program robin_contact
   use signals, only: signals_install
   use sysinfo, only: peak_rss_mb
   use budget, only: check_load_range
-  use contact_types, only: STATUS_FAILED
   use clock, only: wtime
   use strings, only: i2s
   use command_line, only: parse_arguments
   use run_state, only: run_t, start_ranks, set_collective, phase, physics_key
   use run_backend, only: backend_t
   use run_phases, only: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, &
-                        read_restart, factor_estimate, check_condensed, solve_contact, complete_displacements, &
-                        write_output, check_interrupt
+                        read_restart, factor_estimate, check_condensed, solve_steps, write_output, check_interrupt
   use run_summary, only: set_exit_code, summary
   implicit none (type, external)
 
@@ -86,17 +84,10 @@ program robin_contact
   call check_interrupt(run, backend, 'condensation')
   call backend%record_factor_memory(run)
 
-  ! ---- contact forces (rank 0 alone), then the bodies' displacements ----------------------
+  ! ---- contact forces (rank 0 alone), then the bodies' displacements, step by step ---------
   call phase(run, merge('Robin iteration  ', 'monolithic solve ', run%deck%solver%method == METHOD_ROBIN))
   t0 = wtime()
-  call set_collective(.false.)
-  call solve_contact(run)
-  call set_collective(.true.)
-  call backend%share_contact_forces(run)
-  allocate (run%displacement(maxval(run%systems(:)%ndof), run%nbody))
-  run%displacement = 0.0_wp
-  if (run%result%status /= STATUS_FAILED) call backend%recover(run)
-  call complete_displacements(run)
+  call solve_steps(run, backend)
   run%timing%iterate = wtime() - t0
   call set_exit_code(run)
 

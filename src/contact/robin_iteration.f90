@@ -32,7 +32,8 @@ contains
 
   !> The Robin iteration. With `state` the iteration resumes from a checkpoint; `ckpt%save`
   !! is called every ckpt%every iterations and when `stop_requested` turns true.
-  subroutine solve_robin(solver, contact_line, bodies, res, progress_unit, progress_lines, state, ckpt, stop_requested)
+  subroutine solve_robin(solver, contact_line, bodies, res, progress_unit, progress_lines, state, ckpt, stop_requested, &
+                         warm_obstacle, warm_lam)
     type(solver_cfg_t), intent(in) :: solver                !< solver settings
     type(interface_t), intent(in) :: contact_line           !< contact rows of all pairs
     type(body_condensed_t), intent(in) :: bodies(:)         !< condensed bodies
@@ -42,6 +43,8 @@ contains
     type(robin_state_t), intent(inout), optional :: state   !< in: state to resume from (state%it > 0)
     class(checkpointer_t), intent(inout), optional :: ckpt  !< saves checkpoints of (state, res)
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
+    !> (m,2) a fresh start's first obstacles and forces (a load step: the step before's)
+    real(wp), intent(in), optional :: warm_obstacle(:, :), warm_lam(:, :)
     type(robin_state_t) :: run_state
     type(subproblems_t), target :: subproblems
     class(robin_operator_t), allocatable :: robin_op
@@ -61,6 +64,11 @@ contains
       ! the history grows as the run goes (max_outer may be huge)
       call alloc_result(res, m, min(solver%max_outer, HISTORY_CHUNK), size(bodies))
       call state_init(run_state, m, contact_line%g0, size(bodies), contact_line%npair)
+      if (present(warm_obstacle) .and. present(warm_lam)) then
+        run_state%G = warm_obstacle
+        run_state%lam = warm_lam
+        run_state%reuse = 0   ! F_a lam_a is not known for these forces
+      end if
     end if
     res%method = 'robin'
 

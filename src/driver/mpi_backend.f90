@@ -15,11 +15,14 @@ module mpi_backend
   use strings, only: i2s, body_label
   use mpi_env, only: par_finalize, par_split, par_bcast_reals, par_bcast_ints, par_agree, par_max_real, &
                      par_sum_real, par_node_sum
-  use mumps_iface, only: mumps_t, mumps_end
+  use mumps_iface, only: mumps_t, mumps_end, mumps_solve
   use condense_mumps, only: factor_body_mumps, condense_body_mumps, recover_displacement_mumps
   use run_state, only: run_t
   use contact_common, only: gather
   use run_backend, only: backend_t
+  use condense, only: apply_b
+  use floating, only: rigid_rows
+  use load_history, only: prescribed_part
   implicit none (type, external)
   private
 
@@ -34,7 +37,7 @@ module mpi_backend
     type(mumps_t), allocatable :: solver(:) !< (nbody) each body's MUMPS instance (its own bodies')
     type(error_t), allocatable :: err(:)    !< (nbody) each body's failure in the current phase, if any
   contains
-    procedure :: check_memory, factor, condense, record_factor_memory, share_contact_forces, recover, &
+    procedure :: check_memory, factor, condense, condense_load, record_factor_memory, share_contact_forces, recover, &
                  agree_code, report_ranks, finish
     procedure, private :: split_groups, agree_fatal
   end type mpi_backend_t
@@ -187,6 +190,33 @@ contains
         maxval(self%solver(:)%max_rank_mb), ' MB (body ', maxloc(self%solver(:)%max_rank_mb, 1), ')'
     end if
   end subroutine share_condensed
+
+  !> Each group's b_a for the current step's loads (one MUMPS solve), sent to every rank;
+  !! every rank then has each floating body's load along its free motions.
+  subroutine condense_load(self, run)
+    class(mpi_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its bodies' interface loads
+    real(wp), allocatable :: u0(:)
+    integer :: a
+    do a = 1, run%nbody
+      call self%err(a)%clear()
+      if (.not. self%mine(a)) cycle
+      call prescribed_part(run%contact_line, run%systems(a), run%bodies(a))
+      if (self%solver(a)%host) then
+        u0 = run%systems(a)%f
+      else
+        allocate (u0(0))
+      end if
+      call mumps_solve(self%solver(a), u0, a, self%err(a))
+      if (.not. self%err(a)%failed() .and. self%solver(a)%host) call apply_b(run%bodies(a), u0, run%bodies(a)%b)
+      deallocate (u0)
+    end do
+    call self%agree_fatal('load step condensation failed')
+    do a = 1, run%nbody
+      call par_bcast_reals(run%bodies(a)%b, run%bodies(a)%m, self%host(a))
+      if (run%systems(a)%nrig > 0) call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
+    end do
+  end subroutine condense_load
 
   !> The MUMPS factorizations' memory [MiB].
   subroutine record_factor_memory(self, run)

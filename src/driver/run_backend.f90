@@ -15,6 +15,7 @@ module run_backend
     procedure(check_memory_iface), deferred :: check_memory   !< refuse a deck that does not fit (exit 1)
     procedure(phase_iface), deferred :: factor                !< factorize both bodies
     procedure(phase_iface), deferred :: condense              !< both bodies' flexibilities F_a and b_a
+    procedure(phase_iface), deferred :: condense_load         !< b_a alone, for a load step's loads (no factorization)
     procedure(phase_iface), deferred :: record_factor_memory  !< the factors' memory into the timing
     procedure(phase_iface), deferred :: share_contact_forces  !< rank 0's contact forces to every rank
     procedure(phase_iface), deferred :: recover               !< both bodies' displacements under their forces

@@ -11,15 +11,15 @@ module run_phases
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, nodal_stress, stress_field_t
-  use contact_interface, only: build_interface, slot_row
-  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, anderson_history
+  use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT
+  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, anderson_history, contact_result_t
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
   use contact_common, only: gather
   use results, only: write_results
-  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_file, mesh_identity
+  use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
   use files, only: remove_file, special_file
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
@@ -28,17 +28,19 @@ module run_phases
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
   use mpi_env, only: par_built, par_any
-  use run_state, only: run_t
+  use run_state, only: run_t, set_collective
   use run_backend, only: backend_t
   use serial_backend, only: serial_backend_t
   use mpi_backend, only: mpi_backend_t
-  use run_summary, only: summary
+  use run_summary, only: summary, step_line
+  use load_history, only: plan_steps, set_step_loads
+  use results, only: step_result_t
   implicit none (type, external)
   private
 
   public :: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, read_restart, &
             factor_estimate, check_condensed, solve_contact, complete_displacements, write_output, &
-            check_interrupt
+            check_interrupt, solve_steps
 
 contains
 
@@ -152,11 +154,18 @@ contains
     integer :: a
     associate (deck => run%deck)
       allocate (err(deck%nbody))
+      run%plan = plan_steps(deck)
       !$omp parallel do num_threads(run%threads) schedule(dynamic, 1)
       do a = 1, deck%nbody
-        call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
-                           run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
-                           contact_groups=body_groups(deck, a))
+        if (size(run%plan) == 1) then
+          call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
+                             run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
+                             contact_groups=body_groups(deck, a))
+        else   ! each stage's load vectors too, which the steps combine
+          call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
+                             run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
+                             contact_groups=body_groups(deck, a), nstage=run%plan(size(run%plan))%stage)
+        end if
       end do
       !$omp end parallel do
       do a = 1, deck%nbody
@@ -209,15 +218,25 @@ contains
   subroutine read_restart(run)
     type(run_t), intent(inout) :: run   !< the run: its mesh hashes, Robin state and result
     type(error_t) :: err
-    integer :: a
+    integer :: a, k
+    type(contact_result_t), allocatable :: done(:)
     ! an array constructor, not the section body(:)%mesh, whose temporary the checked build reports
     call mesh_identity([(run%deck%body(a)%mesh, a=1, run%nbody)], run%mesh_ids, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
     if (len(run%restart_file) == 0) return
     call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%nbody, &
                          anderson_history(run%nbody, run%contact_line%npair), run%deck%solver%max_outer, &
-                         run%robin_state, run%result, err)
+                         run%robin_state, run%result, err, signed=run%contact_line%kind == ROW_TANGENT)
     call fail_on(err)
+    if (size(run%plan) > 1) then   ! in a load history: the step it resumes, and the steps before it
+      call checkpoint_read_steps(run%restart_file, run%contact_line%m, run%nbody, size(run%plan), &
+                                 run%restart_step, done, err)
+      call fail_on(err)
+      allocate (run%steps(size(done)))
+      do k = 1, size(done)
+        run%steps(k)%res = done(k)
+      end do
+    end if
   end subroutine read_restart
 
   !> The budget's estimate of body a's Cholesky factor (all bodies' without a), '123 MiB'
@@ -302,8 +321,20 @@ contains
         ckpt%key = run%key
         ckpt%meshes = run%mesh_ids
         ckpt%every = deck%output%checkpoint_every
-        call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
-                         run%robin_state, ckpt, stop_requested)
+        if (size(run%plan) > 1) then   ! a restart resumes this step, the ones before replayed
+          ckpt%step = run%step
+          allocate (ckpt%done(run%step - 1))
+          do a = 1, run%step - 1
+            ckpt%done(a) = run%steps(a)%res
+          end do
+        end if
+        if (run%history%step > 0 .and. run%robin_state%it == 0) then   ! a load step after the first
+          call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
+                           run%robin_state, ckpt, stop_requested, run%history%obstacle, run%history%lam)
+        else
+          call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
+                           run%robin_state, ckpt, stop_requested)
+        end if
         if (ckpt%err%failed()) call warn(ckpt%err%text())
       end if
       if (result%status == STATUS_FAILED) return
@@ -330,6 +361,112 @@ contains
       end do
     end associate
   end subroutine solve_contact
+
+  !> The contact forces and the displacements of every load step in turn (one step: the
+  !! deck's loads at once). A step's loads are combined from the stages' vectors and only
+  !! its interface load b_a is condensed again (the factors stay); it starts from the step
+  !! before's obstacles and forces (run%history). A step that does not converge ends the
+  !! loop, the steps before it and it recorded. On a restart in the middle of a history the
+  !! steps before the checkpoint's are replayed from its forces (run%steps), not solved.
+  subroutine solve_steps(run, backend)
+    type(run_t), intent(inout) :: run              !< the run: its result, displacements and steps
+    class(backend_t), intent(inout) :: backend     !< condenses, shares the forces, recovers
+    integer :: k, a
+    type(step_result_t), allocatable :: replayed(:)
+    type(contact_result_t) :: resumed
+    allocate (run%displacement(maxval(run%systems(:)%ndof), run%nbody))
+    if (size(run%plan) == 1) then
+      call solve_step(run, backend)
+      return
+    end if
+    if (allocated(run%steps)) call move_alloc(run%steps, replayed)   ! from the checkpoint
+    allocate (run%steps(0))
+    resumed = run%result   ! a checkpoint's result of the step it resumes
+    do k = 1, size(run%plan)
+      run%step = k
+      do a = 1, run%nbody
+        call set_step_loads(run%systems(a), run%plan(k))
+      end do
+      call backend%condense_load(run)
+      if (k < run%restart_step) then
+        call replay_step(run, backend, replayed(k)%res)
+      else
+        if (k == run%restart_step .and. k > 1) run%result = resumed
+        if (k > run%restart_step) run%robin_state%it = 0   ! a fresh start (warm: run%history)
+        call set_slip_origin(run)
+        call solve_step(run, backend)
+      end if
+      call record_step(run, k)
+      if (run%result%status /= STATUS_CONVERGED) exit
+    end do
+  end subroutine solve_steps
+
+  !> Friction acts on each load step's slip increment: the tangential rows' g0 (rank 0, which
+  !! solves the contact) is the slip w_1 + w_2 the step before ended with, 0 at the first
+  !! step (doc/method.md, "Friction": the load history).
+  subroutine set_slip_origin(run)
+    type(run_t), intent(inout) :: run
+    if (run%rank /= 0 .or. .not. allocated(run%contact_line%kind)) return
+    if (.not. has_friction(run%contact_line)) return
+    associate (itf => run%contact_line, h => run%history)
+      where (itf%kind == ROW_TANGENT) itf%g0 = 0.0_wp
+      if (h%step > 0 .and. allocated(h%w)) then
+        where (itf%kind == ROW_TANGENT) itf%g0 = h%w(:, 1) + h%w(:, 2)
+      end if
+    end associate
+  end subroutine set_slip_origin
+
+  !> One contact solve (rank 0) with the bodies' current interface loads, then every
+  !! body's displacement under its forces.
+  subroutine solve_step(run, backend)
+    type(run_t), intent(inout) :: run
+    class(backend_t), intent(inout) :: backend
+    call set_collective(.false.)
+    call solve_contact(run)
+    call set_collective(.true.)
+    call backend%share_contact_forces(run)
+    run%displacement = 0.0_wp
+    if (run%result%status /= STATUS_FAILED) call backend%recover(run)
+    call complete_displacements(run)
+  end subroutine solve_step
+
+  !> A step a checkpoint holds whole: its forces (rank 0 has them) to every rank, then the
+  !! displacements recovered under them, as the run that solved it did.
+  subroutine replay_step(run, backend, res)
+    type(run_t), intent(inout) :: run
+    class(backend_t), intent(inout) :: backend
+    type(contact_result_t), intent(in) :: res   !< the step's stored result (rank 0)
+    if (run%rank == 0) run%result = res
+    call backend%share_contact_forces(run)
+    run%displacement = 0.0_wp
+    call backend%recover(run)
+    call complete_displacements(run)
+  end subroutine replay_step
+
+  !> Rank 0 keeps step k's result, prints its step: line and, for a converged step, hands
+  !! its forces, interface displacements and obstacles to the next (run%history).
+  subroutine record_step(run, k)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: k
+    type(step_result_t), allocatable :: grown(:)
+    if (run%rank == 0) then
+      allocate (grown(size(run%steps) + 1))
+      grown(1:size(run%steps)) = run%steps
+      grown(k)%stage = run%plan(k)%stage
+      grown(k)%load_factor = run%plan(k)%factor
+      grown(k)%res = run%result
+      grown(k)%u = run%displacement
+      call move_alloc(grown, run%steps)
+      write (output_unit, '(a)') step_line(run, k)
+      flush (output_unit)
+      if (run%result%status == STATUS_CONVERGED) then
+        run%history%step = k
+        run%history%lam = run%result%lam_body
+        run%history%w = run%result%w
+        run%history%obstacle = run%result%obstacle
+      end if
+    end if
+  end subroutine record_step
 
   !> Body a's rigid motion amplitudes (the displacement of its fixing DOFs), space-separated.
   function amplitudes(run, a) result(t)
@@ -373,8 +510,13 @@ contains
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
-    call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                       run%displacement, body_stresses(run), run%timing, err)
+    if (size(run%plan) > 1) then   ! every load step's result too
+      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
+                         run%displacement, body_stresses(run), run%timing, err, run%steps)
+    else
+      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
+                         run%displacement, body_stresses(run), run%timing, err)
+    end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))

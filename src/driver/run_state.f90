@@ -14,7 +14,8 @@ module run_state
   use contact_interface, only: interface_t
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t
-  use results, only: timing_t
+  use results, only: timing_t, step_result_t
+  use load_history, only: load_step_t, step_history_t
   use strings, only: fmt_real
   use clock, only: wtime
   use mpi_env, only: par_built, par_init, par_finalize, par_rank, par_size, par_abort
@@ -40,6 +41,11 @@ module run_state
     type(robin_state_t) :: robin_state                 !< the Robin iteration's state (restart)
     type(contact_result_t) :: result                   !< contact forces, status, counts
     real(wp), allocatable :: displacement(:, :)        !< (max ndof, bodies) the bodies' displacements
+    type(load_step_t), allocatable :: plan(:)          !< the load steps (one: the deck's loads at once)
+    integer :: step = 1                                !< the step being solved
+    integer :: restart_step = 1                        !< the step a checkpoint resumes (earlier ones are replayed)
+    type(step_result_t), allocatable :: steps(:)       !< (steps solved) rank 0: each step's result, with several
+    type(step_history_t) :: history                    !< what the last converged step hands the next
     type(timing_t) :: timing                           !< time per phase, memory
     logical :: written = .false.                       !< this run's result file exists
     integer :: code = 0                                !< the exit code

@@ -5,7 +5,7 @@ module run_summary
   use, intrinsic :: iso_fortran_env, only: error_unit
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED
   use config, only: solver_cfg_t, ROBIN_HARMONIC
-  use contact_interface, only: interface_t
+  use contact_interface, only: interface_t, ROW_NORMAL
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED
@@ -15,7 +15,7 @@ module run_summary
   implicit none (type, external)
   private
 
-  public :: set_exit_code, summary
+  public :: set_exit_code, summary, step_line
 
 contains
 
@@ -84,6 +84,23 @@ contains
       end if
     end associate
   end subroutine summary
+
+  !> The `step:` line of load step k: its stage, load factor, outer iterations, status
+  !! and the sum of the nodal normal contact forces of all pairs.
+  function step_line(run, k) result(t)
+    type(run_t), intent(in) :: run   !< the run: its plan and current result
+    integer, intent(in) :: k         !< the step
+    character(len=:), allocatable :: t
+    real(wp) :: ftot
+    ftot = 0.0_wp
+    if (allocated(run%result%lam)) then
+      ftot = sum(run%result%lam)
+      if (allocated(run%contact_line%kind)) ftot = sum(run%result%lam, mask=run%contact_line%kind == ROW_NORMAL)
+    end if
+    t = 'step: step='//i2s(k)//' of='//i2s(size(run%plan))//' stage='//i2s(run%plan(k)%stage)// &
+        ' load_factor='//fmt_real(run%plan(k)%factor, '(f0.6)')//' outer='//i2s(run%result%outer)// &
+        ' status='//status_name(run%result%status)//' normal_force_sum='//sci(ftot, 5)
+  end function step_line
 
   !> The `contact:` line of each pair: the resultant of its forces on its first body, the sum
   !! of its nodal normal forces, its active rows and imbalance, and the penetration and

@@ -14,6 +14,7 @@ module serial_backend
   use mpi_env, only: par_finalize
   use run_state, only: run_t
   use run_backend, only: backend_t
+  use load_history, only: step_interface_load
   use strings, only: body_label
   implicit none (type, external)
   private
@@ -21,7 +22,7 @@ module serial_backend
   !> Every body here, the bodies on the threads.
   type, extends(backend_t), public :: serial_backend_t
   contains
-    procedure :: check_memory, factor, condense, record_factor_memory, share_contact_forces, recover, &
+    procedure :: check_memory, factor, condense, condense_load, record_factor_memory, share_contact_forces, recover, &
                  agree_code, report_ranks, finish
   end type serial_backend_t
 
@@ -77,6 +78,26 @@ contains
       call fail_on(err(a), 'body '//body_label(a)//': condensation failed')
     end do
   end subroutine condense
+
+  !> Every body's b_a for the current step's loads (one solve each), the largest first.
+  subroutine condense_load(self, run)
+    class(serial_backend_t), intent(inout) :: self
+    type(run_t), intent(inout) :: run   !< the run: its bodies' interface loads
+    type(error_t), allocatable :: err(:)
+    integer, allocatable :: order(:)
+    integer :: a, k
+    allocate (err(run%nbody))
+    order = largest_first(run)
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
+    do k = 1, run%nbody
+      a = order(k)
+      call step_interface_load(run%contact_line, a, run%systems(a), run%bodies(a), err(a))
+    end do
+    !$omp end parallel do
+    do a = 1, run%nbody
+      call fail_on(err(a), 'body '//body_label(a)//': load step condensation failed')
+    end do
+  end subroutine condense_load
 
   !> The Cholesky factors' memory [MiB].
   subroutine record_factor_memory(self, run)

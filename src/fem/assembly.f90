@@ -67,7 +67,7 @@ contains
   !! On an impossible input `err` says why (ERR_INPUT; ERR_NUMERICAL for a LAPACK or
   !! internal failure), naming the body, and `sys` is incomplete.
   subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, err, &
-                           u_prescribed, body_force, boundaries, matrix, contact_groups)
+                           u_prescribed, body_force, boundaries, matrix, contact_groups, nstage)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -91,6 +91,9 @@ contains
     !> the body's contact groups (one per pair it is in), kept clear of fixing DOFs when the
     !! body is held only by contact (a rectangle's 'contact' side is too)
     character(len=*), intent(in), optional :: contact_groups(:)
+    !> the deck's load stages: each stage's load vectors too (sys%f_stage, u_stage,
+    !! fa_stage), for load steps; absent: none
+    integer, intent(in), optional :: nstage
     logical, allocatable :: prescribed(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
@@ -132,6 +135,10 @@ contains
                                with_k .and. .not. mesh%structured .and. shared <= 2)
     if (err%failed()) return
     call add_applied_loads(sys)
+    if (present(nstage)) then
+      call stage_loads(mesh, lame_lambda, lame_mu, tractions(1:ntraction), nstage, sys, err, body_force)
+      if (err%failed()) return
+    end if
     if (with_k) sys%k_norm = stiffness_norm(sys)
     if (sys%nrig > 0) call check_kernel(mesh, body, plane_strain, sys, err)
   end subroutine assemble_body
@@ -324,6 +331,51 @@ contains
     end do
     if (present(body_force)) call add_body_force(mesh, body_force, sys%f_applied)
   end subroutine applied_loads
+
+  !> Each stage's load vectors (sys%f_stage, u_stage, fa_stage): its tractions, its
+  !! prescribed values (sys%dof_stage) and their lifting, as the whole load is assembled;
+  !! the body force is stage 1's. One stage: the whole load's vectors.
+  subroutine stage_loads(mesh, lame_lambda, lame_mu, tractions, nstage, sys, err, body_force)
+    type(mesh_t), intent(in) :: mesh
+    real(wp), intent(in) :: lame_lambda, lame_mu
+    type(traction_cfg_t), intent(in) :: tractions(:)
+    integer, intent(in) :: nstage
+    type(body_system_t), intent(inout) :: sys
+    type(error_t), intent(out) :: err
+    procedure(body_force_fn), optional :: body_force
+    real(wp), allocatable :: f_all(:), u_all(:), fa_all(:)
+    integer :: s
+    sys%nstage = nstage
+    allocate (sys%f_stage(sys%n, nstage), sys%u_stage(sys%ndof, nstage), sys%fa_stage(sys%ndof, nstage))
+    if (nstage == 1) then
+      sys%f_stage(:, 1) = sys%f
+      sys%u_stage(:, 1) = sys%u_fixed
+      sys%fa_stage(:, 1) = sys%f_applied
+      return
+    end if
+    call move_alloc(sys%f, f_all)
+    call move_alloc(sys%u_fixed, u_all)
+    call move_alloc(sys%f_applied, fa_all)
+    do s = 1, nstage
+      sys%u_fixed = merge(u_all, 0.0_wp, sys%dof_stage == s)
+      if (s == 1) then
+        call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_force)
+      else
+        call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err)
+      end if
+      if (err%failed()) return
+      call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, .false., .false.)
+      if (err%failed()) return
+      call add_applied_loads(sys)
+      sys%f_stage(:, s) = sys%f
+      sys%u_stage(:, s) = sys%u_fixed
+      sys%fa_stage(:, s) = sys%f_applied
+      deallocate (sys%f, sys%u_fixed, sys%f_applied)
+    end do
+    call move_alloc(f_all, sys%f)
+    call move_alloc(u_all, sys%u_fixed)
+    call move_alloc(fa_all, sys%f_applied)
+  end subroutine stage_loads
 
   !> The element loop: each cell's stiffness into the CSC values, and the lifting
   !! f -= K_fd u_d of its prescribed values. err = ERR_INPUT on a cell with a non-positive

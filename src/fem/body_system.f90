@@ -23,6 +23,14 @@ module body_system
     !> (ndof) applied nodal loads (tractions, optional body force), all dofs [force]
     real(wp), allocatable :: f_applied(:)
     real(wp) :: k_norm = 0.0_wp               !< max abs row sum of K (infinity norm) [stress]
+    !> The loads by stage, for load steps (allocated when the assembly is asked for them):
+    !! f, u_fixed and f_applied are linear in the loads, so a step's are the sum of the
+    !! earlier stages' columns plus its load factor times its own stage's
+    integer :: nstage = 0                     !< stages assembled (0: none)
+    integer, allocatable :: dof_stage(:)      !< (ndof) stage of each prescribed value (0: free or a support)
+    real(wp), allocatable :: f_stage(:, :)    !< (n, nstage) each stage's f, its lifting included [force]
+    real(wp), allocatable :: u_stage(:, :)    !< (ndof, nstage) each stage's prescribed values [length]
+    real(wp), allocatable :: fa_stage(:, :)   !< (ndof, nstage) each stage's applied loads [force]
     !> A body whose prescribed displacements leave rigid motions free (held only by
     !! contact, doc/method.md, "Bodies held only by contact"): nrig > 0 kernel vectors R of K, and
     !! as many fixing DOFs, prescribed to 0 in the factorized system only, so that the

@@ -14,8 +14,9 @@ module supports
 
 contains
 
-  !> Which DOFs the side conditions prescribe (`prescribed`), and their values (sys%ndof,
-  !! sys%u_fixed). Sides are visited in SIDE_* order; a corner shared by two sides gets
+  !> Which DOFs the side conditions prescribe (`prescribed`), their values and load stages
+  !! (sys%ndof, sys%u_fixed, sys%dof_stage; a support's stage is 0). Sides are visited in
+  !! SIDE_* order; a corner shared by two sides gets
   !! the union of their constraints, and where both prescribe the same component with
   !! different values the later side in SIDE_* order (left, right, bottom, top) wins.
   !! `u_prescribed`, where given, replaces the values at every prescribed DOF.
@@ -29,9 +30,10 @@ contains
     integer :: side, k, cc
 
     sys%ndof = 2*mesh%nnode
-    allocate (prescribed(sys%ndof), sys%u_fixed(sys%ndof))
+    allocate (prescribed(sys%ndof), sys%u_fixed(sys%ndof), sys%dof_stage(sys%ndof))
     prescribed = .false.
     sys%u_fixed = 0.0_wp
+    sys%dof_stage = 0
     do side = 1, 4
       call side_nodes(mesh, side, nodes)
       select case (body%bc(side))
@@ -40,6 +42,7 @@ contains
           do cc = 1, 2
             prescribed(2*(nodes(k) - 1) + cc) = .true.
             sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
+            sys%dof_stage(2*(nodes(k) - 1) + cc) = 0
           end do
         end do
       case (BC_ROLLER)
@@ -48,12 +51,14 @@ contains
         do k = 1, size(nodes)
           prescribed(2*(nodes(k) - 1) + cc) = .true.
           sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
+          sys%dof_stage(2*(nodes(k) - 1) + cc) = 0
         end do
       case (BC_DISPLACEMENT)
         do k = 1, size(nodes)
           do cc = 1, 2
             prescribed(2*(nodes(k) - 1) + cc) = .true.
             sys%u_fixed(2*(nodes(k) - 1) + cc) = body%u_side(cc, side)
+            sys%dof_stage(2*(nodes(k) - 1) + cc) = body%side_stage(side)
           end do
         end do
       case default   ! BC_FREE, BC_CONTACT: nothing
@@ -61,6 +66,7 @@ contains
     end do
     if (present(u_prescribed)) then
       where (prescribed) sys%u_fixed = u_prescribed
+      where (prescribed .and. sys%dof_stage == 0) sys%dof_stage = 1
     end if
   end subroutine prescribed_dofs
 
@@ -96,6 +102,7 @@ contains
           dof = 2*(nodes(k) - 1) + cc
           prescribed(dof) = .true.
           sys%u_fixed(dof) = boundaries(i)%u(cc)
+          sys%dof_stage(dof) = merge(boundaries(i)%stage, 0, boundaries(i)%u(cc) /= 0.0_wp)
         end do
       end do
     end do

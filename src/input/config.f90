@@ -10,11 +10,17 @@ module config
   implicit none (type, external)
   private
 
-  public :: deck_init, pair_oriented
+  public :: deck_init, pair_oriented, stage_count, stage_steps
 
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
   integer, parameter, public :: PATH_LEN = 4096
+  !> The most load stages a deck may have (`stage=` of a load group, `&solver load_steps`).
+  integer, parameter, public :: MAX_STAGES = 16
+  !> The most load steps of one stage.
+  integer, parameter, public :: MAX_STEPS = 10000
+  !> An entry of `&solver load_steps` not given.
+  integer, parameter, public :: STEPS_UNSET = -huge(1)
   integer, parameter, public :: SIDE_LEFT = 1    !< x = x0
   integer, parameter, public :: SIDE_RIGHT = 2   !< x = x0 + width
   integer, parameter, public :: SIDE_BOTTOM = 3  !< y = y0
@@ -105,6 +111,7 @@ module config
     real(wp) :: poisson = 0.3_wp      !< Poisson's ratio [-], in (-1, 0.5)
     integer :: bc(4) = BC_FREE        !< condition per side (SIDE_* order)
     real(wp) :: u_side(2, 4) = 0.0_wp !< prescribed displacement per side when bc = BC_DISPLACEMENT [length]
+    integer :: side_stage(4) = 1      !< load stage of each side's prescribed displacement
   end type body_cfg_t
 
   !> A traction on one side of a rectangle, t(s) = t0 + t1*s with s the global coordinate
@@ -119,6 +126,7 @@ module config
     real(wp) :: tx(2) = 0.0_wp        !< d t / d x [stress/length] (group)
     real(wp) :: ty(2) = 0.0_wp        !< d t / d y [stress/length] (group)
     real(wp) :: pressure = 0.0_wp     !< normal pressure, positive pushing in [stress] (group)
+    integer :: stage = 1              !< the load stage that ramps it
     character(len=64) :: origin = ''  !< where the deck gave it ('line N', 'command-line override k')
   end type traction_cfg_t
 
@@ -128,6 +136,7 @@ module config
     character(len=128) :: group = ''  !< edge group name
     logical :: fix(2) = .false.       !< which components are prescribed (ux, uy)
     real(wp) :: u(2) = 0.0_wp         !< their values [length]
+    integer :: stage = 1              !< the load stage that ramps nonzero values
     character(len=64) :: origin = ''  !< where the deck gave it
   end type boundary_cfg_t
 
@@ -167,6 +176,8 @@ module config
     real(wp) :: inner_rtol_max = 1.0e-2_wp            !< ceiling of the adaptive inner tolerance
     integer :: inner_max_it = 100000                  !< MPRGP iteration limit per subproblem
     real(wp) :: monolithic_rtol = 1.0e-12_wp          !< MPRGP tolerance for method='monolithic'
+    !> load steps per stage: one value for every stage, or one per stage (STEPS_UNSET: not given)
+    integer :: load_steps(MAX_STAGES) = reshape([1], [MAX_STAGES], pad=[STEPS_UNSET])
   end type solver_cfg_t
 
   !> Output settings.
@@ -226,5 +237,30 @@ contains
       q%body_group = p%body_group(2:1:-1)
     end if
   end function pair_oriented
+
+  !> The deck's load stages: the largest `stage=` of its load groups (1 without any).
+  pure integer function stage_count(d) result(n)
+    type(deck_t), intent(in) :: d   !< the deck
+    integer :: b
+    n = 1
+    if (d%ntraction > 0) n = max(n, maxval(d%traction(1:d%ntraction)%stage))
+    if (d%nboundary > 0) n = max(n, maxval(d%boundary(1:d%nboundary)%stage))
+    do b = 1, d%nbody
+      n = max(n, maxval(d%body(b)%side_stage, mask=d%body(b)%bc == BC_DISPLACEMENT))
+    end do
+  end function stage_count
+
+  !> The load steps of each of the nstage stages: `load_steps` per stage, or its one value
+  !! for every stage.
+  pure function stage_steps(solver, nstage) result(steps)
+    type(solver_cfg_t), intent(in) :: solver   !< its load_steps
+    integer, intent(in) :: nstage              !< the deck's stages
+    integer :: steps(nstage)
+    if (count(solver%load_steps /= STEPS_UNSET) <= 1) then
+      steps = solver%load_steps(1)
+    else
+      steps = solver%load_steps(1:nstage)
+    end if
+  end function stage_steps
 
 end module config

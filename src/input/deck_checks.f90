@@ -14,7 +14,7 @@ module deck_checks
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t, &
-                    FRICTION_TRESCA, FRICTION_COULOMB
+                    FRICTION_TRESCA, FRICTION_COULOMB, MAX_STAGES, MAX_STEPS, STEPS_UNSET
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, &
                          traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
   implicit none (type, external)
@@ -49,12 +49,18 @@ contains
     type(deck_t), target, intent(inout) :: d
     type(scene_in_t), target :: sc
     type(vars_t) :: v
+    integer :: k
     select case (g%name)
     case ('scene')
       sc%plane = merge(1, 2, d%plane_strain)
       call scene_vars(d, sc, v)
     case ('solver')
       call solver_vars(d%solver, v)
+      ! a new list replaces the old one whole (an override load_steps=4 means 4 per stage)
+      k = find_asg(g, 'load_steps')
+      if (k > 0) then
+        if (g%a(k)%sub == 0) d%solver%load_steps = STEPS_UNSET
+      end if
     case ('output')
       call output_vars(d%output, v)
     end select
@@ -333,6 +339,14 @@ contains
     if (s%inner_max_it < 1) call bad_value(g, src, 'inner_max_it', i2s(s%inner_max_it), 'must be >= 1')
     if (.not. (s%monolithic_rtol > 0.0_wp .and. s%monolithic_rtol < 1.0_wp)) call bad_value(g, src, &
       'monolithic_rtol', r2s(s%monolithic_rtol), 'must satisfy 0 < monolithic_rtol < 1')
+    if (any(s%load_steps < 1 .and. s%load_steps /= STEPS_UNSET)) call bad_value(g, src, 'load_steps', &
+      i2s(minval(s%load_steps, mask=s%load_steps /= STEPS_UNSET)), 'must be >= 1 (steps per stage)')
+    ! every step's result is kept for the result file: a bound well above any ramp's need
+    if (any(s%load_steps > MAX_STEPS)) call bad_value(g, src, 'load_steps', i2s(maxval(s%load_steps)), &
+      'is too many: at most '//i2s(MAX_STEPS)//' steps per stage')
+    if (s%load_steps(1) == STEPS_UNSET .or. any(s%load_steps(2:) /= STEPS_UNSET .and. &
+        s%load_steps(1:MAX_STAGES - 1) == STEPS_UNSET)) call bad_value(g, src, 'load_steps', '(with gaps)', &
+      'must be given without gaps: one value, or one per stage from stage 1')
   end subroutine check_solver
 
   subroutine check_output(g, src, o)
@@ -448,6 +462,7 @@ contains
     call traction_vars(t, v, ALL_FORMS)
     call read_group(g, src, v)
     call traction_form(g, src, t, d%nbody)
+    call check_stage(g, src, t%stage)
     n = d%ntraction
     if (n == size(d%traction)) then   ! grow geometrically: many tractions stay linear
       allocate (tmp(max(4, 2*n)), wtmp(max(4, 2*n)))
@@ -466,6 +481,7 @@ contains
     d%traction(n)%tx = t%tx
     d%traction(n)%ty = t%ty
     d%traction(n)%pressure = t%pressure
+    d%traction(n)%stage = t%stage
     d%traction(n)%origin = '&traction at '//origin
     st%trac_at(n)%s = origin
   end subroutine add_traction
@@ -507,6 +523,7 @@ contains
     call boundary_vars(t, v, ALL_FORMS)
     call read_group(g, src, v)
     call body_given(g, src, t%body, d%nbody)
+    call check_stage(g, src, t%stage)
     if (len_trim(t%group) == 0) call die_at(src, g%line, 'in group &boundary: no group; give '// &
       'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
       '''bottom'', ''top'')')
@@ -525,6 +542,7 @@ contains
     d%boundary(n)%group = t%group
     d%boundary(n)%fix = [find_asg(g, 'ux') > 0, find_asg(g, 'uy') > 0]
     d%boundary(n)%u = [t%ux, t%uy]
+    d%boundary(n)%stage = t%stage
     d%boundary(n)%origin = '&boundary at '//origin
   end subroutine add_boundary
 
@@ -599,8 +617,9 @@ contains
     integer :: s, body
     character(len=:), allocatable :: side
 
-    call displacement_vars(t, v)
+    call displacement_vars(t, v, ALL_FORMS)
     call read_group(g, src, v)
+    call check_stage(g, src, t%stage)
     call body_and_side(g, src, t, d%nbody)
     if (len_trim(d%body(t%body)%mesh) > 0) call die_at(src, g%line, 'in group &displacement: body '// &
       i2s(t%body)//' comes from a mesh file and has no sides; prescribe its displacement with '// &
@@ -623,8 +642,19 @@ contains
     end if
     d%body(body)%bc(s) = BC_DISPLACEMENT
     d%body(body)%u_side(:, s) = t%u
+    d%body(body)%side_stage(s) = t%stage
     st%disp_given(s, body) = .true.
   end subroutine apply_displacement
+
+  !> The stage= of a load group: >= 1 and at most MAX_STAGES.
+  subroutine check_stage(g, src, stage)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    integer, intent(in) :: stage
+    if (stage < 1) call bad_value(g, src, 'stage', i2s(stage), 'must be >= 1 (the stages are 1, 2, ...)')
+    if (stage > MAX_STAGES) call bad_value(g, src, 'stage', i2s(stage), 'is out of range: a deck has at '// &
+      'most '//i2s(MAX_STAGES)//' stages')
+  end subroutine check_stage
 
   !> Check the body= and side= of a &traction or &displacement.
   subroutine body_and_side(g, src, t, nbody)

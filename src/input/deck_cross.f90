@@ -4,11 +4,12 @@
 !! displacements and loads. Every bad input ends in `fatal(EXIT_INPUT, msg)` naming the
 !! source, the group's line and the value.
 module deck_cross
+  use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
   use strings, only: i2s
   use sorting, only: merge_sort
   use config, only: deck_t, body_cfg_t, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
-                    BC_CONTACT, BC_DISPLACEMENT, bc_names
+                    BC_CONTACT, BC_DISPLACEMENT, bc_names, STEPS_UNSET, stage_count
   use deck_checks, only: state_t
   implicit none (type, external)
   private
@@ -28,6 +29,7 @@ contains
     logical :: groups
 
     p = st%path//': '
+    call check_stages(d, st)
     if (d%npair == 0) call fatal(EXIT_INPUT, p//'the deck has '//i2s(d%nbody)//' bodies and no '// &
       '&contact; name each contact pair with &contact bodies=A,B, groups=''GA'',''GB'' /')
     call check_pairs(d, st)
@@ -74,6 +76,45 @@ contains
 
     call check_loads(d, st)
   end subroutine check_cross
+
+  !> The load stages: with several, each of 1 .. the largest stage= has a load (a traction,
+  !! or a nonzero prescribed displacement); &solver load_steps has one value or one per stage.
+  subroutine check_stages(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: nstage, s, b, given, i
+    logical :: loaded
+    character(len=:), allocatable :: lst
+    nstage = stage_count(d)
+    do s = 1, merge(nstage, 0, nstage > 1)   ! one stage: an unloaded deck is a deck (a gap closed by nothing)
+      loaded = any(d%traction(1:d%ntraction)%stage == s)
+      do i = 1, d%nboundary
+        associate (c => d%boundary(i))
+          if (c%stage == s .and. any(c%fix .and. c%u /= 0.0_wp)) loaded = .true.
+        end associate
+      end do
+      do b = 1, d%nbody
+        associate (c => d%body(b))
+          if (any(c%bc == BC_DISPLACEMENT .and. c%side_stage == s .and. &
+                  (c%u_side(1, :) /= 0.0_wp .or. c%u_side(2, :) /= 0.0_wp))) loaded = .true.
+        end associate
+      end do
+      if (.not. loaded) call fatal(EXIT_INPUT, st%path//': stage = '//i2s(s)//' has no load: no &traction, '// &
+        'and no &displacement or &boundary with a nonzero value, has stage='//i2s(s)//' (the stages are 1 to '// &
+        'the largest stage= given, '//i2s(nstage)//', each with a load; a zero displacement is a support, '// &
+        'no load)')
+    end do
+    given = count(d%solver%load_steps /= STEPS_UNSET)
+    if (given > 1 .and. given /= nstage) then
+      lst = i2s(d%solver%load_steps(1))
+      do i = 2, given
+        lst = lst//','//i2s(d%solver%load_steps(i))
+      end do
+      call fatal(EXIT_INPUT, st%path//': in group &solver: load_steps = '//lst//' has '//i2s(given)// &
+        ' values for '//i2s(nstage)//' stage'//trim(merge('s', ' ', nstage > 1))//' (the largest stage= of '// &
+        'the load groups); give one value for every stage, or one per stage')
+    end if
+  end subroutine check_stages
 
   !> Side tractions on rectangles: not on a contact side; no effect on a prescribed side.
   subroutine check_loads(d, st)

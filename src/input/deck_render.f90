@@ -82,8 +82,15 @@ module deck_render
     '(a rim, a bore). Pairing and normals are computed once, on the initial configuration '// &
     '(small deformation).'
   character(len=*), parameter :: REF_SOLVER = &
-    'The outer (Robin) iteration, the inner solver (MPRGP) and the factorization. Optional, at '// &
-    'most once.'
+    'The outer (Robin) iteration, the inner solver (MPRGP), the factorization and the load '// &
+    'steps. Optional, at most once. **Load steps and stages**: every load group (`&traction`, '// &
+    '`&displacement`, a `&boundary` with a nonzero value) takes `stage=` (default 1). Stage s '// &
+    'ramps its loads and prescribed displacements linearly from 0 to their full value over its '// &
+    '`load_steps` steps while the earlier stages'' are held at full value and the later ones'' are '// &
+    '0: a normal load in stage 1, then a tangential one in stage 2 with the normal one held. '// &
+    'Zero displacements (clamped, roller, `&boundary ux=0`) are supports, in every stage. The '// &
+    'stages are 1 to the largest `stage` given, each with a load; the steps are the sum of '// &
+    '`load_steps` over them.'
   character(len=*), parameter :: REF_OUTPUT = &
     'The result file, checkpoints and progress lines. Optional, at most once.'
 
@@ -120,6 +127,7 @@ contains
       t%tx = c%traction(i)%tx
       t%ty = c%traction(i)%ty
       t%pressure = c%traction(i)%pressure
+      t%stage = c%traction(i)%stage
       call traction_vars(t, v, merge(GROUP_FORM, SIDE_FORM, len_trim(t%group) > 0))
       call tb%add(render_group('traction', v, WIDTH))
     end do
@@ -128,6 +136,7 @@ contains
       t%group = c%boundary(i)%group
       t%ux = c%boundary(i)%u(1)
       t%uy = c%boundary(i)%u(2)
+      t%stage = c%boundary(i)%stage
       if (all(c%boundary(i)%fix)) then
         call boundary_vars(t, v, UXY)
       else
@@ -141,7 +150,8 @@ contains
         t%body = b
         t%side = s
         t%u = c%body(b)%u_side(:, s)
-        call displacement_vars(t, v)
+        t%stage = c%body(b)%side_stage(s)
+        call displacement_vars(t, v, SIDE_FORM)
         call tb%add(render_group('displacement', v, WIDTH))
       end do
     end do
@@ -149,7 +159,7 @@ contains
       call contact_vars(c%pair(i), v, merge(PAIR_FORM, TWO_BODY_FORM, c%pairs_named))
       call tb%add(render_group('contact', v, WIDTH))
     end do
-    call solver_vars(c%solver, v)
+    call solver_vars(c%solver, v, rendering=.true.)
     call tb%add(render_group('solver', v, WIDTH))
     call output_vars(c%output, v)
     call tb%add(render_group('output', v, WIDTH))
@@ -204,7 +214,7 @@ contains
     call traction_vars(t, forms(1), SIDE_FORM)
     call traction_vars(t, forms(2), GROUP_FORM)
     call section('traction', REF_TRACTION, reference_table(v, forms, [str_t('side form'), str_t('group form')]))
-    call displacement_vars(t, v)
+    call displacement_vars(t, v, ALL_FORMS)
     call section('displacement', REF_DISPLACEMENT, reference_table(v))
     call boundary_vars(t, v, ALL_FORMS)
     call section('boundary', REF_BOUNDARY, reference_table(v))

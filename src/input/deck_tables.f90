@@ -10,7 +10,7 @@ module deck_tables
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
                     ORDER_CHOICES, ACCEL_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
-                    UNITS_CHOICES, FRICTION_CHOICES
+                    UNITS_CHOICES, FRICTION_CHOICES, STEPS_UNSET
   implicit none (type, external)
   private
 
@@ -18,6 +18,12 @@ module deck_tables
   public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, TWO_BODY_FORM, PAIR_FORM
   public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
             solver_vars, output_vars
+
+  ! the documentation of `stage`, shared by the load groups
+  character(len=*), parameter :: STAGE_DOC = &
+    'the load stage that applies it: stage s ramps its loads from 0 to their full value over its '// &
+    '`&solver load_steps`, the earlier stages'' loads held at full value, the later ones'' at 0 '// &
+    '(the stages are 1 to the largest `stage` given, each with a load). Rendered only when not 1'
 
   ! the documentation shared by the three unit names of &scene
   character(len=*), parameter :: UNIT_NAME_DOC = &
@@ -39,6 +45,7 @@ module deck_tables
     real(wp) :: pressure = 0.0_wp               ! normal pressure (group)
     real(wp) :: u(2) = 0.0_wp                   ! displacement
     real(wp) :: ux = 0.0_wp, uy = 0.0_wp        ! &boundary components
+    integer :: stage = 1                        ! load stage
   end type load_in_t
 
   ! which variables a table holds: all (reading), or those of one form (rendering)
@@ -135,6 +142,7 @@ contains
       call v%real('pressure', t%pressure, unit='[stress]', doc='a normal pressure, positive '// &
         'pushing into the body (n is the outward unit normal of each edge)')
     end if
+    if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC)
   end subroutine traction_vars
 
   !> &boundary: prescribed components on a group; rendered with the components given.
@@ -149,15 +157,21 @@ contains
       'every node of the group; not given: free')
     if (form /= UX_ONLY) call v%real('uy', t%uy, unit='[length]', doc='the y displacement of '// &
       'every node of the group; not given: free')
+    if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC// &
+      '. A zero displacement (a support) is no load: it holds in every stage')
   end subroutine boundary_vars
 
-  subroutine displacement_vars(t, v)
+  !> &displacement: `form` ALL_FORMS reads every variable, SIDE_FORM renders one.
+  subroutine displacement_vars(t, v, form)
     type(load_in_t), target, intent(inout) :: t
     type(vars_t), intent(out) :: v
+    integer, intent(in) :: form
     call v%int('body', t%body, range='1 to N', required=.true., doc='the body')
     call v%enum('side', t%side, SIDE_CHOICES, required=.true., doc='the side, declared '// &
       '`''displacement''` in the body''s `&body`')
     call v%pair('u', t%u, unit='[length]', doc='the displacement vector of every node of the side')
+    if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC// &
+      '. A zero displacement (a support) is no load: it holds in every stage')
   end subroutine displacement_vars
 
   !> &contact: `form` ALL_FORMS reads every variable; TWO_BODY_FORM renders the pair of
@@ -194,9 +208,14 @@ contains
       doc='*tresca only:* the bound of the shear traction')
   end subroutine contact_vars
 
-  subroutine solver_vars(s, v)
+  !> &solver; `rendering`: load_steps only when not its default.
+  subroutine solver_vars(s, v, rendering)
     type(solver_cfg_t), target, intent(inout) :: s
     type(vars_t), intent(out) :: v
+    logical, intent(in), optional :: rendering
+    logical :: all_vars
+    all_vars = .true.
+    if (present(rendering)) all_vars = .not. rendering
     call v%enum('method', s%method, METHOD_CHOICES, doc='`''robin''`: the Robin domain '// &
       'decomposition; `''monolithic''`: the same discrete problem in one piece (MPRGP on the '// &
       'condensed interface problem), the reference')
@@ -239,6 +258,13 @@ contains
       'subproblem')
     call v%real('monolithic_rtol', s%monolithic_rtol, unit='[-]', range='0 < monolithic_rtol < 1', &
       doc='MPRGP tolerance of `method=''monolithic''`')
+    if (all_vars .or. s%load_steps(1) /= 1 .or. any(s%load_steps(2:) /= STEPS_UNSET)) &
+      call v%list('load_steps', s%load_steps, STEPS_UNSET, range='1 to 10000; one value, or one per stage', &
+      doc='load steps per stage: one value for every stage (`load_steps=4`) or one per stage '// &
+      '(`load_steps=1,4`). Step k of a stage of N steps applies k/N of that stage''s loads and '// &
+      'prescribed displacements; each step is solved in turn, warm-started from the one before; '// &
+      'the result file holds every step (`/steps`) and the last one where a one-step run has it. '// &
+      'Rendered only when not 1')
   end subroutine solver_vars
 
   subroutine output_vars(o, v)

@@ -41,6 +41,7 @@ module namelist_vars
     character(len=:), allocatable :: unit       ! unit in the deck's terms, e.g. '[length]'
     character(len=:), allocatable :: range      ! the values the checks accept, e.g. '> 0'
     logical :: required = .false.               ! the group needs it (no default)
+    integer :: unset = 0                        ! T_INT list (nval > 2): the value of an entry not given
   end type var_t
 
   !> The variables of one group, each bound to its storage (which must outlive the table).
@@ -52,6 +53,7 @@ module namelist_vars
     procedure :: real => add_real     !< a real
     procedure :: pair => add_pair     !< two reals (x and y components)
     procedure :: ints => add_ints     !< two integers
+    procedure :: list => add_list     !< a list of integers, as many as given
     procedure :: str => add_str       !< a quoted string
     procedure :: strs => add_strs     !< two quoted strings
     procedure :: enum => add_enum     !< a quoted string from a list, stored as its code
@@ -150,6 +152,35 @@ contains
     call describe(self%v(self%n), doc=doc, range=range, required=required)
   end subroutine add_ints
 
+  !> A list of up to size(x) integers; the entries not given hold `unset` and are neither
+  !! rendered nor shown as defaults.
+  subroutine add_list(self, name, x, unset, doc, range)
+    class(vars_t), intent(inout) :: self
+    character(len=*), intent(in) :: name      !< variable name (lower case)
+    integer, target, intent(inout) :: x(:)    !< its storage
+    integer, intent(in) :: unset              !< the value of an entry not given
+    character(len=*), intent(in), optional :: doc       !< description
+    character(len=*), intent(in), optional :: range     !< accepted values
+    call push(self, name, T_INT)
+    self%v(self%n)%nval = size(x)
+    self%v(self%n)%iv => x
+    self%v(self%n)%unset = unset
+    call describe(self%v(self%n), doc=doc, range=range)
+  end subroutine add_list
+
+  !> The given entries of an integer list, comma-separated.
+  function list_text(v) result(s)
+    type(var_t), intent(in) :: v
+    character(len=:), allocatable :: s
+    integer :: k
+    s = ''
+    do k = 1, v%nval
+      if (v%iv(k) == v%unset) exit
+      if (k > 1) s = s//', '
+      s = s//i2s(v%iv(k))
+    end do
+  end function list_text
+
   subroutine add_strs(self, name, x, doc, required)
     class(vars_t), intent(inout) :: self
     character(len=*), intent(in) :: name                 !< variable name (lower case)
@@ -239,6 +270,8 @@ contains
         case (T_INT)
           if (v%nval == 1) then
             item = v%name//'='//i2s(v%ip)
+          else if (v%nval > 2) then
+            item = v%name//'='//list_text(v)
           else
             item = v%name//'='//i2s(v%iv(1))//', '//i2s(v%iv(2))
           end if
@@ -290,6 +323,9 @@ contains
           if (v%nval == 1) then
             typ = 'integer'
             def = '`'//i2s(v%ip)//'`'
+          else if (v%nval > 2) then
+            typ = 'integer list (at most '//i2s(v%nval)//')'
+            def = '`'//list_text(v)//'`'
           else
             typ = 'integer pair'
             def = '`'//i2s(v%iv(1))//', '//i2s(v%iv(2))//'`'

@@ -16,7 +16,7 @@ module checkpoint
   use digest, only: file_digest
   use history_io, only: write_history, read_history
   use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
-  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, recycle_size
+  use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, recycle_size, STATUS_CONVERGED
   implicit none (type, external)
   private
 
@@ -27,11 +27,15 @@ module checkpoint
     character(len=:), allocatable :: key      !< fingerprint of the deck
     character(len=:), allocatable :: meshes   !< content hashes of the mesh files (mesh_identity; '' none)
     type(error_t) :: err                      !< why the first checkpoint that failed failed (ERR_IO), naming the file
+    !> In a load history (&solver load_steps): the step being solved (0: a run of one step)
+    !! and the converged results of the steps before it, which a restart replays
+    integer :: step = 0
+    type(contact_result_t), allocatable :: done(:)
   contains
     procedure :: save => checkpoint_write
   end type h5_checkpointer_t
 
-  public :: checkpoint_read, checkpoint_file, mesh_identity
+  public :: checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
 
   integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]
   character(len=*), parameter :: INT_ATTRS(7) = [character(len=16) :: 'it', 'inner', 'nacc', 'stalled', &
@@ -53,6 +57,7 @@ module checkpoint
     integer :: nbody = 2                       ! bodies of this run
     integer :: depth = 5                       ! Anderson depth of this run
     logical :: has_products = .false., has_search = .false., has_recycle = .false., has_mu = .false.
+    logical, allocatable :: signed(:)    ! rows whose force may be negative (friction's tangential rows)
   end type ckpt_reader_t
 
 contains
@@ -135,6 +140,7 @@ contains
     call write_dset(gid, 'mu', st%mu, hs)
     call group_close(gid, hs)
     call write_history(fid, res, hs)
+    if (self%step > 0) call write_load_history(fid, self%step, self%done, hs)
     call file_close(fid, hs)
     ok = .not. hs%failed()
     if (ok) then
@@ -156,7 +162,7 @@ contains
   !! `it` and at most max_outer entries), and after reading, the counters for their ranges
   !! and every real dataset and attribute for finite values; the message names the file
   !! and the object.
-  subroutine checkpoint_read(file, key, meshes, m, nbody, depth, maxout, st, res, err)
+  subroutine checkpoint_read(file, key, meshes, m, nbody, depth, maxout, st, res, err, signed)
     character(len=*), intent(in) :: file          !< checkpoint path
     character(len=*), intent(in) :: key           !< fingerprint of this run
     character(len=*), intent(in) :: meshes        !< this run's mesh_identity
@@ -167,12 +173,16 @@ contains
     type(robin_state_t), intent(out) :: st        !< the outer state
     type(contact_result_t), intent(inout) :: res  !< receives the history and the counters
     type(error_t), intent(out) :: err             !< why it cannot be used
+    logical, intent(in), optional :: signed(:)    !< (m) rows whose force may be negative (tangential rows)
     type(ckpt_reader_t) :: r
     character(len=:), allocatable :: k
     logical :: exists_
 
     r%msg = ''
     r%src = 'restart file '//trim(file)
+    allocate (r%signed(m))
+    r%signed = .false.
+    if (present(signed)) r%signed = signed
     r%m = m
     r%nbody = nbody
     r%depth = depth
@@ -209,6 +219,133 @@ contains
     call file_close(r%fid, r%hs)
     if (len_trim(r%msg) > 0) call err%set(ERR_INPUT, r%msg)
   end subroutine checkpoint_read
+
+  !> /load_history: the step being solved (attribute step) and, for each step k before it,
+  !! group step_<k> with its converged contact result (forces, interface displacements,
+  !! gap, obstacles, rigid amplitudes; status and counts as attributes).
+  subroutine write_load_history(fid, step, done, hs)
+    integer(hid_t), intent(in) :: fid
+    integer, intent(in) :: step
+    type(contact_result_t), intent(in) :: done(:)
+    type(error_t), intent(inout) :: hs
+    integer(hid_t) :: lid, kid
+    integer :: k
+    call group_open(fid, 'load_history', lid, hs, create=.true.)
+    call write_attr(lid, 'step', step, hs)
+    do k = 1, step - 1
+      call group_open(lid, 'step_'//i2s(k), kid, hs, create=.true.)
+      call write_attr(kid, 'status', done(k)%status, hs)
+      call write_attr(kid, 'outer', done(k)%outer, hs)
+      call write_attr(kid, 'inner', done(k)%inner, hs)
+      call write_attr(kid, 'residual', done(k)%residual, hs)
+      call write_dset(kid, 'lam', done(k)%lam, hs)
+      call write_dset(kid, 'lam_body', done(k)%lam_body, hs)
+      call write_dset(kid, 'w', done(k)%w, hs)
+      call write_dset(kid, 'gap', done(k)%gap, hs)
+      call write_dset(kid, 'obstacle', done(k)%obstacle, hs)
+      call write_dset(kid, 'rigid', done(k)%rigid, hs)
+      call group_close(kid, hs)
+    end do
+    call group_close(lid, hs)
+  end subroutine write_load_history
+
+  !> The load history of a checkpoint of a run of nstep load steps: the step it resumes
+  !! (`step`) and the converged results of the steps before it (`done`). Checked as the
+  !! rest of the checkpoint: err (ERR_INPUT) naming the file and the object when the group
+  !! is missing, a shape is not this deck's (m contact nodes, nbody bodies), a value is not
+  !! finite, the step is outside 1 .. nstep, or a step before it did not converge.
+  subroutine checkpoint_read_steps(file, m, nbody, nstep, step, done, err)
+    character(len=*), intent(in) :: file                       !< checkpoint path (read by checkpoint_read)
+    integer, intent(in) :: m                                   !< contact rows of this run
+    integer, intent(in) :: nbody                               !< bodies of this run
+    integer, intent(in) :: nstep                               !< load steps of this run
+    integer, intent(out) :: step                               !< the step to resume
+    type(contact_result_t), allocatable, intent(out) :: done(:) !< (step - 1) the steps before it
+    type(error_t), intent(out) :: err                          !< why it cannot be used
+    type(ckpt_reader_t) :: r
+    integer(hid_t) :: lid, kid
+    integer(hsize_t) :: m2
+    integer :: k
+    character(len=:), allocatable :: path
+    step = 0
+    allocate (done(0))
+    r%msg = ''
+    r%src = 'restart file '//trim(file)
+    m2 = int(m, hsize_t)
+    call file_open(file, r%fid, r%hs)
+    if (r%hs%failed()) then
+      call err%set(ERR_INPUT, r%src//' is not an HDF5 file')
+      return
+    end if
+    lid = -1
+    if (.not. exists(r%fid, 'load_history', .false.)) then
+      r%msg = r%src//' has no group /load_history: it is not from a run of '//i2s(nstep)//' load steps'
+    else
+      call group_open(r%fid, 'load_history', lid, r%hs)
+      call need(r, lid, '/load_history', 'step', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+    end if
+    if (len_trim(r%msg) == 0) then
+      call read_attr(lid, 'step', step, r%hs)
+      if (step < 1 .or. step > nstep) r%msg = r%src//': attribute step of /load_history is '//i2s(step)// &
+                                              ', outside 1 .. '//i2s(nstep)//' (the load steps of this deck)'
+    end if
+    if (len_trim(r%msg) == 0) then
+      deallocate (done)
+      allocate (done(step - 1))
+      do k = 1, step - 1
+        path = '/load_history/step_'//i2s(k)
+        if (.not. exists(lid, 'step_'//i2s(k), .false.)) then
+          r%msg = r%src//' has no group '//path//' (the steps before the one it resumes)'
+          exit
+        end if
+        call group_open(lid, 'step_'//i2s(k), kid, r%hs)
+        call need(r, kid, path, 'status', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+        call need(r, kid, path, 'outer', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+        call need(r, kid, path, 'inner', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+        call need(r, kid, path, 'residual', .true., CLASS_REAL, SCALAR, 'a scalar')
+        call need(r, kid, path, 'lam', .false., CLASS_REAL, [m2], contact_nodes(m))
+        call need(r, kid, path, 'lam_body', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(m))
+        call need(r, kid, path, 'w', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(m))
+        call need(r, kid, path, 'gap', .false., CLASS_REAL, [m2], contact_nodes(m))
+        call need(r, kid, path, 'obstacle', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(m))
+        call need(r, kid, path, 'rigid', .false., CLASS_REAL, [3_hsize_t, int(nbody, hsize_t)], &
+                  'three amplitudes per body')
+        if (len_trim(r%msg) == 0) then
+          associate (d => done(k))
+            call read_attr(kid, 'status', d%status, r%hs)
+            call read_attr(kid, 'outer', d%outer, r%hs)
+            call read_attr(kid, 'inner', d%inner, r%hs)
+            call read_attr(kid, 'residual', d%residual, r%hs)
+            call read_dset(kid, 'lam', d%lam, r%hs)
+            call read_dset(kid, 'lam_body', d%lam_body, r%hs)
+            call read_dset(kid, 'w', d%w, r%hs)
+            call read_dset(kid, 'gap', d%gap, r%hs)
+            call read_dset(kid, 'obstacle', d%obstacle, r%hs)
+            call read_dset(kid, 'rigid', d%rigid, r%hs)
+            if (r%hs%failed()) then
+              r%msg = r%src//' cannot be read ('//r%hs%text()//')'
+            else if (d%status /= STATUS_CONVERGED) then
+              r%msg = r%src//': attribute status of '//path//' is '//i2s(d%status)//', not converged'
+            else if (min(d%outer, d%inner) < 0) then
+              r%msg = r%src//': attribute outer or inner of '//path//' is negative'
+            end if
+            call need_finite(r, 'attribute residual of '//path, [d%residual])
+            call need_finite(r, 'dataset '//path//'/lam', d%lam)
+            call need_finite(r, 'dataset '//path//'/lam_body', d%lam_body)
+            call need_finite(r, 'dataset '//path//'/w', d%w)
+            call need_finite(r, 'dataset '//path//'/gap', d%gap)
+            call need_finite(r, 'dataset '//path//'/obstacle', d%obstacle)
+            call need_finite(r, 'dataset '//path//'/rigid', d%rigid)
+          end associate
+        end if
+        call group_close(kid, r%hs)
+        if (len_trim(r%msg) > 0) exit
+      end do
+    end if
+    if (lid /= -1) call group_close(lid, r%hs)
+    call file_close(r%fid, r%hs)
+    if (len_trim(r%msg) > 0) call err%set(ERR_INPUT, r%msg)
+  end subroutine checkpoint_read_steps
 
   !> Each mesh file of this run (a line `<hash>  <path>` of `meshes`) must have the hash
   !! the checkpoint's /mesh_files records for its path: the file has not changed since.
@@ -536,7 +673,7 @@ contains
     call need_finite(r, 'attribute wall of /state', [st%wall])
     if (len_trim(r%msg) > 0) return
     ! after the finite check: comparing a NaN traps in the checked build
-    if (any(st%lam < 0.0_wp)) then
+    if (any(st%lam(:, 1) < 0.0_wp .and. .not. r%signed) .or. any(st%lam(:, 2) < 0.0_wp .and. .not. r%signed)) then
       r%msg = r%src//': dataset /state/lam holds negative contact forces'
       return
     end if

@@ -19,7 +19,7 @@ module results
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE
   use strings, only: word, body_label, i2s
   use mesh, only: mesh_t
-  use assembly, only: body_system_t, stress_field_t
+  use assembly, only: body_system_t, stress_field_t, nodal_stress
   use contact_interface, only: interface_t, pair_rows
   use contact_types, only: contact_result_t, status_name
   use friction_view, only: tangential_t, split_friction
@@ -43,6 +43,15 @@ module results
     integer :: ranks = 1                      !< MPI processes of the run (1: the serial binary)
   end type timing_t
 
+  !> One load step's result (&solver load_steps): its stage and load factor, its contact
+  !! solution and the bodies' displacements.
+  type, public :: step_result_t
+    integer :: stage = 1                        !< the stage it ramps
+    real(wp) :: load_factor = 1.0_wp            !< k/N_s of its stage's loads [-]
+    type(contact_result_t) :: res               !< its contact solution, status and counts
+    real(wp), allocatable :: u(:, :)            !< (maxndof, bodies) full displacements [length]
+  end type step_result_t
+
   public :: write_results
 
 contains
@@ -52,7 +61,7 @@ contains
   !! last) only when all are complete. Otherwise err (ERR_IO, naming the file and what
   !! failed); then the files of an earlier result at these names are as they were, and no
   !! temporary file is left.
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, stress, tm, err)
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, stress, tm, err, steps)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
@@ -63,7 +72,10 @@ contains
     type(stress_field_t), intent(in) :: stress(:)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     type(error_t), intent(out) :: err                  !< the failure, if any
+    !> the load steps' results (several steps: /steps, and the XDMF files a time series)
+    type(step_result_t), intent(in), optional :: steps(:)
     character(len=len_trim(file) + 32), allocatable :: name(:)
+    real(wp), allocatable :: times(:)
     character(len=len_trim(file) + 160), allocatable :: tmp(:)
     character(len=:), allocatable :: why, h5
     type(error_t) :: st
@@ -85,7 +97,15 @@ contains
     do k = 1, nf
       tmp(k) = temp_name(name(k))
     end do
-    call write_h5(tmp(1), d, msh, sys, itf, res, tg, u, stress, tm, run_id(), st)
+    allocate (times(0))
+    if (present(steps)) then
+      if (size(steps) > 0) times = [(step_time(steps(k)), k=1, size(steps))]
+    end if
+    if (size(times) > 0) then
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, run_id(), st, steps)
+    else
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, run_id(), st)
+    end if
     if (st%failed()) then
       call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%text()//')')
       call remove_temps()
@@ -95,17 +115,17 @@ contains
     ! one pair: its line is all of /contact, the grid 'contact'
     h5 = base_name(file)
     if (np == 1) then
-      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, run_id()), ok)
+      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, run_id(), times), ok)
     else
-      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(k, k=1, np)], h5, msh, itf, run_id()), ok)
+      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(k, k=1, np)], h5, msh, itf, run_id(), times), ok)
     end if
     do a = 1, nb
-      if (ok) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, run_id()), ok)
+      if (ok) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, run_id(), times), ok)
     end do
-    if (ok) call write_text(tmp(3 + nb), xdmf_text([integer ::], [0], h5, msh, itf, run_id()), ok)
+    if (ok) call write_text(tmp(3 + nb), xdmf_text([integer ::], [0], h5, msh, itf, run_id(), times), ok)
     if (np > 1) then
       do k = 1, np
-        if (ok) call write_text(tmp(3 + nb + k), xdmf_text([integer ::], [k], h5, msh, itf, run_id()), ok)
+        if (ok) call write_text(tmp(3 + nb + k), xdmf_text([integer ::], [k], h5, msh, itf, run_id(), times), ok)
       end do
     end if
     if (.not. ok) then
@@ -151,12 +171,13 @@ contains
   end subroutine result_files
 
   !> The HDF5 result file `path`, whole; st records the first failure.
-  subroutine write_h5(path, d, msh, sys, itf, res, tg, u, stress, tm, run_id, st)
+  subroutine write_h5(path, d, msh, sys, itf_all, itf, res, tg, u, stress, tm, run_id, st, steps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
     type(body_system_t), intent(in) :: sys(:)
-    type(interface_t), intent(in) :: itf
+    type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs (normal and tangential)
+    type(interface_t), intent(in) :: itf               !< its normal rows (split_friction)
     type(contact_result_t), intent(in) :: res
     type(tangential_t), intent(in) :: tg               !< the tangential part (friction), per node
     real(wp), intent(in) :: u(:, :)
@@ -164,6 +185,7 @@ contains
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
     type(error_t), intent(inout) :: st
+    type(step_result_t), intent(in), optional :: steps(:)   !< the load steps (/steps)
     integer(hid_t) :: fid, gid
     integer :: a, k
     real(wp), allocatable :: vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
@@ -313,8 +335,125 @@ contains
       deallocate (w2, w3, ua, sigt, vm)
       call group_close(gid, st)
     end do
+    if (present(steps)) call write_steps(fid, d, msh, sys, itf_all, steps, ul, us, uf, st)
     call file_close(fid, st)
   end subroutine write_h5
+
+  !> The time of a load step in the XDMF time series and /steps: the cumulative load
+  !! factor, stage - 1 + its load factor (stage 1 runs over (0, 1], stage 2 over (1, 2]).
+  pure real(wp) function step_time(step) result(t)
+    type(step_result_t), intent(in) :: step
+    t = real(step%stage - 1, wp) + step%load_factor
+  end function step_time
+
+  !> /steps/step_<k> for every load step k: its stage, load factor, time, counts and status
+  !! (attributes), its contact arrays (contact, contact/pair_<q>) and each body's
+  !! displacement and stresses (body<a>), the datasets named as the last result's.
+  subroutine write_steps(fid, d, msh, sys, itf_all, steps, ul, us, uf, st)
+    integer(hid_t), intent(in) :: fid
+    type(deck_t), intent(in) :: d
+    type(mesh_t), intent(in) :: msh(:)
+    type(body_system_t), intent(in) :: sys(:)
+    type(interface_t), intent(in) :: itf_all    !< contact rows of all pairs (normal and tangential)
+    type(step_result_t), intent(in) :: steps(:)
+    character(len=*), intent(in) :: ul, us, uf
+    type(error_t), intent(inout) :: st
+    integer(hid_t) :: sid, kid, gid, pid
+    integer :: k, a, q, nn, r(2), c
+    real(wp), allocatable :: pres(:), sigma(:, :), vm(:), sigt(:, :), pnode(:), disp(:, :)
+    type(interface_t) :: itf
+    type(contact_result_t) :: res
+    type(tangential_t) :: tg
+    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    call group_open(fid, 'steps', sid, st, create=.true.)
+    call write_attr(sid, 'count', size(steps), st)
+    call write_attr(sid, 'time', 'cumulative load factor: stage - 1 + load_factor', st)
+    do k = 1, size(steps)
+      ! one entry per contact node, the tangential part beside it (as the last result)
+      call split_friction(itf_all, steps(k)%res, itf, res, tg)
+      block
+        call group_open(sid, 'step_'//i2s(k), kid, st, create=.true.)
+        call write_attr(kid, 'stage', steps(k)%stage, st)
+        call write_attr(kid, 'load_factor', steps(k)%load_factor, st)
+        call write_attr(kid, 'time', step_time(steps(k)), st)
+        call write_attr(kid, 'outer', res%outer, st)
+        call write_attr(kid, 'inner', res%inner, st)
+        call write_attr(kid, 'status', status_name(res%status), st)
+        call write_attr(kid, 'residual', res%residual, st)
+        if (.not. allocated(res%lam)) then
+          call group_close(kid, st)
+          cycle
+        end if
+        call write_attr(kid, 'normal_force_sum', sum(res%lam), st)
+        allocate (pres(itf%m))
+        where (itf%trib > 0.0_wp)
+          pres = res%lam/itf%trib
+        elsewhere
+          pres = 0.0_wp
+        end where
+        call group_open(kid, 'contact', gid, st, create=.true.)
+        call write_dset(gid, 'normal_force', res%lam, st, uf)
+        call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
+        call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
+        call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
+        call write_dset(gid, 'pressure', pres, st, us)
+        call write_dset(gid, 'gap', res%gap, st, ul)
+        call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
+        call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
+        call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
+        call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
+        call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
+        do q = 1, itf%npair
+          r = pair_rows(itf, q)
+          call group_open(gid, 'pair_'//i2s(q), pid, st, create=.true.)
+          call write_dset(pid, 'normal_force', res%lam(r(1):r(2)), st, uf)
+          call write_dset(pid, 'normal_force_side1', res%lam_body(r(1):r(2), 1), st, uf)
+          call write_dset(pid, 'normal_force_side2', res%lam_body(r(1):r(2), 2), st, uf)
+          call write_dset(pid, 'resultant_on_first_body', tg%resultant(:, q), st, uf)
+          call write_dset(pid, 'pressure', pres(r(1):r(2)), st, us)
+          call write_dset(pid, 'gap', res%gap(r(1):r(2)), st, ul)
+          call write_dset(pid, 'active', merge(1, 0, res%lam(r(1):r(2)) > 0.0_wp), st, '1')
+          call write_dset(pid, 'normal_displacement_side1', res%w(r(1):r(2), 1), st, ul)
+          call write_dset(pid, 'normal_displacement_side2', res%w(r(1):r(2), 2), st, ul)
+          call group_close(pid, st)
+          if (tg%on) then
+            if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(gid, tg, r(1), r(2), ul, us, uf, st, &
+                                                                             'pair_'//i2s(q))
+          end if
+        end do
+        if (tg%on) call write_tangential(gid, tg, 1, itf%m, ul, us, uf, st)
+        call group_close(gid, st)
+        do a = 1, size(msh)
+          nn = msh(a)%nnode
+          call group_open(kid, 'body'//i2s(a), gid, st, create=.true.)
+          associate (ua => steps(k)%u(1:2*nn, a))
+            disp = transpose(reshape(ua, [2, nn]))   ! a contiguous copy (see write_h5)
+            call write_dset(gid, 'displacement', disp, st, ul)
+            call write_dset(gid, 'displacement_xyz', pad3(reshape(ua, [2, nn])), st, ul)
+            allocate (sigma(4, nn), vm(nn), pnode(nn))
+            call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
+          end associate
+          if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) &
+            call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' in load step '//i2s(k)// &
+                        ' are not finite: beyond double precision, rescale the units')
+          sigt = transpose(sigma)
+          call write_dset(gid, 'stress', sigt, st, us)
+          do c = 1, 4
+            call write_dset(gid, comp(c), sigt(:, c), st, us)
+          end do
+          call write_dset(gid, 'von_mises', vm, st, us)
+          call nodal_pressure(itf, a, pres, pnode)
+          call write_dset(gid, 'contact_pressure', pnode, st, us)
+          if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
+          deallocate (sigma, vm, pnode)
+          call group_close(gid, st)
+        end do
+        deallocate (pres)
+        call group_close(kid, st)
+      end block
+    end do
+    call group_close(sid, st)
+  end subroutine write_steps
 
   !> The group pair_<q> of the contact group gid: pair q's rows alone (segments 0-based
   !! within the pair), the ids of its bodies (side 1, side 2), its slave body, and the
@@ -484,45 +623,82 @@ contains
   !> An XDMF 3 file, as text, describing the bodies `bodies` and the contact lines `lines`
   !! (0: all rows, /contact, grid 'contact'; k: pair k, /contact/pair_<k>, grid
   !! 'contact_pair<k>') of the HDF5 file `h5`: one uniform grid directly under Domain for
-  !! one grid (the layout meshio reads), a spatial collection for several (ParaView). A
-  !! comment names the run that wrote it (the HDF5 file's attribute run_id).
-  function xdmf_text(bodies, lines, h5, msh, itf, run_id) result(t)
+  !! one grid (the layout meshio reads), a spatial collection for several (ParaView). With
+  !! load steps (`times`, one per step: the cumulative load factor) a temporal collection
+  !! of those, step k's fields from /steps/step_<k> (ParaView's time slider; meshio's
+  !! TimeSeriesReader for one grid). A comment names the run that wrote it (the HDF5 file's
+  !! attribute run_id).
+  function xdmf_text(bodies, lines, h5, msh, itf, run_id, times) result(t)
     integer, intent(in) :: bodies(:), lines(:)
     character(len=*), intent(in) :: h5
     type(mesh_t), intent(in) :: msh(:)
     type(interface_t), intent(in) :: itf
     character(len=*), intent(in) :: run_id
+    real(wp), intent(in) :: times(:)
     character(len=:), allocatable :: t, h
-    integer :: k, r(2)
-    logical :: many
+    character(len=32) :: tv
+    integer :: k
     h = xml_escape(h5)
-    many = size(bodies) + size(lines) > 1
     t = line('<?xml version="1.0" ?>')//line('<!-- robin_contact '//program_version//' run_id '//run_id//' -->')// &
         line('<Xdmf Version="3.0">')//line('  <Domain>')
-    if (many) t = t//line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
-    do k = 1, size(bodies)
-      t = t//grid_text(bodies(k), h, msh(bodies(k)))
-    end do
-    do k = 1, size(lines)
-      if (lines(k) == 0) then
-        t = t//contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body')
-      else
-        r = pair_rows(itf, lines(k))
-        t = t//contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
-                                 r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side')
-      end if
-    end do
-    if (many) t = t//line('    </Grid>')
+    if (size(times) == 0) then
+      t = t//grids_text(bodies, lines, h, msh, itf, '', '')
+    else
+      t = t//line('    <Grid Name="steps" GridType="Collection" CollectionType="Temporal">')
+      do k = 1, size(times)
+        write (tv, '(es24.16)') times(k)
+        t = t//grids_text(bodies, lines, h, msh, itf, '/steps/step_'//i2s(k), trim(adjustl(tv)))
+      end do
+      t = t//line('    </Grid>')
+    end if
     t = t//line('  </Domain>')//line('</Xdmf>')
   end function xdmf_text
 
+  !> The grids of the bodies and contact lines, their fields under the HDF5 group `fields`
+  !! ('' : the last result's own groups) and, given `time`, at that time.
+  function grids_text(bodies, lines, h, msh, itf, fields, time) result(t)
+    integer, intent(in) :: bodies(:), lines(:)
+    character(len=*), intent(in) :: h, fields, time
+    type(mesh_t), intent(in) :: msh(:)
+    type(interface_t), intent(in) :: itf
+    character(len=:), allocatable :: t, tt
+    integer :: k, r(2)
+    logical :: many
+    many = size(bodies) + size(lines) > 1
+    tt = ''
+    if (len(time) > 0) tt = line('        <Time Value="'//time//'"/>')
+    t = ''
+    if (many) then
+      t = line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
+      t = t//tt
+      tt = ''
+    end if
+    do k = 1, size(bodies)
+      t = t//grid_text(bodies(k), h, msh(bodies(k)), fields, tt)
+    end do
+    do k = 1, size(lines)
+      if (lines(k) == 0) then
+        t = t//contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body', &
+                                 h//':'//fields//'/contact', tt)
+      else
+        r = pair_rows(itf, lines(k))
+        t = t//contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
+                                 r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side', &
+                                 h//':'//fields//'/contact/pair_'//i2s(lines(k)), tt)
+      end if
+    end do
+    if (many) t = t//line('    </Grid>')
+  end function grids_text
+
   !> One body as an XDMF uniform grid (topology, XYZ geometry, nodal fields, body id per
   !! cell); h5 is the HDF5 file name, escaped for XML.
-  function grid_text(a, h5, msh) result(t)
+  function grid_text(a, h5, msh, fields, time) result(t)
     integer, intent(in) :: a
     character(len=*), intent(in) :: h5
     type(mesh_t), intent(in) :: msh
-    character(len=:), allocatable :: t
+    character(len=*), intent(in) :: fields   !< the group of the fields ('' : /body<a>'s own)
+    character(len=*), intent(in) :: time     !< its <Time> element, or ''
+    character(len=:), allocatable :: t, fg
     character(len=16) :: topo
     character(len=64) :: nn, nc, nv
     character(len=:), allocatable :: g
@@ -539,7 +715,8 @@ contains
     write (nc, '(i0)') msh%ncell
     write (nv, '(i0)') msh%nvert
     g = h5//':/body'//body_label(a)
-    t = line('      <Grid Name="body'//body_label(a)//'" GridType="Uniform">')
+    fg = h5//':'//fields//'/body'//body_label(a)
+    t = line('      <Grid Name="body'//body_label(a)//'" GridType="Uniform">')//time
     t = t//line('        <Topology TopologyType="'//trim(topo)//'" NumberOfElements="'//trim(nc)//'">')
     if (msh%element == ELEM_MIXED) then
       write (nv, '(i0)') 5*count(msh%cell_type == ELEM_Q1) + 4*count(msh%cell_type /= ELEM_Q1)
@@ -551,11 +728,11 @@ contains
     end if
     t = t//line('        </Topology>')
     t = t//geometry_text(trim(nn), g//'/geometry_xyz')
-    t = t//field_text('displacement', 'Vector', trim(nn)//' 3', g//'/displacement_xyz')
-    t = t//field_text('von_mises', 'Scalar', trim(nn), g//'/von_mises')
-    t = t//field_text('contact_pressure', 'Scalar', trim(nn), g//'/contact_pressure')
+    t = t//field_text('displacement', 'Vector', trim(nn)//' 3', fg//'/displacement_xyz')
+    t = t//field_text('von_mises', 'Scalar', trim(nn), fg//'/von_mises')
+    t = t//field_text('contact_pressure', 'Scalar', trim(nn), fg//'/contact_pressure')
     do k = 1, 4
-      t = t//field_text(comp(k), 'Scalar', trim(nn), g//'/'//comp(k))
+      t = t//field_text(comp(k), 'Scalar', trim(nn), fg//'/'//comp(k))
     end do
     t = t//field_text('body_id', 'Scalar', trim(nc), g//'/body_id', 'Cell')
     t = t//line('      </Grid>')
@@ -565,8 +742,10 @@ contains
   !! polyline over its n nodes (cells: line_cells of its rows) with the contact fields at its
   !! nodes; `side` names the columns of the normal displacements ('body': the
   !! normal_displacement_body1/2 of /contact, 'side': normal_displacement_side1/2 of a pair).
-  function contact_grid_text(name, g, n, cells, side) result(t)
+  function contact_grid_text(name, g, n, cells, side, fg, time) result(t)
     character(len=*), intent(in) :: name, g, side
+    character(len=*), intent(in) :: fg     !< file:path of the group of its fields
+    character(len=*), intent(in) :: time   !< its <Time> element, or ''
     integer, intent(in) :: n
     integer, intent(in) :: cells(:, :)
     character(len=:), allocatable :: t
@@ -584,13 +763,13 @@ contains
     else
       t = '        <Topology TopologyType="Polyvertex" NodesPerElement="1" NumberOfElements="'
     end if
-    t = line('      <Grid Name="'//name//'" GridType="Uniform">')//line(t//trim(nc)//'">')
+    t = line('      <Grid Name="'//name//'" GridType="Uniform">')//time//line(t//trim(nc)//'">')
     t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
                 '" NumberType="Int" Precision="4" Format="HDF">'//g//'/segments</DataItem>')
     t = t//line('        </Topology>')
     t = t//geometry_text(trim(nn), g//'/geometry_xyz')
     do k = 1, size(f)
-      t = t//field_text(trim(f(k)), 'Scalar', trim(nn), g//'/'//trim(f(k)))
+      t = t//field_text(trim(f(k)), 'Scalar', trim(nn), fg//'/'//trim(f(k)))
     end do
     t = t//line('      </Grid>')
   end function contact_grid_text

@@ -5,8 +5,10 @@ sheared by Q = mu P / 2 (Coulomb, mu = 0.3) with the upper block held along x by
 On three meshes (h = 0.02, 0.01, 0.005) the stick-zone half-width c (fitted to the shear) and
 the shear traction (L2 away from the zone edges) against theory; on the finest one both within
 2%, and Hertz's a and p0 within 1%; the observed orders are printed. The same with Q given by a
-prescribed displacement of the upper block's top (the finest mesh), and the Robin iteration
-(harmonic) = monolithic to 1e-6 on the middle mesh.
+prescribed displacement of the upper block's top (the finest mesh), the same with P and Q in two
+load stages (Coulomb on the slip increment; for equal materials P alone makes no slip, so it
+equals the one-step result), and the Robin iteration (harmonic) = monolithic to 1e-6 on the
+middle mesh.
 """
 import os
 import sys
@@ -57,6 +59,15 @@ def main():
             check(abs(fine["Q"] - fine["Q_applied"]) <= 1e-9 * fine["Q_applied"],
                   "force: the contact's tangential force is the applied Q (1e-9): friction alone holds the block",
                   f"{fine['Q']!r} against {fine['Q_applied']!r}")
+        g = attempt("stages, 400 cells", 400, "stages", "monolithic", os.path.join(tmp, "s"))
+        if g is not None:
+            check(abs(g["c_err"]) <= 0.02 and g["l2"] <= 0.02,
+                  "stages (P in a first load stage, Q in a second), finest mesh: c and the shear within 2%",
+                  f"c {g['c_err']:+.2%}, shear {g['l2']:.2%}")
+            if len(rows) == 3:
+                e = np.linalg.norm(g["lt"] - rows[-1][1]["lt"]) / np.linalg.norm(rows[-1][1]["lt"])
+                check(e <= 1e-6, "stages = P and Q at once for equal materials (P alone makes no slip; 1e-6)",
+                      f"{e:.2e}")
         d = attempt("displacement, 400 cells", 400, "displacement", "monolithic", tmp)
         if d is not None:
             check(abs(d["c_err"]) <= 0.02 and d["l2"] <= 0.02,

@@ -123,13 +123,13 @@ check(list(ref_tables) == GROUPS, "one section per group, in deck order", ", ".j
 # ---- every variable the reader declares is in the reference (and nothing else) ----------
 deck_src = source("src/input/deck_tables.f90")
 kinds = {"int": "integer", "real": "real", "pair": "real pair (x, y)", "str": "string", "enum": "choice",
-         "ints": "integer pair", "strs": "string pair"}
+         "ints": "integer pair", "strs": "string pair", "list": "integer list"}
 declared = {}
 for g in GROUPS:
     body = re.search(rf"subroutine {g}_vars\(.*?end subroutine {g}_vars", deck_src, re.S)
     check(body is not None, f"src/input/deck_tables.f90 has {g}_vars")
     if body:
-        declared[g] = dict((n, k) for k, n in re.findall(r"call v%(ints|int|real|pair|strs|str|enum)\('(\w+)'", body.group(0)))
+        declared[g] = dict((n, k) for k, n in re.findall(r"call v%(ints|int|list|real|pair|strs|str|enum)\('(\w+)'", body.group(0)))
 nvar = 0
 for g, names in declared.items():
     got = ref_tables.get(g, {})
@@ -208,12 +208,13 @@ def override(group, var, value):
         if var == "id":
             return [f"&body id={value} /"]
         return [f"&body id=1, {var}={value} /", f"&body id=2, {var}={value} /"]
+    body = "" if var == "body" else "body=1, "
     if group == "traction":
-        return [f"&traction {var}={value}, side='top' /"]
+        return [f"&traction {body}{var}={value}, side='top' /"]
     if group == "displacement":
-        return [f"&displacement {var}={value}, side='top' /"]
+        return [f"&displacement {body}{var}={value}, side='top' /"]
     if group == "boundary":
-        return [f"&boundary {var}={value}, group='top', ux=0.0 /"]
+        return [f"&boundary {body}{var}={value}, group='top', ux=0.0 /"]
     return [f"&{group} {var}={value} /"]
 
 

@@ -27,6 +27,11 @@ doc/verification.md, "Friction").
     one and two threads bitwise equal.
 (7) MPI: the frictional stack under mpirun -np 1, 2, 4 (factorization='mumps') = the serial run
     to 1e-10 (skipped without bin/robin_contact_mpi or mpirun).
+(8) Load history, steel on aluminium in Hertz contact (Coulomb mu = 0.3): P in a first stage
+    then Q = 60 N/mm in a second, against both at once: the two differ (path dependence, more
+    than 1e-3), and each equals the monolithic solution of its own history (1e-8); slip and
+    slip increment differ after the first stage; a run stopped at max_outer in the second stage
+    and restarted from its checkpoint ends bitwise equal to the uninterrupted one.
 """
 import os
 import re
@@ -267,6 +272,52 @@ def mpi(tmp):
         check(e <= 1e-10, f"{what}: = serial (1e-10)", f"{e:.2e}")
 
 
+PATH_DECK = """&scene units='mm-N-MPa' /
+&body id=1, x0=-1.0, y0=0.0, width=2.0, height=1.0, nx=100, ny=50, young=2.1e5, poisson=0.3, bottom='contact' /
+&body id=2, x0=-1.0, y0=-1.0, width=2.0, height=1.0, nx=100, ny=50, young=7.0e4, poisson=0.33, top='contact',
+      bottom='clamped' /
+&contact friction='coulomb', mu=0.3, gap_radius=1.0, gap_center=0.0 /
+"""
+
+
+def load_history(tmp):
+    press = "&boundary body=1, group='top', uy=-0.02{} /"
+    shear = "&traction body=1, side='top', t0=30.0, 0.0{} /"
+    tight = "&solver stop='residual', tol=1e-10 /"
+    runs = {}
+    for hist, st in (("two stages", (", stage=1", ", stage=2")), ("at once", ("", ""))):
+        for meth in ("monolithic", "robin"):
+            r = Run(tmp, f"path_{hist[:3]}_{meth}", PATH_DECK, press.format(st[0]), shear.format(st[1]), tight,
+                    f"&solver method='{meth}' /")
+            runs[hist, meth] = r
+            converged(r, f"load history {hist} ({meth})")
+    if not all(r.ok for r in runs.values()):
+        return
+    both = {k: np.concatenate([r.c["normal_force"], r.c["tangential_force"]]) for k, r in runs.items()}
+    d = rel(both["two stages", "monolithic"], both["at once", "monolithic"])
+    check(d > 1e-3, "load history: P then Q differs from P and Q at once (path dependence)", f"{d:.2e}")
+    for hist in ("two stages", "at once"):
+        e = rel(both[hist, "robin"], both[hist, "monolithic"])
+        check(e <= 1e-8, f"load history {hist}: Robin = monolithic of the same history (1e-8)", f"{e:.2e}")
+    c = runs["two stages", "monolithic"].c
+    check(not np.allclose(c["slip"], c["slip_increment"]), "load history: the second stage's slip increment is not its slip")
+    # stopped in the second stage, restarted from the checkpoint
+    stem = os.path.join(tmp, "path_restart")
+    deck = os.path.join(tmp, "path_two_robin.nml")
+    over = [press.format(", stage=1"), shear.format(", stage=2"), tight]
+    p1 = subprocess.run([BIN, deck, *over, "&solver max_outer=18 /", f"&output file='{stem}.h5', checkpoint_every=4 /"],
+                        capture_output=True, text=True, env=solver_env(), timeout=600)
+    p2 = subprocess.run([BIN, deck, *over, f"&output file='{stem}.h5', checkpoint_every=4 /", "--restart",
+                         f"{stem}.h5.ckpt.h5"], capture_output=True, text=True, env=solver_env(), timeout=600)
+    ok = p1.returncode == 2 and "step=2 of=2" in p1.stdout and p2.returncode == 0
+    if check(ok, "load history: stopped at max_outer in the second stage (exit 2), restarted (exit 0)",
+             f"exit {p1.returncode}, {p2.returncode}: {(p1.stdout + p2.stderr).strip()[-300:]}"):
+        with h5py.File(stem + ".h5", "r") as f:
+            same = all(np.array_equal(np.array(f["contact"][k]), runs["two stages", "robin"].c[k])
+                       for k in ("normal_force", "tangential_force", "slip", "slip_increment"))
+        check(same, "load history: the restarted run = the uninterrupted one, bitwise")
+
+
 def main():
     with tempfile.TemporaryDirectory(prefix="rc_friction_") as tmp:
         patch_stick(tmp)
@@ -276,6 +327,7 @@ def main():
         bad_input(tmp)
         scenes(tmp)
         mpi(tmp)
+        load_history(tmp)
     print(f"{len(check.failed)} failed")
     return 1 if check.failed else 0
 

@@ -338,5 +338,30 @@ if check(q is not None, f"8 bodies, -np 3, MUMPS failure: every rank ends within
           "8 bodies, -np 3, MUMPS failure: exit 3, one message with the code, no result file",
           f"exit {q.returncode}: {el}")
 
+# 9. load steps (two stages, the upper block held only by contact): -np 2 gives every step of
+# the serial binary's history to 1e-10
+steps_deck = os.path.join(OUT, "steps.nml")
+with open(steps_deck, "w") as fh:
+    fh.write("&body id=1, x0=0, y0=1, width=1, height=0.5, nx=8, ny=4, young=1e9, poisson=0.3, "
+             "bottom='contact', left='roller' /\n"
+             "&body id=2, x0=0, y0=0, width=1, height=1, nx=8, ny=8, young=1e9, poisson=0.3, top='contact', "
+             "bottom='clamped' /\n"
+             "&traction body=1, side='top', t0=0.0,-1.0e6 /\n"
+             "&traction body=1, side='top', t0=2.0e5,0.0, stage=2 /\n"
+             "&solver tol=1e-11, load_steps=2,3 /\n")
+ref = os.path.join(OUT, "steps_serial.h5")
+p, _ = run_solver(BIN, steps_deck, f"&output file='{ref}' /", env=solver_env(1))
+q, out = mpirun(2, steps_deck, MUMPS, name="steps_np2")
+if check(p.returncode == 0 and q is not None and q.returncode == 0, "load steps: the serial run and -np 2 converge",
+         f"exit {p.returncode}, {None if q is None else q.returncode}"):
+    with h5py.File(ref, "r") as a, h5py.File(out, "r") as b:
+        n = len(a["steps"]) if "steps" in a else 0
+        errs = [rel_err(np.array(b[f"steps/step_{k}/{name}"]).ravel(), np.array(a[f"steps/step_{k}/{name}"]).ravel())
+                for k in range(1, n + 1) for name in ("contact/normal_force", "body1/displacement")]
+        check(n == 5 and len(b["steps"]) == 5 and all(e is not None and e < 1e-10 for e in errs),
+              "load steps: -np 2 = serial, every step's contact forces and displacements to 1e-10",
+              f"{n} steps, errors {errs}")
+    check(q.stdout.count("step: ") == 5, "load steps: -np 2 prints one step: line per step")
+
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)
