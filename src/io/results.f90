@@ -679,12 +679,13 @@ contains
     do k = 1, size(lines)
       if (lines(k) == 0) then
         t = t//contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body', &
-                                 h//':'//fields//'/contact', tt)
+                                 h//':'//fields//'/contact', tt, any(itf%pair_friction /= FRICTION_NONE))
       else
         r = pair_rows(itf, lines(k))
         t = t//contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
                                  r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side', &
-                                 h//':'//fields//'/contact/pair_'//i2s(lines(k)), tt)
+                                 h//':'//fields//'/contact/pair_'//i2s(lines(k)), tt, &
+                                 itf%pair_friction(lines(k)) /= FRICTION_NONE)
       end if
     end do
     if (many) t = t//line('    </Grid>')
@@ -741,16 +742,19 @@ contains
   !> A contact line as an XDMF uniform grid `name` over the HDF5 group g (file:path): a
   !! polyline over its n nodes (cells: line_cells of its rows) with the contact fields at its
   !! nodes; `side` names the columns of the normal displacements ('body': the
-  !! normal_displacement_body1/2 of /contact, 'side': normal_displacement_side1/2 of a pair).
-  function contact_grid_text(name, g, n, cells, side, fg, time) result(t)
+  !! normal_displacement_body1/2 of /contact, 'side': normal_displacement_side1/2 of a pair);
+  !! with friction also its shear, tangential force, slip and slip increment.
+  function contact_grid_text(name, g, n, cells, side, fg, time, friction) result(t)
     character(len=*), intent(in) :: name, g, side
     character(len=*), intent(in) :: fg     !< file:path of the group of its fields
     character(len=*), intent(in) :: time   !< its <Time> element, or ''
+    logical, intent(in) :: friction        !< the line has the tangential datasets
     integer, intent(in) :: n
     integer, intent(in) :: cells(:, :)
     character(len=:), allocatable :: t
     character(len=64) :: nn, nc, nv
     character(len=32) :: f(5)
+    character(len=*), parameter :: ft(4) = [character(len=16) :: 'shear', 'tangential_force', 'slip', 'slip_increment']
     integer :: k
     f = [character(len=32) :: 'pressure', 'normal_force', 'gap', 'normal_displacement_', 'normal_displacement_']
     f(4) = trim(f(4))//side//'1'
@@ -771,6 +775,11 @@ contains
     do k = 1, size(f)
       t = t//field_text(trim(f(k)), 'Scalar', trim(nn), fg//'/'//trim(f(k)))
     end do
+    if (friction) then
+      do k = 1, size(ft)
+        t = t//field_text(trim(ft(k)), 'Scalar', trim(nn), fg//'/'//trim(ft(k)))
+      end do
+    end if
     t = t//line('      </Grid>')
   end function contact_grid_text
 

@@ -301,6 +301,18 @@ def load_history(tmp):
         check(e <= 1e-8, f"load history {hist}: Robin = monolithic of the same history (1e-8)", f"{e:.2e}")
     c = runs["two stages", "monolithic"].c
     check(not np.allclose(c["slip"], c["slip_increment"]), "load history: the second stage's slip increment is not its slip")
+    try:
+        import meshio
+        xdmf = runs["two stages", "monolithic"].h5[:-3] + "_contact.xdmf"
+        with meshio.xdmf.TimeSeriesReader(xdmf) as rd:
+            rd.read_points_cells()
+            t, pdata, _ = rd.read_data(rd.num_steps - 1)
+        ok = all(k in pdata for k in ("shear", "tangential_force", "slip", "slip_increment")) and \
+            np.array_equal(np.asarray(pdata["shear"]).ravel(), c["shear"])
+        check(ok and rd.num_steps == 2, "load history: the contact XDMF time series shows the shear, tangential force, "
+              "slip and its increment (meshio), the last step's shear = the file's", f"{rd.num_steps} steps")
+    except ImportError:
+        print("SKIP  meshio absent: the XDMF fields are not read back")
     # stopped in the second stage, restarted from the checkpoint
     stem = os.path.join(tmp, "path_restart")
     deck = os.path.join(tmp, "path_two_robin.nml")
