@@ -253,34 +253,13 @@ contains
     deallocate (w2)
     call write_dset(gid, 'g0', itf%g0, st, ul)
     call write_dset(gid, 'tributary_length', itf%trib, st, ul)
-    call write_dset(gid, 'normal_force', res%lam, st, uf)
-    call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
-    call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
-    ! the contact forces' resultant on body 1 (x, y): what balances its load
-    call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
     allocate (pres(itf%m))
-    where (itf%trib > 0.0_wp)
-      pres = res%lam/itf%trib
-    elsewhere
-      pres = 0.0_wp
-    end where
-    call write_dset(gid, 'pressure', pres, st, us)
-    call write_dset(gid, 'gap', res%gap, st, ul)
-    call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
-    call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
-    call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
-    call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
-    call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
+    call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
     call write_dset(gid, 'segments', line_cells(itf, 1, itf%npair), st, '1')
-    if (tg%on) call write_tangential(gid, tg, 1, itf%m, ul, us, uf, st)
     do k = 1, itf%npair
-      call write_pair(gid, k, itf, res, pres, tg%resultant(:, k), ul, us, uf, st)
-      if (tg%on) then
-        if (itf%pair_friction(k) /= FRICTION_NONE) call write_tangential(gid, tg, itf%pair_ptr(k), itf%pair_ptr(k + 1) - 1, ul, us, &
-                                                             uf, st, 'pair_'//i2s(k))
-      end if
+      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, st)
     end do
     call group_close(gid, st)
     call write_history(fid, res, st)
@@ -358,8 +337,8 @@ contains
     type(step_result_t), intent(in) :: steps(:)
     character(len=*), intent(in) :: ul, us, uf
     type(error_t), intent(inout) :: st
-    integer(hid_t) :: sid, kid, gid, pid
-    integer :: k, a, q, nn, r(2), c
+    integer(hid_t) :: sid, kid, gid
+    integer :: k, a, q, nn, c
     real(wp), allocatable :: pres(:), sigma(:, :), vm(:), sigt(:, :), pnode(:), disp(:, :)
     type(interface_t) :: itf
     type(contact_result_t) :: res
@@ -371,131 +350,140 @@ contains
     do k = 1, size(steps)
       ! one entry per contact node, the tangential part beside it (as the last result)
       call split_friction(itf_all, steps(k)%res, itf, res, tg)
-      block
-        call group_open(sid, 'step_'//i2s(k), kid, st, create=.true.)
-        call write_attr(kid, 'stage', steps(k)%stage, st)
-        call write_attr(kid, 'load_factor', steps(k)%load_factor, st)
-        call write_attr(kid, 'time', step_time(steps(k)), st)
-        call write_attr(kid, 'outer', res%outer, st)
-        call write_attr(kid, 'inner', res%inner, st)
-        call write_attr(kid, 'status', status_name(res%status), st)
-        call write_attr(kid, 'residual', res%residual, st)
-        if (.not. allocated(res%lam)) then
-          call group_close(kid, st)
-          cycle
-        end if
-        call write_attr(kid, 'normal_force_sum', sum(res%lam), st)
-        allocate (pres(itf%m))
-        where (itf%trib > 0.0_wp)
-          pres = res%lam/itf%trib
-        elsewhere
-          pres = 0.0_wp
-        end where
-        call group_open(kid, 'contact', gid, st, create=.true.)
-        call write_dset(gid, 'normal_force', res%lam, st, uf)
-        call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
-        call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
-        call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
-        call write_dset(gid, 'pressure', pres, st, us)
-        call write_dset(gid, 'gap', res%gap, st, ul)
-        call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
-        call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
-        call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
-        call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
-        call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
-        do q = 1, itf%npair
-          r = pair_rows(itf, q)
-          call group_open(gid, 'pair_'//i2s(q), pid, st, create=.true.)
-          call write_dset(pid, 'normal_force', res%lam(r(1):r(2)), st, uf)
-          call write_dset(pid, 'normal_force_side1', res%lam_body(r(1):r(2), 1), st, uf)
-          call write_dset(pid, 'normal_force_side2', res%lam_body(r(1):r(2), 2), st, uf)
-          call write_dset(pid, 'resultant_on_first_body', tg%resultant(:, q), st, uf)
-          call write_dset(pid, 'pressure', pres(r(1):r(2)), st, us)
-          call write_dset(pid, 'gap', res%gap(r(1):r(2)), st, ul)
-          call write_dset(pid, 'active', merge(1, 0, res%lam(r(1):r(2)) > 0.0_wp), st, '1')
-          call write_dset(pid, 'normal_displacement_side1', res%w(r(1):r(2), 1), st, ul)
-          call write_dset(pid, 'normal_displacement_side2', res%w(r(1):r(2), 2), st, ul)
-          call group_close(pid, st)
-          if (tg%on) then
-            if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(gid, tg, r(1), r(2), ul, us, uf, st, &
-                                                                             'pair_'//i2s(q))
-          end if
-        end do
-        if (tg%on) call write_tangential(gid, tg, 1, itf%m, ul, us, uf, st)
-        call group_close(gid, st)
-        do a = 1, size(msh)
-          nn = msh(a)%nnode
-          call group_open(kid, 'body'//i2s(a), gid, st, create=.true.)
-          associate (ua => steps(k)%u(1:2*nn, a))
-            disp = transpose(reshape(ua, [2, nn]))   ! a contiguous copy (see write_h5)
-            call write_dset(gid, 'displacement', disp, st, ul)
-            call write_dset(gid, 'displacement_xyz', pad3(reshape(ua, [2, nn])), st, ul)
-            allocate (sigma(4, nn), vm(nn), pnode(nn))
-            call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
-          end associate
-          if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) &
-            call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' in load step '//i2s(k)// &
-                        ' are not finite: beyond double precision, rescale the units')
-          sigt = transpose(sigma)
-          call write_dset(gid, 'stress', sigt, st, us)
-          do c = 1, 4
-            call write_dset(gid, comp(c), sigt(:, c), st, us)
-          end do
-          call write_dset(gid, 'von_mises', vm, st, us)
-          call nodal_pressure(itf, a, pres, pnode)
-          call write_dset(gid, 'contact_pressure', pnode, st, us)
-          if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
-          deallocate (sigma, vm, pnode)
-          call group_close(gid, st)
-        end do
-        deallocate (pres)
+      call group_open(sid, 'step_'//i2s(k), kid, st, create=.true.)
+      call write_attr(kid, 'stage', steps(k)%stage, st)
+      call write_attr(kid, 'load_factor', steps(k)%load_factor, st)
+      call write_attr(kid, 'time', step_time(steps(k)), st)
+      call write_attr(kid, 'outer', res%outer, st)
+      call write_attr(kid, 'inner', res%inner, st)
+      call write_attr(kid, 'status', status_name(res%status), st)
+      call write_attr(kid, 'residual', res%residual, st)
+      if (.not. allocated(res%lam)) then
         call group_close(kid, st)
-      end block
+        cycle
+      end if
+      call write_attr(kid, 'normal_force_sum', sum(res%lam), st)
+      allocate (pres(itf%m))
+      call group_open(kid, 'contact', gid, st, create=.true.)
+      call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
+      do q = 1, itf%npair
+        call write_pair(gid, q, itf, res, tg, pres, ul, us, uf, st, geometry=.false.)
+      end do
+      call group_close(gid, st)
+      do a = 1, size(msh)
+        nn = msh(a)%nnode
+        call group_open(kid, 'body'//i2s(a), gid, st, create=.true.)
+        associate (ua => steps(k)%u(1:2*nn, a))
+          disp = transpose(reshape(ua, [2, nn]))   ! a contiguous copy (see write_h5)
+          call write_dset(gid, 'displacement', disp, st, ul)
+          call write_dset(gid, 'displacement_xyz', pad3(reshape(ua, [2, nn])), st, ul)
+          allocate (sigma(4, nn), vm(nn), pnode(nn))
+          call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
+        end associate
+        if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) &
+          call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' in load step '//i2s(k)// &
+                      ' are not finite: beyond double precision, rescale the units')
+        sigt = transpose(sigma)
+        call write_dset(gid, 'stress', sigt, st, us)
+        do c = 1, 4
+          call write_dset(gid, comp(c), sigt(:, c), st, us)
+        end do
+        call write_dset(gid, 'von_mises', vm, st, us)
+        call nodal_pressure(itf, a, pres, pnode)
+        call write_dset(gid, 'contact_pressure', pnode, st, us)
+        if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
+        deallocate (sigma, vm, pnode)
+        call group_close(gid, st)
+      end do
+      deallocate (pres)
+      call group_close(kid, st)
     end do
     call group_close(sid, st)
   end subroutine write_steps
 
-  !> The group pair_<q> of the contact group gid: pair q's rows alone (segments 0-based
-  !! within the pair), the ids of its bodies (side 1, side 2), its slave body, and the
-  !! resultant of its contact forces on its first body (side 1).
-  subroutine write_pair(gid, q, itf, res, pres, resultant, ul, us, uf, st)
+  !> The contact solution of all rows into the group gid (/contact, or a load step's):
+  !! forces of both sides, their resultant on body 1, pressure (returned in pres), gap,
+  !! active flags, normal displacements, obstacles and, with friction, the tangential part.
+  subroutine contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
+    integer(hid_t), intent(in) :: gid
+    type(interface_t), intent(in) :: itf
+    type(contact_result_t), intent(in) :: res
+    type(tangential_t), intent(in) :: tg
+    character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
+    type(error_t), intent(inout) :: st
+    real(wp), intent(out) :: pres(:)            !< (m) pressure of each row [stress]
+    call write_dset(gid, 'normal_force', res%lam, st, uf)
+    call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
+    call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
+    ! the contact forces' resultant on body 1 (x, y): what balances its load
+    call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
+    where (itf%trib > 0.0_wp)
+      pres = res%lam/itf%trib
+    elsewhere
+      pres = 0.0_wp
+    end where
+    call write_dset(gid, 'pressure', pres, st, us)
+    call write_dset(gid, 'gap', res%gap, st, ul)
+    call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
+    call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
+    call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
+    call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
+    call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
+    if (tg%on) call write_tangential(gid, tg, 1, itf%m, ul, us, uf, st)
+  end subroutine contact_solution
+
+  !> The group pair_<q> of the contact group gid: pair q's rows alone, its solution (forces
+  !! of both sides, the resultant of all its contact forces on its first body, pressure, gap,
+  !! active flags, normal displacements, with friction the tangential part) and, with
+  !! `geometry` (default), the ids of its bodies (side 1, side 2), its slave body and its
+  !! line (coordinates, normals, g0, tributary lengths, segments 0-based within the pair).
+  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, st, geometry)
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
     type(contact_result_t), intent(in) :: res
+    type(tangential_t), intent(in) :: tg
     real(wp), intent(in), contiguous :: pres(:)  !< (m) pressure of each row [stress]
-    real(wp), intent(in) :: resultant(2)         !< of all the pair's contact forces on its first body [force]
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     type(error_t), intent(inout) :: st
+    logical, intent(in), optional :: geometry
     integer(hid_t) :: pid
     integer :: r(2), i, j
     real(wp), allocatable :: w2(:, :)
+    logical :: geo
+    geo = .true.
+    if (present(geometry)) geo = geometry
     r = pair_rows(itf, q)
     i = r(1)
     j = r(2)
     call group_open(gid, 'pair_'//i2s(q), pid, st, create=.true.)
-    call write_attr_list(pid, 'bodies', itf%pair_body(:, q), st)
-    call write_attr(pid, 'slave_body', itf%pair_body(itf%pair_slave(q), q), st)
-    allocate (w2(j - i + 1, 2))
-    w2 = transpose(itf%xy(:, i:j))
-    call write_dset(pid, 'x', w2(:, 1), st, ul)
-    call write_dset(pid, 'y', w2(:, 2), st, ul)
-    call write_dset(pid, 's', itf%s(i:j), st, ul)
-    w2 = transpose(itf%normal(:, i:j))
-    call write_dset(pid, 'normal', w2, st, '1')
-    call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
-    call write_dset(pid, 'tributary_length', itf%trib(i:j), st, ul)
+    if (geo) then
+      call write_attr_list(pid, 'bodies', itf%pair_body(:, q), st)
+      call write_attr(pid, 'slave_body', itf%pair_body(itf%pair_slave(q), q), st)
+      allocate (w2(j - i + 1, 2))
+      w2 = transpose(itf%xy(:, i:j))
+      call write_dset(pid, 'x', w2(:, 1), st, ul)
+      call write_dset(pid, 'y', w2(:, 2), st, ul)
+      call write_dset(pid, 's', itf%s(i:j), st, ul)
+      w2 = transpose(itf%normal(:, i:j))
+      call write_dset(pid, 'normal', w2, st, '1')
+      call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
+      call write_dset(pid, 'tributary_length', itf%trib(i:j), st, ul)
+      call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
+      call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
+    end if
     call write_dset(pid, 'normal_force', res%lam(i:j), st, uf)
     call write_dset(pid, 'normal_force_side1', res%lam_body(i:j, 1), st, uf)
     call write_dset(pid, 'normal_force_side2', res%lam_body(i:j, 2), st, uf)
-    call write_dset(pid, 'resultant_on_first_body', resultant, st, uf)
+    call write_dset(pid, 'resultant_on_first_body', tg%resultant(:, q), st, uf)
     call write_dset(pid, 'pressure', pres(i:j), st, us)
     call write_dset(pid, 'gap', res%gap(i:j), st, ul)
     call write_dset(pid, 'active', merge(1, 0, res%lam(i:j) > 0.0_wp), st, '1')
     call write_dset(pid, 'normal_displacement_side1', res%w(i:j, 1), st, ul)
     call write_dset(pid, 'normal_displacement_side2', res%w(i:j, 2), st, ul)
-    call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
-    call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
+    if (tg%on) then
+      if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(pid, tg, i, j, ul, us, uf, st)
+    end if
     call group_close(pid, st)
   end subroutine write_pair
 
