@@ -411,7 +411,7 @@ contains
     type(tangential_t), intent(in) :: tg
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     type(error_t), intent(inout) :: st
-    real(wp), intent(out) :: pres(:)            !< (m) pressure of each row [stress]
+    real(wp), intent(out), contiguous :: pres(:)   !< (m) pressure of each row [stress]
     call write_dset(gid, 'normal_force', res%lam, st, uf)
     call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
     call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
