@@ -225,8 +225,8 @@ $(BUILD)/serial_backend.o: $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/conden
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense.o $(BUILD)/condense_mumps.o \
                            $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
-                           $(BUILD)/floating.o $(BUILD)/kinds.o $(BUILD)/load_history.o $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
-                           $(BUILD)/strings.o $(BUILD)/sysinfo.o
+                           $(BUILD)/floating.o $(BUILD)/kinds.o $(BUILD)/mpi_env.o $(BUILD)/mumps_iface.o \
+                           $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_summary.o:    $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
                            $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o \
                            $(BUILD)/sysinfo.o

@@ -57,7 +57,8 @@ module condense
     real(wp) :: t_condense = 0.0_wp         !< wall time of F_a and b_a [s]
   end type body_condensed_t
 
-  public :: factor_body, condense_body, recover_displacement, apply_bt, apply_b, interface_dofs, flex_from_x
+  public :: factor_body, condense_body, recover_displacement, apply_bt, apply_b, interface_dofs, flex_from_x, &
+            prescribed_part
 
 contains
 
@@ -92,15 +93,11 @@ contains
     do i = 1, bc%m
       row = slot_row(bc%slots(i), itf%m)
       side = slot_side(bc%slots(i), itf%m)
-      bc%bfix(i) = 0.0_wp
       associate (b => itf%b(side))
         do e = b%ptr(row), b%ptr(row + 1) - 1
           if (b%val(e) == 0.0_wp) cycle
           p = sys%free_of(b%dof(e))
-          if (p == 0) then
-            bc%bfix(i) = bc%bfix(i) + b%val(e)*sys%u_fixed(b%dof(e))
-            cycle
-          end if
+          if (p == 0) cycle
           if (pos_of(p) == 0) then
             k = k + 1
             idx(k) = p
@@ -114,7 +111,29 @@ contains
       bc%bptr(i + 1) = ne + 1
     end do
     bc%idx = idx(1:k)
+    call prescribed_part(itf, sys, bc)
   end subroutine interface_dofs
+
+  !> B_a's part on the prescribed DOFs, B_a,d u_d (bc%bfix), for the body's current
+  !! u_fixed (a load step changes it): each row's entries on prescribed DOFs, in row order.
+  subroutine prescribed_part(itf, sys, bc)
+    type(interface_t), intent(in) :: itf          !< the contact rows of all pairs
+    type(body_system_t), intent(in) :: sys        !< the body's DOF map and u_fixed
+    type(body_condensed_t), intent(inout) :: bc   !< its rows (slots); gets bfix
+    integer :: i, e, row, side
+    do i = 1, bc%m
+      row = slot_row(bc%slots(i), itf%m)
+      side = slot_side(bc%slots(i), itf%m)
+      bc%bfix(i) = 0.0_wp
+      associate (b => itf%b(side))
+        do e = b%ptr(row), b%ptr(row + 1) - 1
+          if (b%val(e) == 0.0_wp) cycle
+          if (sys%free_of(b%dof(e)) /= 0) cycle
+          bc%bfix(i) = bc%bfix(i) + b%val(e)*sys%u_fixed(b%dof(e))
+        end do
+      end associate
+    end do
+  end subroutine prescribed_part
 
   !> Factorize K_a with the interface DOFs ordered last. ordering='nd' orders the
   !! other DOFs by geometric nested dissection of the body's grid (module ordering);

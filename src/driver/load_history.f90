@@ -11,8 +11,8 @@ module load_history
   use kinds, only: wp
   use config, only: deck_t, stage_count, stage_steps
   use assembly, only: body_system_t
-  use contact_interface, only: interface_t, slot_row, slot_side
-  use condense, only: body_condensed_t, apply_b
+  use contact_interface, only: interface_t
+  use condense, only: body_condensed_t, apply_b, prescribed_part
   use floating, only: rigid_rows
   use errors, only: error_t
   implicit none (type, external)
@@ -36,7 +36,7 @@ module load_history
     real(wp), allocatable :: obstacle(:, :)    !< (m,2) final obstacles of each side [length]
   end type step_history_t
 
-  public :: plan_steps, set_step_loads, step_interface_load, prescribed_part
+  public :: plan_steps, set_step_loads, step_interface_load
 
 contains
 
@@ -78,28 +78,6 @@ contains
       x = x + step%factor*cols(:, step%stage)
     end subroutine combine
   end subroutine set_step_loads
-
-  !> B_a's part on the prescribed DOFs, B_a,d u_d (bc%bfix), for the body's current
-  !! u_fixed: the rows' entries on prescribed DOFs in the order condense%interface_dofs
-  !! sums them.
-  subroutine prescribed_part(itf, sys, bc)
-    type(interface_t), intent(in) :: itf          !< the contact rows of all pairs
-    type(body_system_t), intent(in) :: sys        !< the body's DOF map and u_fixed
-    type(body_condensed_t), intent(inout) :: bc   !< its rows (slots); gets bfix
-    integer :: i, e, row, side
-    do i = 1, bc%m
-      row = slot_row(bc%slots(i), itf%m)
-      side = slot_side(bc%slots(i), itf%m)
-      bc%bfix(i) = 0.0_wp
-      associate (b => itf%b(side))
-        do e = b%ptr(row), b%ptr(row + 1) - 1
-          if (b%val(e) == 0.0_wp) cycle
-          if (sys%free_of(b%dof(e)) /= 0) cycle
-          bc%bfix(i) = bc%bfix(i) + b%val(e)*sys%u_fixed(b%dof(e))
-        end do
-      end associate
-    end do
-  end subroutine prescribed_part
 
   !> The body's interface load for its current loads, on its factor (CHOLMOD or banded):
   !! u0 = K_a^-1 f_a and b_a = B_a u0 + B_a,d u_d; for a body held only by contact its

@@ -20,9 +20,8 @@ module mpi_backend
   use run_state, only: run_t
   use contact_common, only: gather
   use run_backend, only: backend_t
-  use condense, only: apply_b
+  use condense, only: apply_b, prescribed_part
   use floating, only: rigid_rows
-  use load_history, only: prescribed_part
   implicit none (type, external)
   private
 
