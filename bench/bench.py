@@ -48,6 +48,8 @@ import os
 import re
 import resource
 import shutil
+import signal
+import subprocess
 import sys
 import tempfile
 import time
@@ -58,6 +60,8 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))  # the rc_* helpers
 from rc_results import md_header, md_row, rel_err  # noqa: E402
 from rc_run import contact_force, run_solver, solver_env, time_fields  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 COLUMNS = [
     "group", "level", "nx", "ny", "label", "method", "operator", "delta", "factorization",
@@ -108,6 +112,38 @@ def measured_run(args, env):
     hz = os.sysconf("SC_CLK_TCK")
     busy = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
     return p, r, wall, busy
+
+
+def command_text(args, threads):
+    """The command line of a run as a user would type it from the repository root."""
+    return f"OMP_NUM_THREADS={threads} " + " ".join(
+        os.path.relpath(a, ROOT) if os.path.isabs(a) and a.startswith(ROOT) else
+        (a if re.fullmatch(r"[\w./=-]+", a) else '"' + a + '"') for a in args)
+
+
+def timed_run(args, env, timeout):
+    """Run a command in its own session, killed (with its children) after timeout s; returns
+    (exit code, stdout, stderr, wall [s], its CPU time [s], busy_during = cores kept busy by
+    other processes during the run, timed out)."""
+    t0 = time.monotonic()
+    tot0, idle0 = cpu_times()
+    ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                         start_new_session=True)
+    timed_out = False
+    try:
+        out, err = p.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        out, err = p.communicate()
+        timed_out = True
+    wall = time.monotonic() - t0
+    tot1, idle1 = cpu_times()
+    ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+    mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
+    hz = os.sysconf("SC_CLK_TCK")
+    busy = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
+    return p.returncode, out, err, wall, mine, busy, timed_out
 
 
 class Runner:

@@ -37,15 +37,11 @@ shared 2-core machine, most of it waiting for a quiet machine (about 3 minutes o
 """
 import argparse
 import os
-import re
-import resource
-import signal
-import subprocess
 import sys
 import time
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))  # the rc_* helpers
-from bench import busy_cores, fmt, table, write_csv  # noqa: E402
+from bench import busy_cores, command_text, fmt, table, timed_run, write_csv  # noqa: E402
 from rc_results import read_lam, rel_err  # noqa: E402
 from rc_run import result_fields, solver_env, time_fields  # noqa: E402
 
@@ -75,12 +71,6 @@ def assembly(ncol, per, nx, ny):
         lines.append(f"&traction body={c * per + 1}, side='top', t0=0.0, -1.0e6 /")
         pairs += [f"&contact bodies={c * per + k},{c * per + k + 1}, groups='bottom','top' /" for k in range(1, per)]
     return lines + pairs
-
-
-def cpu_ticks():
-    with open("/proc/stat") as f:
-        v = [int(x) for x in f.readline().split()[1:]]
-    return sum(v), v[3] + v[4]
 
 
 class Runner:
@@ -168,33 +158,17 @@ class Runner:
         env.pop("OMP_THREAD_LIMIT", None)
         row["load1"] = round(os.getloadavg()[0], 2)
         row["busy_before"] = self.wait_quiet(wait)
-        row["cmdline"] = f"OMP_NUM_THREADS={threads} " + " ".join(
-            os.path.relpath(a, ROOT) if os.path.isabs(a) and a.startswith(ROOT) else
-            (a if re.fullmatch(r"[\w./=-]+", a) else '"' + a + '"') for a in args[:-1])
-        t0 = time.monotonic()
-        tot0, idle0 = cpu_ticks()
-        ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                             start_new_session=True)
-        try:
-            out, err = p.communicate(timeout=self.timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            out, err = p.communicate()
+        row["cmdline"] = command_text(args[:-1], threads)
+        rc, out, err, wall, _, row["busy_during"], timed_out = timed_run(args, env, self.timeout)
+        if timed_out:
             row["status"] = "timeout"
-        wall = time.monotonic() - t0
-        tot1, idle1 = cpu_ticks()
-        ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
-        hz = os.sysconf("SC_CLK_TCK")
-        row["busy_during"] = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
         row["process_wall_s"] = round(wall, 3)
-        row["exit"] = p.returncode
+        row["exit"] = rc
         lam = None
         r, t = result_fields(out), time_fields(out)
         if row["status"] != "timeout":
             if r is None or t is None:
-                sys.stderr.write(f"bench_bodies: no result/time line from: {row['cmdline']} (exit {p.returncode})\n")
+                sys.stderr.write(f"bench_bodies: no result/time line from: {row['cmdline']} (exit {rc})\n")
                 sys.stderr.write(out[-1500:] + err[-1500:] + "\n")
                 row["status"] = "error"
             else:

@@ -41,10 +41,6 @@ Usage: bench/bench_friction.py [--bin bin/robin_contact] [--quick] [--sizes 128x
 """
 import argparse
 import os
-import re
-import resource
-import signal
-import subprocess
 import sys
 import time
 
@@ -52,7 +48,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))  # the rc_* helpers
-from bench import busy_cores, fmt, table, write_csv  # noqa: E402
+from bench import busy_cores, command_text, fmt, table, timed_run, write_csv  # noqa: E402
 from rc_results import rel_err  # noqa: E402
 from rc_run import line_fields, result_fields, solver_env, time_fields  # noqa: E402
 
@@ -69,12 +65,6 @@ COLUMNS = ["nx", "ny", "dofs", "m", "friction", "solver", "status", "exit", "out
           [p + "_s" for p in PHASES] + \
           ["cpu_s", "peak_mb", "factor_mb", "stick", "slip", "tangential_force_sum", "normal_force_sum", "err_n", "err_t",
            "repeats", "total_s_all", "process_wall_s", "load1", "busy_before", "busy_during", "cmdline"]
-
-
-def cpu_ticks():
-    with open("/proc/stat") as f:
-        v = [int(x) for x in f.readline().split()[1:]]
-    return sum(v), v[3] + v[4]
 
 
 class Runner:
@@ -119,34 +109,18 @@ class Runner:
         env = solver_env(2)
         row["load1"] = round(os.getloadavg()[0], 2)
         row["busy_before"] = self.wait_quiet(wait)
-        row["cmdline"] = "OMP_NUM_THREADS=2 " + " ".join(
-            os.path.relpath(a, ROOT) if os.path.isabs(a) and a.startswith(ROOT) else
-            (a if re.fullmatch(r"[\w./=-]+", a) else '"' + a + '"') for a in args[:-1])
-        t0 = time.monotonic()
-        tot0, idle0 = cpu_ticks()
-        ch0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        p = subprocess.Popen(args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
-                             start_new_session=True)
-        try:
-            out, err = p.communicate(timeout=self.timeout)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            out, err = p.communicate()
+        row["cmdline"] = command_text(args[:-1], 2)
+        rc, out, err, wall, mine, row["busy_during"], timed_out = timed_run(args, env, self.timeout)
+        if timed_out:
             row["status"] = "timeout"
-        wall = time.monotonic() - t0
-        tot1, idle1 = cpu_ticks()
-        ch1 = resource.getrusage(resource.RUSAGE_CHILDREN)
-        mine = (ch1.ru_utime + ch1.ru_stime) - (ch0.ru_utime + ch0.ru_stime)
-        hz = os.sysconf("SC_CLK_TCK")
         row["cpu_s"] = round(mine, 3)
-        row["busy_during"] = round(max(0.0, ((tot1 - tot0) - (idle1 - idle0)) / hz - mine) / max(wall, 1e-3), 2)
         row["process_wall_s"] = round(wall, 3)
-        row["exit"] = p.returncode
+        row["exit"] = rc
         forces = None
         r, t, c = result_fields(out), time_fields(out), line_fields(out, "contact")
         if row.get("status") != "timeout":
             if r is None or t is None:
-                sys.stderr.write(f"bench_friction: no result/time line from: {row['cmdline']} (exit {p.returncode})\n")
+                sys.stderr.write(f"bench_friction: no result/time line from: {row['cmdline']} (exit {rc})\n")
                 sys.stderr.write(out[-1500:] + err[-1500:] + "\n")
                 row["status"] = "error"
             else:
