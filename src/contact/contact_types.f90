@@ -91,6 +91,10 @@ module contact_types
     real(wp), allocatable :: r_prev(:)         !< (2m) previous fixed-point residual
     real(wp), allocatable :: x_prev(:)         !< (2m) previous obstacles (Anderson)
     real(wp), allocatable :: dX(:, :), dR(:, :) !< (2m, depth) Anderson differences
+    !> friction: per row the bound state of both sides' forces in the last iterate
+    !! (robin_iteration's row_bound_state; -1: not known)
+    integer, allocatable :: row_state(:)
+    integer :: settled = 0                     !< 1: row_state did not change in the last iteration
   end type robin_state_t
 
   !> Where the Robin iteration saves its state: `save` is called every `every` outer
@@ -159,7 +163,8 @@ contains
     st%nrw(2, :) = 1
     allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))
     allocate (st%dX(2*m, anderson_history(nbody, npair)), st%dR(2*m, anderson_history(nbody, npair)))
-    allocate (st%flam_v(m, 2), st%srch(m, 2), st%fsrch(m, 2))
+    allocate (st%flam_v(m, 2), st%srch(m, 2), st%fsrch(m, 2), st%row_state(m))
+    st%row_state = -1
     allocate (st%rw(m, 2*recycle_size(m)), st%raw(m, 2*recycle_size(m)))
     st%rw = 0.0_wp
     st%raw = 0.0_wp

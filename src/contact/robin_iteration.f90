@@ -7,16 +7,16 @@
 module robin_iteration
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use config, only: solver_cfg_t, STOP_RESIDUAL
+  use config, only: solver_cfg_t, STOP_RESIDUAL, ACCEL_NONE, ROBIN_HARMONIC
   use clock, only: wtime
-  use contact_interface, only: interface_t, has_friction, row_bounds
+  use contact_interface, only: interface_t, has_friction, row_bounds, ROW_NORMAL
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
                            STATUS_INTERRUPTED
   use contact_common, only: interface_residual, maxabs, all_finite, gather, scatter
   use errors, only: error_t
-  use robin_operators, only: robin_operator_t, new_robin_operator
+  use robin_operators, only: robin_operator_t, new_robin_operator, progress_rtol
   use robin_subproblems, only: subproblems_t, subproblems_init, solve_subproblems
   use acceleration, only: accelerate
   implicit none (type, external)
@@ -24,6 +24,7 @@ module robin_iteration
 
   integer, parameter :: STALL_LIMIT = 25      !< iterations of small increment / large residual before 'diverged'
   integer, parameter :: HISTORY_CHUNK = 256   !< initial history entries (grown by doubling)
+  integer, parameter :: BOUND_LOWER = 1, BOUND_UPPER = 2, BOUND_INSIDE = 3   !< bound_state codes
   integer, parameter :: FLAT_LIMIT = 50       !< iterations without a 1% better residual before 'diverged' (stop='residual')
 
   public :: solve_robin
@@ -114,7 +115,7 @@ contains
     integer, intent(in), optional :: progress_unit
     class(checkpointer_t), intent(inout), optional :: ckpt
     procedure(stop_iface), optional :: stop_requested
-    real(wp), allocatable :: g_new(:, :), w(:, :), dlam(:), corr(:, :)
+    real(wp), allocatable :: g_new(:, :), w(:, :), dlam(:), corr(:, :), g_full(:, :)
     real(wp) :: rtol_in, uref
     integer :: m, it, a
     logical :: printed
@@ -129,6 +130,11 @@ contains
     do it = run_state%it + 1, solver%max_outer
       ! 1. each body against its obstacle, in parallel
       rtol_in = robin_op%inner_tolerance(solver, it, m, run_state%progress, subproblems%lmax_body)
+      ! friction: while the rows still change between stick, slip and open, the boxes
+      ! (Coulomb: and their bounds) are provisional, and solving against them more tightly
+      ! than the outer progress is wasted; once they settle, the operator's own tolerance
+      if (has_friction(contact_line) .and. run_state%settled == 0) &
+        rtol_in = max(rtol_in, progress_rtol(solver, it, run_state%progress))
       ! the obstacles stopped moving but the bodies do not agree: the subproblems' own error
       ! is what is left, so each such iteration solves them ten times tighter, down to rounding
       if (run_state%stalled > 0) rtol_in = max(sqrt(real(m, wp))*epsilon(1.0_wp), &
@@ -141,6 +147,7 @@ contains
                         start=all(run_state%lam == 0.0_wp))
       end if
       call solve_subproblems(subproblems, solver, bodies, rtol_in, it, run_state, w, res)
+      if (has_friction(contact_line)) call update_row_states(subproblems%lb, subproblems%ub, run_state)
       if (m == 0) then
         res%status = STATUS_CONVERGED
         res%outer = it
@@ -156,7 +163,14 @@ contains
       ! 3. the fixed-point map T(G) and the relaxed or accelerated update
       g_new(:, 1) = contact_line%g0 - w(:, 2) + corr(:, 1)
       g_new(:, 2) = contact_line%g0 - w(:, 1) - corr(:, 2)
-      call accelerate(solver%acceleration, solver%delta, run_state, g_new)
+      if (has_friction(contact_line) .and. solver%acceleration == ACCEL_NONE .and. &
+          solver%robin_operator == ROBIN_HARMONIC) then
+        g_full = g_new
+        call accelerate(solver%acceleration, solver%delta, run_state, g_new)
+        call full_step_at_bounds(contact_line, run_state%row_state, g_full, g_new)
+      else
+        call accelerate(solver%acceleration, solver%delta, run_state, g_new)
+      end if
       ! a non-finite iterate is not kept: the result holds the last finite one
       if (.not. (all_finite(g_new) .and. all_finite(run_state%lam) .and. all_finite(w))) then
         res%status = STATUS_DIVERGED
@@ -189,6 +203,48 @@ contains
     if (res%status == STATUS_MAX_OUTER) write (res%message, '(a,i0,a,es10.3)') 'max_outer = ', solver%max_outer, &
       ' reached; last criterion ', res%criterion
   end subroutine outer_loop
+
+  !> The bound state of a force against its box: at the lower bound (a normal row's zero
+  !! force included), at the upper bound, or strictly inside.
+  elemental integer function bound_state(lam, lb, ub) result(code)
+    real(wp), intent(in) :: lam, lb, ub
+    if (lam <= lb) then
+      code = BOUND_LOWER
+    else if (lam >= ub) then
+      code = BOUND_UPPER
+    else
+      code = BOUND_INSIDE
+    end if
+  end function bound_state
+
+  !> Friction: the rows' bound states of this iterate (both sides of a row: side 1's + 4 x
+  !! side 2's), and whether any changed since the last iterate.
+  subroutine update_row_states(lb, ub, run_state)
+    real(wp), intent(in) :: lb(:), ub(:)               !< (m) this iteration's boxes
+    type(robin_state_t), intent(inout) :: run_state
+    integer, allocatable :: now(:)
+    allocate (now(size(lb)))
+    now = bound_state(run_state%lam(:, 1), lb, ub) + 4*bound_state(run_state%lam(:, 2), lb, ub)
+    run_state%settled = merge(1, 0, all(now == run_state%row_state))
+    run_state%row_state = now
+  end subroutine update_row_states
+
+  !> `harmonic`: relaxation leaves the obstacles of a tangential row whose force sits at the
+  !! same bound on both sides at their unrelaxed value T(G): while a row is at its bound its
+  !! obstacle enters neither body's solution, and relaxing it only slows its way to the
+  !! fixed point (at a fixed point G = T(G), so the fixed point is the same). Not for
+  !! `steklov`, whose map needs the relaxation on every row (doc/method.md, "Friction").
+  subroutine full_step_at_bounds(itf, row_state, g_full, g_new)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: row_state(:)                !< (m) update_row_states
+    real(wp), intent(in) :: g_full(:, :)               !< (m, 2) T(G)
+    real(wp), intent(inout) :: g_new(:, :)             !< (m, 2) relaxed obstacles
+    integer :: k
+    do k = 1, itf%m
+      if (itf%kind(k) == ROW_NORMAL) cycle
+      if (row_state(k) == BOUND_LOWER*5 .or. row_state(k) == BOUND_UPPER*5) g_new(k, :) = g_full(k, :)
+    end do
+  end subroutine full_step_at_bounds
 
   !> A run resumed from a checkpoint taken at max_outer has nothing left to do: its result
   !! is the checkpointed iterate (contact forces, obstacles, history), with the normal

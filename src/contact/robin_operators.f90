@@ -117,7 +117,7 @@ module robin_operators
     integer, allocatable :: v(:)
   end type slots_t
 
-  public :: new_robin_operator
+  public :: new_robin_operator, progress_rtol
 
 contains
 
@@ -146,12 +146,21 @@ contains
     integer, intent(in) :: m                       !< contact nodes
     real(wp), intent(in) :: progress               !< min(increment, residual) of iteration it - 1
     real(wp), intent(in) :: lmax(:)                !< bounds of lambda_max(F_a), per body
+    rtol_in = progress_rtol(solver, it, progress)
+  end function progress_tolerance
+
+  !> clamp(inner_factor x progress, inner_rtol_min, inner_rtol_max); inner_rtol_max at the
+  !! first iteration (doc/method.md, "Inner tolerance").
+  pure real(wp) function progress_rtol(solver, it, progress) result(rtol_in)
+    type(solver_cfg_t), intent(in) :: solver       !< solver settings
+    integer, intent(in) :: it                      !< outer iteration
+    real(wp), intent(in) :: progress               !< min(increment, residual) of iteration it - 1
     if (it == 1) then
       rtol_in = solver%inner_rtol_max
     else
       rtol_in = min(solver%inner_rtol_max, max(solver%inner_rtol_min, solver%inner_factor*progress))
     end if
-  end function progress_tolerance
+  end function progress_rtol
 
   !> The row-sum norm |F_a|_inf, an upper bound of lambda_max for a symmetric matrix (so
   !! alpha_bar = 1.9/|F_a|_inf is admissible without MPRGP's guard): one pass over F_a, no

@@ -57,6 +57,7 @@ module checkpoint
     integer :: nbody = 2                       ! bodies of this run
     integer :: depth = 5                       ! Anderson depth of this run
     logical :: has_products = .false., has_search = .false., has_recycle = .false., has_mu = .false.
+    logical :: has_rows = .false.
     logical, allocatable :: signed(:)    ! rows whose force may be negative (friction's tangential rows)
   end type ckpt_reader_t
 
@@ -134,6 +135,8 @@ contains
     call write_attr(gid, 'nsrch', st%nsrch, hs)
     call write_dset(gid, 'srch', st%srch, hs)
     call write_dset(gid, 'fsrch', st%fsrch, hs)
+    call write_attr(gid, 'settled', st%settled, hs)
+    call write_dset(gid, 'row_state', st%row_state, hs)
     call write_dset(gid, 'nrw', reshape(st%nrw, [size(st%nrw)]), hs)
     call write_dset(gid, 'rw', st%rw, hs)
     call write_dset(gid, 'raw', st%raw, hs)
@@ -471,6 +474,12 @@ contains
       call need(r, r%gid, '/state', 'srch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
       call need(r, r%gid, '/state', 'fsrch', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(r%m))
     end if
+    ! friction's row bound states: absent from older checkpoints, checked when present
+    r%has_rows = exists(r%gid, 'settled', .true.) .or. exists(r%gid, 'row_state', .false.)
+    if (r%has_rows) then
+      call need(r, r%gid, '/state', 'settled', .true., CLASS_INTEGER, SCALAR, 'a scalar')
+      call need(r, r%gid, '/state', 'row_state', .false., CLASS_INTEGER, [m2], contact_nodes(r%m))
+    end if
     ! the stored directions of the bodies' solves and their images: absent from older
     ! checkpoints, checked when present
     r%kr = recycle_size(r%m)
@@ -608,6 +617,15 @@ contains
       st%srch = 0.0_wp
       st%fsrch = 0.0_wp
     end if
+    if (r%has_rows) then
+      call read_attr(r%gid, 'settled', st%settled, r%hs)
+      call read_dset(r%gid, 'row_state', st%row_state, r%hs)
+    else
+      ! an older checkpoint: the rows' states are learnt again in the first iterations
+      st%settled = 0
+      allocate (st%row_state(m))
+      st%row_state = -1
+    end if
     allocate (st%mu(3, r%nbody), st%nrw(2, r%nbody))
     st%mu = 0.0_wp
     if (r%has_mu) then
@@ -647,6 +665,10 @@ contains
     else if (any(st%nrw(1, :) < 0 .or. st%nrw(1, :) > r%kr .or. st%nrw(2, :) < 1 .or. st%nrw(2, :) > max(1, r%kr))) then
       r%msg = r%src//': dataset /state/nrw holds counters outside 0 .. '//i2s(r%kr)//' (held) or 1 .. '// &
             i2s(max(1, r%kr))//' (next slot)'
+    else if (st%settled /= 0 .and. st%settled /= 1) then
+      r%msg = r%src//': attribute settled of /state is '//i2s(st%settled)//', not 0 or 1'
+    else if (any(st%row_state < -1 .or. st%row_state > 15)) then
+      r%msg = r%src//': dataset row_state of /state holds a value outside -1 .. 15'
     else if (st%nsrch /= 0 .and. st%nsrch /= 1) then
       r%msg = r%src//': attribute nsrch of /state is '//i2s(st%nsrch)//', not 0 or 1'
     end if

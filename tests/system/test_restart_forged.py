@@ -79,6 +79,8 @@ FORGERIES = [
     ("missing dR", "/state/dR", lambda f: f.__delitem__("state/dR")),
     ("scalar flam", "/state/flam", lambda f: replace(f, "state/flam", 1.0)),
     ("negative counter", "/state", lambda f: set_attr(f, "state", "nacc", np.int32(-4))),
+    ("row state out of range", "row_state", lambda f: f["state/row_state"].__setitem__(0, 99)),
+    ("settled neither 0 nor 1", "settled", lambda f: set_attr(f, "state", "settled", np.int32(7))),
 ]
 
 # control: the unaltered copy restarts
