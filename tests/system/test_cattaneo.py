@@ -13,9 +13,12 @@ Then the same on a half-disc of radius 1 on a block 8 x 4 (`--scene disc`, the s
 inputs/gmsh/cattaneo_disc_a8/16/32.msh, a/R = 0.005), P in a first load stage and Q = mu P / 2 in
 a second: Q as a traction on the disc's flat side, the disc held along x by friction alone, on
 three meshes (a/h = 8, 16, 32), c and the shear within 2% on the finest; Q as a prescribed
-displacement of the flat side, the finest mesh; Robin = monolithic (1e-6) on the middle one.
+displacement of the flat side, the finest mesh; Robin = monolithic (1e-6) on the middle one;
+tools/plot_contact.py --mindlin --radius 1 draws the finest run with its Cattaneo-Mindlin curve.
 """
 import os
+import re
+import subprocess
 import sys
 import tempfile
 
@@ -37,6 +40,18 @@ def attempt(what, *args, run=cs.run):
     except Exception as e:  # a failed run fails its checks, the others still run
         check(False, f"{what}: the run ends converged", str(e)[-300:])
         return None
+
+
+def plot(h5, png):
+    """plot_contact --mindlin on a run whose gap is the disc's geometry (Hertz's radius given)."""
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "plot_contact.py"), h5, "--mindlin",
+                        "--radius", "1", "-o", png], capture_output=True, text=True, timeout=300)
+    m = re.search(r"Mindlin for \S+: .* err_c=(\S+) err_q=(\S+)", p.stdout)
+    check(p.returncode == 0 and m is not None and os.path.isfile(png) and os.path.getsize(png) > 10000
+          and float(m.group(1)) <= 0.02 and float(m.group(2)) <= 0.03,
+          "plot_contact --mindlin --radius 1 draws the disc run with its Cattaneo-Mindlin curve "
+          "(its err_c <= 0.02, err_q <= 0.03 over the whole zone)",
+          (m.group(0) if m else (p.stdout + p.stderr).strip()[-300:]))
 
 
 def disc(tmp):
@@ -66,6 +81,7 @@ def disc(tmp):
         check(abs(fine["Q"] - fine["Q_applied"]) <= 1e-9 * fine["Q_applied"],
               "disc, force: the contact's tangential force is the applied Q (1e-9): friction alone holds the disc",
               f"{fine['Q']!r} against {fine['Q_applied']!r}")
+        plot(os.path.join(tmp, "d", "cmd_force_monolithic_32.h5"), os.path.join(tmp, "disc_contact.png"))
     d = attempt("disc, displacement, a/h = 32", 32, "displacement", "monolithic", os.path.join(tmp, "dd"),
                 run=cs.run_disc)
     if d is not None:
