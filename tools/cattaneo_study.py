@@ -31,16 +31,17 @@ sheared in stage 2:
 A finite disc is not a half-space: under P alone its surface slides against the block's (the
 relative slip over the contact is about 0.4 (a/R) p0 a/E* and odd in x), friction resists it, and
 that odd shear stays in the stick zone after Q; relative to the Cattaneo-Mindlin shear (scale
-mu p0) it is about (a/R)/mu, so the scene has a/R = ac/R = 0.005. Meshes: quadrangles of size
-h = ac/n within 1.5 ac of the contact point (uniform on the contact curves), coarser away;
---n gives the values of a/h (default 8,16,32): inputs/gmsh/cattaneo_disc_a<n>.msh when shipped,
-else written by gmsh into --out. `--ar 0.07,0.02,0.005` (one --n) measures the finite-size effect:
+mu p0) it is about (a/R)/mu, so the scene has a/R = ac/R = 0.005. The table splits the shear's
+L2 error into its parts even and odd in x (the odd one is that effect; the even one the mesh's).
+Meshes: quadrangles, a structured patch of squares h = ac/n under the contact in each body
+(|x| < 1.5 ac), coarser away; --n gives the values of a/h (default 8,16,32):
+inputs/gmsh/cattaneo_disc_a<n>.msh when shipped, else written by gmsh into --out. `--ar 0.07,0.02,0.005` (one --n) measures the finite-size effect:
 for each a/R the relative slip under P alone without friction (the disc held at its flat side's
-middle) and the Cattaneo-Mindlin errors with friction.
+middle) and the Cattaneo-Mindlin errors with friction. `--block L,D`: the block (-L,L) x (-D,0).
 
 usage: cattaneo_study.py [--scene blocks|disc] [--bin BIN] [--n 100,200,400]
        [--mode force|displacement|stages] [--method monolithic|robin] [--out DIR]
-       [--ar LIST] [--mu MU] [--gmsh GMSH]
+       [--ar LIST] [--mu MU] [--block L,D] [--gmsh GMSH]
 Prints one row per mesh and the observed orders of the c and shear errors.
 """
 import argparse
@@ -62,6 +63,7 @@ QFRAC = 0.5                        # Q = QFRAC mu P
 ROOT = os.path.dirname(HERE)
 GEO = os.path.join(ROOT, "inputs", "gmsh", "cattaneo_disc.geo")
 AC = 0.005                         # disc scene: the contact half-width aimed at (a/R)
+BLOCK = (4.0, 4.0)                 # disc scene: the block's half-width and depth
 D0 = 1.0e-4                        # disc scene: the flat side's displacement for a of about 0.0055
 
 
@@ -117,15 +119,15 @@ def solve(binary, path, h5, loads, extra, mu=None):
     return measure(h5, p.stdout, mu)
 
 
-def disc_mesh(n, out, ac=AC, gmsh="gmsh"):
-    """The disc scene's mesh with a/h = n: the shipped one for the default ac, else gmsh's."""
+def disc_mesh(n, out, ac=AC, gmsh="gmsh", block=BLOCK):
+    """The disc scene's mesh with a/h = n: the shipped one for the default ac and block, else gmsh's."""
     shipped = os.path.join(ROOT, "inputs", "gmsh", f"cattaneo_disc_a{n}.msh")
-    if ac == AC and os.path.exists(shipped):
+    if ac == AC and tuple(block) == BLOCK and os.path.exists(shipped):
         return shipped
     os.makedirs(out, exist_ok=True)
-    path = os.path.join(out, f"cattaneo_disc_ac{ac:g}_a{n}.msh")
-    cmd = [gmsh, "-2", "-format", "msh41", "-setnumber", "ac", repr(ac), "-setnumber", "n", str(n), GEO,
-           "-o", path]
+    path = os.path.join(out, f"cattaneo_disc_ac{ac:g}_a{n}_L{block[0]:g}_D{block[1]:g}.msh")
+    cmd = [gmsh, "-2", "-format", "msh41", "-setnumber", "ac", repr(ac), "-setnumber", "n", str(n),
+           "-setnumber", "L", repr(block[0]), "-setnumber", "D", repr(block[1]), GEO, "-o", path]
     p = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     if p.returncode != 0 or not os.path.exists(path):
         raise RuntimeError(f"{' '.join(cmd)}: exit {p.returncode}: {(p.stdout + p.stderr).strip()[-400:]}")
@@ -158,11 +160,11 @@ def disc_press(binary, msh, out, tag, ac, mu, method="monolithic"):
     return d, solve(binary, path, h5, [f"&boundary body=1, group='disc_top', uy={-d!r} /", *hold], None, mu), path, h5
 
 
-def run_disc(binary, n, mode, method, out, extra=(), ac=AC, mu=MU, gmsh="gmsh"):
+def run_disc(binary, n, mode, method, out, extra=(), ac=AC, mu=MU, gmsh="gmsh", block=BLOCK):
     """The disc scene on the mesh a/h = n, P then Q in two load stages; returns the measured run."""
     if mode not in ("force", "displacement"):
         raise ValueError(f"the disc scene has the modes force and displacement, not {mode}")
-    msh = disc_mesh(n, out, ac, gmsh)
+    msh = disc_mesh(n, out, ac, gmsh, block)
     tag = f"cmd_{mode}_{method}_{n}"
     d, p, path, h5 = disc_press(binary, msh, out, tag, ac, mu, method)
     q = QFRAC * mu * p["P"]
@@ -204,23 +206,23 @@ def disc_slip(h5, r):
     return float(np.max(np.abs(s))) / (r["p0"] * a / es), float(np.polyfit(xb, s, 1)[0]) / (r["p0"] / es)
 
 
-def finite_size(binary, ars, n, mu, out, gmsh="gmsh"):
+def finite_size(binary, ars, n, mu, out, gmsh="gmsh", block=BLOCK):
     """For each a/R: the relative slip under P alone (frictionless) and the Cattaneo-Mindlin errors."""
     print("| a/R | mu | (a/R)/mu | slip max / (p0 a/E*) | slip slope / (p0/E*) | shear after P / (mu p0) "
-          "| c err | shear L2 err |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- |")
+          "| c err | shear L2 err | its odd part |")
+    print("| --- " * 9 + "|")
     for ar in ars:
         ac = ar * R
-        msh = disc_mesh(n, out, ac, gmsh)
+        msh = disc_mesh(n, out, ac, gmsh, block)
         _, r0, _, h5 = disc_press(binary, msh, out, f"slip_{ar:g}", ac, 0.0)
         smax, slope = disc_slip(h5, r0)
         _, r1, _, _ = disc_press(binary, msh, out, f"press_{ar:g}", ac, mu)
         with h5py.File(os.path.join(out, f"press_{ar:g}.h5"), "r") as f:
             x, q = np.array(f["contact/x"]), np.array(f["contact/shear"])
         q1 = float(np.sqrt(np.mean(q[np.abs(x) < 0.9 * r1["a"]] ** 2))) / (mu * r1["p0"])
-        r = run_disc(binary, n, "force", "monolithic", out, ac=ac, mu=mu, gmsh=gmsh)
+        r = run_disc(binary, n, "force", "monolithic", out, ac=ac, mu=mu, gmsh=gmsh, block=block)
         print(f"| {r['a'] / R:.4f} | {mu:g} | {r['a'] / R / mu:.3f} | {smax:.4f} | {slope:.4f} | {q1:.4f} | "
-              f"{r['c_err']:+.2%} | {r['l2']:.2%} |", flush=True)
+              f"{r['c_err']:+.2%} | {r['l2']:.2%} | {r['l2_odd']:.2%} |", flush=True)
 
 
 def measure(h5, text, mu=None):
@@ -254,8 +256,12 @@ def measure(h5, text, mu=None):
     c_fit = cs[int(np.argmin([np.linalg.norm((qs - cm(cc))[inside]) for cc in cs]))]
     away = inside & (np.abs(np.abs(x) - c_th) > 0.1 * a) & (np.abs(x) < 0.9 * a)
     l2 = float(np.linalg.norm((qs - cm(c_th))[away]) / np.linalg.norm(cm(c_th)[away]))
+    err = qs - cm(c_th)                # its parts even and odd in x (the mirror by interpolation)
+    mirror = np.interp(-x, x, err)
+    l2_even, l2_odd = (float(np.linalg.norm((0.5 * (err + sg * mirror))[away]) / np.linalg.norm(cm(c_th)[away]))
+                       for sg in (1.0, -1.0))
     stick = x[st == 1]
-    out.update(mu=mu, x=x, q=qs, c=c_th, c_fit=c_fit, c_err=c_fit / c_th - 1.0, l2=l2, a_err=af / a - 1.0, p0_err=p0f / p0 - 1.0,
+    out.update(mu=mu, x=x, q=qs, c=c_th, l2_even=l2_even, l2_odd=l2_odd, c_fit=c_fit, c_err=c_fit / c_th - 1.0, l2=l2, a_err=af / a - 1.0, p0_err=p0f / p0 - 1.0,
                stick_half=float((stick.max() - stick.min()) / 2.0) if stick.size else 0.0)
     return out
 
@@ -276,29 +282,34 @@ def main():
     ap.add_argument("--ar", default=None, help="disc: the a/R values of the finite-size study (one --n)")
     ap.add_argument("--mu", type=float, default=MU, help="disc: the friction coefficient")
     ap.add_argument("--gmsh", default="gmsh")
+    ap.add_argument("--block", default="4,4", help="disc: the block's half-width and depth")
     args = ap.parse_args()
     disc = args.scene == "disc"
+    block = tuple(float(v) for v in args.block.split(","))
     ns = [int(v) for v in (args.n or ("8,16,32" if disc else "100,200,400")).split(",")]
     if disc and args.ar:
-        finite_size(args.bin, [float(v) for v in args.ar.split(",")], ns[0], args.mu, args.out, args.gmsh)
+        finite_size(args.bin, [float(v) for v in args.ar.split(",")], ns[0], args.mu, args.out, args.gmsh, block)
         return
     rows = []
     first = "| a/h | h | a/R" if disc else "| cells per block | h | a/h"
-    print(f"{first} | P | Q/(mu P) | a err | p0 err | c err | shear L2 err | outer |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print(f"{first} | P | Q/(mu P) | a err | p0 err | c err | shear L2 err |" + (" even, odd |" if disc else "")
+          + " outer |")
+    print("| --- " * (11 if disc else 10) + "|")
     for n in ns:
         if disc:
-            r = run_disc(args.bin, n, args.mode, args.method, args.out, mu=args.mu, gmsh=args.gmsh)
+            r = run_disc(args.bin, n, args.mode, args.method, args.out, mu=args.mu, gmsh=args.gmsh, block=block)
             h = AC / n
             lead = f"| {n} | {h:.4g} | {r['a'] / R:.4f}"
+            parts = f" {r['l2_even']:.2%}, {r['l2_odd']:.2%} |"
         else:
             r = run(args.bin, n, args.mode, args.method, args.out)
             h = W / n
             lead = f"| {n} x {n // 2} | {h:.4g} | {r['a'] / h:.1f}"
+            parts = ""
         outer = next((t.split("=")[1] for t in r["text"].split() if t.startswith("outer=")), "")
         rows.append((h, r))
         print(f"{lead} | {r['P']:.6g} | {r['Q'] / (r['mu'] * r['P']):.4f} | "
-              f"{r['a_err']:+.2%} | {r['p0_err']:+.2%} | {r['c_err']:+.2%} | {r['l2']:.2%} | {outer} |", flush=True)
+              f"{r['a_err']:+.2%} | {r['p0_err']:+.2%} | {r['c_err']:+.2%} | {r['l2']:.2%} |{parts} {outer} |", flush=True)
     if len(rows) > 1:
         hs = [h for h, _ in rows]
         print("observed orders, c:", ", ".join(f"{v:.2f}" for v in orders(hs, [r["c_err"] for _, r in rows])),
