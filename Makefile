@@ -367,6 +367,7 @@ meshes:
 	   for h in 0.04 0.02 0.01 0.005; do $(GMSH_MSH) -setnumber h $$h hertz_force.geo -o hertz_force_h$$h.msh; done; \
 	   $(GMSH_MSH) pin_hole.geo -o pin_hole.msh; \
 	   $(GMSH_MSH) cylinders.geo -o cylinders.msh; \
+	   for n in 8 16 32; do $(GMSH_MSH) -setnumber n $$n cattaneo_disc.geo -o cattaneo_disc_a$$n.msh; done; \
 	   for n in 12:18 24:36 48:72; do nu=$${n%:*}; nl=$${n#*:}; \
 	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \
 	   done; \

@@ -2,7 +2,8 @@
 """Normal contact pressure and gap along the contact line of robin_contact runs, several
 runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-gap scene.
 
-Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [--mindlin] [-o contact.png] [--title TEXT]
+Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [--mindlin] [--radius R] [-o contact.png]
+       [--title TEXT]
 
 Top panel: /contact/pressure (nodal force / tributary length) against the arc length s along
 the contact curve (/contact/s). The legend gives each run's contact force per unit thickness:
@@ -45,7 +46,9 @@ err_L2=...') and written in that panel's legend:
 Hertz assumes two half-spaces: with finite bodies and a coarse mesh expect agreement
 only when the contact width 2a is small against the bodies and spans several elements.
 A run without a parabolic gap (gap_radius = 0) or of several pairs gets no Hertz curve (a
-note on stderr).
+note on stderr), unless --radius R gives the relative radius of curvature of a gap that is
+the geometry's (a disc on a flat block: the disc's radius); xc is then the middle of the
+run's contact zone (its edges as above).
 Runs that are identical for Hertz (same P, R, xc, E*) share one curve.
 With --mindlin (implies --hertz), for each Hertzian run with Coulomb friction (friction =
 'coulomb' and mu > 0 in the input deck), Cattaneo-Mindlin's shear of a tangential load Q < mu P
@@ -136,9 +139,14 @@ def gap_parameters(f, path):
     return R, xc, plane_stress(text), src
 
 
-def hertz(f, path):
-    """Hertz curve data of one run, or (None, reason)."""
+def hertz(f, path, radius=None, edges=None):
+    """Hertz curve data of one run, or (None, reason); radius and edges: the relative radius and
+    the contact zone of a run whose gap is its geometry's (used when it has no gap_radius)."""
     R, xc, pstress, src = gap_parameters(f, path)
+    if radius is not None and not (R is not None and R > 0.0):
+        if edges is None:
+            return None, "no contact zone (no active node) to centre the --radius curve on"
+        R, xc, src = radius, 0.5 * (edges[0] + edges[1]), "--radius, centred on the contact zone"
     if R is None:
         return None, "no gap_radius in the attributes or the input deck"
     if not R > 0.0:
@@ -276,14 +284,14 @@ def read_line(f, g, u, resultant_name):
     return r
 
 
-def read_run(path, want_hertz, want_mindlin=False):
+def read_run(path, want_hertz, want_mindlin=False, radius=None):
     """The curves of one result file: one (/contact), or one per pair when it has several."""
     with h5py.File(path, "r") as f:
         u = result_units(f)
         npair = int(f.attrs.get("pairs", 1))
         if npair <= 1:
             r = read_line(f, f["contact"], u, "resultant_body1")
-            r["h"], r["why"] = hertz(f, path) if want_hertz else (None, None)
+            r["h"], r["why"] = hertz(f, path, radius, r["edges"]) if want_hertz else (None, None)
             r["pair"] = ""
             r["m"], r["mwhy"] = None, None
             if want_mindlin:
@@ -311,13 +319,15 @@ def main(argv=None):
     ap.add_argument("--hertz", action="store_true", help="add the Hertz line-contact pressure and p/p0 panel")
     ap.add_argument("--mindlin", action="store_true",
                     help="add Cattaneo-Mindlin's shear to the shear panel (Coulomb friction; implies --hertz)")
+    ap.add_argument("--radius", type=float, default=None,
+                    help="Hertz's relative radius for a run whose gap is its geometry's (no gap_radius)")
     a = ap.parse_args(argv)
     a.hertz = a.hertz or a.mindlin
 
     runs = []
     for path in a.files:
         try:
-            curves = read_run(path, a.hertz, a.mindlin)
+            curves = read_run(path, a.hertz, a.mindlin, a.radius)
         except (OSError, KeyError, ValueError) as e:
             print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
             return 1

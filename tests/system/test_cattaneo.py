@@ -9,8 +9,16 @@ prescribed displacement of the upper block's top (the finest mesh), the same wit
 load stages (Coulomb on the slip increment; for equal materials P alone makes no slip, so it
 equals the one-step result), and the Robin iteration (harmonic) = monolithic to 1e-6 on the
 middle mesh.
+Then the same on a half-disc of radius 1 on a block 8 x 4 (`--scene disc`, the shipped meshes
+inputs/gmsh/cattaneo_disc_a8/16/32.msh, a/R = 0.005), P in a first load stage and Q = mu P / 2 in
+a second: Q as a traction on the disc's flat side, the disc held along x by friction alone, on
+three meshes (a/h = 8, 16, 32), c and the shear within 2% on the finest; Q as a prescribed
+displacement of the flat side, the finest mesh; Robin = monolithic (1e-6) on the middle one;
+tools/plot_contact.py --mindlin --radius 1 draws the finest run with its Cattaneo-Mindlin curve.
 """
 import os
+import re
+import subprocess
 import sys
 import tempfile
 
@@ -26,12 +34,66 @@ BIN = os.path.abspath(os.environ.get("BIN", os.path.join(ROOT, "bin/robin_contac
 check = Checks()
 
 
-def attempt(what, *args):
+def attempt(what, *args, run=cs.run):
     try:
-        return cs.run(BIN, *args)
+        return run(BIN, *args)
     except Exception as e:  # a failed run fails its checks, the others still run
         check(False, f"{what}: the run ends converged", str(e)[-300:])
         return None
+
+
+def plot(h5, png):
+    """plot_contact --mindlin on a run whose gap is the disc's geometry (Hertz's radius given)."""
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "plot_contact.py"), h5, "--mindlin",
+                        "--radius", "1", "-o", png], capture_output=True, text=True, timeout=300)
+    m = re.search(r"Mindlin for \S+: .* err_c=(\S+) err_q=(\S+)", p.stdout)
+    check(p.returncode == 0 and m is not None and os.path.isfile(png) and os.path.getsize(png) > 10000
+          and float(m.group(1)) <= 0.02 and float(m.group(2)) <= 0.03,
+          "plot_contact --mindlin --radius 1 draws the disc run with its Cattaneo-Mindlin curve "
+          "(its err_c <= 0.02, err_q <= 0.03 over the whole zone)",
+          (m.group(0) if m else (p.stdout + p.stderr).strip()[-300:]))
+
+
+def disc(tmp):
+    """The half-disc on a block (see the docstring)."""
+    rows = []
+    for n in (8, 16, 32):
+        r = attempt(f"disc, force, a/h = {n}", n, "force", "monolithic", os.path.join(tmp, "d"), run=cs.run_disc)
+        if r is not None:
+            rows.append((cs.AC / n, r))
+            print(f"INFO  disc, force, a/h = {n}: a/R {r['a'] / cs.R:.4f}, a {r['a_err']:+.2%}, p0 {r['p0_err']:+.2%}, "
+                  f"c {r['c_err']:+.2%}, shear L2 {r['l2']:.2%}", flush=True)
+    if len(rows) == 3:
+        hs = [h for h, _ in rows]
+        print("INFO  disc, observed orders: c", [round(v, 2) for v in cs.orders(hs, [r["c_err"] for _, r in rows])],
+              "shear", [round(v, 2) for v in cs.orders(hs, [r["l2"] for _, r in rows])], flush=True)
+        fine = rows[-1][1]
+        check(abs(fine["c_err"]) <= 0.02, "disc, force, finest mesh: stick-zone half-width c within 2% of theory",
+              f"{fine['c_err']:+.2%}")
+        check(fine["l2"] <= 0.02,
+              "disc, force, finest mesh: shear traction within 2% (L2, away from the zone edges)", f"{fine['l2']:.2%}")
+        check(abs(fine["a_err"]) <= 0.01 and abs(fine["p0_err"]) <= 0.01,
+              "disc, force, finest mesh: Hertz's a and p0 within 1%", f"{fine['a_err']:+.2%}, {fine['p0_err']:+.2%}")
+        check(abs(fine["a"] / cs.R - 0.005) <= 0.0005, "disc: a/R = 0.005 (10%), the scene's size against the disc",
+              f"{fine['a'] / cs.R:.5f}")
+        check(fine["l2"] < rows[0][1]["l2"], "disc, force: the shear error falls with the mesh",
+              f"{rows[0][1]['l2']:.2%} -> {fine['l2']:.2%}")
+        check(abs(fine["Q"] - fine["Q_applied"]) <= 1e-9 * fine["Q_applied"],
+              "disc, force: the contact's tangential force is the applied Q (1e-9): friction alone holds the disc",
+              f"{fine['Q']!r} against {fine['Q_applied']!r}")
+        plot(os.path.join(tmp, "d", "cmd_force_monolithic_32.h5"), os.path.join(tmp, "disc_contact.png"))
+    d = attempt("disc, displacement, a/h = 32", 32, "displacement", "monolithic", os.path.join(tmp, "dd"),
+                run=cs.run_disc)
+    if d is not None:
+        check(abs(d["c_err"]) <= 0.02 and d["l2"] <= 0.02,
+              "disc, displacement, finest mesh: c and the shear within 2% of theory (with the measured P and Q)",
+              f"c {d['c_err']:+.2%}, shear {d['l2']:.2%}, Q/(mu P) = {d['Q'] / (cs.MU * d['P']):.4f}")
+    r = attempt("disc, robin, a/h = 16", 16, "force", "robin", os.path.join(tmp, "dr"), run=cs.run_disc)
+    if r is not None and len(rows) == 3:
+        m = rows[1][1]
+        e = max(np.linalg.norm(r["lam"] - m["lam"]) / np.linalg.norm(m["lam"]),
+                np.linalg.norm(r["lt"] - m["lt"]) / np.linalg.norm(m["lt"]))
+        check(e <= 1e-6, "disc: Robin (harmonic) = monolithic (1e-6), a/h = 16", f"{e:.2e}")
 
 
 def main():
@@ -79,6 +141,7 @@ def main():
             e = max(np.linalg.norm(r["lam"] - m["lam"]) / np.linalg.norm(m["lam"]),
                     np.linalg.norm(r["lt"] - m["lt"]) / np.linalg.norm(m["lt"]))
             check(e <= 1e-6, "Robin (harmonic) = monolithic (1e-6), 200 cells", f"{e:.2e}")
+        disc(tmp)
     print(f"{len(check.failed)} failed")
     return 1 if check.failed else 0
 
