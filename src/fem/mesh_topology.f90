@@ -157,8 +157,8 @@ contains
   end function entity_index
 
   !> One body from what a mesh file holds: choose the body's cells (those of the physical
-  !! surface `region`), renumber its nodes, orient and check its cells, find its groups.
-  !! On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
+  !! surface `region`), number its nodes by tag, orient and check its cells, find its
+  !! groups, then number its nodes and cells for locality (number_for_locality). On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
   !! (its subject the file: 'has no physical surface ...').
   subroutine body_from_file(file_mesh, region, path, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh          !< the file's groups, entities, nodes, elements
