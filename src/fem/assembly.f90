@@ -97,7 +97,7 @@ contains
     logical, allocatable :: prescribed(:)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
-    integer :: info, shared
+    integer :: info
     character(len=512) :: msg
 
     with_k = .true.
@@ -124,15 +124,13 @@ contains
       if (err%failed()) return
     end if
     call number_free_dofs(prescribed, sys)
-    shared = 0
     if (with_k) then
-      call build_pattern(mesh, sys, err, shared)
+      call build_pattern(mesh, sys, err)
       if (err%failed()) return
     end if
     call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
     if (err%failed()) return
-    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, &
-                               with_k .and. .not. mesh%structured .and. shared <= 2)
+    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k)
     if (err%failed()) return
     call add_applied_loads(sys)
     if (present(nstage)) then
@@ -364,7 +362,7 @@ contains
         call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err)
       end if
       if (err%failed()) return
-      call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, .false., .false.)
+      call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, .false.)
       if (err%failed()) return
       call add_applied_loads(sys)
       sys%f_stage(:, s) = sys%f
@@ -378,29 +376,22 @@ contains
   end subroutine stage_loads
 
   !> The element loop: each cell's stiffness into the CSC values, and the lifting
-  !! f -= K_fd u_d of its prescribed values. err = ERR_INPUT on a cell with a non-positive
-  !! Jacobian, ERR_NUMERICAL on a coupling outside the pattern (an internal error).
-  !! `local`: the cells in an order with locality (stiffness_local_order), for a mesh whose
-  !! node pairs each lie in at most two cells; the values are those of the file order.
-  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, local)
+  !! f -= K_fd u_d of its prescribed values, cell by cell (a mesh from a file is numbered
+  !! for locality, so consecutive cells touch nearby columns). err = ERR_INPUT on a cell
+  !! with a non-positive Jacobian, ERR_NUMERICAL on a coupling outside the pattern (an
+  !! internal error).
+  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k)
     type(mesh_t), intent(in) :: mesh
     real(wp), intent(in) :: lame_lambda, lame_mu
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
-    logical, intent(in) :: local
     integer :: c, nd, ldof(MAX_NDOF)
     real(wp) :: ke(MAX_NDOF, MAX_NDOF)
     type(ke_cache_t) :: cache
-    logical :: inside, done
+    logical :: inside
     character(len=512) :: emsg
 
-    if (local) then
-      call stiffness_local_order(mesh, lame_lambda, lame_mu, sys, err, done)
-      if (done .or. err%failed()) return
-      sys%val = 0.0_wp          ! a coupling outside the pattern: the file order names the cell
-      sys%f = 0.0_wp
-    end if
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
       call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
@@ -417,127 +408,9 @@ contains
     end do
   end subroutine stiffness_and_lifting
 
-  !> The element loop of a mesh read from a file, whose cells come in no order of place:
-  !! the same sums as the file-order loop, bit for bit, with fewer cache misses.
-  !! 1. Cells in file order with the stiffness cache, as the file-order loop: the lifting,
-  !!    the sums of the node blocks (both DOFs of one node: the only entries with more than
-  !!    two cells' terms, kept in `blocks`, a node-sized array), the cell whose stiffness
-  !!    each cell reuses, and each cell's place on a Morton curve.
-  !! 2. Cells along the curve: the couplings of distinct nodes into the CSC values. Each
-  !!    has the terms of at most two cells, and a + b = b + a exactly.
-  !! 3. The node blocks into the CSC values, column by column.
-  !! done = .false. (values and loads zeroed by the caller) on a coupling outside the pattern.
-  subroutine stiffness_local_order(mesh, lame_lambda, lame_mu, sys, err, done)
-    type(mesh_t), intent(in) :: mesh
-    real(wp), intent(in) :: lame_lambda, lame_mu
-    type(body_system_t), intent(inout) :: sys
-    type(error_t), intent(out) :: err
-    logical, intent(out) :: done
-    integer, parameter :: BITS = 15                     ! per coordinate of the Morton key
-    integer :: c, m, a, k, nd, ci, cj, fi, fj, pos, src, ldof(MAX_NDOF), q(2)
-    integer, allocatable :: source(:), key(:), order(:)
-    real(wp), allocatable :: blocks(:, :)
-    real(wp) :: ke(MAX_NDOF, MAX_NDOF), xe(2, MAX_NVERT), lo(2), scale(2), minjac
-    type(ke_cache_t) :: cache
-    logical :: reused, inside
-
-    done = .false.
-    allocate (source(mesh%ncell), key(mesh%ncell), blocks(4, mesh%nnode))
-    blocks = 0.0_wp
-    lo = minval(mesh%xy, dim=2)
-    scale = real(2**BITS - 1, wp)/max(maxval(mesh%xy, dim=2) - lo, tiny(1.0_wp))
-    call ke_cache_init(cache, maxval(abs(mesh%xy)))
-    src = 0
-    do c = 1, mesh%ncell
-      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err, reused)
-      if (err%failed()) return
-      if (.not. reused) src = c
-      source(c) = src
-      do a = 1, nd/2
-        k = mesh%cells(a, c)
-        blocks(:, k) = blocks(:, k) + [ke(2*a - 1, 2*a - 1), ke(2*a, 2*a - 1), ke(2*a - 1, 2*a), ke(2*a, 2*a)]
-      end do
-      call lift_prescribed(sys, ldof(1:nd), ke)
-      call cell_coords(mesh, c, xe)
-      q = int((sum(xe(:, 1:nd/2), dim=2)/real(nd/2, wp) - lo)*scale)
-      key(c) = morton(min(max(q(1), 0), 2**BITS - 1), min(max(q(2), 0), 2**BITS - 1), BITS)
-    end do
-    call radix_order(key, 2*BITS, order)
-    deallocate (key)
-    do m = 1, mesh%ncell
-      c = order(m)
-      nd = 2*cell_vertices(mesh, c)
-      call cell_coords(mesh, source(c), xe)
-      call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac)
-      call cell_dofs(mesh, c, ldof)
-      call scatter_element(sys, ldof(1:nd), ke, inside, couplings_only=.true.)
-      if (.not. inside) return
-    end do
-    do k = 1, mesh%nnode
-      do cj = 1, 2
-        fj = sys%free_of(2*(k - 1) + cj)
-        if (fj == 0) cycle
-        pos = sys%colptr(fj) + 1
-        do ci = 1, 2
-          fi = sys%free_of(2*(k - 1) + ci)
-          if (fi == 0) cycle
-          do while (sys%rowind(pos) /= fi - 1)
-            pos = pos + 1
-          end do
-          sys%val(pos) = blocks(ci + 2*(cj - 1), k)
-        end do
-      end do
-    end do
-    done = .true.
-  end subroutine stiffness_local_order
-
-  !> The Morton key of (i, j), each of nbits bits (2 nbits < 32): their bits interleaved,
-  !! i's in the even places.
-  pure integer function morton(i, j, nbits) result(key)
-    integer, intent(in) :: i, j, nbits
-    integer :: b
-    key = 0
-    do b = 0, nbits - 1
-      if (btest(i, b)) key = ibset(key, 2*b)
-      if (btest(j, b)) key = ibset(key, 2*b + 1)
-    end do
-  end function morton
-
-  !> The indices 1..size(key) by increasing key (keys of `nbits` bits, non-negative):
-  !! a stable least-significant-digit radix sort, two digits.
-  subroutine radix_order(key, nbits, order)
-    integer, intent(in) :: key(:)
-    integer, intent(in) :: nbits
-    integer, allocatable, intent(out) :: order(:)
-    integer, allocatable :: count(:), tmp(:)
-    integer :: n, i, d, shift, width, digit
-    n = size(key)
-    width = (nbits + 1)/2
-    allocate (order(n), tmp(n), count(0:2**width))
-    order = [(i, i=1, n)]
-    do d = 0, 1
-      shift = d*width
-      count = 0
-      do i = 1, n
-        digit = ibits(key(i), shift, width)
-        count(digit + 1) = count(digit + 1) + 1
-      end do
-      do i = 1, 2**width
-        count(i) = count(i) + count(i - 1)
-      end do
-      do i = 1, n
-        digit = ibits(key(order(i)), shift, width)
-        count(digit) = count(digit) + 1
-        tmp(count(digit)) = order(i)
-      end do
-      order = tmp
-    end do
-  end subroutine radix_order
-
   !> The stiffness of cell c (nd = its DOF count, ldof its global DOFs); err = ERR_INPUT,
   !! naming the cell's tag, when its Jacobian is not positive (inverted or degenerate).
-  !! reused: the stiffness is the cache's (the last cell computed, translated).
-  subroutine cell_stiffness(mesh, body_id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err, reused)
+  subroutine cell_stiffness(mesh, body_id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id, c
     real(wp), intent(in) :: lame_lambda, lame_mu
@@ -545,12 +418,11 @@ contains
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)
     integer, intent(out) :: nd, ldof(MAX_NDOF)
     type(error_t), intent(inout) :: err
-    logical, intent(out), optional :: reused
     real(wp) :: xe(2, MAX_NVERT), minjac
     character(len=512) :: emsg
     nd = 2*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
-    call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache, reused)
+    call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
     if (.not. (minjac > 0.0_wp)) then
       write (emsg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
         ' has a non-positive Jacobian (inverted or degenerate element)'
@@ -563,19 +435,14 @@ contains
   !> Add the free-free block of an element stiffness to the CSC values. The element's
   !! DOFs are merged in increasing global (hence free) order with the sorted rows of
   !! each column. inside = .false. when a coupling is missing from the pattern.
-  !! couplings_only: leave out the entries of two DOFs of one node.
-  subroutine scatter_element(sys, ldof, ke, inside, couplings_only)
+  subroutine scatter_element(sys, ldof, ke, inside)
     type(body_system_t), intent(inout) :: sys
     integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
     real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
     logical, intent(out) :: inside
-    logical, intent(in), optional :: couplings_only
     integer :: nd, a, b, kk, fc, pos, pend, lfree(MAX_NDOF), perm(MAX_NDOF)
-    logical :: skip_own
 
     inside = .true.
-    skip_own = .false.
-    if (present(couplings_only)) skip_own = couplings_only
     nd = size(ldof)
     ! Local dofs in increasing global order (insertion sort).
     do a = 1, nd
@@ -593,9 +460,6 @@ contains
       do kk = 1, nd
         a = perm(kk)
         if (lfree(a) == 0) cycle
-        if (skip_own) then
-          if ((ldof(a) + 1)/2 == (ldof(b) + 1)/2) cycle
-        end if
         do while (sys%rowind(pos) /= lfree(a) - 1)
           pos = pos + 1
           if (pos > pend) then

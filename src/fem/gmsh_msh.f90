@@ -51,8 +51,9 @@ contains
   !!
   !! The body is the triangles and quadrangles of the physical surface named `region`; with
   !! region = '' the file may hold at most one physical surface, and a file without physical
-  !! groups gives every 2D element. `mesh` gets the body's nodes (renumbered by increasing
-  !! Gmsh tag, `node_tag` keeps the tag), its cells counter-clockwise (`cell_tag`,
+  !! groups gives every 2D element. `mesh` gets the body's nodes and cells numbered for
+  !! locality (`node_tag` keeps the tag; `file_node` and `file_cell` the file's order:
+  !! the nodes by increasing tag), its cells counter-clockwise (`cell_tag`,
   !! `cell_type`), element = ELEM_Q1, ELEM_P1 or ELEM_MIXED, the bounding box, one edge
   !! group per physical curve with edges on the body's boundary, then one node group per
   !! physical point with nodes of the body (`file_groups` lists every physical curve and

@@ -19,6 +19,11 @@
 !!
 !! Every group edge is a boundary edge of one cell, oriented counter-clockwise around the
 !! body (the body on its left), so its outward normal is (dy, -dx)/length.
+!!
+!! A mesh read from a file is numbered for locality (nodes and cells along a space-filling
+!! curve), not in the file's order; `file_node` and `file_cell` keep the file's, and every
+!! per-node or per-cell output goes through `file_order` and `file_cells`, so that results
+!! are written in the file's node and cell order.
 module mesh
   use kinds, only: wp
   use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
@@ -26,7 +31,12 @@ module mesh
   private
 
   public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes, &
-            nodes_only, nodes_only_refusal, cell_element, cell_vertices
+            nodes_only, nodes_only_refusal, cell_element, cell_vertices, file_order, file_cells, file_dof
+
+  !> A nodal field in the file's node order (the order of every per-node output).
+  interface file_order
+    module procedure file_order_1, file_order_2
+  end interface file_order
 
   !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side)
   !! and of single nodes (a Gmsh physical point, or where a physical curve runs inside the
@@ -61,6 +71,12 @@ module mesh
     integer, allocatable :: cell_type(:)  !< (ncell) ELEM_Q1 or ELEM_P1 of each cell
     integer, allocatable :: node_tag(:)   !< (nnode) the file's node tag (structured: the node id)
     integer, allocatable :: cell_tag(:)   !< (ncell) the file's element tag (structured: the cell id)
+    !> (nnode) a mesh from a file: each node's place in the file's order (the body's nodes
+    !! by increasing tag); unallocated: the nodes are in that order
+    integer, allocatable :: file_node(:)
+    !> (ncell) a mesh from a file: each cell's place in the file's order of the body's
+    !! cells; unallocated: the cells are in that order
+    integer, allocatable :: file_cell(:)
     integer :: ngroup = 0                 !< named edge groups of this body
     type(edge_group_t), allocatable :: group(:)   !< (ngroup) the groups
     !> every physical curve name of the file, then '; physical points: ' and every physical
@@ -96,6 +112,55 @@ contains
     cell_vertices = merge(4, 3, cell_element(mesh, c) == ELEM_Q1)
   end function cell_vertices
 
+
+  !> x (one column per node, nodes numbered as the mesh) with its columns in the file's
+  !! node order.
+  pure function file_order_2(mesh, x) result(y)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    real(wp), intent(in) :: x(:, :)    !< (:, nnode) a nodal field
+    real(wp) :: y(size(x, 1), size(x, 2))
+    if (allocated(mesh%file_node)) then
+      y(:, mesh%file_node) = x
+    else
+      y = x
+    end if
+  end function file_order_2
+
+  !> x (one value per node, nodes numbered as the mesh) in the file's node order.
+  pure function file_order_1(mesh, x) result(y)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    real(wp), intent(in) :: x(:)       !< (nnode) a nodal field
+    real(wp) :: y(size(x))
+    if (allocated(mesh%file_node)) then
+      y(mesh%file_node) = x
+    else
+      y = x
+    end if
+  end function file_order_1
+
+  !> The cells in the file's cell order, their nodes numbered in the file's node order
+  !! (a triangle's 4th vertex in a mixed mesh stays 0).
+  pure function file_cells(mesh) result(cells)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    integer :: cells(size(mesh%cells, 1), size(mesh%cells, 2))
+    integer :: c, a, k
+    do c = 1, size(mesh%cells, 2)
+      k = c
+      if (allocated(mesh%file_cell)) k = mesh%file_cell(c)
+      do a = 1, size(mesh%cells, 1)
+        cells(a, k) = mesh%cells(a, c)
+        if (allocated(mesh%file_node) .and. cells(a, k) > 0) cells(a, k) = mesh%file_node(cells(a, k))
+      end do
+    end do
+  end function file_cells
+
+  !> Global DOF `dof` (2*(k-1)+component of node k) numbered by the file's node order.
+  elemental integer function file_dof(mesh, dof)
+    type(mesh_t), intent(in) :: mesh   !< the mesh
+    integer, intent(in) :: dof         !< a global DOF, 1..2*nnode
+    file_dof = dof
+    if (allocated(mesh%file_node)) file_dof = 2*(mesh%file_node((dof + 1)/2) - 1) + 2 - mod(dof, 2)
+  end function file_dof
 
   !> Build the structured mesh of a body (its rectangle, nx x ny grid cells and element).
   !! On a bad body (nx or ny < 1, non-positive extent, unknown element) the mesh is left

@@ -1,7 +1,9 @@
 !> One body's mesh from what a mesh file holds (physical groups, entities, nodes, cells,
 !! lines and points, in file order; module gmsh_msh reads them): the cells of the body's
-!! physical surface, its nodes renumbered 1..nnode in increasing tag order, its cells
-!! counter-clockwise (degenerate cells and non-convex quadrangles refused), and its groups.
+!! physical surface, its cells counter-clockwise (degenerate cells and non-convex
+!! quadrangles refused), and its groups. Its nodes and cells are checked in the file's
+!! order (the body's nodes by increasing tag), then numbered for locality
+!! (number_for_locality; mesh%file_node and mesh%file_cell keep the file's order).
 !! A group keeps the line elements of its physical curve that are boundary edges of the body
 !! (edges of exactly one body cell), oriented as that cell traverses them; the nodes of its
 !! lines inside the body (edges of two body cells) are kept as single nodes. A physical point
@@ -155,8 +157,8 @@ contains
   end function entity_index
 
   !> One body from what a mesh file holds: choose the body's cells (those of the physical
-  !! surface `region`), renumber its nodes, orient and check its cells, find its groups.
-  !! On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
+  !! surface `region`), number its nodes by tag, orient and check its cells, find its
+  !! groups, then number its nodes and cells for locality (number_for_locality). On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
   !! (its subject the file: 'has no physical surface ...').
   subroutine body_from_file(file_mesh, region, path, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh          !< the file's groups, entities, nodes, elements
@@ -298,7 +300,117 @@ contains
 
     call boundary_groups(file_mesh, body_node, mesh, err)
     if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh, err)
+    if (.not. err%failed()) call number_for_locality(mesh, err)
   end subroutine body_from_file
+
+  !> Renumber the body's nodes along a Morton (Z-order) curve of their coordinates, and
+  !! its cells by their smallest node in that numbering: the nodes of a neighbourhood get
+  !! nearby numbers, so the stiffness columns of a cell lie close together and the element
+  !! loop walks the matrix in order. The file's order is kept in file_node and file_cell
+  !! (the order of the output); groups follow the new numbers. err: ERR_MEMORY.
+  subroutine number_for_locality(mesh, err)
+    type(mesh_t), intent(inout) :: mesh
+    type(error_t), intent(inout) :: err
+    integer, parameter :: BITS = 15                     ! per coordinate of the Morton key
+    integer, allocatable :: key(:), order(:), new_node(:), first(:), new_cell(:)
+    real(wp) :: lo(2), scale(2)
+    integer :: k, c, g, q(2), st
+
+    allocate (key(mesh%nnode), new_node(mesh%nnode), first(mesh%nnode + 1), new_cell(mesh%ncell), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory to renumber '//i2s(mesh%nnode)//' nodes')
+      return
+    end if
+    lo = minval(mesh%xy, dim=2)
+    scale = real(2**BITS - 1, wp)/max(maxval(mesh%xy, dim=2) - lo, tiny(1.0_wp))
+    do k = 1, mesh%nnode
+      q = min(max(int((mesh%xy(:, k) - lo)*scale), 0), 2**BITS - 1)
+      key(k) = morton(q(1), q(2), BITS)
+    end do
+    call radix_order(key, 2*BITS, order)
+    new_node(order) = [(k, k=1, mesh%nnode)]
+    call move_alloc(order, mesh%file_node)
+    mesh%xy = mesh%xy(:, mesh%file_node)
+    mesh%node_tag = mesh%node_tag(mesh%file_node)
+    do c = 1, mesh%ncell
+      do k = 1, mesh%nvert
+        if (mesh%cells(k, c) > 0) mesh%cells(k, c) = new_node(mesh%cells(k, c))
+      end do
+    end do
+    do g = 1, mesh%ngroup
+      do k = 1, mesh%group(g)%nedge
+        mesh%group(g)%edge(:, k) = new_node(mesh%group(g)%edge(:, k))
+      end do
+      if (allocated(mesh%group(g)%node)) mesh%group(g)%node = new_node(mesh%group(g)%node)
+    end do
+
+    ! cells by their smallest node (a stable counting sort)
+    first = 0
+    do c = 1, mesh%ncell
+      k = minval(mesh%cells(:, c), mask=mesh%cells(:, c) > 0)
+      first(k + 1) = first(k + 1) + 1
+    end do
+    first(1) = 1
+    do k = 1, mesh%nnode
+      first(k + 1) = first(k + 1) + first(k)
+    end do
+    do c = 1, mesh%ncell
+      k = minval(mesh%cells(:, c), mask=mesh%cells(:, c) > 0)
+      new_cell(c) = first(k)
+      first(k) = first(k) + 1
+    end do
+    allocate (mesh%file_cell(mesh%ncell))
+    mesh%file_cell(new_cell) = [(c, c=1, mesh%ncell)]
+    mesh%cells = mesh%cells(:, mesh%file_cell)
+    mesh%cell_type = mesh%cell_type(mesh%file_cell)
+    mesh%cell_tag = mesh%cell_tag(mesh%file_cell)
+    do g = 1, mesh%ngroup
+      if (allocated(mesh%group(g)%cell)) mesh%group(g)%cell = new_cell(mesh%group(g)%cell)
+    end do
+  end subroutine number_for_locality
+
+  !> The Morton key of (i, j), each of nbits bits (2 nbits < 32): their bits interleaved,
+  !! i's in the even places.
+  pure integer function morton(i, j, nbits) result(key)
+    integer, intent(in) :: i, j, nbits
+    integer :: b
+    key = 0
+    do b = 0, nbits - 1
+      if (btest(i, b)) key = ibset(key, 2*b)
+      if (btest(j, b)) key = ibset(key, 2*b + 1)
+    end do
+  end function morton
+
+  !> The indices 1..size(key) by increasing key (keys of `nbits` bits, non-negative):
+  !! a stable least-significant-digit radix sort, two digits.
+  subroutine radix_order(key, nbits, order)
+    integer, intent(in) :: key(:)
+    integer, intent(in) :: nbits
+    integer, allocatable, intent(out) :: order(:)
+    integer, allocatable :: count(:), tmp(:)
+    integer :: n, i, d, shift, width, digit
+    n = size(key)
+    width = (nbits + 1)/2
+    allocate (order(n), tmp(n), count(0:2**width))
+    order = [(i, i=1, n)]
+    do d = 0, 1
+      shift = d*width
+      count = 0
+      do i = 1, n
+        digit = ibits(key(i), shift, width)
+        count(digit + 1) = count(digit + 1) + 1
+      end do
+      do i = 1, 2**width
+        count(i) = count(i) + count(i - 1)
+      end do
+      do i = 1, n
+        digit = ibits(key(order(i)), shift, width)
+        count(digit) = count(digit) + 1
+        tmp(count(digit)) = order(i)
+      end do
+      order = tmp
+    end do
+  end subroutine radix_order
 
   !> Put cell k counter-clockwise; refuse it if degenerate or (a quadrangle) not convex.
   subroutine orient_cell(mesh, k, err)

@@ -173,7 +173,7 @@ contains
     type(error_t), intent(out) :: err                        !< ERR_INPUT when no fixing DOFs are found
     character(len=*), intent(in), optional :: contact_groups(:)  !< the body's contact groups, kept clear
     logical, allocatable :: avoid(:)
-    integer, allocatable :: nodes(:)
+    integer, allocatable :: nodes(:), order(:)
     integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
     real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
     character(len=512) :: emsg
@@ -199,14 +199,22 @@ contains
     ! the first node: the closest to the contact's centroid off the contact (the centre when
     ! there is none), so that K^+'s contact displacements are measured from a near point and
     ! stay small (the rigid part R alpha then does not cancel a large pinned deformation)
+    ! the nodes in the file's order (a mesh from a file is numbered otherwise), so that the
+    ! choice among nodes at the same distance does not depend on the numbering
+    order = [(k, k=1, mesh%nnode)]
+    if (allocated(mesh%file_node)) order(mesh%file_node) = [(k, k=1, mesh%nnode)]
     ctr = sys%rig_xc
-    if (any(avoid)) then
+    if (any(avoid) .and. allocated(mesh%file_node)) then
+      ctr(1) = sum(mesh%xy(1, order), mask=avoid(order))/count(avoid)
+      ctr(2) = sum(mesh%xy(2, order), mask=avoid(order))/count(avoid)
+    else if (any(avoid)) then
       ctr(1) = sum(mesh%xy(1, :), mask=avoid)/count(avoid)
       ctr(2) = sum(mesh%xy(2, :), mask=avoid)/count(avoid)
     end if
     p = 0
     dbest = huge(1.0_wp)
-    do k = 1, mesh%nnode
+    do i = 1, mesh%nnode
+      k = order(i)
       if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
       d = norm2(mesh%xy(:, k) - ctr)
       if (d < dbest) then
@@ -222,7 +230,8 @@ contains
       return
     end if
     dbest = -1.0_wp
-    do k = 1, mesh%nnode
+    do i = 1, mesh%nnode
+      k = order(i)
       if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
       d = norm2(mesh%xy(:, k) - mesh%xy(:, p(1)))
       if (d > dbest) then

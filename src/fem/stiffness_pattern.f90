@@ -48,22 +48,19 @@ contains
   !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
   !! rows sorted in every column, from the node stencil of the grid. err = ERR_INPUT when
   !! the number of entries does not fit 32-bit indices.
-  subroutine build_pattern(mesh, sys, err, shared)
+  subroutine build_pattern(mesh, sys, err)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     type(body_system_t), intent(inout) :: sys  !< with its DOF numbering; gets colptr, rowind, val = 0
     type(error_t), intent(out) :: err          !< ERR_INPUT when the pattern is too large
-    !> the most cells that hold one pair of distinct nodes (a mesh from a file; 0 on a grid)
-    integer, intent(out), optional :: shared
     integer :: p, s, cc, q, pos, nnbr
     integer(i8) :: nnz
     integer, allocatable :: aptr(:), adj(:), nbr(:)
     character(len=512) :: emsg
 
-    if (present(shared)) shared = 0
     if (mesh%structured) then
       allocate (nbr(9))
     else
-      call node_adjacency(mesh, aptr, adj, shared)
+      call node_adjacency(mesh, aptr, adj)
       allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
     end if
     allocate (sys%colptr(sys%n + 1))
@@ -119,14 +116,12 @@ contains
 
   !> The nodes that share a cell with each node (itself included), in increasing node id:
   !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). Built from the cells by one sort of
-  !! the (node, neighbour) pairs, for any mesh. `shared`: the most cells holding one pair
-  !! of distinct nodes (a pair's copies in the sorted list).
-  subroutine node_adjacency(mesh, aptr, adj, shared)
+  !! the (node, neighbour) pairs, for any mesh.
+  subroutine node_adjacency(mesh, aptr, adj)
     type(mesh_t), intent(in) :: mesh
     integer, allocatable, intent(out) :: aptr(:), adj(:)
-    integer, intent(out), optional :: shared
     integer, allocatable :: cnt(:), pairs(:), pos(:)
-    integer :: c, a, b, nv, k, np, i, last, run, most
+    integer :: c, a, b, nv, k, np, i, last
     ! pairs (k, l) of every cell, bucketed by k, then sorted and deduplicated per node
     allocate (cnt(mesh%nnode + 1))
     cnt = 0
@@ -157,26 +152,17 @@ contains
     allocate (aptr(mesh%nnode + 1), adj(np))
     aptr(1) = 1
     i = 0
-    most = 0
     do k = 1, mesh%nnode
       call sort_ints(pairs(cnt(k):cnt(k + 1) - 1))
       last = 0
-      run = 0
       do a = cnt(k), cnt(k + 1) - 1
-        if (pairs(a) == last) then
-          run = run + 1
-          if (last /= k) most = max(most, run)
-          cycle
-        end if
+        if (pairs(a) == last) cycle
         last = pairs(a)
-        run = 1
-        if (last /= k) most = max(most, run)
         i = i + 1
         adj(i) = last
       end do
       aptr(k + 1) = i + 1
     end do
-    if (present(shared)) shared = most
   end subroutine node_adjacency
 
 end module stiffness_pattern

@@ -18,7 +18,7 @@ module results
                    write_text, commit_files
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE
   use strings, only: word, body_label, i2s
-  use mesh, only: mesh_t
+  use mesh, only: mesh_t, file_order, file_cells, file_dof
   use assembly, only: body_system_t, stress_field_t, nodal_stress
   use contact_interface, only: interface_t, pair_rows
   use contact_types, only: contact_result_t, status_name
@@ -278,30 +278,30 @@ contains
         call write_attr(gid, 'rigid_motions', free_list(sys(a)), st)
         call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
         call write_dset(gid, 'rigid_basis', sys(a)%rig_coef, st, '1')
-        call write_dset(gid, 'fixing_dofs', sys(a)%fixing - 1, st, '1')
+        call write_dset(gid, 'fixing_dofs', file_dof(msh(a), sys(a)%fixing) - 1, st, '1')
       end if
-      ! (nnode, 2) in Fortran order -> h5py shape (2, nnode)
+      ! (nnode, 2) in Fortran order -> h5py shape (2, nnode); nodes and cells in the file's order
       allocate (w2(msh(a)%nnode, 2), w3(3, msh(a)%nnode), ua(sys(a)%ndof))
-      ua = u(1:sys(a)%ndof, a)
-      w2 = transpose(msh(a)%xy)
+      ua = reshape(file_order(msh(a), reshape(u(1:sys(a)%ndof, a), [2, msh(a)%nnode])), [sys(a)%ndof])
+      w2 = transpose(file_order(msh(a), msh(a)%xy))
       call write_dset(gid, 'coordinates', w2, st, ul)
       w2 = transpose(reshape(ua, [2, msh(a)%nnode]))
       call write_dset(gid, 'displacement', w2, st, ul)
-      w3 = pad3(msh(a)%xy)
+      w3 = pad3(file_order(msh(a), msh(a)%xy))
       call write_dset(gid, 'geometry_xyz', w3, st, ul)
       w3 = pad3(reshape(ua, [2, msh(a)%nnode]))
       call write_dset(gid, 'displacement_xyz', w3, st, ul)
       ! 0-based; a triangle of a mixed mesh has -1 as its fourth vertex
-      call write_dset(gid, 'cells', msh(a)%cells - 1, st, '1')
+      call write_dset(gid, 'cells', file_cells(msh(a)) - 1, st, '1')
       if (msh(a)%element == ELEM_MIXED) call write_dset(gid, 'topology', mixed_topology(msh(a)), st, '1')
       call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
       allocate (sigt(msh(a)%nnode, 4))
-      vm = stress(a)%von_mises
+      vm = file_order(msh(a), stress(a)%von_mises)
       if (.not. (all(ieee_is_finite(stress(a)%sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) then
         ! a derived field that is not finite is a failure, never part of a result
         call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
       end if
-      sigt = transpose(stress(a)%sigma)
+      sigt = transpose(file_order(msh(a), stress(a)%sigma))
       call write_dset(gid, 'stress', sigt, st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
       do k = 1, 4
@@ -310,7 +310,7 @@ contains
       call write_dset(gid, 'von_mises', vm, st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
       call nodal_pressure(itf, a, pres, vm)
-      call write_dset(gid, 'contact_pressure', vm, st, us)
+      call write_dset(gid, 'contact_pressure', file_order(msh(a), vm), st, us)
       deallocate (w2, w3, ua, sigt, vm)
       call group_close(gid, st)
     end do
@@ -374,23 +374,23 @@ contains
         nn = msh(a)%nnode
         call group_open(kid, 'body'//i2s(a), gid, st, create=.true.)
         associate (ua => steps(k)%u(1:2*nn, a))
-          disp = transpose(reshape(ua, [2, nn]))   ! a contiguous copy (see write_h5)
+          disp = transpose(file_order(msh(a), reshape(ua, [2, nn])))   ! a contiguous copy (see write_h5)
           call write_dset(gid, 'displacement', disp, st, ul)
-          call write_dset(gid, 'displacement_xyz', pad3(reshape(ua, [2, nn])), st, ul)
+          call write_dset(gid, 'displacement_xyz', pad3(file_order(msh(a), reshape(ua, [2, nn]))), st, ul)
           allocate (sigma(4, nn), vm(nn), pnode(nn))
           call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
         end associate
         if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) &
           call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' in load step '//i2s(k)// &
                       ' are not finite: beyond double precision, rescale the units')
-        sigt = transpose(sigma)
+        sigt = transpose(file_order(msh(a), sigma))
         call write_dset(gid, 'stress', sigt, st, us)
         do c = 1, 4
           call write_dset(gid, comp(c), sigt(:, c), st, us)
         end do
-        call write_dset(gid, 'von_mises', vm, st, us)
+        call write_dset(gid, 'von_mises', file_order(msh(a), vm), st, us)
         call nodal_pressure(itf, a, pres, pnode)
-        call write_dset(gid, 'contact_pressure', pnode, st, us)
+        call write_dset(gid, 'contact_pressure', file_order(msh(a), pnode), st, us)
         if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
         deallocate (sigma, vm, pnode)
         call group_close(gid, st)
@@ -556,17 +556,20 @@ contains
   end subroutine nodal_pressure
 
   !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral)
-  !! and its 0-based vertices.
+  !! and its 0-based vertices, in the file's order.
   function mixed_topology(msh) result(t)
     type(mesh_t), intent(in) :: msh
-    integer, allocatable :: t(:)
+    integer, allocatable :: t(:), cells(:, :), ctype(:)
     integer :: c, k, nv
     allocate (t(count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type /= ELEM_Q1)*4))
+    cells = file_cells(msh)
+    ctype = msh%cell_type
+    if (allocated(msh%file_cell)) ctype(msh%file_cell) = msh%cell_type
     k = 0
     do c = 1, msh%ncell
-      nv = merge(4, 3, msh%cell_type(c) == ELEM_Q1)
+      nv = merge(4, 3, ctype(c) == ELEM_Q1)
       t(k + 1) = merge(5, 4, nv == 4)
-      t(k + 2:k + 1 + nv) = msh%cells(1:nv, c) - 1
+      t(k + 2:k + 1 + nv) = cells(1:nv, c) - 1
       k = k + 1 + nv
     end do
   end function mixed_topology

@@ -12,7 +12,7 @@
 program test_gmsh
   use kinds, only: wp
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
-  use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal
+  use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal, file_order, file_cells
   use gmsh_msh, only: msh_read_err => msh_read
   use errors, only: error_t, exit_code
   use strings, only: i2s, word
@@ -49,11 +49,21 @@ program test_gmsh
   call test_file_order(dir//'paper.msh', 'upper', 'upper_left')
   call test_file_order(dir//'patch_mixed.msh', 'top', 'top_top')
   call test_file_order(dir//'pin_hole.msh', 'plate', 'plate_left')
+  call test_locality(dir//'hertz_h0.02.msh', 'disc')
+  call test_locality(dir//'pin_hole.msh', 'plate')
   call test_summary()
 
 contains
 
   ! ---- helpers --------------------------------------------------------------------------
+
+  !> The node tags in the file's order (mesh%file_node).
+  function file_tags(m) result(tags)
+    type(mesh_t), intent(in) :: m
+    integer, allocatable :: tags(:)
+    allocate (tags(m%nnode))
+    tags(m%file_node) = m%node_tag
+  end function file_tags
 
   !> msh_read with its error as an exit code (0; 1 bad input; 3 other) and a message.
   subroutine msh_read(path, region, body_id, m, info, msg)
@@ -256,10 +266,75 @@ contains
     call report(any(f /= 0.0_wp) .and. all(sys%f == f), what//'lifting = the file-order sums, bit for bit')
   end subroutine test_file_order
 
+  ! ---- numbering for locality -----------------------------------------------------------
+
+  !> A body read from a file is numbered for locality: file_node and file_cell are
+  !! permutations, file_cells gives back the file's cells (the node tags of each cell as the
+  !! file lists them, up to orientation), and the cells' node numbers spread far less than
+  !! in the file's order (the mean over cells of the largest minus the smallest node number,
+  !! and of the jump of the smallest node number from one cell to the next).
+  subroutine test_locality(path, region)
+    character(len=*), intent(in) :: path, region
+    type(mesh_t) :: m
+    type(error_t) :: err
+    integer, allocatable :: tags(:), fc(:, :), seen(:)
+    integer :: c, nv
+    real(wp) :: spread_new, spread_file, jump_new, jump_file
+    logical :: same
+    character(len=:), allocatable :: what
+
+    what = path//' '//region//': '
+    call msh_read_err(path, region, 1, m, err)
+    if (err%failed()) then
+      call report(.false., what//'read: '//err%text())
+      return
+    end if
+    allocate (seen(max(m%nnode, m%ncell)))
+    seen = 0
+    seen(m%file_node) = 1
+    call report(size(m%file_node) == m%nnode .and. all(seen(1:m%nnode) == 1), what//'file_node is a permutation')
+    seen = 0
+    seen(m%file_cell) = 1
+    call report(size(m%file_cell) == m%ncell .and. all(seen(1:m%ncell) == 1), what//'file_cell is a permutation')
+    tags = file_tags(m)
+    fc = file_cells(m)
+    same = .true.
+    do c = 1, m%ncell
+      nv = merge(4, 3, m%cell_type(c) == ELEM_Q1)
+      same = same .and. all(tags(fc(1:nv, m%file_cell(c))) == m%node_tag(m%cells(1:nv, c)))
+    end do
+    call report(same, what//'file_cells: each cell with its nodes in the file''s numbering')
+    call spreads(m%cells, spread_new, jump_new)
+    call spreads(fc, spread_file, jump_file)
+    call report(spread_new < 0.25_wp*spread_file .and. jump_new < 0.25_wp*jump_file, what// &
+                'numbered for locality: node spread per cell '//i2s(nint(spread_new))//' (file '//i2s(nint(spread_file))// &
+                '), jump between cells '//i2s(nint(jump_new))//' (file '//i2s(nint(jump_file))//')')
+  end subroutine test_locality
+
+  !> The mean over cells of the largest minus the smallest node number, and the mean jump
+  !! of the smallest node number from one cell to the next.
+  subroutine spreads(cells, spread, jump)
+    integer, intent(in) :: cells(:, :)
+    real(wp), intent(out) :: spread, jump
+    integer :: k, lo, prev
+    spread = 0.0_wp
+    jump = 0.0_wp
+    prev = 0
+    do k = 1, size(cells, 2)
+      lo = minval(cells(:, k), mask=cells(:, k) > 0)
+      spread = spread + (maxval(cells(:, k)) - lo)
+      if (k > 1) jump = jump + abs(lo - prev)
+      prev = lo
+    end do
+    spread = spread/size(cells, 2)
+    jump = jump/max(1, size(cells, 2) - 1)
+  end subroutine spreads
+
   ! ---- the shipped meshes ---------------------------------------------------------------
 
   subroutine test_paper()
     type(mesh_t) :: up, lo
+    integer, allocatable :: tags(:)
     real(wp) :: dev, length, offgrid
     integer :: ne, k, info
     character(len=512) :: msg
@@ -278,7 +353,8 @@ contains
     call report_le(offgrid, 8*eps, 'paper upper: nodes on the uniform 24x16 grid')
     call report(up%x0 == 0.0_wp .and. up%y0 == 1.0_wp .and. abs(up%width - 3) < 1e-14_wp .and. &
                 abs(up%height - 1) < 1e-14_wp, 'paper upper: bounding box (0,3)x(1,2)')
-    call report(all(up%node_tag(2:) > up%node_tag(:up%nnode - 1)), 'paper upper: nodes in increasing tag order')
+    tags = file_tags(up)
+    call report(all(tags(2:) > tags(:up%nnode - 1)), 'paper upper: the file order is by increasing tag')
     call report(.not. up%structured .and. up%source == dir//'paper.msh' .and. up%nx == 0, &
                 'paper upper: unstructured, source is the file')
     call group_normal(up, 'upper_bottom', [0.0_wp, -1.0_wp], dev, length, ne)
@@ -771,6 +847,7 @@ contains
     real(wp) :: want(8)
     character(len=32) :: nbuf
     logical :: read_all, all_exact
+    real(wp), allocatable :: xy(:, :)
     character(len=60) :: one
     character(len=60), allocatable :: l(:)
 
@@ -796,14 +873,15 @@ contains
     call report(info == 0, 'sparse unordered node tags and unknown sections are read')
     if (info /= 0) write (*, '(a)') trim(msg)
     if (info == 0) then
-      call report(all(m%node_tag == [5, 12, 77, 1000000]), 'nodes renumbered in increasing tag order')
-      call report(all(m%xy(:, 1) == [0.0_wp, 0.0_wp]) .and. all(m%xy(:, 2) == [0.0_wp, 1.0_wp]) .and. &
-                  all(m%xy(:, 3) == [1.0_wp, 1.0_wp]) .and. all(m%xy(:, 4) == [1.0_wp, 0.0_wp]), &
+      call report(all(file_tags(m) == [5, 12, 77, 1000000]), 'the file order is by increasing tag')
+      xy = file_order(m, m%xy)
+      call report(all(xy(:, 1) == [0.0_wp, 0.0_wp]) .and. all(xy(:, 2) == [0.0_wp, 1.0_wp]) .and. &
+                  all(xy(:, 3) == [1.0_wp, 1.0_wp]) .and. all(xy(:, 4) == [1.0_wp, 0.0_wp]), &
                   'sparse tags: coordinates follow their tags')
       call report(area2(m, 1) > 0 .and. abs(total_area(m) - 1) < 1e-15_wp, 'sparse tags: the cell, counter-clockwise')
       g = group_index(m, 'base with blank')
       call report(m%ngroup == 1 .and. g == 1, 'a physical name with a blank is kept')
-      if (g == 1) call report(m%group(1)%nedge == 1 .and. all(m%group(1)%edge(:, 1) == [1, 4]), &
+      if (g == 1) call report(m%group(1)%nedge == 1 .and. all(m%node_tag(m%group(1)%edge(:, 1)) == [5, 1000000]), &
                               'the base edge oriented with the body on its left')
     end if
 
@@ -814,7 +892,7 @@ contains
                     '2 1 3 1', '7 1 2 9 4', '$EndElements']))
     call msh_read(tmp//'range.msh', 'sq', 1, m, info, msg)
     call report(info == 0, 'a node tag beyond the announced range is read')
-    if (info == 0) call report(all(m%node_tag == [1, 2, 4, 9]) .and. all(m%xy(:, 4) == [1.0_wp, 1.0_wp]) .and. &
+    if (info == 0) call report(all(file_tags(m) == [1, 2, 4, 9]) .and. all(m%xy(:, findloc(m%node_tag, 9, dim=1)) == 1.0_wp) .and. &
                                abs(total_area(m) - 1) < 1e-15_wp, 'the node of tag 9 has its coordinates')
 
     call expect_error('skipline.msh', [character(len=60) :: '$MeshFormat', '4.1 0 8', '$EndMeshFormat', &
