@@ -429,15 +429,17 @@ contains
     end do
   end function free_list
 
-  !> The fixing DOFs in words: 'node 12 uy, node 40 ux' (node numbers of the body's mesh).
-  function fixing_list(system) result(s)
+  !> The fixing DOFs in words: 'node 12 uy, node 40 ux', by the nodes' tags (a mesh file's
+  !! node tags; a rectangle's node numbers).
+  function fixing_list(system, node_tag) result(s)
     type(body_system_t), intent(in) :: system
+    integer, intent(in) :: node_tag(:)          !< (nodes) the tag of each node of the body's mesh
     character(len=:), allocatable :: s
     integer :: k
     s = ''
     do k = 1, system%nrig
       if (k > 1) s = s//', '
-      s = s//'node '//i2s((system%fixing(k) + 1)/2)//merge(' ux', ' uy', mod(system%fixing(k), 2) == 1)
+      s = s//'node '//i2s(node_tag((system%fixing(k) + 1)/2))//merge(' ux', ' uy', mod(system%fixing(k), 2) == 1)
     end do
   end function fixing_list
 

@@ -207,7 +207,7 @@ contains
     do a = 1, run%nbody
       associate (system => run%systems(a))
         if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
-          'contact (free: '//free_list(system)//'); fixing DOFs for its generalized inverse: '//fixing_list(system)// &
+          'contact (free: '//free_list(system)//'); fixing DOFs for its generalized inverse: '//fixing_list(system, run%meshes(a)%node_tag)// &
           '; kernel check |K R|/(|K| |R|) = '//sci(system%rig_residual)
       end associate
     end do
