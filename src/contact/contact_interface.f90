@@ -327,7 +327,8 @@ contains
     associate (ms => msh(cc%bodies(sl)), mm => msh(cc%bodies(ma)))
       allocate (removable(ms%nnode))
       removable = .false.
-      call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, mt, why)
+      call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, mt, why, &
+                        ms%node_tag, mm%node_tag)
       if (.not. why%failed()) then
         do j = 1, mt%m
           removable(mt%snode(j)) = normal_fixed(sys(cc%bodies(sl)), mt%snode(j), mt%normal(:, j))
@@ -337,7 +338,7 @@ contains
           end do
         end do
         if (any(removable)) call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, &
-                                              mt, why)
+                                              mt, why, ms%node_tag, mm%node_tag)
       end if
       if (why%failed()) then
         call err%set(ERR_INPUT, 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(cc%bodies(sl))// &

@@ -126,7 +126,7 @@ contains
   !> Build the dual mortar rows of a slave contact chain against a master chain.
   !! err (ERR_INPUT, naming the side and the edge or node) on bad input, or when no slave
   !! node ends up with a row (no overlap, master edges facing away, all removable).
-  subroutine mortar_build(xs, es, removable, xm, em, mt, err)
+  subroutine mortar_build(xs, es, removable, xm, em, mt, err, tag_s, tag_m)
     real(wp), intent(in) :: xs(:, :)        !< (2, nnode_s) slave body node coordinates [length]
     integer, intent(in) :: es(:, :)         !< (2, ne_s) slave contact edges (node ids), slave body on the left of es(1)->es(2)
     logical, intent(in) :: removable(:)     !< (nnode_s) the slave node may carry no multiplier (normal displacement prescribed on both bodies)
@@ -134,6 +134,7 @@ contains
     integer, intent(in) :: em(:, :)         !< (2, ne_m) master contact edges, master body on the left
     type(mortar_t), intent(out) :: mt       !< the constraint rows
     type(error_t), intent(out) :: err       !< the bad input, if any
+    integer, intent(in), optional :: tag_s(:), tag_m(:)   !< (nnode_s), (nnode_m) node tags for messages
     type(mortar_work_t) :: w
     logical :: mclosed
     integer :: i, iter, nbad
@@ -146,14 +147,14 @@ contains
       call err%set(ERR_INPUT, 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes')
       return
     end if
-    call chain_order(xs, es, 'slave', w%cs, w%closed, err)
+    call chain_order(xs, es, 'slave', w%cs, w%closed, err, tag_s)
     if (err%failed()) return
-    call chain_order(xm, em, 'master', w%cm, mclosed, err)
+    call chain_order(xm, em, 'master', w%cm, mclosed, err, tag_m)
     if (err%failed()) return
     w%nes = size(es, 2)
     w%nem = size(em, 2)
 
-    call slave_normals(w, xs, err)
+    call slave_normals(w, xs, err, tag_s)
     if (err%failed()) return
 
     ! Each master node's place on the slave chain: segment mseg and xi (mstat 0), or before
@@ -187,11 +188,12 @@ contains
 
   !> Slave segment lengths, arc length and nodal normals (inverse-length weighted);
   !! err (ERR_INPUT) where the chain folds back on itself.
-  subroutine slave_normals(w, xs, err)
+  subroutine slave_normals(w, xs, err, tag)
     type(mortar_work_t), intent(inout) :: w
     real(wp), intent(in) :: xs(:, :)
     type(error_t), intent(inout) :: err
-    integer :: i, k, nes
+    integer, intent(in), optional :: tag(:)     !< node tags for messages
+    integer :: i, k, nes, nid
     real(wp) :: lo, hi
     nes = w%nes
     allocate (w%slen(nes), w%arc(0:nes), w%nn(2, 0:nes))
@@ -215,7 +217,9 @@ contains
         if (i < nes .or. closed) lo = lo + 1.0_wp / slen(merge(i + 1, 1, i < nes))
         hi = norm2(nn(:, i))
         if (hi <= 1.0e-8_wp * lo) then
-          call err%set(ERR_INPUT, 'mortar: the slave chain folds back on itself at node '//i2s(cs(i))//' (its two edges are opposite)')
+          nid = cs(i)
+          if (present(tag)) nid = tag(cs(i))
+          call err%set(ERR_INPUT, 'mortar: the slave chain folds back on itself at node '//i2s(nid)//' (its two edges are opposite)')
           return
         end if
         nn(:, i) = nn(:, i) / hi

@@ -20,13 +20,14 @@ contains
   !> Order the edges of one side into a single chain: c(0:ne) are its nodes from the start
   !! (the node no edge ends at), edge k joining c(k-1) -> c(k). A closed loop (a rim, a bore)
   !! starts at the first edge's first node and has c(ne) = c(0).
-  subroutine chain_order(x, e, what, c, closed, err)
+  subroutine chain_order(x, e, what, c, closed, err, tag)
     real(wp), intent(in) :: x(:, :)            !< (2, nnode) coordinates
     integer, intent(in) :: e(:, :)             !< (2, ne) edges
     character(len=*), intent(in) :: what       !< 'slave' or 'master', for messages
     integer, allocatable, intent(out) :: c(:)  !< (0:ne) nodes in chain order
     logical, intent(out) :: closed             !< the edges form one closed loop
     type(error_t), intent(inout) :: err        !< set (ERR_INPUT) on bad input
+    integer, intent(in), optional :: tag(:)    !< (nnode) the nodes' tags for messages (default: their numbers)
     integer, allocatable :: eout(:), ein(:), deg(:)
     integer :: ne, nnode, k, a, b, nstart, start, n
     real(wp) :: lo(2), hi(2), diag
@@ -64,7 +65,7 @@ contains
     diag = norm2(hi - lo)
     do k = 1, ne
       if (e(1, k) == e(2, k) .or. norm2(x(:, e(2, k)) - x(:, e(1, k))) <= 1.0e-12_wp * diag) then
-        call err%set(ERR_INPUT, 'mortar: '//what//' edge '//i2s(k)//' (nodes '//i2s(e(1, k))//', '//i2s(e(2, k))//') has zero length')
+        call err%set(ERR_INPUT, 'mortar: '//what//' edge '//i2s(k)//' (nodes '//node_name(e(1, k))//', '//node_name(e(2, k))//') has zero length')
         return
       end if
     end do
@@ -78,7 +79,7 @@ contains
     do k = 1, ne
       do a = 1, 2
         if (deg(e(a, k)) > 2) then
-          call err%set(ERR_INPUT, 'mortar: the '//what//' edges branch at node '//i2s(e(a, k))//' ('//i2s(deg(e(a, k)))// &
+          call err%set(ERR_INPUT, 'mortar: the '//what//' edges branch at node '//node_name(e(a, k))//' ('//i2s(deg(e(a, k)))// &
                 ' edges meet there); one chain is required')
           return
         end if
@@ -88,12 +89,12 @@ contains
       a = e(1, k)
       b = e(2, k)
       if (eout(a) /= 0) then
-        call err%set(ERR_INPUT, 'mortar: '//what//' edges '//i2s(eout(a))//' and '//i2s(k)//' both start at node '//i2s(a)// &
+        call err%set(ERR_INPUT, 'mortar: '//what//' edges '//i2s(eout(a))//' and '//i2s(k)//' both start at node '//node_name(a)// &
               ': they are not consistently oriented (the body must lie on the left of every edge)')
         return
       end if
       if (ein(b) /= 0) then
-        call err%set(ERR_INPUT, 'mortar: '//what//' edges '//i2s(ein(b))//' and '//i2s(k)//' both end at node '//i2s(b)// &
+        call err%set(ERR_INPUT, 'mortar: '//what//' edges '//i2s(ein(b))//' and '//i2s(k)//' both end at node '//node_name(b)// &
               ': they are not consistently oriented (the body must lie on the left of every edge)')
         return
       end if
@@ -137,6 +138,13 @@ contains
             'loop of the other '//i2s(ne - n)//'); one chain is required')
       return
     end if
+  contains
+    function node_name(n) result(t)
+      integer, intent(in) :: n
+      character(len=:), allocatable :: t
+      t = i2s(n)
+      if (present(tag)) t = i2s(tag(n))
+    end function node_name
   end subroutine chain_order
 
   !> Place every master chain node on the slave chain along the interpolated slave normal:

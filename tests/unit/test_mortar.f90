@@ -646,10 +646,28 @@ contains
                     'master edges branch')
     call expect_bad(xs, xm, rem, reshape([3, 2, 2, 1], [2, 2]), ok_em, 'all slave nodes removable', 'removable', all_removable=.true.)
     call expect_bad(xs, xm, rem, reshape([3, 2, 2, 1], [2, 2]), ok_em, 'removable of the wrong size', 'entries', short_removable=.true.)
+    call expect_tagged(xs, xm, rem, ok_em)
     ! master beside the slave: no overlap
     xm(1, :) = xm(1, :) + 20.0_wp
     call expect_bad(xs, xm, rem, reshape([3, 2, 2, 1], [2, 2]), ok_em, 'master beside the slave', 'does not overlap')
   end subroutine test_bad_input
+
+  !> The node a message names is given by its tag when the caller gives tags (a mesh file's
+  !! nodes are numbered for locality inside the program): a branch at node 2, tag 702.
+  subroutine expect_tagged(xs, xm, rem, em_)
+    real(wp), intent(in) :: xs(:, :), xm(:, :)
+    logical, intent(in) :: rem(:)
+    integer, intent(in) :: em_(:, :)
+    type(mortar_t) :: mt
+    integer :: info
+    type(error_t) :: err
+    character(len=256) :: msg
+    call mortar_build(xs, reshape([4, 3, 3, 2, 2, 1, 2, 5], [2, 4]), rem, xm, em_, mt, err, &
+                      tag_s=[701, 702, 703, 704, 705, 706], tag_m=[801, 802, 803])
+    call error_parts(err, info, msg)
+    call report(info == ERR_INPUT .and. index(msg, 'node 702') > 0, 'bad input, branching slave chain with tags: '// &
+                'the message names the tag, "'//trim(msg)//'"')
+  end subroutine expect_tagged
 
   !> One bad input: ERR_INPUT and a message containing word.
   subroutine expect_bad(xs, xm, rem, es, em_, what, word, all_removable, short_removable)
