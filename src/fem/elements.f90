@@ -136,8 +136,8 @@ contains
 
   !> Element stiffness (Q1: 2x2 Gauss; P1: exact) and the smallest Jacobian determinant
   !! met, which is not positive for an inverted or degenerate element. With `cache`, a
-  !! cell that is a translate of the last one computed reuses its stiffness (`reused`).
-  pure subroutine element_stiffness(element, xe, lame_lambda, lame_mu, ke, minjac, cache, reused)
+  !! cell that is a translate of the last one computed reuses its stiffness.
+  pure subroutine element_stiffness(element, xe, lame_lambda, lame_mu, ke, minjac, cache)
     integer, intent(in) :: element                          !< ELEM_Q1 or ELEM_P1
     real(wp), intent(in) :: xe(2, MAX_NVERT)                !< vertex coordinates [length]
     real(wp), intent(in) :: lame_lambda                     !< (effective) first Lame parameter [stress]
@@ -145,12 +145,10 @@ contains
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)         !< element stiffness [stress]
     real(wp), intent(out) :: minjac                         !< smallest Jacobian determinant [length^2]
     type(ke_cache_t), intent(inout), optional :: cache      !< the last stiffness computed
-    logical, intent(out), optional :: reused                !< .true.: ke is the cache's
     real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), nfun(4), det
     integer :: nv, a, ig, jg
 
     nv = element_nvert(element)
-    if (present(reused)) reused = .false.
     if (present(cache)) then
       do a = 1, nv
         rel(:, a) = xe(:, a) - xe(:, 1)
@@ -159,7 +157,6 @@ contains
         if (all(abs(rel(:, 1:nv) - cache%rel(:, 1:nv)) <= cache%tol)) then
           ke = cache%ke
           minjac = cache%minjac
-          if (present(reused)) reused = .true.
           return
         end if
       end if
