@@ -522,18 +522,21 @@ contains
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
 
-  !> Each body's nodal stresses from its displacement (what the result file shows).
+  !> Each body's nodal stresses from its displacement (what the result file shows), the
+  !! bodies on the threads (the file itself is written by one thread).
   function body_stresses(run) result(stress)
     type(run_t), intent(in) :: run
     type(stress_field_t), allocatable :: stress(:)
     integer :: a, nnode
     allocate (stress(run%nbody))
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(nnode)
     do a = 1, run%nbody
       nnode = run%meshes(a)%nnode
       allocate (stress(a)%sigma(4, nnode), stress(a)%von_mises(nnode))
       call nodal_stress(run%meshes(a), run%deck%body(a), run%deck%plane_strain, &
                         run%displacement(1:run%systems(a)%ndof, a), stress(a)%sigma, stress(a)%von_mises)
     end do
+    !$omp end parallel do
   end function body_stresses
 
   !> A signal before the outer iteration (during assembly, ordering, factorization or
