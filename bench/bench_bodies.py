@@ -39,6 +39,7 @@ each, no waiting (a smoke run of about 15 s). The full bench takes 11-15 minutes
 shared 2-core machine, most of it waiting for a quiet machine (about 3 minutes of runs).
 """
 import argparse
+import glob
 import os
 import sys
 import time
@@ -187,7 +188,9 @@ class Runner:
                 row["factor_mb"] = float(t["factor_mb"])
                 if os.path.exists(h5):
                     lam = read_lam(h5)
-        for fn in (h5, h5 + ".ckpt.h5", os.path.splitext(h5)[0] + ".xdmf"):
+        # the result file, its checkpoint and its XDMF companions (one per body and pair too)
+        stem = os.path.splitext(h5)[0]
+        for fn in [h5, h5 + ".ckpt.h5", stem + ".xdmf"] + glob.glob(stem + "_*.xdmf"):
             if os.path.exists(fn):
                 os.remove(fn)
         return row, lam
