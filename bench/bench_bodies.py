@@ -18,7 +18,10 @@ Groups (each run a separate process of bin/robin_contact):
            default Robin solver (harmonic, anderson, residual stop, tol 1e-8) and monolithic.
            OMP_NUM_THREADS=2, fastest of --repeat runs.
   threads  64 blocks of 32x32 cells (8 columns of 8), default Robin, OMP_NUM_THREADS=1 and 2
-           alternating back to back, fastest of --repeat runs each.
+           alternating back to back, --repeat runs each; per phase the fastest of each
+           thread count, the speed-up and the serial share it implies (Amdahl with 2 threads:
+           s = 2/speed-up - 1), the runs' CPU time, the load, and whether the contact
+           forces of 1 and 2 threads are bitwise equal. --only threads runs this group alone.
 
 Timing hygiene: the machine may be shared. busy_before = cores kept busy (by anything) during
 the second before a run; the scale and threads runs wait up to --quiet-wait s for < 0.5 busy
@@ -30,15 +33,18 @@ reading), one CSV row per run to --csv (default results/bench_bodies.csv) and pr
 tables. A benchmark: it reports, it asserts nothing.
 
 Usage: bench/bench_bodies.py [--bin bin/robin_contact] [--quick] [--skip chain,scale,threads]
-                             [--alpha 1e-12] [--repeat 3] [--quiet-wait 30]
+                             [--only chain,scale,threads] [--alpha 1e-12] [--repeat 3] [--quiet-wait 30]
 --quick: chain N = 2, 4, 8; scale N = 8, 32 of 16x16; threads 16 bodies of 16x16; one run
 each, no waiting (a smoke run of about 15 s). The full bench takes 11-15 minutes on the
 shared 2-core machine, most of it waiting for a quiet machine (about 3 minutes of runs).
 """
 import argparse
+import glob
 import os
 import sys
 import time
+
+import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))  # the rc_* helpers
 from bench import busy_cores, command_text, fmt, table, timed_run, write_csv  # noqa: E402
@@ -51,7 +57,7 @@ PHASES = ("assemble", "factor", "condense", "iterate", "output", "total")
 COLUMNS = ["group", "n_bodies", "columns", "per_column", "nx", "ny", "dofs", "pairs", "m", "method", "operator",
            "alpha", "acceleration", "stop", "tol", "max_outer", "threads", "status", "exit", "outer", "inner",
            "residual"] + [p + "_s" for p in PHASES] + \
-          ["peak_mb", "factor_mb", "err", "repeats", "total_s_all", "process_wall_s", "load1", "busy_before",
+          ["peak_mb", "factor_mb", "err", "repeats", "total_s_all", "process_wall_s", "cpu_s", "load1", "busy_before",
            "busy_during", "cmdline"]
 OPERATORS = ("harmonic", "steklov", "constant")
 ACCELERATIONS = ("none", "anderson")
@@ -159,7 +165,8 @@ class Runner:
         row["load1"] = round(os.getloadavg()[0], 2)
         row["busy_before"] = self.wait_quiet(wait)
         row["cmdline"] = command_text(args[:-1], threads)
-        rc, out, err, wall, _, row["busy_during"], timed_out = timed_run(args, env, self.timeout)
+        rc, out, err, wall, cpu, row["busy_during"], timed_out = timed_run(args, env, self.timeout)
+        row["cpu_s"] = round(cpu, 3)
         if timed_out:
             row["status"] = "timeout"
         row["process_wall_s"] = round(wall, 3)
@@ -181,7 +188,9 @@ class Runner:
                 row["factor_mb"] = float(t["factor_mb"])
                 if os.path.exists(h5):
                     lam = read_lam(h5)
-        for fn in (h5, h5 + ".ckpt.h5", os.path.splitext(h5)[0] + ".xdmf"):
+        # the result file, its checkpoint and its XDMF companions (one per body and pair too)
+        stem = os.path.splitext(h5)[0]
+        for fn in [h5, h5 + ".ckpt.h5", stem + ".xdmf"] + glob.glob(stem + "_*.xdmf"):
             if os.path.exists(fn):
                 os.remove(fn)
         return row, lam
@@ -208,11 +217,47 @@ def cell_oi(r):
     return s if r["status"] == "converged" else f"{s} ({r['status']})"
 
 
+def threads_table(thr, repeat):
+    """The threads group's table: per phase the fastest 1- and 2-thread time over the repeats,
+    the speed-up and the serial share s = 2/speed-up - 1 it implies (Amdahl, 2 threads; 0 for
+    a perfectly parallel phase, 1 for a serial one), then the CPU time, load and forces."""
+    one, two = thr[1], thr[2]
+    o = one[0]
+    lines = [f"\n## Threads: {o['n_bodies']} blocks of {o['nx']}x{o['ny']} ({o['columns']} columns of 8), "
+             f"default Robin, OMP_NUM_THREADS=1 and 2 alternating, {repeat} runs each; per phase the "
+             f"fastest of the runs of each thread count\n"]
+    out = []
+    for k in PHASES:
+        t1 = min(r[k + "_s"] for r in one)
+        t2 = min(r[k + "_s"] for r in two)
+        sp = t1 / t2 if t2 > 0 else float("nan")
+        out.append([k, fmt(t1, ".3f"), fmt(t2, ".3f"), fmt(sp, ".2f"), fmt(2.0 / sp - 1.0, ".2f") if t2 > 0 else ""])
+    out.append(["CPU time of the run (user + sys) [s]", fmt(min(r["cpu_s"] for r in one), ".3f"),
+                fmt(min(r["cpu_s"] for r in two), ".3f"), "", ""])
+    out.append(["outer/inner", cell_oi(one[0]), cell_oi(two[0]), "", ""])
+    out.append(["busy (other processes, each run)", " ".join(str(r["busy_during"]) for r in one),
+                " ".join(str(r["busy_during"]) for r in two), "", ""])
+    out.append(["load average (1 min, each run)", " ".join(str(r["load1"]) for r in one),
+                " ".join(str(r["load1"]) for r in two), "", ""])
+    out.append(["all totals [s]", " ".join(f"{r['total_s']:g}" for r in one),
+                " ".join(f"{r['total_s']:g}" for r in two), "", ""])
+    lines.append(table(["phase", "1 thread [s]", "2 threads [s]", "speed-up", "serial share (2/speed-up - 1)"],
+                       out))
+    if max(r["busy_during"] for r in one + two) > 0.5:
+        lines.append("\nother processes kept more than 0.5 cores busy during a run: a second thread waits "
+                     "for a core, and the speed-ups and serial shares above are the machine's, not the code's")
+    if "equal" in thr:
+        lines.append("\ncontact forces of all runs, 1 and 2 threads: " +
+                     ("bitwise equal" if thr["equal"] else f"differ (largest relative difference {thr['diff']:.1e})"))
+    return "\n".join(lines)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--bin", default=os.path.join(ROOT, "bin", "robin_contact"))
     ap.add_argument("--quick", action="store_true", help="small sizes, one run each, no waiting")
     ap.add_argument("--skip", default="", help="comma list of groups to skip: chain,scale,threads")
+    ap.add_argument("--only", default="", help="comma list of the groups to run (the others skipped)")
     ap.add_argument("--chain-n", default="2,4,8,16,32", help="stack heights of the chain group")
     ap.add_argument("--chain-cells", type=int, default=8, help="nx = ny of the chain group's blocks")
     ap.add_argument("--alpha", type=float, default=1.0e-12,
@@ -232,6 +277,8 @@ def main():
         a.chain_n, a.scale_n, a.scale_cells = "2,4,8", "8,32", 16
         a.thread_columns, a.thread_cells, a.repeat, a.quiet_wait = 2, 16, 1, 0.0
     skip = set(s for s in a.skip.split(",") if s)
+    if a.only:
+        skip |= {"chain", "scale", "threads"} - set(s for s in a.only.split(",") if s)
     if not os.access(a.bin, os.X_OK):
         raise SystemExit(f"bench_bodies: no executable {a.bin} (run make first)")
     chain_n = [int(v) for v in a.chain_n.split(",") if v]
@@ -275,7 +322,11 @@ def main():
         for t in (1, 2):
             good = [r for r in runs[t] if ok(r)]
             if good:
-                thr[t] = min(good, key=lambda r: r["total_s"])
+                thr[t] = good
+        if len(thr) == 2:
+            lams = [r["_lam"] for t in (1, 2) for r in thr[t] if r.get("_lam") is not None]
+            thr["equal"] = len(lams) == 2 * len(thr[1]) and all(np.array_equal(lams[0], x) for x in lams[1:])
+            thr["diff"] = max(rel_err(x, lams[0]) or 0.0 for x in lams) if lams else float("nan")
 
     for r in R.rows:
         r.pop("_lam", None)
@@ -323,16 +374,8 @@ def main():
         print(table(["N", "DOFs", "m", "method", "outer/inner"] + list(PHASES) +
                     ["iterate/factor", "peak MB", "factor MB", "ms per body", "peak MB per body",
                      "growth from the previous N", "err vs mono", "busy"], out))
-    if len(thr) == 2:
-        o, t = thr[1], thr[2]
-        print(f"\n## Threads: {o['n_bodies']} blocks of {o['nx']}x{o['ny']} ({o['columns']} columns of 8), "
-              f"default Robin, OMP_NUM_THREADS=1 and 2 alternating, fastest of {a.repeat} each\n")
-        out = [[k, fmt(o[k + "_s"], ".3f"), fmt(t[k + "_s"], ".3f"),
-                fmt(o[k + "_s"] / t[k + "_s"], ".2f") if t[k + "_s"] > 0 else ""] for k in PHASES]
-        out.append(["outer/inner", cell_oi(o), cell_oi(t), ""])
-        out.append(["busy (other processes)", o["busy_during"], t["busy_during"], ""])
-        out.append(["all totals [s]", o["total_s_all"], t["total_s_all"], ""])
-        print(table(["phase", "1 thread [s]", "2 threads [s]", "speed-up"], out))
+    if 1 in thr and 2 in thr:
+        print(threads_table(thr, a.repeat))
     print(f"\nwrote {a.csv} ({len(R.rows)} rows, {R.count} runs)")
 
 

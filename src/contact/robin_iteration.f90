@@ -46,20 +46,41 @@ contains
     procedure(stop_iface), optional :: stop_requested       !< true when the run must stop (signal)
     !> (m,2) a fresh start's first obstacles and forces (a load step: the step before's)
     real(wp), intent(in), optional :: warm_obstacle(:, :), warm_lam(:, :)
-    type(robin_state_t) :: run_state
+    type(robin_state_t) :: own
+    ! the caller's state is iterated in place: a copy in and out would be a serial copy of
+    ! the Anderson history and the recycled directions (megabytes at many bodies)
+    if (present(state)) then
+      call robin_run(solver, contact_line, bodies, res, progress_unit, progress_lines, state, state%it > 0, ckpt, &
+                     stop_requested, warm_obstacle, warm_lam)
+    else
+      call robin_run(solver, contact_line, bodies, res, progress_unit, progress_lines, own, .false., ckpt, &
+                     stop_requested, warm_obstacle, warm_lam)
+    end if
+  end subroutine solve_robin
+
+  !> solve_robin on run_state, a fresh start unless `resumed`.
+  subroutine robin_run(solver, contact_line, bodies, res, progress_unit, progress_lines, run_state, resumed, ckpt, &
+                       stop_requested, warm_obstacle, warm_lam)
+    type(solver_cfg_t), intent(in) :: solver
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    type(contact_result_t), intent(inout) :: res
+    integer, intent(in), optional :: progress_unit
+    integer, intent(in), optional :: progress_lines
+    type(robin_state_t), intent(inout) :: run_state   !< the outer state, iterated in place
+    logical, intent(in) :: resumed                    !< run_state holds a checkpoint's state
+    class(checkpointer_t), intent(inout), optional :: ckpt
+    procedure(stop_iface), optional :: stop_requested
+    real(wp), intent(in), optional :: warm_obstacle(:, :), warm_lam(:, :)
     type(subproblems_t), target :: subproblems
     class(robin_operator_t), allocatable :: robin_op
     real(wp) :: t0
     integer :: m, every
     type(error_t) :: err
-    logical :: resumed
 
     m = contact_line%m
     t0 = wtime()
-    resumed = .false.
-    if (present(state)) resumed = state%it > 0
     if (resumed) then
-      run_state = state
       t0 = t0 - run_state%wall
     else
       ! the history grows as the run goes (max_outer may be huge)
@@ -96,8 +117,7 @@ contains
     end if
     call outer_loop(solver, contact_line, bodies, subproblems, robin_op, t0, every, run_state, res, &
                     progress_unit, ckpt, stop_requested)
-    if (present(state)) state = run_state
-  end subroutine solve_robin
+  end subroutine robin_run
 
   !> The outer iterations from run_state%it + 1 to max_outer: subproblems, correction,
   !! update, record, termination test, progress line, checkpoint.

@@ -73,34 +73,34 @@ contains
     subproblems%order = [(a, a=1, n)]
     call merge_sort_by_keys(subproblems%order, reshape([(-bodies(a)%m, a=1, n)], [1, n]))
     nmv = 0
-    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a) if (contact_line%m > 64)
+    ! every body's part on the threads: F_a, its bound, its Hessian (a copy of F_a, the
+    ! proximal term, the penalty of its equilibrium rows)
+    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a, m, p) if (contact_line%m > 64)
     do k = 1, n
       a = subproblems%order(k)
+      m = bodies(a)%m
       call dense_op_init(subproblems%flexibility(a), bodies(a)%flex)
-      if (bodies(a)%m > 0) subproblems%lmax_body(a) = robin_op%body_lambda_max(subproblems%flexibility(a), &
-                                                                               bodies(a)%flex, nmv(a))
+      if (m > 0) subproblems%lmax_body(a) = robin_op%body_lambda_max(subproblems%flexibility(a), bodies(a)%flex, &
+                                                                     nmv(a))
+      subproblems%lmax_hessian(a) = subproblems%lmax_body(a)
+      subproblems%hessian(a) = subproblems%flexibility(a)
+      subproblems%proximal(a)%n = 0
+      if (bodies(a)%prox > 0.0_wp) then
+        allocate (p(m, m))
+        call robin_op%proximal_term(contact_line, bodies, a, p)
+        call dense_op_init(subproblems%proximal(a), p)
+        subproblems%hessian(a)%a = subproblems%hessian(a)%a + p
+        ! lambda_max(F_a + Pi_a) <= lambda_max(F_a) + |Pi_a|_inf
+        subproblems%lmax_hessian(a) = subproblems%lmax_body(a) + maxval(sum(abs(p), dim=1))
+        deallocate (p)
+      end if
+      if (bodies(a)%nrig > 0 .and. m > 0) then
+        call equality_init(subproblems%equality(a), bodies(a)%rg, bodies(a)%re, subproblems%lmax_hessian(a))
+        call equality_add_penalty(subproblems%equality(a), subproblems%hessian(a), subproblems%lmax_hessian(a))
+      end if
     end do
     !$omp end parallel do
     if (.not. resumed) state%inner = sum(nmv)
-    subproblems%lmax_hessian = subproblems%lmax_body
-    do a = 1, n
-      m = bodies(a)%m
-      subproblems%hessian(a) = subproblems%flexibility(a)
-      subproblems%proximal(a)%n = 0
-      if (.not. bodies(a)%prox > 0.0_wp) cycle
-      allocate (p(m, m))
-      call robin_op%proximal_term(contact_line, bodies, a, p)
-      call dense_op_init(subproblems%proximal(a), p)
-      subproblems%hessian(a)%a = subproblems%hessian(a)%a + p
-      ! lambda_max(F_a + Pi_a) <= lambda_max(F_a) + |Pi_a|_inf
-      subproblems%lmax_hessian(a) = subproblems%lmax_body(a) + maxval(sum(abs(p), dim=1))
-      deallocate (p)
-    end do
-    do a = 1, n
-      if (bodies(a)%nrig == 0 .or. bodies(a)%m == 0) cycle
-      call equality_init(subproblems%equality(a), bodies(a)%rg, bodies(a)%re, subproblems%lmax_hessian(a))
-      call equality_add_penalty(subproblems%equality(a), subproblems%hessian(a), subproblems%lmax_hessian(a))
-    end do
   end subroutine subproblems_init
 
   !> Every body's subproblem at outer iteration `it` to the inner tolerance rtol_in. On

@@ -25,6 +25,7 @@ module run_phases
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
   use strings, only: sci, i2s, word, body_label
+  use sorting, only: merge_sort_by_keys
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
   use mpi_env, only: par_built, par_any
@@ -151,12 +152,15 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its systems
     logical, intent(in) :: matrix       !< assemble the stiffness
     type(error_t), allocatable :: err(:)
-    integer :: a
+    integer, allocatable :: order(:)
+    integer :: a, k
     associate (deck => run%deck)
       allocate (err(deck%nbody))
       run%plan = plan_steps(deck)
-      !$omp parallel do num_threads(run%threads) schedule(dynamic, 1)
-      do a = 1, deck%nbody
+      order = largest_meshes_first(run)
+      !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
+      do k = 1, deck%nbody
+        a = order(k)
         if (size(run%plan) == 1) then
           call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
                              run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
@@ -174,6 +178,16 @@ contains
       end do
     end associate
   end subroutine assemble_bodies
+
+  !> The bodies by their mesh nodes, the largest first (ties by id): the threads' order
+  !! before the bodies' systems are known.
+  function largest_meshes_first(run) result(order)
+    type(run_t), intent(in) :: run
+    integer, allocatable :: order(:)
+    integer :: i
+    order = [(i, i=1, run%nbody)]
+    call merge_sort_by_keys(order, reshape([(-run%meshes(i)%nnode, i=1, run%nbody)], [1, run%nbody]))
+  end function largest_meshes_first
 
   !> The contact groups of body a, one per pair it takes part in ('' : its 'contact' side).
   function body_groups(deck, a) result(g)
@@ -522,18 +536,24 @@ contains
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
 
-  !> Each body's nodal stresses from its displacement (what the result file shows).
+  !> Each body's nodal stresses from its displacement (what the result file shows), the
+  !! bodies on the threads (the file itself is written by one thread).
   function body_stresses(run) result(stress)
     type(run_t), intent(in) :: run
     type(stress_field_t), allocatable :: stress(:)
-    integer :: a, nnode
+    integer, allocatable :: order(:)
+    integer :: a, k, nnode
     allocate (stress(run%nbody))
-    do a = 1, run%nbody
+    order = largest_meshes_first(run)
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a, nnode)
+    do k = 1, run%nbody
+      a = order(k)
       nnode = run%meshes(a)%nnode
       allocate (stress(a)%sigma(4, nnode), stress(a)%von_mises(nnode))
       call nodal_stress(run%meshes(a), run%deck%body(a), run%deck%plane_strain, &
                         run%displacement(1:run%systems(a)%ndof, a), stress(a)%sigma, stress(a)%von_mises)
     end do
+    !$omp end parallel do
   end function body_stresses
 
   !> A signal before the outer iteration (during assembly, ordering, factorization or
