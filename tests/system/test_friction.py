@@ -136,7 +136,7 @@ def patch_stick(tmp):
         deck = patch_deck(tau, p=p, young=young)
         mono = Run(tmp, f"stick_{units}_mono", deck, MONO)
         runs = {"monolithic": mono}
-        for op in ("harmonic", "steklov"):
+        for op in ("harmonic", "steklov") + (("constant_anderson",) if units == "SI" else ()):
             runs[op] = Run(tmp, f"stick_{units}_{op}", deck, ROBIN[op])
         for name, r in runs.items():
             what = f"stick patch ({units}, {name})"
