@@ -278,9 +278,10 @@ contains
   end subroutine parse_int
 
   !> A decimal real: an optional sign, digits with an optional fraction (one digit at least)
-  !! and an optional exponent (e, E, d or D). Exact (correctly rounded) in the common case of at most 18 significant
-  !! digits with a mantissa below 2**53 and a power of ten up to 22 (one multiplication or
-  !! division of two exact doubles); other forms go through a formatted READ.
+  !! and an optional exponent (e, E, d or D). Exact (correctly rounded): with a mantissa below
+  !! 2**53 and a power of ten up to 22 by one multiplication or division of two exact
+  !! doubles; with up to 17 significant digits and a power of ten from -21 to 20 by
+  !! nearest_quotient; other forms (18+ digits, large exponents) by a formatted READ.
   subroutine parse_real(t, v, ok)
     character(len=*), intent(in) :: t
     real(wp), intent(out) :: v
