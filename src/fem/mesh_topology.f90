@@ -427,7 +427,9 @@ contains
     character(len=*), parameter :: what(2) = ['quadrangle', 'triangle  ']
 
     nv = merge(4, 3, mesh%cell_type(k) == ELEM_Q1)
-    p(:, 1:nv) = mesh%xy(:, mesh%cells(1:nv, k))
+    do i = 1, nv
+      p(:, i) = mesh%xy(:, mesh%cells(i, k))
+    end do
     area2 = 0.0_wp
     h2 = 0.0_wp
     do i = 1, nv
