@@ -16,6 +16,8 @@ module text_scanner
   integer, parameter, public :: SCAN_BAD_INPUT = 1       !< info: the text is not what was expected
   integer, parameter, public :: SCAN_OTHER_FAILURE = 3   !< info: anything else (memory)
 
+  integer, parameter :: i16 = selected_int_kind(38)   ! 128-bit integers (nearest_quotient)
+
   real(wp), parameter :: p10(0:22) = [ &   ! the powers of ten that doubles hold exactly
     1.0e0_wp, 1.0e1_wp, 1.0e2_wp, 1.0e3_wp, 1.0e4_wp, 1.0e5_wp, 1.0e6_wp, 1.0e7_wp, 1.0e8_wp, &
     1.0e9_wp, 1.0e10_wp, 1.0e11_wp, 1.0e12_wp, 1.0e13_wp, 1.0e14_wp, 1.0e15_wp, 1.0e16_wp, &
@@ -276,9 +278,10 @@ contains
   end subroutine parse_int
 
   !> A decimal real: an optional sign, digits with an optional fraction (one digit at least)
-  !! and an optional exponent (e, E, d or D). Exact (correctly rounded) in the common case of at most 18 significant
-  !! digits with a mantissa below 2**53 and a power of ten up to 22 (one multiplication or
-  !! division of two exact doubles); other forms go through a formatted READ.
+  !! and an optional exponent (e, E, d or D). Exact (correctly rounded): with a mantissa below
+  !! 2**53 and a power of ten up to 22 by one multiplication or division of two exact
+  !! doubles; with up to 17 significant digits and a power of ten from -21 to 20 by
+  !! nearest_quotient; other forms (18+ digits, large exponents) by a formatted READ.
   subroutine parse_real(t, v, ok)
     character(len=*), intent(in) :: t
     real(wp), intent(out) :: v
@@ -361,8 +364,10 @@ contains
       else
         v = v/p10(-e10)
       end if
+    else if (ok .and. e10 >= -21 .and. e10 <= 20) then
+      v = nearest_quotient(int(m, i16)*10_i16**max(e10, 0), 10_i16**max(-e10, 0))
     else
-      ! Rare forms (17+ digits, large exponents): a formatted READ, only of number
+      ! Rare forms (18+ digits, large exponents): a formatted READ, only of number
       ! characters (a list-directed READ would take '/' or ',' as separators).
       ok = len(t) <= 64 .and. verify(t, '0123456789+-.eEdD') == 0
       if (.not. ok) return
@@ -374,5 +379,46 @@ contains
     end if
     if (neg) v = -v
   end subroutine parse_real
+
+  !> The double nearest to num/den (ties to even), num, den > 0 and num/den a normal
+  !! double, den < 2**72: the 54-bit quotient num 2**s / den, in 128-bit integers, rounded
+  !! to 53 bits with the remainder as the sticky bit. Gmsh writes 16 and 17 significant
+  !! digits, beyond the 2**53 of the exact product in parse_real.
+  pure real(wp) function nearest_quotient(num, den) result(v)
+    integer(i16), intent(in) :: num, den
+    integer(i16) :: q, r, d
+    integer :: s
+    s = 54 - (bit_size_of(num) - bit_size_of(den))
+    do
+      if (s >= 0) then
+        q = (num*2_i16**s)/den
+        r = num*2_i16**s - q*den
+      else
+        d = den*2_i16**(-s)
+        q = num/d
+        r = num - q*d
+      end if
+      if (q >= 2_i16**54) then
+        s = s - 1
+      else if (q < 2_i16**53) then
+        s = s + 1
+      else
+        exit
+      end if
+    end do
+    ! q: 53 bits and a rounding bit
+    if (btest(q, 0) .and. (r /= 0 .or. btest(q, 1))) then
+      q = q/2 + 1
+    else
+      q = q/2
+    end if
+    v = scale(real(q, wp), 1 - s)
+  end function nearest_quotient
+
+  !> The number of bits of x > 0.
+  pure integer function bit_size_of(x) result(n)
+    integer(i16), intent(in) :: x
+    n = int(bit_size(x)) - leadz(x)
+  end function bit_size_of
 
 end module text_scanner

@@ -16,7 +16,7 @@ module mesh_topology
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
-  use sorting, only: sort_ints, merge_sort_by_keys
+  use sorting, only: merge_sort_by_keys
   use mesh, only: mesh_t
   implicit none (type, external)
   private
@@ -311,7 +311,7 @@ contains
   subroutine number_for_locality(mesh, err)
     type(mesh_t), intent(inout) :: mesh
     type(error_t), intent(inout) :: err
-    integer, parameter :: BITS = 15                     ! per coordinate of the Morton key
+    integer, parameter :: BITS = 15                     ! per coordinate of the Morton key (morton's)
     integer, allocatable :: key(:), order(:), new_node(:), first(:), new_cell(:)
     real(wp) :: lo(2), scale(2)
     integer :: k, c, g, q(2), st
@@ -325,7 +325,7 @@ contains
     scale = real(2**BITS - 1, wp)/max(maxval(mesh%xy, dim=2) - lo, tiny(1.0_wp))
     do k = 1, mesh%nnode
       q = min(max(int((mesh%xy(:, k) - lo)*scale), 0), 2**BITS - 1)
-      key(k) = morton(q(1), q(2), BITS)
+      key(k) = morton(q(1), q(2))
     end do
     call radix_order(key, 2*BITS, order)
     new_node(order) = [(k, k=1, mesh%nnode)]
@@ -369,17 +369,22 @@ contains
     end do
   end subroutine number_for_locality
 
-  !> The Morton key of (i, j), each of nbits bits (2 nbits < 32): their bits interleaved,
-  !! i's in the even places.
-  pure integer function morton(i, j, nbits) result(key)
-    integer, intent(in) :: i, j, nbits
-    integer :: b
-    key = 0
-    do b = 0, nbits - 1
-      if (btest(i, b)) key = ibset(key, 2*b)
-      if (btest(j, b)) key = ibset(key, 2*b + 1)
-    end do
+  !> The Morton key of (i, j), each 0 <= i, j < 2**15: their bits interleaved, i's in the
+  !! even places.
+  pure integer function morton(i, j) result(key)
+    integer, intent(in) :: i, j
+    key = ior(spread_bits(i), ishft(spread_bits(j), 1))
   end function morton
+
+  !> The 15 low bits of x moved to the even places (bit b to bit 2 b), by halving shifts.
+  pure integer function spread_bits(x) result(y)
+    integer, intent(in) :: x
+    y = iand(x, int(z'7FFF'))
+    y = iand(ior(y, ishft(y, 8)), int(z'00FF00FF'))
+    y = iand(ior(y, ishft(y, 4)), int(z'0F0F0F0F'))
+    y = iand(ior(y, ishft(y, 2)), int(z'33333333'))
+    y = iand(ior(y, ishft(y, 1)), int(z'55555555'))
+  end function spread_bits
 
   !> The indices 1..size(key) by increasing key (keys of `nbits` bits, non-negative):
   !! a stable least-significant-digit radix sort, two digits.
@@ -422,7 +427,9 @@ contains
     character(len=*), parameter :: what(2) = ['quadrangle', 'triangle  ']
 
     nv = merge(4, 3, mesh%cell_type(k) == ELEM_Q1)
-    p(:, 1:nv) = mesh%xy(:, mesh%cells(1:nv, k))
+    do i = 1, nv
+      p(:, i) = mesh%xy(:, mesh%cells(i, k))
+    end do
     area2 = 0.0_wp
     h2 = 0.0_wp
     do i = 1, nv
@@ -728,39 +735,74 @@ contains
   !> Refuse cells that overlap across an edge: with every cell counter-clockwise, the two
   !! cells of an inner edge run along it in opposite directions, so an edge run twice in
   !! the same direction has two cells on one side (a node moved or swapped, or a wrong
-  !! node in a cell; an edge shared by three cells too). The directed edges are hashed.
+  !! node in a cell; an edge shared by three cells too). The directed edges are bucketed
+  !! by their first node (a counting sort in cell order); in a bucket, an edge whose end
+  !! node was met before repeats. The message names the repeat met first in cell order.
   subroutine check_overlapping_cells(mesh, err)
     type(mesh_t), intent(in) :: mesh
     type(error_t), intent(inout) :: err
-    type(int_hash_t) :: edge_hash
-    integer, allocatable :: edge_cell(:)
-    integer :: c, i, nv, a, b, slot, st
-    integer(i8) :: key, key_base
-    call hash_init(edge_hash, mesh%nvert*mesh%ncell, st)
-    if (st == 0) allocate (edge_cell(0:edge_hash%mask), stat=st)
+    ! seq: 4 (cell - 1) + the edge's place in the cell, increasing in cell order
+    integer, allocatable :: first(:), edge_to(:), edge_seq(:), seen_from(:), seen_seq(:)
+    integer :: c, i, nv, a, b, j, st, ne, dup_seq, dup_first
+    ne = 0
+    do c = 1, mesh%ncell
+      ne = ne + merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+    end do
+    allocate (first(mesh%nnode + 2), edge_to(ne), edge_seq(ne), seen_from(mesh%nnode), seen_seq(mesh%nnode), &
+              stat=st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory to check '//i2s(mesh%ncell)//' cells for overlaps')
       return
     end if
-    key_base = mesh%nnode + 1
+    first = 0
     do c = 1, mesh%ncell
       nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
       do i = 1, nv
         a = mesh%cells(i, c)
-        b = mesh%cells(modulo(i, nv) + 1, c)
-        key = a*key_base + b
-        slot = hash_slot(edge_hash, key)
-        if (edge_hash%key(slot) == key) then
-          call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(edge_cell(slot)))//' and '// &
-                       i2s(mesh%cell_tag(c))//' overlap: both lie on the same side of their edge from node '// &
-                       i2s(mesh%node_tag(a))//' to node '//i2s(mesh%node_tag(b))// &
-                       ' (a node misplaced or a wrong node in a cell)')
-          return
-        end if
-        edge_hash%key(slot) = key
-        edge_cell(slot) = c
+        first(a + 2) = first(a + 2) + 1
       end do
     end do
+    first(1) = 1
+    do a = 1, mesh%nnode + 1
+      first(a + 1) = first(a + 1) + first(a)
+    end do
+    do c = 1, mesh%ncell                            ! first(a + 1): the next free place of bucket a
+      nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+      do i = 1, nv
+        a = mesh%cells(i, c)
+        j = first(a + 1)
+        edge_to(j) = mesh%cells(modulo(i, nv) + 1, c)
+        edge_seq(j) = 4*(c - 1) + i
+        first(a + 1) = j + 1
+      end do
+    end do
+    seen_from = 0
+    dup_seq = huge(1)
+    dup_first = 0
+    do a = 1, mesh%nnode
+      do j = first(a), first(a + 1) - 1
+        b = edge_to(j)
+        if (seen_from(b) == a) then
+          if (edge_seq(j) < dup_seq) then
+            dup_seq = edge_seq(j)
+            dup_first = seen_seq(b)
+          end if
+          exit
+        end if
+        seen_from(b) = a
+        seen_seq(b) = edge_seq(j)
+      end do
+    end do
+    if (dup_first == 0) return
+    c = (dup_seq - 1)/4 + 1
+    i = dup_seq - 4*(c - 1)
+    nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+    a = mesh%cells(i, c)
+    b = mesh%cells(modulo(i, nv) + 1, c)
+    call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag((dup_first - 1)/4 + 1))//' and '// &
+                 i2s(mesh%cell_tag(c))//' overlap: both lie on the same side of their edge from node '// &
+                 i2s(mesh%node_tag(a))//' to node '//i2s(mesh%node_tag(b))// &
+                 ' (a node misplaced or a wrong node in a cell)')
   end subroutine check_overlapping_cells
 
   !> Refuse two cells with the same nodes (in any order): a cell listed twice would count
@@ -785,7 +827,7 @@ contains
     first = 0
     do c = 1, n
       key(1:mesh%nvert, c) = mesh%cells(:, c)       ! a triangle's 4th node is 0 (or absent)
-      call sort_ints(key(:, c))
+      call sort4(key(:, c))
       first(key(4, c) + 2) = first(key(4, c) + 2) + 1
     end do
     first(1) = 1
@@ -825,6 +867,22 @@ contains
                                  i2s(mesh%cell_tag(best_j))//' have the same nodes: a cell listed twice would '// &
                                  'count its stiffness twice')
   contains
+    !> Sort four integers in place (a sorting network: the two pairs, then their
+    !! smaller and larger ends, then the middle two).
+    pure subroutine sort4(v)
+      integer, intent(inout) :: v(4)
+      integer :: lo1, hi1, lo2, hi2, mid1, mid2
+      lo1 = min(v(1), v(2))
+      hi1 = max(v(1), v(2))
+      lo2 = min(v(3), v(4))
+      hi2 = max(v(3), v(4))
+      mid1 = max(lo1, lo2)
+      mid2 = min(hi1, hi2)
+      v(1) = min(lo1, lo2)
+      v(2) = min(mid1, mid2)
+      v(3) = max(mid1, mid2)
+      v(4) = max(hi1, hi2)
+    end subroutine sort4
     !> Keep the duplicate pair (ci, cj), ci < cj the first two of their list, if its node
     !! list is the smallest so far.
     subroutine keep(ci, cj)
