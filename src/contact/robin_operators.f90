@@ -12,7 +12,7 @@ module robin_operators
   use kinds, only: wp
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init
-  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd, dpotrf, dpotri, dpocon
+  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, ROW_NORMAL, ROW_TANGENT
   use condense, only: body_condensed_t
@@ -502,19 +502,58 @@ contains
     integer, intent(out) :: info
     real(wp), allocatable :: sk(:, :)
     integer, allocatable :: idx(:)
-    integer :: k, i, m
+    integer :: k, i, m, kinfo(ROW_NORMAL:ROW_TANGENT)
     m = size(f1, 1)
     allocate (s(m, m))
     s = 0.0_wp
-    info = 0
+    kinfo = 0
+    ! the two kinds' blocks on the two threads (disjoint parts of s)
+    !$omp parallel do num_threads(body_threads()) schedule(static, 1) private(k, idx, sk) if (m > 256)
     do k = ROW_NORMAL, ROW_TANGENT
       idx = pack([(i, i=1, m)], kind == k)
       if (size(idx) == 0) cycle
-      call harmonic_matrix(f1(idx, idx), f2(idx, idx), sk, info)
-      if (info /= 0) return
-      s(idx, idx) = sk
+      call harmonic_lean(f1(idx, idx), f2(idx, idx), sk, kinfo(k))
+      if (kinfo(k) == 0) s(idx, idx) = sk
     end do
+    !$omp end parallel do
+    info = kinfo(ROW_NORMAL)
+    if (info == 0) info = kinfo(ROW_TANGENT)
   end subroutine harmonic_by_kind
+
+  !> S = 2 F_s (F_1 + F_2)^-1 F_o = 2 F_s - 2 Y'Y with Y = L^-1 F_s, L L' = F_1 + F_2 and F_s
+  !! the one of smaller trace (the stiffer body: the subtracted term is then the smaller one):
+  !! one Cholesky factor, one triangular solve and one symmetric rank-k product, about half
+  !! the work of `harmonic_matrix`, and symmetric by construction.
+  subroutine harmonic_lean(f1, f2, s, info)
+    real(wp), intent(in) :: f1(:, :), f2(:, :)
+    real(wp), allocatable, intent(out) :: s(:, :)
+    integer, intent(out) :: info
+    real(wp), allocatable :: a(:, :), y(:, :)
+    real(wp) :: t1, t2
+    integer :: m, i
+    m = size(f1, 1)
+    allocate (a(m, m), s(m, m))
+    a = f1 + f2
+    call dpotrf('L', m, a, m, info)
+    if (info /= 0) return
+    t1 = 0.0_wp
+    t2 = 0.0_wp
+    do i = 1, m
+      t1 = t1 + f1(i, i)
+      t2 = t2 + f2(i, i)
+    end do
+    if (t1 <= t2) then
+      y = f1
+    else
+      y = f2
+    end if
+    s = 2.0_wp*y
+    call dtrsm('L', 'L', 'N', 'N', m, m, 1.0_wp, a, m, y, m)
+    call dsyrk('L', 'T', m, m, -2.0_wp, y, m, 1.0_wp, s, m)
+    do i = 1, m - 1
+      s(i, i + 1:m) = s(i + 1:m, i)
+    end do
+  end subroutine harmonic_lean
 
   subroutine harmonic_matrix(f1, f2, s, info)
     real(wp), intent(in) :: f1(:, :), f2(:, :)
