@@ -100,15 +100,20 @@ def run(binary, n, mode, method, out, extra=()):
         r["Q_applied"] = QFRAC * MU * P
         return r
     f = solve(binary, path, h5, loads, None)
+    ux = mean_ux(h5, H)
+    r = solve(binary, path, h5, [f"&boundary body=1, group='top', ux={ux!r}, uy={-D} /"], extra)
+    r["Q_force"] = f["Q"]
+    return r
+
+
+def mean_ux(h5, y):
+    """The mean x displacement of body 1's nodes on the line y (its loaded side) in a result."""
     with h5py.File(h5, "r") as g:
         xy = np.array(g["body1/coordinates"])
         u = np.array(g["body1/displacement"])
     if xy.shape[0] == 2:
         xy, u = xy.T, u.T
-    ux = float(np.mean(u[np.abs(xy[:, 1] - H) < 1e-12, 0]))
-    r = solve(binary, path, h5, [f"&boundary body=1, group='top', ux={ux!r}, uy={-D} /"], extra)
-    r["Q_force"] = f["Q"]
-    return r
+    return float(np.mean(u[np.abs(xy[:, 1] - y) < 1e-12, 0]))
 
 
 def solve(binary, path, h5, loads, extra, mu=None):
@@ -175,12 +180,7 @@ def run_disc(binary, n, mode, method, out, extra=(), ac=AC, mu=MU, gmsh="gmsh", 
         r.update(Q_applied=q, d=d)
         return r
     f = solve(binary, path, h5, loads, None, mu)
-    with h5py.File(h5, "r") as g:
-        xy = np.array(g["body1/coordinates"])
-        u = np.array(g["body1/displacement"])
-    if xy.shape[0] == 2:
-        xy, u = xy.T, u.T
-    ux = float(np.mean(u[np.abs(xy[:, 1] - R) < 1e-12, 0]))
+    ux = mean_ux(h5, R)
     r = solve(binary, path, h5, [press, f"&boundary body=1, group='disc_top', ux={ux!r}, stage=2 /"], extra, mu)
     r.update(Q_force=f["Q"], d=d, ux=ux)
     return r

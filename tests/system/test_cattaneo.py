@@ -54,33 +54,44 @@ def plot(h5, png):
           (m.group(0) if m else (p.stdout + p.stderr).strip()[-300:]))
 
 
+def force_study(prefix, ns, h_of, out, held, run=cs.run):
+    """Q as a force on three meshes: the rows (h, run) and the checks on the finest mesh (c and
+    the shear within 2% of theory, Hertz's a and p0 within 1%, the error falling with the mesh,
+    the contact's tangential force = the applied Q)."""
+    rows = []
+    for n in ns:
+        r = attempt(f"{prefix}force, n = {n}", n, "force", "monolithic", out, run=run)
+        if r is not None:
+            rows.append((h_of(n), r))
+            print(f"INFO  {prefix}force, n = {n}: a/R {r['a'] / cs.R:.4f}, a {r['a_err']:+.2%}, p0 {r['p0_err']:+.2%}, "
+                  f"c {r['c_err']:+.2%}, shear L2 {r['l2']:.2%}", flush=True)
+    if len(rows) != len(ns):
+        return rows
+    hs = [h for h, _ in rows]
+    print(f"INFO  {prefix}observed orders: c", [round(v, 2) for v in cs.orders(hs, [r["c_err"] for _, r in rows])],
+          "shear", [round(v, 2) for v in cs.orders(hs, [r["l2"] for _, r in rows])], flush=True)
+    fine = rows[-1][1]
+    check(abs(fine["c_err"]) <= 0.02, f"{prefix}force, finest mesh: stick-zone half-width c within 2% of theory",
+          f"{fine['c_err']:+.2%}")
+    check(fine["l2"] <= 0.02, f"{prefix}force, finest mesh: shear traction within 2% (L2, away from the zone edges)",
+          f"{fine['l2']:.2%}")
+    check(abs(fine["a_err"]) <= 0.01 and abs(fine["p0_err"]) <= 0.01,
+          f"{prefix}force, finest mesh: Hertz's a and p0 within 1%", f"{fine['a_err']:+.2%}, {fine['p0_err']:+.2%}")
+    check(fine["l2"] < rows[0][1]["l2"], f"{prefix}force: the shear error falls with the mesh",
+          f"{rows[0][1]['l2']:.2%} -> {fine['l2']:.2%}")
+    check(abs(fine["Q"] - fine["Q_applied"]) <= 1e-9 * fine["Q_applied"],
+          f"{prefix}force: the contact's tangential force is the applied Q (1e-9): friction alone holds the {held}",
+          f"{fine['Q']!r} against {fine['Q_applied']!r}")
+    return rows
+
+
 def disc(tmp):
     """The half-disc on a block (see the docstring)."""
-    rows = []
-    for n in (8, 16, 32):
-        r = attempt(f"disc, force, a/h = {n}", n, "force", "monolithic", os.path.join(tmp, "d"), run=cs.run_disc)
-        if r is not None:
-            rows.append((cs.AC / n, r))
-            print(f"INFO  disc, force, a/h = {n}: a/R {r['a'] / cs.R:.4f}, a {r['a_err']:+.2%}, p0 {r['p0_err']:+.2%}, "
-                  f"c {r['c_err']:+.2%}, shear L2 {r['l2']:.2%}", flush=True)
+    rows = force_study("disc, ", (8, 16, 32), lambda n: cs.AC / n, os.path.join(tmp, "d"), "disc", run=cs.run_disc)
     if len(rows) == 3:
-        hs = [h for h, _ in rows]
-        print("INFO  disc, observed orders: c", [round(v, 2) for v in cs.orders(hs, [r["c_err"] for _, r in rows])],
-              "shear", [round(v, 2) for v in cs.orders(hs, [r["l2"] for _, r in rows])], flush=True)
         fine = rows[-1][1]
-        check(abs(fine["c_err"]) <= 0.02, "disc, force, finest mesh: stick-zone half-width c within 2% of theory",
-              f"{fine['c_err']:+.2%}")
-        check(fine["l2"] <= 0.02,
-              "disc, force, finest mesh: shear traction within 2% (L2, away from the zone edges)", f"{fine['l2']:.2%}")
-        check(abs(fine["a_err"]) <= 0.01 and abs(fine["p0_err"]) <= 0.01,
-              "disc, force, finest mesh: Hertz's a and p0 within 1%", f"{fine['a_err']:+.2%}, {fine['p0_err']:+.2%}")
         check(abs(fine["a"] / cs.R - 0.005) <= 0.0005, "disc: a/R = 0.005 (10%), the scene's size against the disc",
               f"{fine['a'] / cs.R:.5f}")
-        check(fine["l2"] < rows[0][1]["l2"], "disc, force: the shear error falls with the mesh",
-              f"{rows[0][1]['l2']:.2%} -> {fine['l2']:.2%}")
-        check(abs(fine["Q"] - fine["Q_applied"]) <= 1e-9 * fine["Q_applied"],
-              "disc, force: the contact's tangential force is the applied Q (1e-9): friction alone holds the disc",
-              f"{fine['Q']!r} against {fine['Q_applied']!r}")
         plot(os.path.join(tmp, "d", "cmd_force_monolithic_32.h5"), os.path.join(tmp, "disc_contact.png"))
     d = attempt("disc, displacement, a/h = 32", 32, "displacement", "monolithic", os.path.join(tmp, "dd"),
                 run=cs.run_disc)
@@ -98,29 +109,7 @@ def disc(tmp):
 
 def main():
     with tempfile.TemporaryDirectory(prefix="rc_cattaneo_") as tmp:
-        rows = []
-        for n in (100, 200, 400):
-            r = attempt(f"force, {n} cells", n, "force", "monolithic", tmp)
-            if r is not None:
-                rows.append((cs.W / n, r))
-                print(f"INFO  force, h = {cs.W / n:g}: a {r['a_err']:+.2%}, p0 {r['p0_err']:+.2%}, "
-                      f"c {r['c_err']:+.2%}, shear L2 {r['l2']:.2%}", flush=True)
-        if len(rows) == 3:
-            hs = [h for h, _ in rows]
-            print("INFO  observed orders: c", [round(v, 2) for v in cs.orders(hs, [r["c_err"] for _, r in rows])],
-                  "shear", [round(v, 2) for v in cs.orders(hs, [r["l2"] for _, r in rows])], flush=True)
-            fine = rows[-1][1]
-            check(abs(fine["c_err"]) <= 0.02, "force, finest mesh: stick-zone half-width c within 2% of theory",
-                  f"{fine['c_err']:+.2%}")
-            check(fine["l2"] <= 0.02, "force, finest mesh: shear traction within 2% (L2, away from the zone edges)",
-                  f"{fine['l2']:.2%}")
-            check(abs(fine["a_err"]) <= 0.01 and abs(fine["p0_err"]) <= 0.01,
-                  "force, finest mesh: Hertz's a and p0 within 1%", f"{fine['a_err']:+.2%}, {fine['p0_err']:+.2%}")
-            check(rows[-1][1]["l2"] < rows[0][1]["l2"], "force: the shear error falls with the mesh",
-                  f"{rows[0][1]['l2']:.2%} -> {rows[-1][1]['l2']:.2%}")
-            check(abs(fine["Q"] - fine["Q_applied"]) <= 1e-9 * fine["Q_applied"],
-                  "force: the contact's tangential force is the applied Q (1e-9): friction alone holds the block",
-                  f"{fine['Q']!r} against {fine['Q_applied']!r}")
+        rows = force_study("", (100, 200, 400), lambda n: cs.W / n, tmp, "block")
         g = attempt("stages, 400 cells", 400, "stages", "monolithic", os.path.join(tmp, "s"))
         if g is not None:
             check(abs(g["c_err"]) <= 0.02 and g["l2"] <= 0.02,
