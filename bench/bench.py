@@ -114,6 +114,18 @@ def measured_run(args, env):
     return p, r, wall, busy
 
 
+def wait_quiet(wait, quiet_wait):
+    """Cores kept busy by other processes (over a second; over 0.2 s without wait); with wait,
+    wait up to quiet_wait s for fewer than 0.5."""
+    deadline = time.monotonic() + (quiet_wait if wait else 0.0)
+    while True:
+        b = busy_cores(1.0 if wait else 0.2)
+        if b < 0.5 or time.monotonic() >= deadline:
+            return round(b, 2)
+        sys.stderr.write(f"  (machine busy: {b:.2f} cores; waiting)\n")
+        time.sleep(4.0)
+
+
 def command_text(args, threads):
     """The command line of a run as a user would type it from the repository root."""
     return f"OMP_NUM_THREADS={threads} " + " ".join(
@@ -226,16 +238,9 @@ class Runner:
         return row, c
 
     def wait_quiet(self, row):
-        """Cores kept busy by other processes over the last second; for the big runs
-        (level >= 5 and the thread comparison) wait up to quiet_wait s for < 0.5."""
-        big = row["level"] >= 5 or row["group"] == "threads"
-        deadline = time.monotonic() + (self.quiet_wait if big else 0.0)
-        while True:
-            b = busy_cores(1.0 if big else 0.2)
-            if b < 0.5 or time.monotonic() >= deadline:
-                return round(b, 2)
-            sys.stderr.write(f"  (machine busy: {b:.2f} cores; waiting)\n")
-            time.sleep(4.0)
+        """Cores kept busy by other processes; for the big runs (level >= 5 and the thread
+        comparison) wait up to quiet_wait s for < 0.5."""
+        return wait_quiet(row["level"] >= 5 or row["group"] == "threads", self.quiet_wait)
 
     def _clean(self, stem):
         if self.keep:

@@ -42,12 +42,11 @@ import argparse
 import glob
 import os
 import sys
-import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))  # the rc_* helpers
-from bench import busy_cores, command_text, fmt, table, timed_run, write_csv  # noqa: E402
+from bench import command_text, fmt, table, timed_run, wait_quiet, write_csv  # noqa: E402
 from rc_results import read_lam, rel_err  # noqa: E402
 from rc_run import result_fields, solver_env, time_fields  # noqa: E402
 
@@ -163,7 +162,7 @@ class Runner:
         env = solver_env(threads)
         env.pop("OMP_THREAD_LIMIT", None)
         row["load1"] = round(os.getloadavg()[0], 2)
-        row["busy_before"] = self.wait_quiet(wait)
+        row["busy_before"] = wait_quiet(wait, self.quiet_wait)
         row["cmdline"] = command_text(args[:-1], threads)
         rc, out, err, wall, cpu, row["busy_during"], timed_out = timed_run(args, env, self.timeout)
         row["cpu_s"] = round(cpu, 3)
@@ -195,15 +194,6 @@ class Runner:
                 os.remove(fn)
         return row, lam
 
-    def wait_quiet(self, wait):
-        """Cores kept busy over the last second; with wait, wait up to quiet_wait s for < 0.5."""
-        deadline = time.monotonic() + (self.quiet_wait if wait else 0.0)
-        while True:
-            b = busy_cores(1.0 if wait else 0.2)
-            if b < 0.5 or time.monotonic() >= deadline:
-                return round(b, 2)
-            sys.stderr.write(f"  (machine busy: {b:.2f} cores; waiting)\n")
-            time.sleep(4.0)
 
 
 def ok(r):

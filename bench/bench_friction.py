@@ -48,7 +48,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "tools"))  # the rc_* helpers
-from bench import busy_cores, command_text, fmt, table, timed_run, write_csv  # noqa: E402
+from bench import command_text, fmt, table, timed_run, wait_quiet, write_csv  # noqa: E402
 from rc_results import rel_err  # noqa: E402
 from rc_run import line_fields, result_fields, solver_env, time_fields  # noqa: E402
 
@@ -75,13 +75,6 @@ class Runner:
         self.timeout = timeout
         self.count = 0
 
-    def wait_quiet(self, wait):
-        """Cores busy during a second before the run; with wait, up to quiet_wait s for < 0.5."""
-        t0 = time.monotonic()
-        busy = busy_cores(1.0)
-        while wait and busy >= 0.5 and time.monotonic() - t0 < self.quiet_wait:
-            busy = busy_cores(1.0)
-        return round(busy, 2)
 
     def run(self, row, repeats, wait):
         """Run the case of row `repeats` times; fill row with the fastest (least total_s) and
@@ -108,7 +101,7 @@ class Runner:
         args.append(f"&output file='{h5}', progress_lines=0 /")
         env = solver_env(2)
         row["load1"] = round(os.getloadavg()[0], 2)
-        row["busy_before"] = self.wait_quiet(wait)
+        row["busy_before"] = wait_quiet(wait, self.quiet_wait)
         row["cmdline"] = command_text(args[:-1], 2)
         rc, out, err, wall, mine, row["busy_during"], timed_out = timed_run(args, env, self.timeout)
         if timed_out:
