@@ -708,7 +708,7 @@ contains
     real(wp), intent(in) :: g(:, :)                 !< (r, m) equilibrium rows (r = 0: none)
     real(wp), allocatable, intent(out) :: k(:, :)   !< (m, m) Sigma
     logical, intent(out) :: ok
-    real(wp), allocatable :: h(:, :), work(:), y(:, :), gg(:, :), t(:, :)
+    real(wp), allocatable :: h(:, :), work(:)
     integer, allocatable :: iwork(:)
     real(wp) :: rcond
     integer :: m, r, j, info
@@ -728,14 +728,8 @@ contains
       h(j + 1:m, j) = h(j, j + 1:m)
     end do
     if (r > 0) then
-      ! y = F^-1 g', gg = g F^-1 g', t = gg^-1 y': Sigma = F^-1 - y t
-      y = matmul(h, transpose(g))
-      gg = matmul(g, y)
-      t = transpose(y)
-      call dposv('U', r, m, gg, r, t, r, info)
+      call project_rows_out(h, g, info)
       if (info /= 0) return
-      h = h - matmul(y, t)
-      h = 0.5_wp*(h + transpose(h))
     end if
     call move_alloc(h, k)
     ok = .true.
@@ -805,11 +799,10 @@ contains
     real(wp), intent(in) :: g(:, :)
     real(wp), intent(out) :: q(:, :)
     integer, intent(out) :: info
-    real(wp), allocatable :: h(:, :), y(:, :), gg(:, :), t(:, :)
-    integer :: m, r, i
+    real(wp), allocatable :: h(:, :)
+    integer :: m, i
     m = size(f, 1)
-    r = size(g, 1)
-    allocate (h(m, m), y(m, r), gg(r, r), t(r, m))
+    allocate (h(m, m))
     h = f
     q = 0.0_wp
     do i = 1, m
@@ -817,14 +810,26 @@ contains
     end do
     call dposv('U', m, m, h, m, q, m, info)
     if (info /= 0) return
-    ! y = F^-1 G', gg = G F^-1 G': q -= y gg^-1 y'
-    y = matmul(q, transpose(g))
+    call project_rows_out(q, g, info)
+  end subroutine projected_inverse
+
+  !> finv <- F^-1 - y (G F^-1 G')^-1 y' with y = F^-1 G' (finv holds F^-1 on entry, G has
+  !! full row rank), symmetrized; info /= 0: G F^-1 G' is not positive definite.
+  subroutine project_rows_out(finv, g, info)
+    real(wp), intent(inout) :: finv(:, :)           !< (m, m) F^-1 in, the projected inverse out
+    real(wp), intent(in) :: g(:, :)                 !< (r, m) G
+    integer, intent(out) :: info
+    real(wp), allocatable :: y(:, :), gg(:, :), t(:, :)
+    integer :: m, r
+    m = size(finv, 1)
+    r = size(g, 1)
+    y = matmul(finv, transpose(g))
     gg = matmul(g, y)
     t = transpose(y)
     call dposv('U', r, m, gg, r, t, r, info)
     if (info /= 0) return
-    q = q - matmul(y, t)
-    q = 0.5_wp*(q + transpose(q))
-  end subroutine projected_inverse
+    finv = finv - matmul(y, t)
+    finv = 0.5_wp*(finv + transpose(finv))
+  end subroutine project_rows_out
 
 end module robin_operators
