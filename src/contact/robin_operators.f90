@@ -11,7 +11,7 @@
 module robin_operators
   use kinds, only: wp
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
-  use linop, only: dense_op_t, dense_op_init
+  use linop, only: dense_op_t, dense_op_init, dense_op_take
   use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, ROW_NORMAL, ROW_TANGENT
@@ -366,22 +366,24 @@ contains
                        side=1, 2)])
       info = 0
       if (all(npairs(contact_line%pair_body(:, p)) == 1)) then
-        do side = 1, 2
-          a = contact_line%pair_body(side, p)
-          blk(side)%f = bodies(a)%flex
-          blk(side)%nrig = bodies(a)%nrig
-          if (bodies(a)%nrig > 0) blk(side)%g = bodies(a)%rg
-        end do
-        if (blk(1)%nrig + blk(2)%nrig > 0) then
-          call harmonic_floating(blk, s, info)
-          ! a singular F (a mortar master coarser than the slave): no inverse of it
-          if (info /= 0 .and. singular) call harmonic_singular(blk, s, info)
-        else if (has_friction(contact_line)) then
-          ! with friction: S of the normal rows and S of the tangential rows apart (below)
-          call harmonic_by_kind(blk(1)%f, blk(2)%f, contact_line%kind(self%rows(1, p):self%rows(2, p)), s, info)
-        else
-          call harmonic_matrix(blk(1)%f, blk(2)%f, s, info)
-        end if
+        associate (f1 => bodies(contact_line%pair_body(1, p))%flex, f2 => bodies(contact_line%pair_body(2, p))%flex)
+          if (any(bodies(contact_line%pair_body(:, p))%nrig > 0)) then
+            do side = 1, 2
+              a = contact_line%pair_body(side, p)
+              blk(side)%f = bodies(a)%flex
+              blk(side)%nrig = bodies(a)%nrig
+              if (bodies(a)%nrig > 0) blk(side)%g = bodies(a)%rg
+            end do
+            call harmonic_floating(blk, s, info)
+            ! a singular F (a mortar master coarser than the slave): no inverse of it
+            if (info /= 0 .and. singular) call harmonic_singular(blk, s, info)
+          else if (has_friction(contact_line)) then
+            ! with friction: S of the normal rows and S of the tangential rows apart (below)
+            call harmonic_by_kind(f1, f2, contact_line%kind(self%rows(1, p):self%rows(2, p)), s, info)
+          else
+            call harmonic_matrix(f1, f2, s, info)
+          end if
+        end associate
       else
         do side = 1, 2
           a = contact_line%pair_body(side, p)
@@ -407,7 +409,7 @@ contains
         call err%set(ERR_NUMERICAL, emsg)
         return
       end if
-      call dense_op_init(self%s(p), s)
+      call dense_op_take(self%s(p), s)
     end do
   end subroutine harmonic_setup
 

@@ -12,7 +12,7 @@ module linop
   implicit none (type, external)
   private
 
-  public :: linop_t, dense_op_t, csc_op_t, dense_op_init, csc_op_init
+  public :: linop_t, dense_op_t, csc_op_t, dense_op_init, dense_op_take, csc_op_init
 
   !> An abstract symmetric linear operator of size `n`.
   type, abstract :: linop_t
@@ -70,6 +70,16 @@ contains
     op%n = size(a, 1)
     allocate (op%a(op%n, op%n), source=a)
   end subroutine dense_op_init
+
+  !> Make `op` a dense operator of the square matrix `a`, taking its storage (no copy;
+  !! `a` is deallocated on return).
+  subroutine dense_op_take(op, a)
+    type(dense_op_t), intent(out) :: op          !< the operator to set up
+    real(wp), allocatable, intent(inout) :: a(:, :) !< symmetric square matrix, full storage
+    if (.not. allocated(a)) allocate (a(0, 0))
+    op%n = size(a, 1)
+    call move_alloc(a, op%a)
+  end subroutine dense_op_take
 
   !> y = A x for a dense operator (BLAS dsymv).
   subroutine dense_apply(self, x, y)
