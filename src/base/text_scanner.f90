@@ -106,19 +106,22 @@ contains
   subroutine next_token(scanner, s, e)
     type(scanner_t), intent(inout) :: scanner
     integer(i8), intent(out) :: s, e
+    integer(i8) :: pos
     integer :: code
-    do while (scanner%pos <= scanner%n)
-      code = iachar(scanner%text(scanner%pos:scanner%pos))
+    pos = scanner%pos          ! in locals: the loops keep them in registers
+    do while (pos <= scanner%n)
+      code = iachar(scanner%text(pos:pos))
       if (code > 32) exit
       if (code == 10) scanner%line = scanner%line + 1
-      scanner%pos = scanner%pos + 1
+      pos = pos + 1
     end do
-    s = scanner%pos
-    do while (scanner%pos <= scanner%n)
-      if (iachar(scanner%text(scanner%pos:scanner%pos)) <= 32) exit
-      scanner%pos = scanner%pos + 1
+    s = pos
+    do while (pos <= scanner%n)
+      if (iachar(scanner%text(pos:pos)) <= 32) exit
+      pos = pos + 1
     end do
-    e = scanner%pos - 1
+    e = pos - 1
+    scanner%pos = pos
   end subroutine next_token
 
   !> Report the end of the file inside a section, or a token that is not `what`.
@@ -135,14 +138,42 @@ contains
     end if
   end subroutine bad_token
 
-  !> The next token as an integer (0 after an error).
+  !> The next token as an integer (0 after an error). A token of 1 to 18 digits is
+  !! converted as it is scanned; any other goes through next_token and parse_int (the
+  !! same value, or the same refusal).
   integer function get_int(scanner, what) result(v)
     type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: what   ! what the number is, for messages
-    integer(i8) :: s, e
+    integer(i8) :: s, e, pos, m
+    integer :: code, d
     logical :: ok
     v = 0
     if (scanner%info /= 0) return
+    pos = scanner%pos
+    do while (pos <= scanner%n)
+      code = iachar(scanner%text(pos:pos))
+      if (code > 32) exit
+      if (code == 10) scanner%line = scanner%line + 1
+      pos = pos + 1
+    end do
+    scanner%pos = pos
+    m = 0
+    do while (pos <= scanner%n)
+      code = iachar(scanner%text(pos:pos))
+      if (code <= 32) exit
+      d = code - iachar('0')
+      if (d < 0 .or. d > 9 .or. pos - scanner%pos >= 18) then
+        m = -1
+        exit
+      end if
+      m = 10*m + d
+      pos = pos + 1
+    end do
+    if (m >= 0 .and. pos > scanner%pos .and. m <= huge(v)) then
+      v = int(m)
+      scanner%pos = pos
+      return
+    end if
     call next_token(scanner, s, e)
     ok = s <= e
     if (ok) call parse_int(scanner%text(s:e), v, ok)

@@ -45,6 +45,15 @@ module elements
   real(wp), parameter :: xa_q1(4) = [-1.0_wp, 1.0_wp, 1.0_wp, -1.0_wp]  ! reference nodes of Q1
   real(wp), parameter :: ea_q1(4) = [-1.0_wp, -1.0_wp, 1.0_wp, 1.0_wp]
   real(wp), parameter :: gp2 = 0.577350269189625764509148780502_wp      ! 1/sqrt(3)
+  ! The 2x2 Gauss points of the Q1 stiffness, eta outer and xi inner, and the reference
+  ! derivatives of the shape functions there, by q1_gradients's formulas (the same values).
+  integer :: ia_, iq_   ! the implied-do indices of the two tables
+  real(wp), parameter :: xi_g2(4) = [-gp2, gp2, -gp2, gp2]
+  real(wp), parameter :: eta_g2(4) = [-gp2, -gp2, gp2, gp2]
+  real(wp), parameter :: dxi_g2(4, 4) = reshape([((0.25_wp*xa_q1(ia_)*(1.0_wp + eta_g2(iq_)*ea_q1(ia_)), &
+                                                    ia_=1, 4), iq_=1, 4)], [4, 4])
+  real(wp), parameter :: deta_g2(4, 4) = reshape([((0.25_wp*ea_q1(ia_)*(1.0_wp + xi_g2(iq_)*xa_q1(ia_)), &
+                                                     ia_=1, 4), iq_=1, 4)], [4, 4])
 
 contains
 
@@ -113,26 +122,101 @@ contains
   end subroutine p1_gradients
 
   !> Add w * B^T D B to ke for the gradients g of nv shape functions (isotropic D).
+  !! The material factors of vertex a (c11 g(1, a), ...) are formed once; each entry
+  !! adds its two products in turn, as ke + c11 g(1, a) g(1, b) w + mu g(2, a) g(2, b) w.
   pure subroutine add_btdb(nv, g, w, lame_lambda, lame_mu, ke)
     integer, intent(in) :: nv
     real(wp), intent(in) :: g(2, MAX_NVERT), w, lame_lambda, lame_mu
     real(wp), intent(inout) :: ke(MAX_NDOF, MAX_NDOF)
     integer :: a, b
-    real(wp) :: c11, xa, ya, xb, yb
+    real(wp) :: c11, xb, yb, cx(MAX_NVERT), cy(MAX_NVERT), lx(MAX_NVERT), ly(MAX_NVERT), &
+                mx(MAX_NVERT), my(MAX_NVERT)
     c11 = lame_lambda + 2.0_wp*lame_mu
+    do a = 1, nv
+      cx(a) = c11*g(1, a)
+      cy(a) = c11*g(2, a)
+      lx(a) = lame_lambda*g(1, a)
+      ly(a) = lame_lambda*g(2, a)
+      mx(a) = lame_mu*g(1, a)
+      my(a) = lame_mu*g(2, a)
+    end do
     do b = 1, nv
       xb = g(1, b)*w
       yb = g(2, b)*w
       do a = 1, nv
-        xa = g(1, a)
-        ya = g(2, a)
-        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + c11*xa*xb + lame_mu*ya*yb
-        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + lame_lambda*ya*xb + lame_mu*xa*yb
-        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + lame_lambda*xa*yb + lame_mu*ya*xb
-        ke(2*a, 2*b) = ke(2*a, 2*b) + c11*ya*yb + lame_mu*xa*xb
+        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + cx(a)*xb + my(a)*yb
+        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + ly(a)*xb + mx(a)*yb
+        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + lx(a)*yb + my(a)*xb
+        ke(2*a, 2*b) = ke(2*a, 2*b) + cy(a)*yb + mx(a)*xb
       end do
     end do
   end subroutine add_btdb
+
+  !> The Q1 stiffness by 2x2 Gauss from the tabulated reference derivatives: at each
+  !! point the Jacobian, the gradients and w B^T D B with w = det (the Gauss weights are
+  !! 1), with the operations of q1_gradients and add_btdb in their order, so the result
+  !! is theirs bit for bit. A point where det is not positive adds zeros (gradients and
+  !! weight 0), as add_btdb skipped there. Each column of the four 4x4 blocks (xx, yx, xy,
+  !! yy) is summed over the points (the loops unrolled, so the sums stay in registers)
+  !! and then interleaved into ke.
+  !! minjac = the smallest determinant at the points.
+  pure subroutine q1_stiffness(xe, lame_lambda, lame_mu, ke, minjac)
+    real(wp), intent(in) :: xe(2, MAX_NVERT), lame_lambda, lame_mu
+    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF), minjac
+    real(wp) :: j11, j12, j21, j22, det, c11, xb, yb
+    real(wp) :: w(4), gx(4, 4), gy(4, 4), cx(4, 4), cy(4, 4), lx(4, 4), ly(4, 4), mx(4, 4), my(4, 4)
+    real(wp) :: axx(4), ayx(4), axy(4), ayy(4)
+    integer :: q, a, b
+    c11 = lame_lambda + 2.0_wp*lame_mu
+    minjac = huge(1.0_wp)
+    do q = 1, 4
+      j11 = dxi_g2(1, q)*xe(1, 1) + dxi_g2(2, q)*xe(1, 2) + dxi_g2(3, q)*xe(1, 3) + dxi_g2(4, q)*xe(1, 4)
+      j12 = dxi_g2(1, q)*xe(2, 1) + dxi_g2(2, q)*xe(2, 2) + dxi_g2(3, q)*xe(2, 3) + dxi_g2(4, q)*xe(2, 4)
+      j21 = deta_g2(1, q)*xe(1, 1) + deta_g2(2, q)*xe(1, 2) + deta_g2(3, q)*xe(1, 3) + deta_g2(4, q)*xe(1, 4)
+      j22 = deta_g2(1, q)*xe(2, 1) + deta_g2(2, q)*xe(2, 2) + deta_g2(3, q)*xe(2, 3) + deta_g2(4, q)*xe(2, 4)
+      det = j11*j22 - j12*j21
+      minjac = min(minjac, det)
+      if (det > 0.0_wp) then
+        w(q) = det
+        gx(:, q) = (j22*dxi_g2(:, q) - j12*deta_g2(:, q))/det
+        gy(:, q) = (-j21*dxi_g2(:, q) + j11*deta_g2(:, q))/det
+      else
+        w(q) = 0.0_wp
+        gx(:, q) = 0.0_wp
+        gy(:, q) = 0.0_wp
+      end if
+      cx(:, q) = c11*gx(:, q)
+      cy(:, q) = c11*gy(:, q)
+      lx(:, q) = lame_lambda*gx(:, q)
+      ly(:, q) = lame_lambda*gy(:, q)
+      mx(:, q) = lame_mu*gx(:, q)
+      my(:, q) = lame_mu*gy(:, q)
+    end do
+    do b = 1, 4
+      axx = 0.0_wp
+      ayx = 0.0_wp
+      axy = 0.0_wp
+      ayy = 0.0_wp
+!GCC$ unroll 4
+      do q = 1, 4
+        xb = gx(b, q)*w(q)
+        yb = gy(b, q)*w(q)
+!GCC$ unroll 4
+        do a = 1, 4
+          axx(a) = axx(a) + cx(a, q)*xb + my(a, q)*yb
+          ayx(a) = ayx(a) + ly(a, q)*xb + mx(a, q)*yb
+          axy(a) = axy(a) + lx(a, q)*yb + my(a, q)*xb
+          ayy(a) = ayy(a) + cy(a, q)*yb + mx(a, q)*xb
+        end do
+      end do
+      do a = 1, 4
+        ke(2*a - 1, 2*b - 1) = axx(a)
+        ke(2*a, 2*b - 1) = ayx(a)
+        ke(2*a - 1, 2*b) = axy(a)
+        ke(2*a, 2*b) = ayy(a)
+      end do
+    end do
+  end subroutine q1_stiffness
 
   !> Element stiffness (Q1: 2x2 Gauss; P1: exact) and the smallest Jacobian determinant
   !! met, which is not positive for an inverted or degenerate element. With `cache`, a
@@ -145,8 +229,8 @@ contains
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)         !< element stiffness [stress]
     real(wp), intent(out) :: minjac                         !< smallest Jacobian determinant [length^2]
     type(ke_cache_t), intent(inout), optional :: cache      !< the last stiffness computed
-    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), nfun(4), det
-    integer :: nv, a, ig, jg
+    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), det
+    integer :: nv, a
 
     nv = element_nvert(element)
     if (present(cache)) then
@@ -162,17 +246,10 @@ contains
       end if
     end if
 
-    ke = 0.0_wp
     if (element == ELEM_Q1) then
-      minjac = huge(1.0_wp)
-      do jg = -1, 1, 2
-        do ig = -1, 1, 2
-          call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
-          minjac = min(minjac, det)
-          if (det > 0.0_wp) call add_btdb(4, g, det, lame_lambda, lame_mu, ke)   ! Gauss weights are 1
-        end do
-      end do
+      call q1_stiffness(xe, lame_lambda, lame_mu, ke, minjac)
     else
+      ke = 0.0_wp
       call p1_gradients(xe, g, det)
       minjac = det
       if (det > 0.0_wp) call add_btdb(3, g, 0.5_wp*det, lame_lambda, lame_mu, ke)

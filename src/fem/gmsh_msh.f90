@@ -25,7 +25,7 @@ module gmsh_msh
   use text_scanner, only: scanner_t, scanner_load, scan_fail, next_token, get_int, get_real, read_count, &
                           expect, skip_past, bytes_left, SCAN_OTHER_FAILURE
   use mesh, only: mesh_t
-  use mesh_topology, only: file_mesh_t, body_from_file, add_physical, index_entities, entity_index
+  use mesh_topology, only: file_mesh_t, body_from_file, add_physical, index_entities, entity_index, index_groups
   implicit none (type, external)
   private
 
@@ -94,6 +94,7 @@ contains
     allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), body_scanner(n))
     call scanner_load(scanner, path)
     if (scanner%info == 0) call parse(scanner, file_mesh)
+    if (scanner%info == 0) call index_groups(file_mesh)     ! once for all the bodies
     if (allocated(scanner%text)) deallocate (scanner%text)
     do a = 1, n
       body_scanner(a) = scanner

@@ -21,7 +21,7 @@ module mesh_topology
   implicit none (type, external)
   private
 
-  public :: body_from_file, add_physical, index_entities, entity_index
+  public :: body_from_file, add_physical, index_entities, entity_index, index_groups
 
   real(wp), parameter :: AREA_TOL = 1.0e-12_wp       ! degenerate: |area| < AREA_TOL * (longest edge)^2
   ! the largest coordinate whose cell areas and squared edges stay finite (8 x^2 <= huge)
@@ -61,6 +61,14 @@ module mesh_topology
     integer, allocatable :: line_tag(:), line_entity(:), line_node(:, :)
     integer :: npoint = 0                      !< point elements
     integer, allocatable :: point_entity(:), point_node(:)
+    !> by index_groups, once for all the bodies of the file (absent: each body finds what
+    !! it needs in the whole file): the points of each physical group (group_members), the
+    !! lines starting at each node (node k's: node_lines(node_line_first(k):
+    !! node_line_first(k + 1) - 1))
+    integer, allocatable :: point_first(:), point_members(:), node_line_first(:), node_lines(:)
+    !> the cells of each entity, in file order: those of entity e are
+    !! ent_cells(ent_cell_first(e):ent_cell_first(e + 1) - 1), e = 0..nent (by index_groups)
+    integer, allocatable :: ent_cell_first(:), ent_cells(:)
   end type file_mesh_t
 
 contains
@@ -156,17 +164,75 @@ contains
     if (file_mesh%ent_hash%key(slot) == key) k = file_mesh%ent_of_slot(slot)
   end function entity_index
 
+  !> The members of every physical group of points (file_mesh%point_first, ...), the lines
+  !! starting at each node and the cells of every entity (counting sorts, in file order),
+  !! once for all the bodies of the file. Out of memory: left absent.
+  subroutine index_groups(file_mesh)
+    type(file_mesh_t), intent(inout) :: file_mesh
+    integer :: st, c, e, k, line
+    integer, allocatable :: fill(:)
+    allocate (file_mesh%ent_cell_first(0:file_mesh%nent + 1), fill(0:file_mesh%nent), &
+              file_mesh%ent_cells(file_mesh%ncell), stat=st)
+    if (st == 0) then
+      fill = 0
+      do c = 1, file_mesh%ncell
+        fill(file_mesh%cell_entity(c)) = fill(file_mesh%cell_entity(c)) + 1
+      end do
+      file_mesh%ent_cell_first(0) = 1
+      do e = 0, file_mesh%nent
+        file_mesh%ent_cell_first(e + 1) = file_mesh%ent_cell_first(e) + fill(e)
+      end do
+      fill = 0
+      do c = 1, file_mesh%ncell
+        e = file_mesh%cell_entity(c)
+        file_mesh%ent_cells(file_mesh%ent_cell_first(e) + fill(e)) = c
+        fill(e) = fill(e) + 1
+      end do
+    else
+      if (allocated(file_mesh%ent_cell_first)) deallocate (file_mesh%ent_cell_first)
+      if (allocated(file_mesh%ent_cells)) deallocate (file_mesh%ent_cells)
+    end if
+    call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), &
+                       file_mesh%point_first, file_mesh%point_members, st)
+    if (st /= 0) then
+      if (allocated(file_mesh%point_first)) deallocate (file_mesh%point_first)
+      if (allocated(file_mesh%point_members)) deallocate (file_mesh%point_members)
+    end if
+    if (allocated(fill)) deallocate (fill)
+    allocate (file_mesh%node_line_first(file_mesh%nnode + 1), file_mesh%node_lines(file_mesh%nline), &
+              fill(file_mesh%nnode), stat=st)
+    if (st /= 0) then
+      if (allocated(file_mesh%node_line_first)) deallocate (file_mesh%node_line_first)
+      if (allocated(file_mesh%node_lines)) deallocate (file_mesh%node_lines)
+      return
+    end if
+    fill = 0
+    do line = 1, file_mesh%nline
+      fill(file_mesh%line_node(1, line)) = fill(file_mesh%line_node(1, line)) + 1
+    end do
+    file_mesh%node_line_first(1) = 1
+    do k = 1, file_mesh%nnode
+      file_mesh%node_line_first(k + 1) = file_mesh%node_line_first(k) + fill(k)
+    end do
+    fill = 0
+    do line = 1, file_mesh%nline
+      k = file_mesh%line_node(1, line)
+      file_mesh%node_lines(file_mesh%node_line_first(k) + fill(k)) = line
+      fill(k) = fill(k) + 1
+    end do
+  end subroutine index_groups
+
   !> One body from what a mesh file holds: choose the body's cells (those of the physical
   !! surface `region`), number its nodes by tag, orient and check its cells, find its
   !! groups, then number its nodes and cells for locality (number_for_locality). On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
   !! (its subject the file: 'has no physical surface ...').
   subroutine body_from_file(file_mesh, region, path, mesh, err)
-    type(file_mesh_t), intent(in) :: file_mesh          !< the file's groups, entities, nodes, elements
+    type(file_mesh_t), intent(in), target :: file_mesh  !< the file's groups, entities, nodes, elements
     character(len=*), intent(in) :: region              !< physical surface name of the body, or ''
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
     type(error_t), intent(out) :: err                   !< the failure, if any
-    integer :: surface, k, c, nsurf, ncell, st, nquad
+    integer :: surface, k, c, i, nsurf, ncell, st, nquad, nnew
     logical, allocatable :: in_entity(:)
     integer, allocatable :: file_cell(:), body_node(:), order(:)
     character(len=:), allocatable :: surfaces
@@ -178,11 +244,20 @@ contains
     do k = 1, file_mesh%nphys
       if (file_mesh%phys_dim(k) /= 2) cycle
       nsurf = nsurf + 1
-      call list%add(merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'")
-      if (len(region) > 0 .and. file_mesh%phys_name(k)%s == region) surface = k
+      if (len(region) > 0) then
+        if (file_mesh%phys_name(k)%s == region) surface = k
+      end if
     end do
-    surfaces = list%text()
-    surfaces = trim(adjustl(surfaces))
+    if ((len(region) > 0 .and. surface == 0) .or. (len(region) == 0 .and. nsurf > 1)) then
+      nsurf = 0                    ! their names, for the message
+      do k = 1, file_mesh%nphys
+        if (file_mesh%phys_dim(k) /= 2) cycle
+        nsurf = nsurf + 1
+        call list%add(merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'")
+      end do
+      surfaces = list%text()
+      surfaces = trim(adjustl(surfaces))
+    end if
     if (len(region) > 0 .and. surface == 0) then
       if (nsurf == 0) then
         call err%set(ERR_INPUT, "has no physical surface '"//region//"' (it has no physical surfaces)")
@@ -209,7 +284,7 @@ contains
       if (surface > 0) in_entity(k) = file_mesh%ent(k)%dim == 2 .and. &
                                       any(file_mesh%ent(k)%phys == file_mesh%phys_tag(surface))
     end do
-    file_cell = pack([(c, c=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
+    file_cell = entity_cells(file_mesh, in_entity)
     ncell = size(file_cell)
     if (ncell == 0) then
       if (surface > 0) then
@@ -233,12 +308,30 @@ contains
       return
     end if
     body_node = 0
-    do k = 1, ncell
-      do c = 1, 4
-        if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
+    if (4*int(ncell, i8) < file_mesh%nnode/8) then
+      ! a small part of the file: its nodes gathered from its cells (the same set, the same
+      ! order once sorted by tag, as the pass over the file's nodes below)
+      allocate (order(4*ncell))
+      nnew = 0
+      do k = 1, ncell
+        do c = 1, 4
+          i = file_mesh%cell_node(c, file_cell(k))
+          if (i == 0) cycle
+          if (body_node(i) /= 0) cycle
+          body_node(i) = 1
+          nnew = nnew + 1
+          order(nnew) = i
+        end do
       end do
-    end do
-    order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
+      order = order(1:nnew)
+    else
+      do k = 1, ncell
+        do c = 1, 4
+          if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
+        end do
+      end do
+      order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
+    end if
     call sort_by_tag(order, file_mesh%node_tag)
     mesh%nnode = size(order)
     allocate (mesh%xy(2, mesh%nnode), mesh%node_tag(mesh%nnode))
@@ -298,10 +391,38 @@ contains
     mesh%width = maxval(mesh%xy(1, :)) - mesh%x0
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
-    call boundary_groups(file_mesh, body_node, mesh, err)
+    call boundary_groups(file_mesh, body_node, order, mesh, err)
     if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh, err)
     if (.not. err%failed()) call number_for_locality(mesh, err)
   end subroutine body_from_file
+
+  !> The file's cells of the entities with in_entity(e) (e = 0..nent), in file order:
+  !! from the cells of each entity (file_mesh%ent_cells) when those of several entities
+  !! do not interleave, else by one pass over the file's cells.
+  function entity_cells(file_mesh, in_entity) result(cells)
+    type(file_mesh_t), intent(in) :: file_mesh
+    logical, intent(in) :: in_entity(0:)
+    integer, allocatable :: cells(:)
+    integer :: e, n, lo, hi
+    if (allocated(file_mesh%ent_cell_first)) then
+      n = 0
+      do e = 0, file_mesh%nent
+        if (in_entity(e)) n = n + file_mesh%ent_cell_first(e + 1) - file_mesh%ent_cell_first(e)
+      end do
+      allocate (cells(n))
+      n = 0
+      do e = 0, file_mesh%nent
+        if (.not. in_entity(e)) cycle
+        lo = file_mesh%ent_cell_first(e)
+        hi = file_mesh%ent_cell_first(e + 1) - 1
+        cells(n + 1:n + hi - lo + 1) = file_mesh%ent_cells(lo:hi)
+        n = n + hi - lo + 1
+      end do
+      if (n < 2) return
+      if (all(cells(2:n) > cells(1:n - 1))) return
+    end if
+    cells = pack([(e, e=1, file_mesh%ncell)], in_entity(file_mesh%cell_entity(1:file_mesh%ncell)))
+  end function entity_cells
 
   !> Renumber the body's nodes along a Morton (Z-order) curve of their coordinates, and
   !! its cells by their smallest node in that numbering: the nodes of a neighbourhood get
@@ -387,7 +508,9 @@ contains
   end function spread_bits
 
   !> The indices 1..size(key) by increasing key (keys of `nbits` bits, non-negative):
-  !! a stable least-significant-digit radix sort, two digits.
+  !! a stable least-significant-digit radix sort, two digits; fewer keys than an eighth of
+  !! a digit's range (a small body, whose counts would cost more than the keys) by a
+  !! stable merge sort, the same order.
   subroutine radix_order(key, nbits, order)
     integer, intent(in) :: key(:)
     integer, intent(in) :: nbits
@@ -396,6 +519,11 @@ contains
     integer :: n, i, d, shift, width, digit
     n = size(key)
     width = (nbits + 1)/2
+    if (n < 2**width/8) then
+      order = [(i, i=1, n)]
+      call merge_sort_by_keys(order, reshape(key, [1, n]))
+      return
+    end if
     allocate (order(n), tmp(n), count(0:2**width))
     order = [(i, i=1, n)]
     do d = 0, 1
@@ -467,27 +595,51 @@ contains
   !! any of its cells (a corrupted node number) is bad input: its condition would be lost. The lines' edges are hashed (a small table), then every cell
   !! edge between two nodes of lines is looked up in it: a line edge met in exactly one cell
   !! is a boundary edge, oriented as that cell has it; one met in two is inside the body.
-  subroutine boundary_groups(file_mesh, body_node, mesh, err)
+  subroutine boundary_groups(file_mesh, body_node, file_node, mesh, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
+    integer, intent(in) :: file_node(:)   ! body node -> file node index
     type(mesh_t), intent(inout) :: mesh
     type(error_t), intent(inout) :: err
     type(int_hash_t) :: edge_hash
     integer, allocatable :: line_slot(:), edge_count(:), edge_cell(:), edge_local(:), edges(:, :), cells(:), inner(:)
-    integer, allocatable :: seen_group(:), seen_line(:), first(:), members(:)
+    integer, allocatable :: seen_group(:), seen_line(:), first(:), members(:), cand(:), perm(:)
     logical, allocatable :: marked(:), on_line(:)
-    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m
+    integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m, j, ncand, k
     integer(i8) :: key, key_base
     type(text_buffer_t) :: names
 
+    ! the candidate lines, in file order: those starting at a node of the body when it is a
+    ! small part of the file (node_lines), else all
+    if (allocated(file_mesh%node_line_first) .and. 8*int(mesh%nnode, i8) < file_mesh%nnode) then
+      ncand = 0
+      do k = 1, mesh%nnode
+        ncand = ncand + file_mesh%node_line_first(file_node(k) + 1) - file_mesh%node_line_first(file_node(k))
+      end do
+      allocate (cand(ncand))
+      ncand = 0
+      do k = 1, mesh%nnode
+        do j = file_mesh%node_line_first(file_node(k)), file_mesh%node_line_first(file_node(k) + 1) - 1
+          ncand = ncand + 1
+          cand(ncand) = file_mesh%node_lines(j)
+        end do
+      end do
+      perm = [(j, j=1, ncand)]
+      call merge_sort_by_keys(perm, reshape(cand, [1, ncand]))
+      cand = cand(perm)
+    else
+      ncand = file_mesh%nline
+      cand = [(j, j=1, ncand)]
+    end if
+
     ! the body's line edges, keyed by their two nodes (line_slot = -1: not a body edge)
-    call hash_init(edge_hash, file_mesh%nline, st)
-    if (st == 0) allocate (line_slot(file_mesh%nline), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
-                           edge_local(0:edge_hash%mask), edges(2, file_mesh%nline), cells(file_mesh%nline), &
-                           inner(2*file_mesh%nline), marked(mesh%nnode), on_line(mesh%nnode), &
+    call hash_init(edge_hash, ncand, st)
+    if (st == 0) allocate (line_slot(ncand), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
+                           edge_local(0:edge_hash%mask), edges(2, ncand), cells(ncand), &
+                           inner(2*ncand), marked(mesh%nnode), on_line(mesh%nnode), &
                            seen_group(0:edge_hash%mask), &
                            seen_line(0:edge_hash%mask), stat=st)
-    if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, st)
+    if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(cand), first, members, st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory for the boundary edges')
       return
@@ -498,7 +650,8 @@ contains
     marked = .false.
     on_line = .false.
     key_base = mesh%nnode + 1
-    do line = 1, file_mesh%nline
+    do j = 1, ncand
+      line = cand(j)
       if (file_mesh%line_entity(line) == 0) cycle
       a = body_node(file_mesh%line_node(1, line))
       b = body_node(file_mesh%line_node(2, line))
@@ -506,7 +659,7 @@ contains
       key = min(a, b)*key_base + max(a, b)
       slot = hash_slot(edge_hash, key)
       edge_hash%key(slot) = key
-      line_slot(line) = slot
+      line_slot(j) = slot
       on_line(a) = .true.
       on_line(b) = .true.
     end do
@@ -537,9 +690,9 @@ contains
       nedge = 0
       ninner = 0
       do m = first(phys), first(phys + 1) - 1
-        line = members(m)
-        if (line_slot(line) < 0) cycle
-        slot = line_slot(line)
+        line = cand(members(m))
+        if (line_slot(members(m)) < 0) cycle
+        slot = line_slot(members(m))
         if (seen_group(slot) == phys) then      ! the same edge twice: its load would count twice
           call err%set(ERR_INPUT, 'elements '//i2s(file_mesh%line_tag(seen_line(slot)))//' and '// &
                        i2s(file_mesh%line_tag(line))//" of physical curve '"//file_mesh%phys_name(phys)%s// &
@@ -594,19 +747,28 @@ contains
   !! points' names go to file_groups. A point's node is the body's if the body's cells have
   !! it; a node in no cell of the file is matched to the body's node at its place.
   subroutine point_groups(file_mesh, body_node, mesh, err)
-    type(file_mesh_t), intent(in) :: file_mesh
+    type(file_mesh_t), intent(in), target :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
     type(mesh_t), intent(inout) :: mesh
     type(error_t), intent(inout) :: err
     logical, allocatable :: in_cell(:), taken(:)
-    integer, allocatable :: nodes(:), first(:), members(:)
+    integer, allocatable :: nodes(:)
+    integer, allocatable, target :: own_first(:), own_members(:)
+    integer, pointer :: first(:), members(:)
     integer :: phys, point, n, nfound, group, c, i, m, st
     real(wp) :: tol
     character(len=:), allocatable :: names
     type(text_buffer_t) :: list
 
     allocate (nodes(file_mesh%npoint), taken(mesh%nnode), stat=st)
-    if (st == 0) call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), first, members, st)
+    if (st == 0 .and. allocated(file_mesh%point_first)) then
+      first => file_mesh%point_first
+      members => file_mesh%point_members
+    else if (st == 0) then
+      call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), own_first, own_members, st)
+      first => own_first
+      members => own_members
+    end if
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'not enough memory for the physical points')
       return

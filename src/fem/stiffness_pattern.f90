@@ -2,7 +2,6 @@
 !! the grid stencil on a structured mesh, from the cells' node adjacency on any other.
 module stiffness_pattern
   use kinds, only: wp, i8
-  use sorting, only: sort_ints
   use config, only: ELEM_Q1
   use mesh, only: mesh_t, node_id, cell_vertices
   use body_system, only: body_system_t
@@ -46,15 +45,17 @@ contains
   end subroutine node_stencil
 
   !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
-  !! rows sorted in every column, from the node stencil of the grid. err = ERR_INPUT when
-  !! the number of entries does not fit 32-bit indices.
+  !! rows sorted in every column: the free DOFs of the nodes sharing a cell with the
+  !! column's node (the grid stencil, or the cells' node adjacency), formed once per node
+  !! for both of its columns. err = ERR_INPUT when the number of entries does not fit
+  !! 32-bit indices.
   subroutine build_pattern(mesh, sys, err)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     type(body_system_t), intent(inout) :: sys  !< with its DOF numbering; gets colptr, rowind, val = 0
     type(error_t), intent(out) :: err          !< ERR_INPUT when the pattern is too large
-    integer :: p, s, cc, q, pos, nnbr
+    integer :: p, s, cc, k, q, nnbr, nrow, first
     integer(i8) :: nnz
-    integer, allocatable :: aptr(:), adj(:), nbr(:)
+    integer, allocatable :: aptr(:), adj(:), nbr(:), rows(:)
     character(len=512) :: emsg
 
     if (mesh%structured) then
@@ -63,16 +64,27 @@ contains
       call node_adjacency(mesh, aptr, adj)
       allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
     end if
+    allocate (rows(2*size(nbr)))
+    ! column counts: colptr(p + 1) = the entries of free DOF p, then their running sum
     allocate (sys%colptr(sys%n + 1))
-    nnz = 0
-    sys%colptr(1) = 0
-    do p = 1, sys%n
-      call neighbours(p)
+    sys%colptr = 0
+    do k = 1, mesh%nnode
+      if (sys%free_of(2*k - 1) == 0 .and. sys%free_of(2*k) == 0) cycle
+      call neighbours(k)
+      nrow = 0
       do s = 1, nnbr
         do cc = 1, 2
-          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nnz = nnz + 1
+          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nrow = nrow + 1
         end do
       end do
+      do cc = 1, 2
+        p = sys%free_of(2*(k - 1) + cc)
+        if (p > 0) sys%colptr(p + 1) = nrow
+      end do
+    end do
+    nnz = 0
+    do p = 1, sys%n
+      nnz = nnz + sys%colptr(p + 1)
       if (nnz > int(huge(1), i8)) then
         write (emsg, '(a,i0,a)') 'body ', sys%id, ': the stiffness has more than 2^31-1 entries; '// &
           'the mesh is too large for 32-bit CSC indices'
@@ -82,29 +94,34 @@ contains
       sys%colptr(p + 1) = int(nnz)
     end do
     allocate (sys%rowind(nnz), sys%val(nnz))
-    do p = 1, sys%n
-      call neighbours(p)
-      pos = sys%colptr(p)
+    do k = 1, mesh%nnode
+      if (sys%free_of(2*k - 1) == 0 .and. sys%free_of(2*k) == 0) cycle
+      call neighbours(k)
+      nrow = 0
       do s = 1, nnbr
         do cc = 1, 2
           q = sys%free_of(2*(nbr(s) - 1) + cc)
           if (q > 0) then
-            pos = pos + 1
-            sys%rowind(pos) = q - 1
+            nrow = nrow + 1
+            rows(nrow) = q - 1
           end if
         end do
+      end do
+      do cc = 1, 2
+        p = sys%free_of(2*(k - 1) + cc)
+        if (p == 0) cycle
+        first = sys%colptr(p)
+        sys%rowind(first + 1:first + nrow) = rows(1:nrow)
       end do
     end do
     sys%val = 0.0_wp
 
   contains
 
-    !> The nodes sharing a cell with free DOF p's node, in increasing node id: the grid
-    !! stencil of a structured mesh, the adjacency list of any other.
-    subroutine neighbours(p)
-      integer, intent(in) :: p
-      integer :: k
-      k = (sys%dof_of(p) - 1)/2 + 1
+    !> The nodes sharing a cell with node k, in increasing node id: the grid stencil of
+    !! a structured mesh, the adjacency list of any other.
+    subroutine neighbours(k)
+      integer, intent(in) :: k
       if (mesh%structured) then
         call node_stencil(mesh, k, nbr, nnbr)
       else
@@ -115,54 +132,70 @@ contains
   end subroutine build_pattern
 
   !> The nodes that share a cell with each node (itself included), in increasing node id:
-  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). Built from the cells by one sort of
-  !! the (node, neighbour) pairs, for any mesh.
+  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). From the cells of each node (a
+  !! counting sort of the cells by vertex): their vertices, each kept once by a mark,
+  !! then sorted; for any mesh.
   subroutine node_adjacency(mesh, aptr, adj)
     type(mesh_t), intent(in) :: mesh
     integer, allocatable, intent(out) :: aptr(:), adj(:)
-    integer, allocatable :: cnt(:), pairs(:), pos(:)
-    integer :: c, a, b, nv, k, np, i, last
-    ! pairs (k, l) of every cell, bucketed by k, then sorted and deduplicated per node
-    allocate (cnt(mesh%nnode + 1))
-    cnt = 0
+    integer, allocatable :: cptr(:), ccell(:), pos(:), mark(:), nv(:)
+    integer :: c, a, k, l, t, i, first
+    allocate (nv(mesh%ncell), cptr(mesh%nnode + 1))
+    cptr = 0
     do c = 1, mesh%ncell
-      nv = cell_vertices(mesh, c)
-      do a = 1, nv
+      nv(c) = cell_vertices(mesh, c)
+      do a = 1, nv(c)
         k = mesh%cells(a, c)
-        cnt(k + 1) = cnt(k + 1) + nv
+        cptr(k + 1) = cptr(k + 1) + 1
       end do
     end do
-    cnt(1) = 1
+    cptr(1) = 1
     do k = 1, mesh%nnode
-      cnt(k + 1) = cnt(k + 1) + cnt(k)
+      cptr(k + 1) = cptr(k + 1) + cptr(k)
     end do
-    np = cnt(mesh%nnode + 1) - 1
-    allocate (pairs(np), pos(mesh%nnode))
-    pos = cnt(1:mesh%nnode)
+    allocate (ccell(cptr(mesh%nnode + 1) - 1), pos(mesh%nnode))
+    pos = cptr(1:mesh%nnode)
     do c = 1, mesh%ncell
-      nv = cell_vertices(mesh, c)
-      do a = 1, nv
+      do a = 1, nv(c)
         k = mesh%cells(a, c)
-        do b = 1, nv
-          pairs(pos(k)) = mesh%cells(b, c)
-          pos(k) = pos(k) + 1
-        end do
+        ccell(pos(k)) = c
+        pos(k) = pos(k) + 1
       end do
     end do
-    allocate (aptr(mesh%nnode + 1), adj(np))
+    ! at most the vertices of each node's cells
+    allocate (aptr(mesh%nnode + 1), adj(sum(nv)*4), mark(mesh%nnode))
+    mark = 0
     aptr(1) = 1
     i = 0
     do k = 1, mesh%nnode
-      call sort_ints(pairs(cnt(k):cnt(k + 1) - 1))
-      last = 0
-      do a = cnt(k), cnt(k + 1) - 1
-        if (pairs(a) == last) cycle
-        last = pairs(a)
-        i = i + 1
-        adj(i) = last
+      first = i + 1
+      do t = cptr(k), cptr(k + 1) - 1
+        c = ccell(t)
+        do a = 1, nv(c)          ! appended always, kept when not marked (no branch)
+          l = mesh%cells(a, c)
+          adj(i + 1) = l
+          i = i + merge(1, 0, mark(l) /= k)
+          mark(l) = k
+        end do
       end do
+      call sort_distinct(adj(first:i))
       aptr(k + 1) = i + 1
     end do
   end subroutine node_adjacency
+
+  !> Sort a short list of distinct integers (a node's neighbours) ascending: each goes to
+  !! the place given by the count of smaller ones, without a data-dependent branch.
+  pure subroutine sort_distinct(v)
+    integer, intent(inout) :: v(:)
+    integer :: w(size(v)), a, b, r
+    do a = 1, size(v)
+      r = 1
+      do b = 1, size(v)
+        r = r + merge(1, 0, v(b) < v(a))
+      end do
+      w(r) = v(a)
+    end do
+    v = w
+  end subroutine sort_distinct
 
 end module stiffness_pattern

@@ -53,6 +53,7 @@ program test_fem
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
                       body_force_fn, cell_triplets
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
+  use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness, q1_gradients
   use testing, only: report, test_summary, solve_full, error_parts
   use errors, only: error_t
   implicit none (type, external)
@@ -75,6 +76,7 @@ program test_fem
   call test_triplets(ELEM_Q1, 1)
   call test_triplets(ELEM_Q1, 3)
   call test_triplets(ELEM_P1, 4)
+  call test_q1_stiffness_bits()
 
   call test_summary()
 
@@ -212,6 +214,54 @@ contains
     call report(maxval(abs(dense - ref)) <= 1.0e-13_wp*maxval(abs(ref)), trim(what)// &
                 ' the shares add up to the serial matrix (lower triangle)', maxval(abs(dense - ref))/maxval(abs(ref)), 1.0e-13_wp)
   end subroutine test_triplets
+
+  !> The Q1 element stiffness equals, bit for bit, the plain 2x2 Gauss sum over
+  !! q1_gradients (w = det at each point, entries added as ke + c11 xa xb + mu ya yb, ...),
+  !! on random convex quadrilaterals and on a self-crossing one (negative Jacobians).
+  subroutine test_q1_stiffness_bits()
+    real(wp), parameter :: lam = 1.7e5_wp, mu = 0.93e5_wp
+    real(wp), parameter :: gp2 = 0.577350269189625764509148780502_wp   ! 1/sqrt(3), as module elements
+    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ref(MAX_NDOF, MAX_NDOF), minjac, refjac
+    real(wp) :: nfun(4), g(2, MAX_NVERT), det, r(2, 4), c11, xa, ya, xb, yb
+    integer :: t, ig, jg, a, b, bad
+    bad = 0
+    call random_seed(put=[(12345 + 7*t, t=1, 64)])
+    c11 = lam + 2.0_wp*mu
+    do t = 1, 2001
+      call random_number(r)
+      xe(:, 1) = [0.0_wp, 0.0_wp] + 0.3_wp*r(:, 1)
+      xe(:, 2) = [1.0_wp, 0.0_wp] + 0.3_wp*r(:, 2)
+      xe(:, 3) = [1.0_wp, 1.0_wp] + 0.3_wp*r(:, 3)
+      xe(:, 4) = [0.0_wp, 1.0_wp] + 0.3_wp*r(:, 4)
+      xe = 1.0e3_wp*r(1, 1)*xe + 37.0_wp*r(2, 2)
+      if (t == 2001) xe = reshape([0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 1.0_wp, 1.0_wp], [2, 4])
+      call element_stiffness(ELEM_Q1, xe, lam, mu, ke, minjac)
+      ref = 0.0_wp
+      refjac = huge(1.0_wp)
+      do jg = -1, 1, 2
+        do ig = -1, 1, 2
+          call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
+          refjac = min(refjac, det)
+          if (.not. (det > 0.0_wp)) cycle
+          do b = 1, 4
+            xb = g(1, b)*det
+            yb = g(2, b)*det
+            do a = 1, 4
+              xa = g(1, a)
+              ya = g(2, a)
+              ref(2*a - 1, 2*b - 1) = ref(2*a - 1, 2*b - 1) + c11*xa*xb + mu*ya*yb
+              ref(2*a, 2*b - 1) = ref(2*a, 2*b - 1) + lam*ya*xb + mu*xa*yb
+              ref(2*a - 1, 2*b) = ref(2*a - 1, 2*b) + lam*xa*yb + mu*ya*xb
+              ref(2*a, 2*b) = ref(2*a, 2*b) + c11*ya*yb + mu*xa*xb
+            end do
+          end do
+        end do
+      end do
+      if (any(ke /= ref) .or. .not. (minjac == refjac)) bad = bad + 1
+    end do
+    call report(bad == 0, 'Q1 element stiffness: the 2x2 Gauss sum over q1_gradients bit for bit '// &
+                '(2000 random quadrilaterals and a self-crossing one), mismatches', real(bad, wp), 0.0_wp)
+  end subroutine test_q1_stiffness_bits
 
   subroutine test_structure(element)
     integer, intent(in) :: element

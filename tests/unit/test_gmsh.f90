@@ -5,7 +5,8 @@
 !! truncation, unknown sections, numbers in every form, cells and boundary lines listed
 !! twice, tags < 1, counts the file cannot hold), and groups of nodes (physical
 !! points, a physical curve inside a body). The stiffness and lifting of bodies read from
-!! files are those of an element loop in file order, bit for bit.
+!! files are those of an element loop in file order, bit for bit. Bodies read together from
+!! one file of many (each a small part of it) equal the bodies read one by one.
 !!
 !! With arguments, `test_gmsh file.msh [region]` only reads that file and prints the time
 !! taken (the read benchmark).
@@ -13,7 +14,7 @@ program test_gmsh
   use kinds, only: wp
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal, file_order, file_cells
-  use gmsh_msh, only: msh_read_err => msh_read
+  use gmsh_msh, only: msh_read_err => msh_read, msh_read_shared
   use errors, only: error_t, exit_code
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary, write_file
@@ -51,6 +52,7 @@ program test_gmsh
   call test_file_order(dir//'pin_hole.msh', 'plate', 'plate_left')
   call test_locality(dir//'hertz_h0.02.msh', 'disc')
   call test_locality(dir//'pin_hole.msh', 'plate')
+  call test_shared('tests/data/blocks18.msh', 18)
   call test_summary()
 
 contains
@@ -267,6 +269,51 @@ contains
   end subroutine test_file_order
 
   ! ---- numbering for locality -----------------------------------------------------------
+
+  !> The n bodies 'b1'..'bn' of one file read together (msh_read_shared: the file parsed
+  !! once, each body found from the file's indexes, a small part of the file) equal each
+  !! read alone (msh_read: the passes over the whole file): nodes, coordinates, cells,
+  !! tags, file order, groups (edges, their cells, single nodes) and the group names.
+  subroutine test_shared(path, n)
+    character(len=*), intent(in) :: path
+    integer, intent(in) :: n
+    type(mesh_t), allocatable :: m(:)
+    type(mesh_t) :: one
+    type(error_t), allocatable :: errs(:)
+    type(error_t) :: err
+    character(len=16) :: region(n)
+    integer :: a, g, nbad, nedge
+    logical :: same
+    do a = 1, n
+      region(a) = 'b'//i2s(a)
+    end do
+    allocate (m(n), errs(n))
+    call msh_read_shared(path, region, [(a, a=1, n)], m, errs, 2)
+    nbad = 0
+    nedge = 0
+    do a = 1, n
+      call msh_read_err(path, trim(region(a)), a, one, err)
+      same = .not. errs(a)%failed() .and. .not. err%failed()
+      if (same) same = m(a)%nnode == one%nnode .and. m(a)%ncell == one%ncell .and. m(a)%element == one%element
+      if (same) same = all(m(a)%xy == one%xy) .and. all(m(a)%cells == one%cells) .and. &
+                       all(m(a)%node_tag == one%node_tag) .and. all(m(a)%cell_tag == one%cell_tag) .and. &
+                       all(m(a)%file_node == one%file_node) .and. all(m(a)%file_cell == one%file_cell) .and. &
+                       m(a)%ngroup == one%ngroup .and. m(a)%file_groups == one%file_groups
+      if (same) then
+        do g = 1, one%ngroup
+          same = same .and. m(a)%group(g)%name == one%group(g)%name .and. &
+                 m(a)%group(g)%nedge == one%group(g)%nedge .and. m(a)%group(g)%nnode == one%group(g)%nnode
+          if (.not. same) exit
+          same = all(m(a)%group(g)%edge == one%group(g)%edge) .and. all(m(a)%group(g)%cell == one%group(g)%cell) .and. &
+                 all(m(a)%group(g)%node == one%group(g)%node)
+          nedge = nedge + one%group(g)%nedge
+        end do
+      end if
+      if (.not. same) nbad = nbad + 1
+    end do
+    call report(nbad == 0 .and. nedge >= 4*n, path//': '//i2s(n)//' bodies read together = read one by one '// &
+                '(mismatches '//i2s(nbad)//', '//i2s(nedge)//' group edges)')
+  end subroutine test_shared
 
   !> A body read from a file is numbered for locality: file_node and file_cell are
   !! permutations, file_cells gives back the file's cells (the node tags of each cell as the

@@ -2,11 +2,12 @@
 !! independent reference: numbers written with 16 and 17 significant digits (what Gmsh
 !! writes; beyond 2**53, parsed through 128-bit integers), short ones, 18 digits and large
 !! exponents (the READ fallback), and halfway cases between two doubles; every value must be
-!! the same double, bit for bit. Malformed tokens are refused.
+!! the same double, bit for bit. Malformed tokens are refused. get_int gives parse_int's
+!! value or refusal for every token, and counts the lines it passes.
 program test_text_scanner
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: int64
-  use text_scanner, only: parse_real
+  use text_scanner, only: parse_real, parse_int, get_int, scanner_t
   use testing, only: report, test_summary
   implicit none (type, external)
   character(len=40) :: t
@@ -49,9 +50,47 @@ program test_text_scanner
   call report(.not. ok, 'a malformed number is refused (1.2.3)')
   call parse_real('1e', v, ok)
   call report(.not. ok, 'a malformed number is refused (1e)')
+  call test_get_int()
   call test_summary()
 
 contains
+
+  !> get_int on a text of integers: the values of parse_int, the line count; each token
+  !! that parse_int refuses (too large, 19 digits, a letter, a lone sign) refused alike.
+  subroutine test_get_int()
+    character(len=*), parameter :: good(7) = [character(len=20) :: '12', '-7', '+3', &
+                                              '000000000000000042', '2147483647', '-2147483647', '0']
+    character(len=*), parameter :: bad(5) = [character(len=20) :: '2147483648', '0000000000000000007', &
+                                             '12a', '-', '99999999999999999999']
+    type(scanner_t) :: sc
+    integer :: k, v, ref, nbad
+    logical :: ok
+    sc%text = '  12 '//achar(10)//'-7'//achar(9)//'+3 000000000000000042'//achar(13)//achar(10)// &
+              '2147483647 -2147483647 0'
+    sc%n = len(sc%text)
+    sc%section = '$Test'
+    nbad = 0
+    do k = 1, size(good)
+      v = get_int(sc, 'a number')
+      call parse_int(trim(good(k)), ref, ok)
+      if (.not. ok .or. v /= ref .or. sc%info /= 0) nbad = nbad + 1
+    end do
+    call report(nbad == 0 .and. sc%line == 3, 'get_int = parse_int on 7 tokens over 3 lines', real(nbad, wp))
+    v = get_int(sc, 'a number')
+    call report(sc%info /= 0 .and. index(sc%err, 'the file ends inside $Test') > 0, &
+                'get_int at the end of the text: the file ends inside the section')
+    nbad = 0
+    do k = 1, size(bad)
+      sc = scanner_t()
+      sc%text = ' '//trim(bad(k))//' 5'
+      sc%n = len(sc%text)
+      sc%section = '$Test'
+      v = get_int(sc, 'a number')
+      call parse_int(trim(bad(k)), ref, ok)
+      if (ok .or. sc%info == 0 .or. v /= 0 .or. index(sc%err, "found '"//trim(bad(k))//"'") == 0) nbad = nbad + 1
+    end do
+    call report(nbad == 0, 'get_int refuses what parse_int refuses, naming the token (5 tokens)', real(nbad, wp))
+  end subroutine test_get_int
 
   !> A uniform number in [0, 1) from a 64-bit xorshift.
   real(wp) function uniform()
