@@ -526,10 +526,10 @@ contains
     run%timing%total = wtime() - run%t_start
     if (size(run%plan) > 1) then   ! every load step's result too
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, body_stresses(run), run%timing, err, run%steps)
+                         run%displacement, body_stresses(run), run%timing, err, run%steps, threads=run%threads)
     else
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, body_stresses(run), run%timing, err)
+                         run%displacement, body_stresses(run), run%timing, err, threads=run%threads)
     end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')

@@ -60,8 +60,9 @@ contains
   !! run first, and commit them together (`commit_files`: companions first, the HDF5 file
   !! last) only when all are complete. Otherwise err (ERR_IO, naming the file and what
   !! failed); then the files of an earlier result at these names are as they were, and no
-  !! temporary file is left.
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, stress, tm, err, steps)
+  !! temporary file is left. With two threads the companions are written while the HDF5
+  !! file is (the HDF5 library is called from one thread only).
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, stress, tm, err, steps, threads)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
@@ -74,12 +75,13 @@ contains
     type(error_t), intent(out) :: err                  !< the failure, if any
     !> the load steps' results (several steps: /steps, and the XDMF files a time series)
     type(step_result_t), intent(in), optional :: steps(:)
+    integer, intent(in), optional :: threads           !< threads to write with (default 1)
     character(len=len_trim(file) + 32), allocatable :: name(:)
     real(wp), allocatable :: times(:)
     character(len=len_trim(file) + 160), allocatable :: tmp(:)
-    character(len=:), allocatable :: why, h5
+    character(len=:), allocatable :: why, h5, id
     type(error_t) :: st
-    integer :: k, a, nb, np, nf
+    integer :: k, nb, np, nf, nt
     logical :: ok
     type(interface_t) :: itf
     type(contact_result_t) :: res
@@ -101,32 +103,24 @@ contains
     if (present(steps)) then
       if (size(steps) > 0) times = [(step_time(steps(k)), k=1, size(steps))]
     end if
+    nt = 1
+    if (present(threads)) nt = max(1, min(2, threads))
+    id = run_id()
+    h5 = base_name(file)
+    !$omp parallel sections num_threads(nt)
+    !$omp section
     if (size(times) > 0) then
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, run_id(), st, steps)
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, id, st, steps)
     else
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, run_id(), st)
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, id, st)
     end if
+    !$omp section
+    call write_companions(ok)
+    !$omp end parallel sections
     if (st%failed()) then
       call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%text()//')')
       call remove_temps()
       return
-    end if
-    ! the XDMF files: every body and contact line (ParaView), then one grid each (meshio);
-    ! one pair: its line is all of /contact, the grid 'contact'
-    h5 = base_name(file)
-    if (np == 1) then
-      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, run_id(), times), ok)
-    else
-      call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(k, k=1, np)], h5, msh, itf, run_id(), times), ok)
-    end if
-    do a = 1, nb
-      if (ok) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, run_id(), times), ok)
-    end do
-    if (ok) call write_text(tmp(3 + nb), xdmf_text([integer ::], [0], h5, msh, itf, run_id(), times), ok)
-    if (np > 1) then
-      do k = 1, np
-        if (ok) call write_text(tmp(3 + nb + k), xdmf_text([integer ::], [k], h5, msh, itf, run_id(), times), ok)
-      end do
     end if
     if (.not. ok) then
       call err%set(ERR_IO, 'cannot write the XDMF files beside '//trim(file))
@@ -138,6 +132,27 @@ contains
     if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
 
   contains
+
+    !> The XDMF files tmp(2:): every body and contact line (ParaView), then one grid each
+    !! (meshio); one pair: its line is all of /contact, the grid 'contact'.
+    subroutine write_companions(done)
+      logical, intent(out) :: done   !< all written
+      integer :: a, q
+      if (np == 1) then
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, id, times), done)
+      else
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, id, times), done)
+      end if
+      do a = 1, nb
+        if (done) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, id, times), done)
+      end do
+      if (done) call write_text(tmp(3 + nb), xdmf_text([integer ::], [0], h5, msh, itf, id, times), done)
+      if (np > 1) then
+        do q = 1, np
+          if (done) call write_text(tmp(3 + nb + q), xdmf_text([integer ::], [q], h5, msh, itf, id, times), done)
+        end do
+      end if
+    end subroutine write_companions
 
     subroutine remove_temps()
       integer :: j

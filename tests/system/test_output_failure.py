@@ -13,6 +13,9 @@ Real write failures, no test hook in the program:
   In both: exit code 3, one message `output: cannot write <file> (...)` on stderr, no HDF5
   error stack or Fortran runtime text, and no file under the result's names (.h5, .xdmf,
   _body1.xdmf, _body2.xdmf, _contact.xdmf) nor a `.tmp` leftover.
+  With two threads (the XDMF companions written while the HDF5 file is) the HDF5 file's
+  temporary a link to /dev/full, or the .xdmf's a folder: exit 3, no `.tmp` file left, and
+  an earlier result at these names unchanged.
   3. a checkpoint that fails keeps the previous one, byte for byte: (a) the checkpoint's
      temporary name (`<file>.ckpt.h5.<host>.<pid>.1.tmp`, the run's first) a link to
      /dev/full: warning naming the checkpoint, run continues (exit 2), old checkpoint
@@ -50,12 +53,15 @@ def result_names(h5):
 HOST_TOKEN = re.sub(r"[^A-Za-z0-9_-]", "_", socket.gethostname())[:64]
 
 
-def run_with_devfull_temp(final, args):
-    """Run BIN args with the run's first temporary name, <final>.<host>.<pid>.1.tmp, a
-    symbolic link to /dev/full: the shell links it for its own pid, then execs BIN."""
-    script = 'ln -s /dev/full "$0.$HOST_TOKEN.$$.1.tmp" || exit 99; exec "$@"'
+def run_with_devfull_temp(final, args, n=1, threads=1, folder=False):
+    """Run BIN args with the run's n-th temporary name, <final>.<host>.<pid>.<n>.tmp, a
+    symbolic link to /dev/full (folder: a folder, which a text file opened with
+    status='replace' cannot replace, as it does a link): the shell makes it for its own
+    pid, then execs BIN."""
+    make = 'mkdir' if folder else 'ln -s /dev/full'
+    script = make + ' "$0.$HOST_TOKEN.$$.$N.tmp" || exit 99; exec "$@"'
     return subprocess.run(["sh", "-c", script, final, BIN, *args], capture_output=True, text=True,
-                          env=dict(ENV, HOST_TOKEN=HOST_TOKEN))
+                          env=dict(ENV, HOST_TOKEN=HOST_TOKEN, N=str(n), OMP_NUM_THREADS=str(threads)))
 
 
 def out(h5, extra=""):
@@ -151,6 +157,35 @@ os.makedirs(d)
 h5 = os.path.join(d, "r.h5")
 p = run_with_devfull_temp(h5, [DECK, out(h5)])
 check_failed_result("/dev/full", p.returncode, p.stderr, h5, os.listdir(d))
+
+# 2b. two threads write the HDF5 file and its XDMF companions at once: when either fails
+# (the HDF5 file's temporary, the run's first, a link to /dev/full; the .xdmf's, its
+# second, a folder) the run ends with exit 3, every temporary it made removed and the
+# earlier result at these names unchanged
+d = os.path.join(OUT, "devfull2")
+os.makedirs(d)
+h5 = os.path.join(d, "r.h5")
+p = subprocess.run([BIN, DECK, out(h5)], capture_output=True, text=True, env=dict(ENV, OMP_NUM_THREADS="2"))
+check(p.returncode == 0 and all(os.path.exists(n) for n in result_names(h5)),
+      "two threads: the earlier result is written", f"exit {p.returncode}")
+keep = os.path.join(OUT, "devfull2_keep")
+os.makedirs(keep)
+for n in result_names(h5):
+    shutil.copyfile(n, os.path.join(keep, os.path.basename(n)))
+for n, what, msg in ((1, "the HDF5 file's temporary a link to /dev/full", f"output: cannot write {h5}"),
+                     (2, "the .xdmf's temporary a folder", f"output: cannot write the XDMF files beside {h5}")):
+    tag = f"two threads, {what}"
+    p = run_with_devfull_temp(h5 if n == 1 else h5[:-3] + ".xdmf", [DECK, out(h5)], n=n, threads=2,
+                              folder=n > 1)
+    check(p.returncode == 3, f"{tag}: exit code 3", f"exit {p.returncode}")
+    check(msg in p.stderr, f"{tag}: the message says which file failed", p.stderr.strip()[-300:])
+    listing = os.listdir(d)
+    tmp = [x for x in listing if x.endswith(".tmp") and not os.path.isdir(os.path.join(d, x))]
+    check(not tmp, f"{tag}: no .tmp leftovers", " ".join(tmp))
+    same = [os.path.basename(x) for x in result_names(h5)
+            if os.path.exists(x) and filecmp.cmp(x, os.path.join(keep, os.path.basename(x)), shallow=False)]
+    check(len(same) == len(result_names(h5)), f"{tag}: the earlier result is unchanged",
+          f"unchanged: {' '.join(same)}")
 
 # 3a. a checkpoint that cannot be written keeps the previous one
 d = os.path.join(OUT, "ckpt")
