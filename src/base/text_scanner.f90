@@ -107,14 +107,7 @@ contains
     type(scanner_t), intent(inout) :: scanner
     integer(i8), intent(out) :: s, e
     integer(i8) :: pos
-    integer :: code
-    pos = scanner%pos          ! in locals: the loops keep them in registers
-    do while (pos <= scanner%n)
-      code = iachar(scanner%text(pos:pos))
-      if (code > 32) exit
-      if (code == 10) scanner%line = scanner%line + 1
-      pos = pos + 1
-    end do
+    pos = skip_blanks(scanner, scanner%pos)   ! in locals: the loops keep them in registers
     s = pos
     do while (pos <= scanner%n)
       if (iachar(scanner%text(pos:pos)) <= 32) exit
@@ -123,6 +116,21 @@ contains
     e = pos - 1
     scanner%pos = pos
   end subroutine next_token
+
+  !> The first position from pos on that holds neither a blank nor a control character
+  !! (n + 1 at the end), counting the line feeds passed.
+  integer(i8) function skip_blanks(scanner, pos0) result(pos)
+    type(scanner_t), intent(inout) :: scanner
+    integer(i8), intent(in) :: pos0
+    integer :: code
+    pos = pos0
+    do while (pos <= scanner%n)
+      code = iachar(scanner%text(pos:pos))
+      if (code > 32) exit
+      if (code == 10) scanner%line = scanner%line + 1
+      pos = pos + 1
+    end do
+  end function skip_blanks
 
   !> Report the end of the file inside a section, or a token that is not `what`.
   subroutine bad_token(scanner, s, e, what)
@@ -149,13 +157,7 @@ contains
     logical :: ok
     v = 0
     if (scanner%info /= 0) return
-    pos = scanner%pos
-    do while (pos <= scanner%n)
-      code = iachar(scanner%text(pos:pos))
-      if (code > 32) exit
-      if (code == 10) scanner%line = scanner%line + 1
-      pos = pos + 1
-    end do
+    pos = skip_blanks(scanner, scanner%pos)
     scanner%pos = pos
     m = 0
     do while (pos <= scanner%n)

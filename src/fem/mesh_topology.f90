@@ -169,26 +169,10 @@ contains
   !! once for all the bodies of the file. Out of memory: left absent.
   subroutine index_groups(file_mesh)
     type(file_mesh_t), intent(inout) :: file_mesh
-    integer :: st, c, e, k, line
-    integer, allocatable :: fill(:)
-    allocate (file_mesh%ent_cell_first(0:file_mesh%nent + 1), fill(0:file_mesh%nent), &
-              file_mesh%ent_cells(file_mesh%ncell), stat=st)
-    if (st == 0) then
-      fill = 0
-      do c = 1, file_mesh%ncell
-        fill(file_mesh%cell_entity(c)) = fill(file_mesh%cell_entity(c)) + 1
-      end do
-      file_mesh%ent_cell_first(0) = 1
-      do e = 0, file_mesh%nent
-        file_mesh%ent_cell_first(e + 1) = file_mesh%ent_cell_first(e) + fill(e)
-      end do
-      fill = 0
-      do c = 1, file_mesh%ncell
-        e = file_mesh%cell_entity(c)
-        file_mesh%ent_cells(file_mesh%ent_cell_first(e) + fill(e)) = c
-        fill(e) = fill(e) + 1
-      end do
-    else
+    integer :: st
+    call bucket_items(file_mesh%cell_entity(1:file_mesh%ncell), 0, file_mesh%nent, file_mesh%ent_cell_first, &
+                      file_mesh%ent_cells, st)
+    if (st /= 0) then
       if (allocated(file_mesh%ent_cell_first)) deallocate (file_mesh%ent_cell_first)
       if (allocated(file_mesh%ent_cells)) deallocate (file_mesh%ent_cells)
     end if
@@ -198,29 +182,39 @@ contains
       if (allocated(file_mesh%point_first)) deallocate (file_mesh%point_first)
       if (allocated(file_mesh%point_members)) deallocate (file_mesh%point_members)
     end if
-    if (allocated(fill)) deallocate (fill)
-    allocate (file_mesh%node_line_first(file_mesh%nnode + 1), file_mesh%node_lines(file_mesh%nline), &
-              fill(file_mesh%nnode), stat=st)
+    call bucket_items(file_mesh%line_node(1, 1:file_mesh%nline), 1, file_mesh%nnode, file_mesh%node_line_first, &
+                      file_mesh%node_lines, st)
     if (st /= 0) then
       if (allocated(file_mesh%node_line_first)) deallocate (file_mesh%node_line_first)
       if (allocated(file_mesh%node_lines)) deallocate (file_mesh%node_lines)
-      return
     end if
+  end subroutine index_groups
+
+  !> Items 1..size(key) bucketed by their key in [lo, hi] (a counting sort, items in
+  !! increasing order within a bucket): bucket k holds members(first(k):first(k+1)-1).
+  subroutine bucket_items(key, lo, hi, first, members, stat)
+    integer, intent(in) :: key(:), lo, hi
+    integer, allocatable, intent(out) :: first(:), members(:)
+    integer, intent(out) :: stat
+    integer, allocatable :: fill(:)
+    integer :: i, k
+    allocate (first(lo:hi + 1), members(size(key)), fill(lo:hi), stat=stat)
+    if (stat /= 0) return
     fill = 0
-    do line = 1, file_mesh%nline
-      fill(file_mesh%line_node(1, line)) = fill(file_mesh%line_node(1, line)) + 1
+    do i = 1, size(key)
+      fill(key(i)) = fill(key(i)) + 1
     end do
-    file_mesh%node_line_first(1) = 1
-    do k = 1, file_mesh%nnode
-      file_mesh%node_line_first(k + 1) = file_mesh%node_line_first(k) + fill(k)
+    first(lo) = 1
+    do k = lo, hi
+      first(k + 1) = first(k) + fill(k)
     end do
     fill = 0
-    do line = 1, file_mesh%nline
-      k = file_mesh%line_node(1, line)
-      file_mesh%node_lines(file_mesh%node_line_first(k) + fill(k)) = line
+    do i = 1, size(key)
+      k = key(i)
+      members(first(k) + fill(k)) = i
       fill(k) = fill(k) + 1
     end do
-  end subroutine index_groups
+  end subroutine bucket_items
 
   !> One body from what a mesh file holds: choose the body's cells (those of the physical
   !! surface `region`), number its nodes by tag, orient and check its cells, find its
