@@ -1,4 +1,4 @@
-# robin_contact: two-body frictionless contact by Robin domain decomposition.
+# robin_contact: contact of elastic bodies (any number, frictionless or with friction) by Robin domain decomposition.
 # Plain Makefile, explicit module dependencies. `make -j2` works.
 #   make            build bin/robin_contact (installs missing Debian packages first)
 #   make run        build and solve inputs/default.nml

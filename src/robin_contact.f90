@@ -1,6 +1,6 @@
-!> robin_contact: frictionless contact between elastic bodies (any number of bodies and
-!! contact pairs) by a Robin (Lions-type) nonoverlapping domain decomposition (Sassi,
-!! Ipopa, Roux).
+!> robin_contact: contact between elastic bodies, frictionless or with Tresca or Coulomb
+!! friction (any number of bodies and contact pairs), by a Robin (Lions-type) nonoverlapping
+!! domain decomposition (Sassi, Ipopa, Roux).
 !!
 !! Usage: robin_contact DECK.nml ['&group var=value ... /' ...]
 !!        mpirun -np N robin_contact_mpi DECK.nml ... (factorization='mumps')
