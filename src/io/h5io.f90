@@ -535,20 +535,23 @@ contains
 
   ! ---- support ------------------------------------------------------------------------
 
-  !> Open the library once: no HDF5 error printing, and no HDF5 clean-up at exit (a file
-  !! whose flush failed would make it loop; every file is closed explicitly).
+  !> Open the library once, with no HDF5 clean-up at exit (a file whose flush failed would
+  !! make it loop; every file is closed explicitly); and no HDF5 error printing on the
+  !! calling thread, at every call: a thread-safe HDF5 keeps that setting per thread, and
+  !! the result file may be written from another thread than the one that opened the library.
   subroutine library_init(st)
     type(error_t), intent(inout) :: st
     integer :: e
-    if (initialised) return
-    call h5dont_atexit_f(e)
-    call h5open_f(e)
-    if (e /= 0) then
-      call fail(st, 'failed to initialise the HDF5 library')
-      return
+    if (.not. initialised) then
+      call h5dont_atexit_f(e)
+      call h5open_f(e)
+      if (e /= 0) then
+        call fail(st, 'failed to initialise the HDF5 library')
+        return
+      end if
+      initialised = .true.
     end if
     call h5eset_auto_f(0, e)
-    initialised = .true.
   end subroutine library_init
 
   subroutine close_object(attr, obj, loc, name, st)
