@@ -4,7 +4,7 @@ module sorting
   implicit none (type, external)
   private
 
-  public :: sort_by_key, sort_ints, merge_sort, merge_sort_by_keys, index_less
+  public :: sort_by_key, sort_ints, merge_sort, merge_sort_by_keys, index_less, largest_first
 
   abstract interface
     !> The order of merge_sort: true when index a goes before index b.
@@ -103,5 +103,15 @@ contains
       end do
     end function column_less
   end subroutine merge_sort_by_keys
+
+  !> The indices 1..size(sizes) by decreasing size, ties by index (the threads' order of
+  !! the bodies: the largest first).
+  function largest_first(sizes) result(order)
+    integer, intent(in) :: sizes(:)
+    integer, allocatable :: order(:)
+    integer :: i
+    order = [(i, i=1, size(sizes))]
+    call merge_sort_by_keys(order, reshape(-sizes, [1, size(sizes)]))
+  end function largest_first
 
 end module sorting

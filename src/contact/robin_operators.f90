@@ -17,7 +17,7 @@ module robin_operators
   use contact_interface, only: interface_t, has_friction, ROW_NORMAL, ROW_TANGENT
   use condense, only: body_condensed_t
   use contact_common, only: pair_positions, body_threads
-  use sorting, only: merge_sort_by_keys
+  use sorting, only: largest_first
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
@@ -350,8 +350,7 @@ contains
       if (all(npairs(contact_line%pair_body(:, p)) == 1)) cycle
       needs_stiffness(contact_line%pair_body(:, p)) = .true.
     end do
-    order = [(a, a=1, size(bodies))]
-    call merge_sort_by_keys(order, reshape([(-bodies(a)%m, a=1, size(bodies))], [1, size(bodies)]))
+    order = largest_first(bodies(:)%m)
     !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a) if (count(needs_stiffness) > 1)
     do k = 1, size(bodies)
       a = order(k)

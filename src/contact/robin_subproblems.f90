@@ -14,7 +14,7 @@ module robin_subproblems
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
   use contact_common, only: gather, scatter, body_threads, partner_slots
-  use sorting, only: merge_sort_by_keys
+  use sorting, only: largest_first
   use equality_rows, only: equality_t, equality_init, equality_add_penalty
   use robin_operators, only: robin_operator_t
   use contact_interface, only: interface_t, slot_row, slot_side
@@ -70,8 +70,7 @@ contains
     allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n))
     subproblems%lmax_body = 0.0_wp
     ! largest first: the dynamic schedule then balances the threads
-    subproblems%order = [(a, a=1, n)]
-    call merge_sort_by_keys(subproblems%order, reshape([(-bodies(a)%m, a=1, n)], [1, n]))
+    subproblems%order = largest_first(bodies(:)%m)
     nmv = 0
     ! every body's part on the threads: F_a, its bound, its Hessian (a copy of F_a, the
     ! proximal term, the penalty of its equilibrium rows)

@@ -25,7 +25,7 @@ module run_phases
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
   use strings, only: sci, i2s, word, body_label
-  use sorting, only: merge_sort_by_keys
+  use sorting, only: largest_first
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
   use mpi_env, only: par_built, par_any
@@ -157,7 +157,7 @@ contains
     associate (deck => run%deck)
       allocate (err(deck%nbody))
       run%plan = plan_steps(deck)
-      order = largest_meshes_first(run)
+      order = largest_first(run%meshes(:)%nnode)
       !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
       do k = 1, deck%nbody
         a = order(k)
@@ -178,16 +178,6 @@ contains
       end do
     end associate
   end subroutine assemble_bodies
-
-  !> The bodies by their mesh nodes, the largest first (ties by id): the threads' order
-  !! before the bodies' systems are known.
-  function largest_meshes_first(run) result(order)
-    type(run_t), intent(in) :: run
-    integer, allocatable :: order(:)
-    integer :: i
-    order = [(i, i=1, run%nbody)]
-    call merge_sort_by_keys(order, reshape([(-run%meshes(i)%nnode, i=1, run%nbody)], [1, run%nbody]))
-  end function largest_meshes_first
 
   !> The contact groups of body a, one per pair it takes part in ('' : its 'contact' side).
   function body_groups(deck, a) result(g)
@@ -544,7 +534,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k, nnode
     allocate (stress(run%nbody))
-    order = largest_meshes_first(run)
+    order = largest_first(run%meshes(:)%nnode)
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a, nnode)
     do k = 1, run%nbody
       a = order(k)

@@ -8,7 +8,7 @@ module serial_backend
   use assembly, only: expand
   use condense, only: factor_body, condense_body, recover_displacement
   use contact_common, only: gather
-  use sorting, only: merge_sort_by_keys
+  use sorting, only: largest_first
   use sysinfo, only: memory_limit_mb
   use budget, only: check_budget
   use mpi_env, only: par_finalize
@@ -46,7 +46,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k
     allocate (err(run%nbody))
-    order = largest_first(run)
+    order = largest_first(run%systems(:)%n)
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
     do k = 1, run%nbody
       a = order(k)
@@ -67,7 +67,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k
     allocate (err(run%nbody))
-    order = largest_first(run)
+    order = largest_first(run%systems(:)%n)
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
     do k = 1, run%nbody
       a = order(k)
@@ -87,7 +87,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k
     allocate (err(run%nbody))
-    order = largest_first(run)
+    order = largest_first(run%systems(:)%n)
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
     do k = 1, run%nbody
       a = order(k)
@@ -123,7 +123,7 @@ contains
     real(wp), allocatable :: ufree(:)
     integer, allocatable :: order(:)
     integer :: a, k
-    order = largest_first(run)
+    order = largest_first(run%systems(:)%n)
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(ufree, a)
     do k = 1, run%nbody
       a = order(k)
@@ -146,15 +146,6 @@ contains
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run
   end subroutine report_ranks
-
-  !> The bodies by their unknowns, the largest first (ties by id): the threads' order.
-  function largest_first(run) result(order)
-    type(run_t), intent(in) :: run
-    integer, allocatable :: order(:)
-    integer :: i
-    order = [(i, i=1, run%nbody)]
-    call merge_sort_by_keys(order, reshape([(-run%systems(i)%n, i=1, run%nbody)], [1, run%nbody]))
-  end function largest_first
 
   !> End the run with its code.
   subroutine finish(self, run)
