@@ -298,11 +298,12 @@ contains
       ! (nnode, 2) in Fortran order -> h5py shape (2, nnode); nodes and cells in the file's order
       allocate (w2(msh(a)%nnode, 2), w3(3, msh(a)%nnode), ua(sys(a)%ndof))
       ua = reshape(file_order(msh(a), reshape(u(1:sys(a)%ndof, a), [2, msh(a)%nnode])), [sys(a)%ndof])
-      w2 = transpose(file_order(msh(a), msh(a)%xy))
+      w3(1:2, :) = file_order(msh(a), msh(a)%xy)
+      w2 = transpose(w3(1:2, :))
       call write_dset(gid, 'coordinates', w2, st, ul)
       w2 = transpose(reshape(ua, [2, msh(a)%nnode]))
       call write_dset(gid, 'displacement', w2, st, ul)
-      w3 = pad3(file_order(msh(a), msh(a)%xy))
+      w3(3, :) = 0.0_wp
       call write_dset(gid, 'geometry_xyz', w3, st, ul)
       w3 = pad3(reshape(ua, [2, msh(a)%nnode]))
       call write_dset(gid, 'displacement_xyz', w3, st, ul)
