@@ -194,7 +194,7 @@ contains
   !! (dtrsv; dpotrs with one right-hand side goes through dtrsm, three times slower here).
   subroutine hessian_solve(self, x)
     class(hessian_t), intent(inout) :: self
-    real(wp), intent(inout) :: x(:)
+    real(wp), intent(inout), contiguous :: x(:)
     type(error_t) :: err
     if (self%sparse) then
       call self%chol%solve(x, err)

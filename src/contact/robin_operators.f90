@@ -350,7 +350,7 @@ contains
       if (all(npairs(contact_line%pair_body(:, p)) == 1)) cycle
       needs_stiffness(contact_line%pair_body(:, p)) = .true.
     end do
-    order = largest_first(bodies(:)%m)
+    order = largest_first([(bodies(a)%m, a=1, size(bodies))])
     !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a) if (count(needs_stiffness) > 1)
     do k = 1, size(bodies)
       a = order(k)

@@ -70,7 +70,7 @@ contains
     allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n))
     subproblems%lmax_body = 0.0_wp
     ! largest first: the dynamic schedule then balances the threads
-    subproblems%order = largest_first(bodies(:)%m)
+    subproblems%order = largest_first([(bodies(a)%m, a=1, size(bodies))])
     nmv = 0
     ! every body's part on the threads: F_a, its bound, its Hessian (a copy of F_a, the
     ! proximal term, the penalty of its equilibrium rows)

@@ -157,7 +157,7 @@ contains
     associate (deck => run%deck)
       allocate (err(deck%nbody))
       run%plan = plan_steps(deck)
-      order = largest_first(run%meshes(:)%nnode)
+      order = largest_first([(run%meshes(a)%nnode, a=1, run%nbody)])
       !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
       do k = 1, deck%nbody
         a = order(k)
@@ -534,7 +534,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k, nnode
     allocate (stress(run%nbody))
-    order = largest_first(run%meshes(:)%nnode)
+    order = largest_first([(run%meshes(a)%nnode, a=1, run%nbody)])
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a, nnode)
     do k = 1, run%nbody
       a = order(k)

@@ -46,7 +46,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k
     allocate (err(run%nbody))
-    order = largest_first(run%systems(:)%n)
+    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
     do k = 1, run%nbody
       a = order(k)
@@ -67,7 +67,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k
     allocate (err(run%nbody))
-    order = largest_first(run%systems(:)%n)
+    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
     do k = 1, run%nbody
       a = order(k)
@@ -87,7 +87,7 @@ contains
     integer, allocatable :: order(:)
     integer :: a, k
     allocate (err(run%nbody))
-    order = largest_first(run%systems(:)%n)
+    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
     do k = 1, run%nbody
       a = order(k)
@@ -123,7 +123,7 @@ contains
     real(wp), allocatable :: ufree(:)
     integer, allocatable :: order(:)
     integer :: a, k
-    order = largest_first(run%systems(:)%n)
+    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(ufree, a)
     do k = 1, run%nbody
       a = order(k)
