@@ -4,14 +4,7 @@ module sorting
   implicit none (type, external)
   private
 
-  public :: sort_by_key, sort_ints, merge_sort, merge_sort_by_keys, index_less, largest_first
-
-  abstract interface
-    !> The order of merge_sort: true when index a goes before index b.
-    logical function index_less(a, b)
-      integer, intent(in) :: a, b
-    end function index_less
-  end interface
+  public :: sort_by_key, sort_ints, merge_sort_by_keys, largest_first
 
 contains
 
@@ -51,12 +44,14 @@ contains
     end do
   end subroutine sort_ints
 
-  !> Stable bottom-up merge sort of the indices `idx`: `less(a, b)` is true when index a
-  !! goes before index b. n log n comparisons, for the long lists (a mesh's node tags, its
-  !! cells' node sets, a deck's group names).
-  subroutine merge_sort(idx, less)
-    integer, intent(inout) :: idx(:)        !< the indices, sorted on return
-    procedure(index_less) :: less           !< the order
+  !> Stable bottom-up merge sort of the indices `idx` by the columns `keys(:, idx(i))`,
+  !! compared lexicographically (first row first): n log n comparisons, for the long lists
+  !! (a mesh's node tags, its cells' node sets, a deck's group names as character codes).
+  !! The comparison is written out here, not passed in: a procedure argument that is an
+  !! internal procedure needs a trampoline, which makes the program's stack executable.
+  subroutine merge_sort_by_keys(idx, keys)
+    integer, intent(inout) :: idx(:)        !< indices into the columns of keys, sorted on return
+    integer, intent(in) :: keys(:, :)       !< (k, *) the keys
     integer, allocatable :: work(:)
     integer :: n, width, lo, mid, hi, i, j, k
     n = size(idx)
@@ -70,7 +65,7 @@ contains
         i = lo
         j = mid
         do k = lo, hi - 1
-          if (i < mid .and. (j >= hi .or. .not. less(idx(min(j, n)), idx(min(i, n))))) then
+          if (i < mid .and. (j >= hi .or. .not. column_less(idx(min(j, n)), idx(min(i, n))))) then
             work(k) = idx(i)
             i = i + 1
           else
@@ -82,14 +77,6 @@ contains
       idx = work
       width = 2*width
     end do
-  end subroutine merge_sort
-
-  !> Stable merge sort of the indices `idx` by the columns `keys(:, idx(i))`, compared
-  !! lexicographically (first row first).
-  subroutine merge_sort_by_keys(idx, keys)
-    integer, intent(inout) :: idx(:)        !< indices into the columns of keys, sorted on return
-    integer, intent(in) :: keys(:, :)       !< (k, *) the keys
-    call merge_sort(idx, column_less)
   contains
     logical function column_less(a, b)
       integer, intent(in) :: a, b

@@ -7,7 +7,7 @@ module deck_cross
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
   use strings, only: i2s
-  use sorting, only: merge_sort
+  use sorting, only: merge_sort_by_keys
   use config, only: deck_t, body_cfg_t, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
                     BC_CONTACT, BC_DISPLACEMENT, bc_names, STEPS_UNSET, stage_count
   use deck_checks, only: state_t
@@ -210,16 +210,18 @@ contains
     end do
   end subroutine check_pairs
 
-  !> Sort the indices `idx` by `key(idx(i))`, ascending (stable merge sort).
+  !> Sort the indices `idx` by `key(idx(i))`, ascending (stable merge sort): the names
+  !! compared by their character codes, as the character comparison does.
   subroutine sort_names(idx, key)
     integer, intent(inout) :: idx(:)          !< indices into key, sorted on return
     character(len=*), intent(in) :: key(:)    !< the names
-    call merge_sort(idx, name_less)
-  contains
-    logical function name_less(a, b)
-      integer, intent(in) :: a, b
-      name_less = key(a) < key(b)
-    end function name_less
+    integer :: codes(len(key), size(key)), i, c
+    do i = 1, size(key)
+      do c = 1, len(key)
+        codes(c, i) = ichar(key(i)(c:c))
+      end do
+    end do
+    call merge_sort_by_keys(idx, codes)
   end subroutine sort_names
 
   !> The pair form: a rectangle's groups are its sides, none of them declared 'contact'

@@ -341,8 +341,8 @@ if "monolithic" in pr_:
                 if os.path.exists(path):
                     with h5py.File(path, "r") as f:
                         st = text_attr(f, "status")
-                check(p.returncode == 2 and res["status"] == "max_outer" and st in ("", "max_outer"),
-                      f"{tag}: not converged: exit 2, status max_outer (result line and file)",
+                check(p.returncode == 2 and res["status"] in ("max_outer", "diverged") and st in ("", res["status"]),
+                      f"{tag}: not converged: exit 2, status max_outer or diverged (result line and file)",
                       f"exit {p.returncode}, {res['status']}, file '{st}'")
 
 # ---- (g) MUMPS under MPI ----------------------------------------------------------------------------
