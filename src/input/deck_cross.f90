@@ -215,7 +215,9 @@ contains
   subroutine sort_names(idx, key)
     integer, intent(inout) :: idx(:)          !< indices into key, sorted on return
     character(len=*), intent(in) :: key(:)    !< the names
-    integer :: codes(len(key), size(key)), i, c
+    integer, allocatable :: codes(:, :)
+    integer :: i, c
+    allocate (codes(len(key), size(key)))
     do i = 1, size(key)
       do c = 1, len(key)
         codes(c, i) = ichar(key(i)(c:c))
