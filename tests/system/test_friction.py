@@ -25,6 +25,10 @@ doc/verification.md, "Friction").
     monolithic to 1e-6 (harmonic; steklov without Anderson, which stagnates on the frictional
     stack), the a posteriori bound above the measured error;
     one and two threads bitwise equal.
+(6b) The paper's deck with its own settings (steklov, delta 0.95) and Coulomb mu = 0.3: the
+    iteration cycles between two states and ends as diverged ("stagnated"), exit 2, within
+    100 of its 800 outer iterations, the result file flagged; the same deck without friction
+    converges in 189 (a slow but steady iteration is not stopped).
 (7) MPI: the frictional stack under mpirun -np 1, 2, 4 (factorization='mumps') = the serial run
     to 1e-10 (skipped without bin/robin_contact_mpi or mpirun).
 (8) Load history, steel on aluminium in Hertz contact (Coulomb mu = 0.3): P in a first stage
@@ -250,6 +254,24 @@ def scenes(tmp):
                       f"{what} ({op}): one and two threads bitwise equal")
 
 
+def cycle(tmp):
+    default = os.path.join(ROOT, "inputs/default.nml")
+    r = Run(tmp, "cycle_default", default, "&contact friction='coulomb', mu=0.3 /")
+    outer = int(r.res.get("outer", 0)) if r.res else 0
+    st = ""
+    if os.path.exists(r.h5):
+        with h5py.File(r.h5, "r") as f:
+            st = f.attrs["status"]
+            st = st.decode() if isinstance(st, bytes) else str(st)
+    check(r.rc == 2 and r.res is not None and r.res.get("status") == "diverged" and "stagnated" in r.text
+          and 50 < outer <= 100 and st == "diverged",
+          "paper deck (steklov 0.95) with Coulomb: diverged (stagnated) within 100 outer iterations, exit 2, "
+          "file flagged", f"exit {r.rc}, outer {outer}, file '{st}': {r.text.strip()[-300:]}")
+    f = Run(tmp, "cycle_default_frictionless", default)
+    check(f.ok and f.res.get("outer") == "189", "paper deck without friction: converged in 189 (not stopped)",
+          f"exit {f.rc}, outer {f.res.get('outer') if f.res else None}")
+
+
 def mpi(tmp):
     mpi_bin = os.path.abspath(os.environ.get("MPI_BIN", os.path.join(ROOT, "bin/robin_contact_mpi")))
     if not (os.path.exists(mpi_bin) and shutil.which("mpirun")):
@@ -343,6 +365,7 @@ def main():
         threshold(tmp)
         bad_input(tmp)
         scenes(tmp)
+        cycle(tmp)
         mpi(tmp)
         load_history(tmp)
     print(f"{len(check.failed)} failed")
