@@ -34,8 +34,14 @@ Writes the result files to --workdir (default results/bench_friction/; deleted a
 reading), one CSV row per run to --csv (default results/bench_friction.csv), and prints
 Markdown tables. A benchmark: it reports, it asserts nothing.
 
+--pairs N: instead, N alternating pairs of runs of the solver's default (harmonic, delta 0.5)
+without friction and with Coulomb mu = 0.3 at one size (--sizes, default 1024x512), each run
+after waiting for a quiet machine: per pair the two runs' phases, the wall ratio (the `time:`
+line's total) and the CPU ratio, then the medians and the fastest against the fastest. This is
+the measure of "friction within 1.3x of the frictionless solve".
+
 Usage: bench/bench_friction.py [--bin bin/robin_contact] [--quick] [--sizes 128x64,256x128]
-                               [--repeat 1] [--quiet-wait 20] [--timeout 900]
+                               [--repeat 1] [--quiet-wait 20] [--timeout 900] [--pairs N]
 --quick: 64x32 and 128x64, one run each, no waiting (under a minute). The full bench: about
 15-25 minutes on the shared 2-core machine with --repeat 2 (`make bench-friction`).
 """
@@ -155,7 +161,10 @@ def main():
     ap.add_argument("--timeout", type=float, default=900.0, help="seconds per run")
     ap.add_argument("--workdir", default=os.path.join(ROOT, "results", "bench_friction"))
     ap.add_argument("--csv", default=os.path.join(ROOT, "results", "bench_friction.csv"))
+    ap.add_argument("--pairs", type=int, default=0, help="alternating frictionless / Coulomb pairs at one size")
     a = ap.parse_args()
+    if a.pairs > 0:
+        return pairs(a)
     sizes = a.sizes or ("64x32,128x64" if a.quick else "128x64,256x128,512x256,1024x512")
     sizes = [tuple(int(v) for v in s.split("x")) for s in sizes.split(",")]
     os.makedirs(a.workdir, exist_ok=True)
@@ -219,6 +228,49 @@ def main():
                             r1["status"]])
     print(table(["mesh / body", "friction", "solver", "outer/inner none", "outer/inner friction", "total [s]",
                  "ratio", "cpu ratio", "extra f / c / i [s]", "rows m", "extra peak MB", "status"], out))
+    return 0
+
+
+def pairs(a):
+    """--pairs: alternating frictionless and Coulomb runs of the default solver at one size."""
+    nx, ny = (int(v) for v in (a.sizes or "1024x512").split(",")[0].split("x"))
+    os.makedirs(a.workdir, exist_ok=True)
+    runner = Runner(os.path.abspath(a.bin), a.workdir, a.quiet_wait, a.timeout)
+    rows, out = [], []
+    for k in range(a.pairs):
+        pair = {}
+        for fr in ("none", "coulomb"):
+            row = {c: "" for c in COLUMNS}
+            row.update(nx=nx, ny=ny, dofs=2 * (nx + 1) * (ny + 1), friction=fr, solver="harmonic")
+            runner.run(row, 1, True)
+            rows.append(row)
+            pair[fr] = row
+            sys.stderr.write(f"  pair {k + 1} {fr:8s}: {row['status']} outer={row['outer']} inner={row['inner']} "
+                             f"total={row['total_s']} cpu={row['cpu_s']} (busy before {row['busy_before']}, "
+                             f"during {row['busy_during']}, load {row['load1']})\n")
+            sys.stderr.flush()
+        r0, r1 = pair["none"], pair["coulomb"]
+        if r0["total_s"] == "" or r1["total_s"] == "":
+            continue
+        out.append((r0, r1, r1["total_s"] / r0["total_s"], r1["cpu_s"] / r0["cpu_s"]))
+    write_csv(a.csv, rows, COLUMNS)
+
+    def phases(r):
+        return " / ".join(fmt(r[p + "_s"], ".3g") for p in ("factor", "condense", "iterate", "output"))
+
+    print(f"\n### Coulomb mu = 0.3 against frictionless, {nx}x{ny} per body, harmonic delta 0.5, "
+          f"{len(out)} pairs\n")
+    print(table(["pair", "outer/inner none", "outer/inner coulomb", "f / c / i / o none [s]", "f / c / i / o coulomb [s]",
+                 "total none / coulomb [s]", "wall ratio", "CPU ratio", "busy during"],
+                [[str(k + 1), f"{r0['outer']}/{r0['inner']}", f"{r1['outer']}/{r1['inner']}", phases(r0), phases(r1),
+                  f"{fmt(r0['total_s'], '.3g')} / {fmt(r1['total_s'], '.3g')}", f"{w:.2f}", f"{c:.2f}",
+                  f"{fmt(r0['busy_during'], '.2f')} / {fmt(r1['busy_during'], '.2f')}"]
+                 for k, (r0, r1, w, c) in enumerate(out)]))
+    if out:
+        fastest = min(r[1]["total_s"] for r in out) / min(r[0]["total_s"] for r in out)
+        print(f"\nmedian wall ratio {float(np.median([r[2] for r in out])):.3f}, median CPU ratio "
+              f"{float(np.median([r[3] for r in out])):.3f}, fastest against fastest {fastest:.3f}; "
+              f"{os.path.relpath(a.csv, ROOT)}")
     return 0
 
 
