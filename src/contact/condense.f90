@@ -15,7 +15,7 @@ module condense
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL, ERR_MEMORY
-  use lapack, only: dpotrf, dpocon, dpstrf, dsyev
+  use lapack, only: dpotrf, dpocon, dpstrf, dsyevr
   implicit none (type, external)
   private
 
@@ -256,14 +256,14 @@ contains
   !! 1e-10 max diag stop it), unless a plain Cholesky factor and its condition estimate show
   !! full rank with a wide margin; when it is rank deficient, `prox` is a hundredth of its
   !! largest diagonal entry and `kern` an orthonormal basis of the kernel:
-  !! the eigenvectors of the m - rank smallest eigenvalues (LAPACK dsyev, once, O(m^3)).
+  !! the eigenvectors of the m - rank smallest eigenvalues (LAPACK dsyevr, once, O(m^3)).
   !! F_a = 0 (all its contact DOFs prescribed): rank 0, no `kern` (the proximal term is then
   !! the other body's F).
   subroutine flex_rank(bc)
     type(body_condensed_t), intent(inout) :: bc
-    real(wp), allocatable :: f(:, :), work(:), ev(:)
-    integer, allocatable :: piv(:)
-    integer :: lapinfo, r, lwork
+    real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :)
+    integer, allocatable :: piv(:), isuppz(:), iwork(:)
+    integer :: lapinfo, r, lwork, liwork, k, nfound
     real(wp) :: dmax, rcond, anorm
     integer :: i
     dmax = 0.0_wp
@@ -299,15 +299,21 @@ contains
     bc%rank = r
     if (r == bc%m) return
     bc%prox = 1.0e-2_wp*dmax
+    ! the eigenvectors of the m - r smallest eigenvalues only (MRRR: the tridiagonal
+    ! reduction is the O(m^3) part, a tenth of computing all m eigenvectors)
     f = bc%flex
-    allocate (ev(bc%m))
-    call dsyev('V', 'L', bc%m, f, bc%m, ev, work, -1, lapinfo)
-    lwork = max(3*bc%m, int(work(1)))
-    deallocate (work)
-    allocate (work(lwork))
-    call dsyev('V', 'L', bc%m, f, bc%m, ev, work, lwork, lapinfo)
-    ! no eigenvectors (dsyev did not converge): robin_operators then uses the other body's F
-    if (lapinfo == 0) bc%kern = f(:, 1:bc%m - r)
+    k = bc%m - r
+    allocate (ev(bc%m), z(bc%m, k), isuppz(2*k), iwork(1))
+    call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
+                work, -1, iwork, -1, lapinfo)
+    lwork = max(26*bc%m, int(work(1)))
+    liwork = max(10*bc%m, iwork(1))
+    deallocate (work, iwork)
+    allocate (work(lwork), iwork(liwork))
+    call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
+                work, lwork, iwork, liwork, lapinfo)
+    ! no eigenvectors (dsyevr failed): robin_operators then uses the other body's F
+    if (lapinfo == 0 .and. nfound == k) bc%kern = z
   end subroutine flex_rank
 
   !> w(m) = B_a u: the rows on the free displacements u (n) plus the part on prescribed DOFs.

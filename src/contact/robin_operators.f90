@@ -12,7 +12,7 @@ module robin_operators
   use kinds, only: wp
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init, dense_op_take
-  use lapack, only: dgemm, dposv, dgesv, dsyev, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
+  use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, ROW_NORMAL, ROW_TANGENT
   use condense, only: body_condensed_t
@@ -603,7 +603,7 @@ contains
       f = merge(1, 2, blk(1)%nrig > 0)
       o = 3 - f
       ! (I + F_o Q_f) X = F_o, S = 2 X
-      a = matmul(blk(o)%f, q(:, :, f))
+      a = mm('N', 'N', blk(o)%f, q(:, :, f))
       do i = 1, m
         a(i, i) = a(i, i) + 1.0_wp
       end do
@@ -621,16 +621,20 @@ contains
     real(wp), allocatable, intent(out) :: s(:, :)
     integer, intent(out) :: info
     type(stiffness_t) :: st(2)
-    integer :: side
+    integer :: side, infos(2)
+    ! the two bodies' eigendecompositions on the threads
+    !$omp parallel do num_threads(min(2, body_threads())) schedule(static, 1) private(side)
     do side = 1, 2
       if (blk(side)%nrig > 0) then
-        call body_stiffness(blk(side)%f, blk(side)%g, st(side)%k, st(side)%inf, info)
+        call body_stiffness(blk(side)%f, blk(side)%g, st(side)%k, st(side)%inf, infos(side))
       else
         call body_stiffness(blk(side)%f, reshape([real(wp) ::], [0, size(blk(side)%f, 1)]), st(side)%k, &
-                            st(side)%inf, info)
+                            st(side)%inf, infos(side))
       end if
-      if (info /= 0) return
     end do
+    !$omp end parallel do
+    info = maxval(abs(infos))
+    if (info /= 0) return
     call parallel_flex(st(1)%k, st(1)%inf, st(2)%k, st(2)%inf, s, info)
   end subroutine harmonic_singular
 
@@ -645,9 +649,10 @@ contains
     real(wp), allocatable, intent(out) :: k(:, :)   !< (m, m) Sigma
     real(wp), allocatable, intent(out) :: inf(:, :) !< (m, *) the infinitely stiff directions
     integer, intent(out) :: info
-    real(wp), allocatable :: z(:, :), c(:, :), ev(:), work(:), y(:, :)
+    real(wp), allocatable :: z(:, :), c(:, :), ev(:), work(:), y(:, :), w(:, :)
+    integer, allocatable :: iwork(:), keep(:)
     real(wp) :: cut
-    integer :: m, nz, i, j, lwork
+    integer :: m, nz, i, j, lwork, liwork
     logical :: ok
     m = size(f, 1)
     info = 0
@@ -663,38 +668,39 @@ contains
     else
       z = complement(transpose(g), m)
       nz = size(z, 2)
-      c = matmul(transpose(z), matmul(f, z))
+      c = mm('T', 'N', z, mm('N', 'N', f, z))
       c = 0.5_wp*(c + transpose(c))
     end if
-    allocate (ev(nz), work(max(1, 3*nz)), k(m, m))
+    allocate (ev(nz), work(1), iwork(1), k(m, m))
     k = 0.0_wp
     info = 0
     if (nz == 0) then
       allocate (inf(m, 0))
       return
     end if
-    call dsyev('V', 'U', nz, c, nz, ev, work, -1, info)
-    lwork = max(3*nz, int(work(1)))
-    deallocate (work)
-    allocate (work(lwork))
-    call dsyev('V', 'U', nz, c, nz, ev, work, lwork, info)
+    ! all eigenpairs by divide and conquer (a sixth of dsyev's time at nz = 2000)
+    call dsyevd('V', 'U', nz, c, nz, ev, work, -1, iwork, -1, info)
+    lwork = max(1 + 6*nz + 2*nz*nz, int(work(1)))
+    liwork = max(3 + 5*nz, iwork(1))
+    deallocate (work, iwork)
+    allocate (work(lwork), iwork(liwork))
+    call dsyevd('V', 'U', nz, c, nz, ev, work, lwork, iwork, liwork, info)
     if (info /= 0) return
     if (allocated(z)) then
-      y = matmul(z, c)   ! the eigenvectors in the rows' space
+      y = mm('N', 'N', z, c)   ! the eigenvectors in the rows' space
     else
       call move_alloc(c, y)
     end if
     cut = 1.0e-10_wp*maxval(ev)
     inf = y(:, pack([(i, i=1, nz)], ev <= cut))
-    ! Sigma = sum of y_i y_i' / ev_i over the kept eigenpairs, in that order, column by
-    ! column on the upper triangle, then mirrored (each entry is a product of two numbers:
-    ! the mirror is exact)
-    do j = 1, m
-      do i = 1, nz
-        if (ev(i) <= cut) cycle
-        k(1:j, j) = k(1:j, j) + (y(1:j, i)*y(j, i))/ev(i)
-      end do
+    ! Sigma = W W' with W the kept eigenvectors y_i scaled by 1/sqrt(ev_i): its upper triangle
+    ! by one rank-k update, then mirrored (exactly symmetric)
+    keep = pack([(i, i=1, nz)], ev > cut)
+    allocate (w(m, size(keep)))
+    do j = 1, size(keep)
+      w(:, j) = y(:, keep(j))/sqrt(ev(keep(j)))
     end do
+    if (size(keep) > 0) call dsyrk('U', 'N', m, size(keep), 1.0_wp, w, m, 0.0_wp, k, m)
     do j = 1, m - 1
       k(j + 1:m, j) = k(j, j + 1:m)
     end do
@@ -755,14 +761,34 @@ contains
     s = 0.0_wp
     info = 0
     if (nv == 0) return
-    t = matmul(transpose(v), matmul(ka + kb, v))
+    t = mm('T', 'N', v, mm('N', 'N', ka + kb, v))
     t = 0.5_wp*(t + transpose(t))
     x = transpose(v)
     call dposv('U', nv, m, t, nv, x, nv, info)
     if (info /= 0) return
-    s = 2.0_wp*matmul(v, x)
+    s = 2.0_wp*mm('N', 'N', v, x)
     s = 0.5_wp*(s + transpose(s))
   end subroutine parallel_flex
+
+  !> C = op(A) op(B) (op: 'N' as it is, 'T' transposed) by BLAS: the dense blocks of a
+  !! contact line are products of order m^3, where the intrinsic matmul is several times
+  !! slower than dgemm.
+  function mm(ta, tb, a, b) result(c)
+    character(len=1), intent(in) :: ta, tb
+    real(wp), contiguous, intent(in) :: a(:, :), b(:, :)
+    real(wp), allocatable :: c(:, :)
+    integer :: m, n, k
+    m = merge(size(a, 2), size(a, 1), ta == 'T')
+    k = merge(size(a, 1), size(a, 2), ta == 'T')
+    n = merge(size(b, 1), size(b, 2), tb == 'T')
+    allocate (c(m, n))
+    if (m == 0 .or. n == 0) return
+    if (k == 0) then
+      c = 0.0_wp
+      return
+    end if
+    call dgemm(ta, tb, m, n, k, 1.0_wp, a, size(a, 1), b, size(b, 1), 0.0_wp, c, m)
+  end function mm
 
   !> An orthonormal basis of the orthogonal complement of the columns of a (m x n): the
   !! left singular vectors beyond its numerical rank (1e-10 of its largest singular value).

@@ -10,7 +10,7 @@ module lapack
   private
 
   public :: dsymv, dgemm, dgemv, dsyrk, dtrsm, dtrsv
-  public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev
+  public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels, dgesv, dsygv, dgesvd
 
@@ -166,6 +166,54 @@ module lapack
       integer, intent(in) :: lwork          !< size of work (-1: query)
       integer, intent(out) :: info          !< status
     end subroutine dsyev
+
+    !> Eigenvalues (ascending) and, with jobz = 'V', orthonormal eigenvectors of a symmetric A
+    !! by divide and conquer (several times faster than dsyev for all eigenvectors).
+    !! lwork = liwork = -1: workspace query (sizes in work(1), iwork(1)). info > 0: failure.
+    subroutine dsyevd(jobz, uplo, n, a, lda, w, work, lwork, iwork, liwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: jobz  !< 'N' eigenvalues only, 'V' also eigenvectors
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L'
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a
+      real(wp), intent(inout) :: a(lda, *)  !< A on entry, the eigenvectors (jobz = 'V') on exit
+      real(wp), intent(out) :: w(*)         !< (n) eigenvalues, ascending
+      real(wp), intent(out) :: work(*)      !< (lwork) workspace
+      integer, intent(in) :: lwork          !< size of work (-1: query)
+      integer, intent(out) :: iwork(*)      !< (liwork) workspace
+      integer, intent(in) :: liwork         !< size of iwork (-1: query)
+      integer, intent(out) :: info          !< status
+    end subroutine dsyevd
+
+    !> Selected eigenvalues (ascending) and eigenvectors of a symmetric A by the relatively
+    !! robust representations (MRRR): with range = 'I' those of indices il..iu, O(n^3) for the
+    !! reduction only (a few of n eigenvectors cost a small part of dsyev's).
+    !! lwork = liwork = -1: workspace query (sizes in work(1), iwork(1)). info > 0: failure.
+    subroutine dsyevr(jobz, range, uplo, n, a, lda, vl, vu, il, iu, abstol, m, w, z, ldz, isuppz, &
+                      work, lwork, iwork, liwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: jobz   !< 'N' eigenvalues only, 'V' also eigenvectors
+      character(len=1), intent(in) :: range  !< 'A' all, 'V' in (vl, vu], 'I' indices il..iu
+      character(len=1), intent(in) :: uplo   !< 'U' or 'L'
+      integer, intent(in) :: n               !< order of A
+      integer, intent(in) :: lda             !< leading dimension of a
+      real(wp), intent(inout) :: a(lda, *)   !< A on entry, destroyed on exit
+      real(wp), intent(in) :: vl, vu         !< the interval (range = 'V')
+      integer, intent(in) :: il, iu          !< the indices (range = 'I'), 1 <= il <= iu <= n
+      real(wp), intent(in) :: abstol         !< absolute tolerance (0: LAPACK's default)
+      integer, intent(out) :: m              !< eigenvalues found
+      real(wp), intent(out) :: w(*)          !< (n) the eigenvalues found, ascending, in w(1:m)
+      integer, intent(in) :: ldz             !< leading dimension of z
+      real(wp), intent(out) :: z(ldz, *)     !< (n, m) orthonormal eigenvectors (jobz = 'V')
+      integer, intent(out) :: isuppz(*)      !< (2 max(1, m)) support of the eigenvectors
+      real(wp), intent(out) :: work(*)       !< (lwork) workspace
+      integer, intent(in) :: lwork           !< size of work (-1: query)
+      integer, intent(out) :: iwork(*)       !< (liwork) workspace
+      integer, intent(in) :: liwork          !< size of iwork (-1: query)
+      integer, intent(out) :: info           !< status
+    end subroutine dsyevr
 
     !> Solve A X = B with the Cholesky factor from dpotrf.
     subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)
