@@ -7,6 +7,7 @@
 module condense
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  use, intrinsic :: ieee_exceptions, only: ieee_usual, ieee_get_halting_mode, ieee_set_halting_mode
   use config, only: factor_cfg_t, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
   use mesh, only: mesh_t
   use contact_interface, only: interface_t, body_slots, slot_row, slot_side
@@ -264,6 +265,7 @@ contains
     real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :)
     integer, allocatable :: piv(:), isuppz(:), iwork(:)
     integer :: lapinfo, r, lwork, liwork, k, nfound
+    logical :: halting(size(ieee_usual))
     real(wp) :: dmax, rcond, anorm
     integer :: i
     dmax = 0.0_wp
@@ -304,6 +306,11 @@ contains
     f = bc%flex
     k = bc%m - r
     allocate (ev(bc%m), z(bc%m, k), isuppz(2*k), iwork(1))
+    ! MRRR relies on IEEE infinities in its inner loops (LAPACK's workspace query already tests
+    ! that they are safe, by making some): no floating-point trap while it runs (the checked
+    ! build sets them)
+    call ieee_get_halting_mode(ieee_usual, halting)
+    call ieee_set_halting_mode(ieee_usual, .false.)
     call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
                 work, -1, iwork, -1, lapinfo)
     lwork = max(26*bc%m, int(work(1)))
@@ -312,6 +319,7 @@ contains
     allocate (work(lwork), iwork(liwork))
     call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
                 work, lwork, iwork, liwork, lapinfo)
+    call ieee_set_halting_mode(ieee_usual, halting)
     ! no eigenvectors (dsyevr failed): robin_operators then uses the other body's F
     if (lapinfo == 0 .and. nfound == k) bc%kern = z
   end subroutine flex_rank

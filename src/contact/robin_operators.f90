@@ -668,7 +668,8 @@ contains
     else
       z = complement(transpose(g), m)
       nz = size(z, 2)
-      c = mm('T', 'N', z, mm('N', 'N', f, z))
+      y = mm('N', 'N', f, z)
+      c = mm('T', 'N', z, y)
       c = 0.5_wp*(c + transpose(c))
     end if
     allocate (ev(nz), work(1), iwork(1), k(m, m))
@@ -761,7 +762,9 @@ contains
     s = 0.0_wp
     info = 0
     if (nv == 0) return
-    t = mm('T', 'N', v, mm('N', 'N', ka + kb, v))
+    t = ka + kb
+    x = mm('N', 'N', t, v)
+    t = mm('T', 'N', v, x)
     t = 0.5_wp*(t + transpose(t))
     x = transpose(v)
     call dposv('U', nv, m, t, nv, x, nv, info)
@@ -775,7 +778,7 @@ contains
   !! slower than dgemm.
   function mm(ta, tb, a, b) result(c)
     character(len=1), intent(in) :: ta, tb
-    real(wp), contiguous, intent(in) :: a(:, :), b(:, :)
+    real(wp), intent(in) :: a(:, :), b(:, :)
     real(wp), allocatable :: c(:, :)
     integer :: m, n, k
     m = merge(size(a, 2), size(a, 1), ta == 'T')
