@@ -48,7 +48,7 @@ contains
     type(contact_result_t), intent(inout) :: res         !< lam in; error_bound, kappa out
     type(hessian_t) :: hs
     real(wp), allocatable :: g(:), r(:), x(:), y(:), xp(:), yp(:), bs(:, :), lo(:), hi(:)
-    real(wp) :: lmax, lmin, nl, perr
+    real(wp) :: lmax, lmin, nl, perr, lprev, mu, mprev
     integer :: m, i, k, ki, ib
     logical :: ok
     m = contact_line%m
@@ -64,7 +64,7 @@ contains
     end do
     ! the largest eigenvalue (power iteration, a lower estimate, enlarged below) and the
     ! smallest (inverse iteration on the Cholesky factor of H) on two threads
-    !$omp parallel sections num_threads(body_threads()) private(i, k, ki) if (m > 64)
+    !$omp parallel sections num_threads(body_threads()) private(i, k, ki, lprev, mprev) if (m > 64)
     !$omp section
     do i = 1, m
       xp(i) = 1.0_wp + 0.5_wp*sin(real(i, wp))
@@ -73,9 +73,12 @@ contains
     lmax = 0.0_wp
     do k = 1, 60
       call hs%apply(xp, yp)
+      lprev = lmax
       lmax = norm2(yp)
       if (.not. lmax > 0.0_wp) exit
       xp = yp/lmax
+      ! settled: the estimate moves by less than 1e-6 an iteration (kappa is enlarged by 10%)
+      if (k >= 5 .and. abs(lmax - lprev) <= 1.0e-6_wp*lmax) exit
     end do
     !$omp section
     call hs%factor(ok)
@@ -84,10 +87,16 @@ contains
         x(i) = 1.0_wp + 0.5_wp*cos(real(3*i, wp))
       end do
       x = x/norm2(x)
+      mu = 0.0_wp
       do ki = 1, 60
         y = x
         call hs%solve(y)
+        ! x'H^-1 x, an estimate of 1/lambda_min from below: settled when it moves by less
+        ! than 1e-6 an iteration
+        mprev = mu
+        mu = dot_product(x, y)
         x = y/norm2(y)
+        if (ki >= 5 .and. abs(mu - mprev) <= 1.0e-6_wp*abs(mu)) exit
       end do
     end if
     !$omp end parallel sections
