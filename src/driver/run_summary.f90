@@ -50,9 +50,19 @@ contains
     associate (result => run%result, timing => run%timing)
       err = 0
       pairs = pair_lines(run)
-      if (result%outer > 0) then
+      if (result%outer > 0 .and. result%error_bound < 1.0_wp) then
         line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(result%error_bound)// &
           ' (a posteriori bound, cond('//trim(merge('F1+F2', 'H    ', run%contact_line%npair <= 1))//') ~ '//sci(result%kappa)//')'
+      else if (result%outer > 0) then
+        ! a relative error bound of 1 or more says nothing: say why instead
+        line(2) = 'accuracy: no bound (the a posteriori bound is '//sci(result%error_bound)//', cond('// &
+          trim(merge('F1+F2', 'H    ', run%contact_line%npair <= 1))//') ~ '//sci(result%kappa)
+        if (result%kappa > 1.0_wp/epsilon(1.0_wp)) then
+          line(2) = trim(line(2))//': the interface problem is singular, a force the equations leave free, '// &
+                    'such as on a row of prescribed DOFs only)'
+        else
+          line(2) = trim(line(2))//': it says nothing about these forces)'
+        end if
       else
         line(2) = 'accuracy: none (stopped before the first outer iteration: no contact forces to bound)'
       end if
