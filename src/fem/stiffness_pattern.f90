@@ -47,22 +47,36 @@ contains
   !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
   !! rows sorted in every column: the free DOFs of the nodes sharing a cell with the
   !! column's node (the grid stencil, or the cells' node adjacency), formed once per node
-  !! for both of its columns. err = ERR_INPUT when the number of entries does not fit
-  !! 32-bit indices.
-  subroutine build_pattern(mesh, sys, err)
+  !! for both of its columns. On a mesh that is not structured, also where each cell's
+  !! entries go (cell_row), so that its assembly needs no search. err = ERR_INPUT when the
+  !! number of entries does not fit 32-bit indices.
+  subroutine build_pattern(mesh, sys, err, cell_row)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     type(body_system_t), intent(inout) :: sys  !< with its DOF numbering; gets colptr, rowind, val = 0
     type(error_t), intent(out) :: err          !< ERR_INPUT when the pattern is too large
-    integer :: p, s, cc, k, q, nnbr, nrow, first
+    !> (nv, nv, ncell), nv the most vertices of a cell; a mesh that is not structured only
+    !! (else not allocated): cell_row(a, b, c) = how many rows precede the first of vertex
+    !! a's rows in each column of vertex b of cell c (the column's free rows, in order);
+    !! defined where vertex b has a free DOF
+    integer, allocatable, intent(out), optional :: cell_row(:, :, :)
+    integer :: p, s, cc, k, q, nnbr, nrow, first, t, c, a, b, nv, nslot
     integer(i8) :: nnz
-    integer, allocatable :: aptr(:), adj(:), nbr(:), rows(:)
+    integer, allocatable :: aptr(:), adj(:), nbr(:), rows(:), cptr(:), ccell(:), nv_of(:), rowoff(:)
+    logical :: with_map
     character(len=512) :: emsg
 
+    with_map = .false.
     if (mesh%structured) then
       allocate (nbr(9))
     else
-      call node_adjacency(mesh, aptr, adj)
+      call node_adjacency(mesh, aptr, adj, cptr, ccell, nv_of)
       allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
+      with_map = present(cell_row)
+    end if
+    if (with_map) then
+      nv = max(3, maxval(nv_of))
+      nslot = size(mesh%cells, 1)
+      allocate (cell_row(nv, nv, mesh%ncell), rowoff(mesh%nnode))
     end if
     allocate (rows(2*size(nbr)))
     ! column counts: colptr(p + 1) = the entries of free DOF p, then their running sum
@@ -99,6 +113,7 @@ contains
       call neighbours(k)
       nrow = 0
       do s = 1, nnbr
+        if (with_map) rowoff(nbr(s)) = nrow
         do cc = 1, 2
           q = sys%free_of(2*(nbr(s) - 1) + cc)
           if (q > 0) then
@@ -112,6 +127,15 @@ contains
         if (p == 0) cycle
         first = sys%colptr(p)
         sys%rowind(first + 1:first + nrow) = rows(1:nrow)
+      end do
+      if (.not. with_map) cycle
+      ! each cell of node k: the rows of its vertices in node k's columns
+      do t = cptr(k), cptr(k + 1) - 1
+        c = ccell(t)/nslot + 1
+        b = ccell(t) - nslot*(c - 1) + 1
+        do a = 1, nv_of(c)
+          cell_row(a, b, c) = rowoff(mesh%cells(a, c))
+        end do
       end do
     end do
     sys%val = 0.0_wp
@@ -132,14 +156,17 @@ contains
   end subroutine build_pattern
 
   !> The nodes that share a cell with each node (itself included), in increasing node id:
-  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). From the cells of each node (a
-  !! counting sort of the cells by vertex): their vertices, each kept once by a mark,
+  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). From the cells of each node, a
+  !! counting sort of the cells by vertex: node k is vertex a of cell c for each
+  !! ccell(t) = nslot (c - 1) + a - 1, t = cptr(k) .. cptr(k+1)-1, c increasing, nslot =
+  !! size(mesh%cells, 1); their vertices (nv(c) of cell c), each kept once by a mark,
   !! then sorted; for any mesh.
-  subroutine node_adjacency(mesh, aptr, adj)
+  subroutine node_adjacency(mesh, aptr, adj, cptr, ccell, nv)
     type(mesh_t), intent(in) :: mesh
-    integer, allocatable, intent(out) :: aptr(:), adj(:)
-    integer, allocatable :: cptr(:), ccell(:), pos(:), mark(:), nv(:)
-    integer :: c, a, k, l, t, i, first
+    integer, allocatable, intent(out) :: aptr(:), adj(:), cptr(:), ccell(:), nv(:)
+    integer, allocatable :: pos(:), mark(:)
+    integer :: c, a, k, l, t, i, first, nslot
+    nslot = size(mesh%cells, 1)
     allocate (nv(mesh%ncell), cptr(mesh%nnode + 1))
     cptr = 0
     do c = 1, mesh%ncell
@@ -158,7 +185,7 @@ contains
     do c = 1, mesh%ncell
       do a = 1, nv(c)
         k = mesh%cells(a, c)
-        ccell(pos(k)) = c
+        ccell(pos(k)) = nslot*(c - 1) + a - 1
         pos(k) = pos(k) + 1
       end do
     end do
@@ -170,7 +197,7 @@ contains
     do k = 1, mesh%nnode
       first = i + 1
       do t = cptr(k), cptr(k + 1) - 1
-        c = ccell(t)
+        c = ccell(t)/nslot + 1
         do a = 1, nv(c)          ! appended always, kept when not marked (no branch)
           l = mesh%cells(a, c)
           adj(i + 1) = l

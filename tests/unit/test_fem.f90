@@ -46,7 +46,7 @@ end module test_fem_manufactured
 !! and error reporting. Solves use LAPACK's banded Cholesky (testing's band_solve).
 program test_fem
   use kinds, only: wp
-  use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
+  use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
@@ -77,6 +77,9 @@ program test_fem
   call test_triplets(ELEM_Q1, 3)
   call test_triplets(ELEM_P1, 4)
   call test_q1_stiffness_bits()
+  call test_general_scatter(ELEM_Q1)
+  call test_general_scatter(ELEM_P1)
+  call test_mixed_scatter()
 
   call test_summary()
 
@@ -262,6 +265,160 @@ contains
     call report(bad == 0, 'Q1 element stiffness: the 2x2 Gauss sum over q1_gradients bit for bit '// &
                 '(2000 random quadrilaterals and a self-crossing one), mismatches', real(bad, wp), 0.0_wp)
   end subroutine test_q1_stiffness_bits
+
+  !> A mesh that is not structured is assembled at the places its pattern recorded for
+  !! each cell, the grid by searching each column's rows: the grid of loaded_rect and a
+  !! copy of it marked general with its nodes renumbered (k -> 17 (k - 1) mod nnode + 1),
+  !! held by named groups as loaded_rect's sides (left clamped, right displaced, bottom on
+  !! rollers: some nodes have one free DOF), give the same matrix and lifting bit for bit,
+  !! each entry being the same cells' sum in the same order.
+  subroutine test_general_scatter(element)
+    integer, intent(in) :: element
+    type(body_cfg_t) :: body
+    type(traction_cfg_t) :: tr(1)
+    type(mesh_t) :: m, g
+    type(body_system_t) :: s1, s2
+    type(error_t) :: err
+    type(boundary_cfg_t) :: bnd(3)
+    integer, allocatable :: perm(:), fmap(:)
+    real(wp), allocatable :: k1(:, :), k2(:, :)
+    integer :: info, k, c, d, e, i, nbad
+    character(len=256) :: msg
+    character(len=5) :: en
+
+    en = element_names(element)
+    call loaded_rect(element, 7, 4, body, tr(1), m)
+    body%bc = BC_FREE
+    bnd(:)%body = 1
+    bnd(1)%group = 'left'
+    bnd(1)%fix = .true.
+    bnd(2)%group = 'right'
+    bnd(2)%fix = .true.
+    bnd(2)%u = [0.01_wp, -0.02_wp]
+    bnd(3)%group = 'bottom'
+    bnd(3)%fix = [.false., .true.]
+    g = m
+    g%structured = .false.
+    allocate (perm(m%nnode))
+    do k = 1, m%nnode
+      perm(k) = mod(17*(k - 1), m%nnode) + 1
+    end do
+    g%xy(:, perm) = m%xy
+    do c = 1, m%ncell
+      g%cells(1:m%nvert, c) = perm(m%cells(1:m%nvert, c))
+    end do
+    do i = 1, g%ngroup
+      do e = 1, g%group(i)%nedge
+        g%group(i)%edge(:, e) = perm(m%group(i)%edge(:, e))
+      end do
+      if (g%group(i)%nnode > 0) g%group(i)%node = perm(m%group(i)%node)
+    end do
+    call assemble_body(m, body, .true., tr, 0, s1, err, boundaries=bnd)
+    call error_parts(err, info, msg)
+    if (info == 0) call assemble_body(g, body, .true., tr, 0, s2, err, boundaries=bnd)
+    call error_parts(err, info, msg)
+    if (info /= 0 .or. s1%n /= s2%n) then
+      call report(.false., trim(en)//' general numbering: assembled, same free DOF count')
+      return
+    end if
+    ! free index of the grid -> free index of the renumbered copy
+    allocate (fmap(s1%n))
+    do i = 1, s1%n
+      d = s1%dof_of(i)
+      k = (d + 1)/2
+      fmap(i) = s2%free_of(2*(perm(k) - 1) + d - 2*(k - 1))
+    end do
+    k1 = dense_of(s1)
+    k2 = dense_of(s2)
+    nbad = count(k1 /= k2(fmap, fmap)) + count(s1%f /= s2%f(fmap))
+    call report(all(fmap > 0) .and. s1%colptr(s1%n + 1) == s2%colptr(s2%n + 1) .and. nbad == 0 .and. &
+                any(s1%f /= 0.0_wp) .and. count(s1%free_of(2::2) == 0) > count(s1%free_of(1::2) == 0), &
+                trim(en)//' general mesh, nodes renumbered: the same matrix and lifting as the grid, bit for bit '// &
+                '(entries that differ)', real(nbad, wp), 0.0_wp)
+  end subroutine test_general_scatter
+
+  !> A mixed mesh (the grid of loaded_rect, every third cell split into two triangles):
+  !! its assembled lower triangle equals, bit for bit, the sum in cell order of its cells'
+  !! triplets (cell_triplets), and every column's rows are sorted.
+  subroutine test_mixed_scatter()
+    type(body_cfg_t) :: body
+    type(traction_cfg_t) :: tr(1)
+    type(mesh_t) :: m, g
+    type(body_system_t) :: sys
+    type(error_t) :: err
+    integer, allocatable :: irn(:), jcn(:)
+    real(wp), allocatable :: a(:), kd(:, :), ref(:, :)
+    integer :: info, c, n, q, j, nbad, ntri
+    logical :: sorted
+    character(len=256) :: msg
+
+    call loaded_rect(ELEM_Q1, 7, 4, body, tr(1), m)
+    ntri = 0
+    do c = 1, m%ncell
+      if (mod(c, 3) == 0) ntri = ntri + 1
+    end do
+    g = m
+    g%structured = .false.
+    g%element = ELEM_MIXED
+    g%ncell = m%ncell + ntri
+    deallocate (g%cells, g%cell_tag)
+    if (allocated(g%cell_type)) deallocate (g%cell_type)
+    allocate (g%cells(4, g%ncell), g%cell_type(g%ncell), g%cell_tag(g%ncell))
+    n = 0
+    do c = 1, m%ncell
+      if (mod(c, 3) == 0) then
+        g%cells(:, n + 1) = [m%cells(1:3, c), 0]
+        g%cells(:, n + 2) = [m%cells(1, c), m%cells(3:4, c), 0]
+        g%cell_type(n + 1:n + 2) = ELEM_P1
+        n = n + 2
+      else
+        g%cells(:, n + 1) = m%cells(:, c)
+        g%cell_type(n + 1) = ELEM_Q1
+        n = n + 1
+      end if
+    end do
+    g%cell_tag = [(c, c=1, g%ncell)]
+    call assemble_body(g, body, .true., tr, 0, sys, err)
+    call error_parts(err, info, msg)
+    if (info == 0) call cell_triplets(g, body, .true., sys, 1, g%ncell, irn, jcn, a, err)
+    call error_parts(err, info, msg)
+    if (info /= 0) then
+      call report(.false., 'mixed general mesh: assembled, triplets formed')
+      return
+    end if
+    allocate (ref(sys%n, sys%n))
+    ref = 0.0_wp
+    do q = 1, size(a)
+      ref(irn(q), jcn(q)) = ref(irn(q), jcn(q)) + a(q)
+    end do
+    kd = dense_of(sys)
+    nbad = 0
+    do j = 1, sys%n
+      nbad = nbad + count(kd(j:, j) /= ref(j:, j))
+    end do
+    sorted = .true.
+    do j = 1, sys%n
+      do q = sys%colptr(j) + 1, sys%colptr(j + 1) - 1
+        sorted = sorted .and. sys%rowind(q) < sys%rowind(q + 1)
+      end do
+    end do
+    call report(sorted .and. nbad == 0, 'mixed general mesh (Q1 and P1 cells): rows sorted, the lower triangle '// &
+                'is the sum of the cells'' triplets bit for bit (entries that differ)', real(nbad, wp), 0.0_wp)
+  end subroutine test_mixed_scatter
+
+  !> The assembled stiffness as a dense matrix (n x n).
+  function dense_of(sys) result(kd)
+    type(body_system_t), intent(in) :: sys
+    real(wp), allocatable :: kd(:, :)
+    integer :: j, p
+    allocate (kd(sys%n, sys%n))
+    kd = 0.0_wp
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        kd(sys%rowind(p) + 1, j) = sys%val(p)
+      end do
+    end do
+  end function dense_of
 
   subroutine test_structure(element)
     integer, intent(in) :: element
