@@ -14,6 +14,7 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp
+  use, intrinsic :: iso_fortran_env, only: int16
   use strings, only: body_label
   use sorting, only: sort_by_key
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
@@ -95,7 +96,7 @@ contains
     !! fa_stage), for load steps; absent: none
     integer, intent(in), optional :: nstage
     logical, allocatable :: prescribed(:)
-    integer, allocatable :: cell_row(:, :, :)
+    integer(int16), allocatable :: cell_row(:, :, :)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
     integer :: info
@@ -390,7 +391,7 @@ contains
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
-    integer, allocatable, intent(in), optional :: cell_row(:, :, :)   ! build_pattern's
+    integer(int16), allocatable, intent(in), optional :: cell_row(:, :, :)   ! build_pattern's
     integer :: c, nd, ldof(MAX_NDOF)
     real(wp) :: ke(MAX_NDOF, MAX_NDOF)
     type(ke_cache_t) :: cache
@@ -489,7 +490,7 @@ contains
   subroutine scatter_cell(sys, ldof, cell_row, ke)
     type(body_system_t), intent(inout) :: sys
     integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
-    integer, intent(in) :: cell_row(:, :)               ! (nv, nv) build_pattern's, of this cell
+    integer(int16), intent(in) :: cell_row(:, :)        ! (nv, nv) build_pattern's, of this cell
     real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
     integer :: nd, a, b, pos, fr(MAX_NDOF)
 
