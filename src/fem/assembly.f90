@@ -14,6 +14,7 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp
+  use, intrinsic :: iso_fortran_env, only: int16
   use strings, only: body_label
   use sorting, only: sort_by_key
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
@@ -95,6 +96,7 @@ contains
     !! fa_stage), for load steps; absent: none
     integer, intent(in), optional :: nstage
     logical, allocatable :: prescribed(:)
+    integer(int16), allocatable :: cell_row(:, :, :)
     real(wp) :: lame_lambda, lame_mu
     logical :: with_k
     integer :: info
@@ -125,13 +127,14 @@ contains
     end if
     call number_free_dofs(prescribed, sys)
     if (with_k) then
-      call build_pattern(mesh, sys, err)
+      call build_pattern(mesh, sys, err, cell_row)
       if (err%failed()) return
     end if
     call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
     if (err%failed()) return
-    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k)
+    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, cell_row)
     if (err%failed()) return
+    if (allocated(cell_row)) deallocate (cell_row)
     call add_applied_loads(sys)
     if (present(nstage)) then
       call stage_loads(mesh, lame_lambda, lame_mu, tractions(1:ntraction), nstage, sys, err, body_force)
@@ -377,27 +380,36 @@ contains
 
   !> The element loop: each cell's stiffness into the CSC values, and the lifting
   !! f -= K_fd u_d of its prescribed values, cell by cell (a mesh from a file is numbered
-  !! for locality, so consecutive cells touch nearby columns). err = ERR_INPUT on a cell
-  !! with a non-positive Jacobian, ERR_NUMERICAL on a coupling outside the pattern (an
-  !! internal error).
-  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k)
+  !! for locality, so consecutive cells touch nearby columns). The values go where
+  !! cell_row says when it is given (build_pattern's, a mesh that is not structured), else
+  !! each column's rows are searched (the grid, whose regular pattern makes the search
+  !! cheap). err = ERR_INPUT on a cell with a non-positive Jacobian, ERR_NUMERICAL on a
+  !! coupling outside the pattern (an internal error).
+  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, cell_row)
     type(mesh_t), intent(in) :: mesh
     real(wp), intent(in) :: lame_lambda, lame_mu
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
+    integer(int16), allocatable, intent(in), optional :: cell_row(:, :, :)   ! build_pattern's
     integer :: c, nd, ldof(MAX_NDOF)
     real(wp) :: ke(MAX_NDOF, MAX_NDOF)
     type(ke_cache_t) :: cache
-    logical :: inside
+    logical :: inside, mapped
     character(len=512) :: emsg
 
+    mapped = .false.
+    if (present(cell_row)) mapped = allocated(cell_row)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
       call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
       if (err%failed()) return
       inside = .true.
-      if (with_k) call scatter_element(sys, ldof(1:nd), ke, inside)
+      if (with_k .and. mapped) then
+        call scatter_cell(sys, ldof(1:nd), cell_row(:, :, c), ke)
+      else if (with_k) then
+        call scatter_element(sys, ldof(1:nd), ke, inside)
+      end if
       if (.not. inside) then
         write (emsg, '(a,i0,a,i0,a)') 'body ', sys%id, ': internal error, cell ', c, &
           ' couples DOFs outside the stiffness pattern'
@@ -471,6 +483,36 @@ contains
       end do
     end do
   end subroutine scatter_element
+
+  !> Add the free-free block of an element stiffness to the CSC values at the places
+  !! the pattern recorded for the cell: vertex a's free rows follow the first cell_row(a, b)
+  !! rows of each column of vertex b, x before y.
+  subroutine scatter_cell(sys, ldof, cell_row, ke)
+    type(body_system_t), intent(inout) :: sys
+    integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
+    integer(int16), intent(in) :: cell_row(:, :)        ! (nv, nv) build_pattern's, of this cell
+    real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
+    integer :: nd, a, b, pos, fr(MAX_NDOF)
+
+    nd = size(ldof)
+    do a = 1, nd
+      fr(a) = sys%free_of(ldof(a))
+    end do
+    do b = 1, nd
+      if (fr(b) == 0) cycle
+      do a = 1, nd, 2
+        pos = sys%colptr(fr(b)) + cell_row((a + 1)/2, (b + 1)/2)
+        if (fr(a) > 0) then
+          pos = pos + 1
+          sys%val(pos) = sys%val(pos) + ke(a, b)
+        end if
+        if (fr(a + 1) > 0) then
+          pos = pos + 1
+          sys%val(pos) = sys%val(pos) + ke(a + 1, b)
+        end if
+      end do
+    end do
+  end subroutine scatter_cell
 
   !> Lifting of an element's prescribed values: f(free) -= K_fd u_d, skipped when all
   !! its prescribed values are 0.

@@ -2,6 +2,7 @@
 !! the grid stencil on a structured mesh, from the cells' node adjacency on any other.
 module stiffness_pattern
   use kinds, only: wp, i8
+  use, intrinsic :: iso_fortran_env, only: int16
   use config, only: ELEM_Q1
   use mesh, only: mesh_t, node_id, cell_vertices
   use body_system, only: body_system_t
@@ -10,6 +11,9 @@ module stiffness_pattern
   private
 
   public :: build_pattern
+
+  !> The code of "vertex a of cell c" in a node's list of cells: NSLOT (c - 1) + a - 1
+  integer, parameter :: NSLOT = 4
 
 contains
 
@@ -47,27 +51,36 @@ contains
   !> The CSC pattern of the stiffness on free DOFs (sys%colptr, sys%rowind; sys%val = 0),
   !! rows sorted in every column: the free DOFs of the nodes sharing a cell with the
   !! column's node (the grid stencil, or the cells' node adjacency), formed once per node
-  !! for both of its columns. err = ERR_INPUT when the number of entries does not fit
-  !! 32-bit indices.
-  subroutine build_pattern(mesh, sys, err)
+  !! for both of its columns. On a mesh that is not structured, also where each cell's
+  !! entries go (cell_row), so that its assembly needs no search. err = ERR_INPUT when the
+  !! number of entries does not fit 32-bit indices.
+  subroutine build_pattern(mesh, sys, err, cell_row)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     type(body_system_t), intent(inout) :: sys  !< with its DOF numbering; gets colptr, rowind, val = 0
     type(error_t), intent(out) :: err          !< ERR_INPUT when the pattern is too large
-    integer :: p, s, cc, k, q, nnbr, nrow, first
+    !> (nv, nv, ncell), nv the most vertices of a cell; a mesh that is not structured only
+    !! (else, or when a column has more than huge(0_int16) rows, not allocated):
+    !! cell_row(a, b, c) = how many rows precede the first of vertex a's rows in each
+    !! column of vertex b of cell c (the column's free rows, in order); defined where
+    !! vertex b has a free DOF
+    integer(int16), allocatable, intent(out), optional :: cell_row(:, :, :)
+    integer :: p, s, cc, k, q, nnbr, nrow, first, t, c, a, b, nv, maxrow
     integer(i8) :: nnz
-    integer, allocatable :: aptr(:), adj(:), nbr(:), rows(:)
+    integer, allocatable :: aptr(:), adj(:), nbr(:), rows(:), cptr(:), ccell(:), nv_of(:), rowoff(:)
+    logical :: with_map
     character(len=512) :: emsg
 
     if (mesh%structured) then
       allocate (nbr(9))
     else
-      call node_adjacency(mesh, aptr, adj)
+      call node_adjacency(mesh, aptr, adj, cptr, ccell, nv_of)
       allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
     end if
     allocate (rows(2*size(nbr)))
     ! column counts: colptr(p + 1) = the entries of free DOF p, then their running sum
     allocate (sys%colptr(sys%n + 1))
     sys%colptr = 0
+    maxrow = 0
     do k = 1, mesh%nnode
       if (sys%free_of(2*k - 1) == 0 .and. sys%free_of(2*k) == 0) cycle
       call neighbours(k)
@@ -77,11 +90,18 @@ contains
           if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nrow = nrow + 1
         end do
       end do
+      maxrow = max(maxrow, nrow)
       do cc = 1, 2
         p = sys%free_of(2*(k - 1) + cc)
         if (p > 0) sys%colptr(p + 1) = nrow
       end do
     end do
+    ! the places of each cell's entries, unless an offset would not fit 16 bits
+    with_map = present(cell_row) .and. .not. mesh%structured .and. maxrow <= huge(0_int16)
+    if (with_map) then
+      nv = max(3, maxval(nv_of))
+      allocate (cell_row(nv, nv, mesh%ncell), rowoff(mesh%nnode))
+    end if
     nnz = 0
     do p = 1, sys%n
       nnz = nnz + sys%colptr(p + 1)
@@ -99,6 +119,7 @@ contains
       call neighbours(k)
       nrow = 0
       do s = 1, nnbr
+        if (with_map) rowoff(nbr(s)) = nrow
         do cc = 1, 2
           q = sys%free_of(2*(nbr(s) - 1) + cc)
           if (q > 0) then
@@ -112,6 +133,15 @@ contains
         if (p == 0) cycle
         first = sys%colptr(p)
         sys%rowind(first + 1:first + nrow) = rows(1:nrow)
+      end do
+      if (.not. with_map) cycle
+      ! each cell of node k: the rows of its vertices in node k's columns
+      do t = cptr(k), cptr(k + 1) - 1
+        c = ccell(t)/NSLOT + 1
+        b = ccell(t) - NSLOT*(c - 1) + 1
+        do a = 1, nv_of(c)
+          cell_row(a, b, c) = int(rowoff(mesh%cells(a, c)), int16)
+        end do
       end do
     end do
     sys%val = 0.0_wp
@@ -132,13 +162,15 @@ contains
   end subroutine build_pattern
 
   !> The nodes that share a cell with each node (itself included), in increasing node id:
-  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). From the cells of each node (a
-  !! counting sort of the cells by vertex): their vertices, each kept once by a mark,
+  !! node k's neighbours are adj(aptr(k):aptr(k+1)-1). From the cells of each node, a
+  !! counting sort of the cells by vertex: node k is vertex a of cell c for each
+  !! ccell(t) = NSLOT (c - 1) + a - 1, t = cptr(k) .. cptr(k+1)-1, c increasing; their
+  !! vertices (nv(c) of cell c), each kept once by a mark,
   !! then sorted; for any mesh.
-  subroutine node_adjacency(mesh, aptr, adj)
+  subroutine node_adjacency(mesh, aptr, adj, cptr, ccell, nv)
     type(mesh_t), intent(in) :: mesh
-    integer, allocatable, intent(out) :: aptr(:), adj(:)
-    integer, allocatable :: cptr(:), ccell(:), pos(:), mark(:), nv(:)
+    integer, allocatable, intent(out) :: aptr(:), adj(:), cptr(:), ccell(:), nv(:)
+    integer, allocatable :: pos(:), mark(:)
     integer :: c, a, k, l, t, i, first
     allocate (nv(mesh%ncell), cptr(mesh%nnode + 1))
     cptr = 0
@@ -158,7 +190,7 @@ contains
     do c = 1, mesh%ncell
       do a = 1, nv(c)
         k = mesh%cells(a, c)
-        ccell(pos(k)) = c
+        ccell(pos(k)) = NSLOT*(c - 1) + a - 1
         pos(k) = pos(k) + 1
       end do
     end do
@@ -170,7 +202,7 @@ contains
     do k = 1, mesh%nnode
       first = i + 1
       do t = cptr(k), cptr(k + 1) - 1
-        c = ccell(t)
+        c = ccell(t)/NSLOT + 1
         do a = 1, nv(c)          ! appended always, kept when not marked (no branch)
           l = mesh%cells(a, c)
           adj(i + 1) = l

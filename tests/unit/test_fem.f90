@@ -46,7 +46,8 @@ end module test_fem_manufactured
 !! and error reporting. Solves use LAPACK's banded Cholesky (testing's band_solve).
 program test_fem
   use kinds, only: wp
-  use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
+  use, intrinsic :: iso_fortran_env, only: int16
+  use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, mesh_build, side_nodes
@@ -77,6 +78,10 @@ program test_fem
   call test_triplets(ELEM_Q1, 3)
   call test_triplets(ELEM_P1, 4)
   call test_q1_stiffness_bits()
+  call test_general_scatter(ELEM_Q1)
+  call test_general_scatter(ELEM_P1)
+  call test_mixed_scatter()
+  call test_fan_scatter()
 
   call test_summary()
 
@@ -262,6 +267,235 @@ contains
     call report(bad == 0, 'Q1 element stiffness: the 2x2 Gauss sum over q1_gradients bit for bit '// &
                 '(2000 random quadrilaterals and a self-crossing one), mismatches', real(bad, wp), 0.0_wp)
   end subroutine test_q1_stiffness_bits
+
+  !> A mesh that is not structured is assembled at the places its pattern recorded for
+  !! each cell, the grid by searching each column's rows: the grid of loaded_rect and a
+  !! copy of it marked general with its nodes renumbered (k -> 17 (k - 1) mod nnode + 1),
+  !! held by named groups as loaded_rect's sides (left clamped, right displaced, bottom on
+  !! rollers: some nodes have one free DOF), give the same matrix and lifting bit for bit,
+  !! each entry being the same cells' sum in the same order.
+  subroutine test_general_scatter(element)
+    integer, intent(in) :: element
+    type(body_cfg_t) :: body
+    type(traction_cfg_t) :: tr(1)
+    type(mesh_t) :: m, g
+    type(body_system_t) :: s1, s2
+    type(error_t) :: err
+    type(boundary_cfg_t) :: bnd(3)
+    integer, allocatable :: perm(:), fmap(:)
+    real(wp), allocatable :: k1(:, :), k2(:, :)
+    integer :: info, k, c, d, e, i, nbad
+    character(len=256) :: msg
+    character(len=5) :: en
+
+    en = element_names(element)
+    call loaded_rect(element, 7, 4, body, tr(1), m)
+    body%bc = BC_FREE
+    bnd(:)%body = 1
+    bnd(1)%group = 'left'
+    bnd(1)%fix = .true.
+    bnd(2)%group = 'right'
+    bnd(2)%fix = .true.
+    bnd(2)%u = [0.01_wp, -0.02_wp]
+    bnd(3)%group = 'bottom'
+    bnd(3)%fix = [.false., .true.]
+    g = m
+    g%structured = .false.
+    allocate (perm(m%nnode))
+    do k = 1, m%nnode
+      perm(k) = mod(17*(k - 1), m%nnode) + 1
+    end do
+    g%xy(:, perm) = m%xy
+    do c = 1, m%ncell
+      g%cells(1:m%nvert, c) = perm(m%cells(1:m%nvert, c))
+    end do
+    do i = 1, g%ngroup
+      do e = 1, g%group(i)%nedge
+        g%group(i)%edge(:, e) = perm(m%group(i)%edge(:, e))
+      end do
+      if (g%group(i)%nnode > 0) g%group(i)%node = perm(m%group(i)%node)
+    end do
+    call assemble_body(m, body, .true., tr, 0, s1, err, boundaries=bnd)
+    call error_parts(err, info, msg)
+    if (info == 0) call assemble_body(g, body, .true., tr, 0, s2, err, boundaries=bnd)
+    call error_parts(err, info, msg)
+    if (info /= 0 .or. s1%n /= s2%n) then
+      call report(.false., trim(en)//' general numbering: assembled, same free DOF count')
+      return
+    end if
+    ! free index of the grid -> free index of the renumbered copy
+    allocate (fmap(s1%n))
+    do i = 1, s1%n
+      d = s1%dof_of(i)
+      k = (d + 1)/2
+      fmap(i) = s2%free_of(2*(perm(k) - 1) + d - 2*(k - 1))
+    end do
+    k1 = dense_of(s1)
+    k2 = dense_of(s2)
+    nbad = count(k1 /= k2(fmap, fmap)) + count(s1%f /= s2%f(fmap))
+    call report(all(fmap > 0) .and. s1%colptr(s1%n + 1) == s2%colptr(s2%n + 1) .and. nbad == 0 .and. &
+                any(s1%f /= 0.0_wp) .and. count(s1%free_of(2::2) == 0) > count(s1%free_of(1::2) == 0), &
+                trim(en)//' general mesh, nodes renumbered: the same matrix and lifting as the grid, bit for bit '// &
+                '(entries that differ)', real(nbad, wp), 0.0_wp)
+  end subroutine test_general_scatter
+
+  !> A mixed mesh (the grid of loaded_rect, every third cell split into two triangles):
+  !! its assembled lower triangle equals, bit for bit, the sum in cell order of its cells'
+  !! triplets (cell_triplets), and every column's rows are sorted.
+  subroutine test_mixed_scatter()
+    type(body_cfg_t) :: body
+    type(traction_cfg_t) :: tr(1)
+    type(mesh_t) :: m, g
+    type(body_system_t) :: sys
+    type(error_t) :: err
+    integer :: info, c, n, nbad, ntri
+    character(len=256) :: msg
+
+    call loaded_rect(ELEM_Q1, 7, 4, body, tr(1), m)
+    ntri = 0
+    do c = 1, m%ncell
+      if (mod(c, 3) == 0) ntri = ntri + 1
+    end do
+    g = m
+    g%structured = .false.
+    g%element = ELEM_MIXED
+    g%ncell = m%ncell + ntri
+    deallocate (g%cells, g%cell_tag)
+    if (allocated(g%cell_type)) deallocate (g%cell_type)
+    allocate (g%cells(4, g%ncell), g%cell_type(g%ncell), g%cell_tag(g%ncell))
+    n = 0
+    do c = 1, m%ncell
+      if (mod(c, 3) == 0) then
+        g%cells(:, n + 1) = [m%cells(1:3, c), 0]
+        g%cells(:, n + 2) = [m%cells(1, c), m%cells(3:4, c), 0]
+        g%cell_type(n + 1:n + 2) = ELEM_P1
+        n = n + 2
+      else
+        g%cells(:, n + 1) = m%cells(:, c)
+        g%cell_type(n + 1) = ELEM_Q1
+        n = n + 1
+      end if
+    end do
+    g%cell_tag = [(c, c=1, g%ncell)]
+    call assemble_body(g, body, .true., tr, 0, sys, err)
+    call error_parts(err, info, msg)
+    nbad = -1
+    if (info == 0) nbad = triplet_mismatch(g, body, sys)
+    call report(nbad == 0, 'mixed general mesh (Q1 and P1 cells): rows sorted, the lower triangle '// &
+                'is the sum of the cells'' triplets bit for bit (entries that differ)', real(nbad, wp), 0.0_wp)
+  end subroutine test_mixed_scatter
+
+  !> A fan of 16,400 triangles around one node, one rim edge clamped: the centre's
+  !! columns have 32,798 rows, more than 16-bit offsets hold, so the cells' places are not
+  !! recorded and each column's rows are searched; the lower triangle is still the sum of
+  !! the cells' triplets bit for bit.
+  subroutine test_fan_scatter()
+    integer, parameter :: nfan = 16400
+    real(wp), parameter :: pi = acos(-1.0_wp)
+    type(body_cfg_t) :: body
+    type(traction_cfg_t) :: tr(1)
+    type(boundary_cfg_t) :: bnd(1)
+    type(mesh_t) :: g
+    type(body_system_t) :: sys
+    type(error_t) :: err
+    integer :: info, i, nbad, longest
+    character(len=256) :: msg
+
+    body = rect_body(1, 0.0_wp, 0.0_wp, 1.0_wp, 1.0_wp, 1, 1, ELEM_P1, young=70.0_wp, poisson=0.33_wp)
+    g%structured = .false.
+    g%element = ELEM_P1
+    g%nvert = 3
+    g%nnode = nfan + 1
+    g%ncell = nfan
+    allocate (g%xy(2, g%nnode), g%cells(3, g%ncell), g%cell_tag(g%ncell), g%node_tag(g%nnode))
+    g%xy(:, 1) = 0.0_wp
+    do i = 1, nfan
+      g%xy(:, i + 1) = [cos(2.0_wp*pi*(i - 1)/nfan), sin(2.0_wp*pi*(i - 1)/nfan)]
+      g%cells(:, i) = [1, i + 1, mod(i, nfan) + 2]
+    end do
+    g%cell_tag = [(i, i=1, g%ncell)]
+    g%node_tag = [(i, i=1, g%nnode)]
+    g%ngroup = 1
+    allocate (g%group(1))
+    g%group(1)%name = 'rim'
+    g%group(1)%nedge = 1
+    g%group(1)%edge = reshape([2, 3], [2, 1])
+    g%group(1)%cell = [1]
+    bnd(1)%body = 1
+    bnd(1)%group = 'rim'
+    bnd(1)%fix = .true.
+    call assemble_body(g, body, .true., tr, 0, sys, err, boundaries=bnd)
+    call error_parts(err, info, msg)
+    nbad = -1
+    longest = 0
+    if (info == 0) then
+      nbad = triplet_mismatch(g, body, sys)
+      longest = maxval(sys%colptr(2:) - sys%colptr(:sys%n))
+    end if
+    call report(nbad == 0 .and. longest > huge(0_int16), 'fan of 16,400 triangles (a column longer than 16-bit '// &
+                'offsets): the lower triangle is the sum of the cells'' triplets bit for bit (entries that differ)', &
+                real(nbad, wp), 0.0_wp)
+  end subroutine test_fan_scatter
+
+  !> How many lower-triangle entries of sys differ from the sum, in cell order, of the
+  !! cells' triplets (cell_triplets); -1 when the triplets fail, a column's rows are not
+  !! strictly increasing, or a triplet falls outside the pattern.
+  integer function triplet_mismatch(g, body, sys) result(nbad)
+    type(mesh_t), intent(in) :: g
+    type(body_cfg_t), intent(in) :: body
+    type(body_system_t), intent(in) :: sys
+    type(error_t) :: err
+    integer, allocatable :: irn(:), jcn(:)
+    real(wp), allocatable :: a(:), ref(:)
+    integer :: q, j, lo, hi, mid, info
+    character(len=256) :: msg
+    nbad = -1
+    call cell_triplets(g, body, .true., sys, 1, g%ncell, irn, jcn, a, err)
+    call error_parts(err, info, msg)
+    if (info /= 0) return
+    do j = 1, sys%n
+      do q = sys%colptr(j) + 1, sys%colptr(j + 1) - 1
+        if (sys%rowind(q) >= sys%rowind(q + 1)) return
+      end do
+    end do
+    allocate (ref(size(sys%val)))
+    ref = 0.0_wp
+    do q = 1, size(a)
+      lo = sys%colptr(jcn(q)) + 1
+      hi = sys%colptr(jcn(q) + 1)
+      do while (lo < hi)
+        mid = (lo + hi)/2
+        if (sys%rowind(mid) < irn(q) - 1) then
+          lo = mid + 1
+        else
+          hi = mid
+        end if
+      end do
+      if (lo > sys%colptr(jcn(q) + 1)) return
+      if (sys%rowind(lo) /= irn(q) - 1) return
+      ref(lo) = ref(lo) + a(q)
+    end do
+    nbad = 0
+    do j = 1, sys%n
+      do q = sys%colptr(j) + 1, sys%colptr(j + 1)
+        if (sys%rowind(q) + 1 >= j .and. sys%val(q) /= ref(q)) nbad = nbad + 1
+      end do
+    end do
+  end function triplet_mismatch
+
+  !> The assembled stiffness as a dense matrix (n x n).
+  function dense_of(sys) result(kd)
+    type(body_system_t), intent(in) :: sys
+    real(wp), allocatable :: kd(:, :)
+    integer :: j, p
+    allocate (kd(sys%n, sys%n))
+    kd = 0.0_wp
+    do j = 1, sys%n
+      do p = sys%colptr(j) + 1, sys%colptr(j + 1)
+        kd(sys%rowind(p) + 1, j) = sys%val(p)
+      end do
+    end do
+  end function dense_of
 
   subroutine test_structure(element)
     integer, intent(in) :: element
