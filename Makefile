@@ -140,8 +140,8 @@ $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelis
 $(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
 $(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
-$(BUILD)/gmsh_msh.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/text_scanner.o \
-                           $(BUILD)/mesh.o $(BUILD)/mesh_topology.o
+$(BUILD)/gmsh_msh.o:       $(BUILD)/digest.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
+                           $(BUILD)/mesh_topology.o $(BUILD)/strings.o $(BUILD)/text_scanner.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o

@@ -61,37 +61,43 @@ contains
     hex = to_hex(hi, lo)
   end subroutine file_digest
 
-  !> The FNV-1a 64 hash of the characters of `text` (16 lowercase hex digits).
+  !> The FNV-1a 64 hash of the characters of `text` (16 lowercase hex digits): of the bytes
+  !! of a file read whole into `text`, the same as file_digest's (no copy of the text: a mesh
+  !! file of tens of MB is hashed where it lies).
   function text_digest(text) result(hex)
     character(len=*), intent(in) :: text   !< the bytes to hash
     character(len=16) :: hex
-    integer(int8) :: b(len(text))
-    integer(int64) :: hi, lo
-    integer :: i
-    do i = 1, len(text)
-      b(i) = int(ichar(text(i:i)) - merge(256, 0, ichar(text(i:i)) > 127), int8)
-    end do
+    integer(int64) :: hi, lo, i
     hi = BASIS_HI
     lo = BASIS_LO
-    call mix(b, hi, lo)
+    do i = 1, len(text, kind=int64)
+      call step(int(iachar(text(i:i)), int64), hi, lo)
+    end do
     hex = to_hex(hi, lo)
   end function text_digest
 
-  !> FNV-1a 64 over `bytes`, the state held as two 32-bit halves (hi, lo) so that no
-  !! integer operation overflows: h = (h xor byte) * (2**40 + 0x1b3) mod 2**64.
+  !> FNV-1a 64 over `bytes`.
   pure subroutine mix(bytes, hi, lo)
     integer(int8), intent(in) :: bytes(:)
     integer(int64), intent(inout) :: hi, lo
-    integer(int64) :: t
     integer :: i
     do i = 1, size(bytes)
-      lo = ieor(lo, iand(int(bytes(i), int64), 255_int64))
-      ! h * 0x1b3 plus h * 2**40; of the latter only lo's low 24 bits stay below 2**64
-      t = lo*PRIME_LOW
-      hi = iand(hi*PRIME_LOW + shiftr(t, 32) + shiftl(iand(lo, MASK24), 8), MASK32)
-      lo = iand(t, MASK32)
+      call step(int(bytes(i), int64), hi, lo)
     end do
   end subroutine mix
+
+  !> One byte (its low 8 bits) into the FNV-1a 64 state, held as two 32-bit halves (hi, lo)
+  !! so that no integer operation overflows: h = (h xor byte) * (2**40 + 0x1b3) mod 2**64.
+  pure subroutine step(byte, hi, lo)
+    integer(int64), intent(in) :: byte
+    integer(int64), intent(inout) :: hi, lo
+    integer(int64) :: t
+    lo = ieor(lo, iand(byte, 255_int64))
+    ! h * 0x1b3 plus h * 2**40; of the latter only lo's low 24 bits stay below 2**64
+    t = lo*PRIME_LOW
+    hi = iand(hi*PRIME_LOW + shiftr(t, 32) + shiftl(iand(lo, MASK24), 8), MASK32)
+    lo = iand(t, MASK32)
+  end subroutine step
 
   !> The hash as 16 lowercase hex digits.
   function to_hex(hi, lo) result(hex)

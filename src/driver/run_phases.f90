@@ -94,7 +94,8 @@ contains
     associate (deck => run%deck)
       run%nbody = deck%nbody
       allocate (run%meshes(deck%nbody), run%systems(deck%nbody), run%bodies(deck%nbody), err(deck%nbody), &
-                done(deck%nbody))
+                done(deck%nbody), run%mesh_hex(deck%nbody))
+      run%mesh_hex = ''
       do a = 1, deck%nbody   ! opening a FIFO or device would wait or read forever
         if (len_trim(deck%body(a)%mesh) == 0) cycle
         if (special_file(trim(deck%body(a)%mesh))) call fail_on(error_t(ERR_INPUT, 'body '//i2s(a)// &
@@ -110,10 +111,12 @@ contains
         block
           type(mesh_t), allocatable :: shared(:)
           type(error_t), allocatable :: serr(:)
+          character(len=16) :: hex
           allocate (shared(size(ids)), serr(size(ids)))
           call msh_read_shared(trim(deck%body(a)%mesh), [(deck%body(ids(k))%region, k=1, size(ids))], ids, shared, &
-                               serr, run%threads)
+                               serr, run%threads, hex)
           do k = 1, size(ids)
+            run%mesh_hex(ids(k)) = hex
             run%meshes(ids(k)) = shared(k)
             err(ids(k)) = serr(k)
             done(ids(k)) = .true.
@@ -124,7 +127,7 @@ contains
       do a = 1, deck%nbody
         if (done(a)) cycle
         if (len_trim(deck%body(a)%mesh) > 0) then
-          call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a))
+          call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a), run%mesh_hex(a))
         else
           call mesh_build(run%meshes(a), deck%body(a))
         end if
@@ -217,15 +220,16 @@ contains
     end do
   end subroutine build_contact_line
 
-  !> The content hashes of the mesh files just read, which a checkpoint records; the
-  !! checkpoint to restart from is input too: read and checked before any file is touched.
+  !> The content hashes of the mesh files just read (of the bytes the reader parsed), which a
+  !! checkpoint records; the checkpoint to restart from is input too: read and checked
+  !! before any file is touched.
   subroutine read_restart(run)
     type(run_t), intent(inout) :: run   !< the run: its mesh hashes, Robin state and result
     type(error_t) :: err
     integer :: a, k
     type(contact_result_t), allocatable :: done(:)
     ! an array constructor, not the section body(:)%mesh, whose temporary the checked build reports
-    call mesh_identity([(run%deck%body(a)%mesh, a=1, run%nbody)], run%mesh_ids, err)
+    call mesh_identity([(run%deck%body(a)%mesh, a=1, run%nbody)], run%mesh_ids, err, run%mesh_hex)
     call fail_on(err, 'deck '//trim(run%deck%source))
     if (len(run%restart_file) == 0) return
     call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%nbody, &

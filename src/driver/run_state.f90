@@ -32,6 +32,7 @@ module run_state
     character(len=:), allocatable :: restart_file      !< checkpoint to restart from ('' none)
     character(len=:), allocatable :: key               !< the deck's physics, which a checkpoint must match
     character(len=:), allocatable :: mesh_ids          !< content hashes of the mesh files, which a checkpoint must match
+    character(len=16), allocatable :: mesh_hex(:)      !< each body's mesh file's hash, of the bytes read ('' none)
     integer :: threads = 1                             !< OpenMP threads over the bodies
     integer :: nbody = 2                               !< bodies
     type(mesh_t), allocatable :: meshes(:)             !< the bodies' meshes

@@ -21,6 +21,7 @@ module gmsh_msh
   use kinds, only: wp, i8
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s
+  use digest, only: text_digest
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use text_scanner, only: scanner_t, scanner_load, scan_fail, next_token, get_int, get_real, read_count, &
                           expect, skip_past, bytes_left, SCAN_OTHER_FAILURE
@@ -58,17 +59,22 @@ contains
   !! group per physical curve with edges on the body's boundary, then one node group per
   !! physical point with nodes of the body (`file_groups` lists every physical curve and
   !! point name of the file).
-  subroutine msh_read(path, region, body_id, mesh, err)
+  subroutine msh_read(path, region, body_id, mesh, err, hex)
     character(len=*), intent(in) :: path     !< the .msh file
     character(len=*), intent(in) :: region   !< physical surface name of the body, or ''
     integer, intent(in) :: body_id           !< the body's number, for messages
     type(mesh_t), intent(out) :: mesh        !< the body's mesh
     type(error_t), intent(out) :: err        !< ERR_INPUT (bad file) or ERR_MEMORY, one sentence
+    character(len=16), intent(out), optional :: hex  !< the content hash of the bytes read ('' if none)
     type(scanner_t) :: scanner
     type(file_mesh_t) :: file_mesh
 
     allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8))
     call scanner_load(scanner, path)
+    if (present(hex)) then
+      hex = ''
+      if (scanner%info == 0) hex = text_digest(scanner%text)
+    end if
     if (scanner%info == 0) call parse(scanner, file_mesh)
     if (scanner%info == 0) call build(scanner, file_mesh, trim(region), mesh)
     if (allocated(scanner%text)) deallocate (scanner%text)
@@ -78,23 +84,34 @@ contains
   !> Several bodies from one .msh file (the same path for all): the file is read and parsed
   !! once, then each body is built from it (the bodies in parallel on `nthr` threads).
   !! Arguments as msh_read's, one per body.
-  subroutine msh_read_shared(path, region, ids, mesh, err, nthr)
+  subroutine msh_read_shared(path, region, ids, mesh, err, nthr, hex)
     character(len=*), intent(in) :: path          !< the .msh file of these bodies
     character(len=*), intent(in) :: region(:)     !< physical surface name of each body
     integer, intent(in) :: ids(:)                 !< each body's id (messages)
     type(mesh_t), intent(inout) :: mesh(:)        !< the bodies' meshes
     type(error_t), intent(out) :: err(:)          !< each body's error, as msh_read's
     integer, intent(in) :: nthr                   !< threads for the builds
+    character(len=16), intent(out), optional :: hex  !< the content hash of the bytes read ('' if none)
     type(scanner_t) :: scanner
     type(scanner_t), allocatable :: body_scanner(:)
     type(file_mesh_t) :: file_mesh
     integer :: a, n
+    logical :: loaded
 
     n = size(region)
     allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), body_scanner(n))
     call scanner_load(scanner, path)
-    if (scanner%info == 0) call parse(scanner, file_mesh)
+    loaded = scanner%info == 0
+    if (present(hex)) hex = ''
+    ! the content hash (which a checkpoint records) of the same bytes, beside the parse
+    ! (which changes the scanner's position and status, never its text)
+    !$omp parallel sections num_threads(min(2, nthr)) if (loaded .and. present(hex))
+    !$omp section
+    if (loaded) call parse(scanner, file_mesh)
     if (scanner%info == 0) call index_groups(file_mesh)     ! once for all the bodies
+    !$omp section
+    if (loaded .and. present(hex)) hex = text_digest(scanner%text)
+    !$omp end parallel sections
     if (allocated(scanner%text)) deallocate (scanner%text)
     do a = 1, n
       body_scanner(a) = scanner

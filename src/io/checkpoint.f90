@@ -73,17 +73,22 @@ contains
   !> The identity of the mesh files a deck reads: one line `<hash>  <path>` per distinct
   !! file (hash: FNV-1a 64 of its bytes, 16 hex digits), lines joined by a newline; ''
   !! when the deck reads none. err (ERR_IO) when a file cannot be read whole.
-  subroutine mesh_identity(paths, text, err)
+  subroutine mesh_identity(paths, text, err, known)
     character(len=*), intent(in) :: paths(:)            !< each body's mesh file ('' none)
     character(len=:), allocatable, intent(out) :: text  !< the identity
     type(error_t), intent(out) :: err                   !< why a file could not be hashed
+    !> each body's file's hash where already known (the reader's, of the bytes it parsed;
+    !! '': the file is read again and hashed)
+    character(len=16), intent(in), optional :: known(:)
     character(len=16) :: hex
     integer :: a
     text = ''
     do a = 1, size(paths)
       if (len_trim(paths(a)) == 0) cycle
       if (any(paths(1:a - 1) == paths(a))) cycle
-      call file_digest(trim(paths(a)), hex, err)
+      hex = ''
+      if (present(known)) hex = known(a)
+      if (len_trim(hex) == 0) call file_digest(trim(paths(a)), hex, err)
       if (err%failed()) return
       if (len(text) > 0) text = text//achar(10)
       text = text//hex//'  '//trim(paths(a))

@@ -15,6 +15,7 @@ program test_gmsh
   use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
   use mesh, only: mesh_t, group_index, group_nodes, group_names, nodes_only, nodes_only_refusal, file_order, file_cells
   use gmsh_msh, only: msh_read_err => msh_read, msh_read_shared
+  use digest, only: file_digest
   use errors, only: error_t, exit_code
   use strings, only: i2s, word
   use testing, only: report, report_le, test_summary, write_file
@@ -273,7 +274,8 @@ contains
   !> The n bodies 'b1'..'bn' of one file read together (msh_read_shared: the file parsed
   !! once, each body found from the file's indexes, a small part of the file) equal each
   !! read alone (msh_read: the passes over the whole file): nodes, coordinates, cells,
-  !! tags, file order, groups (edges, their cells, single nodes) and the group names.
+  !! tags, file order, groups (edges, their cells, single nodes) and the group names; the
+  !! content hash computed beside the parse (and by msh_read) is the file's (file_digest).
   subroutine test_shared(path, n)
     character(len=*), intent(in) :: path
     integer, intent(in) :: n
@@ -281,14 +283,19 @@ contains
     type(mesh_t) :: one
     type(error_t), allocatable :: errs(:)
     type(error_t) :: err
-    character(len=16) :: region(n)
+    character(len=16) :: region(n), hex, hex_file
     integer :: a, g, nbad, nedge
     logical :: same
     do a = 1, n
       region(a) = 'b'//i2s(a)
     end do
     allocate (m(n), errs(n))
-    call msh_read_shared(path, region, [(a, a=1, n)], m, errs, 2)
+    call msh_read_shared(path, region, [(a, a=1, n)], m, errs, 2, hex)
+    call file_digest(path, hex_file, err)
+    call report(.not. err%failed() .and. hex == hex_file, path//': the content hash of the bytes read together ('// &
+                hex//') = the file'//"'"//'s, read again ('//hex_file//')')
+    call msh_read_err(path, 'b1', 1, one, err, hex)
+    call report(hex == hex_file, path//': the content hash of a body read alone = the file'//"'"//'s ('//hex//')')
     nbad = 0
     nedge = 0
     do a = 1, n
