@@ -18,4 +18,12 @@ int rc_path_kind(const char *path);
 int rc_file_kind(const char *path);
 /* 1 when the folder dir can take new entries (write and search permission), else 0. */
 int rc_dir_writable(const char *dir);
+/* A file's data written at given offsets (the raw data of reserved HDF5 datasets): open
+   for writing (-1 on failure), write n bytes at offset (0 or an errno; short writes and
+   EINTR retried), close (0 or an errno). */
+int rc_open_data(const char *path);
+int rc_write_at(int fd, const void *buf, long long n, long long offset);
+int rc_close_data(int fd);
+/* The text of errno value e into buf (n bytes, NUL-terminated); returns its length. */
+int rc_error_text(int e, char *buf, int n);
 #endif

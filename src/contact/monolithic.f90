@@ -21,7 +21,7 @@ module monolithic
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
-  use contact_common, only: interface_residual, all_finite, gather, scatter
+  use contact_common, only: interface_residual, all_finite, gather, scatter, body_threads
   use equality_rows, only: equality_t, equality_init, equality_add_penalty, stacked_rows, equality_force_scaled
   implicit none (type, external)
   private
@@ -233,8 +233,11 @@ contains
     logical, intent(in), optional :: sorted          !< rows ascending in each column (CHOLMOD's input)
     integer, allocatable :: owner(:, :), colptr(:), rowind(:), mark(:), list(:)
     real(wp), allocatable :: val(:), acc(:), rowsum(:)
-    integer :: m, a, s, i, j, k, nnz, n, row, slot
+    integer :: m, a, s, i, j, k, n, row, slot, p
+    logical :: sort_rows
     m = contact_line%m
+    sort_rows = .false.
+    if (present(sorted)) sort_rows = sorted
     ! owner(:, j): (body, position in its rows) of each side of row j
     allocate (owner(4, m))
     do a = 1, size(bodies)
@@ -245,50 +248,62 @@ contains
         owner(2*s - 1:2*s, row) = [a, i]
       end do
     end do
-    allocate (colptr(m + 1), mark(m), acc(m), list(m), rowsum(m))
+    allocate (colptr(m + 1), rowsum(m))
+    ! the columns on the threads, each with its own work arrays: pass 1 counts a column's
+    ! entries, pass 2 sums and stores them (every column the same sums in the same order)
+    !$omp parallel num_threads(body_threads()) private(j, k, n, p, mark, acc, list) if (m > 256)
+    allocate (mark(m), acc(m), list(m))
     mark = 0
     acc = 0.0_wp
-    ! pass 1: the pattern's size
-    nnz = 0
+    !$omp do schedule(static)
     do j = 1, m
       n = 0
-      call visit(j, .false.)
-      nnz = nnz + n
+      call visit(j, .false., n, mark, acc, list)
+      colptr(j + 1) = n
       do k = 1, n
         mark(list(k)) = 0
       end do
     end do
-    allocate (rowind(nnz), val(nnz))
+    !$omp end do
+    !$omp single
     colptr(1) = 0
-    nnz = 0
+    do j = 1, m
+      colptr(j + 1) = colptr(j) + colptr(j + 1)
+    end do
+    allocate (rowind(colptr(m + 1)), val(colptr(m + 1)))
+    !$omp end single
+    !$omp do schedule(static)
     do j = 1, m
       n = 0
-      call visit(j, .true.)
-      if (present(sorted)) then
-        if (sorted) call sort_ints(list(1:n))
-      end if
+      call visit(j, .true., n, mark, acc, list)
+      if (sort_rows) call sort_ints(list(1:n))
       rowsum(j) = 0.0_wp
+      p = colptr(j)
       do k = 1, n
-        nnz = nnz + 1
-        rowind(nnz) = list(k) - 1
-        val(nnz) = acc(list(k))
+        p = p + 1
+        rowind(p) = list(k) - 1
+        val(p) = acc(list(k))
         rowsum(j) = rowsum(j) + abs(acc(list(k)))
         acc(list(k)) = 0.0_wp
         mark(list(k)) = 0
       end do
-      colptr(j + 1) = nnz
     end do
+    !$omp end do
+    deallocate (mark, acc, list)
+    !$omp end parallel
     lmax = 0.0_wp
     if (m > 0) lmax = maxval(rowsum)
     call csc_op_init(op, m, colptr, rowind, val)
 
   contains
 
-    !> Column j's entries from the blocks of its two bodies: rows into list(1:n), values
-    !! summed into acc (when add).
-    subroutine visit(jj, add)
+    !> Column jj's entries from the blocks of its two bodies: rows into lst(1:nn) (mk marks
+    !! them), values summed into ac (when add).
+    subroutine visit(jj, add, nn, mk, ac, lst)
       integer, intent(in) :: jj
       logical, intent(in) :: add
+      integer, intent(inout) :: nn, mk(:), lst(:)
+      real(wp), intent(inout) :: ac(:)
       integer :: side, b, col, ii, sl, r
       do side = 1, 2
         b = owner(2*side - 1, jj)
@@ -296,12 +311,12 @@ contains
         do ii = 1, bodies(b)%m
           sl = bodies(b)%slots(ii)
           r = slot_row(sl, m)
-          if (mark(r) == 0) then
-            n = n + 1
-            list(n) = r
-            mark(r) = 1
+          if (mk(r) == 0) then
+            nn = nn + 1
+            lst(nn) = r
+            mk(r) = 1
           end if
-          if (add) acc(r) = acc(r) + bodies(b)%flex(ii, col)
+          if (add) ac(r) = ac(r) + bodies(b)%flex(ii, col)
         end do
       end do
     end subroutine visit

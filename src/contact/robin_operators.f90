@@ -329,11 +329,10 @@ contains
     type(error_t), intent(out) :: err
     real(wp), allocatable :: s(:, :)
     integer :: p, info, side, a, k, r(2, 2)
-    integer, allocatable :: npairs(:), order(:), stiff_info(:)
+    integer, allocatable :: npairs(:), order(:), stiff_info(:), pair_info(:)
     logical, allocatable :: needs_stiffness(:)
     type(block_t) :: blk(2)
     type(stiffness_t), allocatable :: stiff(:)
-    logical :: singular
     character(len=100) :: emsg
     allocate (self%s(contact_line%npair), self%rows(2, contact_line%npair), npairs(size(bodies)), stiff(size(bodies)))
     npairs = 0
@@ -357,12 +356,17 @@ contains
       if (needs_stiffness(a)) call body_stiffness(bodies(a)%flex, bodies(a)%rg, stiff(a)%k, stiff(a)%inf, stiff_info(a))
     end do
     !$omp end parallel do
+    ! the pairs on the threads (each S from its own blocks), the first failing pair reported
+    allocate (pair_info(contact_line%npair))
+    pair_info = 0
     do p = 1, contact_line%npair
       self%rows(:, p) = [contact_line%pair_ptr(p), contact_line%pair_ptr(p + 1) - 1]
       self%s(p)%n = 0
+    end do
+    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(p, s, info, side, a, r, blk) &
+    !$omp if (contact_line%npair > 1)
+    do p = 1, contact_line%npair
       if (self%rows(2, p) < self%rows(1, p)) cycle
-      singular = any([(bodies(contact_line%pair_body(side, p))%rank < bodies(contact_line%pair_body(side, p))%m, &
-                       side=1, 2)])
       info = 0
       if (all(npairs(contact_line%pair_body(:, p)) == 1)) then
         associate (f1 => bodies(contact_line%pair_body(1, p))%flex, f2 => bodies(contact_line%pair_body(2, p))%flex)
@@ -375,7 +379,7 @@ contains
             end do
             call harmonic_floating(blk, s, info)
             ! a singular F (a mortar master coarser than the slave): no inverse of it
-            if (info /= 0 .and. singular) call harmonic_singular(blk, s, info)
+            if (info /= 0 .and. pair_singular(p)) call harmonic_singular(blk, s, info)
           else if (has_friction(contact_line)) then
             ! with friction: S of the normal rows and S of the tangential rows apart (below)
             call harmonic_by_kind(f1, f2, contact_line%kind(self%rows(1, p):self%rows(2, p)), s, info)
@@ -397,7 +401,13 @@ contains
           end associate
         end if
       end if
-      if (info /= 0 .and. any(bodies(contact_line%pair_body(:, p))%nrig > 0) .and. singular) then
+      pair_info(p) = info
+      if (info == 0) call dense_op_take(self%s(p), s)
+    end do
+    !$omp end parallel do
+    do p = 1, contact_line%npair
+      info = pair_info(p)
+      if (info /= 0 .and. any(bodies(contact_line%pair_body(:, p))%nrig > 0) .and. pair_singular(p)) then
         call err%set(ERR_NUMERICAL, 'harmonic operator: a body held only by contact is a mortar master coarser than '// &
                      'the slave (singular F): make it the slave (&contact slave), or use steklov or monolithic')
         return
@@ -408,8 +418,18 @@ contains
         call err%set(ERR_NUMERICAL, emsg)
         return
       end if
-      call dense_op_take(self%s(p), s)
     end do
+
+  contains
+
+    !> A body of pair q has a singular F (rank below its rows).
+    logical function pair_singular(q)
+      integer, intent(in) :: q
+      integer :: sd
+      pair_singular = any([(bodies(contact_line%pair_body(sd, q))%rank < bodies(contact_line%pair_body(sd, q))%m, &
+                            sd=1, 2)])
+    end function pair_singular
+
   end subroutine harmonic_setup
 
   !> corr(:, 1) = corr(:, 2) = S d, pair by pair.

@@ -10,7 +10,7 @@ module run_phases
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_shared
-  use assembly, only: assemble_body, nodal_stress, stress_field_t
+  use assembly, only: assemble_body
   use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT
   use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, anderson_history, contact_result_t
   use robin_iteration, only: solve_robin
@@ -520,35 +520,15 @@ contains
     run%timing%total = wtime() - run%t_start
     if (size(run%plan) > 1) then   ! every load step's result too
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, body_stresses(run), run%timing, err, run%steps, threads=run%threads)
+                         run%displacement, run%timing, err, run%steps, threads=run%threads)
     else
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, body_stresses(run), run%timing, err, threads=run%threads)
+                         run%displacement, run%timing, err, threads=run%threads)
     end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
-
-  !> Each body's nodal stresses from its displacement (what the result file shows), the
-  !! bodies on the threads (the file itself is written by one thread).
-  function body_stresses(run) result(stress)
-    type(run_t), intent(in) :: run
-    type(stress_field_t), allocatable :: stress(:)
-    integer, allocatable :: order(:)
-    integer :: a, k, nnode
-    allocate (stress(run%nbody))
-    order = largest_first([(run%meshes(a)%nnode, a=1, run%nbody)])
-    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a, nnode)
-    do k = 1, run%nbody
-      a = order(k)
-      nnode = run%meshes(a)%nnode
-      allocate (stress(a)%sigma(4, nnode), stress(a)%von_mises(nnode))
-      call nodal_stress(run%meshes(a), run%deck%body(a), run%deck%plane_strain, &
-                        run%displacement(1:run%systems(a)%ndof, a), stress(a)%sigma, stress(a)%von_mises)
-    end do
-    !$omp end parallel do
-  end function body_stresses
 
   !> A signal before the outer iteration (during assembly, ordering, factorization or
   !! condensation, where the libraries cannot be interrupted safely): stop at the end of

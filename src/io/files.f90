@@ -9,12 +9,12 @@
 !! there are kept aside, and any failure puts them back, so readers see either all the
 !! old files or all the new ones.
 module files
-  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_long_long
   implicit none (type, external)
   private
 
   public :: temp_name, run_id, replace_suffix, base_name, dir_name, ensure_parent_dir, atomic_rename, &
-            remove_file, write_text, commit_files, special_file
+            remove_file, write_text, commit_files, special_file, data_open, data_write, data_close
 
   interface
     integer(c_int) function c_rename(old, new) bind(c, name='rename')
@@ -69,6 +69,25 @@ module files
       implicit none (type, external)
       character(kind=c_char), intent(in) :: dir(*)
     end function rc_dir_writable
+    integer(c_int) function rc_open_data(path) bind(c, name='rc_open_data')
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: path(*)
+    end function rc_open_data
+    integer(c_int) function rc_write_at(fd, buf, n, offset) bind(c, name='rc_write_at')
+      import :: c_int, c_ptr, c_long_long
+      integer(c_int), value :: fd
+      type(c_ptr), value :: buf
+      integer(c_long_long), value :: n, offset
+    end function rc_write_at
+    integer(c_int) function rc_close_data(fd) bind(c, name='rc_close_data')
+      import :: c_int
+      integer(c_int), value :: fd
+    end function rc_close_data
+    integer(c_int) function rc_error_text(e, buf, n) bind(c, name='rc_error_text')
+      import :: c_int, c_char
+      integer(c_int), value :: e, n
+      character(kind=c_char), intent(out) :: buf(*)
+    end function rc_error_text
   end interface
 
   integer, save :: counter = 0                       ! unique names made by this process
@@ -335,5 +354,56 @@ contains
     close (u, iostat=ios)
     ok = ok .and. ios == 0
   end subroutine write_text
+
+  !> Open the existing file `path` for writing at given offsets (`data_write`), without
+  !! truncating it; fd = -1 and why says so on failure.
+  subroutine data_open(path, fd, why)
+    character(len=*), intent(in) :: path                  !< the file
+    integer, intent(out) :: fd                            !< its descriptor, -1 on failure
+    character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
+    fd = rc_open_data(trim(path)//c_null_char)
+    why = ''
+    if (fd < 0) why = 'cannot open it to write its data'
+  end subroutine data_open
+
+  !> Write n bytes from buf at byte offset `offset` of the file fd (thread-safe: pwrite(2));
+  !! why = '' or the system's reason of a failure.
+  subroutine data_write(fd, buf, n, offset, why)
+    integer, intent(in) :: fd                             !< from data_open
+    type(c_ptr), intent(in) :: buf                        !< the bytes
+    integer(c_long_long), intent(in) :: n, offset         !< their number, where they go
+    character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
+    integer(c_int) :: e
+    why = ''
+    if (n <= 0) return
+    e = rc_write_at(int(fd, c_int), buf, n, offset)
+    if (e /= 0) why = error_text(e)
+  end subroutine data_write
+
+  !> Close a file of data_open (nothing for fd < 0); why = '' or the system's reason of a
+  !! failure (a full disk may show only here).
+  subroutine data_close(fd, why)
+    integer, intent(inout) :: fd                          !< the descriptor; -1 on return
+    character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
+    integer(c_int) :: e
+    why = ''
+    if (fd < 0) return
+    e = rc_close_data(int(fd, c_int))
+    fd = -1
+    if (e /= 0) why = error_text(e)
+  end subroutine data_close
+
+  !> The system's text of the errno value e.
+  function error_text(e) result(t)
+    integer(c_int), intent(in) :: e
+    character(len=:), allocatable :: t
+    character(kind=c_char) :: buf(160)
+    integer :: n, i
+    n = rc_error_text(e, buf, int(size(buf), c_int))
+    allocate (character(len=max(n, 0)) :: t)
+    do i = 1, n
+      t(i:i) = buf(i)
+    end do
+  end function error_text
 
 end module files

@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
+#include <string.h>
 #include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -64,4 +65,43 @@ int rc_file_kind(const char *path)
 int rc_dir_writable(const char *dir)
 {
     return access(dir, W_OK | X_OK) == 0;
+}
+
+int rc_open_data(const char *path)
+{
+    int fd;
+    do {
+        fd = open(path, O_WRONLY | O_CLOEXEC);
+    } while (fd < 0 && errno == EINTR);
+    return fd < 0 ? -1 : fd;
+}
+
+int rc_write_at(int fd, const void *buf, long long n, long long offset)
+{
+    const char *p = buf;
+    while (n > 0) {
+        ssize_t k = pwrite(fd, p, (size_t) n, (off_t) offset);
+        if (k < 0) {
+            if (errno == EINTR) continue;
+            return errno > 0 ? errno : -1;
+        }
+        if (k == 0) return ENOSPC;
+        p += k;
+        n -= k;
+        offset += k;
+    }
+    return 0;
+}
+
+int rc_close_data(int fd)
+{
+    if (fd < 0) return 0;
+    return close(fd) == 0 ? 0 : (errno > 0 ? errno : -1);
+}
+
+int rc_error_text(int e, char *buf, int n)
+{
+    if (n < 1) return 0;
+    int len = snprintf(buf, (size_t) n, "%s", strerror(e));
+    return len < n ? len : n - 1;
 }

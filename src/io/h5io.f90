@@ -29,12 +29,15 @@ module h5io
                   h5screate_simple_f, h5sclose_f, h5sget_simple_extent_ndims_f, &
                   h5sget_simple_extent_dims_f, h5dcreate_f, h5dopen_f, h5dclose_f, h5dwrite_f, &
                   h5dread_f, h5dget_space_f, h5dget_type_f, h5acreate_f, h5aopen_f, h5aclose_f, &
-                  h5awrite_f, h5aread_f, h5tcopy_f, h5tset_size_f, h5tget_size_f, h5tclose_f
+                  h5awrite_f, h5aread_f, h5tcopy_f, h5tset_size_f, h5tget_size_f, h5tclose_f, &
+                  haddr_t, h5pcreate_f, h5pset_alloc_time_f, h5pset_fill_time_f, h5pset_obj_track_times_f, &
+                  h5dget_offset_f, H5P_DATASET_CREATE_F, H5P_GROUP_CREATE_F, H5D_ALLOC_TIME_EARLY_F, &
+                  H5D_FILL_TIME_NEVER_F
   implicit none (type, external)
   private
 
   public :: file_open, file_close, group_open, group_close
-  public :: write_dset, write_attr, write_attr_list, read_dset, read_attr, describe, exists
+  public :: write_dset, write_attr, write_attr_list, read_dset, read_attr, describe, exists, reserve_dset
 
   integer, parameter, public :: CLASS_OTHER = 0     !< a type class the files do not use
   integer, parameter, public :: CLASS_INTEGER = 1   !< integer numbers
@@ -56,6 +59,10 @@ module h5io
 
   integer(hsize_t), parameter :: SCALAR(0) = [integer(hsize_t) ::]   ! the shape of a scalar
   logical, save :: initialised = .false.
+  ! creation properties of every dataset and group written: no modification times (the
+  ! same result gives the same bytes, and each object header is smaller); `reserved`: the
+  ! storage allocated at creation and never filled (reserve_dset)
+  integer(hid_t), save :: dcpl_plain = -1, dcpl_reserved = -1, gcpl_plain = -1
 
 contains
 
@@ -113,7 +120,7 @@ contains
     new = .false.
     if (present(create)) new = create
     if (new) then
-      call h5gcreate_f(loc, name, gid, e)
+      call h5gcreate_f(loc, name, gid, e, gcpl_id=gcpl_plain)
     else
       call h5gopen_f(loc, name, gid, e)
     end if
@@ -279,7 +286,7 @@ contains
     if (attr) then
       call h5acreate_f(loc, name, mtype, sp, obj, e)
     else
-      call h5dcreate_f(loc, name, mtype, sp, obj, e)
+      call h5dcreate_f(loc, name, mtype, sp, obj, e, dcpl_id=dcpl_plain)
     end if
     if (e /= 0) then
       call fail(st, 'failed to create '//kind_name(attr), loc, name)
@@ -297,6 +304,49 @@ contains
     end if
     call h5sclose_f(sp, ec)
   end subroutine put
+
+  !> Create the dataset `name` of `loc`, real (or integer when `int_data`) of shape dims
+  !! (at least one element), with its storage allocated now and not written, and the
+  !! attribute `units` when given: offset is where its data start in the file, for the
+  !! caller to write them there in the memory's layout and byte order (the file type is
+  !! the native one), all of them before the file is used. -1 on failure.
+  subroutine reserve_dset(loc, name, dims, int_data, offset, st, units)
+    integer(hid_t), intent(in) :: loc                   !< file or group
+    character(len=*), intent(in) :: name                !< dataset name
+    integer(hsize_t), intent(in) :: dims(:)             !< its shape (Fortran order)
+    logical, intent(in) :: int_data                     !< integers (else reals)
+    integer(haddr_t), intent(out) :: offset             !< byte offset of its data
+    type(error_t), intent(inout) :: st                  !< status
+    character(len=*), intent(in), optional :: units     !< unit of the values
+    integer(hid_t) :: sp, obj, ty
+    integer :: e, ec
+    offset = -1
+    if (st%failed()) return
+    if (product(dims) < 1) then
+      call fail(st, 'no data to reserve for dataset', loc, name)
+      return
+    end if
+    ty = merge(H5T_NATIVE_INTEGER, H5T_NATIVE_DOUBLE, int_data)
+    call h5screate_simple_f(size(dims), dims, sp, e)
+    if (e /= 0) then
+      call fail(st, 'failed to make the dataspace of', loc, name)
+      return
+    end if
+    call h5dcreate_f(loc, name, ty, sp, obj, e, dcpl_id=dcpl_reserved)
+    if (e /= 0) then
+      call fail(st, 'failed to create dataset', loc, name)
+    else
+      call h5dget_offset_f(obj, offset, e)
+      if (e /= 0 .or. offset < 0) then
+        offset = -1
+        call fail(st, 'failed to allocate the storage of dataset', loc, name)
+      end if
+      if (present(units)) call put_string(obj, 'units', .true., units, st)
+      call close_object(.false., obj, loc, name, st)
+    end if
+    call h5sclose_f(sp, ec)
+    if (st%failed()) offset = -1
+  end subroutine reserve_dset
 
   ! ---- reading --------------------------------------------------------------------------
 
@@ -547,6 +597,18 @@ contains
       call h5open_f(e)
       if (e /= 0) then
         call fail(st, 'failed to initialise the HDF5 library')
+        return
+      end if
+      call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl_plain, e)
+      if (e == 0) call h5pset_obj_track_times_f(dcpl_plain, .false., e)
+      if (e == 0) call h5pcreate_f(H5P_DATASET_CREATE_F, dcpl_reserved, e)
+      if (e == 0) call h5pset_obj_track_times_f(dcpl_reserved, .false., e)
+      if (e == 0) call h5pset_alloc_time_f(dcpl_reserved, H5D_ALLOC_TIME_EARLY_F, e)
+      if (e == 0) call h5pset_fill_time_f(dcpl_reserved, H5D_FILL_TIME_NEVER_F, e)
+      if (e == 0) call h5pcreate_f(H5P_GROUP_CREATE_F, gcpl_plain, e)
+      if (e == 0) call h5pset_obj_track_times_f(gcpl_plain, .false., e)
+      if (e /= 0) then
+        call fail(st, 'failed to make the HDF5 creation properties')
         return
       end if
       initialised = .true.

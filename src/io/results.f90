@@ -10,16 +10,18 @@
 !! counts, 's' for wall times); the root has `unit_length`, `unit_force`, `unit_stress`.
 module results
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_c_binding, only: c_loc, c_long_long
   use kinds, only: wp
-  use hdf5, only: hid_t
-  use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr, write_attr_list
+  use hdf5, only: hid_t, hsize_t, haddr_t
+  use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr, write_attr_list, &
+                  reserve_dset
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
-                   write_text, commit_files
+                   write_text, commit_files, data_open, data_write, data_close
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE
   use strings, only: word, body_label, i2s
   use mesh, only: mesh_t, file_order, file_cells, file_dof
-  use assembly, only: body_system_t, stress_field_t, nodal_stress
+  use assembly, only: body_system_t, nodal_stress
   use contact_interface, only: interface_t, pair_rows
   use contact_types, only: contact_result_t, status_name
   use friction_view, only: tangential_t, split_friction
@@ -54,15 +56,22 @@ module results
 
   public :: write_results
 
+  !> The datasets of a body whose data are written beside the HDF5 library (`body_data`),
+  !! in the order they are created.
+  integer, parameter :: BD_COORDINATES = 1, BD_DISPLACEMENT = 2, BD_GEOMETRY = 3, BD_DISPLACEMENT_XYZ = 4, &
+                        BD_CELLS = 5, BD_TOPOLOGY = 6, BD_BODY_ID = 7, BD_STRESS = 8, BD_SXX = 9, &
+                        BD_VON_MISES = 13, BD_PRESSURE = 14, BD_COUNT = 14
+
 contains
 
   !> Write the HDF5 result and its XDMF companions, each under a temporary name of this
   !! run first, and commit them together (`commit_files`: companions first, the HDF5 file
   !! last) only when all are complete. Otherwise err (ERR_IO, naming the file and what
   !! failed); then the files of an earlier result at these names are as they were, and no
-  !! temporary file is left. With two threads the companions are written while the HDF5
-  !! file is (the HDF5 library is called from one thread only).
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, stress, tm, err, steps, threads)
+  !! temporary file is left. The HDF5 library is called from one thread; with two, the
+  !! other writes the companions and, body by body, computes the fields of each body
+  !! (its stresses) and writes their data into the storage the first has reserved.
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, tm, err, steps, threads)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
@@ -70,7 +79,6 @@ contains
     type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs
     type(contact_result_t), intent(in) :: res_all      !< contact solution
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, bodies) full displacements
-    type(stress_field_t), intent(in) :: stress(:)      !< nodal stresses of each body
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     type(error_t), intent(out) :: err                  !< the failure, if any
     !> the load steps' results (several steps: /steps, and the XDMF files a time series)
@@ -107,16 +115,19 @@ contains
     if (present(threads)) nt = max(1, min(2, threads))
     id = run_id()
     h5 = base_name(file)
-    !$omp parallel sections num_threads(nt)
-    !$omp section
-    if (size(times) > 0) then
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, id, st, steps)
-    else
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, stress, tm, id, st)
-    end if
-    !$omp section
+    ok = .false.
+    !$omp parallel num_threads(nt)
+    !$omp single
+    !$omp task
     call write_companions(ok)
-    !$omp end parallel sections
+    !$omp end task
+    if (size(times) > 0) then
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, tm, id, st, steps)
+    else
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, tm, id, st)
+    end if
+    !$omp end single
+    !$omp end parallel
     if (st%failed()) then
       call err%set(ERR_IO, 'cannot write '//trim(file)//' ('//st%text()//')')
       call remove_temps()
@@ -185,8 +196,10 @@ contains
     end if
   end subroutine result_files
 
-  !> The HDF5 result file `path`, whole; st records the first failure.
-  subroutine write_h5(path, d, msh, sys, itf_all, itf, res, tg, u, stress, tm, run_id, st, steps)
+  !> The HDF5 result file `path`, whole; st records the first failure. The large datasets of
+  !! each body are created with their storage reserved, and a task per body (`body_data`)
+  !! computes and writes their data there; all tasks end before this returns.
+  subroutine write_h5(path, d, msh, sys, itf_all, itf, res, tg, u, tm, run_id, st, steps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
@@ -196,22 +209,30 @@ contains
     type(contact_result_t), intent(in) :: res
     type(tangential_t), intent(in) :: tg               !< the tangential part (friction), per node
     real(wp), intent(in) :: u(:, :)
-    type(stress_field_t), intent(in) :: stress(:)
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
     type(error_t), intent(inout) :: st
     type(step_result_t), intent(in), optional :: steps(:)   !< the load steps (/steps)
     integer(hid_t) :: fid, gid
-    integer :: a, k
-    real(wp), allocatable :: vm(:), pres(:), w2(:, :), w3(:, :), ua(:), sigt(:, :)
+    integer(haddr_t) :: off(BD_COUNT)
+    integer(hsize_t) :: nn, nc
+    integer :: a, k, fd
+    real(wp), allocatable :: pres(:), w2(:, :)
+    type(error_t), allocatable :: body_err(:)
     character(len=8) :: bname
-    character(len=:), allocatable :: ul, us, uf
+    character(len=:), allocatable :: ul, us, uf, why
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
 
     ul = trim(d%units%length)
     us = trim(d%units%stress)
     uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
+    allocate (body_err(size(msh)))
+    fd = -1
     call file_open(path, fid, st, create=.true.)
+    if (.not. st%failed()) then
+      call data_open(path, fd, why)
+      if (fd < 0) call st%set(ERR_IO, path//': '//why)
+    end if
     ! root attributes
     call write_attr(fid, 'status', status_name(res%status), st)
     call write_attr(fid, 'method', trim(res%method), st)
@@ -295,44 +316,132 @@ contains
         call write_dset(gid, 'rigid_basis', sys(a)%rig_coef, st, '1')
         call write_dset(gid, 'fixing_dofs', file_dof(msh(a), sys(a)%fixing) - 1, st, '1')
       end if
-      ! (nnode, 2) in Fortran order -> h5py shape (2, nnode); nodes and cells in the file's order
-      allocate (w2(msh(a)%nnode, 2), w3(3, msh(a)%nnode), ua(sys(a)%ndof))
-      ua = reshape(file_order(msh(a), reshape(u(1:sys(a)%ndof, a), [2, msh(a)%nnode])), [sys(a)%ndof])
-      w3(1:2, :) = file_order(msh(a), msh(a)%xy)
-      w2 = transpose(w3(1:2, :))
-      call write_dset(gid, 'coordinates', w2, st, ul)
-      w2 = transpose(reshape(ua, [2, msh(a)%nnode]))
-      call write_dset(gid, 'displacement', w2, st, ul)
-      w3(3, :) = 0.0_wp
-      call write_dset(gid, 'geometry_xyz', w3, st, ul)
-      w3 = pad3(reshape(ua, [2, msh(a)%nnode]))
-      call write_dset(gid, 'displacement_xyz', w3, st, ul)
+      ! the fields: their storage reserved here, their data computed and written by a task
+      nn = msh(a)%nnode
+      nc = msh(a)%ncell
+      off = -1
+      call reserve_dset(gid, 'coordinates', [nn, 2_hsize_t], .false., off(BD_COORDINATES), st, ul)
+      call reserve_dset(gid, 'displacement', [nn, 2_hsize_t], .false., off(BD_DISPLACEMENT), st, ul)
+      call reserve_dset(gid, 'geometry_xyz', [3_hsize_t, nn], .false., off(BD_GEOMETRY), st, ul)
+      call reserve_dset(gid, 'displacement_xyz', [3_hsize_t, nn], .false., off(BD_DISPLACEMENT_XYZ), st, ul)
       ! 0-based; a triangle of a mixed mesh has -1 as its fourth vertex
-      call write_dset(gid, 'cells', file_cells(msh(a)) - 1, st, '1')
-      if (msh(a)%element == ELEM_MIXED) call write_dset(gid, 'topology', mixed_topology(msh(a)), st, '1')
-      call write_dset(gid, 'body_id', spread(a, 1, msh(a)%ncell), st, '1')
-      allocate (sigt(msh(a)%nnode, 4))
-      vm = file_order(msh(a), stress(a)%von_mises)
-      if (.not. (all(ieee_is_finite(stress(a)%sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) then
-        ! a derived field that is not finite is a failure, never part of a result
-        call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
-      end if
-      sigt = transpose(file_order(msh(a), stress(a)%sigma))
-      call write_dset(gid, 'stress', sigt, st, us)
+      call reserve_dset(gid, 'cells', shape(msh(a)%cells, kind=hsize_t), .true., off(BD_CELLS), st, '1')
+      if (msh(a)%element == ELEM_MIXED) call reserve_dset(gid, 'topology', &
+        [int(count(msh(a)%cell_type == ELEM_Q1)*5 + count(msh(a)%cell_type /= ELEM_Q1)*4, hsize_t)], .true., &
+        off(BD_TOPOLOGY), st, '1')
+      call reserve_dset(gid, 'body_id', [nc], .true., off(BD_BODY_ID), st, '1')
+      call reserve_dset(gid, 'stress', [nn, 4_hsize_t], .false., off(BD_STRESS), st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
       do k = 1, 4
-        call write_dset(gid, comp(k), sigt(:, k), st, us)
+        call reserve_dset(gid, comp(k), [nn], .false., off(BD_SXX + k - 1), st, us)
       end do
-      call write_dset(gid, 'von_mises', vm, st, us)
+      call reserve_dset(gid, 'von_mises', [nn], .false., off(BD_VON_MISES), st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
-      call nodal_pressure(itf, a, pres, vm)
-      call write_dset(gid, 'contact_pressure', file_order(msh(a), vm), st, us)
-      deallocate (w2, w3, ua, sigt, vm)
+      call reserve_dset(gid, 'contact_pressure', [nn], .false., off(BD_PRESSURE), st, us)
       call group_close(gid, st)
+      if (.not. st%failed()) then
+        !$omp task firstprivate(a, off) shared(msh, d, u, sys, itf, pres, body_err, fd)
+        call body_data(fd, off, a, msh(a), d, u(1:sys(a)%ndof, a), itf, pres, body_err(a))
+        !$omp end task
+      end if
     end do
     if (present(steps)) call write_steps(fid, d, msh, sys, itf_all, steps, ul, us, uf, st)
     call file_close(fid, st)
+    ! the bodies' data written (the HDF5 file is closed: no object overlaps their storage)
+    !$omp taskwait
+    call data_close(fd, why)
+    if (len(why) > 0 .and. .not. st%failed()) call st%set(ERR_IO, path//': failed to close (flush to disk) the file: '//why)
+    ! a body's failure (fields not finite, data not written) first, the bodies in order
+    do a = size(msh), 1, -1
+      if (body_err(a)%failed()) st = body_err(a)
+    end do
   end subroutine write_h5
+
+  !> Body a's fields in the file's node and cell order, each written at its reserved offset
+  !! off(BD_*) of the file fd: coordinates and displacement (nnode, 2), both padded with z = 0
+  !! (3, nnode), the cells (0-based), for a mixed mesh its XDMF topology, the body id per
+  !! cell, the nodal stresses (nnode, 4) and each component, von Mises and the contact
+  !! pressure. Fields that are not finite are a failure, never written.
+  subroutine body_data(fd, off, a, msh, d, ua, itf, pres, err)
+    integer, intent(in) :: fd                       !< the result file (data_open)
+    integer(haddr_t), intent(in) :: off(:)          !< (BD_COUNT) where each dataset's data go
+    integer, intent(in) :: a                        !< the body
+    type(mesh_t), intent(in) :: msh                 !< its mesh
+    type(deck_t), intent(in) :: d                   !< the deck (its material, plane strain)
+    real(wp), intent(in) :: ua(:)                   !< (ndof) its displacement
+    type(interface_t), intent(in) :: itf            !< the contact rows (normal)
+    real(wp), intent(in) :: pres(:)                 !< (m) pressure of each row [stress]
+    type(error_t), intent(inout) :: err             !< the first failure
+    real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :)
+    integer, allocatable, target :: iv(:), iw(:, :)
+    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    integer :: k, nn
+    nn = msh%nnode
+    allocate (sigma(4, nn), vm(nn), p(nn))
+    call nodal_stress(msh, d%body(a), d%plane_strain, ua, sigma, vm)
+    vm = file_order(msh, vm)
+    if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm)))) then
+      call err%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
+      return
+    end if
+    uf = file_order(msh, reshape(ua, [2, nn]))
+    allocate (w3(3, nn))
+    w3(1:2, :) = file_order(msh, msh%xy)
+    w2 = transpose(w3(1:2, :))
+    call put(w2, 'coordinates', BD_COORDINATES)
+    w2 = transpose(uf)
+    call put(w2, 'displacement', BD_DISPLACEMENT)
+    w3(3, :) = 0.0_wp
+    call put(w3, 'geometry_xyz', BD_GEOMETRY)
+    w3 = pad3(uf)
+    call put(w3, 'displacement_xyz', BD_DISPLACEMENT_XYZ)
+    iw = file_cells(msh) - 1
+    call put_int(iw, 'cells', BD_CELLS)
+    if (msh%element == ELEM_MIXED) then
+      iv = mixed_topology(msh)
+      call put_int(iv, 'topology', BD_TOPOLOGY)
+    end if
+    iv = spread(a, 1, msh%ncell)
+    call put_int(iv, 'body_id', BD_BODY_ID)
+    sigt = transpose(file_order(msh, sigma))
+    call put(sigt, 'stress', BD_STRESS)
+    do k = 1, 4
+      call put(sigt(:, k), comp(k), BD_SXX + k - 1)
+    end do
+    call put(vm, 'von_mises', BD_VON_MISES)
+    call nodal_pressure(itf, a, pres, p)
+    vm = file_order(msh, p)
+    call put(vm, 'contact_pressure', BD_PRESSURE)
+
+  contains
+
+    subroutine put(x, name, k)
+      real(wp), intent(in), target, contiguous :: x(..)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: k
+      call write_data(c_loc(x), int(size(x), c_long_long)*storage_size(x)/8, name, k)
+    end subroutine put
+
+    subroutine put_int(x, name, k)
+      integer, intent(in), target, contiguous :: x(..)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: k
+      call write_data(c_loc(x), int(size(x), c_long_long)*storage_size(x)/8, name, k)
+    end subroutine put_int
+
+    subroutine write_data(buf, n, name, k)
+      use, intrinsic :: iso_c_binding, only: c_ptr
+      type(c_ptr), intent(in) :: buf
+      integer(c_long_long), intent(in) :: n
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: k
+      character(len=:), allocatable :: why
+      if (err%failed()) return
+      call data_write(fd, buf, n, int(off(k), c_long_long), why)
+      if (len(why) > 0) call err%set(ERR_IO, 'failed to write dataset /body'//i2s(a)//'/'//name//': '//why)
+    end subroutine write_data
+
+  end subroutine body_data
 
   !> The time of a load step in the XDMF time series and /steps: the cumulative load
   !! factor, stage - 1 + its load factor (stage 1 runs over (0, 1], stage 2 over (1, 2]).
