@@ -230,14 +230,14 @@ $(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/conden
 $(BUILD)/run_summary.o:    $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
                            $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o \
                            $(BUILD)/sysinfo.o
-$(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/clock.o $(BUILD)/load_history.o \
-                           $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
+$(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/cholmod_iface.o \
+                           $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
                            $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/files.o \
-                           $(BUILD)/floating.o $(BUILD)/gmsh_msh.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
-                           $(BUILD)/monolithic.o $(BUILD)/mpi_backend.o $(BUILD)/mpi_env.o $(BUILD)/results.o \
-                           $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
-                           $(BUILD)/run_summary.o $(BUILD)/serial_backend.o $(BUILD)/signals.o $(BUILD)/sorting.o $(BUILD)/strings.o \
-                           $(BUILD)/sysinfo.o
+                           $(BUILD)/floating.o $(BUILD)/gmsh_msh.o $(BUILD)/kinds.o $(BUILD)/load_history.o \
+                           $(BUILD)/mesh.o $(BUILD)/monolithic.o $(BUILD)/mpi_backend.o $(BUILD)/mpi_env.o \
+                           $(BUILD)/results.o $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
+                           $(BUILD)/run_summary.o $(BUILD)/serial_backend.o $(BUILD)/signals.o $(BUILD)/sorting.o \
+                           $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/deck.o $(BUILD)/results.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
 $(BUILD)/files_shim.o:     include/files_shim.h

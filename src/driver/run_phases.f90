@@ -28,6 +28,7 @@ module run_phases
   use sorting, only: largest_first
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
   use clock, only: wtime
+  use cholmod_iface, only: cm_init
   use mpi_env, only: par_built, par_any
   use run_state, only: run_t, set_collective
   use run_backend, only: backend_t
@@ -72,6 +73,8 @@ contains
   !! cores we use (measured: 10x slower factorization). So no region below ours is active.
   subroutine choose_threads(run)
     type(run_t), intent(inout) :: run   !< the run: its threads
+    ! BLAS on one thread from the start (its own threads would take the bodies' cores)
+    call cm_init()
     run%threads = max(1, min(2, omp_get_max_threads()))
     if (run%threads == 1) then
       call omp_set_max_active_levels(0)

@@ -56,7 +56,16 @@ static pthread_once_t blas_once = PTHREAD_ONCE_INIT;
  * interfere (different, non-reproducible orderings; a data race).  Every call
  * that may run METIS holds this lock; the rest of CHOLMOD runs unlocked. */
 static pthread_mutex_t metis_lock = PTHREAD_MUTEX_INITIALIZER;
-static void blas_one_thread(void) { openblas_set_num_threads(1); }
+/* OpenBLAS (the pthreads build) starts its pool of threads when it is loaded, and they spin
+ * in sched_yield for a while before they sleep: on the cores the bodies' OpenMP threads need
+ * in the first phase. With BLAS held to one thread they are never used: stop them (a build
+ * without the pool has no such function). */
+extern int blas_thread_shutdown_(void) __attribute__((weak));
+static void blas_one_thread(void)
+{
+    openblas_set_num_threads(1);
+    if (blas_thread_shutdown_) blas_thread_shutdown_();
+}
 
 void chsh_init(void)
 {
