@@ -301,14 +301,14 @@ contains
     bc%rank = r
     if (r == bc%m) return
     bc%prox = 1.0e-2_wp*dmax
-    ! the eigenvectors of the m - r smallest eigenvalues only (MRRR: the tridiagonal
-    ! reduction is the O(m^3) part, a tenth of computing all m eigenvectors)
+    ! the eigenvectors of the m - r smallest eigenvalues only (the tridiagonal reduction is
+    ! the O(m^3) part: a tenth of the time of all m eigenvectors)
     f = bc%flex
     k = bc%m - r
     allocate (ev(bc%m), z(bc%m, k), isuppz(2*k), iwork(1))
-    ! MRRR relies on IEEE infinities in its inner loops (LAPACK's workspace query already tests
-    ! that they are safe, by making some): no floating-point trap while it runs (the checked
-    ! build sets them)
+    ! dsyevr starts by testing that IEEE infinities and NaNs are safe, by making some
+    ! (LAPACK's ILAENV/IEEECK, the workspace query too): no floating-point trap while it runs
+    ! (the checked build sets them)
     call ieee_get_halting_mode(ieee_usual, halting)
     call ieee_set_halting_mode(ieee_usual, .false.)
     call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &

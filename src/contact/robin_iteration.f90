@@ -26,7 +26,8 @@ module robin_iteration
   integer, parameter :: HISTORY_CHUNK = 256   !< initial history entries (grown by doubling)
   integer, parameter :: BOUND_LOWER = 1, BOUND_UPPER = 2, BOUND_INSIDE = 3   !< bound_state codes
   integer, parameter :: FLAT_LIMIT = 50       !< iterations without a 1% better residual (stop='residual'), or
-                                              !! without a 1% better criterion and residual (a cycle), before 'diverged'
+                                              !! without a 1% better criterion and residual than in the
+                                              !! as many before (a cycle), before 'diverged'
 
   public :: solve_robin
 
@@ -391,9 +392,10 @@ contains
     end if
     if (solver%stop /= STOP_RESIDUAL .and. run_state%crit > solver%tol .and. cycling(it)) then
       res%status = STATUS_DIVERGED
-      write (res%message, '(a,i0,a,es10.3,a,es10.3,a)') 'stagnated: in ', FLAT_LIMIT, &
-        ' iterations neither the increment (best ', minval(res%h_criterion(1:it)), ') nor the residual (best ', &
-        minval(res%h_residual(1:it)), ') has improved by 1%: the iteration cycles or stalls'
+      write (res%message, '(a,i0,a,es10.3,a,es10.3,a,i0,a)') 'stagnated: in ', FLAT_LIMIT, &
+        ' iterations neither the increment (best ', minval(res%h_criterion(it - FLAT_LIMIT + 1:it)), &
+        ') nor the residual (best ', minval(res%h_residual(it - FLAT_LIMIT + 1:it)), &
+        ') has come 1% below its best of the ', FLAT_LIMIT, ' before: the iteration cycles or stalls'
       return
     end if
     if (run_state%crit <= solver%tol) then
@@ -418,19 +420,21 @@ contains
     end if
     done = .false.
   contains
-    !> Neither the criterion nor the residual of the last FLAT_LIMIT iterations came within
-    !! 1% below their best before them, and the residual is far above tol: a cycle (friction
-    !! under a weakly damped operator oscillates between two states, for instance), which
-    !! more iterations do not break. The history holds every iteration, also after a restart.
+    !> Neither the criterion nor the residual of the last FLAT_LIMIT iterations came 1% below
+    !! their best in the FLAT_LIMIT iterations before them, and the residual is far above tol:
+    !! a cycle (friction under a weakly damped operator oscillates between two states, for
+    !! instance) or a stall, which more iterations do not break. Windows, not the best since
+    !! the start: a load step's first iterations may be good by luck before slow, steady
+    !! progress. The history holds every iteration, also after a restart.
     logical function cycling(it)
       integer, intent(in) :: it
       integer :: k
       cycling = .false.
-      if (it <= FLAT_LIMIT .or. res%nhist < it) return
+      if (it < 2*FLAT_LIMIT .or. res%nhist < it) return
       if (res%residual <= 1.0e2_wp*solver%tol) return
       k = it - FLAT_LIMIT
-      cycling = minval(res%h_criterion(k + 1:it)) >= 0.99_wp*minval(res%h_criterion(1:k)) .and. &
-                minval(res%h_residual(k + 1:it)) >= 0.99_wp*minval(res%h_residual(1:k))
+      cycling = minval(res%h_criterion(k + 1:it)) >= 0.99_wp*minval(res%h_criterion(k - FLAT_LIMIT + 1:k)) .and. &
+                minval(res%h_residual(k + 1:it)) >= 0.99_wp*minval(res%h_residual(k - FLAT_LIMIT + 1:k))
     end function cycling
   end function check_termination
 

@@ -26,7 +26,7 @@ module run_phases
   use budget, only: body_memory_mb
   use strings, only: sci, i2s, word, body_label
   use sorting, only: largest_first
-  use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels
+  use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels, omp_set_num_threads
   use clock, only: wtime
   use cholmod_iface, only: cm_init
   use mpi_env, only: par_built, par_any
@@ -73,9 +73,13 @@ contains
   !! cores we use (measured: 10x slower factorization). So no region below ours is active.
   subroutine choose_threads(run)
     type(run_t), intent(inout) :: run   !< the run: its threads
-    ! BLAS on one thread from the start (its own threads would take the bodies' cores)
+    integer :: nthr
+    ! BLAS on one thread from the start (its own threads would take the bodies' cores); an
+    ! OpenMP build of OpenBLAS sets the program's OpenMP threads with its own: put them back
+    nthr = omp_get_max_threads()
     call cm_init()
-    run%threads = max(1, min(2, omp_get_max_threads()))
+    call omp_set_num_threads(nthr)
+    run%threads = max(1, min(2, nthr))
     if (run%threads == 1) then
       call omp_set_max_active_levels(0)
     else

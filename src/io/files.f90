@@ -356,14 +356,17 @@ contains
   end subroutine write_text
 
   !> Open the existing file `path` for writing at given offsets (`data_write`), without
-  !! truncating it; fd = -1 and why says so on failure.
+  !! truncating it; fd = -1 and why says so, with the system's reason, on failure.
   subroutine data_open(path, fd, why)
     character(len=*), intent(in) :: path                  !< the file
     integer, intent(out) :: fd                            !< its descriptor, -1 on failure
     character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
     fd = rc_open_data(trim(path)//c_null_char)
     why = ''
-    if (fd < 0) why = 'cannot open it to write its data'
+    if (fd < 0) then
+      why = 'cannot open it to write its data: '//error_text(int(-fd, c_int))
+      fd = -1
+    end if
   end subroutine data_open
 
   !> Write n bytes from buf at byte offset `offset` of the file fd (thread-safe: pwrite(2));

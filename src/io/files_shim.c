@@ -67,13 +67,15 @@ int rc_dir_writable(const char *dir)
     return access(dir, W_OK | X_OK) == 0;
 }
 
+/* The descriptor, or minus the errno value of the failure. */
 int rc_open_data(const char *path)
 {
     int fd;
     do {
         fd = open(path, O_WRONLY | O_CLOEXEC);
     } while (fd < 0 && errno == EINTR);
-    return fd < 0 ? -1 : fd;
+    if (fd < 0) return errno > 0 ? -errno : -EIO;
+    return fd;
 }
 
 int rc_write_at(int fd, const void *buf, long long n, long long offset)
@@ -99,9 +101,16 @@ int rc_close_data(int fd)
     return close(fd) == 0 ? 0 : (errno > 0 ? errno : -1);
 }
 
+/* The system's text of errno value e (strerror_r: the bodies' tasks may fail at once). */
 int rc_error_text(int e, char *buf, int n)
 {
+    char text[160];
     if (n < 1) return 0;
-    int len = snprintf(buf, (size_t) n, "%s", strerror(e));
+#if (_POSIX_C_SOURCE >= 200112L) && !_GNU_SOURCE
+    const char *t = strerror_r(e, text, sizeof text) == 0 ? text : "unknown error";
+#else
+    const char *t = strerror_r(e, text, sizeof text);   /* the GNU form returns the text */
+#endif
+    int len = snprintf(buf, (size_t) n, "%s", t);
     return len < n ? len : n - 1;
 }

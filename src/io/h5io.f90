@@ -101,7 +101,7 @@ contains
     integer :: e
     if (fid < 0) return
     call h5fclose_f(fid, e)
-    if (e /= 0) call fail(st, 'failed to close (flush to disk) the file')
+    if (e /= 0) call fail(st, 'failed to close the file (writing out its buffers)')
     fid = -1
   end subroutine file_close
 

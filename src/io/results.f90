@@ -231,7 +231,7 @@ contains
     call file_open(path, fid, st, create=.true.)
     if (.not. st%failed()) then
       call data_open(path, fd, why)
-      if (fd < 0) call st%set(ERR_IO, path//': '//why)
+      if (fd < 0) call st%set(ERR_IO, trim(path)//': '//why)
     end if
     ! root attributes
     call write_attr(fid, 'status', status_name(res%status), st)
@@ -350,7 +350,7 @@ contains
     ! the bodies' data written (the HDF5 file is closed: no object overlaps their storage)
     !$omp taskwait
     call data_close(fd, why)
-    if (len(why) > 0 .and. .not. st%failed()) call st%set(ERR_IO, path//': failed to close (flush to disk) the file: '//why)
+    if (len(why) > 0 .and. .not. st%failed()) call st%set(ERR_IO, trim(path)//': failed to close the file: '//why)
     ! a body's failure (fields not finite, data not written) first, the bodies in order
     do a = size(msh), 1, -1
       if (body_err(a)%failed()) st = body_err(a)

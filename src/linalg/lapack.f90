@@ -186,9 +186,10 @@ module lapack
       integer, intent(out) :: info          !< status
     end subroutine dsyevd
 
-    !> Selected eigenvalues (ascending) and eigenvectors of a symmetric A by the relatively
-    !! robust representations (MRRR): with range = 'I' those of indices il..iu, O(n^3) for the
-    !! reduction only (a few of n eigenvectors cost a small part of dsyev's).
+    !> Selected eigenvalues (ascending) and eigenvectors of a symmetric A: with range = 'I'
+    !! those of indices il..iu (bisection and inverse iteration on the tridiagonal form for a
+    !! subset, the relatively robust representations for all), O(n^3) for the reduction only
+    !! (a few of n eigenvectors cost a small part of dsyev's).
     !! lwork = liwork = -1: workspace query (sizes in work(1), iwork(1)). info > 0: failure.
     subroutine dsyevr(jobz, range, uplo, n, a, lda, vl, vu, il, iu, abstol, m, w, z, ldz, isuppz, &
                       work, lwork, iwork, liwork, info)
