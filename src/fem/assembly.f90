@@ -34,12 +34,6 @@ module assembly
   public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters, cell_triplets
   public :: body_system_t, body_force_fn, rigid_motion_name
 
-  !> A body's nodal stresses, as the output stage receives them (nodal_stress).
-  type, public :: stress_field_t
-    real(wp), allocatable :: sigma(:, :)       !< (4, nnode) sxx, syy, sxy, szz [stress]
-    real(wp), allocatable :: von_mises(:)      !< (nnode) [stress]
-  end type stress_field_t
-
 contains
 
   !> Lame parameters of the body: plane strain uses lambda, mu; plane stress the

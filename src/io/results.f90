@@ -326,9 +326,8 @@ contains
       call reserve_dset(gid, 'displacement_xyz', [3_hsize_t, nn], .false., off(BD_DISPLACEMENT_XYZ), st, ul)
       ! 0-based; a triangle of a mixed mesh has -1 as its fourth vertex
       call reserve_dset(gid, 'cells', shape(msh(a)%cells, kind=hsize_t), .true., off(BD_CELLS), st, '1')
-      if (msh(a)%element == ELEM_MIXED) call reserve_dset(gid, 'topology', &
-        [int(count(msh(a)%cell_type == ELEM_Q1)*5 + count(msh(a)%cell_type /= ELEM_Q1)*4, hsize_t)], .true., &
-        off(BD_TOPOLOGY), st, '1')
+      if (msh(a)%element == ELEM_MIXED) call reserve_dset(gid, 'topology', [int(topology_size(msh(a)), hsize_t)], &
+        .true., off(BD_TOPOLOGY), st, '1')
       call reserve_dset(gid, 'body_id', [nc], .true., off(BD_BODY_ID), st, '1')
       call reserve_dset(gid, 'stress', [nn, 4_hsize_t], .false., off(BD_STRESS), st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
@@ -686,7 +685,7 @@ contains
     type(mesh_t), intent(in) :: msh
     integer, allocatable :: t(:), cells(:, :), ctype(:)
     integer :: c, k, nv
-    allocate (t(count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type /= ELEM_Q1)*4))
+    allocate (t(topology_size(msh)))
     cells = file_cells(msh)
     ctype = msh%cell_type
     if (allocated(msh%file_cell)) ctype(msh%file_cell) = msh%cell_type
@@ -698,6 +697,12 @@ contains
       k = k + 1 + nv
     end do
   end function mixed_topology
+
+  !> The length of mixed_topology(msh): per cell its type code and its vertices.
+  pure integer function topology_size(msh)
+    type(mesh_t), intent(in) :: msh
+    topology_size = count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type /= ELEM_Q1)*4
+  end function topology_size
 
   function pad3(v) result(p)
     real(wp), intent(in) :: v(:, :)
