@@ -84,6 +84,9 @@ module contact_types
     real(wp), allocatable :: srch(:, :)        !< (m,2) lam_a after its last solve minus before it [force]
     real(wp), allocatable :: fsrch(:, :)       !< (m,2) F_a srch (difference of the two products F_a lam_a) [length]
     integer, allocatable :: nrw(:, :)          !< (2, bodies) per body: directions held in rw, next slot to fill
+    !> (bodies) 1: the body's QP needed the active-set Newton method (inner_solver 'auto'), so its
+    !! later solves start with it; 0: MPRGP first
+    integer, allocatable :: newton(:)
     !> (m, 2 k) per body up to k F_a-orthonormal directions of its solves, in the side layout:
     !! direction j of a body is in column j on its side-1 rows and k + j on its side-2 rows
     real(wp), allocatable :: rw(:, :)          !< [1/sqrt(length force)]
@@ -157,6 +160,7 @@ contains
     integer, intent(in) :: nbody             !< bodies
     integer, intent(in) :: npair             !< pairs
     allocate (st%flam(nbody), st%mu(3, nbody), st%nrw(2, nbody))
+    allocate (st%newton(nbody), source=0)
     st%flam = 0.0_wp
     st%mu = 0.0_wp
     st%nrw(1, :) = 0

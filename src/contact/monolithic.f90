@@ -12,12 +12,12 @@ module monolithic
   use lapack, only: dsyrk, dpotrf, dtrsm, dtrsv
   use clock, only: wtime
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, &
-                   mprgp_status_name
+                   mprgp_status_name, QP_AUTO, QP_MPRGP, QP_NEWTON
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
   use sorting, only: sort_ints
   use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, ROW_TANGENT
-  use config, only: FRICTION_COULOMB
+  use config, only: FRICTION_COULOMB, INNER_MPRGP, INNER_ACTIVE_SET
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
@@ -40,6 +40,11 @@ module monolithic
   end type penalized_op_t
 
   integer, parameter :: COULOMB_MAX_FIXED = 500   !< box solves of the monolithic Coulomb fixed point
+  !> The Coulomb fixed point has settled at the rounding level of its box solves when this
+  !! many solves have not halved its smallest relative change of the slip bounds, which is
+  !! at most STALL_CHANGE (sqrt(eps): the least a QP solve resolves of an ill-conditioned H)
+  integer, parameter :: STALL_FIXED = 10
+  real(wp), parameter :: STALL_CHANGE = 1.0e-8_wp
 
   public :: solve_monolithic, assemble_hessian
 
@@ -59,7 +64,8 @@ contains
     type(equality_t) :: equality
     real(wp), allocatable :: c(:), lb(:), ub(:), lam(:), rows(:, :), rhs(:), mu(:), bs(:, :), wa(:), lfac(:, :), ub_new(:)
     integer :: m, a, r, nrig, info, fixed, nfix, nmv
-    real(wp) :: t0, lmax, change
+    real(wp) :: t0, lmax, change, change_best
+    integer :: fixed_best
     logical :: friction
     logical, allocatable :: tangent(:)
 
@@ -77,7 +83,17 @@ contains
     lb = 0.0_wp
     lam = 0.0_wp
     inner_solver%opts%rtol = solver%monolithic_rtol
+    ! monolithic_rtol relative to |c|, or the rounding level of H lam where that is out of reach
+    inner_solver%opts%rounding_floor = .true.
     inner_solver%opts%max_it = solver%inner_max_it
+    select case (solver%inner_solver)
+    case (INNER_MPRGP)
+      inner_solver%opts%method = QP_MPRGP
+    case (INNER_ACTIVE_SET)
+      inner_solver%opts%method = QP_NEWTON
+    case default
+      inner_solver%opts%method = QP_AUTO
+    end select
     if (present(stop_requested)) inner_solver%opts%stop => stop_requested
     nrig = sum(bodies(:)%nrig)
     if (nrig > 0 .and. m > 0) call stacked_rows(bodies, m, rows, rhs)
@@ -134,6 +150,8 @@ contains
       if (any(contact_line%pair_friction == FRICTION_COULOMB)) nfix = COULOMB_MAX_FIXED
     end if
     nmv = 0
+    change_best = huge(1.0_wp)
+    fixed_best = 0
     do fixed = 1, nfix
     if (m > 0) then
       if (equality%r > 0) then
@@ -163,6 +181,8 @@ contains
           call inner_solver%solve(hessian, c, lb, lam)
         end if
         inner = inner_solver%stats
+        ! the Coulomb fixed point's next box solves: the Newton method at once if this one needed it
+        if (inner%switched) inner_solver%opts%method = QP_NEWTON
       end if
       nmv = nmv + inner%n_matvec
       res%inner = nmv
@@ -188,6 +208,14 @@ contains
     change = huge(1.0_wp)
     if (fixed > 1) change = norm2(pack(ub_new - ub, tangent))/max(norm2(pack(ub_new, tangent)), tiny(1.0_wp))
     if (change <= solver%monolithic_rtol) exit
+    ! the changes stop shrinking below the rounding level of the box solves' forces (an
+    ! ill-conditioned H): settled when STALL_FIXED solves have not halved the smallest change
+    if (change < 0.5_wp*change_best) then
+      change_best = change
+      fixed_best = fixed
+    else if (fixed - fixed_best >= STALL_FIXED .and. change_best <= STALL_CHANGE) then
+      exit
+    end if
     if (fixed == nfix) then
       res%status = STATUS_MAX_OUTER
       write (res%message, '(a,i0,a,es10.3)') 'monolithic Coulomb: the slip bounds still changed after ', nfix, &

@@ -7,9 +7,10 @@
 !! bounds are built once, before the outer loop.
 module robin_subproblems
   use kinds, only: wp
-  use config, only: solver_cfg_t, ACCEL_NONE
+  use config, only: solver_cfg_t, ACCEL_NONE, INNER_MPRGP, INNER_ACTIVE_SET
   use linop, only: dense_op_t, dense_op_init
-  use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name
+  use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
+                   QP_NEWTON
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
@@ -222,6 +223,7 @@ contains
       inner_solver%opts%atol = 0.0_wp
     end if
     inner_solver%opts%max_it = solver%inner_max_it
+    inner_solver%opts%method = inner_method(solver%inner_solver, state%newton(a))
     inner_solver%opts%lambda_max = subproblems%lmax_hessian(a)
     ! F_a is the same in every iteration and the warm start is the last solution: its
     ! gradient comes from F_a lam_a of the last solve (no initial product)
@@ -274,6 +276,7 @@ contains
       end associate
       inner = smalbe_stats%inner
       inner%n_matvec = smalbe_stats%n_matvec
+      inner%switched = smalbe_stats%switched
       updates = smalbe_stats%updates
     else
       if (allocated(ub)) then
@@ -283,6 +286,8 @@ contains
       end if
       inner = inner_solver%stats
     end if
+    ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
+    if (inner%switched) state%newton(a) = 1
     grad = inner_solver%g
     call scatter(lam, body%slots, state%lam)
     call scatter(inner_solver%ax, body%slots, state%flam_v)
@@ -323,6 +328,21 @@ contains
     end subroutine directions_in
 
   end subroutine solve_body
+
+  !> The QP method of a body's solve: the deck's inner_solver, 'auto' resolved by what the
+  !! body's earlier solves needed (newton = 1: the Newton method at once).
+  pure integer function inner_method(choice, newton) result(method)
+    integer, intent(in) :: choice    !< INNER_*
+    integer, intent(in) :: newton    !< robin_state_t%newton of the body
+    select case (choice)
+    case (INNER_MPRGP)
+      method = QP_MPRGP
+    case (INNER_ACTIVE_SET)
+      method = QP_NEWTON
+    case default
+      method = merge(QP_NEWTON, QP_AUTO, newton == 1)
+    end select
+  end function inner_method
 
   !> True when the outer criterion decreased over the last three iterations at a steady
   !! rate (the two last ratios differ by at most SMOOTH_RATE_TOL).

@@ -44,6 +44,11 @@ module config
   integer, parameter, public :: METHOD_MONOLITHIC = 2   !< the monolithic reference
   character(len=*), parameter, public :: METHOD_CHOICES = 'robin monolithic'
 
+  integer, parameter, public :: INNER_AUTO = 1        !< MPRGP within a budget, then the active-set Newton method
+  integer, parameter, public :: INNER_MPRGP = 2       !< MPRGP alone
+  integer, parameter, public :: INNER_ACTIVE_SET = 3  !< the active-set Newton method alone
+  character(len=*), parameter, public :: INNER_CHOICES = 'auto mprgp active_set'
+
   integer, parameter, public :: FRICTION_NONE = 1      !< frictionless
   integer, parameter, public :: FRICTION_TRESCA = 2    !< given slip bound |t| <= slip_bound
   integer, parameter, public :: FRICTION_COULOMB = 3   !< |t| <= mu p
@@ -174,6 +179,7 @@ module config
     real(wp) :: inner_factor = 1.0e-3_wp              !< inner rtol = inner_factor * outer progress (clamped)
     real(wp) :: inner_rtol_min = 1.0e-12_wp           !< floor of the adaptive inner tolerance
     real(wp) :: inner_rtol_max = 1.0e-2_wp            !< ceiling of the adaptive inner tolerance
+    integer :: inner_solver = INNER_AUTO              !< INNER_*: the solver of the interface QPs
     integer :: inner_max_it = 100000                  !< MPRGP iteration limit per subproblem
     real(wp) :: monolithic_rtol = 1.0e-12_wp          !< MPRGP tolerance for method='monolithic'
     !> load steps per stage: one value for every stage, or one per stage (STEPS_UNSET: not given)

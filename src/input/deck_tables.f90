@@ -9,7 +9,7 @@ module deck_tables
   use config, only: deck_t, body_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
-                    ORDER_CHOICES, ACCEL_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
+                    ORDER_CHOICES, ACCEL_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
                     UNITS_CHOICES, FRICTION_CHOICES, STEPS_UNSET
   implicit none (type, external)
   private
@@ -254,8 +254,15 @@ contains
       doc='floor of the adaptive inner tolerance')
     call v%real('inner_rtol_max', s%inner_rtol_max, unit='[-]', range='0 < inner_rtol_max < 1; '// &
       '>= inner_rtol_min', doc='ceiling of the adaptive inner tolerance')
-    call v%int('inner_max_it', s%inner_max_it, range='>= 1', doc='MPRGP iteration limit per '// &
-      'subproblem')
+    call v%enum('inner_solver', s%inner_solver, INNER_CHOICES, doc='the solver of every interface '// &
+      'QP (each body''s subproblem, the monolithic problem): `''mprgp''` (matrix products only; its '// &
+      'work grows with the square root of the QP''s condition number), `''active_set''` (the '// &
+      'primal-dual active-set Newton method: a dense Cholesky factor of the free block per step, '// &
+      'work independent of the conditioning; QPs of at most 4096 unknowns, larger ones by MPRGP) or '// &
+      '`''auto''`: MPRGP within about the work of three factorizations, then the active-set method '// &
+      'from where MPRGP stopped, and for the rest of the run on that body')
+    call v%int('inner_max_it', s%inner_max_it, range='>= 1', doc='inner iteration limit per '// &
+      'subproblem (MPRGP and Newton steps)')
     call v%real('monolithic_rtol', s%monolithic_rtol, unit='[-]', range='0 < monolithic_rtol < 1', &
       doc='MPRGP tolerance of `method=''monolithic''`')
     if (all_vars .or. s%load_steps(1) /= 1 .or. any(s%load_steps(2:) /= STEPS_UNSET)) &

@@ -34,10 +34,12 @@
 module mprgp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
-  use linop, only: linop_t
+  use linop, only: linop_t, dense_op_t
+  use qp_newton, only: newton_work_t, newton_step, NEWTON_FULL, NEWTON_STILL, NEWTON_NOT_SPD
   use strings, only: itoa
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
-                           MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
+                           MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
+                           QP_AUTO, QP_MPRGP, QP_NEWTON
   use mprgp_support, only: lambda_max_estimate, power_iteration, projected_gradient_norm, line_search, &
                            recycled_subspace, store_direction, chopped
   implicit none (type, external)
@@ -46,11 +48,19 @@ module mprgp
   public :: lambda_max_estimate, mprgp_status_name, chopped
   public :: mprgp_t, mprgp_opts_t, mprgp_stats_t
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
+  public :: QP_AUTO, QP_MPRGP, QP_NEWTON
 
   !> Safety factor: default alpha_bar = ALPHA_FACTOR / lambda_max (theory: (0, 2/|A|]).
   real(wp), parameter :: ALPHA_FACTOR = 1.9_wp
   !> At most this many retries of one expansion step with a reduced alpha_bar.
   integer, parameter :: MAX_RETRY = 60
+  !> The Newton method is used up to this size (its dense matrix and factor: 2 n^2 reals,
+  !! 256 MiB at n = 4096); larger problems are solved by MPRGP whatever opts%method says.
+  integer, parameter :: NEWTON_MAX_N = 4096
+  !> QP_AUTO's smallest budget of MPRGP steps.
+  integer, parameter :: AUTO_BUDGET_MIN = 100
+  !> Working precision of a Newton solve: |gP| <= NEWTON_FLOOR n eps lambda_max |x|.
+  real(wp), parameter :: NEWTON_FLOOR = 10.0_wp
 
   !> An MPRGP solver: its options, what its last solve did, and the vectors a sequence of
   !! solves with one operator hands on from one solve to the next. One solver per thread.
@@ -134,8 +144,7 @@ contains
     integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
     real(wp), intent(in), optional :: ub(:)         !< upper bounds (size n, >= lb); +huge(1.0_wp): none
     real(wp), allocatable :: u(:)
-    real(wp) :: betabeta, phitphi
-    logical :: ok
+    integer :: method, max_it, budget
 
     self%stats = mprgp_stats_t()
     if (.not. valid_arguments(self, A%n, b, lb, x, rw, raw, nrw, ub)) then
@@ -155,21 +164,28 @@ contains
       allocate (u(self%n), source=huge(1.0_wp))
     end if
     call start(self, A, b, lb, u, x, rw, raw, nrw)
-    main: do
-      select case (stopping_test(self, A, b, lb, u, x, betabeta, phitphi))
-      case (DONE)
-        exit main
-      case (RETEST)
-        cycle main
-      end select
-      self%it = self%it + 1
-      if (proportional(self, A, lb, u, x, betabeta, phitphi, ok)) then
-        if (ok) ok = cg_or_expansion_step(self, A, lb, u, x, rw, raw, nrw)
-      else if (ok) then
-        ok = proportioning_step(self, A, lb, u, x, betabeta)
+    method = self%opts%method
+    if (method /= QP_MPRGP .and. self%n > NEWTON_MAX_N) method = QP_MPRGP
+    select case (method)
+    case (QP_NEWTON)
+      call newton_loop(self, A, b, lb, u, x)
+    case (QP_AUTO)
+      ! MPRGP within a budget of about three factorizations' work; the Newton method from
+      ! where it stopped (a conditioning MPRGP pays for, the Newton method does not)
+      max_it = self%opts%max_it
+      budget = self%opts%auto_budget
+      if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/2)
+      self%opts%max_it = min(max_it, budget)
+      call mprgp_loop(self, A, b, lb, u, x, rw, raw, nrw)
+      self%opts%max_it = max_it
+      if (self%stats%status == MPRGP_MAX_IT .and. budget < max_it) then
+        self%stats%switched = .true.
+        if (.not. self%fresh) call true_gradient(self, A, b, x)
+        call newton_loop(self, A, b, lb, u, x)
       end if
-      if (.not. ok) exit main
-    end do main
+    case default
+      call mprgp_loop(self, A, b, lb, u, x, rw, raw, nrw)
+    end select
     self%stats%lambda_max = self%lam_lo
     self%stats%alpha_bar = self%ab
     ! Report the true gradient (and |gP| from it) unless the iteration broke down.
@@ -180,6 +196,120 @@ contains
     if (.not. self%fresh) self%ax = self%g + b
     call consume_search(self)
   end subroutine mprgp_solve
+
+  !> MPRGP's steps until the stopping test ends the solve.
+  subroutine mprgp_loop(self, A, b, lb, ub, x, rw, raw, nrw)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:), lb(:), ub(:)
+    real(wp), intent(inout) :: x(:)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
+    integer, intent(inout), optional :: nrw(2)
+    real(wp) :: betabeta, phitphi
+    logical :: ok
+    main: do
+      select case (stopping_test(self, A, b, lb, ub, x, betabeta, phitphi))
+      case (DONE)
+        exit main
+      case (RETEST)
+        cycle main
+      end select
+      self%it = self%it + 1
+      if (proportional(self, A, lb, ub, x, betabeta, phitphi, ok)) then
+        if (ok) ok = cg_or_expansion_step(self, A, lb, ub, x, rw, raw, nrw)
+      else if (ok) then
+        ok = proportioning_step(self, A, lb, ub, x, betabeta)
+      end if
+      if (.not. ok) exit main
+    end do main
+  end subroutine mprgp_loop
+
+  !> The active-set Newton method's steps (module qp_newton) until the stopping test ends
+  !! the solve, on the dense matrix of A (A itself when it is a dense_op_t, else built by n
+  !! products). Two whole steps in a row on the same face leave x at that face's minimiser
+  !! to working precision: if the projected gradient is still above the tolerance then, the
+  !! tolerance is below what double precision resolves for this A, and the solve ends as
+  !! converged to working precision when |gP| is within NEWTON_FLOOR n eps lambda_max |x|
+  !! (a Cholesky solve's backward error), as failed (max_it) above it.
+  subroutine newton_loop(self, A, b, lb, ub, x)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:), lb(:), ub(:)
+    real(wp), intent(inout) :: x(:)
+    type(newton_work_t) :: work
+    real(wp), allocatable :: ad(:, :)
+    real(wp) :: betabeta, phitphi, flops, floor
+    integer :: outcome, j, n
+    character(len=24) :: s1
+    n = self%n
+    select type (A)
+    type is (dense_op_t)
+      call newton_steps(A%a)
+    class default
+      allocate (ad(n, n))
+      do j = 1, n
+        self%v = 0.0_wp
+        self%v(j) = 1.0_wp
+        call A%apply(self%v, ad(:, j))
+      end do
+      self%stats%n_matvec = self%stats%n_matvec + n
+      call newton_steps(ad)
+    end select
+
+  contains
+
+    subroutine newton_steps(am)
+      real(wp), intent(in) :: am(:, :)
+      logical :: refined
+      refined = .false.
+      main: do
+        select case (stopping_test(self, A, b, lb, ub, x, betabeta, phitphi))
+        case (DONE)
+          exit main
+        case (RETEST)
+          cycle main
+        end select
+        self%it = self%it + 1
+        call newton_step(am, lb, ub, x, self%g, self%ax, work, outcome, flops)
+        self%fresh = .false.
+        self%stats%n_newton = self%stats%n_newton + 1
+        if (work%nfree > 0 .and. outcome /= NEWTON_NOT_SPD) self%stats%n_factor = self%stats%n_factor + 1
+        self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(n, wp)**2)))
+        if (outcome == NEWTON_NOT_SPD) then
+          call fail(self, MPRGP_NOT_SPD, 'the active-set Newton method met a curvature <= 0 at step '// &
+                    trim(itoa(self%it))//': A is not SPD')
+          exit main
+        end if
+        if (.not. (outcome == NEWTON_STILL .or. (outcome == NEWTON_FULL .and. work%same_face))) then
+          refined = .false.
+          cycle main
+        end if
+        ! x solves its face (twice in a row): the gradient afresh, and one more step from it
+        ! when that is not enough; a second time, the rounding level of A is reached
+        call true_gradient(self, A, b, x)
+        self%stats%gp_norm = proj_grad_norm(self, lb, ub, x)
+        if ((self%stats%gp_norm <= self%tol .and. .not. self%zero_tol) .or. .not. refined) then
+          refined = .true.
+          cycle main
+        end if
+        if (self%lam_lo <= 0.0_wp) self%lam_lo = maxval(sum(abs(am), dim=1))
+        floor = NEWTON_FLOOR*real(n, wp)*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)
+        write (s1, '(es10.3)') self%stats%gp_norm
+        if (self%stats%gp_norm <= floor) then
+          self%stats%status = MPRGP_CONVERGED
+          self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
+            ' after '//trim(itoa(self%stats%n_newton))//' Newton steps (x solves its face exactly; '// &
+            'the tolerance asked for is below what double precision resolves)'
+        else
+          self%stats%status = MPRGP_MAX_IT
+          self%stats%message = 'not converged: the Newton method stalls at |gP| = '//trim(adjustl(s1))// &
+            ', above the rounding level of A (A nearly singular on the free set)'
+        end if
+        exit main
+      end do main
+    end subroutine newton_steps
+
+  end subroutine newton_loop
 
   !> A solve uses its search direction once.
   subroutine consume_search(self)
@@ -426,6 +556,20 @@ contains
       return
     end if
     if (self%it >= self%opts%max_it) then
+      if (self%opts%rounding_floor .and. self%lam_lo > 0.0_wp) then
+        ! the tolerance was out of reach: within the rounding level of A x it is met
+        if (.not. self%fresh) then
+          call true_gradient(self, A, b, x)
+          self%stats%gp_norm = proj_grad_norm(self, lb, ub, x)
+        end if
+        write (s1, '(es10.3)') self%stats%gp_norm
+        if (self%stats%gp_norm <= 10.0_wp*sqrt(real(n, wp))*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)) then
+          self%stats%status = MPRGP_CONVERGED
+          self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))//' after '// &
+            trim(itoa(self%it))//' steps (the tolerance asked for is below what double precision resolves)'
+          return
+        end if
+      end if
       self%stats%status = MPRGP_MAX_IT
       write (s1, '(es10.3)') self%stats%gp_norm
       write (s2, '(es10.3)') tol_now

@@ -9,6 +9,7 @@ module mprgp_options
 
   public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, mprgp_stop_iface
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
+  public :: QP_AUTO, QP_MPRGP, QP_NEWTON
 
   integer, parameter :: MPRGP_CONVERGED = 0  !< |gP| <= max(rtol |b|, atol) at the true gradient
   integer, parameter :: MPRGP_MAX_IT = 1     !< max_it steps done without convergence
@@ -16,6 +17,11 @@ module mprgp_options
   integer, parameter :: MPRGP_NOT_SPD = 3    !< a direction with p'Ap <= 0 was met (A not SPD)
   integer, parameter :: MPRGP_BAD_ARG = 4    !< inconsistent sizes, invalid options or an empty box (ub < lb)
   integer, parameter :: MPRGP_STOPPED = 5    !< opts%stop turned true (a signal): x is the current iterate
+
+  !> The method of a solve (opts%method).
+  integer, parameter :: QP_AUTO = 0    !< MPRGP within a budget of steps, then the active-set Newton method
+  integer, parameter :: QP_MPRGP = 1   !< MPRGP alone
+  integer, parameter :: QP_NEWTON = 2  !< the active-set Newton method alone (module qp_newton; a dense A)
 
   abstract interface
     !> True when the solve must stop now (polled once per step).
@@ -25,8 +31,17 @@ module mprgp_options
 
   !> Options of an MPRGP solve. Tolerances are in the units of b (for contact: a displacement).
   type :: mprgp_opts_t
+    integer :: method = QP_MPRGP     !< QP_AUTO, QP_MPRGP or QP_NEWTON
+    !> QP_AUTO: the MPRGP steps allowed before the Newton method takes over (0: the
+    !! default budget, about the cost of three factorizations of A: max(100, n/2) steps)
+    integer :: auto_budget = 0
     real(wp) :: rtol = 1.0e-8_wp     !< stop when |gP| <= max(rtol*|b|, atol)
     real(wp) :: atol = 0.0_wp        !< absolute floor of the stopping test (units of b)
+    !> at max_it, a projected gradient (fresh) within the rounding level of A x,
+    !! 10 sqrt(n) eps lambda_max max(|x|, |x_0|) (x_0 the projected start), counts as converged
+    !! to working precision: a tolerance relative to |b| alone is out of reach when A is
+    !! ill-conditioned and x lies along its large eigenvalues (|b| << lambda_max |x|)
+    logical :: rounding_floor = .false.
     integer :: max_it = 10000        !< maximum number of CG + expansion + proportioning steps
     real(wp) :: gamma = 1.0_wp       !< proportioning constant Gamma > 0
     real(wp) :: alpha_bar = 0.0_wp   !< expansion step length; <= 0: 1.9/lambda_max (units 1/[A])
@@ -52,7 +67,12 @@ module mprgp_options
     integer :: n_cg = 0                !< conjugate gradient steps
     integer :: n_exp = 0               !< expansion steps
     integer :: n_prop = 0              !< proportioning steps
-    integer :: n_matvec = 0            !< products with A, power iterations included
+    !> products with A, power iterations included, and the Newton method's factorizations
+    !! and solves counted as the products of the same floating-point work (flops / (2 n^2))
+    integer :: n_matvec = 0
+    integer :: n_newton = 0            !< steps of the active-set Newton method
+    integer :: n_factor = 0            !< Cholesky factorizations of a free block (Newton steps)
+    logical :: switched = .false.      !< QP_AUTO: MPRGP used up its budget and the Newton method finished
     integer :: n_recycled = 0          !< line searches along s and the stored directions that moved x (no product)
     real(wp) :: gp_norm = 0.0_wp       !< |gP| at the returned x (units of b)
     real(wp) :: b_norm = 0.0_wp        !< |b|
@@ -102,6 +122,14 @@ contains
       return
     else if (o%atol < 0.0_wp) then
       why = 'opts%atol is negative: '//trim(rtoa(o%atol))
+      return
+    end if
+    if (o%method < QP_AUTO .or. o%method > QP_NEWTON) then
+      why = 'opts%method is not QP_AUTO, QP_MPRGP or QP_NEWTON'
+      return
+    end if
+    if (o%auto_budget < 0) then
+      why = 'opts%auto_budget is negative'
       return
     end if
     if (o%max_it < 0) then

@@ -25,7 +25,7 @@ module smalbe
   use kinds, only: wp
   use linop, only: linop_t
   use lapack, only: dposv
-  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, chopped
+  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, chopped, QP_NEWTON
   implicit none (type, external)
   private
 
@@ -39,6 +39,8 @@ module smalbe
     type(mprgp_stats_t) :: inner        !< the last MPRGP solve (status: MPRGP_*, converged or not)
     integer :: n_matvec = 0             !< products with A over all MPRGP solves
     integer :: updates = 0              !< multiplier updates (SMALBE outer iterations)
+    !> an inner solve of QP_AUTO switched to the Newton method (the later ones then used it alone)
+    logical :: switched = .false.
     real(wp) :: feas = 0.0_wp           !< |Gx - e| at the returned x
     real(wp) :: m_final = 0.0_wp        !< M at the end
   end type smalbe_stats_t
@@ -107,6 +109,11 @@ contains
       solver%opts%eq_feas = feas
       call solver%solve(A, rhs, lb, x, rw, raw, nrw, ub)
       stats%inner = solver%stats
+      if (solver%stats%switched) then
+        ! the penalized Hessian needs the Newton method: the next solves start with it
+        stats%switched = .true.
+        opts%method = QP_NEWTON
+      end if
       have_ax = .true.
       stats%n_matvec = stats%n_matvec + stats%inner%n_matvec
       r = matmul(gm, x) - e

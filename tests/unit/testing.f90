@@ -15,7 +15,7 @@ module testing
   use assembly, only: body_system_t, expand, assemble_body, lame_parameters
   use linop, only: linop_t, csc_op_t, csc_op_init
   use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_BAD_ARG
-  use lapack, only: dpbsv
+  use lapack, only: dpbsv, dgesv
   use ordering, only: grid_dissection, coordinate_bisection
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_METIS, ORD_AMD, ORD_GIVEN
   use errors, only: error_t
@@ -28,6 +28,7 @@ module testing
   public :: report, report_le, test_summary, write_file, band_solve, solve_full, obstacle_problem
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
+  public :: random_bounds, enumerate_box, box_projected
   public :: error_parts
 
 contains
@@ -494,5 +495,130 @@ contains
     info = err%category
     msg = err%text()
   end subroutine error_parts
+
+
+  ! ---- bound-constrained QPs: random bounds, the solution by enumeration, the projected gradient
+
+  !> Random bounds for variable i around the value t with spread w: kind 0 none, 1 lower
+  !! only, 2 upper only, 3 a box, 4 fixed (l = u).
+  subroutine random_bounds(kind, t, w, l, u)
+    integer, intent(in) :: kind
+    real(wp), intent(in) :: t, w
+    real(wp), intent(out) :: l, u
+    l = -huge(1.0_wp)
+    u = huge(1.0_wp)
+    select case (kind)
+    case (1)
+      l = t + urand(-1.0_wp, 1.0_wp) * w
+    case (2)
+      u = t + urand(-1.0_wp, 1.0_wp) * w
+    case (3)
+      l = t + urand(-1.0_wp, 0.5_wp) * w
+      u = l + urand(0.0_wp, 1.0_wp) * w
+    case (4)
+      l = t + urand(-1.0_wp, 1.0_wp) * w
+      u = l
+    end select
+  end subroutine random_bounds
+
+
+  !> The solution of min 1/2 x'Hx - c'x, l <= x <= u, G x = e (r = size(e) rows, r = 0:
+  !! none) by enumeration of every assignment of the variables to free / at l / at u (a
+  !! KKT solve each): the assignment whose KKT point violates feasibility and the signs of
+  !! the bound multipliers least. g returns Hx - c + G'mu there. ok: a point was found
+  !! with violation <= 1e-10 (relative).
+  subroutine enumerate_box(h, c, gm, e, l, u, x, mu, g, ok)
+    real(wp), intent(in) :: h(:, :), c(:), gm(:, :), e(:), l(:), u(:)
+    real(wp), intent(out) :: x(:), mu(:), g(:)
+    logical, intent(out) :: ok
+    integer :: n, r, code, k, i, nf, info, state(size(c)), fr(size(c)), ipiv(size(c) + size(e))
+    real(wp) :: kkt(size(c) + size(e), size(c) + size(e)), rhs(size(c) + size(e)), xt(size(c)), gt(size(c))
+    real(wp) :: viol, best, xsc, gsc
+    logical :: valid
+    n = size(c)
+    r = size(e)
+    best = huge(1.0_wp)
+    x = 0.0_wp
+    mu = 0.0_wp
+    g = 0.0_wp
+    do code = 0, 3**n - 1
+      k = code
+      valid = .true.
+      do i = 1, n
+        state(i) = mod(k, 3)
+        k = k / 3
+        if (l(i) == u(i) .and. state(i) /= 1) valid = .false.
+        if (state(i) == 1 .and. l(i) <= -huge(1.0_wp)) valid = .false.
+        if (state(i) == 2 .and. (u(i) >= huge(1.0_wp) .or. l(i) == u(i))) valid = .false.
+      end do
+      if (.not. valid) cycle
+      xt = 0.0_wp
+      nf = 0
+      do i = 1, n
+        if (state(i) == 1) xt(i) = l(i)
+        if (state(i) == 2) xt(i) = u(i)
+        if (state(i) == 0) then
+          nf = nf + 1
+          fr(nf) = i
+        end if
+      end do
+      if (nf < r) cycle
+      kkt = 0.0_wp
+      kkt(1:nf, 1:nf) = h(fr(1:nf), fr(1:nf))
+      rhs(1:nf) = c(fr(1:nf)) - matmul(h(fr(1:nf), :), xt)
+      if (r > 0) then
+        kkt(1:nf, nf + 1:nf + r) = transpose(gm(:, fr(1:nf)))
+        kkt(nf + 1:nf + r, 1:nf) = gm(:, fr(1:nf))
+        rhs(nf + 1:nf + r) = e - matmul(gm, xt)
+      end if
+      if (nf + r > 0) then
+        call dgesv(nf + r, 1, kkt, size(kkt, 1), ipiv, rhs, size(rhs), info)
+        if (info /= 0) cycle
+      end if
+      xt(fr(1:nf)) = rhs(1:nf)
+      gt = matmul(h, xt) - c
+      if (r > 0) gt = gt + matmul(rhs(nf + 1:nf + r), gm)
+      xsc = maxval(abs(xt)) + 1.0_wp
+      gsc = maxval(abs(c)) + maxval(abs(h)) * xsc
+      viol = 0.0_wp
+      do i = 1, n
+        select case (state(i))
+        case (0)
+          if (l(i) > -huge(1.0_wp)) viol = max(viol, (l(i) - xt(i)) / xsc)
+          if (u(i) < huge(1.0_wp)) viol = max(viol, (xt(i) - u(i)) / xsc)
+        case (1)
+          if (l(i) < u(i)) viol = max(viol, -gt(i) / gsc)
+        case (2)
+          viol = max(viol, gt(i) / gsc)
+        end select
+      end do
+      if (viol < best) then
+        best = viol
+        x = xt
+        g = gt
+        if (r > 0) mu = rhs(nf + 1:nf + r)
+      end if
+    end do
+    ok = best <= 1.0e-10_wp
+  end subroutine enumerate_box
+
+
+  !> Projected gradient of g at x in the box, computed here (not by the solver's support).
+  function box_projected(g, x, l, u) result(gp)
+    real(wp), intent(in) :: g(:), x(:), l(:), u(:)
+    real(wp) :: gp(size(g))
+    integer :: i
+    do i = 1, size(g)
+      if (l(i) == u(i)) then
+        gp(i) = 0.0_wp
+      else if (x(i) <= l(i)) then
+        gp(i) = min(g(i), 0.0_wp)
+      else if (x(i) >= u(i)) then
+        gp(i) = max(g(i), 0.0_wp)
+      else
+        gp(i) = g(i)
+      end if
+    end do
+  end function box_projected
 
 end module testing

@@ -1,0 +1,299 @@
+!> Unit tests of the active-set Newton method (module qp_newton, run through mprgp_t with
+!! opts%method = QP_NEWTON or QP_AUTO) on bound-constrained QPs l <= x <= u:
+!!  - small random SPD problems (condition 1 to 1e6, every kind of bound, cold and far warm
+!!    starts) against the enumeration of all active sets;
+!!  - random SPD problems of 40 to 200 unknowns with condition numbers 1e2 to 1e12 against
+!!    the KKT conditions, computed here: x in the box, and the projected gradient within the
+!!    rounding level of A x (n eps lambda_max |x|: the work must not depend on the
+!!    conditioning, and no tolerance below that level is asked); the objective no larger
+!!    than MPRGP's where MPRGP converges;
+!!  - QP_AUTO: MPRGP's answer where MPRGP is cheap (no switch, the same iterates), the Newton
+!!    method's where it is not (switched, KKT as above, far fewer products);
+!!  - SMALBE with an equality row, with the Newton method inside, against the enumeration;
+!!  - an indefinite matrix is reported as not SPD, never as converged.
+!! One line per check: PASS/FAIL, the measured value and its tolerance. Exit 1 on a failure.
+program test_qp_newton
+  use kinds, only: wp
+  use linop, only: dense_op_t, dense_op_init
+  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, mprgp_status_name, MPRGP_CONVERGED, MPRGP_NOT_SPD, &
+                   QP_AUTO, QP_MPRGP, QP_NEWTON
+  use smalbe, only: smalbe_solve, smalbe_stats_t
+  use lapack, only: dgesv
+  use strings, only: i2s
+  use testing, only: report, test_summary, set_seed, urand, random_spd, random_bounds, enumerate_box, box_projected
+  implicit none (type, external)
+
+  real(wp), parameter :: eps = epsilon(1.0_wp)
+
+  call set_seed(20261128)
+  call test_enumeration()
+  call test_conditioning()
+  call test_auto()
+  call test_smalbe()
+  call test_indefinite()
+  call test_summary()
+
+contains
+
+  !> min 1/2 x'Ax - b'x by a fresh solver with the given options, bounds l <= x <= u.
+  subroutine solve(a, b, l, u, x, opts, st)
+    real(wp), intent(in) :: a(:, :), b(:), l(:), u(:)
+    real(wp), intent(inout) :: x(:)
+    type(mprgp_opts_t), intent(in) :: opts
+    type(mprgp_stats_t), intent(out) :: st
+    type(dense_op_t) :: op
+    type(mprgp_t) :: solver
+    call dense_op_init(op, a)
+    solver%opts = opts
+    call solver%solve(op, b, l, x, ub=u)
+    st = solver%stats
+  end subroutine solve
+
+  !> The unconstrained minimiser A^-1 b (a scale for the bounds).
+  function unconstrained(a, b) result(x)
+    real(wp), intent(in) :: a(:, :), b(:)
+    real(wp) :: x(size(b)), af(size(b), size(b))
+    integer :: ipiv(size(b)), info
+    af = a
+    x = b
+    call dgesv(size(b), 1, af, size(b), ipiv, x, size(b), info)
+  end function unconstrained
+
+  !> |gP| at x over its rounding level n eps lambda_max max(|x|, |x_0|) (+ this product's own).
+  real(wp) function kkt_ratio(a, b, l, u, x, x0, lmax) result(r)
+    real(wp), intent(in) :: a(:, :), b(:), l(:), u(:), x(:), x0(:), lmax
+    real(wp) :: g(size(b)), n
+    n = real(size(b), wp)
+    g = matmul(a, x) - b
+    r = norm2(box_projected(g, x, l, u))/(20.0_wp*n*eps*(lmax*max(norm2(x), norm2(x0)) + norm2(b)))
+  end function kkt_ratio
+
+  !> Small problems (n = 1..8, condition 1 to 1e6) against the enumeration of active sets.
+  subroutine test_enumeration()
+    integer, parameter :: nprob = 400
+    real(wp), allocatable :: a(:, :), b(:), l(:), u(:), x(:), xs(:), xu(:), g(:), x0(:)
+    real(wp) :: lmin, lmax, err, worst, worst_kkt, mu(0), gm(0, 8), e(0)
+    integer :: ip, n, i, nfound, nconv, nsteps
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st
+    logical :: ok
+    nfound = 0
+    nconv = 0
+    nsteps = 0
+    worst = 0.0_wp
+    worst_kkt = 0.0_wp
+    opts%method = QP_NEWTON
+    opts%rtol = 0.0_wp
+    do ip = 1, nprob
+      n = 1 + mod(ip - 1, 8)
+      if (allocated(a)) deallocate (a, b, l, u, x, xs, xu, g, x0)
+      allocate (a(n, n), b(n), l(n), u(n), x(n), xs(n), xu(n), g(n), x0(n))
+      call random_spd(n, urand(0.0_wp, 6.0_wp), a, lmin, lmax)
+      do i = 1, n
+        b(i) = urand(-1.0_wp, 1.0_wp)
+      end do
+      xu = unconstrained(a, b)
+      do i = 1, n
+        call random_bounds(int(urand(0.0_wp, 5.0_wp)), xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
+      end do
+      call enumerate_box(a, b, gm(:, 1:n), e, l, u, xs, mu, g, ok)
+      if (.not. ok) cycle
+      nfound = nfound + 1
+      x = 0.0_wp
+      if (mod(ip, 2) == 0) then
+        do i = 1, n
+          x(i) = urand(-20.0_wp, 20.0_wp)*(maxval(abs(xs)) + 1.0_wp)
+        end do
+      end if
+      x0 = min(max(x, l), u)
+      call solve(a, b, l, u, x, opts, st)
+      if (st%status == MPRGP_CONVERGED .and. all(x >= l) .and. all(x <= u)) nconv = nconv + 1
+      nsteps = max(nsteps, st%n_newton)
+      ! the enumeration solves with the same conditioning: compare at its accuracy
+      err = maxval(abs(x - xs))/(maxval(abs(xs)) + 1.0e-300_wp)/(1.0e-12_wp*lmax/lmin)
+      worst = max(worst, err)
+      worst_kkt = max(worst_kkt, kkt_ratio(a, b, l, u, x, x0, lmax))
+    end do
+    call report(nfound >= nprob*9/10, 'enumeration: the reference found for '//i2s(nfound)//' of '//i2s(nprob)// &
+                ' problems', real(nfound, wp))
+    call report(nconv == nfound, 'enumeration: converged and feasible in every problem ('//i2s(nconv)//' of '// &
+                i2s(nfound)//'; at most '//i2s(nsteps)//' Newton steps)', real(nconv, wp))
+    call report(worst <= 1.0_wp, 'enumeration: |x - x_enum| / |x_enum| <= 1e-12 cond(A), every problem', worst, 1.0_wp)
+    call report(worst_kkt <= 1.0_wp, 'enumeration: |gP| within 20 n eps (lambda_max |x| + |b|)', worst_kkt, 1.0_wp)
+  end subroutine test_enumeration
+
+  !> n = 40..200, condition 1e2 to 1e12, lower bounds, boxes and fixed variables: the KKT
+  !! conditions to the rounding level, in a number of steps that does not grow with the
+  !! condition number; MPRGP's objective is not lower where MPRGP converges.
+  subroutine test_conditioning()
+    integer, parameter :: sizes(3) = [40, 100, 200]
+    real(wp), allocatable :: a(:, :), b(:), l(:), u(:), x(:), y(:), xu(:), x0(:)
+    real(wp) :: lmin, lmax, r, worst(6), fx, fy, fworst
+    integer :: ic, is, n, i, steps(6), nmv(6), k, nsteps_max
+    type(mprgp_opts_t) :: opts, mopts
+    type(mprgp_stats_t) :: st, sm
+    logical :: conv
+    worst = 0.0_wp
+    steps = 0
+    nmv = 0
+    fworst = -huge(1.0_wp)
+    conv = .true.
+    opts%method = QP_NEWTON
+    opts%rtol = 1.0e-14_wp
+    mopts%method = QP_MPRGP
+    mopts%rtol = 1.0e-10_wp
+    mopts%max_it = 20000
+    do ic = 1, 6
+      do is = 1, size(sizes)
+        n = sizes(is)
+        if (allocated(a)) deallocate (a, b, l, u, x, y, xu, x0)
+        allocate (a(n, n), b(n), l(n), u(n), x(n), y(n), xu(n), x0(n))
+        call random_spd(n, 2.0_wp*ic, a, lmin, lmax)
+        do i = 1, n
+          b(i) = urand(-1.0_wp, 1.0_wp)
+        end do
+        xu = unconstrained(a, b)
+        do i = 1, n
+          k = merge(1, 3, mod(i, 3) /= 0)     ! lower bounds and boxes
+          if (mod(i, 17) == 0) k = 4          ! and a few fixed variables
+          call random_bounds(k, xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
+        end do
+        x = 0.0_wp
+        x0 = min(max(x, l), u)
+        call solve(a, b, l, u, x, opts, st)
+        conv = conv .and. st%status == MPRGP_CONVERGED .and. all(x >= l) .and. all(x <= u)
+        r = kkt_ratio(a, b, l, u, x, x0, lmax)
+        worst(ic) = max(worst(ic), r)
+        steps(ic) = max(steps(ic), st%n_newton)
+        nmv(ic) = max(nmv(ic), st%n_matvec)
+        if (ic <= 2) then
+          ! where MPRGP converges, its objective is not lower (x is the minimiser)
+          y = 0.0_wp
+          call solve(a, b, l, u, y, mopts, sm)
+          if (sm%status == MPRGP_CONVERGED) then
+            fx = 0.5_wp*dot_product(x, matmul(a, x)) - dot_product(b, x)
+            fy = 0.5_wp*dot_product(y, matmul(a, y)) - dot_product(b, y)
+            fworst = max(fworst, (fx - fy)/(abs(fy) + tiny(1.0_wp))/(100.0_wp*n*eps*lmax/lmin))
+          end if
+        end if
+      end do
+    end do
+    call report(conv, 'conditioning 1e2..1e12, n = 40..200: converged and feasible every time')
+    do ic = 1, 6
+      call report(worst(ic) <= 1.0_wp, 'cond 1e'//i2s(2*ic)//': |gP| within 20 n eps (lambda_max |x| + |b|) (at most '// &
+                  i2s(steps(ic))//' steps, '//i2s(nmv(ic))//' product equivalents)', worst(ic), 1.0_wp)
+    end do
+    nsteps_max = maxval(steps)
+    call report(nsteps_max <= 4*maxval(steps(1:2)) + 10, 'the steps do not grow with the conditioning: at most '// &
+                i2s(maxval(steps(1:2)))//' at 1e2-1e4, '//i2s(nsteps_max)//' at any', real(nsteps_max, wp))
+    call report(fworst <= 1.0_wp, 'f(x) <= f(x_MPRGP) + 100 n eps cond |f| where MPRGP converged', fworst, 1.0_wp)
+  end subroutine test_conditioning
+
+  !> QP_AUTO: a well-conditioned problem is MPRGP's alone (bitwise the MPRGP solve); an
+  !! ill-conditioned one switches and meets the KKT conditions with far fewer products.
+  subroutine test_auto()
+    integer, parameter :: n = 120
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), x0(n), xu(n), lmin, lmax, r
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st, sm
+    integer :: i
+    call random_spd(n, 1.0_wp, a, lmin, lmax)
+    do i = 1, n
+      b(i) = urand(-1.0_wp, 1.0_wp)
+    end do
+    xu = unconstrained(a, b)
+    do i = 1, n
+      call random_bounds(merge(1, 3, mod(i, 2) == 0), xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
+    end do
+    opts%rtol = 1.0e-10_wp
+    opts%method = QP_AUTO
+    x = 0.0_wp
+    call solve(a, b, l, u, x, opts, st)
+    opts%method = QP_MPRGP
+    y = 0.0_wp
+    call solve(a, b, l, u, y, opts, sm)
+    call report(st%status == MPRGP_CONVERGED .and. .not. st%switched .and. all(x == y) .and. &
+                st%n_matvec == sm%n_matvec, 'auto, cond 10: MPRGP alone, bitwise its solve ('//i2s(st%n_matvec)// &
+                ' products)', real(st%n_matvec, wp))
+    call random_spd(n, 10.0_wp, a, lmin, lmax)
+    xu = unconstrained(a, b)
+    do i = 1, n
+      call random_bounds(merge(1, 3, mod(i, 2) == 0), xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
+    end do
+    opts%rtol = 1.0e-12_wp
+    opts%method = QP_AUTO
+    x = 0.0_wp
+    x0 = min(max(x, l), u)
+    call solve(a, b, l, u, x, opts, st)
+    r = kkt_ratio(a, b, l, u, x, x0, lmax)
+    call report(st%status == MPRGP_CONVERGED .and. st%switched .and. r <= 1.0_wp, 'auto, cond 1e10: switched to '// &
+                'the Newton method after its budget, KKT to the rounding level ('//i2s(st%n_matvec)//' products, '// &
+                i2s(st%n_newton)//' Newton steps; '//trim(mprgp_status_name(st%status))//')', r, 1.0_wp)
+    opts%method = QP_MPRGP
+    opts%max_it = 5*st%n_matvec
+    y = 0.0_wp
+    call solve(a, b, l, u, y, opts, sm)
+    call report(sm%status /= MPRGP_CONVERGED, 'auto, cond 1e10: MPRGP alone does not converge in five times '// &
+                'that work ('//trim(mprgp_status_name(sm%status))//')')
+  end subroutine test_auto
+
+  !> SMALBE (an equality row) with the Newton method inside, against the enumeration.
+  subroutine test_smalbe()
+    integer, parameter :: n = 7
+    real(wp) :: h(n, n), c(n), l(n), u(n), x(n), xs(n), g(n), gm(1, n), e(1), mu(1), mus(1), lmin, lmax, rho, err
+    real(wp), allocatable :: aug(:, :)
+    type(dense_op_t) :: op
+    type(mprgp_t) :: solver
+    type(smalbe_stats_t) :: st
+    logical :: ok
+    integer :: i
+    call random_spd(n, 5.0_wp, h, lmin, lmax)
+    do i = 1, n
+      c(i) = urand(-1.0_wp, 1.0_wp)
+      gm(1, i) = urand(0.5_wp, 1.0_wp)
+      l(i) = 0.0_wp
+      u(i) = merge(huge(1.0_wp), 0.3_wp, mod(i, 2) == 0)
+    end do
+    e = 0.5_wp
+    call enumerate_box(h, c, gm, e, l, u, xs, mus, g, ok)
+    rho = lmax
+    aug = h + rho*matmul(transpose(gm), gm)
+    call dense_op_init(op, aug)
+    solver%opts%method = QP_NEWTON
+    solver%opts%rtol = 1.0e-12_wp
+    solver%opts%lambda_max = maxval(sum(abs(aug), dim=1))
+    solver%opts%eq_m = 100.0_wp*lmax
+    solver%opts%eq_feas = 1.0e-11_wp
+    x = 0.0_wp
+    mu = 0.0_wp
+    call smalbe_solve(solver, op, c, gm, e, rho, l, x, mu, st, ub=u)
+    err = maxval(abs(x - xs))/maxval(abs(xs))
+    call report(ok .and. st%inner%status == MPRGP_CONVERGED .and. err <= 1.0e-6_wp, 'SMALBE with the Newton '// &
+                'method, cond 1e5, an equality row and boxes: x = the enumeration''s ('//i2s(st%updates)// &
+                ' multiplier updates, '//i2s(st%n_matvec)//' products)', err, 1.0e-6_wp)
+  end subroutine test_smalbe
+
+  !> An indefinite A: not SPD, never converged.
+  subroutine test_indefinite()
+    integer, parameter :: n = 6
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n)
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st
+    integer :: i
+    a = 0.0_wp
+    do i = 1, n
+      a(i, i) = 1.0_wp
+    end do
+    a(1, 2) = 3.0_wp
+    a(2, 1) = 3.0_wp
+    b = 1.0_wp
+    l = -10.0_wp
+    u = 10.0_wp
+    x = 0.0_wp
+    opts%method = QP_NEWTON
+    call solve(a, b, l, u, x, opts, st)
+    call report(st%status == MPRGP_NOT_SPD, 'an indefinite A (eigenvalue -2) is reported not SPD ('// &
+                trim(mprgp_status_name(st%status))//': '//trim(st%message)//')')
+  end subroutine test_indefinite
+
+end program test_qp_newton
