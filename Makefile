@@ -164,8 +164,8 @@ $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o 
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
 $(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
-$(BUILD)/contact_interface.o: $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
-                           $(BUILD)/mortar.o $(BUILD)/strings.o
+$(BUILD)/contact_interface.o: $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o \
+                           $(BUILD)/mesh.o $(BUILD)/mortar.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/cholesky.o $(BUILD)/clock.o $(BUILD)/config.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/mesh.o $(BUILD)/ordering.o
