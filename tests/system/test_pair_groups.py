@@ -8,6 +8,12 @@ test in a temporary folder.
     bodies 1 and 3 on body 1's second name: exit 1, the message names both groups and one
     shared edge (its node tags), no Fortran runtime text, no result written. The stack itself
     (every body's pairs on disjoint curves) runs (control).
+(2) A command-line override of a deck with two pairs of bodies 1 and 2 (rectangles: 'bottom' on
+    'top', and 'left' on 'right'): `&contact bodies=1,2, slave=2 /` is refused (exit 1, naming
+    both candidates by their groups, nothing written); with groups= it changes the pair with
+    those groups, given in either order of the bodies, and only that one (the effective
+    deck); groups= matching neither pair is refused naming both. On a deck with one pair of
+    those bodies the override without groups still changes it (control).
 """
 import os
 import sys
@@ -75,5 +81,49 @@ with tempfile.TemporaryDirectory() as tmp:
     rc, text, h5 = run(tmp, "stack", STACK)
     check(rc == 0 and os.path.exists(h5), "the stack, pairs on disjoint curves: exit 0, result written",
           f"exit {rc}: {text.strip()[-300:]}")
+
+TWO = """&body id=1, x0=0.0, y0=1.0, width=1.0, height=1.0, nx=2, ny=2, left='clamped' /
+&body id=2, x0=0.0, y0=0.0, width=1.0, height=1.0, nx=2, ny=2, bottom='clamped' /
+&contact bodies=1,2, groups='bottom','top' /
+&contact bodies=2,1, groups='right','left' /
+&traction body=1, side='top', t0=0.0, -1.0e6 /
+"""
+
+
+def contact_lines(text):
+    """The &contact groups of the effective deck, one string each (continuation lines joined)."""
+    out, cur = [], None
+    for ln in text.splitlines():
+        if ln.startswith("&contact"):
+            cur = ln
+            out.append(cur)
+        elif cur is not None and ln.startswith("      "):
+            out[-1] += " " + ln.strip()
+        else:
+            cur = None
+    return out
+
+
+with tempfile.TemporaryDirectory() as tmp:
+    rc, text, h5 = run(tmp, "two", TWO, "&contact bodies=1,2, slave=2 /")
+    refused(rc, text, h5, "an override naming two pairs by their bodies", "bodies = 1,2 names 2 pairs",
+            "groups='bottom','top' (&contact at line 3)", "groups='left','right' (&contact at line 4)")
+    for over, want, other in (("&contact bodies=1,2, groups='left','right', slave=2 /",
+                               "&contact bodies=1, 2, groups='left', 'right', slave=2", "groups='bottom', 'top', slave=0"),
+                              ("&contact bodies=2,1, groups='top','bottom', slave=1 /",
+                               "&contact bodies=2, 1, groups='top', 'bottom', slave=1", "groups='right', 'left', slave=0")):
+        rc, text, h5 = run(tmp, "pick", TWO, over)
+        lines = contact_lines(text)
+        check(len(lines) == 2 and sum(want in ln for ln in lines) == 1 and sum(other in ln for ln in lines) == 1,
+              f"override {over}: changes the pair with those groups and not the other", " | ".join(lines))
+    rc, text, h5 = run(tmp, "none", TWO, "&contact bodies=1,2, groups='top','left', slave=2 /")
+    refused(rc, text, h5, "an override whose groups match neither pair", "is none of the 2 pairs of bodies 1 and 2",
+            "groups='bottom','top'", "groups='left','right'")
+    one = TWO.replace("&contact bodies=2,1, groups='right','left' /\n", "")
+    rc, text, h5 = run(tmp, "one", one, "&contact bodies=1,2, slave=2 /")
+    lines = contact_lines(text)
+    check(rc == 0 and len(lines) == 1 and "groups='bottom', 'top', slave=2" in lines[0],
+          "one pair of bodies 1, 2: the override without groups changes it, the run converges",
+          f"exit {rc}: " + " | ".join(lines))
 
 sys.exit(1 if check.failed else 0)
