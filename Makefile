@@ -202,7 +202,7 @@ $(BUILD)/error_estimate.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/cont
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
-$(BUILD)/files.o:
+$(BUILD)/files.o:          $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
                            $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/friction_view.o \

@@ -18,9 +18,9 @@ module run_phases
   use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
   use contact_common, only: gather
-  use results, only: write_results
+  use results, only: write_results, result_files
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
-  use files, only: remove_file, special_file
+  use files, only: remove_file, special_file, check_new_files
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
@@ -42,7 +42,7 @@ module run_phases
 
   public :: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, read_restart, &
             factor_estimate, check_condensed, solve_contact, complete_displacements, write_output, &
-            check_interrupt, solve_steps
+            check_interrupt, solve_steps, check_output_names
 
 contains
 
@@ -66,6 +66,21 @@ contains
       end if
     end associate
   end subroutine choose_backend
+
+  !> Every file the run may write (the result, its XDMF companions, the checkpoint, and
+  !! their temporary names) can be made where the deck puts it, checked before any work:
+  !! a name the file system cannot hold is bad input (exit 1), not a failure after the solve.
+  subroutine check_output_names(run)
+    type(run_t), intent(in) :: run   !< the run: its deck
+    character(len=:), allocatable :: file
+    character(len=len_trim(run%deck%output%file) + 32), allocatable :: name(:)
+    type(error_t) :: err
+    file = trim(run%deck%output%file)
+    call result_files(file, run%deck%nbody, max(1, run%deck%npair), name)
+    name = [character(len=len(name)) :: name, checkpoint_file(file)]
+    call check_new_files(name, err)
+    call fail_on(err, 'deck '//trim(run%deck%source))
+  end subroutine check_output_names
 
   !> One thread per body, at most two. CHOLMOD opens OpenMP regions of its own with a
   !! fixed num_threads(4); inside our 2-thread region they are nested and run serially, but
