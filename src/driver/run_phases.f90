@@ -77,8 +77,8 @@ contains
     type(error_t) :: err
     file = trim(run%deck%output%file)
     call result_files(file, run%deck%nbody, max(1, run%deck%npair), name)
-    name = [character(len=len(name)) :: name, checkpoint_file(file)]
     call check_new_files(name, err)
+    if (.not. err%failed()) call check_new_files([checkpoint_file(file)], err)
     call fail_on(err, 'deck '//trim(run%deck%source))
   end subroutine check_output_names
 
@@ -537,18 +537,23 @@ contains
   subroutine write_output(run)
     type(run_t), intent(inout) :: run   !< the run: whether its result was written
     type(error_t) :: err
+    integer :: stale
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
+    stale = 0
     if (size(run%plan) > 1) then   ! every load step's result too
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%timing, err, run%steps, threads=run%threads)
+                         run%displacement, run%timing, err, run%steps, threads=run%threads, stale=stale)
     else
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%timing, err, threads=run%threads)
+                         run%displacement, run%timing, err, threads=run%threads, stale=stale)
     end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')
+    if (stale > 0) write (output_unit, '(a)') 'output: removed '//i2s(stale)//' stale file'// &
+      trim(merge('s', ' ', stale > 1))//' of an earlier result beside '//trim(run%deck%output%file)// &
+      ' (its XDMF files of bodies or pairs this result does not have)'
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
 

@@ -318,14 +318,22 @@ contains
   !! where links are not supported); (3) the renames; (4) the kept files are removed.
   !! When a step fails, what this call renamed into place is undone, the kept files are
   !! put back, the temporary files are removed, ok = .false. and msg says what failed.
-  subroutine commit_files(tmp, final, ok, msg)
+  !! With `stale_prefix`, once all are renamed and still under the lock, the numbered files
+  !! `<stale_prefix(i)><k><stale_suffix>` for k = stale_first(i), stale_first(i) + 1, ...
+  !! up to the first that does not exist (an earlier, larger set's own files, which the
+  !! new set lacks) are removed; `removed` counts them. A failed commit removes none.
+  subroutine commit_files(tmp, final, ok, msg, stale_prefix, stale_first, stale_suffix, removed)
     character(len=*), intent(in) :: tmp(:)                 !< complete files, temporary names
     character(len=*), intent(in) :: final(:)               !< their final names
     logical, intent(out) :: ok                             !< all renamed
     character(len=:), allocatable, intent(out) :: msg      !< what failed
+    character(len=*), intent(in), optional :: stale_prefix(:)   !< numbered names of an earlier set: the part before k
+    integer, intent(in), optional :: stale_first(:)        !< the first k each prefix's new set lacks
+    character(len=*), intent(in), optional :: stale_suffix !< the part after k
+    integer, intent(out), optional :: removed              !< stale files removed
     character(len=len(final) + 160) :: bak(size(final))
     integer :: kept(size(final)), k, j, fd, kind
-    character(len=:), allocatable :: dir
+    character(len=:), allocatable :: dir, stale
     logical :: done
 
     ok = .false.
@@ -381,6 +389,20 @@ contains
       if (kept(k) /= KEPT_NONE) call remove_file(bak(k))
     end do
     ok = .true.
+    ! 5. an earlier, larger set's numbered files the new set does not have
+    if (present(removed)) removed = 0
+    if (present(stale_prefix) .and. present(stale_first) .and. present(stale_suffix)) then
+      do j = 1, size(stale_prefix)
+        k = stale_first(j)
+        do
+          stale = trim(stale_prefix(j))//i2s(k)//stale_suffix
+          if (rc_path_kind(stale//c_null_char) /= 1) exit
+          if (c_unlink(stale//c_null_char) /= 0) exit
+          if (present(removed)) removed = removed + 1
+          k = k + 1
+        end do
+      end do
+    end if
     call finish()
 
   contains

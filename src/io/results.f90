@@ -71,7 +71,7 @@ contains
   !! temporary file is left. The HDF5 library is called from one thread; with two, the
   !! other writes the companions and, body by body, computes the fields of each body
   !! (its stresses) and writes their data into the storage the first has reserved.
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, tm, err, steps, threads)
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, tm, err, steps, threads, stale)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
@@ -84,12 +84,16 @@ contains
     !> the load steps' results (several steps: /steps, and the XDMF files a time series)
     type(step_result_t), intent(in), optional :: steps(:)
     integer, intent(in), optional :: threads           !< threads to write with (default 1)
+    !> the files of an earlier result at this name that this one lacks, removed once it is
+    !! in place (`<stem>_body<a>.xdmf` beyond its bodies, `<stem>_contact<k>.xdmf` beyond its pairs)
+    integer, intent(out), optional :: stale
     character(len=len_trim(file) + 32), allocatable :: name(:)
     real(wp), allocatable :: times(:)
     character(len=len_trim(file) + 160), allocatable :: tmp(:)
+    character(len=len_trim(file) + 16) :: stale_pre(2)
     character(len=:), allocatable :: why, h5, id
     type(error_t) :: st
-    integer :: k, nb, np, nf, nt
+    integer :: k, nb, np, nf, nt, nstale
     logical :: ok
     type(interface_t) :: itf
     type(contact_result_t) :: res
@@ -138,9 +142,14 @@ contains
       call remove_temps()
       return
     end if
-    ! companions first, the HDF5 file last: it appears only with its XDMF files
-    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why)
+    ! companions first, the HDF5 file last: it appears only with its XDMF files; then the
+    ! companions of an earlier result with more bodies or pairs, which this one lacks
+    stale_pre(1) = replace_suffix(trim(file), '.h5', '_body')
+    stale_pre(2) = replace_suffix(trim(file), '.h5', '_contact')
+    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, [nb + 1, merge(np + 1, 1, np > 1)], '.xdmf', &
+                      nstale)
     if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
+    if (present(stale)) stale = nstale
 
   contains
 
