@@ -323,7 +323,7 @@ contains
   !! its checkpoints, or the monolithic QP; then the a posteriori error bound and, for a
   !! floating body, its load against its contact force.
   subroutine solve_contact(run)
-    type(run_t), intent(inout) :: run   !< the run: its contact result
+    type(run_t), intent(inout), target :: run   !< the run: its contact result (its steps the checkpoint's)
     type(h5_checkpointer_t) :: ckpt
     integer :: a, rigid
     real(wp) :: scale
@@ -353,10 +353,7 @@ contains
         ckpt%every = deck%output%checkpoint_every
         if (size(run%plan) > 1) then   ! a restart resumes this step, the ones before replayed
           ckpt%step = run%step
-          allocate (ckpt%done(run%step - 1))
-          do a = 1, run%step - 1
-            ckpt%done(a) = run%steps(a)%res
-          end do
+          ckpt%done => run%steps(1:run%step - 1)%res
         end if
         if (run%history%step > 0 .and. run%robin_state%it == 0) then   ! a load step after the first
           call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
@@ -429,7 +426,31 @@ contains
       call record_step(run, k)
       if (run%result%status /= STATUS_CONVERGED) exit
     end do
+    ! the steps solved (record_step reserves room for more)
+    if (run%rank == 0 .and. size(run%steps) > min(k, size(run%plan))) call keep_steps(run, min(k, size(run%plan)))
   end subroutine solve_steps
+
+  !> run%steps reduced to its first n entries (moved, not copied).
+  subroutine keep_steps(run, n)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: n
+    type(step_result_t), allocatable :: kept(:)
+    integer :: i
+    allocate (kept(n))
+    do i = 1, n
+      call move_step(run%steps(i), kept(i))
+    end do
+    call move_alloc(kept, run%steps)
+  end subroutine keep_steps
+
+  !> Step result a into b, its arrays moved (a's left unallocated).
+  subroutine move_step(a, b)
+    type(step_result_t), intent(inout) :: a, b
+    b%stage = a%stage
+    b%load_factor = a%load_factor
+    call move_alloc(a%u, b%u)
+    b%res = a%res
+  end subroutine move_step
 
   !> Friction acts on each load step's slip increment: the tangential rows' g0 (rank 0, which
   !! solves the contact) is the slip w_1 + w_2 the step before ended with, 0 at the first
@@ -479,14 +500,19 @@ contains
     type(run_t), intent(inout) :: run
     integer, intent(in) :: k
     type(step_result_t), allocatable :: grown(:)
+    integer :: i
     if (run%rank == 0) then
-      allocate (grown(size(run%steps) + 1))
-      grown(1:size(run%steps)) = run%steps
-      grown(k)%stage = run%plan(k)%stage
-      grown(k)%load_factor = run%plan(k)%factor
-      grown(k)%res = run%result
-      grown(k)%u = run%displacement
-      call move_alloc(grown, run%steps)
+      if (k > size(run%steps)) then   ! room for twice as many: every step moved a bounded number of times
+        allocate (grown(min(size(run%plan), max(k, 2*size(run%steps), 8))))
+        do i = 1, size(run%steps)
+          call move_step(run%steps(i), grown(i))
+        end do
+        call move_alloc(grown, run%steps)
+      end if
+      run%steps(k)%stage = run%plan(k)%stage
+      run%steps(k)%load_factor = run%plan(k)%factor
+      run%steps(k)%res = run%result
+      run%steps(k)%u = run%displacement
       write (output_unit, '(a)') step_line(run, k)
       flush (output_unit)
       if (run%result%status == STATUS_CONVERGED) then
