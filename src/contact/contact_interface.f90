@@ -15,7 +15,7 @@ module contact_interface
                     FRICTION_COULOMB
   use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
   use mortar, only: mortar_t, mortar_build
-  use strings, only: i2s, r2s, sci
+  use strings, only: i2s, sci
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use assembly, only: body_system_t
   use errors, only: error_t, ERR_INPUT
@@ -452,8 +452,8 @@ contains
         j = minloc(gdist, dim=1)
         call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
               ''' overlap in the initial configuration: the gap at slave node '//i2s(ms%node_tag(mt%snode(j)))// &
-              ' of body '//i2s(cc%bodies(sl))//' at ('//r2s(ms%xy(1, mt%snode(j)))//', '//r2s(ms%xy(2, mt%snode(j)))// &
-              ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart')
+              ' of body '//i2s(cc%bodies(sl))//' at ('//sci(ms%xy(1, mt%snode(j)))//', '//sci(ms%xy(2, mt%snode(j)))// &
+              ') is '//sci(gmin)//' (tolerance '//sci(tol)//'); move the bodies apart')
         return
       end if
 
