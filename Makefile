@@ -72,7 +72,7 @@ MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo 
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_qp_newton test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_qp_newton test_cholesky test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names
 BENCH_F := bench_mprgp bench_ordering bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -165,8 +165,8 @@ $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o 
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o
 $(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
-$(BUILD)/contact_interface.o: $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
-                           $(BUILD)/mortar.o $(BUILD)/strings.o
+$(BUILD)/contact_interface.o: $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o \
+                           $(BUILD)/mesh.o $(BUILD)/mortar.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/cholesky.o $(BUILD)/clock.o $(BUILD)/config.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/mesh.o $(BUILD)/ordering.o
@@ -203,7 +203,7 @@ $(BUILD)/error_estimate.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/cont
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
-$(BUILD)/files.o:
+$(BUILD)/files.o:          $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
                            $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/friction_view.o \

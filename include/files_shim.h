@@ -16,6 +16,9 @@ int rc_path_kind(const char *path);
 /* What path names, following symbolic links: 0 nothing, 1 a regular file, 2 a folder,
    3 something else (fifo, device, socket), -1 cannot tell. */
 int rc_file_kind(const char *path);
+/* The longest name of one entry of the folder dir (pathconf _PC_NAME_MAX), -1 when the
+   system does not say. */
+long rc_name_max(const char *dir);
 /* 1 when the folder dir can take new entries (write and search permission), else 0. */
 int rc_dir_writable(const char *dir);
 /* A file's data written at given offsets (the raw data of reserved HDF5 datasets): open

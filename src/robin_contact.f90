@@ -26,7 +26,8 @@ program robin_contact
   use run_state, only: run_t, start_ranks, set_collective, phase, physics_key
   use run_backend, only: backend_t
   use run_phases, only: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, &
-                        read_restart, factor_estimate, check_condensed, solve_steps, write_output, check_interrupt
+                        read_restart, factor_estimate, check_condensed, solve_steps, write_output, check_interrupt, &
+                        check_output_names
   use run_summary, only: set_exit_code, summary
   implicit none (type, external)
 
@@ -48,6 +49,7 @@ program robin_contact
   call backend%check_memory(run, run%deck)
   call check_load_range(run%deck, err)
   call fail_on(err, 'deck '//trim(run%deck%source))
+  call check_output_names(run)
   run%key = physics_key(run%deck)
   write (output_unit, '(a)') 'robin_contact '//program_version//': effective input'
   call print_deck(run%deck, output_unit)

@@ -10,12 +10,13 @@
 !! along the slave tangent: the weighted slip), whose force is bounded by a box (Tresca) or
 !! by mu times the node's normal force (Coulomb): `row_bounds`.
 module contact_interface
-  use kinds, only: wp
+  use kinds, only: wp, i8
   use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented, FRICTION_NONE, FRICTION_TRESCA, &
                     FRICTION_COULOMB
   use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
   use mortar, only: mortar_t, mortar_build
-  use strings, only: i2s, r2s
+  use strings, only: i2s, sci
+  use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use assembly, only: body_system_t
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
@@ -182,6 +183,7 @@ contains
     type(error_t), intent(out) :: err                !< the bad input (ERR_INPUT), if any
     type(interface_t), allocatable :: one(:)
     type(contact_cfg_t) :: cc
+    type(contact_cfg_t), allocatable :: ccs(:)
     integer :: p, a, s, side, np
 
     np = size(pairs)
@@ -191,19 +193,25 @@ contains
     allocate (itf%pair_ptr(np + 1), itf%pair_body(2, np), itf%pair_slave(np), itf%pair_friction(np), itf%pair_mu(np), &
               itf%pair_slip(np))
     itf%pair_ptr(1) = 1
+    allocate (ccs(np))
     do p = 1, np
-      cc = pair_oriented(pairs(p))
-      if (len_trim(cc%body_group(1)) == 0) then
+      ccs(p) = pair_oriented(pairs(p))
+      if (len_trim(ccs(p)%body_group(1)) == 0) then
         do s = 1, 2
-          a = cc%bodies(s)
+          a = ccs(p)%bodies(s)
           side = findloc(body(a)%bc, BC_CONTACT, dim=1)
           if (side == 0) then
             call err%set(ERR_INPUT, 'body '//i2s(a)//' has no contact side')
             return
           end if
-          cc%body_group(s) = side_names(side)
+          ccs(p)%body_group(s) = side_names(side)
         end do
       end if
+    end do
+    call check_shared_edges(ccs, named, msh, err)
+    if (err%failed()) return
+    do p = 1, np
+      cc = ccs(p)
       call mortar_pair(cc, named, msh, sys, one(p), err)
       if (err%failed()) return
       itf%pair_body(:, p) = cc%bodies
@@ -215,6 +223,90 @@ contains
     end do
     call stack_pairs(one, itf)
   end subroutine build_interface
+
+  !> The pairs' contact groups of each body share no edge: two differently named groups over
+  !! the same edges (a Gmsh curve with two physical names) in two pairs would give the edges
+  !! two sets of contact rows and split their force arbitrarily. Per body, the edges of its
+  !! groups in pairs go into one hash set keyed by the edge's two nodes (either order), each
+  !! with the pair end that put it there (linear in the edges). Unknown or node-only groups
+  !! are left to mortar_pair's messages.
+  subroutine check_shared_edges(pairs, named, msh, err)
+    type(contact_cfg_t), intent(in) :: pairs(:)   !< the pairs, oriented, rectangle sides resolved
+    logical, intent(in) :: named                  !< the deck names its pairs (messages)
+    type(mesh_t), intent(in) :: msh(:)            !< meshes of all bodies
+    type(error_t), intent(out) :: err             !< ERR_INPUT naming both groups and a shared edge
+    type(int_hash_t) :: h
+    integer, allocatable :: owner(:), nend(:)
+    integer :: a, p, s, g, e, slot, n1, n2, ne, stat, q, t
+    integer(i8) :: key
+
+    allocate (nend(size(msh)))
+    nend = 0
+    do p = 1, size(pairs)
+      do s = 1, 2
+        nend(pairs(p)%bodies(s)) = nend(pairs(p)%bodies(s)) + 1
+      end do
+    end do
+    do a = 1, size(msh)
+      if (nend(a) < 2) cycle
+      associate (m => msh(a))
+        ne = 0
+        do p = 1, size(pairs)
+          do s = 1, 2
+            if (pairs(p)%bodies(s) /= a) cycle
+            g = group_index(m, pairs(p)%body_group(s))
+            if (g > 0) ne = ne + m%group(g)%nedge
+          end do
+        end do
+        call hash_init(h, ne, stat)
+        if (stat /= 0) then
+          call err%set(ERR_INPUT, 'body '//i2s(a)//': not enough memory to compare its contact groups'' '// &
+                       i2s(ne)//' edges')
+          return
+        end if
+        allocate (owner(0:h%mask))
+        do p = 1, size(pairs)
+          do s = 1, 2
+            if (pairs(p)%bodies(s) /= a) cycle
+            g = group_index(m, pairs(p)%body_group(s))
+            if (g == 0) cycle
+            do e = 1, m%group(g)%nedge
+              n1 = minval(m%group(g)%edge(:, e))
+              n2 = maxval(m%group(g)%edge(:, e))
+              key = int(n1 - 1, i8)*int(m%nnode, i8) + int(n2 - 1, i8)
+              slot = hash_slot(h, key)
+              if (h%key(slot) == HASH_EMPTY) then
+                h%key(slot) = key
+                owner(slot) = 2*p + s - 2
+                cycle
+              end if
+              q = (owner(slot) + 1)/2
+              t = owner(slot) - 2*q + 2
+              if (owner(slot) == 2*p + s - 2) cycle   ! an edge listed twice in one group: the mesh reader's business
+              call err%set(ERR_INPUT, 'body '//i2s(a)//': contact group '''//trim(pairs(q)%body_group(t))// &
+                ''' ('//pair_words(q)//') and contact group '''//trim(pairs(p)%body_group(s))// &
+                ''' ('//pair_words(p)//') share edges, e.g. the edge of nodes '// &
+                i2s(m%node_tag(n1))//' and '//i2s(m%node_tag(n2))//' from ('//sci(m%xy(1, n1))//', '// &
+                sci(m%xy(2, n1))//') to ('//sci(m%xy(1, n2))//', '//sci(m%xy(2, n2))//'); an edge of a body '// &
+                'is in one contact pair at most (two names of one Gmsh curve are one surface)')
+              return
+            end do
+          end do
+        end do
+        deallocate (owner)
+      end associate
+    end do
+  contains
+    function pair_words(k) result(w)
+      integer, intent(in) :: k
+      character(len=:), allocatable :: w
+      if (named) then
+        w = 'pair '//i2s(k)//', &contact bodies='//i2s(pairs(k)%bodies(1))//','//i2s(pairs(k)%bodies(2))
+      else
+        w = 'pair '//i2s(k)
+      end if
+    end function pair_words
+  end subroutine check_shared_edges
 
   !> Stack the pairs' rows (each built with its own rows 1..m_p) into itf, whose pair
   !! fields are set.
@@ -360,8 +452,8 @@ contains
         j = minloc(gdist, dim=1)
         call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
               ''' overlap in the initial configuration: the gap at slave node '//i2s(ms%node_tag(mt%snode(j)))// &
-              ' of body '//i2s(cc%bodies(sl))//' at ('//r2s(ms%xy(1, mt%snode(j)))//', '//r2s(ms%xy(2, mt%snode(j)))// &
-              ') is '//r2s(gmin)//' (tolerance '//r2s(tol)//'); move the bodies apart')
+              ' of body '//i2s(cc%bodies(sl))//' at ('//sci(ms%xy(1, mt%snode(j)))//', '//sci(ms%xy(2, mt%snode(j)))// &
+              ') is '//sci(gmin)//' (tolerance '//sci(tol)//'); move the bodies apart')
         return
       end if
 

@@ -16,7 +16,7 @@ module floating
   use condense, only: body_condensed_t
   use contact_common, only: scatter
   use lapack, only: dsyev, dgels, dsygv
-  use strings, only: i2s, r2s
+  use strings, only: i2s, sci
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
@@ -109,7 +109,7 @@ contains
               'but the contact cannot hold its '//rigid_motion_name(systems(a), c)//': the contact normals '// &
               'have (almost) no component along it (frictionless contact lets the body slide or turn)'
         if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = msg// &
-          '; its load has a component '//r2s(along)//' along that motion, which no contact force balances'
+          '; its load has a component '//sci(along)//' along that motion, which no contact force balances'
         call err%set(ERR_INPUT, msg//'; '//hold)
         return
       end if
@@ -121,7 +121,7 @@ contains
       if (enorm == 0.0_wp .and. m > 0) cycle
       if (m == 0) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
-              'presses it into the contact (load resultant ('//r2s(fx)//', '//r2s(fy)//')): its position '// &
+              'presses it into the contact (load resultant ('//sci(fx)//', '//sci(fy)//')): its position '// &
               'is undetermined; load it towards the body it touches, or '//hold)
         return
       end if
@@ -144,14 +144,14 @@ contains
         c(1:2) = [fx, fy] - dot_product([fx, fy], c(1:2))/max(sum(c(1:2)**2), tiny(1.0_wp))*c(1:2)
         c(1:2) = c(1:2)/max(norm2(c(1:2)), tiny(1.0_wp))
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), and its load '// &
-              '(resultant ('//r2s(fx)//', '//r2s(fy)//')) cannot be balanced by contact forces within the friction '// &
-              'limits (|t| <= mu p, or the Tresca bound): it would slide along ('//r2s(c(1))//', '//r2s(c(2))// &
-              '); no static equilibrium (unbalanced part '//r2s(res)//'): raise mu, lower the tangential load, or '//hold)
+              '(resultant ('//sci(fx)//', '//sci(fy)//')) cannot be balanced by contact forces within the friction '// &
+              'limits (|t| <= mu p, or the Tresca bound): it would slide along ('//sci(c(1))//', '//sci(c(2))// &
+              '); no static equilibrium (unbalanced part '//sci(res)//'): raise mu, lower the tangential load, or '//hold)
         return
       else if (res > 1.0e-8_wp*enorm) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but its load '// &
-              '(resultant ('//r2s(fx)//', '//r2s(fy)//')) pulls it away from the contact: no compressive '// &
-              'contact force balances it (an unbalanced part '//r2s(res)//' remains); reverse the load '// &
+              '(resultant ('//sci(fx)//', '//sci(fy)//')) pulls it away from the contact: no compressive '// &
+              'contact force balances it (an unbalanced part '//sci(res)//' remains); reverse the load '// &
               'or '//hold)
         return
       end if
@@ -244,7 +244,7 @@ contains
       if (res > 1.0e-8_wp*norm2(es)) then
         call err%set(ERR_INPUT, 'bodies '//names//' are '//merge('both', 'all ', nm == 2)// &
               ' held only by contact, and their loads cannot be balanced by compressive contact forces '// &
-              'between them (unbalanced part '//r2s(res)//'); support one of them')
+              'between them (unbalanced part '//sci(res)//'); support one of them')
         return
       end if
       deallocate (gs, es, gg, sr, ev, lam)

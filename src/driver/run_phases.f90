@@ -18,9 +18,9 @@ module run_phases
   use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
   use contact_common, only: gather
-  use results, only: write_results
+  use results, only: write_results, result_files
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
-  use files, only: remove_file, special_file
+  use files, only: remove_file, special_file, check_new_files
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
@@ -42,7 +42,7 @@ module run_phases
 
   public :: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, read_restart, &
             factor_estimate, check_condensed, solve_contact, complete_displacements, write_output, &
-            check_interrupt, solve_steps
+            check_interrupt, solve_steps, check_output_names
 
 contains
 
@@ -66,6 +66,21 @@ contains
       end if
     end associate
   end subroutine choose_backend
+
+  !> Every file the run may write (the result, its XDMF companions, the checkpoint, and
+  !! their temporary names) can be made where the deck puts it, checked before any work:
+  !! a name the file system cannot hold is bad input (exit 1), not a failure after the solve.
+  subroutine check_output_names(run)
+    type(run_t), intent(in) :: run   !< the run: its deck
+    character(len=:), allocatable :: file
+    character(len=len_trim(run%deck%output%file) + 32), allocatable :: name(:)
+    type(error_t) :: err
+    file = trim(run%deck%output%file)
+    call result_files(file, run%deck%nbody, max(1, run%deck%npair), name)
+    call check_new_files(name, err)
+    if (.not. err%failed()) call check_new_files([checkpoint_file(file)], err)
+    call fail_on(err, 'deck '//trim(run%deck%source))
+  end subroutine check_output_names
 
   !> One thread per body, at most two. CHOLMOD opens OpenMP regions of its own with a
   !! fixed num_threads(4); inside our 2-thread region they are nested and run serially, but
@@ -308,7 +323,7 @@ contains
   !! its checkpoints, or the monolithic QP; then the a posteriori error bound and, for a
   !! floating body, its load against its contact force.
   subroutine solve_contact(run)
-    type(run_t), intent(inout) :: run   !< the run: its contact result
+    type(run_t), intent(inout), target :: run   !< the run: its contact result (its steps the checkpoint's)
     type(h5_checkpointer_t) :: ckpt
     integer :: a, rigid
     real(wp) :: scale
@@ -338,10 +353,7 @@ contains
         ckpt%every = deck%output%checkpoint_every
         if (size(run%plan) > 1) then   ! a restart resumes this step, the ones before replayed
           ckpt%step = run%step
-          allocate (ckpt%done(run%step - 1))
-          do a = 1, run%step - 1
-            ckpt%done(a) = run%steps(a)%res
-          end do
+          ckpt%done => run%steps(1:run%step - 1)%res
         end if
         if (run%history%step > 0 .and. run%robin_state%it == 0) then   ! a load step after the first
           call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &
@@ -414,7 +426,31 @@ contains
       call record_step(run, k)
       if (run%result%status /= STATUS_CONVERGED) exit
     end do
+    ! the steps solved (record_step reserves room for more)
+    if (run%rank == 0 .and. size(run%steps) > min(k, size(run%plan))) call keep_steps(run, min(k, size(run%plan)))
   end subroutine solve_steps
+
+  !> run%steps reduced to its first n entries (moved, not copied).
+  subroutine keep_steps(run, n)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: n
+    type(step_result_t), allocatable :: kept(:)
+    integer :: i
+    allocate (kept(n))
+    do i = 1, n
+      call move_step(run%steps(i), kept(i))
+    end do
+    call move_alloc(kept, run%steps)
+  end subroutine keep_steps
+
+  !> Step result a into b, its arrays moved (a's left unallocated).
+  subroutine move_step(a, b)
+    type(step_result_t), intent(inout) :: a, b
+    b%stage = a%stage
+    b%load_factor = a%load_factor
+    call move_alloc(a%u, b%u)
+    b%res = a%res
+  end subroutine move_step
 
   !> Friction acts on each load step's slip increment: the tangential rows' g0 (rank 0, which
   !! solves the contact) is the slip w_1 + w_2 the step before ended with, 0 at the first
@@ -464,14 +500,19 @@ contains
     type(run_t), intent(inout) :: run
     integer, intent(in) :: k
     type(step_result_t), allocatable :: grown(:)
+    integer :: i
     if (run%rank == 0) then
-      allocate (grown(size(run%steps) + 1))
-      grown(1:size(run%steps)) = run%steps
-      grown(k)%stage = run%plan(k)%stage
-      grown(k)%load_factor = run%plan(k)%factor
-      grown(k)%res = run%result
-      grown(k)%u = run%displacement
-      call move_alloc(grown, run%steps)
+      if (k > size(run%steps)) then   ! room for twice as many: every step moved a bounded number of times
+        allocate (grown(min(size(run%plan), max(k, 2*size(run%steps), 8))))
+        do i = 1, size(run%steps)
+          call move_step(run%steps(i), grown(i))
+        end do
+        call move_alloc(grown, run%steps)
+      end if
+      run%steps(k)%stage = run%plan(k)%stage
+      run%steps(k)%load_factor = run%plan(k)%factor
+      run%steps(k)%res = run%result
+      run%steps(k)%u = run%displacement
       write (output_unit, '(a)') step_line(run, k)
       flush (output_unit)
       if (run%result%status == STATUS_CONVERGED) then
@@ -522,18 +563,23 @@ contains
   subroutine write_output(run)
     type(run_t), intent(inout) :: run   !< the run: whether its result was written
     type(error_t) :: err
+    integer :: stale
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
+    stale = 0
     if (size(run%plan) > 1) then   ! every load step's result too
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%timing, err, run%steps, threads=run%threads)
+                         run%displacement, run%timing, err, run%steps, threads=run%threads, stale=stale)
     else
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%timing, err, threads=run%threads)
+                         run%displacement, run%timing, err, threads=run%threads, stale=stale)
     end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')
+    if (stale > 0) write (output_unit, '(a)') 'output: removed '//i2s(stale)//' stale file'// &
+      trim(merge('s', ' ', stale > 1))//' of an earlier result beside '//trim(run%deck%output%file)// &
+      ' (its XDMF files of bodies or pairs this result does not have)'
     if (run%code == EXIT_OK) call remove_file(checkpoint_file(run%deck%output%file))
   end subroutine write_output
 

@@ -36,7 +36,7 @@ contains
     if (run%result%status /= STATUS_CONVERGED) write (error_unit, '(a)') 'robin_contact: '// &
       status_name(run%result%status)//': '//trim(run%result%message)
     if (run%code == EXIT_NOT_CONVERGED) write (error_unit, '(a)') 'robin_contact: next: '// &
-      next_setting(run%deck%solver)
+      next_setting(run%deck%solver, trim(run%result%method) == 'monolithic')
   end subroutine set_exit_code
 
   !> The closing lines (rank 0). A summary that cannot be written (standard output on a
@@ -164,16 +164,21 @@ contains
 
   !> What a user whose Robin run did not converge should try next, in order: the robust
   !! operator and relaxation (the defaults), then the monolithic reference.
-  function next_setting(solver) result(t)
+  function next_setting(solver, monolithic) result(t)
     type(solver_cfg_t), intent(in) :: solver
+    logical, intent(in) :: monolithic   !< the contact problem was solved as one QP (method monolithic)
     character(len=:), allocatable :: t
-    if (solver%robin_operator /= ROBIN_HARMONIC) then
+    if (monolithic) then   ! the Robin settings say nothing of it, and it is already the monolithic QP
+      t = "try a looser tolerance, &solver monolithic_rtol="//sci(min(100.0_wp*solver%monolithic_rtol, 1.0e-2_wp), 1)// &
+          " / (now "//sci(solver%monolithic_rtol, 1)//"), or a larger inner_max_it (now "//i2s(solver%inner_max_it)// &
+          "); and check that the scene is in equilibrium (supports, loads, a body held only by contact)"
+    else if (solver%robin_operator /= ROBIN_HARMONIC) then
       t = "try &solver robin_operator='harmonic', delta=0.5 / (robust to material contrast), "// &
           "or method='monolithic'"
     else if (abs(solver%delta - 0.5_wp) > 0.01_wp) then
       t = "try &solver delta=0.5 / (the harmonic operator's best relaxation), or method='monolithic'"
     else
-      t = "try &solver method='monolithic' / (one QP over both bodies, no outer iteration), "// &
+      t = "try &solver method='monolithic' / (one QP over all bodies, no outer iteration), "// &
           "or a larger max_outer"
     end if
   end function next_setting

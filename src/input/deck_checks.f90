@@ -169,7 +169,9 @@ contains
   end subroutine add_contact
 
   !> A &contact on the command line: the pair form changes the pair of the bodies it names
-  !! (in the order it gives them); the two-body form the pair of bodies 1 and 2 of a
+  !! (in the order it gives them), and where the deck has several pairs of those bodies the
+  !! one whose groups it gives (groups= then picks, never changes; without it the override
+  !! is refused, naming the candidates); the two-body form the pair of bodies 1 and 2 of a
   !! two-body deck.
   subroutine override_contact(g, src, d, st, form)
     type(grp_t), intent(in) :: g
@@ -179,7 +181,8 @@ contains
     integer, intent(in) :: form
     type(contact_cfg_t), target :: c, probe
     type(vars_t) :: v
-    integer :: k, p
+    integer :: k, p, nmatch
+    character(len=:), allocatable :: cands
 
     if (form == TWO_BODY_FORM) then
       if (d%pairs_named) call die_at(src, g%line, 'in group &contact: the deck names its pairs '// &
@@ -195,15 +198,36 @@ contains
       call read_group(g, src, v)
       if (find_asg(g, 'bodies') == 0) call die_at(src, g%line, 'in group &contact: an override '// &
         'in the pair form names the pair it changes: bodies=A,B')
+      ! the pairs of those bodies; several: the override's groups say which
       p = 0
+      nmatch = 0
+      cands = ''
       do k = 1, d%npair
-        if (all(d%pair(k)%bodies == probe%bodies) .or. all(d%pair(k)%bodies == probe%bodies(2:1:-1))) then
-          p = k
-          exit
-        end if
+        if (.not. (all(d%pair(k)%bodies == probe%bodies) .or. all(d%pair(k)%bodies == probe%bodies(2:1:-1)))) cycle
+        nmatch = nmatch + 1
+        if (p == 0) p = k
+        cands = cands//merge(', ', '  ', nmatch > 1)//groups_words(d%pair(k), probe%bodies)//' ('// &
+                st%pair_at(k)%s//')'
       end do
       if (p == 0) call bad_value(g, src, 'bodies', i2s(probe%bodies(1))//', '//i2s(probe%bodies(2)), &
         'is no pair of the deck; an override changes a pair the deck gives')
+      if (nmatch > 1) then
+        if (find_asg(g, 'groups') == 0) call bad_value(g, src, 'bodies', '', 'names '//i2s(nmatch)// &
+          ' pairs of the deck: '//trim(adjustl(cands))//'; say which with its groups, e.g. ''&contact bodies='// &
+          i2s(probe%bodies(1))//','//i2s(probe%bodies(2))//', '//groups_words(d%pair(p), probe%bodies)//', ... /''')
+        p = 0
+        do k = 1, d%npair
+          if ((all(d%pair(k)%bodies == probe%bodies) .and. all(d%pair(k)%body_group == probe%body_group)) .or. &
+              (all(d%pair(k)%bodies == probe%bodies(2:1:-1)) .and. &
+               all(d%pair(k)%body_group == probe%body_group(2:1:-1)))) then
+            p = k
+            exit
+          end if
+        end do
+        if (p == 0) call bad_value(g, src, 'groups', '', 'is none of the '//i2s(nmatch)//' pairs of bodies '// &
+          i2s(probe%bodies(1))//' and '//i2s(probe%bodies(2))//': '//trim(adjustl(cands))// &
+          '; with several pairs of two bodies, groups= picks one of them')
+      end if
       c = d%pair(p)
       if (any(c%bodies /= probe%bodies)) then   ! given in the other order: the groups follow
         c%bodies = probe%bodies
@@ -217,6 +241,17 @@ contains
     d%pair(p) = c
     st%pair_at(p)%s = st%pair_at(p)%s//', changed by '//src%label
   end subroutine override_contact
+
+  !> groups='GA','GB' of pair c in the order of `bodies` (the pair's bodies in either order).
+  function groups_words(c, bodies) result(s)
+    type(contact_cfg_t), intent(in) :: c
+    integer, intent(in) :: bodies(2)
+    character(len=:), allocatable :: s
+    integer :: j1, j2
+    j1 = merge(1, 2, c%bodies(1) == bodies(1))
+    j2 = 3 - j1
+    s = 'groups='''//trim(c%body_group(j1))//''','''//trim(c%body_group(j2))//''''
+  end function groups_words
 
   function form_words(form) result(s)
     integer, intent(in) :: form

@@ -28,9 +28,10 @@ module checkpoint
     character(len=:), allocatable :: meshes   !< content hashes of the mesh files (mesh_identity; '' none)
     type(error_t) :: err                      !< why the first checkpoint that failed failed (ERR_IO), naming the file
     !> In a load history (&solver load_steps): the step being solved (0: a run of one step)
-    !! and the converged results of the steps before it, which a restart replays
+    !! and the converged results of the steps before it, which a restart replays (pointing
+    !! at the run's own: a step copies none of them, so a long history stays linear)
     integer :: step = 0
-    type(contact_result_t), allocatable :: done(:)
+    type(contact_result_t), pointer :: done(:) => null()
   contains
     procedure :: save => checkpoint_write
   end type h5_checkpointer_t

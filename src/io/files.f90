@@ -9,12 +9,15 @@
 !! there are kept aside, and any failure puts them back, so readers see either all the
 !! old files or all the new ones.
 module files
-  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_long_long
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_long_long, c_long
+  use errors, only: error_t, ERR_INPUT
+  use strings, only: i2s
   implicit none (type, external)
   private
 
   public :: temp_name, run_id, replace_suffix, base_name, dir_name, ensure_parent_dir, atomic_rename, &
-            remove_file, write_text, commit_files, special_file, data_open, data_write, data_close
+            remove_file, write_text, commit_files, special_file, data_open, data_write, data_close, &
+            check_new_files
 
   interface
     integer(c_int) function c_rename(old, new) bind(c, name='rename')
@@ -64,6 +67,10 @@ module files
       implicit none (type, external)
       character(kind=c_char), intent(in) :: path(*)
     end function rc_file_kind
+    integer(c_long) function rc_name_max(dir) bind(c, name='rc_name_max')
+      import :: c_long, c_char
+      character(kind=c_char), intent(in) :: dir(*)
+    end function rc_name_max
     integer(c_int) function rc_dir_writable(dir) bind(c, name='rc_dir_writable')
       import :: c_int, c_char
       implicit none (type, external)
@@ -94,6 +101,8 @@ module files
   character(len=:), allocatable, save :: token       ! '<host>.<pid>'
   character(len=:), allocatable, save :: id          ! token and start time
 
+  integer, parameter :: PATH_MAX = 4096   ! Linux's longest path, its terminating NUL included
+  integer, parameter :: NAME_MAX = 255    ! the longest name of one entry where pathconf does not say
   integer, parameter :: KEPT_NONE = 0     ! no earlier file at the final name
   integer, parameter :: KEPT_LINK = 1     ! earlier file kept aside as a hard link (still in place)
   integer, parameter :: KEPT_MOVED = 2    ! earlier file renamed aside (final name free)
@@ -121,6 +130,84 @@ contains
     end if
     r = id
   end function run_id
+
+  !> Whether files can be created at `names` (final paths, one folder), checked before any
+  !! work so that a name the file system cannot hold is bad input, not a failure after the
+  !! solve: each name and the longest temporary or kept-aside name made of it
+  !! (`<name>.<host>.<pid>.<n>.tmp`, n up to 10 digits) within PATH_MAX (4096 bytes with the
+  !! terminating NUL), each of their components within the file system's NAME_MAX (pathconf
+  !! of the nearest existing folder; 255 where it does not say), and that folder a folder
+  !! this process may write into (the missing ones below it are created). err (ERR_INPUT)
+  !! names the file, its length and the limit.
+  subroutine check_new_files(names, err)
+    character(len=*), intent(in) :: names(:)   !< the final paths
+    type(error_t), intent(out) :: err          !< the first name that cannot be made
+    character(len=:), allocatable :: dir, p, longest
+    integer :: k, i, j, n, kind, extra
+    integer(c_long) :: nmax
+
+    if (size(names) == 0) return
+    extra = len('.'//run_token()//'.'//'4294967295'//'.tmp')
+    ! the nearest existing folder of the first name (all are in one folder)
+    dir = dir_name(trim(names(1)))
+    do   ! (a path through a regular file cannot be inspected: ENOTDIR; its parent says why)
+      kind = rc_file_kind(dir//c_null_char)
+      if (kind > 0) exit
+      p = dir_name(dir)
+      if (p == dir) exit
+      dir = p
+    end do
+    if (kind == 1 .or. kind == 3) then
+      call err%set(ERR_INPUT, 'output file '//trim(names(1))//': '//dir//' is not a folder, so the file '// &
+                   'cannot be made there')
+      return
+    else if (kind /= 2) then
+      call err%set(ERR_INPUT, 'output file '//trim(names(1))//': cannot inspect the folder '//dir)
+      return
+    end if
+    if (rc_dir_writable(dir//c_null_char) /= 1) then
+      call err%set(ERR_INPUT, 'output file '//trim(names(1))//': the folder '//dir//' is not writable by '// &
+                   'this process')
+      return
+    end if
+    nmax = rc_name_max(dir//c_null_char)
+    if (nmax <= 0) nmax = NAME_MAX
+    do k = 1, size(names)
+      n = len_trim(names(k))
+      if (n + extra + 1 > PATH_MAX) then
+        call err%set(ERR_INPUT, 'output file '//trim(names(k))//': its path is '//i2s(n)//' bytes, '// &
+          i2s(n + extra)//' with the suffix of its temporary name (.<host>.<pid>.<n>.tmp), over the system''s '// &
+          'limit of '//i2s(PATH_MAX - 1)//' bytes for a path (PATH_MAX); use a shorter &output file')
+        return
+      end if
+      ! each component; the last one with the temporary name's suffix
+      i = 1
+      do while (i <= n)
+        j = index(names(k)(i:n), '/')
+        if (j == 0) then
+          j = n + 1
+        else
+          j = i + j - 1
+        end if
+        if (j == n + 1) then
+          longest = names(k)(i:n)
+          if (len(longest) + extra > nmax) then
+            call err%set(ERR_INPUT, 'output file '//trim(names(k))//': its name '''//longest//''' is '// &
+              i2s(len(longest))//' bytes, '//i2s(len(longest) + extra)//' with the suffix of its temporary '// &
+              'name (.<host>.<pid>.<n>.tmp), over the file system''s limit of '//i2s(int(nmax))// &
+              ' bytes for one name (NAME_MAX) in '//dir//'; use a shorter &output file')
+            return
+          end if
+        else if (j - i > nmax) then
+          call err%set(ERR_INPUT, 'output file '//trim(names(k))//': its folder name '''//names(k)(i:j - 1)// &
+            ''' is '//i2s(j - i)//' bytes, over the file system''s limit of '//i2s(int(nmax))// &
+            ' bytes for one name (NAME_MAX) in '//dir//'; use a shorter &output file')
+          return
+        end if
+        i = j + 1
+      end do
+    end do
+  end subroutine check_new_files
 
   !> `<file>.<host>.<pid>.<n><suffix>` with the next n of this process.
   function unique_name(file, suffix) result(t)
@@ -231,14 +318,22 @@ contains
   !! where links are not supported); (3) the renames; (4) the kept files are removed.
   !! When a step fails, what this call renamed into place is undone, the kept files are
   !! put back, the temporary files are removed, ok = .false. and msg says what failed.
-  subroutine commit_files(tmp, final, ok, msg)
+  !! With `stale_prefix`, once all are renamed and still under the lock, the numbered files
+  !! `<stale_prefix(i)><k><stale_suffix>` for k = stale_first(i), stale_first(i) + 1, ...
+  !! up to the first that does not exist (an earlier, larger set's own files, which the
+  !! new set lacks) are removed; `removed` counts them. A failed commit removes none.
+  subroutine commit_files(tmp, final, ok, msg, stale_prefix, stale_first, stale_suffix, removed)
     character(len=*), intent(in) :: tmp(:)                 !< complete files, temporary names
     character(len=*), intent(in) :: final(:)               !< their final names
     logical, intent(out) :: ok                             !< all renamed
     character(len=:), allocatable, intent(out) :: msg      !< what failed
+    character(len=*), intent(in), optional :: stale_prefix(:)   !< numbered names of an earlier set: the part before k
+    integer, intent(in), optional :: stale_first(:)        !< the first k each prefix's new set lacks
+    character(len=*), intent(in), optional :: stale_suffix !< the part after k
+    integer, intent(out), optional :: removed              !< stale files removed
     character(len=len(final) + 160) :: bak(size(final))
     integer :: kept(size(final)), k, j, fd, kind
-    character(len=:), allocatable :: dir
+    character(len=:), allocatable :: dir, stale
     logical :: done
 
     ok = .false.
@@ -294,6 +389,20 @@ contains
       if (kept(k) /= KEPT_NONE) call remove_file(bak(k))
     end do
     ok = .true.
+    ! 5. an earlier, larger set's numbered files the new set does not have
+    if (present(removed)) removed = 0
+    if (present(stale_prefix) .and. present(stale_first) .and. present(stale_suffix)) then
+      do j = 1, size(stale_prefix)
+        k = stale_first(j)
+        do
+          stale = trim(stale_prefix(j))//i2s(k)//stale_suffix
+          if (rc_path_kind(stale//c_null_char) /= 1) exit
+          if (c_unlink(stale//c_null_char) /= 0) exit
+          if (present(removed)) removed = removed + 1
+          k = k + 1
+        end do
+      end do
+    end if
     call finish()
 
   contains

@@ -62,6 +62,13 @@ int rc_file_kind(const char *path)
     return 3;
 }
 
+long rc_name_max(const char *dir)
+{
+    errno = 0;
+    long n = pathconf(dir, _PC_NAME_MAX);
+    return n > 0 ? n : -1;
+}
+
 int rc_dir_writable(const char *dir)
 {
     return access(dir, W_OK | X_OK) == 0;

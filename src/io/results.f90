@@ -19,7 +19,7 @@ module results
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files, data_open, data_write, data_close
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE
-  use strings, only: word, body_label, i2s
+  use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof
   use assembly, only: body_system_t, nodal_stress
   use contact_interface, only: interface_t, pair_rows
@@ -54,7 +54,7 @@ module results
     real(wp), allocatable :: u(:, :)            !< (maxndof, bodies) full displacements [length]
   end type step_result_t
 
-  public :: write_results
+  public :: write_results, result_files, body_group_name
 
   !> The datasets of a body whose data are written beside the HDF5 library (`body_data`),
   !! in the order they are created.
@@ -71,7 +71,7 @@ contains
   !! temporary file is left. The HDF5 library is called from one thread; with two, the
   !! other writes the companions and, body by body, computes the fields of each body
   !! (its stresses) and writes their data into the storage the first has reserved.
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, tm, err, steps, threads)
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, tm, err, steps, threads, stale)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
@@ -84,12 +84,16 @@ contains
     !> the load steps' results (several steps: /steps, and the XDMF files a time series)
     type(step_result_t), intent(in), optional :: steps(:)
     integer, intent(in), optional :: threads           !< threads to write with (default 1)
+    !> the files of an earlier result at this name that this one lacks, removed once it is
+    !! in place (`<stem>_body<a>.xdmf` beyond its bodies, `<stem>_contact<k>.xdmf` beyond its pairs)
+    integer, intent(out), optional :: stale
     character(len=len_trim(file) + 32), allocatable :: name(:)
     real(wp), allocatable :: times(:)
     character(len=len_trim(file) + 160), allocatable :: tmp(:)
+    character(len=len_trim(file) + 16) :: stale_pre(2)
     character(len=:), allocatable :: why, h5, id
     type(error_t) :: st
-    integer :: k, nb, np, nf, nt
+    integer :: k, nb, np, nf, nt, nstale
     logical :: ok
     type(interface_t) :: itf
     type(contact_result_t) :: res
@@ -138,9 +142,14 @@ contains
       call remove_temps()
       return
     end if
-    ! companions first, the HDF5 file last: it appears only with its XDMF files
-    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why)
+    ! companions first, the HDF5 file last: it appears only with its XDMF files; then the
+    ! companions of an earlier result with more bodies or pairs, which this one lacks
+    stale_pre(1) = replace_suffix(trim(file), '.h5', '_body')
+    stale_pre(2) = replace_suffix(trim(file), '.h5', '_contact')
+    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, [nb + 1, merge(np + 1, 1, np > 1)], '.xdmf', &
+                      nstale)
     if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
+    if (present(stale)) stale = nstale
 
   contains
 
@@ -173,6 +182,13 @@ contains
     end subroutine remove_temps
 
   end subroutine write_results
+
+  !> The HDF5 group of body a, 'body<a>' (any number of digits: no fixed-length name).
+  pure function body_group_name(a) result(g)
+    integer, intent(in) :: a   !< the body
+    character(len=:), allocatable :: g
+    g = 'body'//body_label(a)
+  end function body_group_name
 
   !> The files of a result of nb bodies and np pairs: the HDF5 file, <stem>.xdmf,
   !! <stem>_body<a>.xdmf for a = 1..nb, <stem>_contact.xdmf, and for np > 1
@@ -219,7 +235,6 @@ contains
     integer :: a, k, fd
     real(wp), allocatable :: pres(:), w2(:, :)
     type(error_t), allocatable :: body_err(:)
-    character(len=8) :: bname
     character(len=:), allocatable :: ul, us, uf, why
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
 
@@ -301,8 +316,7 @@ contains
     call write_history(fid, res, st)
     ! bodies
     do a = 1, size(msh)
-      write (bname, '(a,i0)') 'body', a
-      call group_open(fid, trim(bname), gid, st, create=.true.)
+      call group_open(fid, body_group_name(a), gid, st, create=.true.)
       call write_attr(gid, 'element', trim(element_names(msh(a)%element)), st)
       call write_attr(gid, 'young', d%body(a)%young, st)
       call write_attr(gid, 'poisson', d%body(a)%poisson, st)
@@ -758,21 +772,23 @@ contains
     real(wp), intent(in) :: times(:)
     character(len=:), allocatable :: t, h
     character(len=32) :: tv
+    type(text_buffer_t) :: b                 ! one block per step: linear in the steps
     integer :: k
     h = xml_escape(h5)
-    t = line('<?xml version="1.0" ?>')//line('<!-- robin_contact '//program_version//' run_id '//run_id//' -->')// &
-        line('<Xdmf Version="3.0">')//line('  <Domain>')
+    call b%add(line('<?xml version="1.0" ?>')//line('<!-- robin_contact '//program_version//' run_id '//run_id// &
+               ' -->')//line('<Xdmf Version="3.0">')//line('  <Domain>'))
     if (size(times) == 0) then
-      t = t//grids_text(bodies, lines, h, msh, itf, '', '')
+      call b%add(grids_text(bodies, lines, h, msh, itf, '', ''))
     else
-      t = t//line('    <Grid Name="steps" GridType="Collection" CollectionType="Temporal">')
+      call b%add(line('    <Grid Name="steps" GridType="Collection" CollectionType="Temporal">'))
       do k = 1, size(times)
         write (tv, '(es24.16)') times(k)
-        t = t//grids_text(bodies, lines, h, msh, itf, '/steps/step_'//i2s(k), trim(adjustl(tv)))
+        call b%add(grids_text(bodies, lines, h, msh, itf, '/steps/step_'//i2s(k), trim(adjustl(tv))))
       end do
-      t = t//line('    </Grid>')
+      call b%add(line('    </Grid>'))
     end if
-    t = t//line('  </Domain>')//line('</Xdmf>')
+    call b%add(line('  </Domain>')//line('</Xdmf>'))
+    t = b%text()
   end function xdmf_text
 
   !> The grids of the bodies and contact lines, their fields under the HDF5 group `fields`
@@ -783,33 +799,34 @@ contains
     type(mesh_t), intent(in) :: msh(:)
     type(interface_t), intent(in) :: itf
     character(len=:), allocatable :: t, tt
+    type(text_buffer_t) :: b                 ! one grid per body and line: linear in their number
     integer :: k, r(2)
     logical :: many
     many = size(bodies) + size(lines) > 1
     tt = ''
     if (len(time) > 0) tt = line('        <Time Value="'//time//'"/>')
-    t = ''
     if (many) then
-      t = line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">')
-      t = t//tt
+      call b%add(line('    <Grid Name="bodies" GridType="Collection" CollectionType="Spatial">'))
+      call b%add(tt)
       tt = ''
     end if
     do k = 1, size(bodies)
-      t = t//grid_text(bodies(k), h, msh(bodies(k)), fields, tt)
+      call b%add(grid_text(bodies(k), h, msh(bodies(k)), fields, tt))
     end do
     do k = 1, size(lines)
       if (lines(k) == 0) then
-        t = t//contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body', &
-                                 h//':'//fields//'/contact', tt, any(itf%pair_friction /= FRICTION_NONE))
+        call b%add(contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body', &
+                                     h//':'//fields//'/contact', tt, any(itf%pair_friction /= FRICTION_NONE)))
       else
         r = pair_rows(itf, lines(k))
-        t = t//contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
-                                 r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side', &
-                                 h//':'//fields//'/contact/pair_'//i2s(lines(k)), tt, &
-                                 itf%pair_friction(lines(k)) /= FRICTION_NONE)
+        call b%add(contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
+                                     r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side', &
+                                     h//':'//fields//'/contact/pair_'//i2s(lines(k)), tt, &
+                                     itf%pair_friction(lines(k)) /= FRICTION_NONE))
       end if
     end do
-    if (many) t = t//line('    </Grid>')
+    if (many) call b%add(line('    </Grid>'))
+    t = b%text()
   end function grids_text
 
   !> One body as an XDMF uniform grid (topology, XYZ geometry, nodal fields, body id per

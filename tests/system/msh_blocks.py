@@ -3,13 +3,15 @@ mesh the test itself makes (no gmsh needed).
 
 Each block is a rectangle meshed by nx x ny Q1 cells: one physical surface named `name`,
 physical curves `<name>_bottom`, `_right`, `_top`, `_left`, and optional physical points
-`(label, i, j)` at grid node (i, j). Blocks share no node.
+`(label, i, j)` at grid node (i, j), and optional extra physical names of a side's curve
+(`aliases={'bottom': ['other_name']}`: the same edges under two names). Blocks share no node.
 """
 
 
-def block(name, x0, y0, width, height, nx, ny, points=()):
+def block(name, x0, y0, width, height, nx, ny, points=(), aliases=None):
     """A block description for write_msh."""
-    return dict(name=name, x0=x0, y0=y0, w=width, h=height, nx=nx, ny=ny, points=list(points))
+    return dict(name=name, x0=x0, y0=y0, w=width, h=height, nx=nx, ny=ny, points=list(points),
+                aliases=dict(aliases or {}))
 
 
 def write_msh(path, blocks):
@@ -43,7 +45,12 @@ def write_msh(path, blocks):
             ctag = 10 * (b_i + 1) + k + 1
             phys_c = phys_s + k + 1
             names.append((1, phys_c, f"{b['name']}_{side}"))
-            ent_cur.append(f"{ctag} {box[0]} {box[1]} 0 {box[2]} {box[3]} 0 1 {phys_c} 0")
+            phys = [phys_c]
+            for a_i, alias in enumerate(b.get('aliases', {}).get(side, [])):
+                phys.append(phys_s + 10 * (a_i + 1) + k + 1)
+                names.append((1, phys[-1], alias))
+            ent_cur.append(f"{ctag} {box[0]} {box[1]} 0 {box[2]} {box[3]} 0 {len(phys)} "
+                           + " ".join(map(str, phys)) + " 0")
             ctags.append(ctag)
             lines = []
             for s in segs:

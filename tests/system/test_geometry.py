@@ -218,7 +218,7 @@ bad = [
 ]
 # an initial overlap: the paper's rectangles with contact by groups, body 1 moved 0.05 into body 2
 bad.append(("initial overlap", write("overlap.nml", open("inputs/default.nml").read()),
-            ["overlap", "-0.05"]))
+            ["overlap", "-5.000E-02"]))
 OVERLAP = groups + ("&body id=1, y0=0.95 /",)
 for k, (what, deck, words) in enumerate(bad):
     out = os.path.join(tmp, f"never{k}.h5")
