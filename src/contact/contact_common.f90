@@ -172,10 +172,11 @@ contains
     end select
   end function all_finite
 
-  !> Threads over the bodies: min(2, OMP max threads).
+  !> Threads over the bodies and the interface-sized loops: the run's threads (OMP max threads,
+  !! which the driver sets to the user's OMP_NUM_THREADS).
   integer function body_threads()
     use omp_lib, only: omp_get_max_threads
-    body_threads = max(1, min(2, omp_get_max_threads()))
+    body_threads = max(1, omp_get_max_threads())
   end function body_threads
 
 end module contact_common

@@ -82,10 +82,14 @@ contains
     call fail_on(err, 'deck '//trim(run%deck%source))
   end subroutine check_output_names
 
-  !> One thread per body, at most two. CHOLMOD opens OpenMP regions of its own with a
-  !! fixed num_threads(4); inside our 2-thread region they are nested and run serially, but
-  !! with one thread our region is inactive and CHOLMOD's would start 4 threads on the
-  !! cores we use (measured: 10x slower factorization). So no region below ours is active.
+  !> The threads the user gives (OMP_NUM_THREADS): one per body at a time, the largest body
+  !! first, and the interface-sized loops on the same threads. BLAS stays on one thread: a
+  !! threaded OpenBLAS factors a block (dpotrf) in another order for each thread count, and
+  !! the results must be the same to the last bit whatever the threads (measured: 2 BLAS
+  !! threads per body moved a frictional result by 1e-8). CHOLMOD opens OpenMP regions of its own with a fixed num_threads(4);
+  !! inside our region they are nested and run serially, but with one thread our region is
+  !! inactive and CHOLMOD's would start 4 threads on the cores we use (measured: 10x slower
+  !! factorization). So no region below ours is active.
   subroutine choose_threads(run)
     type(run_t), intent(inout) :: run   !< the run: its threads
     integer :: nthr
@@ -94,7 +98,7 @@ contains
     nthr = omp_get_max_threads()
     call cm_init()
     call omp_set_num_threads(nthr)
-    run%threads = max(1, min(2, nthr))
+    run%threads = max(1, nthr)
     if (run%threads == 1) then
       call omp_set_max_active_levels(0)
     else

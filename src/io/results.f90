@@ -116,7 +116,7 @@ contains
       if (size(steps) > 0) times = [(step_time(steps(k)), k=1, size(steps))]
     end if
     nt = 1
-    if (present(threads)) nt = max(1, min(2, threads))
+    if (present(threads)) nt = max(1, threads)
     id = run_id()
     h5 = base_name(file)
     ok = .false.
