@@ -345,6 +345,12 @@ bench-bodies: $(PROG)
 # Friction: the paper's scene at 128x64 ... 1024x512 per body, frictionless against Coulomb
 # (mu 0.3) and Tresca, monolithic and each Robin operator: time per phase, outer/inner counts,
 # memory, error against monolithic (about 20 min); results/bench_friction.csv and Markdown tables
+# the inner solvers on the bolted lap joint (inputs/lap_joint.nml), 1 + 1 and 1 + 20 steps,
+# Robin and monolithic (about 3 min; MPRGP alone on 1 + 1 steps only)
+.PHONY: bench-assemblies
+bench-assemblies: $(PROG)
+	$(PYTHON) bench/bench_assemblies.py --bin $(PROG)
+
 .PHONY: bench-friction
 bench-friction: $(PROG)
 	$(PYTHON) bench/bench_friction.py --bin $(PROG) --repeat 2

@@ -21,7 +21,11 @@ module floating
   implicit none (type, external)
   private
 
-  public :: rigid_rows, check_held, check_pressed, nnls, free_list, fixing_list
+  public :: rigid_rows, check_held, check_pressed, nnls, free_list, fixing_list, friction_edge
+
+  !> A body held by Coulomb friction is on the edge of sliding when its load cannot be
+  !! balanced with mu lowered by this fraction
+  real(wp), parameter :: EDGE_MARGIN = 1.0e-6_wp
 
   !> a free motion counts as held by the contact when at least this fraction of its reach on the
   !! contact (squared) is normal to it (1%: mu >= 1e-4)
@@ -160,6 +164,37 @@ contains
     ! 4. floating bodies that touch each other: each such group together must be held too
     call check_groups(contact_line, systems, bodies, err)
   end subroutine check_held
+
+  !> The floating bodies held by Coulomb friction at the edge of sliding: those whose load
+  !! the contact balances with mu (check_held passed) but not with mu (1 - EDGE_MARGIN). Their
+  !! equilibrium exists but a change of the load by a millionth would break it, and the
+  !! tangential forces that hold them are barely determined. One sentence per such body in
+  !! msg ('' when none).
+  function friction_edge(contact_line, systems, bodies) result(msg)
+    type(interface_t), intent(in) :: contact_line
+    type(body_system_t), intent(in) :: systems(:)
+    type(body_condensed_t), intent(in) :: bodies(:)
+    character(len=:), allocatable :: msg
+    real(wp), allocatable :: gc(:, :), lam(:)
+    real(wp) :: res, enorm
+    integer :: a
+    msg = ''
+    if (.not. any(contact_line%pair_friction == FRICTION_COULOMB)) return
+    do a = 1, size(bodies)
+      if (bodies(a)%nrig == 0 .or. bodies(a)%m == 0) cycle
+      enorm = norm2(bodies(a)%re)
+      if (enorm == 0.0_wp) cycle
+      gc = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), bodies(a)%rg, 1.0_wp - EDGE_MARGIN)
+      allocate (lam(size(gc, 2)))
+      call nnls(gc, bodies(a)%re, lam, res)
+      deallocate (lam)
+      if (res > 1.0e-8_wp*enorm) msg = msg//merge('; ', '  ', len(msg) > 0)//'body '//i2s(a)// &
+        ' (free: '//free_list(systems(a))//') is held by friction at the edge of sliding: its load needs the '// &
+        'full friction limit mu N (with mu 1e-6 lower it would slide), so its tangential forces are barely '// &
+        'determined; lower the tangential load or raise mu for a margin'
+    end do
+    if (len(msg) > 0) msg = msg(3:)
+  end function friction_edge
 
   !> The groups of floating bodies connected by pairs of two floating bodies (each alone
   !! passed check_held): their rows stacked over the union of their contact rows must have
@@ -343,6 +378,9 @@ contains
         allocate (lam(size(rows, 2)))
       end if
       call nnls(rows, target, lam, res)
+      ! not pressed by its own rows' gaps: perhaps through its floating neighbours (a plate
+      ! clamped between two others by a third), decided on their group as a whole
+      if (.not. res <= 1.0e-8_wp) res = group_pressing(contact_line, bodies, root, a, h)
       if (.not. res <= 1.0e-8_wp) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact: its loads have no part along that motion, and its deformation '// &
@@ -356,19 +394,101 @@ contains
 
   end subroutine check_pressed
 
+  !> Whether floating body a is pressed into the contact through the group of floating
+  !! bodies it belongs to (root: floating_groups): is there a set of admissible contact forces
+  !! lam on the group's rows, in equilibrium on every body of the group with tau times its
+  !! load (G_b lam = tau e_b, tau >= 0), that some deformation or load drives (h'lam < 0 or
+  !! tau > 0, h the gaps after the particular deformations) and in which body a takes part
+  !! (a force on one of its normal rows)? By NNLS on the rows [G_b ... ; h'; s_a'] with the
+  !! columns of lam (friction: the cone's generators), tau and two slacks, against
+  !! (0, -1, 1): the residual, <= 1e-8 when such forces exist. A plate pressed by a bolt head
+  !! through another plate has them; a body nothing reaches has not.
+  real(wp) function group_pressing(contact_line, bodies, root, a, h) result(res)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    integer, intent(in) :: root(:), a
+    real(wp), intent(in) :: h(:)
+    real(wp), allocatable :: g(:, :), gc(:, :), x(:), target(:), e(:)
+    integer, allocatable :: col(:), rows(:), r0(:)
+    integer :: b, i, k, nr, nc, mm, n
+    real(wp) :: hs, es
+    mm = contact_line%m
+    ! the group's rows, each once (a row between two of its bodies is in both bodies' slots)
+    allocate (col(mm))
+    col = 0
+    nc = 0
+    nr = 0
+    allocate (r0(size(bodies)))
+    r0 = 0
+    do b = 1, size(bodies)
+      if (root(b) /= root(a) .or. bodies(b)%nrig == 0) cycle
+      r0(b) = nr
+      nr = nr + bodies(b)%nrig
+      do i = 1, bodies(b)%m
+        k = slot_row(bodies(b)%slots(i), mm)
+        if (col(k) == 0) then
+          nc = nc + 1
+          col(k) = nc
+        end if
+      end do
+    end do
+    allocate (rows(nc), g(nr + 2, nc), e(nr))
+    do k = 1, mm
+      if (col(k) > 0) rows(col(k)) = k
+    end do
+    g = 0.0_wp
+    e = 0.0_wp
+    hs = max(maxval(abs(h)), tiny(1.0_wp))
+    do b = 1, size(bodies)
+      if (root(b) /= root(a) .or. bodies(b)%nrig == 0) cycle
+      e(r0(b) + 1:r0(b) + bodies(b)%nrig) = bodies(b)%re
+      do i = 1, bodies(b)%m
+        k = slot_row(bodies(b)%slots(i), mm)
+        g(r0(b) + 1:r0(b) + bodies(b)%nrig, col(k)) = bodies(b)%rg(:, i)
+        if (b == a .and. contact_line%kind(k) /= ROW_TANGENT) g(nr + 2, col(k)) = 1.0_wp
+      end do
+    end do
+    do i = 1, nc
+      g(nr + 1, i) = h(rows(i))/hs
+    end do
+    if (has_friction(contact_line)) then
+      gc = cone_columns(contact_line, rows, g)
+    else
+      gc = g
+    end if
+    ! the columns of tau (the loads, scaled; counted as pressing) and of the two slacks
+    n = size(gc, 2)
+    es = norm2(e)
+    if (es > 0.0_wp) then
+      e = e/es
+      es = 1.0_wp      ! tau presses only when the group has a load
+    end if
+    gc = reshape([gc, [-e, -es, 0.0_wp], [spread(0.0_wp, 1, nr), 1.0_wp, 0.0_wp], &
+                  [spread(0.0_wp, 1, nr), 0.0_wp, -1.0_wp]], [nr + 2, n + 3])
+    allocate (target(nr + 2), x(n + 3))
+    target = 0.0_wp
+    target(nr + 1) = -1.0_wp
+    target(nr + 2) = 1.0_wp
+    call nnls(gc, target, x, res)
+  end function group_pressing
+
   !> The columns of g (column i on contact row rows(i)) as generators of the admissible
   !! contact forces, for a non-negative least squares: a normal row without friction keeps
   !! its column (lam_n >= 0); a Coulomb pair's normal row i with its tangential row j gives
   !! g_i + mu g_j and g_i - mu g_j (lam_n (1, +-mu): exactly the cone |lam_t| <= mu lam_n);
   !! a Tresca pair keeps the normal column and gives +g_j and -g_j (the tangential force
   !! free of the normal one: its bound does not depend on it).
-  function cone_columns(contact_line, rows, g) result(gc)
+  function cone_columns(contact_line, rows, g, mu_scale) result(gc)
     type(interface_t), intent(in) :: contact_line
     integer, intent(in) :: rows(:)
     real(wp), intent(in) :: g(:, :)
+    real(wp), intent(in), optional :: mu_scale   !< Coulomb's mu times this (default 1)
     real(wp), allocatable :: gc(:, :)
     integer, allocatable :: tcol(:)
     integer :: i, n, k, p
+    real(wp) :: sc
+    sc = 1.0_wp
+    if (present(mu_scale)) sc = mu_scale
     allocate (tcol(contact_line%m))
     tcol = 0
     do i = 1, size(rows)
@@ -385,8 +505,8 @@ contains
         gc(:, n + 2) = -g(:, i)
         n = n + 2
       else if (tcol(k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
-        gc(:, n + 1) = g(:, i) + contact_line%pair_mu(p)*g(:, tcol(k))
-        gc(:, n + 2) = g(:, i) - contact_line%pair_mu(p)*g(:, tcol(k))
+        gc(:, n + 1) = g(:, i) + sc*contact_line%pair_mu(p)*g(:, tcol(k))
+        gc(:, n + 2) = g(:, i) - sc*contact_line%pair_mu(p)*g(:, tcol(k))
         n = n + 2
       else
         gc(:, n + 1) = g(:, i)

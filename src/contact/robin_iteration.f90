@@ -140,7 +140,7 @@ contains
     real(wp), allocatable :: g_new(:, :), w(:, :), dlam(:), corr(:, :), g_full(:, :)
     real(wp) :: rtol_in, uref
     integer :: m, it, a
-    logical :: printed
+    logical :: printed, first
 
     m = contact_line%m
     allocate (g_new(m, 2), w(m, 2), dlam(m), corr(m, 2))
@@ -149,6 +149,7 @@ contains
       uref = max(uref, maxabs(bodies(a)%b))
     end do
     printed = .false.
+    first = .true.
     do it = run_state%it + 1, solver%max_outer
       ! 1. each body against its obstacle, in parallel
       rtol_in = robin_op%inner_tolerance(solver, it, m, run_state%progress, subproblems%lmax_body)
@@ -169,6 +170,16 @@ contains
                         start=all(run_state%lam == 0.0_wp))
       end if
       call solve_subproblems(subproblems, solver, bodies, rtol_in, it, run_state, w, res)
+      ! the displacement scale also counts what the first forces would do to each body (its
+      ! own flexibility F_a, not a Robin term's, times the largest force): a soft body loaded only through a stiff one has b_a = 0, and the stiff one's
+      ! b_a is its own small displacement (a punch at contrast 1e8: 1.5e-11 against 1e-3);
+      ! once only, so that forces growing with a diverging iteration do not raise it
+      if (first) then
+        do a = 1, size(bodies)
+          if (bodies(a)%m > 0) uref = max(uref, maxval(sum(abs(bodies(a)%flex), dim=1))*maxval(abs(run_state%lam)))
+        end do
+        first = .false.
+      end if
       if (has_friction(contact_line)) call update_row_states(subproblems%lb, subproblems%ub, run_state)
       if (m == 0) then
         res%status = STATUS_CONVERGED

@@ -16,7 +16,7 @@ module run_phases
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
-  use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list
+  use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list, friction_edge
   use contact_common, only: gather
   use results, only: write_results, result_files
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
@@ -237,6 +237,11 @@ contains
     if (sum(run%systems(:)%nrig) == 0) return
     call check_held(run%contact_line, run%systems, run%bodies, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
+    block
+      character(len=:), allocatable :: edge
+      edge = friction_edge(run%contact_line, run%systems, run%bodies)
+      if (len(edge) > 0) call warn('deck '//trim(run%deck%source)//': '//edge)
+    end block
     do a = 1, run%nbody
       associate (system => run%systems(a))
         if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
