@@ -286,7 +286,7 @@ check(rc == 1 and se.strip().splitlines() == ["paraview_view: rendering under xv
       "any other abnormal end of the re-run (SIGSEGV): exit 1 and one line", f"exit {rc} {se.strip()[-300:]}")
 
 if xserver is not None:
-    xserver.kill()
+    xserver.terminate()              # SIGTERM: Xvfb removes its socket and lock file
     xserver.wait()
 print(f"{len(check.failed)} failed checks")
 sys.exit(1 if check.failed else 0)
