@@ -92,7 +92,8 @@ $(DEPS_STAMP): tools/install-deps.sh
 	   && [ -f /usr/include/suitesparse/cholmod.h ] && [ -f $(HDF5_INC)/hdf5.mod ] \
 	   && [ -f /usr/include/metis.h ] && [ -e /usr/lib/x86_64-linux-gnu/libopenblas.so ] \
 	   && [ -e /usr/lib/x86_64-linux-gnu/liblapack.so ] && command -v pgrep >/dev/null 2>&1 \
-	   && [ -x $(PYTHON) ] && $(PYTHON) -c 'import numpy, h5py, meshio, matplotlib' 2>/dev/null; then :; \
+	   && [ -x $(PYTHON) ] && $(PYTHON) -c 'import numpy, h5py, meshio, matplotlib' 2>/dev/null \
+	   && command -v pvpython >/dev/null 2>&1 && command -v xvfb-run >/dev/null 2>&1; then :; \
 	 else bash tools/install-deps.sh; fi
 	@if [ "$(MPI)" = 1 ] && ! { command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; }; then \
 	   bash tools/install-deps.sh; fi

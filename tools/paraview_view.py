@@ -5,7 +5,7 @@ colour by a chosen point or cell array, write a PNG. Runs headless.
 Usage:
   pvpython tools/paraview_view.py RESULT [-o view.png] [--field NAME] [--scale S|auto]
                                   [--clip P] [--range MIN MAX] [--edges] [--size WxH]
-                                  [--zoom contact|X0,X1,Y0,Y1]
+                                  [--zoom contact|X0,X1,Y0,Y1] [--step K]
   pvpython tools/paraview_view.py RESULT --list      (the point and cell arrays, then exit)
 RESULT is results/x.xdmf or results/x.h5 (then its sibling results/x.xdmf is opened).
 It also runs with pvbatch, or with /usr/bin/python3 when ParaView's Python modules are
@@ -21,6 +21,10 @@ installed (Debian's `paraview` package puts them in dist-packages).
                  MIN MAX sets it explicitly. The scalar bar title says which.
   --edges        draw the element edges (Surface With Edges).
   --size WxH     image size in pixels (default 1200x800).
+  --step K       a result with load steps: draw step K (default the last; the title says which).
+                 x.xdmf holds every step (a Temporal collection), which Xdmf3ReaderT reads as
+                 one block per step, all drawn on top of each other: the tool reads a copy of
+                 the chosen step's grids only (in a temporary folder, removed at the end).
   --zoom Z       frame a part of the picture instead of the whole scene: 'contact' frames
                  the contact zone (the contact nodes with a positive normal force, all
                  contact nodes when none has one), warped like the bodies, with a margin of
@@ -29,8 +33,13 @@ installed (Debian's `paraview` package puts them in dist-packages).
 The contact line is drawn on top of the bodies as a black polyline per body (and per contact
 pair), through the contact nodes of that body (/contact/coordinates, or a pair's
 /contact/pair_<k>, matched to the body's nodes) warped by the
-body's displacement with the same magnification as the bodies: where the bodies touch the
-two lines lie on each other, where they are apart the gap is seen between them.
+body's displacement (of the step drawn) with the same magnification as the bodies: where the
+bodies touch the two lines lie on each other, where they are apart the gap is seen between
+them. A side whose nodes are not the contact nodes (the master side of non-matching meshes)
+gets no line. The file's own contact-line grids (undeformed) are not drawn, except for an
+array that only they have (pressure, shear, state, ...): then they are coloured by it, warped
+by their first body's displacement, over the bodies in a solid grey.
+Tested with Debian 12's ParaView 5.11 (pvpython is in the package python3-paraview).
 
 Headless nodes: rendering needs an X display, or an offscreen (EGL/OSMesa) ParaView build.
 Without DISPLAY the tool re-runs itself as `xvfb-run -a pvbatch tools/paraview_view.py ...`
@@ -77,6 +86,8 @@ def parse(argv):
     ap.add_argument("--edges", action="store_true", help="draw the element edges")
     ap.add_argument("--size", default="1200x800", help="image size WxH in pixels (default 1200x800)")
     ap.add_argument("--list", action="store_true", help="list the point and cell arrays and exit")
+    ap.add_argument("--step", type=int, default=None, metavar="K",
+                    help="load step K of a result with load steps (default: the last)")
     ap.add_argument("--zoom", default=None, metavar="contact|X0,X1,Y0,Y1",
                     help="frame the contact zone ('contact') or a box X0,X1,Y0,Y1")
     return ap.parse_args(argv)
@@ -231,7 +242,7 @@ def values(src, name, assoc, comp):
 
 
 # ---- the contact line and the zoom box (numpy and h5py only: no ParaView needed) ----------
-def contact_lines(h5path, scale):
+def contact_lines(h5path, scale, step=None):
     """The contact line of each body warped by that body's displacement times scale: a list of
     (body, points) with points an (n, 2) array in contact-line order, n >= 2. The contact
     nodes (/contact/coordinates) are matched to a body's nodes by identical coordinates;
@@ -240,12 +251,13 @@ def contact_lines(h5path, scale):
     bodies: a body in two pairs has two lines.
     Also returns the contact nodes of all pairs (m, 2) and the boolean mask of the active ones
     (normal force > 0)."""
-    pieces, c, active = contact_pieces(h5path, scale)
+    pieces, c, active = contact_pieces(h5path, scale, step)
     return [(b, p) for b, p, _ in pieces], c, active
 
 
-def contact_pieces(h5path, scale):
-    """contact_lines with, for each line, the rows of /contact its points come from."""
+def contact_pieces(h5path, scale, step=None):
+    """contact_lines with, for each line, the rows of /contact its points come from. step: the
+    load step K whose displacements and forces are used (/steps/step_K), None: the final ones."""
     import h5py
     import numpy as np
 
@@ -255,7 +267,8 @@ def contact_pieces(h5path, scale):
 
     with h5py.File(h5path, "r") as f:
         c = xy_rows(f["contact/coordinates"][()])                     # (m, 2)
-        lam = np.asarray(f["contact/normal_force"][()], dtype=float).reshape(-1)
+        at = f if step is None or "steps" not in f else f[f"steps/step_{step}"]
+        lam = np.asarray(at["contact/normal_force"][()], dtype=float).reshape(-1)
         npair = int(f.attrs.get("pairs", 1))
         # (first row, last row + 1, bodies) of each pair
         if npair > 1:
@@ -269,10 +282,10 @@ def contact_pieces(h5path, scale):
             spans = [(0, c.shape[0], [1, 2])]
         bodies = {}
         for b in sorted({b for _, _, bs in spans for b in bs}):
-            g = f.get(f"body{b}")
-            if g is None or "coordinates" not in g or "displacement" not in g:
+            g, gu = f.get(f"body{b}"), at.get(f"body{b}")
+            if g is None or gu is None or "coordinates" not in g or "displacement" not in gu:
                 continue
-            bodies[b] = (xy_rows(g["coordinates"][()]), xy_rows(g["displacement"][()]))
+            bodies[b] = (xy_rows(g["coordinates"][()]), xy_rows(gu["displacement"][()]))
     pieces = []
     for r0, r1, bs in spans:
         for b in bs:
@@ -289,7 +302,7 @@ def contact_pieces(h5path, scale):
     return pieces, c, lam > 0.0
 
 
-def zoom_box(spec, h5path=None, scale=0.0):
+def zoom_box(spec, h5path=None, scale=0.0, step=None):
     """(x0, x1, y0, y1) to frame: spec 'X0,X1,Y0,Y1' as given, or 'contact': the active contact
     nodes (all contact nodes when none is active) of both bodies' warped contact lines, with
     a margin of half the box's larger side, at least two contact segments, on every side.
@@ -303,7 +316,7 @@ def zoom_box(spec, h5path=None, scale=0.0):
         if not (x1 > x0 and y1 > y0):
             raise ValueError(f"--zoom box {spec!r}: needs X0 < X1 and Y0 < Y1")
         return x0, x1, y0, y1
-    pieces, c, active = contact_pieces(h5path, scale)
+    pieces, c, active = contact_pieces(h5path, scale, step)
     if c.shape[0] < 2:
         raise ValueError(f"{h5path}: no contact line to zoom on")
     pick = active if active.any() else np.ones(c.shape[0], dtype=bool)
@@ -315,6 +328,82 @@ def zoom_box(spec, h5path=None, scale=0.0):
     (x0, y0), (x1, y1) = pts.min(axis=0), pts.max(axis=0)
     margin = max(0.5 * max(x1 - x0, y1 - y0), 2.0 * seg)
     return x0 - margin, x1 + margin, y0 - margin, y1 + margin
+
+
+def step_view(xdmf, step, folder):
+    """An XDMF of one load step of a result: the grids (bodies and contact lines) of step K
+    (1-based; None: the last) of the Temporal collection, or all the grids of a result without
+    load steps, their HDF5 references made absolute, written into folder. Xdmf3ReaderT reads
+    every step of the Temporal collection of x.xdmf as a block of its own (all drawn on top of
+    each other), hence this file. Returns (path, step shown, number of steps, time or None,
+    body grid names, contact grid names); ValueError for a step that is not there."""
+    import xml.etree.ElementTree as ET
+    tree = ET.parse(xdmf)
+    domain = tree.getroot().find("Domain")
+    top = domain.find("Grid")
+    steps = [g for g in top.findall("Grid")] if top.get("CollectionType") == "Temporal" else [top]
+    n = len(steps)
+    if step is None:
+        step = n
+    if not 1 <= step <= n:
+        raise ValueError(f"--step {step}: the result has {n} load step{'s' if n > 1 else ''} (1 to {n})")
+    grid = steps[step - 1]
+    t = grid.find("Time")
+    time = float(t.get("Value")) if t is not None and n > 1 else None
+    if t is not None:
+        grid.remove(t)
+    here = os.path.dirname(xdmf)
+    for item in grid.iter("DataItem"):
+        if item.get("Format") == "HDF" and item.text and ":" in item.text:
+            file_, path = item.text.strip().split(":", 1)
+            item.text = os.path.join(here, file_) + ":" + path
+    kids = [g.get("Name", "") for g in grid.findall("Grid")] if grid.get("GridType") == "Collection" \
+        else [grid.get("Name", "")]
+    bodies = [k for k in kids if re.fullmatch(r"body\d+", k)]
+    lines = [k for k in kids if k not in bodies]
+    domain.remove(top)
+    domain.append(grid)
+    out = os.path.join(folder, "step.xdmf")
+    tree.write(out, encoding="utf-8", xml_declaration=True)
+    return out, step, n, time, bodies, lines
+
+
+def warped_lines(view_file, h5path, scale, step, line_grids, folder):
+    """A copy of the step's XDMF whose contact-line grids have the warped points of their first
+    body's contact line as geometry (inline), for an array that lives on the contact lines only;
+    a grid whose first body's nodes are not its nodes (a non-matching side) keeps its own,
+    undeformed, points. Returns the path."""
+    import xml.etree.ElementTree as ET
+    import h5py
+    pieces, c, _ = contact_pieces(h5path, scale, step)
+    with h5py.File(h5path, "r") as f:
+        npair = int(f.attrs.get("pairs", 1))
+        sizes = [f[f"contact/pair_{k}/normal_force"].shape[0] for k in range(1, npair + 1)] if npair > 1 \
+            else [c.shape[0]]
+    first = [0]
+    for n in sizes:
+        first.append(first[-1] + n)
+    tree = ET.parse(view_file)
+    for g in tree.getroot().iter("Grid"):
+        name = g.get("Name", "")
+        m = re.fullmatch(r"contact(?:_pair(\d+))?", name)
+        if name not in line_grids or m is None:
+            continue
+        k = int(m.group(1) or 1)
+        if k > len(sizes):
+            continue
+        r0, r1 = first[k - 1], first[k]
+        full = [p for _, p, ci in pieces if len(ci) == r1 - r0 and ci[0] == r0 and ci[-1] == r1 - 1]
+        geo = g.find("Geometry")
+        item = geo.find("DataItem") if geo is not None else None
+        if not full or item is None:
+            continue
+        item.set("Format", "XML")
+        item.set("Dimensions", f"{r1 - r0} 3")
+        item.text = " ".join(f"{x!r} {y!r} 0" for x, y in full[0])
+    out = os.path.join(folder, "lines.xdmf")
+    tree.write(out, encoding="utf-8", xml_declaration=True)
+    return out
 
 
 def camera_box(box, aspect):
@@ -343,6 +432,17 @@ def main(argv=None):
             zoom_box(a.zoom)
         except ValueError as e:
             return fail(str(e))
+    if a.step is not None:
+        import tempfile
+        tmp = tempfile.mkdtemp(prefix="paraview_view.")
+        try:
+            step_view(xdmf, a.step, tmp)
+        except ValueError as e:
+            return fail(str(e))
+        except Exception:  # noqa: BLE001 - reported by render()
+            pass
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
     rc = headless_reexec(argv)
     if rc is not None:
         return rc
@@ -352,7 +452,23 @@ def main(argv=None):
         return fail(f"ParaView's Python modules not found ({e}): run with pvpython or pvbatch "
                     "(Debian: apt-get install paraview xvfb)")
 
-    reader = pvs.Xdmf3ReaderT(FileName=[xdmf])          # T, not S; absolute path: see the docstring
+    import tempfile
+    tmp = tempfile.mkdtemp(prefix="paraview_view.")
+    try:
+        return render(a, pvs, xdmf, h5, field, compname, w, h, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
+    """The picture (after the checks of main): see the docstring."""
+    try:
+        view_file, step, nstep, time, body_grids, line_grids = step_view(xdmf, a.step, tmp)
+    except ValueError as e:
+        return fail(str(e))
+    except Exception as e:  # noqa: BLE001 - an XDMF file this tool does not understand
+        return fail(f"cannot read the grids of {xdmf}: {type(e).__name__}: {e}")
+    reader = pvs.Xdmf3ReaderT(FileName=[view_file])     # T, not S; absolute path: see the docstring
     reader.UpdatePipeline()
     arr = arrays(reader)
     if a.list:
@@ -371,12 +487,19 @@ def main(argv=None):
         comp = 0
 
     # warp
-    src, scale, how = reader, 0.0, "no warp"
+    # the bodies alone (the contact lines are drawn below, warped like them); the reader's
+    # contact grids only for an array that no body has (they are not warped)
+    bodies, on_lines = reader, False
+    if body_grids and line_grids:
+        bodies = pvs.ExtractBlock(Input=reader, Selectors=[f"/Root/{g}" for g in body_grids])
+        bodies.UpdatePipeline()
+        on_lines = field not in arrays(bodies)
+    src, scale, how = bodies, 0.0, "no warp"
     if "displacement" in arr and arr["displacement"][0] == "POINTS" and a.scale not in ("0", "0.0", "none"):
-        info = reader.GetDataInformation()
+        info = bodies.GetDataInformation()
         b = info.GetBounds()
         size = max(b[1] - b[0], b[3] - b[2], b[5] - b[4])
-        umax = reader.PointData["displacement"].GetRange(-1)[1]
+        umax = bodies.PointData["displacement"].GetRange(-1)[1]
         if a.scale == "auto":
             scale = float(f"{0.1 * size / umax:.3g}") if umax > 0.0 and size > 0.0 else 1.0
             how = f"auto: 10% of extent {size:.3g} over largest displacement {umax:.3g}"
@@ -387,16 +510,24 @@ def main(argv=None):
                 return fail(f"--scale must be a number or 'auto', not {a.scale!r}")
             how = f"largest displacement {umax:.3g}"
         if scale != 0.0:
-            src = pvs.WarpByVector(Input=reader, Vectors=["POINTS", "displacement"], ScaleFactor=scale)
+            src = pvs.WarpByVector(Input=bodies, Vectors=["POINTS", "displacement"], ScaleFactor=scale)
     elif a.scale not in ("0", "0.0", "none"):
         how = "no 'displacement' point array: not warped"
 
+    # an array of the contact lines only: the lines coloured by it, warped like the bodies
+    # (their first body's displacement), the bodies in a solid colour
+    coloured = src
+    if on_lines:
+        lines_file = warped_lines(view_file, h5, scale, step if nstep > 1 else None, line_grids, tmp)
+        lreader = pvs.Xdmf3ReaderT(FileName=[lines_file])
+        coloured = pvs.ExtractBlock(Input=lreader, Selectors=[f"/Root/{g}" for g in line_grids])
+        coloured.UpdatePipeline()
     # colour range
     if a.range:
         lo, hi = a.range
         rng_note = "range set by --range"
     else:
-        v = values(reader, field, assoc, comp)
+        v = values(coloured if on_lines else bodies, field, assoc, comp)
         if v is None:
             return fail(f"array '{field}' has no finite values")
         import numpy as np
@@ -420,8 +551,13 @@ def main(argv=None):
             setattr(view, prop, val)
     disp = pvs.Show(src, view)
     disp.Representation = "Surface With Edges" if a.edges else "Surface"
-    if not a.edges and hasattr(disp, "LineWidth"):
-        disp.LineWidth = 3.0           # polyline grids (a contact line) stay visible
+    if on_lines:
+        disp.ColorArrayName = ["POINTS", ""]
+        disp.AmbientColor = disp.DiffuseColor = [0.8, 0.8, 0.8]
+        disp = pvs.Show(coloured, view)
+        disp.Representation = "Surface"
+    if (on_lines or not a.edges) and hasattr(disp, "LineWidth"):
+        disp.LineWidth = 5.0 if on_lines else 3.0     # polyline grids (a contact line) stay visible
     pvs.ColorBy(disp, (assoc, field) if comp < 0 and ncomp > 1 and not compname
                 else (assoc, field, "Magnitude" if comp < 0 else "XYZ"[comp] if ncomp <= 3 else str(comp)))
     lut = pvs.GetColorTransferFunction(field)
@@ -442,7 +578,8 @@ def main(argv=None):
     for prop in ("TitleColor", "LabelColor"):
         if hasattr(bar, prop):
             setattr(bar, prop, [0.0, 0.0, 0.0])
-    title = pvs.Text(Text=f"{os.path.basename(xdmf)}: {label} [{unit or '-'}], {rng_note}\n"
+    step_note = f", load step {step} of {nstep} (time {time:g})" if nstep > 1 else ""
+    title = pvs.Text(Text=f"{os.path.basename(xdmf)}{step_note}: {label} [{unit or '-'}], {rng_note}\n"
                           f"warped by displacement x{scale:g} ({how})")
     td = pvs.Show(title, view)
     td.WindowLocation = "Upper Center"
@@ -451,7 +588,7 @@ def main(argv=None):
         td.Color = [0.0, 0.0, 0.0]
     # the contact line of each body, warped like the bodies, drawn over them
     try:
-        lines, _, _ = contact_lines(h5, scale)
+        lines, _, _ = contact_lines(h5, scale, step if nstep > 1 else None)
     except (OSError, KeyError) as e:
         lines = []
         print(f"{TOOL}: note: no contact line drawn ({e})", file=sys.stderr)
@@ -459,7 +596,7 @@ def main(argv=None):
         pl = pvs.PolyLineSource(Points=[v for x, y in pts for v in (float(x), float(y), 0.0)])
         ld = pvs.Show(pl, view)
         ld.Representation = "Surface"
-        pvs.ColorBy(ld, None)
+        ld.ColorArrayName = ["POINTS", ""]   # solid colour (ColorBy(ld, None) fails in ParaView 5.11)
         ld.AmbientColor = ld.DiffuseColor = [0.0, 0.0, 0.0]
         if hasattr(ld, "LineWidth"):
             ld.LineWidth = 2.0
@@ -471,7 +608,7 @@ def main(argv=None):
     zoom_note = ""
     if a.zoom is not None:
         try:
-            box = zoom_box(a.zoom, h5, scale)
+            box = zoom_box(a.zoom, h5, scale, step if nstep > 1 else None)
         except (ValueError, OSError, KeyError) as e:
             return fail(f"--zoom {a.zoom}: {e}")
         cx, cy, half = camera_box(box, w / h)
@@ -486,7 +623,7 @@ def main(argv=None):
     if not os.path.isfile(out):
         return fail(f"ParaView wrote no {out}")
     print(f"{TOOL}: wrote {a.output} ({label}, {assoc.lower()[:-1]} data, colour {lo:.4g} to {hi:.4g}{' ' + unit if unit else ''}, "
-          f"{rng_note}, magnification {scale:g}, {len(lines)} contact lines{zoom_note})")
+          f"{rng_note}, magnification {scale:g}, {len(lines)} contact lines{zoom_note}{step_note})")
     return 0
 
 

@@ -2,8 +2,8 @@
 """Normal contact pressure and gap along the contact line of robin_contact runs, several
 runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-gap scene.
 
-Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [--mindlin] [--radius R] [-o contact.png]
-       [--title TEXT]
+Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [--mindlin] [--radius R] [--pair K]
+       [-o contact.png] [--title TEXT]
 
 Top panel: /contact/pressure (nodal force / tributary length) against the arc length s along
 the contact curve (/contact/s). The legend gives each run's contact force per unit thickness:
@@ -45,8 +45,10 @@ err_L2=...') and written in that panel's legend:
           w the tributary lengths (/contact/tributary_length)
 Hertz assumes two half-spaces: with finite bodies and a coarse mesh expect agreement
 only when the contact width 2a is small against the bodies and spans several elements.
-A run without a parabolic gap (gap_radius = 0) or of several pairs gets no Hertz curve (a
-note on stderr), unless --radius R gives the relative radius of curvature of a gap that is
+A run of several pairs gets a Hertz curve on pair K only with --pair K (P: that pair's normal
+forces, E*: its two bodies; the other pairs' curves are drawn without one); without --pair it
+gets none, and the note on stderr names the option. A run without a parabolic gap
+(gap_radius = 0) gets no Hertz curve (a note on stderr), unless --radius R gives the relative radius of curvature of a gap that is
 the geometry's (a disc on a flat block: the disc's radius); xc is then the middle of the
 run's contact zone (its edges as above).
 Runs that are identical for Hertz (same P, R, xc, E*) share one curve.
@@ -139,9 +141,10 @@ def gap_parameters(f, path):
     return R, xc, plane_stress(text), src
 
 
-def hertz(f, path, radius=None, edges=None):
+def hertz(f, path, radius=None, edges=None, lam=None, bodies=(1, 2)):
     """Hertz curve data of one run, or (None, reason); radius and edges: the relative radius and
-    the contact zone of a run whose gap is its geometry's (used when it has no gap_radius)."""
+    the contact zone of a run whose gap is its geometry's (used when it has no gap_radius);
+    lam, bodies: the normal forces and the two bodies of the pair (default /contact, 1 and 2)."""
     R, xc, pstress, src = gap_parameters(f, path)
     if radius is not None and not (R is not None and R > 0.0):
         if edges is None:
@@ -151,11 +154,11 @@ def hertz(f, path, radius=None, edges=None):
         return None, "no gap_radius in the attributes or the input deck"
     if not R > 0.0:
         return None, "gap_radius = 0 (no parabolic gap)"
-    P = float(np.sum(np.array(f["/contact/normal_force"])))
+    P = float(np.sum(np.array(f["/contact/normal_force"]) if lam is None else lam))
     if not P > 0.0:
         return None, f"total normal force P = {P:g} <= 0"
     inv = 0.0
-    for b in ("body1", "body2"):
+    for b in (f"body{k}" for k in bodies):
         E = num_attr(f[b], "young")
         nu = num_attr(f[b], "poisson")
         if E is None or nu is None:
@@ -284,8 +287,9 @@ def read_line(f, g, u, resultant_name):
     return r
 
 
-def read_run(path, want_hertz, want_mindlin=False, radius=None):
-    """The curves of one result file: one (/contact), or one per pair when it has several."""
+def read_run(path, want_hertz, want_mindlin=False, radius=None, pair=None):
+    """The curves of one result file: one (/contact), or one per pair when it has several
+    (pair: the one that gets the Hertz and Mindlin curves)."""
     with h5py.File(path, "r") as f:
         u = result_units(f)
         npair = int(f.attrs.get("pairs", 1))
@@ -302,14 +306,27 @@ def read_run(path, want_hertz, want_mindlin=False, radius=None):
                 else:
                     r["m"], r["mwhy"] = mindlin(r, r["h"], *friction_of(deck_text(f, path)[0]))
             return [r]
+        if pair is not None and not 1 <= pair <= npair:
+            raise ValueError(f"--pair {pair}: the file has {npair} contact pairs (1 to {npair})")
         runs = []
         for k in range(1, npair + 1):
             g = f[f"contact/pair_{k}"]
             r = read_line(f, g, u, "resultant_on_first_body")
             a, b = (int(v) for v in np.asarray(g.attrs["bodies"]).reshape(-1)[:2])
             r["pair"] = f"pair {k} (bodies {a},{b})"
-            r["h"], r["why"] = (None, f"{npair} contact pairs") if want_hertz else (None, None)
-            r["m"], r["mwhy"] = (None, f"no Hertz curve ({npair} contact pairs)") if want_mindlin else (None, None)
+            why = f"{npair} contact pairs" + (f", --pair {pair} chosen" if pair else
+                                              f": pick the pair with --pair K (1 to {npair})")
+            r["h"], r["why"] = (None, why) if want_hertz else (None, None)
+            r["m"], r["mwhy"] = (None, f"no Hertz curve ({why})") if want_mindlin else (None, None)
+            if k == pair and want_hertz:
+                r["h"], r["why"] = hertz(f, path, radius, r["edges"], r["lam"], (a, b))
+                if want_mindlin:
+                    if r["h"] is None:
+                        r["mwhy"] = f"no Hertz curve ({r['why']})"
+                    elif not r["friction"]:
+                        r["mwhy"] = f"no friction (no /contact/pair_{k}/shear)"
+                    else:
+                        r["m"], r["mwhy"] = mindlin(r, r["h"], *friction_of(deck_text(f, path)[0]))
             runs.append(r)
         return runs
 
@@ -321,13 +338,15 @@ def main(argv=None):
                     help="add Cattaneo-Mindlin's shear to the shear panel (Coulomb friction; implies --hertz)")
     ap.add_argument("--radius", type=float, default=None,
                     help="Hertz's relative radius for a run whose gap is its geometry's (no gap_radius)")
+    ap.add_argument("--pair", type=int, default=None, metavar="K",
+                    help="with several contact pairs: the pair that gets the Hertz (and Mindlin) curve")
     a = ap.parse_args(argv)
     a.hertz = a.hertz or a.mindlin
 
     runs = []
     for path in a.files:
         try:
-            curves = read_run(path, a.hertz, a.mindlin, a.radius)
+            curves = read_run(path, a.hertz, a.mindlin, a.radius, a.pair)
         except (OSError, KeyError, ValueError) as e:
             print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
             return 1

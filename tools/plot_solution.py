@@ -174,16 +174,23 @@ def contact_lines(f):
 
 def draw_contact_line(ax, pair, ln, tol, fl):
     """One contact line drawn on the deformed boundary of its two bodies `pair` (styles of
-    ln), its active nodes marked on the first; lengths divided by fl."""
+    ln), its active nodes marked on the body that holds the contact nodes (the side whose
+    boundary nodes match most of them: the slave side of non-matching meshes); the legend
+    counts the active contact nodes of the whole line (/contact/active = 1, or the pair's);
+    lengths divided by fl."""
     cxy = ln["cxy"]
-    act_all = np.asarray(ln["active"]).reshape(-1)
+    act_all = np.asarray(ln["active"]).reshape(-1) > 0
+    n = cxy.shape[1]
+    act_line = np.zeros(n, dtype=bool)
+    act_line[:min(n, act_all.size)] = act_all[:n]
+    side = None                                           # (matched count, body, idx, ok)
     for b, st in zip(pair, ln["styles"]):
-        if cxy.shape[1] == 0:
+        if n == 0:
             break
         bn = b["boundary"]
-        idx = np.empty(cxy.shape[1], dtype=np.int64)
-        ok = np.zeros(cxy.shape[1], dtype=bool)
-        for c0 in range(0, cxy.shape[1], 256):            # (256 x boundary nodes) distances at a time
+        idx = np.empty(n, dtype=np.int64)
+        ok = np.zeros(n, dtype=bool)
+        for c0 in range(0, n, 256):                       # (256 x boundary nodes) distances at a time
             cc = cxy[:, c0:c0 + 256]
             dist = np.hypot(b["xy"][0][bn][None, :] - cc[0][:, None], b["xy"][1][bn][None, :] - cc[1][:, None])
             j = np.argmin(dist, axis=1)
@@ -199,18 +206,19 @@ def draw_contact_line(ax, pair, ln, tol, fl):
             if np.hypot(*(p[:, -1] - p[:, 0])) <= 1.5 * step.max():
                 p = np.hstack([p, p[:, :1]])
         ax.plot(p[0], p[1], zorder=4, **st)
-        if b is pair[0]:
-            act = np.zeros(ok.size, dtype=bool)
-            act[:min(ok.size, act_all.size)] = act_all[:ok.size] > 0
-            act &= ok
-            pa = b["def"][:, idx[act]] / fl
-            lab = f"{ln['tag']}active contact nodes ({int(act.sum())} of {ok.size})"
-            if ok.size <= 200:
-                ax.plot(pa[0], pa[1], "o", ms=3.5, mfc=ln["mark"], mec="white", mew=0.5, ls="none", zorder=5,
-                        label=lab)
-            else:
-                o = np.argsort(pa[0], kind="stable")
-                ax.plot(pa[0][o], pa[1][o], ".", color=ln["mark"], ms=1.5, zorder=5, label=lab)
+        if side is None or int(ok.sum()) > side[0]:
+            side = (int(ok.sum()), b, idx, ok)
+    if side is None:
+        return
+    _, b, idx, ok = side
+    pa = b["def"][:, idx[act_line & ok]] / fl
+    lab = f"{ln['tag']}active contact nodes ({int(act_line.sum())} of {n})"
+    if n <= 200:
+        ax.plot(pa[0], pa[1], "o", ms=3.5, mfc=ln["mark"], mec="white", mew=0.5, ls="none", zorder=5,
+                label=lab)
+    else:
+        o = np.argsort(pa[0], kind="stable")
+        ax.plot(pa[0][o], pa[1][o], ".", color=ln["mark"], ms=1.5, zorder=5, label=lab)
 
 
 def nice(x):
