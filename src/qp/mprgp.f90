@@ -75,6 +75,10 @@ module mprgp
     real(wp), allocatable :: as(:)         !< A s
     real(wp), allocatable :: eq_g(:, :)    !< (r, n) equality rows (SMALBE; with eq_e, opts%eq_m)
     real(wp), allocatable :: eq_e(:)       !< (r) their right-hand side
+    !> the Newton method's dense copy of an operator that is not a dense_op_t, kept for the
+    !! next solves of this solver (it is taken to be the same A: a caller whose A changes
+    !! deallocates it)
+    real(wp), allocatable :: dense(:, :)
     ! the iteration's state
     integer, private :: n = 0              ! unknowns
     integer, private :: it = 0             ! steps taken
@@ -226,7 +230,7 @@ contains
 
   !> The active-set Newton method's steps (module qp_newton) until the stopping test ends
   !! the solve, on the dense matrix of A (A itself when it is a dense_op_t, else built by n
-  !! products). Two whole steps in a row on the same face leave x at that face's minimiser
+  !! products once and kept in self%dense for the solver's next solves). Two whole steps in a row on the same face leave x at that face's minimiser
   !! to working precision: if the projected gradient is still above the tolerance then, the
   !! tolerance is below what double precision resolves for this A, and the solve ends as
   !! converged to working precision when |gP| is within NEWTON_FLOOR n eps lambda_max |x|
@@ -237,7 +241,6 @@ contains
     real(wp), intent(in) :: b(:), lb(:), ub(:)
     real(wp), intent(inout) :: x(:)
     type(newton_work_t) :: work
-    real(wp), allocatable :: ad(:, :)
     real(wp) :: betabeta, phitphi, flops, floor
     integer :: outcome, j, n
     character(len=24) :: s1
@@ -246,14 +249,19 @@ contains
     type is (dense_op_t)
       call newton_steps(A%a)
     class default
-      allocate (ad(n, n))
-      do j = 1, n
-        self%v = 0.0_wp
-        self%v(j) = 1.0_wp
-        call A%apply(self%v, ad(:, j))
-      end do
-      self%stats%n_matvec = self%stats%n_matvec + n
-      call newton_steps(ad)
+      if (allocated(self%dense)) then
+        if (size(self%dense, 1) /= n) deallocate (self%dense)
+      end if
+      if (.not. allocated(self%dense)) then
+        allocate (self%dense(n, n))
+        do j = 1, n
+          self%v = 0.0_wp
+          self%v(j) = 1.0_wp
+          call A%apply(self%v, self%dense(:, j))
+        end do
+        self%stats%n_matvec = self%stats%n_matvec + n
+      end if
+      call newton_steps(self%dense)
     end select
 
   contains
