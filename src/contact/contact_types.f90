@@ -16,6 +16,8 @@ module contact_types
   integer, parameter, public :: STATUS_DIVERGED = 3     !< diverged or stagnated (the message says which)
   integer, parameter, public :: STATUS_FAILED = 4       !< a numerical failure (factorization, inner solve)
   integer, parameter, public :: STATUS_INTERRUPTED = 5  !< stopped by a signal
+  !> a load history ended at a step whose loads the contact cannot hold (the steps before kept)
+  integer, parameter, public :: STATUS_NO_EQUILIBRIUM = 6
 
   !> Outcome of a contact solve, with the outer history.
   type, public :: contact_result_t
@@ -130,7 +132,7 @@ module contact_types
 contains
 
   !> The word for a STATUS_* code: 'none', 'converged', 'max_outer', 'diverged', 'failed',
-  !! 'interrupted' (what the results file and the `result:` line hold).
+  !! 'interrupted', 'no_equilibrium' (what the results file and the `result:` line hold).
   function status_name(status) result(name)
     integer, intent(in) :: status   !< a STATUS_* code
     character(len=:), allocatable :: name
@@ -147,6 +149,8 @@ contains
       name = 'failed'
     case (STATUS_INTERRUPTED)
       name = 'interrupted'
+    case (STATUS_NO_EQUILIBRIUM)
+      name = 'no_equilibrium'
     case default
       name = 'unknown'
     end select

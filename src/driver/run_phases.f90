@@ -12,7 +12,8 @@ module run_phases
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body
   use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT
-  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, anderson_history, contact_result_t
+  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
+                           contact_result_t
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
@@ -231,11 +232,16 @@ contains
     call build_interface(run%deck%body, run%deck%pair(1:run%deck%npair), run%deck%pairs_named, run%meshes, &
                          run%systems, run%contact_line, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
+    ! a load history: the checks (and the condensation after them) take its first step's
+    ! loads; solve_steps checks each later step before solving it
     do a = 1, run%nbody
+      if (size(run%plan) > 1) call set_step_loads(run%systems(a), run%plan(1))
       call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
     end do
     if (sum(run%systems(:)%nrig) == 0) return
     call check_held(run%contact_line, run%systems, run%bodies, err)
+    if (err%failed() .and. size(run%plan) > 1) err%message = 'at step 1 of '//i2s(size(run%plan))//' (stage 1, load '// &
+      'factor '//trim(sci(run%plan(1)%factor))//'): '//trim(err%message)
     call fail_on(err, 'deck '//trim(run%deck%source))
     block
       character(len=:), allocatable :: edge
@@ -423,7 +429,12 @@ contains
       do a = 1, run%nbody
         call set_step_loads(run%systems(a), run%plan(k))
       end do
+      ! whether the contact holds the floating bodies under this step's loads (the first
+      ! step's were checked with the deck): a history ends at its first step without a
+      ! static equilibrium, the steps before it kept
+      if (k > 1 .and. k >= run%restart_step .and. .not. step_held(run, k, .false.)) exit
       call backend%condense_load(run)
+      if (k > 1 .and. k >= run%restart_step .and. .not. step_held(run, k, .true.)) exit
       if (k < run%restart_step) then
         call replay_step(run, backend, replayed(k)%res)
       else
@@ -436,8 +447,41 @@ contains
       if (run%result%status /= STATUS_CONVERGED) exit
     end do
     ! the steps solved (record_step reserves room for more)
+    if (k <= size(run%plan)) then
+      if (run%result%status == STATUS_NO_EQUILIBRIUM) k = k - 1
+    end if
     if (run%rank == 0 .and. size(run%steps) > min(k, size(run%plan))) call keep_steps(run, min(k, size(run%plan)))
   end subroutine solve_steps
+
+  !> Can the contact hold the floating bodies under step k's loads (their rigid rows taken
+  !! again)? pressed: the deformation test too (after the step's condensation; on one
+  !! process, where every body's b_a is at hand). When not, run%result (the step before's)
+  !! gets the status STATUS_NO_EQUILIBRIUM and a message naming the step, its stage and
+  !! load factor, and the reason.
+  logical function step_held(run, k, pressed) result(held)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: k
+    logical, intent(in) :: pressed
+    type(error_t) :: err
+    integer :: a
+    held = .true.
+    if (sum(run%systems(:)%nrig) == 0) return
+    if (pressed) then
+      if (run%ranks > 1) return
+      call check_pressed(run%systems, run%contact_line, run%bodies, err)
+    else
+      do a = 1, run%nbody
+        if (run%systems(a)%nrig > 0) call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
+      end do
+      call check_held(run%contact_line, run%systems, run%bodies, err)
+    end if
+    if (.not. err%failed()) return
+    held = .false.
+    run%result%status = STATUS_NO_EQUILIBRIUM
+    run%result%message = 'no static equilibrium from step '//i2s(k)//' of '//i2s(size(run%plan))//' (stage '// &
+      i2s(run%plan(k)%stage)//', load factor '//trim(sci(run%plan(k)%factor))//') on: '//trim(err%message)// &
+      '; the '//i2s(k - 1)//' steps before it are in the result'
+  end function step_held
 
   !> run%steps reduced to its first n entries (moved, not copied).
   subroutine keep_steps(run, n)

@@ -8,7 +8,7 @@ module run_summary
   use contact_interface, only: interface_t, ROW_NORMAL
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
-  use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED
+  use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED, STATUS_NO_EQUILIBRIUM
   use sysinfo, only: write_stdout_checked
   use strings, only: sci, fmt_real, i2s
   use run_state, only: run_t
@@ -35,8 +35,11 @@ contains
     end select
     if (run%result%status /= STATUS_CONVERGED) write (error_unit, '(a)') 'robin_contact: '// &
       status_name(run%result%status)//': '//trim(run%result%message)
-    if (run%code == EXIT_NOT_CONVERGED) write (error_unit, '(a)') 'robin_contact: next: '// &
-      next_setting(run%deck%solver, trim(run%result%method) == 'monolithic')
+    if (run%code == EXIT_NOT_CONVERGED .and. run%result%status /= STATUS_NO_EQUILIBRIUM) write (error_unit, '(a)') &
+      'robin_contact: next: '//next_setting(run%deck%solver, trim(run%result%method) == 'monolithic')
+    if (run%result%status == STATUS_NO_EQUILIBRIUM) write (error_unit, '(a)') 'robin_contact: next: the steps '// &
+      'before it are solved and written; no solver setting gives a step without an equilibrium one: lower its '// &
+      'loads, raise mu, or support the body'
   end subroutine set_exit_code
 
   !> The closing lines (rank 0). A summary that cannot be written (standard output on a
