@@ -344,9 +344,10 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(out) :: err                  !< ERR_INPUT when a body is not pressed
     real(wp), allocatable :: rows(:, :), target(:), lam(:), h(:), bs(:, :), ha(:)
-    integer, allocatable :: root(:)
+    integer, allocatable :: root(:), unpressed(:), members(:)
+    logical, allocatable :: loaded(:)
     real(wp) :: res
-    integer :: a, r, m, i
+    integer :: a, r, m, i, g, k
     if (contact_line%m == 0) return
     allocate (bs(contact_line%m, 2))
     bs = 0.0_wp
@@ -354,16 +355,19 @@ contains
       call scatter(bodies(a)%b, bodies(a)%slots, bs)
     end do
     h = contact_line%g0 - bs(:, 1) - bs(:, 2)
-    allocate (root(size(bodies)))
+    allocate (root(size(bodies)), loaded(size(bodies)), unpressed(0))
     root = floating_groups(contact_line, bodies)
+    ! the groups with a load: check_groups found it balanced by compressive forces through
+    ! the group, which presses its members
+    loaded = .false.
+    do a = 1, size(bodies)
+      if (bodies(a)%nrig > 0 .and. any(bodies(a)%re /= 0.0_wp)) loaded(root(a)) = .true.
+    end do
     do a = 1, size(bodies)
       r = bodies(a)%nrig
       m = bodies(a)%m
       if (r == 0 .or. m == 0) cycle
-      if (any(bodies(a)%re /= 0.0_wp)) cycle
-      ! a member of a group of floating bodies with a load: check_groups found that load
-      ! balanced by compressive forces through the group, which presses its members
-      if (any([(root(i) == root(a) .and. i /= a .and. any(bodies(i)%re /= 0.0_wp), i=1, size(bodies))])) cycle
+      if (any(bodies(a)%re /= 0.0_wp) .or. loaded(root(a))) cycle
       allocate (rows(r + 1, m), target(r + 1), lam(m), ha(m))
       do i = 1, m
         ha(i) = h(slot_row(bodies(a)%slots(i), contact_line%m))
@@ -378,10 +382,24 @@ contains
         allocate (lam(size(rows, 2)))
       end if
       call nnls(rows, target, lam, res)
-      ! not pressed by its own rows' gaps: perhaps through its floating neighbours (a plate
-      ! clamped between two others by a third), decided on their group as a whole
-      if (.not. res <= 1.0e-8_wp) res = group_pressing(contact_line, bodies, root, a, h)
+      if (.not. res <= 1.0e-8_wp) unpressed = [unpressed, a]
+      deallocate (rows, target, lam, ha)
+    end do
+    ! not pressed by its own rows' gaps: perhaps through its floating neighbours (a plate
+    ! clamped between two others by a third), decided on their group as a whole: one solve
+    ! for all of a group's such bodies (a sum of the forces that reach each reaches all),
+    ! and only when that fails one per body, to name it
+    do i = 1, size(unpressed)
+      a = unpressed(i)
+      if (root(a) == 0) cycle
+      g = root(a)
+      members = pack(unpressed, root(unpressed) == g)
+      res = group_pressing(contact_line, bodies, root, members, h)
       if (.not. res <= 1.0e-8_wp) then
+        do k = 1, size(members)
+          if (.not. group_pressing(contact_line, bodies, root, members(k:k), h) <= 1.0e-8_wp) exit
+        end do
+        a = members(min(k, size(members)))
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
               'presses it into the contact: its loads have no part along that motion, and its deformation '// &
               'under the loads and prescribed displacements leaves a rigid motion that lifts it off the '// &
@@ -389,30 +407,37 @@ contains
               'rigid motion with a support: a ''clamped'' side, a ''roller'', or ux/uy on a group (&boundary)')
         return
       end if
-      deallocate (rows, target, lam, ha)
+      where (root(unpressed) == g) root(unpressed) = 0     ! the group is done
     end do
 
   end subroutine check_pressed
 
-  !> Whether floating body a is pressed into the contact through the group of floating
-  !! bodies it belongs to (root: floating_groups): is there a set of admissible contact forces
-  !! lam on the group's rows, in equilibrium on every body of the group with tau times its
-  !! load (G_b lam = tau e_b, tau >= 0), that some deformation or load drives (h'lam < 0 or
-  !! tau > 0, h the gaps after the particular deformations) and in which body a takes part
-  !! (a force on one of its normal rows)? By NNLS on the rows [G_b ... ; h'; s_a'] with the
-  !! columns of lam (friction: the cone's generators), tau and two slacks, against
-  !! (0, -1, 1): the residual, <= 1e-8 when such forces exist. A plate pressed by a bolt head
+  !> Whether the floating bodies `targets` (of one group, root: floating_groups) are
+  !! pressed into the contact through their group: is there a set of admissible contact
+  !! forces lam on the group's rows, in equilibrium on every body of the group with tau times
+  !! its load (G_b lam = tau e_b, tau >= 0), that some deformation or load drives (h'lam < 0
+  !! or tau > 0, h the gaps after the particular deformations) and in which every target
+  !! takes part (a force on one of its normal rows)? By NNLS on the rows [G_b ...; h'; s_a'
+  !! per target] with the columns of lam (friction: the cone's generators), tau and a slack
+  !! per inequality, against (0, -1, 1, ...): the residual, <= 1e-8 when such forces exist
+  !! (the sum of the forces that reach each target reaches them all). A plate pressed by a bolt head
   !! through another plate has them; a body nothing reaches has not.
-  real(wp) function group_pressing(contact_line, bodies, root, a, h) result(res)
+  real(wp) function group_pressing(contact_line, bodies, root, targets, h) result(res)
     type(interface_t), intent(in) :: contact_line
     type(body_condensed_t), intent(in) :: bodies(:)
-    integer, intent(in) :: root(:), a
+    integer, intent(in) :: root(:)
+    integer, intent(in) :: targets(:)   !< the bodies that must take part (one group)
     real(wp), intent(in) :: h(:)
     real(wp), allocatable :: g(:, :), gc(:, :), x(:), target(:), e(:)
-    integer, allocatable :: col(:), rows(:), r0(:)
-    integer :: b, i, k, nr, nc, mm, n
+    integer, allocatable :: col(:), rows(:), r0(:), tgt(:)
+    integer :: b, i, k, nr, nc, mm, n, a, nt
     real(wp) :: hs, es
     mm = contact_line%m
+    nt = size(targets)
+    a = targets(1)
+    allocate (tgt(size(bodies)))
+    tgt = 0
+    tgt(targets) = [(i, i=1, nt)]
     ! the group's rows, each once (a row between two of its bodies is in both bodies' slots)
     allocate (col(mm))
     col = 0
@@ -432,7 +457,7 @@ contains
         end if
       end do
     end do
-    allocate (rows(nc), g(nr + 2, nc), e(nr))
+    allocate (rows(nc), g(nr + 1 + nt, nc), e(nr))
     do k = 1, mm
       if (col(k) > 0) rows(col(k)) = k
     end do
@@ -445,7 +470,7 @@ contains
       do i = 1, bodies(b)%m
         k = slot_row(bodies(b)%slots(i), mm)
         g(r0(b) + 1:r0(b) + bodies(b)%nrig, col(k)) = bodies(b)%rg(:, i)
-        if (b == a .and. contact_line%kind(k) /= ROW_TANGENT) g(nr + 2, col(k)) = 1.0_wp
+        if (tgt(b) > 0 .and. contact_line%kind(k) /= ROW_TANGENT) g(nr + 1 + tgt(b), col(k)) = 1.0_wp
       end do
     end do
     do i = 1, nc
@@ -463,13 +488,21 @@ contains
       e = e/es
       es = 1.0_wp      ! tau presses only when the group has a load
     end if
-    gc = reshape([gc, [-e, -es, 0.0_wp], [spread(0.0_wp, 1, nr), 1.0_wp, 0.0_wp], &
-                  [spread(0.0_wp, 1, nr), 0.0_wp, -1.0_wp]], [nr + 2, n + 3])
-    allocate (target(nr + 2), x(n + 3))
+    ! columns: tau, the slack of the h row, one slack per target's row
+    gc = reshape([gc, [-e, -es, spread(0.0_wp, 1, nt)], [spread(0.0_wp, 1, nr), 1.0_wp, spread(0.0_wp, 1, nt)]], &
+                 [nr + 1 + nt, n + 2])
+    deallocate (g)
+    allocate (g(nr + 1 + nt, n + 2 + nt))
+    g(:, 1:n + 2) = gc
+    g(:, n + 3:) = 0.0_wp
+    do i = 1, nt
+      g(nr + 1 + i, n + 2 + i) = -1.0_wp
+    end do
+    allocate (target(nr + 1 + nt), x(n + 2 + nt))
     target = 0.0_wp
     target(nr + 1) = -1.0_wp
-    target(nr + 2) = 1.0_wp
-    call nnls(gc, target, x, res)
+    target(nr + 2:) = 1.0_wp
+    call nnls(g, target, x, res)
   end function group_pressing
 
   !> The columns of g (column i on contact row rows(i)) as generators of the admissible

@@ -232,17 +232,16 @@ contains
     call build_interface(run%deck%body, run%deck%pair(1:run%deck%npair), run%deck%pairs_named, run%meshes, &
                          run%systems, run%contact_line, err)
     call fail_on(err, 'deck '//trim(run%deck%source))
-    ! a load history: the checks (and the condensation after them) take its first step's
-    ! loads; solve_steps checks each later step before solving it
     do a = 1, run%nbody
-      if (size(run%plan) > 1) call set_step_loads(run%systems(a), run%plan(1))
       call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
     end do
     if (sum(run%systems(:)%nrig) == 0) return
-    call check_held(run%contact_line, run%systems, run%bodies, err)
-    if (err%failed() .and. size(run%plan) > 1) err%message = 'at step 1 of '//i2s(size(run%plan))//' (stage 1, load '// &
-      'factor '//trim(sci(run%plan(1)%factor))//'): '//trim(err%message)
-    call fail_on(err, 'deck '//trim(run%deck%source))
+    ! one step: its loads checked here; a load history: each step's loads by solve_steps,
+    ! before it is solved (the first step's as input, exit 1)
+    if (size(run%plan) == 1) then
+      call check_held(run%contact_line, run%systems, run%bodies, err)
+      call fail_on(err, 'deck '//trim(run%deck%source))
+    end if
     block
       character(len=:), allocatable :: edge
       edge = friction_edge(run%contact_line, run%systems, run%bodies)
@@ -429,12 +428,11 @@ contains
       do a = 1, run%nbody
         call set_step_loads(run%systems(a), run%plan(k))
       end do
-      ! whether the contact holds the floating bodies under this step's loads (the first
-      ! step's were checked with the deck): a history ends at its first step without a
+      ! whether the contact can balance this step's loads on the floating bodies: the first
+      ! step's is input (exit 1), and a history ends at its first later step without a
       ! static equilibrium, the steps before it kept
-      if (k > 1 .and. k >= run%restart_step .and. .not. step_held(run, k, .false.)) exit
+      if (k >= run%restart_step .and. .not. step_held(run, k)) exit
       call backend%condense_load(run)
-      if (k > 1 .and. k >= run%restart_step .and. .not. step_held(run, k, .true.)) exit
       if (k < run%restart_step) then
         call replay_step(run, backend, replayed(k)%res)
       else
@@ -453,29 +451,30 @@ contains
     if (run%rank == 0 .and. size(run%steps) > min(k, size(run%plan))) call keep_steps(run, min(k, size(run%plan)))
   end subroutine solve_steps
 
-  !> Can the contact hold the floating bodies under step k's loads (their rigid rows taken
-  !! again)? pressed: the deformation test too (after the step's condensation; on one
-  !! process, where every body's b_a is at hand). When not, run%result (the step before's)
-  !! gets the status STATUS_NO_EQUILIBRIUM and a message naming the step, its stage and
-  !! load factor, and the reason.
-  logical function step_held(run, k, pressed) result(held)
+  !> Can the contact balance step k's loads on the floating bodies (their rigid rows taken
+  !! again; floating%check_held)? Step 1's failure is bad input (exit 1, nothing written,
+  !! the step and its stage named). A later step's: run%result (the step before's) gets the
+  !! status STATUS_NO_EQUILIBRIUM and a message naming the step, its stage and load factor,
+  !! and the reason. Whether a body without a load is pressed by a deformation is decided
+  !! once, with the deck (check_condensed): through the elastic bodies around it, a step's
+  !! deformation may press it where the rigid test cannot see it.
+  logical function step_held(run, k) result(held)
     type(run_t), intent(inout) :: run
     integer, intent(in) :: k
-    logical, intent(in) :: pressed
     type(error_t) :: err
     integer :: a
     held = .true.
     if (sum(run%systems(:)%nrig) == 0) return
-    if (pressed) then
-      if (run%ranks > 1) return
-      call check_pressed(run%systems, run%contact_line, run%bodies, err)
-    else
-      do a = 1, run%nbody
-        if (run%systems(a)%nrig > 0) call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
-      end do
-      call check_held(run%contact_line, run%systems, run%bodies, err)
-    end if
+    do a = 1, run%nbody
+      if (run%systems(a)%nrig > 0) call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
+    end do
+    call check_held(run%contact_line, run%systems, run%bodies, err)
     if (.not. err%failed()) return
+    if (k == 1) then
+      err%message = 'at step 1 of '//i2s(size(run%plan))//' (stage '//i2s(run%plan(1)%stage)//', load factor '// &
+        trim(sci(run%plan(1)%factor))//'): '//trim(err%message)
+      call fail_on(err, 'deck '//trim(run%deck%source))
+    end if
     held = .false.
     run%result%status = STATUS_NO_EQUILIBRIUM
     run%result%message = 'no static equilibrium from step '//i2s(k)//' of '//i2s(size(run%plan))//' (stage '// &
