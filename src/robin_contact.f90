@@ -28,7 +28,7 @@ program robin_contact
   use run_phases, only: choose_backend, choose_threads, read_meshes, assemble_bodies, build_contact_line, &
                         read_restart, factor_estimate, check_condensed, solve_steps, write_output, check_interrupt, &
                         check_output_names
-  use run_summary, only: set_exit_code, summary
+  use run_summary, only: set_exit_code, summary, print_assembled
   implicit none (type, external)
 
   type(run_t) :: run
@@ -64,8 +64,7 @@ program robin_contact
   call read_restart(run)
   run%timing%assemble = wtime() - t0
   call check_interrupt(run, backend, 'assembly')
-  write (output_unit, '(a,i0,a,i0,a,i0,a,i0)') 'assembled: n1=', run%systems(1)%n, ' n2=', run%systems(2)%n, &
-    ' m=', run%contact_line%m, ' threads=', run%threads
+  call print_assembled(run)
 
   ! ---- factorize and condense on the contact line -------------------------------------
   if (run%nbody == 2) then

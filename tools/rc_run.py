@@ -1,7 +1,7 @@
 """Running robin_contact and reading its console output.
 
 The program's console output ends with key=value lines (see doc/running.md, "What a run prints"):
-  result: status=converged method=robin outer=189 inner=2491 n1=816 n2=816 m=24 delta=0.5 residual=... wall_s=0.036 bodies=2 pairs=1
+  result: status=converged method=robin outer=189 inner=2491 n1=816 n2=816 m=24 delta=0.5 residual=... wall_s=0.036 bodies=2 pairs=1 dofs=1632
   time: assemble=... factor=... condense=... iterate=... output=... total=... peak_mb=... factor_mb=...
   contact: total normal force= ...
 This module parses them (result_fields, time_fields, line_fields, contact_force), runs the
@@ -14,11 +14,12 @@ import re
 import subprocess
 
 # ---- the program's output lines -------------------------------------------------------
-RESULT_KEYS = ("status", "method", "outer", "inner", "n1", "n2", "m", "delta", "residual", "wall_s", "bodies", "pairs")
+RESULT_KEYS = ("status", "method", "outer", "inner", "n1", "n2", "m", "delta", "residual", "wall_s", "bodies", "pairs",
+               "dofs")
 # the documented shape of the result and time lines, checked to the letter by tests/system/test_runs.py
 RESULT_LINE = re.compile(r"^result: status=(\w+) method=(\w+) outer=(\d+) inner=(\d+) n1=(\d+) n2=(\d+) "
                          r"m=(\d+) delta=([0-9.eE+-]+) residual=([0-9.eE+-]+) wall_s=([0-9.eE+-]+) "
-                         r"bodies=(\d+) pairs=(\d+)$", re.M)
+                         r"bodies=(\d+) pairs=(\d+) dofs=(\d+)$", re.M)
 TIME_LINE = re.compile(r"^time: assemble=[0-9.]+ factor=[0-9.]+ condense=[0-9.]+ iterate=[0-9.]+ output=[0-9.]+ "
                        r"total=[0-9.]+", re.M)
 FORCE_RE = re.compile(r"^contact: total normal force=\s*(\S+)", re.M)

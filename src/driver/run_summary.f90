@@ -2,7 +2,7 @@
 !! setting to try on standard error) and the closing summary lines on standard output.
 module run_summary
   use kinds, only: wp
-  use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED
   use config, only: solver_cfg_t, ROBIN_HARMONIC
   use contact_interface, only: interface_t, ROW_NORMAL
@@ -15,7 +15,10 @@ module run_summary
   implicit none (type, external)
   private
 
-  public :: set_exit_code, summary, step_line
+  public :: set_exit_code, summary, step_line, print_assembled
+
+  !> Bodies listed on the `bodies:` line, pairs on a `step:` line (the rest counted).
+  integer, parameter :: MAX_LISTED = 20
 
 contains
 
@@ -77,7 +80,8 @@ contains
         ' n1=', run%systems(1)%n, ' n2=', run%systems(2)%n, ' m=', run%contact_line%m, &
         ' delta=', fmt_real(run%deck%solver%delta, '(f0.6)'), ' residual=', result%residual, &
         ' wall_s=', fmt_real(timing%total, '(f0.3)')
-      line(4) = trim(line(4))//' bodies='//i2s(run%nbody)//' pairs='//i2s(run%contact_line%npair)
+      line(4) = trim(line(4))//' bodies='//i2s(run%nbody)//' pairs='//i2s(run%contact_line%npair)// &
+                ' dofs='//total_dofs(run)
       ! one contact line per pair; the output line sits before the time line when a result
       ! file was written
       do k = 1, size(pairs)
@@ -99,12 +103,14 @@ contains
   end subroutine summary
 
   !> The `step:` line of load step k: its stage, load factor, outer iterations, status
-  !! and the sum of the nodal normal contact forces of all pairs.
+  !! and the sum of the nodal normal contact forces of all pairs; with several pairs, each
+  !! pair's own sum too (the first MAX_LISTED pairs, then how many more).
   function step_line(run, k) result(t)
     type(run_t), intent(in) :: run   !< the run: its plan and current result
     integer, intent(in) :: k         !< the step
     character(len=:), allocatable :: t
     real(wp) :: ftot
+    integer :: p, np
     ftot = 0.0_wp
     if (allocated(run%result%lam)) then
       ftot = sum(run%result%lam)
@@ -113,7 +119,85 @@ contains
     t = 'step: step='//i2s(k)//' of='//i2s(size(run%plan))//' stage='//i2s(run%plan(k)%stage)// &
         ' load_factor='//fmt_real(run%plan(k)%factor, '(f0.6)')//' outer='//i2s(run%result%outer)// &
         ' status='//status_name(run%result%status)//' normal_force_sum='//sci(ftot, 5)
+    np = run%contact_line%npair
+    if (np > 1 .and. allocated(run%contact_line%pair_ptr)) then
+      t = t//' pair_normal_force_sum='
+      do p = 1, min(np, MAX_LISTED)
+        if (p > 1) t = t//','
+        t = t//sci(pair_normal_sum(run, p), 5)
+      end do
+      if (np > MAX_LISTED) t = t//' more_pairs='//i2s(np - MAX_LISTED)
+    end if
   end function step_line
+
+  !> The sum of pair p's nodal normal contact forces (0 before any result).
+  function pair_normal_sum(run, p) result(f)
+    type(run_t), intent(in) :: run
+    integer, intent(in) :: p   !< the pair
+    real(wp) :: f
+    integer :: r1, r2
+    f = 0.0_wp
+    if (.not. allocated(run%result%lam)) return
+    r1 = run%contact_line%pair_ptr(p)
+    r2 = min(run%contact_line%pair_ptr(p + 1) - 1, size(run%result%lam))
+    if (r2 < r1) return
+    if (allocated(run%contact_line%kind)) then
+      f = sum(run%result%lam(r1:r2), mask=run%contact_line%kind(r1:r2) == ROW_NORMAL)
+    else
+      f = sum(run%result%lam(r1:r2))
+    end if
+  end function pair_normal_sum
+
+  !> The DOFs of all bodies (after the supports), as text.
+  function total_dofs(run) result(t)
+    type(run_t), intent(in) :: run
+    character(len=:), allocatable :: t
+    character(len=24) :: buf
+    integer(int64) :: n
+    integer :: a
+    n = 0
+    if (allocated(run%systems)) then
+      do a = 1, size(run%systems)
+        n = n + run%systems(a)%n
+      end do
+    end if
+    write (buf, '(i0)') n
+    t = trim(buf)
+  end function total_dofs
+
+  !> The contact rows of body a: the rows of every pair it takes part in.
+  integer function body_rows(itf, a)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: a   !< the body
+    integer :: p, s
+    body_rows = 0
+    if (.not. (allocated(itf%pair_body) .and. allocated(itf%pair_ptr))) return
+    do p = 1, itf%npair
+      do s = 1, 2
+        if (itf%pair_body(s, p) == a) body_rows = body_rows + itf%pair_ptr(p + 1) - itf%pair_ptr(p)
+      end do
+    end do
+  end function body_rows
+
+  !> The `assembled:` line: the DOFs of bodies 1 and 2 (after the supports), the contact
+  !! rows of all pairs, the threads, and the totals (bodies, pairs, DOFs); on a deck of more
+  !! than two bodies then the `bodies:` line, each body's DOFs and contact rows (the first
+  !! MAX_LISTED bodies, then how many more).
+  subroutine print_assembled(run)
+    type(run_t), intent(in) :: run
+    character(len=:), allocatable :: t
+    integer :: a
+    write (output_unit, '(a)') 'assembled: n1='//i2s(run%systems(1)%n)//' n2='//i2s(run%systems(2)%n)// &
+      ' m='//i2s(run%contact_line%m)//' threads='//i2s(run%threads)//' bodies='//i2s(run%nbody)// &
+      ' pairs='//i2s(run%contact_line%npair)//' dofs='//total_dofs(run)
+    if (run%nbody <= 2) return
+    t = 'bodies: dofs,contact_rows'
+    do a = 1, min(run%nbody, MAX_LISTED)
+      t = t//' '//i2s(a)//'='//i2s(run%systems(a)%n)//','//i2s(body_rows(run%contact_line, a))
+    end do
+    if (run%nbody > MAX_LISTED) t = t//' ... '//i2s(run%nbody - MAX_LISTED)//' more'
+    write (output_unit, '(a)') t
+  end subroutine print_assembled
 
   !> The `contact:` line of each pair: the resultant of its forces on its first body, the sum
   !! of its nodal normal forces, its active rows and imbalance, and the penetration and

@@ -37,9 +37,10 @@ module deck
     'usage: robin_contact DECK.nml [OVERRIDE ...] [--restart FILE.ckpt.h5]'//NL// &
     '       robin_contact --help | --version | --deck-reference'//NL// &
     '       mpirun -np N robin_contact_mpi DECK.nml ...   (factorization=''mumps'')'//NL// &
-    '  DECK.nml  input deck of Fortran namelist groups: &scene, two &body (id=1, id=2),'//NL// &
-    '            any number of &traction, &displacement and &boundary, &contact, &solver,'//NL// &
-    '            &output; /dev/stdin reads it from a pipe'//NL// &
+    '  DECK.nml  input deck of Fortran namelist groups: &scene, two or more &body (ids 1 to'//NL// &
+    '            N), any number of &traction, &displacement and &boundary, &contact (one'//NL// &
+    '            per contact pair; optional for two bodies on their ''contact'' sides),'//NL// &
+    '            &solver, &output; /dev/stdin reads it from a pipe'//NL// &
     '  OVERRIDE  a namelist fragment applied after the deck, in order, e.g.'//NL// &
     "              '&solver delta=0.5 /'   '&body id=2, young=1e9 /'"//NL// &
     '              "&traction body=1, side=''top'', t0=0.0,-1.0e6 /"   (adds a traction)'//NL// &

@@ -4,7 +4,13 @@
   - README.md has at most MAX_README_LINES lines;
   - every relative link and image of README.md and doc/*.md points to an existing file;
   - the module graph of doc/developing.md is what tools/module_graph.py derives from src/;
-  - no issue numbers in README.md or doc/ (CHANGELOG.md holds the history).
+  - no issue numbers in README.md or doc/ (CHANGELOG.md holds the history);
+  - doc/geometry.md's "Shipped scenes" names every inputs/*.nml and the Cattaneo-Mindlin study;
+  - the effective deck of README.md's annotated run is the one bin/robin_contact prints for
+    inputs/default.nml;
+  - doc/running.md's h5py recipe for a body's contact resultant, run on inputs/stack3.nml's
+    result, gives the loads statics fixes (body 1 held up by 6e5, body 2 balanced, body 3 6e5
+    down) and doc/running.md's numbers.
 Each check is also run once on a made-up input that must make it fail, so that a check that
 cannot fail is itself a failure.
 """
@@ -21,6 +27,7 @@ sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_checks import Checks  # noqa: E402
 
 PYTHON = os.environ.get("PYTHON", "/usr/bin/python3")
+BIN = os.path.abspath(os.path.join(ROOT, os.environ.get("BIN", "bin/robin_contact")))
 MAX_README_LINES = 210
 MAY_BE_MISSING = set()
 ISSUE_RE = re.compile(r"issue ?#?[0-9]+", re.I)
@@ -130,6 +137,77 @@ with tempfile.TemporaryDirectory() as tmp:
           f"edges {edges}")
     check('subgraph g_src_one ["src/one"]' in r.stdout and 'subgraph g_src_two ["src/two"]' in r.stdout,
           "module_graph groups the modules by source folder")
+
+# the shipped scenes
+def unnamed_scenes(text, decks):
+    """The decks (inputs/*.nml file names) and study the "Shipped scenes" section of a
+    geometry.md text does not name."""
+    m = re.search(r"^## Shipped scenes\n(.*?)(?=^## |\Z)", text, re.S | re.M)
+    section = m.group(1) if m else ""
+    missing = [d for d in decks if f"inputs/{d}" not in section]
+    return missing + ([] if "cattaneo_study.py" in section else ["Cattaneo-Mindlin (tools/cattaneo_study.py)"])
+
+
+decks = sorted(os.path.basename(p) for p in glob.glob(os.path.join(ROOT, "inputs", "*.nml")))
+geometry = read(os.path.join(ROOT, "doc", "geometry.md"))
+missing = unnamed_scenes(geometry, decks)
+check(not missing, f"doc/geometry.md, Shipped scenes: names the {len(decks)} decks of inputs/ and the Cattaneo-Mindlin study",
+      "missing: " + ", ".join(missing) if missing else "")
+made_up = "## Shipped scenes\n`inputs/a.nml`, tools/cattaneo_study.py\n## Next\n`inputs/b.nml`\n"
+check(unnamed_scenes(made_up, ["a.nml", "b.nml"]) == ["b.nml"]
+      and unnamed_scenes("## Shipped scenes\n", ["a.nml"]) == ["a.nml", "Cattaneo-Mindlin (tools/cattaneo_study.py)"],
+      "the scene check finds a deck and the study left out")
+
+
+# the README's effective deck against the program's
+def echo_of(text):
+    """The effective-deck lines of a run's output: from its first line to the &output group."""
+    lines = text.splitlines()
+    first = next((i for i, ln in enumerate(lines) if ln.startswith("robin_contact ") and "effective input" in ln), None)
+    if first is None:
+        return []
+    last = next((i for i in range(first, len(lines)) if lines[i].startswith("&output")), len(lines) - 1)
+    return lines[first:last + 1]
+
+
+with tempfile.TemporaryDirectory(prefix="rc_docs_") as tmp:
+    h5 = os.path.join(tmp, "default.h5")
+    r = subprocess.run([BIN, os.path.join("inputs", "default.nml"), f"&output file='{h5}' /"], cwd=ROOT,
+                       capture_output=True, text=True, timeout=300)
+    program = [ln.replace(h5, "results/default.h5") for ln in echo_of(r.stdout)]
+
+    def echo_mismatch(text):
+        """How the effective deck of a README text differs from the program's ([] when it does not)."""
+        readme = echo_of(text)
+        diff = [f"README: {a!r} / program: {b!r}" for a, b in zip(readme, program) if a != b]
+        return diff + ([f"{len(readme)} lines against {len(program)}"] if len(readme) != len(program) else [])
+
+    diff = echo_mismatch(read(docs[0]))
+    check(r.returncode == 0 and program and not diff,
+          "README.md's annotated run shows the effective deck the program prints for inputs/default.nml",
+          f"exit {r.returncode}; " + "; ".join(diff[:3]) if diff or r.returncode else "")
+    made_up = "\n".join(program[:10] + program[11:])    # one line of the program's echo left out
+    check(program and echo_mismatch(made_up), "the echo check finds a line left out")
+
+    # doc/running.md's resultant recipe on the three-block stack
+    running = read(os.path.join(ROOT, "doc", "running.md"))
+    code = next((b for b in re.findall(r"^```python\n(.*?)^```", running, re.S | re.M) if "def contact_resultant" in b), "")
+    h5 = os.path.join(tmp, "stack3.h5")
+    r = subprocess.run([BIN, os.path.join("inputs", "stack3.nml"), f"&output file='{h5}' /"], cwd=ROOT,
+                       capture_output=True, text=True, timeout=300)
+    prog = code.split("\nprint(", 1)[0] + "\n" + "\n".join(
+        f"print(*contact_resultant({h5!r}, {b}))" for b in (1, 2, 3))
+    q = subprocess.run([PYTHON, "-c", prog], capture_output=True, text=True, timeout=300)
+    try:
+        got = [[float(v) for v in ln.split()] for ln in q.stdout.splitlines()]
+    except ValueError:
+        got = []
+    want = [[0.0, 6.0e5], [0.0, 0.0], [0.0, -6.0e5]]
+    ok = len(got) == 3 and all(abs(g - w) <= 1e-6 * 6.0e5 for gs, ws in zip(got, want) for g, w in zip(gs, ws))
+    check(bool(code) and r.returncode == 0 and q.returncode == 0 and ok,
+          "doc/running.md's contact_resultant recipe on inputs/stack3.nml: (0, 6e5) on body 1, 0 on body 2, "
+          "(0, -6e5) on body 3", f"exit {r.returncode}/{q.returncode}: {got} {q.stderr.strip()[-300:]}")
+    check("[0, 6e5]" in code and "[0, 0]" in code, "doc/running.md's recipe shows those numbers")
 
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")
 sys.exit(1 if check.failed else 0)
