@@ -3,8 +3,8 @@
 module run_summary
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
-  use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED
-  use config, only: solver_cfg_t, ROBIN_HARMONIC
+  use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
+  use config, only: solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA
   use contact_interface, only: interface_t, ROW_NORMAL
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
@@ -206,7 +206,7 @@ contains
     type(run_t), intent(in) :: run
     character(len=1024), allocatable :: lines(:)
     real(wp) :: ftot, fres(2), imbalance
-    integer :: p, np, r(2), active
+    integer :: p, np, r(2), active, nopen
     character(len=:), allocatable :: head, tail
     type(interface_t) :: itf
     type(contact_result_t) :: result
@@ -241,6 +241,16 @@ contains
         if (tg%on) then
           if (any(tg%state(r(1):r(2)) >= 0)) tail = ' tangential_force_sum='//sci(sum(tg%force(r(1):r(2))), 5)// &
             ' stick='//i2s(count(tg%state(r(1):r(2)) == NODE_STICK))//' slip='//i2s(count(tg%state(r(1):r(2)) == NODE_SLIP))
+          ! Tresca's bound holds whether or not the surfaces touch: a shear across an open gap
+          ! is what given friction means, not a force between bodies that touch; say so
+          if (itf%pair_friction(p) == FRICTION_TRESCA) then
+            nopen = count(result%lam(r(1):r(2)) <= 0.0_wp .and. tg%force(r(1):r(2)) /= 0.0_wp)
+            if (nopen > 0) call warn('pair '//i2s(p)//' (Tresca, slip_bound '//sci(itf%pair_slip(p), 4)// &
+              '): '//i2s(nopen)//' of its '//i2s(r(2) - r(1) + 1)//' nodes carry a shear force across an open gap '// &
+              '(no normal force; their shear sums to '//sci(sum(pack(tg%force(r(1):r(2)), result%lam(r(1):r(2)) <= &
+              0.0_wp)), 4)//'): Tresca''s bound acts whether or not the surfaces touch; for a shear that needs '// &
+              'contact use friction=''coulomb''')
+          end if
         end if
       end if
       write (lines(p), '(a,i0,a,es10.3,a,es10.3,a,es10.3,a)') head// &

@@ -9,7 +9,10 @@
 (2) a monolithic solve stopped by inner_max_it: exit 2, the next: line suggests
     monolithic_rtol and inner_max_it and the equilibrium, never method='monolithic';
 (3) a Robin run that does not converge (delta = 1, max_outer = 40): exit 2, the next: line
-    still suggests method='monolithic'.
+    still suggests method='monolithic';
+(4) Tresca on two blocks 0.1 apart, pushed sideways: converged (given friction allows it),
+    and a warning names the pair, the nodes that carry a shear across the open gap and
+    friction='coulomb'; the same blocks in contact (no gap) print no such warning.
 """
 import os
 import re
@@ -59,5 +62,22 @@ with tempfile.TemporaryDirectory() as work:
     check(p.returncode == 2 and len(nxt) == 1 and "method='monolithic'" in nxt[0],
           "a Robin run that does not converge: exit 2, next: suggests method='monolithic'",
           f"exit {p.returncode}: {nxt}")
+
+    for gap, want in ((0.1, True), (0.0, False)):
+        deck = os.path.join(work, f"tresca_gap{gap}.nml")
+        with open(deck, "w") as f:
+            f.write(f"""&body id = 1, x0 = 0.0, y0 = {1.0 + gap}, width = 1.0, height = 1.0, nx = 10, ny = 10, left = 'clamped' /
+&body id = 2, x0 = 0.0, y0 = 0.0, width = 1.0, height = 1.0, nx = 10, ny = 10, bottom = 'clamped' /
+&contact bodies = 1, 2, groups = 'bottom', 'top', friction = 'tresca', slip_bound = 2.5e4 /
+&traction body = 1, side = 'top', t0 = 1.0e6, {-1.0e6 if gap == 0.0 else 0.0} /
+""")
+        p, res = run_solver(BIN, deck, f"&output file='{h5}' /", cwd=work, env=ENV, timeout=120)
+        warned = re.search(r"warning: pair 1 \(Tresca.*nodes carry a shear force across an open gap.*coulomb", p.stderr)
+        if want:
+            check(p.returncode == 0 and warned is not None, "Tresca across an open gap: converged, a warning names the "
+                  "pair and friction='coulomb'", f"exit {p.returncode}: {p.stderr[-300:]}")
+        else:
+            check(p.returncode == 0 and warned is None, "Tresca on blocks in contact: no open-gap warning",
+                  f"exit {p.returncode}: {p.stderr[-300:]}")
 
 sys.exit(1 if check.failed else 0)
