@@ -241,12 +241,12 @@ contains
     if (size(run%plan) == 1) then
       call check_held(run%contact_line, run%systems, run%bodies, err)
       call fail_on(err, 'deck '//trim(run%deck%source))
+      block
+        character(len=:), allocatable :: edge
+        edge = friction_edge(run%contact_line, run%systems, run%bodies)
+        if (len(edge) > 0) call warn('deck '//trim(run%deck%source)//': '//edge)
+      end block
     end if
-    block
-      character(len=:), allocatable :: edge
-      edge = friction_edge(run%contact_line, run%systems, run%bodies)
-      if (len(edge) > 0) call warn('deck '//trim(run%deck%source)//': '//edge)
-    end block
     do a = 1, run%nbody
       associate (system => run%systems(a))
         if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
@@ -469,7 +469,15 @@ contains
       if (run%systems(a)%nrig > 0) call rigid_rows(run%contact_line, a, run%systems(a), run%bodies(a))
     end do
     call check_held(run%contact_line, run%systems, run%bodies, err)
-    if (.not. err%failed()) return
+    if (.not. err%failed()) then
+      block
+        character(len=:), allocatable :: edge
+        edge = friction_edge(run%contact_line, run%systems, run%bodies)
+        if (len(edge) > 0 .and. run%rank == 0) call warn('deck '//trim(run%deck%source)//': step '//i2s(k)// &
+          ' (stage '//i2s(run%plan(k)%stage)//', load factor '//trim(sci(run%plan(k)%factor))//'): '//edge)
+      end block
+      return
+    end if
     if (k == 1) then
       err%message = 'at step 1 of '//i2s(size(run%plan))//' (stage '//i2s(run%plan(1)%stage)//', load factor '// &
         trim(sci(run%plan(1)%factor))//'): '//trim(err%message)
