@@ -184,7 +184,8 @@ contains
     type(interface_t), allocatable :: one(:)
     type(contact_cfg_t) :: cc
     type(contact_cfg_t), allocatable :: ccs(:)
-    integer :: p, a, s, side, np
+    logical, allocatable :: taken(:)
+    integer :: p, a, s, side, np, q, k
 
     np = size(pairs)
     allocate (one(np))
@@ -212,7 +213,23 @@ contains
     if (err%failed()) return
     do p = 1, np
       cc = ccs(p)
-      call mortar_pair(cc, named, msh, sys, one(p), err)
+      ! a later pair of the same two bodies (a block in a corner): the same slave as the
+      ! first, and its slave nodes that carry rows there carry none here (a crosspoint:
+      ! at the corner node the normal row of one pair and the tangential row of the other
+      ! act on the same displacement, and matching meshes make them the same row)
+      allocate (taken(msh(cc%bodies(1))%nnode + msh(cc%bodies(2))%nnode))
+      taken = .false.
+      do q = 1, p - 1
+        if (any(itf%pair_body(:, q) /= cc%bodies)) cycle
+        if (cc%slave == 0) cc%slave = cc%bodies(itf%pair_slave(q))
+        if (cc%bodies(itf%pair_slave(q)) /= cc%slave) cycle
+        s = itf%pair_slave(q)
+        do k = 1, one(q)%m
+          if (one(q)%node(k, s) > 0) taken(one(q)%node(k, s)) = .true.
+        end do
+      end do
+      call mortar_pair(cc, named, msh, sys, one(p), err, taken)
+      deallocate (taken)
       if (err%failed()) return
       itf%pair_body(:, p) = cc%bodies
       itf%pair_slave(p) = one(p)%pair_slave(1)
@@ -224,12 +241,14 @@ contains
     call stack_pairs(one, itf)
   end subroutine build_interface
 
-  !> The pairs' contact groups of each body share no edge: two differently named groups over
-  !! the same edges (a Gmsh curve with two physical names) in two pairs would give the edges
-  !! two sets of contact rows and split their force arbitrarily. Per body, the edges of its
-  !! groups in pairs go into one hash set keyed by the edge's two nodes (either order), each
-  !! with the pair end that put it there (linear in the edges). Unknown or node-only groups
-  !! are left to mortar_pair's messages.
+  !> Two pairs of the same two bodies share no edge: two differently named groups over the
+  !! same edges (a Gmsh curve with two physical names) in two pairs of the same bodies would
+  !! give the edges two sets of contact rows and split their force arbitrarily. A surface in
+  !! pairs with different bodies (a lid's bottom on two blocks) is allowed: each pair's rows
+  !! hold where its partner's surface covers it. Per body, the edges of its groups in pairs
+  !! go into one hash set keyed by the edge's two nodes (either order) and the partner body,
+  !! each with the pair end that put it there (linear in the edges). Unknown or node-only
+  !! groups are left to mortar_pair's messages.
   subroutine check_shared_edges(pairs, named, msh, err)
     type(contact_cfg_t), intent(in) :: pairs(:)   !< the pairs, oriented, rectangle sides resolved
     logical, intent(in) :: named                  !< the deck names its pairs (messages)
@@ -239,8 +258,11 @@ contains
     integer, allocatable :: owner(:), nend(:)
     integer :: a, p, s, g, e, slot, n1, n2, ne, stat, q, t
     integer(i8) :: key
+    logical :: keyed
 
     allocate (nend(size(msh)))
+    ! the partner in the key unless nnode**2 * nbody could overflow it (then any shared edge
+    ! is refused, as for the same partner)
     nend = 0
     do p = 1, size(pairs)
       do s = 1, 2
@@ -250,6 +272,7 @@ contains
     do a = 1, size(msh)
       if (nend(a) < 2) cycle
       associate (m => msh(a))
+        keyed = real(m%nnode, wp)**2*real(size(msh), wp) < 4.0e18_wp
         ne = 0
         do p = 1, size(pairs)
           do s = 1, 2
@@ -274,6 +297,7 @@ contains
               n1 = minval(m%group(g)%edge(:, e))
               n2 = maxval(m%group(g)%edge(:, e))
               key = int(n1 - 1, i8)*int(m%nnode, i8) + int(n2 - 1, i8)
+              if (keyed) key = key*int(size(msh), i8) + int(pairs(p)%bodies(3 - s) - 1, i8)
               slot = hash_slot(h, key)
               if (h%key(slot) == HASH_EMPTY) then
                 h%key(slot) = key
@@ -288,7 +312,7 @@ contains
                 ''' ('//pair_words(p)//') share edges, e.g. the edge of nodes '// &
                 i2s(m%node_tag(n1))//' and '//i2s(m%node_tag(n2))//' from ('//sci(m%xy(1, n1))//', '// &
                 sci(m%xy(2, n1))//') to ('//sci(m%xy(1, n2))//', '//sci(m%xy(2, n2))//'); an edge of a body '// &
-                'is in one contact pair at most (two names of one Gmsh curve are one surface)')
+                'is in one pair with each other body at most (two names of one Gmsh curve are one surface)')
               return
             end do
           end do
@@ -356,15 +380,17 @@ contains
   !! group has the shorter mean edge (side 1 on a tie). A slave node carries no row when its
   !! normal displacement and that of every master node its row involves are prescribed (the
   !! constraint would only repeat the supports): found by a first build, then the rows are
-  !! built again without those nodes. err = ERR_INPUT for an unknown group, a group facing
-  !! nothing, or an initial overlap.
-  subroutine mortar_pair(cc, named, msh, sys, itf, err)
+  !! built again without those nodes, and without the nodes `taken` by an earlier pair.
+  !! err = ERR_INPUT for an unknown group, a group facing nothing, or an initial overlap.
+  subroutine mortar_pair(cc, named, msh, sys, itf, err, taken)
     type(contact_cfg_t), intent(in) :: cc            !< the pair, cc%bodies(1) < cc%bodies(2)
     logical, intent(in) :: named                     !< the deck names its pairs (messages)
     type(mesh_t), intent(in) :: msh(:)               !< meshes of all bodies
     type(body_system_t), intent(in) :: sys(:)        !< systems of all bodies
     type(interface_t), intent(out) :: itf            !< the pair's rows 1..m_p
     type(error_t), intent(out) :: err
+    !> slave nodes that carry rows in an earlier pair of the same bodies: none here
+    logical, intent(in), optional :: taken(:)
     integer :: g(2), s, sl, ma, j, e, k, ne, nr
     real(wp) :: hmean(2), tol, gmin
     logical, allocatable :: removable(:)
@@ -419,6 +445,7 @@ contains
     associate (ms => msh(cc%bodies(sl)), mm => msh(cc%bodies(ma)))
       allocate (removable(ms%nnode))
       removable = .false.
+      if (present(taken)) removable = taken(1:ms%nnode)
       call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, mt, why, &
                         ms%node_tag, mm%node_tag)
       if (.not. why%failed()) then

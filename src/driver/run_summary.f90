@@ -38,6 +38,8 @@ contains
     end select
     if (run%result%status /= STATUS_CONVERGED) write (error_unit, '(a)') 'robin_contact: '// &
       status_name(run%result%status)//': '//trim(run%result%message)
+    if (run%result%status == STATUS_CONVERGED .and. len_trim(run%result%message) > 0 .and. run%rank == 0) &
+      write (error_unit, '(a)') 'robin_contact: note: '//trim(run%result%message)
     if (run%code == EXIT_NOT_CONVERGED .and. run%result%status /= STATUS_NO_EQUILIBRIUM) write (error_unit, '(a)') &
       'robin_contact: next: '//next_setting(run%deck%solver, trim(run%result%method) == 'monolithic')
     if (run%result%status == STATUS_NO_EQUILIBRIUM) write (error_unit, '(a)') 'robin_contact: next: the steps '// &

@@ -162,22 +162,24 @@ contains
     call check_loads(d, st)
   end subroutine check_groups
 
-  !> Every body is in a pair, and no group of a body is in two pairs: the pairs' ends
+  !> Every body is in a pair, and no group of a body is in two pairs with the same other
+  !! body (a surface may touch several bodies: a lid on two blocks): the pairs' ends
   !! bucketed by body, each bucket sorted by group name (linear in the pairs but for the
   !! sort of a body's own ends).
   subroutine check_pairs(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
-    integer, allocatable :: first(:), ends(:), fill(:), ebody(:)
+    integer, allocatable :: first(:), ends(:), fill(:), ebody(:), partner(:)
     character(len=128), allocatable :: gname(:)
     integer :: k, j, e, b, n, i1, i2
     n = 2*d%npair
-    allocate (first(d%nbody + 1), fill(d%nbody), ends(n), ebody(n), gname(n))
+    allocate (first(d%nbody + 1), fill(d%nbody), ends(n), ebody(n), partner(n), gname(n))
     first = 0
     do k = 1, d%npair
       do j = 1, 2
         e = 2*(k - 1) + j
         ebody(e) = d%pair(k)%bodies(j)
+        partner(e) = d%pair(k)%bodies(3 - j)
         gname(e) = d%pair(k)%body_group(j)
         first(ebody(e) + 1) = first(ebody(e) + 1) + 1
       end do
@@ -199,13 +201,19 @@ contains
     do b = 1, d%nbody
       if (first(b + 1) - first(b) < 2) cycle
       call sort_names(ends(first(b):first(b + 1) - 1), gname)
+      ! within each run of equal names, no two ends with the same partner body
       do j = first(b), first(b + 1) - 2
         i1 = ends(j)
-        i2 = ends(j + 1)
-        if (gname(i1) /= gname(i2) .or. len_trim(gname(i1)) == 0) cycle
-        call fatal(EXIT_INPUT, st%path//': the '//st%pair_at((min(i1, i2) + 1)/2)%s//' and the '// &
-          st%pair_at((max(i1, i2) + 1)/2)%s//' both name group '''//trim(gname(i1))//''' of body '// &
-          i2s(b)//'; a group of a body is in one contact pair at most')
+        if (len_trim(gname(i1)) == 0) cycle
+        do k = j + 1, first(b + 1) - 1
+          i2 = ends(k)
+          if (gname(i2) /= gname(i1)) exit
+          if (partner(i1) /= partner(i2)) cycle
+          call fatal(EXIT_INPUT, st%path//': the '//st%pair_at((min(i1, i2) + 1)/2)%s//' and the '// &
+            st%pair_at((max(i1, i2) + 1)/2)%s//' both name group '''//trim(gname(i1))//''' of body '// &
+            i2s(b)//' with body '//i2s(partner(i1))//'; a group of a body is in one pair with each '// &
+            'other body at most')
+        end do
       end do
     end do
   end subroutine check_pairs

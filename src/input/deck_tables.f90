@@ -185,7 +185,8 @@ contains
         doc='the two bodies of the pair, `bodies=A,B`')
       call v%strs('groups', c%body_group, required=.true., doc='the contact surface of each, '// &
         'in the order of `bodies`: an edge group of its mesh, or a rectangle''s side (`''left''`, '// &
-        '`''right''`, `''bottom''`, `''top''`); a group of a body is in at most one pair')
+        '`''right''`, `''bottom''`, `''top''`); a group of a body is in at most one pair with each '// &
+        'other body (a lid on two blocks: its bottom in a pair with each)')
     end if
     if (form /= PAIR_FORM) then
       call v%str('body1_group', c%body_group(1), doc='body 1''s contact surface as an edge group '// &

@@ -7,7 +7,7 @@
     (printed as INFO, never asserted: the machine may be shared); a SIGTERM then stops it
     with exit 4 and nothing written;
 (b) the same stack with a fault far down the deck gets its own message, exit 1, nothing
-    written: a group of a body in two pairs (naming both pairs' lines), a body in no pair,
+    written: a group of a body in two pairs with the same body (naming both pairs' lines), a body in no pair,
     a pair naming a body the deck does not have.
 """
 import os
@@ -81,12 +81,12 @@ try:
 
     # (b) faults deep in the deck get their own message first
     pairs = [(k, k + 1, "bottom", "top") for k in range(1, N)]
-    twice = pairs + [(N - 1, 1, "left", "bottom")]
+    twice = pairs + [(2, 1, "left", "bottom")]   # body 1's bottom again with body 2
     code, out, _, made = run_deck(work, "twice", stack(N, twice))
     first = N + 1 + 1          # line of the first pair: after the bodies and the traction
     last = first + len(twice) - 1
     check(code == 1 and f"the &contact at line {first} and the &contact at line {last} both name group "
-          "'bottom' of body 1" in out,
+          "'bottom' of body 1 with body 2" in out,
           "a group in two pairs is named with both pairs' lines", out.strip()[-300:])
     check(not made, "nothing is written (group in two pairs)", " ".join(made))
 

@@ -275,8 +275,8 @@ contains
       '&contact bodies=2,4, groups=''bottom'',''top'' /', T1], &
       ':5: in group &contact: bodies = 2,4 names body 4, which does not exist')
     call refused('same_group', [character(len=120) :: B1, B2, B3, P12, &
-      '&contact bodies=3,1, groups=''top'',''bottom'' /', T1], &
-      'the &contact at line 4 and the &contact at line 5 both name group ''bottom'' of body 1')
+      '&contact bodies=2,1, groups=''left'',''bottom'' /', P23, T1], &
+      'the &contact at line 4 and the &contact at line 5 both name group ''bottom'' of body 1 with body 2')
     call refused('gap', [character(len=120) :: B1, B2, '&body id=4, nx=2, ny=2 /', P12, P23, T1], &
       ':3: in group &body: id = 4 is not a body id: the deck''s 3 bodies have ids 1 to 3')
     call refused('duplicate', [character(len=120) :: B1, B2, '&body id=2, nx=2, ny=2 /', P12, P23, T1], &
