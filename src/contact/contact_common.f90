@@ -123,9 +123,11 @@ contains
 
   !> Penetration and complementarity with tangential rows: the normal rows as without
   !! friction; on a tangential row with bound t (row_bounds at the mean normal force) the
-  !! force outside [-t, t], a slip where the node sticks ((t - |lam_t|) |slip|) and a slip
-  !! against the force (max(-lam_t slip, 0)) all count, scaled like the normal ones (the
-  !! largest normal force and the displacement scale).
+  !! force outside [-t, t], a slip where the node sticks (min(t - |lam_t|, lam_max) |slip|:
+  !! a bound far above every force weighs a stuck node's slip as lam_max, not as the bound,
+  !! which would weigh its rounding) and a slip against the force (max(-lam_t slip, 0)) all
+  !! count, scaled like the normal ones (the largest normal force lam_max and the
+  !! displacement scale).
   subroutine frictional_residual(contact_line, uscale, res)
     type(interface_t), intent(in) :: contact_line
     real(wp), intent(in) :: uscale
@@ -143,7 +145,8 @@ contains
         pen = max(pen, res%gap(i))
         comp = max(comp, max(res%lam(i), 0.0_wp)*abs(res%gap(i)))
       else
-        comp = max(comp, max(ub(i) - abs(res%lam(i)), 0.0_wp)*abs(res%gap(i)), max(-res%lam(i)*res%gap(i), 0.0_wp), &
+        comp = max(comp, min(max(ub(i) - abs(res%lam(i)), 0.0_wp), lmax)*abs(res%gap(i)), &
+                   max(-res%lam(i)*res%gap(i), 0.0_wp), &
                    max(abs(res%lam(i)) - ub(i), 0.0_wp)*uscale)
       end if
     end do

@@ -12,7 +12,7 @@ module floating
   use kinds, only: wp
   use assembly, only: body_system_t, rigid_motion_name
   use contact_interface, only: interface_t, body_slots, slot_row, slot_side, has_friction, ROW_TANGENT
-  use config, only: FRICTION_COULOMB
+  use config, only: FRICTION_COULOMB, FRICTION_TRESCA
   use condense, only: body_condensed_t
   use contact_common, only: scatter
   use lapack, only: dsyev, dgels, dsygv
@@ -86,7 +86,7 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(out) :: err
     character(len=:), allocatable :: msg
-    real(wp), allocatable :: gg(:, :), lam(:), ev(:), gc(:, :)
+    real(wp), allocatable :: gg(:, :), ev(:)
     real(wp) :: c(3), fx, fy, along, res, enorm
     integer :: a, r, m, lapinfo, i
     character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
@@ -130,13 +130,8 @@ contains
         return
       end if
       ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
-      if (has_friction(contact_line)) then
-        gc = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), bodies(a)%rg)
-      else
-        gc = bodies(a)%rg
-      end if
-      allocate (lam(size(gc, 2)))
-      call nnls(gc, bodies(a)%re, lam, res)
+      ! (with friction: within the friction limits, Tresca's bound included)
+      call admissible_nnls(contact_line, slot_row(bodies(a)%slots, contact_line%m), bodies(a)%rg, bodies(a)%re, res)
       if (res > 1.0e-8_wp*enorm .and. has_friction(contact_line)) then
         ! the direction it would slide in: the load's part along the contact (its
         ! resultant less its part along the mean normal of the body's contact rows)
@@ -159,7 +154,6 @@ contains
               'or '//hold)
         return
       end if
-      deallocate (lam)
     end do
     ! 4. floating bodies that touch each other: each such group together must be held too
     call check_groups(contact_line, systems, bodies, err)
@@ -205,7 +199,7 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(inout) :: err
     integer, allocatable :: root(:), members(:), col(:), rowof(:)
-    real(wp), allocatable :: gs(:, :), es(:), gg(:, :), sr(:, :), ev(:), lam(:)
+    real(wp), allocatable :: gs(:, :), es(:), gg(:, :), sr(:, :), ev(:)
     real(wp) :: c(3), res
     integer :: a, g, r, nm, ncol, k, i, i0
     character(len=:), allocatable :: names
@@ -266,23 +260,19 @@ contains
         end if
         return
       end if
-      if (has_friction(contact_line)) then
-        allocate (rowof(ncol))
-        do i0 = 1, contact_line%m
-          if (col(i0) > 0) rowof(col(i0)) = i0
-        end do
-        gs = cone_columns(contact_line, rowof, gs)
-        deallocate (rowof)
-      end if
-      allocate (lam(size(gs, 2)))
-      call nnls(gs, es, lam, res)
+      allocate (rowof(ncol))
+      do i0 = 1, contact_line%m
+        if (col(i0) > 0) rowof(col(i0)) = i0
+      end do
+      call admissible_nnls(contact_line, rowof, gs, es, res)
+      deallocate (rowof)
       if (res > 1.0e-8_wp*norm2(es)) then
         call err%set(ERR_INPUT, 'bodies '//names//' are '//merge('both', 'all ', nm == 2)// &
               ' held only by contact, and their loads cannot be balanced by compressive contact forces '// &
               'between them (unbalanced part '//sci(res)//'); support one of them')
         return
       end if
-      deallocate (gs, es, gg, sr, ev, lam)
+      deallocate (gs, es, gg, sr, ev)
     end do
   end subroutine check_groups
 
@@ -519,7 +509,7 @@ contains
     real(wp), allocatable :: gc(:, :)
     integer, allocatable :: tcol(:)
     integer :: i, n, k, p
-    real(wp) :: sc
+    real(wp) :: sc, t
     sc = 1.0_wp
     if (present(mu_scale)) sc = mu_scale
     allocate (tcol(contact_line%m))
@@ -538,8 +528,10 @@ contains
         gc(:, n + 2) = -g(:, i)
         n = n + 2
       else if (tcol(k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
-        gc(:, n + 1) = g(:, i) + sc*contact_line%pair_mu(p)*g(:, tcol(k))
-        gc(:, n + 2) = g(:, i) - sc*contact_line%pair_mu(p)*g(:, tcol(k))
+        ! divided by sqrt(1 + (mu)^2): the same cone, columns of one size for any mu
+        t = sc*contact_line%pair_mu(p)
+        gc(:, n + 1) = (g(:, i) + t*g(:, tcol(k)))/sqrt(1.0_wp + t*t)
+        gc(:, n + 2) = (g(:, i) - t*g(:, tcol(k)))/sqrt(1.0_wp + t*t)
         n = n + 2
       else
         gc(:, n + 1) = g(:, i)
@@ -548,6 +540,68 @@ contains
     end do
     gc = gc(:, 1:n)
   end function cone_columns
+
+  !> nnls(g, e) over the admissible contact forces of the rows `rows` (g's columns): the
+  !! cone's generators (`cone_columns`), and for a Tresca pair's tangential row j its bound
+  !! too, |lam_j| <= t_j = slip_bound x tributary length: lam_j = t_j (s+ - s-) with
+  !! s+ + s- + slack = 1, one more equation per such row, scaled by |e| so that the
+  !! residual weighs a violated bound like an unbalanced load of |e|. res: the residual.
+  subroutine admissible_nnls(contact_line, rows, g, e, res, mu_scale)
+    type(interface_t), intent(in) :: contact_line
+    integer, intent(in) :: rows(:)
+    real(wp), intent(in) :: g(:, :), e(:)
+    real(wp), intent(out) :: res
+    real(wp), intent(in), optional :: mu_scale
+    real(wp), allocatable :: gc(:, :), ga(:, :), ea(:), x(:)
+    integer, allocatable :: tres(:)
+    integer :: i, k, n, nt, r
+    real(wp) :: w, t
+    if (.not. has_friction(contact_line)) then
+      allocate (x(size(g, 2)))
+      call nnls(g, e, x, res)
+      return
+    end if
+    gc = cone_columns(contact_line, rows, g, mu_scale)
+    ! the Tresca rows, in the order cone_columns gave their column pairs
+    tres = pack(rows, [(contact_line%kind(rows(i)) == ROW_TANGENT .and. &
+                        contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_TRESCA, i=1, size(rows))])
+    nt = size(tres)
+    if (nt == 0) then
+      allocate (x(size(gc, 2)))
+      call nnls(gc, e, x, res)
+      return
+    end if
+    r = size(g, 1)
+    w = max(norm2(e), tiny(1.0_wp))
+    allocate (ga(r + nt, size(gc, 2) + nt), ea(r + nt), x(size(gc, 2) + nt))
+    ga = 0.0_wp
+    ga(1:r, 1:size(gc, 2)) = gc
+    ea(1:r) = e
+    ea(r + 1:) = w
+    ! locate each Tresca row's column pair (+g, -g) and scale it by the bound
+    n = 0
+    k = 0
+    do i = 1, size(rows)
+      if (contact_line%kind(rows(i)) == ROW_TANGENT) then
+        if (contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_COULOMB) cycle
+        k = k + 1
+        ! the bound, no larger than 1e3 |e| / |g_j| (a bound beyond that does not bind a
+        ! balance of |e|, and a slip_bound of 1e20 would only spoil the least squares)
+        t = contact_line%pair_slip(contact_line%pair_of(rows(i)))*contact_line%trib(rows(i))
+        t = min(t, 1.0e3_wp*w/max(norm2(ga(1:r, n + 1)), tiny(1.0_wp)))
+        ga(1:r, n + 1:n + 2) = ga(1:r, n + 1:n + 2)*t
+        ga(r + k, n + 1:n + 2) = w
+        ga(r + k, size(gc, 2) + k) = w
+        n = n + 2
+      else if (contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_COULOMB .and. &
+               any(contact_line%kind(rows) == ROW_TANGENT .and. contact_line%nrow(rows) == rows(i))) then
+        n = n + 2
+      else
+        n = n + 1
+      end if
+    end do
+    call nnls(ga, ea, x, res)
+  end subroutine admissible_nnls
 
   !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of
   !! each motion's reach on the contact is normal to it. S singular (a motion that does not

@@ -20,6 +20,9 @@ module deck_checks
   implicit none (type, external)
   private
 
+  real(wp), parameter :: MU_MAX = 1.0e4_wp     !< the largest Coulomb coefficient accepted
+  real(wp), parameter :: SLIP_MAX = 1.0e20_wp  !< the largest Tresca bound accepted [stress]
+
   public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, &
             apply_displacement, add_contact
 
@@ -319,9 +322,11 @@ contains
     character(len=:), allocatable :: shown
     if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
       'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
-    if (c%mu < 0.0_wp) call bad_value(g, src, 'mu', r2s(c%mu), 'must be >= 0 (the Coulomb friction coefficient)')
-    if (c%slip_bound < 0.0_wp) call bad_value(g, src, 'slip_bound', r2s(c%slip_bound), &
-      'must be >= 0 (Tresca''s bound of the shear traction)')
+    if (c%mu < 0.0_wp .or. c%mu > MU_MAX) call bad_value(g, src, 'mu', r2s(c%mu), 'must be >= 0 and <= 1e4 '// &
+      '(the Coulomb friction coefficient: no pair of materials has more than about 10; a pair that must not slip '// &
+      'sticks with any mu its load needs, and a larger one only spoils the conditioning)')
+    if (c%slip_bound < 0.0_wp .or. c%slip_bound > SLIP_MAX) call bad_value(g, src, 'slip_bound', r2s(c%slip_bound), &
+      'must be >= 0 and <= 1e20 (Tresca''s bound of the shear traction, in the deck''s stress unit)')
     if (c%mu /= 0.0_wp .and. c%friction /= FRICTION_COULOMB) call bad_value(g, src, 'mu', r2s(c%mu), &
       'is the Coulomb coefficient: give it with friction=''coulomb''')
     if (c%slip_bound /= 0.0_wp .and. c%friction /= FRICTION_TRESCA) call bad_value(g, src, 'slip_bound', &

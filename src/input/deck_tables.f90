@@ -203,9 +203,10 @@ contains
     call v%enum('friction', c%friction, FRICTION_CHOICES, doc='`''none''` (frictionless), '// &
       '`''tresca''` (the shear traction bounded by `slip_bound`: |t| <= slip_bound) or `''coulomb''` '// &
       '(|t| <= mu p, p the contact pressure); `mu=0` or `slip_bound=0` is frictionless')
-    call v%real('mu', c%mu, unit='[-]', range='>= 0; with `friction=''coulomb''` only', &
+    call v%real('mu', c%mu, unit='[-]', range='0 <= mu <= 1e4; with `friction=''coulomb''` only', &
       doc='*coulomb only:* the friction coefficient')
-    call v%real('slip_bound', c%slip_bound, unit='[stress]', range='>= 0; with `friction=''tresca''` only', &
+    call v%real('slip_bound', c%slip_bound, unit='[stress]', range='0 <= slip_bound <= 1e20; with '// &
+      '`friction=''tresca''` only', &
       doc='*tresca only:* the bound of the shear traction')
   end subroutine contact_vars
 

@@ -56,6 +56,13 @@ alone takes 80-110 s a run on the lap joints (640,000 products): those runs are 
     active-set method (1e-8); no node sticks, and the resultants are those of the block's
     equilibrium at full slip, N_floor = (F_y - mu F_x)/(1 - mu^2), N_wall =
     (F_x - mu F_y)/(1 - mu^2), T = mu N on each (1e-6; F the load's magnitudes).
+(11) the block of (7) with Tresca friction, slip_bound 1e5 over its 1 m width, pushed
+    sideways by 0.95 and 1.05 times the bound: converged (its tangential resultant the push,
+    1e-8, the run's tol) and refused (exit 1, "cannot be balanced ... the Tresca bound"); with slip_bound
+    1e20 (the largest accepted) pushed by 0.95 times 1e5: converged, every node sticks (a
+    bound far above every force left the stuck nodes "slipping" and the run at a residual
+    of 0.16); with Coulomb mu = 1e4 (the largest accepted): converged, every node sticks,
+    the tangential resultant the push (1e-8).
 
 The inner work of each run is printed (INFO), not checked; the wall times likewise.
 """
@@ -343,6 +350,33 @@ def scenes(tmp):
         got = [tuple(q["res"]) for q in pairs]
         err = max(abs(g - w)/w for gw, ww in zip(got, want) for g, w in zip(gw, ww))
         check(err <= 1e-6, "corner: the resultants of the full-slip equilibrium (1e-6)", f"{got} against {want}, {err:.1e}")
+    # (11) Tresca's bound and the largest bounds accepted
+    block = """&scene title = 'block pushed sideways' /
+&body id = 1, x0 = 0.0, y0 = 0.0, width = 4.0, height = 0.5, nx = 40, ny = 5, young = 2.1e11, poisson = 0.3, bottom = 'clamped' /
+&body id = 2, x0 = 1.5, y0 = 0.5, width = 1.0, height = 0.5, nx = 10, ny = 5, young = 2.1e11, poisson = 0.3 /
+&contact bodies = 2, 1, groups = 'bottom', 'top', LAW /
+&traction body = 2, side = 'top', t0 = 0.0, -1.0e6 /
+&traction body = 2, side = 'left', t0 = PUSH, 0.0 /
+"""
+    for k, (law, push, want) in enumerate((("friction = 'tresca', slip_bound = 1.0e5", 1.9e5, "held"),
+                            ("friction = 'tresca', slip_bound = 1.0e5", 2.1e5, "refused"),
+                            ("friction = 'tresca', slip_bound = 1.0e20", 1.9e5, "stuck"),
+                            ("friction = 'coulomb', mu = 1.0e4", 1.9e5, "stuck"))):
+        deck = block.replace("LAW", law).replace("PUSH", repr(push))
+        ok, pairs, text = run(tmp, f"bound {k + 1}", deck)
+        what = f"{law}, pushed by {0.5 * push:.3g} N/m"
+        if want == "refused":
+            check(not ok and "cannot be balanced by contact forces within the friction limits" in text
+                  and "Tresca bound" in text, f"{what}: refused (beyond the Tresca bound)", text[-300:])
+            continue
+        check(ok, f"{what}: converged", text[-300:])
+        if ok:
+            e = abs(abs(pairs[0]["res"][0]) - 0.5 * push) / (0.5 * push)
+            check(e <= 1e-8, f"{what}: the tangential resultant is the push (1e-8, the run's tol)",
+                  f"{pairs[0]['res'][0]:.9e}, {e:.1e}")
+            if want == "stuck":
+                check(bool(np.all(pairs[0]["state"] == 1)), f"{what}: every node sticks",
+                      str(sorted(set(int(v) for v in pairs[0]["state"]))))
     print(f"{len(check.failed)} failed checks")
     return 1 if check.failed else 0
 

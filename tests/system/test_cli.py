@@ -215,6 +215,9 @@ def override(group, var, value):
         return [f"&displacement {body}{var}={value}, side='top' /"]
     if group == "boundary":
         return [f"&boundary {body}{var}={value}, group='top', ux=0.0 /"]
+    if group == "contact" and var in ("mu", "slip_bound"):   # each with the friction law it belongs to
+        law = "coulomb" if var == "mu" else "tresca"
+        return [f"&contact friction='{law}', {var}={value} /"]
     return [f"&{group} {var}={value} /"]
 
 

@@ -326,8 +326,8 @@ def differences(a, b):
     return diff
 
 
-# a slow relaxation: some 500 outer iterations, long enough to be stopped part-way
-SLOW = "&solver delta=0.05, acceleration='none' /"
+# a slow relaxation: some 450 outer iterations, long enough to be stopped part-way
+SLOW = "&solver delta=0.02, acceleration='none' /"
 deckr = write_deck("stack3_slow", stack(nx=32))
 p, _ = run_solver(BIN, deckr, SLOW, out("full"), env=env, timeout=900)
 check(p.returncode == 0, "3 bodies, slow: the uninterrupted run converges", f"exit {p.returncode}")
@@ -356,7 +356,7 @@ if os.path.isfile(ck) and os.path.isfile(f"{OUT}/full.h5"):
               "(every body, every pair, the history)", str(diff[:5]))
 
 # periodic checkpoints: stopped by max_outer, resumed without that limit
-p, _ = run_solver(BIN, deckr, "&solver delta=0.05, acceleration='none', max_outer=200 /",
+p, _ = run_solver(BIN, deckr, "&solver delta=0.02, acceleration='none', max_outer=200 /",
                   out("part").replace(" /", ", checkpoint_every=100 /"), env=env, timeout=900)
 ck2 = f"{OUT}/part.h5.ckpt.h5"
 check(p.returncode == 2 and os.path.isfile(ck2), "3 bodies: max_outer=200 exits 2 with a periodic checkpoint",
