@@ -120,6 +120,11 @@ module robin_operators
     type(dense_op_t) :: s                    !< S on those rows
   end type group_op_t
 
+  !> The most rows a group's dense K may have (1 GB of K and S at 8192; a Cholesky factor
+  !! and inverse of 4096 rows take about 10 s on one core): a larger group takes each pair's
+  !! S from its blocks (the operator of the pairs one by one; doc/method.md).
+  integer, parameter :: GROUP_DENSE_MAX = 4096
+
   !> A body's slots in the side layout (body_condensed_t%slots).
   type :: slots_t
     integer, allocatable :: v(:)
@@ -495,6 +500,19 @@ contains
         if (gof(find(contact_line%pair_body(1, p))) /= g) cycle
         rows = [rows, [(i, i=self%rows(1, p), self%rows(2, p))]]
       end do
+      if (size(rows) > GROUP_DENSE_MAX) then
+        ! too many rows for a dense K: each pair's S from its blocks of the bodies' stiffnesses
+        call pair_blocks(g, info)
+        if (info /= 0) then
+          write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: pair ', p, &
+            ': Sigma_A + Sigma_B is not positive definite, info = ', info
+          call err%set(ERR_NUMERICAL, emsg)
+          return
+        end if
+        allocate (self%group(g)%rows(0))
+        deallocate (rows)
+        cycle
+      end if
       members = pack([(a, a=1, size(bodies))], [(gof(find(a)) == g .and. allocated(stiff(a)%k), a=1, size(bodies))])
       call group_matrix(rows, members, self%group(g)%s, info)
       if (info /= 0) then
@@ -507,6 +525,31 @@ contains
     end do
 
   contains
+
+    !> The pairs of group gg one by one (a group too large for a dense K): S_p = 2 (Sigma_A +
+    !! Sigma_B)^-1 of the blocks of the two bodies' stiffnesses on the pair's rows (its other
+    !! rows held), into self%s(p); p is the failing pair when info /= 0.
+    subroutine pair_blocks(gg, info)
+      integer, intent(in) :: gg
+      integer, intent(out) :: info
+      real(wp), allocatable :: sp(:, :)
+      integer :: sd, ab, r(2, 2)
+      info = 0
+      do p = 1, contact_line%npair
+        if (.not. in_group(p)) cycle
+        if (gof(find(contact_line%pair_body(1, p))) /= gg) cycle
+        do sd = 1, 2
+          ab = contact_line%pair_body(sd, p)
+          r(:, sd) = pair_positions(bodies(ab), contact_line, p)
+        end do
+        associate (ka => stiff(contact_line%pair_body(1, p)), kb => stiff(contact_line%pair_body(2, p)))
+          call parallel_flex(ka%k(r(1, 1):r(2, 1), r(1, 1):r(2, 1)), ka%inf(r(1, 1):r(2, 1), :), &
+                             kb%k(r(1, 2):r(2, 2), r(1, 2):r(2, 2)), kb%inf(r(1, 2):r(2, 2), :), sp, info)
+        end associate
+        if (info /= 0) return
+        call dense_op_take(self%s(p), sp)
+      end do
+    end subroutine pair_blocks
 
     !> Pair q has rows and a body in another pair.
     logical function in_group(q)
@@ -596,6 +639,7 @@ contains
       call self%s(p)%apply(d(self%rows(1, p):self%rows(2, p)), corr(self%rows(1, p):self%rows(2, p), 1))
     end do
     do c = 1, size(self%group)
+      if (size(self%group(c)%rows) == 0) cycle    ! a large group: its pairs' S above
       allocate (y(size(self%group(c)%rows)))
       call self%group(c)%s%apply(d(self%group(c)%rows), y)
       corr(self%group(c)%rows, 1) = y
