@@ -43,6 +43,9 @@ module contact_types
     real(wp) :: equilibrium = 0.0_wp           !< floating bodies: max_a |G_a lam_a - e_a| / |e_a| (0: none)
     real(wp) :: error_bound = 0.0_wp           !< a posteriori bound of |lam - lam_mono| / |lam| (see error_bound)
     real(wp) :: kappa = 0.0_wp                 !< condition number estimate of the monolithic Hessian
+    !> the natural residual |lam - P(lam - (H lam - c)/L)| / |lam| of the mean force (zero at
+    !! the monolithic solution; the bound is 2 kappa times it); -1: not computed
+    real(wp) :: natural = -1.0_wp
     integer :: active = 0                      !< nodes with lam > 0
     !> bodies held only by contact: the amplitudes alpha_a of their rigid motions R_a
     !! (u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a; alpha_a = -mu_a, the equality multipliers)

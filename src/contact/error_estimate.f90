@@ -138,6 +138,7 @@ contains
       ! the projection on the feasible set is not known to any accuracy: no bound
       res%error_bound = huge(1.0_wp)
     else if (nl > 0.0_wp) then
+      res%natural = (norm2(r) + perr)/nl
       res%error_bound = 2.0_wp*res%kappa*((norm2(r) + perr)/nl + 10.0_wp*real(m, wp)*epsilon(1.0_wp))
     else
       res%error_bound = merge(0.0_wp, huge(1.0_wp), norm2(r) == 0.0_wp)

@@ -68,6 +68,11 @@ contains
         if (result%kappa > 1.0_wp/epsilon(1.0_wp)) then
           line(2) = trim(line(2))//': the interface problem is singular, a force the equations leave free, '// &
                     'such as on a row of prescribed DOFs only)'
+        else if (result%natural >= 0.0_wp) then
+          ! what is known: how far the forces are from satisfying the monolithic problem's
+          ! optimality conditions (the bound multiplies it by 2 cond)
+          line(2) = trim(line(2))//': it says nothing about these forces); their natural residual '// &
+                    '|lam - P(lam - grad/L)|/|lam| = '//sci(result%natural)//' (zero at the monolithic solution)'
         else
           line(2) = trim(line(2))//': it says nothing about these forces)'
         end if
