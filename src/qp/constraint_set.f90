@@ -56,6 +56,12 @@ module constraint_set
     procedure(project_i), deferred :: project
     !> free(i): x_i is not on the boundary of the set.
     procedure(free_mask_i), deferred :: free_mask
+    !> x = P(x + t d), and the free set there.
+    procedure(move_i), deferred :: move
+    !> phi, the free gradient (g on the free set, 0 elsewhere).
+    procedure(grad_i), deferred :: free_gradient
+    !> |phi|^2, phit'phi and |beta|^2 in one pass (MPRGP's split of the gradient).
+    procedure(split_i), deferred :: split_gradient
     !> beta, the chopped gradient (0 on the free set).
     procedure(grad_i), deferred :: chopped_gradient
     !> gP = phi + beta, the projected gradient.
@@ -101,6 +107,19 @@ module constraint_set
       real(wp), intent(in) :: x(:)
       logical, intent(out) :: free(:)
     end subroutine free_mask_i
+    subroutine move_i(self, x, d, t, free)
+      import :: constraint_set_t, wp
+      class(constraint_set_t), intent(in) :: self
+      real(wp), intent(inout) :: x(:)
+      real(wp), intent(in) :: d(:), t
+      logical, intent(out) :: free(:)
+    end subroutine move_i
+    subroutine split_i(self, x, g, alpha, phiphi, phitphi, betabeta)
+      import :: constraint_set_t, wp
+      class(constraint_set_t), intent(in) :: self
+      real(wp), intent(in) :: x(:), g(:), alpha
+      real(wp), intent(out) :: phiphi, phitphi, betabeta
+    end subroutine split_i
     subroutine grad_i(self, x, g, v)
       import :: constraint_set_t, wp
       class(constraint_set_t), intent(in) :: self
@@ -163,6 +182,10 @@ module constraint_set
     procedure :: validate => box_validate
     procedure :: project => box_project
     procedure :: free_mask => box_free_mask
+    procedure :: move => box_move
+    procedure :: free_gradient => box_free_gradient
+    procedure :: split_gradient => box_split_gradient
+    procedure :: projected_gradient_norm => box_projected_gradient_norm
     procedure :: chopped_gradient => box_chopped_gradient
     procedure :: projected_gradient => box_projected_gradient
     procedure :: reduced_gradient => box_reduced_gradient
@@ -281,6 +304,82 @@ contains
       free(i) = x(i) > self%lb(i) .and. x(i) < self%ub(i)
     end do
   end subroutine box_free_mask
+
+  !> x = min(max(x + t d, lb), ub), and free(i) = lb_i < x_i < ub_i there.
+  subroutine box_move(self, x, d, t, free)
+    class(box_set_t), intent(in) :: self
+    real(wp), intent(inout) :: x(:)      !< iterate
+    real(wp), intent(in) :: d(:), t      !< direction, step
+    logical, intent(out) :: free(:)      !< the free set at the new x
+    integer :: i
+    do i = 1, size(x)
+      x(i) = min(max(x(i) + t * d(i), self%lb(i)), self%ub(i))
+      free(i) = x(i) > self%lb(i) .and. x(i) < self%ub(i)
+    end do
+  end subroutine box_move
+
+  !> phi_i = g_i when lb_i < x_i < ub_i, else 0.
+  subroutine box_free_gradient(self, x, g, v)
+    class(box_set_t), intent(in) :: self
+    real(wp), intent(in) :: x(:), g(:)   !< iterate, gradient
+    real(wp), intent(out) :: v(:)        !< phi
+    integer :: i
+    do i = 1, size(x)
+      if (x(i) > self%lb(i) .and. x(i) < self%ub(i)) then
+        v(i) = g(i)
+      else
+        v(i) = 0.0_wp
+      end if
+    end do
+  end subroutine box_free_gradient
+
+  !> One pass: |phi|^2 and phit'phi over the free variables, |beta|^2 over the others,
+  !! each summed in index order.
+  subroutine box_split_gradient(self, x, g, alpha, phiphi, phitphi, betabeta)
+    class(box_set_t), intent(in) :: self
+    real(wp), intent(in) :: x(:), g(:)   !< iterate, gradient
+    real(wp), intent(in) :: alpha        !< step length of phit (<= 0: not known, phit = phi)
+    real(wp), intent(out) :: phiphi, phitphi, betabeta   !< the three sums
+    real(wp) :: phi, phit, beta, slack
+    integer :: i
+    phiphi = 0.0_wp
+    phitphi = 0.0_wp
+    betabeta = 0.0_wp
+    do i = 1, size(x)
+      if (x(i) > self%lb(i) .and. x(i) < self%ub(i)) then
+        phi = g(i)
+        phiphi = phiphi + phi * phi
+        phit = phi
+        if (alpha > 0.0_wp) then
+          if (self%lb(i) > -big) then
+            slack = x(i) - self%lb(i)
+            if (slack < alpha * phi) phit = slack / alpha
+          end if
+          if (self%ub(i) < big) then
+            slack = self%ub(i) - x(i)
+            if (slack < -alpha * phi) phit = -slack / alpha
+          end if
+        end if
+        phitphi = phitphi + phit * phi
+      else
+        beta = chopped(g(i), x(i), self%lb(i), self%ub(i))
+        betabeta = betabeta + beta * beta
+      end if
+    end do
+  end subroutine box_split_gradient
+
+  !> |gP| in one pass (no work array).
+  real(wp) function box_projected_gradient_norm(self, x, g) result(r)
+    class(box_set_t), intent(in) :: self
+    real(wp), intent(in) :: x(:)    !< iterate
+    real(wp), intent(in) :: g(:)    !< gradient
+    integer :: j
+    r = 0.0_wp
+    do j = 1, size(x)
+      r = r + chopped(g(j), x(j), self%lb(j), self%ub(j))**2
+    end do
+    r = sqrt(r)
+  end function box_projected_gradient_norm
 
   !> beta_i = min(g_i, 0) at lb, max(g_i, 0) at ub, 0 when free or fixed.
   subroutine box_chopped_gradient(self, x, g, v)

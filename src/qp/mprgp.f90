@@ -509,27 +509,13 @@ contains
     real(wp), intent(in) :: b(:), x(:)
     class(constraint_set_t), intent(in) :: set
     real(wp), intent(out) :: betabeta, phitphi
-    real(wp) :: phiphi, gp2, phi, tol_now, feas, floor_eq
+    real(wp) :: phiphi, gp2, tol_now, feas, floor_eq
     character(len=24) :: s1, s2
-    integer :: i, n
+    integer :: n
     n = self%n
     action = DONE
-    ! Split the gradient: phi and phit on the free set, beta off it (w and v are free here).
-    call set%free_mask(x, self%free)
-    call set%reduced_gradient(x, self%g, self%ab, self%w)
-    call set%chopped_gradient(x, self%g, self%v)
-    phiphi = 0.0_wp
-    phitphi = 0.0_wp
-    betabeta = 0.0_wp
-    do i = 1, n
-      if (self%free(i)) then
-        phi = self%g(i)
-        phiphi = phiphi + phi * phi
-        phitphi = phitphi + self%w(i) * phi
-      else
-        betabeta = betabeta + self%v(i) * self%v(i)
-      end if
-    end do
+    ! Split the gradient (one pass).
+    call set%split_gradient(x, self%g, self%ab, phiphi, phitphi, betabeta)
     gp2 = phiphi + betabeta
     self%stats%gp_norm = sqrt(gp2)
     if (.not. ieee_is_finite(gp2)) then
@@ -609,18 +595,13 @@ contains
     real(wp), intent(in) :: x(:), betabeta
     real(wp), intent(inout) :: phitphi       !< phit'phi (recomputed once alpha_bar is known)
     logical, intent(out) :: ok
-    integer :: i
+    real(wp) :: phiphi, betabeta_now
     prop = .false.
     ok = .true.
     if (betabeta > 0.0_wp .and. self%ab <= 0.0_wp) then
       ok = ensure_alpha(self, A)
       if (.not. ok) return
-      call set%free_mask(x, self%free)
-      call set%reduced_gradient(x, self%g, self%ab, self%w)
-      phitphi = 0.0_wp
-      do i = 1, self%n
-        if (self%free(i)) phitphi = phitphi + self%w(i) * self%g(i)
-      end do
+      call set%split_gradient(x, self%g, self%ab, phiphi, phitphi, betabeta_now)
     end if
     prop = (betabeta <= self%opts%gamma**2 * phitphi)
   end function proportional
@@ -657,14 +638,10 @@ contains
       call set%max_step(x, d, acg, af, blk)
       if (blk == 0) then
         ! CG step.
-        do i = 1, n
-          x(i) = x(i) - acg * p(i)
-          gr(i) = gr(i) - acg * ap(i)
-        end do
-        call set%project(x)
-        call set%free_mask(x, free)
+        call set%move(x, d, acg, free)
         num = 0.0_wp
         do i = 1, n
+          gr(i) = gr(i) - acg * ap(i)
           if (free(i)) num = num + gr(i) * ap(i)
         end do
         gam = num / pap
@@ -681,11 +658,10 @@ contains
       end if
       ! the feasible half step
       af = max(af, 0.0_wp)
+      call set%move(x, d, af, free)
       do i = 1, n
-        x(i) = x(i) - af * p(i)
         gr(i) = gr(i) - af * ap(i)
       end do
-      call set%project(x)
       call set%pin(x, d, blk)
     end associate
     ok = expansion_step(self, A, set, x)
@@ -730,11 +706,10 @@ contains
           retry = retry + 1
           cycle expand
         end if
+        call set%move(x, p, 1.0_wp, self%free)
         do i = 1, n
-          x(i) = x(i) + p(i)
           gr(i) = gr(i) + ap(i)
         end do
-        call set%project(x)
         exit expand
       end do expand
     end associate
@@ -755,7 +730,7 @@ contains
     real(wp) :: pap, pp, acg
     integer :: i, n, blk
     n = self%n
-    associate (p => self%p, ap => self%ap, gr => self%g, d => self%w)
+    associate (p => self%p, ap => self%ap, gr => self%g, d => self%w, free => self%free)
       call set%chopped_gradient(x, gr, p)
       call A%apply(p, ap)
       self%stats%n_matvec = self%stats%n_matvec + 1
@@ -773,11 +748,10 @@ contains
       ! step is cut.
       d = -p
       call set%max_step(x, d, betabeta / pap, acg, blk)
+      call set%move(x, d, acg, free)
       do i = 1, n
-        x(i) = x(i) - acg * p(i)
         gr(i) = gr(i) - acg * ap(i)
       end do
-      call set%project(x)
       call set%pin(x, d, blk)
     end associate
     call set_p_to_phi(self, set, x)
@@ -799,15 +773,7 @@ contains
     type(mprgp_t), intent(inout) :: self
     class(constraint_set_t), intent(in) :: set
     real(wp), intent(in) :: x(:)
-    integer :: j
-    call set%free_mask(x, self%free)
-    do j = 1, self%n
-      if (self%free(j)) then
-        self%p(j) = self%g(j)
-      else
-        self%p(j) = 0.0_wp
-      end if
-    end do
+    call set%free_gradient(x, self%g, self%p)
   end subroutine set_p_to_phi
 
   !> g = A x - b computed directly.

@@ -1,7 +1,7 @@
 !> Unit tests of the constraint set (module constraint_set) as the box lb <= x <= ub:
 !! every method against its formula written out here on random points with variables free,
-!! at either bound, fixed and unbounded (projection, free set, chopped / projected / reduced
-!! gradients, projected step, the three step lengths and the blocker, binding and leaving
+!! at either bound, fixed and unbounded (projection, move, free set, free / chopped /
+!! projected / reduced gradients and MPRGP's split of the gradient, projected step, the three step lengths and the blocker, binding and leaving
 !! tests, landing on a bound), the refusal of bad boxes, and MPRGP through `solve_in` with a
 !! box set against `solve` with lb, ub (the same iterates, bit for bit).
 !! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
@@ -56,7 +56,7 @@ contains
 
   !> Projection, free set, chopped, projected and reduced gradients, projected step.
   subroutine test_pointwise()
-    real(wp) :: l(n), u(n), x(n), g(n), y(n), v(n), ref(n), alpha
+    real(wp) :: l(n), u(n), x(n), g(n), y(n), v(n), ref(n), alpha, s1, s2, s3
     logical :: free(n), freeref(n)
     type(box_set_t) :: box
     integer :: i
@@ -92,6 +92,13 @@ contains
     end do
     call box%chopped_gradient(x, g, v)
     call report(all(v == ref), 'box: chopped gradient beta')
+    ! the split of MPRGP: |phi|^2, phit'phi (alpha unknown: phit = phi) and |beta|^2
+    call box%split_gradient(x, g, 0.0_wp, s1, s2, s3)
+    call report(abs(s1 - sum(g**2, mask=freeref)) <= 4.0_wp*epsilon(1.0_wp)*s1 .and. s2 == s1 .and. &
+                abs(s3 - sum(ref**2)) <= 4.0_wp*epsilon(1.0_wp)*s3, 'box: split_gradient = |phi|^2, phi''phi, |beta|^2')
+    ! free gradient
+    call box%free_gradient(x, g, v)
+    call report(all(v == merge(g, 0.0_wp, freeref)), 'box: free gradient phi')
     ! projected gradient = phi + beta
     where (freeref) ref = g
     call box%projected_gradient(x, g, v)
@@ -111,6 +118,9 @@ contains
     call report(maxval(abs(v - ref)) <= 4.0_wp*epsilon(1.0_wp)*maxval(abs(g)), 'box: reduced free gradient phit')
     call report(all(x - alpha*v >= l - 1.0e-15_wp .and. x - alpha*v <= u + 1.0e-15_wp), &
                 'box: x - alpha phit stays in the box')
+    call box%split_gradient(x, g, alpha, s1, s2, s3)
+    call report(abs(s2 - sum(ref*g, mask=freeref)) <= 8.0_wp*epsilon(1.0_wp)*sum(abs(ref*g)), &
+                'box: split_gradient''s phit''phi = the reduced gradient''s')
     call box%reduced_gradient(x, g, 0.0_wp, v)
     call report(all(merge(g, 0.0_wp, freeref) == v), 'box: phit = phi while alpha is not known')
     ! projected step: x + d = P(x - alpha phi)
@@ -119,6 +129,13 @@ contains
     call box%project(ref)
     call report(maxval(abs(x + v - ref)) <= 8.0_wp*epsilon(1.0_wp)*(1.0_wp + maxval(abs(ref))), &
                 'box: projected step d = P(x - alpha phi) - x')
+    ! move: x = P(x + t d) and the free set there
+    v = x
+    call box%move(v, y, 0.7_wp, free)
+    ref = x + 0.7_wp*y
+    where (ref < l) ref = l
+    where (ref > u) ref = u
+    call report(all(v == ref) .and. all(free .eqv. (ref > l .and. ref < u)), 'box: move = P(x + t d), free set there')
   end subroutine test_pointwise
 
   !> The three step lengths against the least ratio, the blocker and pin.
