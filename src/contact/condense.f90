@@ -2,20 +2,23 @@
 !! in (module contact_interface), its factorization, its normal flexibility
 !! F_a = B_a K_a^-1 B_a' and the normal interface displacement under the load alone
 !! b_a = B_a K_a^-1 f_a (plus B_a's part on prescribed DOFs) (doc/method.md). The free DOFs
-!! that B_a touches are ordered last in the Cholesky factorization, so F_a comes from the
-!! trailing block of the factor at a cost of O(k^3) (k those DOFs), not m solves.
+!! that B_a touches are ordered last in the factorization, so F_a comes from the trailing
+!! block of the factor at a cost of O(k^3) (k those DOFs), not m solves. The body owns its
+!! factorization as one `class(factor_t)` (module factorization: CHOLMOD, banded or MUMPS,
+!! picked by `new_factor` from the deck's setting), so the serial and the MPI path condense
+!! and recover through the same routines; with MUMPS they are collective over the body's
+!! group of ranks and the results are on its host.
 module condense
   use kinds, only: wp
-  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use, intrinsic :: ieee_exceptions, only: ieee_usual, ieee_get_halting_mode, ieee_set_halting_mode
-  use config, only: factor_cfg_t, FACTOR_BANDED, ORDER_AMD, ORDER_NATURAL, ORDER_ND
+  use config, only: factor_cfg_t
   use mesh, only: mesh_t
   use contact_interface, only: interface_t, body_slots, slot_row, slot_side
   use assembly, only: body_system_t
-  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
+  use factorization, only: factor_t, new_factor
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
-  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL, ERR_MEMORY
+  use errors, only: error_t, ERR_MEMORY
   use lapack, only: dpotrf, dpocon, dpstrf, dsyevr
   implicit none (type, external)
   private
@@ -52,14 +55,16 @@ module condense
     !! is what |G_a' v|^2 would be if every contact normal were along the motion R_a v
     real(wp), allocatable :: rreach(:, :)
     real(wp), allocatable :: b(:)           !< (m) B_a K_a^-1 f_a [length]
-    real(wp), allocatable :: u0(:)          !< (n) K_a^-1 f_a [length]
-    type(chol_t) :: chol                    !< the factorization of K_a
+    !> (n) K_a^-1 f_a [length]; not kept with a distributed factor (MUMPS), whose
+    !! displacement recovery solves with f_a - B_a' lam instead
+    real(wp), allocatable :: u0(:)
+    class(factor_t), allocatable :: fac     !< the factorization of K_a
     real(wp) :: t_factor = 0.0_wp           !< wall time of analyze + factorize [s]
     real(wp) :: t_condense = 0.0_wp         !< wall time of F_a and b_a [s]
   end type body_condensed_t
 
-  public :: factor_body, condense_body, recover_displacement, apply_bt, apply_b, interface_dofs, flex_from_x, &
-            prescribed_part
+  public :: factor_body, condense_body, interface_load, recover_displacement, apply_bt, apply_b, interface_dofs, &
+            flex_from_x, prescribed_part
 
 contains
 
@@ -136,37 +141,35 @@ contains
     end do
   end subroutine prescribed_part
 
-  !> Factorize K_a with the interface DOFs ordered last. ordering='nd' orders the
-  !! other DOFs by geometric nested dissection of the body's grid (module ordering);
-  !! its time is part of t_factor.
-  subroutine factor_body(fc, itf, a, msh, sys, bc, err)
+  !> Factorize K_a with the interface DOFs ordered last, by the factor the deck's setting
+  !! names (factorization%new_factor). ordering='nd' (CHOLMOD) orders the other DOFs by
+  !! geometric nested dissection of the body's grid (module ordering); its time is part of
+  !! t_factor. With MUMPS (collective over `comm`) each rank gives its share of K_a's cells
+  !! as triplets irn, jcn, kval (assembly%cell_triplets); the others give the whole K_a (sys).
+  subroutine factor_body(fc, itf, a, msh, sys, bc, err, comm, irn, jcn, kval)
     type(factor_cfg_t), intent(in) :: fc             !< factorization and ordering
     type(interface_t), intent(in) :: itf             !< the contact rows of all pairs
     integer, intent(in) :: a                         !< body number
     type(mesh_t), intent(in) :: msh                  !< mesh of body a
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
     type(body_condensed_t), intent(inout) :: bc      !< receives the factorization
-    type(error_t), intent(out) :: err                !< the failure (see chol_factor), if any
-    integer :: method, iord
+    type(error_t), intent(out) :: err                !< the failure (see the factor's factorize), if any
+    integer, intent(in), optional :: comm            !< MUMPS: the body's group of ranks
+    integer, intent(in), optional :: irn(:), jcn(:)  !< MUMPS: this rank's entries of K_a, 1-based
+    real(wp), intent(in), optional :: kval(:)        !< MUMPS: their values [stress]
     integer, allocatable :: perm(:)
     real(wp) :: t0
 
     t0 = wtime()
     call interface_dofs(itf, a, sys, bc)
-    ! the deck's choice as the Cholesky module's method and ordering ('nd' is our own
-    ! permutation of the interior, given to CHOLMOD)
-    method = merge(FACT_BANDED, FACT_CHOLMOD, fc%factorization == FACTOR_BANDED)
-    select case (fc%ordering)
-    case (ORDER_AMD)
-      iord = ORD_AMD
-    case (ORDER_NATURAL)
-      iord = ORD_NATURAL
-    case (ORDER_ND)
-      iord = ORD_GIVEN
-    case default
-      iord = ORD_METIS
-    end select
-    if (iord == ORD_GIVEN .and. method == FACT_CHOLMOD) then
+    if (allocated(bc%fac)) then
+      call bc%fac%free()
+      deallocate (bc%fac)
+    end if
+    call new_factor(fc, a, bc%fac, comm)
+    if (present(irn)) then
+      call bc%fac%factorize(sys%n, bc%idx, err, irn=irn, jcn=jcn, tval=kval)
+    else if (bc%fac%wants_interior_order()) then
       if (msh%structured) then
         call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, bc%idx, perm, err)
       else
@@ -176,15 +179,17 @@ contains
         bc%t_factor = wtime() - t0
         return
       end if
-      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, err, last=bc%idx, &
-                          interior_perm=perm)
+      call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val, interior_perm=perm)
     else
-      call bc%chol%factor(sys%n, sys%colptr, sys%rowind, sys%val, method, iord, err, last=bc%idx)
+      call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val)
     end if
     bc%t_factor = wtime() - t0
   end subroutine factor_body
 
-  !> Form F_a and b_a (and u0 = K_a^-1 f_a) from the factorization.
+  !> Form F_a and b_a (and u0 = K_a^-1 f_a, unless the factor is distributed) from the
+  !! factorization: X = (K_a^-1) on the interface DOFs by the factor's interface_inverse,
+  !! F_a = B_a X B_a' (flex_from_x), b_a by one solve (interface_load). Collective with MUMPS
+  !! (flex and b on the host).
   subroutine condense_body(sys, bc, err)
     type(body_system_t), intent(in) :: sys           !< assembled system of the body
     type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives flex, b, u0
@@ -193,29 +198,49 @@ contains
     integer :: k, st
     real(wp), allocatable :: x(:, :)
     t0 = wtime()
-    if (allocated(bc%flex)) deallocate (bc%flex)
-    if (allocated(bc%b)) deallocate (bc%b)
-    if (allocated(bc%u0)) deallocate (bc%u0)
-    allocate (bc%b(bc%m), bc%u0(sys%n))
-    k = size(bc%idx)
-    if (bc%m > 0 .and. k > 0) then
-      ! X = (K^-1) on the interface DOFs, then F = B X B' over the few entries of each row
-      allocate (x(k, k), stat=st)
-      if (st /= 0) then
-        call err%set(ERR_MEMORY, 'out of memory for the interface block of K^-1')
-        return
+    if (bc%fac%holds_result()) then
+      if (allocated(bc%flex)) deallocate (bc%flex)
+      k = size(bc%idx)
+      if (bc%m > 0 .and. k > 0) then
+        ! X = (K^-1) on the interface DOFs, then F = B X B' over the few entries of each row
+        allocate (x(k, k), stat=st)
+        if (st /= 0) then
+          call err%set(ERR_MEMORY, 'out of memory for the interface block of K^-1')
+          return
+        end if
+        call bc%fac%interface_inverse(bc%idx, x, err)
+        if (err%failed()) return
       end if
-      call bc%chol%flexibility(bc%idx, spread(1.0_wp, 1, k), x, err)
-      if (err%failed()) return
+      if (.not. allocated(x)) allocate (x(0, 0))
+      call flex_from_x(bc, x)
     end if
-    if (.not. allocated(x)) allocate (x(0, 0))
-    call flex_from_x(bc, x)
-    bc%u0 = sys%f
-    call bc%chol%solve(bc%u0, err)
-    if (err%failed()) return
-    call apply_b(bc, bc%u0, bc%b)
+    call interface_load(sys, bc, err)
     bc%t_condense = wtime() - t0
   end subroutine condense_body
+
+  !> b_a = B_a K_a^-1 f_a + B_a,d u_d for the body's current loads (one solve, collective
+  !! with MUMPS; b on the host), keeping u0 = K_a^-1 f_a unless the factor is distributed.
+  !! B_a,d u_d (bfix) is the caller's (interface_dofs, prescribed_part).
+  subroutine interface_load(sys, bc, err)
+    type(body_system_t), intent(in) :: sys           !< the body's loads
+    type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives b (and u0)
+    type(error_t), intent(out) :: err                !< the solve's failure, if any
+    real(wp), allocatable :: u0(:)
+    if (.not. allocated(bc%b)) allocate (bc%b(bc%m))
+    if (size(bc%b) /= bc%m) then
+      deallocate (bc%b)
+      allocate (bc%b(bc%m))
+    end if
+    if (bc%fac%holds_result()) then
+      u0 = sys%f
+    else
+      allocate (u0(0))
+    end if
+    call bc%fac%solve(u0, err)
+    if (err%failed()) return
+    if (bc%fac%holds_result()) call apply_b(bc, u0, bc%b)
+    if (.not. bc%fac%distributed) call move_alloc(u0, bc%u0)
+  end subroutine interface_load
 
   !> F_a = B_a X B_a' from X = (K_a^-1) on the interface DOFs bc%idx (any factorization:
   !! CHOLMOD's trailing block or MUMPS's inverse Schur complement), over the few entries of
@@ -352,21 +377,36 @@ contains
     end do
   end subroutine apply_bt
 
-  !> u_free = K_a^-1 (f_a - B_a' lam): the body's displacement under its load and
-  !! the contact forces lam (one solve).
-  subroutine recover_displacement(sys, bc, lam, u_free)
+  !> u_free = K_a^-1 (f_a - B_a' lam): the body's displacement under its load and the
+  !! contact forces lam, by one solve: u0 - K_a^-1 B_a' lam when condensation kept u0, else
+  !! K_a^-1 (f_a - B_a' lam) (a distributed factor: collective, u_free on the host).
+  !! err: the solve failed (u_free is then not set).
+  subroutine recover_displacement(sys, bc, lam, u_free, err)
     type(body_system_t), intent(in) :: sys           !< assembled system
     type(body_condensed_t), intent(inout) :: bc      !< factorized body
     real(wp), intent(in) :: lam(:)                   !< (m) contact force on this body [force]
-    real(wp), intent(out) :: u_free(:)               !< (n) displacement at free DOFs [length]
+    real(wp), intent(inout) :: u_free(:)             !< (n) displacement at free DOFs [length] (host)
+    type(error_t), intent(out) :: err                !< the failure, if any
     real(wp), allocatable :: r(:)
-    type(error_t) :: err
-    allocate (r(sys%n))
-    r = 0.0_wp
-    call apply_bt(bc, lam, r)
-    call bc%chol%solve(r, err)
-    if (err%failed()) r = ieee_value(1.0_wp, ieee_quiet_nan)
-    u_free = bc%u0 - r
+    if (allocated(bc%u0)) then
+      allocate (r(sys%n))
+      r = 0.0_wp
+      call apply_bt(bc, lam, r)
+      call bc%fac%solve(r, err)
+      if (err%failed()) return
+      u_free = bc%u0 - r
+    else
+      if (bc%fac%holds_result()) then
+        r = sys%f
+        r = -r
+        call apply_bt(bc, lam, r)
+        r = -r
+      else
+        allocate (r(0))
+      end if
+      call bc%fac%solve(r, err)
+      if (bc%fac%holds_result() .and. .not. err%failed()) u_free = r
+    end if
   end subroutine recover_displacement
 
 end module condense

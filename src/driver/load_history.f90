@@ -12,7 +12,7 @@ module load_history
   use config, only: deck_t, stage_count, stage_steps
   use assembly, only: body_system_t
   use contact_interface, only: interface_t
-  use condense, only: body_condensed_t, apply_b, prescribed_part
+  use condense, only: body_condensed_t, interface_load, prescribed_part
   use floating, only: rigid_rows
   use errors, only: error_t
   implicit none (type, external)
@@ -79,7 +79,7 @@ contains
     end subroutine combine
   end subroutine set_step_loads
 
-  !> The body's interface load for its current loads, on its factor (CHOLMOD or banded):
+  !> The body's interface load for its current loads, on its factor (on one rank: CHOLMOD or banded):
   !! u0 = K_a^-1 f_a and b_a = B_a u0 + B_a,d u_d; for a body held only by contact its
   !! load along the free motions too (floating%rigid_rows). One solve, no factorization.
   subroutine step_interface_load(itf, a, sys, bc, err)
@@ -89,10 +89,8 @@ contains
     type(body_condensed_t), intent(inout) :: bc   !< its factor; gets bfix, u0, b (and re)
     type(error_t), intent(out) :: err             !< the solve's failure, if any
     call prescribed_part(itf, sys, bc)
-    bc%u0 = sys%f
-    call bc%chol%solve(bc%u0, err)
+    call interface_load(sys, bc, err)
     if (err%failed()) return
-    call apply_b(bc, bc%u0, bc%b)
     if (sys%nrig > 0) call rigid_rows(itf, a, sys, bc)
   end subroutine step_interface_load
 

@@ -1,7 +1,8 @@
 !> The MPI back-end (factorization='mumps'): the bodies mapped to the ranks
 !! (budget%body_rank_map: a group of ranks per body, or several bodies per rank when the
 !! ranks are fewer); each rank computes its share of its bodies' element matrices and
-!! factorizes them by MUMPS; the bodies' hosts broadcast the condensed data, rank 0 alone
+!! factorizes them by MUMPS (each body's factorization%mumps_factor_t, through the same
+!! condense routines as the serial path); the bodies' hosts broadcast the condensed data, rank 0 alone
 !! iterates and broadcasts the contact forces, and every rank ends with rank 0's exit code.
 module mpi_backend
   use kinds, only: wp
@@ -15,17 +16,16 @@ module mpi_backend
   use strings, only: i2s, body_label
   use mpi_env, only: par_finalize, par_split, par_bcast_reals, par_bcast_ints, par_agree, par_max_real, &
                      par_sum_real, par_node_sum
-  use mumps_iface, only: mumps_t, mumps_end, mumps_solve
-  use condense_mumps, only: factor_body_mumps, condense_body_mumps, recover_displacement_mumps
+  use factorization, only: new_factor
   use run_state, only: run_t
   use contact_common, only: gather
   use run_backend, only: backend_t
-  use condense, only: apply_b, prescribed_part
+  use condense, only: factor_body, condense_body, interface_load, recover_displacement, prescribed_part
   use floating, only: rigid_rows
   implicit none (type, external)
   private
 
-  !> The ranks' groups and each body's MUMPS instance.
+  !> The ranks' groups (each body's MUMPS factor is its body's, run%bodies(a)%fac).
   type, extends(backend_t), public :: mpi_backend_t
     integer, allocatable :: host(:)         !< (nbody) the world rank hosting each body's group
     integer :: group_comm = 0               !< this rank's group (all its bodies')
@@ -33,7 +33,6 @@ module mpi_backend
     integer, allocatable :: group_size(:)   !< (nbody) ranks of each body's group
     logical, allocatable :: mine(:)         !< (nbody) this rank works on the body
     real(wp) :: assembly_peak_mb = 0.0_wp   !< this rank's peak RSS when the factorization starts [MiB]
-    type(mumps_t), allocatable :: solver(:) !< (nbody) each body's MUMPS instance (its own bodies')
     type(error_t), allocatable :: err(:)    !< (nbody) each body's failure in the current phase, if any
   contains
     procedure :: check_memory, factor, condense, condense_load, record_factor_memory, share_contact_forces, recover, &
@@ -82,8 +81,9 @@ contains
       last = (self%group_rank(a) + 1)*run%meshes(a)%ncell/self%group_size(a)
       call cell_triplets(run%meshes(a), run%deck%body(a), run%deck%plane_strain, run%systems(a), first, last, &
                          irn, jcn, kval, self%err(a))
-      if (.not. self%err(a)%failed()) call factor_body_mumps(run%contact_line, a, run%systems(a), irn, jcn, kval, &
-                                                             self%group_comm, run%bodies(a), self%solver(a), self%err(a))
+      if (.not. self%err(a)%failed()) call factor_body(run%deck%solver%factor, run%contact_line, a, run%meshes(a), &
+                                                       run%systems(a), run%bodies(a), self%err(a), self%group_comm, &
+                                                       irn, jcn, kval)
       if (allocated(irn)) deallocate (irn, jcn, kval)
     end do
     call self%agree_fatal('factorization failed')
@@ -95,12 +95,12 @@ contains
   !! alone in its communicator, for all its bodies (each body on one rank).
   subroutine split_groups(self, run)
     class(mpi_backend_t), intent(inout) :: self
-    type(run_t), intent(in) :: run
+    type(run_t), intent(inout) :: run
     integer :: a, nb, color
     character(len=:), allocatable :: line
     self%assembly_peak_mb = peak_rss_mb()   ! meshes, numbering and loads of every body
     nb = run%nbody
-    allocate (self%host(nb), self%group_size(nb), self%group_rank(nb), self%mine(nb), self%solver(nb), self%err(nb))
+    allocate (self%host(nb), self%group_size(nb), self%group_rank(nb), self%mine(nb), self%err(nb))
     call body_rank_map(run%sized, run%ranks, self%host, self%group_size)
     self%mine = run%rank >= self%host .and. run%rank < self%host + self%group_size
     self%group_rank = merge(run%rank - self%host, 0, self%mine)
@@ -112,6 +112,11 @@ contains
     color = run%rank
     if (run%ranks >= nb) color = findloc(self%mine, .true., 1)
     call par_split(color, self%group_comm)
+    ! every rank has every body's factor object: its own bodies' are factorized, the others
+    ! receive their sizes (share_condensed)
+    do a = 1, nb
+      call new_factor(run%deck%solver%factor, a, run%bodies(a)%fac, self%group_comm)
+    end do
     if (run%ranks == 1) return
     if (run%ranks >= nb) then
       line = 'mumps:'
@@ -133,7 +138,7 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its bodies condensed
     integer :: a
     do a = 1, run%nbody
-      if (self%mine(a)) call condense_body_mumps(run%systems(a), run%bodies(a), self%solver(a), a, self%err(a))
+      if (self%mine(a)) call condense_body(run%systems(a), run%bodies(a), self%err(a))
     end do
     call self%agree_fatal('condensation failed')
     call share_condensed(self, run)
@@ -147,22 +152,23 @@ contains
     type(run_t), intent(inout) :: run
     integer :: b, iv(1), m
     real(wp) :: rv(4)
+    real(wp), allocatable :: max_rank_mb(:)
     do b = 1, run%nbody
-      associate (body => run%bodies(b), solver => self%solver(b))
+      associate (body => run%bodies(b), fac => run%bodies(b)%fac)
         m = body%m
-        if (.not. (self%mine(b) .and. solver%host)) then
+        if (.not. (self%mine(b) .and. fac%holds_result())) then
           if (allocated(body%flex)) deallocate (body%flex)
           allocate (body%flex(m, m))
         end if
         if (.not. allocated(body%b)) allocate (body%b(m))
         call par_bcast_reals(body%flex, m*m, self%host(b))
         call par_bcast_reals(body%b, m, self%host(b))
-        rv = [body%prox, solver%mem_bytes, solver%max_rank_mb, solver%factor_mb]
+        rv = [body%prox, fac%stats%mem_bytes, fac%stats%max_rank_mb, fac%stats%factor_mb]
         call par_bcast_reals(rv, 4, self%host(b))
         body%prox = rv(1)
-        solver%mem_bytes = rv(2)
-        solver%max_rank_mb = rv(3)
-        solver%factor_mb = rv(4)
+        fac%stats%mem_bytes = rv(2)
+        fac%stats%max_rank_mb = rv(3)
+        fac%stats%factor_mb = rv(4)
         iv(1) = body%rank
         call par_bcast_ints(iv, 1, self%host(b))
         body%rank = iv(1)
@@ -172,7 +178,7 @@ contains
         if (allocated(body%kern)) iv(1) = size(body%kern, 2)
         call par_bcast_ints(iv, 1, self%host(b))
         if (iv(1) >= 0) then
-          if (.not. (self%mine(b) .and. solver%host)) then
+          if (.not. (self%mine(b) .and. fac%holds_result())) then
             if (allocated(body%kern)) deallocate (body%kern)
             allocate (body%kern(m, iv(1)))
           end if
@@ -181,12 +187,13 @@ contains
       end associate
       call self%err(b)%clear()
     end do
+    max_rank_mb = [(run%bodies(b)%fac%stats%max_rank_mb, b=1, run%nbody)]
     if (run%nbody == 2) then
       write (output_unit, '(a,2(f0.1,a))') 'mumps: largest rank''s factorization memory: body 1 ', &
-        self%solver(1)%max_rank_mb, ' MB, body 2 ', self%solver(2)%max_rank_mb, ' MB'
+        max_rank_mb(1), ' MB, body 2 ', max_rank_mb(2), ' MB'
     else
       write (output_unit, '(a,f0.1,a,i0,a)') 'mumps: largest rank''s factorization memory ', &
-        maxval(self%solver(:)%max_rank_mb), ' MB (body ', maxloc(self%solver(:)%max_rank_mb, 1), ')'
+        maxval(max_rank_mb), ' MB (body ', maxloc(max_rank_mb, 1), ')'
     end if
   end subroutine share_condensed
 
@@ -195,20 +202,12 @@ contains
   subroutine condense_load(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies' interface loads
-    real(wp), allocatable :: u0(:)
     integer :: a
     do a = 1, run%nbody
       call self%err(a)%clear()
       if (.not. self%mine(a)) cycle
       call prescribed_part(run%contact_line, run%systems(a), run%bodies(a))
-      if (self%solver(a)%host) then
-        u0 = run%systems(a)%f
-      else
-        allocate (u0(0))
-      end if
-      call mumps_solve(self%solver(a), u0, a, self%err(a))
-      if (.not. self%err(a)%failed() .and. self%solver(a)%host) call apply_b(run%bodies(a), u0, run%bodies(a)%b)
-      deallocate (u0)
+      call interface_load(run%systems(a), run%bodies(a), self%err(a))
     end do
     call self%agree_fatal('load step condensation failed')
     do a = 1, run%nbody
@@ -221,7 +220,8 @@ contains
   subroutine record_factor_memory(self, run)
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its timing
-    run%timing%factor_mb = sum(self%solver(:)%mem_bytes)/1048576.0_wp
+    integer :: a
+    run%timing%factor_mb = sum([(run%bodies(a)%fac%stats%mem_bytes, a=1, run%nbody)])/1048576.0_wp
   end subroutine record_factor_memory
 
   !> Rank 0's contact forces and status to every rank (the others need lam to recover their
@@ -252,10 +252,9 @@ contains
       if (.not. self%mine(b)) cycle
       allocate (uf(run%systems(b)%n))
       uf = 0.0_wp
-      call recover_displacement_mumps(run%systems(b), run%bodies(b), self%solver(b), b, &
-                                      gather(run%result%lam_body, run%bodies(b)%slots), &
-                                      uf, self%err(b))
-      if (self%solver(b)%host) call expand(run%systems(b), uf, run%displacement(1:run%systems(b)%ndof, b))
+      call recover_displacement(run%systems(b), run%bodies(b), gather(run%result%lam_body, run%bodies(b)%slots), &
+                                uf, self%err(b))
+      if (run%bodies(b)%fac%holds_result()) call expand(run%systems(b), uf, run%displacement(1:run%systems(b)%ndof, b))
       deallocate (uf)
     end do
     call self%agree_fatal('displacement recovery failed')
@@ -294,7 +293,7 @@ contains
     do r = 0, run%ranks - 1
       rv = [0.0_wp, peak_rss_mb()]
       do a = 1, run%nbody
-        if (self%mine(a)) rv(1) = rv(1) + self%solver(a)%rank_factor_mb
+        if (self%mine(a)) rv(1) = rv(1) + run%bodies(a)%fac%stats%rank_factor_mb
       end do
       iv = merge(1, 0, self%mine)
       call par_bcast_reals(rv, 2, r)
@@ -337,7 +336,7 @@ contains
     integer :: b
     if (allocated(self%mine)) then
       do b = 1, run%nbody
-        if (self%mine(b)) call mumps_end(self%solver(b))
+        if (self%mine(b)) call run%bodies(b)%fac%free()
       end do
     end if
     call par_finalize()

@@ -1,6 +1,6 @@
 !> The serial back-end: every body in this process, the bodies on the OpenMP threads
 !! (dynamic schedule, largest first), factorized by CHOLMOD or the banded Cholesky
-!! (condense::factor_body).
+!! (condense::factor_body, each body's factorization%factor_t).
 module serial_backend
   use kinds, only: wp
   use errors, only: terminate, error_t, fail_on
@@ -99,14 +99,14 @@ contains
     end do
   end subroutine condense_load
 
-  !> The Cholesky factors' memory [MiB].
+  !> The factors' memory [MiB].
   subroutine record_factor_memory(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its timing
     integer :: a
     run%timing%factor_mb = 0.0_wp
     do a = 1, run%nbody
-      run%timing%factor_mb = run%timing%factor_mb + run%bodies(a)%chol%mem_bytes/1048576.0_wp
+      run%timing%factor_mb = run%timing%factor_mb + run%bodies(a)%fac%stats%mem_bytes/1048576.0_wp
     end do
   end subroutine record_factor_memory
 
@@ -121,18 +121,24 @@ contains
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its displacements
     real(wp), allocatable :: ufree(:)
+    type(error_t), allocatable :: err(:)
     integer, allocatable :: order(:)
     integer :: a, k
+    allocate (err(run%nbody))
     order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
     !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(ufree, a)
     do k = 1, run%nbody
       a = order(k)
       allocate (ufree(run%systems(a)%n))
-      call recover_displacement(run%systems(a), run%bodies(a), gather(run%result%lam_body, run%bodies(a)%slots), ufree)
-      call expand(run%systems(a), ufree, run%displacement(1:run%systems(a)%ndof, a))
+      call recover_displacement(run%systems(a), run%bodies(a), gather(run%result%lam_body, run%bodies(a)%slots), ufree, &
+                                err(a))
+      if (.not. err(a)%failed()) call expand(run%systems(a), ufree, run%displacement(1:run%systems(a)%ndof, a))
       deallocate (ufree)
     end do
     !$omp end parallel do
+    do a = 1, run%nbody
+      call fail_on(err(a), 'body '//body_label(a)//': displacement recovery failed')
+    end do
   end subroutine recover
 
   !> One process decides its exit code alone.

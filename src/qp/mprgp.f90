@@ -24,10 +24,14 @@
 !! x gets an exact line search along -beta (proportioning step), which releases variables
 !! from their bounds; in a box it is cut where a released variable reaches its other bound.
 !!
-!! A lower bound -huge(1.0_wp) or an upper bound +huge(1.0_wp) means "no bound"; the upper
-!! bounds are optional (absent: none). All other bounds must be finite, and l <= u. The
-!! upper-bound branches are never taken when u = +huge, so a solve without upper bounds
-!! executes the same floating-point operations, iterate for iterate, with or without ub.
+!! The solver reaches its constraints only through one `class(constraint_set_t)` (module
+!! constraint_set: the projection, the free set, the chopped, projected and reduced
+!! gradients, the feasible step): `solve_in` takes any such set, `solve` the box
+!! lb <= x <= ub as a `box_set_t`. A lower bound -huge(1.0_wp) or an upper bound
+!! +huge(1.0_wp) means "no bound"; the upper bounds are optional (absent: none). All other
+!! bounds must be finite, and l <= u. The upper-bound branches are never taken when
+!! u = +huge, so a solve without upper bounds executes the same floating-point operations,
+!! iterate for iterate, with or without ub.
 !!
 !! Thread safety: no module variables, no SAVE, work arrays are local to each call.
 !! Two threads may solve concurrently with two different operators.
@@ -40,13 +44,13 @@ module mprgp
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
                            QP_AUTO, QP_MPRGP, QP_NEWTON
-  use mprgp_support, only: lambda_max_estimate, power_iteration, projected_gradient_norm, line_search, &
-                           recycled_subspace, store_direction, chopped
+  use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
+  use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped, SET_OK, SET_NONFINITE
   implicit none (type, external)
   private
 
   public :: lambda_max_estimate, mprgp_status_name, chopped
-  public :: mprgp_t, mprgp_opts_t, mprgp_stats_t
+  public :: mprgp_t, mprgp_opts_t, mprgp_stats_t, constraint_set_t, box_set_t, box_set
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
   public :: QP_AUTO, QP_MPRGP, QP_NEWTON
 
@@ -89,8 +93,10 @@ module mprgp
     real(wp), private :: lam_lo = 0.0_wp   ! largest known lower bound of lambda_max
     real(wp), private :: xscale0 = 0.0_wp  ! |x| of the projected start
     real(wp), allocatable, private :: p(:), ap(:), w(:), v(:), av(:)
+    logical, allocatable, private :: free(:)  ! the free set of the iterate, where it was last taken
   contains
     procedure :: solve => mprgp_solve
+    procedure :: solve_in => mprgp_solve_in
   end type mprgp_t
 
   !> What the stopping test asks the main loop to do.
@@ -147,11 +153,24 @@ contains
     real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
     integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
     real(wp), intent(in), optional :: ub(:)         !< upper bounds (size n, >= lb); +huge(1.0_wp): none
-    real(wp), allocatable :: u(:)
+    call mprgp_solve_in(self, A, b, box_set(lb, ub), x, rw, raw, nrw)
+  end subroutine mprgp_solve
+
+  !> Solve min 1/2 x'Ax - b'x subject to x in `set` by MPRGP: `solve` for any constraint
+  !! set (the warm start x is projected onto the set first).
+  subroutine mprgp_solve_in(self, A, b, set, x, rw, raw, nrw)
+    class(mprgp_t), intent(inout) :: self           !< the solver (options in, outcome out)
+    class(linop_t), intent(inout) :: A              !< SPD operator (size A%n)
+    real(wp), intent(in) :: b(:)                    !< linear term (size n)
+    class(constraint_set_t), intent(in) :: set      !< the feasible set
+    real(wp), intent(inout) :: x(:)                 !< in: warm start; out: solution
+    real(wp), intent(inout), optional :: rw(:, :)   !< (n, k) stored directions, A-normalised (needs raw, nrw)
+    real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
+    integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
     integer :: method, max_it, budget
 
     self%stats = mprgp_stats_t()
-    if (.not. valid_arguments(self, A%n, b, lb, x, rw, raw, nrw, ub)) then
+    if (.not. valid_arguments(self, A%n, b, set, x, rw, raw, nrw)) then
       call consume_search(self)
       return
     end if
@@ -162,17 +181,12 @@ contains
       call consume_search(self)
       return
     end if
-    if (present(ub)) then
-      u = ub
-    else
-      allocate (u(self%n), source=huge(1.0_wp))
-    end if
-    call start(self, A, b, lb, u, x, rw, raw, nrw)
+    call start(self, A, b, set, x, rw, raw, nrw)
     method = self%opts%method
     if (method /= QP_MPRGP .and. self%n > NEWTON_MAX_N) method = QP_MPRGP
     select case (method)
     case (QP_NEWTON)
-      call newton_loop(self, A, b, lb, u, x)
+      call newton_loop(self, A, b, set, x)
     case (QP_AUTO)
       ! MPRGP within a budget of about three factorizations' work; the Newton method from
       ! where it stopped (a conditioning MPRGP pays for, the Newton method does not)
@@ -180,49 +194,50 @@ contains
       budget = self%opts%auto_budget
       if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/2)
       self%opts%max_it = min(max_it, budget)
-      call mprgp_loop(self, A, b, lb, u, x, rw, raw, nrw)
+      call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
       self%opts%max_it = max_it
       if (self%stats%status == MPRGP_MAX_IT .and. budget < max_it) then
         self%stats%switched = .true.
         if (.not. self%fresh) call true_gradient(self, A, b, x)
-        call newton_loop(self, A, b, lb, u, x)
+        call newton_loop(self, A, b, set, x)
       end if
     case default
-      call mprgp_loop(self, A, b, lb, u, x, rw, raw, nrw)
+      call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
     end select
     self%stats%lambda_max = self%lam_lo
     self%stats%alpha_bar = self%ab
     ! Report the true gradient (and |gP| from it) unless the iteration broke down.
     if (.not. self%fresh .and. (self%stats%status == MPRGP_MAX_IT .or. self%stats%status == MPRGP_NOT_SPD)) then
       call true_gradient(self, A, b, x)
-      self%stats%gp_norm = proj_grad_norm(self, lb, u, x)
+      self%stats%gp_norm = set%projected_gradient_norm(x, self%g)
     end if
     if (.not. self%fresh) self%ax = self%g + b
     call consume_search(self)
-  end subroutine mprgp_solve
+  end subroutine mprgp_solve_in
 
   !> MPRGP's steps until the stopping test ends the solve.
-  subroutine mprgp_loop(self, A, b, lb, ub, x, rw, raw, nrw)
+  subroutine mprgp_loop(self, A, b, set, x, rw, raw, nrw)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: b(:), lb(:), ub(:)
+    real(wp), intent(in) :: b(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: x(:)
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
     integer, intent(inout), optional :: nrw(2)
     real(wp) :: betabeta, phitphi
     logical :: ok
     main: do
-      select case (stopping_test(self, A, b, lb, ub, x, betabeta, phitphi))
+      select case (stopping_test(self, A, b, set, x, betabeta, phitphi))
       case (DONE)
         exit main
       case (RETEST)
         cycle main
       end select
       self%it = self%it + 1
-      if (proportional(self, A, lb, ub, x, betabeta, phitphi, ok)) then
-        if (ok) ok = cg_or_expansion_step(self, A, lb, ub, x, rw, raw, nrw)
+      if (proportional(self, A, set, x, betabeta, phitphi, ok)) then
+        if (ok) ok = cg_or_expansion_step(self, A, set, x, rw, raw, nrw)
       else if (ok) then
-        ok = proportioning_step(self, A, lb, ub, x, betabeta)
+        ok = proportioning_step(self, A, set, x, betabeta)
       end if
       if (.not. ok) exit main
     end do main
@@ -235,10 +250,11 @@ contains
   !! tolerance is below what double precision resolves for this A, and the solve ends as
   !! converged to working precision when |gP| is within NEWTON_FLOOR n eps lambda_max |x|
   !! (a Cholesky solve's backward error), as failed (max_it) above it.
-  subroutine newton_loop(self, A, b, lb, ub, x)
+  subroutine newton_loop(self, A, b, set, x)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: b(:), lb(:), ub(:)
+    real(wp), intent(in) :: b(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: x(:)
     type(newton_work_t) :: work
     real(wp) :: betabeta, phitphi, flops, floor
@@ -271,14 +287,14 @@ contains
       logical :: refined
       refined = .false.
       main: do
-        select case (stopping_test(self, A, b, lb, ub, x, betabeta, phitphi))
+        select case (stopping_test(self, A, b, set, x, betabeta, phitphi))
         case (DONE)
           exit main
         case (RETEST)
           cycle main
         end select
         self%it = self%it + 1
-        call newton_step(am, lb, ub, x, self%g, self%ax, work, outcome, flops)
+        call newton_step(am, set, x, self%g, self%ax, work, outcome, flops)
         self%fresh = .false.
         self%stats%n_newton = self%stats%n_newton + 1
         if (work%nfree > 0 .and. outcome /= NEWTON_NOT_SPD) self%stats%n_factor = self%stats%n_factor + 1
@@ -295,7 +311,7 @@ contains
         ! x solves its face (twice in a row): the gradient afresh, and one more step from it
         ! when that is not enough; a second time, the rounding level of A is reached
         call true_gradient(self, A, b, x)
-        self%stats%gp_norm = proj_grad_norm(self, lb, ub, x)
+        self%stats%gp_norm = set%projected_gradient_norm(x, self%g)
         if ((self%stats%gp_norm <= self%tol .and. .not. self%zero_tol) .or. .not. refined) then
           refined = .true.
           cycle main
@@ -328,14 +344,15 @@ contains
 
   !> Check sizes, options and finiteness before any work; sets self%n, allocates the
   !! solver's vectors. False (with the status and message) when the solve cannot start.
-  logical function valid_arguments(self, n, b, lb, x, rw, raw, nrw, ub) result(ok)
+  logical function valid_arguments(self, n, b, set, x, rw, raw, nrw) result(ok)
     type(mprgp_t), intent(inout) :: self
     integer, intent(in) :: n
-    real(wp), intent(in) :: b(:), lb(:), x(:)
+    real(wp), intent(in) :: b(:), x(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(in), optional :: rw(:, :), raw(:, :)
     integer, intent(in), optional :: nrw(2)
-    real(wp), intent(in), optional :: ub(:)
-    integer :: i
+    integer :: i, code
+    character(len=:), allocatable :: why
     ok = .false.
     self%n = n
     if (n < 0) then
@@ -346,18 +363,16 @@ contains
       if (size(self%g) /= n) deallocate (self%g)
     end if
     if (.not. allocated(self%g)) allocate (self%g(n))
-    if (size(b) /= n .or. size(lb) /= n .or. size(x) /= n) then
-      write (self%stats%message, '(a,i0,a,i0,a,i0,a,i0)') 'size mismatch: A%n = ', n, &
-        ', size(b) = ', size(b), ', size(lb) = ', size(lb), ', size(x) = ', size(x)
+    if (size(b) /= n .or. size(x) /= n) then
+      write (self%stats%message, '(a,i0,a,i0,a,i0)') 'size mismatch: A%n = ', n, &
+        ', size(b) = ', size(b), ', size(x) = ', size(x)
       self%stats%status = MPRGP_BAD_ARG
       return
     end if
-    if (present(ub)) then
-      if (size(ub) /= n) then
-        write (self%stats%message, '(a,i0,a,i0)') 'size mismatch: A%n = ', n, ', size(ub) = ', size(ub)
-        self%stats%status = MPRGP_BAD_ARG
-        return
-      end if
+    call set%validate(n, code, why)
+    if (code /= SET_OK) then
+      call fail(self, merge(MPRGP_NONFINITE, MPRGP_BAD_ARG, code == SET_NONFINITE), why)
+      return
     end if
     if (self%opts%use_ax) then
       if (.not. allocated(self%ax)) then
@@ -408,23 +423,9 @@ contains
         call fail(self, MPRGP_NONFINITE, 'b('//trim(itoa(i))//') is not finite')
         return
       end if
-      if (.not. ieee_is_finite(lb(i))) then
-        call fail(self, MPRGP_NONFINITE, 'lb('//trim(itoa(i))//') is not finite (use -huge(1.0_wp) for no bound)')
-        return
-      end if
       if (.not. ieee_is_finite(x(i))) then
         call fail(self, MPRGP_NONFINITE, 'initial x('//trim(itoa(i))//') is not finite')
         return
-      end if
-      if (present(ub)) then
-        if (.not. ieee_is_finite(ub(i))) then
-          call fail(self, MPRGP_NONFINITE, 'ub('//trim(itoa(i))//') is not finite (use huge(1.0_wp) for no bound)')
-          return
-        end if
-        if (ub(i) < lb(i)) then
-          call fail(self, MPRGP_BAD_ARG, 'ub('//trim(itoa(i))//') < lb('//trim(itoa(i))//'): the box is empty')
-          return
-        end if
       end if
     end do
     if (allocated(self%ax)) then
@@ -445,10 +446,11 @@ contains
 
   !> Project the warm start, take its gradient (from ax with opts%use_ax), and unless it
   !! already meets the tolerance, the recycled subspace step or the first line search.
-  subroutine start(self, A, b, lb, ub, x, rw, raw, nrw)
+  subroutine start(self, A, b, set, x, rw, raw, nrw)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: b(:), lb(:), ub(:)
+    real(wp), intent(in) :: b(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: x(:)
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
     integer, intent(inout), optional :: nrw(2)
@@ -459,13 +461,13 @@ contains
     self%tol = max(self%opts%rtol * self%stats%b_norm, self%opts%atol)
     self%zero_tol = (self%tol <= 0.0_wp)
     if (allocated(self%p)) then
-      if (size(self%p) /= n) deallocate (self%p, self%ap, self%w, self%v, self%av)
+      if (size(self%p) /= n) deallocate (self%p, self%ap, self%w, self%v, self%av, self%free)
     end if
-    if (.not. allocated(self%p)) allocate (self%p(n), self%ap(n), self%w(n), self%v(n), self%av(n))
+    if (.not. allocated(self%p)) allocate (self%p(n), self%ap(n), self%w(n), self%v(n), self%av(n), self%free(n))
     self%ab = 0.0_wp
     self%lam_lo = 0.0_wp
     if (self%opts%lambda_max > 0.0_wp) self%lam_lo = self%opts%lambda_max
-    x = min(max(x, lb), ub)
+    call set%project(x)
     self%xscale0 = norm2(x)
     if (self%opts%use_ax) then
       self%g = self%ax - b
@@ -477,54 +479,43 @@ contains
     end if
     self%fresh = .true.
     ! a warm start that already meets the tolerance is returned as it is (no product)
-    if (self%zero_tol .or. proj_grad_norm(self, lb, ub, x) > self%tol) then
+    if (self%zero_tol .or. set%projected_gradient_norm(x, self%g) > self%tol) then
       if (present(rw) .and. self%opts%recycle) then
         if (allocated(self%s)) then
-          moved = recycled_subspace(x, self%g, lb, ub, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
+          moved = recycled_subspace(x, self%g, set, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
                                     self%p, self%ap, self%s, self%as)
         else
-          moved = recycled_subspace(x, self%g, lb, ub, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
+          moved = recycled_subspace(x, self%g, set, rw, raw, nrw(1), self%opts%gamma, self%v, self%av, &
                                     self%p, self%ap)
         end if
       else if (allocated(self%s)) then
-        moved = line_search(x, self%g, lb, ub, self%s, self%as, .false., self%opts%gamma, self%p, self%ap)
+        moved = line_search(x, self%g, set, self%s, self%as, .false., self%opts%gamma, self%p, self%ap)
       end if
       if (moved) then
         self%stats%n_recycled = self%stats%n_recycled + 1
         self%fresh = .false.
       end if
     end if
-    call set_p_to_phi(self, lb, ub, x)
+    call set_p_to_phi(self, set, x)
     self%it = 0
   end subroutine start
 
   !> Split the gradient, test convergence (confirmed on the true gradient), max_it and the
   !! stop hook. DONE: the solve ends; RETEST: the true gradient was taken, test again;
   !! GO_ON: take a step (betabeta = |chopped gradient|^2, phitphi = phit'phi).
-  integer function stopping_test(self, A, b, lb, ub, x, betabeta, phitphi) result(action)
+  integer function stopping_test(self, A, b, set, x, betabeta, phitphi) result(action)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: b(:), lb(:), ub(:), x(:)
+    real(wp), intent(in) :: b(:), x(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(out) :: betabeta, phitphi
-    real(wp) :: phiphi, gp2, phi, beta, tol_now, feas, floor_eq
+    real(wp) :: phiphi, gp2, tol_now, feas, floor_eq
     character(len=24) :: s1, s2
-    integer :: i, n
+    integer :: n
     n = self%n
     action = DONE
     ! Split the gradient (one pass).
-    phiphi = 0.0_wp
-    phitphi = 0.0_wp
-    betabeta = 0.0_wp
-    do i = 1, n
-      if (x(i) > lb(i) .and. x(i) < ub(i)) then
-        phi = self%g(i)
-        phiphi = phiphi + phi * phi
-        phitphi = phitphi + reduced_free(self%ab, phi, x(i), lb(i), ub(i)) * phi
-      else
-        beta = chopped(self%g(i), x(i), lb(i), ub(i))
-        betabeta = betabeta + beta * beta
-      end if
-    end do
+    call set%split_gradient(x, self%g, self%ab, phiphi, phitphi, betabeta)
     gp2 = phiphi + betabeta
     self%stats%gp_norm = sqrt(gp2)
     if (.not. ieee_is_finite(gp2)) then
@@ -559,7 +550,7 @@ contains
         return
       end if
       call true_gradient(self, A, b, x)
-      call set_p_to_phi(self, lb, ub, x)
+      call set_p_to_phi(self, set, x)
       action = RETEST
       return
     end if
@@ -568,7 +559,7 @@ contains
         ! the tolerance was out of reach: within the rounding level of A x it is met
         if (.not. self%fresh) then
           call true_gradient(self, A, b, x)
-          self%stats%gp_norm = proj_grad_norm(self, lb, ub, x)
+          self%stats%gp_norm = set%projected_gradient_norm(x, self%g)
         end if
         write (s1, '(es10.3)') self%stats%gp_norm
         if (self%stats%gp_norm <= 10.0_wp*sqrt(real(n, wp))*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)) then
@@ -597,45 +588,37 @@ contains
 
   !> The proportionality test |beta|^2 <= Gamma^2 phit'phi (alpha_bar is needed only when
   !! some bound is active). ok = .false. when alpha_bar could not be had.
-  logical function proportional(self, A, lb, ub, x, betabeta, phitphi, ok) result(prop)
+  logical function proportional(self, A, set, x, betabeta, phitphi, ok) result(prop)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:), ub(:), x(:), betabeta
+    class(constraint_set_t), intent(in) :: set
+    real(wp), intent(in) :: x(:), betabeta
     real(wp), intent(inout) :: phitphi       !< phit'phi (recomputed once alpha_bar is known)
     logical, intent(out) :: ok
-    real(wp) :: phi
-    integer :: i
+    real(wp) :: phiphi, betabeta_now
     prop = .false.
     ok = .true.
     if (betabeta > 0.0_wp .and. self%ab <= 0.0_wp) then
       ok = ensure_alpha(self, A)
       if (.not. ok) return
-      phitphi = 0.0_wp
-      do i = 1, self%n
-        if (x(i) > lb(i) .and. x(i) < ub(i)) then
-          phi = self%g(i)
-          phitphi = phitphi + reduced_free(self%ab, phi, x(i), lb(i), ub(i)) * phi
-        end if
-      end do
+      call set%split_gradient(x, self%g, self%ab, phiphi, phitphi, betabeta_now)
     end if
     prop = (betabeta <= self%opts%gamma**2 * phitphi)
   end function proportional
 
   !> Trial conjugate gradient step along -p: taken when it stays feasible (CG step),
   !! otherwise its feasible part followed by an expansion step. False on a breakdown.
-  logical function cg_or_expansion_step(self, A, lb, ub, x, rw, raw, nrw) result(ok)
+  logical function cg_or_expansion_step(self, A, set, x, rw, raw, nrw) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:), ub(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: x(:)
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
     integer, intent(inout), optional :: nrw(2)
-    real(wp), parameter :: big = huge(1.0_wp)
-    real(wp) :: pap, pp, gtp, acg, af, num, gam, slack
+    real(wp) :: pap, pp, gtp, acg, af, num, gam
     integer :: i, n, blk
-    logical :: blk_up
     n = self%n
-    associate (p => self%p, ap => self%ap, gr => self%g)
+    associate (p => self%p, ap => self%ap, gr => self%g, d => self%w, free => self%free)
       call A%apply(p, ap)
       self%stats%n_matvec = self%stats%n_matvec + 1
       pap = 0.0_wp
@@ -650,39 +633,20 @@ contains
       if (.not. ok) return
       if (present(rw)) call store_direction(p, ap, rw, raw, nrw)
       acg = gtp / pap
-      ! Largest feasible step along -p, capped at acg (no division can overflow); blk is
-      ! the variable that blocks it, blk_up whether at its upper bound.
-      af = acg
-      blk = 0
-      blk_up = .false.
-      do i = 1, n
-        if (p(i) > 0.0_wp .and. lb(i) > -big) then
-          slack = x(i) - lb(i)
-          if (slack < af * p(i)) then
-            af = slack / p(i)
-            blk = i
-            blk_up = .false.
-          end if
-        else if (p(i) < 0.0_wp .and. ub(i) < big) then
-          slack = ub(i) - x(i)
-          if (slack < -af * p(i)) then
-            af = slack / (-p(i))
-            blk = i
-            blk_up = .true.
-          end if
-        end if
-      end do
+      ! Largest feasible step along d = -p, capped at acg; blk is the variable that blocks it.
+      d = -p
+      call set%max_step(x, d, acg, af, blk)
       if (blk == 0) then
         ! CG step.
+        call set%move(x, d, acg, free)
         num = 0.0_wp
         do i = 1, n
-          x(i) = min(max(x(i) - acg * p(i), lb(i)), ub(i))
           gr(i) = gr(i) - acg * ap(i)
-          if (x(i) > lb(i) .and. x(i) < ub(i)) num = num + gr(i) * ap(i)
+          if (free(i)) num = num + gr(i) * ap(i)
         end do
         gam = num / pap
         do i = 1, n
-          if (x(i) > lb(i) .and. x(i) < ub(i)) then
+          if (free(i)) then
             p(i) = gr(i) - gam * p(i)
           else
             p(i) = -gam * p(i)
@@ -694,27 +658,22 @@ contains
       end if
       ! the feasible half step
       af = max(af, 0.0_wp)
+      call set%move(x, d, af, free)
       do i = 1, n
-        x(i) = min(max(x(i) - af * p(i), lb(i)), ub(i))
         gr(i) = gr(i) - af * ap(i)
       end do
-      if (blk_up) then
-        x(blk) = ub(blk)
-      else
-        x(blk) = lb(blk)
-      end if
+      call set%pin(x, d, blk)
     end associate
-    ok = expansion_step(self, A, lb, ub, x)
+    ok = expansion_step(self, A, set, x)
   end function cg_or_expansion_step
 
   !> Projected step of length alpha_bar along the free gradient, recomputed with a cut
   !! alpha_bar while it increases the cost (the guard above); then CG restarts.
-  logical function expansion_step(self, A, lb, ub, x) result(ok)
+  logical function expansion_step(self, A, set, x) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:), ub(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: x(:)
-    real(wp), parameter :: big = huge(1.0_wp)
     real(wp) :: dd, dad, df, ab_prev
     integer :: i, n, retry
     n = self%n
@@ -724,14 +683,9 @@ contains
     associate (p => self%p, ap => self%ap, gr => self%g)
       expand: do
         ! Candidate step d = P(x - ab*phi) - x = -ab*phit, stored in p (reset afterwards).
+        call set%projected_step(x, gr, self%ab, p)
         dd = 0.0_wp
         do i = 1, n
-          if (x(i) > lb(i) .and. x(i) < ub(i)) then
-            p(i) = max(lb(i) - x(i), -self%ab * gr(i))
-            if (ub(i) < big) p(i) = min(p(i), ub(i) - x(i))
-          else
-            p(i) = 0.0_wp
-          end if
           dd = dd + p(i) * p(i)
         end do
         if (dd <= 0.0_wp) exit expand
@@ -752,39 +706,32 @@ contains
           retry = retry + 1
           cycle expand
         end if
+        call set%move(x, p, 1.0_wp, self%free)
         do i = 1, n
-          x(i) = min(max(x(i) + p(i), lb(i)), ub(i))
           gr(i) = gr(i) + ap(i)
         end do
         exit expand
       end do expand
     end associate
-    call set_p_to_phi(self, lb, ub, x)
+    call set_p_to_phi(self, set, x)
     self%stats%n_exp = self%stats%n_exp + 1
     self%fresh = .false.
   end function expansion_step
 
   !> Exact line search along -beta (the chopped gradient), which releases variables from
-  !! their bounds, cut where a released variable reaches its opposite bound (in a box).
-  !! False on a breakdown.
-  logical function proportioning_step(self, A, lb, ub, x, betabeta) result(ok)
+  !! the boundary, cut where a released variable reaches the boundary again (in a box: its
+  !! opposite bound). False on a breakdown.
+  logical function proportioning_step(self, A, set, x, betabeta) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
-    real(wp), intent(in) :: lb(:), ub(:), betabeta
+    class(constraint_set_t), intent(in) :: set
+    real(wp), intent(in) :: betabeta
     real(wp), intent(inout) :: x(:)
-    real(wp), parameter :: big = huge(1.0_wp)
-    real(wp) :: pap, pp, acg, slack
+    real(wp) :: pap, pp, acg
     integer :: i, n, blk
-    logical :: blk_up
     n = self%n
-    associate (p => self%p, ap => self%ap, gr => self%g)
-      do i = 1, n
-        if (x(i) > lb(i) .and. x(i) < ub(i)) then
-          p(i) = 0.0_wp
-        else
-          p(i) = chopped(gr(i), x(i), lb(i), ub(i))
-        end if
-      end do
+    associate (p => self%p, ap => self%ap, gr => self%g, d => self%w, free => self%free)
+      call set%chopped_gradient(x, gr, p)
       call A%apply(p, ap)
       self%stats%n_matvec = self%stats%n_matvec + 1
       pap = 0.0_wp
@@ -795,42 +742,19 @@ contains
       end do
       ok = check_curvature(self, pap, pp, 'proportioning direction')
       if (.not. ok) return
-      acg = betabeta / pap
-      ! A variable released from l may reach u first (and one from u reach l): the step is
-      ! cut there, so that the recurrence gradient stays that of x. With lower bounds only,
-      ! p <= 0 and no upper bound is finite: no step is cut.
-      blk = 0
-      blk_up = .false.
+      ! A variable released from the boundary may reach it again (in a box, one released
+      ! from l may reach u first): the step is cut there, so that the recurrence gradient
+      ! stays that of x. With lower bounds only, p <= 0 and no upper bound is finite: no
+      ! step is cut.
+      d = -p
+      call set%max_step(x, d, betabeta / pap, acg, blk)
+      call set%move(x, d, acg, free)
       do i = 1, n
-        if (p(i) < 0.0_wp .and. ub(i) < big) then
-          slack = ub(i) - x(i)
-          if (slack < -acg * p(i)) then
-            acg = slack / (-p(i))
-            blk = i
-            blk_up = .true.
-          end if
-        else if (p(i) > 0.0_wp .and. lb(i) > -big) then
-          slack = x(i) - lb(i)
-          if (slack < acg * p(i)) then
-            acg = slack / p(i)
-            blk = i
-            blk_up = .false.
-          end if
-        end if
-      end do
-      do i = 1, n
-        x(i) = min(max(x(i) - acg * p(i), lb(i)), ub(i))
         gr(i) = gr(i) - acg * ap(i)
       end do
-      if (blk > 0) then
-        if (blk_up) then
-          x(blk) = ub(blk)
-        else
-          x(blk) = lb(blk)
-        end if
-      end if
+      call set%pin(x, d, blk)
     end associate
-    call set_p_to_phi(self, lb, ub, x)
+    call set_p_to_phi(self, set, x)
     self%stats%n_prop = self%stats%n_prop + 1
     self%fresh = .false.
   end function proportioning_step
@@ -844,44 +768,13 @@ contains
     self%stats%message = msg
   end subroutine fail
 
-  !> p = phi(x).
-  subroutine set_p_to_phi(self, lb, ub, x)
+  !> p = phi(x), the free gradient.
+  subroutine set_p_to_phi(self, set, x)
     type(mprgp_t), intent(inout) :: self
-    real(wp), intent(in) :: lb(:), ub(:), x(:)
-    integer :: j
-    do j = 1, self%n
-      if (x(j) > lb(j) .and. x(j) < ub(j)) then
-        self%p(j) = self%g(j)
-      else
-        self%p(j) = 0.0_wp
-      end if
-    end do
+    class(constraint_set_t), intent(in) :: set
+    real(wp), intent(in) :: x(:)
+    call set%free_gradient(x, self%g, self%p)
   end subroutine set_p_to_phi
-
-  !> |gP| for the current x and g.
-  real(wp) function proj_grad_norm(self, lb, ub, x) result(r)
-    type(mprgp_t), intent(in) :: self
-    real(wp), intent(in) :: lb(:), ub(:), x(:)
-    r = projected_gradient_norm(self%g, x, lb, ub)
-  end function proj_grad_norm
-
-  !> phit_i of a free variable: phi cut to (x - lb)/ab when phi > 0 and to (x - ub)/ab when
-  !! phi < 0, so that x - ab phit stays in the box; phi itself while ab is not known (0).
-  pure real(wp) function reduced_free(ab, phi, x, lb, ub) result(phit)
-    real(wp), intent(in) :: ab, phi, x, lb, ub
-    real(wp), parameter :: big = huge(1.0_wp)
-    real(wp) :: slack
-    phit = phi
-    if (ab <= 0.0_wp) return
-    if (lb > -big) then
-      slack = x - lb
-      if (slack < ab * phi) phit = slack / ab
-    end if
-    if (ub < big) then
-      slack = ub - x
-      if (slack < -ab * phi) phit = -slack / ab
-    end if
-  end function reduced_free
 
   !> g = A x - b computed directly.
   subroutine true_gradient(self, A, b, x)

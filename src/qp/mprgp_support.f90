@@ -2,20 +2,17 @@
 !! lambda_max, the norm of the projected gradient, and the steps that cost no product with
 !! A because the images of their directions are known: an exact line search, and the
 !! Galerkin step over a ring of stored A-normalised directions (Krylov recycling) with the
-!! ring's upkeep. Box bounds lb <= x <= ub: a lower bound -huge(1.0_wp) or an upper bound
-!! +huge(1.0_wp) means "no bound"; x_i is free when lb_i < x_i < ub_i, at its lower bound
-!! when x_i <= lb_i < ub_i, at its upper bound when x_i >= ub_i > lb_i, and fixed when
-!! lb_i = ub_i. The upper-bound branches are never taken when ub = +huge, so a lower-bound
-!! problem executes the same floating-point operations as without ub.
+!! ring's upkeep. The constraints are one `class(constraint_set_t)` (module constraint_set:
+!! projection, free set, chopped gradient, step cut).
 module mprgp_support
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use linop, only: linop_t
+  use constraint_set, only: constraint_set_t
   implicit none (type, external)
   private
 
-  public :: lambda_max_estimate, power_iteration, projected_gradient_norm, line_search, recycled_subspace, &
-            store_direction, chopped
+  public :: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
 
 contains
 
@@ -73,86 +70,50 @@ contains
   end subroutine power_iteration
 
 
-  !> The chopped gradient of one variable off the free set: min(g, 0) at its lower bound,
-  !! max(g, 0) at its upper bound, 0 when it is fixed (lb = ub); g itself when it is free.
-  elemental real(wp) function chopped(g, x, lb, ub) result(beta)
-    real(wp), intent(in) :: g, x, lb, ub  !< gradient, iterate, bounds
-    if (x > lb .and. x < ub) then
-      beta = g
-    else if (x < ub) then
-      beta = min(g, 0.0_wp)
-    else if (x > lb) then
-      beta = max(g, 0.0_wp)
-    else
-      beta = 0.0_wp
-    end if
-  end function chopped
-
-  !> |gP|: the norm of g on the free variables and of the chopped gradient on the others.
-  real(wp) function projected_gradient_norm(g, x, lb, ub) result(r)
-    real(wp), intent(in) :: g(:)    !< gradient
-    real(wp), intent(in) :: x(:)    !< iterate
-    real(wp), intent(in) :: lb(:)   !< lower bounds
-    real(wp), intent(in) :: ub(:)   !< upper bounds
-    integer :: j
-    r = 0.0_wp
-    do j = 1, size(x)
-      r = r + chopped(g(j), x(j), lb(j), ub(j))**2
-    end do
-    r = sqrt(r)
-  end function projected_gradient_norm
-
   !> Exact line search from x along d (A d is given: no product), cut at the bounds, with
   !! the gradient g updated alike; with `whole`, only the whole step, and only if it leaves
   !! a smaller projected gradient and a proportional iterate (|chopped|^2 <= Gamma^2
   !! |free|^2): otherwise MPRGP would first release bounds and redo what the step did
   !! (delta = 1 cycles). True when x moved.
-  logical function line_search(x, g, lb, ub, d, ad, whole, gamma, p, ap) result(moved)
+  logical function line_search(x, g, set, d, ad, whole, gamma, p, ap) result(moved)
     real(wp), intent(inout) :: x(:)      !< iterate
     real(wp), intent(inout) :: g(:)      !< A x - b
-    real(wp), intent(in) :: lb(:)        !< lower bounds
-    real(wp), intent(in) :: ub(:)        !< upper bounds
+    class(constraint_set_t), intent(in) :: set   !< the constraints
     real(wp), intent(in) :: d(:), ad(:)  !< direction and A d
     logical, intent(in) :: whole         !< the whole step or none
     real(wp), intent(in) :: gamma        !< proportioning constant Gamma
     real(wp), intent(inout) :: p(:), ap(:)   !< work (size n)
-    real(wp), parameter :: big = huge(1.0_wp)
     integer :: j, n
-    real(wp) :: dad_, t, vj, gp_before, gp_after, bb_after
+    real(wp) :: dad_, t, gp_before, gp_after, bb_after
+    real(wp), allocatable :: beta(:)
+    logical, allocatable :: free(:)
+    logical :: cut
     moved = .false.
     n = size(x)
     dad_ = dot_product(d, ad)
     if (.not. (dad_ > 0.0_wp .and. ieee_is_finite(dad_))) return
     t = -dot_product(g, d) / dad_
     if (.not. ieee_is_finite(t)) return
-    do j = 1, n
-      vj = t * d(j)
-      if (vj < 0.0_wp .and. lb(j) > -big) then
-        if (x(j) + vj < lb(j)) then
-          if (whole) return
-          t = t * max(0.0_wp, (x(j) - lb(j)) / (-vj))
-        end if
-      else if (vj > 0.0_wp .and. ub(j) < big) then
-        if (x(j) + vj > ub(j)) then
-          if (whole) return
-          t = t * max(0.0_wp, (ub(j) - x(j)) / vj)
-        end if
-      end if
-    end do
+    cut = set%cut_step(x, d, t, whole)
+    if (cut .and. whole) return
     if (t == 0.0_wp) return
     if (whole) then
-      gp_before = projected_gradient_norm(g, x, lb, ub)
+      gp_before = set%projected_gradient_norm(x, g)
       do j = 1, n
-        p(j) = min(max(x(j) + t * d(j), lb(j)), ub(j))
+        p(j) = x(j) + t * d(j)
         ap(j) = g(j) + t * ad(j)
       end do
+      call set%project(p)
+      allocate (free(n), beta(n))
+      call set%free_mask(p, free)
+      call set%chopped_gradient(p, ap, beta)
       gp_after = 0.0_wp
       bb_after = 0.0_wp
       do j = 1, n
-        if (p(j) > lb(j) .and. p(j) < ub(j)) then
+        if (free(j)) then
           gp_after = gp_after + ap(j)**2
         else
-          bb_after = bb_after + chopped(ap(j), p(j), lb(j), ub(j))**2
+          bb_after = bb_after + beta(j)**2
         end if
       end do
       if (.not. (sqrt(gp_after + bb_after) < gp_before .and. bb_after <= gamma**2 * gp_after)) return
@@ -160,9 +121,10 @@ contains
       g = ap
     else
       do j = 1, n
-        x(j) = min(max(x(j) + t * d(j), lb(j)), ub(j))
+        x(j) = x(j) + t * d(j)
         g(j) = g(j) + t * ad(j)
       end do
+      call set%project(x)
     end if
     moved = .true.
   end function line_search
@@ -173,11 +135,10 @@ contains
   !! that belong to the free set) and helps (`line_search`). A direction keeps its place
   !! only if at least 1e-4 of its A-norm squared is left after the A-orthogonalisation: the
   !! rounding of its image then stays within 100 times that of a product. True when x moved.
-  logical function recycled_subspace(x, g, lb, ub, rw, raw, nrw, gamma, v, av, p, ap, s, as) result(moved)
+  logical function recycled_subspace(x, g, set, rw, raw, nrw, gamma, v, av, p, ap, s, as) result(moved)
     real(wp), intent(inout) :: x(:)             !< iterate
     real(wp), intent(inout) :: g(:)             !< A x - b
-    real(wp), intent(in) :: lb(:)               !< lower bounds
-    real(wp), intent(in) :: ub(:)               !< upper bounds
+    class(constraint_set_t), intent(in) :: set  !< the constraints
     real(wp), intent(in) :: rw(:, :), raw(:, :) !< stored directions and their images
     integer, intent(in) :: nrw                  !< directions held in rw
     real(wp), intent(in) :: gamma               !< proportioning constant Gamma
@@ -186,8 +147,10 @@ contains
     real(wp), allocatable :: q(:, :), aq(:, :)
     integer :: j, l, k, pass
     real(wp) :: c, d0, dn
+    logical, allocatable :: free(:)
     moved = .false.
-    allocate (q(size(x), nrw + 1), aq(size(x), nrw + 1))
+    allocate (q(size(x), nrw + 1), aq(size(x), nrw + 1), free(size(x)))
+    call set%free_mask(x, free)
     k = 0
     do j = 0, nrw
       if (j == 0) then
@@ -198,7 +161,7 @@ contains
         v = rw(:, j)
         av = raw(:, j)
       end if
-      if (any(v /= 0.0_wp .and. (x <= lb .or. x >= ub))) cycle
+      if (any(v /= 0.0_wp .and. .not. free)) cycle
       d0 = dot_product(v, av)
       if (.not. (d0 > 0.0_wp .and. ieee_is_finite(d0))) cycle
       do pass = 1, 2
@@ -222,7 +185,7 @@ contains
       v = v + c * q(:, l)
       av = av + c * aq(:, l)
     end do
-    moved = line_search(x, g, lb, ub, v, av, .true., gamma, p, ap)
+    moved = line_search(x, g, set, v, av, .true., gamma, p, ap)
   end function recycled_subspace
 
   !> Keep the direction d (with A d), A-normalised, in the ring rw, raw (the oldest makes

@@ -26,6 +26,10 @@
 !! rounding level of A x). Initial W: the variables of the warm start at a bound whose
 !! gradient does not point into the box.
 !!
+!! The bounds are one `class(constraint_set_t)` (module constraint_set): the working set is
+!! what its `binding` test holds, the step length its `step_bound`, the landing on the
+!! boundary its `settle`; the method itself is that of a box, whose faces are flat.
+!!
 !! The caller (module mprgp) runs the steps, tests convergence on the projected gradient
 !! and counts the work.
 !!
@@ -33,6 +37,7 @@
 module qp_newton
   use kinds, only: wp
   use lapack, only: dpotrf, dpotrs, dsymv
+  use constraint_set, only: constraint_set_t
   implicit none (type, external)
   private
 
@@ -44,16 +49,16 @@ module qp_newton
   integer, parameter :: NEWTON_STILL = 3     !< d = 0: x is its face's minimiser and no multiplier has the wrong sign
   integer, parameter :: NEWTON_NOT_SPD = 4   !< a diagonal entry <= 0 or a curvature <= 0: A is not SPD
 
-  integer, parameter :: HELD_NOT = 0, HELD_LOW = 1, HELD_UP = 2
   integer, parameter :: SHIFT_TRIES = 8      !< shifts of a free block that is not numerically SPD
 
   !> Work arrays and the working set of one solve (allocated on first use, sized n).
   type :: newton_work_t
     real(wp), allocatable :: h(:, :)        !< the free block and its Cholesky factor
     real(wp), allocatable :: d(:), ad(:), rhs(:)
-    integer, allocatable :: held(:)         !< HELD_* of each variable: the working set
+    logical, allocatable :: held(:)         !< the working set: the variables held on the boundary
     integer, allocatable :: free(:)         !< the free variables of the last step
-    integer, allocatable :: rel(:)          !< HELD_* of the variables released by this step, 0 else
+    logical, allocatable :: rel(:)          !< the variables released by this step
+    logical, allocatable :: mask(:)         !< work: the set's binding / leaving test
     integer :: nfree = 0                    !< their number
     logical :: started = .false.            !< the working set was taken from the warm start
     logical :: at_min = .false.             !< the last step reached its face's minimiser
@@ -68,9 +73,9 @@ contains
   !> One step of the method (module header). x, g = A x - b and ax = A x are updated
   !! together (g and ax by the recurrence g + t A d). outcome: NEWTON_*; flops: the
   !! floating-point operations the step made (factor, solves and products).
-  subroutine newton_step(a, lb, ub, x, g, ax, work, outcome, flops)
+  subroutine newton_step(a, set, x, g, ax, work, outcome, flops)
     real(wp), intent(in) :: a(:, :)         !< (n, n) SPD, both triangles stored
-    real(wp), intent(in) :: lb(:), ub(:)    !< bounds (-huge / +huge: none), lb <= ub
+    class(constraint_set_t), intent(in) :: set   !< the bounds
     real(wp), intent(inout) :: x(:)         !< feasible iterate
     real(wp), intent(inout) :: g(:)         !< A x - b at x
     real(wp), intent(inout) :: ax(:)        !< A x at x
@@ -78,7 +83,7 @@ contains
     integer, intent(out) :: outcome
     real(wp), intent(out) :: flops
     integer :: n, i, nf, info, try, nrel, worst
-    real(wp) :: dad, t, ti, dmax, tau, wmax
+    real(wp) :: dad, t, dmax, tau, wmax
 
     n = size(x)
     flops = 0.0_wp
@@ -92,25 +97,19 @@ contains
     ! 1. the working set: from the warm start, or the release of wrong multipliers
     nrel = 0
     if (.not. work%started) then
-      do i = 1, n
-        work%held(i) = HELD_NOT
-        if (x(i) <= lb(i) .and. (g(i) >= 0.0_wp .or. lb(i) == ub(i))) then
-          work%held(i) = HELD_LOW
-        else if (x(i) >= ub(i) .and. g(i) <= 0.0_wp) then
-          work%held(i) = HELD_UP
-        end if
-      end do
+      call set%binding(x, g, work%held)
       work%started = .true.
       work%at_min = .false.
     else if (work%at_min) then
-      ! the wrong multipliers leave W; the most wrong (scaled: |g_i| / sqrt(a_ii)) is kept in mind
+      ! the wrong multipliers leave W (a fixed variable never does); the most wrong (scaled:
+      ! |g_i| / sqrt(a_ii)) is kept in mind
       worst = 0
       wmax = 0.0_wp
+      call set%binding(x, g, work%mask)
       do i = 1, n
-        if (lb(i) == ub(i)) cycle
-        if ((work%held(i) == HELD_LOW .and. g(i) < 0.0_wp) .or. (work%held(i) == HELD_UP .and. g(i) > 0.0_wp)) then
-          work%rel(i) = work%held(i)
-          work%held(i) = HELD_NOT
+        if (work%held(i) .and. .not. work%mask(i)) then
+          work%rel(i) = .true.
+          work%held(i) = .false.
           nrel = nrel + 1
           if (abs(g(i))/sqrt(a(i, i)) > wmax) then
             wmax = abs(g(i))/sqrt(a(i, i))
@@ -126,30 +125,20 @@ contains
     call direction()
     if (outcome == NEWTON_NOT_SPD) return
     if (nrel > 1 .and. outcome /= NEWTON_STILL) then
-      if (any((work%rel == HELD_LOW .and. work%d < 0.0_wp) .or. (work%rel == HELD_UP .and. work%d > 0.0_wp))) then
+      call set%leaving(x, work%d, work%mask)
+      if (any(work%rel .and. work%mask)) then
         do i = 1, n
-          if (work%rel(i) /= 0 .and. i /= worst) work%held(i) = work%rel(i)
+          if (work%rel(i) .and. i /= worst) work%held(i) = .true.
         end do
         call direction()
         if (outcome == NEWTON_NOT_SPD) return
       end if
     end if
-    work%rel = 0
+    work%rel = .false.
     if (outcome == NEWTON_STILL) return
     nf = work%nfree
     ! 3. the longest feasible step up to 1
-    t = 1.0_wp
-    do i = 1, nf
-      associate (j => work%free(i))
-        if (work%d(j) < 0.0_wp .and. lb(j) > -huge(1.0_wp)) then
-          ti = (lb(j) - x(j))/work%d(j)
-          t = min(t, max(ti, 0.0_wp))
-        else if (work%d(j) > 0.0_wp .and. ub(j) < huge(1.0_wp)) then
-          ti = (ub(j) - x(j))/work%d(j)
-          t = min(t, max(ti, 0.0_wp))
-        end if
-      end associate
-    end do
+    t = set%step_bound(x, work%d, 1.0_wp)
     call dsymv('U', n, 1.0_wp, a, n, work%d, 1, 0.0_wp, work%ad, 1)
     flops = flops + 2.0_wp*real(n, wp)**2
     dad = dot_product(work%d, work%ad)
@@ -159,19 +148,8 @@ contains
     end if
     work%at_min = t >= 1.0_wp
     outcome = merge(NEWTON_FULL, NEWTON_CUT, work%at_min)
-    do i = 1, nf
-      associate (j => work%free(i))
-        x(j) = x(j) + t*work%d(j)
-        ! the variables that reach a bound (to rounding) join the working set, on it exactly
-        if (x(j) <= lb(j) .or. (work%d(j) < 0.0_wp .and. (x(j) - lb(j)) <= 4.0_wp*epsilon(1.0_wp)*abs(t*work%d(j)))) then
-          x(j) = lb(j)
-          work%held(j) = HELD_LOW
-        else if (x(j) >= ub(j) .or. (work%d(j) > 0.0_wp .and. (ub(j) - x(j)) <= 4.0_wp*epsilon(1.0_wp)*abs(t*work%d(j)))) then
-          x(j) = ub(j)
-          work%held(j) = HELD_UP
-        end if
-      end associate
-    end do
+    ! the variables that reach a bound (to rounding) join the working set, on it exactly
+    call set%settle(x, work%d, t, work%free(1:nf), work%held)
     g = g + t*work%ad
     ax = ax + t*work%ad
 
@@ -184,7 +162,7 @@ contains
       outcome = NEWTON_CUT
       nf = 0
       do k = 1, n
-        if (work%held(k) /= HELD_NOT) cycle
+        if (work%held(k)) cycle
         nf = nf + 1
         work%free(nf) = k
       end do
@@ -251,11 +229,10 @@ contains
     integer, intent(in) :: n
     if (allocated(work%d)) then
       if (size(work%d) == n) return
-      deallocate (work%h, work%d, work%ad, work%rhs, work%held, work%free, work%rel)
+      deallocate (work%h, work%d, work%ad, work%rhs, work%held, work%free, work%rel, work%mask)
     end if
     allocate (work%h(max(1, n), max(1, n)), work%d(n), work%ad(n), work%rhs(max(1, n)), work%free(n))
-    allocate (work%held(n), source=HELD_NOT)
-    allocate (work%rel(n), source=0)
+    allocate (work%held(n), work%rel(n), work%mask(n), source=.false.)
     work%nfree = 0
     work%shifts = 0
     work%started = .false.

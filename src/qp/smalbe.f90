@@ -14,8 +14,8 @@
 !! c - G'mu + rho G'e, to a projected gradient below min(M |Gx - e|, eta); then
 !! mu <- mu + rho (Gx - e), and M <- beta M when L did not grow by at least
 !! rho/2 |Gx - e|^2. It stops when the projected gradient is below eta and |Gx - e| below
-!! feas. The upper bounds are optional (absent or +huge(1.0_wp): none) and passed through
-!! to MPRGP unchanged.
+!! feas. The upper bounds are optional (absent or +huge(1.0_wp): none); the bounds go to
+!! MPRGP as one `box_set_t` (module constraint_set).
 !!
 !! On return g = Hx - c + G'mu (the gradient of the Lagrangian at the final multipliers,
 !! which is MPRGP's last gradient), so for contact `G_a - g` is still B_a u_a with the
@@ -25,7 +25,8 @@ module smalbe
   use kinds, only: wp
   use linop, only: linop_t
   use lapack, only: dposv
-  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, chopped, QP_NEWTON
+  use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, QP_NEWTON
+  use constraint_set, only: constraint_set_t, box_set_t, box_set
   implicit none (type, external)
   private
 
@@ -74,6 +75,7 @@ contains
     real(wp) :: lag_old, lag_new, rr, m_control, feas
     integer :: n, k
     logical :: have_ax
+    type(box_set_t) :: set
 
     n = size(x)
     allocate (rhs(n), r(size(e)))
@@ -81,13 +83,8 @@ contains
     feas = opts%eq_feas
     m_control = opts%eq_m
     have_ax = opts%use_ax .and. allocated(solver%ax)
-    if (have_ax) then
-      if (present(ub)) then
-        call multiplier_estimate(gm, e, rho, lb, ub, x, c, solver%ax, mu)
-      else
-        call multiplier_estimate(gm, e, rho, lb, spread(huge(1.0_wp), 1, n), x, c, solver%ax, mu)
-      end if
-    end if
+    set = box_set(lb, ub)
+    if (have_ax) call multiplier_estimate(gm, e, rho, set, x, c, solver%ax, mu)
     solver%eq_g = gm
     solver%eq_e = e
     lag_old = -huge(1.0_wp)
@@ -107,7 +104,7 @@ contains
       rhs = c - matmul(mu - rho*e, gm)
       feas = max(opts%eq_feas, opts%eq_feas_x*norm2(x))
       solver%opts%eq_feas = feas
-      call solver%solve(A, rhs, lb, x, rw, raw, nrw, ub)
+      call solver%solve_in(A, rhs, set, x, rw, raw, nrw)
       stats%inner = solver%stats
       if (solver%stats%switched) then
         ! the penalized Hessian needs the Newton method: the next solves start with it
@@ -149,15 +146,17 @@ contains
   !! lost contact: mu_ls is then the rigid shift that brings it back to its obstacle on
   !! average, where the warm start would need of order |shift| / (rho |e|) updates to get).
   !! mu_ls replaces mu when the Lagrangian's projected gradient at x is smaller with it.
-  subroutine multiplier_estimate(gm, e, rho, lb, ub, x, c, ax, mu)
-    real(wp), intent(in) :: gm(:, :), e(:), rho, lb(:), ub(:), x(:), c(:), ax(:)
+  subroutine multiplier_estimate(gm, e, rho, set, x, c, ax, mu)
+    real(wp), intent(in) :: gm(:, :), e(:), rho, x(:), c(:), ax(:)
+    class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: mu(:)
     real(wp), allocatable :: g0(:), gf(:, :), a(:, :), b(:), mls(:)
     logical, allocatable :: free(:)
     integer :: r, i, info
     r = size(e)
     g0 = ax - rho*matmul(matmul(gm, x), gm) - c
-    free = x > lb .and. x < ub
+    allocate (free(size(x)))
+    call set%free_mask(x, free)
     if (count(free) < r) free = .true.
     allocate (a(r, r), b(r))
     gf = gm(:, pack([(i, i=1, size(x))], free))
@@ -166,13 +165,17 @@ contains
     call dposv('U', r, 1, a, r, b, r, info)
     if (info /= 0) return
     mls = b
-    if (proj_norm(g0 + matmul(mls, gm), x, lb, ub) < proj_norm(g0 + matmul(mu, gm), x, lb, ub)) mu = mls
+    if (proj_norm(set, g0 + matmul(mls, gm), x) < proj_norm(set, g0 + matmul(mu, gm), x)) mu = mls
   end subroutine multiplier_estimate
 
-  !> Norm of the projected gradient of g at x (bounds lb, ub).
-  pure real(wp) function proj_norm(g, x, lb, ub) result(v)
-    real(wp), intent(in) :: g(:), x(:), lb(:), ub(:)
-    v = norm2(chopped(g, x, lb, ub))
+  !> Norm of the projected gradient of g at x (norm2 of the vector gP).
+  real(wp) function proj_norm(set, g, x) result(v)
+    class(constraint_set_t), intent(in) :: set
+    real(wp), intent(in) :: g(:), x(:)
+    real(wp), allocatable :: gp(:)
+    allocate (gp(size(x)))
+    call set%projected_gradient(x, g, gp)
+    v = norm2(gp)
   end function proj_norm
 
 

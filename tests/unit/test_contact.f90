@@ -127,7 +127,8 @@ contains
     fscale = 0.0_wp
     do a = 1, 2
       allocate (ufree(systems(a)%n), ufull(systems(a)%ndof), r(systems(a)%ndof))
-      call recover_displacement(systems(a), bodies(a), mono%lam, ufree)
+      call recover_displacement(systems(a), bodies(a), mono%lam, ufree, err)
+      if (err%failed()) error stop 'recover_displacement failed'
       call expand(systems(a), ufree, ufull)
       ! recovered B_a u_a equals the condensed b_a - F_a lam
       allocate (bu(contact_line%m))

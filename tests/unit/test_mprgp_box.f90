@@ -14,6 +14,7 @@ program test_mprgp_box
   use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, mprgp_status_name, MPRGP_CONVERGED, MPRGP_BAD_ARG, &
                    MPRGP_NONFINITE
   use mprgp_support, only: line_search, recycled_subspace
+  use constraint_set, only: box_set
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use lapack, only: dgesv
   use strings, only: i2s
@@ -323,21 +324,21 @@ contains
     d = [1.0_wp, 0.0_wp]
     x = 0.0_wp
     g = [-10.0_wp, 0.0_wp]
-    moved = line_search(x, g, l, u, d, d, .false., 1.0_wp, p, ap)
+    moved = line_search(x, g, box_set(l, u), d, d, .false., 1.0_wp, p, ap)
     call report(moved .and. x(1) == 1.0_wp .and. x(2) == 0.0_wp .and. g(1) == -9.0_wp, &
                 'line search: cut at the upper bound (x = u exactly, g updated)')
     x = 0.0_wp
     g = [-10.0_wp, 0.0_wp]
-    moved = line_search(x, g, l, u, d, d, .true., 1.0_wp, p, ap)
+    moved = line_search(x, g, box_set(l, u), d, d, .true., 1.0_wp, p, ap)
     call report(.not. moved .and. all(x == 0.0_wp) .and. g(1) == -10.0_wp, &
                 'line search: a whole step through the upper bound is refused')
     x = 0.0_wp
     g = [10.0_wp, 0.0_wp]
-    moved = line_search(x, g, l, u, d, d, .false., 1.0_wp, p, ap)
+    moved = line_search(x, g, box_set(l, u), d, d, .false., 1.0_wp, p, ap)
     call report(moved .and. x(1) == -1.0_wp .and. g(1) == 9.0_wp, 'line search: cut at the lower bound')
     x = [1.0_wp, 0.0_wp]
     g = [-3.0_wp, 0.0_wp]
-    moved = line_search(x, g, l, u, d, d, .false., 1.0_wp, p, ap)
+    moved = line_search(x, g, box_set(l, u), d, d, .false., 1.0_wp, p, ap)
     call report(.not. moved .and. x(1) == 1.0_wp, 'line search: no move out of an active upper bound')
   end subroutine test_line_search
 
@@ -352,11 +353,11 @@ contains
     g = [-1.0_wp, -0.5_wp]
     rw(:, 1) = [1.0_wp, 0.0_wp]
     raw = rw
-    moved = recycled_subspace(x, g, l, u, rw, raw, 1, 1.0_wp, v, av, p, ap)
+    moved = recycled_subspace(x, g, box_set(l, u), rw, raw, 1, 1.0_wp, v, av, p, ap)
     call report(.not. moved .and. all(x == [1.0_wp, 0.0_wp]), 'recycled subspace: a direction moving a variable at u is skipped')
     rw(:, 1) = [0.0_wp, 1.0_wp]
     raw = rw
-    moved = recycled_subspace(x, g, l, u, rw, raw, 1, 1.0_wp, v, av, p, ap)
+    moved = recycled_subspace(x, g, box_set(l, u), rw, raw, 1, 1.0_wp, v, av, p, ap)
     call report(moved .and. x(1) == 1.0_wp .and. abs(x(2) - 0.5_wp) <= 4.0_wp * eps .and. abs(g(2)) <= 4.0_wp * eps, &
                 'recycled subspace: a direction of the free variables is taken (x2 = 0.5)')
   end subroutine test_recycled_subspace

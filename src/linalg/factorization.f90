@@ -1,0 +1,362 @@
+!> A body's stiffness factorization as one object, whatever library made it: the abstract
+!! `factor_t` with its CHOLMOD, banded and MUMPS extensions, and `new_factor`, the one place
+!! where the deck's `factorization` picks the extension. The condensed body
+!! (condense%body_condensed_t) owns one on both paths, serial and MPI, and reaches it only
+!! through these methods:
+!!   factorize          K = L L' (or MUMPS's LDL'), the interface DOFs ordered last / Schur
+!!   solve              K u = r in place
+!!   interface_inverse  X = (K^-1) on the interface DOFs (the condensation hook: CHOLMOD's
+!!                      trailing block of L, unit solves for the banded factor, S^-1 for MUMPS)
+!!   free, summary      release; one line of statistics (`stats` holds the numbers)
+!! Every failure is an `error_t` (module errors): a solve or an inverse without a valid
+!! factorization, a matrix that is not positive definite, a library's status, never a NaN.
+!!
+!! A MUMPS factor is collective over its group of ranks (its `comm`): `factorize`, `solve`
+!! and `interface_inverse` are called on every rank of the group, and only the group's host
+!! gives and receives vectors (`holds_result`); the others pass empty ones. A CHOLMOD or
+!! banded factor is on one rank, which holds everything.
+module factorization
+  use kinds, only: wp, ip, i8
+  use config, only: factor_cfg_t, FACTOR_BANDED, FACTOR_MUMPS, ORDER_AMD, ORDER_NATURAL, ORDER_ND
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
+  use mumps_iface, only: mumps_t, mumps_schur_factor, mumps_solve, mumps_end
+  use errors, only: error_t, ERR_NUMERICAL
+  use strings, only: body_label
+  implicit none (type, external)
+  private
+
+  public :: factor_t, chol_factor_t, cholmod_factor_t, banded_factor_t, mumps_factor_t, factor_stats_t, new_factor
+
+  !> What a factorization cost and holds.
+  type :: factor_stats_t
+    real(wp) :: t_analyze = 0.0_wp        !< ordering + symbolic analysis wall time [s]
+    real(wp) :: t_factor = 0.0_wp         !< numeric factorization wall time [s]
+    integer(i8) :: nnz_factor = 0         !< nonzeros in L (0: not known)
+    real(wp) :: flops = 0.0_wp            !< factorization flop count (0: not known)
+    real(wp) :: mem_bytes = 0.0_wp        !< the factor's memory (MUMPS: summed over the group's ranks) [byte]
+    real(wp) :: max_rank_mb = 0.0_wp      !< MUMPS: the largest rank's factorization memory [MiB]
+    real(wp) :: factor_mb = 0.0_wp        !< MUMPS: the factor's entries over the group (INFOG(9)) [MiB]
+    real(wp) :: rank_factor_mb = 0.0_wp   !< MUMPS: this rank's share of them (INFO(9)) [MiB]
+  end type factor_stats_t
+
+  !> One factorization of one body's stiffness K (n x n, symmetric positive definite).
+  type, abstract :: factor_t
+    integer :: n = 0                      !< matrix order (0: not factorized)
+    integer :: body = 0                   !< the body, for messages
+    type(factor_stats_t) :: stats         !< cost and size
+    !> the factor lives on a group of ranks, its results on the host only (the condensed
+    !! body then keeps no K^-1 f of its own)
+    logical :: distributed = .false.
+  contains
+    !> Factorize K with the DOFs `last` ordered last (the interface).
+    procedure(factorize_i), deferred :: factorize
+    !> Solve K u = r in place.
+    procedure(solve_i), deferred :: solve
+    !> X = (K^-1)(idx, idx) for the interface DOFs idx (those given to factorize as `last`).
+    procedure(inverse_i), deferred :: interface_inverse
+    !> Release the factorization.
+    procedure(free_i), deferred :: free
+    !> One line: method, sizes, times, memory.
+    procedure(summary_i), deferred :: summary
+    !> True where the results are: everywhere but on a MUMPS group's other ranks.
+    procedure :: holds_result => factor_holds_result
+    !> True when factorize wants the order of the DOFs before `last` (interior_perm).
+    procedure :: wants_interior_order => factor_wants_interior_order
+  end type factor_t
+
+  abstract interface
+    !> K as full symmetric CSC (CHOLMOD, banded: colptr, rowind, val, 0-based) or as this
+    !! rank's share of triplets of the lower triangle (MUMPS: irn, jcn, tval, 1-based, summed
+    !! over the ranks); interior_perm: the order of the DOFs not in `last`, when wanted.
+    subroutine factorize_i(self, n, last, err, colptr, rowind, val, interior_perm, irn, jcn, tval)
+      import :: factor_t, error_t, ip, wp
+      class(factor_t), intent(inout) :: self
+      integer, intent(in) :: n
+      integer, intent(in) :: last(:)
+      type(error_t), intent(out) :: err
+      integer(ip), intent(in), optional :: colptr(:), rowind(:)
+      real(wp), intent(in), optional :: val(:)
+      integer, intent(in), optional :: interior_perm(:)
+      integer, intent(in), optional :: irn(:), jcn(:)
+      real(wp), intent(in), optional :: tval(:)
+    end subroutine factorize_i
+    subroutine solve_i(self, b, err)
+      import :: factor_t, error_t, wp
+      class(factor_t), intent(inout) :: self
+      real(wp), intent(inout), contiguous :: b(:)
+      type(error_t), intent(out) :: err
+    end subroutine solve_i
+    subroutine inverse_i(self, idx, x, err)
+      import :: factor_t, error_t, wp
+      class(factor_t), intent(inout) :: self
+      integer, intent(in) :: idx(:)
+      real(wp), intent(out) :: x(:, :)
+      type(error_t), intent(out) :: err
+    end subroutine inverse_i
+    subroutine free_i(self)
+      import :: factor_t
+      class(factor_t), intent(inout) :: self
+    end subroutine free_i
+    function summary_i(self) result(line)
+      import :: factor_t
+      class(factor_t), intent(in) :: self
+      character(len=:), allocatable :: line
+    end function summary_i
+  end interface
+
+  !> A Cholesky factor of module cholesky (CHOLMOD or banded) on one rank.
+  type, abstract, extends(factor_t) :: chol_factor_t
+    type(chol_t) :: chol                  !< the factorization
+    integer :: method = FACT_CHOLMOD      !< FACT_CHOLMOD or FACT_BANDED
+    integer :: ordering = ORD_METIS       !< ORD_* (CHOLMOD)
+  contains
+    procedure :: factorize => chol_factorize
+    procedure :: solve => chol_solve
+    procedure :: interface_inverse => chol_inverse
+    procedure :: free => chol_free
+    procedure :: summary => chol_summary
+    procedure :: wants_interior_order => chol_wants_interior_order
+  end type chol_factor_t
+
+  !> CHOLMOD supernodal L L' with the interface last: X from the trailing block of L.
+  type, extends(chol_factor_t) :: cholmod_factor_t
+  end type cholmod_factor_t
+
+  !> Reverse Cuthill-McKee and LAPACK's band Cholesky: X by unit solves.
+  type, extends(chol_factor_t) :: banded_factor_t
+  end type banded_factor_t
+
+  !> MUMPS over the body's group of ranks with the interface DOFs as Schur variables
+  !! (module mumps_iface): X = S^-1 on the host.
+  type, extends(factor_t) :: mumps_factor_t
+    type(mumps_t) :: mt                   !< the MUMPS instance
+    integer :: comm = 0                   !< the group's communicator
+  contains
+    procedure :: factorize => mumps_factorize
+    procedure :: solve => mumps_factor_solve
+    procedure :: interface_inverse => mumps_inverse
+    procedure :: free => mumps_free
+    procedure :: summary => mumps_summary
+    procedure :: holds_result => mumps_holds_result
+  end type mumps_factor_t
+
+contains
+
+  !> The factor the deck's setting names, not yet factorized: CHOLMOD with its ordering
+  !! (ordering='nd': the caller's interior order, interface last), banded, or MUMPS over the
+  !! group `comm` (default: 0).
+  subroutine new_factor(fc, body, fac, comm)
+    type(factor_cfg_t), intent(in) :: fc                  !< factorization and ordering
+    integer, intent(in) :: body                           !< the body, for messages
+    class(factor_t), allocatable, intent(out) :: fac      !< the new factor
+    integer, intent(in), optional :: comm                 !< MUMPS: the body's group of ranks
+    select case (fc%factorization)
+    case (FACTOR_MUMPS)
+      allocate (mumps_factor_t :: fac)
+      select type (fac)
+      type is (mumps_factor_t)
+        if (present(comm)) fac%comm = comm
+        fac%distributed = .true.
+      end select
+    case (FACTOR_BANDED)
+      allocate (banded_factor_t :: fac)
+      select type (fac)
+      type is (banded_factor_t)
+        fac%method = FACT_BANDED
+      end select
+    case default
+      allocate (cholmod_factor_t :: fac)
+      select type (fac)
+      type is (cholmod_factor_t)
+        fac%method = FACT_CHOLMOD
+        select case (fc%ordering)
+        case (ORDER_AMD)
+          fac%ordering = ORD_AMD
+        case (ORDER_NATURAL)
+          fac%ordering = ORD_NATURAL
+        case (ORDER_ND)
+          fac%ordering = ORD_GIVEN
+        case default
+          fac%ordering = ORD_METIS
+        end select
+      end select
+    end select
+    fac%body = body
+  end subroutine new_factor
+
+  !> A factor on one rank holds its results (a distributed one overrides this).
+  logical function factor_holds_result(self) result(yes)
+    class(factor_t), intent(in) :: self
+    yes = .not. self%distributed
+  end function factor_holds_result
+
+  !> No interior order wanted.
+  logical function factor_wants_interior_order(self) result(yes)
+    class(factor_t), intent(in) :: self
+    yes = .false.
+  end function factor_wants_interior_order
+
+  ! ---- CHOLMOD and banded -------------------------------------------------------------
+
+  !> CHOLMOD with ORD_GIVEN takes the caller's interior order.
+  logical function chol_wants_interior_order(self) result(yes)
+    class(chol_factor_t), intent(in) :: self
+    yes = self%method == FACT_CHOLMOD .and. self%ordering == ORD_GIVEN
+  end function chol_wants_interior_order
+
+  !> Factorize the full symmetric CSC K (cholesky%chol_factor), `last` ordered last.
+  subroutine chol_factorize(self, n, last, err, colptr, rowind, val, interior_perm, irn, jcn, tval)
+    class(chol_factor_t), intent(inout) :: self
+    integer, intent(in) :: n                              !< matrix order
+    integer, intent(in) :: last(:)                        !< 1-based DOFs ordered last
+    type(error_t), intent(out) :: err                     !< the failure, if any
+    integer(ip), intent(in), optional :: colptr(:), rowind(:)   !< K (CSC, 0-based)
+    real(wp), intent(in), optional :: val(:)              !< its values
+    integer, intent(in), optional :: interior_perm(:)     !< ORD_GIVEN: the order of the other DOFs
+    integer, intent(in), optional :: irn(:), jcn(:)       !< not used (MUMPS's input)
+    real(wp), intent(in), optional :: tval(:)             !< not used (MUMPS's input)
+    self%n = 0
+    if (.not. (present(colptr) .and. present(rowind) .and. present(val))) then
+      call err%set(ERR_NUMERICAL, 'Cholesky: the factorization needs the stiffness in CSC form.')
+      return
+    end if
+    if (present(irn) .or. present(jcn) .or. present(tval)) then
+      call err%set(ERR_NUMERICAL, 'Cholesky: triplet input is MUMPS''s, not a Cholesky factor''s.')
+      return
+    end if
+    call self%chol%factor(n, colptr, rowind, val, self%method, self%ordering, err, last=last, &
+                          interior_perm=interior_perm)
+    if (err%failed()) return
+    self%n = n
+    self%stats%t_analyze = self%chol%t_analyze
+    self%stats%t_factor = self%chol%t_factor
+    self%stats%nnz_factor = self%chol%nnz_factor
+    self%stats%flops = self%chol%flops
+    self%stats%mem_bytes = real(self%chol%mem_bytes, wp)
+  end subroutine chol_factorize
+
+  !> K u = b in place; err without a valid factorization or on a library failure.
+  subroutine chol_solve(self, b, err)
+    class(chol_factor_t), intent(inout) :: self
+    real(wp), intent(inout), contiguous :: b(:)   !< right-hand side in, solution out
+    type(error_t), intent(out) :: err             !< the failure, if any
+    call self%chol%solve(b, err)
+  end subroutine chol_solve
+
+  !> X = (K^-1)(idx, idx): CHOLMOD's trailing block when idx were ordered last, unit
+  !! solves otherwise (cholesky%chol_flexibility).
+  subroutine chol_inverse(self, idx, x, err)
+    class(chol_factor_t), intent(inout) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based interface DOFs
+    real(wp), intent(out) :: x(:, :)              !< (k,k) (K^-1)(idx, idx)
+    type(error_t), intent(out) :: err             !< the failure, if any
+    call self%chol%flexibility(idx, spread(1.0_wp, 1, size(idx)), x, err)
+  end subroutine chol_inverse
+
+  !> Release the factorization.
+  subroutine chol_free(self)
+    class(chol_factor_t), intent(inout) :: self
+    call self%chol%free()
+    self%n = 0
+    self%stats = factor_stats_t()
+  end subroutine chol_free
+
+  !> cholesky%chol_summary's line.
+  function chol_summary(self) result(line)
+    class(chol_factor_t), intent(in) :: self
+    character(len=:), allocatable :: line
+    line = self%chol%summary()
+  end function chol_summary
+
+  ! ---- MUMPS ----------------------------------------------------------------------------
+
+  !> Analyse and factorize this rank's share of K over the group, `last` as Schur
+  !! variables (collective); on the host, X = S^-1.
+  subroutine mumps_factorize(self, n, last, err, colptr, rowind, val, interior_perm, irn, jcn, tval)
+    class(mumps_factor_t), intent(inout) :: self
+    integer, intent(in) :: n                              !< matrix order (every rank)
+    integer, intent(in) :: last(:)                        !< host: the Schur variables, 1-based
+    type(error_t), intent(out) :: err                     !< the failure, if any
+    integer(ip), intent(in), optional :: colptr(:), rowind(:)   !< not used (a Cholesky factor's input)
+    real(wp), intent(in), optional :: val(:)              !< not used
+    integer, intent(in), optional :: interior_perm(:)     !< not used (MUMPS orders itself)
+    integer, intent(in), optional :: irn(:), jcn(:)       !< this rank's entries, 1-based, row >= column
+    real(wp), intent(in), optional :: tval(:)             !< their values [stress]
+    self%n = 0
+    if (.not. (present(irn) .and. present(jcn) .and. present(tval))) then
+      call err%set(ERR_NUMERICAL, 'MUMPS: the factorization of body '//body_label(self%body)// &
+                   ' needs its share of the stiffness as triplets.')
+      return
+    end if
+    if (present(colptr) .or. present(rowind) .or. present(val) .or. present(interior_perm)) then
+      call err%set(ERR_NUMERICAL, 'MUMPS: CSC input and a given order are a Cholesky factor''s, not MUMPS''s.')
+      return
+    end if
+    call mumps_schur_factor(self%mt, self%comm, n, irn, jcn, tval, last, self%body, err)
+    self%stats%mem_bytes = self%mt%mem_bytes
+    self%stats%max_rank_mb = self%mt%max_rank_mb
+    self%stats%factor_mb = self%mt%factor_mb
+    self%stats%rank_factor_mb = self%mt%rank_factor_mb
+    if (err%failed()) return
+    self%n = n
+  end subroutine mumps_factorize
+
+  !> K u = b in place on the host (the other ranks pass an empty b); collective.
+  subroutine mumps_factor_solve(self, b, err)
+    class(mumps_factor_t), intent(inout) :: self
+    real(wp), intent(inout), contiguous :: b(:)   !< host: right-hand side in, solution out
+    type(error_t), intent(out) :: err             !< the failure, if any
+    if (self%n <= 0) then
+      call err%set(ERR_NUMERICAL, 'MUMPS: solve called without a valid factorization of body '// &
+                   body_label(self%body)//'.')
+      return
+    end if
+    call mumps_solve(self%mt, b, self%body, err)
+  end subroutine mumps_factor_solve
+
+  !> X = S^-1 on the host (the Schur variables are the interface DOFs, in the order given
+  !! to factorize: idx must be them).
+  subroutine mumps_inverse(self, idx, x, err)
+    class(mumps_factor_t), intent(inout) :: self
+    integer, intent(in) :: idx(:)                 !< the interface DOFs (as given to factorize)
+    real(wp), intent(out) :: x(:, :)              !< host: (k,k) S^-1
+    type(error_t), intent(out) :: err             !< the failure, if any
+    character(len=120) :: emsg
+    if (self%n <= 0 .or. .not. allocated(self%mt%x)) then
+      call err%set(ERR_NUMERICAL, 'MUMPS: the interface inverse of body '//body_label(self%body)// &
+                   ' was asked for without a valid factorization.')
+      return
+    end if
+    if (size(self%mt%x, 1) /= size(idx) .or. size(x, 1) /= size(idx) .or. size(x, 2) /= size(idx)) then
+      write (emsg, '(a,i0,a,i0,a)') 'MUMPS: the interface inverse has ', size(self%mt%x, 1), &
+        ' Schur variables, not ', size(idx), '.'
+      call err%set(ERR_NUMERICAL, emsg)
+      return
+    end if
+    x = self%mt%x
+  end subroutine mumps_inverse
+
+  !> Free the instance (collective).
+  subroutine mumps_free(self)
+    class(mumps_factor_t), intent(inout) :: self
+    call mumps_end(self%mt)
+    self%n = 0
+  end subroutine mumps_free
+
+  !> One line: MUMPS, order, Schur variables, memory.
+  function mumps_summary(self) result(line)
+    class(mumps_factor_t), intent(in) :: self
+    character(len=:), allocatable :: line
+    character(len=200) :: buf
+    write (buf, '(a,i0,a,i0,a,f0.1,a,f0.1,a)') 'mumps n=', self%n, ' schur=', self%mt%k, ' mem=', &
+      self%stats%mem_bytes/2.0_wp**20, 'MiB max_rank=', self%stats%max_rank_mb, 'MiB'
+    line = trim(buf)
+  end function mumps_summary
+
+  !> Only the group's host holds the results.
+  logical function mumps_holds_result(self) result(yes)
+    class(mumps_factor_t), intent(in) :: self
+    yes = self%mt%host
+  end function mumps_holds_result
+
+end module factorization
