@@ -367,7 +367,7 @@ contains
         ckpt%every = deck%output%checkpoint_every
         if (size(run%plan) > 1) then   ! a restart resumes this step, the ones before replayed
           ckpt%step = run%step
-          ckpt%done => run%steps(1:run%step - 1)%res
+          ckpt%done => run%steps(1:run%step - 1)
         end if
         if (run%history%step > 0 .and. run%robin_state%it == 0) then   ! a load step after the first
           call solve_robin(deck%solver, contact_line, bodies, result, output_unit, deck%output%progress_lines, &

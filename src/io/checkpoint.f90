@@ -17,6 +17,7 @@ module checkpoint
   use history_io, only: write_history, read_history
   use files, only: temp_name, ensure_parent_dir, atomic_rename, remove_file
   use contact_types, only: robin_state_t, contact_result_t, checkpointer_t, recycle_size, STATUS_CONVERGED
+  use results, only: step_result_t
   implicit none (type, external)
   private
 
@@ -31,7 +32,10 @@ module checkpoint
     !! and the converged results of the steps before it, which a restart replays (pointing
     !! at the run's own: a step copies none of them, so a long history stays linear)
     integer :: step = 0
-    type(contact_result_t), pointer :: done(:) => null()
+    !> whole step records, not their %res component: a pointer to a component of an
+    !! array section lost its stride with gfortran 12 (the second step's record read
+    !! from the wrong place: a load history signalled after two steps crashed here)
+    type(step_result_t), pointer :: done(:) => null()
   contains
     procedure :: save => checkpoint_write
   end type h5_checkpointer_t
@@ -237,7 +241,7 @@ contains
   subroutine write_load_history(fid, step, done, hs)
     integer(hid_t), intent(in) :: fid
     integer, intent(in) :: step
-    type(contact_result_t), intent(in) :: done(:)
+    type(step_result_t), intent(in) :: done(:)
     type(error_t), intent(inout) :: hs
     integer(hid_t) :: lid, kid
     integer :: k
@@ -245,16 +249,16 @@ contains
     call write_attr(lid, 'step', step, hs)
     do k = 1, step - 1
       call group_open(lid, 'step_'//i2s(k), kid, hs, create=.true.)
-      call write_attr(kid, 'status', done(k)%status, hs)
-      call write_attr(kid, 'outer', done(k)%outer, hs)
-      call write_attr(kid, 'inner', done(k)%inner, hs)
-      call write_attr(kid, 'residual', done(k)%residual, hs)
-      call write_dset(kid, 'lam', done(k)%lam, hs)
-      call write_dset(kid, 'lam_body', done(k)%lam_body, hs)
-      call write_dset(kid, 'w', done(k)%w, hs)
-      call write_dset(kid, 'gap', done(k)%gap, hs)
-      call write_dset(kid, 'obstacle', done(k)%obstacle, hs)
-      call write_dset(kid, 'rigid', done(k)%rigid, hs)
+      call write_attr(kid, 'status', done(k)%res%status, hs)
+      call write_attr(kid, 'outer', done(k)%res%outer, hs)
+      call write_attr(kid, 'inner', done(k)%res%inner, hs)
+      call write_attr(kid, 'residual', done(k)%res%residual, hs)
+      call write_dset(kid, 'lam', done(k)%res%lam, hs)
+      call write_dset(kid, 'lam_body', done(k)%res%lam_body, hs)
+      call write_dset(kid, 'w', done(k)%res%w, hs)
+      call write_dset(kid, 'gap', done(k)%res%gap, hs)
+      call write_dset(kid, 'obstacle', done(k)%res%obstacle, hs)
+      call write_dset(kid, 'rigid', done(k)%res%rigid, hs)
       call group_close(kid, hs)
     end do
     call group_close(lid, hs)

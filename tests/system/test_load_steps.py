@@ -17,8 +17,9 @@
    open, a few outer iterations), stage 2 presses it (more than max_outer = 100).
 5. Bad input, exit 1, one message naming the variable and value, nothing written: stage=0,
    load_steps=0 and 10001, more load_steps values than stages, a stage without a load.
-6. SIGTERM in the middle of the history (after the first step: line): exit 4, a checkpoint
-   at step 2; --restart continues at step 2 and ends bitwise as the uninterrupted run.
+6. SIGTERM in the middle of the history (after the second step: line): exit 4, a checkpoint
+   at step 3 holding two steps (the checkpoint of a history with two steps done once
+   crashed); --restart continues at step 3 and ends bitwise as the uninterrupted run.
 """
 import os
 import shutil
@@ -237,26 +238,26 @@ for what, override, words in BAD:
 
 # ---- 6. SIGTERM in the middle of the history, restart -------------------------------------
 DECK = "inputs/table1/q1_16x8.nml"
-SLOW = ["&body id=1, nx=64, ny=8 /", "&body id=2, nx=64, ny=8 /", "&solver delta=0.998, max_outer=40000, load_steps=3 /"]
+SLOW = ["&body id=1, nx=64, ny=8 /", "&body id=2, nx=64, ny=8 /", "&solver delta=0.998, max_outer=40000, load_steps=4 /"]
 full = run(DECK, *SLOW, out("full"))
 check(full.returncode == 0, "slow history: the uninterrupted run converges", f"exit {full.returncode}")
 proc = subprocess.Popen([BIN, DECK, *SLOW, out("sig")], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                         env=env)
 for ln in proc.stdout:
-    if ln.startswith("step: step=1 "):
+    if ln.startswith("step: step=2 "):
         proc.send_signal(signal.SIGTERM)
         break
 so, se = proc.communicate(timeout=600)
-check(proc.returncode == 4, "SIGTERM in step 2: exit 4", f"exit {proc.returncode}: {se[-300:]}")
+check(proc.returncode == 4, "SIGTERM in step 3: exit 4", f"exit {proc.returncode}: {se[-300:]}")
 ck = f"{OUT}/sig.h5.ckpt.h5"
 if os.path.exists(ck):
     with h5py.File(ck, "r") as c:
         at = int(c["load_history"].attrs["step"]) if "load_history" in c else 0
-    check(at == 2, "the checkpoint is at step 2, with step 1's result", f"step {at}")
+    check(at == 3, "the checkpoint is at step 3, with the results of steps 1 and 2", f"step {at}")
     re_ = run(DECK, *SLOW, out("re"), "--restart", ck)
     check(re_.returncode == 0, "the restart converges", f"exit {re_.returncode}: {re_.stderr[-300:]}")
-    check("resuming after outer iteration" in re_.stdout and len(step_lines(re_.stdout)) == 3,
-          "the restart resumes step 2 (step 1 replayed), one step: line per step")
+    check("resuming after outer iteration" in re_.stdout and len(step_lines(re_.stdout)) == 4,
+          "the restart resumes step 3 (steps 1 and 2 replayed), one step: line per step")
     if re_.returncode == 0 and full.returncode == 0:
         with h5py.File(f"{OUT}/full.h5", "r") as a, h5py.File(f"{OUT}/re.h5", "r") as b:
             names = []
@@ -269,7 +270,7 @@ if os.path.exists(ck):
             for k in ["outer_iterations", "inner_iterations", "status"]:
                 check(a.attrs[k] == b.attrs[k], f"restart: root attribute {k} as uninterrupted")
 else:
-    check(False, "SIGTERM in step 2: checkpoint written")
+    check(False, "SIGTERM in step 3: checkpoint written")
 
 print(f"{len(check.failed)} failed checks")
 sys.exit(1 if check.failed else 0)
