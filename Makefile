@@ -212,7 +212,7 @@ $(BUILD)/results.o:        $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contac
                            $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/friction_view.o \
                            $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
-                           $(BUILD)/files.o $(BUILD)/history_io.o
+                           $(BUILD)/files.o $(BUILD)/history_io.o $(BUILD)/results.o
 # the driver's modules (src/driver): the run's data, its two back-ends, its phases
 $(BUILD)/load_history.o:   $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_interface.o \
                            $(BUILD)/errors.o $(BUILD)/floating.o $(BUILD)/kinds.o
