@@ -15,7 +15,7 @@ module floating
   use config, only: FRICTION_COULOMB, FRICTION_TRESCA
   use condense, only: body_condensed_t
   use contact_common, only: scatter
-  use lapack, only: dsyev, dgels, dsygv
+  use lapack, only: dsyev, dsygv, dpotrf
   use strings, only: i2s, sci
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
@@ -200,7 +200,7 @@ contains
     type(error_t), intent(inout) :: err
     integer, allocatable :: root(:), members(:), col(:), rowof(:)
     real(wp), allocatable :: gs(:, :), es(:), gg(:, :), sr(:, :), ev(:)
-    real(wp) :: c(3), res
+    real(wp) :: c(3), res, hold
     integer :: a, g, r, nm, ncol, k, i, i0
     character(len=:), allocatable :: names
 
@@ -244,9 +244,18 @@ contains
         end associate
       end do
       names = group_names(members)
-      gg = matmul(gs, transpose(gs))
-      call held_motions(gg, sr, r, ev, k)
-      if (k == 0 .and. ev(1) <= HOLD_MIN) then
+      gg = gram(gs)
+      ! every joint motion held (G G' v = mu S v with every mu > hold) exactly when
+      ! G G' - hold S is positive definite: one Cholesky factor (r^3/3) decides, the
+      ! eigenproblem (about 9 r^3) only names the free motion when there is one. The
+      ! threshold is HOLD_MIN / nm^2: a chain of nm bodies held at one end has its
+      ! smallest mu near 2.5 / nm^2 (held, though weakly: 4e-5 for 249 blocks), while a
+      ! motion the contact normals miss has mu at the normals' discretisation error
+      hold = HOLD_MIN/real(nm, wp)**2
+      k = 1
+      ev = huge(1.0_wp)
+      if (.not. held_by_cholesky(gg, sr, r, hold)) call held_motions(gg, sr, r, ev, k)
+      if (k == 0 .and. ev(1) <= hold) then
         ! the free motion of the group, as its first body's part of it
         c = matmul(systems(members(1))%rig_coef, gg(1:bodies(members(1))%nrig, 1))
         if (nm == 2) then
@@ -275,6 +284,38 @@ contains
       deallocate (gs, es, gg, sr, ev)
     end do
   end subroutine check_groups
+
+  !> G G' from G's nonzeros (a contact row's column touches the rigid rows of at most two
+  !! bodies: a few products per column, not r^2 per column).
+  function gram(gm) result(gg)
+    real(wp), intent(in) :: gm(:, :)
+    real(wp), allocatable :: gg(:, :)
+    integer, allocatable :: nz(:)
+    integer :: c, a, b, rr
+    rr = size(gm, 1)
+    allocate (gg(rr, rr))
+    gg = 0.0_wp
+    do c = 1, size(gm, 2)
+      nz = pack([(a, a=1, rr)], gm(:, c) /= 0.0_wp)
+      do b = 1, size(nz)
+        do a = 1, size(nz)
+          gg(nz(a), nz(b)) = gg(nz(a), nz(b)) + gm(nz(a), c)*gm(nz(b), c)
+        end do
+      end do
+    end do
+  end function gram
+
+  !> G G' - hold S is positive definite (every joint rigid motion held; dpotrf).
+  logical function held_by_cholesky(gg, s, r, hold) result(held)
+    real(wp), intent(in) :: gg(:, :), s(:, :)
+    integer, intent(in) :: r
+    real(wp), intent(in) :: hold
+    real(wp), allocatable :: a(:, :)
+    integer :: info
+    a = gg(1:r, 1:r) - hold*s(1:r, 1:r)
+    call dpotrf('U', r, a, r, info)
+    held = info == 0
+  end function held_by_cholesky
 
   !> The groups of floating bodies that touch each other (connected by pairs of two
   !! floating bodies): root(a) is the lowest id of body a's group (a itself when alone or
@@ -613,13 +654,20 @@ contains
     integer, intent(in) :: r
     real(wp), intent(out) :: mu(:)
     integer, intent(out) :: info
-    real(wp) :: b(r, r), g0(r, r), work(64)
+    real(wp), allocatable :: b(:, :), g0(:, :), work(:)
+    real(wp) :: wq(1)
+    integer :: lwork
     g0 = gg(1:r, 1:r)
     b = s(1:r, 1:r)
-    call dsygv(1, 'V', 'U', r, gg, r, b, r, mu, work, size(work), info)
+    ! the workspace LAPACK asks for (a fixed 64 was too small from r = 22 on: dsygv and
+    ! dsyev refused it, printed "illegal value" and the group's check was skipped)
+    call dsygv(1, 'V', 'U', r, gg, r, b, r, mu, wq, -1, info)
+    lwork = max(3*r, int(wq(1)))
+    allocate (work(lwork))
+    call dsygv(1, 'V', 'U', r, gg, r, b, r, mu, work, lwork, info)
     if (info /= 0) then
-      gg = g0
-      call dsyev('V', 'U', r, gg, r, mu, work, size(work), info)
+      gg(1:r, 1:r) = g0
+      call dsyev('V', 'U', r, gg, r, mu, work, lwork, info)
       if (info == 0) mu(1) = 0.0_wp
     end if
   end subroutine held_motions
@@ -651,63 +699,193 @@ contains
   end function fixing_list
 
   !> Non-negative least squares min |G x - e|, x >= 0 (Lawson and Hanson's active set
-  !! method; G is r x m with r small, so at most r columns are ever passive). res is
-  !! the residual norm |G x - e| at the returned x.
+  !! method; G is r x m, at most r columns are ever passive). res is the residual norm
+  !! |G x - e| at the returned x. The least squares problem of the passive columns is kept
+  !! as a QR factorization that is updated, not redone, when a column enters (one
+  !! Householder reflection, O(r^2)) or leaves (Givens rotations, O(r np)): a group of 500
+  !! floating blocks took 3 s with a factorization from scratch per step (O(r np^2) each,
+  !! r^4 in all), 0.3 s with the updates.
   subroutine nnls(g, e, x, res)
     real(wp), intent(in) :: g(:, :)     !< (r, m)
     real(wp), intent(in) :: e(:)        !< (r)
     real(wp), intent(out) :: x(:)       !< (m)
     real(wp), intent(out) :: res
-    real(wp), allocatable :: w(:), z(:), a(:, :), rhs(:), work(:)
+    real(wp), allocatable :: w(:), z(:), q(:, :), rr(:, :), v(:), qe(:), cval(:), resv(:)
     logical, allocatable :: passive(:)
-    integer, allocatable :: pidx(:)
-    integer :: r, m, j, np, it, inner, lapinfo
-    real(wp) :: tol, alpha, t
+    integer, allocatable :: cols(:)     ! the passive columns, in the order of rr's columns
+    integer, allocatable :: cptr(:), crow(:)   ! g's nonzeros by column
+    integer :: r, m, j, np, it, inner, k, i
+    real(wp) :: tol, alpha, t, rdiag_min
 
     r = size(g, 1)
     m = size(g, 2)
-    allocate (w(m), z(m), passive(m), rhs(max(r, m)), work(64*(r + m) + 64))
+    allocate (w(m), z(m), passive(m), q(r, r), rr(r, min(r, m)), v(r), cols(min(r, m)), qe(r))
+    ! g's nonzeros by column (a contact row's column touches the rigid rows of two bodies:
+    ! the gradient g'(e - g x) of each step costs its nonzeros, not r m)
+    allocate (cptr(m + 1))
+    cptr(1) = 1
+    do k = 1, m
+      cptr(k + 1) = cptr(k) + count(g(:, k) /= 0.0_wp)
+    end do
+    allocate (crow(cptr(m + 1) - 1), cval(cptr(m + 1) - 1))
+    do k = 1, m
+      crow(cptr(k):cptr(k + 1) - 1) = pack([(i, i=1, r)], g(:, k) /= 0.0_wp)
+      cval(cptr(k):cptr(k + 1) - 1) = g(crow(cptr(k):cptr(k + 1) - 1), k)
+    end do
     x = 0.0_wp
     passive = .false.
+    np = 0
+    q = 0.0_wp
+    do i = 1, r
+      q(i, i) = 1.0_wp
+    end do
+    rr = 0.0_wp
     tol = 1.0e-12_wp*max(maxval(abs(g))*norm2(e), tiny(1.0_wp))
+    rdiag_min = 1.0e-13_wp*max(maxval(abs(g)), tiny(1.0_wp))
     do it = 1, 3*m + 10
-      w = matmul(e - matmul(g, x), g)
+      call gradient()
       j = 0
       t = tol
-      do np = 1, m
-        if (.not. passive(np) .and. w(np) > t) then
-          t = w(np)
-          j = np
+      do k = 1, m
+        if (.not. passive(k) .and. w(k) > t) then
+          t = w(k)
+          j = k
         end if
       end do
-      if (j == 0) exit
+      if (j == 0 .or. np >= min(r, m)) exit
+      if (.not. append_column(j)) exit     ! in the span of the passive ones to rounding
       passive(j) = .true.
       do inner = 1, 3*m + 10
-        pidx = pack([(np, np=1, m)], passive)
-        np = size(pidx)
-        allocate (a(r, np))
-        a = g(:, pidx)
-        rhs = 0.0_wp
-        rhs(1:r) = e
-        call dgels('N', r, np, 1, a, r, rhs, max(r, np), work, size(work), lapinfo)
-        deallocate (a)
-        z = 0.0_wp
-        if (lapinfo == 0) z(pidx) = rhs(1:np)
-        if (all(z(pidx) > 0.0_wp)) exit
+        call passive_solution()
+        if (all(z(cols(1:np)) > 0.0_wp)) exit
         alpha = 1.0_wp
-        do np = 1, size(pidx)
-          j = pidx(np)
+        do k = 1, np
+          j = cols(k)
           if (z(j) <= 0.0_wp) alpha = min(alpha, x(j)/max(x(j) - z(j), tiny(1.0_wp)))
         end do
         x = x + alpha*(z - x)
-        where (passive .and. x <= 1.0e-14_wp*maxval(abs(x))) passive = .false.
+        ! the passive columns at zero leave, the last first (positions stay valid)
+        do k = np, 1, -1
+          j = cols(k)
+          if (x(j) <= 1.0e-14_wp*maxval(abs(x))) then
+            passive(j) = .false.
+            call delete_column(k)
+          end if
+        end do
         where (.not. passive) x = 0.0_wp
-        if (.not. any(passive)) exit
+        if (np == 0) exit
       end do
       x = z
       where (.not. passive) x = 0.0_wp
     end do
     res = norm2(matmul(g, x) - e)
+
+  contains
+
+    !> w = g'(e - g x), by g's nonzeros (x is zero off the passive columns).
+    subroutine gradient()
+      integer :: c, l
+      resv = e
+      do c = 1, np
+        do l = cptr(cols(c)), cptr(cols(c) + 1) - 1
+          resv(crow(l)) = resv(crow(l)) - cval(l)*x(cols(c))
+        end do
+      end do
+      do c = 1, m
+        w(c) = 0.0_wp
+        do l = cptr(c), cptr(c + 1) - 1
+          w(c) = w(c) + cval(l)*resv(crow(l))
+        end do
+      end do
+    end subroutine gradient
+
+    !> Column j of g as column np + 1 of the factorization: v = Q'g_j, a Householder
+    !! reflection zeroes v(np+2:r), applied to Q's columns np+1..r. False (nothing
+    !! changed) when the column has no part outside the passive columns' span.
+    logical function append_column(jc) result(ok)
+      integer, intent(in) :: jc
+      real(wp) :: nrm, beta, v1
+      real(wp), allocatable :: hv(:), qh(:)
+      integer :: n0
+      ok = .false.
+      n0 = np + 1
+      ! v = Q' g_j by the column's nonzeros
+      v = 0.0_wp
+      do k = cptr(jc), cptr(jc + 1) - 1
+        v = v + cval(k)*q(crow(k), :)
+      end do
+      nrm = norm2(v(n0:r))
+      if (.not. nrm > rdiag_min) return
+      ! H = I - beta u u', u = v(n0:r) + sign(v(n0)) |v(n0:r)| e_1: H v(n0:r) = -sign nrm e_1
+      allocate (hv(r - n0 + 1))
+      hv = v(n0:r)
+      v1 = sign(nrm, hv(1))
+      hv(1) = hv(1) + v1
+      beta = 1.0_wp/(v1*hv(1))
+      ! Q(:, n0:r) <- Q(:, n0:r) H
+      qh = matmul(q(:, n0:r), hv)
+      do k = 1, size(hv)
+        q(:, n0 + k - 1) = q(:, n0 + k - 1) - beta*qh*hv(k)
+      end do
+      rr(1:np, n0) = v(1:np)
+      rr(n0, n0) = -v1
+      rr(n0 + 1:, n0) = 0.0_wp
+      np = n0
+      cols(np) = jc
+      ok = .true.
+    end function append_column
+
+    !> Remove the passive column at position kc: shift the later columns left and restore
+    !! the triangle by Givens rotations of rows kc..np-1 (applied to Q's columns as well).
+    subroutine delete_column(kc)
+      integer, intent(in) :: kc
+      integer :: c, l
+      real(wp) :: a, b, cs, sn, hyp, t1, t2
+      do c = kc, np - 1
+        rr(:, c) = rr(:, c + 1)
+        cols(c) = cols(c + 1)
+      end do
+      rr(:, np) = 0.0_wp
+      np = np - 1
+      do c = kc, np
+        a = rr(c, c)
+        b = rr(c + 1, c)
+        if (b == 0.0_wp) cycle
+        hyp = hypot(a, b)
+        cs = a/hyp
+        sn = b/hyp
+        do l = c, np
+          t1 = rr(c, l)
+          t2 = rr(c + 1, l)
+          rr(c, l) = cs*t1 + sn*t2
+          rr(c + 1, l) = -sn*t1 + cs*t2
+        end do
+        rr(c + 1, c) = 0.0_wp
+        do l = 1, r
+          t1 = q(l, c)
+          t2 = q(l, c + 1)
+          q(l, c) = cs*t1 + sn*t2
+          q(l, c + 1) = -sn*t1 + cs*t2
+        end do
+      end do
+    end subroutine delete_column
+
+    !> z on the passive columns: R z_P = (Q'e)(1:np), by back substitution; 0 elsewhere.
+    subroutine passive_solution()
+      integer :: a, b
+      real(wp) :: sacc
+      z = 0.0_wp
+      if (np == 0) return
+      qe(1:np) = matmul(e, q(:, 1:np))
+      do a = np, 1, -1
+        sacc = qe(a)
+        do b = a + 1, np
+          sacc = sacc - rr(a, b)*z(cols(b))
+        end do
+        z(cols(a)) = sacc/rr(a, a)
+      end do
+    end subroutine passive_solution
+
   end subroutine nnls
 
 end module floating

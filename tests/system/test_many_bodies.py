@@ -6,6 +6,9 @@
     checked: the run reaches its assembly phase, whose line gives the time the deck took
     (printed as INFO, never asserted: the machine may be shared); a SIGTERM then stops it
     with exit 4 and nothing written;
+(c) 300 floating blocks on a clamped one are accepted (exit 0); 40 with nothing below are
+    refused as free together (exit 1), with no LAPACK "illegal value" text (from 22 rigid
+    rows on the group check's eigenproblem had too small a workspace and was skipped);
 (b) the same stack with a fault far down the deck gets its own message, exit 1, nothing
     written: a group of a body in two pairs with the same body (naming both pairs' lines), a body in no pair,
     a pair naming a body the deck does not have.
@@ -99,6 +102,25 @@ try:
     check(code == 1 and f"unknown.nml:{first + 500}: in group &contact: bodies = 501,{N + 1} names body "
           f"{N + 1}, which does not exist" in out, "a pair naming a body the deck lacks is named at its line",
           out.strip()[-300:])
+
+    # (c) floating chains: 300 blocks on rollers on a clamped one (held, though the joint
+    # motion's ratio is small) are accepted and solved; 40 blocks on rollers with nothing
+    # below are refused as free together, with no LAPACK text on the way
+    def floating(n, clamped):
+        lines = [f"&body id={k}, x0=0.0, y0={float(n - k)}, width=1.0, height=1.0, nx=2, ny=2"
+                 + (", bottom='clamped'" if k == n and clamped else ", left='roller'") + " /"
+                 for k in range(1, n + 1)]
+        lines.append("&traction body=1, side='top', t0=0.0, -1.0e6 /")
+        return lines + [f"&contact bodies={k},{k + 1}, groups='bottom','top' /" for k in range(1, n)]
+    code, out, dt, _ = run_deck(work, "floating300", floating(300, True))
+    check(code == 0 and "illegal value" not in out, "300 floating blocks on a clamped one: exit 0",
+          out.strip()[-300:])
+    print(f"INFO  300 floating blocks: {dt:.2f} s for the whole run", flush=True)
+    code, out, _, made = run_deck(work, "free40", floating(40, False))
+    check(code == 1 and "together they are free" in out and "translation along y" in out
+          and "illegal value" not in out, "40 floating blocks with nothing below: exit 1, free together",
+          out.strip()[-300:])
+    check(not made, "nothing is written (free together)", " ".join(made))
 finally:
     shutil.rmtree(work, ignore_errors=True)
 
