@@ -184,7 +184,7 @@ $(BUILD)/friction_view.o:  $(BUILD)/contact_interface.o $(BUILD)/contact_types.o
 $(BUILD)/equality_rows.o:  $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/linop.o
 # the Robin operators implement one interface: not every operator needs every argument
-$(BUILD)/robin_operators.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
+$(BUILD)/robin_operators.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/sorting.o
 $(BUILD)/robin_operators.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \

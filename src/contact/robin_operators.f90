@@ -9,9 +9,11 @@
 !! body with a singular F_a. `new_robin_operator` is the one place that picks the operator
 !! from the decoded setting (config's ROBIN_*).
 module robin_operators
-  use kinds, only: wp
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  use kinds, only: wp, ip
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init, dense_op_take
+  use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
   use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, slot_row, slot_side, ROW_NORMAL, ROW_TANGENT
@@ -117,12 +119,14 @@ module robin_operators
   !! S = 2 K^-1 on the group's rows, K the assembled stiffness of its bodies.
   type :: group_op_t
     integer, allocatable :: rows(:)          !< the group's rows (ascending)
-    type(dense_op_t) :: s                    !< S on those rows
+    type(dense_op_t) :: s                    !< S on those rows (a group of at most GROUP_DENSE_MAX rows)
+    logical :: sparse = .false.              !< S = 2 K^-1 applied by kf's solves instead
+    type(chol_t) :: kf                       !< sparse Cholesky factor of K (CHOLMOD)
   end type group_op_t
 
   !> The most rows a group's dense K may have (1 GB of K and S at 8192; a Cholesky factor
-  !! and inverse of 4096 rows take about 10 s on one core): a larger group takes each pair's
-  !! S from its blocks (the operator of the pairs one by one; doc/method.md).
+  !! and inverse of 4096 rows take about 10 s on one core): a larger group keeps K sparse
+  !! (its bodies' blocks) and applies S = 2 K^-1 by CHOLMOD solves (doc/method.md).
   integer, parameter :: GROUP_DENSE_MAX = 4096
 
   !> A body's slots in the side layout (body_condensed_t%slots).
@@ -500,20 +504,19 @@ contains
         if (gof(find(contact_line%pair_body(1, p))) /= g) cycle
         rows = [rows, [(i, i=self%rows(1, p), self%rows(2, p))]]
       end do
+      members = pack([(a, a=1, size(bodies))], [(gof(find(a)) == g .and. allocated(stiff(a)%k), a=1, size(bodies))])
       if (size(rows) > GROUP_DENSE_MAX) then
-        ! too many rows for a dense K: each pair's S from its blocks of the bodies' stiffnesses
-        call pair_blocks(g, info)
+        ! too many rows for a dense K: K sparse, factored by CHOLMOD
+        call sparse_group(self%group(g), rows, members, info)
         if (info /= 0) then
-          write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: pair ', p, &
-            ': Sigma_A + Sigma_B is not positive definite, info = ', info
+          write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: the assembled stiffness of a group of ', &
+            size(members), ' bodies is not positive definite (sparse Cholesky), info = ', info
           call err%set(ERR_NUMERICAL, emsg)
           return
         end if
-        allocate (self%group(g)%rows(0))
-        deallocate (rows)
+        call move_alloc(rows, self%group(g)%rows)
         cycle
       end if
-      members = pack([(a, a=1, size(bodies))], [(gof(find(a)) == g .and. allocated(stiff(a)%k), a=1, size(bodies))])
       call group_matrix(rows, members, self%group(g)%s, info)
       if (info /= 0) then
         write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: the assembled stiffness of a group of ', &
@@ -526,30 +529,111 @@ contains
 
   contains
 
-    !> The pairs of group gg one by one (a group too large for a dense K): S_p = 2 (Sigma_A +
-    !! Sigma_B)^-1 of the blocks of the two bodies' stiffnesses on the pair's rows (its other
-    !! rows held), into self%s(p); p is the failing pair when info /= 0.
-    subroutine pair_blocks(gg, info)
-      integer, intent(in) :: gg
+    !> K of a large group as a sparse matrix (the upper triangles of its bodies' blocks,
+    !! summed where bodies share rows) and its CHOLMOD factor (AMD ordering) in op%kf;
+    !! info /= 0 when the factorization fails.
+    subroutine sparse_group(op, sel, mem, info)
+      type(group_op_t), intent(inout) :: op
+      integer, intent(in) :: sel(:), mem(:)
       integer, intent(out) :: info
-      real(wp), allocatable :: sp(:, :)
-      integer :: sd, ab, r(2, 2)
-      info = 0
-      do p = 1, contact_line%npair
-        if (.not. in_group(p)) cycle
-        if (gof(find(contact_line%pair_body(1, p))) /= gg) cycle
-        do sd = 1, 2
-          ab = contact_line%pair_body(sd, p)
-          r(:, sd) = pair_positions(bodies(ab), contact_line, p)
-        end do
-        associate (ka => stiff(contact_line%pair_body(1, p)), kb => stiff(contact_line%pair_body(2, p)))
-          call parallel_flex(ka%k(r(1, 1):r(2, 1), r(1, 1):r(2, 1)), ka%inf(r(1, 1):r(2, 1), :), &
-                             kb%k(r(1, 2):r(2, 2), r(1, 2):r(2, 2)), kb%inf(r(1, 2):r(2, 2), :), sp, info)
-        end associate
-        if (info /= 0) return
-        call dense_op_take(self%s(p), sp)
+      integer, allocatable :: pos(:), loc(:), gr(:), ci(:), cj(:), ord(:), cnt(:)
+      integer(ip), allocatable :: colptr(:), rowind(:)
+      real(wp), allocatable :: cv(:), sg(:), val(:), blk(:, :)
+      real(wp) :: rho
+      integer :: n, ia, aa, ii, jj, ne, e, ml, c, nz, last_r
+      type(error_t) :: ferr
+      n = size(sel)
+      allocate (pos(m))
+      pos = 0
+      pos(sel) = [(ii, ii=1, n)]
+      ne = 0
+      do ia = 1, size(mem)
+        ne = ne + bodies(mem(ia))%m**2
       end do
-    end subroutine pair_blocks
+      allocate (ci(ne), cj(ne), cv(ne))
+      ne = 0
+      do ia = 1, size(mem)
+        aa = mem(ia)
+        loc = pack([(ii, ii=1, bodies(aa)%m)], [(pos(slot_row(bodies(aa)%slots(ii), m)) > 0, ii=1, bodies(aa)%m)])
+        ml = size(loc)
+        gr = [(pos(slot_row(bodies(aa)%slots(loc(ii)), m)), ii=1, ml)]
+        sg = [(merge(1.0_wp, -1.0_wp, slot_side(bodies(aa)%slots(loc(ii)), m) == 1), ii=1, ml)]
+        ! a body infinitely stiff along some directions (a mortar master coarser than the
+        ! slave): rho d d' added along each, rho = 1e6 |Sigma_a|_max, so that S = 2 K^-1 is
+        ! small there, as the dense path's complement makes it zero (any positive definite
+        ! S keeps the fixed point; this one is within about 1e-6 of that projection)
+        blk = stiff(aa)%k(loc, loc)
+        if (size(stiff(aa)%inf, 2) > 0) then
+          rho = 1.0e6_wp*max(maxval(abs(stiff(aa)%k)), tiny(1.0_wp))
+          do c = 1, size(stiff(aa)%inf, 2)
+            do jj = 1, ml
+              blk(:, jj) = blk(:, jj) + rho*stiff(aa)%inf(loc, c)*stiff(aa)%inf(loc(jj), c)
+            end do
+          end do
+        end if
+        do jj = 1, ml
+          do ii = 1, ml
+            if (gr(ii) > gr(jj)) cycle
+            ne = ne + 1
+            ci(ne) = gr(ii)
+            cj(ne) = gr(jj)
+            cv(ne) = sg(ii)*sg(jj)*blk(ii, jj)
+          end do
+        end do
+      end do
+      ! entries by column, then row (counting sort on the column, insertion within it)
+      allocate (cnt(n + 1), ord(ne))
+      cnt = 0
+      do e = 1, ne
+        cnt(cj(e) + 1) = cnt(cj(e) + 1) + 1
+      end do
+      cnt(1) = 1
+      do c = 1, n
+        cnt(c + 1) = cnt(c + 1) + cnt(c)
+      end do
+      block
+        integer, allocatable :: fill(:)
+        integer :: t, q
+        fill = cnt(1:n)
+        do e = 1, ne
+          ord(fill(cj(e))) = e
+          fill(cj(e)) = fill(cj(e)) + 1
+        end do
+        do c = 1, n
+          do q = cnt(c) + 1, cnt(c + 1) - 1
+            t = ord(q)
+            ii = q - 1
+            do while (ii >= cnt(c))
+              if (ci(ord(ii)) <= ci(t)) exit
+              ord(ii + 1) = ord(ii)
+              ii = ii - 1
+            end do
+            ord(ii + 1) = t
+          end do
+        end do
+      end block
+      ! merge duplicates into 0-based CSC
+      allocate (colptr(n + 1), rowind(ne), val(ne))
+      nz = 0
+      colptr(1) = 0
+      do c = 1, n
+        last_r = 0
+        do e = cnt(c), cnt(c + 1) - 1
+          if (ci(ord(e)) == last_r) then
+            val(nz) = val(nz) + cv(ord(e))
+          else
+            nz = nz + 1
+            rowind(nz) = int(ci(ord(e)) - 1, ip)
+            val(nz) = cv(ord(e))
+            last_r = ci(ord(e))
+          end if
+        end do
+        colptr(c + 1) = int(nz, ip)
+      end do
+      call op%kf%factor(n, colptr, rowind(1:nz), val(1:nz), FACT_CHOLMOD, ORD_AMD, ferr)
+      info = merge(1, 0, ferr%failed())
+      op%sparse = .not. ferr%failed()
+    end subroutine sparse_group
 
     !> Pair q has rows and a body in another pair.
     logical function in_group(q)
@@ -633,6 +717,7 @@ contains
     integer, intent(inout) :: count
     real(wp), allocatable :: y(:)
     integer :: p, c
+    type(error_t) :: serr
     corr(:, 1) = 0.0_wp
     do p = 1, size(self%s)
       if (self%s(p)%n == 0) cycle
@@ -641,7 +726,15 @@ contains
     do c = 1, size(self%group)
       if (size(self%group(c)%rows) == 0) cycle    ! a large group: its pairs' S above
       allocate (y(size(self%group(c)%rows)))
-      call self%group(c)%s%apply(d(self%group(c)%rows), y)
+      if (self%group(c)%sparse) then
+        ! S d = 2 K^-1 d by the factor's solves
+        y = d(self%group(c)%rows)
+        call self%group(c)%kf%solve(y, serr)
+        y = 2.0_wp*y
+        if (serr%failed()) y = ieee_value(1.0_wp, ieee_quiet_nan)   ! the outer loop stops on it
+      else
+        call self%group(c)%s%apply(d(self%group(c)%rows), y)
+      end if
       corr(self%group(c)%rows, 1) = y
       deallocate (y)
     end do
