@@ -19,7 +19,7 @@ module robin_operators
   use contact_interface, only: interface_t, has_friction, slot_row, slot_side, ROW_NORMAL, ROW_TANGENT
   use condense, only: body_condensed_t
   use contact_common, only: pair_positions, body_threads
-  use sorting, only: largest_first
+  use sorting, only: largest_first, merge_sort_by_keys
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
@@ -536,7 +536,7 @@ contains
       type(group_op_t), intent(inout) :: op
       integer, intent(in) :: sel(:), mem(:)
       integer, intent(out) :: info
-      integer, allocatable :: pos(:), loc(:), gr(:), ci(:), cj(:), ord(:), cnt(:)
+      integer, allocatable :: pos(:), loc(:), gr(:), ci(:), cj(:), ord(:)
       integer(ip), allocatable :: colptr(:), rowind(:)
       real(wp), allocatable :: cv(:), sg(:), val(:), blk(:, :)
       real(wp) :: rho
@@ -581,53 +581,28 @@ contains
           end do
         end do
       end do
-      ! entries by column, then row (counting sort on the column, insertion within it)
-      allocate (cnt(n + 1), ord(ne))
-      cnt = 0
-      do e = 1, ne
-        cnt(cj(e) + 1) = cnt(cj(e) + 1) + 1
-      end do
-      cnt(1) = 1
-      do c = 1, n
-        cnt(c + 1) = cnt(c + 1) + cnt(c)
-      end do
-      block
-        integer, allocatable :: fill(:)
-        integer :: t, q
-        fill = cnt(1:n)
-        do e = 1, ne
-          ord(fill(cj(e))) = e
-          fill(cj(e)) = fill(cj(e)) + 1
-        end do
-        do c = 1, n
-          do q = cnt(c) + 1, cnt(c + 1) - 1
-            t = ord(q)
-            ii = q - 1
-            do while (ii >= cnt(c))
-              if (ci(ord(ii)) <= ci(t)) exit
-              ord(ii + 1) = ord(ii)
-              ii = ii - 1
-            end do
-            ord(ii + 1) = t
-          end do
-        end do
-      end block
+      ! entries by column, then row
+      ord = [(e, e=1, ne)]
+      call merge_sort_by_keys(ord, reshape([(cj(e), ci(e), e=1, ne)], [2, ne]))
       ! merge duplicates into 0-based CSC
       allocate (colptr(n + 1), rowind(ne), val(ne))
       nz = 0
-      colptr(1) = 0
-      do c = 1, n
-        last_r = 0
-        do e = cnt(c), cnt(c + 1) - 1
-          if (ci(ord(e)) == last_r) then
-            val(nz) = val(nz) + cv(ord(e))
-          else
-            nz = nz + 1
-            rowind(nz) = int(ci(ord(e)) - 1, ip)
-            val(nz) = cv(ord(e))
-            last_r = ci(ord(e))
-          end if
-        end do
+      colptr = 0
+      c = 0
+      last_r = 0
+      do e = 1, ne
+        if (cj(ord(e)) /= c) then        ! a new column (every column has its diagonal)
+          c = cj(ord(e))
+          last_r = 0
+        end if
+        if (ci(ord(e)) == last_r) then
+          val(nz) = val(nz) + cv(ord(e))
+        else
+          nz = nz + 1
+          rowind(nz) = int(ci(ord(e)) - 1, ip)
+          val(nz) = cv(ord(e))
+          last_r = ci(ord(e))
+        end if
         colptr(c + 1) = int(nz, ip)
       end do
       call op%kf%factor(n, colptr, rowind(1:nz), val(1:nz), FACT_CHOLMOD, ORD_AMD, ferr)
