@@ -508,16 +508,9 @@ contains
       if (size(rows) > GROUP_DENSE_MAX) then
         ! too many rows for a dense K: K sparse, factored by CHOLMOD
         call sparse_group(self%group(g), rows, members, info)
-        if (info /= 0) then
-          write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: the assembled stiffness of a group of ', &
-            size(members), ' bodies is not positive definite (sparse Cholesky), info = ', info
-          call err%set(ERR_NUMERICAL, emsg)
-          return
-        end if
-        call move_alloc(rows, self%group(g)%rows)
-        cycle
+      else
+        call group_matrix(rows, members, self%group(g)%s, info)
       end if
-      call group_matrix(rows, members, self%group(g)%s, info)
       if (info /= 0) then
         write (emsg, '(a,i0,a,i0)') 'harmonic Robin operator: the assembled stiffness of a group of ', &
           size(members), ' bodies is not positive definite, info = ', info
@@ -699,7 +692,6 @@ contains
       call self%s(p)%apply(d(self%rows(1, p):self%rows(2, p)), corr(self%rows(1, p):self%rows(2, p), 1))
     end do
     do c = 1, size(self%group)
-      if (size(self%group(c)%rows) == 0) cycle    ! a large group: its pairs' S above
       allocate (y(size(self%group(c)%rows)))
       if (self%group(c)%sparse) then
         ! S d = 2 K^-1 d by the factor's solves
