@@ -69,7 +69,7 @@ MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo 
         ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe mortar_chains mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
-OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/sighdl.o \
+OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
 TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names
@@ -111,7 +111,7 @@ $(BUILD)/%.o: %.f90 | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(FC) $(FFLAGS) -c $< -o $@
 
-$(BUILD)/%.o: %.c include/cholmod_shim.h include/sighdl.h | $(DEPS_STAMP)
+$(BUILD)/%.o: %.c include/cholmod_shim.h include/blas_tiles.h include/sighdl.h | $(DEPS_STAMP)
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) -c $< -o $@
 
@@ -295,8 +295,11 @@ run: $(PROG)
 # test_regression compares with a reference stored by the release build: to 1e-12; the checked
 # build (-O0 rounds differently) within ten times each run's a posteriori bound
 # the benchmark programs are built too (not run), so an interface change cannot leave them behind
-check: $(PROG) $(TEST_BINS) $(BENCH_BINS) mpi-deps
-	@if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then $(MAKE) MPI=1 all; fi
+# the build runs on every core (-j nproc) unless the caller gave -j already
+CHECK_JOBS = $(if $(findstring -j,$(MAKEFLAGS)),,-j$(shell nproc 2>/dev/null || echo 2))
+check: mpi-deps
+	@$(MAKE) --no-print-directory $(CHECK_JOBS) $(PROG) $(TEST_BINS) $(BENCH_BINS)
+	@if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then $(MAKE) --no-print-directory $(CHECK_JOBS) MPI=1 all; fi
 	@BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
 
 mpi-deps:

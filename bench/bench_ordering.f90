@@ -11,9 +11,11 @@
 !! Columns: mesh, kind, ordering, n, m, order = our ordering's own time (nd only; METIS
 !! and AMD run inside analyze), analyze (ordering + symbolic), factor (numeric),
 !! condense (F_a from the trailing block of L), total = order + analyze + factor +
-!! condense [s], nnz(L), flops, mem = CHOLMOD's peak memory of the factorization [MiB].
+!! condense [s], nnz(L), flops, tiles (of the dense kernels), mem = CHOLMOD's peak memory of
+!! the factorization [MiB].
 !!
-!! Usage: bench_ordering [max_nx]   meshes 128x64, 256x128, ... up to max_nx (default 1024)
+!! Usage: bench_ordering [max_nx [threads [min_nx]]]   meshes min_nx x min_nx/2 (default 128),
+!! doubled up to max_nx (default 1024)
 program bench_ordering
   use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
@@ -28,7 +30,7 @@ program bench_ordering
   implicit none (type, external)
 
   character(len=*), parameter :: onames(3) = [character(len=5) :: 'metis', 'amd', 'nd']
-  integer :: nx, max_nx, kind, o, stat
+  integer :: nx, max_nx, min_nx, threads, kind, o, stat
   character(len=32) :: arg
   type(body_cfg_t) :: b
   type(mesh_t) :: msh
@@ -37,18 +39,30 @@ program bench_ordering
 
   ! as in the program with one thread: CHOLMOD's own OpenMP regions (a fixed
   ! num_threads(4)) would otherwise start 4 threads on the cores being measured
-  call omp_set_max_active_levels(0)
   max_nx = 1024
+  threads = 1
+  min_nx = 128
   if (command_argument_count() >= 1) then
     call get_command_argument(1, arg)
     read (arg, *, iostat=stat) max_nx
-    if (stat /= 0) error stop 'usage: bench_ordering [max_nx]'
+    if (stat /= 0) error stop 'usage: bench_ordering [max_nx [threads [min_nx]]]'
   end if
+  if (command_argument_count() >= 2) then
+    call get_command_argument(2, arg)
+    read (arg, *, iostat=stat) threads
+    if (stat /= 0 .or. threads < 1) error stop 'usage: bench_ordering [max_nx [threads [min_nx]]]'
+  end if
+  if (command_argument_count() >= 3) then
+    call get_command_argument(3, arg)
+    read (arg, *, iostat=stat) min_nx
+    if (stat /= 0 .or. min_nx < 2) error stop 'usage: bench_ordering [max_nx [threads [min_nx]]]'
+  end if
+  call omp_set_max_active_levels(merge(0, 1, threads == 1))
 
   write (output_unit, '(a)') '| mesh | kind | ordering | n | m | order s | analyze s | factor s | condense s | '// &
-    'total s | nnz(L) | flops | mem MiB |'
-  write (output_unit, '(a)') '| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |'
-  nx = 128
+    'total s | nnz(L) | flops | tiles | mem MiB |'
+  write (output_unit, '(a)') '| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |'
+  nx = min_nx
   do while (nx <= max_nx)
     b = body(nx, nx/2)
     do kind = 1, 2
@@ -101,7 +115,11 @@ contains
     else
       allocate (perm(0))
     end if
+    !$omp parallel num_threads(threads) default(shared)
+    !$omp single
     call factor_ordered(ch, sys, o, last, perm, info, msg)
+    !$omp end single
+    !$omp end parallel
     if (info /= 0) then
       write (output_unit, '(a)') 'factor failed: '//trim(msg)
       return
@@ -115,10 +133,10 @@ contains
       write (output_unit, '(a)') 'flexibility failed: '//err%text()
       return
     end if
-    write (output_unit, '(a,i0,a,i0,a,a,a,a,a,i0,a,i0,5(a,f0.3),a,es9.2,a,es9.2,a,f0.0,a)') &
+    write (output_unit, '(a,i0,a,i0,a,a,a,a,a,i0,a,i0,5(a,f0.3),a,es9.2,a,es9.2,a,i0,a,f0.0,a)') &
       '| ', nx, 'x', nx/2, ' | ', trim(kinds(kind)), ' | ', trim(onames(o)), ' | ', sys%n, ' | ', m, &
       ' | ', t_order, ' | ', ch%t_analyze, ' | ', ch%t_factor, ' | ', t_cond, ' | ', &
-      t_order + ch%t_analyze + ch%t_factor + t_cond, ' | ', real(ch%nnz_factor, wp), ' | ', ch%flops, ' | ', &
+      t_order + ch%t_analyze + ch%t_factor + t_cond, ' | ', real(ch%nnz_factor, wp), ' | ', ch%flops, ' | ', ch%tiles, ' | ', &
       real(ch%mem_bytes, wp)/2.0_wp**20, ' |'
     flush (output_unit)
     call ch%free()

@@ -38,6 +38,7 @@ typedef struct chsh_stats {
     double flops;         /* LL' flop count (Common->fl) */
     double mem_peak;      /* peak CHOLMOD memory of this handle [bytes] */
     double mem_inuse;     /* CHOLMOD memory in use now [bytes] */
+    double tiles;         /* dense-kernel tiles the numeric factorization ran (blas_tiles.h) */
     int    n;             /* matrix order */
     int    nlast;         /* number of DOFs requested last */
     int    last_ok;       /* 1 if L->Perm ends with exactly those DOFs, in order */

@@ -84,10 +84,11 @@ contains
   end subroutine check_output_names
 
   !> The threads the user gives (OMP_NUM_THREADS): one per body at a time, the largest body
-  !! first, and the interface-sized loops on the same threads. BLAS stays on one thread: a
-  !! threaded OpenBLAS factors a block (dpotrf) in another order for each thread count, and
-  !! the results must be the same to the last bit whatever the threads (measured: 2 BLAS
-  !! threads per body moved a frictional result by 1e-8). CHOLMOD opens OpenMP regions of its own with a fixed num_threads(4);
+  !! first, and the interface-sized loops on the same threads; a thread without a body takes
+  !! tiles of the others' factorizations (blas_tiles.c). BLAS stays on one thread: a
+  !! threaded OpenBLAS cuts each call by its thread count, and the results must be the same
+  !! to the last bit whatever the threads (measured: 2 BLAS threads per body moved a
+  !! frictional result by 1e-8). CHOLMOD opens OpenMP regions of its own with a fixed num_threads(4);
   !! inside our region they are nested and run serially, but with one thread our region is
   !! inactive and CHOLMOD's would start 4 threads on the cores we use (measured: 10x slower
   !! factorization). So no region below ours is active.

@@ -38,7 +38,9 @@ contains
     call fail_on(err, 'deck '//trim(the_deck%source))
   end subroutine check_memory
 
-  !> Order and factorize every body, the largest first.
+  !> Order and factorize every body, the largest first. The team has all the run's threads
+  !! even with fewer bodies: a thread without a body waits at the loop's barrier, where it
+  !! runs tiles of the others' factorizations (blas_tiles.c).
   subroutine factor(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its systems factorized into its bodies

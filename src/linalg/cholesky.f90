@@ -42,6 +42,9 @@ module cholesky
     real(wp) :: t_factor = 0.0_wp         !< numeric factorization wall time [s]
     integer(i8) :: nnz_factor = 0         !< nonzeros in L (CHOLMOD: without supernodal padding)
     real(wp) :: flops = 0.0_wp            !< factorization flop count
+    !> CHOLMOD: the dense-kernel tiles its numeric factorization ran as tasks (blas_tiles.c;
+    !! 0 when every kernel was small enough to run whole)
+    integer(i8) :: tiles = 0
     integer(i8) :: mem_bytes = 0          !< peak memory of the factorization [bytes]
     integer :: bandwidth = -1             !< half-bandwidth (FACT_BANDED), else -1
     logical :: interface_last_ok = .false.  !< true if L's permutation ends with `last`, in order
@@ -213,6 +216,7 @@ contains
       self%t_factor = st%t_factor
       self%nnz_factor = int(st%lnz, i8)
       self%flops = st%flops
+      self%tiles = int(st%tiles, i8)
       self%mem_bytes = int(st%mem_peak, i8)
       self%interface_last_ok = (st%last_ok == 1 .and. self%m_last > 0)
       if (code /= CM_OK) then
@@ -436,9 +440,9 @@ contains
     character(len=*), parameter :: ordname(4) = [character(len=7) :: 'metis', 'amd', 'natural', 'given']
     select case (self%method)
     case (FACT_CHOLMOD)
-      write (buf, '(a,a,a,i0,a,i0,a,es10.3,a,es10.3,a,f0.3,a,f0.3,a,f0.1,a,l1)') &
+      write (buf, '(a,a,a,i0,a,i0,a,es10.3,a,es10.3,a,i0,a,f0.3,a,f0.3,a,f0.1,a,l1)') &
         'cholmod/', trim(ordname(self%ordering)), ' n=', self%n, ' m_last=', self%m_last, &
-        ' nnz(L)=', real(self%nnz_factor, wp), ' flops=', self%flops, &
+        ' nnz(L)=', real(self%nnz_factor, wp), ' flops=', self%flops, ' tiles=', self%tiles, &
         ' t_analyze=', self%t_analyze, 's t_factor=', self%t_factor, 's mem=', &
         real(self%mem_bytes, wp) / 2.0_wp**20, 'MiB interface_last=', self%interface_last_ok
     case (FACT_BANDED)
@@ -465,6 +469,7 @@ contains
     self%t_analyze = 0.0_wp
     self%t_factor = 0.0_wp
     self%nnz_factor = 0
+    self%tiles = 0
     self%flops = 0.0_wp
     self%mem_bytes = 0
     self%bandwidth = -1

@@ -31,6 +31,7 @@ module cholmod_iface
     real(c_double) :: flops = 0       !< LL' flop count
     real(c_double) :: mem_peak = 0    !< peak CHOLMOD memory of the handle [bytes]
     real(c_double) :: mem_inuse = 0   !< CHOLMOD memory in use [bytes]
+    real(c_double) :: tiles = 0       !< dense-kernel tiles of the numeric factorization (blas_tiles.c)
     integer(c_int) :: n = 0           !< matrix order
     integer(c_int) :: nlast = 0       !< number of DOFs requested last
     integer(c_int) :: last_ok = 0     !< 1 if the factor's permutation ends with them, in order

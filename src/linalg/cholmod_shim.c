@@ -30,6 +30,7 @@
 
 #include "cholmod.h"
 #include "cholmod_shim.h"
+#include "blas_tiles.h"
 
 #ifndef TRUE
 #define TRUE 1
@@ -70,6 +71,7 @@ static void blas_one_thread(void)
 void chsh_init(void)
 {
     pthread_once(&blas_once, blas_one_thread);
+    bt_init();
 }
 
 static void set_msg(char *msg, int msglen, const char *fmt, ...)
@@ -398,7 +400,9 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
 
     /* ---- numeric factorization ---- */
     t0 = SuiteSparse_time();
+    bt_begin();   /* its large dense kernels as tiles on the team's idle threads */
     cholmod_factorize(&A, h->L, c);
+    h->st.tiles = (double) bt_end();
     h->st.t_factor = SuiteSparse_time() - t0;
     h->st.mem_peak = (double) c->memory_usage;
     h->st.mem_inuse = (double) c->memory_inuse;

@@ -6,7 +6,7 @@
 !! if any check fails.
 program test_cholesky
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use omp_lib, only: omp_get_max_threads
+  use omp_lib, only: omp_get_max_threads, omp_get_num_threads, omp_set_max_active_levels
   use kinds, only: wp
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL
   use banded, only: rcm_order, band_width
@@ -67,7 +67,10 @@ program test_cholesky
   call check_concurrent(ORD_METIS)
   call check_concurrent(ORD_AMD)
 
-  ! ---- 8. larger problem: timings ----
+  ! ---- 8. the factorization's dense kernels as tiles: the same bits at any thread count ----
+  call check_tiles()
+
+  ! ---- 9. larger problem: timings ----
   call timing_run()
 
   call test_summary()
@@ -656,6 +659,75 @@ contains
       call c%solve(u, err)
       call error_parts(err, info, msg)
   end subroutine conc_work
+
+  !> A lattice whose last supernode (its top separator and an interface of 2 x 220 DOFs
+  !! ordered last) is large enough for the factorization's dense kernels to run as tiles
+  !! (blas_tiles.c): factorized and solved by one thread of a team of 1, 2, 3, 4 and 8
+  !! threads (the others take the tiles at the team's barrier); the tiles ran, the solution is
+  !! accurate and the same to the last bit for every team. Then a negative pivot in the last
+  !! tile of the tiled dpotrf is reported at its own column (the tile's offset added).
+  subroutine check_tiles()
+    type(csc_t) :: M
+    type(chol_t) :: ch
+    integer, allocatable :: g(:)
+    real(wp), allocatable :: f(:), u(:), u1(:)
+    integer(kind=8) :: tiles1, tiles
+    integer :: info, i, t, nt, team, p
+    type(error_t) :: err
+    character(len=256) :: msg
+    character(len=8) :: tname
+    integer, parameter :: teams(5) = [1, 2, 3, 4, 8]
+    call lattice2d(220, 160, M)
+    g = [(2 * i - 1, i = 1, 220), (2 * i, i = 1, 220)]
+    allocate (f(M%n), u(M%n))
+    f = [(sin(0.37_wp * i), i = 1, M%n)]
+    tiles1 = -1
+    do t = 1, size(teams)
+      nt = teams(t)
+      write (tname, '(i0)') nt
+      team = 0
+      ! as the program does (run_phases choose_threads): no region below the team's is active
+      call omp_set_max_active_levels(merge(0, 1, nt == 1))
+      !$omp parallel num_threads(nt) default(shared)
+      !$omp single
+      team = omp_get_num_threads()
+      call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, err, last=g)
+      call error_parts(err, info, msg)
+      if (info == 0) then
+        u = f
+        call ch%solve(u, err)
+        call error_parts(err, info, msg)
+      end if
+      !$omp end single
+      !$omp end parallel
+      tiles = ch%tiles
+      write (output_unit, '(a)') '      team of '//trim(tname)//': '//ch%summary()
+      if (t == 1) then
+        call report(info == 0 .and. tiles > 0, 'tiled factorization ran tiles (team of 1): '//trim(msg))
+        call report_le(scaled_residual(M, u, f), RES_TOL, 'tiled factorization: scaled residual (team of 1)')
+        u1 = u
+        tiles1 = tiles
+      else
+        call report(info == 0 .and. team == nt .and. tiles == tiles1 .and. all(u == u1), &
+                    'team of '//trim(tname)//': the same tiles and the same solution to the last bit')
+      end if
+    end do
+    ! a negative pivot on the last DOF (ordered last: in the last tile of the last supernode)
+    do p = M%colptr(g(size(g))) + 1, M%colptr(g(size(g)) + 1)
+      if (M%rowind(p) + 1 == g(size(g))) M%val(p) = -M%val(p)
+    end do
+    call omp_set_max_active_levels(1)
+    !$omp parallel num_threads(2) default(shared)
+    !$omp single
+    call ch%factor(M%n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, err, last=g)
+    !$omp end single
+    !$omp end parallel
+    call error_parts(err, info, msg)
+    write (tname, '(i0)') M%n
+    call report(info == ERR_NUMERICAL .and. index(msg, 'column '//trim(tname)//' of '//trim(tname)) > 0, &
+                'tiled dpotrf: a negative last pivot is reported at its column: '//trim(msg))
+    call ch%free()
+  end subroutine check_tiles
 
   !> A larger lattice (200 x 200 cells, ~80k DOFs, 200 interface DOFs): print timings.
   subroutine timing_run()

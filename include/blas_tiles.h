@@ -1,0 +1,13 @@
+/* blas_tiles.h: the dense kernels of a sparse factorization as tiles on the OpenMP team's
+ * idle threads, bitwise the same for any thread count (src/linalg/blas_tiles.c). */
+#ifndef BLAS_TILES_H
+#define BLAS_TILES_H
+
+/* Find the real BLAS/LAPACK routines (once per process; aborts naming a missing one). */
+void bt_init(void);
+/* From here on this thread's large dgemm/dsyrk/dtrsm/dpotrf calls run as tiles. */
+void bt_begin(void);
+/* Back to plain calls; returns the tiles this thread's calls made since bt_begin. */
+long bt_end(void);
+
+#endif
