@@ -19,7 +19,7 @@ module run_phases
   use error_estimate, only: error_bound
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list, friction_edge
   use contact_common, only: gather
-  use results, only: write_results, result_files
+  use results, only: write_results, result_files, per_body_files
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
   use files, only: remove_file, special_file, check_new_files
   use signals, only: stop_requested, pending_signal
@@ -77,7 +77,8 @@ contains
     character(len=len_trim(run%deck%output%file) + 32), allocatable :: name(:)
     type(error_t) :: err
     file = trim(run%deck%output%file)
-    call result_files(file, run%deck%nbody, max(1, run%deck%npair), name)
+    call result_files(file, run%deck%nbody, max(1, run%deck%npair), name, &
+                      per_body_files(run%deck%output%xdmf, run%deck%nbody, max(1, run%deck%npair)))
     call check_new_files(name, err)
     if (.not. err%failed()) call check_new_files([checkpoint_file(file)], err)
     call fail_on(err, 'deck '//trim(run%deck%source))

@@ -86,6 +86,15 @@ module config
   character(len=*), parameter, public :: ELEMENT_CHOICES = 'Q1 P1'                    !< ELEM_* order
   character(len=*), parameter, public :: PLANE_CHOICES = 'strain stress'
 
+  !> The XDMF files beside a result: the collection alone (every body and contact line in
+  !! `<stem>.xdmf`, all lines in `<stem>_contact.xdmf`), or also one per body and one per pair
+  !! (meshio reads one grid per file); auto: those too up to XDMF_PER_BODY_MAX bodies and pairs
+  integer, parameter, public :: XDMF_AUTO = 1
+  integer, parameter, public :: XDMF_PER_BODY = 2
+  integer, parameter, public :: XDMF_COLLECTION = 3
+  character(len=*), parameter, public :: XDMF_CHOICES = 'auto per_body collection'
+  integer, parameter, public :: XDMF_PER_BODY_MAX = 64
+
   integer, parameter, public :: UNITS_SI = 1       !< m, N, Pa
   integer, parameter, public :: UNITS_MM = 2       !< mm, N, MPa (consistent: N/mm^2 = MPa)
   integer, parameter, public :: UNITS_CUSTOM = 3   !< names given by length_unit, force_unit, stress_unit
@@ -191,6 +200,7 @@ module config
     character(len=PATH_LEN) :: file = ''              !< result file ('' -> results/<deck name>.h5)
     integer :: checkpoint_every = 0                   !< outer iterations between checkpoints (0: none)
     integer :: progress_lines = 30                    !< at most about this many progress lines
+    integer :: xdmf = XDMF_AUTO                       !< XDMF_*: which XDMF files beside the result
   end type output_cfg_t
 
   !> A whole input deck, defaults included.

@@ -9,7 +9,7 @@ module deck_tables
   use config, only: deck_t, body_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
-                    ORDER_CHOICES, ACCEL_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
+                    ORDER_CHOICES, ACCEL_CHOICES, XDMF_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
                     UNITS_CHOICES, FRICTION_CHOICES, STEPS_UNSET
   implicit none (type, external)
   private
@@ -285,6 +285,11 @@ contains
       'between checkpoints to `<file>.ckpt.h5`; 0: only on SIGTERM or SIGINT')
     call v%int('progress_lines', o%progress_lines, range='>= 0', doc='at most about this many '// &
       'progress lines')
+    call v%enum('xdmf', o%xdmf, XDMF_CHOICES, doc='the XDMF files beside the result: '// &
+      '`''collection''`: `<stem>.xdmf` (every body and contact line, what ParaView opens) and '// &
+      '`<stem>_contact.xdmf` (all lines); `''per_body''`: also `<stem>_bodyN.xdmf` per body and '// &
+      '`<stem>_contactK.xdmf` per pair (one grid each, for meshio); `''auto''`: `per_body` up to '// &
+      '64 bodies and pairs, `collection` above')
   end subroutine output_vars
 
 end module deck_tables

@@ -18,7 +18,8 @@ module results
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files, data_open, data_write, data_close
-  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE
+  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE, &
+                    XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof
   use assembly, only: body_system_t, nodal_stress
@@ -54,7 +55,7 @@ module results
     real(wp), allocatable :: u(:, :)            !< (maxndof, bodies) full displacements [length]
   end type step_result_t
 
-  public :: write_results, result_files, body_group_name
+  public :: write_results, result_files, per_body_files, body_group_name
 
   !> The datasets of a body whose data are written beside the HDF5 library (`body_data`),
   !! in the order they are created.
@@ -94,7 +95,7 @@ contains
     character(len=:), allocatable :: why, h5, id
     type(error_t) :: st
     integer :: k, nb, np, nf, nt, nstale
-    logical :: ok
+    logical :: ok, per_body
     type(interface_t) :: itf
     type(contact_result_t) :: res
     type(tangential_t) :: tg
@@ -105,7 +106,8 @@ contains
     nb = size(msh)
     np = itf%npair
     call ensure_parent_dir(file)
-    call result_files(file, nb, np, name)
+    per_body = per_body_files(d%output%xdmf, nb, np)
+    call result_files(file, nb, np, name, per_body)
     nf = size(name)
     allocate (tmp(nf))
     do k = 1, nf
@@ -146,15 +148,17 @@ contains
     ! companions of an earlier result with more bodies or pairs, which this one lacks
     stale_pre(1) = replace_suffix(trim(file), '.h5', '_body')
     stale_pre(2) = replace_suffix(trim(file), '.h5', '_contact')
-    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, [nb + 1, merge(np + 1, 1, np > 1)], '.xdmf', &
-                      nstale)
+    ! (without per-body files, every earlier one is stale)
+    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, &
+                      merge([nb + 1, merge(np + 1, 1, np > 1)], [1, 1], per_body), '.xdmf', nstale)
     if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
     if (present(stale)) stale = nstale
 
   contains
 
-    !> The XDMF files tmp(2:): every body and contact line (ParaView), then one grid each
-    !! (meshio); one pair: its line is all of /contact, the grid 'contact'.
+    !> The XDMF files tmp(2:): every body and contact line (ParaView), all contact lines,
+    !! and with per_body one grid each (meshio); one pair: its line is all of /contact, the
+    !! grid 'contact'.
     subroutine write_companions(done)
       logical, intent(out) :: done   !< all written
       integer :: a, q
@@ -162,6 +166,10 @@ contains
         call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, id, times), done)
       else
         call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, id, times), done)
+      end if
+      if (.not. per_body) then   ! the contact lines' collection only
+        if (done) call write_text(tmp(3), xdmf_text([integer ::], [0], h5, msh, itf, id, times), done)
+        return
       end if
       do a = 1, nb
         if (done) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, id, times), done)
@@ -190,14 +198,36 @@ contains
     g = 'body'//body_label(a)
   end function body_group_name
 
-  !> The files of a result of nb bodies and np pairs: the HDF5 file, <stem>.xdmf,
-  !! <stem>_body<a>.xdmf for a = 1..nb, <stem>_contact.xdmf, and for np > 1
-  !! <stem>_contact<k>.xdmf for k = 1..np.
-  subroutine result_files(file, nb, np, name)
+  !> Whether a result of nb bodies and np pairs has one XDMF file per body and per pair
+  !! beside its collection, for the deck's `&output xdmf` (config XDMF_*).
+  pure logical function per_body_files(mode, nb, np)
+    integer, intent(in) :: mode, nb, np
+    select case (mode)
+    case (XDMF_PER_BODY)
+      per_body_files = .true.
+    case (XDMF_COLLECTION)
+      per_body_files = .false.
+    case default
+      per_body_files = nb <= XDMF_PER_BODY_MAX .and. np <= XDMF_PER_BODY_MAX
+    end select
+  end function per_body_files
+
+  !> The files of a result of nb bodies and np pairs: the HDF5 file, <stem>.xdmf, with
+  !! `per_body` <stem>_body<a>.xdmf for a = 1..nb, <stem>_contact.xdmf, and with `per_body`
+  !! and np > 1 <stem>_contact<k>.xdmf for k = 1..np.
+  subroutine result_files(file, nb, np, name, per_body)
     character(len=*), intent(in) :: file
     integer, intent(in) :: nb, np
     character(len=*), allocatable, intent(out) :: name(:)
+    logical, intent(in) :: per_body   !< also one XDMF file per body and per pair (per_body_files)
     integer :: k
+    if (.not. per_body) then
+      allocate (name(3))
+      name(1) = file
+      name(2) = replace_suffix(file, '.h5', '.xdmf')
+      name(3) = replace_suffix(file, '.h5', '_contact.xdmf')
+      return
+    end if
     allocate (name(3 + nb + merge(np, 0, np > 1)))
     name(1) = file
     name(2) = replace_suffix(file, '.h5', '.xdmf')

@@ -167,7 +167,16 @@ def echo_of(text):
     if first is None:
         return []
     last = next((i for i in range(first, len(lines)) if lines[i].startswith("&output")), len(lines) - 1)
-    return lines[first:last + 1]
+    while last + 1 < len(lines) and lines[last + 1].startswith("      "):   # the group's wrapped lines
+        last += 1
+    # one logical line per group: where a line wraps depends on the length of the paths in it
+    out = []
+    for ln in lines[first:last + 1]:
+        if ln.startswith("      ") and out:
+            out[-1] += " " + ln.strip()
+        else:
+            out.append(ln)
+    return out
 
 
 with tempfile.TemporaryDirectory(prefix="rc_docs_") as tmp:
@@ -186,7 +195,8 @@ with tempfile.TemporaryDirectory(prefix="rc_docs_") as tmp:
     check(r.returncode == 0 and program and not diff,
           "README.md's annotated run shows the effective deck the program prints for inputs/default.nml",
           f"exit {r.returncode}; " + "; ".join(diff[:3]) if diff or r.returncode else "")
-    made_up = "\n".join(program[:10] + program[11:])    # one line of the program's echo left out
+    half = len(program) // 2
+    made_up = "\n".join(program[:half] + program[half + 1:])    # one line of the program's echo left out
     check(program and echo_mismatch(made_up), "the echo check finds a line left out")
 
     # doc/running.md's resultant recipe on the three-block stack

@@ -10,7 +10,12 @@
 (2) a failing 3-body run over the 8-body result (its r_body1.xdmf is a folder: exit 3)
     removes nothing: every file of the earlier result is still there, byte for byte;
 (3) a 2-body run (one pair) over the 3-body result removes r_body3.xdmf, r_contact1.xdmf and
-    r_contact2.xdmf (a one-pair result has r_contact.xdmf only).
+    r_contact2.xdmf (a one-pair result has r_contact.xdmf only);
+(4) `&output xdmf`: a 70-body stack with the default ('auto', above 64 bodies) writes the
+    collection alone (r.xdmf with all 70 bodies and 69 lines, r_contact.xdmf) and removes
+    every per-body and per-pair file of the earlier result; xdmf='per_body' writes them all
+    (70 + 69 more files, each one grid); xdmf='collection' on 3 bodies writes the two
+    collection files only; an unknown value is exit 1 naming the group, variable and value.
 """
 import filecmp
 import os
@@ -43,11 +48,12 @@ def stack(n):
     return "\n".join(lines) + "\n"
 
 
-def run(work, n):
+def run(work, n, xdmf_mode=None):
     deck = os.path.join(work, f"stack{n}.nml")
     with open(deck, "w") as f:
         f.write(stack(n))
-    p, _ = run_solver(BIN, deck, "&output file='r.h5' /", cwd=work, env=ENV, timeout=300)
+    over = "&output file='r.h5' /" if xdmf_mode is None else f"&output file='r.h5', xdmf='{xdmf_mode}' /"
+    p, _ = run_solver(BIN, deck, over, cwd=work, env=ENV, timeout=300)
     return p.returncode, p.stdout + p.stderr
 
 
@@ -106,5 +112,32 @@ with tempfile.TemporaryDirectory() as work:
     check(rc == 0 and all(f not in now for f in ("r_body3.xdmf", "r_contact1.xdmf", "r_contact2.xdmf"))
           and "r_contact.xdmf" in now and "removed 3 stale files" in text,
           "2 bodies over 3: r_body3, r_contact1, r_contact2 removed, r_contact.xdmf kept", f"exit {rc}: {now}")
+
+    # (4) which XDMF files: the collection alone above 64 bodies, or asked for (the look-alike
+    # files of (1) stay; only the result's own names count)
+    def xdmf(work):
+        return sorted(f for f in os.listdir(work) if re.fullmatch(r"r(_body\d+|_contact\d*)?\.xdmf", f)
+                      and f != "r_body04.xdmf")
+
+    rc, text = run(work, 70, "per_body")
+    now = xdmf(work)
+    check(rc == 0 and len(now) == 2 + 70 + 69 and "r_body70.xdmf" in now and "r_contact69.xdmf" in now,
+          "70 bodies, xdmf='per_body': r.xdmf, r_contact.xdmf, 70 body and 69 pair files", f"exit {rc}: {len(now)} files")
+    rc, text = run(work, 70)
+    now = xdmf(work)
+    check(rc == 0 and now == ["r.xdmf", "r_contact.xdmf"] and "removed 139 stale files" in text,
+          "70 bodies, default xdmf: the two collection files, the 139 per-body and per-pair ones removed",
+          f"exit {rc}: {now[:5]} ... {len(now)} files; " + " ".join(ln for ln in text.splitlines() if "stale" in ln))
+    body_grids = set(re.findall(r'<Grid Name="(body\d+)"', open(os.path.join(work, "r.xdmf")).read()))
+    line_grids = set(re.findall(r'<Grid Name="(contact_pair\d+)"', open(os.path.join(work, "r.xdmf")).read()))
+    check(body_grids == {f"body{k}" for k in range(1, 71)} and len(line_grids) == 69,
+          "r.xdmf holds every body and every pair's line", f"{len(body_grids)} bodies, {len(line_grids)} lines")
+    rc, text = run(work, 3, "collection")
+    now = xdmf(work)
+    check(rc == 0 and now == ["r.xdmf", "r_contact.xdmf"], "3 bodies, xdmf='collection': the two collection files only",
+          f"exit {rc}: {now}")
+    rc, text = run(work, 3, "none")
+    check(rc == 1 and "xdmf" in text and "'none'" in text and "&output" in text and "Traceback" not in text,
+          "xdmf='none': exit 1 naming &output, xdmf and the value", f"exit {rc}: {text.strip()[-300:]}")
 
 sys.exit(1 if check.failed else 0)
