@@ -83,7 +83,7 @@ DEPS_STAMP := build/.deps-mpi-ok
 endif
 # mpif90 and MUMPS's headers present: `make check` builds and tests the MPI binary too
 
-.PHONY: all mpi mpi-deps run check bench-mprgp bench-ordering table1 bench bench-gmsh bench-mpi hard plots meshes clean deps FORCE
+.PHONY: all mpi mpi-deps run check bench-mprgp bench-ordering table1 bench bench-hertz bench-gmsh bench-mpi hard plots meshes clean deps FORCE
 all: $(PROG)
 
 # ---- system packages: install what is missing (Debian 12) --------------------
@@ -329,6 +329,13 @@ bench: $(PROG)
 # The Gmsh ladder beside the structured one: the paper's scene as unstructured triangles
 # (inputs/gmsh/bench_paper_tri.geo, meshed by gmsh into results/bench_gmsh/, h = 0.02 ...
 # 0.0025: 20k ... 1.27M DOFs per body), time per phase; results/bench_gmsh.csv
+# The Hertz ladder of inputs/hertz_force.nml at a/h = 64 and 256 (meshes by gmsh into
+# results/bench_hertz/, about 2 min); HERTZ_N=64,256,512 adds the 4M-DOF level (6 min of
+# meshing, 7 GB)
+HERTZ_N ?= 64,256
+bench-hertz: $(PROG)
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_hertz.py --bin $(PROG) --gmsh $(GMSH) --n $(HERTZ_N)
+
 bench-gmsh: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_gmsh.py --bin $(PROG) --gmsh $(GMSH) --structured
 

@@ -9,11 +9,15 @@
 // both halves), "disc_arc" (curved side), "disc_axis" (the axis, inside the disc),
 // "block_top", "block_bottom", "block_left", "block_right"; physical point "disc_centre"
 // (the centre (0,2): top of the axis, middle of the flat side; a node of the disc's mesh).
-// `make meshes` writes hertz_force_h0.04.msh ... hertz_force_h0.005.msh:
+// `make meshes` writes hertz_force_h0.04.msh ... hertz_force_h0.005.msh (`make bench-hertz`
+// meshes it finer, with -setnumber dmin 0.1):
 //   gmsh -2 -format msh41 -setnumber h 0.02 hertz_force.geo -o hertz_force_h0.02.msh
 Geometry.AutoCoherence = 0;
 If (!Exists(h))
   h = 0.02;   // mesh size at the contact point
+EndIf
+If (!Exists(dmin))
+  dmin = 0.25;   // the size h holds within this distance of the contact point
 EndIf
 R = 1;
 hmax = R/4;
@@ -48,7 +52,7 @@ Field[2] = Threshold;
 Field[2].InField = 1;
 Field[2].SizeMin = h;
 Field[2].SizeMax = hmax;
-Field[2].DistMin = 0.25;
+Field[2].DistMin = dmin;
 Field[2].DistMax = 2;
 Background Field = 2;
 Mesh.MeshSizeExtendFromBoundary = 0;
