@@ -186,7 +186,7 @@ $(BUILD)/equality_rows.o:  $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BU
 # the Robin operators implement one interface: not every operator needs every argument
 $(BUILD)/robin_operators.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
-                           $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/sorting.o
+                           $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/sorting.o $(BUILD)/strings.o
 $(BUILD)/robin_operators.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o \
                            $(BUILD)/condense.o $(BUILD)/contact_common.o
 $(BUILD)/robin_subproblems.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \

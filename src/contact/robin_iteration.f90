@@ -198,6 +198,12 @@ contains
       ! 2. force imbalance and its Robin correction
       dlam = run_state%lam(:, 1) - run_state%lam(:, 2)
       call robin_op%apply(dlam, corr, run_state%inner)
+      if (robin_op%failure%failed()) then
+        res%status = STATUS_FAILED
+        res%outer = it
+        res%message = robin_op%failure%text()
+        exit
+      end if
       ! 3. the fixed-point map T(G) and the relaxed or accelerated update
       g_new(:, 1) = contact_line%g0 - w(:, 2) + corr(:, 1)
       g_new(:, 2) = contact_line%g0 - w(:, 1) - corr(:, 2)

@@ -9,7 +9,6 @@
 !! body with a singular F_a. `new_robin_operator` is the one place that picks the operator
 !! from the decoded setting (config's ROBIN_*).
 module robin_operators
-  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp, ip
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init, dense_op_take
@@ -21,6 +20,7 @@ module robin_operators
   use contact_common, only: pair_positions, body_threads
   use sorting, only: largest_first, merge_sort_by_keys
   use errors, only: error_t, ERR_NUMERICAL
+  use strings, only: i2s
   implicit none (type, external)
   private
 
@@ -32,6 +32,9 @@ module robin_operators
 
   !> A Robin operator: the correction of the obstacles and what goes with it.
   type, abstract, public :: robin_operator_t
+    !> The first failure of `apply` (a library's solve inside it): the outer loop stops on it
+    !! as a numerical failure (exit 3), with this message
+    type(error_t) :: failure
   contains
     !> Build the correction once, before the outer loop.
     procedure(setup_iface), deferred :: setup
@@ -117,7 +120,7 @@ module robin_operators
 
   !> The harmonic operator of a group of pairs joined through bodies in several pairs:
   !! S = 2 K^-1 on the group's rows, K the assembled stiffness of its bodies.
-  type :: group_op_t
+  type, public :: group_op_t
     integer, allocatable :: rows(:)          !< the group's rows (ascending)
     type(dense_op_t) :: s                    !< S on those rows (a group of at most GROUP_DENSE_MAX rows)
     logical :: sparse = .false.              !< S = 2 K^-1 applied by kf's solves instead
@@ -698,7 +701,11 @@ contains
         y = d(self%group(c)%rows)
         call self%group(c)%kf%solve(y, serr)
         y = 2.0_wp*y
-        if (serr%failed()) y = ieee_value(1.0_wp, ieee_quiet_nan)   ! the outer loop stops on it
+        if (serr%failed()) then   ! the outer loop stops on it (exit 3), never on NaN
+          if (.not. self%failure%failed()) call self%failure%set(ERR_NUMERICAL, &
+            'the harmonic operator of a group of '//i2s(size(self%group(c)%rows))//' contact rows: '//serr%text())
+          y = 0.0_wp
+        end if
       else
         call self%group(c)%s%apply(d(self%group(c)%rows), y)
       end if

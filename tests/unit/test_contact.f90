@@ -14,6 +14,7 @@ program test_contact
   use contact_types, only: contact_result_t, status_name, STATUS_CONVERGED, STATUS_NONE, STATUS_MAX_OUTER, &
                            STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   use robin_iteration, only: solve_robin
+  use robin_operators, only: harmonic_operator_t
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
   use testing, only: report, test_summary, error_parts
@@ -39,10 +40,28 @@ program test_contact
     "&solver robin_operator='harmonic', delta=0.5, stop='residual' /"], .false., max_outer_expected=3)
   call scene('inputs/hard/contrast_1e6.nml', [character(len=80) :: &
     "&solver robin_operator='steklov', delta=0.95, max_outer=200 /"], .false., expect_converged=.false.)
+  call operator_failure()
 
   call test_summary()
 
 contains
+
+  !> A group's sparse harmonic operator whose solve fails (its factor never made: what a
+  !! CHOLMOD failure after a good factorization leaves) records the failure for the outer
+  !! loop (exit 3, its message) and gives a finite correction, never NaN.
+  subroutine operator_failure()
+    type(harmonic_operator_t) :: op
+    real(wp) :: corr(3, 2)
+    integer :: count
+    allocate (op%s(0), op%rows(2, 0), op%group(1))
+    op%group(1)%rows = [1, 2, 3]
+    op%group(1)%sparse = .true.
+    count = 0
+    call op%apply([1.0_wp, 2.0_wp, 3.0_wp], corr, count)
+    call report(op%failure%failed() .and. index(op%failure%text(), 'harmonic operator of a group of 3') > 0 &
+                .and. all(corr == 0.0_wp), 'a failed solve of the group operator is recorded, not NaN: '// &
+                op%failure%text())
+  end subroutine operator_failure
 
   !> The words a run's status is written as (results file, `result:` line; scripts parse them).
   subroutine status_words()
