@@ -151,7 +151,7 @@ contains
     class(mpi_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run
     integer :: b, iv(1), m
-    real(wp) :: rv(4)
+    real(wp) :: rv(5)
     real(wp), allocatable :: max_rank_mb(:)
     do b = 1, run%nbody
       associate (body => run%bodies(b), fac => run%bodies(b)%fac)
@@ -163,12 +163,13 @@ contains
         if (.not. allocated(body%b)) allocate (body%b(m))
         call par_bcast_reals(body%flex, m*m, self%host(b))
         call par_bcast_reals(body%b, m, self%host(b))
-        rv = [body%prox, fac%stats%mem_bytes, fac%stats%max_rank_mb, fac%stats%factor_mb]
-        call par_bcast_reals(rv, 4, self%host(b))
+        rv = [body%prox, fac%stats%mem_bytes, fac%stats%max_rank_mb, fac%stats%factor_mb, fac%stats%tiles]
+        call par_bcast_reals(rv, 5, self%host(b))
         body%prox = rv(1)
         fac%stats%mem_bytes = rv(2)
         fac%stats%max_rank_mb = rv(3)
         fac%stats%factor_mb = rv(4)
+        fac%stats%tiles = rv(5)
         iv(1) = body%rank
         call par_bcast_ints(iv, 1, self%host(b))
         body%rank = iv(1)
@@ -222,6 +223,7 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its timing
     integer :: a
     run%timing%factor_mb = sum([(run%bodies(a)%fac%stats%mem_bytes, a=1, run%nbody)])/1048576.0_wp
+    run%timing%factor_tiles = sum([(run%bodies(a)%fac%stats%tiles, a=1, run%nbody)])
   end subroutine record_factor_memory
 
   !> Rank 0's contact forces and status to every rank (the others need lam to recover their

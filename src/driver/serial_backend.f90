@@ -107,6 +107,7 @@ contains
     type(run_t), intent(inout) :: run   !< the run: its timing
     integer :: a
     run%timing%factor_mb = 0.0_wp
+    run%timing%factor_tiles = sum([(run%bodies(a)%fac%stats%tiles, a=1, run%nbody)])
     do a = 1, run%nbody
       run%timing%factor_mb = run%timing%factor_mb + run%bodies(a)%fac%stats%mem_bytes/1048576.0_wp
     end do

@@ -43,6 +43,9 @@ module results
     real(wp) :: total = 0.0_wp                !< whole run [s]
     real(wp) :: peak_rss_mb = 0.0_wp          !< peak resident memory [MiB]
     real(wp) :: factor_mb = 0.0_wp            !< memory of the two Cholesky factors [MiB]
+    !> the dense-kernel tiles of the bodies' factorizations, which idle threads may run
+    !! (blas_tiles.c; 0: every kernel ran whole)
+    real(wp) :: factor_tiles = 0.0_wp
     integer :: ranks = 1                      !< MPI processes of the run (1: the serial binary)
   end type timing_t
 
@@ -319,6 +322,7 @@ contains
     call write_attr(gid, 'total_s', tm%total, st)
     call write_attr(gid, 'peak_rss_mb', tm%peak_rss_mb, st)
     call write_attr(gid, 'factor_mb', tm%factor_mb, st)
+    call write_attr(gid, 'factor_tiles', tm%factor_tiles, st)
     call group_close(gid, st)
     ! contact
     call group_open(fid, 'contact', gid, st, create=.true.)

@@ -33,6 +33,9 @@ module factorization
     real(wp) :: t_factor = 0.0_wp         !< numeric factorization wall time [s]
     integer(i8) :: nnz_factor = 0         !< nonzeros in L (0: not known)
     real(wp) :: flops = 0.0_wp            !< factorization flop count (0: not known)
+    !> CHOLMOD: the dense-kernel tiles its numeric factorization ran (blas_tiles.c; 0 for
+    !! the other factorizations)
+    real(wp) :: tiles = 0.0_wp
     real(wp) :: mem_bytes = 0.0_wp        !< the factor's memory (MUMPS: summed over the group's ranks) [byte]
     real(wp) :: max_rank_mb = 0.0_wp      !< MUMPS: the largest rank's factorization memory [MiB]
     real(wp) :: factor_mb = 0.0_wp        !< MUMPS: the factor's entries over the group (INFOG(9)) [MiB]
@@ -232,6 +235,7 @@ contains
     self%stats%t_factor = self%chol%t_factor
     self%stats%nnz_factor = self%chol%nnz_factor
     self%stats%flops = self%chol%flops
+    self%stats%tiles = real(self%chol%tiles, wp)
     self%stats%mem_bytes = real(self%chol%mem_bytes, wp)
   end subroutine chol_factorize
 
