@@ -110,18 +110,18 @@ contains
       call mesh_build(msh(a), d%body(a))
       call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, systems(a), err)
       call error_parts(err, info, msg)
-      if (info /= 0) error stop 'assembly failed'
+      if (info /= 0) error stop 'assembly failed: '//trim(msg)
     end do
     call build_interface(d%body, d%pair(1:1), .false., msh, systems, contact_line, err)
     call error_parts(err, info, msg)
-    if (info /= 0) error stop 'interface failed'
+    if (info /= 0) error stop 'interface failed: '//trim(msg)
     do a = 1, 2
       call factor_body(d%solver%factor, contact_line, a, msh(a), systems(a), bodies(a), err)
       call error_parts(err, info, msg)
-      if (info /= 0) error stop 'factor failed'
+      if (info /= 0) error stop 'factor failed: '//trim(msg)
       call condense_body(systems(a), bodies(a), err)
       call error_parts(err, info, msg)
-      if (info /= 0) error stop 'condense failed'
+      if (info /= 0) error stop 'condense failed: '//trim(msg)
     end do
 
     ! ---- monolithic: KKT conditions -------------------------------------------------
@@ -147,7 +147,7 @@ contains
     do a = 1, 2
       allocate (ufree(systems(a)%n), ufull(systems(a)%ndof), r(systems(a)%ndof))
       call recover_displacement(systems(a), bodies(a), mono%lam, ufree, err)
-      if (err%failed()) error stop 'recover_displacement failed'
+      if (err%failed()) error stop 'recover_displacement failed: '//err%text()
       call expand(systems(a), ufree, ufull)
       ! recovered B_a u_a equals the condensed b_a - F_a lam
       allocate (bu(contact_line%m))

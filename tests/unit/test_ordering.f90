@@ -323,7 +323,7 @@ contains
       call mesh_build(msh(a), d%body(a))
       call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), err)
       call error_parts(err, info, msg)
-      if (info /= 0) error stop 'assembly failed'
+      if (info /= 0) error stop 'assembly failed: '//trim(msg)
     end do
     call build_interface(d%body, d%pair(1:1), .false., msh, sys, itf, err)
     call error_parts(err, info, msg)
@@ -339,7 +339,7 @@ contains
         if (info /= 0) return
         call condense_body(sys(a), bc(a, o), err)
         call error_parts(err, info, msg)
-        if (info /= 0) error stop 'condense_body failed'
+        if (info /= 0) error stop 'condense_body failed: '//trim(msg)
       end do
     end do
     do a = 1, 2

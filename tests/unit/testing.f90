@@ -207,9 +207,9 @@ contains
     type(error_t) :: err
     tr(1) = top_traction(b)
     call mesh_build(msh, b, info, msg)
-    if (info /= 0) error stop 'structured_body: mesh_build failed'
+    if (info /= 0) error stop 'structured_body: mesh_build failed: '//trim(msg)
     call assemble_body(msh, b, .true., tr, 1, sys, err)
-    if (err%failed()) error stop 'structured_body: assemble_body failed'
+    if (err%failed()) error stop 'structured_body: assemble_body failed: '//err%text()
     last = side_free_dofs(msh, sys, SIDE_BOTTOM, 2)
   end subroutine structured_body
 
@@ -277,7 +277,7 @@ contains
 
     tr(1) = top_traction(b)
     call mesh_build(grid, b, info, msg)
-    if (info /= 0) error stop 'general_body: mesh_build failed'
+    if (info /= 0) error stop 'general_body: mesh_build failed: '//trim(msg)
     nn = grid%nnode
 
     ! a random renumbering (Fisher-Yates with the Park-Miller generator)
@@ -347,7 +347,7 @@ contains
     tr(1)%tx = tr(1)%t1
     tr(1)%t1 = 0.0_wp
     call assemble_body(msh, free, .true., tr, 1, sys, err, boundaries=bd(1:nbd))
-    if (err%failed()) error stop 'general_body: assemble_body failed on the general mesh'
+    if (err%failed()) error stop 'general_body: assemble_body failed on the general mesh: '//err%text()
 
     call side_nodes(grid, SIDE_BOTTOM, bottom)
     allocate (last(0))
