@@ -4,6 +4,8 @@
   - README.md has at most MAX_README_LINES lines;
   - every relative link and image of README.md and doc/*.md points to an existing file;
   - the module graph of doc/developing.md is what tools/module_graph.py derives from src/;
+  - doc/developing.md's Layout names every source file of src/ in its own folder and every
+    header of include/, and names no file that is not there;
   - no issue numbers in README.md or doc/ (CHANGELOG.md holds the history);
   - doc/geometry.md's "Shipped scenes" names every inputs/*.nml and the Cattaneo-Mindlin study;
   - the effective deck of README.md's annotated run is the one bin/robin_contact prints for
@@ -157,6 +159,47 @@ made_up = "## Shipped scenes\n`inputs/a.nml`, tools/cattaneo_study.py\n## Next\n
 check(unnamed_scenes(made_up, ["a.nml", "b.nml"]) == ["b.nml"]
       and unnamed_scenes("## Shipped scenes\n", ["a.nml"]) == ["a.nml", "Cattaneo-Mindlin (tools/cattaneo_study.py)"],
       "the scene check finds a deck and the study left out")
+
+
+# doc/developing.md's Layout against the tree
+def layout_paths(text):
+    """The src/ files the Layout block names, as paths (folders by indentation), and the
+    include/ line's headers."""
+    block = text.split("## Layout", 1)[1].split("```", 2)[1] if "## Layout" in text else ""
+    stack, paths, headers = [], set(), set()
+    for ln in block.splitlines():
+        m = re.match(r"^( *)(\S+)(\s|$)", ln)
+        if not m:
+            continue
+        indent, name = len(m.group(1)), m.group(2)
+        while stack and stack[-1][0] >= indent:
+            stack.pop()
+        if name.endswith("/"):
+            stack.append((indent, name[:-1]))
+            if name == "include/":
+                headers = set(re.findall(r"([A-Za-z0-9_]+\.h)\b", ln))
+        elif re.fullmatch(r"[A-Za-z0-9_]+\.(f90|c)", name) and stack and stack[0][1] == "src":
+            paths.add("/".join([d for _, d in stack] + [name]))
+    return paths, headers
+
+
+def layout_mismatch(text):
+    paths, headers = layout_paths(text)
+    tree = {os.path.relpath(f, ROOT) for ext in ("f90", "c")
+            for f in glob.glob(os.path.join(ROOT, "src", "**", "*." + ext), recursive=True)}
+    heads = {os.path.basename(f) for f in glob.glob(os.path.join(ROOT, "include", "*.h"))}
+    return sorted(tree - paths), sorted(paths - tree), sorted(heads - headers), sorted(headers - heads)
+
+
+dev = read(os.path.join(ROOT, "doc", "developing.md"))
+missing, extra, hmissing, hextra = layout_mismatch(dev)
+check(not (missing or extra or hmissing or hextra),
+      "doc/developing.md's Layout names every src/ file in its folder and every include/ header, and nothing else",
+      f"not named: {missing + hmissing}; named but absent: {extra + hextra}")
+moved = dev.replace("    blas_tiles.c", "    blas_tile.c", 1).replace("\n    digest.f90", "\n  digest.f90", 1)
+m2, e2, _, _ = layout_mismatch(moved)
+check("src/linalg/blas_tiles.c" in m2 and "src/linalg/blas_tile.c" in e2 and "src/base/digest.f90" in m2,
+      "the layout check finds a renamed file and a file put in the wrong folder", f"{m2} / {e2}")
 
 
 # the README's effective deck against the program's
