@@ -710,7 +710,7 @@ contains
     real(wp), intent(in) :: e(:)        !< (r)
     real(wp), intent(out) :: x(:)       !< (m)
     real(wp), intent(out) :: res
-    real(wp), allocatable :: w(:), z(:), q(:, :), rr(:, :), v(:), qe(:), cval(:), resv(:)
+    real(wp), allocatable :: w(:), z(:), q(:, :), rr(:, :), v(:), qe(:), cval(:), resv(:), rhs(:)
     logical, allocatable :: passive(:)
     integer, allocatable :: cols(:)     ! the passive columns, in the order of rr's columns
     integer, allocatable :: cptr(:), crow(:)   ! g's nonzeros by column
@@ -719,7 +719,7 @@ contains
 
     r = size(g, 1)
     m = size(g, 2)
-    allocate (w(m), z(m), passive(m), q(r, r), rr(r, min(r, m)), v(r), cols(min(r, m)), qe(r))
+    allocate (w(m), z(m), passive(m), q(r, r), rr(r, min(r, m)), v(r), cols(min(r, m)), qe(r), rhs(r))
     ! g's nonzeros by column (a contact row's column touches the rigid rows of two bodies:
     ! the gradient g'(e - g x) of each step costs its nonzeros, not r m)
     allocate (cptr(m + 1))
@@ -830,6 +830,8 @@ contains
       rr(1:np, n0) = v(1:np)
       rr(n0, n0) = -v1
       rr(n0 + 1:, n0) = 0.0_wp
+      ! (Q'e) of the new column (the earlier columns of Q are unchanged)
+      qe(n0) = dot_product(q(:, n0), e)
       np = n0
       cols(np) = jc
       ok = .true.
@@ -867,22 +869,25 @@ contains
           q(l, c) = cs*t1 + sn*t2
           q(l, c + 1) = -sn*t1 + cs*t2
         end do
+        t1 = qe(c)
+        t2 = qe(c + 1)
+        qe(c) = cs*t1 + sn*t2
+        qe(c + 1) = -sn*t1 + cs*t2
       end do
     end subroutine delete_column
 
-    !> z on the passive columns: R z_P = (Q'e)(1:np), by back substitution; 0 elsewhere.
+    !> z on the passive columns: R z_P = (Q'e)(1:np) (kept up to date by append_column and
+    !! delete_column), by back substitution over R's columns (contiguous); 0 elsewhere.
     subroutine passive_solution()
-      integer :: a, b
-      real(wp) :: sacc
+      integer :: a
+      real(wp) :: zc
       z = 0.0_wp
       if (np == 0) return
-      qe(1:np) = matmul(e, q(:, 1:np))
+      rhs(1:np) = qe(1:np)
       do a = np, 1, -1
-        sacc = qe(a)
-        do b = a + 1, np
-          sacc = sacc - rr(a, b)*z(cols(b))
-        end do
-        z(cols(a)) = sacc/rr(a, a)
+        zc = rhs(a)/rr(a, a)
+        z(cols(a)) = zc
+        rhs(1:a - 1) = rhs(1:a - 1) - rr(1:a - 1, a)*zc
       end do
     end subroutine passive_solution
 
