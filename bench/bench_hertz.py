@@ -27,13 +27,11 @@ import re
 import subprocess
 import sys
 
-import h5py
-import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, os.path.join(ROOT, "tools"))
-from hertz_study import hertz_fit  # noqa: E402
+from hertz_study import hertz_fit, read_contact  # noqa: E402
 
 A_HERTZ = 0.0683       # the half-width of inputs/hertz_force.nml's contact (P = 2, E = 1000, nu = 0.3, R = 1)
 R = 1.0
@@ -63,14 +61,7 @@ def solve(binary, msh, out, threads):
            "factor": tim.get("factor", "?"), "iterate": tim.get("iterate", "?"), "total": tim.get("total", "?"),
            "peak": tim.get("peak_mb", "?"), "err_a": None, "err_p0": None}
     if r.returncode == 0:
-        with h5py.File(out, "r") as f:
-            x = np.array(f["/contact/x"], dtype=float)
-            p = np.array(f["/contact/pressure"], dtype=float)
-            lam = np.array(f["/contact/normal_force"], dtype=float)
-            nrm = np.array(f["/contact/normal"], dtype=float)
-            E = float(f["/body1"].attrs["young"])
-            nu = float(f["/body1"].attrs["poisson"])
-        P = float(-np.sum(lam * nrm[1, :]))
+        x, p, P, E, nu, _ = read_contact(out)
         es = E / (2.0 * (1.0 - nu ** 2))
         ah = math.sqrt(4.0 * P * R / (math.pi * es))
         a, p0, _ = hertz_fit(x, p)

@@ -54,6 +54,12 @@ def run(binary, h, method, out, deck="hertz.nml"):
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"h={h}: exit {r.returncode}: {r.stderr.strip()[-300:]}")
+    return read_contact(out)
+
+
+def read_contact(out):
+    """x, pressure, the total vertical force P on the disc, E, nu and the outer count of a
+    Hertz result file."""
     with h5py.File(out, "r") as f:
         x = np.array(f["/contact/x"], dtype=float)
         p = np.array(f["/contact/pressure"], dtype=float)

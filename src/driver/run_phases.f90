@@ -77,8 +77,11 @@ contains
     character(len=len_trim(run%deck%output%file) + 32), allocatable :: name(:)
     type(error_t) :: err
     file = trim(run%deck%output%file)
-    call result_files(file, run%deck%nbody, max(1, run%deck%npair), name, &
-                      per_body_files(run%deck%output%xdmf, run%deck%nbody, max(1, run%deck%npair)))
+    if (per_body_files(run%deck%output%xdmf, run%deck%nbody, max(1, run%deck%npair))) then
+      call result_files(file, run%deck%nbody, max(1, run%deck%npair), name)
+    else
+      call result_files(file, 0, 1, name)
+    end if
     call check_new_files(name, err)
     if (.not. err%failed()) call check_new_files([checkpoint_file(file)], err)
     call fail_on(err, 'deck '//trim(run%deck%source))

@@ -98,6 +98,7 @@ contains
     character(len=:), allocatable :: why, h5, id
     type(error_t) :: st
     integer :: k, nb, np, nf, nt, nstale
+    integer :: nbf, npf   ! the bodies and pairs with an XDMF file of their own
     logical :: ok, per_body
     type(interface_t) :: itf
     type(contact_result_t) :: res
@@ -110,7 +111,9 @@ contains
     np = itf%npair
     call ensure_parent_dir(file)
     per_body = per_body_files(d%output%xdmf, nb, np)
-    call result_files(file, nb, np, name, per_body)
+    nbf = merge(nb, 0, per_body)
+    npf = merge(np, 1, per_body)
+    call result_files(file, nbf, npf, name)
     nf = size(name)
     allocate (tmp(nf))
     do k = 1, nf
@@ -151,16 +154,15 @@ contains
     ! companions of an earlier result with more bodies or pairs, which this one lacks
     stale_pre(1) = replace_suffix(trim(file), '.h5', '_body')
     stale_pre(2) = replace_suffix(trim(file), '.h5', '_contact')
-    ! (without per-body files, every earlier one is stale)
-    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, &
-                      merge([nb + 1, merge(np + 1, 1, np > 1)], [1, 1], per_body), '.xdmf', nstale)
+    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, [nbf + 1, merge(npf + 1, 1, npf > 1)], '.xdmf', &
+                      nstale)
     if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
     if (present(stale)) stale = nstale
 
   contains
 
     !> The XDMF files tmp(2:): every body and contact line (ParaView), all contact lines,
-    !! and with per_body one grid each (meshio); one pair: its line is all of /contact, the
+    !! and one grid each of the nbf bodies and npf pairs (meshio); one pair: its line is all of /contact, the
     !! grid 'contact'.
     subroutine write_companions(done)
       logical, intent(out) :: done   !< all written
@@ -170,17 +172,13 @@ contains
       else
         call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, id, times), done)
       end if
-      if (.not. per_body) then   ! the contact lines' collection only
-        if (done) call write_text(tmp(3), xdmf_text([integer ::], [0], h5, msh, itf, id, times), done)
-        return
-      end if
-      do a = 1, nb
+      do a = 1, nbf
         if (done) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, id, times), done)
       end do
-      if (done) call write_text(tmp(3 + nb), xdmf_text([integer ::], [0], h5, msh, itf, id, times), done)
-      if (np > 1) then
-        do q = 1, np
-          if (done) call write_text(tmp(3 + nb + q), xdmf_text([integer ::], [q], h5, msh, itf, id, times), done)
+      if (done) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, itf, id, times), done)
+      if (npf > 1) then
+        do q = 1, npf
+          if (done) call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, itf, id, times), done)
         end do
       end if
     end subroutine write_companions
@@ -202,7 +200,8 @@ contains
   end function body_group_name
 
   !> Whether a result of nb bodies and np pairs has one XDMF file per body and per pair
-  !! beside its collection, for the deck's `&output xdmf` (config XDMF_*).
+  !! beside its collection, for the deck's `&output xdmf` (config XDMF_*); without them its
+  !! files are result_files(file, 0, 1).
   pure logical function per_body_files(mode, nb, np)
     integer, intent(in) :: mode, nb, np
     select case (mode)
@@ -215,22 +214,15 @@ contains
     end select
   end function per_body_files
 
-  !> The files of a result of nb bodies and np pairs: the HDF5 file, <stem>.xdmf, with
-  !! `per_body` <stem>_body<a>.xdmf for a = 1..nb, <stem>_contact.xdmf, and with `per_body`
-  !! and np > 1 <stem>_contact<k>.xdmf for k = 1..np.
-  subroutine result_files(file, nb, np, name, per_body)
+  !> The files of a result with nb per-body and np per-pair XDMF files: the HDF5 file,
+  !! <stem>.xdmf, <stem>_body<a>.xdmf for a = 1..nb, <stem>_contact.xdmf, and for np > 1
+  !! <stem>_contact<k>.xdmf for k = 1..np (nb = 0, np = 1: the collection files alone;
+  !! per_body_files decides).
+  subroutine result_files(file, nb, np, name)
     character(len=*), intent(in) :: file
     integer, intent(in) :: nb, np
     character(len=*), allocatable, intent(out) :: name(:)
-    logical, intent(in) :: per_body   !< also one XDMF file per body and per pair (per_body_files)
     integer :: k
-    if (.not. per_body) then
-      allocate (name(3))
-      name(1) = file
-      name(2) = replace_suffix(file, '.h5', '.xdmf')
-      name(3) = replace_suffix(file, '.h5', '_contact.xdmf')
-      return
-    end if
     allocate (name(3 + nb + merge(np, 0, np > 1)))
     name(1) = file
     name(2) = replace_suffix(file, '.h5', '.xdmf')

@@ -12,7 +12,7 @@ program test_result_names
   call report(body_group_name(10000) == 'body10000', 'body_group_name(10000) = body10000 ('// &
               body_group_name(10000)//')')
   call report(body_group_name(123456789) == 'body123456789', 'body_group_name(123456789) = body123456789')
-  call result_files('out/r.h5', 10001, 10000, name, .true.)
+  call result_files('out/r.h5', 10001, 10000, name)
   call report(size(name) == 3 + 10001 + 10000, 'result_files: the .h5, .xdmf, 10001 body files, the contact '// &
               'file and 10000 pair files')
   call report(name(1) == 'out/r.h5' .and. name(2) == 'out/r.xdmf', 'result_files: the .h5 and its .xdmf')
