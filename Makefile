@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe mortar_chains mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
+        ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
@@ -168,6 +168,7 @@ $(BUILD)/qp_newton.o:      $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/constrain
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
                            $(BUILD)/constraint_set.o $(BUILD)/mprgp_support.o $(BUILD)/qp_newton.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o $(BUILD)/constraint_set.o
+$(BUILD)/nonneg_lsq.o:     $(BUILD)/cholesky.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o
 $(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
 $(BUILD)/contact_interface.o: $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o \
@@ -177,12 +178,12 @@ $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/factorization.o $(BUILD)
                            $(BUILD)/mesh.o $(BUILD)/ordering.o
 $(BUILD)/floating.o:       $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
-                           $(BUILD)/strings.o
+                           $(BUILD)/nonneg_lsq.o $(BUILD)/strings.o
 $(BUILD)/contact_types.o:  $(BUILD)/kinds.o
 $(BUILD)/contact_common.o: $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
 $(BUILD)/friction_view.o:  $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
 $(BUILD)/equality_rows.o:  $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
-                           $(BUILD)/linop.o
+                           $(BUILD)/linop.o $(BUILD)/nonneg_lsq.o
 # the Robin operators implement one interface: not every operator needs every argument
 $(BUILD)/robin_operators.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
@@ -204,7 +205,8 @@ $(BUILD)/monolithic.o:     $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.
                            $(BUILD)/sorting.o $(BUILD)/strings.o
 $(BUILD)/error_estimate.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
-                           $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o
+                           $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o \
+                           $(BUILD)/nonneg_lsq.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/files.o:          $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o

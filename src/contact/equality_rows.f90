@@ -7,6 +7,7 @@ module equality_rows
   use linop, only: dense_op_t
   use condense, only: body_condensed_t
   use contact_interface, only: slot_row
+  use nonneg_lsq, only: sparse_cols_t
   implicit none (type, external)
   private
 
@@ -25,7 +26,7 @@ module equality_rows
     real(wp) :: feas_x = 0.0_wp               !< e = 0: per unit of |lam| instead (FEAS_RTOL |G|) [-]
   end type equality_t
 
-  public :: equality_init, equality_add_penalty, gram_eigenvalues, stacked_rows, equality_force_scaled
+  public :: equality_init, equality_add_penalty, gram_eigenvalues, stacked_rows, stacked_columns, equality_force_scaled
 
 contains
 
@@ -78,23 +79,53 @@ contains
     integer, intent(in) :: m                             !< contact rows of all pairs
     real(wp), allocatable, intent(out) :: g(:, :)        !< stacked G_a
     real(wp), allocatable, intent(out) :: e(:)           !< stacked e_a
-    integer :: a, r, i
+    type(sparse_cols_t) :: gs
+    integer :: k, l
+    call stacked_columns(bodies, m, gs, e)
+    allocate (g(gs%nrow, m))
+    g = 0.0_wp
+    do k = 1, m
+      do l = gs%ptr(k), gs%ptr(k + 1) - 1
+        g(gs%row(l), k) = gs%val(l)
+      end do
+    end do
+  end subroutine stacked_rows
+
+  !> The same rows by their nonzeros: a column per contact row, its entries in the rigid
+  !! rows of the (at most two) floating bodies it touches (a few per column, whatever the
+  !! number of bodies).
+  subroutine stacked_columns(bodies, m, g, e)
+    type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
+    integer, intent(in) :: m                             !< contact rows of all pairs
+    type(sparse_cols_t), intent(out) :: g                !< stacked G_a, (rigid rows, m)
+    real(wp), allocatable, intent(out) :: e(:)           !< stacked e_a
+    integer, allocatable :: ti(:), tj(:)
+    real(wp), allocatable :: tv(:)
+    integer :: a, r, i, q, nz
     r = 0
+    nz = 0
     do a = 1, size(bodies)
       r = r + bodies(a)%nrig
+      if (bodies(a)%nrig > 0) nz = nz + bodies(a)%nrig*bodies(a)%m
     end do
-    allocate (g(r, m), e(r))
-    g = 0.0_wp
+    allocate (e(r), ti(nz), tj(nz), tv(nz))
     r = 0
+    nz = 0
     do a = 1, size(bodies)
       if (bodies(a)%nrig == 0) cycle
       do i = 1, bodies(a)%m
-        g(r + 1:r + bodies(a)%nrig, slot_row(bodies(a)%slots(i), m)) = bodies(a)%rg(:, i)
+        do q = 1, bodies(a)%nrig
+          nz = nz + 1
+          ti(nz) = r + q
+          tj(nz) = slot_row(bodies(a)%slots(i), m)
+          tv(nz) = bodies(a)%rg(q, i)
+        end do
       end do
       e(r + 1:r + bodies(a)%nrig) = bodies(a)%re
       r = r + bodies(a)%nrig
     end do
-  end subroutine stacked_rows
+    call g%from_triplets(r, m, ti, tj, tv)
+  end subroutine stacked_columns
 
   !> The eigenvalues of G G' (r <= 6 rows), ascending; if LAPACK fails, 0 and, last, the
   !! row-sum bound of the largest (what the penalty and the error bound's projection can

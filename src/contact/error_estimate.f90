@@ -13,7 +13,8 @@ module error_estimate
   use monolithic, only: assemble_hessian
   use errors, only: error_t
   use contact_types, only: contact_result_t
-  use equality_rows, only: stacked_rows
+  use equality_rows, only: stacked_columns
+  use nonneg_lsq, only: sparse_cols_t, gram_t, NNLS_DENSE_MAX
   implicit none (type, external)
   private
 
@@ -217,10 +218,14 @@ contains
   !> z = the Euclidean projection of y on {lo <= l <= hi, G l = e} (G, e: the floating bodies'
   !! equilibrium rows, stacked): z = P(y - G'nu), P the clipping to [lo, hi], with nu the
   !! minimiser of the convex, piecewise quadratic phi(nu) = 1/2 |P(y - G'nu)|^2 + e'nu (r
-  !! unknowns; lo = 0 makes |P(v)|^2 the usual form), by Newton steps on the current free set (Hessian G_P G_P', a small ridge when it is singular) with a
-  !! backtracking line search on phi: exact once the positive set is right, whatever the
-  !! conditioning of G on it. perr bounds |z - exact projection| by the equilibrium left,
-  !! |G z - e| / sqrt(lambda_min(G_P G_P')).
+  !! unknowns; lo = 0 makes |P(v)|^2 the usual form), by Newton steps on the current free set
+  !! (Hessian G_P G_P', a small ridge when it is singular) with a backtracking line search
+  !! on phi: exact once the positive set is right, whatever the conditioning of G on it.
+  !! perr bounds |z - exact projection| by the equilibrium left, |G z - e| /
+  !! sqrt(lambda_min(G_P G_P')). G_P G_P' is dense (LAPACK; lambda_min by dsyev) up to
+  !! NNLS_DENSE_MAX rows, sparse beyond (a sparse Cholesky factor per Newton step; lambda_min
+  !! by inverse iteration, less its residual: a lower bound once it has converged): a
+  !! chain of floating bodies couples each body's rows to its neighbours' only.
   subroutine project_feasible(bodies, m_rows, y, lo, hi, z, perr)
     type(body_condensed_t), intent(in) :: bodies(:)
     integer, intent(in) :: m_rows                   !< contact rows of all pairs
@@ -228,40 +233,49 @@ contains
     real(wp), intent(in) :: lo(:), hi(:)            !< the bounds of the forces (row_bounds)
     real(wp), allocatable, intent(out) :: z(:)
     real(wp), intent(out) :: perr
-    real(wp), allocatable :: gs(:, :), es(:), nu(:), f(:), h(:, :), d(:), nt(:), cval(:, :), ev(:), work(:)
-    integer, allocatable :: crow(:, :), ncol(:)
+    type(sparse_cols_t) :: gs
+    type(gram_t) :: gm
+    type(error_t) :: err
+    real(wp), allocatable :: es(:), nu(:), f(:), h(:, :), d(:), nt(:), ev(:), work(:), rn(:)
     real(wp) :: phi, phit, t, ridge, lmin
-    integer :: m, r, it, k, info, i, nmax
+    integer :: m, r, it, k, info, l
+    logical :: dense
     m = size(y)
-    call stacked_rows(bodies, m_rows, gs, es)
+    call stacked_columns(bodies, m_rows, gs, es)
     r = size(es)
-    ! G by columns: a column has the rows of the (at most two) floating bodies of its row
-    nmax = 0
-    allocate (ncol(m))
-    do k = 1, m
-      ncol(k) = count(gs(:, k) /= 0.0_wp)
-      nmax = max(nmax, ncol(k))
+    dense = r <= NNLS_DENSE_MAX
+    allocate (nu(r), f(r), d(r), nt(r), rn(r))
+    ! the ridge: 1e-14 of the largest row norm squared of G
+    rn = 0.0_wp
+    do l = 1, gs%ptr(m + 1) - 1
+      rn(gs%row(l)) = rn(gs%row(l)) + gs%val(l)**2
     end do
-    allocate (crow(nmax, m), cval(nmax, m))
-    do k = 1, m
-      crow(1:ncol(k), k) = pack([(i, i=1, r)], gs(:, k) /= 0.0_wp)
-      cval(1:ncol(k), k) = gs(crow(1:ncol(k), k), k)
-    end do
-    allocate (nu(r), f(r), h(r, r), d(r), nt(r))
+    ridge = 1.0e-14_wp*maxval(rn)
+    if (dense) then
+      allocate (h(r, r))
+    else
+      call gm%build(gs, [(k, k=1, r + 1)])
+    end if
     nu = 0.0_wp
     z = project(nu)
     phi = 0.5_wp*sum(z**2) + dot_product(es, nu)
-    ridge = 1.0e-14_wp*maxval(sum(gs**2, dim=2))
     do it = 1, 200
-      f = gz(z) - es                   ! = -grad phi
+      f = gs%times(z) - es             ! = -grad phi
       if (norm2(f) <= 1.0e-15_wp*max(norm2(es), tiny(1.0_wp))) exit
-      call gram(z, h)
-      do k = 1, r
-        h(k, k) = h(k, k) + ridge
-      end do
       d = f
-      call dposv('U', r, 1, h, r, d, r, info)
-      if (info /= 0) exit
+      if (dense) then
+        call gram(z, h)
+        do k = 1, r
+          h(k, k) = h(k, k) + ridge
+        end do
+        call dposv('U', r, 1, h, r, d, r, info)
+        if (info /= 0) exit
+      else
+        call gm%factor(gs, free(z), spread(ridge, 1, r), err)
+        if (err%failed()) exit
+        call gm%chol%solve(d, err)
+        if (err%failed()) exit
+      end if
       ! Newton direction for phi is +d (phi's Hessian G_P G_P', gradient -f); backtrack
       t = 1.0_wp
       do k = 1, 60
@@ -277,14 +291,19 @@ contains
       phi = phit
       z = project(nu)
     end do
-    f = gz(z) - es
+    f = gs%times(z) - es
     lmin = 0.0_wp
     if (any(z > lo .and. z < hi)) then
-      call gram(z, h)
-      allocate (ev(r), work(max(64, 3*r)))
-      call dsyev('N', 'U', r, h, r, ev, work, size(work), info)
-      if (info == 0) lmin = max(ev(1), 0.0_wp)
+      if (dense) then
+        call gram(z, h)
+        allocate (ev(r), work(max(64, 3*r)))
+        call dsyev('N', 'U', r, h, r, ev, work, size(work), info)
+        if (info == 0) lmin = max(ev(1), 0.0_wp)
+      else
+        lmin = smallest_eigenvalue()
+      end if
     end if
+    call gm%free()
     perr = norm2(f)/sqrt(max(lmin, tiny(1.0_wp)))
     if (.not. lmin > 0.0_wp) perr = merge(0.0_wp, huge(1.0_wp), norm2(f) == 0.0_wp)
 
@@ -294,25 +313,17 @@ contains
     function project(v) result(zz)
       real(wp), intent(in) :: v(:)
       real(wp) :: zz(m)
-      integer :: kk
-      do kk = 1, m
-        zz(kk) = min(max(y(kk) - dot_product(cval(1:ncol(kk), kk), v(crow(1:ncol(kk), kk))), lo(kk)), hi(kk))
-      end do
+      zz = min(max(y - gs%ttimes(v), lo), hi)
     end function project
 
-    !> G x.
-    function gz(x) result(g)
+    !> 1 on the columns where lo < x < hi, 0 elsewhere.
+    function free(x) result(w)
       real(wp), intent(in) :: x(:)
-      real(wp) :: g(r)
-      integer :: kk
-      g = 0.0_wp
-      do kk = 1, m
-        if (x(kk) == 0.0_wp) cycle
-        g(crow(1:ncol(kk), kk)) = g(crow(1:ncol(kk), kk)) + cval(1:ncol(kk), kk)*x(kk)
-      end do
-    end function gz
+      real(wp) :: w(m)
+      w = merge(1.0_wp, 0.0_wp, x > lo .and. x < hi)
+    end function free
 
-    !> G_P G_P', P the columns where lo < x < hi.
+    !> G_P G_P', P the columns where lo < x < hi (dense).
     subroutine gram(x, hh)
       real(wp), intent(in) :: x(:)
       real(wp), intent(out) :: hh(:, :)
@@ -320,13 +331,39 @@ contains
       hh = 0.0_wp
       do kk = 1, m
         if (.not. (x(kk) > lo(kk) .and. x(kk) < hi(kk))) cycle
-        do b = 1, ncol(kk)
-          do a = 1, ncol(kk)
-            hh(crow(a, kk), crow(b, kk)) = hh(crow(a, kk), crow(b, kk)) + cval(a, kk)*cval(b, kk)
+        do b = gs%ptr(kk), gs%ptr(kk + 1) - 1
+          do a = gs%ptr(kk), gs%ptr(kk + 1) - 1
+            hh(gs%row(a), gs%row(b)) = hh(gs%row(a), gs%row(b)) + gs%val(a)*gs%val(b)
           end do
         end do
       end do
     end subroutine gram
+
+    !> lambda_min(G_P G_P') from below: inverse iteration with its sparse factor (0 when
+    !! it is singular), the Rayleigh quotient less the residual |A v - rho v| (an
+    !! eigenvalue lies within it; the smallest one once the iteration has converged).
+    real(wp) function smallest_eigenvalue() result(lm)
+      real(wp), allocatable :: v(:), av(:), wz(:)
+      real(wp) :: rho, eta
+      integer :: kk
+      lm = 0.0_wp
+      allocate (wz(m))
+      wz = free(z)
+      call gm%factor(gs, wz, spread(0.0_wp, 1, r), err)
+      if (err%failed()) return
+      allocate (v(r))
+      v = 1.0_wp/sqrt(real(r, wp))
+      do kk = 1, 200
+        call gm%chol%solve(v, err)
+        if (err%failed()) return
+        v = v/norm2(v)
+        av = gs%times(wz*gs%ttimes(v))
+        rho = dot_product(v, av)
+        eta = norm2(av - rho*v)
+        if (eta <= 1.0e-3_wp*rho) exit
+      end do
+      lm = max(rho - eta, 0.0_wp)
+    end function smallest_eigenvalue
 
   end subroutine project_feasible
 

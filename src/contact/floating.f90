@@ -17,11 +17,12 @@ module floating
   use contact_common, only: scatter
   use lapack, only: dsyev, dsygv, dpotrf
   use strings, only: i2s, sci
-  use errors, only: error_t, ERR_INPUT
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
+  use nonneg_lsq, only: nnls, sparse_cols_t, gram_t, NNLS_DENSE_MAX
   implicit none (type, external)
   private
 
-  public :: rigid_rows, check_held, check_pressed, nnls, free_list, fixing_list, friction_edge
+  public :: rigid_rows, check_held, check_pressed, free_list, fixing_list, friction_edge
 
   !> A body held by Coulomb friction is on the edge of sliding when its load cannot be
   !! balanced with mu lowered by this fraction
@@ -89,6 +90,7 @@ contains
     real(wp), allocatable :: gg(:, :), ev(:)
     real(wp) :: c(3), fx, fy, along, res, enorm
     integer :: a, r, m, lapinfo, i
+    type(sparse_cols_t) :: gsp
     character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
       'a ''roller'', or ux/uy on a group (&boundary)'
 
@@ -131,7 +133,8 @@ contains
       end if
       ! 3. the load must be balanced by compressive contact forces: lam >= 0, G lam = e
       ! (with friction: within the friction limits, Tresca's bound included)
-      call admissible_nnls(contact_line, slot_row(bodies(a)%slots, contact_line%m), bodies(a)%rg, bodies(a)%re, res)
+      call gsp%from_dense(bodies(a)%rg)
+      call admissible_nnls(contact_line, slot_row(bodies(a)%slots, contact_line%m), gsp, bodies(a)%re, res)
       if (res > 1.0e-8_wp*enorm .and. has_friction(contact_line)) then
         ! the direction it would slide in: the load's part along the contact (its
         ! resultant less its part along the mean normal of the body's contact rows)
@@ -169,7 +172,8 @@ contains
     type(body_system_t), intent(in) :: systems(:)
     type(body_condensed_t), intent(in) :: bodies(:)
     character(len=:), allocatable :: msg
-    real(wp), allocatable :: gc(:, :), lam(:)
+    type(sparse_cols_t) :: gsp, gc
+    real(wp), allocatable :: lam(:)
     real(wp) :: res, enorm
     integer :: a
     msg = ''
@@ -178,8 +182,9 @@ contains
       if (bodies(a)%nrig == 0 .or. bodies(a)%m == 0) cycle
       enorm = norm2(bodies(a)%re)
       if (enorm == 0.0_wp) cycle
-      gc = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), bodies(a)%rg, 1.0_wp - EDGE_MARGIN)
-      allocate (lam(size(gc, 2)))
+      call gsp%from_dense(bodies(a)%rg)
+      gc = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), gsp, 1.0_wp - EDGE_MARGIN)
+      allocate (lam(gc%ncol))
       call nnls(gc, bodies(a)%re, lam, res)
       deallocate (lam)
       if (res > 1.0e-8_wp*enorm) msg = msg//merge('; ', '  ', len(msg) > 0)//'body '//i2s(a)// &
@@ -198,10 +203,12 @@ contains
     type(body_system_t), intent(in) :: systems(:)
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(inout) :: err
-    integer, allocatable :: root(:), members(:), col(:), rowof(:)
-    real(wp), allocatable :: gs(:, :), es(:), gg(:, :), sr(:, :), ev(:)
-    real(wp) :: c(3), res, hold
-    integer :: a, g, r, nm, ncol, k, i, i0
+    integer, allocatable :: root(:), members(:), col(:), rowof(:), ti(:), tj(:), roff(:)
+    real(wp), allocatable :: es(:), tv(:), v(:)
+    type(sparse_cols_t) :: gs
+    real(wp) :: c(3), res, hold, mu
+    integer :: a, g, r, nm, ncol, k, i, i0, q, nz
+    logical :: held
     character(len=:), allocatable :: names
 
     allocate (root(size(bodies)))
@@ -215,10 +222,13 @@ contains
       ! the union of the members' rows: column of each row in the stacked rows
       col = 0
       ncol = 0
-      r = 0
+      nz = 0
+      allocate (roff(nm + 1))
+      roff(1) = 0
       do k = 1, nm
         associate (bd => bodies(members(k)))
-          r = r + bd%nrig
+          roff(k + 1) = roff(k) + bd%nrig
+          nz = nz + bd%nrig*bd%m
           do i = 1, bd%m
             i0 = slot_row(bd%slots(i), contact_line%m)
             if (col(i0) == 0) then
@@ -228,36 +238,41 @@ contains
           end do
         end associate
       end do
-      allocate (gs(r, ncol), es(r), gg(r, r), sr(r, r), ev(r))
-      gs = 0.0_wp
-      sr = 0.0_wp
-      r = 0
+      r = roff(nm + 1)
+      ! G of the group: a column per contact row, its entries in the rigid rows of the one or
+      ! two members it touches (sparse: a group of n bodies has about n columns of 6 entries)
+      allocate (ti(nz), tj(nz), tv(nz), es(r))
+      nz = 0
       do k = 1, nm
         associate (bd => bodies(members(k)))
           do i = 1, bd%m
             i0 = slot_row(bd%slots(i), contact_line%m)
-            gs(r + 1:r + bd%nrig, col(i0)) = bd%rg(:, i)
+            do q = 1, bd%nrig
+              nz = nz + 1
+              ti(nz) = roff(k) + q
+              tj(nz) = col(i0)
+              tv(nz) = bd%rg(q, i)
+            end do
           end do
-          es(r + 1:r + bd%nrig) = bd%re
-          sr(r + 1:r + bd%nrig, r + 1:r + bd%nrig) = bd%rreach
-          r = r + bd%nrig
+          es(roff(k) + 1:roff(k + 1)) = bd%re
         end associate
       end do
+      call gs%from_triplets(r, ncol, ti, tj, tv)
+      deallocate (ti, tj, tv)
       names = group_names(members)
-      gg = gram(gs)
       ! every joint motion held (G G' v = mu S v with every mu > hold) exactly when
-      ! G G' - hold S is positive definite: one Cholesky factor (r^3/3) decides, the
-      ! eigenproblem (about 9 r^3) only names the free motion when there is one. The
-      ! threshold is HOLD_MIN / nm^2: a chain of nm bodies held at one end has its
-      ! smallest mu near 2.5 / nm^2 (held, though weakly: 4e-5 for 249 blocks), while a
-      ! motion the contact normals miss has mu at the normals' discretisation error
+      ! G G' - hold S is positive definite: one Cholesky factor decides (dense r^3/3 up to
+      ! NNLS_DENSE_MAX rows, sparse beyond: a chain's G G' is banded), the eigenproblem or
+      ! inverse iteration only names the free motion when there is one. The threshold is
+      ! HOLD_MIN / nm^2: a chain of nm bodies held at one end has its smallest mu near
+      ! 2.5 / nm^2 (held, though weakly: 4e-5 for 249 blocks), while a motion the contact
+      ! normals miss has mu at the normals' discretisation error
       hold = HOLD_MIN/real(nm, wp)**2
-      k = 1
-      ev = huge(1.0_wp)
-      if (.not. held_by_cholesky(gg, sr, r, hold)) call held_motions(gg, sr, r, ev, k)
-      if (k == 0 .and. ev(1) <= hold) then
+      call group_held(gs, members, roff, hold, held, mu, v, err)
+      if (err%failed()) return
+      if (.not. held .and. mu <= hold) then
         ! the free motion of the group, as its first body's part of it
-        c = matmul(systems(members(1))%rig_coef, gg(1:bodies(members(1))%nrig, 1))
+        c = matmul(systems(members(1))%rig_coef, v(1:bodies(members(1))%nrig))
         if (nm == 2) then
           call err%set(ERR_INPUT, 'bodies '//names//' are both held only by contact, and together they are free: '// &
                 'the pair can move as a whole ('//rigid_motion_name(systems(members(1)), c)//' of both) and nothing '// &
@@ -276,13 +291,108 @@ contains
       call admissible_nnls(contact_line, rowof, gs, es, res)
       deallocate (rowof)
       if (res > 1.0e-8_wp*norm2(es)) then
-        call err%set(ERR_INPUT, 'bodies '//names//' are '//merge('both', 'all ', nm == 2)// &
+        call err%set(ERR_INPUT, 'bodies '//names//' are '//trim(merge('both', 'all ', nm == 2))// &
               ' held only by contact, and their loads cannot be balanced by compressive contact forces '// &
               'between them (unbalanced part '//sci(res)//'); support one of them')
         return
       end if
-      deallocate (gs, es, gg, sr, ev)
+      deallocate (es, roff)
     end do
+
+  contains
+
+    !> Whether G G' - hold S is positive definite (S: the members' rreach blocks); when it
+    !! is not, mu and v: the smallest mu of G G' v = mu S v and its motion (dense: LAPACK's
+    !! generalized eigenproblem; sparse: inverse iteration with G G' + hold S).
+    subroutine group_held(gs, members, roff, hold, held, mu, v, err)
+      type(sparse_cols_t), intent(in) :: gs
+      integer, intent(in) :: members(:), roff(:)
+      real(wp), intent(in) :: hold
+      logical, intent(out) :: held
+      real(wp), intent(out) :: mu
+      real(wp), allocatable, intent(out) :: v(:)
+      type(error_t), intent(inout) :: err
+      real(wp), allocatable :: gd(:, :), gg(:, :), sr(:, :), ev(:), bv(:), sv(:), gv(:)
+      type(gram_t) :: gm
+      type(error_t) :: ferr
+      integer :: r, k, l, info, it, nb
+      r = gs%nrow
+      mu = huge(1.0_wp)
+      if (r <= NNLS_DENSE_MAX) then
+        allocate (gd(r, gs%ncol), sr(r, r), ev(r))
+        gd = 0.0_wp
+        do k = 1, gs%ncol
+          do l = gs%ptr(k), gs%ptr(k + 1) - 1
+            gd(gs%row(l), k) = gs%val(l)
+          end do
+        end do
+        sr = 0.0_wp
+        do k = 1, size(members)
+          sr(roff(k) + 1:roff(k + 1), roff(k) + 1:roff(k + 1)) = bodies(members(k))%rreach
+        end do
+        gg = gram(gd)
+        held = held_by_cholesky(gg, sr, r, hold)
+        if (held) return
+        call held_motions(gg, sr, r, ev, info)
+        held = info /= 0
+        mu = ev(1)
+        v = gg(:, 1)
+        return
+      end if
+      ! sparse: the blocks of -hold S, then of +hold S for the inverse iteration
+      nb = sum([(bodies(members(k))%nrig**2, k=1, size(members))])
+      allocate (bv(nb))
+      l = 0
+      do k = 1, size(members)
+        associate (s => bodies(members(k))%rreach)
+          bv(l + 1:l + size(s)) = reshape(s, [size(s)])
+          l = l + size(s)
+        end associate
+      end do
+      call gm%build(gs, roff + 1)
+      call gm%factor(gs, spread(1.0_wp, 1, gs%ncol), -hold*bv, ferr)
+      held = .not. ferr%failed()
+      if (held) then
+        call gm%free()
+        return
+      end if
+      if (.not. gm%not_posdef) then
+        call err%set(ERR_NUMERICAL, 'the check of the floating bodies '//group_names(members)//': '//ferr%message)
+        return
+      end if
+      ! inverse iteration: v <- (G G' + hold S)^-1 S v converges to the smallest mu's motion
+      call gm%factor(gs, spread(1.0_wp, 1, gs%ncol), hold*bv, ferr)
+      if (ferr%failed()) then
+        held = .true.      ! no motion to name (S singular along it): decided by the NNLS below
+        call gm%free()
+        return
+      end if
+      allocate (v(r))
+      v = 1.0_wp
+      do it = 1, 50
+        sv = s_times(v)
+        v = sv
+        call gm%chol%solve(v, ferr)
+        if (ferr%failed()) exit
+        v = v/max(norm2(v), tiny(1.0_wp))
+      end do
+      sv = s_times(v)
+      gv = gs%ttimes(v)
+      mu = dot_product(gv, gv)/max(dot_product(v, sv), tiny(1.0_wp))
+      call gm%free()
+
+    end subroutine group_held
+
+    !> S v (S: the members' rreach blocks).
+    function s_times(x) result(y)
+      real(wp), intent(in) :: x(:)
+      real(wp) :: y(size(x))
+      integer :: k
+      do k = 1, size(members)
+        y(roff(k) + 1:roff(k + 1)) = matmul(bodies(members(k))%rreach, x(roff(k) + 1:roff(k + 1)))
+      end do
+    end function s_times
+
   end subroutine check_groups
 
   !> G G' from G's nonzeros (a contact row's column touches the rigid rows of at most two
@@ -312,6 +422,7 @@ contains
     real(wp), intent(in) :: hold
     real(wp), allocatable :: a(:, :)
     integer :: info
+    allocate (a(r, r))
     a = gg(1:r, 1:r) - hold*s(1:r, 1:r)
     call dpotrf('U', r, a, r, info)
     held = info == 0
@@ -350,16 +461,23 @@ contains
 
   end function floating_groups
 
-  !> 'a and b' or 'a, b and c' (the bodies of a group).
+  !> 'a and b' or 'a, b and c' (the bodies of a group); beyond 12 bodies the first five,
+  !! '...', the last two and the count ('1, 2, 3, 4, 5, ..., 998 and 999 (999 bodies)').
   function group_names(ids) result(t)
     integer, intent(in) :: ids(:)
     character(len=:), allocatable :: t
-    integer :: k
+    integer :: k, n
+    n = size(ids)
     t = i2s(ids(1))
-    do k = 2, size(ids)
-      t = t//merge(' and ', ',    ', k == size(ids))
+    do k = 2, n
+      if (n > 12 .and. k > 5 .and. k < n - 1) then
+        if (k == 6) t = t//', ...'
+        cycle
+      end if
+      t = t//merge(' and ', ',    ', k == n)
       t = trim(t)//' '//i2s(ids(k))
     end do
+    if (n > 12) t = t//' ('//i2s(n)//' bodies)'
   end function group_names
 
   !> A floating body with e = 0 (no load along its free motions) is pressed into the contact
@@ -375,6 +493,7 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     type(error_t), intent(out) :: err                  !< ERR_INPUT when a body is not pressed
     real(wp), allocatable :: rows(:, :), target(:), lam(:), h(:), bs(:, :), ha(:)
+    type(sparse_cols_t) :: gsp
     integer, allocatable :: root(:), unpressed(:), members(:)
     logical, allocatable :: loaded(:)
     real(wp) :: res
@@ -399,7 +518,7 @@ contains
       m = bodies(a)%m
       if (r == 0 .or. m == 0) cycle
       if (any(bodies(a)%re /= 0.0_wp) .or. loaded(root(a))) cycle
-      allocate (rows(r + 1, m), target(r + 1), lam(m), ha(m))
+      allocate (rows(r + 1, m), target(r + 1), ha(m))
       do i = 1, m
         ha(i) = h(slot_row(bodies(a)%slots(i), contact_line%m))
       end do
@@ -407,12 +526,10 @@ contains
       rows(r + 1, :) = ha/max(maxval(abs(ha)), tiny(1.0_wp))
       target = 0.0_wp
       target(r + 1) = -1.0_wp
-      if (has_friction(contact_line)) then
-        rows = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), rows)
-        deallocate (lam)
-        allocate (lam(size(rows, 2)))
-      end if
-      call nnls(rows, target, lam, res)
+      call gsp%from_dense(rows)
+      if (has_friction(contact_line)) gsp = cone_columns(contact_line, slot_row(bodies(a)%slots, contact_line%m), gsp)
+      allocate (lam(gsp%ncol))
+      call nnls(gsp, target, lam, res)
       if (.not. res <= 1.0e-8_wp) unpressed = [unpressed, a]
       deallocate (rows, target, lam, ha)
     end do
@@ -459,9 +576,10 @@ contains
     integer, intent(in) :: root(:)
     integer, intent(in) :: targets(:)   !< the bodies that must take part (one group)
     real(wp), intent(in) :: h(:)
-    real(wp), allocatable :: g(:, :), gc(:, :), x(:), target(:), e(:)
-    integer, allocatable :: col(:), rows(:), r0(:), tgt(:)
-    integer :: b, i, k, nr, nc, mm, n, a, nt
+    type(sparse_cols_t) :: g, gc
+    real(wp), allocatable :: x(:), target(:), e(:), tv(:)
+    integer, allocatable :: col(:), rows(:), r0(:), tgt(:), ti(:), tj(:)
+    integer :: b, i, k, nr, nc, mm, n, a, nt, nz, q
     real(wp) :: hs, es
     mm = contact_line%m
     nt = size(targets)
@@ -474,12 +592,14 @@ contains
     col = 0
     nc = 0
     nr = 0
+    nz = 0
     allocate (r0(size(bodies)))
     r0 = 0
     do b = 1, size(bodies)
       if (root(b) /= root(a) .or. bodies(b)%nrig == 0) cycle
       r0(b) = nr
       nr = nr + bodies(b)%nrig
+      nz = nz + (bodies(b)%nrig + 1)*bodies(b)%m
       do i = 1, bodies(b)%m
         k = slot_row(bodies(b)%slots(i), mm)
         if (col(k) == 0) then
@@ -488,52 +608,64 @@ contains
         end if
       end do
     end do
-    allocate (rows(nc), g(nr + 1 + nt, nc), e(nr))
+    allocate (rows(nc), e(nr))
     do k = 1, mm
       if (col(k) > 0) rows(col(k)) = k
     end do
-    g = 0.0_wp
+    ! the entries: the members' rigid rows, the h row, a 1 in a target's row on its normal rows
+    allocate (ti(nz + nc), tj(nz + nc), tv(nz + nc))
     e = 0.0_wp
     hs = max(maxval(abs(h)), tiny(1.0_wp))
+    nz = 0
     do b = 1, size(bodies)
       if (root(b) /= root(a) .or. bodies(b)%nrig == 0) cycle
       e(r0(b) + 1:r0(b) + bodies(b)%nrig) = bodies(b)%re
       do i = 1, bodies(b)%m
         k = slot_row(bodies(b)%slots(i), mm)
-        g(r0(b) + 1:r0(b) + bodies(b)%nrig, col(k)) = bodies(b)%rg(:, i)
-        if (tgt(b) > 0 .and. contact_line%kind(k) /= ROW_TANGENT) g(nr + 1 + tgt(b), col(k)) = 1.0_wp
+        do q = 1, bodies(b)%nrig
+          nz = nz + 1
+          ti(nz) = r0(b) + q
+          tj(nz) = col(k)
+          tv(nz) = bodies(b)%rg(q, i)
+        end do
+        if (tgt(b) > 0 .and. contact_line%kind(k) /= ROW_TANGENT) then
+          nz = nz + 1
+          ti(nz) = nr + 1 + tgt(b)
+          tj(nz) = col(k)
+          tv(nz) = 1.0_wp
+        end if
       end do
     end do
     do i = 1, nc
-      g(nr + 1, i) = h(rows(i))/hs
+      nz = nz + 1
+      ti(nz) = nr + 1
+      tj(nz) = i
+      tv(nz) = h(rows(i))/hs
     end do
+    call g%from_triplets(nr + 1 + nt, nc, ti(1:nz), tj(1:nz), tv(1:nz))
     if (has_friction(contact_line)) then
       gc = cone_columns(contact_line, rows, g)
     else
       gc = g
     end if
-    ! the columns of tau (the loads, scaled; counted as pressing) and of the two slacks
-    n = size(gc, 2)
+    n = gc%ncol
     es = norm2(e)
     if (es > 0.0_wp) then
       e = e/es
       es = 1.0_wp      ! tau presses only when the group has a load
     end if
-    ! columns: tau, the slack of the h row, one slack per target's row
-    gc = reshape([gc, [-e, -es, spread(0.0_wp, 1, nt)], [spread(0.0_wp, 1, nr), 1.0_wp, spread(0.0_wp, 1, nt)]], &
-                 [nr + 1 + nt, n + 2])
-    deallocate (g)
-    allocate (g(nr + 1 + nt, n + 2 + nt))
-    g(:, 1:n + 2) = gc
-    g(:, n + 3:) = 0.0_wp
+    ! the columns of tau (the loads, scaled; counted as pressing), of the slack of the h row
+    ! and of one slack per target's row
+    call gc%push([[(i, i=1, nr)], nr + 1], [-e, -es])
+    call gc%push([nr + 1], [1.0_wp])
     do i = 1, nt
-      g(nr + 1 + i, n + 2 + i) = -1.0_wp
+      call gc%push([nr + 1 + i], [-1.0_wp])
     end do
     allocate (target(nr + 1 + nt), x(n + 2 + nt))
     target = 0.0_wp
     target(nr + 1) = -1.0_wp
     target(nr + 2:) = 1.0_wp
-    call nnls(g, target, x, res)
+    call nnls(gc, target, x, res)
   end function group_pressing
 
   !> The columns of g (column i on contact row rows(i)) as generators of the admissible
@@ -545,11 +677,12 @@ contains
   function cone_columns(contact_line, rows, g, mu_scale) result(gc)
     type(interface_t), intent(in) :: contact_line
     integer, intent(in) :: rows(:)
-    real(wp), intent(in) :: g(:, :)
+    type(sparse_cols_t), intent(in) :: g
     real(wp), intent(in), optional :: mu_scale   !< Coulomb's mu times this (default 1)
-    real(wp), allocatable :: gc(:, :)
-    integer, allocatable :: tcol(:)
-    integer :: i, n, k, p
+    type(sparse_cols_t) :: gc
+    integer, allocatable :: tcol(:), cr(:)
+    real(wp), allocatable :: cv(:)
+    integer :: i, k, p
     real(wp) :: sc, t
     sc = 1.0_wp
     if (present(mu_scale)) sc = mu_scale
@@ -558,28 +691,49 @@ contains
     do i = 1, size(rows)
       if (contact_line%kind(rows(i)) == ROW_TANGENT) tcol(contact_line%nrow(rows(i))) = i
     end do
-    allocate (gc(size(g, 1), 2*size(rows)))
-    n = 0
+    call gc%init(g%nrow, 2*(g%ptr(g%ncol + 1) - 1))
     do i = 1, size(rows)
       k = rows(i)
       p = contact_line%pair_of(k)
-      if (contact_line%kind(k) == ROW_TANGENT) then
-        if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
-        gc(:, n + 1) = g(:, i)
-        gc(:, n + 2) = -g(:, i)
-        n = n + 2
-      else if (tcol(k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
-        ! divided by sqrt(1 + (mu)^2): the same cone, columns of one size for any mu
-        t = sc*contact_line%pair_mu(p)
-        gc(:, n + 1) = (g(:, i) + t*g(:, tcol(k)))/sqrt(1.0_wp + t*t)
-        gc(:, n + 2) = (g(:, i) - t*g(:, tcol(k)))/sqrt(1.0_wp + t*t)
-        n = n + 2
-      else
-        gc(:, n + 1) = g(:, i)
-        n = n + 1
-      end if
+      associate (ri => g%row(g%ptr(i):g%ptr(i + 1) - 1), vi => g%val(g%ptr(i):g%ptr(i + 1) - 1))
+        if (contact_line%kind(k) == ROW_TANGENT) then
+          if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
+          call gc%push(ri, vi)
+          call gc%push(ri, -vi)
+        else if (tcol(k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
+          ! divided by sqrt(1 + (mu)^2): the same cone, columns of one size for any mu
+          t = sc*contact_line%pair_mu(p)
+          call combine(i, tcol(k), t)
+          call gc%push(cr, cv/sqrt(1.0_wp + t*t))
+          call combine(i, tcol(k), -t)
+          call gc%push(cr, cv/sqrt(1.0_wp + t*t))
+        else
+          call gc%push(ri, vi)
+        end if
+      end associate
     end do
-    gc = gc(:, 1:n)
+
+  contains
+
+    !> cr, cv: the entries of column a + t column b.
+    subroutine combine(a, b, tt)
+      integer, intent(in) :: a, b
+      real(wp), intent(in) :: tt
+      integer :: l, c, n
+      n = g%ptr(a + 1) - g%ptr(a)
+      cr = g%row(g%ptr(a):g%ptr(a + 1) - 1)
+      cv = g%val(g%ptr(a):g%ptr(a + 1) - 1)
+      do l = g%ptr(b), g%ptr(b + 1) - 1
+        c = findloc(cr(1:n), g%row(l), 1)
+        if (c > 0) then
+          cv(c) = cv(c) + tt*g%val(l)
+        else
+          cr = [cr, g%row(l)]
+          cv = [cv, tt*g%val(l)]
+        end if
+      end do
+    end subroutine combine
+
   end function cone_columns
 
   !> nnls(g, e) over the admissible contact forces of the rows `rows` (g's columns): the
@@ -590,15 +744,18 @@ contains
   subroutine admissible_nnls(contact_line, rows, g, e, res, mu_scale)
     type(interface_t), intent(in) :: contact_line
     integer, intent(in) :: rows(:)
-    real(wp), intent(in) :: g(:, :), e(:)
+    type(sparse_cols_t), intent(in) :: g
+    real(wp), intent(in) :: e(:)
     real(wp), intent(out) :: res
     real(wp), intent(in), optional :: mu_scale
-    real(wp), allocatable :: gc(:, :), ga(:, :), ea(:), x(:)
+    type(sparse_cols_t) :: gc, ga
+    real(wp), allocatable :: ea(:), x(:)
     integer, allocatable :: tres(:)
-    integer :: i, k, n, nt, r
+    logical, allocatable :: has_t(:)
+    integer :: i, k, n, nt, r, p
     real(wp) :: w, t
     if (.not. has_friction(contact_line)) then
-      allocate (x(size(g, 2)))
+      allocate (x(g%ncol))
       call nnls(g, e, x, res)
       return
     end if
@@ -608,40 +765,66 @@ contains
                         contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_TRESCA, i=1, size(rows))])
     nt = size(tres)
     if (nt == 0) then
-      allocate (x(size(gc, 2)))
+      allocate (x(gc%ncol))
       call nnls(gc, e, x, res)
       return
     end if
-    r = size(g, 1)
+    ! the normal rows whose tangential row is among `rows`
+    allocate (has_t(contact_line%m))
+    has_t = .false.
+    do i = 1, size(rows)
+      if (contact_line%kind(rows(i)) == ROW_TANGENT) has_t(contact_line%nrow(rows(i))) = .true.
+    end do
+    r = g%nrow
     w = max(norm2(e), tiny(1.0_wp))
-    allocate (ga(r + nt, size(gc, 2) + nt), ea(r + nt), x(size(gc, 2) + nt))
-    ga = 0.0_wp
-    ga(1:r, 1:size(gc, 2)) = gc
+    allocate (ea(r + nt), x(gc%ncol + nt))
     ea(1:r) = e
     ea(r + 1:) = w
-    ! locate each Tresca row's column pair (+g, -g) and scale it by the bound
+    call ga%init(r + nt, size(gc%val) + 3*nt)
+    ! gc's columns in order; each Tresca row's column pair (+g, -g) scaled by the bound
     n = 0
     k = 0
     do i = 1, size(rows)
+      p = contact_line%pair_of(rows(i))
       if (contact_line%kind(rows(i)) == ROW_TANGENT) then
-        if (contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_COULOMB) cycle
+        if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
         k = k + 1
         ! the bound, no larger than 1e3 |e| / |g_j| (a bound beyond that does not bind a
         ! balance of |e|, and a slip_bound of 1e20 would only spoil the least squares)
-        t = contact_line%pair_slip(contact_line%pair_of(rows(i)))*contact_line%trib(rows(i))
-        t = min(t, 1.0e3_wp*w/max(norm2(ga(1:r, n + 1)), tiny(1.0_wp)))
-        ga(1:r, n + 1:n + 2) = ga(1:r, n + 1:n + 2)*t
-        ga(r + k, n + 1:n + 2) = w
-        ga(r + k, size(gc, 2) + k) = w
+        t = contact_line%pair_slip(p)*contact_line%trib(rows(i))
+        t = min(t, 1.0e3_wp*w/max(norm2(gc%val(gc%ptr(n + 1):gc%ptr(n + 2) - 1)), tiny(1.0_wp)))
+        call push_scaled(n + 1, t, k)
+        call push_scaled(n + 2, t, k)
         n = n + 2
-      else if (contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_COULOMB .and. &
-               any(contact_line%kind(rows) == ROW_TANGENT .and. contact_line%nrow(rows) == rows(i))) then
+      else if (contact_line%pair_friction(p) == FRICTION_COULOMB .and. has_t(rows(i))) then
+        call push_scaled(n + 1, 1.0_wp, 0)
+        call push_scaled(n + 2, 1.0_wp, 0)
         n = n + 2
       else
+        call push_scaled(n + 1, 1.0_wp, 0)
         n = n + 1
       end if
     end do
+    do k = 1, nt
+      call ga%push([r + k], [w])
+    end do
     call nnls(ga, ea, x, res)
+
+  contains
+
+    !> gc's column c times tt into ga, with w in row r + kb when kb > 0 (its bound's row).
+    subroutine push_scaled(c, tt, kb)
+      integer, intent(in) :: c, kb
+      real(wp), intent(in) :: tt
+      associate (rc => gc%row(gc%ptr(c):gc%ptr(c + 1) - 1), vc => gc%val(gc%ptr(c):gc%ptr(c + 1) - 1))
+        if (kb > 0) then
+          call ga%push([rc, r + kb], [vc*tt, w])
+        else
+          call ga%push(rc, vc)
+        end if
+      end associate
+    end subroutine push_scaled
+
   end subroutine admissible_nnls
 
   !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of
@@ -657,6 +840,7 @@ contains
     real(wp), allocatable :: b(:, :), g0(:, :), work(:)
     real(wp) :: wq(1)
     integer :: lwork
+    allocate (g0(r, r), b(r, r))
     g0 = gg(1:r, 1:r)
     b = s(1:r, 1:r)
     ! the workspace LAPACK asks for (a fixed 64 was too small from r = 22 on: dsygv and
@@ -697,200 +881,5 @@ contains
       s = s//'node '//i2s(node_tag((system%fixing(k) + 1)/2))//merge(' ux', ' uy', mod(system%fixing(k), 2) == 1)
     end do
   end function fixing_list
-
-  !> Non-negative least squares min |G x - e|, x >= 0 (Lawson and Hanson's active set
-  !! method; G is r x m, at most r columns are ever passive). res is the residual norm
-  !! |G x - e| at the returned x. The least squares problem of the passive columns is kept
-  !! as a QR factorization that is updated, not redone, when a column enters (one
-  !! Householder reflection, O(r^2)) or leaves (Givens rotations, O(r np)): a group of 500
-  !! floating blocks took 3 s with a factorization from scratch per step (O(r np^2) each,
-  !! r^4 in all), 0.3 s with the updates.
-  subroutine nnls(g, e, x, res)
-    real(wp), intent(in) :: g(:, :)     !< (r, m)
-    real(wp), intent(in) :: e(:)        !< (r)
-    real(wp), intent(out) :: x(:)       !< (m)
-    real(wp), intent(out) :: res
-    real(wp), allocatable :: w(:), z(:), q(:, :), rr(:, :), v(:), qe(:), cval(:), resv(:), rhs(:)
-    logical, allocatable :: passive(:)
-    integer, allocatable :: cols(:)     ! the passive columns, in the order of rr's columns
-    integer, allocatable :: cptr(:), crow(:)   ! g's nonzeros by column
-    integer :: r, m, j, np, it, inner, k, i
-    real(wp) :: tol, alpha, t, rdiag_min
-
-    r = size(g, 1)
-    m = size(g, 2)
-    allocate (w(m), z(m), passive(m), q(r, r), rr(r, min(r, m)), v(r), cols(min(r, m)), qe(r), rhs(r))
-    ! g's nonzeros by column (a contact row's column touches the rigid rows of two bodies:
-    ! the gradient g'(e - g x) of each step costs its nonzeros, not r m)
-    allocate (cptr(m + 1))
-    cptr(1) = 1
-    do k = 1, m
-      cptr(k + 1) = cptr(k) + count(g(:, k) /= 0.0_wp)
-    end do
-    allocate (crow(cptr(m + 1) - 1), cval(cptr(m + 1) - 1))
-    do k = 1, m
-      crow(cptr(k):cptr(k + 1) - 1) = pack([(i, i=1, r)], g(:, k) /= 0.0_wp)
-      cval(cptr(k):cptr(k + 1) - 1) = g(crow(cptr(k):cptr(k + 1) - 1), k)
-    end do
-    x = 0.0_wp
-    passive = .false.
-    np = 0
-    q = 0.0_wp
-    do i = 1, r
-      q(i, i) = 1.0_wp
-    end do
-    rr = 0.0_wp
-    tol = 1.0e-12_wp*max(maxval(abs(g))*norm2(e), tiny(1.0_wp))
-    rdiag_min = 1.0e-13_wp*max(maxval(abs(g)), tiny(1.0_wp))
-    do it = 1, 3*m + 10
-      call gradient()
-      j = 0
-      t = tol
-      do k = 1, m
-        if (.not. passive(k) .and. w(k) > t) then
-          t = w(k)
-          j = k
-        end if
-      end do
-      if (j == 0 .or. np >= min(r, m)) exit
-      if (.not. append_column(j)) exit     ! in the span of the passive ones to rounding
-      passive(j) = .true.
-      do inner = 1, 3*m + 10
-        call passive_solution()
-        if (all(z(cols(1:np)) > 0.0_wp)) exit
-        alpha = 1.0_wp
-        do k = 1, np
-          j = cols(k)
-          if (z(j) <= 0.0_wp) alpha = min(alpha, x(j)/max(x(j) - z(j), tiny(1.0_wp)))
-        end do
-        x = x + alpha*(z - x)
-        ! the passive columns at zero leave, the last first (positions stay valid)
-        do k = np, 1, -1
-          j = cols(k)
-          if (x(j) <= 1.0e-14_wp*maxval(abs(x))) then
-            passive(j) = .false.
-            call delete_column(k)
-          end if
-        end do
-        where (.not. passive) x = 0.0_wp
-        if (np == 0) exit
-      end do
-      x = z
-      where (.not. passive) x = 0.0_wp
-    end do
-    res = norm2(matmul(g, x) - e)
-
-  contains
-
-    !> w = g'(e - g x), by g's nonzeros (x is zero off the passive columns).
-    subroutine gradient()
-      integer :: c, l
-      resv = e
-      do c = 1, np
-        do l = cptr(cols(c)), cptr(cols(c) + 1) - 1
-          resv(crow(l)) = resv(crow(l)) - cval(l)*x(cols(c))
-        end do
-      end do
-      do c = 1, m
-        w(c) = 0.0_wp
-        do l = cptr(c), cptr(c + 1) - 1
-          w(c) = w(c) + cval(l)*resv(crow(l))
-        end do
-      end do
-    end subroutine gradient
-
-    !> Column j of g as column np + 1 of the factorization: v = Q'g_j, a Householder
-    !! reflection zeroes v(np+2:r), applied to Q's columns np+1..r. False (nothing
-    !! changed) when the column has no part outside the passive columns' span.
-    logical function append_column(jc) result(ok)
-      integer, intent(in) :: jc
-      real(wp) :: nrm, beta, v1
-      real(wp), allocatable :: hv(:), qh(:)
-      integer :: n0
-      ok = .false.
-      n0 = np + 1
-      ! v = Q' g_j by the column's nonzeros
-      v = 0.0_wp
-      do k = cptr(jc), cptr(jc + 1) - 1
-        v = v + cval(k)*q(crow(k), :)
-      end do
-      nrm = norm2(v(n0:r))
-      if (.not. nrm > rdiag_min) return
-      ! H = I - beta u u', u = v(n0:r) + sign(v(n0)) |v(n0:r)| e_1: H v(n0:r) = -sign nrm e_1
-      allocate (hv(r - n0 + 1))
-      hv = v(n0:r)
-      v1 = sign(nrm, hv(1))
-      hv(1) = hv(1) + v1
-      beta = 1.0_wp/(v1*hv(1))
-      ! Q(:, n0:r) <- Q(:, n0:r) H
-      qh = matmul(q(:, n0:r), hv)
-      do k = 1, size(hv)
-        q(:, n0 + k - 1) = q(:, n0 + k - 1) - beta*qh*hv(k)
-      end do
-      rr(1:np, n0) = v(1:np)
-      rr(n0, n0) = -v1
-      rr(n0 + 1:, n0) = 0.0_wp
-      ! (Q'e) of the new column (the earlier columns of Q are unchanged)
-      qe(n0) = dot_product(q(:, n0), e)
-      np = n0
-      cols(np) = jc
-      ok = .true.
-    end function append_column
-
-    !> Remove the passive column at position kc: shift the later columns left and restore
-    !! the triangle by Givens rotations of rows kc..np-1 (applied to Q's columns as well).
-    subroutine delete_column(kc)
-      integer, intent(in) :: kc
-      integer :: c, l
-      real(wp) :: a, b, cs, sn, hyp, t1, t2
-      do c = kc, np - 1
-        rr(:, c) = rr(:, c + 1)
-        cols(c) = cols(c + 1)
-      end do
-      rr(:, np) = 0.0_wp
-      np = np - 1
-      do c = kc, np
-        a = rr(c, c)
-        b = rr(c + 1, c)
-        if (b == 0.0_wp) cycle
-        hyp = hypot(a, b)
-        cs = a/hyp
-        sn = b/hyp
-        do l = c, np
-          t1 = rr(c, l)
-          t2 = rr(c + 1, l)
-          rr(c, l) = cs*t1 + sn*t2
-          rr(c + 1, l) = -sn*t1 + cs*t2
-        end do
-        rr(c + 1, c) = 0.0_wp
-        do l = 1, r
-          t1 = q(l, c)
-          t2 = q(l, c + 1)
-          q(l, c) = cs*t1 + sn*t2
-          q(l, c + 1) = -sn*t1 + cs*t2
-        end do
-        t1 = qe(c)
-        t2 = qe(c + 1)
-        qe(c) = cs*t1 + sn*t2
-        qe(c + 1) = -sn*t1 + cs*t2
-      end do
-    end subroutine delete_column
-
-    !> z on the passive columns: R z_P = (Q'e)(1:np) (kept up to date by append_column and
-    !! delete_column), by back substitution over R's columns (contiguous); 0 elsewhere.
-    subroutine passive_solution()
-      integer :: a
-      real(wp) :: zc
-      z = 0.0_wp
-      if (np == 0) return
-      rhs(1:np) = qe(1:np)
-      do a = np, 1, -1
-        zc = rhs(a)/rr(a, a)
-        z(cols(a)) = zc
-        rhs(1:a - 1) = rhs(1:a - 1) - rr(1:a - 1, a)*zc
-      end do
-    end subroutine passive_solution
-
-  end subroutine nnls
 
 end module floating

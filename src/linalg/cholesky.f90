@@ -16,7 +16,7 @@ module cholesky
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
-                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN, CM_OK, CM_OUT_OF_MEMORY
+                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN, CM_OK, CM_OUT_OF_MEMORY, CM_NOT_POSDEF
   use banded, only: band_t
   use lapack, only: dpotri
   use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
@@ -48,6 +48,7 @@ module cholesky
     integer(i8) :: mem_bytes = 0          !< peak memory of the factorization [bytes]
     integer :: bandwidth = -1             !< half-bandwidth (FACT_BANDED), else -1
     logical :: interface_last_ok = .false.  !< true if L's permutation ends with `last`, in order
+    logical :: not_posdef = .false.       !< CHOLMOD: the last factor failed on a pivot <= 0 (K not positive definite)
     type(c_ptr), private :: handle = c_null_ptr
     type(band_t), private :: band
   contains
@@ -220,6 +221,7 @@ contains
       self%mem_bytes = int(st%mem_peak, i8)
       self%interface_last_ok = (st%last_ok == 1 .and. self%m_last > 0)
       if (code /= CM_OK) then
+        self%not_posdef = code == CM_NOT_POSDEF
         call set_cm_error(code, cmsg, err)
         call cm_free(self%handle)
         return
@@ -474,6 +476,7 @@ contains
     self%mem_bytes = 0
     self%bandwidth = -1
     self%interface_last_ok = .false.
+    self%not_posdef = .false.
   end subroutine chol_free
 
 end module cholesky

@@ -7,9 +7,15 @@
     (printed as INFO, never asserted: the machine may be shared); a SIGTERM then stops it
     with exit 4 and nothing written;
 (c) 1,000 floating blocks on a clamped one are accepted and converge in at most 5 outer
-    iterations (4,995 contact rows: the sparse K of the group operator); 40 with nothing below are
-    refused as free together (exit 1), with no LAPACK "illegal value" text (from 22 rigid
-    rows on the group check's eigenproblem had too small a workspace and was skipped);
+    iterations (4,995 contact rows: the sparse K of the group operator); 40 and 300 with
+    nothing below are refused as free together (exit 1; the group check's dense and sparse
+    paths, with no LAPACK "illegal value" text: from 22 rigid rows its eigenproblem once had
+    too small a workspace and was skipped), the 300 named by the first and last few; 20 and
+    300 on a clamped one whose lowest block is pulled up by twice the top block's load are
+    refused as a group whose loads no compressive force balances (each block alone is
+    balanced: the one above it holds it down); the unbalanced part is the least residual
+    |G lam - e| over lam >= 0: the n - 1 floating blocks' residuals must sum to the net
+    pull 1e6, least when equal, 1e6/sqrt(n - 1);
 (b) the same stack with a fault far down the deck gets its own message, exit 1, nothing
     written: a group of a body in two pairs with the same body (naming both pairs' lines), a body in no pair,
     a pair naming a body the deck does not have.
@@ -109,11 +115,13 @@ try:
     # motion's ratio is small) are accepted and solved in a few outer iterations (4,995
     # contact rows: the group operator's sparse K); 40 blocks on rollers with nothing
     # below are refused as free together, with no LAPACK text on the way
-    def floating(n, clamped, cells=2):
+    def floating(n, clamped, cells=2, pull=False):
         lines = [f"&body id={k}, x0=0.0, y0={float(n - k)}, width=1.0, height=1.0, nx={cells}, ny={cells}"
                  + (", bottom='clamped'" if k == n and clamped else ", left='roller'") + " /"
                  for k in range(1, n + 1)]
         lines.append("&traction body=1, side='top', t0=0.0, -1.0e6 /")
+        if pull:   # the lowest floating block pulled up by 2e6 on its free side
+            lines.append(f"&traction body={n - 1}, side='right', t0=0.0, 2.0e6 /")
         return lines + [f"&contact bodies={k},{k + 1}, groups='bottom','top' /" for k in range(1, n)]
     code, out, dt, _ = run_deck(work, "floating1000", floating(1000, True, cells=4))
     outer = re.search(r"^result: .* outer=(\d+) .* m=(\d+) ", out, re.M)
@@ -127,6 +135,19 @@ try:
           and "illegal value" not in out, "40 floating blocks with nothing below: exit 1, free together",
           out.strip()[-300:])
     check(not made, "nothing is written (free together)", " ".join(made))
+    code, out, _, made = run_deck(work, "free300", floating(300, False))
+    check(code == 1 and "together they are free" in out and "translation along y" in out
+          and "bodies 1, 2, 3, 4, 5, ..., 299 and 300 (300 bodies) are all" in out,
+          "300 floating blocks with nothing below: exit 1, free together, the group named in short",
+          out.strip()[-300:])
+    check(not made, "nothing is written (300 free together)", " ".join(made))
+    for n in (20, 300):
+        code, out, _, made = run_deck(work, f"pulled{n}", floating(n, True, pull=True))
+        part = f"(unbalanced part {1.0e6 / (n - 1) ** 0.5:.3E})"
+        check(code == 1 and "are all held only by contact, and their loads cannot be balanced by compressive "
+              f"contact forces between them {part}" in out and not made,
+              f"{n} floating blocks whose lowest is pulled up: exit 1, the group's loads unbalanced, {part}",
+              out.strip()[-300:])
 finally:
     shutil.rmtree(work, ignore_errors=True)
 

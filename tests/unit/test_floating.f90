@@ -7,7 +7,10 @@
 !! (c) SMALBE (bound and equality constrained QPs) against the solution found by
 !!     enumerating active sets and solving each KKT system, and against QPs built with a
 !!     known solution;
-!! (d) nnls against a brute-force search over column subsets.
+!! (d) nnls, both methods (active set, interior point), against a brute-force search over
+!!     column subsets, and on stacks of blocks (a row per block, a column per contact force)
+!!     whose answer is known: balanced, pulled apart (residual: the pull), squeezed (forces
+!!     that balance each other, so x is unbounded along them), in scaled and SI magnitudes.
 !! Products with K are element loops (assembly's residual_full), not the assembled matrix.
 program test_floating
   use kinds, only: wp
@@ -21,7 +24,7 @@ program test_floating
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, MPRGP_CONVERGED
   use smalbe, only: smalbe_solve, smalbe_stats_t
-  use floating, only: nnls
+  use nonneg_lsq, only: nnls, sparse_cols_t, NNLS_ACTIVE_SET, NNLS_INTERIOR
   use lapack, only: dgesv, dsyev
   use testing, only: report, report_le, test_summary, set_seed, error_parts
   use errors, only: error_t
@@ -66,6 +69,13 @@ program test_floating
     call nnls_case(r=1 + mod(i, 3), m=2 + mod(i, 5), feasible=.true., case_no=i)
     call nnls_case(r=1 + mod(i, 3), m=2 + mod(i, 5), feasible=.false., case_no=i)
   end do
+  call nnls_stack(40, 1.0_wp, 1.0_wp, .false.)
+  call nnls_stack(40, -1.0_wp, 1.0_wp, .false.)
+  call nnls_stack(40, 1.0_wp, 1.0_wp, .true.)
+  call nnls_stack(40, -1.0_wp, 1.0_wp, .true.)
+  call nnls_stack(300, 1.0_wp, 2.1e11_wp, .true.)
+  call nnls_stack(300, -1.0_wp, 2.1e11_wp, .false.)
+  call nnls_stack(300, 1.0_wp, 1.0e-3_wp, .false.)
 
   call test_summary()
 
@@ -572,7 +582,10 @@ contains
     integer, intent(in) :: r, m, case_no
     logical, intent(in) :: feasible
     real(wp) :: gm(r, m), e(r), x(m), x0(m), res, best
+    type(sparse_cols_t) :: gs
     character(len=80) :: lab
+    character(len=14) :: mname
+    integer :: meth
     call uniform(gm, -0.5_wp, 1.0_wp)
     call uniform(x0, 0.0_wp, 1.0_wp)
     if (feasible) then
@@ -582,18 +595,70 @@ contains
       e = matmul(gm, x0)
       e(1) = -0.3_wp
     end if
-    write (lab, '(a,i0,a,i0,a,i0,a,a,a)') ' (case ', case_no, ': r=', r, ', m=', m, ', ', &
-      merge('feasible  ', 'infeasible', feasible), ')'
-    call nnls(gm, e, x, res)
+    call gs%from_dense(gm)
     best = nnls_brute(gm, e)
-    call report(all(x >= 0.0_wp), 'nnls: x >= 0'//trim(lab))
-    call report_le(abs(res - norm2(matmul(gm, x) - e))/norm2(e), 1.0e-13_wp, 'nnls: res = |Gx - e|'//trim(lab))
-    call report_le(abs(res - best)/norm2(e), 1.0e-10_wp, 'nnls: residual = brute-force minimum'//trim(lab))
-    if (feasible) then
-      call report_le(res/norm2(e), 1.0e-10_wp, 'nnls: feasible -> residual 0'//trim(lab))
-    else
-      call report(res > 1.0e-3_wp*norm2(e), 'nnls: infeasible -> residual > 0'//trim(lab), res/norm2(e))
-    end if
+    do meth = NNLS_ACTIVE_SET, NNLS_INTERIOR
+      mname = merge('active set    ', 'interior point', meth == NNLS_ACTIVE_SET)
+      write (lab, '(a,i0,a,i0,a,i0,a,a,a)') ' (case ', case_no, ': r=', r, ', m=', m, ', ', &
+        merge('feasible  ', 'infeasible', feasible), ')'
+      lab = trim(mname)//trim(lab)
+      call nnls(gs, e, x, res, meth)
+      call report(all(x >= 0.0_wp), 'nnls: x >= 0, '//trim(lab))
+      call report_le(abs(res - norm2(matmul(gm, x) - e))/norm2(e), 1.0e-13_wp, 'nnls: res = |Gx - e|, '//trim(lab))
+      call report_le(abs(res - best)/norm2(e), 1.0e-10_wp, 'nnls: residual = brute-force minimum, '//trim(lab))
+      if (feasible) then
+        call report_le(res/norm2(e), 1.0e-10_wp, 'nnls: feasible -> residual 0, '//trim(lab))
+      else
+        call report(res > 1.0e-3_wp*norm2(e), 'nnls: infeasible -> residual > 0, '//trim(lab), res/norm2(e))
+      end if
+    end do
   end subroutine nnls_case
+
+  !> A stack of nb blocks, each free along y only (one row), resting on a support: three
+  !! contact forces (columns) between each block and the next, with weights 0.5, 1 and 0.7
+  !! of scale (+ on the upper block, - on the lower), three under the last block. A load
+  !! sign x 1e6 on the top block: pressed (+1) it is balanced (residual 0); pulled (-1) no
+  !! compressive force balances it and the least residual is the pull itself, 1e6 (the
+  !! forces all zero). squeezed: block nb/2 also touches a fixed plate above it (a column on
+  !! its row only), so the plate's force and the stack's below it balance each other:
+  !! x >= 0 with G x = 0 exists, and x is unbounded along it.
+  subroutine nnls_stack(nb, sign, scale, squeezed)
+    integer, intent(in) :: nb
+    real(wp), intent(in) :: sign, scale
+    logical, intent(in) :: squeezed
+    type(sparse_cols_t) :: gs
+    real(wp), allocatable :: e(:), x(:)
+    real(wp) :: res(2), wts(3)
+    integer :: k, c, meth
+    character(len=100) :: lab
+    wts = [0.5_wp, 1.0_wp, 0.7_wp]*scale
+    call gs%init(nb)
+    do k = 1, nb
+      do c = 1, 3
+        if (k < nb) then
+          call gs%push([k, k + 1], [wts(c), -wts(c)])
+        else
+          call gs%push([k], [wts(c)])
+        end if
+      end do
+    end do
+    if (squeezed) call gs%push([nb/2], [-scale])
+    allocate (e(nb), x(gs%ncol))
+    e = 0.0_wp
+    e(1) = sign*1.0e6_wp
+    write (lab, '(a,i0,a,a,a,es8.1,a)') 'nnls stack of ', nb, merge(' pressed', ' pulled ', sign > 0.0_wp), &
+      merge(', squeezed', '          ', squeezed), ', scale ', scale, ', '
+    do meth = NNLS_ACTIVE_SET, NNLS_INTERIOR
+      call nnls(gs, e, x, res(meth), meth)
+      call report(all(x >= 0.0_wp), trim(lab)//merge(' active set', ' interior  ', meth == NNLS_ACTIVE_SET)//': x >= 0')
+      if (sign > 0.0_wp) then
+        call report_le(res(meth)/1.0e6_wp, 1.0e-10_wp, trim(lab)//merge(' active set', ' interior  ', &
+                       meth == NNLS_ACTIVE_SET)//': residual 0 (balanced)')
+      else
+        call report_le(abs(res(meth) - 1.0e6_wp)/1.0e6_wp, 1.0e-9_wp, trim(lab)//merge(' active set', ' interior  ', &
+                       meth == NNLS_ACTIVE_SET)//': residual = the pull')
+      end if
+    end do
+  end subroutine nnls_stack
 
 end program test_floating
