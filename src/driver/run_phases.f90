@@ -7,7 +7,7 @@ module run_phases
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
-  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t
+  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body
@@ -199,11 +199,12 @@ contains
         if (size(run%plan) == 1) then
           call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
                              run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
-                             contact_groups=body_groups(deck, a))
+                             contact_groups=body_groups(deck, a), body_load=body_force_of(deck, a, stage_count(deck)))
         else   ! each stage's load vectors too, which the steps combine
           call assemble_body(run%meshes(a), deck%body(a), deck%plane_strain, deck%traction, deck%ntraction, &
                              run%systems(a), err(a), boundaries=deck%boundary(1:deck%nboundary), matrix=matrix, &
-                             contact_groups=body_groups(deck, a), nstage=run%plan(size(run%plan))%stage)
+                             contact_groups=body_groups(deck, a), nstage=run%plan(size(run%plan))%stage, &
+                             body_load=body_force_of(deck, a, run%plan(size(run%plan))%stage))
         end if
       end do
       !$omp end parallel do

@@ -12,6 +12,9 @@ module run_summary
   use sysinfo, only: write_stdout_checked
   use strings, only: sci, fmt_real, i2s
   use run_state, only: run_t
+  use assembly, only: support_reactions
+  use condense, only: apply_bt
+  use contact_common, only: gather
   implicit none (type, external)
   private
 
@@ -52,12 +55,13 @@ contains
   subroutine summary(run)
     type(run_t), intent(inout) :: run   !< the run: its result and timing; its code on failure
     character(len=1024) :: line(5)
-    character(len=1024), allocatable :: pairs(:)
+    character(len=1024), allocatable :: pairs(:), reactions(:)
     integer :: err(5), k
     if (run%rank /= 0) return
     associate (result => run%result, timing => run%timing)
       err = 0
       pairs = pair_lines(run)
+      reactions = reaction_lines(run)
       if (result%outer > 0 .and. result%error_bound < 1.0_wp) then
         line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(result%error_bound)// &
           ' (a posteriori bound, cond('//trim(merge('F1+F2', 'H    ', run%contact_line%npair <= 1))//') ~ '//sci(result%kappa)//')'
@@ -94,6 +98,10 @@ contains
       do k = 1, size(pairs)
         call write_stdout_checked(trim(pairs(k)), err(1))
         if (err(1) /= 0) exit
+      end do
+      do k = 1, size(reactions)
+        if (err(1) /= 0) exit
+        call write_stdout_checked(trim(reactions(k)), err(1))
       end do
       do k = 2, 4
         if (k == 3 .and. run%written) then
@@ -265,6 +273,52 @@ contains
         ' imbalance=', imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity, tail
     end do
   end function pair_lines
+
+  !> The `reaction:` line of each supported body (the first MAX_LISTED, then how many more):
+  !! the resultant of its supports' forces (K u - f at the prescribed DOFs), of its applied
+  !! loads and of the contact forces on its free DOFs (-B_a' lam_a), and their balance
+  !! |R + F + C| / max(|R|, |F|, |C|): the body's equilibrium, the displacement's and the
+  !! contact forces' independently (rounding level in a converged run). A contact node on a
+  !! support passes its force to the support directly: it is in the pair's resultant, not in
+  !! C. None without a displacement (a run that stopped before it), nor for a body whose
+  !! interface rows live on another rank.
+  function reaction_lines(run) result(lines)
+    type(run_t), intent(in) :: run
+    character(len=1024), allocatable :: lines(:)
+    real(wp), allocatable :: r(:), c(:)
+    real(wp) :: rr(2), ff(2), cc(2), scale
+    integer :: a, p, nsup
+    allocate (lines(0))
+    if (.not. allocated(run%displacement) .or. .not. allocated(run%result%lam_body)) return
+    if (.not. allocated(run%bodies)) return
+    nsup = 0
+    do a = 1, run%nbody
+      associate (sy => run%systems(a), bd => run%bodies(a))
+        if (count(sy%free_of == 0) <= size(sy%fixing)) cycle    ! no support: held only by contact
+        if (.not. allocated(bd%bptr)) cycle
+        nsup = nsup + 1
+        if (nsup > MAX_LISTED) cycle
+        allocate (r(sy%ndof), c(sy%n))
+        call support_reactions(run%meshes(a), run%deck%body(a), run%deck%plane_strain, sy, &
+                               run%displacement(1:sy%ndof, a), sy%f_applied, r)
+        c = 0.0_wp
+        call apply_bt(bd, gather(run%result%lam_body, bd%slots), c)
+        cc = 0.0_wp
+        do p = 1, sy%n
+          cc(2 - mod(sy%dof_of(p), 2)) = cc(2 - mod(sy%dof_of(p), 2)) - c(p)
+        end do
+        rr = [sum(r(1::2)), sum(r(2::2))]
+        ff = [sum(sy%f_applied(1::2)), sum(sy%f_applied(2::2))]
+        scale = max(norm2(rr), norm2(ff), norm2(cc), tiny(1.0_wp))
+        lines = [character(len=1024) :: lines, 'reaction: body='//i2s(a)//' supports='//sci(rr(1), 5)//','// &
+                 sci(rr(2), 5)//' loads='//sci(ff(1), 5)//','//sci(ff(2), 5)//' contact='//sci(cc(1), 5)//','// &
+                 sci(cc(2), 5)//' balance='//sci(norm2(rr + ff + cc)/scale, 2)]
+        deallocate (r, c)
+      end associate
+    end do
+    if (nsup > MAX_LISTED) lines = [character(len=1024) :: lines, 'reaction: ... '//i2s(nsup - MAX_LISTED)// &
+                                    ' more supported bodies (the result file has every node''s reaction)']
+  end function reaction_lines
 
   !> What a user whose Robin run did not converge should try next, in order: the robust
   !! operator and relaxation (the defaults), then the monolithic reference.

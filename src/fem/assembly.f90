@@ -21,7 +21,8 @@ module assembly
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
   use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
-                      element_stiffness, element_body_force, edge_traction, element_stress
+                      element_stiffness, element_body_force, edge_traction, element_stress, &
+                      element_shape_integrals
   use linop, only: csc_symv
   use body_system, only: body_system_t
   use supports, only: prescribed_dofs, group_conditions, unknown_group, number_free_dofs
@@ -31,7 +32,7 @@ module assembly
   implicit none (type, external)
   private
 
-  public :: assemble_body, expand, residual_full, nodal_stress, csc_matvec, lame_parameters, cell_triplets
+  public :: assemble_body, expand, residual_full, support_reactions, nodal_stress, csc_matvec, lame_parameters, cell_triplets
   public :: body_system_t, body_force_fn, rigid_motion_name
 
 contains
@@ -62,7 +63,7 @@ contains
   !! On an impossible input `err` says why (ERR_INPUT; ERR_NUMERICAL for a LAPACK or
   !! internal failure), naming the body, and `sys` is incomplete.
   subroutine assemble_body(mesh, body, plane_strain, tractions, ntraction, sys, err, &
-                           u_prescribed, body_force, boundaries, matrix, contact_groups, nstage)
+                           u_prescribed, body_force, boundaries, matrix, contact_groups, nstage, body_load)
     type(mesh_t), intent(in) :: mesh                     !< the body's mesh (mesh_build)
     type(body_cfg_t), intent(in) :: body                 !< material, side conditions
     logical, intent(in) :: plane_strain                  !< .true. plane strain, .false. plane stress
@@ -89,6 +90,9 @@ contains
     !> the deck's load stages: each stage's load vectors too (sys%f_stage, u_stage,
     !! fa_stage), for load steps; absent: none
     integer, intent(in), optional :: nstage
+    !> (2, nstage or 1) a constant body force per volume of each stage [force/length^3]
+    !! (&body_force: density x gravity + force); the whole load takes their sum
+    real(wp), intent(in), optional :: body_load(:, :)
     logical, allocatable :: prescribed(:)
     integer(int16), allocatable :: cell_row(:, :, :)
     real(wp) :: lame_lambda, lame_mu
@@ -124,14 +128,18 @@ contains
       call build_pattern(mesh, sys, err, cell_row)
       if (err%failed()) return
     end if
-    call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
+    if (present(body_load)) then
+      call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force, sum(body_load, dim=2))
+    else
+      call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
+    end if
     if (err%failed()) return
     call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, cell_row)
     if (err%failed()) return
     if (allocated(cell_row)) deallocate (cell_row)
     call add_applied_loads(sys)
     if (present(nstage)) then
-      call stage_loads(mesh, lame_lambda, lame_mu, tractions(1:ntraction), nstage, sys, err, body_force)
+      call stage_loads(mesh, lame_lambda, lame_mu, tractions(1:ntraction), nstage, sys, err, body_force, body_load)
       if (err%failed()) return
     end if
     if (with_k) sys%k_norm = stiffness_norm(sys)
@@ -291,15 +299,16 @@ contains
   end subroutine check_kernel
 
   !> The applied nodal loads on all DOFs (sys%f_applied): the tractions on this body,
-  !! then the body force if any; sys%f = 0. err = ERR_INPUT when a traction names a group
-  !! the body does not have.
-  subroutine applied_loads(mesh, body_id, tractions, sys, err, body_force)
+  !! then the body forces if any (a density function, a constant); sys%f = 0. err =
+  !! ERR_INPUT when a traction names a group the body does not have.
+  subroutine applied_loads(mesh, body_id, tractions, sys, err, body_force, body_load)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id
     type(traction_cfg_t), intent(in) :: tractions(:)
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     procedure(body_force_fn), optional :: body_force
+    real(wp), intent(in), optional :: body_load(2)   !< constant body force per volume [force/length^3]
     integer :: t, g
 
     allocate (sys%f(sys%n), sys%f_applied(sys%ndof))
@@ -325,12 +334,16 @@ contains
       end if
     end do
     if (present(body_force)) call add_body_force(mesh, body_force, sys%f_applied)
+    if (present(body_load)) then
+      if (any(body_load /= 0.0_wp)) call add_constant_body_force(mesh, body_load, sys%f_applied)
+    end if
   end subroutine applied_loads
 
   !> Each stage's load vectors (sys%f_stage, u_stage, fa_stage): its tractions, its
   !! prescribed values (sys%dof_stage) and their lifting, as the whole load is assembled;
-  !! the body force is stage 1's. One stage: the whole load's vectors.
-  subroutine stage_loads(mesh, lame_lambda, lame_mu, tractions, nstage, sys, err, body_force)
+  !! the body force function is stage 1's, the constant body force column s stage s's. One
+  !! stage: the whole load's vectors.
+  subroutine stage_loads(mesh, lame_lambda, lame_mu, tractions, nstage, sys, err, body_force, body_load)
     type(mesh_t), intent(in) :: mesh
     real(wp), intent(in) :: lame_lambda, lame_mu
     type(traction_cfg_t), intent(in) :: tractions(:)
@@ -338,7 +351,9 @@ contains
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     procedure(body_force_fn), optional :: body_force
+    real(wp), intent(in), optional :: body_load(:, :)
     real(wp), allocatable :: f_all(:), u_all(:), fa_all(:)
+    real(wp) :: bl(2)
     integer :: s
     sys%nstage = nstage
     allocate (sys%f_stage(sys%n, nstage), sys%u_stage(sys%ndof, nstage), sys%fa_stage(sys%ndof, nstage))
@@ -353,10 +368,14 @@ contains
     call move_alloc(sys%f_applied, fa_all)
     do s = 1, nstage
       sys%u_fixed = merge(u_all, 0.0_wp, sys%dof_stage == s)
+      bl = 0.0_wp
+      if (present(body_load)) then
+        if (s <= size(body_load, 2)) bl = body_load(:, s)
+      end if
       if (s == 1) then
-        call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_force)
+        call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_force, bl)
       else
-        call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err)
+        call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_load=bl)
       end if
       if (err%failed()) return
       call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, .false.)
@@ -596,6 +615,24 @@ contains
     r(1:2*mesh%nnode) = r(1:2*mesh%nnode) - f_full(1:2*mesh%nnode)
   end subroutine residual_full
 
+  !> The forces the supports exert on the body at its nodes: K u - f at the prescribed DOFs
+  !! (residual_full with the applied loads f), 0 at the free ones and at the fixing DOFs of a
+  !! body held only by contact (no support there: its residual is the body's equilibrium
+  !! error, of the order of rounding). With the applied loads and
+  !! the contact forces they balance the body: K u sums to zero over each component.
+  subroutine support_reactions(mesh, body, plane_strain, sys, u_full, f_applied, r)
+    type(mesh_t), intent(in) :: mesh            !< the body's mesh
+    type(body_cfg_t), intent(in) :: body        !< material
+    logical, intent(in) :: plane_strain         !< .true. plane strain, .false. plane stress
+    type(body_system_t), intent(in) :: sys      !< its DOF numbering (free_of)
+    real(wp), intent(in) :: u_full(:)           !< (ndof) displacements [length]
+    real(wp), intent(in) :: f_applied(:)        !< (ndof) the applied nodal loads [force]
+    real(wp), intent(out) :: r(:)               !< (ndof) reactions [force]
+    call residual_full(mesh, body, plane_strain, u_full, f_applied, r)
+    where (sys%free_of(1:2*mesh%nnode) /= 0) r(1:2*mesh%nnode) = 0.0_wp
+    if (allocated(sys%fixing)) r(sys%fixing) = 0.0_wp
+  end subroutine support_reactions
+
   !> Nodal stresses: the unweighted average over the cells around each node of the cell
   !! value (Q1: at the cell centre; P1: the constant value), and the von Mises stress of
   !! the 3D state (sxx, syy, szz, sxy).
@@ -721,6 +758,24 @@ contains
       f(2*nb - 1:2*nb) = f(2*nb - 1:2*nb) + len/6.0_wp*(ta + 2.0_wp*tb)
     end do
   end subroutine add_group_traction
+
+  !> Add the consistent nodal loads of a constant body force b [force/length^3] to f: w(a) b
+  !! per cell (element_shape_integrals), exact on any Q1 or P1 cell.
+  subroutine add_constant_body_force(mesh, b, f)
+    type(mesh_t), intent(in) :: mesh
+    real(wp), intent(in) :: b(2)
+    real(wp), intent(inout) :: f(:)
+    integer :: c, a, k
+    real(wp) :: xe(2, MAX_NVERT), w(MAX_NVERT)
+    do c = 1, mesh%ncell
+      call cell_coords(mesh, c, xe)
+      call element_shape_integrals(cell_element(mesh, c), xe, w)
+      do a = 1, cell_vertices(mesh, c)
+        k = mesh%cells(a, c)
+        f(2*k - 1:2*k) = f(2*k - 1:2*k) + w(a)*b
+      end do
+    end do
+  end subroutine add_constant_body_force
 
   !> Add the consistent nodal loads of a body force density to f, cell by cell.
   subroutine add_body_force(mesh, bf, f)

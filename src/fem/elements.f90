@@ -15,7 +15,7 @@ module elements
   private
 
   public :: element_nvert, q1_gradients, p1_gradients, element_stiffness, ke_cache_init
-  public :: element_body_force, edge_traction, element_stress, body_force_fn
+  public :: element_body_force, edge_traction, element_stress, body_force_fn, element_shape_integrals
 
   integer, parameter, public :: MAX_NVERT = 4            !< most vertices of an element (Q1)
   integer, parameter, public :: MAX_NDOF = 2*MAX_NVERT   !< most DOFs of an element (Q1)
@@ -302,6 +302,29 @@ contains
       end do
     end if
   end subroutine element_body_force
+
+  !> w(a) = the integral of shape function a over the element: the consistent nodal load of
+  !! a constant body force b is w(a) b. Q1: 2x2 Gauss, exact (N_a det J is of degree 2 in
+  !! each reference coordinate); P1: a third of the area each.
+  pure subroutine element_shape_integrals(element, xe, w)
+    integer, intent(in) :: element                  !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)        !< vertex coordinates [length]
+    real(wp), intent(out) :: w(MAX_NVERT)           !< [length^2]
+    integer :: ig, jg
+    real(wp) :: nfun(4), g(2, MAX_NVERT), det
+    w = 0.0_wp
+    if (element == ELEM_Q1) then
+      do jg = -1, 1, 2
+        do ig = -1, 1, 2
+          call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
+          w = w + det*nfun
+        end do
+      end do
+    else
+      call p1_gradients(xe, g, det)
+      w(1:3) = det/6.0_wp
+    end if
+  end subroutine element_shape_integrals
 
   !> Add the consistent nodal loads of a linear traction t(s) = t0 + t1 s on the straight
   !! edge from xa to xb to `fe`, s being coordinate `coord` of the point; 2-point Gauss

@@ -373,6 +373,25 @@ contains
         end if
       end if
     end do
+    ! a body force b [force/length^3] makes stresses of about b ext: as a traction of b ext
+    do i = 1, d%nbody_force
+      do a = 1, d%nbody
+        if (d%body_force(i)%body /= 0 .and. d%body_force(i)%body /= a) cycle
+        t = huge(1.0_wp)
+        if (d%body(a)%density < cap/ext .and. maxval(abs(d%body_force(i)%gravity)) < cap/ext &
+            .and. maxval(abs(d%body_force(i)%force)) < cap/ext) then
+          if (d%body(a)%density == 0.0_wp .or. maxval(abs(d%body_force(i)%gravity)) < &
+              cap/(ext*max(d%body(a)%density, tiny(1.0_wp)))) &
+            t = (d%body(a)%density*maxval(abs(d%body_force(i)%gravity)) + maxval(abs(d%body_force(i)%force)))*ext
+        end if
+        if (.not. t < cap .or. .not. log(max(t, tiny(1.0_wp))) + log(ext) - log(ymin) + log(MARGIN) < log(LOAD_MAX)) then
+          call err%set(ERR_INPUT, trim(d%body_force(i)%origin)//' on body '//i2s(a)//' reaches '//sci(t)// &
+                ' [stress] over the scene''s extent '//sci(ext)//' [length]: its stresses or displacements '// &
+                'would overflow double precision; rescale the units (e.g. &scene units=''mm-N-MPa'')')
+          return
+        end if
+      end do
+    end do
     do a = 1, d%nbody
       h = min(d%body(a)%width/real(d%body(a)%nx, wp), d%body(a)%height/real(d%body(a)%ny, wp))
       do s = 1, 4

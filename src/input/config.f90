@@ -10,7 +10,7 @@ module config
   implicit none (type, external)
   private
 
-  public :: deck_init, pair_oriented, stage_count, stage_steps
+  public :: deck_init, pair_oriented, stage_count, stage_steps, body_force_of
 
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
@@ -123,6 +123,7 @@ module config
     integer :: element = ELEM_Q1      !< ELEM_Q1 or ELEM_P1
     real(wp) :: young = 2.1e11_wp     !< Young's modulus [stress]
     real(wp) :: poisson = 0.3_wp      !< Poisson's ratio [-], in (-1, 0.5)
+    real(wp) :: density = 0.0_wp      !< mass per volume [mass/length^3] (&body_force gravity)
     integer :: bc(4) = BC_FREE        !< condition per side (SIDE_* order)
     real(wp) :: u_side(2, 4) = 0.0_wp !< prescribed displacement per side when bc = BC_DISPLACEMENT [length]
     integer :: side_stage(4) = 1      !< load stage of each side's prescribed displacement
@@ -143,6 +144,16 @@ module config
     integer :: stage = 1              !< the load stage that ramps it
     character(len=64) :: origin = ''  !< where the deck gave it ('line N', 'command-line override k')
   end type traction_cfg_t
+
+  !> A body force (&body_force): on one body or on every body (body = 0), the force per
+  !! volume density x gravity + force, constant over the body, ramped by its stage.
+  type, public :: body_force_cfg_t
+    integer :: body = 0               !< body id, 0: every body
+    real(wp) :: gravity(2) = 0.0_wp   !< acceleration [length/time^2] (times each body's density)
+    real(wp) :: force(2) = 0.0_wp     !< force per volume [force/length^3]
+    integer :: stage = 1              !< the load stage that ramps it
+    character(len=64) :: origin = ''  !< where the deck gave it
+  end type body_force_cfg_t
 
   !> Prescribed displacement components on a named edge group (&boundary).
   type, public :: boundary_cfg_t
@@ -213,6 +224,8 @@ module config
     type(body_cfg_t), allocatable :: body(:)          !< the bodies, indexed by id (1 .. nbody)
     integer :: ntraction = 0                          !< number of tractions in use
     type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)
+    integer :: nbody_force = 0                        !< number of &body_force groups
+    type(body_force_cfg_t), allocatable :: body_force(:)  !< body forces (size >= nbody_force)
     integer :: nboundary = 0                          !< number of &boundary groups
     type(boundary_cfg_t), allocatable :: boundary(:)  !< prescribed components on groups (size >= nboundary)
     integer :: npair = 0                              !< number of contact pairs
@@ -254,6 +267,24 @@ contains
     end if
   end function pair_oriented
 
+  !> Body a's body force per volume [force/length^3] in each of nstage stages (columns):
+  !! the sum of the deck's &body_force groups on it or on every body, density x gravity +
+  !! force each.
+  pure function body_force_of(d, a, nstage) result(b)
+    type(deck_t), intent(in) :: d   !< the deck
+    integer, intent(in) :: a        !< body id
+    integer, intent(in) :: nstage   !< the deck's stages (stage_count)
+    real(wp) :: b(2, nstage)
+    integer :: i
+    b = 0.0_wp
+    do i = 1, d%nbody_force
+      associate (f => d%body_force(i))
+        if (f%body /= 0 .and. f%body /= a) cycle
+        b(:, f%stage) = b(:, f%stage) + d%body(a)%density*f%gravity + f%force
+      end associate
+    end do
+  end function body_force_of
+
   !> The deck's load stages: the largest `stage=` of its load groups (1 without any).
   pure integer function stage_count(d) result(n)
     type(deck_t), intent(in) :: d   !< the deck
@@ -261,6 +292,7 @@ contains
     n = 1
     if (d%ntraction > 0) n = max(n, maxval(d%traction(1:d%ntraction)%stage))
     if (d%nboundary > 0) n = max(n, maxval(d%boundary(1:d%nboundary)%stage))
+    if (d%nbody_force > 0) n = max(n, maxval(d%body_force(1:d%nbody_force)%stage))
     do b = 1, d%nbody
       n = max(n, maxval(d%body(b)%side_stage, mask=d%body(b)%bc == BC_DISPLACEMENT))
     end do

@@ -2,8 +2,8 @@
 !! value by value and across fields, with clear messages on bad input, and rendered back as
 !! namelist text.
 !!
-!! Groups: `&scene`, `&body` (N of them, ids 1 to N), `&traction`, `&displacement` and
-!! `&boundary` (any number, any order), `&contact` (the two-body form once, or one per
+!! Groups: `&scene`, `&body` (N of them, ids 1 to N), `&traction`, `&body_force`,
+!! `&displacement` and `&boundary` (any number, any order), `&contact` (the two-body form once, or one per
 !! contact pair), `&solver`, `&output` (each at most once; all optional). Command-line
 !! overrides are namelist fragments applied after the deck: `&body id=2, young=1e9 /`
 !! changes body 2, `&contact bodies=2,3, slave=3 /` the pair of bodies 2 and 3,
@@ -21,7 +21,7 @@ module deck
   use strings, only: i2s, index_of
   use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, die_at, unknown_group
   use config, only: deck_t, ACCEL_AUTO, ACCEL_NONE, ACCEL_ANDERSON, STOP_AUTO, STOP_INCREMENT, STOP_RESIDUAL
-  use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, &
+  use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, add_body_force, &
                          add_boundary, apply_displacement, add_contact
   use deck_cross, only: check_cross
   use deck_render, only: deck_text, print_deck, deck_reference
@@ -38,7 +38,8 @@ module deck
     '       robin_contact --help | --version | --deck-reference'//NL// &
     '       mpirun -np N robin_contact_mpi DECK.nml ...   (factorization=''mumps'')'//NL// &
     '  DECK.nml  input deck of Fortran namelist groups: &scene, two or more &body (ids 1 to'//NL// &
-    '            N), any number of &traction, &displacement and &boundary, &contact (one'//NL// &
+    '            N), any number of &traction, &body_force, &displacement and &boundary,'//NL// &
+    '            &contact (one'//NL// &
     '            per contact pair; optional for two bodies on their ''contact'' sides),'//NL// &
     '            &solver, &output; /dev/stdin reads it from a pipe'//NL// &
     '  OVERRIDE  a namelist fragment applied after the deck, in order, e.g.'//NL// &
@@ -54,7 +55,7 @@ module deck
     '  Documentation: README.md; doc/deck-reference.md (the output of --deck-reference);'//NL// &
     '  inputs/default.nml (the paper''s scene, every group commented).'
 
-  character(len=*), parameter :: GROUP_NAMES = 'scene body traction displacement boundary contact solver output'
+  character(len=*), parameter :: GROUP_NAMES = 'scene body traction body_force displacement boundary contact solver output'
 
 contains
 
@@ -93,7 +94,7 @@ contains
       ig = index_of(GROUP_NAMES, gs(i)%name)
       if (ig == 0) call unknown_group(gs(i), src, GROUP_NAMES)
       select case (gs(i)%name)
-      case ('traction', 'displacement', 'boundary')
+      case ('traction', 'body_force', 'displacement', 'boundary')
         cycle
       case ('body')
         call new_body(gs(i), src, d, st)
@@ -119,6 +120,7 @@ contains
     ! Pass 2: loads, in deck order.
     do i = 1, size(gs)
       if (gs(i)%name == 'traction') call add_traction(gs(i), src, d, st, 'line '//i2s(gs(i)%line))
+      if (gs(i)%name == 'body_force') call add_body_force(gs(i), src, d, 'line '//i2s(gs(i)%line))
       if (gs(i)%name == 'displacement') call apply_displacement(gs(i), src, d, st)
       if (gs(i)%name == 'boundary') call add_boundary(gs(i), src, d, 'line '//i2s(gs(i)%line))
     end do
@@ -140,6 +142,8 @@ contains
           call add_contact(gs(i), src, d, st)
         case ('traction')
           call add_traction(gs(i), src, d, st, olabel)
+        case ('body_force')
+          call add_body_force(gs(i), src, d, olabel)
         case ('displacement')
           call apply_displacement(gs(i), src, d, st)
         case ('boundary')

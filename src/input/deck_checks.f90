@@ -10,12 +10,12 @@ module deck_checks
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
-  use config, only: pair_oriented, deck_t, body_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t, &
                     FRICTION_TRESCA, FRICTION_COULOMB, MAX_STAGES, MAX_STEPS, STEPS_UNSET
-  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, &
+  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, body_force_vars, &
                          traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
   implicit none (type, external)
   private
@@ -23,7 +23,7 @@ module deck_checks
   real(wp), parameter :: MU_MAX = 1.0e4_wp     !< the largest Coulomb coefficient accepted
   real(wp), parameter :: SLIP_MAX = 1.0e20_wp  !< the largest Tresca bound accepted [stress]
 
-  public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, &
+  public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, add_body_force, &
             apply_displacement, add_contact
 
 
@@ -36,7 +36,7 @@ module deck_checks
     type(str_t), allocatable :: trac_at(:)      ! per traction
     integer, allocatable :: disp_line(:, :)     ! deck line of the &displacement per side, body
     logical, allocatable :: disp_given(:, :)    ! a &displacement gives the side's vector
-    integer :: once_line(8) = 0                 ! deck line of each singleton group
+    integer :: once_line(16) = 0                ! deck line of each singleton group (by its place in the group names)
     integer :: contact_form = 0                 ! the deck's &contact form (TWO_BODY_FORM, PAIR_FORM; 0: none)
     integer :: contact_line = 0                 ! line of the deck's first &contact
     type(str_t), allocatable :: pair_at(:)      ! '&contact at line N' (and its overrides), per pair
@@ -478,6 +478,8 @@ contains
       'rejected: this displacement formulation cannot model it')
     if (c%poisson <= -1.0_wp) call bad_value(g, src, 'poisson', r2s(c%poisson), 'is out of range: '// &
       'it must satisfy -1 < poisson < 0.5')
+    if (.not. c%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(c%density), &
+      'must be >= 0 (mass per volume)')
     c%id = b0%id
     do s = 1, 4
       if (c%bc(s) /= BC_DISPLACEMENT) c%u_side(:, s) = 0.0_wp
@@ -548,6 +550,34 @@ contains
       call body_and_side(g, src, t, nbody)
     end if
   end subroutine traction_form
+
+  !> A &body_force group (deck or override): a body force on one body or on every body.
+  subroutine add_body_force(g, src, d, origin)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    character(len=*), intent(in) :: origin
+    type(body_force_cfg_t), target :: f
+    type(vars_t) :: v
+    type(body_force_cfg_t), allocatable :: tmp(:)
+    integer :: n
+    call body_force_vars(f, v)
+    call read_group(g, src, v)
+    if (f%body < 0 .or. f%body > d%nbody) call bad_value(g, src, 'body', i2s(f%body), &
+      'does not exist: the bodies have '//ids_text(d%nbody)//', and 0 means every body')
+    call check_stage(g, src, f%stage)
+    if (.not. allocated(d%body_force)) allocate (d%body_force(4))
+    n = d%nbody_force
+    if (n == size(d%body_force)) then
+      allocate (tmp(2*n))
+      tmp(1:n) = d%body_force(1:n)
+      call move_alloc(tmp, d%body_force)
+    end if
+    n = n + 1
+    d%nbody_force = n
+    f%origin = '&body_force at '//origin
+    d%body_force(n) = f
+  end subroutine add_body_force
 
   !> A &boundary group (deck or override): prescribed components on a named edge group.
   subroutine add_boundary(g, src, d, origin)

@@ -6,7 +6,7 @@
 module deck_cross
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
-  use strings, only: i2s
+  use strings, only: i2s, r2s
   use sorting, only: merge_sort_by_keys
   use config, only: deck_t, body_cfg_t, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
                     BC_CONTACT, BC_DISPLACEMENT, bc_names, STEPS_UNSET, stage_count
@@ -30,6 +30,7 @@ contains
 
     p = st%path//': '
     call check_stages(d, st)
+    call check_body_forces(d, st)
     if (d%npair == 0) call fatal(EXIT_INPUT, p//'the deck has '//i2s(d%nbody)//' bodies and no '// &
       '&contact; name each contact pair with &contact bodies=A,B, groups=''GA'',''GB'' /')
     call check_pairs(d, st)
@@ -88,6 +89,11 @@ contains
     nstage = stage_count(d)
     do s = 1, merge(nstage, 0, nstage > 1)   ! one stage: an unloaded deck is a deck (a gap closed by nothing)
       loaded = any(d%traction(1:d%ntraction)%stage == s)
+      do i = 1, d%nbody_force
+        associate (f => d%body_force(i))
+          if (f%stage == s .and. any(f%gravity /= 0.0_wp .or. f%force /= 0.0_wp)) loaded = .true.
+        end associate
+      end do
       do i = 1, d%nboundary
         associate (c => d%boundary(i))
           if (c%stage == s .and. any(c%fix .and. c%u /= 0.0_wp)) loaded = .true.
@@ -99,7 +105,8 @@ contains
                   (c%u_side(1, :) /= 0.0_wp .or. c%u_side(2, :) /= 0.0_wp))) loaded = .true.
         end associate
       end do
-      if (.not. loaded) call fatal(EXIT_INPUT, st%path//': stage = '//i2s(s)//' has no load: no &traction, '// &
+      if (.not. loaded) call fatal(EXIT_INPUT, st%path//': stage = '//i2s(s)//' has no load: no &traction or '// &
+        '&body_force, '// &
         'and no &displacement or &boundary with a nonzero value, has stage='//i2s(s)//' (the stages are 1 to '// &
         'the largest stage= given, '//i2s(nstage)//', each with a load; a zero displacement is a support, '// &
         'no load)')
@@ -115,6 +122,28 @@ contains
         'the load groups); give one value for every stage, or one per stage')
     end if
   end subroutine check_stages
+
+  !> A gravity needs a density on every body it acts on.
+  subroutine check_body_forces(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: i, b
+    character(len=:), allocatable :: on
+    do i = 1, d%nbody_force
+      associate (f => d%body_force(i))
+        if (all(f%gravity == 0.0_wp)) cycle
+        on = 'every body'
+        if (f%body > 0) on = 'body '//i2s(f%body)
+        do b = 1, d%nbody
+          if (f%body /= 0 .and. f%body /= b) cycle
+          if (d%body(b)%density > 0.0_wp) cycle
+          call fatal(EXIT_INPUT, st%path//': the '//trim(f%origin)//' gives gravity = '// &
+            r2s(f%gravity(1))//', '//r2s(f%gravity(2))//' on '//on//', but body '//i2s(b)//' ('//st%body_at(b)%s//') has density = 0: give it '// &
+            'density= (mass per volume), or a force per volume with force=')
+        end do
+      end associate
+    end do
+  end subroutine check_body_forces
 
   !> Side tractions on rectangles: not on a contact side; no effect on a prescribed side.
   subroutine check_loads(d, st)

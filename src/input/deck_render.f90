@@ -4,11 +4,11 @@
 module deck_render
   use strings, only: text_buffer_t
   use namelist_vars, only: str_t, vars_t, render_group, reference_table
-  use config, only: deck_t, body_cfg_t, contact_cfg_t, BC_DISPLACEMENT
+  use config, only: deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, BC_DISPLACEMENT
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, &
                          TWO_BODY_FORM, PAIR_FORM, &
                          scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, &
-                         contact_vars, solver_vars, output_vars
+                         contact_vars, solver_vars, output_vars, body_force_vars
   implicit none (type, external)
   private
 
@@ -57,6 +57,13 @@ module deck_render
     'coordinate along the side; or on a **group** (`group`, `t0`, `tx`, `ty`, `pressure`): '// &
     't(x,y) = t0 + tx*x + ty*y - pressure*n. Give `side` or `group`, not both. A traction on a '// &
     'contact side is bad input; on a clamped or prescribed side it has no effect (a warning).'
+  character(len=*), parameter :: REF_BODY_FORCE = &
+    'A body force: a force per volume, constant over each body it acts on, `density` x '// &
+    '`gravity` + `force`. Optional, any number; body forces on one body add up. It is a load '// &
+    'like a traction: it ramps with its stage''s load steps (a stage may apply the weight '// &
+    'first, then the service load), it enters the holding check of a body held only by contact '// &
+    'and its equilibrium. In plane stress and plane strain alike it is per unit thickness, as '// &
+    'the tractions are.'
   character(len=*), parameter :: REF_DISPLACEMENT = &
     'A prescribed displacement vector on a side of a rectangle: a side its `&body` declares '// &
     '`''displacement''` (each such side needs one), or a `''free''` one (which becomes '// &
@@ -130,6 +137,10 @@ contains
       t%stage = c%traction(i)%stage
       call traction_vars(t, v, merge(GROUP_FORM, SIDE_FORM, len_trim(t%group) > 0))
       call tb%add(render_group('traction', v, WIDTH))
+    end do
+    do i = 1, c%nbody_force
+      call body_force_vars(c%body_force(i), v)
+      call tb%add(render_group('body_force', v, WIDTH))
     end do
     do i = 1, c%nboundary
       t%body = c%boundary(i)%body
@@ -214,6 +225,11 @@ contains
     call traction_vars(t, forms(1), SIDE_FORM)
     call traction_vars(t, forms(2), GROUP_FORM)
     call section('traction', REF_TRACTION, reference_table(v, forms, [str_t('side form'), str_t('group form')]))
+    block
+      type(body_force_cfg_t), target :: bf
+      call body_force_vars(bf, v)
+      call section('body_force', REF_BODY_FORCE, reference_table(v))
+    end block
     call displacement_vars(t, v, ALL_FORMS)
     call section('displacement', REF_DISPLACEMENT, reference_table(v))
     call boundary_vars(t, v, ALL_FORMS)

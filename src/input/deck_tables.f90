@@ -6,7 +6,7 @@
 module deck_tables
   use kinds, only: wp
   use namelist_vars, only: vars_t
-  use config, only: deck_t, body_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
                     ORDER_CHOICES, ACCEL_CHOICES, XDMF_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
@@ -17,7 +17,7 @@ module deck_tables
   public :: scene_in_t, load_in_t
   public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, TWO_BODY_FORM, PAIR_FORM
   public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
-            solver_vars, output_vars
+            solver_vars, output_vars, body_force_vars
 
   ! the documentation of `stage`, shared by the load groups
   character(len=*), parameter :: STAGE_DOC = &
@@ -105,6 +105,9 @@ contains
     call v%real('poisson', b%poisson, unit='[-]', range='-1 < poisson < 0.5', doc='Poisson''s '// &
       'ratio; 0.5 (an incompressible material) is rejected: this displacement formulation '// &
       'cannot model it')
+    call v%real('density', b%density, unit='[mass/length^3]', range='>= 0', doc='mass per '// &
+      'volume, for `&body_force gravity`; mass in force x time^2 / length: kg with SI units, '// &
+      'tonnes with mm-N-MPa (steel: 7850 and 7.85e-9)')
     if (form /= GROUP_FORM) then
       call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE, doc='condition on the side '// &
         'x = x0: `''free''` (traction-free unless a `&traction` loads it), `''clamped''` (u = 0), '// &
@@ -160,6 +163,19 @@ contains
     if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC// &
       '. A zero displacement (a support) is no load: it holds in every stage')
   end subroutine boundary_vars
+
+  !> &body_force: every variable (reading and rendering alike).
+  subroutine body_force_vars(f, v)
+    type(body_force_cfg_t), target, intent(inout) :: f
+    type(vars_t), intent(out) :: v
+    call v%int('body', f%body, range='0 to N', doc='the body it acts on; 0: every body')
+    call v%pair('gravity', f%gravity, unit='[length/time^2]', doc='an acceleration field: each '// &
+      'body it acts on carries density x gravity per volume (its `density` > 0); SI: '// &
+      '`0.0, -9.81`, mm-N-MPa: `0.0, -9810.0`')
+    call v%pair('force', f%force, unit='[force/length^3]', doc='a force per volume, whatever '// &
+      'the density; added to the gravity''s')
+    call v%int('stage', f%stage, range='>= 1', doc=STAGE_DOC)
+  end subroutine body_force_vars
 
   !> &displacement: `form` ALL_FORMS reads every variable, SIDE_FORM renders one.
   subroutine displacement_vars(t, v, form)

@@ -22,7 +22,7 @@ module results
                     XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof
-  use assembly, only: body_system_t, nodal_stress
+  use assembly, only: body_system_t, nodal_stress, support_reactions
   use contact_interface, only: interface_t, pair_rows
   use contact_types, only: contact_result_t, status_name
   use friction_view, only: tangential_t, split_friction
@@ -64,7 +64,8 @@ module results
   !! in the order they are created.
   integer, parameter :: BD_COORDINATES = 1, BD_DISPLACEMENT = 2, BD_GEOMETRY = 3, BD_DISPLACEMENT_XYZ = 4, &
                         BD_CELLS = 5, BD_TOPOLOGY = 6, BD_BODY_ID = 7, BD_STRESS = 8, BD_SXX = 9, &
-                        BD_VON_MISES = 13, BD_PRESSURE = 14, BD_COUNT = 14
+                        BD_VON_MISES = 13, BD_PRESSURE = 14, BD_REACTION = 15, BD_REACTION_XYZ = 16, &
+                        BD_COUNT = 16
 
 contains
 
@@ -345,6 +346,7 @@ contains
       call group_open(fid, body_group_name(a), gid, st, create=.true.)
       call write_attr(gid, 'element', trim(element_names(msh(a)%element)), st)
       call write_attr(gid, 'young', d%body(a)%young, st)
+      call write_attr(gid, 'density', d%body(a)%density, st)
       call write_attr(gid, 'poisson', d%body(a)%poisson, st)
       call write_attr(gid, 'free_dofs', sys(a)%n, st)
       ! a body held only by contact: its free rigid motions, their amplitudes (the
@@ -377,10 +379,13 @@ contains
       call reserve_dset(gid, 'von_mises', [nn], .false., off(BD_VON_MISES), st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
       call reserve_dset(gid, 'contact_pressure', [nn], .false., off(BD_PRESSURE), st, us)
+      ! the supports' forces on the body at its nodes (0 off the supports)
+      call reserve_dset(gid, 'reaction', [nn, 2_hsize_t], .false., off(BD_REACTION), st, uf)
+      call reserve_dset(gid, 'reaction_xyz', [3_hsize_t, nn], .false., off(BD_REACTION_XYZ), st, uf)
       call group_close(gid, st)
       if (.not. st%failed()) then
         !$omp task firstprivate(a, off) shared(msh, d, u, sys, itf, pres, body_err, fd)
-        call body_data(fd, off, a, msh(a), d, u(1:sys(a)%ndof, a), itf, pres, body_err(a))
+        call body_data(fd, off, a, msh(a), d, sys(a), u(1:sys(a)%ndof, a), itf, pres, body_err(a))
         !$omp end task
       end if
     end do
@@ -400,18 +405,20 @@ contains
   !! off(BD_*) of the file fd: coordinates and displacement (nnode, 2), both padded with z = 0
   !! (3, nnode), the cells (0-based), for a mixed mesh its XDMF topology, the body id per
   !! cell, the nodal stresses (nnode, 4) and each component, von Mises and the contact
-  !! pressure. Fields that are not finite are a failure, never written.
-  subroutine body_data(fd, off, a, msh, d, ua, itf, pres, err)
+  !! pressure, the supports' reactions (nnode, 2) and padded (3, nnode). Fields that are not
+  !! finite are a failure, never written.
+  subroutine body_data(fd, off, a, msh, d, sys, ua, itf, pres, err)
     integer, intent(in) :: fd                       !< the result file (data_open)
     integer(haddr_t), intent(in) :: off(:)          !< (BD_COUNT) where each dataset's data go
     integer, intent(in) :: a                        !< the body
     type(mesh_t), intent(in) :: msh                 !< its mesh
     type(deck_t), intent(in) :: d                   !< the deck (its material, plane strain)
+    type(body_system_t), intent(in) :: sys          !< its system (DOF numbering, applied loads)
     real(wp), intent(in) :: ua(:)                   !< (ndof) its displacement
     type(interface_t), intent(in) :: itf            !< the contact rows (normal)
     real(wp), intent(in) :: pres(:)                 !< (m) pressure of each row [stress]
     type(error_t), intent(inout) :: err             !< the first failure
-    real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :)
+    real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :), rf(:)
     integer, allocatable, target :: iv(:), iw(:, :)
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
     integer :: k, nn
@@ -451,6 +458,13 @@ contains
     call nodal_pressure(itf, a, pres, p)
     vm = file_order(msh, p)
     call put(vm, 'contact_pressure', BD_PRESSURE)
+    allocate (rf(2*nn))
+    call support_reactions(msh, d%body(a), d%plane_strain, sys, ua, sys%f_applied, rf)
+    uf = file_order(msh, reshape(rf, [2, nn]))
+    w2 = transpose(uf)
+    call put(w2, 'reaction', BD_REACTION)
+    w3 = pad3(uf)
+    call put(w3, 'reaction_xyz', BD_REACTION_XYZ)
 
   contains
 
@@ -555,6 +569,7 @@ contains
         call write_dset(gid, 'von_mises', file_order(msh(a), vm), st, us)
         call nodal_pressure(itf, a, pres, pnode)
         call write_dset(gid, 'contact_pressure', file_order(msh(a), pnode), st, us)
+        call step_reactions(a, steps(k))
         if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
         deallocate (sigma, vm, pnode)
         call group_close(gid, st)
@@ -563,6 +578,34 @@ contains
       call group_close(kid, st)
     end do
     call group_close(sid, st)
+
+  contains
+
+    !> Body a's reactions in step sk: its applied loads those of the step (the earlier stages
+    !! whole, its own stage times its load factor).
+    subroutine step_reactions(a, sk)
+      integer, intent(in) :: a
+      type(step_result_t), intent(in) :: sk
+      real(wp), allocatable :: fa(:), rf(:), rr(:, :)
+      integer :: s
+      associate (sy => sys(a))
+        allocate (fa(sy%ndof), rf(sy%ndof))
+        if (allocated(sy%fa_stage)) then
+          fa = 0.0_wp
+          do s = 1, sk%stage - 1
+            fa = fa + sy%fa_stage(:, s)
+          end do
+          fa = fa + sk%load_factor*sy%fa_stage(:, sk%stage)
+        else
+          fa = sk%load_factor*sy%f_applied
+        end if
+        call support_reactions(msh(a), d%body(a), d%plane_strain, sy, sk%u(1:sy%ndof, a), fa, rf)
+        rr = file_order(msh(a), reshape(rf, [2, msh(a)%nnode]))
+        call write_dset(gid, 'reaction', transpose(rr), st, uf)
+        call write_dset(gid, 'reaction_xyz', pad3(rr), st, uf)
+      end associate
+    end subroutine step_reactions
+
   end subroutine write_steps
 
   !> The contact solution of all rows into the group gid (/contact, or a load step's):
@@ -896,6 +939,7 @@ contains
     t = t//field_text('displacement', 'Vector', trim(nn)//' 3', fg//'/displacement_xyz')
     t = t//field_text('von_mises', 'Scalar', trim(nn), fg//'/von_mises')
     t = t//field_text('contact_pressure', 'Scalar', trim(nn), fg//'/contact_pressure')
+    t = t//field_text('reaction', 'Vector', trim(nn)//' 3', fg//'/reaction_xyz')
     do k = 1, 4
       t = t//field_text(comp(k), 'Scalar', trim(nn), fg//'/'//comp(k))
     end do

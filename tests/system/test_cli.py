@@ -21,7 +21,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 BIN = os.path.abspath(os.environ.get("BIN", "bin/robin_contact"))
 DOC = os.path.join(ROOT, "doc", "deck-reference.md")
 DECK = os.path.join(ROOT, "inputs", "table1", "q1_3x1.nml")   # the smallest shipped deck
-GROUPS = ["scene", "body", "traction", "displacement", "boundary", "contact", "solver", "output"]
+GROUPS = ["scene", "body", "traction", "body_force", "displacement", "boundary", "contact", "solver", "output"]
 REGENERATE = "regenerate it: bin/robin_contact --deck-reference > doc/deck-reference.md"
 check = Checks()
 work = tempfile.mkdtemp(prefix="test_cli_")   # runs happen here: a stray result lands nowhere else
@@ -253,6 +253,9 @@ for group, rows in ref_tables.items():
             bad += [0, 3]
         elif rule == "0 or a body of the pair":   # DECK's pair is bodies 1 and 2
             bad += [-1, 3]
+        elif rule == "0 to N":   # a body id or 0 (every body); DECK has two bodies
+            bad += [-1, 3]
+            good += [0, 2]
         elif m := re.fullmatch(r"(-?\d+)(?:, (-?\d+))* or (-?\d+)", rule):
             vals = [int(v) for v in re.findall(r"-?\d+", rule)]
             bad += [min(vals) - 1, max(vals) + 1]

@@ -88,8 +88,8 @@ TWO_BODY = ["input_deck"] + [f"history/{k}" for k in ("active", "criterion", "in
                              "normal_force_body1", "normal_force_body2", "obstacle_body1", "obstacle_body2",
                              "pressure", "resultant_body1", "s", "segments", "tributary_length", "x", "y")] + [
     f"body{b}/{k}" for b in (1, 2) for k in ("body_id", "cells", "contact_pressure", "coordinates", "displacement",
-                                             "displacement_xyz", "geometry_xyz", "stress", "sxx", "sxy", "syy",
-                                             "szz", "von_mises")]
+                                             "displacement_xyz", "geometry_xyz", "reaction", "reaction_xyz",
+                                             "stress", "sxx", "sxy", "syy", "szz", "von_mises")]
 PAIR = ["x", "y", "s", "normal", "normal_force", "normal_force_side1", "normal_force_side2", "pressure", "gap",
         "active", "normal_displacement_side1", "normal_displacement_side2", "geometry_xyz", "segments",
         "resultant_on_first_body"]

@@ -50,7 +50,7 @@ from rc_run import run_solver  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DECK = "inputs/table1/q1_6x2.nml"
 BODY_XDMF = "{stem}_body{b}.xdmf"          # per-body files that meshio can read
-FIELDS = ("displacement", "von_mises", "contact_pressure")
+FIELDS = ("displacement", "von_mises", "contact_pressure", "reaction")
 COMPONENTS = ("sxx", "syy", "sxy", "szz")                  # rows of /bodyN/stress
 BODY_FIELDS = FIELDS + COMPONENTS + ("body_id",)           # body_id: per cell
 CONTACT_XDMF = "{stem}_contact.xdmf"                       # the contact line, for meshio
@@ -74,7 +74,7 @@ for _b in ("body1", "body2"):
     UNITS.update({f"{_b}/{k}": u for k, u in [
         ("coordinates", "L"), ("displacement", "L"), ("geometry_xyz", "L"), ("displacement_xyz", "L"),
         ("cells", "1"), ("body_id", "1"), ("stress", "S"), ("sxx", "S"), ("syy", "S"), ("sxy", "S"),
-        ("szz", "S"), ("von_mises", "S"), ("contact_pressure", "S")]})
+        ("szz", "S"), ("von_mises", "S"), ("contact_pressure", "S"), ("reaction", "F/L"), ("reaction_xyz", "F/L")]})
 check = Checks()
 
 
@@ -213,6 +213,11 @@ def compare_body(path, g, contact_xy, tag):
               and np.all(d[:, 2] == 0.0),
               f"{tag}: displacement == displacement_xyz == displacement' (+ z = 0), max |u| = "
               f"{np.abs(d).max():.3e}")
+    if "reaction" in m.point_data:
+        rxn = np.asarray(m.point_data["reaction"])
+        check(np.array_equal(rxn, g["reaction_xyz"][()]) and np.array_equal(rxn[:, :2], g["reaction"][()].T)
+              and np.all(rxn[:, 2] == 0.0),
+              f"{tag}: reaction == reaction_xyz == reaction' (+ z = 0), max |r| = {np.abs(rxn).max():.3e}")
     for name in ("von_mises", "contact_pressure"):
         if name in m.point_data:
             check(np.array_equal(np.asarray(m.point_data[name]).reshape(-1), g[name][()])

@@ -54,7 +54,7 @@ program test_fem
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
                       body_force_fn, cell_triplets
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
-  use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness, q1_gradients
+  use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness, q1_gradients, element_shape_integrals
   use testing, only: report, test_summary, solve_full, error_parts
   use errors, only: error_t
   implicit none (type, external)
@@ -82,10 +82,45 @@ program test_fem
   call test_general_scatter(ELEM_P1)
   call test_mixed_scatter()
   call test_fan_scatter()
+  call test_shape_integrals()
 
   call test_summary()
 
 contains
+
+  !> The integrals of the shape functions (a constant body force's nodal loads, w(a) b) on a
+  !! distorted quadrilateral and a triangle, against the polygon's area and first moments
+  !! by the shoelace formulas: sum_a w(a) = area, sum_a w(a) x_a = the integral of x
+  !! (isoparametric: x = sum_a N_a x_a exactly), each to rounding.
+  subroutine test_shape_integrals()
+    real(wp) :: xe(2, MAX_NVERT), w(MAX_NVERT), area, mx, my, cr
+    integer :: n, a, b, el
+    do el = 1, 2
+      xe = 0.0_wp
+      if (el == 1) then
+        xe(:, 1:4) = reshape([0.1_wp, -0.2_wp, 2.3_wp, 0.1_wp, 1.9_wp, 1.7_wp, -0.4_wp, 1.2_wp], [2, 4])
+        n = 4
+        call element_shape_integrals(ELEM_Q1, xe, w)
+      else
+        xe(:, 1:3) = reshape([0.3_wp, 0.1_wp, 2.2_wp, 0.6_wp, 0.9_wp, 1.8_wp], [2, 3])
+        n = 3
+        call element_shape_integrals(ELEM_P1, xe, w)
+      end if
+      area = 0.0_wp
+      mx = 0.0_wp
+      my = 0.0_wp
+      do a = 1, n
+        b = mod(a, n) + 1
+        cr = xe(1, a)*xe(2, b) - xe(1, b)*xe(2, a)
+        area = area + 0.5_wp*cr
+        mx = mx + (xe(1, a) + xe(1, b))*cr/6.0_wp
+        my = my + (xe(2, a) + xe(2, b))*cr/6.0_wp
+      end do
+      call report(abs(sum(w(1:n)) - area) <= 8*eps*area .and. abs(sum(w(1:n)*xe(1, 1:n)) - mx) <= 8*eps*abs(mx) &
+                  .and. abs(sum(w(1:n)*xe(2, 1:n)) - my) <= 8*eps*abs(my) .and. all(w(n + 1:) == 0.0_wp), &
+                  merge('Q1', 'P1', el == 1)//' shape integrals: their sum is the area, their moments the polygon''s')
+    end do
+  end subroutine test_shape_integrals
 
   !> Assemble and solve one body on its mesh; stops the test on an assembly error.
   subroutine solve_body(m, body, plane_strain, tr, ntr, sys, u_full, u_prescribed, body_force)
