@@ -235,8 +235,8 @@ $(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/conden
                            $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_summary.o:    $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
-                           $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/run_state.o $(BUILD)/strings.o \
-                           $(BUILD)/sysinfo.o
+                           $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/namelist_vars.o \
+                           $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/cholmod_iface.o \
                            $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
                            $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/files.o \
@@ -390,6 +390,7 @@ meshes:
 	   for h in 0.04 0.02 0.01 0.005; do $(GMSH_MSH) -setnumber h $$h hertz_force.geo -o hertz_force_h$$h.msh; done; \
 	   $(GMSH_MSH) pin_hole.geo -o pin_hole.msh; \
 	   $(GMSH_MSH) cylinders.geo -o cylinders.msh; \
+	   $(GMSH_MSH) shrink_fit.geo -o shrink_fit.msh; \
 	   for n in 8 16 32; do $(GMSH_MSH) -setnumber n $$n cattaneo_disc.geo -o cattaneo_disc_a$$n.msh; done; \
 	   for n in 12:18 24:36 48:72; do nu=$${n%:*}; nl=$${n#*:}; \
 	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \

@@ -12,6 +12,7 @@
 module contact_interface
   use kinds, only: wp, i8
   use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented, FRICTION_NONE, FRICTION_TRESCA, &
+                    OVERLAP_INTERFERENCE, &
                     FRICTION_COULOMB
   use mesh, only: mesh_t, group_index, group_names, nodes_only, nodes_only_refusal
   use mortar, only: mortar_t, mortar_build
@@ -392,7 +393,7 @@ contains
     !> slave nodes that carry rows in an earlier pair of the same bodies: none here
     logical, intent(in), optional :: taken(:)
     integer :: g(2), s, sl, ma, j, e, k, ne, nr
-    real(wp) :: hmean(2), tol, gmin
+    real(wp) :: hmean(2), tol, gmin, ext
     logical, allocatable :: removable(:)
     real(wp), allocatable :: gdist(:)
     character(len=300) :: what(2)               ! each side's words for messages
@@ -468,8 +469,12 @@ contains
 
       ! an initial overlap beyond a thousandth of the slave's mean edge is bad input
       ! (the gap of a row divided by its slave weight sum: the distance, where the row's
-      ! weights sum to more or less than one next to a removed node or at a partly covered end)
+      ! weights sum to more or less than one next to a removed node or at a partly covered end);
+      ! a pair declared an interference fit takes an overlap of up to 1% of the slave group's
+      ! extent (a strain of 1%: small strain), its negative gaps pressing the bodies apart
       tol = 1.0e-3_wp*hmean(sl)
+      ext = norm2(maxval(ms%xy(:, mt%snode), dim=2) - minval(ms%xy(:, mt%snode), dim=2))
+      if (cc%overlap == OVERLAP_INTERFERENCE) tol = 1.0e-2_wp*ext
       allocate (gdist(mt%m))
       do j = 1, mt%m
         gdist(j) = mt%g0(j)/sum(mt%sval(mt%sptr(j):mt%sptr(j + 1) - 1))
@@ -477,10 +482,21 @@ contains
       gmin = minval(gdist)
       if (gmin < -tol) then
         j = minloc(gdist, dim=1)
-        call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''//trim(cc%body_group(2))// &
-              ''' overlap in the initial configuration: the gap at slave node '//i2s(ms%node_tag(mt%snode(j)))// &
-              ' of body '//i2s(cc%bodies(sl))//' at ('//sci(ms%xy(1, mt%snode(j)))//', '//sci(ms%xy(2, mt%snode(j)))// &
-              ') is '//sci(gmin)//' (tolerance '//sci(tol)//'); move the bodies apart')
+        if (cc%overlap == OVERLAP_INTERFERENCE) then
+          call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''// &
+                trim(cc%body_group(2))//''' (overlap=''interference''): the overlap at slave node '// &
+                i2s(ms%node_tag(mt%snode(j)))//' of body '//i2s(cc%bodies(sl))//' at ('// &
+                sci(ms%xy(1, mt%snode(j)))//', '//sci(ms%xy(2, mt%snode(j)))//') is '//sci(-gmin)// &
+                ', beyond 1% of the slave group''s extent '//sci(ext)//' (a strain beyond small strain, '// &
+                'which this linear model does not cover); check the geometry')
+        else
+          call err%set(ERR_INPUT, 'contact groups '''//trim(cc%body_group(1))//''' and '''// &
+                trim(cc%body_group(2))//''' overlap in the initial configuration: the gap at slave node '// &
+                i2s(ms%node_tag(mt%snode(j)))//' of body '//i2s(cc%bodies(sl))//' at ('// &
+                sci(ms%xy(1, mt%snode(j)))//', '//sci(ms%xy(2, mt%snode(j)))//') is '//sci(gmin)// &
+                ' (tolerance '//sci(tol)//'); move the bodies apart, or, for a fit, give the pair '// &
+                'overlap=''interference''')
+        end if
         return
       end if
 

@@ -340,8 +340,10 @@ contains
     end subroutine gram
 
     !> lambda_min(G_P G_P') from below: inverse iteration with its sparse factor (0 when
-    !! it is singular), the Rayleigh quotient less the residual |A v - rho v| (an
-    !! eigenvalue lies within it; the smallest one once the iteration has converged).
+    !! it is singular) from a start with a part along every eigenvector, the Rayleigh quotient
+    !! less the residual |A v - rho v| (an eigenvalue lies within it), then certified: the
+    !! factor of G_P G_P' - lm I must exist (positive definite: every eigenvalue above lm),
+    !! else lm is quartered until it does (0 after ten tries).
     real(wp) function smallest_eigenvalue() result(lm)
       real(wp), allocatable :: v(:), av(:), wz(:)
       real(wp) :: rho, eta
@@ -352,7 +354,8 @@ contains
       call gm%factor(gs, wz, spread(0.0_wp, 1, r), err)
       if (err%failed()) return
       allocate (v(r))
-      v = 1.0_wp/sqrt(real(r, wp))
+      v = [(1.0_wp + 0.5_wp*sin(real(kk, wp)), kk=1, r)]
+      v = v/norm2(v)
       do kk = 1, 200
         call gm%chol%solve(v, err)
         if (err%failed()) return
@@ -363,6 +366,13 @@ contains
         if (eta <= 1.0e-3_wp*rho) exit
       end do
       lm = max(rho - eta, 0.0_wp)
+      do kk = 1, 10
+        if (.not. lm > 0.0_wp) exit
+        call gm%factor(gs, wz, spread(-lm, 1, r), err)
+        if (.not. err%failed()) return
+        lm = 0.25_wp*lm
+      end do
+      lm = 0.0_wp
     end function smallest_eigenvalue
 
   end subroutine project_feasible

@@ -18,7 +18,7 @@ module floating
   use lapack, only: dsyev, dsygv, dpotrf
   use strings, only: i2s, sci
   use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
-  use nonneg_lsq, only: nnls, sparse_cols_t, gram_t, NNLS_DENSE_MAX
+  use nonneg_lsq, only: nnls, sparse_cols_t, gram_t, NNLS_DENSE_MAX, NNLS_ACTIVE_SET, NNLS_INTERIOR
   implicit none (type, external)
   private
 
@@ -378,7 +378,10 @@ contains
       end do
       sv = s_times(v)
       gv = gs%ttimes(v)
-      mu = dot_product(gv, gv)/max(dot_product(v, sv), tiny(1.0_wp))
+      ! the factor decided (G G' - hold S is not positive definite: some mu is below hold);
+      ! the Rayleigh quotient only names the motion, and may sit above hold when the
+      ! smallest mu are clustered
+      mu = min(dot_product(gv, gv)/max(dot_product(v, sv), tiny(1.0_wp)), hold)
       call gm%free()
 
     end subroutine group_held
@@ -665,7 +668,7 @@ contains
     target = 0.0_wp
     target(nr + 1) = -1.0_wp
     target(nr + 2:) = 1.0_wp
-    call nnls(gc, target, x, res)
+    call nnls(gc, target, x, res, merge(NNLS_ACTIVE_SET, NNLS_INTERIOR, nr <= NNLS_DENSE_MAX))
   end function group_pressing
 
   !> The columns of g (column i on contact row rows(i)) as generators of the admissible
@@ -808,7 +811,9 @@ contains
     do k = 1, nt
       call ga%push([r + k], [w])
     end do
-    call nnls(ga, ea, x, res)
+    ! the method by the rigid rows (the bound rows, one per Tresca node, do not make the
+    ! active set method's problem harder to decide, only longer)
+    call nnls(ga, ea, x, res, merge(NNLS_ACTIVE_SET, NNLS_INTERIOR, r <= NNLS_DENSE_MAX))
 
   contains
 

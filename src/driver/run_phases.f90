@@ -452,7 +452,16 @@ contains
     end do
     ! the steps solved (record_step reserves room for more)
     if (k <= size(run%plan)) then
-      if (run%result%status == STATUS_NO_EQUILIBRIUM) k = k - 1
+      if (run%result%status == STATUS_NO_EQUILIBRIUM) then
+        k = k - 1
+        ! the loads of the last step solved, whose displacement and forces the result holds
+        ! (its reactions are K u - f with them)
+        if (k >= 1) then
+          do a = 1, run%nbody
+            call set_step_loads(run%systems(a), run%plan(k))
+          end do
+        end if
+      end if
     end if
     if (run%rank == 0 .and. size(run%steps) > min(k, size(run%plan))) call keep_steps(run, min(k, size(run%plan)))
   end subroutine solve_steps

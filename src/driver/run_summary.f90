@@ -4,7 +4,7 @@ module run_summary
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
-  use config, only: solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA
+  use config, only: solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
   use contact_interface, only: interface_t, ROW_NORMAL
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
@@ -13,6 +13,8 @@ module run_summary
   use strings, only: sci, fmt_real, i2s
   use run_state, only: run_t
   use assembly, only: support_reactions
+  use mesh, only: group_index, group_nodes
+  use namelist_vars, only: str_t
   use condense, only: apply_bt
   use contact_common, only: gather
   implicit none (type, external)
@@ -277,7 +279,8 @@ contains
   !> The `reaction:` line of each supported body (the first MAX_LISTED, then how many more):
   !! the resultant of its supports' forces (K u - f at the prescribed DOFs), of its applied
   !! loads and of the contact forces on its free DOFs (-B_a' lam_a), and their balance
-  !! |R + F + C| / max(|R|, |F|, |C|): the body's equilibrium, the displacement's and the
+  !! |R + F + C| / (the sum of every nodal force's magnitude): the body's equilibrium, the
+  !! displacement's and the
   !! contact forces' independently (rounding level in a converged run). A contact node on a
   !! support passes its force to the support directly: it is in the pair's resultant, not in
   !! C. None without a displacement (a run that stopped before it), nor for a body whose
@@ -294,7 +297,7 @@ contains
     nsup = 0
     do a = 1, run%nbody
       associate (sy => run%systems(a), bd => run%bodies(a))
-        if (count(sy%free_of == 0) <= size(sy%fixing)) cycle    ! no support: held only by contact
+        if (count(sy%free_of == 0) <= sy%nrig) cycle    ! no support: held only by contact (its fixing DOFs)
         if (.not. allocated(bd%bptr)) cycle
         nsup = nsup + 1
         if (nsup > MAX_LISTED) cycle
@@ -309,15 +312,83 @@ contains
         end do
         rr = [sum(r(1::2)), sum(r(2::2))]
         ff = [sum(sy%f_applied(1::2)), sum(sy%f_applied(2::2))]
-        scale = max(norm2(rr), norm2(ff), norm2(cc), tiny(1.0_wp))
+        ! the size of the forces that balance: every nodal force's magnitude (a body between two
+        ! others carries large contact forces whose resultant is zero)
+        scale = max(sum(abs(r)) + sum(abs(sy%f_applied)) + sum(abs(c)), tiny(1.0_wp))
         lines = [character(len=1024) :: lines, 'reaction: body='//i2s(a)//' supports='//sci(rr(1), 5)//','// &
                  sci(rr(2), 5)//' loads='//sci(ff(1), 5)//','//sci(ff(2), 5)//' contact='//sci(cc(1), 5)//','// &
-                 sci(cc(2), 5)//' balance='//sci(norm2(rr + ff + cc)/scale, 2)]
+                 sci(cc(2), 5)//' balance='//sci(norm2(rr + ff + cc)/scale, 2)//group_parts(a, r)]
         deallocate (r, c)
       end associate
     end do
     if (nsup > MAX_LISTED) lines = [character(len=1024) :: lines, 'reaction: ... '//i2s(nsup - MAX_LISTED)// &
                                     ' more supported bodies (the result file has every node''s reaction)']
+
+  contains
+
+    !> ' groups: ''NAME''=Rx,Ry ...': the reaction of each of body a's supports, a rectangle's
+    !! clamped, roller or prescribed side and each &boundary group, in that order (the first
+    !! 10, then '...'). A DOF counts once, in the first support that prescribes its component
+    !! (a clamped corner's uy in the clamp, not in the roller beside it, which holds ux only),
+    !! so the groups add up to the body's supports.
+    function group_parts(a, r) result(t)
+      integer, intent(in) :: a
+      real(wp), intent(in) :: r(:)
+      character(len=:), allocatable :: t
+      type(str_t), allocatable :: names(:)
+      logical, allocatable :: comp(:, :), taken(:)
+      integer, allocatable :: nodes(:)
+      integer :: s, i, g, k, ng, n, c
+      real(wp) :: rg(2)
+      allocate (names(0), comp(2, 0))
+      do s = 1, 4
+        if (len_trim(run%deck%body(a)%mesh) > 0) exit
+        select case (run%deck%body(a)%bc(s))
+        case (BC_CLAMPED, BC_DISPLACEMENT)
+          names = [names, str_t(trim(side_names(s)))]
+          comp = reshape([comp, .true., .true.], [2, size(names)])
+        case (BC_ROLLER)     ! the normal component: ux on left and right, uy on bottom and top
+          names = [names, str_t(trim(side_names(s)))]
+          comp = reshape([comp, s <= 2, s > 2], [2, size(names)])
+        end select
+      end do
+      do i = 1, run%deck%nboundary
+        if (run%deck%boundary(i)%body /= a) cycle
+        k = findloc([(names(c)%s == trim(run%deck%boundary(i)%group), c=1, size(names))], .true., 1)
+        if (k == 0) then
+          names = [names, str_t(trim(run%deck%boundary(i)%group))]
+          comp = reshape([comp, run%deck%boundary(i)%fix], [2, size(names)])
+        else
+          comp(:, k) = comp(:, k) .or. run%deck%boundary(i)%fix
+        end if
+      end do
+      allocate (taken(size(r)))
+      taken = .false.
+      t = ''
+      ng = 0
+      do k = 1, size(names)
+        g = group_index(run%meshes(a), names(k)%s)
+        if (g == 0) cycle
+        ng = ng + 1
+        if (ng > 10) then
+          t = t//' ...'
+          exit
+        end if
+        call group_nodes(run%meshes(a), g, nodes)
+        rg = 0.0_wp
+        do i = 1, size(nodes)
+          do c = 1, 2
+            n = 2*nodes(i) - 2 + c
+            if (.not. comp(c, k) .or. taken(n)) cycle
+            taken(n) = .true.
+            rg(c) = rg(c) + r(n)
+          end do
+        end do
+        t = t//' '''//names(k)%s//'''='//sci(rg(1), 5)//','//sci(rg(2), 5)
+      end do
+      if (ng > 0) t = ' groups:'//t
+    end function group_parts
+
   end function reaction_lines
 
   !> What a user whose Robin run did not converge should try next, in order: the robust

@@ -53,6 +53,9 @@ module config
   integer, parameter, public :: FRICTION_TRESCA = 2    !< given slip bound |t| <= slip_bound
   integer, parameter, public :: FRICTION_COULOMB = 3   !< |t| <= mu p
   character(len=*), parameter, public :: FRICTION_CHOICES = 'none tresca coulomb'
+  integer, parameter, public :: OVERLAP_REFUSE = 1        !< an initial overlap is bad input
+  integer, parameter, public :: OVERLAP_INTERFERENCE = 2  !< an initial overlap is an interference fit
+  character(len=*), parameter, public :: OVERLAP_CHOICES = 'refuse interference'
 
   integer, parameter, public :: ROBIN_STEKLOV = 1    !< the paper's operator: the other body's flexibility
   integer, parameter, public :: ROBIN_CONSTANT = 2   !< alpha M^-1 (constant Robin parameter)
@@ -183,6 +186,7 @@ module config
     integer :: friction = FRICTION_NONE               !< FRICTION_*
     real(wp) :: mu = 0.0_wp                           !< Coulomb coefficient [-]
     real(wp) :: slip_bound = 0.0_wp                   !< Tresca's bound on the shear traction [stress]
+    integer :: overlap = OVERLAP_REFUSE               !< OVERLAP_*: what an initial overlap of the groups is
   end type contact_cfg_t
 
   !> Outer and inner solver settings (what the contact stage needs, and the factorization).

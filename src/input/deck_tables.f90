@@ -10,7 +10,7 @@ module deck_tables
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
                     ORDER_CHOICES, ACCEL_CHOICES, XDMF_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
-                    UNITS_CHOICES, FRICTION_CHOICES, STEPS_UNSET
+                    UNITS_CHOICES, FRICTION_CHOICES, OVERLAP_CHOICES, STEPS_UNSET
   implicit none (type, external)
   private
 
@@ -224,6 +224,10 @@ contains
     call v%real('slip_bound', c%slip_bound, unit='[stress]', range='0 <= slip_bound <= 1e20; with '// &
       '`friction=''tresca''` only', &
       doc='*tresca only:* the bound of the shear traction')
+    call v%enum('overlap', c%overlap, OVERLAP_CHOICES, doc='what an overlap of the two groups in the '// &
+      'initial configuration is: `''refuse''` (bad input beyond a thousandth of the slave''s mean '// &
+      'edge, below it taken as contact) or `''interference''` (a fit: the bodies are pressed apart '// &
+      'by the overlap, solved in one step; up to 1% of the slave group''s extent, a small strain)')
   end subroutine contact_vars
 
   !> &solver; `rendering`: load_steps only when not its default.

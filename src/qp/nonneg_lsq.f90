@@ -35,6 +35,10 @@ module nonneg_lsq
   !> Interior point: a residual below this (relative to |e|) is taken as zero (x >= 0 holds
   !! at every step, so |G x - e| is a true upper bound of the minimum)
   real(wp), parameter :: ZERO_RES = 1.0e-11_wp
+  !> Interior point: when complementarity reaches rounding, a residual below this (relative
+  !! to |e|) is returned as it is (a true upper bound of the minimum, ten times below the
+  !! 1e-8 at which every caller decides); above it the active set method decides
+  real(wp), parameter :: SMALL_RES = 1.0e-9_wp
   integer, parameter :: MAX_STEPS = 200
 
   !> A matrix stored by columns (1-based: column j's rows row(ptr(j):ptr(j+1)-1)).
@@ -189,8 +193,9 @@ contains
   end function sc_ttimes
 
   !> min |G x - e| over x >= 0; res: |G x - e| at the returned x. method: NNLS_AUTO
-  !! (default), NNLS_ACTIVE_SET or NNLS_INTERIOR. The interior point method falls back to
-  !! the active set one when a factor fails (it cannot in exact arithmetic: I + G D G' >= I).
+  !! (default: by G's rows; a caller whose rows are mostly bound rows chooses by its own
+  !! count), NNLS_ACTIVE_SET or NNLS_INTERIOR. The interior point method falls back to the
+  !! active set one when it has no certificate of its answer (module doc).
   subroutine nnls(g, e, x, res, method)
     type(sparse_cols_t), intent(in) :: g   !< (r, m)
     real(wp), intent(in) :: e(:)           !< (r)
@@ -392,8 +397,11 @@ contains
   !! D = z/x + u/w, to (I + G D^-1 G') dy = rhs: one sparse factor per step, two solves
   !! (predictor and corrector). Stops when |G x - e| (a true upper bound of the minimum,
   !! x >= 0 at every step) is below ZERO_RES, or when the duality gap is below 1e-10 of
-  !! its square (then it is the minimum to 5e-11 relative), or when mu stops falling.
-  !! ok = .false. when a factorization failed (the caller falls back).
+  !! its square (then it is the minimum to 5e-11 relative), or when complementarity reaches
+  !! rounding with the residual below SMALL_RES. ok = .false. (the caller falls back to the
+  !! active set method) when a factorization failed, or when no certificate came:
+  !! complementarity at rounding with a larger residual left (a balance on the edge of
+  !! feasibility, where the iterates stall), or MAX_STEPS steps.
   subroutine interior_point(g, e, x, res, ok)
     type(sparse_cols_t), intent(in) :: g
     real(wp), intent(in) :: e(:)
@@ -450,16 +458,22 @@ contains
       ru = XMAX - xs - w
       mu = (dot_product(xs, z) + dot_product(w, u))/real(2*n, wp)
       if (2*n*mu <= 1.0e-10_wp*resid**2 .and. norm2(rp) <= 1.0e-12_wp .and. maxval(abs(rd)) <= 1.0e-12_wp) exit
-      if (mu <= 1.0e-18_wp) exit
+      ! complementarity at rounding with the primal residual left (a balance on the edge of
+      ! feasibility, x pressed against its bound): an upper bound below SMALL_RES stands,
+      ! above it nothing is certified and the active set method decides
+      if (mu <= 1.0e-18_wp) then
+        ok = resid <= SMALL_RES
+        exit
+      end if
       dinv = 1.0_wp/(z/xs + u/w)
       call mm%factor(gs, dinv, spread(1.0_wp, 1, r), err)
       ok = .not. err%failed()
-      if (.not. ok) return
+      if (.not. ok) exit
       ! predictor (affine scaling)
       rc1 = -xs*z
       rc2 = -w*u
       call direction()
-      if (.not. ok) return
+      if (.not. ok) exit
       alpha = max_step()
       mu_aff = (dot_product(xs + alpha*dx, z + alpha*dz) + dot_product(w + alpha*dw, u + alpha*du))/real(2*n, wp)
       sigma = min(1.0_wp, (mu_aff/mu)**3)
@@ -467,7 +481,7 @@ contains
       rc1 = sigma*mu - xs*z - dx*dz
       rc2 = sigma*mu - w*u - dw*du
       call direction()
-      if (.not. ok) return
+      if (.not. ok) exit
       alpha = min(1.0_wp, 0.995_wp*max_step())
       xs = xs + alpha*dx
       w = w + alpha*dw
@@ -475,7 +489,11 @@ contains
       u = u + alpha*du
       y = y + alpha*dy
     end do
+    ! without a certificate (the residual below ZERO_RES, or the duality gap closed) after
+    ! MAX_STEPS steps, the caller's active set method decides
+    if (step > MAX_STEPS) ok = .false.
     call mm%free()
+    if (.not. ok) return
     x(live) = es*xs/cn(live)
     res = norm2(g%times(x) - e)
 

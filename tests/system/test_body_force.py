@@ -15,6 +15,11 @@ temporary folder). The reference is statics: a block's weight is density x g x i
     the result file, to 1e-9, and every body's `reaction:` line balances (supports + loads +
     contact forces, the last from the mortar forces, independent of the displacement) to
     1e-10;
+    A history whose stage 2 pulls the top block up beyond its weight (1e5 on its top face
+    over two steps: 5e4 < W still presses it, 1e5 > W does not) ends with exit 2 after step
+    2: the result is step 2's, and so are its reactions (3W - 5e4 on the clamped block, the
+    same as /steps/step_2, not the loads of the step that failed) and its `reaction:` lines
+    (balanced);
 (3) `force=` on one body only (density 0 everywhere): 2e5 N/m^3 down on the top block, of
     area 0.5 (1 x 0.5): both pairs carry 1e5;
 (4) bad input, exit 1, one message, nothing written: gravity on a body whose density is 0
@@ -22,8 +27,17 @@ temporary folder). The reference is statics: a block's weight is density x g x i
     negative density, an unknown variable of &body_force, and a gravity of 1e300 (its
     stresses would overflow: refused before any work, not a non-finite solve, exit 3);
 (5) the effective deck printed by the run holds the &body_force and every body's density,
-    and reads back to the same run (its result equal to the first to the last bit).
+    and reads back to the same run (its result equal to the first to the last bit);
+(6) per support group: the clamped block also on a roller on its left side: its 'bottom'
+    carries the 3W in y (the printed 6 digits), its 'left' nothing in y (a roller holds x
+    only: the clamped corner's uy is the clamp's), and their x reactions cancel (each DOF
+    counts once, in the first support that prescribes it);
+(7) global equilibrium on every shipped deck (inputs/*.nml): each supported body's
+    `reaction:` line balances (supports + loads + contact forces on it, over the sum of all
+    their magnitudes) to 1e-10.
 """
+import glob
+import re
 import os
 import shutil
 import sys
@@ -84,7 +98,7 @@ def reaction_sum(path, body, step=None):
 
 def balances(out):
     """The balance of every `reaction:` line."""
-    return [float(ln.rsplit("balance=", 1)[1]) for ln in out.splitlines() if ln.startswith("reaction: body=")]
+    return [float(ln.split("balance=", 1)[1].split()[0]) for ln in out.splitlines() if ln.startswith("reaction: body=")]
 
 
 def close(a, b, tol=1e-9):
@@ -125,6 +139,15 @@ try:
           "weight in stage 1, a pressure in stage 2 over two steps: each step's pairs to 1e-9",
           f"{got} against {want}; " + out.strip()[-200:])
 
+    code, out, h5 = run(work, "pulled", stack(extra=["&traction body=1, side='top', t0=0.0, 1.0e5, stage=2 /",
+                                                     "&solver load_steps=1,2 /"]))
+    rs = [reaction_sum(h5, 3), reaction_sum(h5, 3, 2)] if code == 2 and os.path.exists(h5) else []
+    b = balances(out)
+    check(code == 2 and "no static equilibrium from step 3" in out and len(rs) == 2 and close(rs[0], 3 * W - 5e4)
+          and rs[0] == rs[1] and len(b) == 3 and max(b) <= 1e-10,
+          f"no equilibrium from step 3: the result's reactions are step 2's, 3W - 5e4 ({rs}), its lines balance ({b})",
+          out.strip()[-300:])
+
     # (3) a force per volume on one body only
     code, out, h5 = run(work, "force", stack(density=0.0, gravity=False, heights=(0.5, 1.0, 1.0),
                                              extra=["&body_force body=1, force=0.0, -2.0e5 /"]))
@@ -162,6 +185,25 @@ try:
         with h5py.File(h5, "r") as a, h5py.File(h52, "r") as b:
             same = all(np.array_equal(a[f"body{k}/displacement"][()], b[f"body{k}/displacement"][()]) for k in (1, 2, 3))
     check(same, "the effective deck gives the same displacements to the last bit", out2.strip()[-300:])
+
+    # (6) two support groups on one body
+    code, out, h5 = run(work, "groups", stack().replace("bottom='clamped' /", "bottom='clamped', left='roller' /"))
+    line = next((ln for ln in out.splitlines() if ln.startswith("reaction: body=3 ")), "")
+    grp = {k: (float(x), float(y)) for k, x, y in re.findall(r"'(\w+)'=(\S+?),(\S+)", line)}
+    check(code == 0 and set(grp) == {"bottom", "left"} and close(grp["bottom"][1], 3 * W, 1e-5)
+          and grp["left"][1] == 0.0 and abs(grp["left"][0] + grp["bottom"][0]) <= 1e-5 * W,
+          f"per group: 'bottom' carries 3W in y, 'left' (a roller) nothing in y, their x parts cancel ({grp})",
+          out.strip()[-400:])
+
+    # (7) every shipped deck is in equilibrium body by body
+    for deck in sorted(glob.glob(os.path.join(ROOT, "inputs", "*.nml"))):
+        name = os.path.basename(deck)[:-4]
+        p, _ = run_solver(BIN, deck, f"&output file='{os.path.join(work, name)}.h5' /", cwd=work, env=ENV,
+                          timeout=300)
+        b = balances(p.stdout)
+        check(p.returncode == 0 and len(b) > 0 and max(b) <= 1e-10,
+              f"inputs/{name}.nml: every supported body balances to 1e-10 ({len(b)} bodies, worst "
+              f"{max(b) if b else float('nan'):.1e})", (p.stdout + p.stderr).strip()[-300:])
 finally:
     shutil.rmtree(work, ignore_errors=True)
 

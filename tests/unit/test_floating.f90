@@ -76,6 +76,8 @@ program test_floating
   call nnls_stack(300, 1.0_wp, 2.1e11_wp, .true.)
   call nnls_stack(300, -1.0_wp, 2.1e11_wp, .false.)
   call nnls_stack(300, 1.0_wp, 1.0e-3_wp, .false.)
+  call nnls_tilt(0.499999_wp)
+  call nnls_tilt(0.500001_wp)
 
   call test_summary()
 
@@ -660,5 +662,48 @@ contains
       end if
     end do
   end subroutine nnls_stack
+
+  !> A stack of 90 blocks, each with a vertical and a rotation row, standing on two
+  !! contact points per interface at -+500 (the rotation row in units where the lever is
+  !! 1e3: a body of mm size): a weight 1 and a moment fac x 1e3 on each block, so every
+  !! interface carries its resultant at fac of the half-width from the centre. fac =
+  !! 0.499999 is balanced at the very edge of the support (its least residual 0), 0.500001
+  !! is not (the least residual is positive): the interior point method, whose iterates
+  !! stall there with the primal residual left, must not call the first unbalanced (its
+  !! answer is then the active set method's) and both methods give the same residual.
+  subroutine nnls_tilt(fac)
+    real(wp), intent(in) :: fac
+    integer, parameter :: nb = 90
+    real(wp), parameter :: lever = 1.0e3_wp
+    type(sparse_cols_t) :: gs
+    real(wp), allocatable :: e(:), x(:)
+    real(wp) :: res(2), xs(2)
+    integer :: k, c, meth
+    character(len=80) :: lab
+    xs = [-0.5_wp, 0.5_wp]*lever
+    call gs%init(2*nb)
+    do k = 1, nb
+      do c = 1, 2
+        if (k > 1) then
+          call gs%push([2*k - 3, 2*k - 2, 2*k - 1, 2*k], [-1.0_wp, -xs(c), 1.0_wp, xs(c)])
+        else
+          call gs%push([2*k - 1, 2*k], [1.0_wp, xs(c)])
+        end if
+      end do
+    end do
+    allocate (e(2*nb), x(gs%ncol))
+    e(1::2) = 1.0_wp
+    e(2::2) = fac*lever
+    do meth = NNLS_ACTIVE_SET, NNLS_INTERIOR
+      call nnls(gs, e, x, res(meth), meth)
+    end do
+    write (lab, '(a,f9.6,a)') 'nnls tilting stack, resultant at ', fac, ' of the width'
+    if (fac < 0.5_wp) then
+      call report_le(maxval(res)/norm2(e), 1.0e-10_wp, trim(lab)//': both methods balance it')
+    else
+      call report(minval(res)/norm2(e) > 1.0e-10_wp, trim(lab)//': neither balances it', minval(res)/norm2(e))
+    end if
+    call report_le(abs(res(1) - res(2))/norm2(e), 1.0e-9_wp, trim(lab)//': the same residual')
+  end subroutine nnls_tilt
 
 end program test_floating
