@@ -8,7 +8,8 @@
 settings, again with method='monolithic' and with the harmonic operator at delta 0.5, and stores, per deck: the exit code, the status, the outer iteration count and the
 nodal contact forces (/contact/normal_force). Without --store it runs them again and compares:
 same exit code, status and outer count, and max |f - f_ref| <= 1e-12 max |f_ref| (scale-aware;
-exactly 0 = 0 for a deck without contact); with --loose (a build that rounds differently, such as
+exactly 0 = 0 for a deck without contact), and, for a converged run, every body in equilibrium
+(each `reaction:` line's balance below 1e-9, or below ten times its own rounding level); with --loose (a build that rounds differently, such as
 `make DEBUG=1`) the forces within ten times each run's own a posteriori bound and no outer counts.
 A store recorded on another kind of processor (its vendor, model and vector units, the kernels
 OpenBLAS picks) is compared the loose way too, and the run says so: the same binary rounds
@@ -21,6 +22,7 @@ import argparse
 import glob
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -69,6 +71,10 @@ def machine():
     units = [u for u in ("avx", "avx2", "fma", "avx512f", "avx512vl") if u in flags]
     return " / ".join([info.get(k, "?") for k in ("vendor_id", "cpu family", "model", "model name")]
                       + [" ".join(units), os.environ.get("OPENBLAS_CORETYPE", "")])
+
+
+BALANCE_MAX = 1e-9   # a converged run's bodies balance to rounding (measured: 4e-12 at worst where
+                     # K u's terms do not cancel; contrast_1e6's stiff body 1.4e-8, its rounding 3e-7)
 
 
 def run_deck(binary, key, deck, overrides, tmp):
@@ -158,6 +164,14 @@ def main():
                 bad += 1
                 continue
             diffs = compare(ref[deck], rec, loose)
+            # every converged run is in equilibrium body by body: each `reaction:` line's
+            # balance (supports + loads + contact forces over the sum of their magnitudes)
+            # (or to its own rounding level, where K u's terms cancel far below the forces)
+            for b, lvl in re.findall(r"^reaction: body=.* balance=(\S+) \(rounding (\S+)\)", p.stdout, re.M):
+                if rec["exit"] == 0 and float(b) > max(BALANCE_MAX, 10.0 * float(lvl)):
+                    diffs.append(f"a body out of equilibrium: reaction balance {b} > {BALANCE_MAX:.0e} and > 10 x "
+                                 f"its rounding level {lvl}")
+                    break
             print(("FAIL " if diffs else "PASS ") + f"{deck} outer={rec.get('outer')} "
                   + "; ".join(diffs))
             if diffs:

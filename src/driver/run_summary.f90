@@ -279,7 +279,8 @@ contains
   !> The `reaction:` line of each supported body (the first MAX_LISTED, then how many more):
   !! the resultant of its supports' forces (K u - f at the prescribed DOFs), of its applied
   !! loads and of the contact forces on its free DOFs (-B_a' lam_a), and their balance
-  !! |R + F + C| / (the sum of every nodal force's magnitude): the body's equilibrium, the
+  !! |R + F + C| / (the sum of every nodal force's magnitude), with its rounding level (eps
+  !! times the size of the terms K u adds up, over the same sum): the body's equilibrium, the
   !! displacement's and the
   !! contact forces' independently (rounding level in a converged run). A contact node on a
   !! support passes its force to the support directly: it is in the pair's resultant, not in
@@ -288,7 +289,7 @@ contains
   function reaction_lines(run) result(lines)
     type(run_t), intent(in) :: run
     character(len=1024), allocatable :: lines(:)
-    real(wp), allocatable :: r(:), c(:)
+    real(wp), allocatable :: r(:), c(:), mag(:)
     real(wp) :: rr(2), ff(2), cc(2), scale
     integer :: a, p, nsup
     allocate (lines(0))
@@ -301,9 +302,9 @@ contains
         if (.not. allocated(bd%bptr)) cycle
         nsup = nsup + 1
         if (nsup > MAX_LISTED) cycle
-        allocate (r(sy%ndof), c(sy%n))
+        allocate (r(sy%ndof), c(sy%n), mag(sy%ndof))
         call support_reactions(run%meshes(a), run%deck%body(a), run%deck%plane_strain, sy, &
-                               run%displacement(1:sy%ndof, a), sy%f_applied, r)
+                               run%displacement(1:sy%ndof, a), sy%f_applied, r, mag)
         c = 0.0_wp
         call apply_bt(bd, gather(run%result%lam_body, bd%slots), c)
         cc = 0.0_wp
@@ -313,12 +314,15 @@ contains
         rr = [sum(r(1::2)), sum(r(2::2))]
         ff = [sum(sy%f_applied(1::2)), sum(sy%f_applied(2::2))]
         ! the size of the forces that balance: every nodal force's magnitude (a body between two
-        ! others carries large contact forces whose resultant is zero)
+        ! others carries large contact forces whose resultant is zero); K u is known to eps
+        ! times the size of its terms, which may cancel far below the forces (a stiff body
+        ! moved almost rigidly): that is the rounding level the balance is read against
         scale = max(sum(abs(r)) + sum(abs(sy%f_applied)) + sum(abs(c)), tiny(1.0_wp))
         lines = [character(len=1024) :: lines, 'reaction: body='//i2s(a)//' supports='//sci(rr(1), 5)//','// &
                  sci(rr(2), 5)//' loads='//sci(ff(1), 5)//','//sci(ff(2), 5)//' contact='//sci(cc(1), 5)//','// &
-                 sci(cc(2), 5)//' balance='//sci(norm2(rr + ff + cc)/scale, 2)//group_parts(a, r)]
-        deallocate (r, c)
+                 sci(cc(2), 5)//' balance='//sci(norm2(rr + ff + cc)/scale, 2)//' (rounding '// &
+                 sci(epsilon(1.0_wp)*sum(mag)/scale, 1)//')'//group_parts(a, r)]
+        deallocate (r, c, mag)
       end associate
     end do
     if (nsup > MAX_LISTED) lines = [character(len=1024) :: lines, 'reaction: ... '//i2s(nsup - MAX_LISTED)// &

@@ -590,20 +590,24 @@ contains
 
   !> r = K_full u_full - f_full over all DOFs, by an element loop. At prescribed DOFs
   !! r is the reaction force that the supports exert on the body [force].
-  subroutine residual_full(mesh, body, plane_strain, u_full, f_full, r)
+  subroutine residual_full(mesh, body, plane_strain, u_full, f_full, r, mag)
     type(mesh_t), intent(in) :: mesh         !< the body's mesh
     type(body_cfg_t), intent(in) :: body     !< material
     logical, intent(in) :: plane_strain      !< .true. plane strain, .false. plane stress
     real(wp), intent(in) :: u_full(:)        !< (ndof) displacements [length]
     real(wp), intent(in) :: f_full(:)        !< (ndof) nodal loads [force]
     real(wp), intent(out) :: r(:)            !< (ndof) residual [force]
-    integer :: c, nd, ldof(MAX_NDOF)
+    !> (ndof) optional: sum over the cells of |ke_ij u_j| at each DOF, the size of the terms
+    !! that K u adds up (its rounding is eps times that, however much they cancel) [force]
+    real(wp), intent(out), optional :: mag(:)
+    integer :: c, nd, ldof(MAX_NDOF), i
     real(wp) :: lame_lambda, lame_mu, xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
     type(ke_cache_t) :: cache
 
     call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:2*mesh%nnode) = 0.0_wp
+    if (present(mag)) mag(1:2*mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
       nd = 2*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
@@ -611,6 +615,11 @@ contains
       call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
+      if (present(mag)) then
+        do i = 1, nd
+          mag(ldof(i)) = mag(ldof(i)) + sum(abs(ke(i, 1:nd)*ue(1:nd)))
+        end do
+      end if
     end do
     r(1:2*mesh%nnode) = r(1:2*mesh%nnode) - f_full(1:2*mesh%nnode)
   end subroutine residual_full
@@ -620,7 +629,7 @@ contains
   !! body held only by contact (no support there: its residual is the body's equilibrium
   !! error, of the order of rounding). With the applied loads and
   !! the contact forces they balance the body: K u sums to zero over each component.
-  subroutine support_reactions(mesh, body, plane_strain, sys, u_full, f_applied, r)
+  subroutine support_reactions(mesh, body, plane_strain, sys, u_full, f_applied, r, mag)
     type(mesh_t), intent(in) :: mesh            !< the body's mesh
     type(body_cfg_t), intent(in) :: body        !< material
     logical, intent(in) :: plane_strain         !< .true. plane strain, .false. plane stress
@@ -628,7 +637,8 @@ contains
     real(wp), intent(in) :: u_full(:)           !< (ndof) displacements [length]
     real(wp), intent(in) :: f_applied(:)        !< (ndof) the applied nodal loads [force]
     real(wp), intent(out) :: r(:)               !< (ndof) reactions [force]
-    call residual_full(mesh, body, plane_strain, u_full, f_applied, r)
+    real(wp), intent(out), optional :: mag(:)   !< (ndof) the size of K u's terms (residual_full)
+    call residual_full(mesh, body, plane_strain, u_full, f_applied, r, mag)
     where (sys%free_of(1:2*mesh%nnode) /= 0) r(1:2*mesh%nnode) = 0.0_wp
     if (allocated(sys%fixing)) r(sys%fixing) = 0.0_wp
   end subroutine support_reactions
