@@ -385,9 +385,12 @@ contains
             t = (d%body(a)%density*maxval(abs(d%body_force(i)%gravity)) + maxval(abs(d%body_force(i)%force)))*ext
         end if
         if (.not. t < cap .or. .not. log(max(t, tiny(1.0_wp))) + log(ext) - log(ymin) + log(MARGIN) < log(LOAD_MAX)) then
-          call err%set(ERR_INPUT, trim(d%body_force(i)%origin)//' on body '//i2s(a)//' reaches '//sci(t)// &
-                ' [stress] over the scene''s extent '//sci(ext)//' [length]: its stresses or displacements '// &
-                'would overflow double precision; rescale the units (e.g. &scene units=''mm-N-MPa'')')
+          ! (the inputs named, not t: the product itself may be beyond double precision)
+          call err%set(ERR_INPUT, trim(d%body_force(i)%origin)//' on body '//i2s(a)//' (density '// &
+                sci(d%body(a)%density)//', gravity up to '//sci(maxval(abs(d%body_force(i)%gravity)))// &
+                ', force up to '//sci(maxval(abs(d%body_force(i)%force)))//' over the scene''s extent '// &
+                sci(ext)//' [length]) makes stresses or displacements beyond double precision; rescale '// &
+                'the units (e.g. &scene units=''mm-N-MPa'')')
           return
         end if
       end do

@@ -159,7 +159,8 @@ try:
             ["body = 4", "does not exist", "0 means every body"]),
            ("negdensity", stack(), ["&body id=2, density=-1.0 /"], ["density = -1", "must be >= 0"]),
            ("unknownvar", stack(extra=["&body_force gravty=0.0, -9.81 /"]), [], ["gravty"]),
-           ("overflow", stack(g=1e300), [], ["&body_force at line 4 on body 1 reaches", "overflow double precision"])]
+           ("overflow", stack(g=1e300), [], ["&body_force at line 4 on body 1 (density 7.850E+03, gravity up to "
+                                               "1.000E+300", "beyond double precision"])]
     for name, text, over, words in bad:
         before = set(os.listdir(work))
         code, out, _ = run(work, name, text, *over)
