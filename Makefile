@@ -233,7 +233,7 @@ $(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/conden
                            $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
                            $(BUILD)/floating.o $(BUILD)/kinds.o $(BUILD)/mpi_env.o \
                            $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
-$(BUILD)/run_summary.o:    $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
+$(BUILD)/run_summary.o:    $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
                            $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/namelist_vars.o \
                            $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o

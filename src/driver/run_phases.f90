@@ -10,7 +10,7 @@ module run_phases
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count
   use mesh, only: mesh_t, mesh_build
   use gmsh_msh, only: msh_read, msh_read_shared
-  use assembly, only: assemble_body
+  use assembly, only: assemble_body, support_reactions
   use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT
   use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
                            contact_result_t
@@ -632,6 +632,28 @@ contains
     end if
   end subroutine complete_displacements
 
+  !> The supports' forces on every body (K u - f at its prescribed DOFs) of the final result,
+  !! once, for the result file and the summary's reaction: lines; bodies in parallel.
+  subroutine support_forces(run)
+    type(run_t), intent(inout) :: run   !< the run: its reactions
+    real(wp), allocatable :: mag(:)
+    integer :: a
+    if (allocated(run%reaction)) deallocate (run%reaction, run%reaction_mag)
+    allocate (run%reaction(size(run%displacement, 1), run%nbody), run%reaction_mag(run%nbody))
+    run%reaction = 0.0_wp
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(mag)
+    do a = 1, run%nbody
+      associate (sy => run%systems(a))
+        allocate (mag(sy%ndof))
+        call support_reactions(run%meshes(a), run%deck%body(a), run%deck%plane_strain, sy, &
+                               run%displacement(1:sy%ndof, a), sy%f_applied, run%reaction(1:sy%ndof, a), mag)
+        run%reaction_mag(a) = sum(mag)
+        deallocate (mag)
+      end associate
+    end do
+    !$omp end parallel do
+  end subroutine support_forces
+
   !> The result file (rank 0, unless the run failed). A converged run has no use for its
   !! checkpoint; a run that stopped keeps it. An earlier result at this path stays until
   !! this one replaces it whole; a run that fails leaves it untouched.
@@ -640,15 +662,16 @@ contains
     type(error_t) :: err
     integer :: stale
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
+    call support_forces(run)
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
     stale = 0
     if (size(run%plan) > 1) then   ! every load step's result too
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%timing, err, run%steps, threads=run%threads, stale=stale)
+                         run%displacement, run%reaction, run%timing, err, run%steps, threads=run%threads, stale=stale)
     else
       call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%timing, err, threads=run%threads, stale=stale)
+                         run%displacement, run%reaction, run%timing, err, threads=run%threads, stale=stale)
     end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')

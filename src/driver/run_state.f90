@@ -42,6 +42,10 @@ module run_state
     type(robin_state_t) :: robin_state                 !< the Robin iteration's state (restart)
     type(contact_result_t) :: result                   !< contact forces, status, counts
     real(wp), allocatable :: displacement(:, :)        !< (max ndof, bodies) the bodies' displacements
+    !> (max ndof, bodies) the supports' forces on each body (assembly's support_reactions, rank
+    !! 0, once the displacements are complete) and (bodies) the size of the terms of K u they
+    !! come from (their rounding level over eps)
+    real(wp), allocatable :: reaction(:, :), reaction_mag(:)
     type(load_step_t), allocatable :: plan(:)          !< the load steps (one: the deck's loads at once)
     integer :: step = 1                                !< the step being solved
     integer :: restart_step = 1                        !< the step a checkpoint resumes (earlier ones are replayed)

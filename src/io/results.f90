@@ -76,7 +76,7 @@ contains
   !! temporary file is left. The HDF5 library is called from one thread; with two, the
   !! other writes the companions and, body by body, computes the fields of each body
   !! (its stresses) and writes their data into the storage the first has reserved.
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, tm, err, steps, threads, stale)
+  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, rf, tm, err, steps, threads, stale)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
@@ -84,6 +84,7 @@ contains
     type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs
     type(contact_result_t), intent(in) :: res_all      !< contact solution
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, bodies) full displacements
+    real(wp), intent(in) :: rf(:, :)                   !< (maxndof, bodies) the supports' forces (support_reactions)
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     type(error_t), intent(out) :: err                  !< the failure, if any
     !> the load steps' results (several steps: /steps, and the XDMF files a time series)
@@ -135,9 +136,9 @@ contains
     call write_companions(ok)
     !$omp end task
     if (size(times) > 0) then
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, tm, id, st, steps)
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, rf, tm, id, st, steps)
     else
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, tm, id, st)
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, rf, tm, id, st)
     end if
     !$omp end single
     !$omp end parallel
@@ -241,7 +242,7 @@ contains
   !> The HDF5 result file `path`, whole; st records the first failure. The large datasets of
   !! each body are created with their storage reserved, and a task per body (`body_data`)
   !! computes and writes their data there; all tasks end before this returns.
-  subroutine write_h5(path, d, msh, sys, itf_all, itf, res, tg, u, tm, run_id, st, steps)
+  subroutine write_h5(path, d, msh, sys, itf_all, itf, res, tg, u, rf, tm, run_id, st, steps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
@@ -251,6 +252,7 @@ contains
     type(contact_result_t), intent(in) :: res
     type(tangential_t), intent(in) :: tg               !< the tangential part (friction), per node
     real(wp), intent(in) :: u(:, :)
+    real(wp), intent(in) :: rf(:, :)                   !< (maxndof, bodies) the supports' forces
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
     type(error_t), intent(inout) :: st
@@ -384,8 +386,8 @@ contains
       call reserve_dset(gid, 'reaction_xyz', [3_hsize_t, nn], .false., off(BD_REACTION_XYZ), st, uf)
       call group_close(gid, st)
       if (.not. st%failed()) then
-        !$omp task firstprivate(a, off) shared(msh, d, u, sys, itf, pres, body_err, fd)
-        call body_data(fd, off, a, msh(a), d, sys(a), u(1:sys(a)%ndof, a), itf, pres, body_err(a))
+        !$omp task firstprivate(a, off) shared(msh, d, u, rf, sys, itf, pres, body_err, fd)
+        call body_data(fd, off, a, msh(a), d, u(1:sys(a)%ndof, a), rf(1:sys(a)%ndof, a), itf, pres, body_err(a))
         !$omp end task
       end if
     end do
@@ -407,18 +409,18 @@ contains
   !! cell, the nodal stresses (nnode, 4) and each component, von Mises and the contact
   !! pressure, the supports' reactions (nnode, 2) and padded (3, nnode). Fields that are not
   !! finite are a failure, never written.
-  subroutine body_data(fd, off, a, msh, d, sys, ua, itf, pres, err)
+  subroutine body_data(fd, off, a, msh, d, ua, ra, itf, pres, err)
     integer, intent(in) :: fd                       !< the result file (data_open)
     integer(haddr_t), intent(in) :: off(:)          !< (BD_COUNT) where each dataset's data go
     integer, intent(in) :: a                        !< the body
     type(mesh_t), intent(in) :: msh                 !< its mesh
     type(deck_t), intent(in) :: d                   !< the deck (its material, plane strain)
-    type(body_system_t), intent(in) :: sys          !< its system (DOF numbering, applied loads)
     real(wp), intent(in) :: ua(:)                   !< (ndof) its displacement
+    real(wp), intent(in) :: ra(:)                   !< (ndof) the supports' forces on it
     type(interface_t), intent(in) :: itf            !< the contact rows (normal)
     real(wp), intent(in) :: pres(:)                 !< (m) pressure of each row [stress]
     type(error_t), intent(inout) :: err             !< the first failure
-    real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :), rf(:)
+    real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :)
     integer, allocatable, target :: iv(:), iw(:, :)
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
     integer :: k, nn
@@ -458,9 +460,7 @@ contains
     call nodal_pressure(itf, a, pres, p)
     vm = file_order(msh, p)
     call put(vm, 'contact_pressure', BD_PRESSURE)
-    allocate (rf(2*nn))
-    call support_reactions(msh, d%body(a), d%plane_strain, sys, ua, sys%f_applied, rf)
-    uf = file_order(msh, reshape(rf, [2, nn]))
+    uf = file_order(msh, reshape(ra, [2, nn]))
     w2 = transpose(uf)
     call put(w2, 'reaction', BD_REACTION)
     w3 = pad3(uf)
