@@ -65,14 +65,14 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
+MODS := kinds errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials
 BENCH_F := bench_mprgp bench_ordering bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -134,7 +134,9 @@ $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o
 $(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o \
                            $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
-$(BUILD)/deck_cross.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o
+$(BUILD)/material_laws.o:  $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/deck_cross.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o \
+                           $(BUILD)/material_laws.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
                            $(BUILD)/deck_checks.o $(BUILD)/deck_cross.o $(BUILD)/deck_render.o

@@ -7,8 +7,8 @@ module run_phases
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
-  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count
-  use mesh, only: mesh_t, mesh_build
+  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count, body_stiffness
+  use mesh, only: mesh_t, mesh_build, assign_cell_laws
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, support_reactions
   use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT
@@ -168,6 +168,23 @@ contains
       do a = 1, deck%nbody   ! the mesh reader's message names the body
         call fail_on(err(a), 'deck '//trim(deck%source))
       end do
+      do a = 1, deck%nbody   ! each cell's material, from the deck's regions
+        block
+          character(len=:), allocatable :: msg
+          integer :: bad, i, n
+          call assign_cell_laws(run%meshes(a), deck%body(a), msg, bad)
+          if (len(msg) == 0) cycle
+          n = 1
+          do i = 1, deck%nregion     ! law bad is the (bad-1)-th region of body a
+            if (deck%region(i)%body /= a) cycle
+            n = n + 1
+            if (n == bad) exit
+          end do
+          call fail_on(error_t(ERR_INPUT, 'the '//trim(deck%region(i)%origin)//" (body "//i2s(a)//", name = '"// &
+            trim(deck%region(i)%name)//"'): mesh file '"//trim(deck%body(a)%mesh)//"': "//msg), &
+            'deck '//trim(deck%source))
+        end block
+      end do
       run%sized = deck
       if (any([(len_trim(deck%body(a)%mesh) > 0, a=1, deck%nbody)])) then
         do a = 1, deck%nbody
@@ -321,10 +338,12 @@ contains
     integer :: a
     type(error_t) :: err
     character(len=1024) :: msg
+    real(wp) :: lo, hi
     do a = 1, run%nbody
       if (.not. all(ieee_is_finite(run%bodies(a)%flex))) then
-        write (msg, '(a,i0,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (young = ', &
-          run%deck%body(a)%young, '): the stiffness is out of the range of double precision; rescale the units'
+        call body_stiffness(run%deck%body(a), lo, hi)
+        write (msg, '(a,i0,a,es10.3,a,es10.3,a)') 'body ', a, ': its interface flexibility is not finite (stiffness ', &
+          lo, ' to ', hi, '): the stiffness is out of the range of double precision; rescale the units'
         call fatal(EXIT_NUMERICAL, trim(msg))
       else if (.not. all(ieee_is_finite(run%bodies(a)%b))) then
         write (msg, '(a,i0,a)') 'body ', a, ': its interface load is not finite: its prescribed displacements '// &

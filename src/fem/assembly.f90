@@ -17,12 +17,13 @@ module assembly
   use, intrinsic :: iso_fortran_env, only: int16
   use strings, only: body_label
   use sorting, only: sort_by_key
-  use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
+  use config, only: body_cfg_t, elastic_law_t, body_stiffness, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
   use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress, &
-                      element_shape_integrals
+                      element_shape_integrals, element_stress_general
+  use material_laws, only: isotropic_law
   use linop, only: csc_symv
   use body_system, only: body_system_t
   use supports, only: prescribed_dofs, group_conditions, unknown_group, number_free_dofs
@@ -36,6 +37,29 @@ module assembly
   public :: body_system_t, body_force_fn, rigid_motion_name
 
 contains
+
+  !> The elastic laws of a body: its resolved laws (body%law, from the deck), or for a body
+  !! built in code without them the isotropic law of its young and poisson.
+  function body_laws(body, plane_strain) result(laws)
+    type(body_cfg_t), intent(in) :: body
+    logical, intent(in) :: plane_strain
+    type(elastic_law_t), allocatable :: laws(:)
+    if (allocated(body%law)) then
+      laws = body%law
+    else
+      allocate (laws(1))
+      call isotropic_law(body%young, body%poisson, plane_strain, laws(1))
+      laws(1)%density = body%density
+    end if
+  end function body_laws
+
+  !> The law of cell c: mesh%cell_law's, or 1.
+  pure integer function law_of(mesh, c)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: c
+    law_of = 1
+    if (allocated(mesh%cell_law)) law_of = mesh%cell_law(c)
+  end function law_of
 
   !> Lame parameters of the body: plane strain uses lambda, mu; plane stress the
   !! reduced lambda* = 2 lambda mu / (lambda + 2 mu).
@@ -90,12 +114,13 @@ contains
     !> the deck's load stages: each stage's load vectors too (sys%f_stage, u_stage,
     !! fa_stage), for load steps; absent: none
     integer, intent(in), optional :: nstage
-    !> (2, nstage or 1) a constant body force per volume of each stage [force/length^3]
-    !! (&body_force: density x gravity + force); the whole load takes their sum
-    real(wp), intent(in), optional :: body_load(:, :)
+    !> (2, nstage or 1, laws) a constant body force per volume of each stage in the cells of
+    !! each elastic law [force/length^3] (&body_force: density x gravity + force, the law's
+    !! density); the whole load takes their sum over the stages
+    real(wp), intent(in), optional :: body_load(:, :, :)
     logical, allocatable :: prescribed(:)
     integer(int16), allocatable :: cell_row(:, :, :)
-    real(wp) :: lame_lambda, lame_mu
+    type(elastic_law_t), allocatable :: laws(:)
     logical :: with_k
     integer :: info
     character(len=512) :: msg
@@ -106,7 +131,21 @@ contains
     sys%id = body%id
     call check_input(mesh, body, tractions, ntraction, err, u_prescribed)
     if (err%failed()) return
-    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    laws = body_laws(body, plane_strain)
+    if (allocated(mesh%cell_law)) then
+      if (maxval(mesh%cell_law) > size(laws)) then
+        call err%set(ERR_NUMERICAL, 'body '//body_label(body%id)//': internal error, a cell''s law is '// &
+                     'beyond the body''s laws')
+        return
+      end if
+    end if
+    if (present(body_load)) then
+      if (size(body_load, 3) /= size(laws)) then
+        call err%set(ERR_NUMERICAL, 'body '//body_label(body%id)//': internal error, body forces for '// &
+                     'another number of laws')
+        return
+      end if
+    end if
 
     call prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
     if (present(boundaries)) then
@@ -134,12 +173,12 @@ contains
       call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
     end if
     if (err%failed()) return
-    call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, cell_row)
+    call stiffness_and_lifting(mesh, laws, sys, err, with_k, cell_row)
     if (err%failed()) return
     if (allocated(cell_row)) deallocate (cell_row)
     call add_applied_loads(sys)
     if (present(nstage)) then
-      call stage_loads(mesh, lame_lambda, lame_mu, tractions(1:ntraction), nstage, sys, err, body_force, body_load)
+      call stage_loads(mesh, laws, tractions(1:ntraction), nstage, sys, err, body_force, body_load)
       if (err%failed()) return
     end if
     if (with_k) sys%k_norm = stiffness_norm(sys)
@@ -161,18 +200,19 @@ contains
     real(wp), allocatable, intent(out) :: a(:)           !< the entries [stress]
     type(error_t), intent(out) :: err                    !< the bad cell, if any
     integer :: c, nd, i, j, q, fi, fj, ldof(MAX_NDOF)
-    real(wp) :: ke(MAX_NDOF, MAX_NDOF), lame_lambda, lame_mu
+    real(wp) :: ke(MAX_NDOF, MAX_NDOF)
     type(ke_cache_t) :: cache
     integer, allocatable :: ti(:), tj(:)
     real(wp), allocatable :: ta(:)
+    type(elastic_law_t), allocatable :: laws(:)
 
-    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    laws = body_laws(body, plane_strain)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     q = max(0, c2 - c1 + 1)*(MAX_NDOF*(MAX_NDOF + 1))/2
     allocate (ti(q), tj(q), ta(q))
     q = 0
     do c = max(1, c1), min(mesh%ncell, c2)
-      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
+      call cell_stiffness(mesh, sys%id, c, laws, cache, ke, nd, ldof, err)
       if (err%failed()) return
       do j = 1, nd
         fj = sys%free_of(ldof(j))
@@ -275,7 +315,7 @@ contains
     type(error_t), intent(out) :: err
     character(len=512) :: emsg
     real(wp), allocatable :: kr(:), zero(:)
-    real(wp) :: worst, knorm
+    real(wp) :: worst, knorm, lo
     integer :: j
     logical, allocatable :: live(:)
     allocate (kr(sys%ndof), zero(sys%ndof), live(sys%ndof))
@@ -284,7 +324,10 @@ contains
     live(sys%fixing) = .true.
     ! no assembled matrix (MUMPS ranks): Young's modulus is the scale of K's entries
     knorm = sys%k_norm
-    if (knorm <= 0.0_wp) knorm = max(body%young, tiny(1.0_wp))
+    if (knorm <= 0.0_wp) then
+      call body_stiffness(body, lo, knorm)
+      knorm = max(knorm, tiny(1.0_wp))
+    end if
     worst = 0.0_wp
     do j = 1, sys%nrig
       call residual_full(mesh, body, plane_strain, sys%rig(:, j), zero, kr)
@@ -308,7 +351,8 @@ contains
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     procedure(body_force_fn), optional :: body_force
-    real(wp), intent(in), optional :: body_load(2)   !< constant body force per volume [force/length^3]
+    !> (2, laws) constant body force per volume in the cells of each law [force/length^3]
+    real(wp), intent(in), optional :: body_load(:, :)
     integer :: t, g
 
     allocate (sys%f(sys%n), sys%f_applied(sys%ndof))
@@ -343,17 +387,17 @@ contains
   !! prescribed values (sys%dof_stage) and their lifting, as the whole load is assembled;
   !! the body force function is stage 1's, the constant body force column s stage s's. One
   !! stage: the whole load's vectors.
-  subroutine stage_loads(mesh, lame_lambda, lame_mu, tractions, nstage, sys, err, body_force, body_load)
+  subroutine stage_loads(mesh, laws, tractions, nstage, sys, err, body_force, body_load)
     type(mesh_t), intent(in) :: mesh
-    real(wp), intent(in) :: lame_lambda, lame_mu
+    type(elastic_law_t), intent(in) :: laws(:)
     type(traction_cfg_t), intent(in) :: tractions(:)
     integer, intent(in) :: nstage
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     procedure(body_force_fn), optional :: body_force
-    real(wp), intent(in), optional :: body_load(:, :)
+    real(wp), intent(in), optional :: body_load(:, :, :)
     real(wp), allocatable :: f_all(:), u_all(:), fa_all(:)
-    real(wp) :: bl(2)
+    real(wp) :: bl(2, size(laws))
     integer :: s
     sys%nstage = nstage
     allocate (sys%f_stage(sys%n, nstage), sys%u_stage(sys%ndof, nstage), sys%fa_stage(sys%ndof, nstage))
@@ -370,7 +414,7 @@ contains
       sys%u_fixed = merge(u_all, 0.0_wp, sys%dof_stage == s)
       bl = 0.0_wp
       if (present(body_load)) then
-        if (s <= size(body_load, 2)) bl = body_load(:, s)
+        if (s <= size(body_load, 2)) bl = body_load(:, s, :)
       end if
       if (s == 1) then
         call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_force, bl)
@@ -378,7 +422,7 @@ contains
         call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_load=bl)
       end if
       if (err%failed()) return
-      call stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, .false.)
+      call stiffness_and_lifting(mesh, laws, sys, err, .false.)
       if (err%failed()) return
       call add_applied_loads(sys)
       sys%f_stage(:, s) = sys%f
@@ -398,9 +442,9 @@ contains
   !! each column's rows are searched (the grid, whose regular pattern makes the search
   !! cheap). err = ERR_INPUT on a cell with a non-positive Jacobian, ERR_NUMERICAL on a
   !! coupling outside the pattern (an internal error).
-  subroutine stiffness_and_lifting(mesh, lame_lambda, lame_mu, sys, err, with_k, cell_row)
+  subroutine stiffness_and_lifting(mesh, laws, sys, err, with_k, cell_row)
     type(mesh_t), intent(in) :: mesh
-    real(wp), intent(in) :: lame_lambda, lame_mu
+    type(elastic_law_t), intent(in) :: laws(:)
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
@@ -415,7 +459,7 @@ contains
     if (present(cell_row)) mapped = allocated(cell_row)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
-      call cell_stiffness(mesh, sys%id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
+      call cell_stiffness(mesh, sys%id, c, laws, cache, ke, nd, ldof, err)
       if (err%failed()) return
       inside = .true.
       if (with_k .and. mapped) then
@@ -435,10 +479,10 @@ contains
 
   !> The stiffness of cell c (nd = its DOF count, ldof its global DOFs); err = ERR_INPUT,
   !! naming the cell's tag, when its Jacobian is not positive (inverted or degenerate).
-  subroutine cell_stiffness(mesh, body_id, c, lame_lambda, lame_mu, cache, ke, nd, ldof, err)
+  subroutine cell_stiffness(mesh, body_id, c, laws, cache, ke, nd, ldof, err)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id, c
-    real(wp), intent(in) :: lame_lambda, lame_mu
+    type(elastic_law_t), intent(in) :: laws(:)
     type(ke_cache_t), intent(inout) :: cache
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)
     integer, intent(out) :: nd, ldof(MAX_NDOF)
@@ -447,7 +491,7 @@ contains
     character(len=512) :: emsg
     nd = 2*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
-    call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+    call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache)
     if (.not. (minjac > 0.0_wp)) then
       write (emsg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
         ' has a non-positive Jacobian (inverted or degenerate element)'
@@ -456,6 +500,21 @@ contains
     end if
     call cell_dofs(mesh, c, ldof)
   end subroutine cell_stiffness
+
+  !> The stiffness of a cell of element `element` and law k of `laws`: the isotropic kernel
+  !! (Lame parameters) or the general one (its plane stiffness).
+  pure subroutine law_stiffness(element, xe, laws, k, ke, minjac, cache)
+    integer, intent(in) :: element, k
+    real(wp), intent(in) :: xe(2, MAX_NVERT)
+    type(elastic_law_t), intent(in) :: laws(:)
+    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF), minjac
+    type(ke_cache_t), intent(inout) :: cache
+    if (laws(k)%isotropic) then
+      call element_stiffness(element, xe, laws(k)%lame_lambda, laws(k)%lame_mu, ke, minjac, cache, key=k)
+    else
+      call element_stiffness(element, xe, 0.0_wp, 0.0_wp, ke, minjac, cache, dmat=laws(k)%d, key=k)
+    end if
+  end subroutine law_stiffness
 
   !> Add the free-free block of an element stiffness to the CSC values. The element's
   !! DOFs are merged in increasing global (hence free) order with the sorted rows of
@@ -601,10 +660,11 @@ contains
     !! that K u adds up (its rounding is eps times that, however much they cancel) [force]
     real(wp), intent(out), optional :: mag(:)
     integer :: c, nd, ldof(MAX_NDOF), i
-    real(wp) :: lame_lambda, lame_mu, xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
+    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
     type(ke_cache_t) :: cache
+    type(elastic_law_t), allocatable :: laws(:)
 
-    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    laws = body_laws(body, plane_strain)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:2*mesh%nnode) = 0.0_wp
     if (present(mag)) mag(1:2*mesh%nnode) = 0.0_wp
@@ -612,7 +672,7 @@ contains
       nd = 2*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
-      call element_stiffness(cell_element(mesh, c), xe, lame_lambda, lame_mu, ke, minjac, cache)
+      call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache)
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
       if (present(mag)) then
@@ -654,12 +714,13 @@ contains
     !> (4, nnode) sxx, syy, sxy, szz [stress]; szz = nu (sxx + syy) in plane strain, 0 in plane stress
     real(wp), intent(out) :: sigma(:, :)
     real(wp), intent(out) :: von_mises(:)       !< (nnode) von Mises stress [stress]
-    integer :: c, a, k, nd, ldof(MAX_NDOF)
+    integer :: c, a, k, nd, ldof(MAX_NDOF), law
     integer, allocatable :: cnt(:)
-    real(wp) :: lame_lambda, lame_mu, xe(2, MAX_NVERT), ue(MAX_NDOF), cs(4)
+    real(wp) :: xe(2, MAX_NVERT), ue(MAX_NDOF), cs(4)
     real(wp) :: sxx, syy, sxy, szz
+    type(elastic_law_t), allocatable :: laws(:)
 
-    call lame_parameters(body, plane_strain, lame_lambda, lame_mu)
+    laws = body_laws(body, plane_strain)
     allocate (cnt(mesh%nnode))
     cnt = 0
     sigma(:, 1:mesh%nnode) = 0.0_wp
@@ -668,7 +729,12 @@ contains
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
       ue(1:nd) = u_full(ldof(1:nd))
-      call element_stress(cell_element(mesh, c), xe, ue, lame_lambda, lame_mu, plane_strain, cs)
+      law = law_of(mesh, c)
+      if (laws(law)%isotropic) then
+        call element_stress(cell_element(mesh, c), xe, ue, laws(law)%lame_lambda, laws(law)%lame_mu, plane_strain, cs)
+      else
+        call element_stress_general(cell_element(mesh, c), xe, ue, laws(law)%d, cs)
+      end if
       do a = 1, nd/2
         k = mesh%cells(a, c)
         sigma(:, k) = sigma(:, k) + cs
@@ -769,20 +835,22 @@ contains
     end do
   end subroutine add_group_traction
 
-  !> Add the consistent nodal loads of a constant body force b [force/length^3] to f: w(a) b
-  !! per cell (element_shape_integrals), exact on any Q1 or P1 cell.
+  !> Add the consistent nodal loads of a body force b [force/length^3], constant in the cells
+  !! of each law, to f: w(a) b per cell (element_shape_integrals), exact on any Q1 or P1 cell.
   subroutine add_constant_body_force(mesh, b, f)
     type(mesh_t), intent(in) :: mesh
-    real(wp), intent(in) :: b(2)
+    real(wp), intent(in) :: b(:, :)        ! (2, laws) the force in the cells of each law
     real(wp), intent(inout) :: f(:)
-    integer :: c, a, k
+    integer :: c, a, k, law
     real(wp) :: xe(2, MAX_NVERT), w(MAX_NVERT)
     do c = 1, mesh%ncell
+      law = law_of(mesh, c)
+      if (all(b(:, law) == 0.0_wp)) cycle
       call cell_coords(mesh, c, xe)
       call element_shape_integrals(cell_element(mesh, c), xe, w)
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
-        f(2*k - 1:2*k) = f(2*k - 1:2*k) + w(a)*b
+        f(2*k - 1:2*k) = f(2*k - 1:2*k) + w(a)*b(:, law)
       end do
     end do
   end subroutine add_constant_body_force

@@ -16,6 +16,7 @@ module elements
 
   public :: element_nvert, q1_gradients, p1_gradients, element_stiffness, ke_cache_init
   public :: element_body_force, edge_traction, element_stress, body_force_fn, element_shape_integrals
+  public :: element_stress_general
 
   integer, parameter, public :: MAX_NVERT = 4            !< most vertices of an element (Q1)
   integer, parameter, public :: MAX_NDOF = 2*MAX_NVERT   !< most DOFs of an element (Q1)
@@ -36,6 +37,7 @@ module elements
     private
     logical :: valid = .false.
     integer :: element = 0                   ! the element of the cached stiffness
+    integer :: key = 0                       ! the material of the cached stiffness (the caller's number)
     real(wp) :: rel(2, MAX_NVERT) = 0.0_wp   ! vertex coordinates relative to vertex 1 [length]
     real(wp) :: tol = 0.0_wp                 ! coordinate tolerance below which cells are the same [length]
     real(wp) :: ke(MAX_NDOF, MAX_NDOF) = 0.0_wp
@@ -219,9 +221,11 @@ contains
   end subroutine q1_stiffness
 
   !> Element stiffness (Q1: 2x2 Gauss; P1: exact) and the smallest Jacobian determinant
-  !! met, which is not positive for an inverted or degenerate element. With `cache`, a
-  !! cell that is a translate of the last one computed reuses its stiffness.
-  pure subroutine element_stiffness(element, xe, lame_lambda, lame_mu, ke, minjac, cache)
+  !! met, which is not positive for an inverted or degenerate element. The material is
+  !! isotropic (lame_lambda, lame_mu), or any plane stiffness `dmat` (then the Lame
+  !! parameters are not used). With `cache`, a cell that is a translate of the last one
+  !! computed, of the same material `key`, reuses its stiffness.
+  pure subroutine element_stiffness(element, xe, lame_lambda, lame_mu, ke, minjac, cache, dmat, key)
     integer, intent(in) :: element                          !< ELEM_Q1 or ELEM_P1
     real(wp), intent(in) :: xe(2, MAX_NVERT)                !< vertex coordinates [length]
     real(wp), intent(in) :: lame_lambda                     !< (effective) first Lame parameter [stress]
@@ -229,15 +233,20 @@ contains
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)         !< element stiffness [stress]
     real(wp), intent(out) :: minjac                         !< smallest Jacobian determinant [length^2]
     type(ke_cache_t), intent(inout), optional :: cache      !< the last stiffness computed
-    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), det
-    integer :: nv, a
+    !> (3, 3) the plane stiffness, (sxx, syy, sxy) = dmat (exx, eyy, gxy) [stress]
+    real(wp), intent(in), optional :: dmat(:, :)
+    integer, intent(in), optional :: key                    !< the material's number for the cache (default 0)
+    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), det, nfun(4)
+    integer :: nv, a, k, ig, jg
 
     nv = element_nvert(element)
+    k = 0
+    if (present(key)) k = key
     if (present(cache)) then
       do a = 1, nv
         rel(:, a) = xe(:, a) - xe(:, 1)
       end do
-      if (cache%valid .and. cache%element == element) then
+      if (cache%valid .and. cache%element == element .and. cache%key == k) then
         if (all(abs(rel(:, 1:nv) - cache%rel(:, 1:nv)) <= cache%tol)) then
           ke = cache%ke
           minjac = cache%minjac
@@ -246,7 +255,23 @@ contains
       end if
     end if
 
-    if (element == ELEM_Q1) then
+    if (present(dmat)) then
+      ke = 0.0_wp
+      if (element == ELEM_Q1) then
+        minjac = huge(1.0_wp)
+        do jg = -1, 1, 2
+          do ig = -1, 1, 2
+            call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
+            minjac = min(minjac, det)
+            if (det > 0.0_wp) call add_btdb_general(4, g, det, dmat, ke)
+          end do
+        end do
+      else
+        call p1_gradients(xe, g, det)
+        minjac = det
+        if (det > 0.0_wp) call add_btdb_general(3, g, 0.5_wp*det, dmat, ke)
+      end if
+    else if (element == ELEM_Q1) then
       call q1_stiffness(xe, lame_lambda, lame_mu, ke, minjac)
     else
       ke = 0.0_wp
@@ -257,11 +282,33 @@ contains
     if (present(cache)) then
       cache%valid = .true.
       cache%element = element
+      cache%key = k
       cache%rel(:, 1:nv) = rel(:, 1:nv)
       cache%ke = ke
       cache%minjac = minjac
     end if
   end subroutine element_stiffness
+
+  !> Add w B' D B to ke for the gradients g of nv shape functions and any plane stiffness D;
+  !! B of vertex a maps (ux, uy) to (exx, eyy, gxy): [gx 0; 0 gy; gy gx].
+  pure subroutine add_btdb_general(nv, g, w, dmat, ke)
+    integer, intent(in) :: nv
+    real(wp), intent(in) :: g(2, MAX_NVERT), w, dmat(:, :)
+    real(wp), intent(inout) :: ke(MAX_NDOF, MAX_NDOF)
+    real(wp) :: db(3, 2), ba(3, 2)
+    integer :: a, b
+    do b = 1, nv
+      ba(:, 1) = [g(1, b), 0.0_wp, g(2, b)]
+      ba(:, 2) = [0.0_wp, g(2, b), g(1, b)]
+      db = matmul(dmat(1:3, 1:3), ba)*w
+      do a = 1, nv
+        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + g(1, a)*db(1, 1) + g(2, a)*db(3, 1)
+        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + g(2, a)*db(2, 1) + g(1, a)*db(3, 1)
+        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + g(1, a)*db(1, 2) + g(2, a)*db(3, 2)
+        ke(2*a, 2*b) = ke(2*a, 2*b) + g(2, a)*db(2, 2) + g(1, a)*db(3, 2)
+      end do
+    end do
+  end subroutine add_btdb_general
 
   !> Add the consistent nodal loads of a body force density to `fe`: Q1 3x3 Gauss,
   !! P1 the 3-point interior rule of degree 2.
@@ -388,5 +435,29 @@ contains
       cs(4) = 0.0_wp
     end if
   end subroutine element_stress
+
+  !> Stress of an element of any plane stiffness d (config's elastic_law_t%d): Q1 at the cell
+  !! centre, P1 the constant value; cs = (sxx, syy, sxy, szz) = d (exx, eyy, gxy, 0).
+  pure subroutine element_stress_general(element, xe, ue, d, cs)
+    integer, intent(in) :: element               !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)     !< vertex coordinates [length]
+    real(wp), intent(in) :: ue(MAX_NDOF)         !< element displacements, interleaved [length]
+    real(wp), intent(in) :: d(4, 4)              !< the stiffness [stress]
+    real(wp), intent(out) :: cs(4)               !< sxx, syy, sxy, szz [stress]
+    real(wp) :: g(2, MAX_NVERT), nfun(4), det, e(3)
+    integer :: a
+    if (element == ELEM_Q1) then
+      call q1_gradients(xe, 0.0_wp, 0.0_wp, nfun, g, det)
+    else
+      call p1_gradients(xe, g, det)
+    end if
+    e = 0.0_wp
+    do a = 1, element_nvert(element)
+      e(1) = e(1) + g(1, a)*ue(2*a - 1)
+      e(2) = e(2) + g(2, a)*ue(2*a)
+      e(3) = e(3) + g(2, a)*ue(2*a - 1) + g(1, a)*ue(2*a)
+    end do
+    cs = matmul(d(:, 1:3), e)
+  end subroutine element_stress_general
 
 end module elements

@@ -26,10 +26,11 @@
 !! are written in the file's node and cell order.
 module mesh
   use kinds, only: wp
-  use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
+  use config, only: body_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
   implicit none (type, external)
   private
 
+  public :: assign_cell_laws
   public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes, &
             nodes_only, nodes_only_refusal, cell_element, cell_vertices, file_order, file_cells, file_dof
 
@@ -50,6 +51,13 @@ module mesh
     integer, allocatable :: node(:)            !< (nnode) their node ids
     logical :: point = .false.                 !< a Gmsh physical point (nedge = 0)
   end type edge_group_t
+
+  !> The body's cells in one physical surface of its mesh file other than the body's own
+  !! (a region: a coating, a ply, an insert).
+  type, public :: cell_group_t
+    character(len=:), allocatable :: name      !< the physical surface's name
+    integer, allocatable :: cell(:)            !< the body's cells in it
+  end type cell_group_t
 
   !> The mesh of one body (structured or general).
   type, public :: mesh_t
@@ -77,6 +85,11 @@ module mesh
     !> (ncell) a mesh from a file: each cell's place in the file's order of the body's
     !! cells; unallocated: the cells are in that order
     integer, allocatable :: file_cell(:)
+    integer :: nregion = 0                !< physical surfaces other than the body's with cells of it
+    type(cell_group_t), allocatable :: region(:)   !< (nregion) their cells
+    !> (ncell) the elastic law of each cell (an index into body_cfg_t%law; set by the driver
+    !! from the deck's regions); unallocated: law 1 everywhere
+    integer, allocatable :: cell_law(:)
     integer :: ngroup = 0                 !< named edge groups of this body
     type(edge_group_t), allocatable :: group(:)   !< (ngroup) the groups
     !> every physical curve name of the file, then '; physical points: ' and every physical
@@ -85,6 +98,68 @@ module mesh
   end type mesh_t
 
 contains
+
+  !> The elastic law of each cell (mesh%cell_law) from the body's laws (body_cfg_t%law: 1 the
+  !! body's own, then one per region, named by its physical surface): unallocated when the
+  !! body has one law. msg = '' on success; else a region that is no physical surface of the
+  !! body's cells, or a cell in two regions of different laws.
+  subroutine assign_cell_laws(mesh, body, msg, bad)
+    type(mesh_t), intent(inout) :: mesh               !< the body's mesh
+    type(body_cfg_t), intent(in) :: body              !< its laws
+    character(len=:), allocatable, intent(out) :: msg !< '' or why not
+    integer, intent(out) :: bad                       !< the law that fails (its region's), 0: none
+    integer :: k, r, j, c
+    character(len=:), allocatable :: names
+    msg = ''
+    bad = 0
+    if (allocated(mesh%cell_law)) deallocate (mesh%cell_law)
+    if (.not. allocated(body%law)) return
+    if (size(body%law) < 2) return
+    allocate (mesh%cell_law(mesh%ncell))
+    mesh%cell_law = 1
+    do k = 2, size(body%law)
+      r = 0
+      do j = 1, mesh%nregion
+        if (mesh%region(j)%name == trim(body%law(k)%region)) r = j
+      end do
+      bad = k
+      if (r == 0) then
+        names = ''
+        do j = 1, mesh%nregion
+          names = names//merge(', ', '  ', j > 1)//"'"//mesh%region(j)%name//"'"
+        end do
+        if (mesh%nregion == 0) then
+          msg = "the body's cells are in no physical surface '"//trim(body%law(k)%region)// &
+                "' (they are in no physical surface but the body's own)"
+        else
+          msg = "the body's cells are in no physical surface '"//trim(body%law(k)%region)// &
+                "' (the physical surfaces holding its cells: "//trim(adjustl(names))//')'
+        end if
+        return
+      end if
+      do j = 1, size(mesh%region(r)%cell)
+        c = mesh%region(r)%cell(j)
+        if (mesh%cell_law(c) /= 1) then
+          if (any(body%law(mesh%cell_law(c))%d /= body%law(k)%d)) then
+            msg = 'cell '//itoa(mesh%cell_tag(c))//" is in region '"//trim(body%law(mesh%cell_law(c))%region)// &
+                  "' and in region '"//trim(body%law(k)%region)//"', of different materials: a cell "// &
+                  'is of one material'
+            return
+          end if
+        end if
+        mesh%cell_law(c) = k
+      end do
+    end do
+    bad = 0
+  contains
+    function itoa(i) result(t)
+      integer, intent(in) :: i
+      character(len=:), allocatable :: t
+      character(len=16) :: buf
+      write (buf, '(i0)') i
+      t = trim(buf)
+    end function itoa
+  end subroutine assign_cell_laws
 
   !> Id of grid node (i,j), i = 0..nx, j = 0..ny.
   pure integer function node_id(mesh, i, j)

@@ -17,7 +17,7 @@ module mesh_topology
   use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use sorting, only: merge_sort_by_keys
-  use mesh, only: mesh_t
+  use mesh, only: mesh_t, cell_group_t
   implicit none (type, external)
   private
 
@@ -385,10 +385,45 @@ contains
     mesh%width = maxval(mesh%xy(1, :)) - mesh%x0
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
+    call cell_regions(file_mesh, surface, file_cell, mesh)
     call boundary_groups(file_mesh, body_node, order, mesh, err)
     if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh, err)
     if (.not. err%failed()) call number_for_locality(mesh, err)
   end subroutine body_from_file
+
+  !> The body's regions: each physical surface of the file other than the body's own
+  !! (`surface`) that holds cells of the body, with those cells (in file order, as numbered
+  !! before number_for_locality).
+  subroutine cell_regions(file_mesh, surface, file_cell, mesh)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: surface           ! the body's physical surface, 0: none
+    integer, intent(in) :: file_cell(:)      ! the body's cells in the file
+    type(mesh_t), intent(inout) :: mesh
+    integer :: k, c, e, n
+    integer, allocatable :: cells(:)
+    type(cell_group_t), allocatable :: tmp(:)
+    mesh%nregion = 0
+    allocate (mesh%region(0), cells(size(file_cell)))
+    do k = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(k) /= 2 .or. k == surface) cycle
+      n = 0
+      do c = 1, size(file_cell)
+        e = file_mesh%cell_entity(file_cell(c))
+        if (e == 0) cycle
+        if (any(file_mesh%ent(e)%phys == file_mesh%phys_tag(k))) then
+          n = n + 1
+          cells(n) = c
+        end if
+      end do
+      if (n == 0) cycle
+      allocate (tmp(mesh%nregion + 1))
+      tmp(1:mesh%nregion) = mesh%region
+      tmp(mesh%nregion + 1)%name = file_mesh%phys_name(k)%s
+      tmp(mesh%nregion + 1)%cell = cells(1:n)
+      call move_alloc(tmp, mesh%region)
+      mesh%nregion = mesh%nregion + 1
+    end do
+  end subroutine cell_regions
 
   !> The file's cells of the entities with in_entity(e) (e = 0..nent), in file order:
   !! from the cells of each entity (file_mesh%ent_cells) when those of several entities
@@ -481,6 +516,9 @@ contains
     mesh%cell_tag = mesh%cell_tag(mesh%file_cell)
     do g = 1, mesh%ngroup
       if (allocated(mesh%group(g)%cell)) mesh%group(g)%cell = new_cell(mesh%group(g)%cell)
+    end do
+    do g = 1, mesh%nregion
+      mesh%region(g)%cell = new_cell(mesh%region(g)%cell)
     end do
   end subroutine number_for_locality
 

@@ -10,7 +10,7 @@ module config
   implicit none (type, external)
   private
 
-  public :: deck_init, pair_oriented, stage_count, stage_steps, body_force_of
+  public :: deck_init, pair_oriented, stage_count, stage_steps, body_force_of, body_stiffness
 
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
@@ -112,6 +112,52 @@ module config
     character(len=16) :: stress = 'Pa'             !< stress unit name (force/length^2)
   end type units_cfg_t
 
+  integer, parameter, public :: MAT_ISOTROPIC = 1     !< young, poisson
+  integer, parameter, public :: MAT_ORTHOTROPIC = 2   !< e1, e2, e3, nu12, nu13, nu23, g12 in the material axes
+  integer, parameter, public :: MAT_ANISOTROPIC = 3   !< the stiffness constants c11 .. c66 in the material axes
+  character(len=*), parameter, public :: MAT_KIND_NAMES = 'isotropic orthotropic anisotropic'
+  !> Not given (a constant of a &material that its kind does not need, or left out).
+  real(wp), parameter, public :: UNSET = -huge(1.0_wp)
+
+  !> A named material (&material): its kind follows from the constants given. Orthotropic:
+  !! engineering constants of the material axes 1, 2 (in the plane, axis 1 at the body's or
+  !! region's `angle` from x) and 3 (out of the plane); anisotropic: the 3D stiffness in Voigt
+  !! order 1 = xx, 2 = yy, 3 = zz, 6 = xy of the material axes, z a plane of symmetry (the
+  !! constants coupling yz, xz to the rest are 0). Constants not given are UNSET.
+  type, public :: material_cfg_t
+    character(len=64) :: name = ''
+    integer :: kind = 0                     !< MAT_*, 0: not known yet
+    real(wp) :: young = UNSET, poisson = UNSET                     !< isotropic [stress], [-]
+    real(wp) :: e1 = UNSET, e2 = UNSET, e3 = UNSET                 !< orthotropic moduli [stress]
+    real(wp) :: nu12 = UNSET, nu13 = UNSET, nu23 = UNSET, g12 = UNSET   !< [-], [stress]
+    real(wp) :: c11 = UNSET, c12 = UNSET, c16 = UNSET, c22 = UNSET, c26 = UNSET, c66 = UNSET  !< [stress]
+    real(wp) :: c13 = UNSET, c23 = UNSET, c36 = UNSET, c33 = UNSET  !< out of the plane [stress]
+    real(wp) :: density = 0.0_wp            !< mass per volume [mass/length^3]
+    character(len=64) :: origin = ''        !< where the deck gave it ('line N', ...)
+  end type material_cfg_t
+
+  !> A part of a body from a mesh file, its cells those of a physical surface, made of a
+  !! material of its own (&region).
+  type, public :: region_cfg_t
+    integer :: body = 0                     !< body id
+    character(len=128) :: name = ''         !< the physical surface
+    character(len=64) :: material = ''      !< the material's name
+    real(wp) :: angle = 0.0_wp              !< material axis 1 from x [degrees]
+    character(len=64) :: origin = ''        !< where the deck gave it
+  end type region_cfg_t
+
+  !> The elastic law of a body or of one of its regions, for the scene's plane model, resolved
+  !! from the deck (deck_cross): stress (sxx, syy, sxy, szz) = d (exx, eyy, gxy, ezz); plane
+  !! strain: ezz = 0 (column 4 unused); plane stress: szz = 0 (row and column 4 are 0).
+  type, public :: elastic_law_t
+    character(len=128) :: region = ''       !< the physical surface of its cells ('': the body's own)
+    logical :: isotropic = .true.           !< then lame_lambda, lame_mu give d
+    real(wp) :: lame_lambda = 0.0_wp        !< (effective) first Lame parameter [stress]
+    real(wp) :: lame_mu = 0.0_wp            !< shear modulus [stress]
+    real(wp) :: d(4, 4) = 0.0_wp            !< the stiffness [stress]
+    real(wp) :: density = 0.0_wp            !< mass per volume [mass/length^3]
+  end type elastic_law_t
+
   !> One elastic body: a rectangle meshed by nx x ny cells, or the cells of a Gmsh file.
   type, public :: body_cfg_t
     integer :: id = 0                 !< 1 .. nbody
@@ -127,9 +173,14 @@ module config
     real(wp) :: young = 2.1e11_wp     !< Young's modulus [stress]
     real(wp) :: poisson = 0.3_wp      !< Poisson's ratio [-], in (-1, 0.5)
     real(wp) :: density = 0.0_wp      !< mass per volume [mass/length^3] (&body_force gravity)
+    character(len=64) :: material = ''  !< a &material's name ('': young, poisson, density above)
+    real(wp) :: angle = 0.0_wp        !< the material's axis 1 from x [degrees]
     integer :: bc(4) = BC_FREE        !< condition per side (SIDE_* order)
     real(wp) :: u_side(2, 4) = 0.0_wp !< prescribed displacement per side when bc = BC_DISPLACEMENT [length]
     integer :: side_stage(4) = 1      !< load stage of each side's prescribed displacement
+    !> its elastic laws, resolved from the deck: law(1) its own material, then one per &region
+    !! of the body in deck order (unallocated: young and poisson, isotropic)
+    type(elastic_law_t), allocatable :: law(:)
   end type body_cfg_t
 
   !> A traction on one side of a rectangle, t(s) = t0 + t1*s with s the global coordinate
@@ -230,6 +281,10 @@ module config
     type(traction_cfg_t), allocatable :: traction(:)  !< tractions (size >= ntraction)
     integer :: nbody_force = 0                        !< number of &body_force groups
     type(body_force_cfg_t), allocatable :: body_force(:)  !< body forces (size >= nbody_force)
+    integer :: nmaterial = 0                          !< number of &material groups
+    type(material_cfg_t), allocatable :: material(:)  !< named materials (size >= nmaterial)
+    integer :: nregion = 0                            !< number of &region groups
+    type(region_cfg_t), allocatable :: region(:)      !< regions of bodies (size >= nregion)
     integer :: nboundary = 0                          !< number of &boundary groups
     type(boundary_cfg_t), allocatable :: boundary(:)  !< prescribed components on groups (size >= nboundary)
     integer :: npair = 0                              !< number of contact pairs
@@ -271,23 +326,62 @@ contains
     end if
   end function pair_oriented
 
-  !> Body a's body force per volume [force/length^3] in each of nstage stages (columns):
-  !! the sum of the deck's &body_force groups on it or on every body, density x gravity +
-  !! force each.
+  !> Body a's body force per volume [force/length^3] in each of nstage stages (columns), for
+  !! each of its elastic laws (planes; one for a body without laws): the sum of the deck's
+  !! &body_force groups on it or on every body, density x gravity + force each, the density
+  !! the law's.
   pure function body_force_of(d, a, nstage) result(b)
     type(deck_t), intent(in) :: d   !< the deck
     integer, intent(in) :: a        !< body id
     integer, intent(in) :: nstage   !< the deck's stages (stage_count)
-    real(wp) :: b(2, nstage)
-    integer :: i
+    real(wp), allocatable :: b(:, :, :)
+    integer :: i, k, nlaw
+    nlaw = 1
+    if (allocated(d%body(a)%law)) nlaw = size(d%body(a)%law)
+    allocate (b(2, nstage, nlaw))
     b = 0.0_wp
-    do i = 1, d%nbody_force
-      associate (f => d%body_force(i))
-        if (f%body /= 0 .and. f%body /= a) cycle
-        b(:, f%stage) = b(:, f%stage) + d%body(a)%density*f%gravity + f%force
-      end associate
+    do k = 1, nlaw
+      do i = 1, d%nbody_force
+        associate (f => d%body_force(i))
+          if (f%body /= 0 .and. f%body /= a) cycle
+          if (allocated(d%body(a)%law)) then
+            b(:, f%stage, k) = b(:, f%stage, k) + d%body(a)%law(k)%density*f%gravity + f%force
+          else
+            b(:, f%stage, k) = b(:, f%stage, k) + d%body(a)%density*f%gravity + f%force
+          end if
+        end associate
+      end do
     end do
   end function body_force_of
+
+  !> The density of a body's own material (its `density`, or its &material's).
+  pure real(wp) function body_density(b)
+    type(body_cfg_t), intent(in) :: b
+    body_density = b%density
+    if (allocated(b%law)) body_density = b%law(1)%density
+  end function body_density
+
+  !> The range of a body's stiffness over its laws [stress]: Young's modulus for a body of
+  !! young and poisson; else the largest and the smallest diagonal entry of the plane
+  !! stiffness (the scales of K's entries, for the checks of the number range).
+  pure subroutine body_stiffness(b, lo, hi)
+    type(body_cfg_t), intent(in) :: b   !< the body
+    real(wp), intent(out) :: lo         !< the smallest [stress]
+    real(wp), intent(out) :: hi         !< the largest [stress]
+    integer :: k, i
+    lo = b%young
+    hi = b%young
+    if (.not. allocated(b%law)) return
+    if (len_trim(b%material) == 0 .and. size(b%law) == 1) return
+    lo = huge(1.0_wp)
+    hi = 0.0_wp
+    do k = 1, size(b%law)
+      do i = 1, 3
+        lo = min(lo, b%law(k)%d(i, i))
+        hi = max(hi, b%law(k)%d(i, i))
+      end do
+    end do
+  end subroutine body_stiffness
 
   !> The deck's load stages: the largest `stage=` of its load groups (1 without any).
   pure integer function stage_count(d) result(n)

@@ -2,7 +2,8 @@
 !! value by value and across fields, with clear messages on bad input, and rendered back as
 !! namelist text.
 !!
-!! Groups: `&scene`, `&body` (N of them, ids 1 to N), `&traction`, `&body_force`,
+!! Groups: `&scene`, `&material` and `&region` (any number), `&body` (N of them, ids 1 to N),
+!! `&traction`, `&body_force`,
 !! `&displacement` and `&boundary` (any number, any order), `&contact` (the two-body form once, or one per
 !! contact pair), `&solver`, `&output` (each at most once; all optional). Command-line
 !! overrides are namelist fragments applied after the deck: `&body id=2, young=1e9 /`
@@ -22,8 +23,8 @@ module deck
   use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, die_at, unknown_group
   use config, only: deck_t, ACCEL_AUTO, ACCEL_NONE, ACCEL_ANDERSON, STOP_AUTO, STOP_INCREMENT, STOP_RESIDUAL
   use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, add_body_force, &
-                         add_boundary, apply_displacement, add_contact
-  use deck_cross, only: check_cross
+                         add_boundary, apply_displacement, add_contact, add_material, add_region
+  use deck_cross, only: check_cross, resolve_materials
   use deck_render, only: deck_text, print_deck, deck_reference
   implicit none (type, external)
   private
@@ -38,7 +39,8 @@ module deck
     '       robin_contact --help | --version | --deck-reference'//NL// &
     '       mpirun -np N robin_contact_mpi DECK.nml ...   (factorization=''mumps'')'//NL// &
     '  DECK.nml  input deck of Fortran namelist groups: &scene, two or more &body (ids 1 to'//NL// &
-    '            N), any number of &traction, &body_force, &displacement and &boundary,'//NL// &
+    '            N), any number of &material, &region, &traction, &body_force,'//NL// &
+    '            &displacement and &boundary,'//NL// &
     '            &contact (one'//NL// &
     '            per contact pair; optional for two bodies on their ''contact'' sides),'//NL// &
     '            &solver, &output; /dev/stdin reads it from a pipe'//NL// &
@@ -55,7 +57,8 @@ module deck
     '  Documentation: README.md; doc/deck-reference.md (the output of --deck-reference);'//NL// &
     '  inputs/default.nml (the paper''s scene, every group commented).'
 
-  character(len=*), parameter :: GROUP_NAMES = 'scene body traction body_force displacement boundary contact solver output'
+  character(len=*), parameter :: GROUP_NAMES = &
+    'scene body material region traction body_force displacement boundary contact solver output'
 
 contains
 
@@ -98,6 +101,10 @@ contains
         cycle
       case ('body')
         call new_body(gs(i), src, d, st)
+      case ('material')
+        call add_material(gs(i), src, d, 'line '//i2s(gs(i)%line), .false.)
+      case ('region')
+        call add_region(gs(i), src, d, 'line '//i2s(gs(i)%line), .false.)
       case ('contact')
         call add_contact(gs(i), src, d, st)
       case default
@@ -138,6 +145,10 @@ contains
         select case (gs(i)%name)
         case ('body')
           call override_body(gs(i), src, d, st)
+        case ('material')
+          call add_material(gs(i), src, d, olabel, .true.)
+        case ('region')
+          call add_region(gs(i), src, d, olabel, .true.)
         case ('contact')
           call add_contact(gs(i), src, d, st)
         case ('traction')
@@ -156,6 +167,7 @@ contains
 
     if (len_trim(d%output%file) == 0) d%output%file = default_output(path)
     call check_cross(d, st)
+    call resolve_materials(d, st)
     ! the defaults that depend on the scene: two bodies in one pair keep the paper's stop and no
     ! acceleration; a chain of bodies passes its forces one contact per outer iteration
     if (d%solver%acceleration == ACCEL_AUTO) d%solver%acceleration = merge(ACCEL_NONE, ACCEL_ANDERSON, d%npair <= 1)

@@ -10,13 +10,15 @@ module deck_checks
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
-  use config, only: pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, &
+                    MAT_ISOTROPIC, MAT_ORTHOTROPIC, MAT_ANISOTROPIC, MAT_KIND_NAMES, UNSET, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t, &
                     FRICTION_TRESCA, FRICTION_COULOMB, MAX_STAGES, MAX_STEPS, STEPS_UNSET
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, body_force_vars, &
-                         traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars
+                         traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars, &
+                         material_vars, region_vars
   implicit none (type, external)
   private
 
@@ -24,7 +26,7 @@ module deck_checks
   real(wp), parameter :: SLIP_MAX = 1.0e20_wp  !< the largest Tresca bound accepted [stress]
 
   public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, add_body_force, &
-            apply_displacement, add_contact
+            apply_displacement, add_contact, add_material, add_region
 
 
   !> Where things came from, for cross-field messages.
@@ -480,6 +482,19 @@ contains
       'it must satisfy -1 < poisson < 0.5')
     if (.not. c%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(c%density), &
       'must be >= 0 (mass per volume)')
+    if (find_asg(g, 'material') > 0) then
+      do s = 1, 3
+        if (find_asg(g, trim(word('young poisson density', s))) > 0) call bad_value(g, src, &
+          trim(word('young poisson density', s)), '', 'is given with material = '//quote(trim(c%material))// &
+          ': the material holds the body''s constants; give one or the other')
+      end do
+      if (len_trim(c%material) == 0) call bad_value(g, src, 'material', "''", 'is empty: name a '// &
+        '&material, or leave material out and give young and poisson')
+    else if (find_asg(g, 'young') > 0 .or. find_asg(g, 'poisson') > 0 .or. find_asg(g, 'density') > 0) then
+      c%material = ''       ! an override's constants replace the body's material
+    end if
+    if (.not. abs(c%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', r2s(c%angle), &
+      'is out of range: an angle in degrees, at most 3600 in magnitude')
     c%id = b0%id
     do s = 1, 4
       if (c%bc(s) /= BC_DISPLACEMENT) c%u_side(:, s) = 0.0_wp
@@ -578,6 +593,176 @@ contains
     f%origin = '&body_force at '//origin
     d%body_force(n) = f
   end subroutine add_body_force
+
+  !> A &material group: a new material (deck), or a change of the one it names (override;
+  !! a new name there adds one). Its kind is that of the constants given; each constant in
+  !! its range.
+  subroutine add_material(g, src, d, origin, override)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    character(len=*), intent(in) :: origin
+    logical, intent(in) :: override
+    type(material_cfg_t), target :: m
+    type(material_cfg_t), allocatable :: tmp(:)
+    type(vars_t) :: v
+    character(len=*), parameter :: ISO = 'young poisson', &
+      ORTHO = 'e1 e2 e3 nu12 nu13 nu23 g12', ANISO = 'c11 c12 c16 c22 c26 c66 c13 c23 c36 c33'
+    character(len=40), parameter :: LISTS(3) = [character(len=40) :: ISO, ORTHO, ANISO]
+    character(len=:), allocatable :: first_name
+    integer :: n, k, j, kinds(3), kind
+    call material_vars(m, v)
+    call read_group(g, src, v)
+    if (len_trim(m%name) == 0) call bad_value(g, src, 'name', "''", 'is empty: a material needs a name')
+    n = 0
+    do k = 1, d%nmaterial
+      if (d%material(k)%name == m%name) n = k
+    end do
+    if (n > 0 .and. .not. override) call bad_value(g, src, 'name', quote(trim(m%name)), 'is used twice '// &
+      '(also by the '//trim(d%material(n)%origin)//'); each material once')
+    if (n > 0) then            ! an override: the material's values, changed by the group's
+      m = d%material(n)
+      call material_vars(m, v)
+      call read_group(g, src, v)
+    end if
+    ! the kind: the constants given (in this group, or before it for an override)
+    kinds = [(count_given(m, trim(LISTS(k))), k=1, 3)]
+    if (count(kinds > 0) > 1) then
+      first_name = ''
+      do k = 1, 3
+        if (kinds(k) == 0) cycle
+        j = first_given(m, trim(LISTS(k)))
+        first_name = first_name//merge(' and ', '     ', len(first_name) > 0)//trim(word(MAT_KIND_NAMES, k))// &
+                     ' ('//trim(word(LISTS(k), j))//')'
+      end do
+      call die_at(src, g%line, 'in group &material: material '//quote(trim(m%name))//' has constants of '// &
+        'two kinds: '//trim(adjustl(first_name))//'; give those of one kind: isotropic (young, poisson), '// &
+        'orthotropic (e1, e2, e3, nu12, nu13, nu23, g12) or anisotropic (c11 to c66)')
+    end if
+    if (all(kinds == 0)) call die_at(src, g%line, 'in group &material: material '//quote(trim(m%name))// &
+      ' has no elastic constant; give young and poisson (isotropic), e1, e2, nu12, g12 (orthotropic; '// &
+      'e3, nu13, nu23 too in plane strain) or c11, c12, c22, c66 (anisotropic)')
+    kind = maxloc(kinds, 1)
+    m%kind = merge(MAT_ISOTROPIC, merge(MAT_ORTHOTROPIC, MAT_ANISOTROPIC, kind == 2), kind == 1)
+    if (m%kind == MAT_ISOTROPIC) then
+      if (m%young == UNSET) call die_at(src, g%line, 'in group &material: isotropic material '// &
+        quote(trim(m%name))//' has poisson but no young; give both')
+      if (m%poisson == UNSET) call die_at(src, g%line, 'in group &material: isotropic material '// &
+        quote(trim(m%name))//' has young but no poisson; give both')
+      if (.not. m%young > 0.0_wp) call bad_value(g, src, 'young', r2s(m%young), 'must be > 0 (Young''s modulus)')
+      if (.not. (m%poisson > -1.0_wp .and. m%poisson < 0.5_wp)) call bad_value(g, src, 'poisson', &
+        r2s(m%poisson), 'is out of range: it must satisfy -1 < poisson < 0.5')
+    end if
+    do k = 1, 4
+      call positive(trim(word('e1 e2 e3 g12', k)), [m%e1, m%e2, m%e3, m%g12])
+    end do
+    if (.not. m%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(m%density), &
+      'must be >= 0 (mass per volume)')
+    if (n == 0) then
+      if (.not. allocated(d%material)) allocate (d%material(4))
+      n = d%nmaterial + 1
+      if (n > size(d%material)) then
+        allocate (tmp(2*size(d%material)))
+        tmp(1:n - 1) = d%material(1:n - 1)
+        call move_alloc(tmp, d%material)
+      end if
+      d%nmaterial = n
+      m%origin = '&material at '//origin
+    end if
+    d%material(n) = m
+  contains
+    subroutine positive(name, vals)
+      character(len=*), intent(in) :: name
+      real(wp), intent(in) :: vals(4)
+      real(wp) :: x
+      x = vals(k)
+      if (x /= UNSET .and. .not. x > 0.0_wp) call bad_value(g, src, name, r2s(x), 'must be > 0 (a modulus)')
+    end subroutine positive
+  end subroutine add_material
+
+  !> How many of the constants `names` material m has.
+  integer function count_given(m, names) result(n)
+    type(material_cfg_t), intent(in) :: m
+    character(len=*), intent(in) :: names
+    n = 0
+    if (first_given(m, names) > 0) n = 1
+  end function count_given
+
+  !> The first of the constants `names` (blank-separated) that m has, 0: none.
+  integer function first_given(m, names) result(j)
+    type(material_cfg_t), intent(in) :: m
+    character(len=*), intent(in) :: names
+    real(wp) :: x
+    do j = 1, 10
+      if (len_trim(word(names, j)) == 0) exit
+      select case (trim(word(names, j)))
+      case ('young'); x = m%young
+      case ('poisson'); x = m%poisson
+      case ('e1'); x = m%e1
+      case ('e2'); x = m%e2
+      case ('e3'); x = m%e3
+      case ('nu12'); x = m%nu12
+      case ('nu13'); x = m%nu13
+      case ('nu23'); x = m%nu23
+      case ('g12'); x = m%g12
+      case ('c11'); x = m%c11
+      case ('c12'); x = m%c12
+      case ('c16'); x = m%c16
+      case ('c22'); x = m%c22
+      case ('c26'); x = m%c26
+      case ('c66'); x = m%c66
+      case ('c13'); x = m%c13
+      case ('c23'); x = m%c23
+      case ('c36'); x = m%c36
+      case default; x = m%c33
+      end select
+      if (x /= UNSET) return
+    end do
+    j = 0
+  end function first_given
+
+  !> A &region group: a part of a body made of a material of its own (deck), or a change of
+  !! the region of that body and name (override).
+  subroutine add_region(g, src, d, origin, override)
+    type(grp_t), intent(in) :: g
+    type(src_t), intent(in) :: src
+    type(deck_t), intent(inout) :: d
+    character(len=*), intent(in) :: origin
+    logical, intent(in) :: override
+    type(region_cfg_t), target :: r
+    type(region_cfg_t), allocatable :: tmp(:)
+    type(vars_t) :: v
+    integer :: n, k
+    call region_vars(r, v)
+    call read_group(g, src, v)
+    call body_given(g, src, r%body, d%nbody)
+    if (len_trim(r%name) == 0) call bad_value(g, src, 'name', "''", 'is empty: name a physical surface '// &
+      'of the body''s mesh file')
+    if (len_trim(r%material) == 0) call bad_value(g, src, 'material', "''", 'is empty: a region is '// &
+      'made of a &material, named here')
+    if (.not. abs(r%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', r2s(r%angle), &
+      'is out of range: an angle in degrees, at most 3600 in magnitude')
+    n = 0
+    do k = 1, d%nregion
+      if (d%region(k)%body == r%body .and. d%region(k)%name == r%name) n = k
+    end do
+    if (n > 0 .and. .not. override) call bad_value(g, src, 'name', quote(trim(r%name)), 'is a region of '// &
+      'body '//i2s(r%body)//' twice (also the '//trim(d%region(n)%origin)//'); each region once')
+    if (n == 0) then
+      if (.not. allocated(d%region)) allocate (d%region(4))
+      n = d%nregion + 1
+      if (n > size(d%region)) then
+        allocate (tmp(2*size(d%region)))
+        tmp(1:n - 1) = d%region(1:n - 1)
+        call move_alloc(tmp, d%region)
+      end if
+      d%nregion = n
+      r%origin = '&region at '//origin
+    else
+      r%origin = d%region(n)%origin
+    end if
+    d%region(n) = r
+  end subroutine add_region
 
   !> A &boundary group (deck or override): prescribed components on a named edge group.
   subroutine add_boundary(g, src, d, origin)

@@ -6,15 +6,16 @@
 module deck_cross
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
-  use strings, only: i2s, r2s
+  use strings, only: i2s, r2s, word
   use sorting, only: merge_sort_by_keys
-  use config, only: deck_t, body_cfg_t, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
+  use config, only: deck_t, body_cfg_t, elastic_law_t, MAT_KIND_NAMES, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
                     BC_CONTACT, BC_DISPLACEMENT, bc_names, STEPS_UNSET, stage_count
   use deck_checks, only: state_t
+  use material_laws, only: isotropic_law, material_law
   implicit none (type, external)
   private
 
-  public :: check_cross
+  public :: check_cross, resolve_materials
 
 contains
 
@@ -30,7 +31,6 @@ contains
 
     p = st%path//': '
     call check_stages(d, st)
-    call check_body_forces(d, st)
     if (d%npair == 0) call fatal(EXIT_INPUT, p//'the deck has '//i2s(d%nbody)//' bodies and no '// &
       '&contact; name each contact pair with &contact bodies=A,B, groups=''GA'',''GB'' /')
     call check_pairs(d, st)
@@ -123,7 +123,8 @@ contains
     end if
   end subroutine check_stages
 
-  !> A gravity needs a density on every body it acts on.
+  !> A gravity needs a density on every body it acts on (in one of its materials at least;
+  !! the laws resolved).
   subroutine check_body_forces(d, st)
     type(deck_t), intent(in) :: d
     type(state_t), intent(in) :: st
@@ -136,7 +137,11 @@ contains
         if (f%body > 0) on = 'body '//i2s(f%body)
         do b = 1, d%nbody
           if (f%body /= 0 .and. f%body /= b) cycle
-          if (d%body(b)%density > 0.0_wp) cycle
+          if (maxval(d%body(b)%law%density) > 0.0_wp) cycle
+          if (len_trim(d%body(b)%material) > 0) call fatal(EXIT_INPUT, st%path//': the '//trim(f%origin)// &
+            ' gives gravity = '//r2s(f%gravity(1))//', '//r2s(f%gravity(2))//' on '//on//', but body '// &
+            i2s(b)//' ('//st%body_at(b)%s//') is of material '''//trim(d%body(b)%material)//''', whose '// &
+            'density = 0: give the &material density= (mass per volume), or a force per volume with force=')
           call fatal(EXIT_INPUT, st%path//': the '//trim(f%origin)//' gives gravity = '// &
             r2s(f%gravity(1))//', '//r2s(f%gravity(2))//' on '//on//', but body '//i2s(b)//' ('//st%body_at(b)%s//') has density = 0: give it '// &
             'density= (mass per volume), or a force per volume with force=')
@@ -316,5 +321,81 @@ contains
     s = 'left='''//trim(bc_names(b%bc(SIDE_LEFT)))//''', right='''//trim(bc_names(b%bc(SIDE_RIGHT)))// &
       ''', top='''//trim(bc_names(b%bc(SIDE_TOP)))//''', bottom='''//trim(bc_names(b%bc(SIDE_BOTTOM)))//''''
   end function side_list
+
+  !> Each body's elastic laws (body_cfg_t%law): law(1) its own material (its &material, or
+  !! young and poisson), then one per &region of the body, in deck order. Bad input: a
+  !! material= naming no &material, a &region on a rectangle or of an unknown material, a
+  !! material the scene's model cannot use (a constant missing, a tensor not positive definite).
+  subroutine resolve_materials(d, st)
+    type(deck_t), intent(inout) :: d
+    type(state_t), intent(in) :: st
+    integer :: b, k, i, n
+    character(len=:), allocatable :: msg
+
+    do k = 1, d%nmaterial     ! every material, used or not, is one the scene's model can use
+      block
+        type(elastic_law_t) :: law
+        call material_law(d%material(k), 0.0_wp, d%plane_strain, law, msg)
+        if (len(msg) > 0) call fatal(EXIT_INPUT, st%path//': the '//trim(d%material(k)%origin)// &
+          ' (material '''//trim(d%material(k)%name)//''', '//trim(word(MAT_KIND_NAMES, d%material(k)%kind))// &
+          ', in plane '//merge('strain', 'stress', d%plane_strain)//'): '//msg)
+      end block
+    end do
+    do b = 1, d%nbody
+      n = 1
+      do i = 1, d%nregion
+        if (d%region(i)%body == b) n = n + 1
+      end do
+      if (allocated(d%body(b)%law)) deallocate (d%body(b)%law)
+      allocate (d%body(b)%law(n))
+      if (len_trim(d%body(b)%material) == 0) then
+        call isotropic_law(d%body(b)%young, d%body(b)%poisson, d%plane_strain, d%body(b)%law(1))
+        d%body(b)%law(1)%density = d%body(b)%density
+      else
+        k = material_index(d, d%body(b)%material)
+        if (k == 0) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('//st%body_at(b)%s//'): material = '''// &
+          trim(d%body(b)%material)//''' names no &material ('//material_names(d)//')')
+        call material_law(d%material(k), d%body(b)%angle, d%plane_strain, d%body(b)%law(1), msg)
+      end if
+      n = 1
+      do i = 1, d%nregion
+        if (d%region(i)%body /= b) cycle
+        n = n + 1
+        if (len_trim(d%body(b)%mesh) == 0) call fatal(EXIT_INPUT, st%path//': the '// &
+          trim(d%region(i)%origin)//' is on body '//i2s(b)//', a rectangle ('//st%body_at(b)%s// &
+          '): a region is a physical surface of a mesh file; a rectangle is of one material')
+        k = material_index(d, d%region(i)%material)
+        if (k == 0) call fatal(EXIT_INPUT, st%path//': the '//trim(d%region(i)%origin)//': material = '''// &
+          trim(d%region(i)%material)//''' names no &material ('//material_names(d)//')')
+        d%body(b)%law(n)%region = d%region(i)%name
+        call material_law(d%material(k), d%region(i)%angle, d%plane_strain, d%body(b)%law(n), msg)
+      end do
+    end do
+    call check_body_forces(d, st)
+  end subroutine resolve_materials
+
+  integer function material_index(d, name) result(k)
+    type(deck_t), intent(in) :: d
+    character(len=*), intent(in) :: name
+    do k = 1, d%nmaterial
+      if (d%material(k)%name == name) return
+    end do
+    k = 0
+  end function material_index
+
+  !> The deck's materials for a message: 'the materials are 'a', 'b'' or 'the deck has no &material'.
+  function material_names(d) result(s)
+    type(deck_t), intent(in) :: d
+    character(len=:), allocatable :: s
+    integer :: k
+    if (d%nmaterial == 0) then
+      s = 'the deck has no &material'
+      return
+    end if
+    s = 'the materials are'
+    do k = 1, d%nmaterial
+      s = s//trim(merge(', ', '  ', k > 1))//' '''//trim(d%material(k)%name)//''''
+    end do
+  end function material_names
 
 end module deck_cross

@@ -4,11 +4,11 @@
 module deck_render
   use strings, only: text_buffer_t
   use namelist_vars, only: str_t, vars_t, render_group, reference_table
-  use config, only: deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, BC_DISPLACEMENT
+  use config, only: deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, material_cfg_t, region_cfg_t, BC_DISPLACEMENT
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, &
                          TWO_BODY_FORM, PAIR_FORM, &
                          scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, &
-                         contact_vars, solver_vars, output_vars, body_force_vars
+                         contact_vars, solver_vars, output_vars, body_force_vars, material_vars, region_vars
   implicit none (type, external)
   private
 
@@ -51,6 +51,22 @@ module deck_render
     '`&contact`): with `mesh`, a rectangle''s variable is bad input. A body that its supports '// &
     'leave free to move is held only by contact; the program finds that on the mesh and checks '// &
     'that the contact can hold it.'
+  character(len=*), parameter :: REF_MATERIAL = &
+    'A named material, for `&body material=` and `&region material=`. Optional, any number, each '// &
+    'name once. Its kind follows from the constants given: **isotropic** (`young`, `poisson`), '// &
+    '**orthotropic** (`e1`, `e2`, `nu12`, `g12` in the plane; `e3`, `nu13`, `nu23` too in plane '// &
+    'strain) or **anisotropic** (the stiffness `c11` ... `c66` in Voigt form); constants of two '// &
+    'kinds are bad input. The material axes 1, 2 lie in the plane, axis 1 at the `angle` of the '// &
+    'body or region that uses it; axis 3 is z. A material whose tensor is not positive definite '// &
+    'is bad input, its eigenvalues named.'
+  character(len=*), parameter :: REF_REGION = &
+    'A part of a body from a mesh file made of a material of its own: the body''s cells in a '// &
+    'physical surface of the file (a coating, a ply, an insert), bonded to the rest. Optional, any '// &
+    'number. In Gmsh, the body is a physical surface holding every part and each region a '// &
+    'physical surface of its own: `Physical Surface("punch") = {1, 2}; Physical Surface("coating") '// &
+    '= {2};`. Cells outside every region are of the body''s material; a body whose regions do not '// &
+    'cover it needs one (`material`, or `young` and `poisson`, given). A cell in two regions of '// &
+    'different materials is bad input.'
   character(len=*), parameter :: REF_TRACTION = &
     'A traction on part of a body''s boundary. Optional, any number; loads on one part add up. '// &
     'Either on a rectangle''s **side** (`side`, `t0`, `t1`): t(s) = t0 + t1*s with s the global '// &
@@ -121,9 +137,17 @@ contains
     sc%plane = merge(1, 2, c%plane_strain)
     call scene_vars(c, sc, v)
     call tb%add(render_group('scene', v, WIDTH))
+    do i = 1, c%nmaterial
+      call material_vars(c%material(i), v, rendering=.true.)
+      call tb%add(render_group('material', v, WIDTH))
+    end do
     do b = 1, c%nbody
       call body_vars(c%body(b), v, merge(GROUP_FORM, SIDE_FORM, len_trim(c%body(b)%mesh) > 0))
       call tb%add(render_group('body', v, WIDTH))
+    end do
+    do i = 1, c%nregion
+      call region_vars(c%region(i), v)
+      call tb%add(render_group('region', v, WIDTH))
     end do
     do i = 1, c%ntraction
       t%body = c%traction(i)%body
@@ -221,6 +245,14 @@ contains
     call body_vars(b, forms(1), SIDE_FORM)
     call body_vars(b, forms(2), GROUP_FORM)
     call section('body', REF_BODY, reference_table(v, forms, [str_t('rectangle'), str_t('mesh file')]))
+    block
+      type(material_cfg_t), target :: m
+      type(region_cfg_t), target :: r
+      call material_vars(m, v)
+      call section('material', REF_MATERIAL, reference_table(v))
+      call region_vars(r, v)
+      call section('region', REF_REGION, reference_table(v))
+    end block
     call traction_vars(t, v, ALL_FORMS)
     call traction_vars(t, forms(1), SIDE_FORM)
     call traction_vars(t, forms(2), GROUP_FORM)

@@ -6,7 +6,7 @@
 module deck_tables
   use kinds, only: wp
   use namelist_vars, only: vars_t
-  use config, only: deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
+  use config, only: deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, UNSET, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
                     ORDER_CHOICES, ACCEL_CHOICES, XDMF_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
@@ -17,7 +17,7 @@ module deck_tables
   public :: scene_in_t, load_in_t
   public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, TWO_BODY_FORM, PAIR_FORM
   public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
-            solver_vars, output_vars, body_force_vars
+            solver_vars, output_vars, body_force_vars, material_vars, region_vars
 
   ! the documentation of `stage`, shared by the load groups
   character(len=*), parameter :: STAGE_DOC = &
@@ -101,13 +101,24 @@ contains
         '(2x2 Gauss); `''P1''`: linear triangles, each cell split along its lower-left/upper-right '// &
         'diagonal')
     end if
-    call v%real('young', b%young, unit='[stress]', range='> 0', doc='Young''s modulus')
-    call v%real('poisson', b%poisson, unit='[-]', range='-1 < poisson < 0.5', doc='Poisson''s '// &
-      'ratio; 0.5 (an incompressible material) is rejected: this displacement formulation '// &
-      'cannot model it')
-    call v%real('density', b%density, unit='[mass/length^3]', range='>= 0', doc='mass per '// &
-      'volume, for `&body_force gravity`; mass in force x time^2 / length: kg with SI units, '// &
-      'tonnes with mm-N-MPa (steel: 7850 and 7.85e-9)')
+    if (form == ALL_FORMS .or. len_trim(b%material) > 0) then
+      call v%str('material', b%material, doc='the name of a `&material`: the body is made of it '// &
+        '(its cells outside every `&region`); give `material` or `young`, `poisson`, `density`, '// &
+        'not both. Rendered only when given')
+    end if
+    if (form == ALL_FORMS .or. b%angle /= 0.0_wp) call v%real('angle', b%angle, unit='[degrees]', &
+      doc='the direction of the material''s axis 1 (orthotropic and anisotropic materials), from x '// &
+      'counter-clockwise. Rendered only when not 0')
+    if (form == ALL_FORMS .or. len_trim(b%material) == 0) then
+      call v%real('young', b%young, unit='[stress]', range='> 0', doc='Young''s modulus of the '// &
+        'body''s isotropic material (without `material`)')
+      call v%real('poisson', b%poisson, unit='[-]', range='-1 < poisson < 0.5', doc='Poisson''s '// &
+        'ratio; 0.5 (an incompressible material) is rejected: this displacement formulation '// &
+        'cannot model it')
+      call v%real('density', b%density, unit='[mass/length^3]', range='>= 0', doc='mass per '// &
+        'volume, for `&body_force gravity`; mass in force x time^2 / length: kg with SI units, '// &
+        'tonnes with mm-N-MPa (steel: 7850 and 7.85e-9)')
+    end if
     if (form /= GROUP_FORM) then
       call v%enum('left', b%bc(SIDE_LEFT), BC_CHOICES, base=BC_FREE, doc='condition on the side '// &
         'x = x0: `''free''` (traction-free unless a `&traction` loads it), `''clamped''` (u = 0), '// &
@@ -176,6 +187,69 @@ contains
       'the density; added to the gravity''s')
     call v%int('stage', f%stage, range='>= 1', doc=STAGE_DOC)
   end subroutine body_force_vars
+
+  !> &material: every variable for reading; rendering (`rendering`) the ones given.
+  subroutine material_vars(m, v, rendering)
+    type(material_cfg_t), target, intent(inout) :: m
+    type(vars_t), intent(out) :: v
+    logical, intent(in), optional :: rendering
+    logical :: all_vars
+    all_vars = .true.
+    if (present(rendering)) all_vars = .not. rendering
+    call v%str('name', m%name, required=.true., doc='the material''s name, by which `&body` and '// &
+      '`&region` use it; each name once')
+    call opt('young', m%young, '[stress]', '> 0', 'isotropic: Young''s modulus')
+    call opt('poisson', m%poisson, '[-]', '-1 < poisson < 0.5', 'isotropic: Poisson''s ratio')
+    call opt('e1', m%e1, '[stress]', '> 0', 'orthotropic: the modulus along the material''s axis '// &
+      '1 (in the plane, at the body''s or region''s `angle` from x)')
+    call opt('e2', m%e2, '[stress]', '> 0', 'orthotropic: the modulus along axis 2 (in the plane)')
+    call opt('e3', m%e3, '[stress]', '> 0', 'orthotropic: the modulus along axis 3 (out of the '// &
+      'plane); plane strain only')
+    call opt('nu12', m%nu12, '[-]', '', 'orthotropic: the contraction along 2 under a stress '// &
+      'along 1 (nu12/e1 = nu21/e2); the Poisson''s ratios must leave the compliance positive '// &
+      'definite (nu12^2 < e1/e2, ...)')
+    call opt('nu13', m%nu13, '[-]', '', 'orthotropic: the contraction along 3 under a stress '// &
+      'along 1; plane strain only')
+    call opt('nu23', m%nu23, '[-]', '', 'orthotropic: the contraction along 3 under a stress '// &
+      'along 2; plane strain only')
+    call opt('g12', m%g12, '[stress]', '> 0', 'orthotropic: the in-plane shear modulus')
+    call opt('c11', m%c11, '[stress]', '', 'anisotropic: the stiffness in Voigt order 1 = xx, '// &
+      '2 = yy, 3 = zz, 6 = xy of the material axes: sxx = c11 exx + c12 eyy + c13 ezz + c16 gxy, '// &
+      '...; it must be positive definite')
+    call opt('c12', m%c12, '[stress]', '', 'anisotropic: xx-yy')
+    call opt('c16', m%c16, '[stress]', '', 'anisotropic: xx-xy; not given: 0')
+    call opt('c22', m%c22, '[stress]', '', 'anisotropic: yy-yy')
+    call opt('c26', m%c26, '[stress]', '', 'anisotropic: yy-xy; not given: 0')
+    call opt('c66', m%c66, '[stress]', '', 'anisotropic: xy-xy')
+    call opt('c13', m%c13, '[stress]', '', 'anisotropic: xx-zz; plane strain needs c13 and c23; '// &
+      'in plane stress c13, c23, c33 are given together (ezz condensed out) or not at all (c11 '// &
+      'to c66 are then the plane-stress stiffness)')
+    call opt('c23', m%c23, '[stress]', '', 'anisotropic: yy-zz')
+    call opt('c36', m%c36, '[stress]', '', 'anisotropic: zz-xy; not given: 0')
+    call opt('c33', m%c33, '[stress]', '', 'anisotropic: zz-zz')
+    if (all_vars .or. m%density /= 0.0_wp) call v%real('density', m%density, unit='[mass/length^3]', &
+      range='>= 0', doc='mass per volume, for `&body_force gravity` (as `&body density`). '// &
+      'Rendered only when not 0')
+  contains
+    subroutine opt(name, x, unit, range, doc)
+      character(len=*), intent(in) :: name, unit, range, doc
+      real(wp), target, intent(inout) :: x
+      if (all_vars .or. x /= UNSET) call v%real(name, x, unit=unit, range=range, doc=doc)
+    end subroutine opt
+  end subroutine material_vars
+
+  !> &region: every variable (reading and rendering alike).
+  subroutine region_vars(r, v)
+    type(region_cfg_t), target, intent(inout) :: r
+    type(vars_t), intent(out) :: v
+    call v%int('body', r%body, range='1 to N', required=.true., doc='the body, from a mesh file')
+    call v%str('name', r%name, required=.true., doc='a physical surface of the body''s mesh file '// &
+      'whose cells (those of the body) are this region; each region of a body once')
+    call v%str('material', r%material, required=.true., doc='the name of the `&material` the '// &
+      'region is made of')
+    call v%real('angle', r%angle, unit='[degrees]', doc='the direction of the material''s axis 1 in '// &
+      'the region, from x counter-clockwise')
+  end subroutine region_vars
 
   !> &displacement: `form` ALL_FORMS reads every variable, SIDE_FORM renders one.
   subroutine displacement_vars(t, v, form)

@@ -334,6 +334,7 @@ contains
           if (v%nval == 1) then
             typ = 'real'
             def = '`'//r2s(v%rs)//'`'
+            if (v%rs == -huge(1.0_wp)) def = 'not given'
           else
             typ = 'real pair (x, y)'
             def = '`'//r2s(v%rv(1))//', '//r2s(v%rv(2))//'`'

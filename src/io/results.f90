@@ -19,7 +19,7 @@ module results
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files, data_open, data_write, data_close
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE, &
-                    XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX
+                    XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof
   use assembly, only: body_system_t, nodal_stress, support_reactions
@@ -347,9 +347,7 @@ contains
     do a = 1, size(msh)
       call group_open(fid, body_group_name(a), gid, st, create=.true.)
       call write_attr(gid, 'element', trim(element_names(msh(a)%element)), st)
-      call write_attr(gid, 'young', d%body(a)%young, st)
-      call write_attr(gid, 'density', d%body(a)%density, st)
-      call write_attr(gid, 'poisson', d%body(a)%poisson, st)
+      call write_material(gid, d, a, st)
       call write_attr(gid, 'free_dofs', sys(a)%n, st)
       ! a body held only by contact: its free rigid motions, their amplitudes (the
       ! displacement includes them) and the fixing DOFs of the generalized inverse
@@ -1046,5 +1044,37 @@ contains
     character(len=:), allocatable :: t
     t = s//achar(10)
   end function line
+
+  !> A body's material attributes: young, poisson, density of its isotropic material (its own
+  !! or a &material's); with a &material its name and angle too; with regions their names.
+  subroutine write_material(gid, d, a, st)
+    integer(hid_t), intent(in) :: gid
+    type(deck_t), intent(in) :: d
+    integer, intent(in) :: a
+    type(error_t), intent(inout) :: st
+    integer :: k, i
+    character(len=:), allocatable :: names
+    if (len_trim(d%body(a)%material) == 0) then
+      call write_attr(gid, 'young', d%body(a)%young, st)
+      call write_attr(gid, 'density', d%body(a)%density, st)
+      call write_attr(gid, 'poisson', d%body(a)%poisson, st)
+    else
+      call write_attr(gid, 'material', trim(d%body(a)%material), st)
+      call write_attr(gid, 'angle', d%body(a)%angle, st)
+      do k = 1, d%nmaterial
+        if (d%material(k)%name /= d%body(a)%material) cycle
+        call write_attr(gid, 'density', d%material(k)%density, st)
+        if (d%material(k)%kind /= MAT_ISOTROPIC) cycle
+        call write_attr(gid, 'young', d%material(k)%young, st)
+        call write_attr(gid, 'poisson', d%material(k)%poisson, st)
+      end do
+    end if
+    names = ''
+    do i = 1, d%nregion
+      if (d%region(i)%body == a) names = names//merge(', ', '  ', len(names) > 0)//trim(d%region(i)%name)// &
+                                         ' ('//trim(d%region(i)%material)//')'
+    end do
+    if (len(names) > 0) call write_attr(gid, 'regions', trim(adjustl(names)), st)
+  end subroutine write_material
 
 end module results

@@ -21,7 +21,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 BIN = os.path.abspath(os.environ.get("BIN", "bin/robin_contact"))
 DOC = os.path.join(ROOT, "doc", "deck-reference.md")
 DECK = os.path.join(ROOT, "inputs", "table1", "q1_3x1.nml")   # the smallest shipped deck
-GROUPS = ["scene", "body", "traction", "body_force", "displacement", "boundary", "contact", "solver", "output"]
+GROUPS = ["scene", "body", "material", "region", "traction", "body_force", "displacement", "boundary", "contact", "solver", "output"]
 REGENERATE = "regenerate it: bin/robin_contact --deck-reference > doc/deck-reference.md"
 check = Checks()
 work = tempfile.mkdtemp(prefix="test_cli_")   # runs happen here: a stray result lands nowhere else
@@ -130,6 +130,8 @@ for g in GROUPS:
     check(body is not None, f"src/input/deck_tables.f90 has {g}_vars")
     if body:
         declared[g] = dict((n, k) for k, n in re.findall(r"call v%(ints|int|list|real|pair|strs|str|enum)\('(\w+)'", body.group(0)))
+        # &material's optional constants go through its helper opt (a real each)
+        declared[g].update((n, "real") for n in re.findall(r"call opt\('(\w+)'", body.group(0)))
 nvar = 0
 for g, names in declared.items():
     got = ref_tables.get(g, {})
@@ -209,6 +211,14 @@ def override(group, var, value):
             return [f"&body id={value} /"]
         return [f"&body id=1, {var}={value} /", f"&body id=2, {var}={value} /"]
     body = "" if var == "body" else "body=1, "
+    if group == "material":   # a material of the kind the variable belongs to, all else valid
+        base = {"young": 2e11, "poisson": 0.3}
+        if var in ("e1", "e2", "e3", "g12"):
+            base = {"e1": 2e11, "e2": 1e11, "e3": 1e11, "nu12": 0.3, "nu13": 0.3, "nu23": 0.3, "g12": 5e10}
+        base[var] = value
+        return ["&material name='probe', " + ", ".join(f"{k}={v}" for k, v in base.items()) + " /"]
+    if group == "region":
+        return [f"&region {var}={value}, name='r', material='m' /"]
     if group == "traction":
         return [f"&traction {body}{var}={value}, side='top' /"]
     if group == "displacement":
