@@ -154,7 +154,7 @@ $(BUILD)/stiffness_pattern.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config
 $(BUILD)/rigid_modes.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
 $(BUILD)/assembly.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
                            $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/body_system.o $(BUILD)/supports.o \
-                           $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o
+                           $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o $(BUILD)/material_laws.o
 $(BUILD)/ordering.o:       $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
