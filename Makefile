@@ -393,6 +393,8 @@ meshes:
 	   $(GMSH_MSH) pin_hole.geo -o pin_hole.msh; \
 	   $(GMSH_MSH) cylinders.geo -o cylinders.msh; \
 	   $(GMSH_MSH) shrink_fit.geo -o shrink_fit.msh; \
+	   $(GMSH_MSH) -setnumber h 0.00025 coated_punch.geo -o coated_punch.msh; \
+	   for h in 0.02 0.01 0.005; do $(GMSH_MSH) -setnumber h $$h sphere_flat.geo -o sphere_flat_h$$h.msh; done; \
 	   for n in 8 16 32; do $(GMSH_MSH) -setnumber n $$n cattaneo_disc.geo -o cattaneo_disc_a$$n.msh; done; \
 	   for n in 12:18 24:36 48:72; do nu=$${n%:*}; nl=$${n#*:}; \
 	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \

@@ -448,7 +448,7 @@ contains
       removable = .false.
       if (present(taken)) removable = taken(1:ms%nnode)
       call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, mt, why, &
-                        ms%node_tag, mm%node_tag)
+                        ms%node_tag, mm%node_tag, ms%axisymmetric)
       if (.not. why%failed()) then
         do j = 1, mt%m
           removable(mt%snode(j)) = normal_fixed(sys(cc%bodies(sl)), mt%snode(j), mt%normal(:, j))
@@ -458,7 +458,7 @@ contains
           end do
         end do
         if (any(removable)) call mortar_build(ms%xy, ms%group(g(sl))%edge, removable, mm%xy, mm%group(g(ma))%edge, &
-                                              mt, why, ms%node_tag, mm%node_tag)
+                                              mt, why, ms%node_tag, mm%node_tag, ms%axisymmetric)
       end if
       if (why%failed()) then
         call err%set(ERR_INPUT, 'contact group '''//trim(cc%body_group(sl))//''' of body '//i2s(cc%bodies(sl))// &

@@ -106,6 +106,7 @@ module mortar
     integer :: nes = 0, nem = 0                 ! slave and master edges
     integer, allocatable :: cs(:), cm(:)        ! (0:ne) slave and master nodes in chain order
     logical :: closed = .false.                 ! the slave chain is a closed loop
+    logical :: axisym = .false.                 ! meridian sections: every integral weighted by r = x
     real(wp), allocatable :: slen(:)            ! (nes) slave segment lengths
     real(wp), allocatable :: arc(:)             ! (0:nes) arc length of the slave chain nodes
     real(wp), allocatable :: nn(:, :)           ! (2, 0:nes) slave nodal unit normals
@@ -126,7 +127,7 @@ contains
   !> Build the dual mortar rows of a slave contact chain against a master chain.
   !! err (ERR_INPUT, naming the side and the edge or node) on bad input, or when no slave
   !! node ends up with a row (no overlap, master edges facing away, all removable).
-  subroutine mortar_build(xs, es, removable, xm, em, mt, err, tag_s, tag_m)
+  subroutine mortar_build(xs, es, removable, xm, em, mt, err, tag_s, tag_m, axisymmetric)
     real(wp), intent(in) :: xs(:, :)        !< (2, nnode_s) slave body node coordinates [length]
     integer, intent(in) :: es(:, :)         !< (2, ne_s) slave contact edges (node ids), slave body on the left of es(1)->es(2)
     logical, intent(in) :: removable(:)     !< (nnode_s) the slave node may carry no multiplier (normal displacement prescribed on both bodies)
@@ -135,6 +136,9 @@ contains
     type(mortar_t), intent(out) :: mt       !< the constraint rows
     type(error_t), intent(out) :: err       !< the bad input, if any
     integer, intent(in), optional :: tag_s(:), tag_m(:)   !< (nnode_s), (nnode_m) node tags for messages
+    !> meridian sections of bodies of revolution (x = r): D, M and the dual functions of the
+    !! r-weighted arc length r ds (per radian), the dual basis biorthogonal in it
+    logical, intent(in), optional :: axisymmetric
     type(mortar_work_t) :: w
     logical :: mclosed
     integer :: i, iter, nbad
@@ -147,6 +151,7 @@ contains
       call err%set(ERR_INPUT, 'mortar: removable has '//i2s(size(removable))//' entries for '//i2s(size(xs, 2))//' slave nodes')
       return
     end if
+    if (present(axisymmetric)) w%axisym = axisymmetric
     call chain_order(xs, es, 'slave', w%cs, w%closed, err, tag_s)
     if (err%failed()) return
     call chain_order(xm, em, 'master', w%cm, mclosed, err, tag_m)
@@ -383,7 +388,7 @@ contains
     integer :: j, m, cap, ns_, nm_, side, kk, other, ii, g, l, l1, l2, e, e2, pc, s0, m0_, nlast
     integer, allocatable :: pos(:)
     real(wp) :: dj, ws(-1:1), xa(2), xb(2), c0(2), c1(2), mm0(2), mm1(2), p1(2), dq(2), half, mid, xi, w, &
-                ph, p(2), ng(2), den, t, sw, g0
+                ph, p(2), ng(2), den, t, sw, g0, rj, ro, aown, aoth, det
     logical :: dual, isb
 
     associate (nes => wk%nes, closed => wk%closed, cs => wk%cs, cm => wk%cm, nn => wk%nn, slen => wk%slen, &
@@ -433,12 +438,33 @@ contains
           other = ii + side
           if (other < 0) other = nes - 1
           dual = isrow(other)
-          dj = dj + 0.5_wp * slen(kk)
-          if (full(kk)) then
-            ws(0) = ws(0) + 0.5_wp * slen(kk)
-            if (.not. dual) ws(side) = ws(side) + 0.5_wp * slen(kk)
-          end if
           xa = xs(:, cs(kk - 1)); xb = xs(:, cs(kk))
+          if (wk%axisym) then
+            ! r-weighted: int N_j r ds = L/6 (2 r_j + r_o); the dual function of this node on the
+            ! segment Phi_j = aown N_j + aoth N_o, the row of D_e M_e^-1 (M_e the segment's
+            ! r-weighted mass matrix, D_e its row sums): (2, -1) where r is constant
+            rj = merge(xb(1), xa(1), isb)
+            ro = merge(xa(1), xb(1), isb)
+            dj = dj + slen(kk) / 6.0_wp * (2.0_wp * rj + ro)
+            if (full(kk)) then
+              ws(0) = ws(0) + slen(kk) / 6.0_wp * (2.0_wp * rj + ro)
+              if (.not. dual) ws(side) = ws(side) + slen(kk) / 6.0_wp * (rj + 2.0_wp * ro)
+            end if
+            det = 2.0_wp * rj * rj + 8.0_wp * rj * ro + 2.0_wp * ro * ro
+            if (det > 0.0_wp) then
+              aown = 2.0_wp * (2.0_wp * rj + ro) * (rj + 3.0_wp * ro) / det
+              aoth = -2.0_wp * (2.0_wp * rj + ro) * (rj + ro) / det
+            else                     ! a segment on the axis: r = 0, it adds nothing
+              aown = 2.0_wp
+              aoth = -1.0_wp
+            end if
+          else
+            dj = dj + 0.5_wp * slen(kk)
+            if (full(kk)) then
+              ws(0) = ws(0) + 0.5_wp * slen(kk)
+              if (.not. dual) ws(side) = ws(side) + 0.5_wp * slen(kk)
+            end if
+          end if
           c0 = 0.5_wp * (xa + xb); c1 = 0.5_wp * (xb - xa)
           mm0 = 0.5_wp * (nn(:, kk - 1) + nn(:, kk)); mm1 = 0.5_wp * (nn(:, kk) - nn(:, kk - 1))
           do e = kptr(kk), kptr(kk + 1) - 1
@@ -452,12 +478,17 @@ contains
               w = GW(g) * half * 0.5_wp * slen(kk)
               if (.not. dual) then
                 ph = 1.0_wp
+              else if (wk%axisym .and. isb) then
+                ph = aown * 0.5_wp * (1.0_wp + xi) + aoth * 0.5_wp * (1.0_wp - xi)
+              else if (wk%axisym) then
+                ph = aown * 0.5_wp * (1.0_wp - xi) + aoth * 0.5_wp * (1.0_wp + xi)
               else if (isb) then
                 ph = 0.5_wp * (1.0_wp + 3.0_wp * xi)
               else
                 ph = 0.5_wp * (1.0_wp - 3.0_wp * xi)
               end if
               p = c0 + xi * c1
+              if (wk%axisym) w = w * p(1)
               ng = mm0 + xi * mm1
               den = cross(dq, ng)
               if (den /= 0.0_wp) then

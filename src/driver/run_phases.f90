@@ -168,6 +168,17 @@ contains
       do a = 1, deck%nbody   ! the mesh reader's message names the body
         call fail_on(err(a), 'deck '//trim(deck%source))
       end do
+      do a = 1, deck%nbody   ! a meridian section lies at x = r >= 0
+        run%meshes(a)%axisymmetric = deck%axisymmetric
+        if (.not. deck%axisymmetric) cycle
+        associate (xy => run%meshes(a)%xy)
+          if (minval(xy(1, :)) < -1.0e-9_wp*max(maxval(xy(1, :)) - minval(xy(1, :)), &
+                                                 maxval(xy(2, :)) - minval(xy(2, :)))) &
+            call fail_on(error_t(ERR_INPUT, 'body '//i2s(a)//": mesh file '"//trim(deck%body(a)%mesh)// &
+              "': a node lies at x = "//sci(minval(xy(1, :)))//', below the axis: with &scene plane = '// &
+              "'axisymmetric' x is the radius, every node at x >= 0"), 'deck '//trim(deck%source))
+        end associate
+      end do
       do a = 1, deck%nbody   ! each cell's material, from the deck's regions
         block
           character(len=:), allocatable :: msg

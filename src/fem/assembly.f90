@@ -22,7 +22,8 @@ module assembly
   use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress, &
-                      element_shape_integrals, element_stress_general
+                      element_shape_integrals, element_stress_general, axi_stiffness, axi_stress, &
+                      axi_shape_integrals
   use material_laws, only: isotropic_law
   use linop, only: csc_symv
   use body_system, only: body_system_t
@@ -155,8 +156,9 @@ contains
         return
       end if
     end if
+    if (mesh%axisymmetric) call axis_conditions(mesh, prescribed, sys)
     ! rigid motions the supports leave free: a body held only by contact
-    call rigid_kernel(mesh, prescribed, sys, err)
+    call rigid_kernel(mesh, prescribed, sys, err, mesh%axisymmetric)
     if (err%failed()) return
     if (sys%nrig > 0) then
       call choose_fixing(mesh, body, prescribed, sys, err, contact_groups)
@@ -304,6 +306,23 @@ contains
       end if
     end if
   end subroutine check_input
+
+  !> A meridian section's nodes on the axis (x within 1e-9 of the section's extent of 0)
+  !! have ur = 0: prescribed, a support of no load.
+  subroutine axis_conditions(mesh, prescribed, sys)
+    type(mesh_t), intent(in) :: mesh
+    logical, intent(inout) :: prescribed(:)
+    type(body_system_t), intent(inout) :: sys
+    real(wp) :: tol
+    integer :: k
+    tol = 1.0e-9_wp*max(maxval(mesh%xy(1, :)) - minval(mesh%xy(1, :)), maxval(mesh%xy(2, :)) - minval(mesh%xy(2, :)))
+    do k = 1, mesh%nnode
+      if (abs(mesh%xy(1, k)) > tol) cycle
+      prescribed(2*k - 1) = .true.
+      sys%u_fixed(2*k - 1) = 0.0_wp
+      sys%dof_stage(2*k - 1) = 0
+    end do
+  end subroutine axis_conditions
 
   !> The kernel is computed, not guessed: |K R| over the DOFs that are not prescribed
   !! (fixing DOFs included) must be at rounding level, 1e-9 |K| |R|. err = ERR_INPUT otherwise.
@@ -491,7 +510,7 @@ contains
     character(len=512) :: emsg
     nd = 2*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
-    call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache)
+    call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache, mesh%axisymmetric)
     if (.not. (minjac > 0.0_wp)) then
       write (emsg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
         ' has a non-positive Jacobian (inverted or degenerate element)'
@@ -503,13 +522,16 @@ contains
 
   !> The stiffness of a cell of element `element` and law k of `laws`: the isotropic kernel
   !! (Lame parameters) or the general one (its plane stiffness).
-  pure subroutine law_stiffness(element, xe, laws, k, ke, minjac, cache)
+  pure subroutine law_stiffness(element, xe, laws, k, ke, minjac, cache, axisymmetric)
     integer, intent(in) :: element, k
     real(wp), intent(in) :: xe(2, MAX_NVERT)
     type(elastic_law_t), intent(in) :: laws(:)
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF), minjac
     type(ke_cache_t), intent(inout) :: cache
-    if (laws(k)%isotropic) then
+    logical, intent(in) :: axisymmetric        ! a meridian section: per radian, with the hoop strain
+    if (axisymmetric) then     ! no cache: a translate in r is not the same cell
+      call axi_stiffness(element, xe, laws(k)%d, ke, minjac)
+    else if (laws(k)%isotropic) then
       call element_stiffness(element, xe, laws(k)%lame_lambda, laws(k)%lame_mu, ke, minjac, cache, key=k)
     else
       call element_stiffness(element, xe, 0.0_wp, 0.0_wp, ke, minjac, cache, dmat=laws(k)%d, key=k)
@@ -672,7 +694,7 @@ contains
       nd = 2*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
-      call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache)
+      call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache, mesh%axisymmetric)
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
       if (present(mag)) then
@@ -730,7 +752,9 @@ contains
       call cell_dofs(mesh, c, ldof)
       ue(1:nd) = u_full(ldof(1:nd))
       law = law_of(mesh, c)
-      if (laws(law)%isotropic) then
+      if (mesh%axisymmetric) then
+        call axi_stress(cell_element(mesh, c), xe, ue, laws(law)%d, cs)
+      else if (laws(law)%isotropic) then
         call element_stress(cell_element(mesh, c), xe, ue, laws(law)%lame_lambda, laws(law)%lame_mu, plane_strain, cs)
       else
         call element_stress_general(cell_element(mesh, c), xe, ue, laws(law)%d, cs)
@@ -805,7 +829,7 @@ contains
       nb = nodes(e + 1)
       fe(:, 1) = f(2*na - 1:2*na)
       fe(:, 2) = f(2*nb - 1:2*nb)
-      call edge_traction(mesh%xy(:, na), mesh%xy(:, nb), coord, tr%t0, tr%t1, fe)
+      call edge_traction(mesh%xy(:, na), mesh%xy(:, nb), coord, tr%t0, tr%t1, fe, mesh%axisymmetric)
       f(2*na - 1:2*na) = fe(:, 1)
       f(2*nb - 1:2*nb) = fe(:, 2)
     end do
@@ -830,10 +854,34 @@ contains
       nrm = [xb(2) - xa(2), -(xb(1) - xa(1))]/len
       ta = tr%t0 + tr%tx*xa(1) + tr%ty*xa(2) - tr%pressure*nrm
       tb = tr%t0 + tr%tx*xb(1) + tr%ty*xb(2) - tr%pressure*nrm
-      f(2*na - 1:2*na) = f(2*na - 1:2*na) + len/6.0_wp*(2.0_wp*ta + tb)
-      f(2*nb - 1:2*nb) = f(2*nb - 1:2*nb) + len/6.0_wp*(ta + 2.0_wp*tb)
+      if (mesh%axisymmetric) then
+        ! per radian: int N t r ds, the cubic integrand by 2-point Gauss (exact)
+        call radial_edge_load(xa, xb, ta, tb, f(2*na - 1:2*na), f(2*nb - 1:2*nb))
+      else
+        f(2*na - 1:2*na) = f(2*na - 1:2*na) + len/6.0_wp*(2.0_wp*ta + tb)
+        f(2*nb - 1:2*nb) = f(2*nb - 1:2*nb) + len/6.0_wp*(ta + 2.0_wp*tb)
+      end if
     end do
   end subroutine add_group_traction
+
+  !> Per radian, the nodal loads of a traction linear along the straight edge xa-xb (ta at
+  !! xa, tb at xb) on a meridian section: int N t r ds, r = x, by 2-point Gauss (exact).
+  pure subroutine radial_edge_load(xa, xb, ta, tb, fa, fb)
+    real(wp), intent(in) :: xa(2), xb(2), ta(2), tb(2)
+    real(wp), intent(inout) :: fa(2), fb(2)
+    real(wp), parameter :: gp = 0.577350269189625764509148780502_wp
+    real(wp) :: len, wa, wb, r, t(2)
+    integer :: ig
+    len = norm2(xb - xa)
+    do ig = -1, 1, 2
+      wa = 0.5_wp*(1.0_wp - ig*gp)
+      wb = 0.5_wp*(1.0_wp + ig*gp)
+      r = wa*xa(1) + wb*xb(1)
+      t = (wa*ta + wb*tb)*r
+      fa = fa + 0.5_wp*len*wa*t
+      fb = fb + 0.5_wp*len*wb*t
+    end do
+  end subroutine radial_edge_load
 
   !> Add the consistent nodal loads of a body force b [force/length^3], constant in the cells
   !! of each law, to f: w(a) b per cell (element_shape_integrals), exact on any Q1 or P1 cell.
@@ -847,7 +895,11 @@ contains
       law = law_of(mesh, c)
       if (all(b(:, law) == 0.0_wp)) cycle
       call cell_coords(mesh, c, xe)
-      call element_shape_integrals(cell_element(mesh, c), xe, w)
+      if (mesh%axisymmetric) then
+        call axi_shape_integrals(cell_element(mesh, c), xe, w)
+      else
+        call element_shape_integrals(cell_element(mesh, c), xe, w)
+      end if
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
         f(2*k - 1:2*k) = f(2*k - 1:2*k) + w(a)*b(:, law)

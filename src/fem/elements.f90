@@ -16,7 +16,7 @@ module elements
 
   public :: element_nvert, q1_gradients, p1_gradients, element_stiffness, ke_cache_init
   public :: element_body_force, edge_traction, element_stress, body_force_fn, element_shape_integrals
-  public :: element_stress_general
+  public :: element_stress_general, axi_stiffness, axi_stress, axi_shape_integrals
 
   integer, parameter, public :: MAX_NVERT = 4            !< most vertices of an element (Q1)
   integer, parameter, public :: MAX_NDOF = 2*MAX_NVERT   !< most DOFs of an element (Q1)
@@ -376,16 +376,21 @@ contains
   !> Add the consistent nodal loads of a linear traction t(s) = t0 + t1 s on the straight
   !! edge from xa to xb to `fe`, s being coordinate `coord` of the point; 2-point Gauss
   !! (exact for a linear traction times linear shape functions).
-  pure subroutine edge_traction(xa, xb, coord, t0, t1, fe)
+  pure subroutine edge_traction(xa, xb, coord, t0, t1, fe, axisymmetric)
     real(wp), intent(in) :: xa(2)            !< first end of the edge [length]
     real(wp), intent(in) :: xb(2)            !< second end of the edge [length]
     integer, intent(in) :: coord             !< s is x (1) or y (2)
     real(wp), intent(in) :: t0(2)            !< traction at s = 0 [stress]
     real(wp), intent(in) :: t1(2)            !< traction slope d t / d s [stress/length]
     real(wp), intent(inout) :: fe(2, 2)      !< nodal loads of the two ends, added to [force]
+    !> .true.: per radian, the integrand weighted by r = x (still exact: of degree 3)
+    logical, intent(in), optional :: axisymmetric
     integer :: ig
     real(wp) :: len, xi, wa, wb, s, tv(2)
+    logical :: axi
 
+    axi = .false.
+    if (present(axisymmetric)) axi = axisymmetric
     len = norm2(xb - xa)
     do ig = -1, 1, 2
       xi = ig*gp2
@@ -393,6 +398,7 @@ contains
       wb = 0.5_wp*(1.0_wp + xi)
       s = wa*xa(coord) + wb*xb(coord)
       tv = t0 + t1*s
+      if (axi) tv = tv*(wa*xa(1) + wb*xb(1))
       ! Gauss weight 1, Jacobian len/2.
       fe(:, 1) = fe(:, 1) + 0.5_wp*len*wa*tv
       fe(:, 2) = fe(:, 2) + 0.5_wp*len*wb*tv
@@ -459,5 +465,136 @@ contains
     end do
     cs = matmul(d(:, 1:3), e)
   end subroutine element_stress_general
+
+  ! ---------------------------------------------------------------------------------
+  ! Axisymmetric bodies: x is the radius r >= 0, y the axis z; strains (err, ezz, grz, ett)
+  ! with the hoop strain ett = ur/r; every integral per radian, weighted by r.
+  ! ---------------------------------------------------------------------------------
+
+  !> The quadrature points of an axisymmetric cell: Q1 2x2 Gauss; P1 the 3-point interior
+  !! rule of degree 2 (the hoop term N/r is not a polynomial: a one-point rule would not
+  !! pass the patch test of a uniform radial strain). np points, shape functions, gradients,
+  !! radius and weight (det J times the reference weight; r not included).
+  pure subroutine axi_points(element, xe, np, nf, g, r, w, minjac)
+    integer, intent(in) :: element
+    real(wp), intent(in) :: xe(2, MAX_NVERT)
+    integer, intent(out) :: np
+    real(wp), intent(out) :: nf(4, 4), g(2, MAX_NVERT, 4), r(4), w(4), minjac
+    real(wp), parameter :: bary(3, 3) = reshape([2.0_wp/3.0_wp, 1.0_wp/6.0_wp, 1.0_wp/6.0_wp, &
+                                                 1.0_wp/6.0_wp, 2.0_wp/3.0_wp, 1.0_wp/6.0_wp, &
+                                                 1.0_wp/6.0_wp, 1.0_wp/6.0_wp, 2.0_wp/3.0_wp], [3, 3])
+    real(wp) :: det, gg(2, MAX_NVERT)
+    integer :: q, ig, jg
+    nf = 0.0_wp
+    g = 0.0_wp
+    if (element == ELEM_Q1) then
+      np = 4
+      minjac = huge(1.0_wp)
+      q = 0
+      do jg = -1, 1, 2
+        do ig = -1, 1, 2
+          q = q + 1
+          call q1_gradients(xe, ig*gp2, jg*gp2, nf(:, q), g(:, :, q), det)
+          minjac = min(minjac, det)
+          w(q) = max(det, 0.0_wp)
+          r(q) = sum(nf(:, q)*xe(1, :))
+        end do
+      end do
+    else
+      np = 3
+      call p1_gradients(xe, gg, det)
+      minjac = det
+      do q = 1, 3
+        nf(1:3, q) = bary(:, q)
+        g(:, :, q) = gg
+        w(q) = max(det, 0.0_wp)/6.0_wp
+        r(q) = sum(bary(:, q)*xe(1, 1:3))
+      end do
+    end if
+  end subroutine axi_points
+
+  !> Axisymmetric element stiffness per radian, int B' d B r dA, d the 4x4 stiffness of
+  !! (err, ezz, grz, ett); B of vertex a: [gr 0; 0 gz; gz gr; N/r 0]. minjac as
+  !! element_stiffness.
+  pure subroutine axi_stiffness(element, xe, d, ke, minjac)
+    integer, intent(in) :: element                   !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)         !< vertex coordinates (r, z) [length]
+    real(wp), intent(in) :: d(4, 4)                  !< the stiffness [stress]
+    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)  !< [stress x length]
+    real(wp), intent(out) :: minjac                  !< smallest Jacobian determinant [length^2]
+    real(wp) :: nf(4, 4), g(2, MAX_NVERT, 4), r(4), w(4), bm(4, MAX_NDOF), db(4, MAX_NDOF)
+    integer :: np, q, a, nv
+    ke = 0.0_wp
+    call axi_points(element, xe, np, nf, g, r, w, minjac)
+    if (.not. minjac > 0.0_wp) return
+    nv = element_nvert(element)
+    do q = 1, np
+      bm = 0.0_wp
+      do a = 1, nv
+        bm(1, 2*a - 1) = g(1, a, q)
+        bm(2, 2*a) = g(2, a, q)
+        bm(3, 2*a - 1) = g(2, a, q)
+        bm(3, 2*a) = g(1, a, q)
+        bm(4, 2*a - 1) = nf(a, q)/r(q)
+      end do
+      db(:, 1:2*nv) = matmul(d, bm(:, 1:2*nv))
+      ke(1:2*nv, 1:2*nv) = ke(1:2*nv, 1:2*nv) + (w(q)*r(q))*matmul(transpose(bm(:, 1:2*nv)), db(:, 1:2*nv))
+    end do
+    ke(1:2*nv, 1:2*nv) = 0.5_wp*(ke(1:2*nv, 1:2*nv) + transpose(ke(1:2*nv, 1:2*nv)))
+  end subroutine axi_stiffness
+
+  !> The stress of an axisymmetric element at its centre (Q1) or centroid (P1):
+  !! cs = (srr, szz, srz, stt) = d (err, ezz, grz, ett).
+  pure subroutine axi_stress(element, xe, ue, d, cs)
+    integer, intent(in) :: element               !< ELEM_Q1 or ELEM_P1
+    real(wp), intent(in) :: xe(2, MAX_NVERT)     !< vertex coordinates (r, z) [length]
+    real(wp), intent(in) :: ue(MAX_NDOF)         !< element displacements (ur, uz) interleaved [length]
+    real(wp), intent(in) :: d(4, 4)              !< the stiffness [stress]
+    real(wp), intent(out) :: cs(4)               !< srr, szz, srz, stt [stress]
+    real(wp) :: g(2, MAX_NVERT), nfun(4), det, e(4), rc
+    integer :: a, nv
+    nv = element_nvert(element)
+    if (element == ELEM_Q1) then
+      call q1_gradients(xe, 0.0_wp, 0.0_wp, nfun, g, det)
+    else
+      call p1_gradients(xe, g, det)
+      nfun = [1.0_wp, 1.0_wp, 1.0_wp, 0.0_wp]/3.0_wp
+    end if
+    rc = sum(nfun(1:nv)*xe(1, 1:nv))
+    e = 0.0_wp
+    do a = 1, nv
+      e(1) = e(1) + g(1, a)*ue(2*a - 1)
+      e(2) = e(2) + g(2, a)*ue(2*a)
+      e(3) = e(3) + g(2, a)*ue(2*a - 1) + g(1, a)*ue(2*a)
+      e(4) = e(4) + nfun(a)*ue(2*a - 1)
+    end do
+    e(4) = e(4)/rc
+    cs = matmul(d, e)
+  end subroutine axi_stress
+
+  !> w(a) = int N_a r dA per radian: the consistent nodal load of a constant body force b
+  !! is w(a) b. Q1: 2x2 Gauss (exact, N_a det J r of degree 3 in each reference coordinate);
+  !! P1: A/12 (2 r_a + r_b + r_c), exact.
+  pure subroutine axi_shape_integrals(element, xe, w)
+    integer, intent(in) :: element
+    real(wp), intent(in) :: xe(2, MAX_NVERT)
+    real(wp), intent(out) :: w(MAX_NVERT)            !< [length^3]
+    integer :: ig, jg
+    real(wp) :: nfun(4), g(2, MAX_NVERT), det
+    w = 0.0_wp
+    if (element == ELEM_Q1) then
+      do jg = -1, 1, 2
+        do ig = -1, 1, 2
+          call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
+          w = w + det*nfun*sum(nfun*xe(1, :))
+        end do
+      end do
+    else
+      call p1_gradients(xe, g, det)
+      w(1) = det/24.0_wp*(2.0_wp*xe(1, 1) + xe(1, 2) + xe(1, 3))
+      w(2) = det/24.0_wp*(xe(1, 1) + 2.0_wp*xe(1, 2) + xe(1, 3))
+      w(3) = det/24.0_wp*(xe(1, 1) + xe(1, 2) + 2.0_wp*xe(1, 3))
+    end if
+  end subroutine axi_shape_integrals
 
 end module elements

@@ -75,6 +75,9 @@ module mesh
     integer, allocatable :: cells(:, :)   !< (nvert, ncell) 1-based node ids, counter-clockwise
                                           !! (a triangle in a mixed mesh: cells(4, c) = 0)
     logical :: structured = .true.        !< built by mesh_build (nx, ny, x0... valid)
+    !> a meridian section of a body of revolution about the y axis (x = r >= 0, y = z): its
+    !! integrals are per radian, weighted by r, with the hoop strain ur/r (set by the driver)
+    logical :: axisymmetric = .false.
     character(len=:), allocatable :: source  !< the mesh file ('' for a structured mesh)
     integer, allocatable :: cell_type(:)  !< (ncell) ELEM_Q1 or ELEM_P1 of each cell
     integer, allocatable :: node_tag(:)   !< (nnode) the file's node tag (structured: the node id)

@@ -26,11 +26,14 @@ contains
   !! SVD. A true kernel has singular value ~ eps; a support of length l on a body of size h
   !! has ~ l/h, so the test is scale-free and holds to aspect ratios of about 1e9. Sets sys%nrig, rig_coef, rig_xc, rig_h and
   !! sys%rig (ndof x nrig, zero at prescribed DOFs).
-  subroutine rigid_kernel(mesh, prescribed, sys, err)
+  subroutine rigid_kernel(mesh, prescribed, sys, err, axisymmetric)
     type(mesh_t), intent(in) :: mesh           !< the body's mesh
     logical, intent(in) :: prescribed(:)       !< (ndof) whether each DOF is prescribed
     type(body_system_t), intent(inout) :: sys  !< gets nrig, rig, rig_coef, rig_xc, rig_h
     type(error_t), intent(out) :: err          !< ERR_NUMERICAL when the SVD fails
+    !> a meridian section: a motion along x (r) or a rotation strains the hoop, so only the
+    !! translation along the axis (y) is rigid
+    logical, intent(in), optional :: axisymmetric
     real(wp) :: g(3, 3), r(3), ev(3), work(64), top, vt(3, 3), dummy(1, 1)
     integer :: k, cc, j, lapinfo, nk
     character(len=512) :: emsg
@@ -38,6 +41,12 @@ contains
     sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
     sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
     g = 0.0_wp
+    if (present(axisymmetric)) then
+      if (axisymmetric) then
+        call givens_add_row(g, [1.0_wp, 0.0_wp, 0.0_wp])
+        call givens_add_row(g, [0.0_wp, 0.0_wp, 1.0_wp])
+      end if
+    end if
     do k = 1, mesh%nnode
       do cc = 1, 2
         if (.not. prescribed(2*(k - 1) + cc)) cycle

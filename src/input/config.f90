@@ -87,7 +87,7 @@ module config
   character(len=*), parameter, public :: SIDE_CHOICES = 'left right bottom top'       !< SIDE_* order
   character(len=*), parameter, public :: BC_CHOICES = 'free clamped roller contact displacement'  !< BC_* order, from 0
   character(len=*), parameter, public :: ELEMENT_CHOICES = 'Q1 P1'                    !< ELEM_* order
-  character(len=*), parameter, public :: PLANE_CHOICES = 'strain stress'
+  character(len=*), parameter, public :: PLANE_CHOICES = 'strain stress axisymmetric'
 
   !> The XDMF files beside a result: the collection alone (every body and contact line in
   !! `<stem>.xdmf`, all lines in `<stem>_contact.xdmf`), or also one per body and one per pair
@@ -273,7 +273,10 @@ module config
   type, public :: deck_t
     character(len=PATH_LEN) :: source = ''            !< deck path as given
     character(len=256) :: title = ''                  !< free text
-    logical :: plane_strain = .true.                  !< .true.: plane strain, .false.: plane stress
+    logical :: plane_strain = .true.                  !< .true.: plane strain (or axisymmetric), .false.: plane stress
+    !> bodies of revolution about the y axis, x = r >= 0: every integral per radian, with the
+    !! hoop strain (plane_strain is .true.: the laws have the out-of-plane, here hoop, row)
+    logical :: axisymmetric = .false.
     type(units_cfg_t) :: units                        !< unit names (&scene units=...)
     integer :: nbody = 0                              !< number of bodies
     type(body_cfg_t), allocatable :: body(:)          !< the bodies, indexed by id (1 .. nbody)

@@ -57,7 +57,7 @@ contains
     integer :: k
     select case (g%name)
     case ('scene')
-      sc%plane = merge(1, 2, d%plane_strain)
+      sc%plane = merge(3, merge(1, 2, d%plane_strain), d%axisymmetric)
       call scene_vars(d, sc, v)
     case ('solver')
       call solver_vars(d%solver, v)
@@ -72,7 +72,8 @@ contains
     call read_group(g, src, v)
     select case (g%name)
     case ('scene')
-      d%plane_strain = (sc%plane == 1)
+      d%plane_strain = (sc%plane /= 2)
+      d%axisymmetric = (sc%plane == 3)
       call check_units(g, src, d%units)
     case ('solver')
       call check_solver(g, src, d%solver)

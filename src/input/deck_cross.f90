@@ -338,7 +338,8 @@ contains
         call material_law(d%material(k), 0.0_wp, d%plane_strain, law, msg)
         if (len(msg) > 0) call fatal(EXIT_INPUT, st%path//': the '//trim(d%material(k)%origin)// &
           ' (material '''//trim(d%material(k)%name)//''', '//trim(word(MAT_KIND_NAMES, d%material(k)%kind))// &
-          ', in plane '//merge('strain', 'stress', d%plane_strain)//'): '//msg)
+          ', in '//trim(merge('axisymmetric', merge('plane strain', 'plane stress', d%plane_strain), &
+          d%axisymmetric))//'): '//msg)
       end block
     end do
     do b = 1, d%nbody
@@ -372,6 +373,14 @@ contains
       end do
     end do
     call check_body_forces(d, st)
+    if (d%axisymmetric) then    ! a rectangle's section lies at x >= 0
+      do b = 1, d%nbody
+        if (len_trim(d%body(b)%mesh) > 0) cycle
+        if (d%body(b)%x0 < 0.0_wp) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('// &
+          st%body_at(b)%s//'): x0 = '//r2s(d%body(b)%x0)//' is below the axis: with plane = '// &
+          '''axisymmetric'' x is the radius, x0 >= 0')
+      end do
+    end if
   end subroutine resolve_materials
 
   integer function material_index(d, name) result(k)

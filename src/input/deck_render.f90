@@ -134,7 +134,7 @@ contains
 
     c = d
     call tb%add('! effective deck (every value, defaults included); source: '//trim(c%source)//NL)
-    sc%plane = merge(1, 2, c%plane_strain)
+    sc%plane = merge(3, merge(1, 2, c%plane_strain), c%axisymmetric)
     call scene_vars(c, sc, v)
     call tb%add(render_group('scene', v, WIDTH))
     do i = 1, c%nmaterial
@@ -238,7 +238,7 @@ contains
     type(body_cfg_t), target :: b
 
     call tb%add(REF_INTRO)
-    sc%plane = merge(1, 2, c%plane_strain)
+    sc%plane = merge(3, merge(1, 2, c%plane_strain), c%axisymmetric)
     call scene_vars(c, sc, v)
     call section('scene', REF_SCENE, reference_table(v))
     call body_vars(b, v, ALL_FORMS)

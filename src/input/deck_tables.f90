@@ -62,7 +62,11 @@ contains
     type(scene_in_t), target, intent(inout) :: sc
     type(vars_t), intent(out) :: v
     call v%str('title', d%title, doc='free text, stored in the result file')
-    call v%enum('plane', sc%plane, PLANE_CHOICES, doc='plane strain or plane stress')
+    call v%enum('plane', sc%plane, PLANE_CHOICES, doc='`''strain''` (plane strain), `''stress''` '// &
+      '(plane stress) or `''axisymmetric''`: every body a body of revolution about the y axis, '// &
+      'drawn by its meridian section at x = r >= 0 (y = z); nodes on the axis have ur = 0, a '// &
+      'motion along x or a rotation is no rigid motion, and every load, reaction and contact '// &
+      'force is per radian (the whole circumference: 2 pi times)')
     call v%enum('units', d%units%system, UNITS_CHOICES, doc='the units of the deck''s numbers, '// &
       'named in the result file, the plots and the summary (the solver is unit-free): `''SI''` (m, '// &
       'N, Pa), `''mm-N-MPa''` (mm, N, MPa: consistent, N/mm^2 = MPa) or `''custom''` (the names '// &
