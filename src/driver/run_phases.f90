@@ -11,7 +11,7 @@ module run_phases
   use mesh, only: mesh_t, mesh_build, assign_cell_laws
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, support_reactions
-  use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT
+  use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT, ROW_NORMAL
   use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
                            contact_result_t
   use robin_iteration, only: solve_robin
@@ -464,6 +464,7 @@ contains
       do a = 1, run%nbody
         call set_step_loads(run%systems(a), run%plan(k))
       end do
+      call set_interference(run, k)
       ! whether the contact can balance this step's loads on the floating bodies: the first
       ! step's is input (exit 1), and a history ends at its first later step without a
       ! static equilibrium, the steps before it kept
@@ -556,6 +557,32 @@ contains
     call move_alloc(a%u, b%u)
     b%res = a%res
   end subroutine move_step
+
+  !> An interference fit ramped over a stage (&contact interference_stage = s): the overlap
+  !! (g0 < 0) of that pair's normal rows times stage s's factor in step k, 0 before the stage
+  !! and 1 after it; run%g0_full keeps the geometry's gaps (doc/method.md, "Interference").
+  subroutine set_interference(run, k)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: k            !< the step
+    integer :: r, s
+    real(wp) :: f
+    if (.not. allocated(run%contact_line%g0) .or. run%deck%npair == 0) return
+    if (.not. any(run%deck%pair(1:run%deck%npair)%interference_stage > 0)) return
+    if (.not. allocated(run%g0_full)) run%g0_full = run%contact_line%g0
+    associate (itf => run%contact_line, st => run%plan(k))
+      do r = 1, size(itf%g0)
+        s = run%deck%pair(itf%pair_of(r))%interference_stage
+        if (s == 0 .or. run%g0_full(r) >= 0.0_wp) cycle
+        if (allocated(itf%kind)) then
+          if (itf%kind(r) /= ROW_NORMAL) cycle
+        end if
+        f = 1.0_wp
+        if (st%stage < s) f = 0.0_wp
+        if (st%stage == s) f = st%factor
+        itf%g0(r) = f*run%g0_full(r)
+      end do
+    end associate
+  end subroutine set_interference
 
   !> Friction acts on each load step's slip increment: the tangential rows' g0 (rank 0, which
   !! solves the contact) is the slip w_1 + w_2 the step before ended with, 0 at the first

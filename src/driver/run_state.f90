@@ -38,6 +38,9 @@ module run_state
     type(mesh_t), allocatable :: meshes(:)             !< the bodies' meshes
     type(body_system_t), allocatable :: systems(:)     !< their DOF maps, stiffnesses and loads
     type(interface_t) :: contact_line                  !< the contact rows of all pairs (mortar pairing)
+    !> the rows' initial gaps of the geometry, kept while an interference fit is ramped over a
+    !! stage (contact_line%g0 then holds the step's share of the overlap)
+    real(wp), allocatable :: g0_full(:)
     type(body_condensed_t), allocatable :: bodies(:)   !< the bodies condensed on their contact rows
     type(robin_state_t) :: robin_state                 !< the Robin iteration's state (restart)
     type(contact_result_t) :: result                   !< contact forces, status, counts

@@ -238,6 +238,9 @@ module config
     real(wp) :: mu = 0.0_wp                           !< Coulomb coefficient [-]
     real(wp) :: slip_bound = 0.0_wp                   !< Tresca's bound on the shear traction [stress]
     integer :: overlap = OVERLAP_REFUSE               !< OVERLAP_*: what an initial overlap of the groups is
+    !> an interference fit's stage: 0 the whole overlap at every step; s >= 1 ramped over stage
+    !! s's load steps as a load (none before it, whole after it)
+    integer :: interference_stage = 0
   end type contact_cfg_t
 
   !> Outer and inner solver settings (what the contact stage needs, and the factorization).
@@ -394,6 +397,7 @@ contains
     if (d%ntraction > 0) n = max(n, maxval(d%traction(1:d%ntraction)%stage))
     if (d%nboundary > 0) n = max(n, maxval(d%boundary(1:d%nboundary)%stage))
     if (d%nbody_force > 0) n = max(n, maxval(d%body_force(1:d%nbody_force)%stage))
+    if (d%npair > 0) n = max(n, maxval(d%pair(1:d%npair)%interference_stage))
     do b = 1, d%nbody
       n = max(n, maxval(d%body(b)%side_stage, mask=d%body(b)%bc == BC_DISPLACEMENT))
     end do

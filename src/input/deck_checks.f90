@@ -15,7 +15,7 @@ module deck_checks
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
                     ROBIN_CONSTANT, SIDE_CHOICES, UNITS_CHOICES, UNITS_SI, UNITS_MM, units_cfg_t, &
-                    FRICTION_TRESCA, FRICTION_COULOMB, MAX_STAGES, MAX_STEPS, STEPS_UNSET
+                    FRICTION_TRESCA, FRICTION_COULOMB, OVERLAP_INTERFERENCE, MAX_STAGES, MAX_STEPS, STEPS_UNSET
   use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, TWO_BODY_FORM, PAIR_FORM, scene_vars, body_vars, body_force_vars, &
                          traction_vars, boundary_vars, displacement_vars, contact_vars, solver_vars, output_vars, &
                          material_vars, region_vars
@@ -334,6 +334,12 @@ contains
       'is the Coulomb coefficient: give it with friction=''coulomb''')
     if (c%slip_bound /= 0.0_wp .and. c%friction /= FRICTION_TRESCA) call bad_value(g, src, 'slip_bound', &
       r2s(c%slip_bound), 'is Tresca''s bound: give it with friction=''tresca''')
+    if (c%interference_stage < 0 .or. c%interference_stage > MAX_STAGES) call bad_value(g, src, &
+      'interference_stage', i2s(c%interference_stage), 'must be >= 0 and <= '//i2s(MAX_STAGES)// &
+      ' (0: the whole interference at once; s: ramped over stage s''s load steps)')
+    if (c%interference_stage /= 0 .and. c%overlap /= OVERLAP_INTERFERENCE) call bad_value(g, src, &
+      'interference_stage', i2s(c%interference_stage), 'ramps an interference fit: give it with '// &
+      'overlap=''interference''')
     if (form == TWO_BODY_FORM) then
       if (c%slave < 0 .or. c%slave > 2) call bad_value(g, src, 'slave', i2s(c%slave), &
         'must be 1 or 2 (the body whose contact surface carries the multipliers), or 0 for the finer one')

@@ -99,6 +99,9 @@ contains
           if (c%stage == s .and. any(c%fix .and. c%u /= 0.0_wp)) loaded = .true.
         end associate
       end do
+      if (d%npair > 0) then
+        if (any(d%pair(1:d%npair)%interference_stage == s)) loaded = .true.
+      end if
       do b = 1, d%nbody
         associate (c => d%body(b))
           if (any(c%bc == BC_DISPLACEMENT .and. c%side_stage == s .and. &

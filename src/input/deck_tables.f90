@@ -305,7 +305,12 @@ contains
     call v%enum('overlap', c%overlap, OVERLAP_CHOICES, doc='what an overlap of the two groups in the '// &
       'initial configuration is: `''refuse''` (bad input beyond a thousandth of the slave''s mean '// &
       'edge, below it taken as contact) or `''interference''` (a fit: the bodies are pressed apart '// &
-      'by the overlap, solved in one step; up to 1% of the slave group''s extent, a small strain)')
+      'by the overlap; up to 1% of the slave group''s extent, a small strain)')
+    if (form == ALL_FORMS .or. c%interference_stage /= 0) call v%int('interference_stage', &
+      c%interference_stage, range='>= 0; > 0 with `overlap=''interference''` only', doc='*interference '// &
+      'only:* 0: the whole overlap in every load step (a fit solved at once); s >= 1: the overlap '// &
+      'ramped over the load steps of stage s as a load is (none in the stages before, whole in '// &
+      'those after), a fit pressed together step by step. Rendered only when not 0')
   end subroutine contact_vars
 
   !> &solver; `rendering`: load_steps only when not its default.

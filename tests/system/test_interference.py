@@ -15,7 +15,11 @@ p = E' delta (c^2 - b^2)/(2 b c^2) = 8.654e7 Pa.
 (3) Robin = monolithic: the contact forces to 1e-8 of the largest;
 (4) without overlap='interference' the overlap is bad input (exit 1, the message names the
     node and the word that makes it a fit, nothing written); two blocks overlapping by 3% of
-    the slave group's extent, declared a fit, are bad input too (a strain beyond small strain).
+    the slave group's extent, declared a fit, are bad input too (a strain beyond small strain);
+(5) ramped: `interference_stage=1` with `load_steps=4` presses the fit step by step, each
+    step's normal force k/4 of the one-step run's to 1e-9 (linear elasticity, the whole bore in
+    contact at every step), the last step the one-step result to 1e-9; interference_stage
+    without overlap='interference' is bad input.
 """
 import os
 import shutil
@@ -110,6 +114,29 @@ try:
     check(code == 1 and "beyond 1% of the slave group's extent" in out and not made,
           "an overlap of 3% of the slave group's extent is refused as beyond small strain, nothing written",
           out.strip()[-300:])
+
+    # (5) the interference ramped over stage 1's four steps
+    code0, out0, h0 = run(work, "once")
+    code, out, h = run(work, "ramped", "&contact bodies=1,2, interference_stage=1 /", "&solver load_steps=4 /")
+    steps = []
+    if code == 0:
+        with h5py.File(h, "r") as f:
+            steps = [float(np.sum(f[f"steps/step_{k}/contact/normal_force"][()])) for k in range(1, 5)]
+    if code0 == 0 and code == 0 and len(steps) == 4:
+        _, f0, _ = contact(h0)
+        _, f4, _ = contact(h)
+        full = f0.sum()
+        dev = max(abs(steps[k] / ((k + 1) / 4 * full) - 1) for k in range(4))
+        check(dev <= 1e-9, "ramped interference: step k carries k/4 of the fit's normal force", f"{dev:.1e}, {steps}")
+        d4 = np.abs(f4 - f0).max() / np.abs(f0).max()
+        check(d4 <= 1e-9, "ramped interference: the last step is the one-step fit", f"{d4:.1e}")
+    else:
+        check(False, "the ramped fit runs its four steps", out.strip()[-300:])
+    before = set(os.listdir(work))
+    code, out, _ = run(work, "stage_no_fit", "&contact bodies=1,2, overlap='refuse', interference_stage=1 /")
+    made = set(os.listdir(work)) - before
+    check(code == 1 and "interference_stage" in out and "overlap='interference'" in out and not made,
+          "interference_stage without overlap='interference': bad input, nothing written", out.strip()[-300:])
 finally:
     shutil.rmtree(work, ignore_errors=True)
 
