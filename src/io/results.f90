@@ -286,6 +286,11 @@ contains
     call write_attr(fid, 'run_id', run_id, st)
     call write_attr(fid, 'unit_length', ul, st)
     call write_attr(fid, 'unit_force', trim(d%units%force), st)
+    ! the plane model; a body of revolution's forces are per radian (its loads, reactions and
+    ! contact forces: the whole circumference carries 2 pi times)
+    call write_attr(fid, 'plane', trim(merge('axisymmetric', merge('strain      ', 'stress      ', d%plane_strain), &
+                    d%axisymmetric)), st)
+    call write_attr(fid, 'forces_per', trim(merge('radian        ', 'unit thickness', d%axisymmetric)), st)
     call write_attr(fid, 'unit_stress', us, st)
     call write_attr(fid, 'outer_iterations', res%outer, st)
     call write_attr(fid, 'inner_iterations', res%inner, st)
