@@ -5,7 +5,7 @@ module run_summary
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
   use config, only: solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
-  use contact_interface, only: interface_t, ROW_NORMAL
+  use contact_interface, only: interface_t, ROW_NORMAL, contact_resultant
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED, STATUS_NO_EQUILIBRIUM
@@ -23,6 +23,8 @@ module run_summary
 
   !> Bodies listed on the `bodies:` line, pairs on a `step:` line (the rest counted).
   integer, parameter :: MAX_LISTED = 20
+  !> the most pairs whose resultant a step: line shows (it stays under 600 characters)
+  integer, parameter :: MAX_STEP_RESULTANTS = 6
 
 contains
 
@@ -125,7 +127,7 @@ contains
     type(run_t), intent(in) :: run   !< the run: its plan and current result
     integer, intent(in) :: k         !< the step
     character(len=:), allocatable :: t
-    real(wp) :: ftot
+    real(wp) :: ftot, f2(2)
     integer :: p, np
     ftot = 0.0_wp
     if (allocated(run%result%lam)) then
@@ -143,6 +145,18 @@ contains
         t = t//sci(pair_normal_sum(run, p), 5)
       end do
       if (np > MAX_LISTED) t = t//' more_pairs='//i2s(np - MAX_LISTED)
+    end if
+    ! the contact resultant (normal and tangential forces) of each pair on its first body,
+    ! fx:fy, for the first MAX_STEP_RESULTANTS pairs (the result file has every pair's)
+    if (allocated(run%result%lam) .and. allocated(run%contact_line%pair_ptr) .and. np >= 1) then
+      t = t//' pair_resultant='
+      do p = 1, min(np, MAX_STEP_RESULTANTS)
+        if (p > 1) t = t//','
+        f2 = contact_resultant(run%contact_line, 1, run%result%lam, run%contact_line%pair_ptr(p), &
+                               min(run%contact_line%pair_ptr(p + 1) - 1, size(run%result%lam)))
+        t = t//sci(f2(1), 4)//':'//sci(f2(2), 4)
+      end do
+      if (np > MAX_STEP_RESULTANTS) t = t//',...'
     end if
   end function step_line
 

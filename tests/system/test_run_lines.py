@@ -116,6 +116,13 @@ try:
             ref = [float(np.sum(f[f"/contact/pair_{k}/normal_force"])) for k in (1, 2, 3)]
         check(len(sums) == 3 and all(abs(a - b) <= 1e-5 * abs(b) for a, b in zip(sums, ref)),
               "stack of 4: the last step's pair sums are those of /contact/pair_K/normal_force", f"{sums} vs {ref}")
+        vecs = [[float(c) for c in v.split(":")] for v in steps[-1].get("pair_resultant", "").split(",") if v]
+        with h5py.File(h5, "r") as f:
+            ref = [f[f"/contact/pair_{k}/resultant_on_first_body"][()] for k in (1, 2, 3)]
+        scale = max(abs(c) for r in ref for c in r)
+        check(len(vecs) == 3 and all(abs(a - b) <= 1e-4 * scale for v, r in zip(vecs, ref) for a, b in zip(v, r)),
+              "stack of 4: the last step's pair_resultant (fx:fy per pair) is /contact/pair_K/resultant_on_first_body",
+              f"{vecs} vs {ref}")
 
     # (c) two bodies: no bodies: line, no per-pair sums
     p, res, h5 = run(work, "two", stack(2))
@@ -137,6 +144,10 @@ try:
     check(len(steps) == 2 and all(len(s.get("pair_normal_force_sum", "").split(",")) == 20
                                   and s.get("more_pairs") == "2" for s in steps),
           "23 bodies: step: lines list 20 pair sums, then more_pairs=2", str(steps[-1] if steps else None))
+    check(len(steps) == 2 and all(s.get("pair_resultant", "").count(":") == 6
+                                  and s.get("pair_resultant", "").endswith(",...") for s in steps),
+          "23 bodies: step: lines give the resultants of the first 6 pairs, then ',...'",
+          str(steps[-1].get("pair_resultant") if steps else None))
     check(len(max(p.stdout.splitlines(), key=len)) < 600, "23 bodies: every line stays short")
 finally:
     shutil.rmtree(work, ignore_errors=True)
