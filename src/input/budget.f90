@@ -18,7 +18,7 @@
 !! node are summed against the node's memory, each one against ulimit -v.
 module budget
   use kinds, only: wp
-  use config, only: deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
+  use config, only: body_stiffness, deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
   use strings, only: i2s, sci, fmt_real
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
@@ -308,12 +308,14 @@ contains
     type(deck_t), intent(in) :: d                       !< the deck
     type(error_t), intent(out) :: err                   !< why the loads are not representable, if so
     real(wp), parameter :: MARGIN = 1.0e6_wp
-    real(wp) :: ext, t, h, u, cap, ymin, hx, hy
+    real(wp) :: ext, t, h, u, cap, ymin, hx, hy, rho, elo, ehi
     integer :: i, a, s
     ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
     do a = 1, d%nbody
-      if (.not. (d%body(a)%young < LOAD_MAX/MARGIN .and. d%body(a)%young > MARGIN/LOAD_MAX)) then
-        call err%set(ERR_INPUT, 'body '//i2s(a)//': young = '//sci(d%body(a)%young)//' is outside ['// &
+      call body_stiffness(d%body(a), elo, ehi)
+      if (.not. (ehi < LOAD_MAX/MARGIN .and. elo > MARGIN/LOAD_MAX)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': '//modulus(a, merge(ehi, elo, ehi >= LOAD_MAX/MARGIN))// &
+              ' is outside ['// &
               sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
               'stay within double precision; rescale the units')
         return
@@ -333,10 +335,11 @@ contains
       ! an element's stiffness holds young/h and young (longer side)/(shorter side)
       hx = d%body(a)%width/real(d%body(a)%nx, wp)
       hy = d%body(a)%height/real(d%body(a)%ny, wp)
-      if (.not. log(d%body(a)%young) + log(max(1.0_wp, hx, hy)) - log(min(hx, hy)) + log(MARGIN) &
+      call body_stiffness(d%body(a), elo, ehi)
+      if (.not. log(ehi) + log(max(1.0_wp, hx, hy)) - log(min(hx, hy)) + log(MARGIN) &
           < log(LOAD_MAX)) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//': its cells of '//sci(hx)//' x '//sci(hy)// &
-              ' [length] with young = '//sci(d%body(a)%young)//' have a stiffness beyond double '// &
+              ' [length] with '//modulus(a, ehi)//' have a stiffness beyond double '// &
               'precision; rescale the geometry or the units')
         return
       end if
@@ -345,7 +348,8 @@ contains
     ymin = huge(1.0_wp)
     do a = 1, d%nbody
       ext = max(ext, abs(d%body(a)%x0) + d%body(a)%width, abs(d%body(a)%y0) + d%body(a)%height)
-      ymin = min(ymin, d%body(a)%young)
+      call body_stiffness(d%body(a), elo, ehi)
+      ymin = min(ymin, elo)
     end do
     ! every product below stays finite (no overflow trap in the checked build): ext is a
     ! coordinate extent, at most COORD_MAX, far below huge/MARGIN
@@ -378,16 +382,21 @@ contains
       do a = 1, d%nbody
         if (d%body_force(i)%body /= 0 .and. d%body_force(i)%body /= a) cycle
         t = huge(1.0_wp)
-        if (d%body(a)%density < cap/ext .and. maxval(abs(d%body_force(i)%gravity)) < cap/ext &
+        rho = d%body(a)%density                     ! the largest density of its materials
+        if (allocated(d%body(a)%law)) rho = maxval(d%body(a)%law%density)
+        if (rho < cap/ext .and. maxval(abs(d%body_force(i)%gravity)) < cap/ext &
             .and. maxval(abs(d%body_force(i)%force)) < cap/ext) then
-          if (d%body(a)%density == 0.0_wp .or. maxval(abs(d%body_force(i)%gravity)) < &
-              cap/(ext*max(d%body(a)%density, tiny(1.0_wp)))) &
-            t = (d%body(a)%density*maxval(abs(d%body_force(i)%gravity)) + maxval(abs(d%body_force(i)%force)))*ext
+          ! (Fortran's .or. may evaluate both sides: no quotient by a zero density)
+          if (rho == 0.0_wp) then
+            t = maxval(abs(d%body_force(i)%force))*ext
+          else if (maxval(abs(d%body_force(i)%gravity)) < cap/(ext*rho)) then
+            t = (rho*maxval(abs(d%body_force(i)%gravity)) + maxval(abs(d%body_force(i)%force)))*ext
+          end if
         end if
         if (.not. t < cap .or. .not. log(max(t, tiny(1.0_wp))) + log(ext) - log(ymin) + log(MARGIN) < log(LOAD_MAX)) then
           ! (the inputs named, not t: the product itself may be beyond double precision)
           call err%set(ERR_INPUT, trim(d%body_force(i)%origin)//' on body '//i2s(a)//' (density '// &
-                sci(d%body(a)%density)//', gravity up to '//sci(maxval(abs(d%body_force(i)%gravity)))// &
+                sci(rho)//', gravity up to '//sci(maxval(abs(d%body_force(i)%gravity)))// &
                 ', force up to '//sci(maxval(abs(d%body_force(i)%force)))//' over the scene''s extent '// &
                 sci(ext)//' [length]) makes stresses or displacements beyond double precision; rescale '// &
                 'the units (e.g. &scene units=''mm-N-MPa'')')
@@ -400,9 +409,10 @@ contains
       do s = 1, 4
         u = maxval(abs(d%body(a)%u_side(:, s)))
         if (.not. u > 0.0_wp) cycle   ! (no short-circuit in Fortran: log(0) must not be evaluated)
-        if (.not. log(u) + log(d%body(a)%young) - log(h) + log(MARGIN) < log(LOAD_MAX)) then
+        call body_stiffness(d%body(a), elo, ehi)
+        if (.not. log(u) + log(ehi) - log(h) + log(MARGIN) < log(LOAD_MAX)) then
           call err%set(ERR_INPUT, 'the &displacement of body '//i2s(a)//' ('//sci(u)// &
-                ' [length]) with young = '//sci(d%body(a)%young)//' gives stresses beyond double '// &
+                ' [length]) with '//modulus(a, ehi)//' gives stresses beyond double '// &
                 'precision; rescale the units')
           return
         end if
@@ -415,13 +425,26 @@ contains
       if (a < 1 .or. a > d%nbody) cycle
       u = maxval(abs(d%boundary(i)%u), mask=d%boundary(i)%fix)
       if (.not. u > 0.0_wp) cycle
-      if (.not. log(u) + log(d%body(a)%young) + log(MARGIN) < log(LOAD_MAX)) then
+      call body_stiffness(d%body(a), elo, ehi)
+      if (.not. log(u) + log(ehi) + log(MARGIN) < log(LOAD_MAX)) then
         call err%set(ERR_INPUT, '&boundary '//i2s(i)//' (body '//i2s(a)//", group '"// &
-              trim(d%boundary(i)%group)//"') prescribes "//sci(u)//' [length] with young = '// &
-              sci(d%body(a)%young)//': its loads would overflow double precision; rescale the units')
+              trim(d%boundary(i)%group)//"') prescribes "//sci(u)//' [length] with '// &
+              modulus(a, ehi)//': its loads would overflow double precision; rescale the units')
         return
       end if
     end do
+  contains
+    !> 'young = X' for a body of young and poisson, else 'a stiffness of X (its materials)'.
+    function modulus(a, x) result(txt)
+      integer, intent(in) :: a
+      real(wp), intent(in) :: x
+      character(len=:), allocatable :: txt
+      if (len_trim(d%body(a)%material) == 0 .and. d%nregion == 0) then
+        txt = 'young = '//sci(x)
+      else
+        txt = 'a stiffness of '//sci(x)//' (its materials'' moduli)'
+      end if
+    end function modulus
   end subroutine check_load_range
 
 end module budget
