@@ -15,7 +15,7 @@
 module assembly
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: int16
-  use strings, only: body_label
+  use strings, only: body_label, sci
   use sorting, only: sort_by_key
   use config, only: body_cfg_t, elastic_law_t, body_stiffness, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
@@ -156,7 +156,10 @@ contains
         return
       end if
     end if
-    if (mesh%axisymmetric) call axis_conditions(mesh, prescribed, sys)
+    if (mesh%axisymmetric) then
+      call axis_conditions(mesh, prescribed, sys, err)
+      if (err%failed()) return
+    end if
     ! rigid motions the supports leave free: a body held only by contact
     call rigid_kernel(mesh, prescribed, sys, err, mesh%axisymmetric)
     if (err%failed()) return
@@ -308,16 +311,24 @@ contains
   end subroutine check_input
 
   !> A meridian section's nodes on the axis (x within 1e-9 of the section's extent of 0)
-  !! have ur = 0: prescribed, a support of no load.
-  subroutine axis_conditions(mesh, prescribed, sys)
+  !! have ur = 0: prescribed, a support of no load. err = ERR_INPUT where a support already
+  !! prescribes a nonzero ur there (a node on the axis cannot move off it).
+  subroutine axis_conditions(mesh, prescribed, sys, err)
     type(mesh_t), intent(in) :: mesh
     logical, intent(inout) :: prescribed(:)
     type(body_system_t), intent(inout) :: sys
+    type(error_t), intent(out) :: err
     real(wp) :: tol
     integer :: k
     tol = 1.0e-9_wp*max(maxval(mesh%xy(1, :)) - minval(mesh%xy(1, :)), maxval(mesh%xy(2, :)) - minval(mesh%xy(2, :)))
     do k = 1, mesh%nnode
       if (abs(mesh%xy(1, k)) > tol) cycle
+      if (prescribed(2*k - 1) .and. sys%u_fixed(2*k - 1) /= 0.0_wp) then
+        call err%set(ERR_INPUT, 'body '//body_label(sys%id)//': node '//body_label(mesh%node_tag(k))// &
+                     ' lies on the axis (x = 0), where ur = 0, but a support prescribes ux = '// &
+                     sci(sys%u_fixed(2*k - 1))//' there; a body of revolution''s axis cannot move off it')
+        return
+      end if
       prescribed(2*k - 1) = .true.
       sys%u_fixed(2*k - 1) = 0.0_wp
       sys%dof_stage(2*k - 1) = 0

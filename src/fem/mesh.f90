@@ -126,7 +126,11 @@ contains
         if (mesh%region(j)%name == trim(body%law(k)%region)) r = j
       end do
       bad = k
-      if (r == 0) then
+      if (r == 0 .and. trim(body%law(k)%region) == trim(body%region)) then
+        msg = "'"//trim(body%law(k)%region)//"' is the body's own physical surface: a region is "// &
+              'another physical surface holding some of its cells'
+        return
+      else if (r == 0) then
         names = ''
         do j = 1, mesh%nregion
           names = names//merge(', ', '  ', j > 1)//"'"//mesh%region(j)%name//"'"

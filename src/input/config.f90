@@ -368,8 +368,8 @@ contains
   end function body_density
 
   !> The range of a body's stiffness over its laws [stress]: Young's modulus for a body of
-  !! young and poisson; else the largest and the smallest diagonal entry of the plane
-  !! stiffness (the scales of K's entries, for the checks of the number range).
+  !! young and poisson; else the smallest diagonal entry of the plane stiffness and the
+  !! largest entry of any (the scales of K's entries, for the checks of the number range).
   pure subroutine body_stiffness(b, lo, hi)
     type(body_cfg_t), intent(in) :: b   !< the body
     real(wp), intent(out) :: lo         !< the smallest [stress]
@@ -384,8 +384,8 @@ contains
     do k = 1, size(b%law)
       do i = 1, 3
         lo = min(lo, b%law(k)%d(i, i))
-        hi = max(hi, b%law(k)%d(i, i))
       end do
+      hi = max(hi, maxval(abs(b%law(k)%d)))
     end do
   end subroutine body_stiffness
 

@@ -489,16 +489,23 @@ contains
       'it must satisfy -1 < poisson < 0.5')
     if (.not. c%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(c%density), &
       'must be >= 0 (mass per volume)')
-    if (find_asg(g, 'material') > 0) then
+    if (find_asg(g, 'material') > 0 .and. len_trim(c%material) > 0) then
       do s = 1, 3
         if (find_asg(g, trim(word('young poisson density', s))) > 0) call bad_value(g, src, &
           trim(word('young poisson density', s)), '', 'is given with material = '//quote(trim(c%material))// &
           ': the material holds the body''s constants; give one or the other')
       end do
-      if (len_trim(c%material) == 0) call bad_value(g, src, 'material', "''", 'is empty: name a '// &
-        '&material, or leave material out and give young and poisson')
-    else if (find_asg(g, 'young') > 0 .or. find_asg(g, 'poisson') > 0 .or. find_asg(g, 'density') > 0) then
-      c%material = ''       ! an override's constants replace the body's material
+    else if (find_asg(g, 'material') > 0) then
+      ! material='' (an override back to young and poisson): both given, the body's own
+      if (find_asg(g, 'young') == 0 .or. find_asg(g, 'poisson') == 0) call bad_value(g, src, 'material', "''", &
+        'leaves the body without a material: give young and poisson with it, or name a &material')
+    else if (len_trim(c%material) > 0) then
+      do s = 1, 3
+        if (find_asg(g, trim(word('young poisson density', s))) > 0) call bad_value(g, src, &
+          trim(word('young poisson density', s)), '', 'would change body '//i2s(id)//', which is of '// &
+          'material = '//quote(trim(c%material))//': change the material (''&material name='// &
+          quote(trim(c%material))//', ... /''), or give material='''' with young and poisson')
+      end do
     end if
     if (.not. abs(c%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', r2s(c%angle), &
       'is out of range: an angle in degrees, at most 3600 in magnitude')
@@ -764,10 +771,8 @@ contains
         call move_alloc(tmp, d%region)
       end if
       d%nregion = n
-      r%origin = '&region at '//origin
-    else
-      r%origin = d%region(n)%origin
     end if
+    r%origin = '&region at '//origin
     d%region(n) = r
   end subroutine add_region
 

@@ -338,7 +338,7 @@ contains
     do k = 1, d%nmaterial     ! every material, used or not, is one the scene's model can use
       block
         type(elastic_law_t) :: law
-        call material_law(d%material(k), 0.0_wp, d%plane_strain, law, msg)
+        call material_law(d%material(k), 0.0_wp, d%plane_strain, law, msg, d%axisymmetric)
         if (len(msg) > 0) call fatal(EXIT_INPUT, st%path//': the '//trim(d%material(k)%origin)// &
           ' (material '''//trim(d%material(k)%name)//''', '//trim(word(MAT_KIND_NAMES, d%material(k)%kind))// &
           ', in '//trim(merge('axisymmetric', merge('plane strain', 'plane stress', d%plane_strain), &
@@ -359,7 +359,7 @@ contains
         k = material_index(d, d%body(b)%material)
         if (k == 0) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('//st%body_at(b)%s//'): material = '''// &
           trim(d%body(b)%material)//''' names no &material ('//material_names(d)//')')
-        call material_law(d%material(k), d%body(b)%angle, d%plane_strain, d%body(b)%law(1), msg)
+        call material_law(d%material(k), d%body(b)%angle, d%plane_strain, d%body(b)%law(1), msg, d%axisymmetric)
       end if
       n = 1
       do i = 1, d%nregion
@@ -372,7 +372,7 @@ contains
         if (k == 0) call fatal(EXIT_INPUT, st%path//': the '//trim(d%region(i)%origin)//': material = '''// &
           trim(d%region(i)%material)//''' names no &material ('//material_names(d)//')')
         d%body(b)%law(n)%region = d%region(i)%name
-        call material_law(d%material(k), d%region(i)%angle, d%plane_strain, d%body(b)%law(n), msg)
+        call material_law(d%material(k), d%region(i)%angle, d%plane_strain, d%body(b)%law(n), msg, d%axisymmetric)
       end do
     end do
     call check_body_forces(d, st)

@@ -63,23 +63,28 @@ contains
   !> The law of material m, its axis 1 at `angle` degrees from x, in plane strain or plane
   !! stress. msg = '' on success; else why not: a constant the model needs and m lacks
   !! (named), or a tensor that is not positive definite (its eigenvalues named).
-  subroutine material_law(m, angle, plane_strain, law, msg)
+  subroutine material_law(m, angle, plane_strain, law, msg, axisymmetric)
     type(material_cfg_t), intent(in) :: m          !< the material (its kind known)
     real(wp), intent(in) :: angle                  !< axis 1 from x [degrees]
     logical, intent(in) :: plane_strain            !< plane strain (else plane stress)
+    !> a body of revolution: the hoop strain is not 0, so the whole 4x4 (c33 too) is needed
+    logical, intent(in), optional :: axisymmetric
     type(elastic_law_t), intent(inout) :: law      !< the law (region kept)
     character(len=:), allocatable, intent(out) :: msg
     real(wp) :: s4(4, 4), c4(4, 4), c3(3, 3), ev(4)
     integer :: n
+    logical :: axi
 
     msg = ''
+    axi = .false.
+    if (present(axisymmetric)) axi = axisymmetric
     law%density = m%density
     select case (m%kind)
     case (MAT_ISOTROPIC)
       call isotropic_law(m%young, m%poisson, plane_strain, law)
       return
     case (MAT_ORTHOTROPIC)
-      msg = missing(m, plane_strain)
+      msg = missing(m, plane_strain, axi)
       if (len(msg) > 0) return
       s4 = 0.0_wp
       s4(1, 1) = 1.0_wp/m%e1
@@ -106,7 +111,7 @@ contains
       c4 = 0.0_wp
       call invert(s4(1:n, 1:n), c4(1:n, 1:n))
     case (MAT_ANISOTROPIC)
-      msg = missing(m, plane_strain)
+      msg = missing(m, plane_strain, axi)
       if (len(msg) > 0) return
       c3 = reshape([m%c11, m%c12, value_or_zero(m%c16), m%c12, m%c22, value_or_zero(m%c26), &
                     value_or_zero(m%c16), value_or_zero(m%c26), m%c66], [3, 3])
@@ -145,9 +150,10 @@ contains
   !> What a kind's model lacks, '' if nothing: orthotropic e1, e2, nu12, g12 always, e3, nu13,
   !! nu23 in plane strain; anisotropic c11 .. c66 always, c13, c23 in plane strain; in plane
   !! stress c13, c23, c33 together or none (none: c11 .. c66 are the plane-stress stiffness).
-  function missing(m, plane_strain) result(msg)
+  function missing(m, plane_strain, axi) result(msg)
     type(material_cfg_t), intent(in) :: m
     logical, intent(in) :: plane_strain
+    logical, intent(in) :: axi             ! axisymmetric: c33 too (the hoop strain is not 0)
     character(len=:), allocatable :: msg
     character(len=:), allocatable :: lst
     lst = ''
@@ -165,7 +171,8 @@ contains
         if (m%nu13 == UNSET) lst = lst//' nu13'
         if (m%nu23 == UNSET) lst = lst//' nu23'
         if (len(lst) > 0) then
-          msg = 'plane strain needs the out-of-plane constants e3, nu13 and nu23 of an orthotropic '// &
+          msg = trim(merge('an axisymmetric body needs', 'plane strain needs        ', axi))// &
+                ' the out-of-plane constants e3, nu13 and nu23 of an orthotropic '// &
                 'material (szz and the plane stiffness depend on them); not given:'//lst
           return
         end if
@@ -179,7 +186,16 @@ contains
         msg = 'an anisotropic material needs c11, c12, c22 and c66 (c16, c26 default to 0); not given:'//lst
         return
       end if
-      if (plane_strain) then
+      if (axi) then
+        if (m%c13 == UNSET) lst = lst//' c13'
+        if (m%c23 == UNSET) lst = lst//' c23'
+        if (m%c33 == UNSET) lst = lst//' c33'
+        if (len(lst) > 0) then
+          msg = 'an axisymmetric body needs the hoop constants c13, c23 and c33 (axis 3 is the hoop '// &
+                'direction, its strain ur/r is not 0); not given:'//lst
+          return
+        end if
+      else if (plane_strain) then
         if (m%c13 == UNSET) lst = lst//' c13'
         if (m%c23 == UNSET) lst = lst//' c23'
         if (len(lst) > 0) then

@@ -263,12 +263,15 @@ contains
     integer :: a, k, fd
     real(wp), allocatable :: pres(:), w2(:, :)
     type(error_t), allocatable :: body_err(:)
-    character(len=:), allocatable :: ul, us, uf, why
+    character(len=:), allocatable :: ul, us, uf, why, trib_unit
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
 
     ul = trim(d%units%length)
     us = trim(d%units%stress)
     uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
+    if (d%axisymmetric) uf = trim(d%units%force)//'/rad'   ! per radian of a body of revolution
+    trib_unit = ul                        ! D_jj: a length, or int N r ds, an area per radian
+    if (d%axisymmetric) trib_unit = ul//'^2/rad'
     allocate (body_err(size(msh)))
     fd = -1
     call file_open(path, fid, st, create=.true.)
@@ -337,7 +340,7 @@ contains
     call write_dset(gid, 'coordinates', w2, st, ul)
     deallocate (w2)
     call write_dset(gid, 'g0', itf%g0, st, ul)
-    call write_dset(gid, 'tributary_length', itf%trib, st, ul)
+    call write_dset(gid, 'tributary_length', itf%trib, st, trib_unit)
     allocate (pres(itf%m))
     call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
@@ -660,7 +663,12 @@ contains
     integer(hid_t) :: pid
     integer :: r(2), i, j
     real(wp), allocatable :: w2(:, :)
+    character(len=:), allocatable :: trib_unit
     logical :: geo
+    trib_unit = ul                         ! per radian (uf ends in /rad): int N r ds
+    if (len(uf) > 4) then
+      if (uf(len(uf) - 3:) == '/rad') trib_unit = ul//'^2/rad'
+    end if
     geo = .true.
     if (present(geometry)) geo = geometry
     r = pair_rows(itf, q)
@@ -678,7 +686,7 @@ contains
       w2 = transpose(itf%normal(:, i:j))
       call write_dset(pid, 'normal', w2, st, '1')
       call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
-      call write_dset(pid, 'tributary_length', itf%trib(i:j), st, ul)
+      call write_dset(pid, 'tributary_length', itf%trib(i:j), st, trib_unit)
       call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
       call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
     end if

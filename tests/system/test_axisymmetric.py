@@ -22,7 +22,8 @@ temporary folder, the sphere's mesh shipped). References are closed forms of ela
 (4) A hollow ring held only by contact: the only rigid motion a body of revolution has is a
     translation along its axis (y), and the run names it.
 (5) Bad input, exit 1, one message, nothing written: a rectangle at x0 < 0, a mesh with a node
-    at x < 0.
+    at x < 0, an anisotropic material without c33 (the hoop strain needs it), a support that
+    prescribes ux != 0 on the axis; the result file's forces are labelled per radian.
 """
 import math
 import os
@@ -182,6 +183,32 @@ try:
                         .replace("gmsh/sphere_flat_h0.01.msh", msh))
     check(code == 1 and "below the axis" in out and not os.path.exists(h5),
           "a mesh with nodes at x < 0: exit 1, named, nothing written", out[-300:])
+    lame2 = ("&scene plane='axisymmetric' /\n"
+             "&material name='a', c11=2.8e11, c12=1.2e11, c22=2.8e11, c66=8.1e10, c13=1.2e11, c23=1.2e11 /\n"
+             "&body id=1, x0=0.1, y0=0.0, width=0.05, height=0.05, nx=4, ny=2, right='contact', bottom='roller', "
+             "top='roller', material='a' /\n"
+             "&body id=2, x0=0.15, y0=0.0, width=0.05, height=0.05, nx=4, ny=2, left='contact', bottom='roller', "
+             "top='roller' /\n&traction body=1, side='left', t0=1e8, 0.0 /\n")
+    code, out, h5 = run(work, "noc33", lame2)
+    check(code == 1 and "c33" in out and "hoop" in out and not os.path.exists(h5),
+          "an anisotropic material without c33 in an axisymmetric scene: exit 1, c33 named", out[-300:])
+    code, out, h5 = run(work, "withc33", lame2.replace("c23=1.2e11 /", "c23=1.2e11, c33=2.8e11 /"))
+    check(code == 0, "the same with c33: it runs", out[-300:])
+    if code == 0:
+        with h5py.File(h5, "r") as f:
+            units = (f["/contact/normal_force"].attrs.get("units", b""), f["/contact/tributary_length"].attrs.get("units", b""))
+            units = tuple(u.decode() if isinstance(u, bytes) else str(u) for u in units)
+            per = f.attrs["forces_per"]
+        check(units == ("N/rad", "m^2/rad") and per == "radian",
+              "axisymmetric result file: forces in N/rad, tributary 'lengths' in m^2/rad, forces_per = radian",
+              f"{units}, {per}")
+    axis = ("&scene plane='axisymmetric' /\n"
+            "&body id=1, x0=0.0, y0=0.0, width=0.5, height=0.25, nx=4, ny=2, bottom='contact' /\n"
+            "&body id=2, x0=0.0, y0=-0.25, width=0.5, height=0.25, nx=4, ny=2, top='contact', bottom='clamped' /\n"
+            "&boundary body=1, group='left', ux=0.001 /\n&traction body=1, side='top', t0=0.0, -1.0e6 /\n")
+    code, out, h5 = run(work, "axisux", axis)
+    check(code == 1 and "on the axis" in out and "ux = " in out and not os.path.exists(h5),
+          "a support prescribing ux != 0 on the axis: exit 1, named", out[-300:])
 finally:
     shutil.rmtree(work, ignore_errors=True)
 

@@ -22,7 +22,8 @@ temporary folder, no gmsh needed). References are closed forms of statics.
     name is no physical surface of the body's cells (its surfaces listed), a material= naming
     no &material, constants of two kinds, Poisson's ratios beyond positive definiteness (its
     eigenvalue named), plane strain without e3, material= with young on one &body, a cell in
-    two regions of different materials, a material's modulus beyond double precision's range
+    two regions of different materials, an override of density on a body of a material (it
+    would silently replace the material), a material's modulus beyond double precision's range
     (the budget's check of the stiffness, on the materials' moduli);
 (4) the shipped inputs/coated_punch.nml (a flat punch on an aluminium block with a titanium
     nitride coating, the coating a region of the block's mesh): Robin = monolithic to 1e-8 of
@@ -216,6 +217,8 @@ try:
     bad("strain_no_e3", good.replace("plane='stress'", "plane='strain'"), "plane strain", "e3", "line 3")
     bad("material_and_young", good.replace("material='steel'", "material='steel', young=1e9"),
         "young = 1e9", "material = 'steel'", "material_and_young.nml:5:")
+    bad("override_density", good, "density", "material = 'steel'", "change the material",
+        over=("&body id=1, density=2700.0 /",))
     bad("huge_modulus", good.replace("young=2.0e11, poisson=0.3 /", "young=1.0e300, poisson=0.3 /"),
         "its materials' moduli", "outside", "rescale the units")
     write_bar(os.path.join(work, "bar2.msh"), extra_region=True)
