@@ -141,7 +141,7 @@ $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
                            $(BUILD)/deck_checks.o $(BUILD)/deck_cross.o $(BUILD)/deck_render.o
 $(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o
-$(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/mesh.o:           $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
 $(BUILD)/gmsh_msh.o:       $(BUILD)/digest.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
                            $(BUILD)/mesh_topology.o $(BUILD)/strings.o $(BUILD)/text_scanner.o

@@ -19,49 +19,8 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "system"))
+from msh_bar import write_bar  # noqa: E402
 
-
-def write_mesh(path, n):
-    """[0, 2] x [0, 0.5], 2n x n/4 Q1 cells; surface 1 the left half, 2 the right; physical
-    'bar' = {1, 2}, 'soft' = {2}; curves 'bar_left', 'bar_bottom', 'bar_right'."""
-    nx, ny = 2 * n, max(1, n // 4)
-    xs = [2.0 * i / nx for i in range(nx + 1)]
-    ys = [0.5 * j / ny for j in range(ny + 1)]
-
-    def nid(i, j):
-        return j * (nx + 1) + i + 1
-    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat", "$PhysicalNames", "5", '2 100 "bar"', '2 200 "soft"',
-           '1 11 "bar_left"', '1 12 "bar_bottom"', '1 13 "bar_right"', "$EndPhysicalNames", "$Entities", "0 3 2 0",
-           "1 0 0 0 0 0.5 0 1 11 0", "2 0 0 0 2 0 0 1 12 0", "3 2 0 0 2 0.5 0 1 13 0",
-           "1 0 0 0 1 0.5 0 1 100 0", "2 1 0 0 2 0.5 0 2 100 200 0", "$EndEntities"]
-    nn = (nx + 1) * (ny + 1)
-    out += ["$Nodes", f"1 {nn} 1 {nn}", f"2 1 0 {nn}"]
-    out += [str(nid(i, j)) for j in range(ny + 1) for i in range(nx + 1)]
-    out += [f"{xs[i]!r} {ys[j]!r} 0" for j in range(ny + 1) for i in range(nx + 1)]
-    out.append("$EndNodes")
-    blocks, tag = [], 0
-    for ent, (i0, i1) in ((1, (0, n)), (2, (n, nx))):
-        q = []
-        for j in range(ny):
-            for i in range(i0, i1):
-                tag += 1
-                q.append(f"{tag} {nid(i, j)} {nid(i + 1, j)} {nid(i + 1, j + 1)} {nid(i, j + 1)}")
-        blocks.append((2, ent, 3, q))
-    for ent, segs in ((1, [(nid(0, j + 1), nid(0, j)) for j in range(ny)]),
-                      (2, [(nid(i, 0), nid(i + 1, 0)) for i in range(nx)]),
-                      (3, [(nid(nx, j), nid(nx, j + 1)) for j in range(ny)])):
-        q = []
-        for a, b in segs:
-            tag += 1
-            q.append(f"{tag} {a} {b}")
-        blocks.append((1, ent, 1, q))
-    out += ["$Elements", f"{len(blocks)} {tag} 1 {tag}"]
-    for d, t, typ, ls in blocks:
-        out.append(f"{d} {t} {typ} {len(ls)}")
-        out += ls
-    out.append("$EndElements")
-    with open(path, "w") as f:
-        f.write("\n".join(out) + "\n")
 
 
 ORTHO = "e1=1.0e11, e2=4.0e10, nu12=0.15, g12=3.0e10"
@@ -82,7 +41,7 @@ def main():
     ap.add_argument("--repeat", type=int, default=5)
     a = ap.parse_args()
     work = tempfile.mkdtemp(prefix="rc_bench_materials_")
-    write_mesh(os.path.join(work, "bar.msh"), a.n)
+    write_bar(os.path.join(work, "bar.msh"), a.n, max(1, a.n // 4))
     best = {}
     for rep in range(a.repeat):
         for label, body1, extra in VARIANTS:

@@ -71,6 +71,15 @@ def run_solver(binary, *args, env=None, **kwargs):
     return p, result_fields(p.stdout)
 
 
+def run_text(binary, work, name, text, *over, env=None, timeout=300):
+    """Write the deck `text` to work/name.nml and run it there with the overrides `over` and
+    its result in work/name.h5. Returns (exit code, stdout + stderr, the result's path)."""
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text)
+    p, _ = run_solver(binary, deck, *over, f"&output file='{name}.h5' /", cwd=work, env=env, timeout=timeout)
+    return p.returncode, p.stdout + p.stderr, os.path.join(work, name + ".h5")
+
 
 def tool_parser(doc, binary="bin/robin_contact"):
     """The argument parser of a tool that runs the program: the tool's docstring as its help

@@ -26,6 +26,7 @@
 !! are written in the file's node and cell order.
 module mesh
   use kinds, only: wp
+  use strings, only: i2s
   use config, only: body_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
   implicit none (type, external)
   private
@@ -148,7 +149,7 @@ contains
         c = mesh%region(r)%cell(j)
         if (mesh%cell_law(c) /= 1) then
           if (any(body%law(mesh%cell_law(c))%d /= body%law(k)%d)) then
-            msg = 'cell '//itoa(mesh%cell_tag(c))//" is in region '"//trim(body%law(mesh%cell_law(c))%region)// &
+            msg = 'cell '//i2s(mesh%cell_tag(c))//" is in region '"//trim(body%law(mesh%cell_law(c))%region)// &
                   "' and in region '"//trim(body%law(k)%region)//"', of different materials: a cell "// &
                   'is of one material'
             return
@@ -158,14 +159,6 @@ contains
       end do
     end do
     bad = 0
-  contains
-    function itoa(i) result(t)
-      integer, intent(in) :: i
-      character(len=:), allocatable :: t
-      character(len=16) :: buf
-      write (buf, '(i0)') i
-      t = trim(buf)
-    end function itoa
   end subroutine assign_cell_laws
 
   !> Id of grid node (i,j), i = 0..nx, j = 0..ny.

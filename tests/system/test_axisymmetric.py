@@ -36,7 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_checks import Checks  # noqa: E402
-from rc_run import run_solver, solver_env  # noqa: E402
+from rc_run import run_solver, run_text, solver_env  # noqa: E402
 
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
@@ -47,11 +47,7 @@ check = Checks()
 
 
 def run(work, name, text, *over):
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write(text)
-    p, _ = run_solver(BIN, deck, *over, f"&output file='{name}.h5' /", cwd=work, env=ENV, timeout=300)
-    return p.returncode, p.stdout + p.stderr, os.path.join(work, name + ".h5")
+    return run_text(BIN, work, name, text, *over, env=ENV)
 
 
 def nodal(f, b, name):

@@ -40,7 +40,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_checks import Checks  # noqa: E402
-from rc_run import run_solver, solver_env  # noqa: E402
+from rc_run import run_solver, run_text, solver_env  # noqa: E402
+from msh_bar import write_bar  # noqa: E402
 
 import h5py  # noqa: E402
 import numpy as np  # noqa: E402
@@ -52,63 +53,6 @@ check = Checks()
 L, H, NX, NY = 1.0, 0.5, 8, 3      # each half L x H, NX x NY cells
 T = 1.0e6
 
-
-def write_bar(path, extra_region=False):
-    """The bar [0, 2L] x [0, H] of 2 NX x NY Q1 cells: surface 1 the left half, 2 the right
-    half; physical surfaces 'bar' = {1, 2}, 'soft' = {2} (and 'strip' = {1, 2} when
-    extra_region: every cell in it), curves 'bar_left', 'bar_bottom', 'bar_right'."""
-    nx = 2 * NX
-    xs = [2 * L * i / nx for i in range(nx + 1)]
-    ys = [H * j / NY for j in range(NY + 1)]
-
-    def nid(i, j):
-        return j * (nx + 1) + i + 1
-    names = [(2, 100, "bar"), (2, 200, "soft"), (1, 11, "bar_left"), (1, 12, "bar_bottom"), (1, 13, "bar_right")]
-    if extra_region:
-        names.append((2, 300, "strip"))
-    s1 = "100 300" if extra_region else "100"
-    s2 = "100 200 300" if extra_region else "100 200"
-    n1, n2 = len(s1.split()), len(s2.split())
-    out = ["$MeshFormat", "4.1 0 8", "$EndMeshFormat", "$PhysicalNames", str(len(names))]
-    out += [f'{d} {t} "{n}"' for d, t, n in names]
-    out += ["$EndPhysicalNames", "$Entities", "0 3 2 0",
-            f"1 0 0 0 0 {H} 0 1 11 0", f"2 0 0 0 {2 * L} 0 0 1 12 0", f"3 {2 * L} 0 0 {2 * L} {H} 0 1 13 0",
-            f"1 0 0 0 {L} {H} 0 {n1} {s1} 0", f"2 {L} 0 0 {2 * L} {H} 0 {n2} {s2} 0", "$EndEntities"]
-    nn = (nx + 1) * (NY + 1)
-    out += ["$Nodes", f"1 {nn} 1 {nn}", f"2 1 0 {nn}"]
-    out += [str(nid(i, j)) for j in range(NY + 1) for i in range(nx + 1)]
-    out += [f"{xs[i]!r} {ys[j]!r} 0" for j in range(NY + 1) for i in range(nx + 1)]
-    out.append("$EndNodes")
-    blocks, tag = [], 0
-
-    def quads(i0, i1):
-        nonlocal tag
-        q = []
-        for j in range(NY):
-            for i in range(i0, i1):
-                tag += 1
-                q.append(f"{tag} {nid(i, j)} {nid(i + 1, j)} {nid(i + 1, j + 1)} {nid(i, j + 1)}")
-        return q
-
-    def lines(segs):
-        nonlocal tag
-        q = []
-        for a, b in segs:
-            tag += 1
-            q.append(f"{tag} {a} {b}")
-        return q
-    blocks.append((2, 1, 3, quads(0, NX)))
-    blocks.append((2, 2, 3, quads(NX, nx)))
-    blocks.append((1, 1, 1, lines([(nid(0, j + 1), nid(0, j)) for j in range(NY)])))
-    blocks.append((1, 2, 1, lines([(nid(i, 0), nid(i + 1, 0)) for i in range(nx)])))
-    blocks.append((1, 3, 1, lines([(nid(nx, j), nid(nx, j + 1)) for j in range(NY)])))
-    out += ["$Elements", f"{len(blocks)} {tag} 1 {tag}"]
-    for d, t, typ, ls in blocks:
-        out.append(f"{d} {t} {typ} {len(ls)}")
-        out += ls
-    out.append("$EndElements")
-    with open(path, "w") as f:
-        f.write("\n".join(out) + "\n")
 
 
 def bar_deck(soft, region_extra="", body1_extra="material='steel'", materials_extra=""):
@@ -129,11 +73,7 @@ def bar_deck(soft, region_extra="", body1_extra="material='steel'", materials_ex
 
 
 def run(work, name, text, *over):
-    deck = os.path.join(work, name + ".nml")
-    with open(deck, "w") as f:
-        f.write(text)
-    p, _ = run_solver(BIN, deck, *over, f"&output file='{name}.h5' /", cwd=work, env=ENV, timeout=300)
-    return p.returncode, p.stdout + p.stderr, os.path.join(work, name + ".h5")
+    return run_text(BIN, work, name, text, *over, env=ENV)
 
 
 def exact_ux(x):
@@ -142,7 +82,7 @@ def exact_ux(x):
 
 work = tempfile.mkdtemp(prefix="rc_materials_")
 try:
-    write_bar(os.path.join(work, "bar.msh"))
+    write_bar(os.path.join(work, "bar.msh"), NX, NY)
     ortho0 = "&material name='soft', e1=1.0e11, e2=4.0e10, nu12=0.15, g12=3.0e10 /"
     ortho90 = "&material name='soft', e1=5.0e10, e2=1.0e11, nu12=0.075, g12=3.0e10 /"
     # the anisotropic form of ortho0: the inverse of its plane-stress compliance
@@ -221,7 +161,7 @@ try:
         over=("&body id=1, density=2700.0 /",))
     bad("huge_modulus", good.replace("young=2.0e11, poisson=0.3 /", "young=1.0e300, poisson=0.3 /"),
         "its materials' moduli", "outside", "rescale the units")
-    write_bar(os.path.join(work, "bar2.msh"), extra_region=True)
+    write_bar(os.path.join(work, "bar2.msh"), NX, NY, extra_region=True)
     bad("two_regions", good.replace("bar.msh", "bar2.msh") + "&region body=1, name='strip', material='steel' /\n",
         "in region 'soft' and in region 'strip'", "of different materials")
 
