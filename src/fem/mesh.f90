@@ -106,7 +106,7 @@ contains
   !> The elastic law of each cell (mesh%cell_law) from the body's laws (body_cfg_t%law: 1 the
   !! body's own, then one per region, named by its physical surface): unallocated when the
   !! body has one law. msg = '' on success; else a region that is no physical surface of the
-  !! body's cells, or a cell in two regions of different laws.
+  !! body's cells, or a cell in two regions of different laws (stiffness or density).
   subroutine assign_cell_laws(mesh, body, msg, bad)
     type(mesh_t), intent(inout) :: mesh               !< the body's mesh
     type(body_cfg_t), intent(in) :: body              !< its laws
@@ -148,7 +148,8 @@ contains
       do j = 1, size(mesh%region(r)%cell)
         c = mesh%region(r)%cell(j)
         if (mesh%cell_law(c) /= 1) then
-          if (any(body%law(mesh%cell_law(c))%d /= body%law(k)%d)) then
+          if (any(body%law(mesh%cell_law(c))%d /= body%law(k)%d) .or. &
+              body%law(mesh%cell_law(c))%density /= body%law(k)%density) then
             msg = 'cell '//i2s(mesh%cell_tag(c))//" is in region '"//trim(body%law(mesh%cell_law(c))%region)// &
                   "' and in region '"//trim(body%law(k)%region)//"', of different materials: a cell "// &
                   'is of one material'
