@@ -236,8 +236,8 @@ contains
     !> (3, 3) the plane stiffness, (sxx, syy, sxy) = dmat (exx, eyy, gxy) [stress]
     real(wp), intent(in), optional :: dmat(:, :)
     integer, intent(in), optional :: key                    !< the material's number for the cache (default 0)
-    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), det, nfun(4)
-    integer :: nv, a, k, ig, jg
+    real(wp) :: rel(2, MAX_NVERT), g(2, MAX_NVERT), det
+    integer :: nv, a, k, q
 
     nv = element_nvert(element)
     k = 0
@@ -259,12 +259,10 @@ contains
       ke = 0.0_wp
       if (element == ELEM_Q1) then
         minjac = huge(1.0_wp)
-        do jg = -1, 1, 2
-          do ig = -1, 1, 2
-            call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
-            minjac = min(minjac, det)
-            if (det > 0.0_wp) call add_btdb_general(4, g, det, dmat, ke)
-          end do
+        do q = 1, 4      ! the tabulated 2x2 Gauss points, as q1_stiffness
+          call q1_point(xe, q, g, det)
+          minjac = min(minjac, det)
+          if (det > 0.0_wp) call add_btdb_general(4, g, det, dmat, ke)
         end do
       else
         call p1_gradients(xe, g, det)
@@ -295,20 +293,53 @@ contains
     integer, intent(in) :: nv
     real(wp), intent(in) :: g(2, MAX_NVERT), w, dmat(:, :)
     real(wp), intent(inout) :: ke(MAX_NDOF, MAX_NDOF)
-    real(wp) :: db(3, 2), ba(3, 2)
+    real(wp) :: d11, d12, d13, d22, d23, d33, gx, gy, p1, p2, p3, q1, q2, q3
     integer :: a, b
+    d11 = dmat(1, 1)*w
+    d12 = dmat(1, 2)*w
+    d13 = dmat(1, 3)*w
+    d22 = dmat(2, 2)*w
+    d23 = dmat(2, 3)*w
+    d33 = dmat(3, 3)*w
     do b = 1, nv
-      ba(:, 1) = [g(1, b), 0.0_wp, g(2, b)]
-      ba(:, 2) = [0.0_wp, g(2, b), g(1, b)]
-      db = matmul(dmat(1:3, 1:3), ba)*w
+      gx = g(1, b)
+      gy = g(2, b)
+      ! w D B_b: its ux column (p) and its uy column (q); D symmetric
+      p1 = d11*gx + d13*gy
+      p2 = d12*gx + d23*gy
+      p3 = d13*gx + d33*gy
+      q1 = d12*gy + d13*gx
+      q2 = d22*gy + d23*gx
+      q3 = d23*gy + d33*gx
       do a = 1, nv
-        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + g(1, a)*db(1, 1) + g(2, a)*db(3, 1)
-        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + g(2, a)*db(2, 1) + g(1, a)*db(3, 1)
-        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + g(1, a)*db(1, 2) + g(2, a)*db(3, 2)
-        ke(2*a, 2*b) = ke(2*a, 2*b) + g(2, a)*db(2, 2) + g(1, a)*db(3, 2)
+        ke(2*a - 1, 2*b - 1) = ke(2*a - 1, 2*b - 1) + g(1, a)*p1 + g(2, a)*p3
+        ke(2*a, 2*b - 1) = ke(2*a, 2*b - 1) + g(2, a)*p2 + g(1, a)*p3
+        ke(2*a - 1, 2*b) = ke(2*a - 1, 2*b) + g(1, a)*q1 + g(2, a)*q3
+        ke(2*a, 2*b) = ke(2*a, 2*b) + g(2, a)*q2 + g(1, a)*q3
       end do
     end do
   end subroutine add_btdb_general
+
+  !> The gradients and the Jacobian determinant of the Q1 shape functions at the q-th 2x2
+  !! Gauss point, from the tabulated reference derivatives (q1_stiffness's arithmetic); g = 0
+  !! where det is not positive.
+  pure subroutine q1_point(xe, q, g, det)
+    real(wp), intent(in) :: xe(2, MAX_NVERT)
+    integer, intent(in) :: q
+    real(wp), intent(out) :: g(2, MAX_NVERT), det
+    real(wp) :: j11, j12, j21, j22
+    j11 = dxi_g2(1, q)*xe(1, 1) + dxi_g2(2, q)*xe(1, 2) + dxi_g2(3, q)*xe(1, 3) + dxi_g2(4, q)*xe(1, 4)
+    j12 = dxi_g2(1, q)*xe(2, 1) + dxi_g2(2, q)*xe(2, 2) + dxi_g2(3, q)*xe(2, 3) + dxi_g2(4, q)*xe(2, 4)
+    j21 = deta_g2(1, q)*xe(1, 1) + deta_g2(2, q)*xe(1, 2) + deta_g2(3, q)*xe(1, 3) + deta_g2(4, q)*xe(1, 4)
+    j22 = deta_g2(1, q)*xe(2, 1) + deta_g2(2, q)*xe(2, 2) + deta_g2(3, q)*xe(2, 3) + deta_g2(4, q)*xe(2, 4)
+    det = j11*j22 - j12*j21
+    if (det > 0.0_wp) then
+      g(1, :) = (j22*dxi_g2(:, q) - j12*deta_g2(:, q))/det
+      g(2, :) = (-j21*dxi_g2(:, q) + j11*deta_g2(:, q))/det
+    else
+      g = 0.0_wp
+    end if
+  end subroutine q1_point
 
   !> Add the consistent nodal loads of a body force density to `fe`: Q1 3x3 Gauss,
   !! P1 the 3-point interior rule of degree 2.
