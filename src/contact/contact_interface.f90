@@ -11,6 +11,7 @@
 !! by mu times the node's normal force (Coulomb): `row_bounds`.
 module contact_interface
   use kinds, only: wp, i8
+  use space, only: NCOMP, node_dof, dof_comp
   use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented, FRICTION_NONE, FRICTION_TRESCA, &
                     OVERLAP_INTERFERENCE, &
                     FRICTION_COULOMB
@@ -164,7 +165,7 @@ contains
     f = 0.0_wp
     do k = first, last
       do e = itf%b(side)%ptr(k), itf%b(side)%ptr(k + 1) - 1
-        c = 2 - mod(itf%b(side)%dof(e), 2)
+        c = dof_comp(itf%b(side)%dof(e))
         f(c) = f(c) - itf%b(side)%val(e)*lam(k)
       end do
     end do
@@ -555,9 +556,9 @@ contains
       do r = 1, nr
         jj = itf%nrow(r)
         do kk = ptr(jj), ptr(jj + 1) - 1
-          do c = 1, 2
+          do c = 1, NCOMP
             q = q + 1
-            b%dof(q) = 2*(nod(kk) - 1) + c
+            b%dof(q) = node_dof(nod(kk), c)
             b%val(q) = sgn*val(kk)*itf%normal(c, r)
           end do
         end do
@@ -575,8 +576,8 @@ contains
     real(wp), intent(in) :: nrm(2)
     integer :: c
     normal_fixed = .true.
-    do c = 1, 2
-      if (abs(nrm(c)) > 1.0e-12_wp .and. sys%free_of(2*(k - 1) + c) > 0) normal_fixed = .false.
+    do c = 1, NCOMP
+      if (abs(nrm(c)) > 1.0e-12_wp .and. sys%free_of(node_dof(k, c)) > 0) normal_fixed = .false.
     end do
   end function normal_fixed
 

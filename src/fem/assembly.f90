@@ -14,6 +14,7 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp
+  use space, only: NCOMP, node_dof
   use, intrinsic :: iso_fortran_env, only: int16
   use strings, only: body_label, sci
   use sorting, only: sort_by_key
@@ -323,15 +324,15 @@ contains
     tol = 1.0e-9_wp*max(maxval(mesh%xy(1, :)) - minval(mesh%xy(1, :)), maxval(mesh%xy(2, :)) - minval(mesh%xy(2, :)))
     do k = 1, mesh%nnode
       if (abs(mesh%xy(1, k)) > tol) cycle
-      if (prescribed(2*k - 1) .and. sys%u_fixed(2*k - 1) /= 0.0_wp) then
+      if (prescribed(node_dof(k, 1)) .and. sys%u_fixed(node_dof(k, 1)) /= 0.0_wp) then
         call err%set(ERR_INPUT, 'body '//body_label(sys%id)//': node '//body_label(mesh%node_tag(k))// &
                      ' lies on the axis (x = 0), where ur = 0, but a support prescribes ux = '// &
-                     sci(sys%u_fixed(2*k - 1))//' there; a body of revolution''s axis cannot move off it')
+                     sci(sys%u_fixed(node_dof(k, 1)))//' there; a body of revolution''s axis cannot move off it')
         return
       end if
-      prescribed(2*k - 1) = .true.
-      sys%u_fixed(2*k - 1) = 0.0_wp
-      sys%dof_stage(2*k - 1) = 0
+      prescribed(node_dof(k, 1)) = .true.
+      sys%u_fixed(node_dof(k, 1)) = 0.0_wp
+      sys%dof_stage(node_dof(k, 1)) = 0
     end do
   end subroutine axis_conditions
 
@@ -818,8 +819,8 @@ contains
     integer :: a
     ldof = 0
     do a = 1, cell_vertices(mesh, c)
-      ldof(2*a - 1) = 2*(mesh%cells(a, c) - 1) + 1
-      ldof(2*a) = 2*(mesh%cells(a, c) - 1) + 2
+      ldof(node_dof(a, 1)) = node_dof(mesh%cells(a, c), 1)
+      ldof(node_dof(a, 2)) = node_dof(mesh%cells(a, c), 2)
     end do
   end subroutine cell_dofs
 
@@ -913,7 +914,7 @@ contains
       end if
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
-        f(2*k - 1:2*k) = f(2*k - 1:2*k) + w(a)*b(:, law)
+        f(node_dof(k, 1):node_dof(k, NCOMP)) = f(node_dof(k, 1):node_dof(k, NCOMP)) + w(a)*b(:, law)
       end do
     end do
   end subroutine add_constant_body_force
@@ -931,12 +932,12 @@ contains
       call cell_coords(mesh, c, xe)
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
-        fe(:, a) = f(2*k - 1:2*k)
+        fe(:, a) = f(node_dof(k, 1):node_dof(k, NCOMP))
       end do
       call element_body_force(cell_element(mesh, c), xe, bf, fe)
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
-        f(2*k - 1:2*k) = fe(:, a)
+        f(node_dof(k, 1):node_dof(k, NCOMP)) = fe(:, a)
       end do
     end do
   end subroutine add_body_force

@@ -26,6 +26,7 @@
 !! are written in the file's node and cell order.
 module mesh
   use kinds, only: wp
+  use space, only: node_dof, dof_node, dof_comp
   use strings, only: i2s
   use config, only: body_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
   implicit none (type, external)
@@ -230,12 +231,12 @@ contains
     end do
   end function file_cells
 
-  !> Global DOF `dof` (2*(k-1)+component of node k) numbered by the file's node order.
+  !> Global DOF `dof` (space's node_dof(k, c)) numbered by the file's node order.
   elemental integer function file_dof(mesh, dof)
     type(mesh_t), intent(in) :: mesh   !< the mesh
-    integer, intent(in) :: dof         !< a global DOF, 1..2*nnode
+    integer, intent(in) :: dof         !< a global DOF, 1..NCOMP nnode
     file_dof = dof
-    if (allocated(mesh%file_node)) file_dof = 2*(mesh%file_node((dof + 1)/2) - 1) + 2 - mod(dof, 2)
+    if (allocated(mesh%file_node)) file_dof = node_dof(mesh%file_node(dof_node(dof)), dof_comp(dof))
   end function file_dof
 
   !> Build the structured mesh of a body (its rectangle, nx x ny grid cells and element).

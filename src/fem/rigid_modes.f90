@@ -5,6 +5,7 @@
 !! floating's use). Fills the rigid-motion fields of body_system_t.
 module rigid_modes
   use kinds, only: wp
+  use space, only: NCOMP, node_dof
   use config, only: body_cfg_t, BC_CONTACT
   use mesh, only: mesh_t, side_nodes, group_index, group_nodes
   use lapack, only: dgesvd
@@ -48,8 +49,8 @@ contains
       end if
     end if
     do k = 1, mesh%nnode
-      do cc = 1, 2
-        if (.not. prescribed(2*(k - 1) + cc)) cycle
+      do cc = 1, NCOMP
+        if (.not. prescribed(node_dof(k, cc))) cycle
         r = rigid_row(sys, mesh%xy(:, k), cc)
         call givens_add_row(g, r)
       end do
@@ -81,11 +82,11 @@ contains
     end if
     do j = 1, nk
       do k = 1, mesh%nnode
-        do cc = 1, 2
-          if (prescribed(2*(k - 1) + cc)) then
-            sys%rig(2*(k - 1) + cc, j) = 0.0_wp
+        do cc = 1, NCOMP
+          if (prescribed(node_dof(k, cc))) then
+            sys%rig(node_dof(k, cc), j) = 0.0_wp
           else
-            sys%rig(2*(k - 1) + cc, j) = dot_product(rigid_row(sys, mesh%xy(:, k), cc), sys%rig_coef(:, j))
+            sys%rig(node_dof(k, cc), j) = dot_product(rigid_row(sys, mesh%xy(:, k), cc), sys%rig_coef(:, j))
           end if
         end do
       end do
@@ -224,7 +225,7 @@ contains
     dbest = huge(1.0_wp)
     do i = 1, mesh%nnode
       k = order(i)
-      if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
+      if (avoid(k) .or. all(prescribed(node_dof(k, 1):node_dof(k, NCOMP)))) cycle
       d = norm2(mesh%xy(:, k) - ctr)
       if (d < dbest) then
         dbest = d
@@ -241,7 +242,7 @@ contains
     dbest = -1.0_wp
     do i = 1, mesh%nnode
       k = order(i)
-      if (avoid(k) .or. (prescribed(2*k - 1) .and. prescribed(2*k))) cycle
+      if (avoid(k) .or. all(prescribed(node_dof(k, 1):node_dof(k, NCOMP)))) cycle
       d = norm2(mesh%xy(:, k) - mesh%xy(:, p(1)))
       if (d > dbest) then
         dbest = d
@@ -249,9 +250,9 @@ contains
       end if
     end do
     nc = 0
-    do i = 1, 2
-      do j = 1, 2
-        k = 2*(p(i) - 1) + j
+    do i = 1, 2          ! the two nodes chosen
+      do j = 1, NCOMP
+        k = node_dof(p(i), j)
         if (.not. prescribed(k) .and. .not. any(cand(1:nc) == k)) then
           nc = nc + 1
           cand(nc) = k

@@ -2,6 +2,7 @@
 !! the grid stencil on a structured mesh, from the cells' node adjacency on any other.
 module stiffness_pattern
   use kinds, only: wp, i8
+  use space, only: NCOMP, node_dof
   use, intrinsic :: iso_fortran_env, only: int16
   use config, only: ELEM_Q1
   use mesh, only: mesh_t, node_id, cell_vertices
@@ -82,17 +83,17 @@ contains
     sys%colptr = 0
     maxrow = 0
     do k = 1, mesh%nnode
-      if (sys%free_of(2*k - 1) == 0 .and. sys%free_of(2*k) == 0) cycle
+      if (all(sys%free_of(node_dof(k, 1):node_dof(k, NCOMP)) == 0)) cycle
       call neighbours(k)
       nrow = 0
       do s = 1, nnbr
-        do cc = 1, 2
-          if (sys%free_of(2*(nbr(s) - 1) + cc) > 0) nrow = nrow + 1
+        do cc = 1, NCOMP
+          if (sys%free_of(node_dof(nbr(s), cc)) > 0) nrow = nrow + 1
         end do
       end do
       maxrow = max(maxrow, nrow)
-      do cc = 1, 2
-        p = sys%free_of(2*(k - 1) + cc)
+      do cc = 1, NCOMP
+        p = sys%free_of(node_dof(k, cc))
         if (p > 0) sys%colptr(p + 1) = nrow
       end do
     end do
@@ -115,21 +116,21 @@ contains
     end do
     allocate (sys%rowind(nnz), sys%val(nnz))
     do k = 1, mesh%nnode
-      if (sys%free_of(2*k - 1) == 0 .and. sys%free_of(2*k) == 0) cycle
+      if (all(sys%free_of(node_dof(k, 1):node_dof(k, NCOMP)) == 0)) cycle
       call neighbours(k)
       nrow = 0
       do s = 1, nnbr
         if (with_map) rowoff(nbr(s)) = nrow
-        do cc = 1, 2
-          q = sys%free_of(2*(nbr(s) - 1) + cc)
+        do cc = 1, NCOMP
+          q = sys%free_of(node_dof(nbr(s), cc))
           if (q > 0) then
             nrow = nrow + 1
             rows(nrow) = q - 1
           end if
         end do
       end do
-      do cc = 1, 2
-        p = sys%free_of(2*(k - 1) + cc)
+      do cc = 1, NCOMP
+        p = sys%free_of(node_dof(k, cc))
         if (p == 0) cycle
         first = sys%colptr(p)
         sys%rowind(first + 1:first + nrow) = rows(1:nrow)

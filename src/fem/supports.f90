@@ -3,6 +3,7 @@
 !! the DOFs left free (body_system_t's ndof, u_fixed, n, free_of, dof_of).
 module supports
   use kinds, only: wp
+  use space, only: NCOMP, node_dof
   use strings, only: body_label
   use config, only: body_cfg_t, boundary_cfg_t, SIDE_BOTTOM, SIDE_TOP, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
   use mesh, only: mesh_t, side_nodes, group_index, group_names, group_nodes
@@ -29,7 +30,7 @@ contains
     integer, allocatable :: nodes(:)
     integer :: side, k, cc
 
-    sys%ndof = 2*mesh%nnode
+    sys%ndof = NCOMP*mesh%nnode
     allocate (prescribed(sys%ndof), sys%u_fixed(sys%ndof), sys%dof_stage(sys%ndof))
     prescribed = .false.
     sys%u_fixed = 0.0_wp
@@ -39,26 +40,26 @@ contains
       select case (body%bc(side))
       case (BC_CLAMPED)
         do k = 1, size(nodes)
-          do cc = 1, 2
-            prescribed(2*(nodes(k) - 1) + cc) = .true.
-            sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
-            sys%dof_stage(2*(nodes(k) - 1) + cc) = 0
+          do cc = 1, NCOMP
+            prescribed(node_dof(nodes(k), cc)) = .true.
+            sys%u_fixed(node_dof(nodes(k), cc)) = 0.0_wp
+            sys%dof_stage(node_dof(nodes(k), cc)) = 0
           end do
         end do
       case (BC_ROLLER)
         cc = 1
         if (side == SIDE_BOTTOM .or. side == SIDE_TOP) cc = 2
         do k = 1, size(nodes)
-          prescribed(2*(nodes(k) - 1) + cc) = .true.
-          sys%u_fixed(2*(nodes(k) - 1) + cc) = 0.0_wp
-          sys%dof_stage(2*(nodes(k) - 1) + cc) = 0
+          prescribed(node_dof(nodes(k), cc)) = .true.
+          sys%u_fixed(node_dof(nodes(k), cc)) = 0.0_wp
+          sys%dof_stage(node_dof(nodes(k), cc)) = 0
         end do
       case (BC_DISPLACEMENT)
         do k = 1, size(nodes)
-          do cc = 1, 2
-            prescribed(2*(nodes(k) - 1) + cc) = .true.
-            sys%u_fixed(2*(nodes(k) - 1) + cc) = body%u_side(cc, side)
-            sys%dof_stage(2*(nodes(k) - 1) + cc) = body%side_stage(side)
+          do cc = 1, NCOMP
+            prescribed(node_dof(nodes(k), cc)) = .true.
+            sys%u_fixed(node_dof(nodes(k), cc)) = body%u_side(cc, side)
+            sys%dof_stage(node_dof(nodes(k), cc)) = body%side_stage(side)
           end do
         end do
       case default   ! BC_FREE, BC_CONTACT: nothing
@@ -97,9 +98,9 @@ contains
       end if
       call group_nodes(mesh, g, nodes)
       do k = 1, size(nodes)
-        do cc = 1, 2
+        do cc = 1, NCOMP
           if (.not. boundaries(i)%fix(cc)) cycle
-          dof = 2*(nodes(k) - 1) + cc
+          dof = node_dof(nodes(k), cc)
           prescribed(dof) = .true.
           sys%u_fixed(dof) = boundaries(i)%u(cc)
           sys%dof_stage(dof) = merge(boundaries(i)%stage, 0, boundaries(i)%u(cc) /= 0.0_wp)

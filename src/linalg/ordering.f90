@@ -28,6 +28,7 @@
 !! DOF to its free index (0: prescribed), dof_of a free index to its global DOF.
 module ordering
   use kinds, only: wp, i8
+  use space, only: NCOMP, node_dof
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
   private
@@ -402,8 +403,8 @@ contains
     type(order_t), intent(inout) :: order
     integer, intent(in) :: free_of(:), n, node
     integer :: c, f
-    do c = 1, 2
-      f = free_of(2*(node - 1) + c)
+    do c = 1, NCOMP
+      f = free_of(node_dof(node, c))
       if (f <= 0) cycle
       if (f > n) then
         order%bad_map = .true.
@@ -483,8 +484,8 @@ contains
       do i = 1, na
         node = graph%mesh_node(i)
         cnt = graph%xadj(i)
-        do c = 1, 2
-          p = free_of(2*(node - 1) + c)
+        do c = 1, NCOMP
+          p = free_of(node_dof(node, c))
           if (p < 1 .or. p > n) cycle
           if (skip(p)) cycle
           do kk = colptr(p) + 1, colptr(p + 1)

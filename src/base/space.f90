@@ -1,0 +1,39 @@
+!> The spatial dimension and what follows from it, named once: the coordinates of a node, the
+!! components of its displacement, the rigid motions of a free body, the stress components a
+!! node carries, and the numbering of the DOFs (node k, component c is DOF NCOMP (k - 1) + c,
+!! the components of a node consecutive). Every body is plane today (plane strain, plane
+!! stress, or the meridian section of a body of revolution); a module that depends on the
+!! dimension says so through these names, not through a literal 2, 3 or 4.
+module space
+  implicit none (type, external)
+  private
+
+  integer, parameter, public :: NDIM = 2                     !< coordinates of a node (x, y)
+  integer, parameter, public :: NCOMP = NDIM                 !< displacement components of a node (ux, uy)
+  integer, parameter, public :: NRIGID = NDIM*(NDIM + 1)/2   !< rigid motions of a free body: translations and rotations
+  integer, parameter, public :: NSTRESS = 4                  !< stress components of a node: sxx, syy, sxy and szz
+
+  public :: node_dof, dof_node, dof_comp
+
+contains
+
+  !> The DOF of node k's component c: NCOMP (k - 1) + c.
+  elemental integer function node_dof(k, c)
+    integer, intent(in) :: k   !< the node, 1..nnode
+    integer, intent(in) :: c   !< the component, 1..NCOMP (1 = x, 2 = y)
+    node_dof = NCOMP*(k - 1) + c
+  end function node_dof
+
+  !> The node of DOF i.
+  elemental integer function dof_node(i)
+    integer, intent(in) :: i   !< a DOF, 1..NCOMP nnode
+    dof_node = (i - 1)/NCOMP + 1
+  end function dof_node
+
+  !> The component of DOF i (1 = x, 2 = y).
+  elemental integer function dof_comp(i)
+    integer, intent(in) :: i   !< a DOF, 1..NCOMP nnode
+    dof_comp = i - NCOMP*((i - 1)/NCOMP)
+  end function dof_comp
+
+end module space
