@@ -302,9 +302,9 @@ contains
       end if
     end do
     if (present(u_prescribed)) then
-      if (size(u_prescribed) /= 2*mesh%nnode) then
+      if (size(u_prescribed) /= NCOMP*mesh%nnode) then
         write (emsg, '(a,i0,a,i0,a,i0)') 'body ', body%id, ': u_prescribed has ', size(u_prescribed), &
-          ' values, expected ndof = ', 2*mesh%nnode
+          ' values, expected ndof = ', NCOMP*mesh%nnode
         call err%set(ERR_INPUT, emsg)
         return
       end if
@@ -700,8 +700,8 @@ contains
 
     laws = body_laws(body, plane_strain)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
-    r(1:2*mesh%nnode) = 0.0_wp
-    if (present(mag)) mag(1:2*mesh%nnode) = 0.0_wp
+    r(1:NCOMP*mesh%nnode) = 0.0_wp
+    if (present(mag)) mag(1:NCOMP*mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
       nd = 2*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
@@ -715,7 +715,7 @@ contains
         end do
       end if
     end do
-    r(1:2*mesh%nnode) = r(1:2*mesh%nnode) - f_full(1:2*mesh%nnode)
+    r(1:NCOMP*mesh%nnode) = r(1:NCOMP*mesh%nnode) - f_full(1:NCOMP*mesh%nnode)
   end subroutine residual_full
 
   !> The forces the supports exert on the body at its nodes: K u - f at the prescribed DOFs
@@ -733,7 +733,7 @@ contains
     real(wp), intent(out) :: r(:)               !< (ndof) reactions [force]
     real(wp), intent(out), optional :: mag(:)   !< (ndof) the size of K u's terms (residual_full)
     call residual_full(mesh, body, plane_strain, u_full, f_applied, r, mag)
-    where (sys%free_of(1:2*mesh%nnode) /= 0) r(1:2*mesh%nnode) = 0.0_wp
+    where (sys%free_of(1:NCOMP*mesh%nnode) /= 0) r(1:NCOMP*mesh%nnode) = 0.0_wp
     if (allocated(sys%fixing)) r(sys%fixing) = 0.0_wp
   end subroutine support_reactions
 

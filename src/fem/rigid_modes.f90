@@ -5,7 +5,7 @@
 !! floating's use). Fills the rigid-motion fields of body_system_t.
 module rigid_modes
   use kinds, only: wp
-  use space, only: NCOMP, node_dof
+  use space, only: NCOMP, NRIGID, node_dof
   use config, only: body_cfg_t, BC_CONTACT
   use mesh, only: mesh_t, side_nodes, group_index, group_nodes
   use lapack, only: dgesvd
@@ -35,7 +35,7 @@ contains
     !> a meridian section: a motion along x (r) or a rotation strains the hoop, so only the
     !! translation along the axis (y) is rigid
     logical, intent(in), optional :: axisymmetric
-    real(wp) :: g(3, 3), r(3), ev(3), work(64), top, vt(3, 3), dummy(1, 1)
+    real(wp) :: g(NRIGID, NRIGID), r(NRIGID), ev(NRIGID), work(64), top, vt(NRIGID, NRIGID), dummy(1, 1)
     integer :: k, cc, j, lapinfo, nk
     character(len=512) :: emsg
 
@@ -55,7 +55,7 @@ contains
         call givens_add_row(g, r)
       end do
     end do
-    call dgesvd('N', 'A', 3, 3, g, 3, ev, dummy, 1, vt, 3, work, size(work), lapinfo)
+    call dgesvd('N', 'A', NRIGID, NRIGID, g, NRIGID, ev, dummy, 1, vt, NRIGID, work, size(work), lapinfo)
     top = max(ev(1), 0.0_wp)
     nk = 0
     if (lapinfo /= 0) then
@@ -65,17 +65,20 @@ contains
       return
     end if
     nk = count(ev <= 1.0e-10_wp*top)
-    if (top <= 0.0_wp) nk = 3
+    if (top <= 0.0_wp) nk = NRIGID
     ! the kernel, smallest singular value first (the order the Gram eigenvectors had)
-    do j = 1, 3
-      g(:, j) = vt(4 - j, :)
+    do j = 1, NRIGID
+      g(:, j) = vt(NRIGID + 1 - j, :)
     end do
     sys%nrig = nk
     if (nk == 0) return
     ! ascending eigenvalues: the kernel is the first nk columns (nothing prescribed: identity)
-    allocate (sys%rig_coef(3, nk), sys%rig(sys%ndof, nk))
+    allocate (sys%rig_coef(NRIGID, nk), sys%rig(sys%ndof, nk))
     if (top <= 0.0_wp) then
-      sys%rig_coef = reshape([1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 1.0_wp], [3, 3])
+      sys%rig_coef = 0.0_wp
+      do j = 1, NRIGID
+        sys%rig_coef(j, j) = 1.0_wp
+      end do
     else
       sys%rig_coef = g(:, 1:nk)
       call tidy_basis(sys%rig_coef)
@@ -93,37 +96,38 @@ contains
     end do
   end subroutine rigid_kernel
 
-  !> Add the row r to the upper triangle rt of a QR factorization by three Givens rotations.
+  !> Add the row r to the upper triangle rt of a QR factorization by NRIGID Givens rotations.
   pure subroutine givens_add_row(rt, r)
-    real(wp), intent(inout) :: rt(3, 3)   !< upper triangular R (below the diagonal: zero)
-    real(wp), intent(in) :: r(3)          !< the new row
-    real(wp) :: w(3), c, s, rho
+    real(wp), intent(inout) :: rt(NRIGID, NRIGID)   !< upper triangular R (below the diagonal: zero)
+    real(wp), intent(in) :: r(NRIGID)               !< the new row
+    real(wp) :: w(NRIGID), c, s, rho
     integer :: i
     w = r
-    do i = 1, 3
+    do i = 1, NRIGID
       if (w(i) == 0.0_wp) cycle
       rho = hypot(rt(i, i), w(i))
       c = rt(i, i)/rho
       s = w(i)/rho
       rt(i, i) = rho
       w(i) = 0.0_wp
-      if (i < 3) then
+      if (i < NRIGID) then
         block
-          real(wp) :: row(3 - i)
-          row = rt(i, i + 1:3)
-          rt(i, i + 1:3) = c*row + s*w(i + 1:3)
-          w(i + 1:3) = -s*row + c*w(i + 1:3)
+          real(wp) :: row(NRIGID - i)
+          row = rt(i, i + 1:NRIGID)
+          rt(i, i + 1:NRIGID) = c*row + s*w(i + 1:NRIGID)
+          w(i + 1:NRIGID) = -s*row + c*w(i + 1:NRIGID)
         end block
       end if
     end do
   end subroutine givens_add_row
 
-  !> Component cc of the three basis rigid modes at the point x.
+  !> Component cc of the NRIGID basis rigid modes at the point x: the translations, then the
+  !! rotation about rig_xc scaled by rig_h.
   pure function rigid_row(sys, x, cc) result(r)
     type(body_system_t), intent(in) :: sys
     real(wp), intent(in) :: x(2)
     integer, intent(in) :: cc
-    real(wp) :: r(3)
+    real(wp) :: r(NRIGID)
     r = 0.0_wp
     r(cc) = 1.0_wp
     if (cc == 1) r(3) = -(x(2) - sys%rig_xc(2))/sys%rig_h
@@ -146,7 +150,7 @@ contains
   !! along x', 'translation along (0.6, 0.8)', 'rotation about (x0, y0)'.
   function rigid_motion_name(sys, c) result(s)
     type(body_system_t), intent(in) :: sys  !< the body's system (rig_xc, rig_h)
-    real(wp), intent(in) :: c(3)            !< coefficients in the basis of rigid_kernel
+    real(wp), intent(in) :: c(NRIGID)       !< coefficients in the basis of rigid_kernel
     character(len=:), allocatable :: s
     character(len=64) :: buf
     real(wp) :: w, t(2)

@@ -12,6 +12,7 @@ module results
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_c_binding, only: c_loc, c_long_long
   use kinds, only: wp
+  use space, only: NSTRESS
   use hdf5, only: hid_t, hsize_t, haddr_t
   use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr, write_attr_list, &
                   reserve_dset
@@ -431,7 +432,7 @@ contains
     character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
     integer :: k, nn
     nn = msh%nnode
-    allocate (sigma(4, nn), vm(nn), p(nn))
+    allocate (sigma(NSTRESS, nn), vm(nn), p(nn))
     call nodal_stress(msh, d%body(a), d%plane_strain, ua, sigma, vm)
     vm = file_order(msh, vm)
     if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm)))) then
@@ -561,7 +562,7 @@ contains
           disp = transpose(file_order(msh(a), reshape(ua, [2, nn])))   ! a contiguous copy (see write_h5)
           call write_dset(gid, 'displacement', disp, st, ul)
           call write_dset(gid, 'displacement_xyz', pad3(file_order(msh(a), reshape(ua, [2, nn]))), st, ul)
-          allocate (sigma(4, nn), vm(nn), pnode(nn))
+          allocate (sigma(NSTRESS, nn), vm(nn), pnode(nn))
           call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
         end associate
         if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) &
