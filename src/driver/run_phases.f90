@@ -7,12 +7,13 @@ module run_phases
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
-  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count, body_stiffness
+  use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count, body_stiffness, &
+                    solver_cfg_t, ROBIN_HARMONIC, ROBIN_STEKLOV
   use mesh, only: mesh_t, mesh_build, assign_cell_laws
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, support_reactions
   use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT, ROW_NORMAL
-  use contact_types, only: STATUS_FAILED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
+  use contact_types, only: STATUS_FAILED, STATUS_DIVERGED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
                            contact_result_t
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
@@ -413,6 +414,7 @@ contains
                            run%robin_state, ckpt, stop_requested)
         end if
         if (ckpt%err%failed()) call warn(ckpt%err%text())
+        call steklov_fallback(run, ckpt)
       end if
       if (result%status == STATUS_FAILED) return
       call error_bound(contact_line, bodies, result)
@@ -438,6 +440,38 @@ contains
       end do
     end associate
   end subroutine solve_contact
+
+  !> The harmonic operator's known stall (doc/method.md, "Near-kernel"): where its iteration
+  !! stagnates, the obstacles fixed but the bodies not agreeing (a Coulomb fit, a sphere's
+  !! friction at the axis), the Steklov operator, whose S_1 + S_2 = F_1 + F_2 is well
+  !! conditioned, goes on from its iterate, and the summary says so. A run that converges,
+  !! diverges otherwise, or uses another operator is untouched.
+  subroutine steklov_fallback(run, ckpt)
+    type(run_t), intent(inout), target :: run
+    type(h5_checkpointer_t), intent(inout) :: ckpt
+    type(solver_cfg_t) :: steklov
+    real(wp), allocatable :: g(:, :), lam(:, :)
+    integer :: outer0
+    associate (result => run%result)
+      if (run%deck%solver%robin_operator /= ROBIN_HARMONIC .or. result%status /= STATUS_DIVERGED) return
+      if (index(result%message, 'stagnated') == 0) return
+      if (.not. allocated(run%robin_state%G) .or. .not. allocated(run%robin_state%lam)) return
+      write (output_unit, '(a)') 'robin: the harmonic operator stalled ('//trim(result%message)// &
+        '); the steklov operator goes on from its iterate'
+      outer0 = result%outer
+      g = run%robin_state%G
+      lam = run%robin_state%lam
+      steklov = run%deck%solver
+      steklov%robin_operator = ROBIN_STEKLOV
+      run%robin_state%it = 0
+      call solve_robin(steklov, run%contact_line, run%bodies, result, output_unit, run%deck%output%progress_lines, &
+                       run%robin_state, ckpt, stop_requested, g, lam)
+      if (ckpt%err%failed()) call warn(ckpt%err%text())
+      result%outer = result%outer + outer0
+      result%message = trim(result%message)//' (after '//i2s(outer0)//' outer iterations of the harmonic '// &
+                       'operator, which stalled, then the steklov operator)'
+    end associate
+  end subroutine steklov_fallback
 
   !> The contact forces and the displacements of every load step in turn (one step: the
   !! deck's loads at once). A step's loads are combined from the stages' vectors and only

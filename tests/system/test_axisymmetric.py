@@ -19,6 +19,10 @@ temporary folder, the sphere's mesh shipped). References are closed forms of ela
     per radian, the contact radius a = (3 P R/(4 E*))^(1/3) and the peak pressure p0 = 3 P /
     (2 pi a^2), each within 1% of the Hertz shape fitted to the nodal pressures; the bodies
     balance along the axis (the `reaction:` lines) to 1e-9.
+    With Coulomb friction (mu = 0.3) the harmonic Robin operator stalls (the tangential row at
+    the axis, where ur = 0 on both bodies, is left free by the equations); the run says so,
+    the Steklov operator goes on from its iterate, and the forces are the monolithic ones to
+    1e-6.
 (4) A hollow ring held only by contact: the only rigid motion a body of revolution has is a
     translation along its axis (y), and the run names it.
 (5) Bad input, exit 1, one message, nothing written: a rectangle at x0 < 0, a mesh with a node
@@ -145,6 +149,25 @@ try:
         bal = [float(m) for m in re.findall(r"^reaction: .* balance=(\S+)", out, re.M)]
         check(len(bal) == 2 and max(bal) <= 1e-9, "sphere on a flat: both bodies balance along the axis",
               str(bal))
+
+    # (3b) Coulomb friction on the sphere: the harmonic operator's stall, then Steklov
+    fr = {}
+    for method in ("robin", "monolithic"):
+        h5 = os.path.join(work, f"coulomb_{method}.h5")
+        p_, _ = run_solver(BIN, os.path.join(ROOT, "inputs", "sphere_flat.nml"),
+                           "&contact friction='coulomb', mu=0.3 /", f"&solver method='{method}' /",
+                           f"&output file='{h5}' /", cwd=work, env=ENV, timeout=300)
+        if method == "robin":
+            check(p_.returncode == 0 and "robin: the harmonic operator stalled" in p_.stdout
+                  and "the steklov operator goes on" in p_.stdout,
+                  "sphere with Coulomb friction: the harmonic stall is said, the Steklov operator converges",
+                  (p_.stdout + p_.stderr)[-400:])
+        if p_.returncode == 0:
+            with h5py.File(h5, "r") as f:
+                fr[method] = f["/contact/normal_force"][...]
+    if len(fr) == 2:
+        dd = np.max(np.abs(fr["robin"] - fr["monolithic"])) / np.max(np.abs(fr["monolithic"]))
+        check(dd <= 1e-6, "sphere with Coulomb friction: Robin = monolithic", f"{dd:.1e}")
 
     # (4) a hollow ring held only by contact: its one rigid motion is along the axis
     deck = ("&scene plane='axisymmetric' /\n"
