@@ -14,7 +14,7 @@ module run_phases
   use assembly, only: assemble_body, support_reactions
   use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT, ROW_NORMAL
   use contact_types, only: STATUS_FAILED, STATUS_DIVERGED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
-                           contact_result_t
+                           contact_result_t, robin_state_t
   use robin_iteration, only: solve_robin
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
@@ -450,6 +450,8 @@ contains
     type(run_t), intent(inout), target :: run
     type(h5_checkpointer_t), intent(inout) :: ckpt
     type(solver_cfg_t) :: steklov
+    type(contact_result_t) :: harmonic
+    type(robin_state_t) :: harmonic_state
     real(wp), allocatable :: g(:, :), lam(:, :)
     integer :: outer0
     associate (result => run%result)
@@ -458,6 +460,8 @@ contains
       if (.not. allocated(run%robin_state%G) .or. .not. allocated(run%robin_state%lam)) return
       write (output_unit, '(a)') 'robin: the harmonic operator stalled ('//trim(result%message)// &
         '); the steklov operator goes on from its iterate'
+      harmonic = result
+      harmonic_state = run%robin_state
       outer0 = result%outer
       g = run%robin_state%G
       lam = run%robin_state%lam
@@ -467,6 +471,14 @@ contains
       call solve_robin(steklov, run%contact_line, run%bodies, result, output_unit, run%deck%output%progress_lines, &
                        run%robin_state, ckpt, stop_requested, g, lam)
       if (ckpt%err%failed()) call warn(ckpt%err%text())
+      if (result%status /= STATUS_CONVERGED .and. .not. result%residual < harmonic%residual) then
+        ! no better (a material contrast the Steklov operator cannot take): the harmonic result
+        write (output_unit, '(a)') 'robin: the steklov operator did no better ('//trim(result%message)// &
+          '); the harmonic operator''s result stands'
+        result = harmonic
+        run%robin_state = harmonic_state
+        return
+      end if
       result%outer = result%outer + outer0
       result%message = trim(result%message)//' (after '//i2s(outer0)//' outer iterations of the harmonic '// &
                        'operator, which stalled, then the steklov operator)'
