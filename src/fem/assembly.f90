@@ -23,8 +23,7 @@ module assembly
   use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
   use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
                       element_stiffness, element_body_force, edge_traction, element_stress, &
-                      element_shape_integrals, element_stress_general, axi_stiffness, axi_stress, &
-                      axi_shape_integrals
+                      element_shape_integrals, element_stress_general, axi_stiffness, axi_stress
   use material_laws, only: isotropic_law
   use linop, only: csc_symv
   use body_system, only: body_system_t
@@ -907,11 +906,7 @@ contains
       law = law_of(mesh, c)
       if (all(b(:, law) == 0.0_wp)) cycle
       call cell_coords(mesh, c, xe)
-      if (mesh%axisymmetric) then
-        call axi_shape_integrals(cell_element(mesh, c), xe, w)
-      else
-        call element_shape_integrals(cell_element(mesh, c), xe, w)
-      end if
+      call element_shape_integrals(cell_element(mesh, c), xe, w, mesh%axisymmetric)
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
         f(node_dof(k, 1):node_dof(k, NCOMP)) = f(node_dof(k, 1):node_dof(k, NCOMP)) + w(a)*b(:, law)

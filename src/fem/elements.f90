@@ -16,7 +16,7 @@ module elements
 
   public :: element_nvert, q1_gradients, p1_gradients, element_stiffness, ke_cache_init
   public :: element_body_force, edge_traction, element_stress, body_force_fn, element_shape_integrals
-  public :: element_stress_general, axi_stiffness, axi_stress, axi_shape_integrals
+  public :: element_stress_general, axi_stiffness, axi_stress
 
   integer, parameter, public :: MAX_NVERT = 4            !< most vertices of an element (Q1)
   integer, parameter, public :: MAX_NDOF = 2*MAX_NVERT   !< most DOFs of an element (Q1)
@@ -383,24 +383,40 @@ contains
 
   !> w(a) = the integral of shape function a over the element: the consistent nodal load of
   !! a constant body force b is w(a) b. Q1: 2x2 Gauss, exact (N_a det J is of degree 2 in
-  !! each reference coordinate); P1: a third of the area each.
-  pure subroutine element_shape_integrals(element, xe, w)
+  !! each reference coordinate); P1: a third of the area each. With `axisymmetric`, per radian
+  !! int N_a r dA: Q1 the same points (N_a det J r of degree 3: exact), P1 A/12 (2 r_a + r_b +
+  !! r_c), exact.
+  pure subroutine element_shape_integrals(element, xe, w, axisymmetric)
     integer, intent(in) :: element                  !< ELEM_Q1 or ELEM_P1
     real(wp), intent(in) :: xe(2, MAX_NVERT)        !< vertex coordinates [length]
-    real(wp), intent(out) :: w(MAX_NVERT)           !< [length^2]
+    real(wp), intent(out) :: w(MAX_NVERT)           !< [length^2], axisymmetric [length^3]
+    logical, intent(in), optional :: axisymmetric   !< a meridian section (x = r): weighted by r
     integer :: ig, jg
     real(wp) :: nfun(4), g(2, MAX_NVERT), det
+    logical :: axi
+    axi = .false.
+    if (present(axisymmetric)) axi = axisymmetric
     w = 0.0_wp
     if (element == ELEM_Q1) then
       do jg = -1, 1, 2
         do ig = -1, 1, 2
           call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
-          w = w + det*nfun
+          if (axi) then
+            w = w + det*nfun*sum(nfun*xe(1, :))
+          else
+            w = w + det*nfun
+          end if
         end do
       end do
     else
       call p1_gradients(xe, g, det)
-      w(1:3) = det/6.0_wp
+      if (axi) then
+        w(1) = det/24.0_wp*(2.0_wp*xe(1, 1) + xe(1, 2) + xe(1, 3))
+        w(2) = det/24.0_wp*(xe(1, 1) + 2.0_wp*xe(1, 2) + xe(1, 3))
+        w(3) = det/24.0_wp*(xe(1, 1) + xe(1, 2) + 2.0_wp*xe(1, 3))
+      else
+        w(1:3) = det/6.0_wp
+      end if
     end if
   end subroutine element_shape_integrals
 
@@ -602,30 +618,5 @@ contains
     e(4) = e(4)/rc
     cs = matmul(d, e)
   end subroutine axi_stress
-
-  !> w(a) = int N_a r dA per radian: the consistent nodal load of a constant body force b
-  !! is w(a) b. Q1: 2x2 Gauss (exact, N_a det J r of degree 3 in each reference coordinate);
-  !! P1: A/12 (2 r_a + r_b + r_c), exact.
-  pure subroutine axi_shape_integrals(element, xe, w)
-    integer, intent(in) :: element
-    real(wp), intent(in) :: xe(2, MAX_NVERT)
-    real(wp), intent(out) :: w(MAX_NVERT)            !< [length^3]
-    integer :: ig, jg
-    real(wp) :: nfun(4), g(2, MAX_NVERT), det
-    w = 0.0_wp
-    if (element == ELEM_Q1) then
-      do jg = -1, 1, 2
-        do ig = -1, 1, 2
-          call q1_gradients(xe, ig*gp2, jg*gp2, nfun, g, det)
-          w = w + det*nfun*sum(nfun*xe(1, :))
-        end do
-      end do
-    else
-      call p1_gradients(xe, g, det)
-      w(1) = det/24.0_wp*(2.0_wp*xe(1, 1) + xe(1, 2) + xe(1, 3))
-      w(2) = det/24.0_wp*(xe(1, 1) + 2.0_wp*xe(1, 2) + xe(1, 3))
-      w(3) = det/24.0_wp*(xe(1, 1) + xe(1, 2) + 2.0_wp*xe(1, 3))
-    end if
-  end subroutine axi_shape_integrals
 
 end module elements

@@ -271,8 +271,7 @@ contains
     us = trim(d%units%stress)
     uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
     if (d%axisymmetric) uf = trim(d%units%force)//'/rad'   ! per radian of a body of revolution
-    trib_unit = ul                        ! D_jj: a length, or int N r ds, an area per radian
-    if (d%axisymmetric) trib_unit = ul//'^2/rad'
+    trib_unit = tributary_unit(d, ul)
     allocate (body_err(size(msh)))
     fd = -1
     call file_open(path, fid, st, create=.true.)
@@ -348,7 +347,7 @@ contains
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
     call write_dset(gid, 'segments', line_cells(itf, 1, itf%npair), st, '1')
     do k = 1, itf%npair
-      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, st)
+      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, trib_unit, st)
     end do
     call group_close(gid, st)
     call write_history(fid, res, st)
@@ -552,7 +551,7 @@ contains
       call group_open(kid, 'contact', gid, st, create=.true.)
       call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
       do q = 1, itf%npair
-        call write_pair(gid, q, itf, res, tg, pres, ul, us, uf, st, geometry=.false.)
+        call write_pair(gid, q, itf, res, tg, pres, ul, us, uf, tributary_unit(d, ul), st, geometry=.false.)
       end do
       call group_close(gid, st)
       do a = 1, size(msh)
@@ -651,7 +650,7 @@ contains
   !! active flags, normal displacements, with friction the tangential part) and, with
   !! `geometry` (default), the ids of its bodies (side 1, side 2), its slave body and its
   !! line (coordinates, normals, g0, tributary lengths, segments 0-based within the pair).
-  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, st, geometry)
+  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, trib_unit, st, geometry)
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
@@ -659,17 +658,13 @@ contains
     type(tangential_t), intent(in) :: tg
     real(wp), intent(in), contiguous :: pres(:)  !< (m) pressure of each row [stress]
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
+    character(len=*), intent(in) :: trib_unit   !< of the tributary lengths (tributary_unit)
     type(error_t), intent(inout) :: st
     logical, intent(in), optional :: geometry
     integer(hid_t) :: pid
     integer :: r(2), i, j
     real(wp), allocatable :: w2(:, :)
-    character(len=:), allocatable :: trib_unit
     logical :: geo
-    trib_unit = ul                         ! per radian (uf ends in /rad): int N r ds
-    if (len(uf) > 4) then
-      if (uf(len(uf) - 3:) == '/rad') trib_unit = ul//'^2/rad'
-    end if
     geo = .true.
     if (present(geometry)) geo = geometry
     r = pair_rows(itf, q)
@@ -1090,5 +1085,15 @@ contains
     end do
     if (len(names) > 0) call write_attr(gid, 'regions', trim(adjustl(names)), st)
   end subroutine write_material
+
+  !> The unit of the tributary lengths D_jj: a length, or for bodies of revolution int N r ds,
+  !! an area per radian.
+  function tributary_unit(d, ul) result(u)
+    type(deck_t), intent(in) :: d
+    character(len=*), intent(in) :: ul     !< the length unit
+    character(len=:), allocatable :: u
+    u = ul
+    if (d%axisymmetric) u = ul//'^2/rad'
+  end function tributary_unit
 
 end module results
