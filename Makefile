@@ -65,14 +65,14 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
+MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
+        ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d
 BENCH_F := bench_mprgp bench_ordering bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -128,7 +128,7 @@ $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
 $(BUILD)/mpi_env.o:        $(BUILD)/kinds.o
-$(BUILD)/space.o:
+$(BUILD)/space.o:          $(BUILD)/kinds.o
 $(BUILD)/config.o:         $(BUILD)/kinds.o
 $(BUILD)/namelist_vars.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o
@@ -147,6 +147,8 @@ $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o
 $(BUILD)/gmsh_msh.o:       $(BUILD)/digest.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
                            $(BUILD)/mesh_topology.o $(BUILD)/strings.o $(BUILD)/text_scanner.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/elements_3d.o:    $(BUILD)/kinds.o
+$(BUILD)/element_types.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/elements.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
 $(BUILD)/body_system.o:    $(BUILD)/kinds.o
@@ -154,14 +156,15 @@ $(BUILD)/supports.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $
 $(BUILD)/stiffness_pattern.o: $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
 $(BUILD)/rigid_modes.o:    $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
 $(BUILD)/assembly.o:       $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o \
-                           $(BUILD)/elements.o $(BUILD)/linop.o $(BUILD)/body_system.o $(BUILD)/supports.o \
-                           $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o $(BUILD)/material_laws.o
+                           $(BUILD)/elements.o $(BUILD)/element_types.o $(BUILD)/linop.o $(BUILD)/body_system.o \
+                           $(BUILD)/supports.o $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o \
+                           $(BUILD)/material_laws.o
 $(BUILD)/ordering.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
 $(BUILD)/mumps_iface.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/lapack.o
-$(BUILD)/factorization.o: FFLAGS += -Wno-unused-dummy-argument
+$(BUILD)/factorization.o $(BUILD)/element_types.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/factorization.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/cholesky.o $(BUILD)/mumps_iface.o \
                            $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
@@ -173,7 +176,11 @@ $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o 
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o $(BUILD)/constraint_set.o
 $(BUILD)/nonneg_lsq.o:     $(BUILD)/cholesky.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o
 $(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
-$(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o
+$(BUILD)/mortar_rows.o:    $(BUILD)/kinds.o
+$(BUILD)/mortar_segments.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_chains.o \
+                           $(BUILD)/mortar_rows.o
+$(BUILD)/mortar.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/mortar_rows.o \
+                           $(BUILD)/mortar_segments.o
 $(BUILD)/contact_interface.o: $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o \
                            $(BUILD)/mesh.o $(BUILD)/mortar.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/factorization.o $(BUILD)/clock.o $(BUILD)/config.o \

@@ -5,6 +5,7 @@
 !! stress, or the meridian section of a body of revolution); a module that depends on the
 !! dimension says so through these names, not through a literal 2, 3 or 4.
 module space
+  use kinds, only: wp
   implicit none (type, external)
   private
 
@@ -13,7 +14,7 @@ module space
   integer, parameter, public :: NRIGID = NDIM*(NDIM + 1)/2   !< rigid motions of a free body: translations and rotations
   integer, parameter, public :: NSTRESS = 4                  !< stress components of a node: sxx, syy, sxy and szz
 
-  public :: node_dof, dof_node, dof_comp
+  public :: node_dof, dof_node, dof_comp, frame_of
 
 contains
 
@@ -35,5 +36,26 @@ contains
     integer, intent(in) :: i   !< a DOF, 1..NCOMP nnode
     dof_comp = i - NCOMP*((i - 1)/NCOMP)
   end function dof_comp
+
+  !> The frame of a contact node with unit normal n: the columns n, then size(n) - 1 unit
+  !! tangents, orthonormal and right-handed. In the plane the tangent is (-n_y, n_x); in space
+  !! t1 is n x e_k normalized, e_k the axis along which n is smallest, and t2 = n x t1.
+  pure function frame_of(n) result(f)
+    real(wp), intent(in) :: n(:)                  !< the unit normal (NDIM)
+    real(wp) :: f(size(n), size(n))               !< (NDIM, NDIM) the frame, column 1 = n
+    real(wp) :: e(3), t(3)
+    f(:, 1) = n
+    if (size(n) == 2) then
+      f(1, 2) = -n(2)
+      f(2, 2) = n(1)
+    else if (size(n) == 3) then
+      e = 0.0_wp
+      e(minloc(abs(n), dim=1)) = 1.0_wp
+      t = [n(2)*e(3) - n(3)*e(2), n(3)*e(1) - n(1)*e(3), n(1)*e(2) - n(2)*e(1)]
+      t = t/norm2(t)
+      f(:, 2) = t
+      f(:, 3) = [n(2)*t(3) - n(3)*t(2), n(3)*t(1) - n(1)*t(3), n(1)*t(2) - n(2)*t(1)]
+    end if
+  end function frame_of
 
 end module space

@@ -4,7 +4,7 @@
 module contact_common
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, ROW_NORMAL
+  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, DIR_NORMAL
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t
   implicit none (type, external)
@@ -118,7 +118,7 @@ contains
       end associate
     end do
     res%residual = max(res%imbalance, res%penetration, res%complementarity, res%equilibrium)
-    res%active = count(res%lam > 0.0_wp .and. contact_line%kind == ROW_NORMAL)
+    res%active = count(res%lam > 0.0_wp .and. contact_line%dir == DIR_NORMAL)
   end subroutine interface_residual
 
   !> Penetration and complementarity with tangential rows: the normal rows as without
@@ -137,11 +137,11 @@ contains
     integer :: i
     allocate (lb(contact_line%m), ub(contact_line%m))
     call row_bounds(contact_line, res%lam, lb, ub)
-    lmax = maxval(res%lam, mask=contact_line%kind == ROW_NORMAL)
+    lmax = maxval(res%lam, mask=contact_line%dir == DIR_NORMAL)
     pen = 0.0_wp
     comp = 0.0_wp
     do i = 1, contact_line%m
-      if (contact_line%kind(i) == ROW_NORMAL) then
+      if (contact_line%dir(i) == DIR_NORMAL) then
         pen = max(pen, res%gap(i))
         comp = max(comp, max(res%lam(i), 0.0_wp)*abs(res%gap(i)))
       else

@@ -5,13 +5,15 @@
 !! A body's contact rows are its sides of every pair it takes part in (`body_slots`), so a
 !! body in several pairs is condensed on all of them at once. The rows come from two edge
 !! groups per pair (named groups, or the rectangle sides declared 'contact') paired by dual
-!! mortar (module mortar; row j = the weighted normal gap at slave node j). A frictional pair
-!! has, after its normal rows, one tangential row per slave node (the same mortar weights
-!! along the slave tangent: the weighted slip), whose force is bounded by a box (Tresca) or
-!! by mu times the node's normal force (Coulomb): `row_bounds`.
+!! mortar (module mortar; row j = the weighted normal gap at slave node j). Each contact node
+!! carries a frame (`frame_of`: its unit normal, then NDIM - 1 unit tangents), and each row is
+!! one direction of its node's frame (`dir`: DIR_NORMAL, or the tangent 1 .. NDIM - 1). A
+!! frictional pair has, after its normal rows, NDIM - 1 tangential rows per slave node (the
+!! same mortar weights along each tangent: the weighted slip), whose force is bounded by a
+!! box (Tresca) or by mu times the node's normal force (Coulomb): `row_bounds`.
 module contact_interface
   use kinds, only: wp, i8
-  use space, only: NCOMP, node_dof, dof_comp
+  use space, only: NDIM, NCOMP, node_dof, dof_comp, frame_of
   use config, only: body_cfg_t, contact_cfg_t, BC_CONTACT, side_names, pair_oriented, FRICTION_NONE, FRICTION_TRESCA, &
                     OVERLAP_INTERFERENCE, &
                     FRICTION_COULOMB
@@ -42,10 +44,11 @@ module contact_interface
     integer, allocatable :: pair_slave(:)   !< (npair) the side whose nodes carry the rows (1 or 2)
     integer, allocatable :: pair_of(:)      !< (m) the pair of each row
     real(wp), allocatable :: s(:)           !< (m) arc length along the pair's slave contact chain [length]
-    real(wp), allocatable :: xy(:, :)       !< (2,m) slave node coordinates [length]
-    real(wp), allocatable :: normal(:, :)   !< (2,m) the row's direction: unit normal outward from the slave
-                                            !! body (normal rows), unit tangent (-n_y, n_x) (tangential rows)
-    integer, allocatable :: kind(:)         !< (m) ROW_NORMAL or ROW_TANGENT
+    real(wp), allocatable :: xy(:, :)       !< (NDIM,m) slave node coordinates [length]
+    !> (NDIM,NDIM,m) the frame of the row's slave node: column 1 the unit normal outward from
+    !! the slave body, columns 2.. the unit tangents (frame_of)
+    real(wp), allocatable :: frame(:, :, :)
+    integer, allocatable :: dir(:)          !< (m) the row's direction in its node's frame: DIR_NORMAL, or tangent 1..NDIM-1
     integer, allocatable :: nrow(:)         !< (m) the normal row of the row's slave node (itself for a normal row)
     integer, allocatable :: pair_friction(:)   !< (npair) FRICTION_* of the pair (NONE when it has no tangential rows)
     real(wp), allocatable :: pair_mu(:)        !< (npair) Coulomb coefficient [-]
@@ -56,12 +59,33 @@ module contact_interface
     type(brows_t) :: b(2)                   !< the rows of side 1 and side 2
   end type interface_t
 
-  integer, parameter, public :: ROW_NORMAL = 0    !< a row of the normal gap: force >= 0
-  integer, parameter, public :: ROW_TANGENT = 1   !< a row of the slip: force in a box
+  integer, parameter, public :: DIR_NORMAL = 0    !< a row of the normal gap (force >= 0); dir > 0: a row of the slip
 
   public :: build_interface, contact_resultant, body_slots, pair_rows, slot_row, slot_side, row_bounds, has_friction
+  public :: row_direction, row_directions
 
 contains
+
+  !> The direction of row k: its node's normal for a normal row, the row's tangent for a
+  !! tangential one [-].
+  pure function row_direction(itf, k) result(d)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: k                  !< a row, 1..m
+    real(wp) :: d(NDIM)
+    d = itf%frame(:, itf%dir(k) + 1, k)
+  end function row_direction
+
+  !> The directions of rows i..j, one column per row [-].
+  pure function row_directions(itf, i, j) result(d)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: i, j               !< the first and the last row
+    real(wp) :: d(NDIM, max(0, j - i + 1))
+    integer :: k
+    do k = i, j
+      d(:, k - i + 1) = itf%frame(:, itf%dir(k) + 1, k)
+    end do
+  end function row_directions
+
 
   !> The positions of body a's contact rows in the (m, 2) side layout of the contact
   !! vectors (row + (side - 1) m), pair by pair in the order of the pairs: body a's own
@@ -115,7 +139,7 @@ contains
   !> Whether any pair has tangential rows.
   pure logical function has_friction(itf)
     type(interface_t), intent(in) :: itf
-    has_friction = any(itf%kind == ROW_TANGENT)
+    has_friction = any(itf%dir > DIR_NORMAL)
   end function has_friction
 
   !> The bounds of the contact forces on the rows: a normal row's force is >= 0 (no upper
@@ -134,7 +158,7 @@ contains
     first = .false.
     if (present(start)) first = start
     do k = 1, itf%m
-      if (itf%kind(k) == ROW_NORMAL) then
+      if (itf%dir(k) == DIR_NORMAL) then
         lb(k) = 0.0_wp
         ub(k) = huge(1.0_wp)
       else
@@ -342,8 +366,8 @@ contains
     integer :: p, s, m, r0, ne(2), k, e0
     m = itf%pair_ptr(size(one) + 1) - 1
     itf%m = m
-    allocate (itf%s(m), itf%xy(2, m), itf%g0(m), itf%trib(m), itf%node(m, 2), itf%normal(2, m), itf%pair_of(m), &
-              itf%kind(m), itf%nrow(m))
+    allocate (itf%s(m), itf%xy(NDIM, m), itf%g0(m), itf%trib(m), itf%node(m, 2), itf%frame(NDIM, NDIM, m), &
+              itf%pair_of(m), itf%dir(m), itf%nrow(m))
     ne = 0
     do p = 1, size(one)
       do s = 1, 2
@@ -359,11 +383,11 @@ contains
       associate (o => one(p), rows => [(r0 + k, k=1, one(p)%m)])
         itf%s(rows) = o%s
         itf%xy(:, rows) = o%xy
-        itf%normal(:, rows) = o%normal
+        itf%frame(:, :, rows) = o%frame
         itf%g0(rows) = o%g0
         itf%trib(rows) = o%trib
         itf%node(rows, :) = o%node
-        itf%kind(rows) = o%kind
+        itf%dir(rows) = o%dir
         itf%nrow(rows) = o%nrow + r0
         itf%pair_of(rows) = p
         do s = 1, 2
@@ -501,65 +525,70 @@ contains
         return
       end if
 
-      ! a pair with friction (a positive bound) has a tangential row per slave node after
-      ! the normal ones: nr = 2 mt%m rows, else mt%m
+      ! a pair with friction (a positive bound) has NDIM - 1 tangential rows per slave node
+      ! after the normal ones: nr = NDIM mt%m rows, else mt%m
       itf%pair_friction = [FRICTION_NONE]
       if ((cc%friction == FRICTION_TRESCA .and. cc%slip_bound > 0.0_wp) .or. &
           (cc%friction == FRICTION_COULOMB .and. cc%mu > 0.0_wp)) itf%pair_friction = [cc%friction]
-      nr = merge(2*mt%m, mt%m, itf%pair_friction(1) /= FRICTION_NONE)
+      nr = merge(NDIM*mt%m, mt%m, itf%pair_friction(1) /= FRICTION_NONE)
       itf%m = nr
-      allocate (itf%s(nr), itf%xy(2, nr), itf%g0(nr), itf%trib(nr), itf%node(nr, 2), itf%normal(2, nr), &
-                itf%kind(nr), itf%nrow(nr))
+      allocate (itf%s(nr), itf%xy(NDIM, nr), itf%g0(nr), itf%trib(nr), itf%node(nr, 2), itf%frame(NDIM, NDIM, nr), &
+                itf%dir(nr), itf%nrow(nr))
       itf%s(1:mt%m) = mt%s
       itf%xy(:, 1:mt%m) = ms%xy(:, mt%snode)
     end associate
-    itf%normal(:, 1:mt%m) = mt%normal
+    do j = 1, mt%m
+      itf%frame(:, :, j) = frame_of(mt%normal(:, j))
+    end do
     itf%trib(1:mt%m) = mt%d
     itf%node(1:mt%m, sl) = mt%snode
     itf%node(:, ma) = 0
     itf%g0(1:mt%m) = mt%g0
     if (cc%gap_radius > 0.0_wp) itf%g0(1:mt%m) = itf%g0(1:mt%m) + (itf%xy(1, 1:mt%m) - cc%gap_center)**2/ &
                                                   (2.0_wp*cc%gap_radius)
-    itf%kind(1:mt%m) = ROW_NORMAL
+    itf%dir(1:mt%m) = DIR_NORMAL
     itf%nrow(1:mt%m) = [(j, j=1, mt%m)]
-    if (nr > mt%m) then
-      itf%s(mt%m + 1:) = itf%s(1:mt%m)
-      itf%xy(:, mt%m + 1:) = itf%xy(:, 1:mt%m)
-      itf%normal(1, mt%m + 1:) = -mt%normal(2, :)
-      itf%normal(2, mt%m + 1:) = mt%normal(1, :)
-      itf%trib(mt%m + 1:) = mt%d
-      itf%node(mt%m + 1:, sl) = mt%snode
-      itf%g0(mt%m + 1:) = 0.0_wp
-      itf%kind(mt%m + 1:) = ROW_TANGENT
-      itf%nrow(mt%m + 1:) = [(j, j=1, mt%m)]
-    end if
-    ! B_s: + sum_k ws_k d_j.u_k ; B_m: - sum_l wm_l d_j.u_l (both components of each node),
-    ! d_j the row's direction (normal, then tangent)
-    ne = (nr/mt%m)*2*(mt%sptr(mt%m + 1) - 1)
+    do k = 1, nr/mt%m - 1          ! tangent k's rows: k mt%m + 1 .. (k + 1) mt%m
+      associate (t => [(k*mt%m + j, j=1, mt%m)])
+        itf%s(t) = itf%s(1:mt%m)
+        itf%xy(:, t) = itf%xy(:, 1:mt%m)
+        itf%frame(:, :, t) = itf%frame(:, :, 1:mt%m)
+        itf%trib(t) = mt%d
+        itf%node(t, sl) = mt%snode
+        itf%g0(t) = 0.0_wp
+        itf%dir(t) = k
+        itf%nrow(t) = [(j, j=1, mt%m)]
+      end associate
+    end do
+    ! B_s: + sum_k ws_k d_j.u_k ; B_m: - sum_l wm_l d_j.u_l (every component of each node),
+    ! d_j the row's direction (normal, then tangents)
+    ne = (nr/mt%m)*NCOMP*(mt%sptr(mt%m + 1) - 1)
     allocate (itf%b(sl)%ptr(nr + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
-    ne = (nr/mt%m)*2*(mt%mptr(mt%m + 1) - 1)
+    ne = (nr/mt%m)*NCOMP*(mt%mptr(mt%m + 1) - 1)
     allocate (itf%b(ma)%ptr(nr + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
     call fill_rows(mt%sptr, mt%snod, mt%sval, 1.0_wp, itf%b(sl))
     call fill_rows(mt%mptr, mt%mnod, mt%mval, -1.0_wp, itf%b(ma))
 
   contains
 
-    !> Rows of one side: each node entry (weight w) of slave node j gives sgn*w*d_r on both
-    !! its DOFs, d_r the direction of row r (j's normal, or its tangent for r = j + mt%m).
+    !> Rows of one side: each node entry (weight w) of slave node j gives sgn*w*d_r on each
+    !! of its DOFs, d_r the direction of row r (j's normal, or its tangent k for r = j + k mt%m).
     subroutine fill_rows(ptr, nod, val, sgn, b)
       integer, intent(in) :: ptr(:), nod(:)
       real(wp), intent(in) :: val(:), sgn
       type(brows_t), intent(inout) :: b
       integer :: r, jj, kk, q, c
+      real(wp) :: d(NDIM)
       q = 0
       b%ptr(1) = 1
       do r = 1, nr
         jj = itf%nrow(r)
+        d = row_direction(itf, r)
         do kk = ptr(jj), ptr(jj + 1) - 1
           do c = 1, NCOMP
             q = q + 1
             b%dof(q) = node_dof(nod(kk), c)
-            b%val(q) = sgn*val(kk)*itf%normal(c, r)
+            b%val(q) = sgn*val(kk)*d(c)
           end do
         end do
         b%ptr(r + 1) = q + 1
@@ -573,7 +602,7 @@ contains
   pure logical function normal_fixed(sys, k, nrm)
     type(body_system_t), intent(in) :: sys
     integer, intent(in) :: k
-    real(wp), intent(in) :: nrm(2)
+    real(wp), intent(in) :: nrm(NDIM)
     integer :: c
     normal_fixed = .true.
     do c = 1, NCOMP

@@ -11,7 +11,7 @@
 module floating
   use kinds, only: wp
   use assembly, only: body_system_t, rigid_motion_name
-  use contact_interface, only: interface_t, body_slots, slot_row, slot_side, has_friction, ROW_TANGENT
+  use contact_interface, only: interface_t, body_slots, slot_row, slot_side, has_friction, DIR_NORMAL, row_direction
   use config, only: FRICTION_COULOMB, FRICTION_TRESCA
   use condense, only: body_condensed_t
   use contact_common, only: scatter
@@ -140,8 +140,8 @@ contains
         ! resultant less its part along the mean normal of the body's contact rows)
         c = 0.0_wp
         do i = 1, m
-          if (contact_line%kind(slot_row(bodies(a)%slots(i), contact_line%m)) /= ROW_TANGENT) &
-            c(1:2) = c(1:2) + contact_line%normal(:, slot_row(bodies(a)%slots(i), contact_line%m))
+          if (contact_line%dir(slot_row(bodies(a)%slots(i), contact_line%m)) == DIR_NORMAL) &
+            c(1:2) = c(1:2) + row_direction(contact_line, slot_row(bodies(a)%slots(i), contact_line%m))
         end do
         c(1:2) = [fx, fy] - dot_product([fx, fy], c(1:2))/max(sum(c(1:2)**2), tiny(1.0_wp))*c(1:2)
         c(1:2) = c(1:2)/max(norm2(c(1:2)), tiny(1.0_wp))
@@ -631,7 +631,7 @@ contains
           tj(nz) = col(k)
           tv(nz) = bodies(b)%rg(q, i)
         end do
-        if (tgt(b) > 0 .and. contact_line%kind(k) /= ROW_TANGENT) then
+        if (tgt(b) > 0 .and. contact_line%dir(k) == DIR_NORMAL) then
           nz = nz + 1
           ti(nz) = nr + 1 + tgt(b)
           tj(nz) = col(k)
@@ -692,14 +692,14 @@ contains
     allocate (tcol(contact_line%m))
     tcol = 0
     do i = 1, size(rows)
-      if (contact_line%kind(rows(i)) == ROW_TANGENT) tcol(contact_line%nrow(rows(i))) = i
+      if (contact_line%dir(rows(i)) > DIR_NORMAL) tcol(contact_line%nrow(rows(i))) = i
     end do
     call gc%init(g%nrow, 2*(g%ptr(g%ncol + 1) - 1))
     do i = 1, size(rows)
       k = rows(i)
       p = contact_line%pair_of(k)
       associate (ri => g%row(g%ptr(i):g%ptr(i + 1) - 1), vi => g%val(g%ptr(i):g%ptr(i + 1) - 1))
-        if (contact_line%kind(k) == ROW_TANGENT) then
+        if (contact_line%dir(k) > DIR_NORMAL) then
           if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
           call gc%push(ri, vi)
           call gc%push(ri, -vi)
@@ -764,7 +764,7 @@ contains
     end if
     gc = cone_columns(contact_line, rows, g, mu_scale)
     ! the Tresca rows, in the order cone_columns gave their column pairs
-    tres = pack(rows, [(contact_line%kind(rows(i)) == ROW_TANGENT .and. &
+    tres = pack(rows, [(contact_line%dir(rows(i)) > DIR_NORMAL .and. &
                         contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_TRESCA, i=1, size(rows))])
     nt = size(tres)
     if (nt == 0) then
@@ -776,7 +776,7 @@ contains
     allocate (has_t(contact_line%m))
     has_t = .false.
     do i = 1, size(rows)
-      if (contact_line%kind(rows(i)) == ROW_TANGENT) has_t(contact_line%nrow(rows(i))) = .true.
+      if (contact_line%dir(rows(i)) > DIR_NORMAL) has_t(contact_line%nrow(rows(i))) = .true.
     end do
     r = g%nrow
     w = max(norm2(e), tiny(1.0_wp))
@@ -789,7 +789,7 @@ contains
     k = 0
     do i = 1, size(rows)
       p = contact_line%pair_of(rows(i))
-      if (contact_line%kind(rows(i)) == ROW_TANGENT) then
+      if (contact_line%dir(rows(i)) > DIR_NORMAL) then
         if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
         k = k + 1
         ! the bound, no larger than 1e3 |e| / |g_j| (a bound beyond that does not bind a

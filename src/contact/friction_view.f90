@@ -4,7 +4,7 @@
 !! force of its node, the shear traction, the slip and the node's state (stick, slip, open).
 module friction_view
   use kinds, only: wp
-  use contact_interface, only: interface_t, row_bounds, contact_resultant, ROW_NORMAL, ROW_TANGENT
+  use contact_interface, only: interface_t, row_bounds, contact_resultant, DIR_NORMAL
   use contact_types, only: contact_result_t
   implicit none (type, external)
   private
@@ -53,7 +53,7 @@ contains
     real(wp), allocatable :: lb(:), ub(:)
     integer :: k, p, s, n, e, q, mn
     real(wp) :: margin
-    keep = pack([(k, k=1, itf%m)], itf%kind == ROW_NORMAL)
+    keep = pack([(k, k=1, itf%m)], itf%dir == DIR_NORMAL)
     mn = size(keep)
     itf_n%m = mn
     itf_n%npair = itf%npair
@@ -66,16 +66,16 @@ contains
     allocate (itf_n%pair_ptr(itf%npair + 1))
     itf_n%pair_ptr(1) = 1
     do p = 1, itf%npair
-      itf_n%pair_ptr(p + 1) = itf_n%pair_ptr(p) + count(itf%kind(itf%pair_ptr(p):itf%pair_ptr(p + 1) - 1) == ROW_NORMAL)
+      itf_n%pair_ptr(p + 1) = itf_n%pair_ptr(p) + count(itf%dir(itf%pair_ptr(p):itf%pair_ptr(p + 1) - 1) == DIR_NORMAL)
     end do
     itf_n%pair_of = itf%pair_of(keep)
     itf_n%s = itf%s(keep)
     itf_n%xy = itf%xy(:, keep)
-    itf_n%normal = itf%normal(:, keep)
+    itf_n%frame = itf%frame(:, :, keep)
     itf_n%g0 = itf%g0(keep)
     itf_n%trib = itf%trib(keep)
     itf_n%node = itf%node(keep, :)
-    itf_n%kind = itf%kind(keep)
+    itf_n%dir = itf%dir(keep)
     itf_n%nrow = [(k, k=1, mn)]
     do s = 1, 2
       n = 0
@@ -112,13 +112,13 @@ contains
         tg%resultant(:, p) = contact_resultant(itf, 1, res%lam, itf%pair_ptr(p), itf%pair_ptr(p + 1) - 1)
       end do
     end if
-    tg%on = any(itf%kind == ROW_TANGENT)
+    tg%on = any(itf%dir > DIR_NORMAL)
     if (.not. tg%on) return
     ! the tangential row of each normal row (0: none)
     allocate (tan(itf%m))
     tan = 0
     do k = 1, itf%m
-      if (itf%kind(k) == ROW_TANGENT) tan(itf%nrow(k)) = k
+      if (itf%dir(k) > DIR_NORMAL) tan(itf%nrow(k)) = k
     end do
     allocate (tg%force(mn), tg%shear(mn), tg%bound(mn), tg%slip(mn), tg%slip_increment(mn), tg%state(mn))
     tg%force = 0.0_wp

@@ -16,7 +16,7 @@ module monolithic
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use strings, only: itoa
   use sorting, only: sort_ints
-  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, ROW_TANGENT
+  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, DIR_NORMAL
   use config, only: FRICTION_COULOMB, INNER_MPRGP, INNER_ACTIVE_SET
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
@@ -146,7 +146,7 @@ contains
     if (friction) then
       allocate (ub(m), ub_new(m))
       call row_bounds(contact_line, lam, lb, ub, start=.true.)
-      tangent = contact_line%kind == ROW_TANGENT
+      tangent = contact_line%dir > DIR_NORMAL
       if (any(contact_line%pair_friction == FRICTION_COULOMB)) nfix = COULOMB_MAX_FIXED
     end if
     nmv = 0

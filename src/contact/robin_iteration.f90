@@ -9,7 +9,7 @@ module robin_iteration
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use config, only: solver_cfg_t, STOP_RESIDUAL, ACCEL_NONE, ROBIN_HARMONIC
   use clock, only: wtime
-  use contact_interface, only: interface_t, has_friction, row_bounds, ROW_NORMAL
+  use contact_interface, only: interface_t, has_friction, row_bounds, DIR_NORMAL
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
@@ -285,7 +285,7 @@ contains
     real(wp), intent(inout) :: g_new(:, :)             !< (m, 2) relaxed obstacles
     integer :: k
     do k = 1, itf%m
-      if (itf%kind(k) == ROW_NORMAL) cycle
+      if (itf%dir(k) == DIR_NORMAL) cycle
       if (row_state(k) == BOUND_LOWER*5 .or. row_state(k) == BOUND_UPPER*5) g_new(k, :) = g_full(k, :)
     end do
   end subroutine full_step_at_bounds

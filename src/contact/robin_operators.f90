@@ -15,7 +15,7 @@ module robin_operators
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
   use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
   use mprgp, only: lambda_max_estimate
-  use contact_interface, only: interface_t, has_friction, slot_row, slot_side, ROW_NORMAL, ROW_TANGENT
+  use contact_interface, only: interface_t, has_friction, slot_row, slot_side, DIR_NORMAL
   use condense, only: body_condensed_t
   use contact_common, only: pair_positions, body_threads
   use sorting, only: largest_first, merge_sort_by_keys
@@ -402,7 +402,7 @@ contains
             if (info /= 0 .and. pair_singular(p)) call harmonic_singular(blk, s, info)
           else if (has_friction(contact_line)) then
             ! with friction: S of the normal rows and S of the tangential rows apart (below)
-            call harmonic_by_kind(f1, f2, contact_line%kind(self%rows(1, p):self%rows(2, p)), s, info)
+            call harmonic_by_kind(f1, f2, contact_line%dir(self%rows(1, p):self%rows(2, p)) > DIR_NORMAL, s, info)
           else
             call harmonic_matrix(f1, f2, s, info)
           end if
@@ -785,29 +785,29 @@ contains
   !! whole F's block on the normal rows is not (the paper's scene with mu = 0.3: 52 outer
   !! iterations with the whole F, 10 with this; half stick, half slip (Cattaneo-Mindlin): 14
   !! and 15; all stick: 25 and 22). Any symmetric positive definite S keeps the fixed point.
-  subroutine harmonic_by_kind(f1, f2, kind, s, info)
+  subroutine harmonic_by_kind(f1, f2, tangential, s, info)
     real(wp), intent(in) :: f1(:, :), f2(:, :)
-    integer, intent(in) :: kind(:)
+    logical, intent(in) :: tangential(:)      ! the rows of the slip (the others: of the normal gap)
     real(wp), allocatable, intent(out) :: s(:, :)
     integer, intent(out) :: info
     real(wp), allocatable :: sk(:, :)
     integer, allocatable :: idx(:)
-    integer :: k, i, m, kinfo(ROW_NORMAL:ROW_TANGENT)
+    integer :: k, i, m, kinfo(0:1)
     m = size(f1, 1)
     allocate (s(m, m))
     s = 0.0_wp
     kinfo = 0
-    ! the two kinds' blocks on the two threads (disjoint parts of s)
+    ! the two kinds' blocks (0: normal, 1: tangential) on the two threads (disjoint parts of s)
     !$omp parallel do num_threads(body_threads()) schedule(static, 1) private(k, idx, sk) if (m > 256)
-    do k = ROW_NORMAL, ROW_TANGENT
-      idx = pack([(i, i=1, m)], kind == k)
+    do k = 0, 1
+      idx = pack([(i, i=1, m)], tangential .eqv. (k == 1))
       if (size(idx) == 0) cycle
       call harmonic_lean(f1(idx, idx), f2(idx, idx), sk, kinfo(k))
       if (kinfo(k) == 0) s(idx, idx) = sk
     end do
     !$omp end parallel do
-    info = kinfo(ROW_NORMAL)
-    if (info == 0) info = kinfo(ROW_TANGENT)
+    info = kinfo(0)
+    if (info == 0) info = kinfo(1)
   end subroutine harmonic_by_kind
 
   !> S = 2 F_s (F_1 + F_2)^-1 F_o = 2 F_s - 2 Y'Y with Y = L^-1 F_s, L L' = F_1 + F_2 and F_s

@@ -12,7 +12,7 @@ module run_phases
   use mesh, only: mesh_t, mesh_build, assign_cell_laws
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, support_reactions
-  use contact_interface, only: build_interface, slot_row, has_friction, ROW_TANGENT, ROW_NORMAL
+  use contact_interface, only: build_interface, slot_row, has_friction, DIR_NORMAL
   use contact_types, only: STATUS_FAILED, STATUS_DIVERGED, STATUS_INTERRUPTED, STATUS_CONVERGED, STATUS_NO_EQUILIBRIUM, anderson_history, &
                            contact_result_t, robin_state_t
   use robin_iteration, only: solve_robin
@@ -305,7 +305,7 @@ contains
     if (len(run%restart_file) == 0) return
     call checkpoint_read(run%restart_file, run%key, run%mesh_ids, run%contact_line%m, run%nbody, &
                          anderson_history(run%nbody, run%contact_line%npair), run%deck%solver%max_outer, &
-                         run%robin_state, run%result, err, signed=run%contact_line%kind == ROW_TANGENT)
+                         run%robin_state, run%result, err, signed=run%contact_line%dir > DIR_NORMAL)
     call fail_on(err)
     if (size(run%plan) > 1) then   ! in a load history: the step it resumes, and the steps before it
       call checkpoint_read_steps(run%restart_file, run%contact_line%m, run%nbody, size(run%plan), &
@@ -619,8 +619,8 @@ contains
       do r = 1, size(itf%g0)
         s = run%deck%pair(itf%pair_of(r))%interference_stage
         if (s == 0 .or. run%g0_full(r) >= 0.0_wp) cycle
-        if (allocated(itf%kind)) then
-          if (itf%kind(r) /= ROW_NORMAL) cycle
+        if (allocated(itf%dir)) then
+          if (itf%dir(r) /= DIR_NORMAL) cycle
         end if
         f = 1.0_wp
         if (st%stage < s) f = 0.0_wp
@@ -635,12 +635,12 @@ contains
   !! step (doc/method.md, "Friction": the load history).
   subroutine set_slip_origin(run)
     type(run_t), intent(inout) :: run
-    if (run%rank /= 0 .or. .not. allocated(run%contact_line%kind)) return
+    if (run%rank /= 0 .or. .not. allocated(run%contact_line%dir)) return
     if (.not. has_friction(run%contact_line)) return
     associate (itf => run%contact_line, h => run%history)
-      where (itf%kind == ROW_TANGENT) itf%g0 = 0.0_wp
+      where (itf%dir > DIR_NORMAL) itf%g0 = 0.0_wp
       if (h%step > 0 .and. allocated(h%w)) then
-        where (itf%kind == ROW_TANGENT) itf%g0 = h%w(:, 1) + h%w(:, 2)
+        where (itf%dir > DIR_NORMAL) itf%g0 = h%w(:, 1) + h%w(:, 2)
       end if
     end associate
   end subroutine set_slip_origin

@@ -5,7 +5,7 @@ module run_summary
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
   use config, only: solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
-  use contact_interface, only: interface_t, ROW_NORMAL, contact_resultant
+  use contact_interface, only: interface_t, DIR_NORMAL, contact_resultant
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED, STATUS_NO_EQUILIBRIUM
@@ -132,7 +132,7 @@ contains
     ftot = 0.0_wp
     if (allocated(run%result%lam)) then
       ftot = sum(run%result%lam)
-      if (allocated(run%contact_line%kind)) ftot = sum(run%result%lam, mask=run%contact_line%kind == ROW_NORMAL)
+      if (allocated(run%contact_line%dir)) ftot = sum(run%result%lam, mask=run%contact_line%dir == DIR_NORMAL)
     end if
     t = 'step: step='//i2s(k)//' of='//i2s(size(run%plan))//' stage='//i2s(run%plan(k)%stage)// &
         ' load_factor='//fmt_real(run%plan(k)%factor, '(f0.6)')//' outer='//i2s(run%result%outer)// &
@@ -171,8 +171,8 @@ contains
     r1 = run%contact_line%pair_ptr(p)
     r2 = min(run%contact_line%pair_ptr(p + 1) - 1, size(run%result%lam))
     if (r2 < r1) return
-    if (allocated(run%contact_line%kind)) then
-      f = sum(run%result%lam(r1:r2), mask=run%contact_line%kind(r1:r2) == ROW_NORMAL)
+    if (allocated(run%contact_line%dir)) then
+      f = sum(run%result%lam(r1:r2), mask=run%contact_line%dir(r1:r2) == DIR_NORMAL)
     else
       f = sum(run%result%lam(r1:r2))
     end if
@@ -244,7 +244,7 @@ contains
     np = max(1, run%contact_line%npair)
     allocate (lines(np))
     ! one entry per contact node: the normal rows, the tangential part beside them
-    if (allocated(run%contact_line%kind)) then
+    if (allocated(run%contact_line%dir)) then
       call split_friction(run%contact_line, run%result, itf, result, tg)
     else
       result = run%result

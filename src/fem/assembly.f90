@@ -14,16 +14,15 @@
 !! consistently: [length], [stress] = [force]/[length]^2, forces per unit thickness.
 module assembly
   use kinds, only: wp
-  use space, only: NCOMP, node_dof
+  use space, only: NDIM, NCOMP, node_dof
   use, intrinsic :: iso_fortran_env, only: int16
   use strings, only: body_label, sci
   use sorting, only: sort_by_key
   use config, only: body_cfg_t, elastic_law_t, body_stiffness, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
   use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
-  use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, &
-                      element_stiffness, element_body_force, edge_traction, element_stress, &
-                      element_shape_integrals, element_stress_general, axi_stiffness, axi_stress
+  use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, edge_traction
+  use element_types, only: element_slot_t, element_table, model_of, NSHAPE
   use material_laws, only: isotropic_law
   use linop, only: csc_symv
   use body_system, only: body_system_t
@@ -122,6 +121,7 @@ contains
     logical, allocatable :: prescribed(:)
     integer(int16), allocatable :: cell_row(:, :, :)
     type(elastic_law_t), allocatable :: laws(:)
+    type(element_slot_t) :: elems(NSHAPE)
     logical :: with_k
     integer :: info
     character(len=512) :: msg
@@ -178,7 +178,8 @@ contains
       call applied_loads(mesh, body%id, tractions(1:ntraction), sys, err, body_force)
     end if
     if (err%failed()) return
-    call stiffness_and_lifting(mesh, laws, sys, err, with_k, cell_row)
+    call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
+    call stiffness_and_lifting(mesh, laws, elems, sys, err, with_k, cell_row)
     if (err%failed()) return
     if (allocated(cell_row)) deallocate (cell_row)
     call add_applied_loads(sys)
@@ -210,14 +211,16 @@ contains
     integer, allocatable :: ti(:), tj(:)
     real(wp), allocatable :: ta(:)
     type(elastic_law_t), allocatable :: laws(:)
+    type(element_slot_t) :: elems(NSHAPE)
 
     laws = body_laws(body, plane_strain)
+    call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     q = max(0, c2 - c1 + 1)*(MAX_NDOF*(MAX_NDOF + 1))/2
     allocate (ti(q), tj(q), ta(q))
     q = 0
     do c = max(1, c1), min(mesh%ncell, c2)
-      call cell_stiffness(mesh, sys%id, c, laws, cache, ke, nd, ldof, err)
+      call cell_stiffness(mesh, sys%id, c, laws, elems, cache, ke, nd, ldof, err)
       if (err%failed()) return
       do j = 1, nd
         fj = sys%free_of(ldof(j))
@@ -427,7 +430,8 @@ contains
     procedure(body_force_fn), optional :: body_force
     real(wp), intent(in), optional :: body_load(:, :, :)
     real(wp), allocatable :: f_all(:), u_all(:), fa_all(:)
-    real(wp) :: bl(2, size(laws))
+    real(wp) :: bl(NCOMP, size(laws))
+    type(element_slot_t) :: elems(NSHAPE)
     integer :: s
     sys%nstage = nstage
     allocate (sys%f_stage(sys%n, nstage), sys%u_stage(sys%ndof, nstage), sys%fa_stage(sys%ndof, nstage))
@@ -452,7 +456,9 @@ contains
         call applied_loads(mesh, sys%id, pack(tractions, tractions%stage == s), sys, err, body_load=bl)
       end if
       if (err%failed()) return
-      call stiffness_and_lifting(mesh, laws, sys, err, .false.)
+      ! the lifting: the stiffness of a plane cell is its law's, in plane strain or stress alike
+      call element_table(model_of(mesh%axisymmetric, .true.), elems)
+      call stiffness_and_lifting(mesh, laws, elems, sys, err, .false.)
       if (err%failed()) return
       call add_applied_loads(sys)
       sys%f_stage(:, s) = sys%f
@@ -472,9 +478,10 @@ contains
   !! each column's rows are searched (the grid, whose regular pattern makes the search
   !! cheap). err = ERR_INPUT on a cell with a non-positive Jacobian, ERR_NUMERICAL on a
   !! coupling outside the pattern (an internal error).
-  subroutine stiffness_and_lifting(mesh, laws, sys, err, with_k, cell_row)
+  subroutine stiffness_and_lifting(mesh, laws, elems, sys, err, with_k, cell_row)
     type(mesh_t), intent(in) :: mesh
     type(elastic_law_t), intent(in) :: laws(:)
+    type(element_slot_t), intent(in) :: elems(:)        ! the element of each cell shape
     type(body_system_t), intent(inout) :: sys
     type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
@@ -489,7 +496,7 @@ contains
     if (present(cell_row)) mapped = allocated(cell_row)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     do c = 1, mesh%ncell
-      call cell_stiffness(mesh, sys%id, c, laws, cache, ke, nd, ldof, err)
+      call cell_stiffness(mesh, sys%id, c, laws, elems, cache, ke, nd, ldof, err)
       if (err%failed()) return
       inside = .true.
       if (with_k .and. mapped) then
@@ -509,19 +516,22 @@ contains
 
   !> The stiffness of cell c (nd = its DOF count, ldof its global DOFs); err = ERR_INPUT,
   !! naming the cell's tag, when its Jacobian is not positive (inverted or degenerate).
-  subroutine cell_stiffness(mesh, body_id, c, laws, cache, ke, nd, ldof, err)
+  subroutine cell_stiffness(mesh, body_id, c, laws, elems, cache, ke, nd, ldof, err)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: body_id, c
     type(elastic_law_t), intent(in) :: laws(:)
+    type(element_slot_t), intent(in) :: elems(:)
     type(ke_cache_t), intent(inout) :: cache
     real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)
     integer, intent(out) :: nd, ldof(MAX_NDOF)
     type(error_t), intent(inout) :: err
-    real(wp) :: xe(2, MAX_NVERT), minjac
+    real(wp) :: xe(NDIM, MAX_NVERT), minjac
     character(len=512) :: emsg
-    nd = 2*cell_vertices(mesh, c)
+    nd = NCOMP*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
-    call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache, mesh%axisymmetric)
+    associate (k => law_of(mesh, c))
+      call elems(cell_element(mesh, c))%e%stiffness(xe, laws(k), k, ke, minjac, cache)
+    end associate
     if (.not. (minjac > 0.0_wp)) then
       write (emsg, '(a,i0,a,i0,a)') 'body ', body_id, ': cell ', mesh%cell_tag(c), &
         ' has a non-positive Jacobian (inverted or degenerate element)'
@@ -530,24 +540,6 @@ contains
     end if
     call cell_dofs(mesh, c, ldof)
   end subroutine cell_stiffness
-
-  !> The stiffness of a cell of element `element` and law k of `laws`: the isotropic kernel
-  !! (Lame parameters) or the general one (its plane stiffness).
-  pure subroutine law_stiffness(element, xe, laws, k, ke, minjac, cache, axisymmetric)
-    integer, intent(in) :: element, k
-    real(wp), intent(in) :: xe(2, MAX_NVERT)
-    type(elastic_law_t), intent(in) :: laws(:)
-    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF), minjac
-    type(ke_cache_t), intent(inout) :: cache
-    logical, intent(in) :: axisymmetric        ! a meridian section: per radian, with the hoop strain
-    if (axisymmetric) then     ! no cache: a translate in r is not the same cell
-      call axi_stiffness(element, xe, laws(k)%d, ke, minjac)
-    else if (laws(k)%isotropic) then
-      call element_stiffness(element, xe, laws(k)%lame_lambda, laws(k)%lame_mu, ke, minjac, cache, key=k)
-    else
-      call element_stiffness(element, xe, 0.0_wp, 0.0_wp, ke, minjac, cache, dmat=laws(k)%d, key=k)
-    end if
-  end subroutine law_stiffness
 
   !> Add the free-free block of an element stiffness to the CSC values. The element's
   !! DOFs are merged in increasing global (hence free) order with the sorted rows of
@@ -693,19 +685,23 @@ contains
     !! that K u adds up (its rounding is eps times that, however much they cancel) [force]
     real(wp), intent(out), optional :: mag(:)
     integer :: c, nd, ldof(MAX_NDOF), i
-    real(wp) :: xe(2, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
+    real(wp) :: xe(NDIM, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
     type(ke_cache_t) :: cache
     type(elastic_law_t), allocatable :: laws(:)
+    type(element_slot_t) :: elems(NSHAPE)
 
     laws = body_laws(body, plane_strain)
+    call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:NCOMP*mesh%nnode) = 0.0_wp
     if (present(mag)) mag(1:NCOMP*mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
-      nd = 2*cell_vertices(mesh, c)
+      nd = NCOMP*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
-      call law_stiffness(cell_element(mesh, c), xe, laws, law_of(mesh, c), ke, minjac, cache, mesh%axisymmetric)
+      associate (k => law_of(mesh, c))
+        call elems(cell_element(mesh, c))%e%stiffness(xe, laws(k), k, ke, minjac, cache)
+      end associate
       ue(1:nd) = u_full(ldof(1:nd))
       r(ldof(1:nd)) = r(ldof(1:nd)) + matmul(ke(1:nd, 1:nd), ue(1:nd))
       if (present(mag)) then
@@ -749,28 +745,24 @@ contains
     real(wp), intent(out) :: von_mises(:)       !< (nnode) von Mises stress [stress]
     integer :: c, a, k, nd, ldof(MAX_NDOF), law
     integer, allocatable :: cnt(:)
-    real(wp) :: xe(2, MAX_NVERT), ue(MAX_NDOF), cs(4)
+    real(wp) :: xe(NDIM, MAX_NVERT), ue(MAX_NDOF), cs(4)
     real(wp) :: sxx, syy, sxy, szz
     type(elastic_law_t), allocatable :: laws(:)
+    type(element_slot_t) :: elems(NSHAPE)
 
     laws = body_laws(body, plane_strain)
+    call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
     allocate (cnt(mesh%nnode))
     cnt = 0
     sigma(:, 1:mesh%nnode) = 0.0_wp
     do c = 1, mesh%ncell
-      nd = 2*cell_vertices(mesh, c)
+      nd = NCOMP*cell_vertices(mesh, c)
       call cell_coords(mesh, c, xe)
       call cell_dofs(mesh, c, ldof)
       ue(1:nd) = u_full(ldof(1:nd))
       law = law_of(mesh, c)
-      if (mesh%axisymmetric) then
-        call axi_stress(cell_element(mesh, c), xe, ue, laws(law)%d, cs)
-      else if (laws(law)%isotropic) then
-        call element_stress(cell_element(mesh, c), xe, ue, laws(law)%lame_lambda, laws(law)%lame_mu, plane_strain, cs)
-      else
-        call element_stress_general(cell_element(mesh, c), xe, ue, laws(law)%d, cs)
-      end if
-      do a = 1, nd/2
+      call elems(cell_element(mesh, c))%e%stress(xe, ue, laws(law), cs)
+      do a = 1, nd/NCOMP
         k = mesh%cells(a, c)
         sigma(:, k) = sigma(:, k) + cs
         cnt(k) = cnt(k) + 1
@@ -802,7 +794,7 @@ contains
   pure subroutine cell_coords(mesh, c, xe)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: c
-    real(wp), intent(out) :: xe(2, MAX_NVERT)
+    real(wp), intent(out) :: xe(NDIM, MAX_NVERT)
     integer :: a
     xe = 0.0_wp
     do a = 1, cell_vertices(mesh, c)
@@ -901,12 +893,14 @@ contains
     real(wp), intent(in) :: b(:, :)        ! (2, laws) the force in the cells of each law
     real(wp), intent(inout) :: f(:)
     integer :: c, a, k, law
-    real(wp) :: xe(2, MAX_NVERT), w(MAX_NVERT)
+    real(wp) :: xe(NDIM, MAX_NVERT), w(MAX_NVERT)
+    type(element_slot_t) :: elems(NSHAPE)
+    call element_table(model_of(mesh%axisymmetric, .true.), elems)   ! loads: plane strain or stress alike
     do c = 1, mesh%ncell
       law = law_of(mesh, c)
       if (all(b(:, law) == 0.0_wp)) cycle
       call cell_coords(mesh, c, xe)
-      call element_shape_integrals(cell_element(mesh, c), xe, w, mesh%axisymmetric)
+      call elems(cell_element(mesh, c))%e%shape_integrals(xe, w)
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
         f(node_dof(k, 1):node_dof(k, NCOMP)) = f(node_dof(k, 1):node_dof(k, NCOMP)) + w(a)*b(:, law)
@@ -920,8 +914,10 @@ contains
     procedure(body_force_fn) :: bf
     real(wp), intent(inout) :: f(:)
     integer :: c, a, k
-    real(wp) :: xe(2, MAX_NVERT), fe(2, MAX_NVERT)
+    real(wp) :: xe(NDIM, MAX_NVERT), fe(NCOMP, MAX_NVERT)
+    type(element_slot_t) :: elems(NSHAPE)
 
+    call element_table(model_of(mesh%axisymmetric, .true.), elems)   ! loads: plane strain or stress alike
     fe = 0.0_wp
     do c = 1, mesh%ncell
       call cell_coords(mesh, c, xe)
@@ -929,7 +925,7 @@ contains
         k = mesh%cells(a, c)
         fe(:, a) = f(node_dof(k, 1):node_dof(k, NCOMP))
       end do
-      call element_body_force(cell_element(mesh, c), xe, bf, fe)
+      call elems(cell_element(mesh, c))%e%body_force(xe, bf, fe)
       do a = 1, cell_vertices(mesh, c)
         k = mesh%cells(a, c)
         f(node_dof(k, 1):node_dof(k, NCOMP)) = fe(:, a)

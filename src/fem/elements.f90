@@ -22,12 +22,11 @@ module elements
   integer, parameter, public :: MAX_NDOF = 2*MAX_NVERT   !< most DOFs of an element (Q1)
 
   abstract interface
-    !> A body force density b(x, y) [force/length^3] (per unit thickness: [force/length^2]/[length]).
-    subroutine body_force_fn(x, y, b)
+    !> A body force density b(x) [force/length^3] (per unit thickness: [force/length^2]/[length]).
+    subroutine body_force_fn(x, b)
       import :: wp
-      real(wp), intent(in) :: x            !< position x [length]
-      real(wp), intent(in) :: y            !< position y [length]
-      real(wp), intent(out) :: b(2)        !< body force density [force/length^3]
+      real(wp), intent(in) :: x(:)         !< position (NDIM) [length]
+      real(wp), intent(out) :: b(:)        !< body force density (NCOMP) [force/length^3]
     end subroutine body_force_fn
   end interface
 
@@ -342,12 +341,14 @@ contains
   end subroutine q1_point
 
   !> Add the consistent nodal loads of a body force density to `fe`: Q1 3x3 Gauss,
-  !! P1 the 3-point interior rule of degree 2.
-  subroutine element_body_force(element, xe, bf, fe)
+  !! P1 the 3-point interior rule of degree 2; with `axisymmetric`, per radian (b r).
+  subroutine element_body_force(element, xe, bf, fe, axisymmetric)
     integer, intent(in) :: element                  !< ELEM_Q1 or ELEM_P1
     real(wp), intent(in) :: xe(2, MAX_NVERT)        !< vertex coordinates [length]
     procedure(body_force_fn) :: bf                  !< body force density
     real(wp), intent(inout) :: fe(2, MAX_NVERT)     !< nodal loads of the vertices, added to [force]
+    !> .true.: per radian, the integrand weighted by r = x (a meridian section)
+    logical, intent(in), optional :: axisymmetric
     real(wp), parameter :: q3(3) = [-0.774596669241483377035853079956_wp, 0.0_wp, &
                                      0.774596669241483377035853079956_wp]
     real(wp), parameter :: w3(3) = [5.0_wp/9.0_wp, 8.0_wp/9.0_wp, 5.0_wp/9.0_wp]
@@ -356,13 +357,17 @@ contains
                                                  1.0_wp/6.0_wp, 1.0_wp/6.0_wp, 2.0_wp/3.0_wp], [3, 3])
     integer :: a, ig, jg
     real(wp) :: nfun(4), g(2, MAX_NVERT), det, xq(2), bv(2)
+    logical :: axi
 
+    axi = .false.
+    if (present(axisymmetric)) axi = axisymmetric
     if (element == ELEM_Q1) then
       do jg = 1, 3
         do ig = 1, 3
           call q1_gradients(xe, q3(ig), q3(jg), nfun, g, det)
           xq = matmul(xe, nfun)
-          call bf(xq(1), xq(2), bv)
+          call bf(xq, bv)
+          if (axi) bv = bv*xq(1)
           do a = 1, 4
             fe(:, a) = fe(:, a) + w3(ig)*w3(jg)*det*nfun(a)*bv
           end do
@@ -372,7 +377,8 @@ contains
       call p1_gradients(xe, g, det)
       do ig = 1, 3
         xq = matmul(xe(:, 1:3), bary(:, ig))
-        call bf(xq(1), xq(2), bv)
+        call bf(xq, bv)
+        if (axi) bv = bv*xq(1)
         do a = 1, 3
           ! weight area/3 = det/6
           fe(:, a) = fe(:, a) + (det/6.0_wp)*bary(a, ig)*bv

@@ -24,7 +24,7 @@ module results
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof
   use assembly, only: body_system_t, nodal_stress, support_reactions
-  use contact_interface, only: interface_t, pair_rows
+  use contact_interface, only: interface_t, pair_rows, row_directions
   use contact_types, only: contact_result_t, status_name
   use friction_view, only: tangential_t, split_friction
   use floating, only: free_list
@@ -334,7 +334,7 @@ contains
     call write_dset(gid, 'x', w2(:, 1), st, ul)
     call write_dset(gid, 'y', w2(:, 2), st, ul)
     call write_dset(gid, 's', itf%s, st, ul)
-    w2 = transpose(itf%normal)
+    w2 = transpose(row_directions(itf, 1, itf%m))
     call write_dset(gid, 'normal', w2, st, '1')
     w2 = transpose(itf%xy)   ! contiguous (gfortran passes a transpose as a strided view)
     call write_dset(gid, 'coordinates', w2, st, ul)
@@ -679,7 +679,7 @@ contains
       call write_dset(pid, 'x', w2(:, 1), st, ul)
       call write_dset(pid, 'y', w2(:, 2), st, ul)
       call write_dset(pid, 's', itf%s(i:j), st, ul)
-      w2 = transpose(itf%normal(:, i:j))
+      w2 = transpose(row_directions(itf, i, j))
       call write_dset(pid, 'normal', w2, st, '1')
       call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
       call write_dset(pid, 'tributary_length', itf%trib(i:j), st, trib_unit)

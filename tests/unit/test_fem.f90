@@ -25,10 +25,12 @@ contains
   end subroutine ms_u
 
   !> f = -div sigma = -(lambda + mu) grad div u - mu lap u.
-  subroutine ms_force(x, y, f)
-    real(wp), intent(in) :: x, y
-    real(wp), intent(out) :: f(2)
-    real(wp) :: u1xx, u1yy, u1xy, u2xx, u2yy, u2xy
+  subroutine ms_force(xy, f)
+    real(wp), intent(in) :: xy(:)
+    real(wp), intent(out) :: f(:)
+    real(wp) :: x, y, u1xx, u1yy, u1xy, u2xx, u2yy, u2xy
+    x = xy(1)
+    y = xy(2)
     u1xx = -ka**2*sin(ka*x)*cos(kb*y)
     u1yy = -kb**2*sin(ka*x)*cos(kb*y)
     u1xy = -ka*kb*cos(ka*x)*sin(kb*y)

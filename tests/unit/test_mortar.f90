@@ -1,10 +1,12 @@
 !> Unit tests of module mortar: matching and non-matching flat lines (identity, partition of
 !! unity, linear reproduction, the uniform-pressure patch test), a master at distance h, a
 !! curved slave over a flat master (g0 against the normal distance, second-order in h),
-!! removed nodes, partial overlap, bad input, and the build time at 100k x 130k segments.
+!! removed nodes, partial overlap, bad input, and the build time at 100k x 130k segments;
+!! the contract's consistency diagnostic, the dispatch by dimension, and the node frames.
 program test_mortar
   use kinds, only: wp
-  use mortar, only: mortar_t, mortar_build
+  use mortar, only: mortar_t, mortar_build, mortar_consistency
+  use space, only: frame_of
   use testing, only: report, report_le, test_summary, error_parts
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
@@ -21,6 +23,8 @@ program test_mortar
   call test_partial()
   call test_closed_loops()
   call test_bad_input()
+  call test_dispatch()
+  call test_frames()
   call test_timing()
 
   call test_summary()
@@ -214,6 +218,9 @@ contains
     call report_le(err_g, tol, 'matching: g0 = 0')
     call report_le(err_n, tol, 'matching: normals (0, 1)')
     call report_le(err_a, tol, 'matching: arc length from the chain start')
+    call mortar_consistency(mt, w, k)
+    call report(k == n + 1, 'matching: consistency measured on every row (all fully covered)')
+    call report_le(w, tol, 'matching: max |sum_l M_jl - D_jj| / D_jj = 0')
   end subroutine test_matching
 
   !> Slave 7 segments, master 5, both perturbed, master at normal distance h, the whole
@@ -260,6 +267,9 @@ contains
     call report_le(e_g, tol, what//': g0 = h on every row')
     call report_le(e_n, tol, what//': normals')
     call report_le(e_d, tol, what//': D = slave tributary length')
+    call mortar_consistency(mt, e_pu, k)
+    call report(k == ns + 1, what//': consistency measured on every row')
+    call report_le(e_pu, tol, what//': max |sum_l M_jl - D_jj| / D_jj = 0 (flat)')
     ! Uniform pressure p: lam_j = p D_jj gives the master the consistent nodal forces p * tributary.
     p = 7.0_wp
     lam = p * mt%d
@@ -617,6 +627,60 @@ contains
   end subroutine rim
 
   !> Each bad input gives ERR_INPUT and a message.
+  !> One entry point for every dimension: mismatched coordinates and faces no mortar
+  !! implements are bad input naming what was given.
+  subroutine test_dispatch()
+    real(wp) :: x2(2, 2), x3(3, 3)
+    integer :: e2(2, 1), f3(3, 1)
+    type(mortar_t) :: mt
+    type(error_t) :: err
+    x2 = reshape([0.0_wp, 0.0_wp, 1.0_wp, 0.0_wp], [2, 2])
+    x3 = 0.0_wp
+    e2(:, 1) = [1, 2]
+    f3(:, 1) = [1, 2, 3]
+    call mortar_build(x2, e2, [.false., .false.], x3, f3, mt, err)
+    call report(err%category == ERR_INPUT .and. index(err%text(), '2 coordinates') > 0 .and. &
+                index(err%text(), 'master nodes 3') > 0, 'dispatch: slave 2D, master 3D refused ('//err%text()//')')
+    call mortar_build(x3, f3, [.false., .false., .false.], x3, f3, mt, err)
+    call report(err%category == ERR_INPUT .and. index(err%text(), '3-coordinate') > 0, &
+                'dispatch: 3D faces not (yet) implemented refused ('//err%text()//')')
+  end subroutine test_dispatch
+
+  !> frame_of: column 1 the normal, orthonormal, right-handed (det = +1), in 2D the tangent
+  !! (-n_y, n_x) exactly; in 3D for normals along and between the axes.
+  subroutine test_frames()
+    real(wp) :: f2(2, 2), f3(3, 3), n3(3), e_orth, e_det, e_n, th
+    integer :: i, j
+    th = 0.7_wp
+    f2 = frame_of([cos(th), sin(th)])
+    call report(f2(1, 2) == -sin(th) .and. f2(2, 2) == cos(th) .and. f2(1, 1) == cos(th), &
+                'frames 2D: tangent (-n_y, n_x) bit for bit')
+    e_orth = 0.0_wp
+    e_det = 0.0_wp
+    e_n = 0.0_wp
+    do i = 1, 7
+      select case (i)
+      case (1:3)
+        n3 = 0.0_wp
+        n3(i) = 1.0_wp
+      case (4)
+        n3 = [-1.0_wp, 0.0_wp, 0.0_wp]
+      case default
+        n3 = [cos(i*1.3_wp), sin(i*1.3_wp)*cos(i*0.4_wp), -sin(i*1.3_wp)*sin(i*0.4_wp)]
+      end select
+      f3 = frame_of(n3)
+      e_n = max(e_n, norm2(f3(:, 1) - n3))
+      do j = 1, 3
+        e_orth = max(e_orth, maxval(abs(matmul(transpose(f3), f3(:, j)) - merge(1.0_wp, 0.0_wp, [1, 2, 3] == j))))
+      end do
+      e_det = max(e_det, abs(f3(1, 1)*(f3(2, 2)*f3(3, 3) - f3(3, 2)*f3(2, 3)) - f3(1, 2)*(f3(2, 1)*f3(3, 3) - &
+                  f3(3, 1)*f3(2, 3)) + f3(1, 3)*(f3(2, 1)*f3(3, 2) - f3(3, 1)*f3(2, 2)) - 1.0_wp))
+    end do
+    call report_le(e_n, tol, 'frames 3D: column 1 is the normal')
+    call report_le(e_orth, tol, 'frames 3D: orthonormal')
+    call report_le(e_det, tol, 'frames 3D: right-handed (det = 1)')
+  end subroutine test_frames
+
   subroutine test_bad_input()
     real(wp) :: xs(2, 6), xm(2, 3)
     integer :: ok_em(2, 2)
