@@ -2,26 +2,42 @@
 !! components of its displacement, the rigid motions of a free body, the stress components a
 !! node carries, and the numbering of the DOFs (node k, component c is DOF NCOMP (k - 1) + c,
 !! the components of a node consecutive). Every body is plane today (plane strain, plane
-!! stress, or the meridian section of a body of revolution); a module that depends on the
-!! dimension says so through these names, not through a literal 2, 3 or 4.
+!! stress, or the meridian section of a body of revolution) or solid; a module that depends on
+!! the dimension says so through these names, not through a literal 2, 3 or 4. The dimension
+!! is the run's, set once (`set_dimension`) when the deck is read: one binary solves plane
+!! and solid scenes.
 module space
   use kinds, only: wp
   implicit none (type, external)
   private
 
-  integer, parameter, public :: NDIM = 2                     !< coordinates of a node (x, y)
-  integer, parameter, public :: NCOMP = NDIM                 !< displacement components of a node (ux, uy)
-  integer, parameter, public :: NRIGID = NDIM*(NDIM + 1)/2   !< rigid motions of a free body: translations and rotations
-  integer, parameter, public :: NSTRESS = 4                  !< stress components of a node: sxx, syy, sxy and szz
+  ! Set once per run by set_dimension (the deck's dimension), read everywhere else.
+  integer, protected, public :: NDIM = 2       !< coordinates of a node: (x, y), or (x, y, z)
+  integer, protected, public :: NCOMP = 2      !< displacement components of a node: NDIM
+  integer, protected, public :: NRIGID = 3     !< rigid motions of a free body, NDIM (NDIM + 1) / 2: translations and rotations
+  !> stress components of a node: in the plane sxx, syy, sxy and szz; in space sxx, syy, szz,
+  !! syz, sxz, sxy (Voigt order)
+  integer, protected, public :: NSTRESS = 4
 
-  public :: node_dof, dof_node, dof_comp, frame_of
+  public :: set_dimension, node_dof, dof_node, dof_comp, frame_of
 
 contains
+
+  !> Set the run's dimension: 2 (plane and axisymmetric bodies) or 3 (solid bodies). Any
+  !! other value leaves it unchanged (the deck has refused it before).
+  subroutine set_dimension(d)
+    integer, intent(in) :: d             !< 2 or 3
+    if (d /= 2 .and. d /= 3) return
+    NDIM = d
+    NCOMP = d
+    NRIGID = d*(d + 1)/2
+    NSTRESS = merge(4, 6, d == 2)
+  end subroutine set_dimension
 
   !> The DOF of node k's component c: NCOMP (k - 1) + c.
   elemental integer function node_dof(k, c)
     integer, intent(in) :: k   !< the node, 1..nnode
-    integer, intent(in) :: c   !< the component, 1..NCOMP (1 = x, 2 = y)
+    integer, intent(in) :: c   !< the component, 1..NCOMP (1 = x, 2 = y, 3 = z)
     node_dof = NCOMP*(k - 1) + c
   end function node_dof
 
@@ -31,7 +47,7 @@ contains
     dof_node = (i - 1)/NCOMP + 1
   end function dof_node
 
-  !> The component of DOF i (1 = x, 2 = y).
+  !> The component of DOF i (1 = x, 2 = y, 3 = z).
   elemental integer function dof_comp(i)
     integer, intent(in) :: i   !< a DOF, 1..NCOMP nnode
     dof_comp = i - NCOMP*((i - 1)/NCOMP)

@@ -184,7 +184,7 @@ contains
     integer, intent(in) :: side               !< side (1 or 2)
     real(wp), intent(in) :: lam(:)            !< (m) contact forces [force]
     integer, intent(in) :: first, last        !< rows
-    real(wp) :: f(2)
+    real(wp) :: f(NCOMP)
     integer :: k, e, c
     f = 0.0_wp
     do k = first, last
@@ -282,7 +282,7 @@ contains
     type(error_t), intent(out) :: err             !< ERR_INPUT naming both groups and a shared edge
     type(int_hash_t) :: h
     integer, allocatable :: owner(:), nend(:)
-    integer :: a, p, s, g, e, slot, n1, n2, ne, stat, q, t
+    integer :: a, p, s, g, e, slot, n1, n2, n3, ne, stat, q, t
     integer(i8) :: key
     logical :: keyed
 
@@ -298,7 +298,8 @@ contains
     do a = 1, size(msh)
       if (nend(a) < 2) cycle
       associate (m => msh(a))
-        keyed = real(m%nnode, wp)**2*real(size(msh), wp) < 4.0e18_wp
+        keyed = real(m%nnode, wp)**(NDIM)*real(size(msh), wp) < 4.0e18_wp
+        if (NDIM == 3 .and. real(m%nnode, wp)**3 >= 4.0e18_wp) cycle     ! a face's key would not fit 64 bits
         ne = 0
         do p = 1, size(pairs)
           do s = 1, 2
@@ -320,9 +321,13 @@ contains
             g = group_index(m, pairs(p)%body_group(s))
             if (g == 0) cycle
             do e = 1, m%group(g)%nedge
-              n1 = minval(m%group(g)%edge(:, e))
+              n1 = minval(m%group(g)%edge(:, e), mask=m%group(g)%edge(:, e) > 0)
               n2 = maxval(m%group(g)%edge(:, e))
               key = int(n1 - 1, i8)*int(m%nnode, i8) + int(n2 - 1, i8)
+              if (NDIM == 3) then    ! a face: its smallest, second smallest and largest node
+                n3 = minval(m%group(g)%edge(:, e), mask=m%group(g)%edge(:, e) > n1)
+                key = (int(n1 - 1, i8)*int(m%nnode, i8) + int(n3 - 1, i8))*int(m%nnode, i8) + int(n2 - 1, i8)
+              end if
               if (keyed) key = key*int(size(msh), i8) + int(pairs(p)%bodies(3 - s) - 1, i8)
               slot = hash_slot(h, key)
               if (h%key(slot) == HASH_EMPTY) then

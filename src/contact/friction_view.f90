@@ -4,6 +4,7 @@
 !! force of its node, the shear traction, the slip and the node's state (stick, slip, open).
 module friction_view
   use kinds, only: wp
+  use space, only: NCOMP
   use contact_interface, only: interface_t, row_bounds, contact_resultant, DIR_NORMAL
   use contact_types, only: contact_result_t
   implicit none (type, external)
@@ -25,8 +26,8 @@ module friction_view
     logical :: on = .false.                   !< some pair has friction
     !> the resultant of all contact forces (normal and tangential) on side 1 of each pair,
     !! and of all pairs together [force]
-    real(wp), allocatable :: resultant(:, :)  !< (2, npair)
-    real(wp) :: resultant_all(2) = 0.0_wp
+    real(wp), allocatable :: resultant(:, :)  !< (NCOMP, npair)
+    real(wp), allocatable :: resultant_all(:) !< (NCOMP)
     real(wp), allocatable :: force(:)         !< tangential force of the node (0: frictionless pair) [force]
     real(wp), allocatable :: shear(:)         !< force / tributary length [stress]
     real(wp), allocatable :: bound(:)         !< the bound of |force| (Tresca's, or mu x the normal force) [force]
@@ -104,8 +105,9 @@ contains
       res_n%obstacle = res%obstacle(keep, :)
     end if
 
-    allocate (tg%resultant(2, itf%npair))
+    allocate (tg%resultant(NCOMP, itf%npair), tg%resultant_all(NCOMP))
     tg%resultant = 0.0_wp
+    tg%resultant_all = 0.0_wp
     if (allocated(res%lam)) then
       tg%resultant_all = contact_resultant(itf, 1, res%lam, 1, itf%m)
       do p = 1, itf%npair

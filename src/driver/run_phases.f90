@@ -9,7 +9,9 @@ module run_phases
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count, body_stiffness, &
                     solver_cfg_t, ROBIN_HARMONIC, ROBIN_STEKLOV
-  use mesh, only: mesh_t, mesh_build, assign_cell_laws
+  use space, only: NDIM
+  use mesh, only: mesh_t, mesh_build, box_build, assign_cell_laws
+  use elements_3d, only: kuhn_tets
   use gmsh_msh, only: msh_read, msh_read_shared
   use assembly, only: assemble_body, support_reactions
   use contact_interface, only: build_interface, slot_row, has_friction, DIR_NORMAL
@@ -161,6 +163,13 @@ contains
         if (done(a)) cycle
         if (len_trim(deck%body(a)%mesh) > 0) then
           call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a), run%mesh_hex(a))
+        else if (NDIM == 3) then
+          block
+            integer :: info
+            character(len=256) :: bmsg
+            call box_build(run%meshes(a), deck%body(a), kuhn_tets, info, bmsg)
+            if (info /= 0) err(a) = error_t(ERR_INPUT, trim(bmsg))
+          end block
         else
           call mesh_build(run%meshes(a), deck%body(a))
         end if

@@ -2,9 +2,10 @@
 !! setting to try on standard error) and the closing summary lines on standard output.
 module run_summary
   use kinds, only: wp
+  use space, only: NCOMP, node_dof, dof_comp
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
-  use config, only: solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
+  use config, only: side_axis, MAX_SIDES, solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
   use contact_interface, only: interface_t, DIR_NORMAL, contact_resultant
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
@@ -127,7 +128,7 @@ contains
     type(run_t), intent(in) :: run   !< the run: its plan and current result
     integer, intent(in) :: k         !< the step
     character(len=:), allocatable :: t
-    real(wp) :: ftot, f2(2)
+    real(wp) :: ftot, f2(NCOMP)
     integer :: p, np
     ftot = 0.0_wp
     if (allocated(run%result%lam)) then
@@ -154,7 +155,7 @@ contains
         if (p > 1) t = t//','
         f2 = contact_resultant(run%contact_line, 1, run%result%lam, run%contact_line%pair_ptr(p), &
                                min(run%contact_line%pair_ptr(p + 1) - 1, size(run%result%lam)))
-        t = t//sci(f2(1), 4)//':'//sci(f2(2), 4)
+        t = t//vec_text(f2, ':', 4)
       end do
       if (np > MAX_STEP_RESULTANTS) t = t//',...'
     end if
@@ -235,7 +236,7 @@ contains
   function pair_lines(run) result(lines)
     type(run_t), intent(in) :: run
     character(len=1024), allocatable :: lines(:)
-    real(wp) :: ftot, fres(2), imbalance
+    real(wp) :: ftot, fres(NCOMP), imbalance
     integer :: p, np, r(2), active, nopen
     character(len=:), allocatable :: head, tail
     type(interface_t) :: itf
@@ -284,7 +285,7 @@ contains
         end if
       end if
       write (lines(p), '(a,i0,a,es10.3,a,es10.3,a,es10.3,a)') head// &
-        sci(fres(1), 5)//','//sci(fres(2), 5)//' normal_force_sum='//sci(ftot, 5)//' active=', active, &
+        vec_text(fres, ',', 5)//' normal_force_sum='//sci(ftot, 5)//' active=', active, &
         ' imbalance=', imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity, tail
     end do
   end function pair_lines
@@ -303,8 +304,8 @@ contains
     type(run_t), intent(in) :: run
     character(len=1024), allocatable :: lines(:)
     real(wp), allocatable :: c(:)
-    real(wp) :: rr(2), ff(2), cc(2), scale, bal
-    integer :: a, p, nsup
+    real(wp) :: rr(NCOMP), ff(NCOMP), cc(NCOMP), scale, bal
+    integer :: a, p, nsup, k
     allocate (lines(0))
     if (.not. allocated(run%reaction) .or. .not. allocated(run%result%lam_body)) return
     if (.not. allocated(run%bodies)) return
@@ -320,10 +321,12 @@ contains
         call apply_bt(bd, gather(run%result%lam_body, bd%slots), c)
         cc = 0.0_wp
         do p = 1, sy%n
-          cc(2 - mod(sy%dof_of(p), 2)) = cc(2 - mod(sy%dof_of(p), 2)) - c(p)
+          cc(dof_comp(sy%dof_of(p))) = cc(dof_comp(sy%dof_of(p))) - c(p)
         end do
-        rr = [sum(r(1::2)), sum(r(2::2))]
-        ff = [sum(sy%f_applied(1::2)), sum(sy%f_applied(2::2))]
+        do k = 1, NCOMP
+          rr(k) = sum(r(k::NCOMP))
+          ff(k) = sum(sy%f_applied(k::NCOMP))
+        end do
         ! the size of the forces that balance: every nodal force's magnitude (a body between two
         ! others carries large contact forces whose resultant is zero); K u is known to eps
         ! times the size of its terms, which may cancel far below the forces (a stiff body
@@ -336,9 +339,9 @@ contains
         else
           bal = norm2(rr + ff + cc)/scale
         end if
-        lines = [character(len=1024) :: lines, 'reaction: body='//i2s(a)//' supports='//sci(rr(1), 5)//','// &
-                 sci(rr(2), 5)//' loads='//sci(ff(1), 5)//','//sci(ff(2), 5)//' contact='//sci(cc(1), 5)//','// &
-                 sci(cc(2), 5)//' balance='//sci(bal, 2)//' (rounding '// &
+        lines = [character(len=1024) :: lines, 'reaction: body='//i2s(a)//' supports='//vec_text(rr, ',', 5)// &
+                 ' loads='//vec_text(ff, ',', 5)//' contact='//vec_text(cc, ',', 5)// &
+                 ' balance='//sci(bal, 2)//' (rounding '// &
                  sci(epsilon(1.0_wp)*run%reaction_mag(a)/scale, 1)//')'//group_parts(a, r)]
         deallocate (c)
       end associate
@@ -361,17 +364,17 @@ contains
       logical, allocatable :: comp(:, :), taken(:)
       integer, allocatable :: nodes(:)
       integer :: s, i, g, k, ng, n, c
-      real(wp) :: rg(2)
-      allocate (names(0), comp(2, 0))
-      do s = 1, 4
+      real(wp) :: rg(NCOMP)
+      allocate (names(0), comp(NCOMP, 0))
+      do s = 1, MAX_SIDES
         if (len_trim(run%deck%body(a)%mesh) > 0) exit
         select case (run%deck%body(a)%bc(s))
         case (BC_CLAMPED, BC_DISPLACEMENT)
           names = [names, str_t(trim(side_names(s)))]
-          comp = reshape([comp, .true., .true.], [2, size(names)])
-        case (BC_ROLLER)     ! the normal component: ux on left and right, uy on bottom and top
+          comp = reshape([comp, [(.true., c=1, NCOMP)]], [NCOMP, size(names)])
+        case (BC_ROLLER)     ! the normal component: ux on left and right, uy on bottom and top, uz front and back
           names = [names, str_t(trim(side_names(s)))]
-          comp = reshape([comp, s <= 2, s > 2], [2, size(names)])
+          comp = reshape([comp, [(c == side_axis(s), c=1, NCOMP)]], [NCOMP, size(names)])
         end select
       end do
       do i = 1, run%deck%nboundary
@@ -379,9 +382,9 @@ contains
         k = findloc([(names(c)%s == trim(run%deck%boundary(i)%group), c=1, size(names))], .true., 1)
         if (k == 0) then
           names = [names, str_t(trim(run%deck%boundary(i)%group))]
-          comp = reshape([comp, run%deck%boundary(i)%fix], [2, size(names)])
+          comp = reshape([comp, run%deck%boundary(i)%fix(1:NCOMP)], [NCOMP, size(names)])
         else
-          comp(:, k) = comp(:, k) .or. run%deck%boundary(i)%fix
+          comp(:, k) = comp(:, k) .or. run%deck%boundary(i)%fix(1:NCOMP)
         end if
       end do
       allocate (taken(size(r)))
@@ -399,14 +402,14 @@ contains
         call group_nodes(run%meshes(a), g, nodes)
         rg = 0.0_wp
         do i = 1, size(nodes)
-          do c = 1, 2
-            n = 2*nodes(i) - 2 + c
+          do c = 1, NCOMP
+            n = node_dof(nodes(i), c)
             if (.not. comp(c, k) .or. taken(n)) cycle
             taken(n) = .true.
             rg(c) = rg(c) + r(n)
           end do
         end do
-        t = t//' '''//names(k)%s//'''='//sci(rg(1), 5)//','//sci(rg(2), 5)
+        t = t//' '''//names(k)%s//'''='//vec_text(rg, ',', 5)
       end do
       if (ng > 0) t = ' groups:'//t
     end function group_parts
@@ -433,5 +436,18 @@ contains
           "or a larger max_outer"
     end if
   end function next_setting
+
+  !> A vector's components as text, sci with `digits` significant digits, joined by `sep`.
+  function vec_text(v, sep, digits) result(t)
+    real(wp), intent(in) :: v(:)
+    character(len=*), intent(in) :: sep
+    integer, intent(in) :: digits
+    character(len=:), allocatable :: t
+    integer :: k
+    t = sci(v(1), digits)
+    do k = 2, size(v)
+      t = t//sep//sci(v(k), digits)
+    end do
+  end function vec_text
 
 end module run_summary

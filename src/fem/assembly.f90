@@ -18,11 +18,12 @@ module assembly
   use, intrinsic :: iso_fortran_env, only: int16
   use strings, only: body_label, sci
   use sorting, only: sort_by_key
-  use config, only: body_cfg_t, elastic_law_t, body_stiffness, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, &
+  use config, only: body_cfg_t, elastic_law_t, body_stiffness, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, NSHAPE, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
   use mesh, only: mesh_t, side_nodes, group_index, nodes_only, nodes_only_refusal, cell_element, cell_vertices
-  use elements, only: MAX_NVERT, MAX_NDOF, body_force_fn, ke_cache_t, ke_cache_init, edge_traction
-  use element_types, only: element_slot_t, element_table, model_of, NSHAPE
+  use elements, only: body_force_fn, ke_cache_t, ke_cache_init, edge_traction
+  use element_types, only: element_slot_t, element_table, model_of, element_sizes
+  use elements_3d, only: face_traction, face_area_normal
   use material_laws, only: isotropic_law
   use linop, only: csc_symv
   use body_system, only: body_system_t
@@ -205,8 +206,9 @@ contains
     integer, allocatable, intent(out) :: irn(:), jcn(:)  !< row and column of each entry (free, 1-based)
     real(wp), allocatable, intent(out) :: a(:)           !< the entries [stress]
     type(error_t), intent(out) :: err                    !< the bad cell, if any
-    integer :: c, nd, i, j, q, fi, fj, ldof(MAX_NDOF)
-    real(wp) :: ke(MAX_NDOF, MAX_NDOF)
+    integer :: c, nd, i, j, q, fi, fj, nvx, ndx, nsx
+    integer, allocatable :: ldof(:)
+    real(wp), allocatable :: ke(:, :)
     type(ke_cache_t) :: cache
     integer, allocatable :: ti(:), tj(:)
     real(wp), allocatable :: ta(:)
@@ -215,8 +217,10 @@ contains
 
     laws = body_laws(body, plane_strain)
     call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
+    call element_sizes(nvx, ndx, nsx)
+    allocate (ldof(ndx), ke(ndx, ndx))
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
-    q = max(0, c2 - c1 + 1)*(MAX_NDOF*(MAX_NDOF + 1))/2
+    q = max(0, c2 - c1 + 1)*(ndx*(ndx + 1))/2
     allocate (ti(q), tj(q), ta(q))
     q = 0
     do c = max(1, c1), min(mesh%ncell, c2)
@@ -257,7 +261,8 @@ contains
       call err%set(ERR_INPUT, emsg)
       return
     end if
-    if (mesh%element /= ELEM_Q1 .and. mesh%element /= ELEM_P1 .and. mesh%element /= ELEM_MIXED) then
+    if (.not. (NDIM == 2 .and. (mesh%element == ELEM_Q1 .or. mesh%element == ELEM_P1 .or. mesh%element == ELEM_MIXED)) &
+        .and. .not. (NDIM == 3 .and. (mesh%element == ELEM_HEX8 .or. mesh%element == ELEM_TET4))) then
       write (emsg, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', mesh%element
       call err%set(ERR_INPUT, emsg)
       return
@@ -273,7 +278,7 @@ contains
       call err%set(ERR_INPUT, emsg)
       return
     end if
-    do side = 1, 4
+    do side = 1, 2*NDIM
       if (body%bc(side) < BC_FREE .or. body%bc(side) > BC_DISPLACEMENT) then
         write (emsg, '(a,i0,a,a,a,i0)') 'body ', body%id, ': unknown condition code on side ', &
           trim(side_names(side)), ': ', body%bc(side)
@@ -290,15 +295,15 @@ contains
     do t = 1, ntraction
       if (tractions(t)%body /= body%id) cycle
       if (len_trim(tractions(t)%group) > 0) cycle
-      if (.not. mesh%structured) then
+      if (.not. (mesh%structured .or. mesh%box)) then
         write (emsg, '(a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
           ' is on a side, but the body comes from a mesh file: load a group'
         call err%set(ERR_INPUT, emsg)
         return
       end if
-      if (tractions(t)%side < SIDE_LEFT .or. tractions(t)%side > SIDE_TOP) then
-        write (emsg, '(a,i0,a,i0,a,i0,a)') 'traction ', t, ' on body ', body%id, &
-          ' has side index ', tractions(t)%side, ', outside 1..4'
+      if (tractions(t)%side < SIDE_LEFT .or. tractions(t)%side > 2*NDIM) then
+        write (emsg, '(a,i0,a,i0,a,i0,a,i0)') 'traction ', t, ' on body ', body%id, &
+          ' has side index ', tractions(t)%side, ', outside 1..', 2*NDIM
         call err%set(ERR_INPUT, emsg)
         return
       end if
@@ -405,7 +410,13 @@ contains
                 nodes_only_refusal(mesh, g, 'a traction needs'))
           return
         end if
-        call add_group_traction(mesh, g, tractions(t), sys%f_applied)
+        if (NDIM == 3) then
+          call add_face_traction(mesh, g, tractions(t), sys%f_applied)
+        else
+          call add_group_traction(mesh, g, tractions(t), sys%f_applied)
+        end if
+      else if (NDIM == 3) then     ! a box's side is its group
+        call add_face_traction(mesh, tractions(t)%side, tractions(t), sys%f_applied)
       else
         call add_traction(mesh, tractions(t), sys%f_applied)
       end if
@@ -486,12 +497,15 @@ contains
     type(error_t), intent(out) :: err
     logical, intent(in) :: with_k                       ! .false.: the lifting only
     integer(int16), allocatable, intent(in), optional :: cell_row(:, :, :)   ! build_pattern's
-    integer :: c, nd, ldof(MAX_NDOF)
-    real(wp) :: ke(MAX_NDOF, MAX_NDOF)
+    integer :: c, nd, nvx, ndx, nsx
+    integer, allocatable :: ldof(:)
+    real(wp), allocatable :: ke(:, :)
     type(ke_cache_t) :: cache
     logical :: inside, mapped
     character(len=512) :: emsg
 
+    call element_sizes(nvx, ndx, nsx)
+    allocate (ldof(ndx), ke(ndx, ndx))
     mapped = .false.
     if (present(cell_row)) mapped = allocated(cell_row)
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
@@ -522,10 +536,10 @@ contains
     type(elastic_law_t), intent(in) :: laws(:)
     type(element_slot_t), intent(in) :: elems(:)
     type(ke_cache_t), intent(inout) :: cache
-    real(wp), intent(out) :: ke(MAX_NDOF, MAX_NDOF)
-    integer, intent(out) :: nd, ldof(MAX_NDOF)
+    real(wp), intent(out) :: ke(:, :)                  ! (element_sizes's nd, nd)
+    integer, intent(out) :: nd, ldof(:)
     type(error_t), intent(inout) :: err
-    real(wp) :: xe(NDIM, MAX_NVERT), minjac
+    real(wp) :: xe(NDIM, size(ldof)/NCOMP), minjac
     character(len=512) :: emsg
     nd = NCOMP*cell_vertices(mesh, c)
     call cell_coords(mesh, c, xe)
@@ -547,9 +561,9 @@ contains
   subroutine scatter_element(sys, ldof, ke, inside)
     type(body_system_t), intent(inout) :: sys
     integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
-    real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
+    real(wp), intent(in) :: ke(:, :)
     logical, intent(out) :: inside
-    integer :: nd, a, b, kk, fc, pos, pend, lfree(MAX_NDOF), perm(MAX_NDOF)
+    integer :: nd, a, b, kk, fc, pos, pend, lfree(size(ldof)), perm(size(ldof))
 
     inside = .true.
     nd = size(ldof)
@@ -588,8 +602,8 @@ contains
     type(body_system_t), intent(inout) :: sys
     integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
     integer(int16), intent(in) :: cell_row(:, :)        ! (nv, nv) build_pattern's, of this cell
-    real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
-    integer :: nd, a, b, pos, fr(MAX_NDOF)
+    real(wp), intent(in) :: ke(:, :)
+    integer :: nd, a, b, pos, fr(size(ldof))
 
     nd = size(ldof)
     do a = 1, nd
@@ -616,9 +630,9 @@ contains
   subroutine lift_prescribed(sys, ldof, ke)
     type(body_system_t), intent(inout) :: sys
     integer, intent(in) :: ldof(:)                      ! (nd) global dofs of the element
-    real(wp), intent(in) :: ke(MAX_NDOF, MAX_NDOF)
+    real(wp), intent(in) :: ke(:, :)
     integer :: nd, a, fa
-    real(wp) :: ue(MAX_NDOF)
+    real(wp) :: ue(size(ldof))
     logical :: lift
 
     nd = size(ldof)
@@ -684,14 +698,18 @@ contains
     !> (ndof) optional: sum over the cells of |ke_ij u_j| at each DOF, the size of the terms
     !! that K u adds up (its rounding is eps times that, however much they cancel) [force]
     real(wp), intent(out), optional :: mag(:)
-    integer :: c, nd, ldof(MAX_NDOF), i
-    real(wp) :: xe(NDIM, MAX_NVERT), ke(MAX_NDOF, MAX_NDOF), ue(MAX_NDOF), minjac
+    integer :: c, nd, i, nvx, ndx, nsx
+    integer, allocatable :: ldof(:)
+    real(wp), allocatable :: xe(:, :), ke(:, :), ue(:)
+    real(wp) :: minjac
     type(ke_cache_t) :: cache
     type(elastic_law_t), allocatable :: laws(:)
     type(element_slot_t) :: elems(NSHAPE)
 
     laws = body_laws(body, plane_strain)
     call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
+    call element_sizes(nvx, ndx, nsx)
+    allocate (ldof(ndx), xe(NDIM, nvx), ke(ndx, ndx), ue(ndx))
     call ke_cache_init(cache, maxval(abs(mesh%xy)))
     r(1:NCOMP*mesh%nnode) = 0.0_wp
     if (present(mag)) mag(1:NCOMP*mesh%nnode) = 0.0_wp
@@ -743,15 +761,17 @@ contains
     !> (4, nnode) sxx, syy, sxy, szz [stress]; szz = nu (sxx + syy) in plane strain, 0 in plane stress
     real(wp), intent(out) :: sigma(:, :)
     real(wp), intent(out) :: von_mises(:)       !< (nnode) von Mises stress [stress]
-    integer :: c, a, k, nd, ldof(MAX_NDOF), law
-    integer, allocatable :: cnt(:)
-    real(wp) :: xe(NDIM, MAX_NVERT), ue(MAX_NDOF), cs(4)
+    integer :: c, a, k, nd, law, nvx, ndx, nsx
+    integer, allocatable :: cnt(:), ldof(:)
+    real(wp), allocatable :: xe(:, :), ue(:), cs(:)
     real(wp) :: sxx, syy, sxy, szz
     type(elastic_law_t), allocatable :: laws(:)
     type(element_slot_t) :: elems(NSHAPE)
 
     laws = body_laws(body, plane_strain)
     call element_table(model_of(mesh%axisymmetric, plane_strain), elems)
+    call element_sizes(nvx, ndx, nsx)
+    allocate (ldof(ndx), xe(NDIM, nvx), ue(ndx), cs(nsx))
     allocate (cnt(mesh%nnode))
     cnt = 0
     sigma(:, 1:mesh%nnode) = 0.0_wp
@@ -770,6 +790,11 @@ contains
     end do
     do k = 1, mesh%nnode
       if (cnt(k) > 0) sigma(:, k) = sigma(:, k)/real(cnt(k), wp)
+      if (NDIM == 3) then     ! sxx, syy, szz, syz, sxz, sxy
+        von_mises(k) = sqrt(0.5_wp*((sigma(1, k) - sigma(2, k))**2 + (sigma(2, k) - sigma(3, k))**2 + &
+                                    (sigma(3, k) - sigma(1, k))**2) + 3.0_wp*sum(sigma(4:6, k)**2))
+        cycle
+      end if
       sxx = sigma(1, k)
       syy = sigma(2, k)
       sxy = sigma(3, k)
@@ -794,7 +819,7 @@ contains
   pure subroutine cell_coords(mesh, c, xe)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: c
-    real(wp), intent(out) :: xe(NDIM, MAX_NVERT)
+    real(wp), intent(out) :: xe(:, :)       ! (NDIM, element_sizes's nv)
     integer :: a
     xe = 0.0_wp
     do a = 1, cell_vertices(mesh, c)
@@ -806,12 +831,13 @@ contains
   pure subroutine cell_dofs(mesh, c, ldof)
     type(mesh_t), intent(in) :: mesh
     integer, intent(in) :: c
-    integer, intent(out) :: ldof(MAX_NDOF)
-    integer :: a
+    integer, intent(out) :: ldof(:)         ! (element_sizes's nd)
+    integer :: a, cc
     ldof = 0
     do a = 1, cell_vertices(mesh, c)
-      ldof(node_dof(a, 1)) = node_dof(mesh%cells(a, c), 1)
-      ldof(node_dof(a, 2)) = node_dof(mesh%cells(a, c), 2)
+      do cc = 1, NCOMP
+        ldof(node_dof(a, cc)) = node_dof(mesh%cells(a, c), cc)
+      end do
     end do
   end subroutine cell_dofs
 
@@ -832,7 +858,7 @@ contains
       nb = nodes(e + 1)
       fe(:, 1) = f(2*na - 1:2*na)
       fe(:, 2) = f(2*nb - 1:2*nb)
-      call edge_traction(mesh%xy(:, na), mesh%xy(:, nb), coord, tr%t0, tr%t1, fe, mesh%axisymmetric)
+      call edge_traction(mesh%xy(:, na), mesh%xy(:, nb), coord, tr%t0(1:2), tr%t1(1:2), fe, mesh%axisymmetric)
       f(2*na - 1:2*na) = fe(:, 1)
       f(2*nb - 1:2*nb) = fe(:, 2)
     end do
@@ -855,8 +881,8 @@ contains
       xb = mesh%xy(:, nb)
       len = norm2(xb - xa)
       nrm = [xb(2) - xa(2), -(xb(1) - xa(1))]/len
-      ta = tr%t0 + tr%tx*xa(1) + tr%ty*xa(2) - tr%pressure*nrm
-      tb = tr%t0 + tr%tx*xb(1) + tr%ty*xb(2) - tr%pressure*nrm
+      ta = tr%t0(1:2) + tr%tx(1:2)*xa(1) + tr%ty(1:2)*xa(2) - tr%pressure*nrm
+      tb = tr%t0(1:2) + tr%tx(1:2)*xb(1) + tr%ty(1:2)*xb(2) - tr%pressure*nrm
       if (mesh%axisymmetric) then
         ! per radian: int N t r ds, the cubic integrand by 2-point Gauss (exact)
         call radial_edge_load(xa, xb, ta, tb, f(2*na - 1:2*na), f(2*nb - 1:2*nb))
@@ -866,6 +892,32 @@ contains
       end if
     end do
   end subroutine add_group_traction
+
+  !> Add the consistent nodal loads of t = t0 - pressure n on the faces of group g (n each
+  !! face's outward unit normal; a bilinear face's normal varies over it: its traction is t0
+  !! plus the pressure on its area-weighted mean normal, exact on a planar face).
+  subroutine add_face_traction(mesh, g, tr, f)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: g
+    type(traction_cfg_t), intent(in) :: tr
+    real(wp), intent(inout) :: f(:)
+    integer :: e, nv, a, k
+    real(wp) :: xf(3, 4), an(3), t(3), fe(3, 4)
+    do e = 1, mesh%group(g)%nedge
+      nv = count(mesh%group(g)%edge(:, e) > 0)
+      xf = 0.0_wp
+      do a = 1, nv
+        xf(:, a) = mesh%xy(:, mesh%group(g)%edge(a, e))
+      end do
+      call face_area_normal(nv, xf, an)
+      t = tr%t0 - tr%pressure*an/norm2(an)
+      call face_traction(nv, xf, t, fe)
+      do a = 1, nv
+        k = mesh%group(g)%edge(a, e)
+        f(node_dof(k, 1):node_dof(k, 3)) = f(node_dof(k, 1):node_dof(k, 3)) + fe(:, a)
+      end do
+    end do
+  end subroutine add_face_traction
 
   !> Per radian, the nodal loads of a traction linear along the straight edge xa-xb (ta at
   !! xa, tb at xb) on a meridian section: int N t r ds, r = x, by 2-point Gauss (exact).
@@ -892,10 +944,12 @@ contains
     type(mesh_t), intent(in) :: mesh
     real(wp), intent(in) :: b(:, :)        ! (2, laws) the force in the cells of each law
     real(wp), intent(inout) :: f(:)
-    integer :: c, a, k, law
-    real(wp) :: xe(NDIM, MAX_NVERT), w(MAX_NVERT)
+    integer :: c, a, k, law, nvx, ndx, nsx
+    real(wp), allocatable :: xe(:, :), w(:)
     type(element_slot_t) :: elems(NSHAPE)
     call element_table(model_of(mesh%axisymmetric, .true.), elems)   ! loads: plane strain or stress alike
+    call element_sizes(nvx, ndx, nsx)
+    allocate (xe(NDIM, nvx), w(nvx))
     do c = 1, mesh%ncell
       law = law_of(mesh, c)
       if (all(b(:, law) == 0.0_wp)) cycle
@@ -913,11 +967,13 @@ contains
     type(mesh_t), intent(in) :: mesh
     procedure(body_force_fn) :: bf
     real(wp), intent(inout) :: f(:)
-    integer :: c, a, k
-    real(wp) :: xe(NDIM, MAX_NVERT), fe(NCOMP, MAX_NVERT)
+    integer :: c, a, k, nvx, ndx, nsx
+    real(wp), allocatable :: xe(:, :), fe(:, :)
     type(element_slot_t) :: elems(NSHAPE)
 
     call element_table(model_of(mesh%axisymmetric, .true.), elems)   ! loads: plane strain or stress alike
+    call element_sizes(nvx, ndx, nsx)
+    allocate (xe(NDIM, nvx), fe(NCOMP, nvx))
     fe = 0.0_wp
     do c = 1, mesh%ncell
       call cell_coords(mesh, c, xe)

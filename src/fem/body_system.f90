@@ -37,8 +37,11 @@ module body_system
     !! factor is a generalized inverse K^+ (K K^+ K = K) and u = K^+ (f - B'lam) + R alpha
     integer :: nrig = 0                       !< rigid motions left free (0..3)
     real(wp), allocatable :: rig(:, :)        !< (ndof, nrig) kernel of K, zero at prescribed DOFs [length/length]
-    real(wp), allocatable :: rig_coef(:, :)   !< (3, nrig) each column in the basis (1,0), (0,1), (-(y-yc), x-xc)/h
-    real(wp) :: rig_xc(2) = 0.0_wp            !< centre of the rotation basis [length]
+    !> (NRIGID, nrig) each column in the basis of rigid motions: the translations along the
+    !! axes, then the rotations about them through rig_xc over rig_h (in the plane (1,0), (0,1),
+    !! (-(y-yc), x-xc)/h; in space e_k and e_k x (x - xc)/h, k = x, y, z)
+    real(wp), allocatable :: rig_coef(:, :)
+    real(wp) :: rig_xc(3) = 0.0_wp            !< centre of the rotation basis (NDIM used) [length]
     real(wp) :: rig_h = 1.0_wp                !< scale of the rotation basis (largest extent) [length]
     integer, allocatable :: fixing(:)         !< (nrig) the fixing DOFs (global dof numbers)
     real(wp) :: rig_residual = 0.0_wp         !< max |K R| / (k_norm max |R|), the check of the kernel

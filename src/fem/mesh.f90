@@ -28,12 +28,13 @@ module mesh
   use kinds, only: wp
   use space, only: node_dof, dof_node, dof_comp
   use strings, only: i2s
-  use config, only: body_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP
+  use config, only: body_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, ELEM_HEX8, ELEM_TET4, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, &
+                    SIDE_TOP, MAX_SIDES, side_names, shape_vertices
   implicit none (type, external)
   private
 
   public :: assign_cell_laws
-  public :: mesh_build, side_nodes, node_id, group_index, group_names, group_nodes, &
+  public :: mesh_build, box_build, box_node, side_nodes, node_id, group_index, group_names, group_nodes, &
             nodes_only, nodes_only_refusal, cell_element, cell_vertices, file_order, file_cells, file_dof
 
   !> A nodal field in the file's node order (the order of every per-node output).
@@ -41,13 +42,16 @@ module mesh
     module procedure file_order_1, file_order_2
   end interface file_order
 
-  !> A named set of boundary edges of one body (a Gmsh physical curve, or a rectangle side)
-  !! and of single nodes (a Gmsh physical point, or where a physical curve runs inside the
-  !! body: its nodes off the boundary edges).
+  !> A named set of boundary facets of one body (in the plane edges: a Gmsh physical curve or
+  !! a rectangle side; in space faces: a box side) and of single nodes (a Gmsh physical point,
+  !! or where a physical curve runs inside the body: its nodes off the boundary edges).
   type, public :: edge_group_t
     character(len=:), allocatable :: name      !< the group's name (Gmsh physical name)
-    integer :: nedge = 0                       !< edges of this body in the group
-    integer, allocatable :: edge(:, :)         !< (2, nedge) node ids, the body on the left
+    integer :: nedge = 0                       !< facets (edges, faces) of this body in the group
+    !> (nvf, nedge) node ids of each facet: an edge (nvf = 2) with the body on its left; a face
+    !! of 3 or 4 nodes (nvf = 3 or 4; a triangle among quadrilaterals has a 0 in row 4)
+    !! counter-clockwise seen from outside (the right-hand rule gives the outward normal)
+    integer, allocatable :: edge(:, :)
     integer, allocatable :: cell(:)            !< (nedge) the cell each edge bounds
     integer :: nnode = 0                       !< single nodes of this body in the group
     integer, allocatable :: node(:)            !< (nnode) their node ids
@@ -66,6 +70,7 @@ module mesh
     integer :: element = ELEM_Q1          !< ELEM_Q1, ELEM_P1 or (general meshes) ELEM_MIXED (module config)
     integer :: nx = 0                     !< grid cells along x (0 on a general mesh)
     integer :: ny = 0                     !< grid cells along y (0 on a general mesh)
+    integer :: nz = 0                     !< a box's grid cells along z (0 otherwise)
     integer :: nnode = 0                  !< nodes: (nx+1)*(ny+1) on a grid
     integer :: ncell = 0                  !< cells: nx*ny (Q1) or 2*nx*ny (P1) on a grid
     integer :: nvert = 0                  !< vertices per cell: 4 (Q1, mixed) or 3 (P1)
@@ -73,10 +78,14 @@ module mesh
     real(wp) :: y0 = 0.0_wp               !< lower-left corner y (of the bounding box) [length]
     real(wp) :: width = 0.0_wp            !< extent in x [length]
     real(wp) :: height = 0.0_wp           !< extent in y [length]
-    real(wp), allocatable :: xy(:, :)     !< (2, nnode) node coordinates [length]
+    real(wp) :: z0 = 0.0_wp               !< a box's front z [length]
+    real(wp) :: depth = 0.0_wp            !< a box's extent in z [length]
+    real(wp), allocatable :: xy(:, :)     !< (NDIM, nnode) node coordinates [length]
     integer, allocatable :: cells(:, :)   !< (nvert, ncell) 1-based node ids, counter-clockwise
-                                          !! (a triangle in a mixed mesh: cells(4, c) = 0)
-    logical :: structured = .true.        !< built by mesh_build (nx, ny, x0... valid)
+                                          !! (a triangle in a mixed mesh: cells(4, c) = 0); in
+                                          !! space in Gmsh's order, positively oriented
+    logical :: structured = .true.        !< built by mesh_build (nx, ny, x0... valid; a rectangle's grid)
+    logical :: box = .false.              !< built by box_build (nx, ny, nz, x0... valid; not `structured`)
     !> a meridian section of a body of revolution about the y axis (x = r >= 0, y = z): its
     !! integrals are per radian, weighted by r, with the hoop strain ur/r (set by the driver)
     logical :: axisymmetric = .false.
@@ -186,7 +195,7 @@ contains
   pure integer function cell_vertices(mesh, c)
     type(mesh_t), intent(in) :: mesh   !< the mesh
     integer, intent(in) :: c           !< a cell, 1..ncell
-    cell_vertices = merge(4, 3, cell_element(mesh, c) == ELEM_Q1)
+    cell_vertices = shape_vertices(cell_element(mesh, c))
   end function cell_vertices
 
 
@@ -317,6 +326,178 @@ contains
     call side_groups(mesh)
   end subroutine mesh_build
 
+  !> Id of node (i, j, k) of a box's grid, i = 0..nx, j = 0..ny, k = 0..nz: 1 + i + j (nx + 1)
+  !! + k (nx + 1)(ny + 1).
+  pure integer function box_node(mesh, i, j, k)
+    type(mesh_t), intent(in) :: mesh  !< a box's mesh
+    integer, intent(in) :: i, j, k    !< grid indices along x, y, z
+    box_node = 1 + i + (mesh%nx + 1)*(j + (mesh%ny + 1)*k)
+  end function box_node
+
+  !> Build the mesh of a box body: [x0, x0 + width] x [y0, y0 + height] x [z0, z0 + depth] on an
+  !! nx x ny x nz grid, each grid cell a trilinear hexahedron (element Q1: ELEM_HEX8, in Gmsh's
+  !! vertex order) or six linear tetrahedra (P1: ELEM_TET4, the Kuhn split of elements_3d:
+  !! kuhn_tets, all sharing the cell's diagonal from its lowest to its highest corner, so
+  !! neighbouring cells' faces match). Grid cell (i, j, k) is hexahedron 1 + i + nx (j + ny k),
+  !! or tetrahedra 6 (that - 1) + 1 .. 6. The six sides are the groups 'left', 'right',
+  !! 'bottom', 'top', 'front' (z = z0), 'back' (z = z0 + depth), their faces oriented outward:
+  !! quadrilaterals, or each grid face cut along its diagonal from its lowest to its highest
+  !! grid corner into two triangles (the tetrahedra's faces). info /= 0 with msg on a bad grid.
+  subroutine box_build(mesh, body, tets, info, msg)
+    type(mesh_t), intent(out) :: mesh                  !< the mesh built
+    type(body_cfg_t), intent(in) :: body               !< the box's geometry, grid and element
+    !> the six tetrahedra of a grid cell's eight vertices (elements_3d's kuhn_tets, passed in
+    !! so that mesh does not depend on the element kernels)
+    interface
+      pure subroutine tets(v, t)
+        integer, intent(in) :: v(8)
+        integer, intent(out) :: t(4, 6)
+      end subroutine tets
+    end interface
+    integer, intent(out) :: info                       !< 0 on success
+    character(len=*), intent(out) :: msg               !< the error sentence when info /= 0
+    integer :: i, j, k, c, v(8), t(4, 6)
+
+    info = 0
+    msg = ''
+    if (body%nx < 1 .or. body%ny < 1 .or. body%nz < 1) then
+      info = 1
+      msg = 'body '//i2s(body%id)//': the grid needs nx, ny, nz >= 1 (got '//i2s(body%nx)//' x '// &
+            i2s(body%ny)//' x '//i2s(body%nz)//')'
+      return
+    else if (.not. (body%width > 0.0_wp .and. body%height > 0.0_wp .and. body%depth > 0.0_wp)) then
+      info = 2
+      msg = 'body '//i2s(body%id)//': width, height and depth must be positive'
+      return
+    else if (body%element /= ELEM_Q1 .and. body%element /= ELEM_P1) then
+      info = 3
+      msg = 'body '//i2s(body%id)//': unknown element code '//i2s(body%element)
+      return
+    end if
+    mesh%element = merge(ELEM_HEX8, ELEM_TET4, body%element == ELEM_Q1)
+    mesh%nx = body%nx
+    mesh%ny = body%ny
+    mesh%nz = body%nz
+    mesh%x0 = body%x0
+    mesh%y0 = body%y0
+    mesh%z0 = body%z0
+    mesh%width = body%width
+    mesh%height = body%height
+    mesh%depth = body%depth
+    mesh%nnode = (mesh%nx + 1)*(mesh%ny + 1)*(mesh%nz + 1)
+    allocate (mesh%xy(3, mesh%nnode))
+    do k = 0, mesh%nz
+      do j = 0, mesh%ny
+        do i = 0, mesh%nx
+          mesh%xy(:, box_node(mesh, i, j, k)) = [mesh%x0 + mesh%width*real(i, wp)/real(mesh%nx, wp), &
+                                                 mesh%y0 + mesh%height*real(j, wp)/real(mesh%ny, wp), &
+                                                 mesh%z0 + mesh%depth*real(k, wp)/real(mesh%nz, wp)]
+        end do
+      end do
+    end do
+    mesh%nvert = shape_vertices(mesh%element)
+    mesh%ncell = mesh%nx*mesh%ny*mesh%nz*merge(1, 6, mesh%element == ELEM_HEX8)
+    allocate (mesh%cells(mesh%nvert, mesh%ncell))
+    do k = 0, mesh%nz - 1
+      do j = 0, mesh%ny - 1
+        do i = 0, mesh%nx - 1
+          c = 1 + i + mesh%nx*(j + mesh%ny*k)
+          v = [box_node(mesh, i, j, k), box_node(mesh, i + 1, j, k), box_node(mesh, i + 1, j + 1, k), &
+               box_node(mesh, i, j + 1, k), box_node(mesh, i, j, k + 1), box_node(mesh, i + 1, j, k + 1), &
+               box_node(mesh, i + 1, j + 1, k + 1), box_node(mesh, i, j + 1, k + 1)]
+          if (mesh%element == ELEM_HEX8) then
+            mesh%cells(:, c) = v
+          else
+            call tets(v, t)
+            mesh%cells(:, 6*(c - 1) + 1:6*c) = t
+          end if
+        end do
+      end do
+    end do
+    mesh%structured = .false.
+    mesh%box = .true.
+    mesh%source = ''
+    allocate (mesh%cell_type(mesh%ncell), mesh%node_tag(mesh%nnode), mesh%cell_tag(mesh%ncell))
+    mesh%cell_type = mesh%element
+    mesh%node_tag = [(i, i=1, mesh%nnode)]
+    mesh%cell_tag = [(i, i=1, mesh%ncell)]
+    call box_side_groups(mesh)
+  end subroutine box_build
+
+  !> The six sides of a box as face groups, each face counter-clockwise seen from outside:
+  !! side s spans grid axes (p, q) with e_p x e_q its outward normal; its face at grid
+  !! position (a, b) is (a, b), (a+1, b), (a+1, b+1), (a, b+1) in (p, q), or the two
+  !! triangles of its cut from (a, b) to (a+1, b+1). The cell each face bounds is its
+  !! hexahedron, or the tetrahedron holding the triangle.
+  subroutine box_side_groups(mesh)
+    type(mesh_t), intent(inout) :: mesh
+    ! per side: the fixed axis and its grid index (0 or n), and the axes p, q
+    integer, parameter :: fixed(6) = [1, 1, 2, 2, 3, 3], pax(6) = [3, 2, 1, 3, 2, 1], qax(6) = [2, 3, 3, 1, 1, 2]
+    integer :: side, n(3), a, b, nf, f, ijk(3), corner(4), g(3)
+    logical :: hex
+
+    hex = mesh%element == ELEM_HEX8
+    n = [mesh%nx, mesh%ny, mesh%nz]
+    mesh%ngroup = MAX_SIDES
+    allocate (mesh%group(MAX_SIDES))
+    mesh%file_groups = 'left right bottom top front back'
+    do side = 1, MAX_SIDES
+      nf = n(pax(side))*n(qax(side))*merge(1, 2, hex)
+      mesh%group(side)%name = trim(side_names(side))
+      mesh%group(side)%nedge = nf
+      allocate (mesh%group(side)%edge(merge(4, 3, hex), nf), mesh%group(side)%cell(nf))
+      f = 0
+      do b = 0, n(qax(side)) - 1
+        do a = 0, n(pax(side)) - 1
+          corner(1) = node_at(a, b)
+          corner(2) = node_at(a + 1, b)
+          corner(3) = node_at(a + 1, b + 1)
+          corner(4) = node_at(a, b + 1)
+          ! the grid cell behind the face
+          g(pax(side)) = a
+          g(qax(side)) = b
+          g(fixed(side)) = merge(0, n(fixed(side)) - 1, mod(side, 2) == 1)
+          if (hex) then
+            f = f + 1
+            mesh%group(side)%edge(:, f) = corner
+            mesh%group(side)%cell(f) = 1 + g(1) + mesh%nx*(g(2) + mesh%ny*g(3))
+          else
+            f = f + 1
+            mesh%group(side)%edge(:, f) = corner([1, 2, 3])
+            mesh%group(side)%cell(f) = tet_of(1 + g(1) + mesh%nx*(g(2) + mesh%ny*g(3)), corner([1, 2, 3]))
+            f = f + 1
+            mesh%group(side)%edge(:, f) = corner([1, 3, 4])
+            mesh%group(side)%cell(f) = tet_of(1 + g(1) + mesh%nx*(g(2) + mesh%ny*g(3)), corner([1, 3, 4]))
+          end if
+        end do
+      end do
+    end do
+
+  contains
+
+    !> The node at grid position (a, b) of the side: the fixed axis at 0 (odd sides) or n.
+    integer function node_at(a, b)
+      integer, intent(in) :: a, b
+      ijk(pax(side)) = a
+      ijk(qax(side)) = b
+      ijk(fixed(side)) = merge(0, n(fixed(side)), mod(side, 2) == 1)
+      node_at = box_node(mesh, ijk(1), ijk(2), ijk(3))
+    end function node_at
+
+    !> The tetrahedron of grid cell q holding the three nodes (0 if none: not a face of it).
+    integer function tet_of(q, tri)
+      integer, intent(in) :: q, tri(3)
+      integer :: t, m
+      tet_of = 0
+      do t = 6*(q - 1) + 1, 6*q
+        if (all([(any(mesh%cells(:, t) == tri(m)), m=1, 3)])) then
+          tet_of = t
+          return
+        end if
+      end do
+    end function tet_of
+  end subroutine box_side_groups
+
   !> The four sides of a structured mesh as edge groups 'left', 'right', 'bottom', 'top'.
   subroutine side_groups(mesh)
     type(mesh_t), intent(inout) :: mesh
@@ -411,7 +592,7 @@ contains
     allocate (on(mesh%nnode))
     on = .false.
     do k = 1, mesh%group(g)%nedge
-      on(mesh%group(g)%edge(:, k)) = .true.
+      on(pack(mesh%group(g)%edge(:, k), mesh%group(g)%edge(:, k) > 0)) = .true.
     end do
     do k = 1, mesh%group(g)%nnode
       on(mesh%group(g)%node(k)) = .true.
@@ -452,6 +633,10 @@ contains
     integer, allocatable, intent(out) :: nodes(:)    !< node ids along the side
     integer :: k
 
+    if (mesh%box) then       ! a box's side: its group's nodes, in increasing id
+      call group_nodes(mesh, side, nodes)
+      return
+    end if
     select case (side)
     case (SIDE_LEFT)
       nodes = [(node_id(mesh, 0, k), k=0, mesh%ny)]

@@ -5,7 +5,7 @@
 !! floating's use). Fills the rigid-motion fields of body_system_t.
 module rigid_modes
   use kinds, only: wp
-  use space, only: NCOMP, NRIGID, node_dof
+  use space, only: NDIM, NCOMP, NRIGID, node_dof
   use config, only: body_cfg_t, BC_CONTACT
   use mesh, only: mesh_t, side_nodes, group_index, group_nodes
   use lapack, only: dgesvd
@@ -39,7 +39,8 @@ contains
     integer :: k, cc, j, lapinfo, nk
     character(len=512) :: emsg
 
-    sys%rig_xc = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
+    sys%rig_xc = 0.0_wp
+    sys%rig_xc(1:NDIM) = 0.5_wp*(maxval(mesh%xy, dim=2) + minval(mesh%xy, dim=2))
     sys%rig_h = max(maxval(maxval(mesh%xy, dim=2) - minval(mesh%xy, dim=2)), tiny(1.0_wp))
     g = 0.0_wp
     if (present(axisymmetric)) then
@@ -125,13 +126,28 @@ contains
   !! rotation about rig_xc scaled by rig_h.
   pure function rigid_row(sys, x, cc) result(r)
     type(body_system_t), intent(in) :: sys
-    real(wp), intent(in) :: x(2)
+    real(wp), intent(in) :: x(:)              ! (NDIM) the node
     integer, intent(in) :: cc
-    real(wp) :: r(NRIGID)
+    real(wp) :: r(NRIGID), d(3)
     r = 0.0_wp
     r(cc) = 1.0_wp
-    if (cc == 1) r(3) = -(x(2) - sys%rig_xc(2))/sys%rig_h
-    if (cc == 2) r(3) = (x(1) - sys%rig_xc(1))/sys%rig_h
+    if (NDIM == 2) then
+      if (cc == 1) r(3) = -(x(2) - sys%rig_xc(2))/sys%rig_h
+      if (cc == 2) r(3) = (x(1) - sys%rig_xc(1))/sys%rig_h
+    else      ! component cc of e_k x d, d = (x - xc)/h, for the rotations about x, y, z
+      d = (x(1:3) - sys%rig_xc)/sys%rig_h
+      select case (cc)
+      case (1)
+        r(5) = d(3)
+        r(6) = -d(2)
+      case (2)
+        r(4) = -d(3)
+        r(6) = d(1)
+      case default
+        r(4) = d(2)
+        r(5) = -d(1)
+      end select
+    end if
   end function rigid_row
 
   !> Round a kernel basis to its simplest form: entries below 1e-12 become 0 and each
@@ -188,14 +204,21 @@ contains
     character(len=*), intent(in), optional :: contact_groups(:)  !< the body's contact groups, kept clear
     logical, allocatable :: avoid(:)
     integer, allocatable :: nodes(:), order(:)
-    integer :: side, g, k, p(2), cand(4), nc, i, j, l, best(3), r
-    real(wp) :: ctr(2), d, dbest, det, detbest, sub(3, 3)
+    integer :: side, g, k, p(2), cand(2*NCOMP), nc, i, j, l, best(3), r, c
+    real(wp) :: ctr(NDIM), d, dbest, det, detbest, sub(3, 3)
     character(len=512) :: emsg
 
     r = sys%nrig
+    if (r > 3) then
+      write (emsg, '(a,i0,a,i0,a)') 'body ', body%id, ' is held only by contact, with ', r, ' free rigid '// &
+        'motions: a solid body held only by contact is not solved yet; support it (a side clamped, '// &
+        'rollers, or a prescribed displacement)'
+      call err%set(ERR_INPUT, emsg)
+      return
+    end if
     allocate (avoid(mesh%nnode))
     avoid = .false.
-    do side = 1, 4
+    do side = 1, 2*NDIM
       if (body%bc(side) /= BC_CONTACT) cycle
       call side_nodes(mesh, side, nodes)
       avoid(nodes) = .true.
@@ -217,14 +240,14 @@ contains
     ! choice among nodes at the same distance does not depend on the numbering
     order = [(k, k=1, mesh%nnode)]
     if (allocated(mesh%file_node)) order(mesh%file_node) = [(k, k=1, mesh%nnode)]
-    ctr = sys%rig_xc
-    if (any(avoid) .and. allocated(mesh%file_node)) then
-      ctr(1) = sum(mesh%xy(1, order), mask=avoid(order))/count(avoid)
-      ctr(2) = sum(mesh%xy(2, order), mask=avoid(order))/count(avoid)
-    else if (any(avoid)) then
-      ctr(1) = sum(mesh%xy(1, :), mask=avoid)/count(avoid)
-      ctr(2) = sum(mesh%xy(2, :), mask=avoid)/count(avoid)
-    end if
+    ctr = sys%rig_xc(1:NDIM)
+    do c = 1, NDIM
+      if (any(avoid) .and. allocated(mesh%file_node)) then
+        ctr(c) = sum(mesh%xy(c, order), mask=avoid(order))/count(avoid)
+      else if (any(avoid)) then
+        ctr(c) = sum(mesh%xy(c, :), mask=avoid)/count(avoid)
+      end if
+    end do
     p = 0
     dbest = huge(1.0_wp)
     do i = 1, mesh%nnode

@@ -14,7 +14,7 @@ module stiffness_pattern
   public :: build_pattern
 
   !> The code of "vertex a of cell c" in a node's list of cells: NSLOT (c - 1) + a - 1
-  integer, parameter :: NSLOT = 4
+  integer, parameter :: NSLOT = 8
 
 contains
 
@@ -77,7 +77,7 @@ contains
       call node_adjacency(mesh, aptr, adj, cptr, ccell, nv_of)
       allocate (nbr(maxval(aptr(2:) - aptr(:size(aptr) - 1))))
     end if
-    allocate (rows(2*size(nbr)))
+    allocate (rows(NCOMP*size(nbr)))
     ! column counts: colptr(p + 1) = the entries of free DOF p, then their running sum
     allocate (sys%colptr(sys%n + 1))
     sys%colptr = 0
@@ -98,7 +98,7 @@ contains
       end do
     end do
     ! the places of each cell's entries, unless an offset would not fit 16 bits
-    with_map = present(cell_row) .and. .not. mesh%structured .and. maxrow <= huge(0_int16)
+    with_map = present(cell_row) .and. .not. mesh%structured .and. maxrow <= huge(0_int16) .and. NCOMP == 2
     if (with_map) then
       nv = max(3, maxval(nv_of))
       allocate (cell_row(nv, nv, mesh%ncell), rowoff(mesh%nnode))
@@ -196,7 +196,7 @@ contains
       end do
     end do
     ! at most the vertices of each node's cells
-    allocate (aptr(mesh%nnode + 1), adj(sum(nv)*4), mark(mesh%nnode))
+    allocate (aptr(mesh%nnode + 1), adj(sum(nv)*max(4, maxval(nv))), mark(mesh%nnode))
     mark = 0
     aptr(1) = 1
     i = 0

@@ -3,9 +3,9 @@
 !! the DOFs left free (body_system_t's ndof, u_fixed, n, free_of, dof_of).
 module supports
   use kinds, only: wp
-  use space, only: NCOMP, node_dof
+  use space, only: NDIM, NCOMP, node_dof
   use strings, only: body_label
-  use config, only: body_cfg_t, boundary_cfg_t, SIDE_BOTTOM, SIDE_TOP, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
+  use config, only: body_cfg_t, boundary_cfg_t, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_axis
   use mesh, only: mesh_t, side_nodes, group_index, group_names, group_nodes
   use body_system, only: body_system_t
   implicit none (type, external)
@@ -35,7 +35,7 @@ contains
     prescribed = .false.
     sys%u_fixed = 0.0_wp
     sys%dof_stage = 0
-    do side = 1, 4
+    do side = 1, 2*NDIM
       call side_nodes(mesh, side, nodes)
       select case (body%bc(side))
       case (BC_CLAMPED)
@@ -47,8 +47,7 @@ contains
           end do
         end do
       case (BC_ROLLER)
-        cc = 1
-        if (side == SIDE_BOTTOM .or. side == SIDE_TOP) cc = 2
+        cc = side_axis(side)
         do k = 1, size(nodes)
           prescribed(node_dof(nodes(k), cc)) = .true.
           sys%u_fixed(node_dof(nodes(k), cc)) = 0.0_wp

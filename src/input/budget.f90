@@ -18,7 +18,7 @@
 !! node are summed against the node's memory, each one against ulimit -v.
 module budget
   use kinds, only: wp
-  use config, only: body_stiffness, deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
+  use config, only: MAX_SIDES, body_stiffness, deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
   use strings, only: i2s, sci, fmt_real
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
@@ -406,7 +406,7 @@ contains
     end do
     do a = 1, d%nbody
       h = min(d%body(a)%width/real(d%body(a)%nx, wp), d%body(a)%height/real(d%body(a)%ny, wp))
-      do s = 1, 4
+      do s = 1, MAX_SIDES
         u = maxval(abs(d%body(a)%u_side(:, s)))
         if (.not. u > 0.0_wp) cycle   ! (no short-circuit in Fortran: log(0) must not be evaluated)
         call body_stiffness(d%body(a), elo, ehi)

@@ -7,10 +7,12 @@
 !! reader to accept and by every writer to print it (`strings%word(list, code)`).
 module config
   use kinds, only: wp
+  use space, only: NCOMP
   implicit none (type, external)
   private
 
   public :: deck_init, pair_oriented, stage_count, stage_steps, body_force_of, body_stiffness
+  public :: shape_vertices, side_axis
 
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
@@ -25,7 +27,11 @@ module config
   integer, parameter, public :: SIDE_RIGHT = 2   !< x = x0 + width
   integer, parameter, public :: SIDE_BOTTOM = 3  !< y = y0
   integer, parameter, public :: SIDE_TOP = 4     !< y = y0 + height
-  character(len=6), parameter, public :: side_names(4) = ['left  ', 'right ', 'bottom', 'top   ']
+  integer, parameter, public :: SIDE_FRONT = 5   !< z = z0 (a box)
+  integer, parameter, public :: SIDE_BACK = 6    !< z = z0 + depth (a box)
+  integer, parameter, public :: MAX_SIDES = 6    !< sides of a box; a rectangle has the first 4
+  character(len=6), parameter, public :: side_names(MAX_SIDES) = ['left  ', 'right ', 'bottom', 'top   ', &
+                                                                  'front ', 'back  ']
 
   integer, parameter, public :: BC_FREE = 0          !< traction-free (unless a &traction says otherwise)
   integer, parameter, public :: BC_CLAMPED = 1       !< u = 0
@@ -37,8 +43,11 @@ module config
 
   integer, parameter, public :: ELEM_Q1 = 1  !< bilinear quadrilateral, 2x2 Gauss
   integer, parameter, public :: ELEM_P1 = 2  !< linear triangle, each cell split in two
-  integer, parameter, public :: ELEM_MIXED = 3  !< a mesh file's mix of Q1 and P1 cells
-  character(len=5), parameter, public :: element_names(3) = ['Q1   ', 'P1   ', 'mixed']
+  integer, parameter, public :: ELEM_MIXED = 3  !< a mesh file's mix of cells (Q1 and P1, or HEX8 and TET4)
+  integer, parameter, public :: ELEM_HEX8 = 4   !< trilinear hexahedron, 2x2x2 Gauss (a box's 'Q1')
+  integer, parameter, public :: ELEM_TET4 = 5   !< linear tetrahedron (a box's 'P1': each cell split in six)
+  integer, parameter, public :: NSHAPE = 5      !< the codes above: the cell shapes and the mixed mesh
+  character(len=5), parameter, public :: element_names(NSHAPE) = ['Q1   ', 'P1   ', 'mixed', 'HEX8 ', 'TET4 ']
 
   integer, parameter, public :: METHOD_ROBIN = 1        !< Robin domain decomposition
   integer, parameter, public :: METHOD_MONOLITHIC = 2   !< the monolithic reference
@@ -84,7 +93,7 @@ module config
   integer, parameter, public :: ACCEL_AUTO = 4       !< none for one pair, anderson for several (resolved by the deck)
   character(len=*), parameter, public :: ACCEL_CHOICES = 'none aitken anderson auto'
 
-  character(len=*), parameter, public :: SIDE_CHOICES = 'left right bottom top'       !< SIDE_* order
+  character(len=*), parameter, public :: SIDE_CHOICES = 'left right bottom top front back'  !< SIDE_* order
   character(len=*), parameter, public :: BC_CHOICES = 'free clamped roller contact displacement'  !< BC_* order, from 0
   character(len=*), parameter, public :: ELEMENT_CHOICES = 'Q1 P1'                    !< ELEM_* order
   character(len=*), parameter, public :: PLANE_CHOICES = 'strain stress axisymmetric'
@@ -167,17 +176,21 @@ module config
     real(wp) :: y0 = 0.0_wp           !< lower-left corner y [length]
     real(wp) :: width = 1.0_wp        !< extent in x [length]
     real(wp) :: height = 1.0_wp       !< extent in y [length]
+    real(wp) :: z0 = 0.0_wp           !< a box's front z [length]
+    real(wp) :: depth = UNSET         !< a box's extent in z [length] (UNSET: not given; given: a box)
     integer :: nx = 8                 !< cells along x
     integer :: ny = 8                 !< cells along y
-    integer :: element = ELEM_Q1      !< ELEM_Q1 or ELEM_P1
+    integer :: nz = 8                 !< a box's cells along z
+    integer :: element = ELEM_Q1      !< ELEM_Q1 or ELEM_P1 (a box: hexahedra or tetrahedra)
     real(wp) :: young = 2.1e11_wp     !< Young's modulus [stress]
     real(wp) :: poisson = 0.3_wp      !< Poisson's ratio [-], in (-1, 0.5)
     real(wp) :: density = 0.0_wp      !< mass per volume [mass/length^3] (&body_force gravity)
     character(len=64) :: material = ''  !< a &material's name ('': young, poisson, density above)
     real(wp) :: angle = 0.0_wp        !< the material's axis 1 from x [degrees]
-    integer :: bc(4) = BC_FREE        !< condition per side (SIDE_* order)
-    real(wp) :: u_side(2, 4) = 0.0_wp !< prescribed displacement per side when bc = BC_DISPLACEMENT [length]
-    integer :: side_stage(4) = 1      !< load stage of each side's prescribed displacement
+    integer :: bc(MAX_SIDES) = BC_FREE        !< condition per side (SIDE_* order; a rectangle's first 4)
+    !> prescribed displacement per side when bc = BC_DISPLACEMENT (NCOMP components) [length]
+    real(wp) :: u_side(3, MAX_SIDES) = 0.0_wp
+    integer :: side_stage(MAX_SIDES) = 1      !< load stage of each side's prescribed displacement
     !> its elastic laws, resolved from the deck: law(1) its own material, then one per &region
     !! of the body in deck order (unallocated: young and poisson, isotropic)
     type(elastic_law_t), allocatable :: law(:)
@@ -190,10 +203,10 @@ module config
     integer :: body = 0               !< body id
     integer :: side = 0               !< SIDE_* (0 with a group)
     character(len=128) :: group = ''  !< edge group name ('' : the side)
-    real(wp) :: t0(2) = 0.0_wp        !< [stress]
-    real(wp) :: t1(2) = 0.0_wp        !< [stress/length] (side)
-    real(wp) :: tx(2) = 0.0_wp        !< d t / d x [stress/length] (group)
-    real(wp) :: ty(2) = 0.0_wp        !< d t / d y [stress/length] (group)
+    real(wp) :: t0(3) = 0.0_wp        !< [stress] (NCOMP components used)
+    real(wp) :: t1(3) = 0.0_wp        !< [stress/length] (side; plane only)
+    real(wp) :: tx(3) = 0.0_wp        !< d t / d x [stress/length] (group; plane only)
+    real(wp) :: ty(3) = 0.0_wp        !< d t / d y [stress/length] (group; plane only)
     real(wp) :: pressure = 0.0_wp     !< normal pressure, positive pushing in [stress] (group)
     integer :: stage = 1              !< the load stage that ramps it
     character(len=64) :: origin = ''  !< where the deck gave it ('line N', 'command-line override k')
@@ -203,8 +216,8 @@ module config
   !! volume density x gravity + force, constant over the body, ramped by its stage.
   type, public :: body_force_cfg_t
     integer :: body = 0               !< body id, 0: every body
-    real(wp) :: gravity(2) = 0.0_wp   !< acceleration [length/time^2] (times each body's density)
-    real(wp) :: force(2) = 0.0_wp     !< force per volume [force/length^3]
+    real(wp) :: gravity(3) = 0.0_wp   !< acceleration [length/time^2] (times each body's density; NCOMP used)
+    real(wp) :: force(3) = 0.0_wp     !< force per volume [force/length^3]
     integer :: stage = 1              !< the load stage that ramps it
     character(len=64) :: origin = ''  !< where the deck gave it
   end type body_force_cfg_t
@@ -213,8 +226,8 @@ module config
   type, public :: boundary_cfg_t
     integer :: body = 0               !< body id
     character(len=128) :: group = ''  !< edge group name
-    logical :: fix(2) = .false.       !< which components are prescribed (ux, uy)
-    real(wp) :: u(2) = 0.0_wp         !< their values [length]
+    logical :: fix(3) = .false.       !< which components are prescribed (ux, uy, uz; NCOMP used)
+    real(wp) :: u(3) = 0.0_wp         !< their values [length]
     integer :: stage = 1              !< the load stage that ramps nonzero values
     character(len=64) :: origin = ''  !< where the deck gave it
   end type boundary_cfg_t
@@ -276,6 +289,9 @@ module config
   type, public :: deck_t
     character(len=PATH_LEN) :: source = ''            !< deck path as given
     character(len=256) :: title = ''                  !< free text
+    !> the scene's dimension: 2 (plane or axisymmetric bodies) or 3 (solid bodies); 0 until
+    !! resolved (&scene dimension, or 3 where a body gives a depth)
+    integer :: dimension = 0
     logical :: plane_strain = .true.                  !< .true.: plane strain (or axisymmetric), .false.: plane stress
     !> bodies of revolution about the y axis, x = r >= 0: every integral per radian, with the
     !! hoop strain (plane_strain is .true.: the laws have the out-of-plane, here hoop, row)
@@ -302,6 +318,28 @@ module config
   end type deck_t
 
 contains
+
+  !> The vertices of a cell of shape `shape` (ELEM_*): 4, 3, 8, 4; 0 for ELEM_MIXED.
+  elemental integer function shape_vertices(shape)
+    integer, intent(in) :: shape         !< ELEM_Q1, ELEM_P1, ELEM_HEX8 or ELEM_TET4
+    select case (shape)
+    case (ELEM_Q1, ELEM_TET4)
+      shape_vertices = 4
+    case (ELEM_P1)
+      shape_vertices = 3
+    case (ELEM_HEX8)
+      shape_vertices = 8
+    case default
+      shape_vertices = 0
+    end select
+  end function shape_vertices
+
+  !> The coordinate axis normal to a side (1 = x: left, right; 2 = y: bottom, top; 3 = z:
+  !! front, back).
+  elemental integer function side_axis(side)
+    integer, intent(in) :: side          !< SIDE_*
+    side_axis = (side + 1)/2
+  end function side_axis
 
   !> A deck of `nbody` default bodies (ids 1 .. nbody) and `npair` default pairs (bodies
   !! 1 and 2, each on its 'contact' side): the start of a deck built in code.
@@ -344,16 +382,17 @@ contains
     integer :: i, k, nlaw
     nlaw = 1
     if (allocated(d%body(a)%law)) nlaw = size(d%body(a)%law)
-    allocate (b(2, nstage, nlaw))
+    allocate (b(NCOMP, nstage, nlaw))
     b = 0.0_wp
     do k = 1, nlaw
       do i = 1, d%nbody_force
         associate (f => d%body_force(i))
           if (f%body /= 0 .and. f%body /= a) cycle
           if (allocated(d%body(a)%law)) then
-            b(:, f%stage, k) = b(:, f%stage, k) + d%body(a)%law(k)%density*f%gravity + f%force
+            b(:, f%stage, k) = b(:, f%stage, k) + d%body(a)%law(k)%density*f%gravity(1:size(b, 1)) + &
+                               f%force(1:size(b, 1))
           else
-            b(:, f%stage, k) = b(:, f%stage, k) + d%body(a)%density*f%gravity + f%force
+            b(:, f%stage, k) = b(:, f%stage, k) + d%body(a)%density*f%gravity(1:size(b, 1)) + f%force(1:size(b, 1))
           end if
         end associate
       end do

@@ -23,6 +23,7 @@ module deck
   use namelist_input, only: src_t, grp_t, load_file, text_source, parse_source, die_at, unknown_group
   use config, only: deck_t, ACCEL_AUTO, ACCEL_NONE, ACCEL_ANDERSON, STOP_AUTO, STOP_INCREMENT, STOP_RESIDUAL
   use deck_checks, only: state_t, start_state, apply_single, new_body, override_body, add_traction, add_body_force, &
+                         resolve_dimension, &
                          add_boundary, apply_displacement, add_contact, add_material, add_region
   use deck_cross, only: check_cross, resolve_materials
   use deck_render, only: deck_text, print_deck, deck_reference
@@ -119,6 +120,7 @@ contains
       'at least two, &body id=1 ... / and &body id=2 ... /')
     if (st%nbody == 1) call fatal(EXIT_INPUT, path//': the deck has only one &body group (id=1, '// &
       'line '//i2s(st%body_line(1))//'); it needs at least two, in contact')
+    call resolve_dimension(path, d, st)
     if (d%npair == 0 .and. d%nbody == 2) then   ! no &contact: bodies 1 and 2 on their 'contact' sides
       d%npair = 1
       st%pair_at(1)%s = 'two-body contact'

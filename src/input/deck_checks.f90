@@ -6,11 +6,13 @@
 !! and value.
 module deck_checks
   use kinds, only: wp
+  use space, only: NDIM, set_dimension
+  use errors, only: fatal, EXIT_INPUT
   use strings, only: i2s, r2s, quote, quoted_list, word
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
-  use config, only: pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, &
+  use config, only: MAX_SIDES, pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, &
                     MAT_ISOTROPIC, MAT_ORTHOTROPIC, MAT_ANISOTROPIC, MAT_KIND_NAMES, UNSET, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
@@ -26,7 +28,7 @@ module deck_checks
   real(wp), parameter :: SLIP_MAX = 1.0e20_wp  !< the largest Tresca bound accepted [stress]
 
   public :: state_t, start_state, apply_single, new_body, override_body, add_traction, add_boundary, add_body_force, &
-            apply_displacement, add_contact, add_material, add_region
+            apply_displacement, add_contact, add_material, add_region, resolve_dimension
 
 
   !> Where things came from, for cross-field messages.
@@ -42,6 +44,9 @@ module deck_checks
     integer :: contact_form = 0                 ! the deck's &contact form (TWO_BODY_FORM, PAIR_FORM; 0: none)
     integer :: contact_line = 0                 ! line of the deck's first &contact
     type(str_t), allocatable :: pair_at(:)      ! '&contact at line N' (and its overrides), per pair
+    !> per body: its first variable of a box ('z0', 'depth', 'nz', 'front', 'back') given, as
+    !! 'line N: name = value', '' if none
+    type(str_t), allocatable :: box_var(:)
   end type state_t
 
 contains
@@ -54,10 +59,11 @@ contains
     type(deck_t), target, intent(inout) :: d
     type(scene_in_t), target :: sc
     type(vars_t) :: v
-    integer :: k
+    integer :: k, dim0
     select case (g%name)
     case ('scene')
       sc%plane = merge(3, merge(1, 2, d%plane_strain), d%axisymmetric)
+      dim0 = d%dimension       ! 0 in the deck (resolved after its bodies), 2 or 3 in an override
       call scene_vars(d, sc, v)
     case ('solver')
       call solver_vars(d%solver, v)
@@ -74,6 +80,13 @@ contains
     case ('scene')
       d%plane_strain = (sc%plane /= 2)
       d%axisymmetric = (sc%plane == 3)
+      if (find_asg(g, 'dimension') > 0) then
+        if (d%dimension /= 2 .and. d%dimension /= 3) call bad_value(g, src, 'dimension', i2s(d%dimension), &
+          'must be 2 (plane or axisymmetric bodies) or 3 (solid bodies)')
+        if (dim0 /= 0 .and. d%dimension /= dim0) call bad_value(g, src, 'dimension', i2s(d%dimension), &
+          'cannot be changed by a command-line override (the deck is '//i2s(dim0)//'D: its loads were read '// &
+          'so); give it in the deck''s &scene')
+      end if
       call check_units(g, src, d%units)
     case ('solver')
       call check_solver(g, src, d%solver)
@@ -92,13 +105,15 @@ contains
     integer :: b
     st%path = path
     allocate (d%body(nbody), d%pair(4), d%traction(4), d%boundary(4), st%trac_at(4), st%pair_at(4))
-    allocate (st%body_line(nbody), st%body_at(nbody), st%disp_line(4, nbody), st%disp_given(4, nbody))
+    allocate (st%body_line(nbody), st%body_at(nbody), st%disp_line(MAX_SIDES, nbody), st%disp_given(MAX_SIDES, nbody))
+    allocate (st%box_var(nbody))
     st%body_line = 0
     st%disp_line = 0
     st%disp_given = .false.
     do b = 1, nbody
       d%body(b)%id = 0
       st%body_at(b)%s = ''
+      st%box_var(b)%s = ''
     end do
     d%nbody = nbody
     d%npair = 0
@@ -470,7 +485,7 @@ contains
     type(state_t), intent(inout) :: st
     type(body_cfg_t), target :: c
     type(vars_t) :: v
-    integer :: s
+    integer :: s, k
 
     c = b0
     call body_vars(c, v, ALL_FORMS)
@@ -510,8 +525,16 @@ contains
     if (.not. abs(c%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', r2s(c%angle), &
       'is out of range: an angle in degrees, at most 3600 in magnitude')
     c%id = b0%id
-    do s = 1, 4
+    do s = 1, MAX_SIDES
       if (c%bc(s) /= BC_DISPLACEMENT) c%u_side(:, s) = 0.0_wp
+    end do
+    if (find_asg(g, 'depth') > 0 .and. .not. c%depth > 0.0_wp) call bad_value(g, src, 'depth', r2s(c%depth), &
+      'must be > 0')
+    if (c%nz < 1) call bad_value(g, src, 'nz', i2s(c%nz), 'must be >= 1 (cells along z)')
+    do s = 1, 5
+      k = find_asg(g, trim(word('depth z0 nz front back', s)))
+      if (k > 0 .and. len(st%box_var(id)%s) == 0) st%box_var(id)%s = 'line '//i2s(g%a(k)%line)//': '// &
+        trim(word('depth z0 nz front back', s))//' = '//g%a(k)%value
     end do
     d%body(id) = c
     st%disp_given(:, id) = st%disp_given(:, id) .and. d%body(id)%bc == BC_DISPLACEMENT
@@ -564,6 +587,11 @@ contains
     type(load_in_t), intent(inout) :: t
     integer, intent(in) :: nbody
     integer :: k
+    do k = 1, 3
+      if (NDIM == 3 .and. find_asg(g, trim(word('t1 tx ty', k))) > 0) call die_at(src, g%line, &
+        'in group &traction: '//trim(word('t1 tx ty', k))//' (a traction varying along x or y) is for '// &
+        '2D decks; in a 3D deck a traction is t0 - pressure*n, constant over its side or group')
+    end do
     if (len_trim(t%group) > 0) then
       if (find_asg(g, 'side') > 0) call die_at(src, g%line, 'in group &traction: give side= '// &
         '(a rectangle''s side) or group= (a named edge group), not both')
@@ -794,9 +822,11 @@ contains
     if (len_trim(t%group) == 0) call die_at(src, g%line, 'in group &boundary: no group; give '// &
       'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
       '''bottom'', ''top'')')
-    if (find_asg(g, 'ux') == 0 .and. find_asg(g, 'uy') == 0) call die_at(src, g%line, &
-      'in group &boundary: neither ux nor uy is given; give the components to prescribe '// &
-      '(ux=0.0 for a roller on a vertical wall, ux=0.0, uy=0.0 to clamp)')
+    if (find_asg(g, 'uz') > 0 .and. NDIM == 2) call die_at(src, g%line, 'in group &boundary: uz = '// &
+      r2s(t%uz)//' in a 2D deck: a plane body has no z displacement (a 3D deck: &scene dimension=3)')
+    if (find_asg(g, 'ux') == 0 .and. find_asg(g, 'uy') == 0 .and. find_asg(g, 'uz') == 0) call die_at(src, g%line, &
+      'in group &boundary: neither ux nor uy'//trim(merge(' nor uz', '       ', NDIM == 3))//' is given; give '// &
+      'the components to prescribe (ux=0.0 for a roller on a vertical wall, ux=0.0, uy=0.0 to clamp)')
     n = d%nboundary
     if (n == size(d%boundary)) then
       allocate (tmp(max(4, 2*n)))
@@ -807,8 +837,8 @@ contains
     d%nboundary = n
     d%boundary(n)%body = t%body
     d%boundary(n)%group = t%group
-    d%boundary(n)%fix = [find_asg(g, 'ux') > 0, find_asg(g, 'uy') > 0]
-    d%boundary(n)%u = [t%ux, t%uy]
+    d%boundary(n)%fix = [find_asg(g, 'ux') > 0, find_asg(g, 'uy') > 0, find_asg(g, 'uz') > 0]
+    d%boundary(n)%u = [t%ux, t%uy, t%uz]
     d%boundary(n)%stage = t%stage
     d%boundary(n)%origin = '&boundary at '//origin
   end subroutine add_boundary
@@ -933,5 +963,40 @@ contains
     if (t%side == 0) call die_at(src, g%line, 'in group &'//g%name//': no side; give '// &
       'side='//quoted_list(SIDE_CHOICES, ''))
   end subroutine body_and_side
+
+  !> The scene's dimension, before the loads are read (they take NCOMP components): `&scene
+  !! dimension`, else 3 where a body gives `depth` (a box), else 2; set for the run (space's
+  !! set_dimension). A 2D deck with a box's variable, a 3D deck with a body that is no box,
+  !! or with plane stress or axisymmetric bodies, is bad input naming the body and the line.
+  subroutine resolve_dimension(path, d, st)
+    character(len=*), intent(in) :: path          !< the deck
+    type(deck_t), intent(inout) :: d              !< its dimension resolved
+    type(state_t), intent(in) :: st               !< where each body's box variables were given
+    integer :: b, first
+    character(len=:), allocatable :: why
+    first = 0
+    do b = d%nbody, 1, -1
+      if (d%body(b)%depth /= UNSET) first = b
+    end do
+    if (d%dimension == 0) d%dimension = merge(3, 2, first > 0)
+    do b = 1, d%nbody
+      if (d%dimension == 2 .and. len(st%box_var(b)%s) > 0) call fatal(EXIT_INPUT, path//': '// &
+        st%body_at(b)%s//' (body '//i2s(b)//'), '//st%box_var(b)%s//': a variable of a box, in a 2D '// &
+        'deck (&scene dimension=2); give &scene dimension=3 (or leave dimension out) for 3D bodies')
+      if (d%dimension == 3 .and. len_trim(d%body(b)%mesh) > 0) call fatal(EXIT_INPUT, path//': '// &
+        st%body_at(b)%s//' (body '//i2s(b)//'): mesh = '''//trim(d%body(b)%mesh)//''' in a 3D deck: '// &
+        'a 3D body is a box (z0, depth, nz) for now; Gmsh volume meshes are not read yet')
+      if (d%dimension == 3 .and. d%body(b)%depth == UNSET) then
+        why = '&scene dimension=3'
+        if (first > 0) why = 'the depth of body '//i2s(first)
+        call fatal(EXIT_INPUT, path//': '//st%body_at(b)%s//' (body '//i2s(b)//') gives no depth, in a 3D '// &
+          'deck ('//why//'): every body of a 3D deck is a box; give its z0, depth and nz')
+      end if
+    end do
+    if (d%dimension == 3 .and. (d%axisymmetric .or. .not. d%plane_strain)) call fatal(EXIT_INPUT, path// &
+      ': &scene plane='''//trim(merge('axisymmetric', 'stress      ', d%axisymmetric))//''' in a 3D deck: '// &
+      'plane strain, plane stress and axisymmetric bodies are 2D models; leave plane out of a 3D deck')
+    call set_dimension(d%dimension)
+  end subroutine resolve_dimension
 
 end module deck_checks

@@ -8,7 +8,7 @@ module deck_cross
   use errors, only: fatal, warn, EXIT_INPUT
   use strings, only: i2s, r2s, word
   use sorting, only: merge_sort_by_keys
-  use config, only: deck_t, body_cfg_t, elastic_law_t, MAT_KIND_NAMES, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
+  use config, only: MAX_SIDES, FRICTION_NONE, FRICTION_CHOICES, deck_t, body_cfg_t, elastic_law_t, MAT_KIND_NAMES, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
                     BC_CONTACT, BC_DISPLACEMENT, bc_names, STEPS_UNSET, stage_count
   use deck_checks, only: state_t
   use material_laws, only: isotropic_law, material_law
@@ -31,6 +31,7 @@ contains
 
     p = st%path//': '
     call check_stages(d, st)
+    if (d%dimension == 3) call check_solid(d, st)
     if (d%npair == 0) call fatal(EXIT_INPUT, p//'the deck has '//i2s(d%nbody)//' bodies and no '// &
       '&contact; name each contact pair with &contact bodies=A,B, groups=''GA'',''GB'' /')
     call check_pairs(d, st)
@@ -52,7 +53,7 @@ contains
       nc = count(d%body(b)%bc == BC_CONTACT)
       if (nc /= 1) then
         lst = ''
-        do s = 1, 4
+        do s = 1, MAX_SIDES
           if (d%body(b)%bc(s) == BC_CONTACT) lst = lst//merge(', ', '  ', len(lst) > 0)//trim(side_names(s))
         end do
         if (nc == 0) then
@@ -77,6 +78,31 @@ contains
 
     call check_loads(d, st)
   end subroutine check_cross
+
+  !> What a 3D deck cannot have yet: friction, a parabolic gap, materials other than isotropic
+  !! young and poisson, regions; each refusal names the group.
+  subroutine check_solid(d, st)
+    type(deck_t), intent(in) :: d
+    type(state_t), intent(in) :: st
+    integer :: k
+    character(len=:), allocatable :: p
+    p = st%path//': '
+    do k = 1, d%npair
+      if (d%pair(k)%friction /= FRICTION_NONE) call fatal(EXIT_INPUT, p//st%pair_at(k)%s//': friction='''// &
+        trim(word(FRICTION_CHOICES, d%pair(k)%friction))//''' in a 3D deck: contact between solid bodies is '// &
+        'frictionless for now; give friction=''none''')
+      if (d%pair(k)%gap_radius > 0.0_wp) call fatal(EXIT_INPUT, p//st%pair_at(k)%s//': gap_radius = '// &
+        r2s(d%pair(k)%gap_radius)//' in a 3D deck: the parabolic gap is a 2D profile; in 3D the gap is '// &
+        'the geometry''s')
+    end do
+    do k = 1, d%nbody
+      if (len_trim(d%body(k)%material) > 0) call fatal(EXIT_INPUT, p//st%body_at(k)%s//' (body '//i2s(k)// &
+        '): material = '''//trim(d%body(k)%material)//''' in a 3D deck: a solid body is isotropic for now; '// &
+        'give young and poisson')
+    end do
+    if (d%nregion > 0) call fatal(EXIT_INPUT, p//'&region in a 3D deck (the '//trim(d%region(1)%origin)// &
+      '): regions are physical surfaces of a 2D mesh file; a 3D body is a box of one material for now')
+  end subroutine check_solid
 
   !> The load stages: with several, each of 1 .. the largest stage= has a load (a traction,
   !! or a nonzero prescribed displacement); &solver load_steps has one value or one per stage.
@@ -309,7 +335,7 @@ contains
     logical, intent(in) :: hint
     integer :: s
     character(len=:), allocatable :: add
-    do s = 1, 4
+    do s = 1, MAX_SIDES
       if (d%body(b)%bc(s) /= BC_DISPLACEMENT .or. st%disp_given(s, b)) cycle
       add = ''
       if (hint) add = '; add &displacement body='//i2s(b)//', side='''//trim(side_names(s))//''', u=ux, uy /'

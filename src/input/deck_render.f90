@@ -4,8 +4,8 @@
 module deck_render
   use strings, only: text_buffer_t
   use namelist_vars, only: str_t, vars_t, render_group, reference_table
-  use config, only: deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, material_cfg_t, region_cfg_t, BC_DISPLACEMENT
-  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, &
+  use config, only: MAX_SIDES, deck_t, body_cfg_t, body_force_cfg_t, contact_cfg_t, material_cfg_t, region_cfg_t, BC_DISPLACEMENT
+  use deck_tables, only: scene_in_t, load_in_t, ALL_FORMS, SIDE_FORM, GROUP_FORM, GIVEN_FORM, &
                          TWO_BODY_FORM, PAIR_FORM, &
                          scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, &
                          contact_vars, solver_vars, output_vars, body_force_vars, material_vars, region_vars
@@ -135,7 +135,7 @@ contains
     c = d
     call tb%add('! effective deck (every value, defaults included); source: '//trim(c%source)//NL)
     sc%plane = merge(3, merge(1, 2, c%plane_strain), c%axisymmetric)
-    call scene_vars(c, sc, v)
+    call scene_vars(c, sc, v, rendering=.true.)
     call tb%add(render_group('scene', v, WIDTH))
     do i = 1, c%nmaterial
       call material_vars(c%material(i), v, rendering=.true.)
@@ -171,16 +171,14 @@ contains
       t%group = c%boundary(i)%group
       t%ux = c%boundary(i)%u(1)
       t%uy = c%boundary(i)%u(2)
+      t%uz = c%boundary(i)%u(3)
+      t%fix = c%boundary(i)%fix
       t%stage = c%boundary(i)%stage
-      if (all(c%boundary(i)%fix)) then
-        call boundary_vars(t, v, UXY)
-      else
-        call boundary_vars(t, v, merge(UX_ONLY, UY_ONLY, c%boundary(i)%fix(1)))
-      end if
+      call boundary_vars(t, v, GIVEN_FORM)
       call tb%add(render_group('boundary', v, WIDTH))
     end do
     do b = 1, c%nbody
-      do s = 1, 4
+      do s = 1, MAX_SIDES
         if (c%body(b)%bc(s) /= BC_DISPLACEMENT) cycle
         t%body = b
         t%side = s

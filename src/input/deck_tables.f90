@@ -5,9 +5,10 @@
 !! is its field in `config` and one line here.
 module deck_tables
   use kinds, only: wp
+  use space, only: NDIM, NCOMP
   use namelist_vars, only: vars_t
   use config, only: deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, UNSET, contact_cfg_t, solver_cfg_t, output_cfg_t, &
-                    SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, &
+                    SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, SIDE_FRONT, SIDE_BACK, BC_FREE, &
                     METHOD_CHOICES, ROBIN_CHOICES, STOP_CHOICES, FACTOR_CHOICES, &
                     ORDER_CHOICES, ACCEL_CHOICES, XDMF_CHOICES, INNER_CHOICES, SIDE_CHOICES, BC_CHOICES, ELEMENT_CHOICES, PLANE_CHOICES, &
                     UNITS_CHOICES, FRICTION_CHOICES, OVERLAP_CHOICES, STEPS_UNSET
@@ -15,7 +16,7 @@ module deck_tables
   private
 
   public :: scene_in_t, load_in_t
-  public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, UX_ONLY, UY_ONLY, UXY, TWO_BODY_FORM, PAIR_FORM
+  public :: ALL_FORMS, SIDE_FORM, GROUP_FORM, GIVEN_FORM, TWO_BODY_FORM, PAIR_FORM
   public :: scene_vars, body_vars, traction_vars, boundary_vars, displacement_vars, contact_vars, &
             solver_vars, output_vars, body_force_vars, material_vars, region_vars
 
@@ -40,16 +41,17 @@ module deck_tables
     integer :: body = 0
     integer :: side = 0                         ! SIDE_*; 0 = not given
     character(len=128) :: group = ''            ! edge group ('' = not given)
-    real(wp) :: t0(2) = 0.0_wp, t1(2) = 0.0_wp  ! traction
-    real(wp) :: tx(2) = 0.0_wp, ty(2) = 0.0_wp  ! traction gradient (group)
+    real(wp) :: t0(3) = 0.0_wp, t1(3) = 0.0_wp  ! traction (NCOMP components read; t1 plane only)
+    real(wp) :: tx(3) = 0.0_wp, ty(3) = 0.0_wp  ! traction gradient (group; plane only)
     real(wp) :: pressure = 0.0_wp               ! normal pressure (group)
-    real(wp) :: u(2) = 0.0_wp                   ! displacement
-    real(wp) :: ux = 0.0_wp, uy = 0.0_wp        ! &boundary components
+    real(wp) :: u(3) = 0.0_wp                   ! displacement (NCOMP components read)
+    real(wp) :: ux = 0.0_wp, uy = 0.0_wp, uz = 0.0_wp   ! &boundary components
+    logical :: fix(3) = .false.                 ! &boundary, rendering: the components given
     integer :: stage = 1                        ! load stage
   end type load_in_t
 
   ! which variables a table holds: all (reading), or those of one form (rendering)
-  integer, parameter :: ALL_FORMS = 0, SIDE_FORM = 1, GROUP_FORM = 2, UX_ONLY = 3, UY_ONLY = 4, UXY = 5
+  integer, parameter :: ALL_FORMS = 0, SIDE_FORM = 1, GROUP_FORM = 2, GIVEN_FORM = 3
   ! the two forms of &contact: bodies 1 and 2 (body1_group, body2_group), or a named pair
   integer, parameter :: TWO_BODY_FORM = 6, PAIR_FORM = 7
 
@@ -57,12 +59,21 @@ contains
 
 
   !> &scene. The units named here are the ones the other tables' unit column refers to.
-  subroutine scene_vars(d, sc, v)
+  subroutine scene_vars(d, sc, v, rendering)
     type(deck_t), target, intent(inout) :: d
     type(scene_in_t), target, intent(inout) :: sc
     type(vars_t), intent(out) :: v
+    logical, intent(in), optional :: rendering    ! .true.: the effective deck (dimension only when 3)
+    logical :: all_vars
+    all_vars = .true.
+    if (present(rendering)) all_vars = .not. rendering
     call v%str('title', d%title, doc='free text, stored in the result file')
-    call v%enum('plane', sc%plane, PLANE_CHOICES, doc='`''strain''` (plane strain), `''stress''` '// &
+    if (all_vars .or. d%dimension == 3) call v%int('dimension', d%dimension, range='2 or 3', &
+      doc='`2`: plane (or axisymmetric) bodies, x and y; `3`: solid bodies (boxes: `&body` with '// &
+      '`z0`, `depth`, `nz`), x, y and z, every vector of the deck with three components. Not '// &
+      'given: 3 where a `&body` gives `depth`, else 2; a deck is one or the other as a whole. '// &
+      'Rendered only when 3')
+    if (all_vars .or. NDIM == 2) call v%enum('plane', sc%plane, PLANE_CHOICES, doc='`''strain''` (plane strain), `''stress''` '// &
       '(plane stress) or `''axisymmetric''`: every body a body of revolution about the y axis, '// &
       'drawn by its meridian section at x = r >= 0 (y = z); nodes on the axis have ur = 0, a '// &
       'motion along x or a rotation is no rigid motion, and every load, reaction and contact '// &
@@ -101,9 +112,17 @@ contains
       call v%real('height', b%height, unit='[length]', range='> 0', doc='extent in y')
       call v%int('nx', b%nx, range='>= 1', doc='cells along x')
       call v%int('ny', b%ny, range='>= 1', doc='cells along y')
+      if (form == ALL_FORMS .or. NDIM == 3) then
+        call v%real('z0', b%z0, unit='[length]', doc='a box (3D deck): z of its front side')
+        call v%real('depth', b%depth, unit='[length]', range='> 0', doc='a box (3D deck): extent in '// &
+          'z; giving it makes the deck 3D (unless `&scene dimension=2`, then it is bad input). Not '// &
+          'given in a 2D deck')
+        call v%int('nz', b%nz, range='>= 1', doc='a box (3D deck): cells along z')
+      end if
       call v%enum('element', b%element, ELEMENT_CHOICES, doc='`''Q1''`: bilinear quadrilaterals '// &
         '(2x2 Gauss); `''P1''`: linear triangles, each cell split along its lower-left/upper-right '// &
-        'diagonal')
+        'diagonal. A box: `''Q1''` trilinear hexahedra (2x2x2 Gauss), `''P1''` linear tetrahedra, each '// &
+        'cell split into six around its diagonal from the lowest to the highest corner')
     end if
     if (form == ALL_FORMS .or. len_trim(b%material) > 0) then
       call v%str('material', b%material, doc='the name of a `&material`: the body is made of it '// &
@@ -136,6 +155,12 @@ contains
         'y = y0 + height, as `left`')
       call v%enum('bottom', b%bc(SIDE_BOTTOM), BC_CHOICES, base=BC_FREE, doc='condition on the '// &
         'side y = y0, as `left`')
+      if (form == ALL_FORMS .or. NDIM == 3) then
+        call v%enum('front', b%bc(SIDE_FRONT), BC_CHOICES, base=BC_FREE, doc='a box: condition on '// &
+          'the side z = z0, as `left`')
+        call v%enum('back', b%bc(SIDE_BACK), BC_CHOICES, base=BC_FREE, doc='a box: condition on '// &
+          'the side z = z0 + depth, as `left`')
+      end if
     end if
   end subroutine body_vars
 
@@ -149,21 +174,26 @@ contains
       'rectangle loaded (not its contact side)')
     if (form /= SIDE_FORM) call v%str('group', t%group, doc='the edge group loaded: a physical '// &
       'curve of the body''s mesh (a rectangle has `''left''`, `''right''`, `''bottom''`, `''top''`)')
-    call v%pair('t0', t%t0, unit='[stress]', doc='the constant part of the traction vector')
-    if (form /= GROUP_FORM) call v%pair('t1', t%t1, unit='[stress/length]', doc='its rate along '// &
+    call v%pair('t0', t%t0(1:NCOMP), unit='[stress]', doc='the constant part of the traction vector '// &
+      '(x, y; in a 3D deck x, y, z)')
+    if (form /= GROUP_FORM .and. (form == ALL_FORMS .or. NDIM == 2)) call v%pair('t1', t%t1(1:2), &
+      unit='[stress/length]', doc='plane only: its rate along '// &
       'the side: t(s) = t0 + t1*s, s the global coordinate along the side (x on top and bottom, '// &
       'y on left and right)')
+    if (form /= SIDE_FORM .and. (form == ALL_FORMS .or. NDIM == 2)) then
+      call v%pair('tx', t%tx(1:2), unit='[stress/length]', doc='plane only: its rate along x: t(x,y) = '// &
+        't0 + tx*x + ty*y - pressure*n')
+      call v%pair('ty', t%ty(1:2), unit='[stress/length]', doc='plane only: its rate along y')
+    end if
     if (form /= SIDE_FORM) then
-      call v%pair('tx', t%tx, unit='[stress/length]', doc='its rate along x: t(x,y) = t0 + tx*x + '// &
-        'ty*y - pressure*n')
-      call v%pair('ty', t%ty, unit='[stress/length]', doc='its rate along y')
       call v%real('pressure', t%pressure, unit='[stress]', doc='a normal pressure, positive '// &
         'pushing into the body (n is the outward unit normal of each edge)')
     end if
     if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC)
   end subroutine traction_vars
 
-  !> &boundary: prescribed components on a group; rendered with the components given.
+  !> &boundary: prescribed components on a group; read with every component (ALL_FORMS),
+  !! rendered (GIVEN_FORM) with the components given (t%fix).
   subroutine boundary_vars(t, v, form)
     type(load_in_t), target, intent(inout) :: t
     type(vars_t), intent(out) :: v
@@ -171,10 +201,12 @@ contains
     call v%int('body', t%body, range='1 to N', required=.true., doc='the body')
     call v%str('group', t%group, required=.true., doc='the group: a physical curve or point of '// &
       'the body''s mesh, or a rectangle''s side (`''left''`, `''right''`, `''bottom''`, `''top''`)')
-    if (form /= UY_ONLY) call v%real('ux', t%ux, unit='[length]', doc='the x displacement of '// &
-      'every node of the group; not given: free')
-    if (form /= UX_ONLY) call v%real('uy', t%uy, unit='[length]', doc='the y displacement of '// &
-      'every node of the group; not given: free')
+    if (form == ALL_FORMS .or. t%fix(1)) call v%real('ux', t%ux, unit='[length]', doc='the x '// &
+      'displacement of every node of the group; not given: free')
+    if (form == ALL_FORMS .or. t%fix(2)) call v%real('uy', t%uy, unit='[length]', doc='the y '// &
+      'displacement of every node of the group; not given: free')
+    if (form == ALL_FORMS .or. t%fix(3)) call v%real('uz', t%uz, unit='[length]', doc='3D deck: the '// &
+      'z displacement of every node of the group; not given: free')
     if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC// &
       '. A zero displacement (a support) is no load: it holds in every stage')
   end subroutine boundary_vars
@@ -184,10 +216,10 @@ contains
     type(body_force_cfg_t), target, intent(inout) :: f
     type(vars_t), intent(out) :: v
     call v%int('body', f%body, range='0 to N', doc='the body it acts on; 0: every body')
-    call v%pair('gravity', f%gravity, unit='[length/time^2]', doc='an acceleration field: each '// &
+    call v%pair('gravity', f%gravity(1:NCOMP), unit='[length/time^2]', doc='an acceleration field: each '// &
       'body it acts on carries density x gravity per volume (its `density` > 0); SI: '// &
       '`0.0, -9.81`, mm-N-MPa: `0.0, -9810.0`')
-    call v%pair('force', f%force, unit='[force/length^3]', doc='a force per volume, whatever '// &
+    call v%pair('force', f%force(1:NCOMP), unit='[force/length^3]', doc='a force per volume, whatever '// &
       'the density; added to the gravity''s')
     call v%int('stage', f%stage, range='>= 1', doc=STAGE_DOC)
   end subroutine body_force_vars
@@ -263,7 +295,7 @@ contains
     call v%int('body', t%body, range='1 to N', required=.true., doc='the body')
     call v%enum('side', t%side, SIDE_CHOICES, required=.true., doc='the side, declared '// &
       '`''displacement''` in the body''s `&body`')
-    call v%pair('u', t%u, unit='[length]', doc='the displacement vector of every node of the side')
+    call v%pair('u', t%u(1:NCOMP), unit='[length]', doc='the displacement vector of every node of the side')
     if (form == ALL_FORMS .or. t%stage /= 1) call v%int('stage', t%stage, range='>= 1', doc=STAGE_DOC// &
       '. A zero displacement (a support) is no load: it holds in every stage')
   end subroutine displacement_vars

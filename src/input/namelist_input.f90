@@ -414,7 +414,7 @@ contains
               call die_at(src, a%line, head//': too many values ('//a%name//' takes one value)')
             else if (v%typ == T_REAL) then
               call die_at(src, a%line, head//': too many values ('//a%name//' takes '// &
-                i2s(v%nval)//': the x and y components)')
+                i2s(v%nval)//': the '//trim(merge('x and y   ', 'x, y and z', v%nval == 2))//' components)')
             else
               call die_at(src, a%line, head//': too many values ('//a%name//' takes '// &
                 i2s(v%nval)//')')

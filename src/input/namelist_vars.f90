@@ -51,7 +51,7 @@ module namelist_vars
   contains
     procedure :: int => add_int       !< an integer
     procedure :: real => add_real     !< a real
-    procedure :: pair => add_pair     !< two reals (x and y components)
+    procedure :: pair => add_pair     !< a vector of reals (x and y components, or x, y and z)
     procedure :: ints => add_ints     !< two integers
     procedure :: list => add_list     !< a list of integers, as many as given
     procedure :: str => add_str       !< a quoted string
@@ -130,11 +130,11 @@ contains
   subroutine add_pair(self, name, x, doc, unit)
     class(vars_t), intent(inout) :: self
     character(len=*), intent(in) :: name      !< variable name (lower case)
-    real(wp), target, intent(inout) :: x(2)   !< its storage (x and y components)
+    real(wp), target, intent(inout) :: x(:)   !< its storage (x and y components, or x, y and z)
     character(len=*), intent(in), optional :: doc       !< description
-    character(len=*), intent(in), optional :: unit      !< unit of both components
+    character(len=*), intent(in), optional :: unit      !< unit of every component
     call push(self, name, T_REAL)
-    self%v(self%n)%nval = 2
+    self%v(self%n)%nval = size(x)
     self%v(self%n)%rv => x
     call describe(self%v(self%n), doc=doc, unit=unit)
   end subroutine add_pair
@@ -280,6 +280,7 @@ contains
             item = v%name//'='//r2s(v%rs)
           else
             item = v%name//'='//r2s(v%rv(1))//', '//r2s(v%rv(2))
+            if (v%nval == 3) item = item//', '//r2s(v%rv(3))
           end if
         case (T_STR)
           if (v%nval == 1) then
@@ -338,6 +339,10 @@ contains
           else
             typ = 'real pair (x, y)'
             def = '`'//r2s(v%rv(1))//', '//r2s(v%rv(2))//'`'
+            if (v%nval == 3) then
+              typ = 'real vector (x, y, z)'
+              def = '`'//r2s(v%rv(1))//', '//r2s(v%rv(2))//', '//r2s(v%rv(3))//'`'
+            end if
           end if
         case (T_STR)
           if (v%nval == 1) then

@@ -12,14 +12,14 @@ module results
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_c_binding, only: c_loc, c_long_long
   use kinds, only: wp
-  use space, only: NSTRESS
+  use space, only: NDIM, NCOMP, NSTRESS, dof_node
   use hdf5, only: hid_t, hsize_t, haddr_t
   use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr, write_attr_list, &
                   reserve_dset
   use history_io, only: write_history
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files, data_open, data_write, data_close
-  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, FACTOR_CHOICES, FRICTION_NONE, &
+  use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, element_names, FACTOR_CHOICES, FRICTION_NONE, &
                     XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof
@@ -65,8 +65,8 @@ module results
   !! in the order they are created.
   integer, parameter :: BD_COORDINATES = 1, BD_DISPLACEMENT = 2, BD_GEOMETRY = 3, BD_DISPLACEMENT_XYZ = 4, &
                         BD_CELLS = 5, BD_TOPOLOGY = 6, BD_BODY_ID = 7, BD_STRESS = 8, BD_SXX = 9, &
-                        BD_VON_MISES = 13, BD_PRESSURE = 14, BD_REACTION = 15, BD_REACTION_XYZ = 16, &
-                        BD_COUNT = 16
+                        BD_VON_MISES = 15, BD_PRESSURE = 16, BD_REACTION = 17, BD_REACTION_XYZ = 18, &
+                        BD_COUNT = 18
 
 contains
 
@@ -265,12 +265,14 @@ contains
     real(wp), allocatable :: pres(:), w2(:, :)
     type(error_t), allocatable :: body_err(:)
     character(len=:), allocatable :: ul, us, uf, why, trib_unit
-    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    character(len=3), allocatable :: comp(:)
 
+    comp = stress_names()
     ul = trim(d%units%length)
     us = trim(d%units%stress)
     uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
     if (d%axisymmetric) uf = trim(d%units%force)//'/rad'   ! per radian of a body of revolution
+    if (NDIM == 3) uf = trim(d%units%force)               ! a solid's nodal force
     trib_unit = tributary_unit(d, ul)
     allocate (body_err(size(msh)))
     fd = -1
@@ -291,9 +293,13 @@ contains
     call write_attr(fid, 'unit_force', trim(d%units%force), st)
     ! the plane model; a body of revolution's forces are per radian (its loads, reactions and
     ! contact forces: the whole circumference carries 2 pi times)
-    call write_attr(fid, 'plane', trim(merge('axisymmetric', merge('strain      ', 'stress      ', d%plane_strain), &
-                    d%axisymmetric)), st)
-    call write_attr(fid, 'forces_per', trim(merge('radian        ', 'unit thickness', d%axisymmetric)), st)
+    if (NDIM == 2) then
+      call write_attr(fid, 'plane', trim(merge('axisymmetric', merge('strain      ', 'stress      ', d%plane_strain), &
+                      d%axisymmetric)), st)
+      call write_attr(fid, 'forces_per', trim(merge('radian        ', 'unit thickness', d%axisymmetric)), st)
+    else
+      call write_attr(fid, 'dimension', 3, st)
+    end if
     call write_attr(fid, 'unit_stress', us, st)
     call write_attr(fid, 'outer_iterations', res%outer, st)
     call write_attr(fid, 'inner_iterations', res%inner, st)
@@ -329,10 +335,11 @@ contains
     call group_close(gid, st)
     ! contact
     call group_open(fid, 'contact', gid, st, create=.true.)
-    allocate (w2(itf%m, 2))
-    w2 = transpose(itf%xy)   ! columns are contiguous: x, y
+    allocate (w2(itf%m, NDIM))
+    w2 = transpose(itf%xy)   ! columns are contiguous: x, y (z)
     call write_dset(gid, 'x', w2(:, 1), st, ul)
     call write_dset(gid, 'y', w2(:, 2), st, ul)
+    if (NDIM == 3) call write_dset(gid, 'z', w2(:, 3), st, ul)
     call write_dset(gid, 's', itf%s, st, ul)
     w2 = transpose(row_directions(itf, 1, itf%m))
     call write_dset(gid, 'normal', w2, st, '1')
@@ -340,7 +347,7 @@ contains
     call write_dset(gid, 'coordinates', w2, st, ul)
     deallocate (w2)
     call write_dset(gid, 'g0', itf%g0, st, ul)
-    call write_dset(gid, 'tributary_length', itf%trib, st, trib_unit)
+    call write_dset(gid, tributary_name(), itf%trib, st, trib_unit)
     allocate (pres(itf%m))
     call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
@@ -370,8 +377,8 @@ contains
       nn = msh(a)%nnode
       nc = msh(a)%ncell
       off = -1
-      call reserve_dset(gid, 'coordinates', [nn, 2_hsize_t], .false., off(BD_COORDINATES), st, ul)
-      call reserve_dset(gid, 'displacement', [nn, 2_hsize_t], .false., off(BD_DISPLACEMENT), st, ul)
+      call reserve_dset(gid, 'coordinates', [nn, int(NDIM, hsize_t)], .false., off(BD_COORDINATES), st, ul)
+      call reserve_dset(gid, 'displacement', [nn, int(NCOMP, hsize_t)], .false., off(BD_DISPLACEMENT), st, ul)
       call reserve_dset(gid, 'geometry_xyz', [3_hsize_t, nn], .false., off(BD_GEOMETRY), st, ul)
       call reserve_dset(gid, 'displacement_xyz', [3_hsize_t, nn], .false., off(BD_DISPLACEMENT_XYZ), st, ul)
       ! 0-based; a triangle of a mixed mesh has -1 as its fourth vertex
@@ -379,16 +386,16 @@ contains
       if (msh(a)%element == ELEM_MIXED) call reserve_dset(gid, 'topology', [int(topology_size(msh(a)), hsize_t)], &
         .true., off(BD_TOPOLOGY), st, '1')
       call reserve_dset(gid, 'body_id', [nc], .true., off(BD_BODY_ID), st, '1')
-      call reserve_dset(gid, 'stress', [nn, 4_hsize_t], .false., off(BD_STRESS), st, us)
+      call reserve_dset(gid, 'stress', [nn, int(NSTRESS, hsize_t)], .false., off(BD_STRESS), st, us)
       ! the components once more, one dataset each (what XDMF readers show as fields)
-      do k = 1, 4
+      do k = 1, NSTRESS
         call reserve_dset(gid, comp(k), [nn], .false., off(BD_SXX + k - 1), st, us)
       end do
       call reserve_dset(gid, 'von_mises', [nn], .false., off(BD_VON_MISES), st, us)
       ! contact pressure as a nodal field of the body (0 off the contact line)
       call reserve_dset(gid, 'contact_pressure', [nn], .false., off(BD_PRESSURE), st, us)
       ! the supports' forces on the body at its nodes (0 off the supports)
-      call reserve_dset(gid, 'reaction', [nn, 2_hsize_t], .false., off(BD_REACTION), st, uf)
+      call reserve_dset(gid, 'reaction', [nn, int(NCOMP, hsize_t)], .false., off(BD_REACTION), st, uf)
       call reserve_dset(gid, 'reaction_xyz', [3_hsize_t, nn], .false., off(BD_REACTION_XYZ), st, uf)
       call group_close(gid, st)
       if (.not. st%failed()) then
@@ -428,8 +435,9 @@ contains
     type(error_t), intent(inout) :: err             !< the first failure
     real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :)
     integer, allocatable, target :: iv(:), iw(:, :)
-    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    character(len=3), allocatable :: comp(:)
     integer :: k, nn
+    comp = stress_names()
     nn = msh%nnode
     allocate (sigma(NSTRESS, nn), vm(nn), p(nn))
     call nodal_stress(msh, d%body(a), d%plane_strain, ua, sigma, vm)
@@ -438,14 +446,14 @@ contains
       call err%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
       return
     end if
-    uf = file_order(msh, reshape(ua, [2, nn]))
+    uf = file_order(msh, reshape(ua, [NCOMP, nn]))
     allocate (w3(3, nn))
-    w3(1:2, :) = file_order(msh, msh%xy)
-    w2 = transpose(w3(1:2, :))
+    w3(1:NDIM, :) = file_order(msh, msh%xy)
+    w2 = transpose(w3(1:NDIM, :))
     call put(w2, 'coordinates', BD_COORDINATES)
     w2 = transpose(uf)
     call put(w2, 'displacement', BD_DISPLACEMENT)
-    w3(3, :) = 0.0_wp
+    if (NDIM == 2) w3(3, :) = 0.0_wp
     call put(w3, 'geometry_xyz', BD_GEOMETRY)
     w3 = pad3(uf)
     call put(w3, 'displacement_xyz', BD_DISPLACEMENT_XYZ)
@@ -459,14 +467,14 @@ contains
     call put_int(iv, 'body_id', BD_BODY_ID)
     sigt = transpose(file_order(msh, sigma))
     call put(sigt, 'stress', BD_STRESS)
-    do k = 1, 4
+    do k = 1, NSTRESS
       call put(sigt(:, k), comp(k), BD_SXX + k - 1)
     end do
     call put(vm, 'von_mises', BD_VON_MISES)
     call nodal_pressure(itf, a, pres, p)
     vm = file_order(msh, p)
     call put(vm, 'contact_pressure', BD_PRESSURE)
-    uf = file_order(msh, reshape(ra, [2, nn]))
+    uf = file_order(msh, reshape(ra, [NCOMP, nn]))
     w2 = transpose(uf)
     call put(w2, 'reaction', BD_REACTION)
     w3 = pad3(uf)
@@ -527,7 +535,8 @@ contains
     type(interface_t) :: itf
     type(contact_result_t) :: res
     type(tangential_t) :: tg
-    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    character(len=3), allocatable :: comp(:)
+    comp = stress_names()
     call group_open(fid, 'steps', sid, st, create=.true.)
     call write_attr(sid, 'count', size(steps), st)
     call write_attr(sid, 'time', 'cumulative load factor: stage - 1 + load_factor', st)
@@ -557,10 +566,10 @@ contains
       do a = 1, size(msh)
         nn = msh(a)%nnode
         call group_open(kid, 'body'//i2s(a), gid, st, create=.true.)
-        associate (ua => steps(k)%u(1:2*nn, a))
-          disp = transpose(file_order(msh(a), reshape(ua, [2, nn])))   ! a contiguous copy (see write_h5)
+        associate (ua => steps(k)%u(1:NCOMP*nn, a))
+          disp = transpose(file_order(msh(a), reshape(ua, [NCOMP, nn])))   ! a contiguous copy (see write_h5)
           call write_dset(gid, 'displacement', disp, st, ul)
-          call write_dset(gid, 'displacement_xyz', pad3(file_order(msh(a), reshape(ua, [2, nn]))), st, ul)
+          call write_dset(gid, 'displacement_xyz', pad3(file_order(msh(a), reshape(ua, [NCOMP, nn]))), st, ul)
           allocate (sigma(NSTRESS, nn), vm(nn), pnode(nn))
           call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
         end associate
@@ -569,7 +578,7 @@ contains
                       ' are not finite: beyond double precision, rescale the units')
         sigt = transpose(file_order(msh(a), sigma))
         call write_dset(gid, 'stress', sigt, st, us)
-        do c = 1, 4
+        do c = 1, NSTRESS
           call write_dset(gid, comp(c), sigt(:, c), st, us)
         end do
         call write_dset(gid, 'von_mises', file_order(msh(a), vm), st, us)
@@ -606,7 +615,7 @@ contains
           fa = sk%load_factor*sy%f_applied
         end if
         call support_reactions(msh(a), d%body(a), d%plane_strain, sy, sk%u(1:sy%ndof, a), fa, rf)
-        rr = file_order(msh(a), reshape(rf, [2, msh(a)%nnode]))
+        rr = file_order(msh(a), reshape(rf, [NCOMP, msh(a)%nnode]))
         call write_dset(gid, 'reaction', transpose(rr), st, uf)
         call write_dset(gid, 'reaction_xyz', pad3(rr), st, uf)
       end associate
@@ -674,15 +683,16 @@ contains
     if (geo) then
       call write_attr_list(pid, 'bodies', itf%pair_body(:, q), st)
       call write_attr(pid, 'slave_body', itf%pair_body(itf%pair_slave(q), q), st)
-      allocate (w2(j - i + 1, 2))
+      allocate (w2(j - i + 1, NDIM))
       w2 = transpose(itf%xy(:, i:j))
       call write_dset(pid, 'x', w2(:, 1), st, ul)
       call write_dset(pid, 'y', w2(:, 2), st, ul)
+      if (NDIM == 3) call write_dset(pid, 'z', w2(:, 3), st, ul)
       call write_dset(pid, 's', itf%s(i:j), st, ul)
       w2 = transpose(row_directions(itf, i, j))
       call write_dset(pid, 'normal', w2, st, '1')
       call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
-      call write_dset(pid, 'tributary_length', itf%trib(i:j), st, trib_unit)
+      call write_dset(pid, tributary_name(), itf%trib(i:j), st, trib_unit)
       call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
       call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
     end if
@@ -753,10 +763,14 @@ contains
           cycle
         end if
         do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 1
-          ! a node's two entries (x, y) are adjacent: weight |w n| = w
-          do e = itf%b(sd)%ptr(k), itf%b(sd)%ptr(k + 1) - 2, 2
-            i = (itf%b(sd)%dof(e) + 1)/2
-            w = hypot(itf%b(sd)%val(e), itf%b(sd)%val(e + 1))
+          ! a node's entries (x, y, z) are adjacent: weight |w n| = w
+          do e = itf%b(sd)%ptr(k), itf%b(sd)%ptr(k + 1) - NCOMP, NCOMP
+            i = dof_node(itf%b(sd)%dof(e))
+            if (NCOMP == 2) then
+              w = hypot(itf%b(sd)%val(e), itf%b(sd)%val(e + 1))
+            else
+              w = norm2(itf%b(sd)%val(e:e + NCOMP - 1))
+            end if
             if (w <= 1.0e-12_wp) cycle             ! a rounding-level weight of a matching line
             w = w*itf%trib(k)
             p(i) = p(i) + w*pres(k)
@@ -794,17 +808,36 @@ contains
     topology_size = count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type /= ELEM_Q1)*4
   end function topology_size
 
+  !> Points or vectors (NDIM, n) as (3, n): in the plane padded with z = 0.
   function pad3(v) result(p)
     real(wp), intent(in) :: v(:, :)
     real(wp) :: p(3, size(v, 2))
-    p(1:2, :) = v
-    p(3, :) = 0.0_wp
+    p(1:size(v, 1), :) = v
+    if (size(v, 1) < 3) p(3, :) = 0.0_wp
   end function pad3
+
+  !> The names of the stress components, in the order of nodal_stress: in the plane sxx,
+  !! syy, sxy, szz; in space sxx, syy, szz, syz, sxz, sxy.
+  function stress_names() result(c)
+    character(len=3), allocatable :: c(:)
+    if (NDIM == 3) then
+      c = ['sxx', 'syy', 'szz', 'syz', 'sxz', 'sxy']
+    else
+      c = ['sxx', 'syy', 'sxy', 'szz']
+    end if
+  end function stress_names
+
+  !> The name of the contact rows' tributary measure D_jj: a length in the plane, an area in
+  !! space.
+  function tributary_name() result(n)
+    character(len=:), allocatable :: n
+    n = trim(merge('tributary_length', 'tributary_area  ', NDIM == 2))
+  end function tributary_name
 
   !> The cells of the contact lines of pairs p1..p2 over their n rows (0-based from the
   !! first row of p1, h5py shape (cells, 2)): within each pair the segments (k, k+1) of
   !! neighbouring rows, never one joining two pairs; with no segment at all (each pair
-  !! one row or none) the n rows as vertices (shape (n, 1)).
+  !! one row or none), and in space, the n rows as vertices (shape (n, 1)).
   function line_cells(itf, p1, p2) result(c)
     type(interface_t), intent(in) :: itf
     integer, intent(in) :: p1, p2              !< first and last pair
@@ -816,6 +849,7 @@ contains
     do q = p1, p2
       nseg = nseg + max(0, itf%pair_ptr(q + 1) - itf%pair_ptr(q) - 1)
     end do
+    if (NDIM == 3) nseg = 0      ! a contact surface's nodes: its vertices (its faces are not kept)
     if (nseg > 0) then
       allocate (c(2, nseg))
       nseg = 0
@@ -917,12 +951,17 @@ contains
     character(len=16) :: topo
     character(len=64) :: nn, nc, nv
     character(len=:), allocatable :: g
-    character(len=3), parameter :: comp(4) = ['sxx', 'syy', 'sxy', 'szz']
+    character(len=3), allocatable :: comp(:)
     integer :: k
+    comp = stress_names()
     if (msh%element == ELEM_Q1) then
       topo = 'Quadrilateral'
     else if (msh%element == ELEM_P1) then
       topo = 'Triangle'
+    else if (msh%element == ELEM_HEX8) then
+      topo = 'Hexahedron'
+    else if (msh%element == ELEM_TET4) then
+      topo = 'Tetrahedron'
     else
       topo = 'Mixed'
     end if
@@ -947,7 +986,7 @@ contains
     t = t//field_text('von_mises', 'Scalar', trim(nn), fg//'/von_mises')
     t = t//field_text('contact_pressure', 'Scalar', trim(nn), fg//'/contact_pressure')
     t = t//field_text('reaction', 'Vector', trim(nn)//' 3', fg//'/reaction_xyz')
-    do k = 1, 4
+    do k = 1, size(comp)
       t = t//field_text(comp(k), 'Scalar', trim(nn), fg//'/'//comp(k))
     end do
     t = t//field_text('body_id', 'Scalar', trim(nc), g//'/body_id', 'Cell')
@@ -1094,6 +1133,7 @@ contains
     character(len=:), allocatable :: u
     u = ul
     if (d%axisymmetric) u = ul//'^2/rad'
+    if (NDIM == 3) u = ul//'^2'
   end function tributary_unit
 
 end module results

@@ -17,6 +17,7 @@
 !! banded factor is on one rank, which holds everything.
 module factorization
   use kinds, only: wp, ip, i8
+  use space, only: NDIM
   use config, only: factor_cfg_t, FACTOR_BANDED, FACTOR_MUMPS, ORDER_AMD, ORDER_NATURAL, ORDER_ND
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
   use mumps_iface, only: mumps_t, mumps_schur_factor, mumps_solve, mumps_end
@@ -177,8 +178,8 @@ contains
           fac%ordering = ORD_AMD
         case (ORDER_NATURAL)
           fac%ordering = ORD_NATURAL
-        case (ORDER_ND)
-          fac%ordering = ORD_GIVEN
+        case (ORDER_ND)     ! the geometric dissection is the plane's; a solid body: METIS
+          fac%ordering = merge(ORD_GIVEN, ORD_METIS, NDIM == 2)
         case default
           fac%ordering = ORD_METIS
         end select

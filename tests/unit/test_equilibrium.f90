@@ -49,11 +49,11 @@ contains
     body%bc(SIDE_BOTTOM) = BC_CONTACT          ! contact side: no condition when alone
     tr(1)%body = 1
     tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [0.0_wp, -3.0e6_wp]*ss
-    tr(1)%t1 = [0.0_wp, -1.0e6_wp]*ss/ls
+    tr(1)%t0(1:2) = [0.0_wp, -3.0e6_wp]*ss
+    tr(1)%t1(1:2) = [0.0_wp, -1.0e6_wp]*ss/ls
     tr(2)%body = 1
     tr(2)%side = SIDE_RIGHT
-    tr(2)%t0 = [0.0_wp, 2.0e6_wp]*ss
+    tr(2)%t0(1:2) = [0.0_wp, 2.0e6_wp]*ss
     tr(2)%t1 = 0.0_wp
   end subroutine seed_body
 

@@ -66,7 +66,7 @@ contains
     tr(1)%body = 1
     tr(1)%group = 'no_such_group'
     tr(1)%origin = '&traction 1'
-    tr(1)%t0 = [0.0_wp, -1.0_wp]
+    tr(1)%t0(1:2) = [0.0_wp, -1.0_wp]
     call assemble_body(m, body, .true., tr, 1, sys, err)
     write (*, '(a)') '      message: '//err%text()
     call report(err%category == ERR_INPUT, 'assembly, traction on an unknown group: ERR_INPUT')
@@ -132,12 +132,12 @@ contains
     d%ntraction = 1
     allocate (d%traction(1))
     d%traction(1)%body = 2
-    d%traction(1)%t0 = [0.0_wp, -1.0e305_wp]
+    d%traction(1)%t0(1:2) = [0.0_wp, -1.0e305_wp]
     call check_load_range(d, err)
     call report(err%category == ERR_INPUT .and. index(err%text(), '&traction 1 (body 2)') > 0, &
                 'budget, overflowing traction: ERR_INPUT naming the traction ('//err%text()//')')
     call report(index(err%text(), 'inputs/x.nml') == 0, 'budget: the message leaves the deck to the driver')
-    d%traction(1)%t0 = [0.0_wp, -1.0_wp]
+    d%traction(1)%t0(1:2) = [0.0_wp, -1.0_wp]
     call check_load_range(d, err)
     call report(.not. err%failed(), 'budget, a representable traction: no error')
   end subroutine test_budget

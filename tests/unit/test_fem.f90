@@ -172,11 +172,11 @@ contains
     type(traction_cfg_t), intent(out) :: tr
     type(mesh_t), intent(out) :: m
     body = rect_body(1, -0.4_wp, 0.3_wp, 2.5_wp, 1.2_wp, nx, ny, element, young=70.0_wp, poisson=0.33_wp)
-    body%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
-    body%u_side(:, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
+    body%bc(1:4) = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
+    body%u_side(1:2, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
     tr%body = 1
     tr%side = SIDE_TOP
-    tr%t0 = [0.3_wp, -1.0_wp]
+    tr%t0(1:2) = [0.3_wp, -1.0_wp]
     call mesh_build(m, body)
   end subroutine loaded_rect
 
@@ -333,9 +333,9 @@ contains
     bnd(1)%fix = .true.
     bnd(2)%group = 'right'
     bnd(2)%fix = .true.
-    bnd(2)%u = [0.01_wp, -0.02_wp]
+    bnd(2)%u(1:2) = [0.01_wp, -0.02_wp]
     bnd(3)%group = 'bottom'
-    bnd(3)%fix = [.false., .true.]
+    bnd(3)%fix(1:2) = [.false., .true.]
     g = m
     g%structured = .false.
     allocate (perm(m%nnode))
@@ -550,7 +550,7 @@ contains
 
     en = element_names(element)
     call loaded_rect(element, 5, 3, body, tr(1), m)
-    tr(1)%t1 = [0.0_wp, 0.5_wp]
+    tr(1)%t1(1:2) = [0.0_wp, 0.5_wp]
     call assemble_body(m, body, .true., tr, 1, sys, err)
     call error_parts(err, info, msg)
     call report(info == 0, trim(en)//' assemble_body info = 0 on a valid body', real(info, wp), 0.0_wp)
@@ -899,16 +899,16 @@ contains
         tr(1)%body = 2
         tr(1)%side = side
         if (kase == 1) then
-          tr(1)%t0 = [1.3_wp, -0.7_wp]
+          tr(1)%t0(1:2) = [1.3_wp, -0.7_wp]
           tr(1)%t1 = 0.0_wp
         else
-          tr(1)%t0 = [0.4_wp, -1.1_wp]
-          tr(1)%t1 = [2.5_wp, 0.8_wp]
+          tr(1)%t0(1:2) = [0.4_wp, -1.1_wp]
+          tr(1)%t1(1:2) = [2.5_wp, 0.8_wp]
         end if
         ! A traction on the other body must be ignored.
         tr(2)%body = 1
         tr(2)%side = SIDE_TOP
-        tr(2)%t0 = [100.0_wp, 100.0_wp]
+        tr(2)%t0(1:2) = [100.0_wp, 100.0_wp]
         call assemble_body(m, body, .false., tr, 2, sys, status)
         call error_parts(status, info, msg)
         if (info /= 0) then
@@ -932,8 +932,8 @@ contains
         do k = 1, m%nnode
           if (.not. onside(k)) other = max(other, maxval(abs(sys%f_applied(2*k - 1:2*k))))
         end do
-        fex = tr(1)%t0*(sb - sa) + tr(1)%t1*(sb**2 - sa**2)/2
-        mex = tr(1)%t0*(sb**2 - sa**2)/2 + tr(1)%t1*(sb**3 - sa**3)/3
+        fex = tr(1)%t0(1:2)*(sb - sa) + tr(1)%t1(1:2)*(sb**2 - sa**2)/2
+        mex = tr(1)%t0(1:2)*(sb**2 - sa**2)/2 + tr(1)%t1(1:2)*(sb**3 - sa**3)/3
         scale = (maxval(abs(tr(1)%t0)) + maxval(abs(tr(1)%t1))*max(abs(sa), abs(sb)))*(sb - sa)
         write (what, '(a,a,1x,a,1x,a)') 'traction ', element_names(element), &
           trim(merge('uniform', 'linear ', kase == 1)), trim(side_names(side))
@@ -960,15 +960,15 @@ contains
     real(wp) :: err, scale
 
     b_si = rect_body(1, 0.1_wp, 0.2_wp, 0.5_wp, 0.3_wp, 10, 6, element, young=7.0e10_wp, poisson=0.33_wp)
-    b_si%bc = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
-    b_si%u_side(:, SIDE_RIGHT) = [1.0e-4_wp, -2.0e-4_wp]
+    b_si%bc(1:4) = [BC_CLAMPED, BC_DISPLACEMENT, BC_ROLLER, BC_FREE]
+    b_si%u_side(1:2, SIDE_RIGHT) = [1.0e-4_wp, -2.0e-4_wp]
     t_si(1)%body = 1
     t_si(1)%side = SIDE_TOP
-    t_si(1)%t0 = [1.0e6_wp, -2.0e7_wp]
-    t_si(1)%t1 = [0.0_wp, 3.0e7_wp]
+    t_si(1)%t0(1:2) = [1.0e6_wp, -2.0e7_wp]
+    t_si(1)%t1(1:2) = [0.0_wp, 3.0e7_wp]
     t_si(2)%body = 1
     t_si(2)%side = SIDE_RIGHT
-    t_si(2)%t0 = [5.0e6_wp, 0.0_wp]      ! on a prescribed side: reaches f_applied only
+    t_si(2)%t0(1:2) = [5.0e6_wp, 0.0_wp]      ! on a prescribed side: reaches f_applied only
 
     b_mm = b_si
     b_mm%x0 = b_si%x0*1.0e3_wp

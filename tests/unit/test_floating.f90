@@ -287,13 +287,13 @@ contains
     body%element = element
     body%young = 1000.0_wp
     body%poisson = 0.3_wp
-    body%bc = bc
+    body%bc(1:4) = bc
     allocate (bnd(merge(1, 0, len(group) > 0)))
     rot_at = [0.7_wp, 0.4_wp]
     if (len(group) > 0) then
       bnd(1)%body = 1
       bnd(1)%group = group
-      bnd(1)%fix = fix
+      bnd(1)%fix(1:2) = fix
       bnd(1)%u = 0.0_wp
       bnd(1)%origin = 'test'
       if (group == 'bottom') rot_at = [0.7_wp, 0.0_wp]   ! ux = 0 on y = 0: rotations about points of it
@@ -325,7 +325,7 @@ contains
     body%bc = BC_FREE
     bnd(1)%body = 1
     bnd(1)%group = 'disc_axis'
-    bnd(1)%fix = [.true., .false.]
+    bnd(1)%fix(1:2) = [.true., .false.]
     bnd(1)%origin = 'test'
     call msh_read('inputs/gmsh/hertz_force_h0.02.msh', 'disc', 1, msh, err)
     call error_parts(err, info, msg)

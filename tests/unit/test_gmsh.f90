@@ -233,7 +233,7 @@ contains
     bnd(1)%body = 1
     bnd(1)%group = group
     bnd(1)%fix = .true.
-    bnd(1)%u = [1.0e-3_wp, -2.0e-3_wp]
+    bnd(1)%u(1:2) = [1.0e-3_wp, -2.0e-3_wp]
     if (.not. err%failed()) call assemble_body(m, body, .true., tr, 0, sys, err, boundaries=bnd)
     if (err%failed()) then
       call report(.false., what//'read and assembled: '//err%text())

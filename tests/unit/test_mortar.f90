@@ -641,9 +641,10 @@ contains
     call mortar_build(x2, e2, [.false., .false.], x3, f3, mt, err)
     call report(err%category == ERR_INPUT .and. index(err%text(), '2 coordinates') > 0 .and. &
                 index(err%text(), 'master nodes 3') > 0, 'dispatch: slave 2D, master 3D refused ('//err%text()//')')
-    call mortar_build(x3, f3, [.false., .false., .false.], x3, f3, mt, err)
-    call report(err%category == ERR_INPUT .and. index(err%text(), '3-coordinate') > 0, &
-                'dispatch: 3D faces not (yet) implemented refused ('//err%text()//')')
+    call mortar_build(x3, e2, [.false., .false., .false.], x3, e2, mt, err)
+    call report(err%category == ERR_INPUT .and. index(err%text(), '3-coordinate') > 0 .and. &
+                index(err%text(), 'faces of 2 (slave) and 2 (master)') > 0, &
+                'dispatch: 3-coordinate nodes with 2-node faces refused ('//err%text()//')')
   end subroutine test_dispatch
 
   !> frame_of: column 1 the normal, orthonormal, right-handed (det = +1), in 2D the tangent

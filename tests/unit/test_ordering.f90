@@ -315,10 +315,10 @@ contains
     d%body(2)%id = 2
     tr(1)%body = 1
     tr(1)%side = SIDE_TOP
-    tr(1)%t0 = [0.0_wp, -3.0e6_wp]
+    tr(1)%t0(1:2) = [0.0_wp, -3.0e6_wp]
     tr(2)%body = 2
     tr(2)%side = SIDE_BOTTOM
-    tr(2)%t0 = [5.0e5_wp, 1.0e6_wp]
+    tr(2)%t0(1:2) = [5.0e5_wp, 1.0e6_wp]
     do a = 1, 2
       call mesh_build(msh(a), d%body(a))
       call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), err)

@@ -179,7 +179,7 @@ contains
     b%element = element
     b%young = 2.1e11_wp
     b%poisson = 0.3_wp
-    b%bc = bcs
+    b%bc(1:4) = bcs
   end function rectangle_body
 
   !> The load of the ordering bodies: on b's top side the traction t0 + t1 x, (1, -3) MPa
@@ -189,8 +189,8 @@ contains
     type(traction_cfg_t) :: tr
     tr%body = b%id
     tr%side = SIDE_TOP
-    tr%t0 = [1.0e6_wp, -3.0e6_wp]
-    tr%t1 = [0.0_wp, -1.0e6_wp]
+    tr%t0(1:2) = [1.0e6_wp, -3.0e6_wp]
+    tr%t1(1:2) = [0.0_wp, -1.0e6_wp]
   end function top_traction
 
   !> The structured mesh of `b` and its system, its top loaded by a linear traction (that
@@ -330,10 +330,10 @@ contains
       case (BC_CLAMPED, BC_DISPLACEMENT)
         nbd = nbd + 1
         bd(nbd)%fix = .true.
-        bd(nbd)%u = merge(b%u_side(:, side), [0.0_wp, 0.0_wp], b%bc(side) == BC_DISPLACEMENT)
+        bd(nbd)%u(1:2) = merge(b%u_side(1:2, side), [0.0_wp, 0.0_wp], b%bc(side) == BC_DISPLACEMENT)
       case (BC_ROLLER)
         nbd = nbd + 1
-        bd(nbd)%fix = [side == SIDE_LEFT .or. side == SIDE_RIGHT, side == SIDE_BOTTOM .or. side == SIDE_TOP]
+        bd(nbd)%fix(1:2) = [side == SIDE_LEFT .or. side == SIDE_RIGHT, side == SIDE_BOTTOM .or. side == SIDE_TOP]
       case default
         cycle
       end select

@@ -1,0 +1,172 @@
+#!/usr/bin/python3
+"""Solid (3D) bodies, whole program (run by `make check`; decks written by the test in a
+temporary folder). References are exact solutions and the 2D program itself.
+
+(1) Patch test: a box of hexahedra (3 x 2 x 4) on a box of tetrahedra (5 x 3 x 2 cells, six
+    tetrahedra each), non-matching, the upper box held only by contact (one free rigid motion,
+    along y: SMALBE), rollers on x = 0 and z = 0 of both and under the lower one, a uniform
+    pressure p on top. Exact: u = (nu p x / E, -p y / E, nu p z / E), syy = -p, every other
+    stress 0, every contact node's pressure p: each to 1e-9 of its scale; the contact resultant
+    p A; the bodies balance (`reaction:` lines) to 1e-12; the result's XDMF opens in meshio with
+    hexahedra, tetrahedra and six stress components.
+(2) Consistency with 2D: the paper's two blocks (constant loads) in plane strain, and the same
+    as boxes one hexahedron deep with rollers front and back: the 3D nodal contact forces,
+    summed through the depth and divided by it, are the 2D ones to 1e-10; uz = 0; the same
+    outer count.
+(3) Robin = monolithic: two boxes pressed by a prescribed displacement, the forces to 1e-8;
+    the bodies balance to 1e-12.
+(4) Bad input, exit 1, one message, nothing written: a box's variable in a 2D deck, a body
+    with no depth in a 3D deck, a mesh file in a 3D deck, plane stress in a 3D deck, uz in a 2D
+    deck, dimension = 4, friction and a parabolic gap in a 3D deck, t1 in a 3D deck, an override
+    that changes the dimension, a box held only by contact with six free rigid motions.
+"""
+import os
+import shutil
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from rc_checks import Checks  # noqa: E402
+from rc_run import run_text, solver_env  # noqa: E402
+
+import h5py  # noqa: E402
+import numpy as np  # noqa: E402
+
+BIN = os.path.abspath(os.environ.get("BIN", os.path.join(ROOT, "bin/robin_contact")))
+ENV = solver_env(2)
+check = Checks()
+
+
+def run(work, name, text, *over):
+    return run_text(BIN, work, name, text, *over, env=ENV)
+
+
+def nodal(f, b, name):
+    """A nodal field of body b as (nnode, components)."""
+    return f[f"/body{b}/{name}"][...].T
+
+
+def balances(out):
+    """The balance of every `reaction:` line."""
+    return [float(line.split("balance=")[1].split()[0]) for line in out.splitlines() if line.startswith("reaction:")]
+
+
+work = tempfile.mkdtemp(prefix="rc_solid_")
+try:
+    # (1) the patch test
+    E, nu, p = 2.1e11, 0.3, 1.0e6
+    patch = ("&scene title='patch' /\n"
+             "&body id=1, x0=0.0, y0=1.0, z0=0.0, width=1.0, height=1.0, depth=1.0, nx=3, ny=2, nz=4, "
+             f"young={E}, poisson={nu}, bottom='contact', left='roller', front='roller' /\n"
+             "&body id=2, x0=0.0, y0=0.0, z0=0.0, width=1.0, height=1.0, depth=1.0, nx=5, ny=3, nz=2, "
+             f"element='P1', young={E}, poisson={nu}, bottom='roller', left='roller', front='roller', "
+             "top='contact' /\n"
+             f"&traction body=1, side='top', t0=0.0, {-p}, 0.0 /\n")
+    code, out, h5 = run(work, "patch", patch)
+    check(code == 0, "patch test: converged", out[-400:])
+    if code == 0:
+        with h5py.File(h5, "r") as f:
+            pres = f["/contact/pressure"][...]
+            check(np.abs(pres - p).max() <= 1e-9 * p, "patch test: every contact node's pressure is p",
+                  f"max |p_j - p|/p = {np.abs(pres - p).max() / p:.2e}")
+            res = f["/contact/resultant_body1"][...]
+            check(np.abs(res - [0.0, p, 0.0]).max() <= 1e-9 * p, "patch test: the contact resultant is p A",
+                  f"{res}")
+            check(abs(f["/contact/tributary_area"][...].sum() - 1.0) <= 1e-12, "patch test: the tributary areas sum to A")
+            for b in (1, 2):
+                x, u, s = nodal(f, b, "coordinates"), nodal(f, b, "displacement"), nodal(f, b, "stress")
+                exact = np.c_[nu * p / E * x[:, 0], -p / E * x[:, 1], nu * p / E * x[:, 2]]
+                eu = np.abs(u - exact).max() / np.abs(exact).max()
+                es = max(np.abs(s[:, 1] + p).max(), np.abs(s[:, [0, 2, 3, 4, 5]]).max()) / p
+                check(eu <= 1e-9, f"patch test: body {b} ({['hexahedra', 'tetrahedra'][b - 1]}) displacement exact",
+                      f"{eu:.2e}")
+                check(es <= 1e-9, f"patch test: body {b} stress exact (syy = -p, the others 0)", f"{es:.2e}")
+        bal = balances(out)
+        check(len(bal) == 2 and max(bal) <= 1e-12, "patch test: both bodies balance", f"{bal}")
+        check("rigid motion amplitudes" in out, "patch test: the upper box is held only by contact (SMALBE)")
+        try:
+            import meshio
+            m1 = meshio.read(os.path.join(work, "patch_body1.xdmf"))
+            m2 = meshio.read(os.path.join(work, "patch_body2.xdmf"))
+            ok = ([c.type for c in m1.cells] == ["hexahedron"] and [c.type for c in m2.cells] == ["tetra"]
+                  and all(k in m1.point_data for k in ("sxx", "syy", "szz", "syz", "sxz", "sxy")))
+            check(ok, "patch test: the XDMF files open in meshio (hexahedra, tetrahedra, six stresses)",
+                  f"{[c.type for c in m1.cells]}, {[c.type for c in m2.cells]}")
+        except ImportError:
+            check(False, "meshio is installed (python3-meshio)")
+
+    # (2) consistency with the plane program
+    body = ("young=2.1e11, poisson=0.277, nx=12, ny=4, width=3.0, height=1.0, x0=0.0, left='clamped'")
+    deck2 = (f"&body id=1, y0=1.0, {body}, bottom='contact' /\n&body id=2, y0=0.0, {body}, top='contact' /\n"
+             "&traction body=1, side='top', t0=0.0, -3.0e6 /\n&traction body=1, side='right', t0=0.0, 2.0e6 /\n"
+             "&solver tol=1e-12 /\n")
+    box = "z0=0.0, depth=0.5, nz=1, front='roller', back='roller'"
+    deck3 = (f"&body id=1, y0=1.0, {body}, {box}, bottom='contact' /\n"
+             f"&body id=2, y0=0.0, {body}, {box}, top='contact' /\n"
+             "&traction body=1, side='top', t0=0.0, -3.0e6, 0.0 /\n"
+             "&traction body=1, side='right', t0=0.0, 2.0e6, 0.0 /\n&solver tol=1e-12 /\n")
+    c2, o2, h2 = run(work, "plane", deck2)
+    c3, o3, h3 = run(work, "solid", deck3)
+    check(c2 == 0 and c3 == 0, "2D and one-cell-deep 3D blocks: both converge", (o2 + o3)[-400:])
+    if c2 == 0 and c3 == 0:
+        with h5py.File(h2, "r") as a, h5py.File(h3, "r") as b:
+            f2, x2 = a["/contact/normal_force"][...], a["/contact/x"][...]
+            f3, x3 = b["/contact/normal_force"][...], b["/contact/x"][...]
+            per = np.array([f3[np.isclose(x3, x)].sum() for x in x2]) / 0.5
+            err = np.abs(per - f2).max() / np.abs(f2).max()
+            uz = np.abs(nodal(b, 1, "displacement")[:, 2]).max()
+        check(len(f3) == 2 * len(f2) and err <= 1e-10, "3D forces through the depth / depth = the 2D forces",
+              f"{err:.2e}")
+        check(uz == 0.0, "3D with rollers front and back: uz = 0", f"{uz:.1e}")
+        n2 = [w for w in o2.split() if w.startswith("outer=")]
+        n3 = [w for w in o3.split() if w.startswith("outer=")]
+        check(n2 == n3, "2D and 3D: the same outer count", f"{n2} {n3}")
+
+    # (3) Robin = monolithic
+    boxes = ("&body id=1, x0=0.0, y0=1.0, z0=0.0, width=1.0, height=1.0, depth=1.0, nx=4, ny=3, nz=4, "
+             "bottom='contact', top='displacement' /\n"
+             "&body id=2, x0=0.0, y0=0.0, z0=0.0, width=1.0, height=1.0, depth=1.0, nx=3, ny=3, nz=3, "
+             "element='P1', bottom='clamped', top='contact' /\n"
+             "&displacement body=1, side='top', u=2.0e-5, -1.0e-4, 0.0 /\n")
+    cr, orb, hr = run(work, "robin", boxes)
+    cm, om, hm = run(work, "mono", boxes, "&solver method='monolithic' /")
+    check(cr == 0 and cm == 0, "boxes pressed and sheared by a displacement: Robin and monolithic converge",
+          (orb + om)[-400:])
+    if cr == 0 and cm == 0:
+        with h5py.File(hr, "r") as a, h5py.File(hm, "r") as b:
+            fr, fm = a["/contact/normal_force"][...], b["/contact/normal_force"][...]
+        d = np.abs(fr - fm).max() / np.abs(fm).max()
+        check(d <= 1e-8, "boxes: Robin = monolithic", f"{d:.2e}")
+        bal = balances(orb)
+        check(len(bal) == 2 and max(bal) <= 1e-12, "boxes: both bodies balance", f"{bal}")
+
+    # (4) bad input
+    bad = [
+        ("dim2depth", "&scene dimension=2 /\n" + boxes, "a variable of a box, in a 2D deck"),
+        ("nodepth", boxes.replace("depth=1.0, nx=3, ny=3, nz=3,", "nx=3, ny=3,"), "gives no depth"),
+        ("meshfile", boxes.split("&body id=2")[0] + "&body id=2, mesh='x.msh' /\n"
+         "&displacement body=1, side='top', u=2.0e-5, -1.0e-4, 0.0 /\n", "Gmsh volume meshes are not read"),
+        ("stress", "&scene plane='stress' /\n" + boxes, "plane strain, plane stress and axisymmetric bodies"),
+        ("uz2d", deck2 + "&boundary body=2, group='bottom', uz=0.0 /\n", "uz = 0.0 in a 2D deck"),
+        ("dim4", "&scene dimension=4 /\n" + boxes, "must be 2 (plane or axisymmetric bodies) or 3"),
+        ("friction", boxes + "&contact friction='coulomb', mu=0.3 /\n", "frictionless for now"),
+        ("gap", boxes + "&contact gap_radius=2.0 /\n", "the parabolic gap is a 2D profile"),
+        ("t1", boxes + "&traction body=1, side='right', t0=0.0, 0.0, 0.0, t1=1.0, 0.0 /\n", "t1 (a traction varying"),
+        ("floating6", boxes.replace("top='displacement'", "top='free'").replace(
+            "&displacement body=1, side='top', u=2.0e-5, -1.0e-4, 0.0 /\n", "&traction body=1, side='top', t0=0.0, -1e6, 0.0 /\n"),
+         "not solved yet"),
+    ]
+    for name, text, want in bad:
+        code, out, h5 = run(work, name, text)
+        check(code == 1 and want in out and "Backtrace" not in out and not os.path.exists(h5),
+              f"bad input '{name}': exit 1, named, nothing written", out.strip().splitlines()[-1][:300] if out.strip() else "")
+    code, out, h5 = run(work, "override", boxes, "&scene dimension=2 /")
+    check(code == 1 and "cannot be changed by a command-line override" in out and not os.path.exists(h5),
+          "an override changing the dimension: exit 1, named", out[-300:])
+finally:
+    shutil.rmtree(work, ignore_errors=True)
+
+print(f"{len(check.failed)} failed checks")
+sys.exit(1 if check.failed else 0)
