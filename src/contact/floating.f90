@@ -10,6 +10,7 @@
 !! mu times its normal load does not (it would slide: no static equilibrium).
 module floating
   use kinds, only: wp
+  use space, only: NDIM, NCOMP, NRIGID, node_dof, dof_node
   use assembly, only: body_system_t, rigid_motion_name
   use contact_interface, only: interface_t, body_slots, slot_row, slot_side, has_friction, DIR_NORMAL, row_direction
   use config, only: FRICTION_COULOMB, FRICTION_TRESCA
@@ -44,7 +45,8 @@ contains
     type(body_system_t), intent(in) :: system       !< its system
     type(body_condensed_t), intent(inout) :: body   !< receives slots, nrig, rg, re, rreach
     integer :: k, i, e, row, side, m
-    integer :: l, nd
+    integer :: l, nd, c
+    real(wp) :: dotkl
     body%slots = body_slots(contact_line, a)
     m = size(body%slots)
     body%m = m
@@ -62,10 +64,13 @@ contains
           do e = b%ptr(row), b%ptr(row + 1) - 1
             body%rg(k, i) = body%rg(k, i) + b%val(e)*system%rig(b%dof(e), k)
             ! the motions' vectors at the entry's node, against the coefficient's weight
-            nd = (b%dof(e) + 1)/2
+            nd = dof_node(b%dof(e))
             do l = 1, system%nrig
-              body%rreach(k, l) = body%rreach(k, l) + b%val(e)**2* &
-                                (system%rig(2*nd - 1, k)*system%rig(2*nd - 1, l) + system%rig(2*nd, k)*system%rig(2*nd, l))
+              dotkl = 0.0_wp
+              do c = 1, NCOMP
+                dotkl = dotkl + system%rig(node_dof(nd, c), k)*system%rig(node_dof(nd, c), l)
+              end do
+              body%rreach(k, l) = body%rreach(k, l) + b%val(e)**2*dotkl
             end do
           end do
         end associate
@@ -88,18 +93,21 @@ contains
     type(error_t), intent(out) :: err
     character(len=:), allocatable :: msg
     real(wp), allocatable :: gg(:, :), ev(:)
-    real(wp) :: c(3), fx, fy, along, res, enorm
-    integer :: a, r, m, lapinfo, i
+    real(wp) :: cm(NRIGID), f(NCOMP), sl(NDIM), along, res, enorm
+    integer :: a, r, m, lapinfo, i, k
     type(sparse_cols_t) :: gsp
-    character(len=*), parameter :: hold = 'hold that rigid motion with a support: a ''clamped'' side, '// &
-      'a ''roller'', or ux/uy on a group (&boundary)'
+    character(len=:), allocatable :: hold
+
+    hold = 'hold that rigid motion with a support: a ''clamped'' side, a ''roller'', or ux/uy'// &
+           trim(merge('/uz', '   ', NDIM == 3))//' on a group (&boundary)'
 
     do a = 1, size(bodies)
       r = bodies(a)%nrig
       if (r == 0) cycle
       m = bodies(a)%m
-      fx = sum(systems(a)%f_applied(1::2))
-      fy = sum(systems(a)%f_applied(2::2))
+      do k = 1, NCOMP                     ! the load's resultant
+        f(k) = sum(systems(a)%f_applied(k::NCOMP))
+      end do
       ! 1. every free motion must meet the contact normals: min over motions v of
       ! |G'v|^2 / (v'S v), the part of the motion's reach on the contact that is normal to it
       ! (generalized eigenproblem G G' v = mu S v), at least HOLD_MIN. A disc on a flat
@@ -109,12 +117,12 @@ contains
       gg = matmul(bodies(a)%rg, transpose(bodies(a)%rg))
       call held_motions(gg, bodies(a)%rreach, r, ev, lapinfo)
       if (lapinfo == 0 .and. ev(1) <= HOLD_MIN) then
-        c = matmul(systems(a)%rig_coef, gg(:, 1))
+        cm = matmul(systems(a)%rig_coef, gg(:, 1))
         along = dot_product(gg(:, 1), bodies(a)%re)
         msg = 'body '//i2s(a)//' is held only by contact (its supports leave rigid motion free), '// &
-              'but the contact cannot hold its '//rigid_motion_name(systems(a), c)//': the contact normals '// &
+              'but the contact cannot hold its '//rigid_motion_name(systems(a), cm)//': the contact normals '// &
               'have (almost) no component along it (frictionless contact lets the body slide or turn)'
-        if (abs(along) > 1.0e-10_wp*max(hypot(fx, fy), tiny(1.0_wp))) msg = msg// &
+        if (abs(along) > 1.0e-10_wp*max(norm2(f), tiny(1.0_wp))) msg = msg// &
           '; its load has a component '//sci(along)//' along that motion, which no contact force balances'
         call err%set(ERR_INPUT, msg//'; '//hold)
         return
@@ -127,7 +135,7 @@ contains
       if (enorm == 0.0_wp .and. m > 0) cycle
       if (m == 0) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but no load '// &
-              'presses it into the contact (load resultant ('//sci(fx)//', '//sci(fy)//')): its position '// &
+              'presses it into the contact (load resultant '//vec_text(f)//'): its position '// &
               'is undetermined; load it towards the body it touches, or '//hold)
         return
       end if
@@ -138,21 +146,21 @@ contains
       if (res > 1.0e-8_wp*enorm .and. has_friction(contact_line)) then
         ! the direction it would slide in: the load's part along the contact (its
         ! resultant less its part along the mean normal of the body's contact rows)
-        c = 0.0_wp
+        sl = 0.0_wp
         do i = 1, m
           if (contact_line%dir(slot_row(bodies(a)%slots(i), contact_line%m)) == DIR_NORMAL) &
-            c(1:2) = c(1:2) + row_direction(contact_line, slot_row(bodies(a)%slots(i), contact_line%m))
+            sl = sl + row_direction(contact_line, slot_row(bodies(a)%slots(i), contact_line%m))
         end do
-        c(1:2) = [fx, fy] - dot_product([fx, fy], c(1:2))/max(sum(c(1:2)**2), tiny(1.0_wp))*c(1:2)
-        c(1:2) = c(1:2)/max(norm2(c(1:2)), tiny(1.0_wp))
+        sl = f - dot_product(f, sl)/max(sum(sl**2), tiny(1.0_wp))*sl
+        sl = sl/max(norm2(sl), tiny(1.0_wp))
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), and its load '// &
-              '(resultant ('//sci(fx)//', '//sci(fy)//')) cannot be balanced by contact forces within the friction '// &
-              'limits (|t| <= mu p, or the Tresca bound): it would slide along ('//sci(c(1))//', '//sci(c(2))// &
-              '); no static equilibrium (unbalanced part '//sci(res)//'): raise mu, lower the tangential load, or '//hold)
+              '(resultant '//vec_text(f)//') cannot be balanced by contact forces within the friction '// &
+              'limits (|t| <= mu p, or the Tresca bound): it would slide along '//vec_text(sl)// &
+              '; no static equilibrium (unbalanced part '//sci(res)//'): raise mu, lower the tangential load, or '//hold)
         return
       else if (res > 1.0e-8_wp*enorm) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' is held only by contact (free: '//free_list(systems(a))//'), but its load '// &
-              '(resultant ('//sci(fx)//', '//sci(fy)//')) pulls it away from the contact: no compressive '// &
+              '(resultant '//vec_text(f)//') pulls it away from the contact: no compressive '// &
               'contact force balances it (an unbalanced part '//sci(res)//' remains); reverse the load '// &
               'or '//hold)
         return
@@ -160,6 +168,20 @@ contains
     end do
     ! 4. floating bodies that touch each other: each such group together must be held too
     call check_groups(contact_line, systems, bodies, err)
+
+  contains
+
+    !> '(vx, vy)' or '(vx, vy, vz)'.
+    function vec_text(v) result(t)
+      real(wp), intent(in) :: v(:)
+      character(len=:), allocatable :: t
+      integer :: j
+      t = '('//sci(v(1))
+      do j = 2, size(v)
+        t = t//', '//sci(v(j))
+      end do
+      t = t//')'
+    end function vec_text
   end subroutine check_held
 
   !> The floating bodies held by Coulomb friction at the edge of sliding: those whose load
@@ -206,7 +228,7 @@ contains
     integer, allocatable :: root(:), members(:), col(:), rowof(:), ti(:), tj(:), roff(:)
     real(wp), allocatable :: es(:), tv(:), v(:)
     type(sparse_cols_t) :: gs
-    real(wp) :: c(3), res, hold, mu
+    real(wp) :: c(NRIGID), res, hold, mu
     integer :: a, g, r, nm, ncol, k, i, i0, q, nz
     logical :: held
     character(len=:), allocatable :: names

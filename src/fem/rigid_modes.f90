@@ -170,6 +170,10 @@ contains
     character(len=:), allocatable :: s
     character(len=64) :: buf
     real(wp) :: w, t(2)
+    if (NDIM == 3) then
+      s = solid_motion_name(sys, c)
+      return
+    end if
     w = c(3)/sys%rig_h
     t = c(1:2)
     if (abs(c(3)) <= 1.0e-8_wp*norm2(c)) then
@@ -190,6 +194,45 @@ contains
     end if
   end function rigid_motion_name
 
+  !> A solid body's rigid motion in words: 'translation along (tx, ty, tz)' (an axis named
+  !! 'x', 'y', 'z'), or 'rotation about the axis (ax, ay, az) through (px, py, pz)' (the
+  !! point of the axis nearest the basis centre), a screw motion's translation along its axis
+  !! added as 'with translation s along it'.
+  function solid_motion_name(sys, c) result(s)
+    type(body_system_t), intent(in) :: sys
+    real(wp), intent(in) :: c(:)
+    character(len=:), allocatable :: s
+    character(len=160) :: buf
+    real(wp) :: t(3), w(3), a(3), p(3), ax
+    integer :: k
+    t = c(1:3)
+    w = c(4:6)/sys%rig_h
+    if (norm2(c(4:6)) <= 1.0e-8_wp*norm2(c)) then
+      t = t/norm2(t)
+      k = maxloc(abs(t), dim=1)
+      if (abs(abs(t(k)) - 1.0_wp) <= 1.0e-8_wp) then
+        s = 'translation along '//'xyz'(k:k)
+      else
+        write (buf, '(a,3(f7.4,a))') 'translation along (', t(1), ', ', t(2), ', ', t(3), ')'
+        s = trim(buf)
+      end if
+      return
+    end if
+    ! u(x) = t + w x (x - xc): the axis through p = xc + w x t / |w|^2, along w
+    a = w/norm2(w)
+    p = sys%rig_xc + [w(2)*t(3) - w(3)*t(2), w(3)*t(1) - w(1)*t(3), w(1)*t(2) - w(2)*t(1)]/dot_product(w, w)
+    where (abs(p) < 1.0e-9_wp*sys%rig_h) p = 0.0_wp
+    where (abs(a) < 1.0e-9_wp) a = 0.0_wp
+    write (buf, '(a,3(f7.4,a),3(g0.6,a))') 'rotation about the axis (', a(1), ', ', a(2), ', ', a(3), ') through (', &
+      p(1), ', ', p(2), ', ', p(3), ')'
+    s = trim(buf)
+    ax = dot_product(t, a)     ! a screw: the translation along the axis per unit of rotation
+    if (abs(ax) > 1.0e-8_wp*max(norm2(t), tiny(1.0_wp))) then
+      write (buf, '(a,g0.6,a)') ' with translation ', ax/norm2(w), ' per radian along it'
+      s = s//trim(buf)
+    end if
+  end function solid_motion_name
+
   !> The fixing DOFs of a floating body: sys%nrig DOFs that are not prescribed, not on the
   !! contact (the contact group, or a rectangle's 'contact' side), on which the kernel is
   !! nonsingular, taken from two nodes far apart (the node closest to the contact off it,
@@ -209,13 +252,6 @@ contains
     character(len=512) :: emsg
 
     r = sys%nrig
-    if (r > 3) then
-      write (emsg, '(a,i0,a,i0,a)') 'body ', body%id, ' is held only by contact, with ', r, ' free rigid '// &
-        'motions: a solid body held only by contact is not solved yet; support it (a side clamped, '// &
-        'rollers, or a prescribed displacement)'
-      call err%set(ERR_INPUT, emsg)
-      return
-    end if
     allocate (avoid(mesh%nnode))
     avoid = .false.
     do side = 1, 2*NDIM
@@ -276,6 +312,10 @@ contains
         p(2) = k
       end if
     end do
+    if (NDIM == 3) then      ! up to six motions: a third node, and the best r of their DOFs
+      call solid_fixing(avoid, order)
+      return
+    end if
     nc = 0
     do i = 1, 2          ! the two nodes chosen
       do j = 1, NCOMP
@@ -316,7 +356,105 @@ contains
     sys%fixing = best(1:r)
     prescribed(sys%fixing) = .true.
     sys%u_fixed(sys%fixing) = 0.0_wp
+
+  contains
+
+    !> A solid body: a third node, the farthest from the line through the first two, and of
+    !! the three nodes' free DOFs (at most 9) the r with the largest |det R(fix, :)| (every
+    !! r-subset tried: at most 84).
+    subroutine solid_fixing(avoid, order)
+      logical, intent(in) :: avoid(:)
+      integer, intent(in) :: order(:)
+      integer :: cand3(9), pick(6), bestp(6), n3, kk
+      real(wp) :: axis(3), dd, sub6(6, 6)
+      axis = mesh%xy(:, p(2)) - mesh%xy(:, p(1))
+      axis = axis/max(norm2(axis), tiny(1.0_wp))
+      kk = 0
+      dbest = -1.0_wp
+      do i = 1, mesh%nnode
+        k = order(i)
+        if (avoid(k) .or. all(prescribed(node_dof(k, 1):node_dof(k, NCOMP)))) cycle
+        dd = norm2((mesh%xy(:, k) - mesh%xy(:, p(1))) - dot_product(mesh%xy(:, k) - mesh%xy(:, p(1)), axis)*axis)
+        if (dd > dbest) then
+          dbest = dd
+          kk = k
+        end if
+      end do
+      n3 = 0
+      do i = 1, 3
+        l = merge(p(min(i, 2)), kk, i < 3)
+        if (l == 0) cycle
+        do j = 1, NCOMP
+          k = node_dof(l, j)
+          if (.not. prescribed(k) .and. .not. any(cand3(1:n3) == k)) then
+            n3 = n3 + 1
+            cand3(n3) = k
+          end if
+        end do
+      end do
+      detbest = 0.0_wp
+      bestp = 0
+      pick(1:r) = [(j, j=1, r)]
+      if (n3 >= r) then
+        do
+          do i = 1, r
+            sub6(i, 1:r) = sys%rig(cand3(pick(i)), 1:r)
+          end do
+          det = abs(lu_det(sub6(1:r, 1:r)))
+          if (det > detbest) then
+            detbest = det
+            bestp(1:r) = cand3(pick(1:r))
+          end if
+          ! the next r-subset of 1..n3 in lexicographic order
+          i = r
+          do while (i >= 1)
+            if (pick(i) < n3 - r + i) exit
+            i = i - 1
+          end do
+          if (i < 1) exit
+          pick(i) = pick(i) + 1
+          pick(i + 1:r) = [(pick(i) + j, j=1, r - i)]
+        end do
+      end if
+      if (.not. detbest > 1.0e-6_wp) then
+        write (emsg, '(a,i0,a)') 'body ', body%id, ' is held only by contact, but no three nodes away '// &
+          'from the contact fix its free rigid motions for the factorization; support the body'
+        call err%set(ERR_INPUT, emsg)
+        return
+      end if
+      allocate (sys%fixing(r))
+      sys%fixing = bestp(1:r)
+      prescribed(sys%fixing) = .true.
+      sys%u_fixed(sys%fixing) = 0.0_wp
+    end subroutine solid_fixing
   end subroutine choose_fixing
+
+  !> The determinant of a small square matrix by Gaussian elimination with partial pivoting.
+  pure real(wp) function lu_det(a0) result(d)
+    real(wp), intent(in) :: a0(:, :)
+    real(wp) :: a(size(a0, 1), size(a0, 1)), t(size(a0, 1))
+    integer :: n, k, pv, i
+    a = a0
+    n = size(a, 1)
+    d = 1.0_wp
+    do k = 1, n
+      pv = k - 1 + maxloc(abs(a(k:n, k)), dim=1)
+      if (a(pv, k) == 0.0_wp) then
+        d = 0.0_wp
+        return
+      end if
+      if (pv /= k) then
+        t = a(k, :)
+        a(k, :) = a(pv, :)
+        a(pv, :) = t
+        d = -d
+      end if
+      d = d*a(k, k)
+      do i = k + 1, n
+        a(i, k + 1:n) = a(i, k + 1:n) - a(i, k)/a(k, k)*a(k, k + 1:n)
+      end do
+    end do
+  end function lu_det
 
   !> Determinant of the leading r x r block (r = 1..3).
   pure real(wp) function small_det(a, r) result(d)

@@ -265,9 +265,9 @@ contains
     real(wp), allocatable :: pres(:), w2(:, :)
     type(error_t), allocatable :: body_err(:)
     character(len=:), allocatable :: ul, us, uf, why, trib_unit
-    character(len=3), allocatable :: comp(:)
+    character(len=3) :: comp(6)
 
-    comp = stress_names()
+    comp(1:NSTRESS) = stress_names()
     ul = trim(d%units%length)
     us = trim(d%units%stress)
     uf = trim(d%units%force)//'/'//ul     ! nodal force per unit thickness (2D)
@@ -435,9 +435,9 @@ contains
     type(error_t), intent(inout) :: err             !< the first failure
     real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :)
     integer, allocatable, target :: iv(:), iw(:, :)
-    character(len=3), allocatable :: comp(:)
+    character(len=3) :: comp(6)
     integer :: k, nn
-    comp = stress_names()
+    comp(1:NSTRESS) = stress_names()
     nn = msh%nnode
     allocate (sigma(NSTRESS, nn), vm(nn), p(nn))
     call nodal_stress(msh, d%body(a), d%plane_strain, ua, sigma, vm)
@@ -535,8 +535,8 @@ contains
     type(interface_t) :: itf
     type(contact_result_t) :: res
     type(tangential_t) :: tg
-    character(len=3), allocatable :: comp(:)
-    comp = stress_names()
+    character(len=3) :: comp(6)
+    comp(1:NSTRESS) = stress_names()
     call group_open(fid, 'steps', sid, st, create=.true.)
     call write_attr(sid, 'count', size(steps), st)
     call write_attr(sid, 'time', 'cumulative load factor: stage - 1 + load_factor', st)
@@ -951,9 +951,9 @@ contains
     character(len=16) :: topo
     character(len=64) :: nn, nc, nv
     character(len=:), allocatable :: g
-    character(len=3), allocatable :: comp(:)
+    character(len=3) :: comp(6)
     integer :: k
-    comp = stress_names()
+    comp(1:NSTRESS) = stress_names()
     if (msh%element == ELEM_Q1) then
       topo = 'Quadrilateral'
     else if (msh%element == ELEM_P1) then
@@ -986,7 +986,7 @@ contains
     t = t//field_text('von_mises', 'Scalar', trim(nn), fg//'/von_mises')
     t = t//field_text('contact_pressure', 'Scalar', trim(nn), fg//'/contact_pressure')
     t = t//field_text('reaction', 'Vector', trim(nn)//' 3', fg//'/reaction_xyz')
-    do k = 1, size(comp)
+    do k = 1, NSTRESS
       t = t//field_text(comp(k), 'Scalar', trim(nn), fg//'/'//comp(k))
     end do
     t = t//field_text('body_id', 'Scalar', trim(nc), g//'/body_id', 'Cell')

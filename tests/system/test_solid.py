@@ -16,9 +16,14 @@ temporary folder). References are exact solutions and the 2D program itself.
 (3) Robin = monolithic: two boxes pressed by a prescribed displacement, the forces to 1e-8;
     the bodies balance to 1e-12.
 (4) Bad input, exit 1, one message, nothing written: a box's variable in a 2D deck, a body
-    with no depth in a 3D deck, a mesh file in a 3D deck, plane stress in a 3D deck, uz in a 2D
-    deck, dimension = 4, friction and a parabolic gap in a 3D deck, t1 in a 3D deck, an override
-    that changes the dimension, a box held only by contact with six free rigid motions.
+    with no depth in a 3D deck, plane stress in a 3D deck, uz in a 2D deck, dimension = 4,
+    friction and a parabolic gap in a 3D deck, t1 in a 3D deck, an override that changes the
+    dimension, a box resting on another held only by contact (nothing holds it along x).
+(6) A cube held only by contact, its six rigid motions free, pressed into a corner of three
+    clamped walls by a pressure on its other three faces: each wall's contact resultant is
+    p A along its normal to 1e-9 (the cube's equilibrium), Robin = monolithic to 1e-8.
+(7) The memory check in 3D: a 40^3 box against a 200 MiB limit is refused before assembly,
+    naming the estimate and what else fits a solid body's factor.
 """
 import os
 import shutil
@@ -146,8 +151,6 @@ try:
     bad = [
         ("dim2depth", "&scene dimension=2 /\n" + boxes, "a variable of a box, in a 2D deck"),
         ("nodepth", boxes.replace("depth=1.0, nx=3, ny=3, nz=3,", "nx=3, ny=3,"), "gives no depth"),
-        ("meshfile", boxes.split("&body id=2")[0] + "&body id=2, mesh='x.msh' /\n"
-         "&displacement body=1, side='top', u=2.0e-5, -1.0e-4, 0.0 /\n", "Gmsh volume meshes are not read"),
         ("stress", "&scene plane='stress' /\n" + boxes, "plane strain, plane stress and axisymmetric bodies"),
         ("uz2d", deck2 + "&boundary body=2, group='bottom', uz=0.0 /\n", "uz = 0.0 in a 2D deck"),
         ("dim4", "&scene dimension=4 /\n" + boxes, "must be 2 (plane or axisymmetric bodies) or 3"),
@@ -156,7 +159,7 @@ try:
         ("t1", boxes + "&traction body=1, side='right', t0=0.0, 0.0, 0.0, t1=1.0, 0.0 /\n", "t1 (a traction varying"),
         ("floating6", boxes.replace("top='displacement'", "top='free'").replace(
             "&displacement body=1, side='top', u=2.0e-5, -1.0e-4, 0.0 /\n", "&traction body=1, side='top', t0=0.0, -1e6, 0.0 /\n"),
-         "not solved yet"),
+         "the contact cannot hold its translation along x"),
     ]
     for name, text, want in bad:
         code, out, h5 = run(work, name, text)
@@ -165,6 +168,43 @@ try:
     code, out, h5 = run(work, "override", boxes, "&scene dimension=2 /")
     check(code == 1 and "cannot be changed by a command-line override" in out and not os.path.exists(h5),
           "an override changing the dimension: exit 1, named", out[-300:])
+
+    # (6) a cube held only by contact, all six rigid motions free, pressed into a corner of three
+    # walls (each clamped on its far side) by a pressure on its three other faces: by the cube's
+    # equilibrium each wall's contact carries p A along its normal, exactly
+    wall = "young=2.1e11, poisson=0.3, nx=3, ny=3, nz=3"
+    corner = ("&body id=1, x0=0.0, y0=0.0, z0=0.0, width=1.0, height=1.0, depth=1.0, " + wall + " /\n"
+              "&body id=2, x0=-0.5, y0=0.0, z0=0.0, width=0.5, height=1.0, depth=1.0, nx=2, ny=4, nz=4, left='clamped' /\n"
+              "&body id=3, x0=0.0, y0=-0.5, z0=0.0, width=1.0, height=0.5, depth=1.0, nx=4, ny=2, nz=4, bottom='clamped' /\n"
+              "&body id=4, x0=0.0, y0=0.0, z0=-0.5, width=1.0, height=1.0, depth=0.5, nx=4, ny=4, nz=2, front='clamped' /\n"
+              "&contact bodies=1,2, groups='left','right' /\n&contact bodies=1,3, groups='bottom','top' /\n"
+              "&contact bodies=1,4, groups='front','back' /\n"
+              f"&traction body=1, side='right', t0={-p}, 0.0, 0.0 /\n&traction body=1, side='top', t0=0.0, {-p}, 0.0 /\n"
+              f"&traction body=1, side='back', t0=0.0, 0.0, {-p} /\n&solver tol=1e-10 /\n")
+    cc, oc, hc = run(work, "corner", corner)
+    cm, om, hm = run(work, "corner_mono", corner, "&solver method='monolithic' /")
+    check(cc == 0 and cm == 0, "a cube held only by contact (six free motions) pressed into a corner: Robin and "
+          "monolithic converge", (oc + om)[-400:])
+    if cc == 0 and cm == 0:
+        with h5py.File(hc, "r") as a, h5py.File(hm, "r") as b:
+            res = [a[f"/contact/pair_{q}/resultant_on_first_body"][...] for q in (1, 2, 3)]
+            d = np.abs(a["/contact/normal_force"][...] - b["/contact/normal_force"][...]).max() / \
+                np.abs(b["/contact/normal_force"][...]).max()
+        want = [np.array([p, 0, 0]), np.array([0, p, 0]), np.array([0, 0, p])]
+        err = max(np.abs(r - w).max() for r, w in zip(res, want)) / p
+        check(err <= 1e-9, "corner: each wall's contact carries p A along its normal", f"{err:.2e}")
+        check(d <= 1e-8, "corner: Robin = monolithic", f"{d:.2e}")
+        check("free: 6" in oc or "6 free" in oc or "rigid motion amplitudes" in oc,
+              "corner: the cube's six rigid motions are handled (SMALBE)")
+
+    # (7) the memory check, before assembly: a 40^3 box against a 200 MiB limit
+    big = boxes.replace("nx=4, ny=3, nz=4", "nx=40, ny=40, nz=40")
+    env = dict(ENV)
+    env["ROBIN_MEMORY_LIMIT_MB"] = "200"
+    code, out, h5 = run_text(BIN, work, "budget", big, env=env)
+    check(code == 1 and "needs about" in out and "(its DOFs)^1.4" in out and "phase: assembly" not in out
+          and not os.path.exists(h5), "a 40^3 box beyond a 200 MiB limit: exit 1 before assembly, the estimate and "
+          "the remedies named", out.strip().splitlines()[-1][:300] if out.strip() else "")
 finally:
     shutil.rmtree(work, ignore_errors=True)
 

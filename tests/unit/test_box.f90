@@ -5,7 +5,7 @@
 program test_box
   use kinds, only: wp
   use space, only: set_dimension
-  use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, ELEM_HEX8, ELEM_TET4, MAX_SIDES, UNSET
+  use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, ELEM_HEX8, ELEM_TET4, MAX_SIDES, UNSET, side_axis
   use mesh, only: mesh_t, box_build
   use elements_3d, only: kuhn_tets, face_area_normal, tet4_gradients, hex8_gradients
   use testing, only: report, report_le, test_summary
@@ -73,7 +73,7 @@ contains
     area = 0.0_wp
     do s = 1, MAX_SIDES
       outward = 0.0_wp
-      outward((s + 1)/2) = merge(-1.0_wp, 1.0_wp, mod(s, 2) == 1)
+      outward(side_axis(s)) = merge(-1.0_wp, 1.0_wp, mod(s, 2) == 1)
       do f = 1, m%group(s)%nedge
         k = count(m%group(s)%edge(:, f) > 0)
         xf = 0.0_wp
