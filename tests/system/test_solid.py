@@ -22,11 +22,16 @@ temporary folder). References are exact solutions and the 2D program itself.
 (6) A cube held only by contact, its six rigid motions free, pressed into a corner of three
     clamped walls by a pressure on its other three faces: each wall's contact resultant is
     p A along its normal to 1e-9 (the cube's equilibrium), Robin = monolithic to 1e-8.
+(8) The shipped boxes (inputs/boxes.nml): 1 and 2 threads bit for bit; 3 load steps, each
+    carrying its third of p A, the last the one-step forces to 1e-10; a checkpoint after one
+    outer iteration and a restart that ends as the uninterrupted run (forces to 1e-12, the
+    same outer count).
 (7) The memory check in 3D: a 40^3 box against a 200 MiB limit is refused before assembly,
     naming the estimate and what else fits a solid body's factor.
 """
 import os
 import shutil
+import subprocess
 import sys
 import tempfile
 
@@ -196,6 +201,47 @@ try:
         check(d <= 1e-8, "corner: Robin = monolithic", f"{d:.2e}")
         check("free: 6" in oc or "6 free" in oc or "rigid motion amplitudes" in oc,
               "corner: the cube's six rigid motions are handled (SMALBE)")
+
+    # (8) threads, load steps and a restart on the shipped boxes
+    deck = os.path.join(ROOT, "inputs", "boxes.nml")
+    runs = {}
+    for name, threads, over in (("t1", 1, ()), ("t2", 2, ()), ("steps", 2, ("&solver load_steps=3 /",)),
+                                ("ckpt", 2, ("&solver max_outer=1 /",))):
+        out = os.path.join(work, name + ".h5")
+        extra = [f"&output file='{out}'" + (", checkpoint_every=1 /" if name == "ckpt" else " /")]
+        p_ = subprocess.run([BIN, deck, *over, *extra], capture_output=True, text=True, env=solver_env(threads))
+        runs[name] = (p_.returncode, out, p_.stdout)
+    ck = os.path.join(work, "ckpt.h5.ckpt.h5")
+    ck_written = os.path.exists(ck)          # (a converged restart removes it)
+    p_ = subprocess.run([BIN, deck, "&solver max_outer=1 /", f"&output file='{os.path.join(work, 'ckpt.h5')}', "
+                         "checkpoint_every=1 /", "&solver max_outer=800 /", "--restart", ck],
+                        capture_output=True, text=True, env=solver_env(2))
+    check(runs["t1"][0] == 0 and runs["t2"][0] == 0, "boxes: 1 and 2 threads converge")
+    if runs["t1"][0] == 0 and runs["t2"][0] == 0:
+        with h5py.File(runs["t1"][1], "r") as a, h5py.File(runs["t2"][1], "r") as b:
+            diff = []
+            a.visititems(lambda n, o: diff.append(n) if isinstance(o, h5py.Dataset) and n not in
+                         ("history/wall_s", "input_deck") and not np.array_equal(o[...], b[n][...]) else None)
+        check(not diff, "boxes: 1 and 2 threads give the same result file bit for bit", f"{diff[:4]}")
+        with h5py.File(runs["t1"][1], "r") as a:
+            ref = a["/contact/normal_force"][...]
+        if check(runs["steps"][0] == 0, "boxes in 3 load steps: converged"):
+            with h5py.File(runs["steps"][1], "r") as a:
+                sums = [a[f"/steps/step_{k}/contact/normal_force"][...].sum() for k in (1, 2, 3)]
+                last = a["/contact/normal_force"][...]
+            e = max(abs(sums[k] - (k + 1) * p / 3) for k in range(3)) / p
+            d = np.abs(last - ref).max() / np.abs(ref).max()
+            check(e <= 1e-9 and d <= 1e-10, "boxes in 3 load steps: each step carries its third of p A, the last "
+                  "the one-step forces", f"{e:.1e}, {d:.1e}")
+        if check(runs["ckpt"][0] == 2 and ck_written and p_.returncode == 0,
+                 "boxes: a checkpoint after one outer iteration (exit 2: max_outer), and the restart converges", p_.stderr[-300:]):
+            with h5py.File(os.path.join(work, "ckpt.h5"), "r") as a:
+                d = np.abs(a["/contact/normal_force"][...] - ref).max() / np.abs(ref).max()
+                outer = int(a.attrs["outer_iterations"])
+            with h5py.File(runs["t1"][1], "r") as a:
+                outer_ref = int(a.attrs["outer_iterations"])
+            check(d <= 1e-12 and outer == outer_ref, "boxes: the restart = the uninterrupted run (forces, outer count)",
+                  f"{d:.1e}, outer {outer} / {outer_ref}")
 
     # (7) the memory check, before assembly: a 40^3 box against a 200 MiB limit
     big = boxes.replace("nx=4, ny=3, nz=4", "nx=40, ny=40, nz=40")
