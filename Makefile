@@ -65,14 +65,14 @@ endif
 
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
-MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
+MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology volume_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box test_gmsh_3d
 BENCH_F := bench_mprgp bench_ordering bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -144,8 +144,11 @@ $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelis
 $(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o $(BUILD)/space.o
 $(BUILD)/mesh.o:           $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
+$(BUILD)/volume_topology.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/int_hash.o \
+                           $(BUILD)/sorting.o $(BUILD)/mesh.o $(BUILD)/mesh_topology.o
 $(BUILD)/gmsh_msh.o:       $(BUILD)/digest.o $(BUILD)/errors.o $(BUILD)/int_hash.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
-                           $(BUILD)/mesh_topology.o $(BUILD)/strings.o $(BUILD)/text_scanner.o
+                           $(BUILD)/mesh_topology.o $(BUILD)/volume_topology.o $(BUILD)/space.o $(BUILD)/strings.o \
+                           $(BUILD)/text_scanner.o
 $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/elements_3d.o:    $(BUILD)/kinds.o
 $(BUILD)/element_types.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/elements.o $(BUILD)/elements_3d.o $(BUILD)/space.o
@@ -408,6 +411,7 @@ meshes:
 	   for n in 12:18 24:36 48:72; do nu=$${n%:*}; nl=$${n#*:}; \
 	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \
 	   done; \
+	   $(GMSH) -3 -format msh41 -v 2 blocks_3d.geo -o blocks_3d.msh; \
 	 fi
 
 clean:

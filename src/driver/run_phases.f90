@@ -8,7 +8,7 @@ module run_phases
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count, body_stiffness, &
-                    solver_cfg_t, ROBIN_HARMONIC, ROBIN_STEKLOV
+                    solver_cfg_t, ROBIN_HARMONIC, ROBIN_STEKLOV, ELEM_Q1, ELEM_P1, ELEM_HEX8
   use space, only: NDIM
   use mesh, only: mesh_t, mesh_build, box_build, assign_cell_laws
   use elements_3d, only: kuhn_tets
@@ -210,6 +210,13 @@ contains
       if (any([(len_trim(deck%body(a)%mesh) > 0, a=1, deck%nbody)])) then
         do a = 1, deck%nbody
           if (len_trim(deck%body(a)%mesh) == 0) cycle
+          if (NDIM == 3) then    ! a volume mesh: the cube of as many nodes (tetrahedra: six per grid cell)
+            run%sized%body(a)%nx = max(1, nint(real(run%meshes(a)%nnode, wp)**(1.0_wp/3.0_wp)) - 1)
+            run%sized%body(a)%ny = run%sized%body(a)%nx
+            run%sized%body(a)%nz = max(1, run%meshes(a)%nnode/(run%sized%body(a)%nx + 1)**2 - 1)
+            run%sized%body(a)%element = merge(ELEM_Q1, ELEM_P1, run%meshes(a)%element == ELEM_HEX8)
+            cycle
+          end if
           run%sized%body(a)%nx = max(1, nint(sqrt(real(run%meshes(a)%nnode, wp))) - 1)
           run%sized%body(a)%ny = max(1, run%meshes(a)%nnode/(run%sized%body(a)%nx + 1) - 1)
         end do

@@ -262,7 +262,8 @@ contains
       return
     end if
     if (.not. (NDIM == 2 .and. (mesh%element == ELEM_Q1 .or. mesh%element == ELEM_P1 .or. mesh%element == ELEM_MIXED)) &
-        .and. .not. (NDIM == 3 .and. (mesh%element == ELEM_HEX8 .or. mesh%element == ELEM_TET4))) then
+        .and. .not. (NDIM == 3 .and. (mesh%element == ELEM_HEX8 .or. mesh%element == ELEM_TET4 .or. &
+                                      mesh%element == ELEM_MIXED))) then
       write (emsg, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', mesh%element
       call err%set(ERR_INPUT, emsg)
       return

@@ -1,6 +1,9 @@
 !> The Gmsh MSH 4.1 ASCII reader: one body's mesh (module mesh, type mesh_t) from the
 !! triangles and quadrangles of a physical surface, with the boundary edges of every
-!! physical curve and the nodes of every physical point as named groups.
+!! physical curve and the nodes of every physical point as named groups. In a 3D run
+!! (space's NDIM = 3) from the tetrahedra and hexahedra of a physical volume, with the
+!! boundary faces of every physical surface as face groups and the nodes of every physical
+!! curve and point as node groups (module volume_topology).
 !!
 !! The file is read whole into memory and scanned once, token by token (module
 !! text_scanner: a 500k-node mesh, 4 million numbers, in about 1 s; peak memory about 2.8
@@ -16,9 +19,11 @@
 !!
 !! Errors: an error_t, ERR_INPUT for bad input (the message names the body, the file and
 !! the line or element tag), ERR_MEMORY otherwise. Only first-order elements (2-node
-!! lines, 3-node triangles, 4-node quadrangles, points) in the plane z = 0 are read.
+!! lines, 3-node triangles, 4-node quadrangles, points) in the plane z = 0 are read; in a 3D
+!! run also 4-node tetrahedra and 8-node hexahedra, anywhere in space.
 module gmsh_msh
   use kinds, only: wp, i8
+  use space, only: NDIM
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s
   use digest, only: text_digest
@@ -27,6 +32,7 @@ module gmsh_msh
                           expect, skip_past, bytes_left, SCAN_OTHER_FAILURE
   use mesh, only: mesh_t
   use mesh_topology, only: file_mesh_t, body_from_file, add_physical, index_entities, entity_index, index_groups
+  use volume_topology, only: body_from_volumes
   implicit none (type, external)
   private
 
@@ -58,7 +64,8 @@ contains
   !! `cell_type`), element = ELEM_Q1, ELEM_P1 or ELEM_MIXED, the bounding box, one edge
   !! group per physical curve with edges on the body's boundary, then one node group per
   !! physical point with nodes of the body (`file_groups` lists every physical curve and
-  !! point name of the file).
+  !! point name of the file). In a 3D run (NDIM = 3) the body is the tetrahedra and
+  !! hexahedra of the physical volume `region` (volume_topology's body_from_volumes).
   subroutine msh_read(path, region, body_id, mesh, err, hex)
     character(len=*), intent(in) :: path     !< the .msh file
     character(len=*), intent(in) :: region   !< physical surface name of the body, or ''
@@ -151,7 +158,11 @@ contains
     character(len=*), intent(in) :: region
     type(mesh_t), intent(inout) :: mesh
     type(error_t) :: err
-    call body_from_file(file_mesh, region, scanner%path, mesh, err)
+    if (NDIM == 3) then
+      call body_from_volumes(file_mesh, region, scanner%path, mesh, err)
+    else
+      call body_from_file(file_mesh, region, scanner%path, mesh, err)
+    end if
     if (err%failed()) call scan_fail(scanner, err%text(), merge(SCAN_OTHER_FAILURE, 1, err%category == ERR_MEMORY), &
                                      .false.)
   end subroutine build
@@ -198,7 +209,11 @@ contains
         has_nodes = .true.
       case ('$Elements')
         if (.not. has_nodes) call scan_fail(scanner, '$Elements comes before $Nodes')
-        call read_elements(scanner, file_mesh, by_tag)
+        if (NDIM == 3) then
+          call read_elements_3d(scanner, file_mesh, by_tag)
+        else
+          call read_elements(scanner, file_mesh, by_tag)
+        end if
         has_elements = .true.
       case default
         if (tok(1:1) /= '$' .or. len(tok) < 2) then
@@ -293,7 +308,8 @@ contains
     call expect(scanner, '$EndPhysicalNames')
   end subroutine read_physical_names
 
-  !> $Entities: the physical tags of every point, curve and surface (volumes skipped).
+  !> $Entities: the physical tags of every point, curve and surface (volumes skipped, but
+  !! in a 3D run).
   subroutine read_entities(scanner, file_mesh)
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
@@ -301,7 +317,7 @@ contains
     ! surface or volume (tag, a box of 6, no physical tag, no bounding entity)
     integer, parameter :: POINT_BYTES = 10, OTHER_BYTES = 18
     character(len=*), parameter :: KIND(0:3) = ['points  ', 'curves  ', 'surfaces', 'volumes ']
-    integer :: nents(0:3), dim, k, j, nb, tag, np, bound, st
+    integer :: nents(0:3), dim, k, j, nb, tag, np, bound, st, nkeep
     integer(i8) :: need
     real(wp) :: r
     integer, allocatable :: phys(:)
@@ -317,10 +333,11 @@ contains
                      'is too short for them')
       return
     end if
-    allocate (file_mesh%ent(nents(0) + nents(1) + nents(2)), stat=st)
+    nkeep = nents(0) + nents(1) + nents(2)
+    if (NDIM == 3) nkeep = nkeep + nents(3)     ! the volumes are read, and kept in a 3D run
+    allocate (file_mesh%ent(nkeep), stat=st)
     if (st /= 0) then
-      call scan_fail(scanner, 'not enough memory for '//i2s(nents(0) + nents(1) + nents(2))//' entities', &
-                     SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, 'not enough memory for '//i2s(nkeep)//' entities', SCAN_OTHER_FAILURE)
       return
     end if
     do dim = 0, 3
@@ -348,7 +365,7 @@ contains
           end do
         end if
         if (scanner%info /= 0) return
-        if (dim <= 2) then
+        if (dim <= 2 .or. NDIM == 3) then
           file_mesh%nent = file_mesh%nent + 1
           file_mesh%ent(file_mesh%nent)%dim = dim
           file_mesh%ent(file_mesh%nent)%tag = tag
@@ -374,7 +391,7 @@ contains
     call expect(scanner, '$EndEntities')
   end subroutine read_entities
 
-  !> $Nodes: blocks of tags then coordinates; z must be 0.
+  !> $Nodes: blocks of tags then coordinates; z must be 0 (but in a 3D run).
   subroutine read_nodes(scanner, file_mesh, by_tag)
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
@@ -389,7 +406,7 @@ contains
     tag_lo = get_int(scanner, 'the smallest node tag')
     tag_hi = get_int(scanner, 'the largest node tag')
     if (scanner%info /= 0) return
-    allocate (file_mesh%node_tag(ntotal), file_mesh%node_xy(2, ntotal), stat=st)
+    allocate (file_mesh%node_tag(ntotal), file_mesh%node_xy(merge(3, 2, NDIM == 3), ntotal), stat=st)
     by_tag%direct = tag_lo >= 1 .and. tag_hi >= tag_lo .and. &
                     int(tag_hi, i8) - tag_lo + 1 <= DIRECT_SPAN*(int(ntotal, i8) + 1)
     if (by_tag%direct) then
@@ -452,9 +469,12 @@ contains
           end do
         end if
         if (scanner%info /= 0) return
-        if (z /= 0.0_wp) then
+        if (NDIM == 3) then
+          file_mesh%node_xy(3, k) = z
+        else if (z /= 0.0_wp) then
           call scan_fail(scanner, 'node '//i2s(file_mesh%node_tag(k))//' has z = '//trim(real_text(z))// &
-                    '; only 2D meshes in the plane z = 0 are read (this is a 3D mesh)')
+                    '; only 2D meshes in the plane z = 0 are read (this is a 3D mesh: a 3D deck, &scene '// &
+                    'dimension=3, reads it)')
           return
         end if
       end do
@@ -517,7 +537,7 @@ contains
       t = t + nb
       if (edim == 3) then
         call scan_fail(scanner, 'has elements of type '//i2s(etype)//' on volume '//i2s(etag)// &
-                  ': a 3D mesh, and only 2D meshes are read')
+                  ': a 3D mesh, and a 2D deck reads only 2D meshes (a 3D deck, &scene dimension=3, reads it)')
         return
       end if
       if (all(etype /= [1, 2, 3, 15])) then
@@ -574,6 +594,164 @@ contains
     call expect(scanner, '$EndElements')
   end subroutine read_elements
 
+  !> $Elements in a 3D run: tetrahedra and hexahedra (volume entities, the cells),
+  !! triangles and quadrangles (surface entities, the faces), lines (curve entities),
+  !! points. Each kind's arrays grow by blocks (doubling), so a file of tetrahedra does not
+  !! hold room for every element in every kind. A block's type must be of its entity's
+  !! dimension.
+  subroutine read_elements_3d(scanner, file_mesh, by_tag)
+    type(scanner_t), intent(inout) :: scanner
+    type(file_mesh_t), intent(inout) :: file_mesh
+    type(node_index_t), intent(in) :: by_tag
+    ! the fewest characters of an element (a point: tag and node) and of a block's header
+    integer, parameter :: ELEMENT_BYTES = 4, BLOCK_BYTES = 8
+    character(len=*), parameter :: WHAT(0:3) = ['a point      ', 'a line       ', 'a surface    ', 'a volume     ']
+    integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, st, t, dim, nodes(8)
+
+    nblock = read_count(scanner, 'the number of element blocks', BLOCK_BYTES, 'element blocks')
+    ntotal = read_count(scanner, 'the number of elements', ELEMENT_BYTES, 'elements')
+    k = get_int(scanner, 'the smallest element tag')
+    k = get_int(scanner, 'the largest element tag')
+    if (scanner%info /= 0) return
+    allocate (file_mesh%cell_tag(0), file_mesh%cell_entity(0), file_mesh%cell_node(8, 0), &
+              file_mesh%face_tag(0), file_mesh%face_entity(0), file_mesh%face_node(4, 0), &
+              file_mesh%line_tag(0), file_mesh%line_entity(0), file_mesh%line_node(2, 0), &
+              file_mesh%point_entity(0), file_mesh%point_node(0))
+    t = 0
+    do b = 1, nblock
+      edim = get_int(scanner, 'an entity dimension')
+      etag = get_int(scanner, 'an entity tag')
+      etype = get_int(scanner, 'an element type')
+      select case (etype)
+      case (1)
+        nv = 2
+        dim = 1
+      case (2)
+        nv = 3
+        dim = 2
+      case (3)
+        nv = 4
+        dim = 2
+      case (4)
+        nv = 4
+        dim = 3
+      case (5)
+        nv = 8
+        dim = 3
+      case default     ! 15, and the types refused below
+        nv = 1
+        dim = 0
+      end select
+      ! an element takes at least its tag and nodes, each a digit and a separator
+      nb = read_count(scanner, 'the number of elements in the block', 2*(nv + 1), 'elements in a block')
+      if (scanner%info /= 0) return
+      if (int(t, i8) + nb > ntotal) then
+        call scan_fail(scanner, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
+        return
+      end if
+      t = t + nb
+      if (all(etype /= [1, 2, 3, 4, 5, 15])) then
+        call scan_fail(scanner, unsupported_type_3d(etype))
+        return
+      end if
+      if (edim /= dim) then
+        call scan_fail(scanner, 'a block of entity dimension '//i2s(edim)//' (entity '//i2s(etag)// &
+                       ') holds elements of type '//i2s(etype)//', which are those of '//trim(WHAT(dim)))
+        return
+      end if
+      ent = entity_index(file_mesh, edim, etag)
+      select case (etype)
+      case (4, 5)
+        call grow(file_mesh%cell_tag, file_mesh%cell_entity, file_mesh%ncell, nb, ntotal, st, file_mesh%cell_node)
+      case (2, 3)
+        call grow(file_mesh%face_tag, file_mesh%face_entity, file_mesh%nface, nb, ntotal, st, file_mesh%face_node)
+      case (1)
+        call grow(file_mesh%line_tag, file_mesh%line_entity, file_mesh%nline, nb, ntotal, st, file_mesh%line_node)
+      case default
+        call grow(file_mesh%point_node, file_mesh%point_entity, file_mesh%npoint, nb, ntotal, st)
+      end select
+      if (st /= 0) then
+        call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
+        return
+      end if
+      do k = 1, nb
+        tag = get_int(scanner, 'an element tag')
+        if (scanner%info /= 0) return
+        if (tag < 1) then
+          call scan_fail(scanner, 'element tag '//i2s(tag)//' in $Elements: tags must be >= 1')
+          return
+        end if
+        nodes = 0
+        do j = 1, nv
+          ntg = get_int(scanner, 'a node tag')
+          if (scanner%info /= 0) return
+          if (ntg < 1) then
+            call scan_fail(scanner, 'element '//i2s(tag)//' refers to node tag '//i2s(ntg)//': tags must be >= 1')
+            return
+          end if
+          nodes(j) = node_of(by_tag, ntg)
+          if (nodes(j) == 0) then
+            call scan_fail(scanner, 'element '//i2s(tag)//' refers to node '//i2s(ntg)//', which is not in $Nodes')
+            return
+          end if
+        end do
+        select case (etype)
+        case (4, 5)
+          file_mesh%ncell = file_mesh%ncell + 1
+          file_mesh%cell_tag(file_mesh%ncell) = tag
+          file_mesh%cell_entity(file_mesh%ncell) = ent
+          file_mesh%cell_node(:, file_mesh%ncell) = nodes
+        case (2, 3)
+          file_mesh%nface = file_mesh%nface + 1
+          file_mesh%face_tag(file_mesh%nface) = tag
+          file_mesh%face_entity(file_mesh%nface) = ent
+          file_mesh%face_node(:, file_mesh%nface) = nodes(1:4)
+        case (1)
+          file_mesh%nline = file_mesh%nline + 1
+          file_mesh%line_tag(file_mesh%nline) = tag
+          file_mesh%line_entity(file_mesh%nline) = ent
+          file_mesh%line_node(:, file_mesh%nline) = nodes(1:2)
+        case default
+          file_mesh%npoint = file_mesh%npoint + 1
+          file_mesh%point_entity(file_mesh%npoint) = ent
+          file_mesh%point_node(file_mesh%npoint) = nodes(1)
+        end select
+      end do
+    end do
+    if (t /= ntotal) then
+      call scan_fail(scanner, 'the element blocks hold '//i2s(t)//' elements, not the '//i2s(ntotal)//' announced')
+      return
+    end if
+    call expect(scanner, '$EndElements')
+  end subroutine read_elements_3d
+
+  !> Room for `nb` more items after the `used` ones of one kind's arrays (a and e, and the
+  !! columns of `nodes` if present): the capacity doubled, at least used + nb, at most
+  !! `cap_max` (the elements announced). stat /= 0: out of memory.
+  subroutine grow(a, e, used, nb, cap_max, stat, nodes)
+    integer, allocatable, intent(inout) :: a(:), e(:)
+    integer, intent(in) :: used, nb, cap_max
+    integer, intent(out) :: stat
+    integer, allocatable, intent(inout), optional :: nodes(:, :)
+    integer, allocatable :: a2(:), e2(:), n2(:, :)
+    integer :: cap
+    stat = 0
+    if (used + nb <= size(a)) return
+    cap = int(min(int(cap_max, i8), max(int(used, i8) + nb, 2_i8*size(a))))
+    allocate (a2(cap), e2(cap), stat=stat)
+    if (stat /= 0) return
+    a2(1:used) = a(1:used)
+    e2(1:used) = e(1:used)
+    call move_alloc(a2, a)
+    call move_alloc(e2, e)
+    if (present(nodes)) then
+      allocate (n2(size(nodes, 1), cap), stat=stat)
+      if (stat /= 0) return
+      n2(:, 1:used) = nodes(:, 1:used)
+      call move_alloc(n2, nodes)
+    end if
+  end subroutine grow
+
   !> The file node of tag `tag`, 0 if no node has it.
   integer function node_of(by_tag, tag) result(node)
     type(node_index_t), intent(in) :: by_tag
@@ -613,7 +791,8 @@ contains
     character(len=:), allocatable :: s
     select case (etype)
     case (4, 5, 6, 7, 11, 12, 13, 14, 17, 18, 19, 29:35, 92, 93)
-      s = 'has 3D elements (type '//i2s(etype)//'), and only 2D meshes are read'
+      s = 'has 3D elements (type '//i2s(etype)//'), and a 2D deck reads only 2D meshes (a 3D deck: &scene '// &
+          'dimension=3)'
     case (8, 26, 27, 28)
       s = 'has higher-order lines (type '//i2s(etype)//'); use first-order elements '// &
           '(gmsh -order 1, Mesh.ElementOrder = 1)'
@@ -628,6 +807,31 @@ contains
           'quadrangles (3) and points (15) are read'
     end select
   end function unsupported_type
+
+  !> The sentence refusing an element type in a 3D run.
+  function unsupported_type_3d(etype) result(s)
+    integer, intent(in) :: etype
+    character(len=:), allocatable :: s
+    character(len=*), parameter :: FIRST = '; use first-order elements (gmsh -order 1, Mesh.ElementOrder = 1)'
+    select case (etype)
+    case (11, 29, 30, 31, 32, 33)
+      s = 'has higher-order tetrahedra (type '//i2s(etype)//', e.g. 11 = 10-node second order)'//FIRST
+    case (12, 17, 92, 93)
+      s = 'has higher-order hexahedra (type '//i2s(etype)//', e.g. 12 = 27-node and 17 = 20-node second '// &
+          'order)'//FIRST
+    case (6, 13, 18)
+      s = 'has prisms (type '//i2s(etype)//'), and only tetrahedra (type 4) and hexahedra (type 5) are read; '// &
+          'mesh the volumes with tetrahedra only or hexahedra only'
+    case (7, 14, 19)
+      s = 'has pyramids (type '//i2s(etype)//'), and only tetrahedra (type 4) and hexahedra (type 5) are '// &
+          'read; mesh the volumes with tetrahedra only or hexahedra only'
+    case (8, 26, 27, 28, 9, 20, 21, 22, 23, 24, 25, 10, 16, 36, 37, 38)
+      s = unsupported_type(etype)
+    case default
+      s = 'has elements of type '//i2s(etype)//'; only first-order points (15), lines (1), triangles (2), '// &
+          'quadrangles (3), tetrahedra (4) and hexahedra (5) are read'
+    end select
+  end function unsupported_type_3d
 
   !> A real for messages.
   function real_text(x) result(s)

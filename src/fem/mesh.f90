@@ -1,5 +1,6 @@
-!> The mesh of one body: a structured grid of a rectangle (mesh_build), or a general 2D
-!! mesh read from a file (module gmsh_msh), in one type.
+!> The mesh of one body: a structured grid of a rectangle (mesh_build) or of a box
+!! (box_build), or a general mesh read from a file (module gmsh_msh: 2D, or in a 3D run a
+!! volume mesh of tetrahedra and hexahedra, module volume_topology), in one type.
 !!
 !! Structured meshes: nodes on a uniform (nx+1) x (ny+1) grid, bilinear quadrilaterals (Q1)
 !! or linear triangles (P1, two per grid cell). Node (i,j), i = 0..nx along x, j = 0..ny
@@ -90,7 +91,7 @@ module mesh
     !! integrals are per radian, weighted by r, with the hoop strain ur/r (set by the driver)
     logical :: axisymmetric = .false.
     character(len=:), allocatable :: source  !< the mesh file ('' for a structured mesh)
-    integer, allocatable :: cell_type(:)  !< (ncell) ELEM_Q1 or ELEM_P1 of each cell
+    integer, allocatable :: cell_type(:)  !< (ncell) ELEM_Q1 or ELEM_P1 of each cell (in space ELEM_HEX8 or ELEM_TET4)
     integer, allocatable :: node_tag(:)   !< (nnode) the file's node tag (structured: the node id)
     integer, allocatable :: cell_tag(:)   !< (ncell) the file's element tag (structured: the cell id)
     !> (nnode) a mesh from a file: each node's place in the file's order (the body's nodes
@@ -99,7 +100,7 @@ module mesh
     !> (ncell) a mesh from a file: each cell's place in the file's order of the body's
     !! cells; unallocated: the cells are in that order
     integer, allocatable :: file_cell(:)
-    integer :: nregion = 0                !< physical surfaces other than the body's with cells of it
+    integer :: nregion = 0                !< physical surfaces (volumes) other than the body's with cells of it
     type(cell_group_t), allocatable :: region(:)   !< (nregion) their cells
     !> (ncell) the elastic law of each cell (an index into body_cfg_t%law; set by the driver
     !! from the deck's regions); unallocated: law 1 everywhere
@@ -107,7 +108,8 @@ module mesh
     integer :: ngroup = 0                 !< named edge groups of this body
     type(edge_group_t), allocatable :: group(:)   !< (ngroup) the groups
     !> every physical curve name of the file, then '; physical points: ' and every physical
-    !! point name if there are any, for messages
+    !! point name if there are any, for messages (a volume mesh: every physical surface name,
+    !! then '; physical curves: ' and '; physical points: ' with theirs)
     character(len=:), allocatable :: file_groups
   end type mesh_t
 
@@ -563,7 +565,9 @@ contains
   end function group_index
 
   !> The names of the body's groups, quoted and comma-separated, a physical point's
-  !! followed by ' (point)', a curve's inside the body by ' (inside the body)' (for messages).
+  !! followed by ' (point)', a curve's inside the body by ' (inside the body)' (a volume
+  !! mesh's other groups of nodes only, a physical curve or a surface inside the body, by
+  !! ' (nodes only)') (for messages).
   function group_names(mesh) result(s)
     type(mesh_t), intent(in) :: mesh
     character(len=:), allocatable :: s
@@ -574,6 +578,8 @@ contains
       s = s//"'"//mesh%group(g)%name//"'"
       if (mesh%group(g)%point) then
         s = s//' (point)'
+      else if (nodes_only(mesh, g) .and. size(mesh%xy, 1) == 3) then
+        s = s//' (nodes only)'        ! a physical curve, or a surface inside the body
       else if (nodes_only(mesh, g)) then
         s = s//' (inside the body)'
       end if
@@ -609,12 +615,24 @@ contains
   end function nodes_only
 
   !> The sentence refusing group g (nodes_only) where boundary edges are needed: `use` is
-  !! what needs them, with its verb, e.g. 'a traction needs' or 'contact needs'.
+  !! what needs them, with its verb, e.g. 'a traction needs' or 'contact needs'. In space
+  !! (a volume mesh) what is needed is a surface with faces on the boundary.
   function nodes_only_refusal(mesh, g, use) result(s)
     type(mesh_t), intent(in) :: mesh        !< the body's mesh
     integer, intent(in) :: g                !< a group without edges (nodes_only)
     character(len=*), intent(in) :: use     !< what needs a curve, with its verb
     character(len=:), allocatable :: s
+    if (size(mesh%xy, 1) == 3) then
+      if (mesh%group(g)%point) then
+        s = "group '"//mesh%group(g)%name//"' is a physical point: "//use//' a surface'
+      else
+        s = "group '"//mesh%group(g)%name//"' has no face on the boundary of the body (a physical curve, or a "// &
+            'surface inside the body): '//use//' a surface on the boundary'
+      end if
+      s = s//' (a physical surface with faces on the boundary of the body); a group of nodes can '// &
+          'only prescribe displacements (&boundary)'
+      return
+    end if
     if (mesh%group(g)%point) then
       s = "group '"//mesh%group(g)%name//"' is a physical point: "//use//' a curve'
     else

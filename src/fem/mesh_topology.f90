@@ -12,7 +12,7 @@
 !! within 1e-9 times the body's size, if it has one.
 module mesh_topology
   use kinds, only: wp, i8
-  use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED
+  use config, only: ELEM_Q1, ELEM_P1, ELEM_MIXED, shape_vertices
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
@@ -22,6 +22,9 @@ module mesh_topology
   private
 
   public :: body_from_file, add_physical, index_entities, entity_index, index_groups
+  ! for the volume meshes of module volume_topology
+  public :: group_members, entity_cells, cell_regions, point_groups, number_for_locality, &
+            check_one_piece, sort_by_tag
 
   real(wp), parameter :: AREA_TOL = 1.0e-12_wp       ! degenerate: |area| < AREA_TOL * (longest edge)^2
   ! the largest coordinate whose cell areas and squared edges stay finite (8 x^2 <= huge)
@@ -32,7 +35,7 @@ module mesh_topology
     character(len=:), allocatable :: s
   end type name_t
 
-  !> A point, curve or surface entity and its physical tags.
+  !> A point, curve or surface entity (in a 3D run also a volume) and its physical tags.
   type, public :: entity_t
     integer :: dim = 0, tag = 0
     integer, allocatable :: phys(:)
@@ -47,16 +50,20 @@ module mesh_topology
     type(name_t), allocatable :: phys_name(:)
     type(int_hash_t) :: phys_hash              !< the groups' keys (group_key)
     integer, allocatable :: phys_of_slot(:)    !< (0:phys_hash%mask) the group in each slot
-    integer :: nent = 0                        !< point, curve and surface entities
+    integer :: nent = 0                        !< point, curve and surface entities (3D: and volumes)
     type(entity_t), allocatable :: ent(:)
     type(int_hash_t) :: ent_hash               !< the entities' keys (group_key), by index_entities
     integer, allocatable :: ent_of_slot(:)     !< (0:ent_hash%mask) the entity in each slot
     integer :: nnode = 0                       !< nodes
     integer, allocatable :: node_tag(:)
-    real(wp), allocatable :: node_xy(:, :)
-    integer :: ncell = 0                       !< triangles and quadrangles
+    real(wp), allocatable :: node_xy(:, :)     !< (2, nnode); 3D: (3, nnode)
+    integer :: ncell = 0                       !< triangles and quadrangles (3D: tetrahedra and hexahedra)
     integer, allocatable :: cell_tag(:), cell_entity(:)
-    integer, allocatable :: cell_node(:, :)    !< (4, ncell) nodes; a triangle's 4th is 0
+    !> (4, ncell) nodes; a triangle's 4th is 0 (3D: (8, ncell), a tetrahedron's 5th to 8th are 0)
+    integer, allocatable :: cell_node(:, :)
+    integer :: nface = 0                       !< 3D: triangles and quadrangles (the faces of surfaces)
+    integer, allocatable :: face_tag(:), face_entity(:)
+    integer, allocatable :: face_node(:, :)    !< (4, nface) nodes; a triangle's 4th is 0
     integer :: nline = 0                       !< 2-node lines
     integer, allocatable :: line_tag(:), line_entity(:), line_node(:, :)
     integer :: npoint = 0                      !< point elements
@@ -132,7 +139,7 @@ contains
     file_mesh%phys_of_slot(slot) = file_mesh%nphys
   end subroutine add_physical
 
-  !> Hash the entities (dim 0..2) for entity_index; of two with the same dimension and tag
+  !> Hash the entities (dim 0..2; 3D: 0..3) for entity_index; of two with the same dimension and tag
   !! the first is found. stat /= 0: out of memory.
   subroutine index_entities(file_mesh, stat)
     type(file_mesh_t), intent(inout) :: file_mesh
@@ -151,14 +158,15 @@ contains
     end do
   end subroutine index_entities
 
-  !> The index in file_mesh%ent of entity (dim, tag), 0 if it has none (or dim is not 0..2).
+  !> The index in file_mesh%ent of entity (dim, tag), 0 if it has none (or dim is not 0..3;
+  !! a 2D run keeps no volume).
   integer function entity_index(file_mesh, dim, tag) result(k)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: dim, tag
     integer :: slot
     integer(i8) :: key
     k = 0
-    if (.not. allocated(file_mesh%ent_of_slot) .or. dim < 0 .or. dim > 2) return
+    if (.not. allocated(file_mesh%ent_of_slot) .or. dim < 0 .or. dim > 3) return
     key = group_key(dim, tag)
     slot = hash_slot(file_mesh%ent_hash, key)
     if (file_mesh%ent_hash%key(slot) == key) k = file_mesh%ent_of_slot(slot)
@@ -385,18 +393,19 @@ contains
     mesh%width = maxval(mesh%xy(1, :)) - mesh%x0
     mesh%height = maxval(mesh%xy(2, :)) - mesh%y0
 
-    call cell_regions(file_mesh, surface, file_cell, mesh)
+    call cell_regions(file_mesh, 2, surface, file_cell, mesh)
     call boundary_groups(file_mesh, body_node, order, mesh, err)
     if (.not. err%failed()) call point_groups(file_mesh, body_node, mesh, err)
     if (.not. err%failed()) call number_for_locality(mesh, err)
   end subroutine body_from_file
 
-  !> The body's regions: each physical surface of the file other than the body's own
-  !! (`surface`) that holds cells of the body, with those cells (in file order, as numbered
-  !! before number_for_locality).
-  subroutine cell_regions(file_mesh, surface, file_cell, mesh)
+  !> The body's regions: each physical surface (dim = 2; a volume mesh's: physical volume,
+  !! dim = 3) of the file other than the body's own (`surface`) that holds cells of the body,
+  !! with those cells (in file order, as numbered before number_for_locality).
+  subroutine cell_regions(file_mesh, dim, surface, file_cell, mesh)
     type(file_mesh_t), intent(in) :: file_mesh
-    integer, intent(in) :: surface           ! the body's physical surface, 0: none
+    integer, intent(in) :: dim               ! the cells' dimension: 2, or 3
+    integer, intent(in) :: surface           ! the body's physical surface (volume), 0: none
     integer, intent(in) :: file_cell(:)      ! the body's cells in the file
     type(mesh_t), intent(inout) :: mesh
     integer :: k, c, e, n
@@ -405,7 +414,7 @@ contains
     mesh%nregion = 0
     allocate (mesh%region(0), cells(size(file_cell)))
     do k = 1, file_mesh%nphys
-      if (file_mesh%phys_dim(k) /= 2 .or. k == surface) cycle
+      if (file_mesh%phys_dim(k) /= dim .or. k == surface) cycle
       n = 0
       do c = 1, size(file_cell)
         e = file_mesh%cell_entity(file_cell(c))
@@ -457,14 +466,16 @@ contains
   !! its cells by their smallest node in that numbering: the nodes of a neighbourhood get
   !! nearby numbers, so the stiffness columns of a cell lie close together and the element
   !! loop walks the matrix in order. The file's order is kept in file_node and file_cell
-  !! (the order of the output); groups follow the new numbers. err: ERR_MEMORY.
+  !! (the order of the output); groups follow the new numbers. err: ERR_MEMORY. In space
+  !! (mesh%xy of 3 rows) the key interleaves 10 bits of each of x, y, z.
   subroutine number_for_locality(mesh, err)
     type(mesh_t), intent(inout) :: mesh
     type(error_t), intent(inout) :: err
     integer, parameter :: BITS = 15                     ! per coordinate of the Morton key (morton's)
+    integer, parameter :: BITS3 = 10                    ! per coordinate in space (morton3's)
     integer, allocatable :: key(:), order(:), new_node(:), first(:), new_cell(:)
-    real(wp) :: lo(2), scale(2)
-    integer :: k, c, g, q(2), st
+    real(wp) :: lo(size(mesh%xy, 1)), scale(size(mesh%xy, 1))
+    integer :: k, c, g, q(size(mesh%xy, 1)), st, i
 
     allocate (key(mesh%nnode), new_node(mesh%nnode), first(mesh%nnode + 1), new_cell(mesh%ncell), stat=st)
     if (st /= 0) then
@@ -472,12 +483,21 @@ contains
       return
     end if
     lo = minval(mesh%xy, dim=2)
-    scale = real(2**BITS - 1, wp)/max(maxval(mesh%xy, dim=2) - lo, tiny(1.0_wp))
-    do k = 1, mesh%nnode
-      q = min(max(int((mesh%xy(:, k) - lo)*scale), 0), 2**BITS - 1)
-      key(k) = morton(q(1), q(2))
-    end do
-    call radix_order(key, 2*BITS, order)
+    if (size(mesh%xy, 1) == 2) then
+      scale = real(2**BITS - 1, wp)/max(maxval(mesh%xy, dim=2) - lo, tiny(1.0_wp))
+      do k = 1, mesh%nnode
+        q = min(max(int((mesh%xy(:, k) - lo)*scale), 0), 2**BITS - 1)
+        key(k) = morton(q(1), q(2))
+      end do
+      call radix_order(key, 2*BITS, order)
+    else
+      scale = real(2**BITS3 - 1, wp)/max(maxval(mesh%xy, dim=2) - lo, tiny(1.0_wp))
+      do k = 1, mesh%nnode
+        q = min(max(int((mesh%xy(:, k) - lo)*scale), 0), 2**BITS3 - 1)
+        key(k) = morton3(q(1), q(2), q(3))
+      end do
+      call radix_order(key, 3*BITS3, order)
+    end if
     new_node(order) = [(k, k=1, mesh%nnode)]
     call move_alloc(order, mesh%file_node)
     mesh%xy = mesh%xy(:, mesh%file_node)
@@ -489,7 +509,9 @@ contains
     end do
     do g = 1, mesh%ngroup
       do k = 1, mesh%group(g)%nedge
-        mesh%group(g)%edge(:, k) = new_node(mesh%group(g)%edge(:, k))
+        do i = 1, size(mesh%group(g)%edge, 1)      ! a triangle among quadrangles: a 0 in row 4
+          if (mesh%group(g)%edge(i, k) > 0) mesh%group(g)%edge(i, k) = new_node(mesh%group(g)%edge(i, k))
+        end do
       end do
       if (allocated(mesh%group(g)%node)) mesh%group(g)%node = new_node(mesh%group(g)%node)
     end do
@@ -528,6 +550,23 @@ contains
     integer, intent(in) :: i, j
     key = ior(spread_bits(i), ishft(spread_bits(j), 1))
   end function morton
+
+  !> The Morton key of (i, j, k), each 0 <= i, j, k < 2**10: their bits interleaved, i's in
+  !! the places 0, 3, 6, ..., j's in 1, 4, ..., k's in 2, 5, ... (30 bits).
+  pure integer function morton3(i, j, k) result(key)
+    integer, intent(in) :: i, j, k
+    key = ior(ior(spread_bits3(i), ishft(spread_bits3(j), 1)), ishft(spread_bits3(k), 2))
+  end function morton3
+
+  !> The 10 low bits of x moved to every third place (bit b to bit 3 b), by halving shifts.
+  pure integer function spread_bits3(x) result(y)
+    integer, intent(in) :: x
+    y = iand(x, int(z'3FF'))
+    y = iand(ior(y, ishft(y, 16)), int(z'030000FF'))
+    y = iand(ior(y, ishft(y, 8)), int(z'0300F00F'))
+    y = iand(ior(y, ishft(y, 4)), int(z'030C30C3'))
+    y = iand(ior(y, ishft(y, 2)), int(z'09249249'))
+  end function spread_bits3
 
   !> The 15 low bits of x moved to the even places (bit b to bit 2 b), by halving shifts.
   pure integer function spread_bits(x) result(y)
@@ -777,7 +816,8 @@ contains
   !> One node group per physical point with nodes in the body, after the edge groups (a
   !! physical point named as a physical curve adds its nodes to the curve's group); the
   !! points' names go to file_groups. A point's node is the body's if the body's cells have
-  !! it; a node in no cell of the file is matched to the body's node at its place.
+  !! it; a node in no cell of the file is matched to the body's node at its place. The same
+  !! for a volume mesh (its face groups, its cells the volume cells).
   subroutine point_groups(file_mesh, body_node, mesh, err)
     type(file_mesh_t), intent(in), target :: file_mesh
     integer, intent(in) :: body_node(:)   ! file node index -> body node (0: not in the body)
@@ -806,7 +846,7 @@ contains
       return
     end if
     taken = .false.
-    tol = 1.0e-9_wp*max(mesh%width, mesh%height)
+    tol = 1.0e-9_wp*max(mesh%width, mesh%height, mesh%depth)
     do phys = 1, file_mesh%nphys
       if (file_mesh%phys_dim(phys) /= 0) cycle
       call list%add(' '//file_mesh%phys_name(phys)%s)
@@ -819,7 +859,7 @@ contains
             allocate (in_cell(file_mesh%nnode))
             in_cell = .false.
             do c = 1, file_mesh%ncell
-              do i = 1, 4
+              do i = 1, size(file_mesh%cell_node, 1)
                 if (file_mesh%cell_node(i, c) > 0) in_cell(file_mesh%cell_node(i, c)) = .true.
               end do
             end do
@@ -844,7 +884,7 @@ contains
         group = mesh%ngroup
         mesh%group(group)%name = file_mesh%phys_name(phys)%s
         mesh%group(group)%point = .true.
-        allocate (mesh%group(group)%edge(2, 0), mesh%group(group)%cell(0))
+        allocate (mesh%group(group)%edge(merge(2, 3, size(mesh%xy, 1) == 2), 0), mesh%group(group)%cell(0))
       end if
       if (.not. allocated(mesh%group(group)%node)) allocate (mesh%group(group)%node(0))
       mesh%group(group)%node = [mesh%group(group)%node, nodes(1:nfound)]
@@ -859,7 +899,7 @@ contains
   !> The body node within tol of xy (the nearest), 0 if none.
   integer function node_at(mesh, xy, tol) result(n)
     type(mesh_t), intent(in) :: mesh
-    real(wp), intent(in) :: xy(2), tol
+    real(wp), intent(in) :: xy(:), tol
     real(wp) :: dist, best
     integer :: k
     n = 0
@@ -1111,7 +1151,7 @@ contains
     end if
     parent = [(i, i=1, mesh%nnode)]
     do c = 1, mesh%ncell
-      nv = merge(4, 3, mesh%cell_type(c) == ELEM_Q1)
+      nv = shape_vertices(mesh%cell_type(c))
       root = find(mesh%cells(1, c))
       do i = 2, nv
         r = find(mesh%cells(i, c))
@@ -1124,7 +1164,8 @@ contains
       other = c
       call err%set(ERR_INPUT, 'its cells form more than one piece (element '//i2s(mesh%cell_tag(1))// &
                    ' and element '//i2s(mesh%cell_tag(other))//' share no chain of nodes): a body is one '// &
-                   'connected piece; give each piece its own physical surface and &body')
+                   'connected piece; give each piece its own physical '// &
+                   trim(merge('surface', 'volume ', size(mesh%xy, 1) == 2))//' and &body')
       return
     end do
   contains

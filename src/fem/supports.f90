@@ -108,14 +108,24 @@ contains
     end do
   end subroutine group_conditions
 
-  !> The sentence for a group name the body's mesh does not have.
+  !> The sentence for a group name the body's mesh does not have (in space: no face, and
+  !! the physical surfaces of its volume mesh's file).
   function unknown_group(mesh, name) result(s)
     type(mesh_t), intent(in) :: mesh      !< the body's mesh
     character(len=*), intent(in) :: name  !< the group name it lacks
     character(len=:), allocatable :: s, src
     src = 'the rectangle'
+    if (mesh%box) src = 'the box'
     if (allocated(mesh%source)) then
       if (len(mesh%source) > 0) src = mesh%source
+    end if
+    if (NDIM == 3) then
+      s = 'group '''//trim(name)//''' has no face on the boundary of this body ('//src// &
+          '); its groups are '//group_names(mesh)
+      if (allocated(mesh%file_groups) .and. .not. mesh%box) then
+        if (len_trim(mesh%file_groups) > 0) s = s//' (physical surfaces of the file: '//trim(mesh%file_groups)//')'
+      end if
+      return
     end if
     s = 'group '''//trim(name)//''' has no edge on the boundary of this body ('//src// &
         '); its groups are '//group_names(mesh)

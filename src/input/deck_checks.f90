@@ -819,6 +819,9 @@ contains
     call read_group(g, src, v)
     call body_given(g, src, t%body, d%nbody)
     call check_stage(g, src, t%stage)
+    if (len_trim(t%group) == 0 .and. NDIM == 3) call die_at(src, g%line, 'in group &boundary: no group; '// &
+      'give group=''NAME'', a physical surface, curve or point of the body''s mesh (a box has ''left'', '// &
+      '''right'', ''bottom'', ''top'', ''front'', ''back'')')
     if (len_trim(t%group) == 0) call die_at(src, g%line, 'in group &boundary: no group; give '// &
       'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
       '''bottom'', ''top'')')
@@ -966,8 +969,10 @@ contains
 
   !> The scene's dimension, before the loads are read (they take NCOMP components): `&scene
   !! dimension`, else 3 where a body gives `depth` (a box), else 2; set for the run (space's
-  !! set_dimension). A 2D deck with a box's variable, a 3D deck with a body that is no box,
-  !! or with plane stress or axisymmetric bodies, is bad input naming the body and the line.
+  !! set_dimension). A 2D deck with a box's variable, a 3D deck with a body that is neither a
+  !! box nor a mesh file (a Gmsh volume mesh), a body of a mesh file with a box's variable, or
+  !! a 3D deck with plane stress or axisymmetric bodies, is bad input naming the body and the
+  !! line.
   subroutine resolve_dimension(path, d, st)
     character(len=*), intent(in) :: path          !< the deck
     type(deck_t), intent(inout) :: d              !< its dimension resolved
@@ -983,14 +988,16 @@ contains
       if (d%dimension == 2 .and. len(st%box_var(b)%s) > 0) call fatal(EXIT_INPUT, path//': '// &
         st%body_at(b)%s//' (body '//i2s(b)//'), '//st%box_var(b)%s//': a variable of a box, in a 2D '// &
         'deck (&scene dimension=2); give &scene dimension=3 (or leave dimension out) for 3D bodies')
-      if (d%dimension == 3 .and. len_trim(d%body(b)%mesh) > 0) call fatal(EXIT_INPUT, path//': '// &
-        st%body_at(b)%s//' (body '//i2s(b)//'): mesh = '''//trim(d%body(b)%mesh)//''' in a 3D deck: '// &
-        'a 3D body is a box (z0, depth, nz) for now; Gmsh volume meshes are not read yet')
-      if (d%dimension == 3 .and. d%body(b)%depth == UNSET) then
+      if (d%dimension == 3 .and. len_trim(d%body(b)%mesh) > 0 .and. len(st%box_var(b)%s) > 0) call fatal( &
+        EXIT_INPUT, path//': '//st%body_at(b)%s//' (body '//i2s(b)//'), '//st%box_var(b)%s//': a variable of a '// &
+        'box, but this body comes from mesh='''//trim(d%body(b)%mesh)//''' (a Gmsh volume mesh, its geometry the '// &
+        'file''s); give its conditions with &boundary and &traction on the mesh''s physical surfaces')
+      if (d%dimension == 3 .and. d%body(b)%depth == UNSET .and. len_trim(d%body(b)%mesh) == 0) then
         why = '&scene dimension=3'
         if (first > 0) why = 'the depth of body '//i2s(first)
         call fatal(EXIT_INPUT, path//': '//st%body_at(b)%s//' (body '//i2s(b)//') gives no depth, in a 3D '// &
-          'deck ('//why//'): every body of a 3D deck is a box; give its z0, depth and nz')
+          'deck ('//why//'): every body of a 3D deck is a box (give its z0, depth and nz) or a Gmsh volume '// &
+          'mesh (mesh=)')
       end if
     end do
     if (d%dimension == 3 .and. (d%axisymmetric .or. .not. d%plane_strain)) call fatal(EXIT_INPUT, path// &

@@ -101,7 +101,8 @@ contains
         'give young and poisson')
     end do
     if (d%nregion > 0) call fatal(EXIT_INPUT, p//'&region in a 3D deck (the '//trim(d%region(1)%origin)// &
-      '): regions are physical surfaces of a 2D mesh file; a 3D body is a box of one material for now')
+      '): a region is made of a &material, and a solid body is of one isotropic material (young, poisson) '// &
+      'for now')
   end subroutine check_solid
 
   !> The load stages: with several, each of 1 .. the largest stage= has a load (a traction,

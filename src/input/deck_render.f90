@@ -48,7 +48,8 @@ module deck_render
     'here (`left`, `right`, `bottom`, `top`) and are its groups `''left''`, `''right''`, '// &
     '`''bottom''`, `''top''`; or the cells of a **mesh file** (`mesh`, `region`), whose '// &
     'conditions go on the file''s physical curves and points (`&boundary`, `&traction`, '// &
-    '`&contact`): with `mesh`, a rectangle''s variable is bad input. A body that its supports '// &
+    '`&contact`; in a 3D deck a **Gmsh volume mesh**, its conditions on its physical '// &
+    'surfaces, curves and points): with `mesh`, a rectangle''s or a box''s variable is bad input. A body that its supports '// &
     'leave free to move is held only by contact; the program finds that on the mesh and checks '// &
     'that the contact can hold it.'
   character(len=*), parameter :: REF_MATERIAL = &
@@ -87,7 +88,7 @@ module deck_render
     'A body from a mesh file has no sides: use `&boundary`.'
   character(len=*), parameter :: REF_BOUNDARY = &
     'Prescribed displacement components on a group of a body (a physical curve or point of its '// &
-    'mesh, or a rectangle''s side). Optional, any number, applied in order after the side '// &
+    'mesh, in 3D also a physical surface, or a rectangle''s or box''s side). Optional, any number, applied in order after the side '// &
     'conditions; a body from a mesh file is supported by these alone. The components given (at '// &
     'least one) are prescribed on every node of the group, a component not given stays free: '// &
     '`ux` alone is a roller on a vertical wall, both clamp or prescribe.'

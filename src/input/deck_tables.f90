@@ -99,11 +99,12 @@ contains
       'names: `''&body id=2, young=1e9 /''`')
     if (form /= SIDE_FORM) then
       call v%str('mesh', b%mesh, doc='a Gmsh mesh file, MSH 4.1 ASCII, holding the body''s '// &
-        'cells (3-node triangles and 4-node quadrilaterals, mixed allowed); a path relative to '// &
-        'the deck''s folder (for an override too); `''''`: the built-in rectangle')
+        'cells (3-node triangles and 4-node quadrilaterals, mixed allowed; in a 3D deck 4-node '// &
+        'tetrahedra and 8-node hexahedra, mixed allowed); a path relative to the deck''s folder '// &
+        '(for an override too); `''''`: the built-in rectangle (box)')
       call v%str('region', b%region, doc='the physical surface of the file that is this body '// &
-        '(one file may hold both bodies); `''''`: the file''s only physical surface, or every 2D '// &
-        'cell if the file has none')
+        '(in a 3D deck its physical volume; one file may hold both bodies); `''''`: the file''s '// &
+        'only physical surface (volume), or every 2D (3D) cell if the file has none')
     end if
     if (form /= GROUP_FORM) then
       call v%real('x0', b%x0, unit='[length]', doc='x of the lower-left corner')
@@ -173,7 +174,8 @@ contains
     if (form /= GROUP_FORM) call v%enum('side', t%side, SIDE_CHOICES, doc='the side of the '// &
       'rectangle loaded (not its contact side)')
     if (form /= SIDE_FORM) call v%str('group', t%group, doc='the edge group loaded: a physical '// &
-      'curve of the body''s mesh (a rectangle has `''left''`, `''right''`, `''bottom''`, `''top''`)')
+      'curve of the body''s mesh (3D: a physical surface; a rectangle has `''left''`, `''right''`, '// &
+      '`''bottom''`, `''top''`)')
     call v%pair('t0', t%t0(1:NCOMP), unit='[stress]', doc='the constant part of the traction vector '// &
       '(x, y; in a 3D deck x, y, z)')
     if (form /= GROUP_FORM .and. (form == ALL_FORMS .or. NDIM == 2)) call v%pair('t1', t%t1(1:2), &
@@ -200,7 +202,8 @@ contains
     integer, intent(in) :: form
     call v%int('body', t%body, range='1 to N', required=.true., doc='the body')
     call v%str('group', t%group, required=.true., doc='the group: a physical curve or point of '// &
-      'the body''s mesh, or a rectangle''s side (`''left''`, `''right''`, `''bottom''`, `''top''`)')
+      'the body''s mesh (3D: a physical surface, curve or point), or a rectangle''s side '// &
+      '(`''left''`, `''right''`, `''bottom''`, `''top''`; a box''s also `''front''`, `''back''`)')
     if (form == ALL_FORMS .or. t%fix(1)) call v%real('ux', t%ux, unit='[length]', doc='the x '// &
       'displacement of every node of the group; not given: free')
     if (form == ALL_FORMS .or. t%fix(2)) call v%real('uy', t%uy, unit='[length]', doc='the y '// &

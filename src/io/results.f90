@@ -783,8 +783,8 @@ contains
     where (on_slave) p = ps
   end subroutine nodal_pressure
 
-  !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral)
-  !! and its 0-based vertices, in the file's order.
+  !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral,
+  !! 6 tetrahedron, 9 hexahedron) and its 0-based vertices, in the file's order.
   function mixed_topology(msh) result(t)
     type(mesh_t), intent(in) :: msh
     integer, allocatable :: t(:), cells(:, :), ctype(:)
@@ -795,8 +795,20 @@ contains
     if (allocated(msh%file_cell)) ctype(msh%file_cell) = msh%cell_type
     k = 0
     do c = 1, msh%ncell
-      nv = merge(4, 3, ctype(c) == ELEM_Q1)
-      t(k + 1) = merge(5, 4, nv == 4)
+      select case (ctype(c))
+      case (ELEM_Q1)
+        nv = 4
+        t(k + 1) = 5
+      case (ELEM_P1)
+        nv = 3
+        t(k + 1) = 4
+      case (ELEM_TET4)
+        nv = 4
+        t(k + 1) = 6
+      case default      ! ELEM_HEX8
+        nv = 8
+        t(k + 1) = 9
+      end select
       t(k + 2:k + 1 + nv) = cells(1:nv, c) - 1
       k = k + 1 + nv
     end do
@@ -805,7 +817,8 @@ contains
   !> The length of mixed_topology(msh): per cell its type code and its vertices.
   pure integer function topology_size(msh)
     type(mesh_t), intent(in) :: msh
-    topology_size = count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type /= ELEM_Q1)*4
+    topology_size = count(msh%cell_type == ELEM_Q1)*5 + count(msh%cell_type == ELEM_P1)*4 + &
+                    count(msh%cell_type == ELEM_TET4)*5 + count(msh%cell_type == ELEM_HEX8)*9
   end function topology_size
 
   !> Points or vectors (NDIM, n) as (3, n): in the plane padded with z = 0.
@@ -973,7 +986,7 @@ contains
     t = line('      <Grid Name="body'//body_label(a)//'" GridType="Uniform">')//time
     t = t//line('        <Topology TopologyType="'//trim(topo)//'" NumberOfElements="'//trim(nc)//'">')
     if (msh%element == ELEM_MIXED) then
-      write (nv, '(i0)') 5*count(msh%cell_type == ELEM_Q1) + 4*count(msh%cell_type /= ELEM_Q1)
+      write (nv, '(i0)') topology_size(msh)
       t = t//line('          <DataItem Dimensions="'//trim(nv)// &
                   '" NumberType="Int" Precision="4" Format="HDF">'//g//'/topology</DataItem>')
     else
