@@ -412,6 +412,7 @@ meshes:
 	     $(GMSH_MSH) -setnumber nu $$nu -setnumber nl $$nl paper_nonmatching.geo -o paper_nonmatching_$${nu}_$${nl}.msh; \
 	   done; \
 	   $(GMSH) -3 -format msh41 -v 2 blocks_3d.geo -o blocks_3d.msh; \
+	   for h in 0.02 0.01; do $(GMSH) -3 -format msh41 -v 2 -setnumber hc $$h sphere_block.geo -o sphere_block_h$$h.msh; done; \
 	 fi
 
 clean:
