@@ -115,6 +115,20 @@ $(BUILD)/%.o: %.c include/cholmod_shim.h include/blas_tiles.h include/sighdl.h |
 	@mkdir -p $(BUILD)
 	$(CC) $(CFLAGS) -c $< -o $@
 
+# make check's MPI build (MPI=1 SHARE=build/release, the serial build made just before it):
+# the modules that use neither MPI nor MUMPS, not even through another module
+# (tools/mpi_free_modules.py), are the serial build's objects and module files, copied; only
+# the others are compiled again with mpif90.
+ifeq ($(MPI),1)
+ifneq ($(SHARE),)
+SHARED_MODS := $(shell $(PYTHON) tools/mpi_free_modules.py)
+$(addprefix $(BUILD)/,$(addsuffix .o,$(SHARED_MODS))): $(BUILD)/%.o: $(SHARE)/%.o
+	@mkdir -p $(BUILD)
+	cp -p $< $@
+	cp -p $(SHARE)/$*.mod $(BUILD)/$*.mod
+endif
+endif
+
 # Explicit module dependencies: each object depends on the modules its source `use`s
 # (tests/test_makefile_deps.py checks that these lines are exactly the real ones).
 $(BUILD)/kinds.o:
@@ -316,7 +330,8 @@ run: $(PROG)
 CHECK_JOBS = $(if $(findstring -j,$(MAKEFLAGS)),,-j$(shell nproc 2>/dev/null || echo 2))
 check: mpi-deps
 	@$(MAKE) --no-print-directory $(CHECK_JOBS) $(PROG) $(TEST_BINS) $(BENCH_BINS)
-	@if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then $(MAKE) --no-print-directory $(CHECK_JOBS) MPI=1 all; fi
+	@if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then \
+	   $(MAKE) --no-print-directory $(CHECK_JOBS) MPI=1 $(if $(filter 1,$(DEBUG)),,SHARE=$(BUILD)) all; fi
 	@BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
 
 mpi-deps:
