@@ -330,9 +330,14 @@ run: $(PROG)
 CHECK_JOBS = $(if $(findstring -j,$(MAKEFLAGS)),,-j$(shell nproc 2>/dev/null || echo 2))
 check: mpi-deps
 	@$(MAKE) --no-print-directory $(CHECK_JOBS) $(PROG) $(TEST_BINS) $(BENCH_BINS)
-	@if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then \
-	   $(MAKE) --no-print-directory $(CHECK_JOBS) MPI=1 $(if $(filter 1,$(DEBUG)),,SHARE=$(BUILD)) all; fi
-	@BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
+	@rm -f $(BUILD)/mpi-build.status; \
+	if command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; then \
+	  echo "check: building bin/robin_contact_mpi beside the first tests (log: $(BUILD)/mpi-build.log)"; \
+	  ( nice -n 10 $(MAKE) --no-print-directory $(CHECK_JOBS) MPI=1 $(if $(filter 1,$(DEBUG)),,SHARE=$(BUILD)) all \
+	      > $(BUILD)/mpi-build.log 2>&1; echo $$? > $(BUILD)/mpi-build.status ) & \
+	  export MPI_BUILD_STATUS=$(BUILD)/mpi-build.status; \
+	fi; \
+	BUILD=$(BUILD) BIN=$(PROG) PYTHON=$(PYTHON) bash tests/run_tests.sh
 
 mpi-deps:
 	@if ! { command -v mpif90 >/dev/null 2>&1 && [ -f /usr/include/dmumps_struc.h ]; }; then \

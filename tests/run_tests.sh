@@ -39,6 +39,17 @@ for t in tests/system/test_*.sh tests/test_*.sh; do
   [ -f "$t" ] || continue
   run_one "$(basename "$t" .sh)" bash "$t"
 done
+# the MPI binary, built beside the tests so far (make check): wait for it before the Python
+# tests, some of which run it when it exists
+if [ -n "${MPI_BUILD_STATUS:-}" ]; then
+  waited=0
+  while [ ! -f "$MPI_BUILD_STATUS" ] && [ $waited -lt 1800 ]; do sleep 1; waited=$((waited + 1)); done
+  if [ "$(cat "$MPI_BUILD_STATUS" 2>/dev/null)" != 0 ]; then
+    fail=$((fail+1)); failed="$failed mpi_build"
+    echo "FAIL mpi_build (the MPI binary did not build; last lines of ${MPI_BUILD_STATUS%.status}.log)"
+    tail -n 25 "${MPI_BUILD_STATUS%.status}.log" 2>/dev/null
+  fi
+fi
 for t in tests/system/test_*.py tests/test_*.py; do
   [ -f "$t" ] || continue
   run_one "$(basename "$t" .py)" "$PYTHON" "$t"
