@@ -21,7 +21,7 @@ module mesh_topology
   implicit none (type, external)
   private
 
-  public :: body_from_file, add_physical, index_entities, entity_index, index_groups
+  public :: body_from_file, body_group, add_physical, index_entities, entity_index, index_groups
   ! for the volume meshes of module volume_topology
   public :: group_members, entity_cells, cell_regions, point_groups, number_for_locality, &
             check_one_piece, sort_by_tag
@@ -224,6 +224,60 @@ contains
     end do
   end subroutine bucket_items
 
+  !> The physical group of dimension `dim` (2: a surface, 3: a volume) that is the body:
+  !! the one named `region`, or with region = '' the file's only one (0 when the file has
+  !! none: every cell of that dimension is the body). err (ERR_INPUT, a phrase about the file)
+  !! when no group has that name (`hint` appended) or region = '' and there are several.
+  subroutine body_group(file_mesh, region, dim, hint, group, err)
+    type(file_mesh_t), intent(in) :: file_mesh   !< the file's physical groups
+    character(len=*), intent(in) :: region       !< the body's group name, or ''
+    integer, intent(in) :: dim                   !< 2 or 3
+    character(len=*), intent(in) :: hint         !< appended to a 'has no physical ...' message
+    integer, intent(out) :: group                !< its index in file_mesh%phys_*, 0: none
+    type(error_t), intent(out) :: err
+    integer :: k, n
+    character(len=:), allocatable :: noun, names
+    type(text_buffer_t) :: list
+    noun = trim(merge('surface', 'volume ', dim == 2))
+    n = 0
+    group = 0
+    do k = 1, file_mesh%nphys
+      if (file_mesh%phys_dim(k) /= dim) cycle
+      n = n + 1
+      if (len(region) > 0) then
+        if (file_mesh%phys_name(k)%s == region) group = k
+      end if
+    end do
+    if ((len(region) > 0 .and. group == 0) .or. (len(region) == 0 .and. n > 1)) then
+      n = 0                    ! their names, for the message
+      do k = 1, file_mesh%nphys
+        if (file_mesh%phys_dim(k) /= dim) cycle
+        n = n + 1
+        call list%add(merge(', ', '  ', n > 1)//"'"//file_mesh%phys_name(k)%s//"'")
+      end do
+      names = list%text()
+      names = trim(adjustl(names))
+    end if
+    if (len(region) > 0 .and. group == 0) then
+      if (n == 0) then
+        call err%set(ERR_INPUT, "has no physical "//noun//" '"//region//"' (it has no physical "//noun//"s)"//hint)
+      else
+        call err%set(ERR_INPUT, "has no physical "//noun//" '"//region//"' (its physical "//noun//"s: "//names//')'// &
+                     hint)
+      end if
+      return
+    end if
+    if (len(region) == 0 .and. n > 1) then
+      call err%set(ERR_INPUT, 'holds '//i2s(n)//' physical '//noun//'s ('//names//'); name the body''s one as its region')
+      return
+    end if
+    if (len(region) == 0 .and. n == 1) then
+      do k = 1, file_mesh%nphys
+        if (file_mesh%phys_dim(k) == dim) group = k
+      end do
+    end if
+  end subroutine body_group
+
   !> One body from what a mesh file holds: choose the body's cells (those of the physical
   !! surface `region`), number its nodes by tag, orient and check its cells, find its
   !! groups, then number its nodes and cells for locality (number_for_locality). On failure err holds ERR_INPUT (bad input) or ERR_MEMORY and a phrase about the file
@@ -234,50 +288,13 @@ contains
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
     type(error_t), intent(out) :: err                   !< the failure, if any
-    integer :: surface, k, c, i, nsurf, ncell, st, nquad, nnew
+    integer :: surface, k, c, i, ncell, st, nquad, nnew
     logical, allocatable :: in_entity(:)
     integer, allocatable :: file_cell(:), body_node(:), order(:)
-    character(len=:), allocatable :: surfaces
-    type(text_buffer_t) :: list
 
     ! the physical surface of the body
-    nsurf = 0
-    surface = 0
-    do k = 1, file_mesh%nphys
-      if (file_mesh%phys_dim(k) /= 2) cycle
-      nsurf = nsurf + 1
-      if (len(region) > 0) then
-        if (file_mesh%phys_name(k)%s == region) surface = k
-      end if
-    end do
-    if ((len(region) > 0 .and. surface == 0) .or. (len(region) == 0 .and. nsurf > 1)) then
-      nsurf = 0                    ! their names, for the message
-      do k = 1, file_mesh%nphys
-        if (file_mesh%phys_dim(k) /= 2) cycle
-        nsurf = nsurf + 1
-        call list%add(merge(', ', '  ', nsurf > 1)//"'"//file_mesh%phys_name(k)%s//"'")
-      end do
-      surfaces = list%text()
-      surfaces = trim(adjustl(surfaces))
-    end if
-    if (len(region) > 0 .and. surface == 0) then
-      if (nsurf == 0) then
-        call err%set(ERR_INPUT, "has no physical surface '"//region//"' (it has no physical surfaces)")
-      else
-        call err%set(ERR_INPUT, "has no physical surface '"//region//"' (its physical surfaces: "//surfaces//')')
-      end if
-      return
-    end if
-    if (len(region) == 0 .and. nsurf > 1) then
-      call err%set(ERR_INPUT, 'holds '//i2s(nsurf)//' physical surfaces ('//surfaces// &
-                '); name the body''s one as its region')
-      return
-    end if
-    if (len(region) == 0 .and. nsurf == 1) then
-      do k = 1, file_mesh%nphys
-        if (file_mesh%phys_dim(k) == 2) surface = k
-      end do
-    end if
+    call body_group(file_mesh, region, 2, '', surface, err)
+    if (err%failed()) return
 
     ! its cells: those of the surface entities in the group (every one without a group)
     allocate (in_entity(0:file_mesh%nent))

@@ -29,7 +29,7 @@ module volume_topology
   use int_hash, only: int_hash_t, hash_init, hash_slot
   use sorting, only: merge_sort_by_keys
   use mesh, only: mesh_t
-  use mesh_topology, only: file_mesh_t, group_members, entity_cells, cell_regions, point_groups, number_for_locality, &
+  use mesh_topology, only: file_mesh_t, body_group, group_members, entity_cells, cell_regions, point_groups, number_for_locality, &
                            check_one_piece, sort_by_tag
   implicit none (type, external)
   private
@@ -82,52 +82,14 @@ contains
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
     type(error_t), intent(out) :: err                   !< the failure, if any
-    integer :: volume, k, c, i, nvol, ncell, st, nhex, nnew
+    integer :: volume, k, c, i, ncell, st, nhex, nnew
     logical, allocatable :: in_entity(:)
     integer, allocatable :: file_cell(:), body_node(:), order(:)
-    character(len=:), allocatable :: volumes
-    type(text_buffer_t) :: list
     type(face_table_t) :: faces
 
     ! the physical volume of the body
-    nvol = 0
-    volume = 0
-    do k = 1, file_mesh%nphys
-      if (file_mesh%phys_dim(k) /= 3) cycle
-      nvol = nvol + 1
-      if (len(region) > 0) then
-        if (file_mesh%phys_name(k)%s == region) volume = k
-      end if
-    end do
-    if ((len(region) > 0 .and. volume == 0) .or. (len(region) == 0 .and. nvol > 1)) then
-      nvol = 0                    ! their names, for the message
-      do k = 1, file_mesh%nphys
-        if (file_mesh%phys_dim(k) /= 3) cycle
-        nvol = nvol + 1
-        call list%add(merge(', ', '  ', nvol > 1)//"'"//file_mesh%phys_name(k)%s//"'")
-      end do
-      volumes = list%text()
-      volumes = trim(adjustl(volumes))
-    end if
-    if (len(region) > 0 .and. volume == 0) then
-      if (nvol == 0) then
-        call err%set(ERR_INPUT, "has no physical volume '"//region//"' (it has no physical volumes)"//surface_hint())
-      else
-        call err%set(ERR_INPUT, "has no physical volume '"//region//"' (its physical volumes: "//volumes//')'// &
-                     surface_hint())
-      end if
-      return
-    end if
-    if (len(region) == 0 .and. nvol > 1) then
-      call err%set(ERR_INPUT, 'holds '//i2s(nvol)//' physical volumes ('//volumes// &
-                   '); name the body''s one as its region')
-      return
-    end if
-    if (len(region) == 0 .and. nvol == 1) then
-      do k = 1, file_mesh%nphys
-        if (file_mesh%phys_dim(k) == 3) volume = k
-      end do
-    end if
+    call body_group(file_mesh, region, 3, surface_hint(), volume, err)
+    if (err%failed()) return
 
     ! its cells: those of the volume entities in the group (every one without a group)
     allocate (in_entity(0:file_mesh%nent))
