@@ -6,6 +6,7 @@ Usage:
   pvpython tools/paraview_view.py RESULT [-o view.png] [--field NAME] [--scale S|auto]
                                   [--clip P] [--range MIN MAX] [--edges] [--size WxH]
                                   [--zoom contact|X0,X1,Y0,Y1] [--step K]
+                                  [--cut auto|none|x|y|z|x=V|PX,PY,PZ,NX,NY,NZ]
   pvpython tools/paraview_view.py RESULT --list      (the point and cell arrays, then exit)
 RESULT is results/x.xdmf or results/x.h5 (then its sibling results/x.xdmf is opened).
 It also runs with pvbatch, or with /usr/bin/python3 when ParaView's Python modules are
@@ -39,6 +40,23 @@ them. A side whose nodes are not the contact nodes (the master side of non-match
 gets no line. The file's own contact-line grids (undeformed) are not drawn, except for an
 array that only they have (pressure, shear, state, ...): then they are coloured by it, warped
 by their first body's displacement, over the bodies in a solid grey.
+Solid (3D) results (root attribute dimension = 3): the bodies are clipped by a plane through
+the contact (undeformed, then warped) and drawn in a parallel view along the plane's normal,
+the coordinate axis closest to the contact's mean normal up (cut_plane):
+  --cut auto     (default) a symmetry plane through the contact zone: a plane of the model's
+                 bounding box across the contact normal on which the active zone ends on one
+                 side only (x = 0 of a quarter model: the whole model kept, its symmetry face
+                 seen); else the plane through the contact centre (the normal-force weighted
+                 mean of the active contact nodes) across the first such axis
+  --cut x|y|z    the plane normal to that axis through the contact centre; x=V at x = V; an
+                 axis plane keeps the side where the model reaches farther
+  --cut PX,PY,PZ,NX,NY,NZ  the plane through P with normal N, keeping N's side
+  --cut none     no clip
+  --zoom contact frames the active contact zone (warped) in that view; a box X0,X1,Y0,Y1 is
+                 for plane results only.
+The log line names the plane. An array of the contact surfaces only (pressure, gap, ...)
+shows the surfaces alone (the file's faces, warped by their slave body's displacement), seen
+along their mean normal. No contact lines are drawn.
 Tested with Debian 12's ParaView 5.11 (pvpython is in the package python3-paraview).
 
 Headless nodes: rendering needs an X display, or an offscreen (EGL/OSMesa) ParaView build.
@@ -89,7 +107,9 @@ def parse(argv):
     ap.add_argument("--step", type=int, default=None, metavar="K",
                     help="load step K of a result with load steps (default: the last)")
     ap.add_argument("--zoom", default=None, metavar="contact|X0,X1,Y0,Y1",
-                    help="frame the contact zone ('contact') or a box X0,X1,Y0,Y1")
+                    help="frame the contact zone ('contact') or a box X0,X1,Y0,Y1 (plane results)")
+    ap.add_argument("--cut", default="auto", metavar="auto|none|x|y|z|x=V|PX,PY,PZ,NX,NY,NZ",
+                    help="solid results: the clip plane through the contact (default auto)")
     return ap.parse_args(argv)
 
 
@@ -190,7 +210,8 @@ def field_unit(xdmf, name):
     field ('' for an unknown one)."""
     import xml.etree.ElementTree as ET
     kind = "length" if name.startswith("displacement") or name in ("gap", "g0") else \
-        "stress" if name in ("von_mises", "contact_pressure", "pressure", "sxx", "syy", "sxy", "szz", "stress") \
+        "stress" if name in ("von_mises", "contact_pressure", "pressure", "sxx", "syy", "sxy", "szz", "syz", "sxz",
+                             "stress") \
         else None
     default = {"length": "m", "stress": "Pa", None: ""}[kind]
     try:
@@ -330,6 +351,167 @@ def zoom_box(spec, h5path=None, scale=0.0, step=None):
     return x0 - margin, x1 + margin, y0 - margin, y1 + margin
 
 
+# ---- solid (3D) results: the clip plane and the contact surfaces (numpy and h5py only) -----
+AXES = "xyz"
+
+
+def result_dimension(h5path):
+    """3 for a result of solid bodies (the root attribute `dimension` that 3D runs write), else 2."""
+    import h5py
+    with h5py.File(h5path, "r") as f:
+        return int(f.attrs.get("dimension", 2))
+
+
+def contact_zone_3d(h5path, step=None):
+    """The contact of a solid result, all pairs: the contact nodes (m, 3), their normal forces
+    (m) (of load step `step`, None: the final ones), the unit mean normal weighted by the normal
+    forces (all nodes alike when none is positive), and the model's bounding box (lo, hi) over
+    every body's nodes."""
+    import h5py
+    import numpy as np
+    with h5py.File(h5path, "r") as f:
+        c = np.asarray(f["contact/coordinates"][()], dtype=float).T
+        nrm = np.asarray(f["contact/normal"][()], dtype=float).T
+        at = f if step is None or "steps" not in f else f[f"steps/step_{step}"]
+        lam = np.asarray(at["contact/normal_force"][()], dtype=float).reshape(-1)
+        xs = [np.asarray(f[f"body{b}/coordinates"][()], dtype=float)
+              for b in range(1, int(f.attrs.get("bodies", 2)) + 1)]
+    if c.shape[0] == 0:
+        raise ValueError(f"{h5path}: no contact node")
+    w = np.where(lam > 0.0, lam, 0.0) if np.any(lam > 0.0) else np.ones(lam.size)
+    n = (w[:, None] * nrm).sum(axis=0)
+    n = n / np.linalg.norm(n) if np.linalg.norm(n) > 0.0 else np.array([0.0, 1.0, 0.0])
+    lo = np.min([x.min(axis=1) for x in xs], axis=0)
+    hi = np.max([x.max(axis=1) for x in xs], axis=0)
+    return c, lam, n, lo, hi
+
+
+def cut_plane(spec, h5path, step=None):
+    """The clip plane of a solid result's picture, or None for --cut none: (origin (3,), unit
+    normal (3,), up axis 0-2, note). The picture keeps the part of the bodies on the side the
+    normal points to and looks at the cut along the normal; the up axis is the coordinate axis
+    closest to the contact's mean normal (contact_zone_3d) that the plane does not face.
+    The contact centre is the normal-force weighted mean of the active contact nodes (all
+    contact nodes when none is active). spec:
+      auto     a symmetry plane through the contact zone: the plane of the model's bounding box
+               normal to an axis across the contact normal on which the active zone ends on one
+               side only (a half or quarter model: the zone is the part of a whole one); else
+               the plane through the contact centre normal to the first such axis (x before y
+               before z)
+      x, y, z  the plane normal to that axis through the contact centre; x=V at x = V
+      PX,PY,PZ,NX,NY,NZ  the plane through point P with normal N (the kept side: N's)
+    An axis plane keeps the side where the model reaches farther from it (+ on a tie).
+    ValueError for a spec it does not understand or a result without contact nodes."""
+    import numpy as np
+    spec = spec.strip().lower()
+    if spec == "none":
+        return None
+    c, lam, n, lo, hi = contact_zone_3d(h5path, step)
+    pick = lam > 0.0 if np.any(lam > 0.0) else np.ones(lam.size, dtype=bool)
+    w = lam[pick] if np.any(lam > 0.0) else np.ones(int(pick.sum()))
+    centre = (w[:, None] * c[pick]).sum(axis=0) / w.sum()
+    order = [int(i) for i in np.argsort(-np.abs(n), kind="stable")]
+    across = [i for i in range(3) if i != order[0]]
+    tol = 1e-9 * float(np.max(hi - lo))
+
+    def axis_plane(i, v, note):
+        origin = centre.copy()
+        origin[i] = v
+        normal = np.zeros(3)
+        normal[i] = 1.0 if hi[i] - v >= v - lo[i] - tol else -1.0
+        return origin, normal, note
+
+    m = re.fullmatch(r"([xyz])(?:\s*=\s*(.+))?", spec)
+    if spec == "auto":
+        sym = []
+        for i in across:
+            ends = [v for v in (lo[i], hi[i]) if np.any(np.abs(c[pick, i] - v) <= tol)]
+            if len(ends) == 1:
+                sym.append((i, float(ends[0])))
+        if sym:
+            i, v = sym[0]
+            origin, normal, note = axis_plane(i, v, f"symmetry plane {AXES[i]} = {v:.4g} (the contact zone ends "
+                                                    f"on the model's boundary there)")
+        else:
+            i = across[0]
+            origin, normal, note = axis_plane(i, float(centre[i]),
+                                              f"plane {AXES[i]} = {centre[i]:.4g} through the contact centre")
+    elif m:
+        i = AXES.index(m.group(1))
+        if m.group(2) is None:
+            origin, normal, note = axis_plane(i, float(centre[i]),
+                                              f"plane {AXES[i]} = {centre[i]:.4g} through the contact centre")
+        else:
+            try:
+                v = float(m.group(2))
+            except ValueError:
+                raise ValueError(f"{m.group(1)}=V takes a number, not {m.group(2)!r}") from None
+            origin, normal, note = axis_plane(i, v, f"plane {AXES[i]} = {v:.4g}")
+    else:
+        try:
+            t = [float(x) for x in spec.split(",")]
+        except ValueError:
+            t = []
+        if len(t) != 6 or not np.linalg.norm(t[3:]) > 0.0:
+            raise ValueError(f"expected auto, none, x, y, z, x=V (y=V, z=V) or PX,PY,PZ,NX,NY,NZ "
+                             f"(a point and a nonzero normal), not {spec!r}")
+        origin = np.array(t[:3])
+        normal = np.array(t[3:]) / np.linalg.norm(t[3:])
+        note = (f"plane through ({', '.join(f'{v:.4g}' for v in origin)}) normal "
+                f"({', '.join(f'{v:.3g}' for v in normal)})")
+    up = next(i for i in order if abs(normal[i]) < 0.9)
+    return origin, normal, up, note
+
+
+def contact_points_3d(h5path, scale, step=None):
+    """The contact nodes of a solid result (m, 3), each pair's warped by scale times its slave
+    body's displacement (of load step `step`, None: the final one); a node that is none of its
+    slave body's nodes stays where it is."""
+    import h5py
+    import numpy as np
+    with h5py.File(h5path, "r") as f:
+        c = np.asarray(f["contact/coordinates"][()], dtype=float).T
+        at = f if step is None or "steps" not in f else f[f"steps/step_{step}"]
+        npair = int(f.attrs.get("pairs", 1))
+        out, first = c.copy(), 0
+        for k in range(1, npair + 1):
+            g = f[f"contact/pair_{k}"]
+            n = g["normal_force"].shape[0]
+            b = int(np.asarray(g.attrs.get("slave_body", 1)).reshape(-1)[0])
+            if f"body{b}" in f and f"body{b}" in at and "displacement" in at[f"body{b}"]:
+                xyz = np.asarray(f[f"body{b}/coordinates"][()], dtype=float).T
+                u = np.asarray(at[f"body{b}/displacement"][()], dtype=float).T
+                index = {tuple(p): j for j, p in enumerate(xyz.tolist())}
+                for i in range(first, first + n):
+                    j = index.get(tuple(c[i].tolist()))
+                    if j is not None:
+                        out[i] = c[i] + scale * u[j]
+            first += n
+    return out
+
+
+def zoom_box_3d(h5path, scale, step, origin, normal, up):
+    """(focal point (3,), half width, half height) of a view along `normal` (up: the axis up
+    in the picture) that frames the active contact nodes (all when none is active) warped by
+    scale, with a margin of half the larger side (at least two mean contact-node spacings)."""
+    import numpy as np
+    pts = contact_points_3d(h5path, scale, step)
+    c, lam, _, _, _ = contact_zone_3d(h5path, step)
+    pick = lam > 0.0 if np.any(lam > 0.0) else np.ones(lam.size, dtype=bool)
+    u = np.zeros(3)
+    u[up] = 1.0
+    u = u - (u @ normal) * normal
+    u /= np.linalg.norm(u)
+    r = np.cross(normal, u)
+    pr, pu = pts[pick] @ r, pts[pick] @ u
+    spacing = float(np.sqrt(np.ptp(c @ r) * np.ptp(c @ u) / max(c.shape[0], 1))) if c.shape[0] > 1 else 0.0
+    (r0, r1), (u0, u1) = (pr.min(), pr.max()), (pu.min(), pu.max())
+    margin = max(0.5 * max(r1 - r0, u1 - u0), 2.0 * spacing)
+    d = float(origin @ normal)
+    focal = 0.5 * (r0 + r1) * r + 0.5 * (u0 + u1) * u + d * normal
+    return focal, 0.5 * (r1 - r0) + margin, 0.5 * (u1 - u0) + margin
+
+
 def step_view(xdmf, step, folder):
     """An XDMF of one load step of a result: the grids (bodies and contact lines) of step K
     (1-based; None: the last) of the Temporal collection, or all the grids of a result without
@@ -375,6 +557,8 @@ def warped_lines(view_file, h5path, scale, step, line_grids, folder):
     undeformed, points. Returns the path."""
     import xml.etree.ElementTree as ET
     import h5py
+    if result_dimension(h5path) == 3:
+        return warped_surfaces(view_file, h5path, scale, step, line_grids, folder)
     pieces, c, _ = contact_pieces(h5path, scale, step)
     with h5py.File(h5path, "r") as f:
         npair = int(f.attrs.get("pairs", 1))
@@ -406,6 +590,38 @@ def warped_lines(view_file, h5path, scale, step, line_grids, folder):
     return out
 
 
+def warped_surfaces(view_file, h5path, scale, step, line_grids, folder):
+    """warped_lines for a solid result: a copy of the step's XDMF whose contact-surface grids
+    have the contact nodes warped by their slave body's displacement (contact_points_3d) as
+    geometry (inline). Returns the path."""
+    import xml.etree.ElementTree as ET
+    import h5py
+    pts = contact_points_3d(h5path, scale, step)
+    with h5py.File(h5path, "r") as f:
+        npair = int(f.attrs.get("pairs", 1))
+        sizes = [f[f"contact/pair_{k}/normal_force"].shape[0] for k in range(1, npair + 1)]
+    first = [0]
+    for n in sizes:
+        first.append(first[-1] + n)
+    tree = ET.parse(view_file)
+    for g in tree.getroot().iter("Grid"):
+        name = g.get("Name", "")
+        m = re.fullmatch(r"contact(?:_pair(\d+))?", name)
+        if name not in line_grids or m is None:
+            continue
+        r0, r1 = (first[int(m.group(1)) - 1], first[int(m.group(1))]) if m.group(1) else (0, first[-1])
+        geo = g.find("Geometry")
+        item = geo.find("DataItem") if geo is not None else None
+        if item is None:
+            continue
+        item.set("Format", "XML")
+        item.set("Dimensions", f"{r1 - r0} 3")
+        item.text = " ".join(f"{x!r} {y!r} {z!r}" for x, y, z in pts[r0:r1])
+    out = os.path.join(folder, "lines.xdmf")
+    tree.write(out, encoding="utf-8", xml_declaration=True)
+    return out
+
+
 def camera_box(box, aspect):
     """(centre x, centre y, parallel scale) of a 2D camera that shows the box whole in a
     picture of width/height = aspect (parallel scale: half the visible height)."""
@@ -432,6 +648,14 @@ def main(argv=None):
             zoom_box(a.zoom)
         except ValueError as e:
             return fail(str(e))
+    if a.cut != "auto":
+        try:
+            if result_dimension(h5) == 3:
+                cut_plane(a.cut, h5)          # a bad --cut fails here, before ParaView starts
+        except ValueError as e:
+            return fail(f"--cut {a.cut}: {e}")
+        except Exception:  # noqa: BLE001 - an unreadable file: reported by render()
+            pass
     if a.step is not None:
         import tempfile
         tmp = tempfile.mkdtemp(prefix="paraview_view.")
@@ -486,6 +710,13 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
     elif ncomp == 1:
         comp = 0
 
+    try:
+        dim = result_dimension(h5)
+    except (OSError, ValueError):
+        dim = 2
+    if dim == 3 and a.zoom not in (None, "contact"):
+        return fail(f"--zoom {a.zoom}: a solid result takes --zoom contact (the view is along the clip plane's normal)")
+
     # warp
     # the bodies alone (the contact lines are drawn below, warped like them); the reader's
     # contact grids only for an array that no body has (they are not warped)
@@ -494,7 +725,23 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
         bodies = pvs.ExtractBlock(Input=reader, Selectors=[f"/Root/{g}" for g in body_grids])
         bodies.UpdatePipeline()
         on_lines = field not in arrays(bodies)
-    src, scale, how = bodies, 0.0, "no warp"
+    # a solid result: the bodies clipped by a plane through the contact (undeformed, then warped)
+    cut, shown = None, bodies
+    if dim == 3 and not on_lines:
+        try:
+            cut = cut_plane(a.cut, h5, step if nstep > 1 else None)
+        except (ValueError, OSError, KeyError) as e:
+            return fail(f"--cut {a.cut}: {e}")
+        if cut is not None:
+            shown = pvs.Clip(Input=bodies)
+            shown.ClipType = "Plane"
+            shown.ClipType.Origin = [float(v) for v in cut[0]]
+            shown.ClipType.Normal = [float(v) for v in cut[1]]
+            shown.Invert = 0                     # keep the side the normal points to
+            if hasattr(shown, "Crinkleclip"):
+                shown.Crinkleclip = 0
+            shown.UpdatePipeline()
+    src, scale, how = shown, 0.0, "no warp"
     if "displacement" in arr and arr["displacement"][0] == "POINTS" and a.scale not in ("0", "0.0", "none"):
         info = bodies.GetDataInformation()
         b = info.GetBounds()
@@ -510,7 +757,7 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
                 return fail(f"--scale must be a number or 'auto', not {a.scale!r}")
             how = f"largest displacement {umax:.3g}"
         if scale != 0.0:
-            src = pvs.WarpByVector(Input=bodies, Vectors=["POINTS", "displacement"], ScaleFactor=scale)
+            src = pvs.WarpByVector(Input=shown, Vectors=["POINTS", "displacement"], ScaleFactor=scale)
     elif a.scale not in ("0", "0.0", "none"):
         how = "no 'displacement' point array: not warped"
 
@@ -527,7 +774,7 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
         lo, hi = a.range
         rng_note = "range set by --range"
     else:
-        v = values(coloured if on_lines else bodies, field, assoc, comp)
+        v = values(coloured if on_lines else shown, field, assoc, comp)
         if v is None:
             return fail(f"array '{field}' has no finite values")
         import numpy as np
@@ -554,8 +801,10 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
     if on_lines:
         disp.ColorArrayName = ["POINTS", ""]
         disp.AmbientColor = disp.DiffuseColor = [0.8, 0.8, 0.8]
+        if dim == 3:                              # the contact surfaces lie inside the bodies: alone
+            pvs.Hide(src, view)
         disp = pvs.Show(coloured, view)
-        disp.Representation = "Surface"
+        disp.Representation = "Surface With Edges" if a.edges and dim == 3 else "Surface"
     if (on_lines or not a.edges) and hasattr(disp, "LineWidth"):
         disp.LineWidth = 5.0 if on_lines else 3.0     # polyline grids (a contact line) stay visible
     pvs.ColorBy(disp, (assoc, field) if comp < 0 and ncomp > 1 and not compname
@@ -586,11 +835,12 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
     td.FontSize = 14
     if hasattr(td, "Color"):
         td.Color = [0.0, 0.0, 0.0]
-    # the contact line of each body, warped like the bodies, drawn over them
+    # the contact line of each body, warped like the bodies, drawn over them (plane results)
+    lines = []
     try:
-        lines, _, _ = contact_lines(h5, scale, step if nstep > 1 else None)
+        if dim == 2:
+            lines, _, _ = contact_lines(h5, scale, step if nstep > 1 else None)
     except (OSError, KeyError) as e:
-        lines = []
         print(f"{TOOL}: note: no contact line drawn ({e})", file=sys.stderr)
     for _, pts in lines:
         pl = pvs.PolyLineSource(Points=[v for x, y in pts for v in (float(x), float(y), 0.0)])
@@ -600,12 +850,15 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
         ld.AmbientColor = ld.DiffuseColor = [0.0, 0.0, 0.0]
         if hasattr(ld, "LineWidth"):
             ld.LineWidth = 2.0
+    zoom_note = ""
+    if dim == 3:
+        return render_3d(a, pvs, view, h5, w, h, scale, step if nstep > 1 else None, cut, on_lines,
+                         (label, assoc, lo, hi, unit, rng_note, step_note))
     view.InteractionMode = "2D"
     view.CameraPosition = [0.0, 0.0, 1.0]
     view.CameraFocalPoint = [0.0, 0.0, 0.0]
     view.CameraViewUp = [0.0, 1.0, 0.0]
     view.ResetCamera()
-    zoom_note = ""
     if a.zoom is not None:
         try:
             box = zoom_box(a.zoom, h5, scale, step if nstep > 1 else None)
@@ -624,6 +877,53 @@ def render(a, pvs, xdmf, h5, field, compname, w, h, tmp):
         return fail(f"ParaView wrote no {out}")
     print(f"{TOOL}: wrote {a.output} ({label}, {assoc.lower()[:-1]} data, colour {lo:.4g} to {hi:.4g}{' ' + unit if unit else ''}, "
           f"{rng_note}, magnification {scale:g}, {len(lines)} contact lines{zoom_note}{step_note})")
+    return 0
+
+
+def render_3d(a, pvs, view, h5, w, h, scale, step, cut, on_lines, what):
+    """The camera and the picture of a solid result (render's end): a parallel view of the clip
+    plane's kept part along its normal, its up axis up (cut_plane); the contact surfaces alone
+    (an array of theirs) along the contact's mean normal; --zoom contact frames the active
+    contact zone (zoom_box_3d)."""
+    import numpy as np
+    label, assoc, lo, hi, unit, rng_note, step_note = what
+    if cut is not None:
+        origin, normal, up, note = cut
+        clip_note = f"clip: {note}, normal ({', '.join(f'{v:.3g}' for v in normal)})"
+    else:
+        c, lam, n, _, _ = contact_zone_3d(h5, step)
+        pick = lam > 0.0 if np.any(lam > 0.0) else np.ones(lam.size, dtype=bool)
+        origin = c[pick].mean(axis=0)
+        order = [int(i) for i in np.argsort(-np.abs(n), kind="stable")]
+        if on_lines:               # the contact surfaces seen along their normal
+            normal, up = np.sign(n[order[0]] or 1.0) * np.eye(3)[order[0]], order[1]
+            clip_note = "the contact surfaces alone, seen along their mean normal"
+        else:                      # --cut none: the whole bodies, from the side of the first axis across
+            normal, up = np.eye(3)[[i for i in range(3) if i != order[0]][0]], order[0]
+            clip_note = "no clip"
+    view.CameraParallelProjection = 1
+    view.CameraFocalPoint = [float(v) for v in origin]
+    view.CameraPosition = [float(v) for v in origin - normal]
+    view.CameraViewUp = [float(v) for v in np.eye(3)[up]]
+    view.ResetCamera()
+    zoom_note = ""
+    if a.zoom == "contact":
+        try:
+            focal, hw, hh = zoom_box_3d(h5, scale, step, np.asarray(origin, dtype=float), normal, up)
+        except (ValueError, OSError, KeyError) as e:
+            return fail(f"--zoom contact: {e}")
+        dist = float(np.linalg.norm(np.asarray(view.CameraPosition) - np.asarray(view.CameraFocalPoint)))
+        view.CameraFocalPoint = [float(v) for v in focal]
+        view.CameraPosition = [float(v) for v in focal - dist * normal]
+        view.CameraParallelScale = max(hh, hw / (w / h))
+        zoom_note = f", zoom on the contact zone ({2 * hw:.4g} x {2 * hh:.4g})"
+    out = os.path.abspath(a.output)
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    pvs.SaveScreenshot(out, view, ImageResolution=[w, h])
+    if not os.path.isfile(out):
+        return fail(f"ParaView wrote no {out}")
+    print(f"{TOOL}: wrote {a.output} ({label}, {assoc.lower()[:-1]} data, colour {lo:.4g} to {hi:.4g}"
+          f"{' ' + unit if unit else ''}, {rng_note}, magnification {scale:g}, {clip_note}{zoom_note}{step_note})")
     return 0
 
 

@@ -1,9 +1,12 @@
 #!/usr/bin/python3
 """Normal contact pressure and gap along the contact line of robin_contact runs, several
-runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-gap scene.
+runs overlaid, optionally with the Hertz line-contact pressure of a parabolic-gap scene; for
+solid (3D) results a pressure map of each contact surface and the pressure along a line
+through it, optionally with Hertz's point contact (the end of this text).
 
 Usage: tools/plot_contact.py FILE.h5 [FILE.h5 ...] [--hertz] [--mindlin] [--radius R] [--pair K]
        [-o contact.png] [--title TEXT]
+       solid results also [--line x|y|z|DX,DY,DZ] [--centre X,Y,Z] [--force P] [--csv FILE]
 
 Top panel: /contact/pressure (nodal force / tributary length) against the arc length s along
 the contact curve (/contact/s). The legend gives each run's contact force per unit thickness:
@@ -64,6 +67,36 @@ panel; printed: 'plot_contact: Mindlin for NAME: mu=... Q=... c=... c_num=... er
 err_q=...' with c_num half the width of the stick zone, err_c = |c_num - c| / a and
 err_q = sqrt(sum w (q - q_M)^2 / sum w q_M^2) over the Hertz zone. A run without Coulomb
 friction or without a Hertz curve gets no Mindlin curve (a note on stderr).
+Solid results (3D; root attribute dimension = 3, every file of the run solid): per contact
+surface (/contact, or each /contact/pair_<k>) a pressure map over the surface's two
+coordinates across its normal (the axis closest to the mean normal, weighted by the normal
+forces, is left out: x, z for a normal along y), drawn on its faces (/contact/.../faces,
+quadrilaterals split in two), the first 4 surfaces side by side; below, the pressure and the
+gap along a line through the contact centre, linearly interpolated on those faces, against
+the signed distance t from the centre, the nodes within half a median face edge of the line
+as dots. The contact centre is the normal-force weighted mean of the active nodes, moved onto
+each symmetry plane: a plane of the model's bounding box across the surface on which the
+active zone ends on one side only (a half or quarter model, as inputs/sphere_block.nml).
+  --line x|y|z|DX,DY,DZ  the line's direction (default: the map's first axis); its component
+                         along the normal axis is dropped
+  --centre X,Y,Z         the line's point instead of the contact centre
+  --csv FILE             the line's samples: curve, t, x, y, z (on the faces), pressure, gap,
+                         hertz_pressure (empty without a Hertz curve)
+  --hertz --radius R     Hertz's point contact: a = (3 P R / (4 E*))^(1/3), p0 = 3 P / (2 pi a^2),
+                         p(r) = p0 sqrt(1 - r^2/a^2), R the relative radius of curvature (a
+                         sphere of radius R on a flat: R), 1/E* = sum (1 - nu^2)/E of the two
+                         bodies, P the resultant's component along the normal axis
+                         (/contact/resultant_body1, a pair's resultant_on_first_body) times 2 per
+                         symmetry plane, or --force P. The curve against |t| on the line, the
+                         circle r = a on the map; printed ('plot_contact: Hertz for NAME: P=...
+                         a=... p0=... a_fit=... p0_fit=... err_a=... err_p0=... err_L2=...'):
+                         the Hertz shape fitted to the nodal pressures (p^2 linear in r^2, least
+                         squares over the nodes with p > 0, r the distance from the centre across
+                         the normal), err_a = |a_fit - a| / a, err_p0 = |max p - p0| / p0,
+                         err_L2 weighted by the tributary areas. Several pairs: on --pair K only.
+Printed per surface: its nodes, faces, map axes, centre, symmetry planes, largest pressure and
+active nodes; per line its direction, samples and largest interpolated pressure. No Mindlin
+curve (solid bodies are frictionless).
 Exit 0 on success, 1 (with a message) on a missing or unreadable file or any other failure.
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
 """
@@ -331,17 +364,400 @@ def read_run(path, want_hertz, want_mindlin=False, radius=None, pair=None):
         return runs
 
 
+# ---- solid (3D) results: a pressure map of each contact surface and the pressure along a line --
+AXES = "xyz"
+
+
+def is_solid(path):
+    """Whether a result file is of solid bodies (its root attribute `dimension` is 3)."""
+    with h5py.File(path, "r") as f:
+        return int(np.asarray(f.attrs.get("dimension", 2)).reshape(-1)[0]) == 3
+
+
+def parse_vector(text, what):
+    """Three numbers 'X,Y,Z' (ValueError naming the option otherwise)."""
+    try:
+        v = np.array([float(t) for t in text.split(",")])
+    except ValueError:
+        v = np.zeros(0)
+    if v.size != 3:
+        raise ValueError(f"{what} takes three numbers X,Y,Z, not {text!r}")
+    return v
+
+
+def model_box(f):
+    """(lo, hi) of every body's nodes of a result file."""
+    xs = [np.asarray(f[f"body{b}/coordinates"][()], dtype=float) for b in range(1, int(f.attrs.get("bodies", 2)) + 1)]
+    return np.min([x.min(axis=1) for x in xs], axis=0), np.max([x.max(axis=1) for x in xs], axis=0)
+
+
+def surface_frame(xyz, normal, lam, box, centre=None):
+    """The frame of one contact surface: the axis k closest to its mean normal (weighted by the
+    normal forces; all nodes alike when none is positive), the two other axes (i, j) in order
+    (the map's coordinates), the contact centre and the symmetry planes. The centre is the
+    normal-force weighted mean of the active nodes (all when none is active), or `centre`;
+    a symmetry plane is the plane of the model's bounding box normal to i or j on which the
+    active zone ends on one side only (a half or quarter model: the zone is part of a whole
+    one); the centre lies on it."""
+    act = lam > 0.0
+    w = np.where(act, lam, 0.0) if act.any() else np.ones(lam.size)
+    n = (w[:, None] * normal).sum(axis=0)
+    k = int(np.argmax(np.abs(n)))
+    i, j = (a for a in range(3) if a != k)
+    pick = act if act.any() else np.ones(lam.size, dtype=bool)
+    c = (w[pick, None] * xyz[pick]).sum(axis=0) / w[pick].sum()
+    lo, hi = box
+    tol = 1e-9 * float(np.max(hi - lo))
+    sym = []
+    for a in (i, j):
+        ends = [float(v) for v in (lo[a], hi[a]) if np.any(np.abs(xyz[pick, a] - v) <= tol)]
+        if len(ends) == 1:
+            sym.append((a, ends[0]))
+            c[a] = ends[0]
+    if centre is not None:
+        c = np.asarray(centre, dtype=float)
+    return k, (i, j), c, sym
+
+
+def read_surface(f, g, u, resultant_name, box, centre=None):
+    """One contact surface of a solid result (HDF5 group g: /contact or /contact/pair_<k>):
+    its nodes, fields, faces (the file's `faces`: triangles, quadrilaterals split in two; a
+    Delaunay triangulation of the map's coordinates without them) and frame (surface_frame)."""
+    xyz = np.stack([np.asarray(g[c], dtype=float) for c in ("x", "y", "z")], axis=1)
+    normal = np.asarray(g["normal"][()], dtype=float).T
+    lam = np.asarray(g["normal_force"][()], dtype=float)
+    r = dict(xyz=xyz, lam=lam, p=np.asarray(g["pressure"][()], dtype=float),
+             gap=np.asarray(g["gap"][()], dtype=float),
+             area=np.asarray(g["tributary_area"][()], dtype=float) if "tributary_area" in g else np.ones(lam.size),
+             method=text_attr(f, "method", "?"), status=text_attr(f, "status", "?"),
+             delta=num_attr(f, "delta", float("nan")),
+             resultant=np.asarray(g[resultant_name][()], dtype=float).reshape(-1) if resultant_name in g else None,
+             ux=dataset_unit(g["x"], u["length"]), up=dataset_unit(g["pressure"], u["stress"]),
+             uf=dataset_unit(g["normal_force"], u["force"]), ug=dataset_unit(g["gap"], u["length"]))
+    r["k"], r["ij"], r["c"], r["sym"] = surface_frame(xyz, normal, lam, box, centre)
+    tris = []
+    if "faces" in g:
+        for fc in np.asarray(g["faces"][()], dtype=int).reshape(len(g["faces"]), -1):
+            v = fc[fc >= 0]
+            tris += [v[[0, 1, 2]]] + ([v[[0, 2, 3]]] if v.size == 4 else [])
+    r["tris"] = np.array(tris, dtype=int).reshape(-1, 3)
+    r["nfaces"] = len(g["faces"]) if "faces" in g else 0
+    return r
+
+
+def surface_triangulation(r):
+    """The matplotlib triangulation of a surface in its map's coordinates."""
+    import matplotlib.tri as mtri
+    i, j = r["ij"]
+    x, y = r["xyz"][:, i], r["xyz"][:, j]
+    return mtri.Triangulation(x, y, r["tris"]) if len(r["tris"]) else mtri.Triangulation(x, y)
+
+
+def line_direction(spec, r):
+    """The unit direction of the line through a surface's centre: an axis name or DX,DY,DZ
+    (default: the map's first axis), its component along the surface's normal axis dropped."""
+    if spec is None:
+        d = np.eye(3)[r["ij"][0]]
+    elif spec.strip().lower() in ("x", "y", "z"):
+        d = np.eye(3)[AXES.index(spec.strip().lower())]
+    else:
+        d = parse_vector(spec, "--line")
+    d = np.array(d, dtype=float)
+    d[r["k"]] = 0.0
+    if not np.linalg.norm(d) > 0.0:
+        raise ValueError(f"--line {spec}: along the contact normal ({AXES[r['k']]}), not across the surface")
+    return d / np.linalg.norm(d)
+
+
+def sample_line(r, d, n=401):
+    """The pressure and gap along the line through the centre c with direction d, linearly
+    interpolated on the surface's triangles (in the map's coordinates), at n points evenly
+    spaced over the nodes' extent along d (and t = 0): the samples inside the surface, as
+    (t, points (n, 3), pressure, gap), t the signed distance from c, the points on the
+    triangles (their coordinate along the normal axis interpolated too); and the nodes within
+    half a median face edge of the line (t, pressure)."""
+    import matplotlib.tri as mtri
+    i, j = r["ij"]
+    tri = surface_triangulation(r)
+    q = r["xyz"][:, [i, j]] - r["c"][[i, j]]
+    d2 = d[[i, j]]
+    t_nodes = q @ d2
+    t = np.linspace(t_nodes.min(), t_nodes.max(), n)
+    t = np.union1d(t, [0.0]) if t_nodes.min() < 0.0 < t_nodes.max() else t
+    px, py = r["c"][i] + t * d2[0], r["c"][j] + t * d2[1]
+    pres = mtri.LinearTriInterpolator(tri, r["p"])(px, py)
+    gap = mtri.LinearTriInterpolator(tri, r["gap"])(px, py)
+    inside = ~np.ma.getmaskarray(pres)
+    pts = np.zeros((t.size, 3))
+    pts[:, i], pts[:, j] = px, py
+    pts[:, r["k"]] = np.ma.filled(mtri.LinearTriInterpolator(tri, r["xyz"][:, r["k"]])(px, py), np.nan)
+    edges = np.concatenate([tri.x[tri.edges[:, 0]] - tri.x[tri.edges[:, 1]],
+                            tri.y[tri.edges[:, 0]] - tri.y[tri.edges[:, 1]]]).reshape(2, -1)
+    h = float(np.median(np.hypot(*edges))) if edges.size else 0.0
+    off = np.abs(q @ np.array([-d2[1], d2[0]]))
+    near = off <= 0.5 * h
+    return dict(t=t[inside], xyz=pts[inside], p=np.asarray(pres)[inside], gap=np.asarray(gap)[inside],
+                t_nodes=t_nodes[near], p_nodes=r["p"][near], h=h)
+
+
+def hertz_point(P, R, Es):
+    """Radius a = (3 P R / (4 E*))^(1/3) and peak pressure p0 = 3 P / (2 pi a^2) of Hertz's
+    point contact: total force P, relative radius R, contact modulus E*."""
+    a = (3.0 * P * R / (4.0 * Es)) ** (1.0 / 3.0)
+    return a, 3.0 * P / (2.0 * np.pi * a * a)
+
+
+def hertz_3d(f, r, radius, force, bodies):
+    """Hertz's point contact for one surface, or (None, reason): R = --radius; E* from the
+    young/poisson attributes of its two bodies (1/E* = sum (1 - nu^2)/E); P = --force, else
+    the resultant's component along the surface's normal axis times 2 per symmetry plane."""
+    if radius is None:
+        return None, "a solid result needs --radius R (the relative radius of curvature)"
+    if not radius > 0.0:
+        return None, f"--radius {radius:g} <= 0"
+    inv = 0.0
+    for b in (f"body{k}" for k in bodies):
+        E, nu = num_attr(f[b], "young"), num_attr(f[b], "poisson")
+        if E is None or nu is None:
+            return None, f"/{b} has no young/poisson attributes"
+        inv += (1.0 - nu * nu) / E
+    nsym = len(r["sym"])
+    if force is not None:
+        P, src = force, "--force"
+    else:
+        if r["resultant"] is None:
+            return None, "no contact resultant in the file (give --force P)"
+        part = abs(float(r["resultant"][r["k"]]))
+        P = part * 2 ** nsym
+        src = "resultant" if not nsym else (f"{2 ** nsym} x the resultant {part:.6g} (symmetry planes "
+                                           + ", ".join(f"{AXES[a]} = {v:g}" for a, v in r["sym"]) + ")")
+    if not P > 0.0:
+        return None, f"total normal force P = {P:g} <= 0"
+    a, p0 = hertz_point(P, radius, 1.0 / inv)
+    return dict(P=P, R=radius, Es=1.0 / inv, a=a, p0=p0, src=src), None
+
+
+def hertz_3d_errors(r, h):
+    """The Hertz shape fitted to the nodal pressures (p^2 = p0^2 (1 - rho^2/a^2), linear least
+    squares over the nodes with p > 0, rho the distance from the centre in the map's plane),
+    err_a, err_p0 (|max p - p0| / p0) and err_L2 (weighted by the tributary areas, over the
+    nodes where Hertz's pressure or the normal force is positive)."""
+    i, j = r["ij"]
+    rho = np.hypot(r["xyz"][:, i] - r["c"][i], r["xyz"][:, j] - r["c"][j])
+    p = r["p"]
+    e = {"a_fit": float("nan"), "p0_fit": float("nan"), "err_a": float("nan"), "err_L2": float("nan"),
+         "err_p0": abs(float(p.max(initial=0.0)) - h["p0"]) / h["p0"]}
+    m = p > 0.0
+    if m.sum() >= 2:
+        c, *_ = np.linalg.lstsq(np.c_[np.ones(m.sum()), -rho[m] ** 2], p[m] ** 2, rcond=None)
+        if c[0] > 0.0 and c[1] > 0.0:
+            e["p0_fit"], e["a_fit"] = float(np.sqrt(c[0])), float(np.sqrt(c[0] / c[1]))
+            e["err_a"] = abs(e["a_fit"] - h["a"]) / h["a"]
+    ph = h["p0"] * np.sqrt(np.clip(1.0 - (rho / h["a"]) ** 2, 0.0, None))
+    zone = (ph > 0.0) | (r["lam"] > 0.0)
+    den = float(np.sum(r["area"][zone] * ph[zone] ** 2))
+    if den > 0.0:
+        e["err_L2"] = float(np.sqrt(np.sum(r["area"][zone] * (p[zone] - ph[zone]) ** 2) / den))
+    return e
+
+
+def read_run_3d(path, a):
+    """The contact surfaces of one solid result: one (/contact), or one per pair (the Hertz
+    curve on --pair K's only)."""
+    centre = parse_vector(a.centre, "--centre") if a.centre else None
+    with h5py.File(path, "r") as f:
+        u = result_units(f)
+        box = model_box(f)
+        npair = int(f.attrs.get("pairs", 1))
+        if a.pair is not None and not 1 <= a.pair <= npair:
+            raise ValueError(f"--pair {a.pair}: the file has {npair} contact pairs (1 to {npair})")
+        out = []
+        for k in ([None] if npair <= 1 else range(1, npair + 1)):
+            g = f["contact"] if k is None else f[f"contact/pair_{k}"]
+            r = read_surface(f, g, u, "resultant_body1" if k is None else "resultant_on_first_body", box, centre)
+            bodies = (1, 2) if k is None else tuple(int(v) for v in np.asarray(g.attrs["bodies"]).reshape(-1)[:2])
+            r["pair"] = "" if k is None else f"pair {k} (bodies {bodies[0]},{bodies[1]})"
+            r["h"], r["why"] = None, None
+            if a.hertz:
+                if k is None or k == a.pair:
+                    r["h"], r["why"] = hertz_3d(f, r, a.radius, a.force, bodies)
+                else:
+                    r["why"] = f"{npair} contact pairs" + (f", --pair {a.pair} chosen" if a.pair else
+                                                           f": pick the pair with --pair K (1 to {npair})")
+            out.append(r)
+        return out
+
+
+def main_3d(a):
+    """plot_contact.py on solid results (see the docstring's last part)."""
+    runs = []
+    for path in a.files:
+        try:
+            surfaces = read_run_3d(path, a)
+        except (OSError, KeyError, ValueError) as e:
+            print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
+            return 1
+        for r in surfaces:
+            r["name"], r["label"] = run_label(path, r["method"], r["status"], r["delta"])
+            if r["pair"]:
+                r["name"] += f" {r['pair']}"
+                r["label"] = f"{r['pair']}, {r['label']}"
+            runs.append(r)
+    if a.mindlin:
+        print("plot_contact: no Mindlin curve: solid results are frictionless", file=sys.stderr)
+    ux, up, ug = runs[0]["ux"], runs[0]["up"], runs[0]["ug"]
+    rows = []
+    nhertz = 0
+    for r in runs:
+        try:
+            d = line_direction(a.line, r)
+        except ValueError as e:
+            print(f"plot_contact: {e}", file=sys.stderr)
+            return 1
+        r["d"], r["line"] = d, sample_line(r, d)
+        i, j = r["ij"]
+        sym = ", ".join(f"{AXES[s]} = {v:g}" for s, v in r["sym"]) or "none"
+        print(f"plot_contact: {r['name']}: contact surface of {len(r['p'])} nodes, {r['nfaces']} faces, map in "
+              f"{AXES[i]}, {AXES[j]} (normal along {AXES[r['k']]}), centre ({', '.join(f'{v:.6g}' for v in r['c'])}), "
+              f"symmetry planes {sym}, max pressure {format_quantity(r['p'].max(initial=0.0), up)}, "
+              f"{int(np.sum(r['lam'] > 0))} active nodes")
+        ln = r["line"]
+        at = float(ln["t"][np.argmax(ln["p"])]) if ln["p"].size else float("nan")
+        print(f"plot_contact: {r['name']}: line through the centre along ({', '.join(f'{v:.4g}' for v in d)}): "
+              f"{ln['t'].size} samples, max pressure {ln['p'].max(initial=0.0):.6g} at t={at:.6g}")
+        h = r["h"]
+        if a.hertz and h is None:
+            print(f"plot_contact: {r['name']}: no Hertz curve: {r['why']}", file=sys.stderr)
+        if h is not None:
+            nhertz += 1
+            r["err"] = e = hertz_3d_errors(r, h)
+            print(f"plot_contact: Hertz for {r['name']}: P={h['P']:.6g} R={h['R']:.6g} E*={h['Es']:.6g} a={h['a']:.6g} "
+                  f"p0={h['p0']:.6g} (P from {h['src']}) a_fit={e['a_fit']:.6g} p0_fit={e['p0_fit']:.6g} "
+                  f"err_a={e['err_a']:.3g} err_p0={e['err_p0']:.3g} err_L2={e['err_L2']:.3g}")
+        for t, q, p, g_ in zip(ln["t"], ln["xyz"], ln["p"], ln["gap"]):
+            ph = h["p0"] * np.sqrt(max(1.0 - (t / h["a"]) ** 2, 0.0)) if h else None
+            rows.append((r["name"], t, *q, p, g_, ph))
+    if a.csv:
+        import csv
+        folder = os.path.dirname(a.csv)
+        if folder:
+            os.makedirs(folder, exist_ok=True)
+        with open(a.csv, "w", newline="") as fh:
+            wr = csv.writer(fh)
+            wr.writerow(["curve", "t", "x", "y", "z", "pressure", "gap", "hertz_pressure"])
+            for row in rows:
+                wr.writerow([row[0]] + [repr(float(v)) if np.isfinite(v) else "" for v in row[1:7]]
+                            + ["" if row[7] is None else repr(float(row[7]))])
+        print(f"plot_contact: wrote {a.csv} ({len(rows)} samples along the line)")
+
+    # panels: one pressure map per surface (at most 4), the pressure and the gap along the line
+    maps = runs[:4]
+    if len(runs) > 4:
+        print(f"plot_contact: note: {len(runs)} contact surfaces, the first 4 mapped", file=sys.stderr)
+    fig = plt.figure(figsize=(max(8.0, 4.2 * len(maps)), 11.0), dpi=120)
+    gs = fig.add_gridspec(3, len(maps), height_ratios=[2.4, 2.0, 1.0])
+    fx, lx = si_scale(np.concatenate([r["xyz"].reshape(-1) for r in runs]), ux)
+    fp, lp = si_scale(np.concatenate([r["p"] for r in runs] + [[r["h"]["p0"]] for r in runs if r["h"]]), up)
+    fg, lg = si_scale(np.concatenate([r["line"]["gap"] for r in runs]), ug)
+    for col, r in enumerate(maps):
+        ax = fig.add_subplot(gs[0, col])
+        i, j = r["ij"]
+        tri = surface_triangulation(r)
+        tri.x, tri.y = tri.x / fx, tri.y / fx
+        # the colour scale from 0 (a uniform pressure shows as one colour, not as rounding)
+        pc = ax.tripcolor(tri, r["p"] / fp, shading="gouraud", cmap="viridis",
+                          vmin=min(0.0, r["p"].min(initial=0.0) / fp), vmax=max(r["p"].max(initial=0.0) / fp, 1e-300))
+        if len(r["tris"]) <= 5000:
+            ax.triplot(tri, color="0.85", lw=0.3)
+        cb = fig.colorbar(pc, ax=ax, label=axis_label("contact pressure p", lp), shrink=0.85)
+        cb.formatter.set_useOffset(False)
+        cb.update_ticks()
+        ln = r["line"]
+        cx, cy = r["c"][i], r["c"][j]
+        ax.plot((cx + ln["t"] * r["d"][i]) / fx, (cy + ln["t"] * r["d"][j]) / fx, "k--", lw=1.0, label="the line")
+        ax.plot([cx / fx], [cy / fx], "k+", ms=9, label="contact centre")
+        if r["h"]:
+            th = np.linspace(0.0, 2.0 * np.pi, 361)
+            ax.plot((cx + r["h"]["a"] * np.cos(th)) / fx, (cy + r["h"]["a"] * np.sin(th)) / fx, "w:", lw=1.3,
+                    label=f"Hertz a = {format_quantity(r['h']['a'], ux)}")
+        ax.set_aspect("equal")
+        ax.set_xlim(tri.x.min(), tri.x.max())
+        ax.set_ylim(tri.y.min(), tri.y.max())
+        ax.set_xlabel(axis_label(AXES[i], lx))
+        ax.set_ylabel(axis_label(AXES[j], lx))
+        ax.set_title(f"{r['name']}: contact pressure", fontsize=8)
+        ax.legend(fontsize=6, loc="upper right", framealpha=0.6)
+        plain_axis(ax)
+    ax = fig.add_subplot(gs[1, :])
+    axg = fig.add_subplot(gs[2, :], sharex=ax)
+    colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
+    for n, r in enumerate(runs):
+        c = colours[n % len(colours)]
+        ln = r["line"]
+        dtext = ", ".join(f"{v:.3g}" for v in r["d"])
+        ax.plot(ln["t"] / fx, ln["p"] / fp, "-", color=c, lw=1.3, label=f"{r['label']}, along ({dtext})")
+        ax.plot(ln["t_nodes"] / fx, ln["p_nodes"] / fp, "o", color=c, ms=3.0, alpha=0.7,
+                label=f"{r['name']}: nodes within half an edge of the line")
+        axg.plot(ln["t"] / fx, ln["gap"] / fg, "-", color=c, lw=1.1)
+        h = r["h"]
+        if h:
+            tt = np.linspace(min(ln["t"].min(initial=0.0), -1.2 * h["a"] if ln["t"].min(initial=0.0) < 0 else 0.0),
+                             max(ln["t"].max(initial=0.0), 1.2 * h["a"]), 801)
+            e = r["err"]
+            ax.plot(tt / fx, h["p0"] * np.sqrt(np.clip(1.0 - (tt / h["a"]) ** 2, 0.0, None)) / fp, "--",
+                    color="k" if len(runs) == 1 else c, lw=1.3,
+                    label=f"Hertz p0 sqrt(1 - r²/a²): P = {format_quantity(h['P'], r['uf'])}, "
+                          f"R = {format_quantity(h['R'], ux)}, a = {format_quantity(h['a'], ux)}, "
+                          f"p0 = {format_quantity(h['p0'], up)}; err_a = {e['err_a']:.2g}, err_p0 = {e['err_p0']:.2g}")
+    for axx in (ax, axg):
+        axx.axhline(0.0, color="0.5", lw=0.6)
+        axx.axvline(0.0, color="0.5", lw=0.6, ls=":")
+        axx.grid(True, alpha=0.4)
+        plain_axis(axx)
+    ax.set_ylabel(axis_label("contact pressure p", lp))
+    axg.set_ylabel(axis_label("gap", lg))
+    axg.set_xlabel(axis_label("distance t from the contact centre along the line", lx))
+    ax.tick_params(labelbottom=False)
+    ax.set_title(a.title or "contact pressure along the line through the contact centre (dots: the nodes on it)"
+                 + (", Hertz point contact" if nhertz else ""), fontsize=9)
+    ax.legend(fontsize=7, loc="best")
+    save_figure(fig, a.output)
+    print(f"plot_contact: wrote {a.output} ({len(a.files)} runs, {len(runs)} contact surfaces, {nhertz} Hertz curves)")
+    return 0
+
+
 def main(argv=None):
     ap = plot_parser(__doc__, "contact.png")
-    ap.add_argument("--hertz", action="store_true", help="add the Hertz line-contact pressure and p/p0 panel")
+    ap.add_argument("--hertz", action="store_true",
+                    help="add the Hertz line-contact pressure and p/p0 panel (solid results: point contact)")
     ap.add_argument("--mindlin", action="store_true",
                     help="add Cattaneo-Mindlin's shear to the shear panel (Coulomb friction; implies --hertz)")
     ap.add_argument("--radius", type=float, default=None,
                     help="Hertz's relative radius for a run whose gap is its geometry's (no gap_radius)")
     ap.add_argument("--pair", type=int, default=None, metavar="K",
                     help="with several contact pairs: the pair that gets the Hertz (and Mindlin) curve")
+    ap.add_argument("--line", default=None, metavar="x|y|z|DX,DY,DZ",
+                    help="solid results: the direction of the line through the contact centre")
+    ap.add_argument("--centre", default=None, metavar="X,Y,Z", help="solid results: the line's point")
+    ap.add_argument("--force", type=float, default=None, metavar="P",
+                    help="solid results: Hertz's total normal force (default: from the file)")
+    ap.add_argument("--csv", default=None, metavar="FILE", help="solid results: write the line's samples")
     a = ap.parse_args(argv)
     a.hertz = a.hertz or a.mindlin
+    solid = []
+    for path in a.files:
+        try:
+            solid.append(is_solid(path))
+        except OSError as e:
+            print(f"plot_contact: cannot read {path}: {e}", file=sys.stderr)
+            return 1
+    if any(solid):
+        if not all(solid):
+            print("plot_contact: cannot draw plane and solid results together (solid: "
+                  + ", ".join(p for p, s in zip(a.files, solid) if s) + "; plane: "
+                  + ", ".join(p for p, s in zip(a.files, solid) if not s) + ")", file=sys.stderr)
+            return 1
+        return main_3d(a)
 
     runs = []
     for path in a.files:

@@ -3,7 +3,9 @@
 !! ParaView opens every body and contact line directly, and meshio reads each.
 !!
 !! `/contact` holds the rows of all contact pairs stacked; `/contact/pair_<k>` the rows of
-!! pair k alone, with the ids of its two bodies.
+!! pair k alone, with the ids of its two bodies. In the plane a contact grid is a polyline
+!! through its rows; in space a surface, the faces of the slave's contact group whose every
+!! node carries a row (`faces`).
 !!
 !! Every numeric dataset has a string attribute `units` (the deck's unit names: length,
 !! stress, force/length for the nodal contact force in 2D, '1' for pure numbers and
@@ -20,9 +22,10 @@ module results
   use files, only: temp_name, run_id, replace_suffix, base_name, ensure_parent_dir, remove_file, &
                    write_text, commit_files, data_open, data_write, data_close
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, element_names, FACTOR_CHOICES, FRICTION_NONE, &
-                    XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC
+                    XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC, contact_cfg_t, pair_oriented, &
+                    side_names, BC_CONTACT
   use strings, only: word, body_label, i2s, text_buffer_t
-  use mesh, only: mesh_t, file_order, file_cells, file_dof
+  use mesh, only: mesh_t, file_order, file_cells, file_dof, group_index
   use assembly, only: body_system_t, nodal_stress, support_reactions
   use contact_interface, only: interface_t, pair_rows, row_directions
   use contact_types, only: contact_result_t, status_name
@@ -60,6 +63,13 @@ module results
   end type step_result_t
 
   public :: write_results, result_files, per_body_files, body_group_name
+
+  !> The faces of one pair's contact surface (in space).
+  type :: faces_t
+    !> (4, nf) the vertices of each face as rows of the pair, 0-based from its first row,
+    !! counter-clockwise seen from outside the slave body; a triangle's fourth is -1
+    integer, allocatable :: f(:, :)
+  end type faces_t
 
   !> The datasets of a body whose data are written beside the HDF5 library (`body_data`),
   !! in the order they are created.
@@ -106,10 +116,12 @@ contains
     type(interface_t) :: itf
     type(contact_result_t) :: res
     type(tangential_t) :: tg
+    type(faces_t), allocatable :: surf(:)
 
     ! the file shows one entry per contact node: the normal rows, with friction the
     ! tangential part of each node beside them
     call split_friction(itf_all, res_all, itf, res, tg)
+    call contact_surfaces(d, msh, itf, surf)
     nb = size(msh)
     np = itf%npair
     call ensure_parent_dir(file)
@@ -137,9 +149,9 @@ contains
     call write_companions(ok)
     !$omp end task
     if (size(times) > 0) then
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, rf, tm, id, st, steps)
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, surf, res, tg, u, rf, tm, id, st, steps)
     else
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, res, tg, u, rf, tm, id, st)
+      call write_h5(tmp(1), d, msh, sys, itf_all, itf, surf, res, tg, u, rf, tm, id, st)
     end if
     !$omp end single
     !$omp end parallel
@@ -171,17 +183,17 @@ contains
       logical, intent(out) :: done   !< all written
       integer :: a, q
       if (np == 1) then
-        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, id, times), done)
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, surf, id, times), done)
       else
-        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, id, times), done)
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, surf, id, times), done)
       end if
       do a = 1, nbf
-        if (done) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, id, times), done)
+        if (done) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, surf, id, times), done)
       end do
-      if (done) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, itf, id, times), done)
+      if (done) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, itf, surf, id, times), done)
       if (npf > 1) then
         do q = 1, npf
-          if (done) call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, itf, id, times), done)
+          if (done) call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, itf, surf, id, times), done)
         end do
       end if
     end subroutine write_companions
@@ -243,13 +255,14 @@ contains
   !> The HDF5 result file `path`, whole; st records the first failure. The large datasets of
   !! each body are created with their storage reserved, and a task per body (`body_data`)
   !! computes and writes their data there; all tasks end before this returns.
-  subroutine write_h5(path, d, msh, sys, itf_all, itf, res, tg, u, rf, tm, run_id, st, steps)
+  subroutine write_h5(path, d, msh, sys, itf_all, itf, surf, res, tg, u, rf, tm, run_id, st, steps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
     type(body_system_t), intent(in) :: sys(:)
     type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs (normal and tangential)
     type(interface_t), intent(in) :: itf               !< its normal rows (split_friction)
+    type(faces_t), intent(in) :: surf(:)               !< (npair) the contact surfaces (in space)
     type(contact_result_t), intent(in) :: res
     type(tangential_t), intent(in) :: tg               !< the tangential part (friction), per node
     real(wp), intent(in) :: u(:, :)
@@ -350,11 +363,12 @@ contains
     call write_dset(gid, tributary_name(), itf%trib, st, trib_unit)
     allocate (pres(itf%m))
     call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
-    ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments
+    ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments (in
+    ! space: the contact surfaces' faces)
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
-    call write_dset(gid, 'segments', line_cells(itf, 1, itf%npair), st, '1')
+    call write_contact_cells(gid, contact_cells(itf, surf, 1, itf%npair), st)
     do k = 1, itf%npair
-      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, trib_unit, st)
+      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, trib_unit, st, cells=contact_cells(itf, surf, k, k))
     end do
     call group_close(gid, st)
     call write_history(fid, res, st)
@@ -560,7 +574,7 @@ contains
       call group_open(kid, 'contact', gid, st, create=.true.)
       call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
       do q = 1, itf%npair
-        call write_pair(gid, q, itf, res, tg, pres, ul, us, uf, tributary_unit(d, ul), st, geometry=.false.)
+        call write_pair(gid, q, itf, res, tg, pres, ul, us, uf, tributary_unit(d, ul), st)
       end do
       call group_close(gid, st)
       do a = 1, size(msh)
@@ -656,10 +670,11 @@ contains
 
   !> The group pair_<q> of the contact group gid: pair q's rows alone, its solution (forces
   !! of both sides, the resultant of all its contact forces on its first body, pressure, gap,
-  !! active flags, normal displacements, with friction the tangential part) and, with
-  !! `geometry` (default), the ids of its bodies (side 1, side 2), its slave body and its
-  !! line (coordinates, normals, g0, tributary lengths, segments 0-based within the pair).
-  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, trib_unit, st, geometry)
+  !! active flags, normal displacements, with friction the tangential part) and, given its
+  !! `cells` (contact_cells), the ids of its bodies (side 1, side 2), its slave body and its
+  !! line (coordinates, normals, g0, tributary lengths, segments or faces 0-based within the
+  !! pair).
+  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, trib_unit, st, cells)
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
@@ -669,13 +684,12 @@ contains
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     character(len=*), intent(in) :: trib_unit   !< of the tributary lengths (tributary_unit)
     type(error_t), intent(inout) :: st
-    logical, intent(in), optional :: geometry
+    integer, intent(in), optional :: cells(:, :)   !< the cells of its grid (absent: its solution alone)
     integer(hid_t) :: pid
     integer :: r(2), i, j
     real(wp), allocatable :: w2(:, :)
     logical :: geo
-    geo = .true.
-    if (present(geometry)) geo = geometry
+    geo = present(cells)
     r = pair_rows(itf, q)
     i = r(1)
     j = r(2)
@@ -694,7 +708,7 @@ contains
       call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
       call write_dset(pid, tributary_name(), itf%trib(i:j), st, trib_unit)
       call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
-      call write_dset(pid, 'segments', line_cells(itf, q, q), st, '1')
+      call write_contact_cells(pid, cells, st)
     end if
     call write_dset(pid, 'normal_force', res%lam(i:j), st, uf)
     call write_dset(pid, 'normal_force_side1', res%lam_body(i:j, 1), st, uf)
@@ -862,7 +876,7 @@ contains
     do q = p1, p2
       nseg = nseg + max(0, itf%pair_ptr(q + 1) - itf%pair_ptr(q) - 1)
     end do
-    if (NDIM == 3) nseg = 0      ! a contact surface's nodes: its vertices (its faces are not kept)
+    if (NDIM == 3) nseg = 0      ! a contact surface without a face (contact_cells): its nodes as vertices
     if (nseg > 0) then
       allocate (c(2, nseg))
       nseg = 0
@@ -878,6 +892,121 @@ contains
     end if
   end function line_cells
 
+  !> The contact surface of each pair in space (surf(q) for pair q; in the plane none): the
+  !! faces of the pair's slave group every node of which carries a row of the pair. The
+  !! group is the slave side's `&contact` group, or the side of its box declared 'contact'
+  !! (as build_interface resolves them). A face with a node that carries no row (not covered
+  !! by the master, or removed) is left out.
+  subroutine contact_surfaces(d, msh, itf, surf)
+    type(deck_t), intent(in) :: d
+    type(mesh_t), intent(in) :: msh(:)
+    type(interface_t), intent(in) :: itf            !< the normal rows (split_friction)
+    type(faces_t), allocatable, intent(out) :: surf(:)
+    type(contact_cfg_t) :: cc
+    integer, allocatable :: rowof(:), f(:, :)
+    integer :: q, sl, a, g, e, k, nf, nd
+    character(len=:), allocatable :: name
+    allocate (surf(itf%npair))
+    do q = 1, itf%npair
+      allocate (surf(q)%f(4, 0))
+      if (NDIM /= 3 .or. q > d%npair) cycle
+      sl = itf%pair_slave(q)
+      a = itf%pair_body(sl, q)
+      cc = pair_oriented(d%pair(q))
+      if (len_trim(cc%body_group(1)) == 0) then
+        k = findloc(d%body(a)%bc, BC_CONTACT, dim=1)
+        if (k == 0) cycle
+        name = trim(side_names(k))
+      else
+        name = trim(cc%body_group(sl))
+      end if
+      g = group_index(msh(a), name)
+      if (g == 0) cycle
+      ! each slave node's row, 1-based within the pair (0: none)
+      allocate (rowof(msh(a)%nnode))
+      rowof = 0
+      do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 1
+        if (itf%node(k, sl) > 0) rowof(itf%node(k, sl)) = k - itf%pair_ptr(q) + 1
+      end do
+      associate (grp => msh(a)%group(g))
+        allocate (f(4, grp%nedge))
+        f = -1
+        nf = 0
+        do e = 1, grp%nedge
+          nd = count(grp%edge(:, e) > 0)
+          if (nd < 3) cycle
+          if (any(rowof(grp%edge(1:nd, e)) == 0)) cycle
+          nf = nf + 1
+          f(1:nd, nf) = rowof(grp%edge(1:nd, e)) - 1
+        end do
+        surf(q)%f = f(:, 1:nf)
+      end associate
+      deallocate (rowof, f)
+    end do
+  end subroutine contact_surfaces
+
+  !> The cells of the contact grid of pairs p1..p2, 0-based from the first row of p1: in the
+  !! plane line_cells; in space the pairs' faces (contact_surfaces), (3, nf) when all are
+  !! triangles, else (4, nf) with -1 as a triangle's fourth vertex, and without any face the
+  !! rows as vertices (line_cells).
+  function contact_cells(itf, surf, p1, p2) result(c)
+    type(interface_t), intent(in) :: itf
+    type(faces_t), intent(in) :: surf(:)
+    integer, intent(in) :: p1, p2              !< first and last pair
+    integer, allocatable :: c(:, :)
+    integer :: q, nf, k, off
+    nf = 0
+    if (NDIM == 3) then
+      do q = p1, p2
+        nf = nf + size(surf(q)%f, 2)
+      end do
+    end if
+    if (nf == 0) then
+      c = line_cells(itf, p1, p2)
+      return
+    end if
+    allocate (c(4, nf))
+    nf = 0
+    do q = p1, p2
+      k = size(surf(q)%f, 2)
+      off = itf%pair_ptr(q) - itf%pair_ptr(p1)
+      c(:, nf + 1:nf + k) = merge(surf(q)%f + off, -1, surf(q)%f >= 0)
+      nf = nf + k
+    end do
+    if (all(c(4, :) < 0)) c = c(1:3, :)
+  end function contact_cells
+
+  !> The cells of a contact grid (contact_cells) into the group gid: `segments` (a
+  !! polyline's, or its vertices), or a surface's `faces` and, where it mixes triangles and
+  !! quadrilaterals, their XDMF `topology` (face_topology).
+  subroutine write_contact_cells(gid, c, st)
+    integer(hid_t), intent(in) :: gid
+    integer, intent(in) :: c(:, :)
+    type(error_t), intent(inout) :: st
+    if (size(c, 1) <= 2) then
+      call write_dset(gid, 'segments', c, st, '1')
+    else
+      call write_dset(gid, 'faces', c, st, '1')
+      if (any(c < 0)) call write_dset(gid, 'topology', face_topology(c), st, '1')
+    end if
+  end subroutine write_contact_cells
+
+  !> The XDMF 'Mixed' topology of faces (4, nf) (a triangle's fourth vertex -1): per face its
+  !! type (4 triangle, 5 quadrilateral) and its vertices.
+  pure function face_topology(c) result(t)
+    integer, intent(in) :: c(:, :)
+    integer, allocatable :: t(:)
+    integer :: e, k, nd
+    allocate (t(count(c >= 0) + size(c, 2)))
+    k = 0
+    do e = 1, size(c, 2)
+      nd = count(c(:, e) >= 0)
+      t(k + 1) = merge(4, 5, nd == 3)
+      t(k + 2:k + 1 + nd) = c(1:nd, e)
+      k = k + 1 + nd
+    end do
+  end function face_topology
+
   !> An XDMF 3 file, as text, describing the bodies `bodies` and the contact lines `lines`
   !! (0: all rows, /contact, grid 'contact'; k: pair k, /contact/pair_<k>, grid
   !! 'contact_pair<k>') of the HDF5 file `h5`: one uniform grid directly under Domain for
@@ -886,11 +1015,12 @@ contains
   !! of those, step k's fields from /steps/step_<k> (ParaView's time slider; meshio's
   !! TimeSeriesReader for one grid). A comment names the run that wrote it (the HDF5 file's
   !! attribute run_id).
-  function xdmf_text(bodies, lines, h5, msh, itf, run_id, times) result(t)
+  function xdmf_text(bodies, lines, h5, msh, itf, surf, run_id, times) result(t)
     integer, intent(in) :: bodies(:), lines(:)
     character(len=*), intent(in) :: h5
     type(mesh_t), intent(in) :: msh(:)
     type(interface_t), intent(in) :: itf
+    type(faces_t), intent(in) :: surf(:)     !< the contact surfaces (in space)
     character(len=*), intent(in) :: run_id
     real(wp), intent(in) :: times(:)
     character(len=:), allocatable :: t, h
@@ -901,12 +1031,12 @@ contains
     call b%add(line('<?xml version="1.0" ?>')//line('<!-- robin_contact '//program_version//' run_id '//run_id// &
                ' -->')//line('<Xdmf Version="3.0">')//line('  <Domain>'))
     if (size(times) == 0) then
-      call b%add(grids_text(bodies, lines, h, msh, itf, '', ''))
+      call b%add(grids_text(bodies, lines, h, msh, itf, surf, '', ''))
     else
       call b%add(line('    <Grid Name="steps" GridType="Collection" CollectionType="Temporal">'))
       do k = 1, size(times)
         write (tv, '(es24.16)') times(k)
-        call b%add(grids_text(bodies, lines, h, msh, itf, '/steps/step_'//i2s(k), trim(adjustl(tv))))
+        call b%add(grids_text(bodies, lines, h, msh, itf, surf, '/steps/step_'//i2s(k), trim(adjustl(tv))))
       end do
       call b%add(line('    </Grid>'))
     end if
@@ -916,11 +1046,12 @@ contains
 
   !> The grids of the bodies and contact lines, their fields under the HDF5 group `fields`
   !! ('' : the last result's own groups) and, given `time`, at that time.
-  function grids_text(bodies, lines, h, msh, itf, fields, time) result(t)
+  function grids_text(bodies, lines, h, msh, itf, surf, fields, time) result(t)
     integer, intent(in) :: bodies(:), lines(:)
     character(len=*), intent(in) :: h, fields, time
     type(mesh_t), intent(in) :: msh(:)
     type(interface_t), intent(in) :: itf
+    type(faces_t), intent(in) :: surf(:)
     character(len=:), allocatable :: t, tt
     type(text_buffer_t) :: b                 ! one grid per body and line: linear in their number
     integer :: k, r(2)
@@ -938,12 +1069,12 @@ contains
     end do
     do k = 1, size(lines)
       if (lines(k) == 0) then
-        call b%add(contact_grid_text('contact', h//':/contact', itf%m, line_cells(itf, 1, itf%npair), 'body', &
+        call b%add(contact_grid_text('contact', h//':/contact', itf%m, contact_cells(itf, surf, 1, itf%npair), 'body', &
                                      h//':'//fields//'/contact', tt, any(itf%pair_friction /= FRICTION_NONE)))
       else
         r = pair_rows(itf, lines(k))
         call b%add(contact_grid_text('contact_pair'//i2s(lines(k)), h//':/contact/pair_'//i2s(lines(k)), &
-                                     r(2) - r(1) + 1, line_cells(itf, lines(k), lines(k)), 'side', &
+                                     r(2) - r(1) + 1, contact_cells(itf, surf, lines(k), lines(k)), 'side', &
                                      h//':'//fields//'/contact/pair_'//i2s(lines(k)), tt, &
                                      itf%pair_friction(lines(k)) /= FRICTION_NONE))
       end if
@@ -1007,7 +1138,8 @@ contains
   end function grid_text
 
   !> A contact line as an XDMF uniform grid `name` over the HDF5 group g (file:path): a
-  !! polyline over its n nodes (cells: line_cells of its rows) with the contact fields at its
+  !! polyline over its n nodes (cells: line_cells of its rows; in space a surface of
+  !! triangles, quadrilaterals or both, contact_cells) with the contact fields at its
   !! nodes; `side` names the columns of the normal displacements ('body': the
   !! normal_displacement_body1/2 of /contact, 'side': normal_displacement_side1/2 of a pair);
   !! with friction also its shear, tangential force, slip and slip increment.
@@ -1029,14 +1161,29 @@ contains
     write (nn, '(i0)') n
     write (nc, '(i0)') size(cells, 2)
     write (nv, '(i0)') size(cells, 1)
-    if (size(cells, 1) == 2) then
+    select case (size(cells, 1))
+    case (2)
       t = '        <Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="'
-    else
+    case (1)
       t = '        <Topology TopologyType="Polyvertex" NodesPerElement="1" NumberOfElements="'
-    end if
+    case (3)
+      t = '        <Topology TopologyType="Triangle" NumberOfElements="'
+    case default
+      t = '        <Topology TopologyType="'//trim(merge('Mixed        ', 'Quadrilateral', any(cells < 0)))// &
+          '" NumberOfElements="'
+    end select
     t = line('      <Grid Name="'//name//'" GridType="Uniform">')//time//line(t//trim(nc)//'">')
-    t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
-                '" NumberType="Int" Precision="4" Format="HDF">'//g//'/segments</DataItem>')
+    if (size(cells, 1) <= 2) then
+      t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
+                  '" NumberType="Int" Precision="4" Format="HDF">'//g//'/segments</DataItem>')
+    else if (any(cells < 0)) then
+      write (nv, '(i0)') count(cells >= 0) + size(cells, 2)     ! the length of face_topology(cells)
+      t = t//line('          <DataItem Dimensions="'//trim(nv)// &
+                  '" NumberType="Int" Precision="4" Format="HDF">'//g//'/topology</DataItem>')
+    else
+      t = t//line('          <DataItem Dimensions="'//trim(nc)//' '//trim(nv)// &
+                  '" NumberType="Int" Precision="4" Format="HDF">'//g//'/faces</DataItem>')
+    end if
     t = t//line('        </Topology>')
     t = t//geometry_text(trim(nn), g//'/geometry_xyz')
     do k = 1, size(f)

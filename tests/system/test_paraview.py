@@ -14,7 +14,14 @@ without ParaView, the tool's geometry: the
 contact line of each body warped by its displacement (on the Hertz deck: the normal distance
 between the two warped lines, over the magnification, minus the initial gap g0 is the gap
 the program wrote) and the box of --zoom contact (it holds the active contact nodes and is
-much smaller than the contact line)."""
+much smaller than the contact line). A solid result (Hertz's sphere on a block, the quarter
+model inputs/sphere_block.nml on the coarse mesh; the boxes of inputs/boxes.nml): without
+ParaView, the clip plane --cut auto picks (the quarter model's symmetry plane x = 0, keeping
+x >= 0, y up; on the boxes, whose contact covers the whole face, the plane x = 0.5 through
+the centre of the uniform pressure), the contact nodes warped by the sphere's displacement,
+the 3D --zoom contact box and the refusal of bad --cut specs; with ParaView, the clipped
+view: its colour range, at full range, is the von Mises range of both bodies in the HDF5
+file (the symmetry plane cuts nothing away) and the picture is coloured."""
 import os
 import re
 import shutil
@@ -78,6 +85,54 @@ for bad in ("1,2,3", "2,1,0,1", "a,b,c,d"):
 check(paraview_view.camera_box((0.0, 4.0, 0.0, 1.0), 1.5) == (2.0, 0.5, 4.0 / 3.0)
       and paraview_view.camera_box((0.0, 1.0, 0.0, 4.0), 1.5) == (0.5, 2.0, 2.0),
       "camera_box: the whole box in view, wide or tall")
+
+# 0b. a solid result: the clip plane, the warped contact nodes and the zoom box, without ParaView
+sb = f"{OUT}/sphere.h5"
+coarse = os.path.join(ROOT, "inputs/gmsh/sphere_block_h0.02.msh")
+p, _ = run_solver(BIN, os.path.join(ROOT, "inputs/sphere_block.nml"), f"&body id=1, mesh='{coarse}' /",
+                  f"&body id=2, mesh='{coarse}' /", f"&output file='{sb}' /")
+solid = check(p.returncode == 0, "Hertz 3D (quarter model, coarse mesh) solved", f"exit {p.returncode}")
+if solid:
+    with h5py.File(sb, "r") as f:
+        cxyz = f["contact/coordinates"][()].T
+        lam3 = f["contact/normal_force"][()]
+        x1, u1 = f["body1/coordinates"][()].T, f["body1/displacement"][()].T
+        vm3 = np.concatenate([f[f"body{b}/von_mises"][()] for b in (1, 2)])
+    origin, normal, up, note = paraview_view.cut_plane("auto", sb)
+    check(origin[0] == 0.0 and np.array_equal(normal, [1.0, 0.0, 0.0]) and up == 1 and "symmetry plane x = 0" in note,
+          "cut_plane auto on the quarter model: its symmetry plane x = 0, keeping x >= 0, y up",
+          f"origin {origin}, normal {normal}, up {up}: {note}")
+    # the contact nodes warped by the sphere's (the slave's) displacement: its node at each
+    # contact node found here by the nearest node
+    near = np.array([int(np.argmin(np.sum((x1 - q) ** 2, axis=1))) for q in cxyz])
+    w0, w7 = paraview_view.contact_points_3d(sb, 0.0), paraview_view.contact_points_3d(sb, 7.0)
+    dev = float(np.abs((w7 - cxyz) / 7.0 - u1[near]).max() / np.abs(u1).max())
+    check(np.array_equal(w0, cxyz) and dev < 1e-12,
+          "contact_points_3d: the contact nodes x0, and x7 moved by 7 times the sphere's displacement there",
+          f"max deviation {dev:.1e} of max |u|")
+    focal, hw, hh = paraview_view.zoom_box_3d(sb, 7.0, None, origin, normal, up)
+    act = w7[lam3 > 0]
+    inside = np.all(np.abs(act[:, 2] - focal[2]) <= hw) and np.all(np.abs(act[:, 1] - focal[1]) <= hh)
+    check(inside and focal[0] == 0.0 and 2 * max(hw, hh) < 0.25 * 2.0,
+          "zoom_box_3d: in the plane x = 0, holds the active warped contact nodes, under a quarter of the block",
+          f"focal {focal}, half sizes {hw:.3g} x {hh:.3g}, {len(act)} active nodes")
+    for bad in ("1,2,3", "w", "x=a", "0,0,0,0,0,0"):
+        try:
+            paraview_view.cut_plane(bad, sb)
+            check(False, f"cut_plane {bad!r}: rejected")
+        except ValueError as e:
+            check(bool(str(e)), f"cut_plane {bad!r}: rejected with a message", str(e))
+bx = f"{OUT}/boxes.h5"
+p, _ = run_solver(BIN, os.path.join(ROOT, "inputs/boxes.nml"), f"&output file='{bx}' /")
+if check(p.returncode == 0, "boxes deck solved", f"exit {p.returncode}"):
+    origin, normal, up, note = paraview_view.cut_plane("auto", bx)
+    check(abs(origin[0] - 0.5) < 1e-9 and abs(origin[2] - 0.5) < 1e-9 and abs(normal[0]) == 1.0 and up == 1
+          and "through the contact centre" in note,
+          "cut_plane auto on the boxes (the contact covers the whole face): x = 0.5 through the centre of the "
+          "uniform pressure", f"origin {origin}, normal {normal}, up {up}: {note}")
+    origin, normal, up, note = paraview_view.cut_plane("z=0.3", bx)
+    check(origin[2] == 0.3 and np.array_equal(normal, [0.0, 0.0, 1.0]) and up == 1,
+          "cut_plane z=0.3: that plane, keeping the larger side z >= 0.3", f"origin {origin}, normal {normal}")
 
 # ParaView and Xvfb come with the project's dependencies (tools/install-deps.sh, run by make):
 # without them this is a failure, not a skip
@@ -233,6 +288,17 @@ if solve(os.path.join(ROOT, "inputs/lap_joint.nml"), "lap", *lap, "&solver load_
     check(rc == 0 and "shear, point data" in so, "--field shear (contact lines only) exits 0",
           f"exit {rc} {se.strip()[-300:]}")
     picture(f"{OUT}/lap_shear.png", "shear on the warped contact lines", coloured=False)
+
+# 4b. a solid result: the bodies clipped by the quarter model's symmetry plane (nothing cut away:
+# the colour range at full range is the von Mises range of both bodies), coloured
+if solid:
+    rc, so, se = view(sb, "--clip", "100", "--size", "600x400", "-o", f"{OUT}/sphere.png", cwd=ROOT)
+    m = re.search(r"colour (\S+) to (\S+) Pa, full range, .*clip: symmetry plane x = 0", so)
+    want = (f"{vm3.min():.4g}", f"{vm3.max():.4g}")
+    check(rc == 0 and m is not None and m.groups() == want,
+          "solid result: clipped by its symmetry plane x = 0, colour range the bodies' von Mises range "
+          f"{want[0]} to {want[1]} Pa", f"exit {rc} {so.strip()} {se.strip()[-300:]}")
+    picture(f"{OUT}/sphere.png", "sphere on a block, clipped")
 
 # 5. a dead display from xvfb-run -a (seen in 2 of 36 headless runs: ParaView says "bad X
 # server connection" and aborts, exit 134): a stand-in xvfb-run on PATH hands out a display

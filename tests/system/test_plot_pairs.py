@@ -5,7 +5,11 @@ meshes; a small deck written here): tools/plot_contact.py --hertz picks a pair w
 the note names the option; a pair that is not there: exit 1 with a message), and
 tools/plot_solution.py's legend counts every active contact node of each pair (the count in
 the file), also where the pair's first body is the side whose nodes are not the contact
-nodes."""
+nodes. Solid bodies: three boxes stacked (hexahedra on tetrahedra on hexahedra, two pairs,
+a uniform pressure p on the top: the contact patch test, every contact pressure p):
+plot_contact maps each pair's contact surface (its nodes and faces those of
+/contact/pair_<k>, quadrilaterals on pair 1, triangles on pair 2) and the CSV of the line
+across both has the pressure p at every sample."""
 import os
 import re
 import subprocess
@@ -67,6 +71,43 @@ check(rc == 0 and m and abs(float(m.group(1)) - P2) <= 1e-5 * P2 and "1 Hertz cu
 rc, so, se = tool("plot_contact.py", h5, "--hertz", "--pair", "3", "-o", os.path.join(tmp, "bad.png"))
 check(rc == 1 and "--pair 3: the file has 2 contact pairs" in se and not os.path.exists(os.path.join(tmp, "bad.png")),
       "--pair 3 of 2: exit 1 with a message", f"exit {rc} {se.strip()}")
+
+# solid bodies: three boxes, two pairs, the contact patch test (every pressure p)
+deck3 = os.path.join(tmp, "boxes3.nml")
+with open(deck3, "w") as f:
+    f.write("""&scene title = 'three boxes, two pairs', dimension = 3 /
+&body id = 1, x0 = 0.0, y0 = 2.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 3,
+      element = 'Q1', left = 'roller', front = 'roller' /
+&body id = 2, x0 = 0.0, y0 = 1.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 3, ny = 2, nz = 2,
+      element = 'P1', left = 'roller', front = 'roller' /
+&body id = 3, x0 = 0.0, y0 = 0.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 2,
+      element = 'Q1', left = 'roller', front = 'roller', bottom = 'roller' /
+&traction body = 1, side = 'top', t0 = 0.0, -1.0e6, 0.0 /
+&contact bodies = 1, 2, groups = 'bottom', 'top' /
+&contact bodies = 2, 3, groups = 'bottom', 'top' /
+&solver tol = 1.0e-10 /
+""")
+h53 = os.path.join(tmp, "boxes3.h5")
+p, _ = run_solver(BIN, deck3, f"&output file='{h53}' /")
+if check(p.returncode == 0, "three boxes, two pairs (3D) solved", f"exit {p.returncode} {p.stderr.strip()[-200:]}"):
+    with h5py.File(h53, "r") as f:
+        sizes = [(f[f"contact/pair_{k}/pressure"].shape[0], f[f"contact/pair_{k}/faces"].shape) for k in (1, 2)]
+    csv_path = os.path.join(tmp, "line3.csv")
+    rc, so, se = tool("plot_contact.py", h53, "--csv", csv_path, "-o", os.path.join(tmp, "c3.png"))
+    for k, (n, shape) in enumerate(sizes, start=1):
+        m = re.search(rf"pair {k} \(bodies {k},{k + 1}\): contact surface of (\d+) nodes, (\d+) faces", so)
+        check(rc == 0 and m is not None and (int(m.group(1)), int(m.group(2))) == (n, shape[0])
+              and shape[1] == (4 if k == 1 else 3),
+              f"plot_contact on a solid result: pair {k}'s surface mapped, the nodes and faces of /contact/pair_{k}",
+              f"exit {rc} {m.group(0) if m else so.strip()[-300:]} against {n} nodes, faces {shape}")
+    import csv  # noqa: E402
+    rows = list(csv.DictReader(open(csv_path))) if os.path.isfile(csv_path) else []
+    pres = np.array([float(r["pressure"]) for r in rows])
+    curves = sorted({r["curve"] for r in rows})
+    check(len(curves) == 2 and pres.size > 600 and np.abs(pres / 1.0e6 - 1.0).max() <= 1e-6,
+          "the line across both surfaces: the patch test's pressure p at every sample",
+          f"curves {curves}, {pres.size} samples, "
+          f"max |p/p_exact - 1| = {np.abs(pres / 1e6 - 1).max() if pres.size else None}")
 
 # plot_solution's legend: the labels of the figure it saves
 import matplotlib  # noqa: E402

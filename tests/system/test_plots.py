@@ -26,7 +26,18 @@ instead of swamping the machine, and checks:
     numbers with units);
   - plot_contact names the force it shows: the sum of the nodal normal forces as one number
     with its unit ('1.579e9 N/mm', not '1.579 1e9 N/mm'), or the resultant vector when the
-    result file stores one.
+    result file stores one;
+  - a solid result (Hertz's sphere on a block, the quarter model inputs/sphere_block.nml on
+    the coarse mesh): plot_contact --hertz --radius 1 --csv maps the contact surface and
+    writes the pressure along the line through the contact centre: the Hertz P, a and p0 it
+    prints are those computed here (P four times the resultant's y component of the quarter
+    model, E* from the deck's E and nu); every sample of the CSV lies on the line (along x
+    from the centre on the symmetry planes, t = x, z = 0), its pressure, gap and y equal the
+    linear interpolation on the file's /contact/faces computed here (barycentric coordinates
+    of the face that holds the sample), its Hertz column p0 sqrt(1 - t^2/a^2); the samples
+    span the surface along the line; a diagonal line (--line 1,5,1: the component along the
+    normal dropped) gives t = (x + z)/sqrt(2), x = z; plane and solid results together: exit
+    1 with a message.
 Wall times are printed (TIME lines), never asserted.
 """
 import os
@@ -136,6 +147,93 @@ if line:
     err = {k: float(v) for k, v in (w.split("=") for w in line[0].split() if w.startswith("err_"))}
     check(err["err_p0"] < 0.05 and err["err_L2"] < 0.05, "Hertz deck (80x40): p0 and L2 errors below 5%", str(err))
 picture(f"{OUT}/hertz.png", "hertz.png")
+
+# ---- a solid result: the pressure map and the pressure along a line ------------------------
+def line_check(csv_path, h5, direction, hertz=None):
+    """The CSV of plot_contact on a solid result against the file: the samples on the line
+    through the centre (0, ., 0) along direction (in x, z), and their pressure, gap and y the
+    linear interpolation on /contact/faces (computed here); returns the samples' t and x."""
+    import csv
+    with h5py.File(h5, "r") as f:
+        xyz = np.stack([f["contact/x"][()], f["contact/y"][()], f["contact/z"][()]], axis=1)
+        pres, gap = f["contact/pressure"][()], f["contact/gap"][()]
+        faces = f["contact/faces"][()]
+    with open(csv_path) as fh:
+        rows = list(csv.DictReader(fh))
+    t = np.array([float(r["t"]) for r in rows])
+    q = np.array([[float(r[k]) for k in ("x", "y", "z")] for r in rows])
+    pc, gc = np.array([float(r["pressure"]) for r in rows]), np.array([float(r["gap"]) for r in rows])
+    d = np.asarray(direction, dtype=float) / np.hypot(*direction)
+    on_line = len(rows) > 0 and max(np.abs(q[:, 0] - t * d[0]).max(), np.abs(q[:, 2] - t * d[1]).max()) <= 1e-12
+    worst, missing = 0.0, 0
+    a, b, c = (xyz[faces[:, k]][:, [0, 2]] for k in range(3))
+    for k in range(len(rows)):
+        pt = q[k, [0, 2]]
+        den = (b[:, 1] - c[:, 1]) * (a[:, 0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (a[:, 1] - c[:, 1])
+        l1 = ((b[:, 1] - c[:, 1]) * (pt[0] - c[:, 0]) + (c[:, 0] - b[:, 0]) * (pt[1] - c[:, 1])) / den
+        l2 = ((c[:, 1] - a[:, 1]) * (pt[0] - c[:, 0]) + (a[:, 0] - c[:, 0]) * (pt[1] - c[:, 1])) / den
+        lam = np.stack([l1, l2, 1.0 - l1 - l2], axis=1)
+        hold = np.nonzero(lam.min(axis=1) >= -1e-9)[0]
+        if not hold.size:
+            missing += 1
+            continue
+        e, w = hold[0], lam[hold[0]]
+        worst = max(worst, abs(w @ pres[faces[e]] - pc[k]) / pres.max(),
+                    abs(w @ gap[faces[e]] - gc[k]) / np.abs(gap).max(),
+                    abs(w @ xyz[faces[e], 1] - q[k, 1]) / np.abs(xyz).max())
+    check(len(rows) >= 300 and on_line, f"plot_contact --csv (line {direction}): {len(rows)} samples, all on the line "
+          "through the centre", f"{len(rows)} rows, on the line: {on_line}")
+    check(missing == 0 and worst <= 1e-12, f"plot_contact --csv (line {direction}): pressure, gap and y are the linear "
+          "interpolation on the file's faces", f"largest relative difference {worst:.1e}, {missing} samples on no face")
+    if hertz is not None:
+        hz_col = np.array([float(r["hertz_pressure"]) for r in rows])
+        p0_, a_ = hertz
+        ref = p0_ * np.sqrt(np.clip(1.0 - (t / a_) ** 2, 0.0, None))
+        check(np.abs(hz_col - ref).max() <= 1e-9 * p0_, "plot_contact --csv: the Hertz column is p0 sqrt(1 - t^2/a^2)",
+              f"max difference {np.abs(hz_col - ref).max():.2e}")
+    return t, q[:, 0]
+
+
+E3, NU3, R3 = 1000.0, 0.3, 1.0          # inputs/sphere_block.nml
+sb = f"{OUT}/sphere.h5"
+coarse = os.path.join(ROOT, "inputs/gmsh/sphere_block_h0.02.msh")
+p, _ = run_solver(BIN, os.path.join(ROOT, "inputs/sphere_block.nml"), f"&body id=1, mesh='{coarse}' /",
+                  f"&body id=2, mesh='{coarse}' /", f"&output file='{sb}' /")
+if check(p.returncode == 0, "Hertz 3D (quarter model, coarse mesh) solved", f"exit {p.returncode}"):
+    with h5py.File(sb, "r") as f:
+        P3 = 4.0 * float(f["contact/resultant_body1"][1])
+        xz = np.stack([f["contact/x"][()], f["contact/z"][()]], axis=1)
+    a3 = (3.0 * P3 * R3 / (4.0 * E3 / (2.0 * (1.0 - NU3 ** 2)))) ** (1.0 / 3.0)
+    p03 = 3.0 * P3 / (2.0 * np.pi * a3 ** 2)
+    rc, out, wall, mb = tool("plot_contact.py", sb, "--hertz", "--radius", "1", "--csv", f"{OUT}/line.csv",
+                             "-o", f"{OUT}/sphere.png")
+    print(f"TIME  plot_contact.py --hertz on a solid result: {wall:.2f} s wall, peak RSS {mb:.0f} MB")
+    check(rc == 0 and "1 Hertz curves" in out, "plot_contact --hertz --radius 1 on a solid result: exit 0, "
+          "one Hertz curve", f"exit {rc} {out.strip()[-300:]}")
+    picture(f"{OUT}/sphere.png", "sphere.png (pressure map and line)")
+    line = [ln for ln in out.splitlines() if ln.startswith("plot_contact: Hertz for sphere:")]
+    vals = {k: float(v) for k, v in (w.split("=") for w in line[0].split() if w.count("=") == 1
+                                     and w.split("=")[0] in ("P", "a", "p0", "a_fit"))} if line else {}
+    check(bool(vals) and abs(vals["P"] / P3 - 1) < 1e-5 and abs(vals["a"] / a3 - 1) < 1e-5
+          and abs(vals["p0"] / p03 - 1) < 1e-5 and "symmetry planes x = 0, z = 0" in line[0],
+          "plot_contact --hertz on the quarter model: P = 4 x the resultant, a and p0 of Hertz's point contact",
+          f"{line} against P={P3:.6g} a={a3:.6g} p0={p03:.6g}")
+    check(bool(vals) and abs(vals["a_fit"] / a3 - 1) < 0.05, "the Hertz shape fitted to the pressures: a within 5%",
+          f"{vals}")
+    t, x = line_check(f"{OUT}/line.csv", sb, (1.0, 0.0), hertz=(p03, a3))
+    xmax = float(xz[xz[:, 1] == 0.0, 0].max())
+    check(t.size and t.min() == 0.0 and xmax - t.max() < 0.01 * xmax,
+          "the samples span the surface along the line (from the centre to the last node on z = 0)",
+          f"t from {t.min() if t.size else None} to {t.max() if t.size else None}, last node at x = {xmax:.6g}")
+    rc, out, _, _ = tool("plot_contact.py", sb, "--line", "1,5,1", "--csv", f"{OUT}/diag.csv", "-o", f"{OUT}/diag.png")
+    check(rc == 0 and "along (0.7071, 0, 0.7071)" in out, "plot_contact --line 1,5,1: the line along (1, 0, 1)/sqrt(2)",
+          f"exit {rc} {out.strip()[-300:]}")
+    if rc == 0:
+        line_check(f"{OUT}/diag.csv", sb, (1.0, 1.0))
+    rc, out, _, _ = tool("plot_contact.py", sb, hz, "-o", f"{OUT}/both.png")
+    check(rc == 1 and "cannot draw plane and solid results together" in out and "Traceback" not in out
+          and not os.path.exists(f"{OUT}/both.png"),
+          "plot_contact on a plane and a solid result: exit 1 with a message", out.strip()[-300:])
 
 # ---- friction: the shear panel and Cattaneo-Mindlin ---------------------------------------
 E, NU, R_GAP, MU = 2.1e11, 0.3, 100.0, 0.3

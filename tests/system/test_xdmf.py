@@ -27,6 +27,21 @@ special characters & < > " ', into a temporary folder, then for each run:
      f.attrs['status'] == 'converged';
   7. every XDMF file names the run that wrote the HDF5 file (the comment run_id equals
      the root attribute run_id).
+  8. solid bodies, where a contact grid is a surface: three boxes stacked (hexahedra on
+     tetrahedra on hexahedra, two pairs, two load steps) and Hertz's sphere on a block (the
+     quarter model inputs/sphere_block.nml on the coarse mesh):
+     - each pair's /contact/pair_<k>/faces are the faces of its slave's contact side: the
+       deck's nx x nz quadrilaterals (hexahedra) or 2 nx nz triangles (tetrahedra), tiling
+       the contact square (their areas sum to its area), each counter-clockwise seen from
+       outside the slave (its normal along the file's contact normals); /contact/faces
+       stacks them, a triangle's fourth vertex -1 beside quadrilaterals, and
+       /contact/topology is their XDMF Mixed list (computed here); no `segments`;
+     - the XDMF grids: a Quadrilateral, a Triangle and a Mixed surface with the right
+       counts, every DataItem an existing dataset of its Dimensions; meshio reads each
+       one-grid file back (TimeSeriesReader: both steps' pressures those of /steps);
+     - Hertz: the faces are exactly the file's 'sphere_arc' triangles (read from the .msh
+       by meshio) all of whose nodes are contact nodes, and every active contact node is
+       on one of them; meshio reads the Triangle surface with its point data.
 Prints PASS/FAIL lines; exits 1 if any check failed. Run with /usr/bin/python3.
 """
 import io
@@ -354,6 +369,160 @@ def run_case(tmp, tag, overrides, units=("m", "N", "Pa"), name=None):
             compare_body(path, f[f"body{b}"], cxy, f"{tag} body{b}")
 
 
+# ---- solid bodies: contact surfaces ---------------------------------------------------------
+STACK3 = """&scene title = 'three boxes, two pairs', dimension = 3 /
+&body id = 1, x0 = 0.0, y0 = 2.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 3,
+      element = 'Q1', left = 'roller', front = 'roller' /
+&body id = 2, x0 = 0.0, y0 = 1.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 3, ny = 2, nz = 2,
+      element = 'P1', left = 'roller', front = 'roller' /
+&body id = 3, x0 = 0.0, y0 = 0.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 2,
+      element = 'Q1', left = 'roller', front = 'roller', bottom = 'roller' /
+&traction body = 1, side = 'top', t0 = 0.0, -1.0e6, 0.0 /
+&contact bodies = 1, 2, groups = 'bottom', 'top' /
+&contact bodies = 2, 3, groups = 'bottom', 'top' /
+&solver load_steps = 2 /
+"""
+
+
+def face_vectors(xyz, faces):
+    """(area, unit normal by the right-hand rule) of each face (a -1 fourth vertex: a triangle;
+    a quadrilateral by its diagonals)."""
+    areas, normals = [], []
+    for fc in faces:
+        v = fc[fc >= 0]
+        p = xyz[v]
+        c = np.cross(p[2] - p[0], p[3] - p[1]) if v.size == 4 else np.cross(p[1] - p[0], p[2] - p[0])
+        areas.append(0.5 * np.linalg.norm(c))
+        normals.append(c / np.linalg.norm(c))
+    return np.array(areas), np.array(normals)
+
+
+def check_surface_grid(xdmf, f, tag, want):
+    """A one-grid (or temporal) XDMF file of a contact surface: its Topology and that every
+    DataItem is an existing dataset of its Dimensions."""
+    root = ET.parse(xdmf).getroot()
+    bad = []
+    topos = list(root.iter("Topology"))
+    got = {(t.get("TopologyType"), t.get("NumberOfElements")) for t in topos}
+    if got != {want}:
+        bad.append(f"topologies {got}, expected {want}")
+    for item in root.iter("DataItem"):
+        ref = (item.text or "").strip()
+        dset = ref.partition(":")[2]
+        dims = tuple(int(x) for x in item.get("Dimensions", "").split())
+        if dset not in f or f[dset].shape != dims:
+            bad.append(f"{ref}: dims {dims}, dataset {f[dset].shape if dset in f else 'missing'}")
+    check(not bad, f"{tag}: {os.path.basename(xdmf)}: a {want[0]} surface of {want[1]} faces, every DataItem a "
+          "dataset of its Dimensions" + ("" if not bad else " (" + "; ".join(bad[:4]) + ")"))
+
+
+def solid_stack(tmp):
+    tag = "solid stack"
+    deck = os.path.join(tmp, "stack3.nml")
+    with open(deck, "w") as fh:
+        fh.write(STACK3)
+    h5 = os.path.join(tmp, "stack3.h5")
+    p, _ = run_solver(binary(), deck, f"&output file='{h5}' /", cwd=tmp, timeout=600)
+    if not check(p.returncode == 0 and os.path.isfile(h5), f"{tag}: three boxes, two pairs, two load steps solved",
+                 f"exit {p.returncode} {p.stderr.strip()[-300:]}"):
+        return
+    with h5py.File(h5, "r") as f:
+        c = f["contact"]
+        xyz = c["geometry_xyz"][()]
+        normal = c["normal"][()].T
+        f1, f2 = c["pair_1/faces"][()], c["pair_2/faces"][()]
+        n1 = c["pair_1/normal_force"].shape[0]
+        # the deck: body 1 (2 x 3 hexahedra) on body 2 (3 x 2 cells of tetrahedra) on body 3; the
+        # upper body of each pair has the finer contact side: the slave
+        check(f1.shape == (6, 4) and f2.shape == (12, 3) and f1.min() >= 0 and f2.min() >= 0
+              and int(c["pair_1"].attrs["slave_body"]) == 1 and int(c["pair_2"].attrs["slave_body"]) == 2,
+              f"{tag}: pair 1's faces the 2 x 3 quadrilaterals of body 1's bottom, pair 2's the 2 x 3 x 2 triangles "
+              "of body 2's", f"{f1.shape}, {f2.shape}")
+        for k, (fk, r0) in enumerate(((f1, 0), (f2, n1)), start=1):
+            pts = xyz[r0:r0 + c[f"pair_{k}/normal_force"].shape[0]]
+            area, nf = face_vectors(pts, fk)
+            rows = np.unique(fk[fk >= 0])
+            nodal = np.array([normal[r0 + fc[fc >= 0]].mean(axis=0) for fc in fk])
+            check(abs(area.sum() - 1.0) <= 1e-12 and np.all(np.sum(nf * nodal, axis=1) > 0.999)
+                  and np.array_equal(rows, np.arange(pts.shape[0])),
+                  f"{tag}: pair {k}'s faces tile the contact square (area {area.sum():.15g}), outward from the "
+                  "slave (along the contact normals), over every contact node of the pair")
+        stacked = np.vstack([np.c_[f1, -np.ones((6, 0), dtype=int)], np.c_[f2 + n1, -np.ones((12, 1), dtype=int)]])
+        topo = np.concatenate([np.r_[5, fc] for fc in f1] + [np.r_[4, fc + n1] for fc in f2])
+        check(np.array_equal(c["faces"][()], stacked) and np.array_equal(c["topology"][()], topo)
+              and "segments" not in c and "segments" not in c["pair_1"],
+              f"{tag}: /contact/faces stacks the pairs' faces (a triangle's fourth -1), /contact/topology their "
+              "XDMF Mixed list, no segments")
+        check(all(f[d].attrs.get("units") == "1"
+                  for d in ("contact/faces", "contact/topology", "contact/pair_1/faces")),
+              f"{tag}: faces and topology have units '1'")
+        stem = h5[:-3]
+        check_surface_grid(stem + "_contact.xdmf", f, tag, ("Mixed", "18"))
+        check_surface_grid(stem + "_contact1.xdmf", f, tag, ("Quadrilateral", "6"))
+        check_surface_grid(stem + "_contact2.xdmf", f, tag, ("Triangle", "12"))
+        grids = [g.get("Name") for g in ET.parse(stem + ".xdmf").getroot().iter("Grid")
+                 if g.get("GridType") == "Uniform"]
+        check(grids == ["body1", "body2", "body3", "contact_pair1", "contact_pair2"] * 2,
+              f"{tag}: the collection has the bodies and both contact surfaces at each step", str(grids))
+        for name, k, cells in (("_contact1", 1, [("quad", f1)]), ("_contact2", 2, [("triangle", f2)]),
+                               ("_contact", 0, [("quad", f1), ("triangle", f2 + n1)])):
+            g = c if k == 0 else c[f"pair_{k}"]
+            try:
+                with meshio.xdmf.TimeSeriesReader(stem + name + ".xdmf") as r:
+                    pts, blocks = r.read_points_cells()
+                    steps = [r.read_data(s)[1]["pressure"] for s in range(r.num_steps)]
+            except Exception as e:  # noqa: BLE001 (report any reader failure as a FAIL)
+                check(False, f"{tag}: meshio reads {os.path.basename(stem + name)}.xdmf ({type(e).__name__}: {e})")
+                continue
+            want = [f[f"steps/step_{s}/contact" + ("" if k == 0 else f"/pair_{k}") + "/pressure"][()] for s in (1, 2)]
+            check(np.array_equal(pts, g["geometry_xyz"][()])
+                  and [(b.type, np.asarray(b.data).tolist()) for b in blocks] == [(t, d.tolist()) for t, d in cells]
+                  and len(steps) == 2 and all(np.array_equal(np.ravel(a), b) for a, b in zip(steps, want)),
+                  f"{tag}: meshio reads {os.path.basename(stem + name)}.xdmf back: points, "
+                  f"{' and '.join(t for t, _ in cells)} cells, both steps' pressures")
+
+
+def solid_hertz(tmp):
+    tag = "solid Hertz"
+    h5 = os.path.join(tmp, "sphere.h5")
+    msh = os.path.join(ROOT, "inputs", "gmsh", "sphere_block_h0.02.msh")
+    p, _ = run_solver(binary(), os.path.join(ROOT, "inputs", "sphere_block.nml"), f"&body id=1, mesh='{msh}' /",
+                      f"&body id=2, mesh='{msh}' /", f"&output file='{h5}' /", cwd=tmp, timeout=600)
+    if not check(p.returncode == 0 and os.path.isfile(h5), f"{tag}: sphere on a block solved", f"exit {p.returncode}"):
+        return
+    with contextlib.redirect_stdout(io.StringIO()):
+        mesh = meshio.read(msh)
+    arc = mesh.field_data["sphere_arc"][0]
+    tris = np.vstack([b.data for b, tags in zip(mesh.cells, mesh.cell_data["gmsh:physical"])
+                      if b.type == "triangle" and np.all(tags == arc)])
+    with h5py.File(h5, "r") as f:
+        c = f["contact"]
+        xyz = c["geometry_xyz"][()]
+        faces = c["faces"][()]
+        lam = c["normal_force"][()]
+        normal = c["normal"][()].T
+        row = {tuple(q): k for k, q in enumerate(xyz.tolist())}
+        mapped = [[row.get(tuple(mesh.points[v].tolist())) for v in t] for t in tris]
+        want = {frozenset(t) for t in mapped if None not in t}
+        got = [frozenset(t) for t in faces.tolist()]
+        check(len(got) == len(set(got)) and set(got) == want and 0 < len(want) < len(tris),
+              f"{tag}: the faces are the 'sphere_arc' triangles of the mesh file whose nodes are all contact nodes "
+              f"({len(want)} of {len(tris)})", f"{len(got)} faces in the file")
+        _, nf = face_vectors(xyz, faces)
+        nodal = normal[faces].mean(axis=1)
+        check(np.all(np.sum(nf * nodal, axis=1) > 0.9), f"{tag}: every face counter-clockwise seen from outside "
+              "the sphere (along the contact normals)")
+        check(np.all(np.isin(np.nonzero(lam > 0)[0], faces)), f"{tag}: every active contact node is on a face "
+              f"({int(np.sum(lam > 0))} active nodes)")
+        check_surface_grid(h5[:-3] + "_contact.xdmf", f, tag, ("Triangle", str(len(faces))))
+        m, err = meshio_read(h5[:-3] + "_contact.xdmf")
+        if check(m is not None, f"{tag}: meshio.read(sphere_contact.xdmf)" + (f": {err}" if err else "")):
+            check([b.type for b in m.cells] == ["triangle"] and np.array_equal(m.cells[0].data, faces)
+                  and np.array_equal(m.points, xyz) and sorted(m.point_data) == sorted(CONTACT_FIELDS)
+                  and all(np.array_equal(np.ravel(m.point_data[k]), c[k][()]) for k in CONTACT_FIELDS),
+                  f"{tag}: meshio reads the contact surface back: triangles == /contact/faces, points, point data")
+
+
 def main():
     print(f"meshio {meshio.__version__}, h5py {h5py.__version__}, binary {binary()}")
     with tempfile.TemporaryDirectory(prefix="test_xdmf_") as tmp:
@@ -362,6 +531,8 @@ def main():
         run_case(tmp, "q1_6x2_mm", ["&scene units='mm-N-MPa' /"], units=("mm", "N", "MPa"))
         # a name with the XML special characters: the XDMF files stay well-formed
         run_case(tmp, "xml_chars", [], name="a&b<c>d\"e'f")
+        solid_stack(tmp)
+        solid_hertz(tmp)
     print(f"test_xdmf: {len(check.failed)} failed check(s)")
     return 1 if check.failed else 0
 
