@@ -405,6 +405,14 @@ bench-assemblies: $(PROG)
 bench-friction: $(PROG)
 	$(PYTHON) bench/bench_friction.py --bin $(PROG) --repeat 2
 
+# CalculiX 2.20 beside robin_contact on the same tetrahedra: Hertz's sphere on a block
+# (inputs/sphere_block.nml, hc = 0.02 and 0.01), P, a, p0 against Hertz and wall times
+# (tools/ccx_hertz3d.py, about 2 min). Needs ccx: apt-get install -y calculix-ccx (not
+# installed by tools/install-deps.sh; make check does not use it)
+.PHONY: ccx-hertz3d
+ccx-hertz3d: $(PROG)
+	$(PYTHON) tools/ccx_hertz3d.py --bin $(PROG)
+
 plots: $(PROG)
 	BIN=$(PROG) PYTHON=$(PYTHON) bash tools/make_plots.sh
 
