@@ -66,14 +66,14 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology volume_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        ordering cholmod_iface banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
+        cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
 TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box test_gmsh_3d
-BENCH_F := bench_mprgp bench_ordering bench_assembly_rate
+BENCH_F := bench_mprgp bench_ordering bench_ordering_3d bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
 
@@ -83,7 +83,7 @@ DEPS_STAMP := build/.deps-mpi-ok
 endif
 # mpif90 and MUMPS's headers present: `make check` builds and tests the MPI binary too
 
-.PHONY: all mpi mpi-deps run check bench-mprgp bench-ordering table1 bench bench-hertz bench-gmsh bench-mpi hard plots meshes clean deps FORCE
+.PHONY: all mpi mpi-deps run check bench-mprgp bench-ordering bench-ordering-3d table1 bench bench-hertz bench-gmsh bench-mpi hard plots meshes clean deps FORCE
 all: $(PROG)
 
 # ---- system packages: install what is missing (Debian 12) --------------------
@@ -176,10 +176,11 @@ $(BUILD)/assembly.o:       $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $
                            $(BUILD)/elements.o $(BUILD)/element_types.o $(BUILD)/linop.o $(BUILD)/body_system.o \
                            $(BUILD)/supports.o $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o \
                            $(BUILD)/material_laws.o
-$(BUILD)/ordering.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/errors.o
+$(BUILD)/ordering.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/cholmod_iface.o
 $(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
 $(BUILD)/banded.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
-$(BUILD)/cholesky.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o
+$(BUILD)/cholesky.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o \
+                           $(BUILD)/ordering.o $(BUILD)/clock.o
 $(BUILD)/mumps_iface.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/lapack.o
 $(BUILD)/factorization.o $(BUILD)/element_types.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/factorization.o:  $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/config.o $(BUILD)/cholesky.o $(BUILD)/mumps_iface.o \
@@ -352,6 +353,13 @@ bench-mprgp: $(BENCH_BINS)
 # the ordering ladder: metis / amd / nd, 128x64 ... 1024x512, 1 and 2 threads (about 6 min)
 bench-ordering: $(PROG) $(BENCH_BINS)
 	$(PYTHON) bench/bench_ordering.py --bin $(PROG) --bench $(BUILD)/bench/bench_ordering
+
+# the orderings of a solid body: METIS on the node graph (what 'nd' gives a solid body), METIS
+# on the DOF graph, CHOLMOD's own analysis, on the cubes 10^3 ... 40^3 (CUBES=10,15,20,25,30,40),
+# one process each; results/bench_ordering_3d.csv and Markdown tables (about 10 min, 3.5 GB at 40^3)
+CUBES ?= 10,15,20,25,30,40
+bench-ordering-3d: $(BUILD)/bench/bench_ordering_3d
+	$(PYTHON) bench/bench_ordering_3d.py --bench $(BUILD)/bench/bench_ordering_3d --k $(CUBES)
 
 table1: $(PROG)
 	$(PYTHON) tools/table1.py --bin $(PROG) --csv results/table1.csv

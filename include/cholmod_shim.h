@@ -26,6 +26,9 @@ extern "C" {
 #define CHSH_ORD_AMD        2
 #define CHSH_ORD_NATURAL    3
 #define CHSH_ORD_GIVEN      4   /* interior order given by the caller */
+/* (5 is module cholesky's ORD_NODES: it computes the interior order itself, METIS on the
+ * node graph through chsh_metis_order, and hands it over as CHSH_ORD_GIVEN) */
+#define CHSH_ORD_AUTO       6   /* CHOLMOD's own choice (nmethods = 0); no DOFs last */
 
 typedef struct chsh_factor chsh_factor;   /* opaque */
 
@@ -39,10 +42,14 @@ typedef struct chsh_stats {
     double mem_peak;      /* peak CHOLMOD memory of this handle [bytes] */
     double mem_inuse;     /* CHOLMOD memory in use now [bytes] */
     double tiles;         /* dense-kernel tiles the numeric factorization ran (blas_tiles.h) */
+    double t_order;       /* wall time of the interface-last permutation, part of t_analyze
+                             (METIS or CAMD of the interior, the check of a given order) [s] */
     int    n;             /* matrix order */
     int    nlast;         /* number of DOFs requested last */
     int    last_ok;       /* 1 if L->Perm ends with exactly those DOFs, in order */
     int    is_super;      /* 1 if L is supernodal */
+    int    ordering_used; /* the CHOLMOD ordering the analysis kept (CHOLMOD_GIVEN 1,
+                             CHOLMOD_AMD 2, CHOLMOD_METIS 3, ...), -1 before one */
 } chsh_stats;
 
 /* Hold OpenBLAS to one thread (done once per process; parallelism is over
@@ -56,14 +63,24 @@ int chsh_create(chsh_factor **h, char *msg, int msglen);
 /* Analyze + factorize a symmetric positive definite matrix given in full
  * symmetric CSC (both triangles; only the upper triangle is read).
  * colptr[n+1], rowind[colptr[n]], val[colptr[n]]; rows sorted per column.
- * ordering: CHSH_ORD_*.  last[nlast] (may be NULL when nlast == 0): DOFs to be
- * ordered last, in this order (the interface).  interior[n - nlast]: with
- * CHSH_ORD_GIVEN, the order of all the other DOFs (a permutation of the DOFs
- * not in `last`), followed by `last`; ignored (may be NULL) otherwise.  A
- * previous factor in the handle is released first. */
+ * ordering: CHSH_ORD_* (CHSH_ORD_AUTO only with nlast == 0).  last[nlast]
+ * (may be NULL when nlast == 0): DOFs to be ordered last, in this order (the
+ * interface).  interior[n - nlast]: with CHSH_ORD_GIVEN, the order of all the
+ * other DOFs (a permutation of the DOFs not in `last`), followed by `last`;
+ * ignored (may be NULL) otherwise.  A previous factor in the handle is
+ * released first. */
 int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
                    const double *val, int ordering, int nlast, const int *last,
                    const int *interior, char *msg, int msglen);
+
+/* METIS nested dissection of the graph of a symmetric pattern (n x n CSC, 0-based,
+ * rows sorted in each column; only the strictly upper triangle is read, the diagonal
+ * may be there or not): perm[k] is the vertex placed k-th, postordered by the
+ * elimination tree (cholmod_metis).  A graph partitioner's ordering of a body's node
+ * graph; serialized with every other METIS call of the process (METIS draws from libc's
+ * global rand()).  Needs no handle. */
+int chsh_metis_order(int n, const int *colptr, const int *rowind, int *perm,
+                     char *msg, int msglen);
 
 /* Solve K X = B in place: b is n x nrhs with leading dimension ldb >= n. */
 int chsh_solve(chsh_factor *h, int nrhs, double *b, int ldb,

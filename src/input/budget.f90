@@ -77,8 +77,10 @@ contains
   !! matrix row; the factor's fill with METIS and the contact face last follows CHOLMOD's own
   !! analysis of Q1 cubes 16^3 .. 96^3 (METHOD-3D, section 8: lnz = 11.2 N^1.4 within 5%),
   !! raised to 13 N^1.4 for the supernodal factor's storage beyond lnz (measured: 2.84 GiB for
-  !! a 40^3 box of 201,720 DOFs, where 11.2 N^1.4 gives 2.5 GiB); banded and natural orderings
-  !! fill the band of the two smaller grid extents.
+  !! a 40^3 box of 201,720 DOFs, where 11.2 N^1.4 gives 2.5 GiB; with METIS on the node graph,
+  !! 'nd', 1.13-1.28 times the entries CHOLMOD stores and 0.89-1.00 of its peak memory on the
+  !! cubes 10^3 .. 40^3, bench/bench_ordering_3d.py); banded and natural orderings fill the band
+  !! of the two smaller grid extents.
   real(wp) function box_memory_mb(b, fc, nnz_matrix, nnz_factor) result(mb)
     type(body_cfg_t), intent(in) :: b
     type(factor_cfg_t), intent(in) :: fc

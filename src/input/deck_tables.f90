@@ -381,7 +381,8 @@ contains
       'Schur variables (`bin/robin_contact_mpi` only)')
     call v%enum('ordering', s%factor%ordering, ORDER_CHOICES, doc='fill-reducing ordering of '// &
       'each body for `''cholmod''`, the interface always last: `''metis''`, `''amd''` (CAMD), '// &
-      '`''natural''` or `''nd''` (the program''s geometric nested dissection)')
+      '`''natural''` or `''nd''` (the program''s own: geometric nested dissection of a plane body, '// &
+      'METIS on the node graph of a solid one)')
     call v%enum('acceleration', s%acceleration, ACCEL_CHOICES, doc='outer fixed-point '// &
       'acceleration: `''none''`, `''aitken''` (dynamic relaxation), `''anderson''` (mixing delta; '// &
       'history depth 5, for several pairs the number of bodies up to 64) or `''auto''`: none for two '// &

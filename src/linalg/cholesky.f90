@@ -16,9 +16,12 @@ module cholesky
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
                            cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
-                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN, CM_OK, CM_OUT_OF_MEMORY, CM_NOT_POSDEF
+                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN, CM_ORD_AUTO, CM_OK, CM_OUT_OF_MEMORY, &
+                           CM_NOT_POSDEF
   use banded, only: band_t
   use lapack, only: dpotri
+  use ordering, only: node_dissection
+  use clock, only: wtime
   use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
   implicit none (type, external)
   private
@@ -30,6 +33,11 @@ module cholesky
   integer, parameter, public :: ORD_AMD = 2        !< AMD, or CAMD when an interface is given
   integer, parameter, public :: ORD_NATURAL = 3    !< natural order (interface last if given)
   integer, parameter, public :: ORD_GIVEN = 4      !< caller's interior order (interior_perm), interface last
+  !> METIS on the node graph (ordering%node_dissection: a solid body's nodes, from the pattern), interface last
+  integer, parameter, public :: ORD_NODES = 5
+  !> CHOLMOD's own analysis (its default strategy: AMD, and METIS too when AMD fills much; the
+  !! better kept), nothing last: a reference for benchmarks
+  integer, parameter, public :: ORD_AUTO = 6
 
   !> One factorization of one symmetric positive definite matrix K (n x n).
   type, public :: chol_t
@@ -39,8 +47,15 @@ module cholesky
     integer :: m_last = 0                 !< number of DOFs ordered last (interface)
     integer, allocatable :: last(:)       !< those DOFs, 1-based, in the order given
     real(wp) :: t_analyze = 0.0_wp        !< ordering + symbolic analysis wall time [s]
+    !> the ordering's part of t_analyze (CHOLMOD with DOFs last or ORD_NODES: the permutation of
+    !! the interior; 0 where CHOLMOD's analysis orders, without DOFs last) [s]
+    real(wp) :: t_order = 0.0_wp
     real(wp) :: t_factor = 0.0_wp         !< numeric factorization wall time [s]
     integer(i8) :: nnz_factor = 0         !< nonzeros in L (CHOLMOD: without supernodal padding)
+    integer(i8) :: nnz_stored = 0         !< CHOLMOD: entries stored in the supernodal L (with padding)
+    !> CHOLMOD: the ordering its analysis kept, in CHOLMOD's codes (1 given, 2 AMD, 3 METIS; what
+    !! ORD_AUTO chose), -1 if none
+    integer :: ordering_used = -1
     real(wp) :: flops = 0.0_wp            !< factorization flop count
     !> CHOLMOD: the dense-kernel tiles its numeric factorization ran as tasks (blas_tiles.c;
     !! 0 when every kernel was small enough to run whole)
@@ -66,7 +81,8 @@ contains
   !> Factorize K, given in full symmetric CSC (both triangles, 0-based, rows sorted
   !! increasingly in each column, K symmetric).
   !! With ORD_GIVEN (CHOLMOD), interior_perm is the elimination order of every DOF not in
-  !! `last` (e.g. module ordering's nested dissection), followed by `last`.
+  !! `last` (e.g. module ordering's nested dissection), followed by `last`; ORD_NODES computes
+  !! it (ordering%node_dissection, its time part of t_analyze); ORD_AUTO takes no `last`.
   !! err: ERR_NUMERICAL (not positive definite, bad arguments, CHOLMOD failure) or ERR_MEMORY.
   subroutine chol_factor(self, n, colptr, rowind, val, method, ordering, err, last, interior_perm)
     class(chol_t), intent(inout) :: self
@@ -75,13 +91,15 @@ contains
     integer(ip), intent(in) :: rowind(:)        !< row indices, 0-based, size >= colptr(n+1)
     real(wp), intent(in) :: val(:)              !< values, size >= colptr(n+1)
     integer, intent(in) :: method               !< FACT_CHOLMOD or FACT_BANDED
-    integer, intent(in) :: ordering             !< ORD_METIS, ORD_AMD, ORD_NATURAL or ORD_GIVEN (CHOLMOD)
+    integer, intent(in) :: ordering             !< ORD_* (CHOLMOD)
     type(error_t), intent(out) :: err           !< the failure, if any
     integer, intent(in), optional :: last(:)    !< 1-based DOFs to order last (interface), CHOLMOD
     integer, intent(in), optional :: interior_perm(:)  !< ORD_GIVEN: 1-based order of the DOFs not in `last`
     integer :: j, p, nnz, k
     logical, allocatable :: seen(:)
     integer(c_int), allocatable :: last0(:), inter0(:)
+    integer, allocatable :: node_perm(:)
+    real(wp) :: t_order
     type(cm_stats_t) :: st
     character(len=200) :: emsg
     character(len=512) :: cmsg
@@ -134,7 +152,7 @@ contains
       call err%set(ERR_NUMERICAL, emsg)
       return
     end if
-    if (method == FACT_CHOLMOD .and. (ordering < ORD_METIS .or. ordering > ORD_GIVEN)) then
+    if (method == FACT_CHOLMOD .and. (ordering < ORD_METIS .or. ordering > ORD_AUTO)) then
       write (emsg, '(a,i0,a)') 'Cholesky: unknown ordering ', ordering, '.'
       call err%set(ERR_NUMERICAL, emsg)
       return
@@ -188,6 +206,17 @@ contains
       end do
     end if
     deallocate (seen)
+    if (method == FACT_CHOLMOD .and. ordering == ORD_AUTO .and. size(self%last) > 0) then
+      call err%set(ERR_NUMERICAL, 'Cholesky: ordering AUTO (CHOLMOD''s own choice) cannot put DOFs last.')
+      return
+    end if
+    t_order = 0.0_wp
+    if (method == FACT_CHOLMOD .and. ordering == ORD_NODES) then
+      t_order = wtime()
+      call node_dissection(colptr(1:n + 1), rowind(1:nnz), self%last, node_perm, err)
+      t_order = wtime() - t_order
+      if (err%failed()) return
+    end if
     self%m_last = size(self%last)
     self%n = n
     self%ordering = ordering
@@ -203,9 +232,15 @@ contains
       end if
       allocate (last0(self%m_last))
       last0 = int(self%last - 1, c_int)
-      if (ordering == ORD_GIVEN) then
-        allocate (inter0(size(interior_perm)))
-        inter0 = int(interior_perm - 1, c_int)
+      if (ordering == ORD_GIVEN .or. ordering == ORD_NODES) then
+        if (ordering == ORD_NODES) then
+          allocate (inter0(size(node_perm)))
+          inter0 = int(node_perm - 1, c_int)
+          deallocate (node_perm)
+        else
+          allocate (inter0(size(interior_perm)))
+          inter0 = int(interior_perm - 1, c_int)
+        end if
         call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, code, cmsg, &
                           interior0=inter0)
         deallocate (inter0)
@@ -213,9 +248,12 @@ contains
         call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, code, cmsg)
       end if
       st = cm_get_stats(self%handle)
-      self%t_analyze = st%t_analyze
+      self%t_analyze = st%t_analyze + t_order
+      self%t_order = st%t_order + t_order
       self%t_factor = st%t_factor
       self%nnz_factor = int(st%lnz, i8)
+      self%nnz_stored = int(st%lsize, i8)
+      self%ordering_used = st%ordering_used
       self%flops = st%flops
       self%tiles = int(st%tiles, i8)
       self%mem_bytes = int(st%mem_peak, i8)
@@ -261,8 +299,10 @@ contains
       cm_ordering = CM_ORD_METIS
     case (ORD_AMD)
       cm_ordering = CM_ORD_AMD
-    case (ORD_GIVEN)
+    case (ORD_GIVEN, ORD_NODES)
       cm_ordering = CM_ORD_GIVEN
+    case (ORD_AUTO)
+      cm_ordering = CM_ORD_AUTO
     case default
       cm_ordering = CM_ORD_NATURAL
     end select
@@ -439,7 +479,7 @@ contains
     class(chol_t), intent(in) :: self
     character(len=:), allocatable :: line
     character(len=400) :: buf
-    character(len=*), parameter :: ordname(4) = [character(len=7) :: 'metis', 'amd', 'natural', 'given']
+    character(len=*), parameter :: ordname(6) = [character(len=7) :: 'metis', 'amd', 'natural', 'given', 'nodes', 'auto']
     select case (self%method)
     case (FACT_CHOLMOD)
       write (buf, '(a,a,a,i0,a,i0,a,es10.3,a,es10.3,a,i0,a,f0.3,a,f0.3,a,f0.1,a,l1)') &
@@ -469,8 +509,11 @@ contains
     self%n = 0
     self%m_last = 0
     self%t_analyze = 0.0_wp
+    self%t_order = 0.0_wp
     self%t_factor = 0.0_wp
     self%nnz_factor = 0
+    self%nnz_stored = 0
+    self%ordering_used = -1
     self%tiles = 0
     self%flops = 0.0_wp
     self%mem_bytes = 0

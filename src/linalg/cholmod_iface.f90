@@ -19,6 +19,7 @@ module cholmod_iface
   integer, parameter, public :: CM_ORD_AMD = 2        !< (constrained) approximate minimum degree
   integer, parameter, public :: CM_ORD_NATURAL = 3    !< natural order (interface last if given)
   integer, parameter, public :: CM_ORD_GIVEN = 4      !< interior order given by the caller, interface last
+  integer, parameter, public :: CM_ORD_AUTO = 6       !< CHOLMOD's own choice (AMD, METIS if AMD fills much), nothing last
 
   integer, parameter :: MSG_LEN = 512
 
@@ -32,14 +33,17 @@ module cholmod_iface
     real(c_double) :: mem_peak = 0    !< peak CHOLMOD memory of the handle [bytes]
     real(c_double) :: mem_inuse = 0   !< CHOLMOD memory in use [bytes]
     real(c_double) :: tiles = 0       !< dense-kernel tiles of the numeric factorization (blas_tiles.c)
+    real(c_double) :: t_order = 0     !< wall time of the interface-last permutation, part of t_analyze [s]
     integer(c_int) :: n = 0           !< matrix order
     integer(c_int) :: nlast = 0       !< number of DOFs requested last
     integer(c_int) :: last_ok = 0     !< 1 if the factor's permutation ends with them, in order
     integer(c_int) :: is_super = 0    !< 1 if the factor is supernodal
+    !> the CHOLMOD ordering its analysis kept (CHOLMOD's codes: 1 given, 2 AMD, 3 METIS), -1 before one
+    integer(c_int) :: ordering_used = -1
   end type cm_stats_t
 
   public :: cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, cm_get_stats, &
-            cm_release_workspace, cm_free
+            cm_release_workspace, cm_free, cm_metis_order
 
   interface
     function chsh_create(h, msg, msglen) bind(c, name='chsh_create') result(code)
@@ -64,6 +68,16 @@ module cholmod_iface
       integer(c_int), value :: msglen
       integer(c_int) :: code
     end function chsh_factorize
+
+    function chsh_metis_order(n, colptr, rowind, perm, msg, msglen) bind(c, name='chsh_metis_order') result(code)
+      import :: c_int, c_char
+      integer(c_int), value :: n
+      integer(c_int), intent(in) :: colptr(*), rowind(*)
+      integer(c_int), intent(out) :: perm(*)
+      character(kind=c_char), intent(out) :: msg(*)
+      integer(c_int), value :: msglen
+      integer(c_int) :: code
+    end function chsh_metis_order
 
     function chsh_solve(h, nrhs, b, ldb, msg, msglen) bind(c, name='chsh_solve') result(code)
       import :: c_ptr, c_int, c_double, c_char
@@ -174,6 +188,28 @@ contains
     end if
     if (info /= CM_OK) msg = c_to_f(buf)
   end subroutine cm_factorize
+
+  !> METIS nested dissection (postordered) of the graph of a symmetric pattern: n vertices,
+  !! CSC 0-based with rows sorted in each column, the strictly upper triangle read; perm0(k)
+  !! is the vertex (0-based) placed k-th, checked to be a permutation. Serialized with every
+  !! other METIS call of the process; needs no handle.
+  subroutine cm_metis_order(n, colptr, rowind, perm0, info, msg)
+    integer, intent(in) :: n                      !< vertices
+    integer(c_int), intent(in) :: colptr(:)       !< column pointers, size n+1, 0-based
+    integer(c_int), intent(in) :: rowind(:)       !< row indices, 0-based (size >= 1)
+    integer(c_int), intent(out) :: perm0(:)       !< (n) the order, 0-based
+    integer, intent(out) :: info                  !< CM_* code
+    character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
+    character(kind=c_char) :: buf(MSG_LEN)
+    msg = ''
+    if (size(colptr) < n + 1 .or. size(perm0) < n .or. size(rowind) < 1) then
+      info = CM_FAILURE
+      msg = 'cm_metis_order: the graph''s arrays are shorter than its size.'
+      return
+    end if
+    info = chsh_metis_order(int(n, c_int), colptr, rowind, perm0, buf, MSG_LEN)
+    if (info /= CM_OK) msg = c_to_f(buf)
+  end subroutine cm_metis_order
 
   !> Solve K X = B in place for the columns of `b` (n x nrhs).
   subroutine cm_solve(h, b, info, msg)

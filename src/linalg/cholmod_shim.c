@@ -16,11 +16,14 @@
  *             in the given order;
  *   NATURAL - interior in increasing index order;
  *   GIVEN   - interior in the caller's order (e.g. geometric nested
- *             dissection; checked to be a permutation of the interior).
+ *             dissection, or METIS on a solid body's node graph through
+ *             chsh_metis_order; checked to be a permutation of the interior).
  * The permutation is handed to cholmod_analyze_p as CHOLMOD_GIVEN with the
  * etree postorder switched off (a postorder could move interior columns
  * behind interface ones).  After the analysis the tail of L->Perm is
  * compared with `last`; the result is reported in chsh_stats.last_ok.
+ * AUTO (no DOFs last) is CHOLMOD's own analysis with its default strategy
+ * (nmethods = 0: AMD, and METIS too when AMD's fill is high; the better kept).
  */
 #include <stdarg.h>
 #include <stdio.h>
@@ -297,6 +300,59 @@ done:
     return code;
 }
 
+int chsh_metis_order(int n, const int *colptr, const int *rowind, int *perm,
+                     char *msg, int msglen)
+{
+    cholmod_common c;
+    cholmod_sparse A;
+    int ok, code = CHSH_OK, k;
+
+    set_msg(msg, msglen, "%s", "");
+    if (n < 0 || colptr == NULL || perm == NULL || (n > 0 && colptr[n] > 0 && rowind == NULL)) {
+        set_msg(msg, msglen, "chsh_metis_order: invalid graph (n = %d or NULL arrays).", n);
+        return CHSH_FAILURE;
+    }
+    if (n <= 1) {            /* nothing to order (METIS wants an edge) */
+        if (n == 1) perm[0] = 0;
+        return CHSH_OK;
+    }
+    if (!cholmod_start(&c)) {
+        code = translate(&c, "start", msg, msglen);
+        return code == CHSH_OK ? CHSH_FAILURE : code;
+    }
+    c.print = 0;
+    wrap_sparse(&A, n, colptr, rowind, NULL);
+    pthread_mutex_lock(&metis_lock);
+    ok = cholmod_metis(&A, NULL, 0, TRUE, perm, &c);
+    pthread_mutex_unlock(&metis_lock);
+    if (!ok || c.status < CHOLMOD_OK) {
+        code = translate(&c, "METIS ordering of the node graph", msg, msglen);
+        if (code == CHSH_OK) code = CHSH_FAILURE;
+    }
+    if (!cholmod_finish(&c) && code == CHSH_OK) {
+        code = translate(&c, "finish", msg, msglen);
+        if (code == CHSH_OK) code = CHSH_FAILURE;
+    }
+    if (code == CHSH_OK) {   /* a permutation of 0..n-1, or a failure */
+        char *seen = (char *) calloc((size_t) n, 1);
+        if (seen == NULL) {
+            set_msg(msg, msglen, "chsh_metis_order: out of memory for the check of the permutation.");
+            return CHSH_OUT_OF_MEMORY;
+        }
+        for (k = 0; k < n; k++) {
+            if (perm[k] < 0 || perm[k] >= n || seen[perm[k]]) {
+                set_msg(msg, msglen, "METIS ordering of the node graph: entry %d (%d) is not a permutation's.",
+                        k + 1, perm[k] + 1);
+                code = CHSH_FAILURE;
+                break;
+            }
+            seen[perm[k]] = 1;
+        }
+        free(seen);
+    }
+    return code;
+}
+
 int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
                    const double *val, int ordering, int nlast, const int *last,
                    const int *interior, char *msg, int msglen)
@@ -319,8 +375,13 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
         return CHSH_FAILURE;
     }
     if (ordering != CHSH_ORD_METIS && ordering != CHSH_ORD_AMD
-        && ordering != CHSH_ORD_NATURAL && ordering != CHSH_ORD_GIVEN) {
+        && ordering != CHSH_ORD_NATURAL && ordering != CHSH_ORD_GIVEN
+        && ordering != CHSH_ORD_AUTO) {
         set_msg(msg, msglen, "chsh_factorize: unknown ordering code %d.", ordering);
+        return CHSH_FAILURE;
+    }
+    if (ordering == CHSH_ORD_AUTO && nlast > 0) {
+        set_msg(msg, msglen, "chsh_factorize: CHOLMOD's own ordering cannot put %d DOFs last.", nlast);
         return CHSH_FAILURE;
     }
     if (nlast < 0 || nlast > n || (nlast > 0 && last == NULL)) {
@@ -333,6 +394,7 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
     }
     h->st.n = n;
     h->st.nlast = nlast;
+    h->st.ordering_used = -1;
     wrap_sparse(&A, n, colptr, rowind, val);
 
     /* ---- analysis ---- */
@@ -359,8 +421,10 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
             seen[last[k]] = 1;
         }
         free(seen);
+        h->st.t_order = SuiteSparse_time();
         code = build_last_perm(h, &A, n, colptr, rowind, ordering, nlast, last,
                                interior, perm, msg, msglen);
+        h->st.t_order = SuiteSparse_time() - h->st.t_order;
         if (code != CHSH_OK) {
             free(perm);
             return code;
@@ -370,13 +434,18 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
         h->L = cholmod_analyze_p(&A, perm, NULL, 0, c);
         free(perm);
     } else {
-        c->method[0].ordering = (ordering == CHSH_ORD_METIS) ? CHOLMOD_METIS
-                              : (ordering == CHSH_ORD_AMD) ? CHOLMOD_AMD
-                              : CHOLMOD_NATURAL;
+        int may_run_metis = (ordering == CHSH_ORD_METIS || ordering == CHSH_ORD_AUTO);
+        if (ordering == CHSH_ORD_AUTO) {
+            c->nmethods = 0;     /* CHOLMOD's default strategy: AMD, METIS if AMD fills much */
+        } else {
+            c->method[0].ordering = (ordering == CHSH_ORD_METIS) ? CHOLMOD_METIS
+                                  : (ordering == CHSH_ORD_AMD) ? CHOLMOD_AMD
+                                  : CHOLMOD_NATURAL;
+        }
         c->postorder = (ordering != CHSH_ORD_NATURAL);
-        if (ordering == CHSH_ORD_METIS) pthread_mutex_lock(&metis_lock);
+        if (may_run_metis) pthread_mutex_lock(&metis_lock);
         h->L = cholmod_analyze(&A, c);
-        if (ordering == CHSH_ORD_METIS) pthread_mutex_unlock(&metis_lock);
+        if (may_run_metis) pthread_mutex_unlock(&metis_lock);
     }
     h->st.t_analyze = SuiteSparse_time() - t0;
     if (h->L == NULL || c->status < CHOLMOD_OK) {
@@ -386,6 +455,8 @@ int chsh_factorize(chsh_factor *h, int n, const int *colptr, const int *rowind,
     }
     h->st.lnz = c->lnz;
     h->st.flops = c->fl;
+    if (c->selected >= 0 && c->selected < CHOLMOD_MAXMETHODS)
+        h->st.ordering_used = c->method[c->selected].ordering;
 
     /* does L->Perm end with the interface DOFs, in the given order? */
     if (nlast > 0) {

@@ -19,7 +19,7 @@ module factorization
   use kinds, only: wp, ip, i8
   use space, only: NDIM
   use config, only: factor_cfg_t, FACTOR_BANDED, FACTOR_MUMPS, ORDER_AMD, ORDER_NATURAL, ORDER_ND
-  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN, ORD_NODES
   use mumps_iface, only: mumps_t, mumps_schur_factor, mumps_solve, mumps_end
   use errors, only: error_t, ERR_NUMERICAL
   use strings, only: body_label
@@ -147,8 +147,8 @@ module factorization
 contains
 
   !> The factor the deck's setting names, not yet factorized: CHOLMOD with its ordering
-  !! (ordering='nd': the caller's interior order, interface last), banded, or MUMPS over the
-  !! group `comm` (default: 0).
+  !! (ordering='nd': in the plane the caller's interior order, a solid body's by METIS on its
+  !! node graph; the interface last), banded, or MUMPS over the group `comm` (default: 0).
   subroutine new_factor(fc, body, fac, comm)
     type(factor_cfg_t), intent(in) :: fc                  !< factorization and ordering
     integer, intent(in) :: body                           !< the body, for messages
@@ -178,8 +178,8 @@ contains
           fac%ordering = ORD_AMD
         case (ORDER_NATURAL)
           fac%ordering = ORD_NATURAL
-        case (ORDER_ND)     ! the geometric dissection is the plane's; a solid body: METIS
-          fac%ordering = merge(ORD_GIVEN, ORD_METIS, NDIM == 2)
+        case (ORDER_ND)     ! the geometric dissection is the plane's; a solid body: METIS on its nodes
+          fac%ordering = merge(ORD_GIVEN, ORD_NODES, NDIM == 2)
         case default
           fac%ordering = ORD_METIS
         end select

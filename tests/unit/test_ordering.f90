@@ -8,26 +8,34 @@
 !! invalid inputs are reported; two bodies condensed with 'nd' equal 'metis'; on general
 !! meshes (a grid renumbered at random, interior nodes moved: structured = .false.) the
 !! coordinate bisection is a permutation with node DOFs together, factors to the METIS
-!! solution and flexibility, with nnz(L) within 1.5x METIS's.
+!! solution and flexibility, with nnz(L) within 1.5x METIS's. Solid boxes (node_dissection,
+!! ORD_NODES, what 'nd' gives a solid body): the order is a permutation of exactly the DOFs
+!! not ordered last, each node's DOFs together, consecutive and in component order (checked
+!! with the assembly's DOF map, and the check fails on a reversed order); the nodes found in
+!! the pattern are the mesh's; the factor has the contact DOFs last in the given (scrambled)
+!! order, solves K u = f and gives METIS's flexibility; on a 12^3 box its nnz(L) is within
+!! 1.2x that of METIS on the DOF graph and below the natural order's; bad inputs reported.
 !! One line per check; exits non-zero if any check fails.
 program test_ordering
   use, intrinsic :: iso_fortran_env, only: output_unit
   use kinds, only: wp
   use config, only: deck_t, deck_init, body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, ORDER_METIS, ORDER_ND, &
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
-                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, factor_cfg_t
+  use space, only: set_dimension, node_dof, dof_node
   use mesh, only: mesh_t, mesh_build, node_id
   use assembly, only: body_system_t, assemble_body, csc_matvec
   use supports, only: number_free_dofs
-  use ordering, only: grid_dissection, coordinate_bisection, ND_LEAF_NODES
-  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN
+  use ordering, only: grid_dissection, coordinate_bisection, ND_LEAF_NODES, node_dissection, node_groups
+  use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_GIVEN, ORD_NODES, ORD_AUTO, &
+                      ORD_NATURAL
   use contact_interface, only: interface_t, build_interface
   use condense, only: body_condensed_t, factor_body, condense_body
-  use factorization, only: cholmod_factor_t
+  use factorization, only: cholmod_factor_t, factor_t, new_factor
   use clock, only: wtime
   use strings, only: body_label
   use testing, only: report, report_le, test_summary, rectangle_body, structured_body, general_body, &
-                     side_free_dofs, order_body, factor_ordered, error_parts
+                     side_free_dofs, order_body, factor_ordered, error_parts, box_system
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
 
@@ -66,6 +74,16 @@ program test_ordering
   call check_general('general Q1 64x32, not moved', 64, 32, ELEM_Q1, 0.0_wp, 3)
   call check_general('general Q1 5x3, moved 0.3', 5, 3, ELEM_Q1, 0.3_wp, 5)
   call check_general_bad()
+
+  ! ---- solid bodies: METIS on the node graph ----
+  call set_dimension(3)
+  call check_nodes_3d('box Q1 6x5x4, bottom clamped, left roller', 6, 5, 4, ELEM_Q1, &
+                      [BC_ROLLER, BC_FREE, BC_CLAMPED, BC_CONTACT, BC_FREE, BC_FREE])
+  call check_nodes_3d('box P1 3x4x5, bottom clamped, front roller', 3, 4, 5, ELEM_P1, &
+                      [BC_FREE, BC_FREE, BC_CLAMPED, BC_CONTACT, BC_ROLLER, BC_FREE])
+  call check_fill_3d(12)
+  call check_nodes_bad()
+  call set_dimension(2)
 
   ! ---- a large grid: ordering time at 1024 x 512 cells (printed, not asserted) ----
   call check_large()
@@ -485,6 +503,217 @@ contains
     call report(info == 0 .and. size(perm) == n - size(last) .and. all(seen), &
                 '1024x512 cells: a permutation of the free non-interface DOFs')
   end subroutine check_large
+
+  !> Whether each node's DOFs in perm are consecutive, in increasing component order (the
+  !! assembly's DOF map: node k, component c is free DOF free_of(node_dof(k, c))).
+  logical function node_dofs_consecutive(sys, nnode, perm, is_last) result(ok)
+    type(body_system_t), intent(in) :: sys    !< the body's numbering
+    integer, intent(in) :: nnode              !< its nodes
+    integer, intent(in) :: perm(:)            !< an interior order (covers_rest)
+    logical, intent(in) :: is_last(:)         !< the DOFs ordered last by the caller
+    integer, allocatable :: pos(:)
+    integer :: k, c, f, prev
+    allocate (pos(sys%n))
+    pos = 0
+    pos(perm) = [(k, k=1, size(perm))]
+    ok = .true.
+    do k = 1, nnode
+      prev = 0
+      do c = 1, 3
+        f = sys%free_of(node_dof(k, c))
+        if (f == 0) cycle
+        if (is_last(f)) cycle
+        if (prev > 0) ok = ok .and. pos(f) == prev + 1
+        prev = pos(f)
+      end do
+    end do
+  end function node_dofs_consecutive
+
+  !> A solid box's node order: a permutation of the DOFs not last, nodes together and
+  !! consecutive, the nodes of the pattern the mesh's; factored with ORD_NODES and the contact
+  !! DOFs last in a scrambled order: the trailing block, the solution and the flexibility of
+  !! METIS on the DOF graph.
+  subroutine check_nodes_3d(name, nx, ny, nz, elem, bcs)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: nx, ny, nz, elem, bcs(6)
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    type(chol_t) :: ch
+    integer, allocatable :: last(:), perm(:), group_of(:), members(:), gptr(:), node_of_group(:)
+    logical, allocatable :: is_last(:), has_inner(:)
+    real(wp), allocatable :: u(:), r(:), sgn(:), flex(:, :, :)
+    real(wp) :: res, d
+    integer :: info, m, o, ng, g, k, p
+    logical :: ok, used
+    type(error_t) :: err
+    character(len=256) :: msg
+    character(len=200) :: emsg
+    character(len=96) :: tag
+
+    call box_system(nx, ny, nz, elem, bcs, msh, sys, last)
+    m = size(last)
+    last = [(last(k), k=m, 1, -2), (last(k), k=m - 1, 1, -2)]   ! a scrambled given order
+    allocate (is_last(sys%n))
+    is_last = .false.
+    is_last(last) = .true.
+    call node_dissection(sys%colptr, sys%rowind, last, perm, err)
+    call error_parts(err, info, msg)
+    call report(info == 0, name//': node ordering info = 0 '//trim(msg))
+    if (info /= 0) return
+    ok = size(perm) == sys%n - m
+    if (ok) ok = covers_rest(perm, is_last)
+    call report(ok, name//': a permutation of exactly the free DOFs not last')
+    if (.not. ok) return
+    call report(node_dofs_consecutive(sys, msh%nnode, perm, is_last), &
+                name//': each node''s DOFs together, consecutive, in component order')
+    call report(.not. node_dofs_consecutive(sys, msh%nnode, perm(size(perm):1:-1), is_last), &
+                name//': (the same check fails on the reversed order)')
+
+    ! the nodes of the pattern are the mesh's nodes with a DOF not last
+    emsg = ''
+    call node_groups(sys%colptr, sys%rowind, is_last, group_of, members, gptr, ng, emsg)
+    allocate (has_inner(msh%nnode), node_of_group(max(ng, 1)))
+    has_inner = .false.
+    do k = 1, sys%n
+      if (.not. is_last(k)) has_inner(dof_node(sys%dof_of(k))) = .true.
+    end do
+    ok = ng == count(has_inner)
+    do g = 1, max(ng, 0)
+      node_of_group(g) = dof_node(sys%dof_of(members(gptr(g))))
+      do p = gptr(g), gptr(g + 1) - 1
+        ok = ok .and. dof_node(sys%dof_of(members(p))) == node_of_group(g) .and. group_of(members(p)) == g
+      end do
+    end do
+    if (ng > 1) ok = ok .and. all(node_of_group(2:ng) > node_of_group(1:ng - 1))
+    call report(ok, name//': the pattern''s nodes are the mesh''s (one per node with a DOF not last)', &
+                real(ng, wp), real(count(has_inner), wp))
+
+    allocate (u(sys%n), r(sys%n), sgn(m), flex(m, m, 2))
+    sgn = -1.0_wp
+    do o = 1, 2
+      tag = name//merge(' nodes', ' metis', o == 1)
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, merge(ORD_NODES, ORD_METIS, o == 1), &
+                     err, last=last)
+      call error_parts(err, info, msg)
+      call report(info == 0 .and. ch%interface_last_ok, trim(tag)//': factor ok, contact DOFs last in the given order '//trim(msg))
+      if (info /= 0) cycle
+      write (output_unit, '(a)') '      '//ch%summary()
+      u = sys%f
+      call ch%solve(u, err)
+      call error_parts(err, info, msg)
+      call csc_matvec(sys, u, r)
+      res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u))*eps)
+      call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
+      call ch%flexibility(last, sgn, flex(:, :, o), err, used_block=used)
+      call error_parts(err, info, msg)
+      call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
+      call ch%free()
+    end do
+    d = norm2(flex(:, :, 1) - flex(:, :, 2))/norm2(flex(:, :, 2))
+    call report_le(d, FLEX_TOL, name//' nodes: flexibility = METIS''s (relative)')
+  end subroutine check_nodes_3d
+
+  !> The fill of the node order on a k^3 box of hexahedra (bottom clamped, the top's normal
+  !! DOFs last): nnz(L) within 1.2x METIS's on the DOF graph and below the natural order's;
+  !! the program's choice for 'nd' in 3D (new_factor) is the node order, factoring the same.
+  subroutine check_fill_3d(k)
+    integer, intent(in) :: k
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    type(chol_t) :: ch
+    type(factor_cfg_t) :: fc
+    class(factor_t), allocatable :: fac
+    integer, allocatable :: last(:)
+    real(wp) :: nnz(3), t(3)
+    integer :: o, info
+    integer, parameter :: ords(3) = [ORD_NODES, ORD_METIS, ORD_NATURAL]
+    character(len=*), parameter :: onames(3) = [character(len=7) :: 'nodes', 'metis', 'natural']
+    character(len=256) :: msg
+    character(len=32) :: name
+    type(error_t) :: err
+    logical :: ok
+
+    write (name, '(a,i0,a)') 'box Q1 ', k, '^3'
+    call box_system(k, k, k, ELEM_Q1, [BC_FREE, BC_FREE, BC_CLAMPED, BC_CONTACT, BC_FREE, BC_FREE], msh, sys, last)
+    nnz = 0.0_wp
+    do o = 1, 3
+      call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ords(o), err, last=last)
+      call error_parts(err, info, msg)
+      call report(info == 0 .and. ch%interface_last_ok, trim(name)//' '//trim(onames(o))//': factor ok, last last '//trim(msg))
+      nnz(o) = real(ch%nnz_factor, wp)
+      t(o) = ch%t_analyze
+      call ch%free()
+    end do
+    write (output_unit, '(a,3(a,es10.3),a,2(f0.3,a))') '      '//trim(name)//' nnz(L):', ' nodes=', nnz(1), &
+      ' metis=', nnz(2), ' natural=', nnz(3), ' (analyze nodes ', t(1), ' s, metis ', t(2), ' s)'
+    call report(nnz(1) > 0.0_wp .and. nnz(1) <= 1.2_wp*nnz(2), trim(name)//': nnz(L) nodes <= 1.2 x METIS on the DOFs', &
+                nnz(1)/max(nnz(2), 1.0_wp), 1.2_wp)
+    call report(nnz(1) > 0.0_wp .and. nnz(1) < nnz(3), trim(name)//': nnz(L) nodes < natural order''s', &
+                nnz(1)/max(nnz(3), 1.0_wp), 1.0_wp)
+
+    ! ordering 'nd' in 3D: the node order, the interface last (the plane: the caller's order)
+    fc%ordering = ORDER_ND
+    call new_factor(fc, 1, fac)
+    ok = .false.
+    select type (fac)
+    type is (cholmod_factor_t)
+      ok = fac%ordering == ORD_NODES .and. .not. fac%wants_interior_order()
+    end select
+    call report(ok, 'ordering ''nd'' of a solid body: CHOLMOD with the node order, no order wanted from the caller')
+    call fac%factorize(sys%n, last, err, sys%colptr, sys%rowind, sys%val)
+    call error_parts(err, info, msg)
+    call report(info == 0 .and. index(fac%summary(), 'cholmod/nodes') > 0 .and. real(fac%stats%nnz_factor, wp) == nnz(1), &
+                trim(name)//' ''nd'': factorize as ORD_NODES: '//fac%summary())
+    call fac%free()
+    call set_dimension(2)
+    call new_factor(fc, 1, fac)
+    ok = .false.
+    select type (fac)
+    type is (cholmod_factor_t)
+      ok = fac%ordering == ORD_GIVEN .and. fac%wants_interior_order()
+    end select
+    call report(ok, 'ordering ''nd'' of a plane body: the caller''s order (unchanged)')
+    call set_dimension(3)
+  end subroutine check_fill_3d
+
+  !> Bad inputs of the node order and of ORD_AUTO are reported, not crashed on; ORD_AUTO
+  !! without DOFs last is CHOLMOD's own choice (AMD or METIS).
+  subroutine check_nodes_bad()
+    type(mesh_t) :: msh
+    type(body_system_t) :: sys
+    type(chol_t) :: ch
+    integer, allocatable :: last(:), perm(:), rows(:)
+    integer :: info
+    type(error_t) :: err
+    character(len=256) :: msg
+
+    call box_system(3, 3, 3, ELEM_Q1, [BC_FREE, BC_FREE, BC_CLAMPED, BC_CONTACT, BC_FREE, BC_FREE], msh, sys, last)
+    call node_dissection(sys%colptr, sys%rowind, [last, sys%n + 1], perm, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. size(perm) == 0 .and. len_trim(msg) > 0, &
+                'node ordering: an interface DOF out of range rejected: '//trim(msg))
+    call node_dissection(sys%colptr, sys%rowind, [last, last(1)], perm, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'node ordering: a repeated interface DOF rejected: '//trim(msg))
+    rows = sys%rowind
+    rows(5) = sys%n
+    call node_dissection(sys%colptr, rows, last, perm, err)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. size(perm) == 0 .and. len_trim(msg) > 0, &
+                'node ordering: a row index out of range rejected: '//trim(msg))
+    call node_dissection(sys%colptr, sys%rowind, [(info, info=1, sys%n)], perm, err)
+    call error_parts(err, info, msg)
+    call report(info == 0 .and. size(perm) == 0, 'node ordering: every DOF last, an empty order '//trim(msg))
+    call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AUTO, err, last=last)
+    call error_parts(err, info, msg)
+    call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'ORD_AUTO with DOFs last rejected: '//trim(msg))
+    call ch%factor(sys%n, sys%colptr, sys%rowind, sys%val, FACT_CHOLMOD, ORD_AUTO, err)
+    call error_parts(err, info, msg)
+    call report(info == 0 .and. (ch%ordering_used == 2 .or. ch%ordering_used == 3), &
+                'ORD_AUTO without DOFs last: CHOLMOD''s own choice (2 AMD, 3 METIS) '//trim(msg), &
+                real(ch%ordering_used, wp))
+    call ch%free()
+  end subroutine check_nodes_bad
 
   !> The body's CHOLMOD factor has the interface DOFs last in its permutation.
   logical function interface_last(bc)

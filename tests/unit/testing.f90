@@ -3,14 +3,16 @@
 !! assembled body (LAPACK band Cholesky in the natural order) so the FE tests do not
 !! depend on the Cholesky module that other tests check; the bodies of the ordering test
 !! and benchmark (a rectangle on its structured mesh, the same on a general,
-!! unstructured-looking mesh, the ordering of either); for the MPRGP tests and benchmark,
+!! unstructured-looking mesh, the ordering of either; a solid box); for the MPRGP tests and benchmark,
 !! the 1D obstacle problem, seeded random SPD matrices and one solve by a fresh solver.
 module testing
   use, intrinsic :: iso_fortran_env, only: output_unit, int64
   use kinds, only: wp
+  use space, only: NDIM, node_dof
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, SIDE_TOP, SIDE_BOTTOM, SIDE_LEFT, SIDE_RIGHT, &
-                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
-  use mesh, only: mesh_t, mesh_build, side_nodes
+                    BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, MAX_SIDES
+  use mesh, only: mesh_t, mesh_build, box_build, side_nodes
+  use elements_3d, only: kuhn_tets
   use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness
   use assembly, only: body_system_t, expand, assemble_body, lame_parameters
   use linop, only: linop_t, csc_op_t, csc_op_init
@@ -26,7 +28,7 @@ module testing
   integer, public, protected :: nfail = 0   !< checks failed so far
 
   public :: report, report_le, test_summary, write_file, band_solve, solve_full, obstacle_problem
-  public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered
+  public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered, box_system
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
   public :: random_bounds, enumerate_box, box_projected
   public :: error_parts
@@ -231,6 +233,54 @@ contains
       if (f > 0) idx = [idx, f]
     end do
   end function side_free_dofs
+
+  !> A solid box, the unit cube at the origin (steel: E = 2.1e11, nu = 0.3) with nx x ny x nz
+  !! grid cells of hexahedra (ELEM_Q1) or tetrahedra (ELEM_P1), side conditions `bcs` (left,
+  !! right, bottom, top, front, back), its top (y = 1) loaded by (0, -1, 0) MPa; `last` = the
+  !! free normal (y) DOFs of the top side, the contact face. The run's dimension must be 3
+  !! (space::set_dimension). Stops the program on failure.
+  subroutine box_system(nx, ny, nz, element, bcs, msh, sys, last)
+    integer, intent(in) :: nx, ny, nz                 !< grid cells along x, y, z
+    integer, intent(in) :: element                    !< ELEM_Q1 or ELEM_P1
+    integer, intent(in) :: bcs(MAX_SIDES)             !< BC_* of each side
+    type(mesh_t), intent(out) :: msh                  !< the box's mesh
+    type(body_system_t), intent(out) :: sys           !< its assembled system
+    integer, allocatable, intent(out) :: last(:)      !< interface DOFs (top side, y)
+    type(body_cfg_t) :: b
+    type(traction_cfg_t) :: tr(1)
+    integer, allocatable :: nodes(:)
+    integer :: info, k, f
+    character(len=256) :: msg
+    type(error_t) :: err
+    if (NDIM /= 3) error stop 'box_system: the dimension is not 3 (space::set_dimension)'
+    b%id = 1
+    b%x0 = 0.0_wp
+    b%y0 = 0.0_wp
+    b%z0 = 0.0_wp
+    b%width = 1.0_wp
+    b%height = 1.0_wp
+    b%depth = 1.0_wp
+    b%nx = nx
+    b%ny = ny
+    b%nz = nz
+    b%element = element
+    b%young = 2.1e11_wp
+    b%poisson = 0.3_wp
+    b%bc = bcs
+    tr(1)%body = 1
+    tr(1)%side = SIDE_TOP
+    tr(1)%t0 = [0.0_wp, -1.0e6_wp, 0.0_wp]
+    call box_build(msh, b, kuhn_tets, info, msg)
+    if (info /= 0) error stop 'box_system: box_build failed: '//trim(msg)
+    call assemble_body(msh, b, .true., tr, 1, sys, err)
+    if (err%failed()) error stop 'box_system: assemble_body failed: '//err%text()
+    call side_nodes(msh, SIDE_TOP, nodes)
+    allocate (last(0))
+    do k = 1, size(nodes)
+      f = sys%free_of(node_dof(nodes(k), 2))
+      if (f > 0) last = [last, f]
+    end do
+  end subroutine box_system
 
   !> The nested-dissection order of a body's free DOFs not in `last`, as the program takes
   !! it (module condense): along the grid lines of a structured mesh, by coordinate
