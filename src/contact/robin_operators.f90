@@ -137,7 +137,7 @@ module robin_operators
     integer, allocatable :: v(:)
   end type slots_t
 
-  public :: new_robin_operator, progress_rtol
+  public :: new_robin_operator, progress_rtol, range_proximal
 
 contains
 
@@ -753,6 +753,10 @@ contains
     real(wp) :: floor
     integer :: i, k, m
     fo = partner_flex(contact_line, bodies, a)
+    if (allocated(bodies(a)%rng)) then
+      call range_proximal(bodies(a)%rng, fo, p)
+      return
+    end if
     if (.not. allocated(bodies(a)%kern)) then
       p = fo
       return
@@ -776,6 +780,38 @@ contains
     call dgemm('N', 'T', m, m, k, 1.0_wp, zr, m, bodies(a)%kern, m, 0.0_wp, p, m)
     p = 0.5_wp*(p + transpose(p))
   end subroutine kernel_proximal
+
+  !> kernel_proximal's Z R Z' from the range basis Q of F_a instead (Z Z' = I - Q Q', the
+  !! kernel the larger part): P = (I - QQ') F_o (I - QQ') + floor (I - QQ'), as
+  !! F_o - C Q' - Q C' - floor Q Q' + floor I with C = F_o Q - Q (Q' F_o Q)/2: O(m^2 r).
+  subroutine range_proximal(q, fo, p)
+    real(wp), intent(in) :: q(:, :)          !< (m, r) orthonormal basis of range F_a
+    real(wp), intent(in) :: fo(:, :)         !< (m, m) the partners' flexibilities on a's rows
+    real(wp), intent(out) :: p(:, :)         !< (m, m) the proximal term
+    real(wp), allocatable :: c(:, :), b(:, :)
+    real(wp) :: floor
+    integer :: i, m, r
+    m = size(q, 1)
+    r = size(q, 2)
+    floor = 0.0_wp
+    do i = 1, m
+      floor = max(floor, 1.0e-10_wp*fo(i, i))
+    end do
+    p = fo
+    do i = 1, m
+      p(i, i) = p(i, i) + floor
+    end do
+    if (r > 0) then
+      allocate (c(m, r), b(r, r))
+      call dgemm('N', 'N', m, r, m, 1.0_wp, fo, m, q, m, 0.0_wp, c, m)
+      call dgemm('T', 'N', r, r, m, 1.0_wp, q, m, c, m, 0.0_wp, b, r)
+      call dgemm('N', 'N', m, r, r, -0.5_wp, q, m, b, r, 1.0_wp, c, m)
+      call dgemm('N', 'T', m, m, r, -1.0_wp, c, m, q, m, 1.0_wp, p, m)
+      call dgemm('N', 'T', m, m, r, -1.0_wp, q, m, c, m, 1.0_wp, p, m)
+      call dgemm('N', 'T', m, m, r, -floor, q, m, q, m, 1.0_wp, p, m)
+    end if
+    p = 0.5_wp*(p + transpose(p))
+  end subroutine range_proximal
 
   !> S = 2 F_1 (F_1 + F_2)^-1 F_2 = 2 (F_1^-1 + F_2^-1)^-1 (symmetric positive definite).
   !> S = 2 (F1^-1 + F2^-1)^-1 for the normal rows and for the tangential rows of a pair apart

@@ -185,6 +185,17 @@ contains
           end if
           if (iv(1) > 0) call par_bcast_reals(body%kern, m*iv(1), self%host(b))
         end if
+        ! or the basis of its range, when that is the smaller part (condense `low_rank_range`)
+        iv(1) = -1
+        if (allocated(body%rng)) iv(1) = size(body%rng, 2)
+        call par_bcast_ints(iv, 1, self%host(b))
+        if (iv(1) >= 0) then
+          if (.not. (self%mine(b) .and. fac%holds_result())) then
+            if (allocated(body%rng)) deallocate (body%rng)
+            allocate (body%rng(m, iv(1)))
+          end if
+          if (iv(1) > 0) call par_bcast_reals(body%rng, m*iv(1), self%host(b))
+        end if
       end associate
       call self%err(b)%clear()
     end do

@@ -12,7 +12,7 @@ module lapack
   public :: dsymv, dgemm, dgemv, dsyrk, dtrsm, dtrsv
   public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
   public :: dpbtrf, dpbtrs, dpbsv
-  public :: dgels, dgesv, dsygv, dgesvd
+  public :: dgels, dgesv, dsygv, dgesvd, dgeqrf, dorgqr
 
   interface
 
@@ -215,6 +215,38 @@ module lapack
       integer, intent(in) :: liwork          !< size of iwork (-1: query)
       integer, intent(out) :: info           !< status
     end subroutine dsyevr
+
+    !> QR factorization A = Q R of an m x n matrix (Householder): R in the upper triangle,
+    !! Q as reflectors below it and in tau (dorgqr forms it).
+    !! lwork = -1: workspace query (size in work(1)). info < 0: a bad argument.
+    subroutine dgeqrf(m, n, a, lda, tau, work, lwork, info)
+      import :: wp
+      implicit none
+      integer, intent(in) :: m               !< rows of A
+      integer, intent(in) :: n               !< columns of A
+      integer, intent(in) :: lda             !< leading dimension of a, >= max(1, m)
+      real(wp), intent(inout) :: a(lda, *)   !< A on entry; R and the reflectors on exit
+      real(wp), intent(out) :: tau(*)        !< (min(m, n)) the reflectors' scales
+      real(wp), intent(inout) :: work(*)     !< (lwork) workspace
+      integer, intent(in) :: lwork           !< size of work (-1: query)
+      integer, intent(out) :: info           !< status
+    end subroutine dgeqrf
+
+    !> The m x n matrix Q with orthonormal columns from dgeqrf's k reflectors (n <= m).
+    !! lwork = -1: workspace query (size in work(1)). info < 0: a bad argument.
+    subroutine dorgqr(m, n, k, a, lda, tau, work, lwork, info)
+      import :: wp
+      implicit none
+      integer, intent(in) :: m               !< rows of Q
+      integer, intent(in) :: n               !< columns of Q, <= m
+      integer, intent(in) :: k               !< reflectors, <= n
+      integer, intent(in) :: lda             !< leading dimension of a, >= max(1, m)
+      real(wp), intent(inout) :: a(lda, *)   !< dgeqrf's reflectors on entry; Q on exit
+      real(wp), intent(in) :: tau(*)         !< (k) dgeqrf's scales
+      real(wp), intent(inout) :: work(*)     !< (lwork) workspace
+      integer, intent(in) :: lwork           !< size of work (-1: query)
+      integer, intent(out) :: info           !< status
+    end subroutine dorgqr
 
     !> Solve A X = B with the Cholesky factor from dpotrf.
     subroutine dpotrs(uplo, n, nrhs, a, lda, b, ldb, info)

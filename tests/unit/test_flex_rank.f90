@@ -10,10 +10,18 @@
 !! the kernel basis takes that direction too (rank m - 2, one more than the pivoted factor's
 !! m - 1), |F z| <= 1e-6 |F| on it; the same pair without the empty row keeps full rank and no
 !! kernel (a nonsingular F_a gets none, however small its smallest eigenvalue).
+!! Rows of many entries (a solid master's: F_a by Y = X B' and B Y): F_a = B X B' formed
+!! densely, to 1e-13. Rows over at most half as many DOFs (a coarse master: the rank from
+!! the QR of B and a k x k eigenproblem): rank(B) (B of full column rank, and with one
+!! column a combination of two others), the range basis orthonormal and F_a = Q Q' F_a Q Q',
+!! no kernel basis; the proximal term built on that range basis (robin_operators
+!! `range_proximal`) is Z (Z' F_o Z + floor I) Z' with Z the kernel from a dense symmetric
+!! eigensolver (LAPACK dsyev), to 1e-12.
 program test_flex_rank
   use kinds, only: wp
   use condense, only: body_condensed_t, flex_from_x
-  use lapack, only: dpstrf
+  use robin_operators, only: range_proximal
+  use lapack, only: dpstrf, dsyev
   use testing, only: report, report_le, test_summary
   implicit none (type, external)
   integer, parameter :: M = 60
@@ -24,6 +32,9 @@ program test_flex_rank
   call case('two rows 1e-7 apart', 1.0e-7_wp, .true., .false., M - 1)
   call case('a row on no free DOF', 0.0_wp, .false., .true., M - 1)
   call case('a row on no free DOF, two rows 1e-4 apart', 1.0e-4_wp, .true., .true., M - 2, near=1)
+  call dense_rows(30, 20)
+  call coarse_rows(40, 12, .false.)
+  call coarse_rows(40, 12, .true.)
   call test_summary()
 
 contains
@@ -88,5 +99,102 @@ contains
       call report(.not. allocated(bc%kern) .and. bc%prox == 0.0_wp, what//': no kernel, no proximal weight')
     end if
   end subroutine case
+
+  !> m rows over all k DOFs (nnz = m k > 4 (k + m)): F_a against B X B' formed densely.
+  subroutine dense_rows(m, k)
+    integer, intent(in) :: m, k
+    type(body_condensed_t) :: bc
+    real(wp) :: x(k, k), b(m, k), ref(m, m)
+    call fill(m, k, .false., bc, x, b)
+    call flex_from_x(bc, x)
+    ref = matmul(b, matmul(x, transpose(b)))
+    call report_le(maxval(abs(bc%flex - ref))/maxval(abs(ref)), 1.0e-13_wp, &
+                   'rows of many entries: F_a = B X B'' (formed densely)')
+    call report(bc%rank == min(m, k) .or. (k < m .and. bc%rank == k), 'rows of many entries: rank min(m, k)', &
+                real(bc%rank, wp), real(min(m, k), wp))
+  end subroutine dense_rows
+
+  !> m rows over k <= m/2 DOFs: rank(B), the range basis, and the proximal term on it.
+  subroutine coarse_rows(m, k, dependent)
+    integer, intent(in) :: m, k
+    logical, intent(in) :: dependent     !< B's last column the sum of its first two
+    type(body_condensed_t) :: bc
+    real(wp) :: x(k, k), b(m, k), qq(m, m), fo(m, m), p(m, m), pref(m, m), z(m, m), ev(m), work(4*m*m)
+    real(wp) :: floor
+    integer :: i, r, info, nk
+    character(len=40) :: what
+    what = merge('coarse rows, a dependent column', 'coarse rows                    ', dependent)
+    call fill(m, k, dependent, bc, x, b)
+    call flex_from_x(bc, x)
+    r = merge(k - 1, k, dependent)
+    call report(bc%rank == r, trim(what)//': the rank of B', real(bc%rank, wp), real(r, wp))
+    call report(allocated(bc%rng) .and. .not. allocated(bc%kern) .and. bc%prox > 0.0_wp, &
+                trim(what)//': a range basis, no kernel basis, a proximal weight')
+    if (.not. allocated(bc%rng)) return
+    call report(size(bc%rng, 2) == r, trim(what)//': the range basis has rank columns')
+    qq = matmul(bc%rng, transpose(bc%rng))
+    call report_le(maxval(abs(matmul(transpose(bc%rng), bc%rng) - identity(r))), 1.0e-12_wp, &
+                   trim(what)//': Q''Q = I')
+    call report_le(maxval(abs(matmul(qq, matmul(bc%flex, qq)) - bc%flex))/maxval(abs(bc%flex)), 1.0e-12_wp, &
+                   trim(what)//': F_a = QQ'' F_a QQ''')
+    ! the partner's flexibility: any SPD matrix; the reference kernel: the eigenvectors of
+    ! F_a's m - r smallest eigenvalues (dsyev, all of them)
+    call random_number(fo)
+    fo = matmul(fo, transpose(fo)) + identity(m)
+    z = bc%flex
+    call dsyev('V', 'L', m, z, m, ev, work, size(work), info)
+    nk = m - r
+    floor = 1.0e-10_wp*maxval([(fo(i, i), i=1, m)])
+    pref = matmul(z(:, 1:nk), matmul(matmul(transpose(z(:, 1:nk)), matmul(fo, z(:, 1:nk))) + floor*identity(nk), &
+                                     transpose(z(:, 1:nk))))
+    call range_proximal(bc%rng, fo, p)
+    call report(info == 0, trim(what)//': dsyev of the reference')
+    call report_le(maxval(abs(p - pref))/maxval(abs(pref)), 1.0e-12_wp, &
+                   trim(what)//': range_proximal = Z (Z''F_o Z + floor I) Z''')
+  end subroutine coarse_rows
+
+  !> Rows over k DOFs, each on every DOF (coefficients in [-1/2, 1/2] plus 1 on DOF i mod k),
+  !! X = G G' + I; b the dense B.
+  subroutine fill(m, k, dependent, bc, x, b)
+    integer, intent(in) :: m, k
+    logical, intent(in) :: dependent
+    type(body_condensed_t), intent(out) :: bc
+    real(wp), intent(out) :: x(k, k), b(m, k)
+    real(wp) :: g(k, k)
+    integer :: i, j, e
+    call random_seed(put=[(104729*i, i=1, 64)])
+    call random_number(g)
+    g = g - 0.5_wp
+    x = matmul(g, transpose(g)) + identity(k)
+    call random_number(b)
+    b = b - 0.5_wp
+    do i = 1, m
+      b(i, modulo(i - 1, k) + 1) = b(i, modulo(i - 1, k) + 1) + 1.0_wp
+    end do
+    if (dependent) b(:, k) = b(:, 1) + b(:, 2)
+    bc%m = m
+    allocate (bc%idx(k), bc%bptr(m + 1), bc%bpos(m*k), bc%bval(m*k))
+    bc%idx = [(i, i=1, k)]
+    e = 0
+    do i = 1, m
+      bc%bptr(i) = e + 1
+      do j = 1, k
+        e = e + 1
+        bc%bpos(e) = j
+        bc%bval(e) = b(i, j)
+      end do
+    end do
+    bc%bptr(m + 1) = e + 1
+  end subroutine fill
+
+  pure function identity(n) result(a)
+    integer, intent(in) :: n
+    real(wp) :: a(n, n)
+    integer :: i
+    a = 0.0_wp
+    do i = 1, n
+      a(i, i) = 1.0_wp
+    end do
+  end function identity
 
 end program test_flex_rank
