@@ -5,7 +5,10 @@ _h0.01.msh). With P = 4 x the quarter's force, Hertz gives a = (3 P R/(4 E*))^(1
 p0 = 3 P/(2 pi a^2); the Hertz shape fitted to the nodal pressures (tools/hertz3d_study.py's
 fit) has a within 2% and p0 within 3% on the finer mesh, both closer than on the coarser one
 (a finer mesh, hc = 0.005, reaches 0.95% and 1.8%: doc/verification.md); both bodies balance
-(`reaction:` lines) to 1e-9; Robin = monolithic to 1e-8 on the coarser mesh.
+(`reaction:` lines) to 1e-9; Robin = monolithic to 1e-8 on the coarser mesh. Force control on
+the finer mesh: the sphere's top under a uniform pressure q, the sphere held along y by the
+contact alone (SMALBE): the contact force is 4 q A to 1e-9 (A the area of the top's
+triangles, summed by meshio), a and p0 within 2% and 3% of Hertz for that force.
 """
 import os
 import shutil
@@ -25,6 +28,21 @@ import numpy as np  # noqa: E402
 BIN = os.path.abspath(os.environ.get("BIN", os.path.join(ROOT, "bin/robin_contact")))
 DECK = os.path.join(ROOT, "inputs", "sphere_block.nml")
 check = Checks()
+
+
+def face_area(msh, name):
+    """The area of the triangles of a physical surface of a Gmsh file (read by meshio)."""
+    import meshio
+    m = meshio.read(msh)
+    tag = m.field_data[name][0]
+    area = 0.0
+    for cells, phys in zip(m.cells, m.cell_data["gmsh:physical"]):
+        if cells.type == "triangle":
+            x = m.points[cells.data[phys == tag]]
+            area += 0.5 * np.linalg.norm(np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0]), axis=1).sum()
+    return area
+
+
 work = tempfile.mkdtemp(prefix="rc_hertz3d_")
 try:
     errs = {}
@@ -47,6 +65,30 @@ try:
         errs[h] = (a_f / a_h - 1, p0_f / p0_h - 1)
         print(f"INFO  hc = {h}: P = {P:.5f}, a {a_f:.5f} / Hertz {a_h:.5f} ({100 * errs[h][0]:+.2f}%), "
               f"p0 {p0_f:.3f} / Hertz {p0_h:.3f} ({100 * errs[h][1]:+.2f}%)")
+    # force control: the sphere's top loaded by a uniform pressure q instead of pushed down,
+    # held along y by the contact alone (the symmetry planes hold the rest: SMALBE); its force
+    # is known before the run, P = 4 q pi R^2 / 4, and it is about the pushed run's
+    with open(DECK) as f:
+        text = f.read()
+    q = 0.328
+    lines = [l for l in text.splitlines() if "group = 'sphere_top'" not in l]
+    lines.append(f"&traction body = 1, group = 'sphere_top', t0 = 0.0, {-q}, 0.0 /")
+    deck = os.path.join(work, "force.nml")
+    with open(deck, "w") as f:
+        f.write("\n".join(lines).replace("'gmsh/", "'" + os.path.join(ROOT, "inputs", "gmsh") + "/") + "\n")
+    h5 = os.path.join(work, "force.h5")
+    p, _ = run_solver(BIN, deck, f"&output file='{h5}' /", env=solver_env(2), timeout=300)
+    if check(p.returncode == 0, "Hertz 3D, force control: converged", (p.stdout + p.stderr)[-300:]):
+        check("is held only by contact (free: translation along y)" in p.stdout,
+              "Hertz 3D, force control: the sphere is held only by contact (SMALBE)")
+        P, a_h, p0_h, a_f, p0_f = measure(h5)
+        want = 4.0 * q * face_area(os.path.join(ROOT, "inputs", "gmsh", "sphere_block_h0.01.msh"), "sphere_top")
+        check(abs(P - want) <= 1e-9 * want, "Hertz 3D, force control: the contact force is the load, 4 q A "
+              "(A the area of the top's triangles, by meshio)", f"{P:.12f} / {want:.12f}")
+        ea, ep = a_f / a_h - 1, p0_f / p0_h - 1
+        print(f"INFO  force control, hc = 0.01: P = {P:.5f}, a {100 * ea:+.2f}%, p0 {100 * ep:+.2f}%")
+        check(abs(ea) <= 0.02 and abs(ep) <= 0.03, "Hertz 3D, force control, hc = 0.01: a within 2%, p0 within 3%",
+              f"{100 * ea:+.2f}%, {100 * ep:+.2f}%")
     if len(errs) == 2:
         (ea1, ep1), (ea2, ep2) = errs["0.02"], errs["0.01"]
         check(abs(ea2) <= 0.02 and abs(ep2) <= 0.03, "Hertz 3D, hc = 0.01: a within 2%, p0 within 3%",

@@ -26,6 +26,10 @@ temporary folder). References are exact solutions and the 2D program itself.
     carrying its third of p A, the last the one-step forces to 1e-10; a checkpoint after one
     outer iteration and a restart that ends as the uninterrupted run (forces to 1e-12, the
     same outer count).
+(9) The shipped stack of three cubes on a plate (inputs/cube_stack.nml: four bodies, three
+    pairs, no two surfaces matching, the cubes held along y only by contact): each interface's
+    resultant p A to 1e-9, every contact node's pressure p and every body's stress the
+    uniform syy = -p to 1e-9, Robin = monolithic to 1e-8.
 (7) The memory check in 3D: a 40^3 box against a 200 MiB limit is refused before assembly,
     naming the estimate and what else fits a solid body's factor.
 """
@@ -51,6 +55,13 @@ check = Checks()
 
 def run(work, name, text, *over):
     return run_text(BIN, work, name, text, *over, env=ENV)
+
+
+def run_deck_file(work, name, deck, *over):
+    """Run a shipped deck (its relative paths from its folder) into work/name.h5."""
+    with open(deck) as f:
+        text = f.read()
+    return run(work, name, text, *over)
 
 
 def nodal(f, b, name):
@@ -201,6 +212,30 @@ try:
         check(d <= 1e-8, "corner: Robin = monolithic", f"{d:.2e}")
         check("free: 6" in oc or "6 free" in oc or "rigid motion amplitudes" in oc,
               "corner: the cube's six rigid motions are handled (SMALBE)")
+
+    # (9) the shipped stack of three cubes on a plate (four bodies, three pairs, non-matching;
+    # the cubes held along y by their contacts alone): every interface carries p A, every
+    # contact node's pressure and every body's stress are the uniform exact ones
+    stack = os.path.join(ROOT, "inputs", "cube_stack.nml")
+    cs, os_, hs = run_deck_file(work, "stack", stack)
+    cm, om, hm = run_deck_file(work, "stack_mono", stack, "&solver method='monolithic' /")
+    check(cs == 0 and cm == 0, "cube stack: Robin and monolithic converge", (os_ + om)[-400:])
+    if cs == 0 and cm == 0:
+        with h5py.File(hs, "r") as a, h5py.File(hm, "r") as b:
+            res = [a[f"/contact/pair_{q}/resultant_on_first_body"][...] for q in (1, 2, 3)]
+            pres = a["/contact/pressure"][...]
+            es = max(max(np.abs(nodal(a, k, "stress")[:, 1] + p).max(),
+                         np.abs(nodal(a, k, "stress")[:, [0, 2, 3, 4, 5]]).max()) for k in (1, 2, 3, 4)) / p
+            d = np.abs(a["/contact/normal_force"][...] - b["/contact/normal_force"][...]).max() / \
+                np.abs(b["/contact/normal_force"][...]).max()
+        err = max(np.abs(r - [0.0, -p, 0.0]).max() for r in res) / p
+        check(err <= 1e-9, "cube stack: each of the three interfaces carries p A", f"{err:.2e}")
+        check(len(pres) == 25 + 16 + 25 and np.abs(pres - p).max() <= 1e-9 * p,
+              "cube stack: every contact node's pressure is p", f"{len(pres)} nodes, {np.abs(pres - p).max() / p:.2e}")
+        check(es <= 1e-9, "cube stack: every body's stress is uniform (syy = -p, the others 0)", f"{es:.2e}")
+        check(d <= 1e-8, "cube stack: Robin = monolithic", f"{d:.2e}")
+        check(os_.count("is held only by contact (free: translation along y)") == 3,
+              "cube stack: the three cubes are held only by contact")
 
     # (8) threads, load steps and a restart on the shipped boxes
     deck = os.path.join(ROOT, "inputs", "boxes.nml")
