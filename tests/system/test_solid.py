@@ -30,6 +30,11 @@ temporary folder). References are exact solutions and the 2D program itself.
     pairs, no two surfaces matching, the cubes held along y only by contact): each interface's
     resultant p A to 1e-9, every contact node's pressure p and every body's stress the
     uniform syy = -p to 1e-9, Robin = monolithic to 1e-8.
+(10) A long cylinder on a block against the plane program: the 2D Hertz mesh
+    (inputs/gmsh/hertz_h0.02.msh) extruded one layer deep into tetrahedra (msh_extrude.py),
+    uz = 0 on both end faces: the force per length within twice the 2D force's change from h
+    to h/2 (the discretization error), the same contact zone, the pressure averaged through the
+    depth within 1% of p0 of the 2D one.
 (7) The memory check in 3D: a 40^3 box against a 200 MiB limit is refused before assembly,
     naming the estimate and what else fits a solid body's factor.
 """
@@ -236,6 +241,54 @@ try:
         check(d <= 1e-8, "cube stack: Robin = monolithic", f"{d:.2e}")
         check(os_.count("is held only by contact (free: translation along y)") == 3,
               "cube stack: the three cubes are held only by contact")
+
+    # (10) a long cylinder on a block in plane strain against the plane program: the 2D Hertz
+    # mesh (half-disc on a block) extruded one prism layer deep into tetrahedra, uz = 0 on
+    # both end faces of both bodies
+    sys.path.insert(0, HERE)
+    from msh_extrude import extrude
+    gm = os.path.join(ROOT, "inputs", "gmsh")
+    dz = 0.02
+    extrude(os.path.join(gm, "hertz_h0.02.msh"), os.path.join(work, "cyl3d.msh"), dz)
+    mat = "young=1000.0, poisson=0.3"
+    plane = ("&scene plane='strain' /\n"
+             f"&body id=1, mesh='{gm}/hertz_h0.02.msh', region='disc', {mat} /\n"
+             f"&body id=2, mesh='{gm}/hertz_h0.02.msh', region='block', {mat} /\n"
+             "&boundary body=1, group='disc_top', ux=0.0, uy=-0.01 /\n"
+             "&boundary body=2, group='block_bottom', ux=0.0, uy=0.0 /\n"
+             "&contact body1_group='disc_arc', body2_group='block_top' /\n&solver tol=1e-10 /\n")
+    solid = ("&scene dimension=3 /\n"
+             f"&body id=1, mesh='cyl3d.msh', region='disc', {mat} /\n"
+             f"&body id=2, mesh='cyl3d.msh', region='block', {mat} /\n"
+             "&boundary body=1, group='disc_top', ux=0.0, uy=-0.01, uz=0.0 /\n"
+             "&boundary body=2, group='block_bottom', ux=0.0, uy=0.0, uz=0.0 /\n"
+             + "".join(f"&boundary body={b}, group='{g}_{e}', uz=0.0 /\n"
+                       for b, g in ((1, "disc"), (2, "block")) for e in ("front", "back"))
+             + "&contact body1_group='disc_arc', body2_group='block_top' /\n&solver tol=1e-10 /\n")
+    c2, o2, h2 = run(work, "cyl2d", plane)
+    cf, of, hf = run(work, "cyl2d_fine", plane.replace("hertz_h0.02", "hertz_h0.01"))
+    c3, o3, h3 = run(work, "cyl3d", solid)
+    check(c2 == 0 and cf == 0 and c3 == 0, "cylinder: the 2D (h, h/2) and 3D runs converge", (o2 + of + o3)[-400:])
+    if c2 == 0 and cf == 0 and c3 == 0:
+        with h5py.File(h2, "r") as a, h5py.File(hf, "r") as f_, h5py.File(h3, "r") as b:
+            P2, Pf = a["/contact/resultant_body1"][1], f_["/contact/resultant_body1"][1]
+            P3 = b["/contact/resultant_body1"][1] / dz
+            x2, p2 = a["/contact/x"][...], a["/contact/pressure"][...]
+            x3, p3 = b["/contact/x"][...], b["/contact/pressure"][...]
+        # the 3D pressure averaged over the two end faces' nodes at each x of the 2D slave nodes
+        # (the slave nodes of both runs along the arc: the 3D slave has them on both end faces)
+        near = [np.isclose(x3, x, atol=1e-12) for x in x2]
+        both = np.array([k.sum() == 2 for k in near])
+        check(both[p2 > 0].all() and both.sum() >= 2 * (p2 > 0).sum(), "cylinder: each 2D slave node in contact, "
+              "and as many again around them, is a 3D slave node on both end faces", f"{both.sum()} of {len(x2)}")
+        p3x = np.array([p3[k].mean() if k.any() else 0.0 for k in near])
+        check(abs(P3 - P2) <= 2.0 * abs(P2 - Pf), "cylinder: the 3D force per length is the 2D one within the 2D "
+              "discretization error (twice its change from h to h/2)",
+              f"3D {P3:.6f}, 2D {P2:.6f} (h/2: {Pf:.6f}): {abs(P3 - P2) / P2:.2e} vs {abs(P2 - Pf) / P2:.2e}")
+        check(np.array_equal(p3x > 0, p2 > 0), "cylinder: the same contact zone in 2D and 3D",
+              f"{np.sort(x2[p2 > 0])} / {np.sort(x2[p3x > 0])}")
+        check(np.abs(p3x - p2).max() <= 0.01 * p2.max(), "cylinder: the 3D pressure (averaged through the depth) "
+              "is the 2D one within 1% of p0", f"{np.abs(p3x - p2).max() / p2.max():.2e}")
 
     # (8) threads, load steps and a restart on the shipped boxes
     deck = os.path.join(ROOT, "inputs", "boxes.nml")
