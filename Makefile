@@ -384,6 +384,14 @@ bench-hertz: $(PROG)
 bench-gmsh: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_gmsh.py --bin $(PROG) --gmsh $(GMSH) --structured
 
+# Hertz in 3D, a ladder of meshes of inputs/sphere_block.nml's sphere on a block (meshes by
+# gmsh into results/bench_hertz3d/; hc = 0.01, 0.005, 0.0035: up to about 2 x 120k DOFs, a few
+# minutes); HERTZ3D_HC=0.01,0.005,0.0035,0.0028 adds about 2 x 235k DOFs (12 GB)
+HERTZ3D_HC ?= 0.01,0.005,0.0035
+.PHONY: bench-hertz3d
+bench-hertz3d: $(PROG)
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_hertz3d.py --bin $(PROG) --gmsh $(GMSH) --hc $(HERTZ3D_HC)
+
 # The MPI binary beside the serial one: the paper's scene at 1024x512 per body,
 # serial CHOLMOD and MUMPS at -np 2, 4, 8 (oversubscribed here), time per phase and the
 # largest per-rank peak memory; then the largest body per path (CHOLMOD, -np 2, -np 4) by a
