@@ -12,7 +12,11 @@ runtime error, no backtrace, no hang (each run has a timeout), no result file. C
 4. a quadrangle listed twice (rotated) and a boundary line listed twice (both tags named);
 5. 100k physical groups (the file reads; its time is printed, not asserted);
 9. a UTF-8 byte-order mark (accepted), node and element tags < 1, a 10,000-character
-   physical name (accepted), coordinates whose products overflow, a missing $Entities.
+   physical name (accepted), coordinates whose products overflow, a missing $Entities;
+10. the same for solid (3D) sections (inputs/gmsh/blocks_3d.msh: tetrahedra and hexahedra):
+   a block count the file cannot hold, a tetrahedron listed twice with its nodes rotated
+   (both tags named), a cell on a node the file lacks and on node 0, coordinates whose
+   volume products overflow, no $Entities.
 """
 import os
 import re
@@ -39,9 +43,9 @@ def deck_text(mesh):
     return PAPER_NML.replace("gmsh/paper.msh", mesh)
 
 
-def run_case(name, mesh_text, mesh_name="m.msh", folder=None, timeout=60, mesh_bytes=None):
-    """Write the mesh and the deck into a fresh folder and run there; returns
-    (CompletedProcess or None on timeout, folder)."""
+def run_case(name, mesh_text, mesh_name="m.msh", folder=None, timeout=60, mesh_bytes=None, deck_of=None):
+    """Write the mesh and the deck (deck_of(mesh name), default the paper's) into a fresh
+    folder and run there; returns (CompletedProcess or None on timeout, folder)."""
     folder = folder or os.path.join(TMP, name)
     os.makedirs(folder, exist_ok=True)
     path = os.path.join(folder, mesh_name)
@@ -53,7 +57,7 @@ def run_case(name, mesh_text, mesh_name="m.msh", folder=None, timeout=60, mesh_b
             f.write(mesh_text)
     deck = os.path.join(folder, "d.nml")
     with open(deck, "w") as f:
-        f.write(deck_text(mesh_name))
+        f.write((deck_of or deck_text)(mesh_name))
     try:
         p = subprocess.run([BIN, deck, "&output file='out.h5' /"], capture_output=True, text=True,
                            cwd=folder, env=solver_env("2"), timeout=timeout)
@@ -222,6 +226,55 @@ bad("coordinates_overflow", big, [r"m\.msh", r"overflow"])
 s, e = section(PAPER_MSH, "Entities")
 no_ent = PAPER_MSH[:s - len("$Entities\n")] + PAPER_MSH[e + len("$EndEntities\n"):]
 bad("missing_entities", no_ent, [r"m\.msh", r"\$Entities"])
+
+# ---- 10. solid (3D) sections ---------------------------------------------------------------
+# inputs/gmsh/blocks_3d.msh (hexahedra below, tetrahedra above) under the patch deck of
+# test_gmsh_3d.py, corrupted: counts the file cannot hold, a tetrahedron listed twice (its
+# nodes rotated, the same cell), a cell on a node the file does not have, a node tag 0,
+# coordinates whose volume products overflow, no $Entities
+BLOCKS = open(os.path.join(ROOT, "inputs", "gmsh", "blocks_3d.msh")).read()
+
+
+def solid_deck(mesh):
+    return ("&scene dimension=3 /\n"
+            f"&body id=1, mesh='{mesh}', region='upper', young=2.1e11, poisson=0.3 /\n"
+            f"&body id=2, mesh='{mesh}', region='lower', young=2.1e11, poisson=0.3 /\n"
+            "&contact bodies=1,2, groups='upper_bottom','lower_top' /\n"
+            "&boundary body=1, group='upper_x0', ux=0.0 /\n&boundary body=1, group='upper_z0', uz=0.0 /\n"
+            "&boundary body=2, group='lower_x0', ux=0.0 /\n&boundary body=2, group='lower_z0', uz=0.0 /\n"
+            "&boundary body=2, group='lower_bottom', uy=0.0 /\n"
+            "&traction body=1, group='upper_top', pressure=1.0e6 /\n")
+
+
+good("solid_as_shipped", BLOCKS, deck_of=solid_deck)
+tet_head = "3 2 4 686\n"
+bad("solid_count_beyond_file", BLOCKS.replace(tet_head, "3 2 4 686000000\n"), [r"m\.msh", r"686000000"],
+    deck_of=solid_deck)
+s, e = section(BLOCKS, "Elements")
+lines = BLOCKS[s:e].splitlines()
+nb, nt, lo, hi = map(int, lines[0].split())
+first_tet = lines.index(tet_head.strip()) + 1
+t = lines[first_tet].split()                       # tag a b c d: the same cell as (b c a d)
+twice = [f"{nb} {nt + 1} {lo} {hi + 1}"] + lines[1:first_tet - 1] + ["3 2 4 687"] + lines[first_tet:] + \
+    [f"{hi + 1} {t[2]} {t[3]} {t[1]} {t[4]}"]
+bad("solid_tetrahedron_twice", replace_section(BLOCKS, "Elements", "\n".join(twice) + "\n"),
+    [r"m\.msh", rf"\b{t[0]}\b", rf"\b{hi + 1}\b"], deck_of=solid_deck)
+lost = list(lines)
+lost[first_tet] = f"{t[0]} {t[1]} {t[2]} {t[3]} 99999"
+bad("solid_node_missing", replace_section(BLOCKS, "Elements", "\n".join(lost) + "\n"), [r"m\.msh", r"99999"],
+    deck_of=solid_deck)
+zero = list(lines)
+zero[first_tet] = f"{t[0]} {t[1]} {t[2]} {t[3]} 0"
+bad("solid_node_zero", replace_section(BLOCKS, "Elements", "\n".join(zero) + "\n"), [r"m\.msh", r"\b0\b"],
+    deck_of=solid_deck)
+s, e = section(BLOCKS, "Nodes")
+scaled = [" ".join(f"{float(v) * 1e120:.17g}" for v in ln.split()) if len(ln.split()) == 3 and "." in ln else ln
+          for ln in BLOCKS[s:e].splitlines()]
+bad("solid_coordinates_overflow", replace_section(BLOCKS, "Nodes", "\n".join(scaled) + "\n"),
+    [r"m\.msh", r"overflow"], deck_of=solid_deck)
+s, e = section(BLOCKS, "Entities")
+bad("solid_missing_entities", BLOCKS[:s - len("$Entities\n")] + BLOCKS[e + len("$EndEntities\n"):],
+    [r"m\.msh", r"\$Entities"], deck_of=solid_deck)
 
 shutil.rmtree(TMP, ignore_errors=True)
 if check.failed:
