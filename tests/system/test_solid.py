@@ -14,7 +14,7 @@ temporary folder). References are exact solutions and the 2D program itself.
     summed through the depth and divided by it, are the 2D ones to 1e-10; uz = 0; the same
     outer count.
 (3) Robin = monolithic: two boxes pressed by a prescribed displacement, the forces to 1e-8;
-    the bodies balance to 1e-12.
+    the bodies balance to 1e-12; the 'steklov' and 'constant' operators too (to 1e-8).
 (4) Bad input, exit 1, one message, nothing written: a box's variable in a 2D deck, a body
     with no depth in a 3D deck, plane stress in a 3D deck, uz in a 2D deck, dimension = 4,
     friction and a parabolic gap in a 3D deck, t1 in a 3D deck, an override that changes the
@@ -167,6 +167,15 @@ try:
         check(d <= 1e-8, "boxes: Robin = monolithic", f"{d:.2e}")
         bal = balances(orb)
         check(len(bal) == 2 and max(bal) <= 1e-12, "boxes: both bodies balance", f"{bal}")
+        # the paper's operator (the other body's flexibility) and the constant one (alpha of
+        # the flexibilities' scale, 1/(E h)) on the same scene
+        for op, over in (("steklov", "&solver robin_operator='steklov', tol=1e-10 /"),
+                         ("constant", "&solver robin_operator='constant', alpha=1e-12, tol=1e-10 /")):
+            co, oo, ho = run(work, op, boxes, over)
+            if check(co == 0, f"boxes: the {op} operator converges", oo[-300:]):
+                with h5py.File(ho, "r") as a:
+                    d = np.abs(a["/contact/normal_force"][...] - fm).max() / np.abs(fm).max()
+                check(d <= 1e-8, f"boxes: the {op} operator = monolithic", f"{d:.2e}")
 
     # (4) bad input
     bad = [
