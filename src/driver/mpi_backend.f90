@@ -173,29 +173,11 @@ contains
         iv(1) = body%rank
         call par_bcast_ints(iv, 1, self%host(b))
         body%rank = iv(1)
-        ! the kernel basis of a singular F_a (flex_rank; -1: none), which the harmonic
-        ! operator's proximal term needs on rank 0 as much as on the body's host
-        iv(1) = -1
-        if (allocated(body%kern)) iv(1) = size(body%kern, 2)
-        call par_bcast_ints(iv, 1, self%host(b))
-        if (iv(1) >= 0) then
-          if (.not. (self%mine(b) .and. fac%holds_result())) then
-            if (allocated(body%kern)) deallocate (body%kern)
-            allocate (body%kern(m, iv(1)))
-          end if
-          if (iv(1) > 0) call par_bcast_reals(body%kern, m*iv(1), self%host(b))
-        end if
-        ! or the basis of its range, when that is the smaller part (condense `low_rank_range`)
-        iv(1) = -1
-        if (allocated(body%rng)) iv(1) = size(body%rng, 2)
-        call par_bcast_ints(iv, 1, self%host(b))
-        if (iv(1) >= 0) then
-          if (.not. (self%mine(b) .and. fac%holds_result())) then
-            if (allocated(body%rng)) deallocate (body%rng)
-            allocate (body%rng(m, iv(1)))
-          end if
-          if (iv(1) > 0) call par_bcast_reals(body%rng, m*iv(1), self%host(b))
-        end if
+        ! the kernel basis of a singular F_a (flex_rank), or the basis of its range when that
+        ! is the smaller part (condense `low_rank_range`), which the harmonic operator's
+        ! proximal term needs on rank 0 as much as on the body's host
+        call share_basis(body%kern, .not. (self%mine(b) .and. fac%holds_result()), m, self%host(b))
+        call share_basis(body%rng, .not. (self%mine(b) .and. fac%holds_result()), m, self%host(b))
       end associate
       call self%err(b)%clear()
     end do
@@ -208,6 +190,24 @@ contains
         maxval(max_rank_mb), ' MB (body ', maxloc(max_rank_mb, 1), ')'
     end if
   end subroutine share_condensed
+
+  !> Broadcast an (m, k) basis from the host (k = -1 on the host: none, left unallocated);
+  !! `receives` on the ranks that take it.
+  subroutine share_basis(basis, receives, m, host)
+    real(wp), allocatable, intent(inout) :: basis(:, :)
+    logical, intent(in) :: receives
+    integer, intent(in) :: m, host
+    integer :: iv(1)
+    iv(1) = -1
+    if (allocated(basis)) iv(1) = size(basis, 2)
+    call par_bcast_ints(iv, 1, host)
+    if (iv(1) < 0) return
+    if (receives) then
+      if (allocated(basis)) deallocate (basis)
+      allocate (basis(m, iv(1)))
+    end if
+    if (iv(1) > 0) call par_bcast_reals(basis, m*iv(1), host)
+  end subroutine share_basis
 
   !> Each group's b_a for the current step's loads (one MUMPS solve), sent to every rank;
   !! every rank then has each floating body's load along its free motions.
