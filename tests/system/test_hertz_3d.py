@@ -46,14 +46,23 @@ def face_area(msh, name):
     return area
 
 
+RUNS = (("0.02", ()), ("0.01", ()), ("0.02m", ("&solver method='monolithic' /",)))
+
+
+def solve(h, over, name, sphere=""):
+    """The deck on the shipped mesh of size h[:4] with the overrides; (process, result path)."""
+    msh = os.path.join(ROOT, "inputs", "gmsh", f"sphere_block_h{h[:4]}.msh")
+    h5 = os.path.join(work, f"{name}{h}.h5")
+    p, _ = run_solver(BIN, DECK, f"&body id=1, mesh='{msh}'{sphere} /", f"&body id=2, mesh='{msh}' /", *over,
+                      f"&output file='{h5}' /", env=solver_env(2), timeout=300)
+    return p, h5
+
+
 work = tempfile.mkdtemp(prefix="rc_hertz3d_")
 try:
     errs = {}
-    for h, over in (("0.02", ()), ("0.01", ()), ("0.02m", ("&solver method='monolithic' /",))):
-        msh = os.path.join(ROOT, "inputs", "gmsh", f"sphere_block_h{h[:4]}.msh")
-        h5 = os.path.join(work, f"r{h}.h5")
-        p, _ = run_solver(BIN, DECK, f"&body id=1, mesh='{msh}' /", f"&body id=2, mesh='{msh}' /", *over,
-                          f"&output file='{h5}' /", env=solver_env(2), timeout=300)
+    for h, over in RUNS:
+        p, h5 = solve(h, over, "r")
         if not check(p.returncode == 0, f"Hertz 3D, hc = {h}: converged", (p.stdout + p.stderr)[-300:]):
             continue
         bal = [float(l.split("balance=")[1].split()[0]) for l in p.stdout.splitlines() if l.startswith("reaction:")]
@@ -97,11 +106,8 @@ try:
     E1, E2, nu = 3000.0, 1000.0, 0.3
     estar = 1.0 / ((1 - nu * nu) / E1 + (1 - nu * nu) / E2)
     mats = {}
-    for h, over in (("0.01", ()), ("0.02", ()), ("0.02m", ("&solver method='monolithic' /",))):
-        msh = os.path.join(ROOT, "inputs", "gmsh", f"sphere_block_h{h[:4]}.msh")
-        h5 = os.path.join(work, f"mat{h}.h5")
-        p, _ = run_solver(BIN, DECK, f"&body id=1, mesh='{msh}', young={E1} /", f"&body id=2, mesh='{msh}' /", *over,
-                          f"&output file='{h5}' /", env=solver_env(2), timeout=300)
+    for h, over in RUNS:
+        p, h5 = solve(h, over, "mat", sphere=f", young={E1}")
         if check(p.returncode == 0, f"Hertz 3D, E1 = 3 E2, hc = {h}: converged", (p.stdout + p.stderr)[-300:]):
             with h5py.File(h5, "r") as f:
                 mats[h] = (f["/contact/x"][...], f["/contact/z"][...], f["/contact/pressure"][...],

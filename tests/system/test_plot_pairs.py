@@ -23,6 +23,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_checks import Checks  # noqa: E402
 from rc_run import run_solver  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from solid_decks import THREE_BOXES  # noqa: E402
 
 BIN = os.path.abspath(os.environ.get("BIN", "bin/robin_contact"))
 PYTHON = os.environ.get("PYTHON", "/usr/bin/python3")
@@ -75,18 +77,7 @@ check(rc == 1 and "--pair 3: the file has 2 contact pairs" in se and not os.path
 # solid bodies: three boxes, two pairs, the contact patch test (every pressure p)
 deck3 = os.path.join(tmp, "boxes3.nml")
 with open(deck3, "w") as f:
-    f.write("""&scene title = 'three boxes, two pairs', dimension = 3 /
-&body id = 1, x0 = 0.0, y0 = 2.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 3,
-      element = 'Q1', left = 'roller', front = 'roller' /
-&body id = 2, x0 = 0.0, y0 = 1.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 3, ny = 2, nz = 2,
-      element = 'P1', left = 'roller', front = 'roller' /
-&body id = 3, x0 = 0.0, y0 = 0.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 2,
-      element = 'Q1', left = 'roller', front = 'roller', bottom = 'roller' /
-&traction body = 1, side = 'top', t0 = 0.0, -1.0e6, 0.0 /
-&contact bodies = 1, 2, groups = 'bottom', 'top' /
-&contact bodies = 2, 3, groups = 'bottom', 'top' /
-&solver tol = 1.0e-10 /
-""")
+    f.write(THREE_BOXES + "&solver tol = 1.0e-10 /\n")
 h53 = os.path.join(tmp, "boxes3.h5")
 p, _ = run_solver(BIN, deck3, f"&output file='{h53}' /")
 if check(p.returncode == 0, "three boxes, two pairs (3D) solved", f"exit {p.returncode} {p.stderr.strip()[-200:]}"):

@@ -61,6 +61,8 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 from rc_checks import Checks  # noqa: E402
 from rc_results import text_attr  # noqa: E402
 from rc_run import run_solver  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from solid_decks import THREE_BOXES  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DECK = "inputs/table1/q1_6x2.nml"
@@ -370,18 +372,7 @@ def run_case(tmp, tag, overrides, units=("m", "N", "Pa"), name=None):
 
 
 # ---- solid bodies: contact surfaces ---------------------------------------------------------
-STACK3 = """&scene title = 'three boxes, two pairs', dimension = 3 /
-&body id = 1, x0 = 0.0, y0 = 2.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 3,
-      element = 'Q1', left = 'roller', front = 'roller' /
-&body id = 2, x0 = 0.0, y0 = 1.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 3, ny = 2, nz = 2,
-      element = 'P1', left = 'roller', front = 'roller' /
-&body id = 3, x0 = 0.0, y0 = 0.0, z0 = 0.0, width = 1.0, height = 1.0, depth = 1.0, nx = 2, ny = 1, nz = 2,
-      element = 'Q1', left = 'roller', front = 'roller', bottom = 'roller' /
-&traction body = 1, side = 'top', t0 = 0.0, -1.0e6, 0.0 /
-&contact bodies = 1, 2, groups = 'bottom', 'top' /
-&contact bodies = 2, 3, groups = 'bottom', 'top' /
-&solver load_steps = 2 /
-"""
+STACK3 = THREE_BOXES + "&solver load_steps = 2 /\n"
 
 
 def face_vectors(xyz, faces):
