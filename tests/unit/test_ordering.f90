@@ -199,6 +199,35 @@ contains
     end if
   end subroutine check_perm
 
+  !> With a body's factor in ch: its summary, one solve (the scaled residual checked) and the
+  !! flexibility on `last` from the trailing block of L; then the factor is freed.
+  subroutine solve_and_flex(ch, sys, last, sgn, tag, flex)
+    type(chol_t), intent(inout) :: ch
+    type(body_system_t), intent(in) :: sys
+    integer, intent(in) :: last(:)
+    real(wp), intent(in) :: sgn(:)
+    character(len=*), intent(in) :: tag
+    real(wp), intent(out) :: flex(:, :)
+    real(wp), allocatable :: u(:), r(:)
+    real(wp) :: res
+    integer :: info
+    logical :: used
+    character(len=256) :: msg
+    type(error_t) :: err
+    write (output_unit, '(a)') '      '//ch%summary()
+    allocate (r(sys%n))
+    u = sys%f
+    call ch%solve(u, err)
+    call error_parts(err, info, msg)
+    call csc_matvec(sys, u, r)
+    res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u))*eps)
+    call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
+    call ch%flexibility(last, sgn, flex, err, used_block=used)
+    call error_parts(err, info, msg)
+    call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L '//trim(msg))
+    call ch%free()
+  end subroutine solve_and_flex
+
   !> Factor one body with METIS, AMD and nd, interface (bottom normal DOFs) last.
   subroutine check_factor(name, nx, ny, elem)
     character(len=*), intent(in) :: name
@@ -208,17 +237,15 @@ contains
     type(body_system_t) :: sys
     type(chol_t) :: ch
     integer, allocatable :: last(:), perm(:)
-    real(wp), allocatable :: u(:), r(:), sgn(:), flex(:, :, :)
-    real(wp) :: res, d, nnz(3)
+    real(wp), allocatable :: sgn(:), flex(:, :, :)
+    real(wp) :: d, nnz(3)
     integer :: o, info, m
-    type(error_t) :: err
-    logical :: used
     character(len=256) :: msg
     character(len=64) :: tag
 
     call structured_body(rectangle_body(nx, ny, elem, [BC_CLAMPED, BC_FREE, BC_CONTACT, BC_FREE]), msh, sys, last)
     m = size(last)
-    allocate (u(sys%n), r(sys%n), sgn(m), flex(m, m, 3))
+    allocate (sgn(m), flex(m, m, 3))
     sgn = -1.0_wp
     nnz = 0.0_wp
     call order_body(msh, sys, last, perm, info, msg)
@@ -230,19 +257,9 @@ contains
       call factor_ordered(ch, sys, o, last, perm, info, msg)
       call report(info == 0, trim(tag)//': factor info = 0 '//trim(msg))
       if (info /= 0) cycle
-      write (output_unit, '(a)') '      '//ch%summary()
       nnz(o) = real(ch%nnz_factor, wp)
       call report(ch%interface_last_ok, trim(tag)//': interface DOFs ordered last, in the given order')
-      u = sys%f
-      call ch%solve(u, err)
-      call error_parts(err, info, msg)
-      call csc_matvec(sys, u, r)
-      res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u))*eps)
-      call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
-      call ch%flexibility(last, sgn, flex(:, :, o), err, used_block=used)
-      call error_parts(err, info, msg)
-      call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
-      call ch%free()
+      call solve_and_flex(ch, sys, last, sgn, tag, flex(:, :, o))
     end do
     do o = 2, 3
       d = norm2(flex(:, :, o) - flex(:, :, 1))/norm2(flex(:, :, 1))
@@ -384,7 +401,7 @@ contains
     logical, allocatable :: is_last(:)
     real(wp), allocatable :: u(:, :), r(:), sgn(:), flex(:, :, :)
     real(wp) :: res, d, nnz(3), t0, t_nd
-    integer :: o, info, m, k, f, g
+    integer :: o, info, m
     type(error_t) :: err
     logical :: ok, used
     character(len=256) :: msg
@@ -541,10 +558,10 @@ contains
     type(chol_t) :: ch
     integer, allocatable :: last(:), perm(:), group_of(:), members(:), gptr(:), node_of_group(:)
     logical, allocatable :: is_last(:), has_inner(:)
-    real(wp), allocatable :: u(:), r(:), sgn(:), flex(:, :, :)
-    real(wp) :: res, d
+    real(wp), allocatable :: sgn(:), flex(:, :, :)
+    real(wp) :: d
     integer :: info, m, o, ng, g, k, p
-    logical :: ok, used
+    logical :: ok
     type(error_t) :: err
     character(len=256) :: msg
     character(len=200) :: emsg
@@ -588,7 +605,7 @@ contains
     call report(ok, name//': the pattern''s nodes are the mesh''s (one per node with a DOF not last)', &
                 real(ng, wp), real(count(has_inner), wp))
 
-    allocate (u(sys%n), r(sys%n), sgn(m), flex(m, m, 2))
+    allocate (sgn(m), flex(m, m, 2))
     sgn = -1.0_wp
     do o = 1, 2
       tag = name//merge(' nodes', ' metis', o == 1)
@@ -597,17 +614,7 @@ contains
       call error_parts(err, info, msg)
       call report(info == 0 .and. ch%interface_last_ok, trim(tag)//': factor ok, contact DOFs last in the given order '//trim(msg))
       if (info /= 0) cycle
-      write (output_unit, '(a)') '      '//ch%summary()
-      u = sys%f
-      call ch%solve(u, err)
-      call error_parts(err, info, msg)
-      call csc_matvec(sys, u, r)
-      res = maxval(abs(r - sys%f))/(real(sys%n, wp)*sys%k_norm*maxval(abs(u))*eps)
-      call report(info == 0 .and. res <= RES_TOL, trim(tag)//': scaled residual |Ku-f|/(n|K||u|eps)', res, RES_TOL)
-      call ch%flexibility(last, sgn, flex(:, :, o), err, used_block=used)
-      call error_parts(err, info, msg)
-      call report(info == 0 .and. used, trim(tag)//': flexibility from the trailing block of L')
-      call ch%free()
+      call solve_and_flex(ch, sys, last, sgn, tag, flex(:, :, o))
     end do
     d = norm2(flex(:, :, 1) - flex(:, :, 2))/norm2(flex(:, :, 2))
     call report_le(d, FLEX_TOL, name//' nodes: flexibility = METIS''s (relative)')
