@@ -555,8 +555,8 @@ def warped_lines(view_file, h5path, scale, step, line_grids, folder):
     body's contact line as geometry (inline), for an array that lives on the contact lines only;
     a grid whose first body's nodes are not its nodes (a non-matching side) keeps its own,
     undeformed, points. Returns the path."""
-    import xml.etree.ElementTree as ET
     import h5py
+    import numpy as np
     if result_dimension(h5path) == 3:
         return warped_surfaces(view_file, h5path, scale, step, line_grids, folder)
     pieces, c, _ = contact_pieces(h5path, scale, step)
@@ -564,59 +564,57 @@ def warped_lines(view_file, h5path, scale, step, line_grids, folder):
         npair = int(f.attrs.get("pairs", 1))
         sizes = [f[f"contact/pair_{k}/normal_force"].shape[0] for k in range(1, npair + 1)] if npair > 1 \
             else [c.shape[0]]
-    first = [0]
-    for n in sizes:
-        first.append(first[-1] + n)
-    tree = ET.parse(view_file)
-    for g in tree.getroot().iter("Grid"):
-        name = g.get("Name", "")
-        m = re.fullmatch(r"contact(?:_pair(\d+))?", name)
-        if name not in line_grids or m is None:
-            continue
-        k = int(m.group(1) or 1)
+    first = np.cumsum([0] + sizes)
+
+    def points(pair):
+        k = int(pair or 1)
         if k > len(sizes):
-            continue
+            return None
         r0, r1 = first[k - 1], first[k]
         full = [p for _, p, ci in pieces if len(ci) == r1 - r0 and ci[0] == r0 and ci[-1] == r1 - 1]
-        geo = g.find("Geometry")
-        item = geo.find("DataItem") if geo is not None else None
-        if not full or item is None:
-            continue
-        item.set("Format", "XML")
-        item.set("Dimensions", f"{r1 - r0} 3")
-        item.text = " ".join(f"{x!r} {y!r} 0" for x, y in full[0])
-    out = os.path.join(folder, "lines.xdmf")
-    tree.write(out, encoding="utf-8", xml_declaration=True)
-    return out
+        return (r1 - r0, " ".join(f"{x!r} {y!r} 0" for x, y in full[0])) if full else None
+
+    return inline_contact_geometry(view_file, line_grids, points, folder)
 
 
 def warped_surfaces(view_file, h5path, scale, step, line_grids, folder):
     """warped_lines for a solid result: a copy of the step's XDMF whose contact-surface grids
     have the contact nodes warped by their slave body's displacement (contact_points_3d) as
     geometry (inline). Returns the path."""
-    import xml.etree.ElementTree as ET
     import h5py
+    import numpy as np
     pts = contact_points_3d(h5path, scale, step)
     with h5py.File(h5path, "r") as f:
         npair = int(f.attrs.get("pairs", 1))
         sizes = [f[f"contact/pair_{k}/normal_force"].shape[0] for k in range(1, npair + 1)]
-    first = [0]
-    for n in sizes:
-        first.append(first[-1] + n)
+    first = np.cumsum([0] + sizes)
+
+    def points(pair):
+        r0, r1 = (first[int(pair) - 1], first[int(pair)]) if pair else (0, first[-1])
+        return r1 - r0, " ".join(f"{x!r} {y!r} {z!r}" for x, y, z in pts[r0:r1])
+
+    return inline_contact_geometry(view_file, line_grids, points, folder)
+
+
+def inline_contact_geometry(view_file, line_grids, points, folder):
+    """A copy of view_file (folder/lines.xdmf) in which each contact grid among line_grids
+    ('contact' or 'contact_pair<k>') takes the points that points(k or None) gives, (count,
+    'x y z ...'), as inline geometry (None: it keeps its own). Returns the path."""
+    import xml.etree.ElementTree as ET
     tree = ET.parse(view_file)
     for g in tree.getroot().iter("Grid"):
         name = g.get("Name", "")
         m = re.fullmatch(r"contact(?:_pair(\d+))?", name)
         if name not in line_grids or m is None:
             continue
-        r0, r1 = (first[int(m.group(1)) - 1], first[int(m.group(1))]) if m.group(1) else (0, first[-1])
+        new = points(m.group(1))
         geo = g.find("Geometry")
         item = geo.find("DataItem") if geo is not None else None
-        if item is None:
+        if new is None or item is None:
             continue
         item.set("Format", "XML")
-        item.set("Dimensions", f"{r1 - r0} 3")
-        item.text = " ".join(f"{x!r} {y!r} {z!r}" for x, y, z in pts[r0:r1])
+        item.set("Dimensions", f"{new[0]} 3")
+        item.text = new[1]
     out = os.path.join(folder, "lines.xdmf")
     tree.write(out, encoding="utf-8", xml_declaration=True)
     return out
