@@ -24,7 +24,7 @@ module mesh_topology
   public :: body_from_file, body_group, add_physical, index_entities, entity_index, index_groups
   ! for the volume meshes of module volume_topology
   public :: group_members, entity_cells, cell_regions, point_groups, number_for_locality, &
-            check_one_piece, sort_by_tag
+            check_one_piece, sort_by_tag, body_file_nodes
 
   real(wp), parameter :: AREA_TOL = 1.0e-12_wp       ! degenerate: |area| < AREA_TOL * (longest edge)^2
   ! the largest coordinate whose cell areas and squared edges stay finite (8 x^2 <= huge)
@@ -288,7 +288,7 @@ contains
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
     type(error_t), intent(out) :: err                   !< the failure, if any
-    integer :: surface, k, c, i, ncell, st, nquad, nnew
+    integer :: surface, k, c, ncell, nquad
     logical, allocatable :: in_entity(:)
     integer, allocatable :: file_cell(:), body_node(:), order(:)
 
@@ -321,37 +321,8 @@ contains
     end if
 
     ! its nodes, in increasing tag order
-    allocate (body_node(file_mesh%nnode), stat=st)
-    if (st /= 0) then
-      call err%set(ERR_MEMORY, 'not enough memory for '//i2s(file_mesh%nnode)//' nodes')
-      return
-    end if
-    body_node = 0
-    if (4*int(ncell, i8) < file_mesh%nnode/8) then
-      ! a small part of the file: its nodes gathered from its cells (the same set, the same
-      ! order once sorted by tag, as the pass over the file's nodes below)
-      allocate (order(4*ncell))
-      nnew = 0
-      do k = 1, ncell
-        do c = 1, 4
-          i = file_mesh%cell_node(c, file_cell(k))
-          if (i == 0) cycle
-          if (body_node(i) /= 0) cycle
-          body_node(i) = 1
-          nnew = nnew + 1
-          order(nnew) = i
-        end do
-      end do
-      order = order(1:nnew)
-    else
-      do k = 1, ncell
-        do c = 1, 4
-          if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
-        end do
-      end do
-      order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
-    end if
-    call sort_by_tag(order, file_mesh%node_tag)
+    call body_file_nodes(file_mesh, file_cell, 4, body_node, order, err)
+    if (err%failed()) return
     mesh%nnode = size(order)
     allocate (mesh%xy(2, mesh%nnode), mesh%node_tag(mesh%nnode))
     do k = 1, mesh%nnode
@@ -1196,6 +1167,49 @@ contains
       end do
     end function find
   end subroutine check_one_piece
+
+  !> The file's nodes of a body's cells (`file_cell`, each of up to nvert nodes, 0 = none) in
+  !! increasing tag order (`order`), and `body_node` (file_mesh%nnode) marking them (1) and
+  !! every other node 0. A body that is a small part of the file gathers its nodes from its
+  !! cells (the same set, the same order once sorted by tag, as a pass over all the file's nodes).
+  subroutine body_file_nodes(file_mesh, file_cell, nvert, body_node, order, err)
+    type(file_mesh_t), intent(in) :: file_mesh
+    integer, intent(in) :: file_cell(:)            !< the body's cells in the file
+    integer, intent(in) :: nvert                   !< nodes per cell row of file_mesh%cell_node
+    integer, allocatable, intent(out) :: body_node(:), order(:)
+    type(error_t), intent(out) :: err
+    integer :: k, c, i, nnew, st, ncell
+    ncell = size(file_cell)
+    allocate (body_node(file_mesh%nnode), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for '//i2s(file_mesh%nnode)//' nodes')
+      return
+    end if
+    body_node = 0
+    if (int(nvert, i8)*int(ncell, i8) < file_mesh%nnode/8) then
+      allocate (order(nvert*ncell))
+      nnew = 0
+      do k = 1, ncell
+        do c = 1, nvert
+          i = file_mesh%cell_node(c, file_cell(k))
+          if (i == 0) cycle
+          if (body_node(i) /= 0) cycle
+          body_node(i) = 1
+          nnew = nnew + 1
+          order(nnew) = i
+        end do
+      end do
+      order = order(1:nnew)
+    else
+      do k = 1, ncell
+        do c = 1, nvert
+          if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
+        end do
+      end do
+      order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
+    end if
+    call sort_by_tag(order, file_mesh%node_tag)
+  end subroutine body_file_nodes
 
   !> Sort the file node indices `idx` by increasing tag (bottom-up merge sort).
   subroutine sort_by_tag(idx, tag)

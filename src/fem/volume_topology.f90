@@ -27,10 +27,10 @@ module volume_topology
   use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s, sci, text_buffer_t
   use int_hash, only: int_hash_t, hash_init, hash_slot
-  use sorting, only: merge_sort_by_keys
+  use sorting, only: merge_sort_by_keys, sort_ints
   use mesh, only: mesh_t
   use mesh_topology, only: file_mesh_t, body_group, group_members, entity_cells, cell_regions, point_groups, number_for_locality, &
-                           check_one_piece, sort_by_tag
+                           check_one_piece, body_file_nodes
   implicit none (type, external)
   private
 
@@ -82,7 +82,7 @@ contains
     character(len=*), intent(in) :: path                !< the file, kept as mesh%source
     type(mesh_t), intent(inout) :: mesh                 !< the body's mesh
     type(error_t), intent(out) :: err                   !< the failure, if any
-    integer :: volume, k, c, i, ncell, st, nhex, nnew
+    integer :: volume, k, c, ncell, st, nhex
     logical, allocatable :: in_entity(:)
     integer, allocatable :: file_cell(:), body_node(:), order(:)
     type(face_table_t) :: faces
@@ -119,36 +119,8 @@ contains
     end if
 
     ! its nodes, in increasing tag order
-    allocate (body_node(file_mesh%nnode), stat=st)
-    if (st /= 0) then
-      call err%set(ERR_MEMORY, 'not enough memory for '//i2s(file_mesh%nnode)//' nodes')
-      return
-    end if
-    body_node = 0
-    if (8*int(ncell, i8) < file_mesh%nnode/8) then
-      ! a small part of the file: its nodes gathered from its cells
-      allocate (order(8*ncell))
-      nnew = 0
-      do k = 1, ncell
-        do c = 1, 8
-          i = file_mesh%cell_node(c, file_cell(k))
-          if (i == 0) cycle
-          if (body_node(i) /= 0) cycle
-          body_node(i) = 1
-          nnew = nnew + 1
-          order(nnew) = i
-        end do
-      end do
-      order = order(1:nnew)
-    else
-      do k = 1, ncell
-        do c = 1, 8
-          if (file_mesh%cell_node(c, file_cell(k)) > 0) body_node(file_mesh%cell_node(c, file_cell(k))) = 1
-        end do
-      end do
-      order = pack([(k, k=1, file_mesh%nnode)], body_node > 0)
-    end if
-    call sort_by_tag(order, file_mesh%node_tag)
+    call body_file_nodes(file_mesh, file_cell, 8, body_node, order, err)
+    if (err%failed()) return
     mesh%nnode = size(order)
     allocate (mesh%xy(3, mesh%nnode), mesh%node_tag(mesh%nnode), stat=st)
     if (st /= 0) then
@@ -356,7 +328,7 @@ contains
     first = 0
     do c = 1, n
       key(1:mesh%nvert, c) = mesh%cells(:, c)       ! a tetrahedron among hexahedra: 0s
-      call sort_small(key(:, c))
+      call sort_ints(key(:, c))
       first(key(8, c) + 2) = first(key(8, c) + 2) + 1
     end do
     first(1) = 1
@@ -400,22 +372,6 @@ contains
     end subroutine refuse
   end subroutine check_duplicate_cells
 
-  !> Sort a few integers ascending, in place (insertion sort).
-  pure subroutine sort_small(v)
-    integer, intent(inout) :: v(:)
-    integer :: i, j, x
-    do i = 2, size(v)
-      x = v(i)
-      j = i - 1
-      do while (j >= 1)
-        if (v(j) <= x) exit
-        v(j + 1) = v(j)
-        j = j - 1
-      end do
-      v(j + 1) = x
-    end do
-  end subroutine sort_small
-
   ! ---- faces --------------------------------------------------------------------------------
 
   !> The nodes of local face f of cell c (counter-clockwise seen from outside): nv = 3 or 4,
@@ -440,7 +396,7 @@ contains
     integer :: key(4)
     key = 0
     key(1:nv) = v(1:nv)
-    call sort_small(key(1:nv))
+    call sort_ints(key(1:nv))
   end function face_key
 
   !> The 32-bit hash of a face key (each node folded in by a multiplicative mix whose products
