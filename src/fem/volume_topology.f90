@@ -495,7 +495,7 @@ contains
         end if
         call slot_face(faces, s, c0, f0)
         if (slot_count(faces, s) == 2) then
-          call err%set(ERR_INPUT, 'element '//i2s(mesh%cell_tag(c))//' has the face of nodes '//node_list(v, nv)// &
+          call err%set(ERR_INPUT, 'element '//i2s(mesh%cell_tag(c))//' has the face of nodes '//face_tags(mesh, v, nv)// &
                        ', which two other cells (element '//i2s(mesh%cell_tag(c0))//' and another) already '// &
                        'share: a face bounds at most two cells (cells overlap, or a node is wrong)')
           return
@@ -505,28 +505,13 @@ contains
         p = findloc(w(1:nw), v(1), dim=1)
         if (w(modulo(p - 2, nw) + 1) /= v(2)) then
           call err%set(ERR_INPUT, 'elements '//i2s(mesh%cell_tag(c0))//' and '//i2s(mesh%cell_tag(c))// &
-                       ' overlap: both lie on the same side of their face of nodes '//node_list(v, nv)// &
+                       ' overlap: both lie on the same side of their face of nodes '//face_tags(mesh, v, nv)// &
                        ' (a node misplaced or a wrong node in a cell)')
           return
         end if
         faces%v(s) = faces%v(s) + 2_i8**31      ! a second cell
       end do
     end do
-  contains
-    !> The tags of a face's nodes, for messages.
-    function node_list(v, nv) result(t)
-      integer, intent(in) :: v(4), nv
-      character(len=:), allocatable :: t
-      integer :: i
-      t = i2s(mesh%node_tag(v(1)))
-      do i = 2, nv
-        if (i == nv) then
-          t = t//' and '//i2s(mesh%node_tag(v(i)))
-        else
-          t = t//', '//i2s(mesh%node_tag(v(i)))
-        end if
-      end do
-    end function node_list
   end subroutine hash_faces
 
   ! ---- groups -------------------------------------------------------------------------------
@@ -590,7 +575,7 @@ contains
         if (seen%key(seen_slot) == key) then
           call err%set(ERR_INPUT, 'elements '//i2s(file_mesh%face_tag(seen_face(seen_slot)))//' and '// &
                        i2s(file_mesh%face_tag(face))//" of physical surface '"//file_mesh%phys_name(phys)%s// &
-                       "' are the same face (nodes "//tags(v, nv)//'): a face listed twice would apply its load twice')
+                       "' are the same face (nodes "//face_tags(mesh, v, nv)//'): a face listed twice would apply its load twice')
           return
         end if
         seen%key(seen_slot) = key
@@ -598,7 +583,7 @@ contains
         if (faces%v(s) == 0) then               ! its nodes are the body's, but no cell has that face
           call err%set(ERR_INPUT, 'element '//i2s(file_mesh%face_tag(face))//" of physical surface '"// &
                        file_mesh%phys_name(phys)%s//"' (a "//trim(merge('quadrangle', 'triangle  ', nv == 4))// &
-                       ' of nodes '//tags(v, nv)//') is not a face of any cell of the body: its condition or '// &
+                       ' of nodes '//face_tags(mesh, v, nv)//') is not a face of any cell of the body: its condition or '// &
                        'load would be lost')
           return
         end if
@@ -632,22 +617,23 @@ contains
     mesh%file_groups = names%text()
     mesh%file_groups = trim(adjustl(mesh%file_groups))
     mesh%ngroup = ngroup
-  contains
-    !> The tags of the body nodes v(1:nv), for messages.
-    function tags(v, nv) result(t)
-      integer, intent(in) :: v(4), nv
-      character(len=:), allocatable :: t
-      integer :: i
-      t = i2s(mesh%node_tag(v(1)))
-      do i = 2, nv
-        if (i == nv) then
-          t = t//' and '//i2s(mesh%node_tag(v(i)))
-        else
-          t = t//', '//i2s(mesh%node_tag(v(i)))
-        end if
-      end do
-    end function tags
   end subroutine face_groups
+
+  !> The tags of the body nodes v(1:nv) of a face, 'a, b and c', for messages.
+  function face_tags(mesh, v, nv) result(t)
+    type(mesh_t), intent(in) :: mesh
+    integer, intent(in) :: v(4), nv
+    character(len=:), allocatable :: t
+    integer :: i
+    t = i2s(mesh%node_tag(v(1)))
+    do i = 2, nv
+      if (i == nv) then
+        t = t//' and '//i2s(mesh%node_tag(v(i)))
+      else
+        t = t//', '//i2s(mesh%node_tag(v(i)))
+      end if
+    end do
+  end function face_tags
 
   !> One node group per physical curve with lines of the body (both nodes the body's), after
   !! the face groups: their nodes, once each; a curve named as a surface adds its nodes to
