@@ -89,8 +89,9 @@ module contact_types
     real(wp), allocatable :: srch(:, :)        !< (m,2) lam_a after its last solve minus before it [force]
     real(wp), allocatable :: fsrch(:, :)       !< (m,2) F_a srch (difference of the two products F_a lam_a) [length]
     integer, allocatable :: nrw(:, :)          !< (2, bodies) per body: directions held in rw, next slot to fill
-    !> (bodies) 1: the body's QP needed the active-set Newton method (inner_solver 'auto'), so its
-    !! later solves start with it; 0: MPRGP first
+    !> (bodies, inner_solver 'auto') 1: the body's QP needed the active-set Newton method, so its
+    !! later solves use it alone; k >= 2: its last MPRGP solve cost more than two Newton steps,
+    !! so its next solve starts with the Newton method, within k - 1 steps; 0: MPRGP first
     integer, allocatable :: newton(:)
     !> (m, 2 k) per body up to k F_a-orthonormal directions of its solves, in the side layout:
     !! direction j of a body is in column j on its side-1 rows and k + j on its side-2 rows

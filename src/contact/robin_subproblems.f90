@@ -7,10 +7,10 @@
 !! bounds are built once, before the outer loop.
 module robin_subproblems
   use kinds, only: wp
-  use config, only: solver_cfg_t, ACCEL_NONE, INNER_MPRGP, INNER_ACTIVE_SET
+  use config, only: solver_cfg_t, ACCEL_NONE, INNER_MPRGP, INNER_ACTIVE_SET, INNER_AUTO
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
-                   QP_NEWTON
+                   QP_NEWTON, QP_NEWTON_FIRST
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
@@ -24,6 +24,9 @@ module robin_subproblems
 
   real(wp), parameter :: SMOOTH_RATE_TOL = 0.1_wp   !< rate change below which the outer iteration counts as smooth
   real(wp), parameter :: FEAS_RTOL_MIN = 1.0e-15_wp !< equilibrium of a floating body: max(inner tolerance, rounding, this) |e|
+  !> the most Newton steps a solve of inner_solver 'auto' tries before MPRGP when the body's
+  !! last solve suggests starting with the Newton method
+  integer, parameter :: NEWTON_FIRST_MAX = 64
 
   !> The bodies' subproblems as the outer loop solves them (one entry per body).
   type, public :: subproblems_t
@@ -193,8 +196,9 @@ contains
     type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
-    integer :: m, k, ka, r, mm
+    integer :: m, k, ka, r, mm, nfree
     logical :: moved
+    real(wp) :: cost
     m = size(rhs)
     mm = size(state%G, 1)
     updates = 0
@@ -224,6 +228,7 @@ contains
     end if
     inner_solver%opts%max_it = solver%inner_max_it
     inner_solver%opts%method = inner_method(solver%inner_solver, state%newton(a))
+    inner_solver%opts%newton_budget = max(1, state%newton(a) - 1)
     inner_solver%opts%lambda_max = subproblems%lmax_hessian(a)
     ! F_a is the same in every iteration and the warm start is the last solution: its
     ! gradient comes from F_a lam_a of the last solve (no initial product)
@@ -288,6 +293,22 @@ contains
     end if
     ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
     if (inner%switched) state%newton(a) = 1
+    ! 'auto' on a body held by its supports: while a solve that MPRGP finished costs more than
+    ! two steps of the Newton method on its free set, the next solve starts with the Newton
+    ! method (from the warm start: one step when the active set stays), within half that
+    ! solve's work, then MPRGP from where it stopped
+    if (solver%inner_solver == INNER_AUTO .and. r == 0 .and. state%newton(a) /= 1 .and. &
+        inner%status == MPRGP_CONVERGED .and. (state%newton(a) == 0 .or. inner%fell_back)) then
+      if (allocated(ub)) then
+        nfree = count(lam > lb .and. lam < ub)
+      else
+        nfree = count(lam > lb)
+      end if
+      cost = newton_step_cost(m, nfree)
+      state%newton(a) = 0
+      if (real(inner%n_matvec, wp) > 2.0_wp*cost) &
+        state%newton(a) = 1 + max(2, min(NEWTON_FIRST_MAX, int(real(inner%n_matvec, wp)/(2.0_wp*cost))))
+    end if
     grad = inner_solver%g
     call scatter(lam, body%slots, state%lam)
     call scatter(inner_solver%ax, body%slots, state%flam_v)
@@ -330,7 +351,8 @@ contains
   end subroutine solve_body
 
   !> The QP method of a body's solve: the deck's inner_solver, 'auto' resolved by what the
-  !! body's earlier solves needed (newton = 1: the Newton method at once).
+  !! body's earlier solves needed (newton = 1: the Newton method at once; k >= 2: the Newton
+  !! method within k - 1 steps, then MPRGP).
   pure integer function inner_method(choice, newton) result(method)
     integer, intent(in) :: choice    !< INNER_*
     integer, intent(in) :: newton    !< robin_state_t%newton of the body
@@ -340,9 +362,24 @@ contains
     case (INNER_ACTIVE_SET)
       method = QP_NEWTON
     case default
-      method = merge(QP_NEWTON, QP_AUTO, newton == 1)
+      select case (newton)
+      case (1)
+        method = QP_NEWTON
+      case (2:)
+        method = QP_NEWTON_FIRST
+      case default
+        method = QP_AUTO
+      end select
     end select
   end function inner_method
+
+  !> One step of the active-set Newton method on n unknowns with nf free, in products with
+  !! the n x n Hessian (2 n^2 flops each): the free block's factor (nf^3/3) and solves
+  !! (2 nf^2), the step's product and the product that confirms the gradient.
+  pure real(wp) function newton_step_cost(n, nf) result(c)
+    integer, intent(in) :: n, nf
+    c = (real(nf, wp)**3/3.0_wp + 2.0_wp*real(nf, wp)**2)/(2.0_wp*real(max(n, 1), wp)**2) + 2.0_wp
+  end function newton_step_cost
 
   !> True when the outer criterion decreased over the last three iterations at a steady
   !! rate (the two last ratios differ by at most SMOOTH_RATE_TOL).

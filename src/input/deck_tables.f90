@@ -401,7 +401,9 @@ contains
       'primal-dual active-set Newton method: a dense Cholesky factor of the free block per step, '// &
       'work independent of the conditioning; QPs of at most 4096 unknowns, larger ones by MPRGP) or '// &
       '`''auto''`: MPRGP within about the work of three factorizations, then the active-set method '// &
-      'from where MPRGP stopped, and for the rest of the run on that body')
+      'from where MPRGP stopped, and for the rest of the run on that body; a body held by its '// &
+      'supports whose last solve cost MPRGP more than two active-set steps starts its next solve '// &
+      'with the active-set method (one step when its contact set stays), MPRGP after a budget')
     call v%int('inner_max_it', s%inner_max_it, range='>= 1', doc='inner iteration limit per '// &
       'subproblem (MPRGP and Newton steps)')
     call v%real('monolithic_rtol', s%monolithic_rtol, unit='[-]', range='0 < monolithic_rtol < 1', &

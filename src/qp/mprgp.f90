@@ -43,7 +43,7 @@ module mprgp
   use strings, only: itoa
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
-                           QP_AUTO, QP_MPRGP, QP_NEWTON
+                           QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
   use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
   use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped, SET_OK, SET_NONFINITE
   implicit none (type, external)
@@ -52,7 +52,7 @@ module mprgp
   public :: lambda_max_estimate, mprgp_status_name, chopped
   public :: mprgp_t, mprgp_opts_t, mprgp_stats_t, constraint_set_t, box_set_t, box_set
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
-  public :: QP_AUTO, QP_MPRGP, QP_NEWTON
+  public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
 
   !> Safety factor: default alpha_bar = ALPHA_FACTOR / lambda_max (theory: (0, 2/|A|]).
   real(wp), parameter :: ALPHA_FACTOR = 1.9_wp
@@ -188,18 +188,20 @@ contains
     case (QP_NEWTON)
       call newton_loop(self, A, b, set, x)
     case (QP_AUTO)
-      ! MPRGP within a budget of about three factorizations' work; the Newton method from
-      ! where it stopped (a conditioning MPRGP pays for, the Newton method does not)
+      call auto_steps()
+    case (QP_NEWTON_FIRST)
+      ! the Newton method within its budget (a warm start on the solution's face ends in one
+      ! step); 'auto' from where it stopped when the active set moved more than that
       max_it = self%opts%max_it
-      budget = self%opts%auto_budget
-      if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/2)
+      budget = self%opts%newton_budget
       self%opts%max_it = min(max_it, budget)
-      call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
+      call newton_loop(self, A, b, set, x)
       self%opts%max_it = max_it
-      if (self%stats%status == MPRGP_MAX_IT .and. budget < max_it) then
-        self%stats%switched = .true.
+      if (self%stats%status == MPRGP_MAX_IT .and. self%it < max_it) then
+        self%stats%fell_back = .true.
         if (.not. self%fresh) call true_gradient(self, A, b, x)
-        call newton_loop(self, A, b, set, x)
+        call set_p_to_phi(self, set, x)
+        call auto_steps()
       end if
     case default
       call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
@@ -213,6 +215,27 @@ contains
     end if
     if (.not. self%fresh) self%ax = self%g + b
     call consume_search(self)
+
+  contains
+
+    !> MPRGP within a budget of about three factorizations' work (counted on from the steps
+    !! already taken); the Newton method from where it stopped (a conditioning MPRGP pays
+    !! for, the Newton method does not).
+    subroutine auto_steps()
+      max_it = self%opts%max_it
+      budget = self%opts%auto_budget
+      if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/2)
+      budget = self%it + budget
+      self%opts%max_it = min(max_it, budget)
+      call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
+      self%opts%max_it = max_it
+      if (self%stats%status == MPRGP_MAX_IT .and. budget < max_it) then
+        self%stats%switched = .true.
+        if (.not. self%fresh) call true_gradient(self, A, b, x)
+        call newton_loop(self, A, b, set, x)
+      end if
+    end subroutine auto_steps
+
   end subroutine mprgp_solve_in
 
   !> MPRGP's steps until the stopping test ends the solve.

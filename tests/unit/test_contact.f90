@@ -186,10 +186,14 @@ contains
     ! ---- Robin equals monolithic --------------------------------------------------------
     call solve_robin(d%solver, contact_line, bodies, rob)
     call error_bound(contact_line, bodies, rob)
-    ! the a posteriori bound holds whatever the outcome
+    call error_bound(contact_line, bodies, mono)
+    ! the a posteriori bound holds whatever the outcome; the monolithic solve is not exact
+    ! either, so the two differ by at most the sum of their bounds (an exactly solved Robin
+    ! subproblem leaves the Robin iterate as close to the solution as the monolithic one)
     e = norm2(rob%lam - mono%lam)
-    call check(e <= rob%error_bound*norm2(rob%lam)*(1.0_wp + 1.0e-9_wp), 'robin error within its reported bound', &
-               e/max(norm2(rob%lam), tiny(1.0_wp)), rob%error_bound)
+    call check(e <= (rob%error_bound*norm2(rob%lam) + mono%error_bound*norm2(mono%lam))*(1.0_wp + 1.0e-9_wp), &
+               'robin - monolithic within the sum of their reported bounds', e/max(norm2(rob%lam), tiny(1.0_wp)), &
+               rob%error_bound + mono%error_bound*norm2(mono%lam)/max(norm2(rob%lam), tiny(1.0_wp)))
     if (present(expect_converged)) then
       if (.not. expect_converged) then
         call check(rob%status /= STATUS_CONVERGED, 'robin reports not converged ('//status_name(rob%status)//')', &

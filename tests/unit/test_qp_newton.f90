@@ -9,6 +9,10 @@
 !!    than MPRGP's where MPRGP converges;
 !!  - QP_AUTO: MPRGP's answer where MPRGP is cheap (no switch, the same iterates), the Newton
 !!    method's where it is not (switched, KKT as above, far fewer products);
+!!  - QP_NEWTON_FIRST: from a warm start on the solution's face one Newton step ends the solve;
+!!    from a cold start its budget runs out and 'auto' finishes from there, to the solution
+!!    of the Newton method alone (and an ill-conditioned problem still switches back to the
+!!    Newton method rather than running MPRGP to its limit);
 !!  - SMALBE with an equality row, with the Newton method inside, against the enumeration;
 !!  - an indefinite matrix is reported as not SPD, never as converged.
 !! One line per check: PASS/FAIL, the measured value and its tolerance. Exit 1 on a failure.
@@ -16,7 +20,7 @@ program test_qp_newton
   use kinds, only: wp
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, mprgp_status_name, MPRGP_CONVERGED, MPRGP_NOT_SPD, &
-                   QP_AUTO, QP_MPRGP, QP_NEWTON
+                   QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use lapack, only: dgesv
   use strings, only: i2s
@@ -29,6 +33,7 @@ program test_qp_newton
   call test_enumeration()
   call test_conditioning()
   call test_auto()
+  call test_newton_first()
   call test_smalbe()
   call test_indefinite()
   call test_summary()
@@ -236,6 +241,63 @@ contains
     call report(sm%status /= MPRGP_CONVERGED, 'auto, cond 1e10: MPRGP alone does not converge in five times '// &
                 'that work ('//trim(mprgp_status_name(sm%status))//')')
   end subroutine test_auto
+
+  !> QP_NEWTON_FIRST: one step from the solution's face; from a cold start with a budget of
+  !! one step, the fall back to 'auto' reaches the Newton method's own solution, also on an
+  !! ill-conditioned problem (MPRGP's budget there, then the Newton method again).
+  subroutine test_newton_first()
+    integer, parameter :: n = 150
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), z(n), x0(n), xu(n), lmin, lmax, r, cond
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st, sn
+    integer :: i, k
+    do k = 1, 2
+      cond = merge(1.0e2_wp, 1.0e10_wp, k == 1)
+      call random_spd(n, log10(cond), a, lmin, lmax)
+      do i = 1, n
+        b(i) = urand(-1.0_wp, 1.0_wp)
+      end do
+      xu = unconstrained(a, b)
+      do i = 1, n
+        call random_bounds(merge(1, 3, mod(i, 2) == 0), xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
+      end do
+      opts = mprgp_opts_t()
+      opts%rtol = 1.0e-12_wp
+      opts%method = QP_NEWTON
+      y = 0.0_wp
+      call solve(a, b, l, u, y, opts, sn)
+      ! cold: the budget of one step runs out, 'auto' finishes
+      opts%method = QP_NEWTON_FIRST
+      opts%newton_budget = 1
+      x = 0.0_wp
+      x0 = min(max(x, l), u)
+      call solve(a, b, l, u, x, opts, st)
+      r = kkt_ratio(a, b, l, u, x, x0, lmax)
+      call report(st%status == MPRGP_CONVERGED .and. st%fell_back .and. r <= 1.0_wp .and. &
+                  (k == 1 .or. st%switched), 'Newton first, cond '//trim(i2s(nint(log10(cond))))//' decades, cold '// &
+                  'start, budget 1: fell back to auto'//trim(merge(' and switched back', '                  ', k == 2))// &
+                  ', KKT to the rounding level ('//i2s(st%n_matvec)//' products)', r, 1.0_wp)
+      call report(maxval(abs(x - y)) <= 1.0e3_wp*cond*eps*maxval(abs(y)), '  ... the Newton method''s solution: '// &
+                  'max |x - x_Newton| / max |x_Newton| within 1e3 cond eps', &
+                  maxval(abs(x - y))/maxval(abs(y)), 1.0e3_wp*cond*eps)
+      ! warm: from the solution's face (the Newton solution nudged inside its face), one step
+      z = y
+      do i = 1, n
+        if (z(i) > l(i) .and. z(i) < u(i)) z(i) = z(i) + 1.0e-3_wp*urand(-1.0_wp, 1.0_wp)*abs(z(i))
+      end do
+      z = min(max(z, l), u)
+      opts%newton_budget = 4
+      x0 = z
+      call solve(a, b, l, u, z, opts, st)
+      r = kkt_ratio(a, b, l, u, z, x0, lmax)
+      ! (cond 1e10: a tolerance below the rounding level takes the two confirming steps of
+      ! module mprgp's newton_loop, once more after the fresh gradient)
+      call report(st%status == MPRGP_CONVERGED .and. .not. st%fell_back .and. st%n_newton <= merge(2, 4, k == 1) &
+                  .and. r <= 1.0_wp, 'Newton first, cond '//trim(i2s(nint(log10(cond))))//' decades, warm start on '// &
+                  'the solution''s face: '//i2s(st%n_newton)//' Newton step(s) (at most '//i2s(merge(2, 4, k == 1))// &
+                  '), KKT to the rounding level', r, 1.0_wp)
+    end do
+  end subroutine test_newton_first
 
   !> SMALBE (an equality row) with the Newton method inside, against the enumeration.
   subroutine test_smalbe()
