@@ -7,9 +7,10 @@ p0 = 3 P/(2 pi a^2) for that P (E* = E/(2 (1 - nu^2)), R = 1), against the Hertz
 p = p0 sqrt(1 - r^2/a^2) fitted to the nodal pressures (r the distance from the y axis; linear
 least squares on p^2, then Gauss-Newton on p), the wall time and peak memory of the run.
 Prints a Markdown table. The runs use the default outer tolerance (1e-8), not the deck's
-1e-10, which asks for a disagreement of the bodies close to what rounding leaves on these
-meshes (the shipped hc = 0.01 mesh ends at 5.4e-9, within the 100 tol the stopping rule
-allows); a and p0 do not move in their fourth digit.
+1e-10, which asks for a disagreement of the bodies close to what rounding leaves on the finer
+meshes (at hc = 0.005 the run ends with the bodies disagreeing by 3.4e-9, within the 100 tol
+the stopping rule allows; with MPRGP alone they stalled at 1.2e-8 and the run did not
+converge); a and p0 do not move in their fourth digit.
 
 usage: tools/hertz3d_study.py [--bin bin/robin_contact] [--no-gmsh]
 """
