@@ -72,7 +72,7 @@ MODS := kinds space errors clock strings digest int_hash text_scanner sorting sy
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box test_gmsh_3d
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box test_gmsh_3d test_frames
 BENCH_F := bench_mprgp bench_ordering bench_ordering_3d bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -204,7 +204,7 @@ $(BUILD)/contact_interface.o: $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/conf
                            $(BUILD)/mesh.o $(BUILD)/mortar.o $(BUILD)/strings.o
 $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/factorization.o $(BUILD)/clock.o $(BUILD)/config.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
-                           $(BUILD)/mesh.o $(BUILD)/ordering.o
+                           $(BUILD)/mesh.o $(BUILD)/ordering.o $(BUILD)/space.o
 $(BUILD)/floating.o:       $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/nonneg_lsq.o $(BUILD)/strings.o
@@ -387,10 +387,14 @@ bench-gmsh: $(PROG)
 # Hertz in 3D, a ladder of meshes of inputs/sphere_block.nml's sphere on a block (meshes by
 # gmsh into results/bench_hertz3d/; hc = 0.01, 0.005, 0.0035: up to about 2 x 120k DOFs, a few
 # minutes); HERTZ3D_HC=0.01,0.005,0.0035,0.0028 adds about 2 x 235k DOFs (12 GB)
+# HERTZ3D_SLAVE=2 makes the block the slave, HERTZ3D_METHOD=monolithic solves in one piece
 HERTZ3D_HC ?= 0.01,0.005,0.0035
+HERTZ3D_SLAVE ?= 0
+HERTZ3D_METHOD ?= robin
 .PHONY: bench-hertz3d
 bench-hertz3d: $(PROG)
-	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_hertz3d.py --bin $(PROG) --gmsh $(GMSH) --hc $(HERTZ3D_HC)
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_hertz3d.py --bin $(PROG) --gmsh $(GMSH) --hc $(HERTZ3D_HC) \
+	  --slave $(HERTZ3D_SLAVE) --method $(HERTZ3D_METHOD)
 
 # The MPI binary beside the serial one: the paper's scene at 1024x512 per body,
 # serial CHOLMOD and MUMPS at -np 2, 4, 8 (oversubscribed here), time per phase and the

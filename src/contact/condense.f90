@@ -10,6 +10,7 @@
 !! group of ranks and the results are on its host.
 module condense
   use kinds, only: wp
+  use space, only: NCOMP, node_dof, dof_node, dof_comp
   use, intrinsic :: ieee_exceptions, only: ieee_usual, ieee_get_halting_mode, ieee_set_halting_mode
   use config, only: factor_cfg_t
   use mesh, only: mesh_t
@@ -40,6 +41,14 @@ module condense
     integer, allocatable :: bpos(:)         !<   position in idx of each entry
     real(wp), allocatable :: bval(:)        !<   and its coefficient
     real(wp), allocatable :: bfix(:)        !< (m) B_a's part on prescribed DOFs, B_a,d u_d [length]
+    !> Contact frames (contact_frames): the nodes whose displacement the factorization sees in
+    !! the frame of the one contact row that acts on them alone (a slave node: its normal n
+    !! and tangents), so that row touches one DOF. The factor is that of T'K_a T, every
+    !! vector of the factorization's (u0, the solves, B_a's rows above) is in those frames,
+    !! u = T u~; nrot = 0: none
+    integer :: nrot = 0
+    integer, allocatable :: rot_dof(:, :)   !< (NCOMP, nrot) the free DOFs of each node (consecutive)
+    real(wp), allocatable :: rot(:, :, :)   !< (NCOMP, NCOMP, nrot) its frame R, columns n, t1 (, t2) [-]
     real(wp), allocatable :: flex(:, :)     !< (m,m) F_a [length/force]
     !> > 0 when F_a is singular (mortar: a master surface coarser than the slave has fewer
     !! normal DOFs than the slave has rows): then the body's subproblem gets a proximal term
@@ -75,7 +84,7 @@ module condense
   end type body_condensed_t
 
   public :: factor_body, condense_body, interface_load, recover_displacement, apply_bt, apply_b, interface_dofs, &
-            flex_from_x, prescribed_part
+            flex_from_x, prescribed_part, to_global, contact_frames, frame_of_normal, rotated_values, rotated_triplets
 
 contains
 
@@ -129,7 +138,289 @@ contains
     end do
     bc%idx = idx(1:k)
     call prescribed_part(itf, sys, bc)
+    call contact_frames(sys, bc)
   end subroutine interface_dofs
+
+  !> The contact frames: a row whose entries on free DOFs all lie on one node, on two or more
+  !! of its components, with every component of that node free (a curved or inclined slave
+  !! node's row D_jj n_j . u_j), turns that node's displacement into the row's frame
+  !! R = [n, t1 (, t2)] (n its direction; t1 along the axis least aligned with n crossed
+  !! with n, t2 = n x t1), the first such row for each node; B_a's rows are rewritten on
+  !! those frames (B_a T), where the defining row touches the node's first DOF alone. Nodes
+  !! whose columns of K_a do not share one pattern keep the global frame. The factor then
+  !! orders one DOF per such row last instead of NCOMP, and the dense trailing block and its
+  !! inverse shrink by NCOMP^3 (doc/method.md, "Contact frames").
+  subroutine contact_frames(sys, bc)
+    type(body_system_t), intent(in) :: sys           !< the body's DOF map and pattern
+    type(body_condensed_t), intent(inout) :: bc      !< its rows on the free DOFs; gets the frames
+    integer, allocatable :: rot_of(:), nidx(:), pos_of(:), nbpos(:), nbptr(:)
+    real(wp), allocatable :: nbval(:), rtmp(:, :, :)
+    integer, allocatable :: dtmp(:, :)
+    integer :: i, e, p, nd, node, c, k, ne, nr, j, p1, q
+    real(wp) :: v(NCOMP), w(NCOMP), vn
+    logical :: one
+    bc%nrot = 0
+    if (allocated(bc%rot)) deallocate (bc%rot, bc%rot_dof)
+    if (bc%m == 0) return
+    allocate (rot_of(sys%n), dtmp(NCOMP, bc%m), rtmp(NCOMP, NCOMP, bc%m))
+    rot_of = 0
+    nr = 0
+    do i = 1, bc%m
+      if (bc%bptr(i + 1) - bc%bptr(i) < 2) cycle
+      node = dof_node(sys%dof_of(bc%idx(bc%bpos(bc%bptr(i)))))
+      one = .true.
+      v = 0.0_wp
+      do e = bc%bptr(i), bc%bptr(i + 1) - 1
+        nd = sys%dof_of(bc%idx(bc%bpos(e)))
+        if (dof_node(nd) /= node) one = .false.
+        if (one) v(dof_comp(nd)) = v(dof_comp(nd)) + bc%bval(e)
+      end do
+      if (.not. one) cycle
+      p1 = sys%free_of(node_dof(node, 1))
+      if (p1 == 0 .or. rot_of(max(p1, 1)) /= 0) cycle
+      if (.not. all([(sys%free_of(node_dof(node, c)) == p1 + c - 1, c=1, NCOMP)])) cycle
+      if (.not. same_columns(p1)) cycle
+      vn = norm2(v)
+      if (.not. (vn > 0.0_wp)) cycle
+      nr = nr + 1
+      dtmp(:, nr) = [(p1 + c - 1, c=1, NCOMP)]
+      rtmp(:, :, nr) = frame_of_normal(v/vn)
+      rot_of(p1:p1 + NCOMP - 1) = nr
+    end do
+    if (nr == 0) return
+    ! B_a T: each row's entries on a rotated node become R' v, the defining row's exactly
+    ! (|v|, 0, ...); components below 1e-13 |v| are rounding of an orthogonal frame
+    allocate (nidx(sys%n), pos_of(sys%n), nbpos(size(bc%bval) + NCOMP*bc%m), nbval(size(bc%bval) + NCOMP*bc%m), &
+              nbptr(bc%m + 1))
+    pos_of = 0
+    k = 0
+    ne = 0
+    nbptr(1) = 1
+    do i = 1, bc%m
+      do e = bc%bptr(i), bc%bptr(i + 1) - 1
+        p = bc%idx(bc%bpos(e))
+        j = rot_of(p)
+        if (j == 0) then
+          call put(p, bc%bval(e))
+          cycle
+        end if
+        if (p /= bc%idx(bc%bpos(first_on(i, j)))) cycle     ! the node's entries, once
+        v = 0.0_wp
+        do q = bc%bptr(i), bc%bptr(i + 1) - 1
+          if (rot_of(bc%idx(bc%bpos(q))) == j) v(bc%idx(bc%bpos(q)) - dtmp(1, j) + 1) = bc%bval(q)
+        end do
+        w = matmul(transpose(rtmp(:, :, j)), v)
+        vn = norm2(v)
+        if (abs(w(1) - vn) <= 1.0e-13_wp*vn .and. all(abs(w(2:)) <= 1.0e-13_wp*vn)) w = [vn, (0.0_wp, c=2, NCOMP)]
+        do c = 1, NCOMP
+          if (abs(w(c)) > 1.0e-13_wp*vn) call put(dtmp(c, j), w(c))
+        end do
+      end do
+      nbptr(i + 1) = ne + 1
+    end do
+    bc%nrot = nr
+    bc%rot_dof = dtmp(:, 1:nr)
+    bc%rot = rtmp(:, :, 1:nr)
+    bc%idx = nidx(1:k)
+    bc%bptr = nbptr
+    bc%bpos = nbpos(1:ne)
+    bc%bval = nbval(1:ne)
+
+  contains
+
+    !> One entry of the new row i on free DOF p.
+    subroutine put(p, val)
+      integer, intent(in) :: p
+      real(wp), intent(in) :: val
+      if (pos_of(p) == 0) then
+        k = k + 1
+        nidx(k) = p
+        pos_of(p) = k
+      end if
+      ne = ne + 1
+      nbpos(ne) = pos_of(p)
+      nbval(ne) = val
+    end subroutine put
+
+    !> The first entry of row i on rotated node j.
+    integer function first_on(i, j) result(ef)
+      integer, intent(in) :: i, j
+      do ef = bc%bptr(i), bc%bptr(i + 1) - 1
+        if (rot_of(bc%idx(bc%bpos(ef))) == j) return
+      end do
+    end function first_on
+
+    !> The columns of the node's DOFs p1 .. p1 + NCOMP - 1 have one pattern (rows), which
+    !! rotated_values needs (the triplets of a distributed factor do not).
+    logical function same_columns(p1)
+      integer, intent(in) :: p1
+      integer :: c, l
+      same_columns = .true.
+      if (.not. allocated(sys%colptr)) return     ! a distributed factor takes triplets: any pattern
+      l = sys%colptr(p1 + 1) - sys%colptr(p1)
+      do c = 1, NCOMP - 1
+        if (sys%colptr(p1 + c + 1) - sys%colptr(p1 + c) /= l) then
+          same_columns = .false.
+          return
+        end if
+        if (any(sys%rowind(sys%colptr(p1 + c) + 1:sys%colptr(p1 + c + 1)) /= &
+                sys%rowind(sys%colptr(p1) + 1:sys%colptr(p1 + 1)))) then
+          same_columns = .false.
+          return
+        end if
+      end do
+    end function same_columns
+
+  end subroutine contact_frames
+
+  !> An orthonormal frame whose first column is the unit vector n: in the plane [n, t] with
+  !! t = (-n_y, n_x); in space t1 = a x n / |a x n| (a the axis least aligned with n),
+  !! t2 = n x t1.
+  pure function frame_of_normal(n) result(r)
+    real(wp), intent(in) :: n(:)
+    real(wp) :: r(size(n), size(n)), a(3), t1(3)
+    integer :: c
+    r(:, 1) = n
+    if (size(n) == 2) then
+      r(:, 2) = [-n(2), n(1)]
+      return
+    end if
+    a = 0.0_wp
+    c = minloc(abs(n), dim=1)
+    a(c) = 1.0_wp
+    t1 = [a(2)*n(3) - a(3)*n(2), a(3)*n(1) - a(1)*n(3), a(1)*n(2) - a(2)*n(1)]
+    t1 = t1/norm2(t1)
+    r(:, 2) = t1
+    r(:, 3) = [n(2)*t1(3) - n(3)*t1(2), n(3)*t1(1) - n(1)*t1(3), n(1)*t1(2) - n(2)*t1(1)]
+  end function frame_of_normal
+
+  !> v = T v~ (to the global frame) or, with inverse, v~ = T' v: the rotated nodes' triples.
+  pure subroutine to_global(bc, v, inverse)
+    type(body_condensed_t), intent(in) :: bc         !< the body's frames
+    real(wp), intent(inout) :: v(:)                  !< (n) a vector of free DOFs
+    logical, intent(in), optional :: inverse
+    integer :: j
+    logical :: inv
+    inv = .false.
+    if (present(inverse)) inv = inverse
+    do j = 1, bc%nrot
+      if (inv) then
+        v(bc%rot_dof(:, j)) = matmul(transpose(bc%rot(:, :, j)), v(bc%rot_dof(:, j)))
+      else
+        v(bc%rot_dof(:, j)) = matmul(bc%rot(:, :, j), v(bc%rot_dof(:, j)))
+      end if
+    end do
+  end subroutine to_global
+
+  !> T'K_a T in CSC (the pattern of K_a: a rotated node's columns share one pattern and its
+  !! DOFs are consecutive rows): first the columns of each rotated node (K R), then in every
+  !! column the rotated nodes' rows (R' (K R)).
+  subroutine rotated_values(sys, bc, val)
+    type(body_system_t), intent(in) :: sys
+    type(body_condensed_t), intent(in) :: bc
+    real(wp), allocatable, intent(out) :: val(:)
+    integer, allocatable :: rot_row(:)
+    integer :: j, c, l, q, q0, len
+    real(wp), allocatable :: cols(:, :)
+    val = sys%val
+    allocate (rot_row(sys%n))
+    rot_row = 0
+    do j = 1, bc%nrot
+      rot_row(bc%rot_dof(1, j)) = j
+      q0 = sys%colptr(bc%rot_dof(1, j))
+      len = sys%colptr(bc%rot_dof(1, j) + 1) - q0
+      allocate (cols(len, NCOMP))
+      do c = 1, NCOMP
+        cols(:, c) = val(sys%colptr(bc%rot_dof(c, j)) + 1:sys%colptr(bc%rot_dof(c, j)) + len)
+      end do
+      cols = matmul(cols, bc%rot(:, :, j))
+      do c = 1, NCOMP
+        val(sys%colptr(bc%rot_dof(c, j)) + 1:sys%colptr(bc%rot_dof(c, j)) + len) = cols(:, c)
+      end do
+      deallocate (cols)
+    end do
+    do l = 1, sys%n
+      q = sys%colptr(l) + 1
+      do while (q <= sys%colptr(l + 1))
+        j = rot_row(sys%rowind(q) + 1)
+        if (j > 0) then
+          val(q:q + NCOMP - 1) = matmul(transpose(bc%rot(:, :, j)), val(q:q + NCOMP - 1))
+          q = q + NCOMP
+        else
+          q = q + 1
+        end if
+      end do
+    end do
+  end subroutine rotated_values
+
+  !> T'K_a T as triplets of its lower triangle, from K_a's (lower triangle, duplicates to be
+  !! summed): an entry on a rotated node is taken with its mirror, spread over the frames of
+  !! its row's and its column's nodes, and kept where it falls on or below the diagonal.
+  subroutine rotated_triplets(bc, n, irn, jcn, kval, ri, rj, rv)
+    type(body_condensed_t), intent(in) :: bc
+    integer, intent(in) :: n, irn(:), jcn(:)
+    real(wp), intent(in) :: kval(:)
+    integer, allocatable, intent(out) :: ri(:), rj(:)
+    real(wp), allocatable, intent(out) :: rv(:)
+    integer, allocatable :: rot_of(:)
+    integer :: e, q, a, b, ja, jb, ca, cb, na, nb, side, r0, c0, i1, j1
+    allocate (rot_of(n))
+    rot_of = 0
+    do ja = 1, bc%nrot
+      rot_of(bc%rot_dof(:, ja)) = ja
+    end do
+    q = 0
+    do e = 1, size(irn)
+      if (rot_of(irn(e)) > 0 .or. rot_of(jcn(e)) > 0) then
+        q = q + 2*NCOMP*NCOMP
+      else
+        q = q + 1
+      end if
+    end do
+    allocate (ri(q), rj(q), rv(q))
+    q = 0
+    do e = 1, size(irn)
+      if (rot_of(irn(e)) == 0 .and. rot_of(jcn(e)) == 0) then
+        q = q + 1
+        ri(q) = irn(e)
+        rj(q) = jcn(e)
+        rv(q) = kval(e)
+        cycle
+      end if
+      do side = 1, merge(1, 2, irn(e) == jcn(e))
+        i1 = merge(irn(e), jcn(e), side == 1)
+        j1 = merge(jcn(e), irn(e), side == 1)
+        ja = rot_of(i1)
+        jb = rot_of(j1)
+        na = merge(NCOMP, 1, ja > 0)
+        nb = merge(NCOMP, 1, jb > 0)
+        do a = 1, na
+          r0 = i1
+          if (ja > 0) r0 = bc%rot_dof(a, ja)
+          do b = 1, nb
+            c0 = j1
+            if (jb > 0) c0 = bc%rot_dof(b, jb)
+            if (r0 < c0) cycle
+            q = q + 1
+            ri(q) = r0
+            rj(q) = c0
+            rv(q) = kval(e)
+            if (ja > 0) then
+              ca = i1 - bc%rot_dof(1, ja) + 1
+              rv(q) = rv(q)*bc%rot(ca, a, ja)
+            end if
+            if (jb > 0) then
+              cb = j1 - bc%rot_dof(1, jb) + 1
+              rv(q) = rv(q)*bc%rot(cb, b, jb)
+            end if
+          end do
+        end do
+      end do
+    end do
+    ri = ri(1:q)
+    rj = rj(1:q)
+    rv = rv(1:q)
+  end subroutine rotated_triplets
 
   !> B_a's part on the prescribed DOFs, B_a,d u_d (bc%bfix), for the body's current
   !! u_fixed (a load step changes it): each row's entries on prescribed DOFs, in row order.
@@ -168,7 +459,8 @@ contains
     integer, intent(in), optional :: comm            !< MUMPS: the body's group of ranks
     integer, intent(in), optional :: irn(:), jcn(:)  !< MUMPS: this rank's entries of K_a, 1-based
     real(wp), intent(in), optional :: kval(:)        !< MUMPS: their values [stress]
-    integer, allocatable :: perm(:)
+    integer, allocatable :: perm(:), ri(:), rj(:)
+    real(wp), allocatable :: kr(:), rv(:)
     real(wp) :: t0
 
     t0 = wtime()
@@ -178,8 +470,14 @@ contains
       deallocate (bc%fac)
     end if
     call new_factor(fc, a, bc%fac, comm)
+    if (bc%nrot > 0 .and. .not. present(irn)) call rotated_values(sys, bc, kr)
     if (present(irn)) then
-      call bc%fac%factorize(sys%n, bc%idx, err, irn=irn, jcn=jcn, tval=kval)
+      if (bc%nrot > 0) then
+        call rotated_triplets(bc, sys%n, irn, jcn, kval, ri, rj, rv)
+        call bc%fac%factorize(sys%n, bc%idx, err, irn=ri, jcn=rj, tval=rv)
+      else
+        call bc%fac%factorize(sys%n, bc%idx, err, irn=irn, jcn=jcn, tval=kval)
+      end if
     else if (bc%fac%wants_interior_order()) then
       if (msh%structured) then
         call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, bc%idx, perm, err)
@@ -190,7 +488,13 @@ contains
         bc%t_factor = wtime() - t0
         return
       end if
-      call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val, interior_perm=perm)
+      if (bc%nrot > 0) then
+        call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, kr, interior_perm=perm)
+      else
+        call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val, interior_perm=perm)
+      end if
+    else if (bc%nrot > 0) then
+      call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, kr)
     else
       call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val)
     end if
@@ -244,6 +548,7 @@ contains
     end if
     if (bc%fac%holds_result()) then
       u0 = sys%f
+      call to_global(bc, u0, inverse=.true.)
     else
       allocate (u0(0))
     end if
@@ -471,7 +776,8 @@ contains
     bc%rank = r
   end subroutine low_rank_range
 
-  !> w(m) = B_a u: the rows on the free displacements u (n) plus the part on prescribed DOFs.
+  !> w(m) = B_a u: the rows on the free displacements u (n, in the body's contact frames:
+  !! `to_global` with inverse turns a global one into them) plus the part on prescribed DOFs.
   subroutine apply_b(bc, u, w)
     type(body_condensed_t), intent(in) :: bc         !< condensed body
     real(wp), intent(in) :: u(:)                     !< (n) free displacements [length]
@@ -486,7 +792,8 @@ contains
     end do
   end subroutine apply_b
 
-  !> r(n) = B_a' lam: scatter the interface forces onto the normal DOFs.
+  !> r(n) = B_a' lam: scatter the interface forces onto the normal DOFs (in the body's
+  !! contact frames: `to_global` turns r into the global frame).
   subroutine apply_bt(bc, lam, r)
     type(body_condensed_t), intent(in) :: bc         !< condensed body
     real(wp), intent(in) :: lam(:)                   !< (m) interface forces [force]
@@ -517,9 +824,11 @@ contains
       call bc%fac%solve(r, err)
       if (err%failed()) return
       u_free = bc%u0 - r
+      call to_global(bc, u_free)
     else
       if (bc%fac%holds_result()) then
         r = sys%f
+        call to_global(bc, r, inverse=.true.)
         r = -r
         call apply_bt(bc, lam, r)
         r = -r
@@ -527,7 +836,10 @@ contains
         allocate (r(0))
       end if
       call bc%fac%solve(r, err)
-      if (bc%fac%holds_result() .and. .not. err%failed()) u_free = r
+      if (bc%fac%holds_result() .and. .not. err%failed()) then
+        u_free = r
+        call to_global(bc, u_free)
+      end if
     end if
   end subroutine recover_displacement
 

@@ -15,7 +15,7 @@ module run_summary
   use run_state, only: run_t
   use mesh, only: group_index, group_nodes
   use namelist_vars, only: str_t
-  use condense, only: apply_bt
+  use condense, only: apply_bt, to_global
   use contact_common, only: gather
   implicit none (type, external)
   private
@@ -319,6 +319,7 @@ contains
         allocate (c(sy%n))
         c = 0.0_wp
         call apply_bt(bd, gather(run%result%lam_body, bd%slots), c)
+        call to_global(bd, c)
         cc = 0.0_wp
         do p = 1, sy%n
           cc(dof_comp(sy%dof_of(p))) = cc(dof_comp(sy%dof_of(p))) - c(p)

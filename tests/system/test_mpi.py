@@ -11,7 +11,8 @@ that converges as an uninterrupted run; an eight-body deck at -np 1 to 12 (sever
 per rank, one, several ranks per body) gives the serial binary's contact forces, and each
 rank holds the factors of its own bodies only; the four solid bodies of inputs/cube_stack.nml
 (three held only by contact) at -np 1, 2 and 4 give the serial contact forces and
-displacements to 1e-10."""
+displacements to 1e-10, and so does Hertz's sphere (a curved slave, factored in its contact
+frames) at -np 1 and 2."""
 import os
 import re
 import shutil
@@ -379,6 +380,25 @@ if check(p.returncode == 0, "3D stack: the serial run converges", f"exit {p.retu
                                  np.array(a[f"body{k}/displacement"]).ravel()) for k in (1, 2, 3, 4))
             check(e is not None and e < 1e-10 and eu is not None and eu < 1e-10,
                   f"3D stack: -np {np_} = serial (contact forces, displacements of the four bodies) to 1e-10",
+                  f"{e}, {eu}")
+
+# 8c. a curved slave in 3D: Hertz's sphere on the block (hc = 0.02 mesh), whose slave nodes
+# are factored in their contact frames (the MUMPS triplets rotated, condense
+# `rotated_triplets`), at -np 1 and 2 = the serial binary (CHOLMOD on rotated CSC values)
+msh = os.path.abspath(os.path.join("inputs", "gmsh", "sphere_block_h0.02.msh"))
+over = (f"&body id=1, mesh='{msh}' /", f"&body id=2, mesh='{msh}' /")
+ref = os.path.join(OUT, "sphere_serial.h5")
+p, _ = run_solver(BIN, "inputs/sphere_block.nml", *over, f"&output file='{ref}' /", env=solver_env(1))
+if check(p.returncode == 0, "3D sphere: the serial run converges", f"exit {p.returncode}"):
+    for np_ in (1, 2):
+        q, out = mpirun(np_, "inputs/sphere_block.nml", *over, MUMPS, name=f"sphere_np{np_}")
+        if check(q is not None and q.returncode == 0, f"3D sphere: mpirun -np {np_} converges"):
+            with h5py.File(ref, "r") as a, h5py.File(out, "r") as b:
+                e = rel_err(np.array(b["contact/normal_force"]), np.array(a["contact/normal_force"]))
+                eu = max(rel_err(np.array(b[f"body{k}/displacement"]).ravel(),
+                                 np.array(a[f"body{k}/displacement"]).ravel()) for k in (1, 2))
+            check(e is not None and e < 1e-10 and eu is not None and eu < 1e-10,
+                  f"3D sphere (curved slave in contact frames): -np {np_} = serial (forces, displacements) to 1e-10",
                   f"{e}, {eu}")
 
 print(f"{'FAILED: ' + str(len(check.failed)) if check.failed else 'all checks passed'}")

@@ -10,7 +10,7 @@ program test_contact
   use mesh, only: mesh_t, mesh_build
   use assembly, only: body_system_t, assemble_body, expand, residual_full
   use contact_interface, only: interface_t, build_interface
-  use condense, only: body_condensed_t, factor_body, condense_body, recover_displacement, apply_b, apply_bt
+  use condense, only: body_condensed_t, factor_body, condense_body, recover_displacement, apply_b, apply_bt, to_global
   use contact_types, only: contact_result_t, status_name, STATUS_CONVERGED, STATUS_NONE, STATUS_MAX_OUTER, &
                            STATUS_DIVERGED, STATUS_FAILED, STATUS_INTERRUPTED
   use robin_iteration, only: solve_robin
@@ -151,7 +151,10 @@ contains
       call expand(systems(a), ufree, ufull)
       ! recovered B_a u_a equals the condensed b_a - F_a lam
       allocate (bu(contact_line%m))
-      call apply_b(bodies(a), ufree, bu)
+      ! (B_a acts on the body's contact frames)
+      r(1:systems(a)%n) = ufree
+      call to_global(bodies(a), r(1:systems(a)%n), inverse=.true.)
+      call apply_b(bodies(a), r(1:systems(a)%n), bu)
       e = maxval(abs(bu - mono%w(:, a)))
       deallocate (bu)
       call check(e <= 1.0e-10_wp*uscale, 'body '//achar(48 + a)//': recovered B u = b - F lam', e/uscale, 1.0e-10_wp)
@@ -166,6 +169,7 @@ contains
       ! force exerted on body a by the contact: -B_a' lam, summed by component
       r = 0.0_wp
       call apply_bt(bodies(a), mono%lam, r)
+      call to_global(bodies(a), r(1:systems(a)%n))
       cont = 0.0_wp
       do i = 1, systems(a)%n
         c = 2 - mod(systems(a)%dof_of(i), 2)
