@@ -59,8 +59,9 @@ module mprgp
   !> At most this many retries of one expansion step with a reduced alpha_bar.
   integer, parameter :: MAX_RETRY = 60
   !> The Newton method is used up to this size (its dense matrix and factor: 2 n^2 reals,
-  !! 256 MiB at n = 4096); larger problems are solved by MPRGP whatever opts%method says.
-  integer, parameter :: NEWTON_MAX_N = 4096
+  !! 1 GiB at n = 8192, beside a body's flexibility of n^2 reals that the problem holds
+  !! anyway); larger problems are solved by MPRGP whatever opts%method says.
+  integer, parameter :: NEWTON_MAX_N = 8192
   !> QP_AUTO's smallest budget of MPRGP steps.
   integer, parameter :: AUTO_BUDGET_MIN = 100
   !> Working precision of a Newton solve: |gP| <= NEWTON_FLOOR n eps lambda_max |x|.
