@@ -197,7 +197,7 @@ contains
     type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
     integer :: m, k, ka, r, mm, nfree
-    logical :: moved
+    logical :: moved, settled
     real(wp) :: cost
     m = size(rhs)
     mm = size(state%G, 1)
@@ -293,20 +293,23 @@ contains
     end if
     ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
     if (inner%switched) state%newton(a) = 1
-    ! 'auto' on a body held by its supports: while a solve that MPRGP finished costs more than
-    ! two steps of the Newton method on its free set, the next solve starts with the Newton
-    ! method (from the warm start: one step when the active set stays), within half that
-    ! solve's work, then MPRGP from where it stopped
+    ! 'auto' on a body held by its supports: when a solve that MPRGP finished left the body's
+    ! active set as it found it (settled) and cost more than two steps of the Newton method on
+    ! its free set, the next solve starts with the Newton method (from the warm start: one
+    ! step while the set stays), within half that solve's work, then 'auto' from where it
+    ! stopped; a solve that had to fall back returns the body to MPRGP first
     if (solver%inner_solver == INNER_AUTO .and. r == 0 .and. state%newton(a) /= 1 .and. &
         inner%status == MPRGP_CONVERGED .and. (state%newton(a) == 0 .or. inner%fell_back)) then
+      state%newton(a) = 0
       if (allocated(ub)) then
         nfree = count(lam > lb .and. lam < ub)
+        settled = all((lam > lb) .eqv. (lam0 > lb)) .and. all((lam < ub) .eqv. (lam0 < ub))
       else
         nfree = count(lam > lb)
+        settled = all((lam > lb) .eqv. (lam0 > lb))
       end if
       cost = newton_step_cost(m, nfree)
-      state%newton(a) = 0
-      if (real(inner%n_matvec, wp) > 2.0_wp*cost) &
+      if (settled .and. .not. inner%fell_back .and. real(inner%n_matvec, wp) > 2.0_wp*cost) &
         state%newton(a) = 1 + max(2, min(NEWTON_FIRST_MAX, int(real(inner%n_matvec, wp)/(2.0_wp*cost))))
     end if
     grad = inner_solver%g

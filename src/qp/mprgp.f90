@@ -58,10 +58,12 @@ module mprgp
   real(wp), parameter :: ALPHA_FACTOR = 1.9_wp
   !> At most this many retries of one expansion step with a reduced alpha_bar.
   integer, parameter :: MAX_RETRY = 60
-  !> The Newton method is used up to this size (its dense matrix and factor: 2 n^2 reals,
-  !! 1 GiB at n = 8192, beside a body's flexibility of n^2 reals that the problem holds
-  !! anyway); larger problems are solved by MPRGP whatever opts%method says.
+  !> The Newton method is used up to this size on a dense A (its factor: n^2 reals, 512 MiB
+  !! at n = 8192, beside A that the problem holds anyway) and up to NEWTON_MAX_N_BUILT on
+  !! any other operator (whose dense matrix it must first build by n products: 2 n^2 reals);
+  !! larger problems are solved by MPRGP whatever opts%method says.
   integer, parameter :: NEWTON_MAX_N = 8192
+  integer, parameter :: NEWTON_MAX_N_BUILT = 4096
   !> QP_AUTO's smallest budget of MPRGP steps.
   integer, parameter :: AUTO_BUDGET_MIN = 100
   !> Working precision of a Newton solve: |gP| <= NEWTON_FLOOR n eps lambda_max |x|.
@@ -184,7 +186,14 @@ contains
     end if
     call start(self, A, b, set, x, rw, raw, nrw)
     method = self%opts%method
-    if (method /= QP_MPRGP .and. self%n > NEWTON_MAX_N) method = QP_MPRGP
+    if (method /= QP_MPRGP) then
+      select type (A)
+      type is (dense_op_t)
+        if (self%n > NEWTON_MAX_N) method = QP_MPRGP
+      class default
+        if (self%n > NEWTON_MAX_N_BUILT) method = QP_MPRGP
+      end select
+    end if
     select case (method)
     case (QP_NEWTON)
       call newton_loop(self, A, b, set, x)

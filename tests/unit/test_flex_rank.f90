@@ -22,7 +22,7 @@ program test_flex_rank
   use condense, only: body_condensed_t, flex_from_x
   use robin_operators, only: range_proximal
   use lapack, only: dpstrf, dsyev
-  use testing, only: report, report_le, test_summary
+  use testing, only: report, report_le, test_summary, identity
   implicit none (type, external)
   integer, parameter :: M = 60
 
@@ -187,14 +187,5 @@ contains
     bc%bptr(m + 1) = e + 1
   end subroutine fill
 
-  pure function identity(n) result(a)
-    integer, intent(in) :: n
-    real(wp) :: a(n, n)
-    integer :: i
-    a = 0.0_wp
-    do i = 1, n
-      a(i, i) = 1.0_wp
-    end do
-  end function identity
 
 end program test_flex_rank

@@ -17,7 +17,7 @@ program test_frames
   use space, only: set_dimension, NCOMP, node_dof
   use assembly, only: body_system_t
   use condense, only: body_condensed_t, contact_frames, frame_of_normal, rotated_values, rotated_triplets, to_global
-  use testing, only: report, report_le, test_summary, set_seed, urand, random_spd
+  use testing, only: report, report_le, test_summary, set_seed, urand, random_spd, identity
   implicit none (type, external)
   integer, parameter :: NNODE = 4
   type(body_system_t) :: sys
@@ -25,7 +25,7 @@ program test_frames
   real(wp), allocatable :: k(:, :), b(:, :), t(:, :), kt(:, :), bt(:, :), kv(:), v(:), w(:), lo(:, :), rv(:)
   integer, allocatable :: irn(:), jcn(:), ri(:), rj(:)
   real(wp) :: n1(3), lmin, lmax, r2(2, 2), r3(3, 3), err
-  integer :: n, i, j, e, p, q
+  integer :: n, i, j, e
 
   call set_seed(20261129)
   call set_dimension(3)
@@ -131,16 +131,6 @@ contains
     integer, intent(in) :: nd, c
     fr = sys%free_of(node_dof(nd, c))
   end function fr
-
-  function identity(m) result(a)
-    integer, intent(in) :: m
-    real(wp) :: a(m, m)
-    integer :: ii
-    a = 0.0_wp
-    do ii = 1, m
-      a(ii, ii) = 1.0_wp
-    end do
-  end function identity
 
   !> The condensed body's rows from a dense B (its non-zero entries, idx in first-touch order).
   subroutine rows_in(bd, c)

@@ -64,6 +64,22 @@ contains
     call dgesv(size(b), 1, af, size(b), ipiv, x, size(b), info)
   end function unconstrained
 
+  !> b uniform in [-1, 1] and bounds of every kind (lower, box; module testing's
+  !! random_bounds) around the unconstrained minimiser A^-1 b.
+  subroutine random_problem(a, b, l, u)
+    real(wp), intent(in) :: a(:, :)
+    real(wp), intent(out) :: b(:), l(:), u(:)
+    real(wp) :: xu(size(b))
+    integer :: i
+    do i = 1, size(b)
+      b(i) = urand(-1.0_wp, 1.0_wp)
+    end do
+    xu = unconstrained(a, b)
+    do i = 1, size(b)
+      call random_bounds(merge(1, 3, mod(i, 2) == 0), xu(i), norm2(xu)/sqrt(real(size(b), wp)), l(i), u(i))
+    end do
+  end subroutine random_problem
+
   !> |gP| at x over its rounding level n eps lambda_max max(|x|, |x_0|) (+ this product's own).
   real(wp) function kkt_ratio(a, b, l, u, x, x0, lmax) result(r)
     real(wp), intent(in) :: a(:, :), b(:), l(:), u(:), x(:), x0(:), lmax
@@ -203,13 +219,7 @@ contains
     type(mprgp_stats_t) :: st, sm
     integer :: i
     call random_spd(n, 1.0_wp, a, lmin, lmax)
-    do i = 1, n
-      b(i) = urand(-1.0_wp, 1.0_wp)
-    end do
-    xu = unconstrained(a, b)
-    do i = 1, n
-      call random_bounds(merge(1, 3, mod(i, 2) == 0), xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
-    end do
+    call random_problem(a, b, l, u)
     opts%rtol = 1.0e-10_wp
     opts%method = QP_AUTO
     x = 0.0_wp
@@ -247,20 +257,14 @@ contains
   !! ill-conditioned problem (MPRGP's budget there, then the Newton method again).
   subroutine test_newton_first()
     integer, parameter :: n = 150
-    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), z(n), x0(n), xu(n), lmin, lmax, r, cond
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), z(n), x0(n), lmin, lmax, r, cond
     type(mprgp_opts_t) :: opts
     type(mprgp_stats_t) :: st, sn
     integer :: i, k
     do k = 1, 2
       cond = merge(1.0e2_wp, 1.0e10_wp, k == 1)
       call random_spd(n, log10(cond), a, lmin, lmax)
-      do i = 1, n
-        b(i) = urand(-1.0_wp, 1.0_wp)
-      end do
-      xu = unconstrained(a, b)
-      do i = 1, n
-        call random_bounds(merge(1, 3, mod(i, 2) == 0), xu(i), norm2(xu)/sqrt(real(n, wp)), l(i), u(i))
-      end do
+      call random_problem(a, b, l, u)
       opts = mprgp_opts_t()
       opts%rtol = 1.0e-12_wp
       opts%method = QP_NEWTON

@@ -30,7 +30,7 @@ module testing
   public :: report, report_le, test_summary, write_file, band_solve, solve_full, obstacle_problem
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered, box_system
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
-  public :: random_bounds, enumerate_box, box_projected
+  public :: random_bounds, enumerate_box, box_projected, identity
   public :: error_parts
 
 contains
@@ -464,6 +464,17 @@ contains
     call random_number(r)
     urand = lo + (hi - lo) * r
   end function urand
+
+  !> The n x n identity matrix.
+  pure function identity(n) result(a)
+    integer, intent(in) :: n
+    real(wp) :: a(n, n)
+    integer :: i
+    a = 0.0_wp
+    do i = 1, n
+      a(i, i) = 1.0_wp
+    end do
+  end function identity
 
   !> Random SPD matrix Q diag(d) Q' with log-uniform eigenvalues in [1, 10**cexp]
   !! (the extremes 1 and 10**cexp included when n >= 2).
