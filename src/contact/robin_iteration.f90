@@ -197,7 +197,7 @@ contains
       end if
       ! 2. force imbalance and its Robin correction
       dlam = run_state%lam(:, 1) - run_state%lam(:, 2)
-      call robin_op%apply(dlam, corr, run_state%inner)
+      call robin_op%apply(dlam, corr, run_state%inner, it)
       if (robin_op%failure%failed()) then
         res%status = STATUS_FAILED
         res%outer = it

@@ -13,7 +13,7 @@ module robin_operators
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
   use linop, only: dense_op_t, dense_op_init, dense_op_take
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
-  use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk
+  use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk, dsymv, dtrsv
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, slot_row, slot_side, DIR_NORMAL
   use condense, only: body_condensed_t
@@ -60,13 +60,14 @@ module robin_operators
       type(error_t), intent(out) :: err
     end subroutine setup_iface
 
-    !> The corrections of both sides of every row from the imbalance d.
-    subroutine apply_iface(self, d, corr, count)
+    !> The corrections of both sides of every row from the imbalance d of outer iteration it.
+    subroutine apply_iface(self, d, corr, count, it)
       import :: robin_operator_t, wp
       class(robin_operator_t), intent(inout) :: self
       real(wp), intent(in) :: d(:)
       real(wp), intent(out) :: corr(:, :)
       integer, intent(inout) :: count
+      integer, intent(in) :: it
     end subroutine apply_iface
   end interface
 
@@ -94,9 +95,11 @@ module robin_operators
   !> 'harmonic': per pair, S = 2 F_A (F_A+F_B)^-1 F_B of the pair's blocks of its two
   !! bodies' flexibilities, for both obstacles (contrast-robust).
   type, extends(robin_operator_t), public :: harmonic_operator_t
-    type(dense_op_t), allocatable :: s(:)    !< S of each pair, formed once (n = 0: in a group)
+    type(dense_op_t), allocatable :: s(:)    !< S of each pair, formed (n = 0: factored or in a group)
     integer, allocatable :: rows(:, :)       !< (2, pairs) each pair's rows, first and last
     type(group_op_t), allocatable :: group(:) !< S of each group of pairs joined by their bodies
+    type(pair_factor_t), allocatable :: fac(:) !< S of each pair applied from its factors until formed
+    type(dense_op_t), pointer :: flexibility(:) => null()   !< the bodies' F_a (the factored S's products)
   contains
     procedure :: setup => harmonic_setup
     procedure :: apply => harmonic_apply
@@ -117,6 +120,16 @@ module robin_operators
     real(wp), allocatable :: k(:, :)
     real(wp), allocatable :: inf(:, :)
   end type stiffness_t
+
+  !> S = 2 F_s - 2 F_s (F_1 + F_2)^-1 F_s of a two-body pair, F_s the flexibility of the
+  !! stiffer body (smaller trace), held as the Cholesky factor L of F_1 + F_2 and applied by two
+  !! products with F_s and two triangular solves, until the outer iteration `form_at`, from
+  !! which S is formed (harmonic_apply).
+  type, public :: pair_factor_t
+    real(wp), allocatable :: l(:, :)         !< L, lower triangle (unallocated: S formed or not factored)
+    integer :: stiff = 0                     !< the body whose F is F_s
+    integer :: form_at = 0                   !< the outer iteration that forms S
+  end type pair_factor_t
 
   !> The harmonic operator of a group of pairs joined through bodies in several pairs:
   !! S = 2 K^-1 on the group's rows, K the assembled stiffness of its bodies.
@@ -249,11 +262,12 @@ contains
   !! and the partner's obstacle on each of those rows moves by -y (corr(:, 1) = -y where b
   !! is side 2, corr(:, 2) = y where it is side 1). Two bodies: corr(:, 1) = F_2 d,
   !! corr(:, 2) = F_1 d.
-  subroutine steklov_apply(self, d, corr, count)
+  subroutine steklov_apply(self, d, corr, count, it)
     class(steklov_operator_t), intent(inout) :: self
     real(wp), intent(in) :: d(:)
     real(wp), intent(out) :: corr(:, :)
     integer, intent(inout) :: count
+    integer, intent(in) :: it                       !< outer iteration
     real(wp), allocatable :: db(:), y(:)
     integer :: b, k, m, sl, row
     m = size(d)
@@ -324,11 +338,12 @@ contains
   end subroutine constant_setup
 
   !> corr(:, 1) = corr(:, 2) = alpha d ./ w (no Hessian-sized product).
-  subroutine constant_apply(self, d, corr, count)
+  subroutine constant_apply(self, d, corr, count, it)
     class(constant_operator_t), intent(inout) :: self
     real(wp), intent(in) :: d(:)
     real(wp), intent(out) :: corr(:, :)
     integer, intent(inout) :: count
+    integer, intent(in) :: it                       !< outer iteration
     corr(:, 1) = self%alpha*d/self%w
     corr(:, 2) = corr(:, 1)
   end subroutine constant_apply
@@ -355,6 +370,8 @@ contains
     type(stiffness_t), allocatable :: stiff(:)
     character(len=100) :: emsg
     allocate (self%s(contact_line%npair), self%rows(2, contact_line%npair), npairs(size(bodies)), stiff(size(bodies)))
+    allocate (self%fac(contact_line%npair))
+    self%flexibility => flexibility
     npairs = 0
     do p = 1, contact_line%npair
       npairs(contact_line%pair_body(:, p)) = npairs(contact_line%pair_body(:, p)) + 1
@@ -404,7 +421,11 @@ contains
             ! with friction: S of the normal rows and S of the tangential rows apart (below)
             call harmonic_by_kind(f1, f2, contact_line%dir(self%rows(1, p):self%rows(2, p)) > DIR_NORMAL, s, info)
           else
-            call harmonic_matrix(f1, f2, s, info)
+            ! factored; formed once the run is long enough to repay it (pair_factor_t)
+            call harmonic_factor(f1, f2, self%fac(p), info)
+            if (info == 0) self%fac(p)%stiff = contact_line%pair_body(self%fac(p)%stiff, p)
+            pair_info(p) = info
+            cycle
           end if
         end associate
       else
@@ -681,16 +702,28 @@ contains
   end subroutine group_operators
 
   !> corr(:, 1) = corr(:, 2) = S d, pair by pair and group by group.
-  subroutine harmonic_apply(self, d, corr, count)
+  subroutine harmonic_apply(self, d, corr, count, it)
     class(harmonic_operator_t), intent(inout) :: self
     real(wp), intent(in) :: d(:)
     real(wp), intent(out) :: corr(:, :)
     integer, intent(inout) :: count
+    integer, intent(in) :: it                       !< outer iteration
     real(wp), allocatable :: y(:)
     integer :: p, c
     type(error_t) :: serr
     corr(:, 1) = 0.0_wp
     do p = 1, size(self%s)
+      if (allocated(self%fac)) then
+        if (allocated(self%fac(p)%l)) then
+          if (it < self%fac(p)%form_at) then
+            call factored_apply(self%fac(p), self%flexibility(self%fac(p)%stiff)%a, &
+                                d(self%rows(1, p):self%rows(2, p)), corr(self%rows(1, p):self%rows(2, p), 1))
+            count = count + 3     ! two products and two triangular solves
+            cycle
+          end if
+          call form_factored(self%fac(p), self%flexibility(self%fac(p)%stiff)%a, self%s(p))
+        end if
+      end if
       if (self%s(p)%n == 0) cycle
       call self%s(p)%apply(d(self%rows(1, p):self%rows(2, p)), corr(self%rows(1, p):self%rows(2, p), 1))
     end do
@@ -848,54 +881,92 @@ contains
 
   !> S = 2 F_s (F_1 + F_2)^-1 F_o = 2 F_s - 2 Y'Y with Y = L^-1 F_s, L L' = F_1 + F_2 and F_s
   !! the one of smaller trace (the stiffer body: the subtracted term is then the smaller one):
-  !! one Cholesky factor, one triangular solve and one symmetric rank-k product, about half
-  !! the work of `harmonic_matrix`, and symmetric by construction.
+  !! one Cholesky factor, one triangular solve and one symmetric rank-k product, and symmetric
+  !! by construction.
   subroutine harmonic_lean(f1, f2, s, info)
     real(wp), intent(in) :: f1(:, :), f2(:, :)
     real(wp), allocatable, intent(out) :: s(:, :)
     integer, intent(out) :: info
-    real(wp), allocatable :: a(:, :), y(:, :)
-    real(wp) :: t1, t2
+    type(pair_factor_t) :: fac
+    call harmonic_factor(f1, f2, fac, info)
+    if (info /= 0) return
+    if (fac%stiff == 1) then
+      call lean_matrix(fac, f1, s)
+    else
+      call lean_matrix(fac, f2, s)
+    end if
+  end subroutine harmonic_lean
+
+  !> The Cholesky factor of F_1 + F_2 (fac%l) and the side of the smaller trace (fac%stiff:
+  !! 1 or 2); fac%form_at from the size: forming S (a triangular solve with m right-hand sides
+  !! and a symmetric rank-m product, 2 m^3 flops at the speed of matrix products) takes about
+  !! as long as m/16 factored applications (two symmetric products and two triangular solves,
+  !! 6 m^2 flops at the speed of the memory), so a run of up to max(8, m/16) outer iterations
+  !! never forms it, and a longer one spends at most twice the least it could.
+  subroutine harmonic_factor(f1, f2, fac, info)
+    real(wp), intent(in) :: f1(:, :), f2(:, :)
+    type(pair_factor_t), intent(out) :: fac
+    integer, intent(out) :: info
     integer :: m, i
     m = size(f1, 1)
-    allocate (a(m, m), s(m, m))
-    a = f1 + f2
-    call dpotrf('L', m, a, m, info)
-    if (info /= 0) return
-    t1 = 0.0_wp
-    t2 = 0.0_wp
-    do i = 1, m
-      t1 = t1 + f1(i, i)
-      t2 = t2 + f2(i, i)
-    end do
-    if (t1 <= t2) then
-      y = f1
-    else
-      y = f2
+    allocate (fac%l(m, m))
+    fac%l = f1 + f2
+    call dpotrf('L', m, fac%l, m, info)
+    if (info /= 0) then
+      deallocate (fac%l)
+      return
     end if
-    s = 2.0_wp*y
-    call dtrsm('L', 'L', 'N', 'N', m, m, 1.0_wp, a, m, y, m)
+    fac%stiff = 1
+    if (sum([(f2(i, i), i=1, m)]) < sum([(f1(i, i), i=1, m)])) fac%stiff = 2
+    fac%form_at = max(8, m/16) + 1
+  end subroutine harmonic_factor
+
+  !> y = S d = 2 F_s d - 2 F_s (L L')^-1 F_s d.
+  subroutine factored_apply(fac, fs, d, y)
+    type(pair_factor_t), intent(in) :: fac
+    real(wp), intent(in) :: fs(:, :)               !< F_s
+    real(wp), intent(in) :: d(:)
+    real(wp), intent(out) :: y(:)
+    real(wp), allocatable :: w(:), z(:)
+    integer :: m
+    m = size(d)
+    allocate (w(m), z(m))
+    call dsymv('U', m, 1.0_wp, fs, m, d, 1, 0.0_wp, w, 1)
+    z = w
+    call dtrsv('L', 'N', 'N', m, fac%l, m, z, 1)
+    call dtrsv('L', 'T', 'N', m, fac%l, m, z, 1)
+    call dsymv('U', m, 1.0_wp, fs, m, z, 1, 0.0_wp, y, 1)
+    y = 2.0_wp*(w - y)
+  end subroutine factored_apply
+
+  !> S = 2 F_s - 2 Y'Y with Y = L^-1 F_s into s; the factor released.
+  subroutine form_factored(fac, fs, s)
+    type(pair_factor_t), intent(inout) :: fac
+    real(wp), intent(in) :: fs(:, :)               !< F_s
+    type(dense_op_t), intent(inout) :: s
+    real(wp), allocatable :: sm(:, :)
+    call lean_matrix(fac, fs, sm)
+    deallocate (fac%l)
+    call dense_op_take(s, sm)
+  end subroutine form_factored
+
+  !> s = 2 F_s - 2 Y'Y, Y = L^-1 F_s (both triangles).
+  subroutine lean_matrix(fac, fs, s)
+    type(pair_factor_t), intent(in) :: fac
+    real(wp), intent(in) :: fs(:, :)               !< F_s
+    real(wp), allocatable, intent(out) :: s(:, :)
+    real(wp), allocatable :: y(:, :)
+    integer :: m, i
+    m = size(fs, 1)
+    y = fs
+    s = 2.0_wp*fs
+    call dtrsm('L', 'L', 'N', 'N', m, m, 1.0_wp, fac%l, m, y, m)
     call dsyrk('L', 'T', m, m, -2.0_wp, y, m, 1.0_wp, s, m)
     do i = 1, m - 1
       s(i, i + 1:m) = s(i + 1:m, i)
     end do
-  end subroutine harmonic_lean
+  end subroutine lean_matrix
 
-  subroutine harmonic_matrix(f1, f2, s, info)
-    real(wp), intent(in) :: f1(:, :), f2(:, :)
-    real(wp), allocatable, intent(out) :: s(:, :)
-    integer, intent(out) :: info
-    real(wp), allocatable :: a(:, :), x(:, :)
-    integer :: m
-    m = size(f1, 1)
-    allocate (a(m, m), x(m, m), s(m, m))
-    a = f1 + f2
-    x = f2
-    call dposv('U', m, m, a, m, x, m, info)
-    if (info /= 0) return
-    call dgemm('N', 'N', m, m, m, 2.0_wp, f1, m, x, m, 0.0_wp, s, m)
-    s = 0.5_wp*(s + transpose(s))
-  end subroutine harmonic_matrix
 
   !> The harmonic operator of a pair with a floating body: S = 2 (Sigma_A + Sigma_B)^-1,
   !! Sigma = F^-1 for a supported body's block and the projected inverse Q (`projected_inverse`)

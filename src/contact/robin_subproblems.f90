@@ -12,6 +12,7 @@ module robin_subproblems
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
                    QP_NEWTON, QP_NEWTON_FIRST
   use smalbe, only: smalbe_solve, smalbe_stats_t
+  use qp_newton, only: newton_work_t
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
   use contact_common, only: gather, scatter, body_threads, partner_slots
@@ -27,6 +28,8 @@ module robin_subproblems
   !> the most Newton steps a solve of inner_solver 'auto' tries before MPRGP when the body's
   !! last solve suggests starting with the Newton method
   integer, parameter :: NEWTON_FIRST_MAX = 64
+  !> a Newton step on an updated factor, in products: one product and two triangular solves
+  real(wp), parameter :: UPDATED_STEP_COST = 2.0_wp
 
   !> The bodies' subproblems as the outer loop solves them (one entry per body).
   type, public :: subproblems_t
@@ -40,6 +43,9 @@ module robin_subproblems
     !> with friction: the bounds of the forces on every row (row_bounds), set by the outer
     !! loop (Coulomb: from the last iterate); not allocated: l >= 0 on every row
     real(wp), allocatable :: lb(:), ub(:)
+    !> each body's Newton work from one solve to the next (a body held by its supports: its
+    !! Hessian does not change, and a free set that recurs keeps its factor)
+    type(newton_work_t), allocatable :: newton_work(:)
   end type subproblems_t
 
   !> A vector per body.
@@ -71,7 +77,7 @@ contains
     integer :: a, k, n, m
     n = size(bodies)
     allocate (subproblems%flexibility(n), subproblems%hessian(n), subproblems%proximal(n), subproblems%equality(n))
-    allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n))
+    allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n), subproblems%newton_work(n))
     subproblems%lmax_body = 0.0_wp
     ! largest first: the dynamic schedule then balances the threads
     subproblems%order = largest_first([(bodies(a)%m, a=1, size(bodies))])
@@ -181,7 +187,7 @@ contains
   !! last change of lam_a, and the Krylov recycling of its stored directions; its vectors
   !! are taken out of the side-layout state and put back.
   subroutine solve_body(subproblems, solver, body, a, rtol_in, search, lam_other, state, rhs, grad, inner, updates)
-    type(subproblems_t), intent(inout) :: subproblems
+    type(subproblems_t), target, intent(inout) :: subproblems
     type(solver_cfg_t), intent(in) :: solver
     type(body_condensed_t), intent(in) :: body
     integer, intent(in) :: a
@@ -196,8 +202,8 @@ contains
     type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
-    integer :: m, k, ka, r, mm, nfree
-    logical :: moved, settled
+    integer :: m, k, ka, r, mm, nfree, changed
+    logical :: moved
     real(wp) :: cost
     m = size(rhs)
     mm = size(state%G, 1)
@@ -284,6 +290,8 @@ contains
       inner%switched = smalbe_stats%switched
       updates = smalbe_stats%updates
     else
+      inner_solver%keep => subproblems%newton_work(a)
+      inner_solver%keep_same_a = .true.
       if (allocated(ub)) then
         call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a), ub=ub)
       else
@@ -303,14 +311,15 @@ contains
       state%newton(a) = 0
       if (allocated(ub)) then
         nfree = count(lam > lb .and. lam < ub)
-        settled = all((lam > lb) .eqv. (lam0 > lb)) .and. all((lam < ub) .eqv. (lam0 < ub))
+        changed = count((lam > lb) .neqv. (lam0 > lb)) + count((lam < ub) .neqv. (lam0 < ub))
       else
         nfree = count(lam > lb)
-        settled = all((lam > lb) .eqv. (lam0 > lb))
+        changed = count((lam > lb) .neqv. (lam0 > lb))
       end if
       cost = newton_step_cost(m, nfree)
-      if (settled .and. .not. inner%fell_back .and. real(inner%n_matvec, wp) > 2.0_wp*cost) &
-        state%newton(a) = 1 + max(2, min(NEWTON_FIRST_MAX, int(real(inner%n_matvec, wp)/(2.0_wp*cost))))
+      if (12*changed <= nfree .and. .not. inner%fell_back .and. real(inner%n_matvec, wp) > 2.0_wp*cost) &
+        state%newton(a) = 1 + max(2, min(NEWTON_FIRST_MAX, 1 + int((0.5_wp*real(inner%n_matvec, wp) - cost)/ &
+                                                                   UPDATED_STEP_COST)))
     end if
     grad = inner_solver%g
     call scatter(lam, body%slots, state%lam)

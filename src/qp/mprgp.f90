@@ -39,7 +39,7 @@ module mprgp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use linop, only: linop_t, dense_op_t
-  use qp_newton, only: newton_work_t, newton_step, NEWTON_FULL, NEWTON_STILL, NEWTON_NOT_SPD
+  use qp_newton, only: newton_work_t, newton_step, newton_begin, NEWTON_FULL, NEWTON_STILL, NEWTON_NOT_SPD
   use strings, only: itoa
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
@@ -86,6 +86,10 @@ module mprgp
     !! next solves of this solver (it is taken to be the same A: a caller whose A changes
     !! deallocates it)
     real(wp), allocatable :: dense(:, :)
+    !> the caller's Newton work kept from one solve to the next (its free block's factor is
+    !! taken again while the free set recurs); `keep_same_a`: A is the one of its last solve
+    type(newton_work_t), pointer :: keep => null()
+    logical :: keep_same_a = .false.
     ! the iteration's state
     integer, private :: n = 0              ! unknowns
     integer, private :: it = 0             ! steps taken
@@ -289,11 +293,19 @@ contains
     real(wp), intent(in) :: b(:)
     class(constraint_set_t), intent(in) :: set
     real(wp), intent(inout) :: x(:)
-    type(newton_work_t) :: work
+    type(newton_work_t), target :: own
+    type(newton_work_t), pointer :: work
     real(wp) :: betabeta, phitphi, flops, floor
     integer :: outcome, j, n
     character(len=24) :: s1
     n = self%n
+    if (associated(self%keep)) then
+      work => self%keep
+      call newton_begin(work, self%keep_same_a)
+      self%keep_same_a = .true.     ! a second Newton phase of this solve: the same A
+    else
+      work => own
+    end if
     select type (A)
     type is (dense_op_t)
       call newton_steps(A%a)
@@ -318,6 +330,7 @@ contains
     subroutine newton_steps(am)
       real(wp), intent(in) :: am(:, :)
       logical :: refined
+      integer :: nfac
       refined = .false.
       main: do
         select case (stopping_test(self, A, b, set, x, betabeta, phitphi))
@@ -327,10 +340,11 @@ contains
           cycle main
         end select
         self%it = self%it + 1
+        nfac = work%factored
         call newton_step(am, set, x, self%g, self%ax, work, outcome, flops)
         self%fresh = .false.
         self%stats%n_newton = self%stats%n_newton + 1
-        if (work%nfree > 0 .and. outcome /= NEWTON_NOT_SPD) self%stats%n_factor = self%stats%n_factor + 1
+        self%stats%n_factor = self%stats%n_factor + work%factored - nfac
         self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(n, wp)**2)))
         if (outcome == NEWTON_NOT_SPD) then
           call fail(self, MPRGP_NOT_SPD, 'the active-set Newton method met a curvature <= 0 at step '// &

@@ -76,7 +76,7 @@ module mprgp_options
     !! and solves counted as the products of the same floating-point work (flops / (2 n^2))
     integer :: n_matvec = 0
     integer :: n_newton = 0            !< steps of the active-set Newton method
-    integer :: n_factor = 0            !< Cholesky factorizations of a free block (Newton steps)
+    integer :: n_factor = 0            !< Cholesky factorizations of a free block (a Newton step on a recurring free set makes none)
     logical :: switched = .false.      !< QP_AUTO: MPRGP used up its budget and the Newton method finished
     logical :: fell_back = .false.     !< QP_NEWTON_FIRST: the Newton method used up its budget and MPRGP finished
     integer :: n_recycled = 0          !< line searches along s and the stored directions that moved x (no product)

@@ -36,12 +36,12 @@
 !! Thread safety: no module variables; each solve has its own work arrays.
 module qp_newton
   use kinds, only: wp
-  use lapack, only: dpotrf, dpotrs, dsymv
+  use lapack, only: dpotrf, dpotrs, dsymv, dtrsv
   use constraint_set, only: constraint_set_t
   implicit none (type, external)
   private
 
-  public :: newton_work_t, newton_step
+  public :: newton_work_t, newton_step, newton_begin, chol_delete, chol_append
   public :: NEWTON_FULL, NEWTON_CUT, NEWTON_STILL, NEWTON_NOT_SPD
 
   integer, parameter :: NEWTON_FULL = 0      !< a whole step: x is the minimiser of f on its face
@@ -66,6 +66,16 @@ module qp_newton
     !! in a row on one face leave x at its minimiser to working precision
     logical :: same_face = .false.
     integer :: shifts = 0                   !< steps whose free block needed a shift
+    !> the free set whose factor h holds, in the factor's order (fac_nf < 0: none), and its
+    !! shift: a step on the same free set of the same A takes it as it is (the factor it
+    !! would compute again); a free set a few variables away, an unshifted factor updated
+    !! (chol_delete, chol_append)
+    integer, allocatable :: fac_free(:)
+    integer, allocatable :: fac_pos(:)      !< position of each variable in fac_free (0: not in it)
+    integer :: fac_nf = -1
+    real(wp) :: fac_tau = 0.0_wp
+    integer :: fac_updates = 0              !< variables added or removed since the factor was made
+    integer :: factored = 0                 !< factorizations made (a count that only grows)
   end type newton_work_t
 
 contains
@@ -173,6 +183,14 @@ contains
         work%at_min = .true.
         return
       end if
+      if (work%fac_nf >= 0) then
+        if (kept_factor()) then
+          if (work%fac_tau > 0.0_wp) work%shifts = work%shifts + 1
+          call solve_face()
+          return
+        end if
+      end if
+      call forget_factor()
       dmax = 0.0_wp
       do k = 1, nf
         dmax = max(dmax, a(work%free(k), work%free(k)))
@@ -190,13 +208,75 @@ contains
         return
       end if
       if (tau > 0.0_wp) work%shifts = work%shifts + 1
+      work%factored = work%factored + 1
+      work%fac_nf = nf
+      work%fac_free(1:nf) = work%free(1:nf)
+      work%fac_pos(work%free(1:nf)) = [(k, k=1, nf)]
+      work%fac_tau = tau
+      work%fac_updates = 0
+      call solve_face()
+    end subroutine direction
+
+    !> The kept factor brought to the free set work%free(1:nf): true when it is that set's
+    !! already, or after updates (the variables that left it deleted, the last first; those
+    !! that joined appended); false when it is too far (more changes than nf/12 at once, as
+    !! dear as a new factor, or over nf/4 since it was made), shifted, or an appended pivot
+    !! is not clearly positive (a new factor then decides).
+    logical function kept_factor() result(ok)
+      integer :: k, nrem, nadd, p, q
+      integer, allocatable :: rem(:)
+      real(wp) :: piv
+      ok = .false.
+      nadd = count(work%fac_pos(work%free(1:nf)) == 0)
+      nrem = work%fac_nf - (nf - nadd)
+      if (nadd + nrem == 0) then
+        ok = .true.
+        return
+      end if
+      if (work%fac_tau > 0.0_wp .or. 12*(nadd + nrem) > nf .or. 4*(work%fac_updates + nadd + nrem) > nf) return
+      ! deletions, from the last position down (the positions above stay valid)
+      rem = pack(work%fac_pos(work%fac_free(1:work%fac_nf)), work%held(work%fac_free(1:work%fac_nf)))
+      do k = size(rem), 1, -1
+        p = work%fac_nf
+        call chol_delete(work%h, p, rem(k))
+        flops = flops + 4.0_wp*real(p - rem(k), wp)**2
+        work%fac_pos(work%fac_free(rem(k))) = 0
+        work%fac_free(rem(k):p - 1) = work%fac_free(rem(k) + 1:p)
+        work%fac_nf = p - 1
+      end do
+      work%fac_pos(work%fac_free(1:work%fac_nf)) = [(k, k=1, work%fac_nf)]
+      ! additions, each a new last row
       do k = 1, nf
-        work%rhs(k) = -g(work%free(k))
+        q = work%free(k)
+        if (work%fac_pos(q) > 0) cycle
+        p = work%fac_nf
+        call chol_append(a, work%fac_free(1:p), q, work%h, piv)
+        flops = flops + real(p, wp)**2 + 2.0_wp*real(p, wp)
+        if (.not. piv > 1.0e-8_wp*a(q, q)) return
+        work%fac_nf = p + 1
+        work%fac_free(p + 1) = q
+        work%fac_pos(q) = p + 1
+      end do
+      work%fac_updates = work%fac_updates + nadd + nrem
+      ok = .true.
+    end function kept_factor
+
+    !> No factor kept.
+    subroutine forget_factor()
+      if (work%fac_nf > 0) work%fac_pos(work%fac_free(1:work%fac_nf)) = 0
+      work%fac_nf = -1
+    end subroutine forget_factor
+
+    !> d_F from the factor of A_FF (+ tau I) in h, in the factor's order.
+    subroutine solve_face()
+      integer :: k
+      do k = 1, nf
+        work%rhs(k) = -g(work%fac_free(k))
       end do
       call dpotrs('L', nf, 1, work%h, n, work%rhs, n, info)
       flops = flops + 2.0_wp*real(nf, wp)**2
       do k = 1, nf
-        work%d(work%free(k)) = work%rhs(k)
+        work%d(work%fac_free(k)) = work%rhs(k)
       end do
       ! a step below the rounding of x: x is the face's minimiser to working precision
       if (norm2(work%d) <= epsilon(1.0_wp)*norm2(x) .or. all(work%d == 0.0_wp)) then
@@ -205,7 +285,7 @@ contains
         work%at_min = .true.
         return
       end if
-    end subroutine direction
+    end subroutine solve_face
 
   end subroutine newton_step
 
@@ -223,6 +303,70 @@ contains
     end do
   end subroutine gather_block
 
+  !> A new solve with `work`: its working set is taken again from the warm start; the
+  !! factor stays when `same_a` (the caller's A is the one the factor was made of) and it
+  !! was made, not updated: a solve's first factor is then the one LAPACK makes of its first
+  !! free set, to the bit, whether it is kept or made again (a run resumed from a checkpoint,
+  !! which keeps no factor, takes the same steps); within the solve it is updated.
+  subroutine newton_begin(work, same_a)
+    type(newton_work_t), intent(inout) :: work
+    logical, intent(in) :: same_a
+    work%started = .false.
+    work%at_min = .false.
+    work%same_face = .false.
+    work%shifts = 0
+    if (same_a .and. work%fac_updates == 0) return
+    if (work%fac_nf > 0) work%fac_pos(work%fac_free(1:work%fac_nf)) = 0
+    work%fac_nf = -1
+  end subroutine newton_begin
+
+  !> Delete row and column k of the Cholesky factor L (lower, p x p, in h): the rows below
+  !! keep their first k - 1 columns, and the trailing block becomes the factor of
+  !! L33 L33' + l l' (l = L(k+1:p, k)) by the rank-one update of plane rotations; the rows
+  !! and columns after k move up and left by one.
+  pure subroutine chol_delete(h, p, k)
+    real(wp), intent(inout) :: h(:, :)
+    integer, intent(in) :: p, k
+    real(wp) :: v(p), r, c, s
+    integer :: j
+    v(k + 1:p) = h(k + 1:p, k)
+    do j = k + 1, p
+      r = hypot(h(j, j), v(j))
+      c = r/h(j, j)
+      s = v(j)/h(j, j)
+      h(j, j) = r
+      if (j < p) then
+        h(j + 1:p, j) = (h(j + 1:p, j) + s*v(j + 1:p))/c
+        v(j + 1:p) = c*v(j + 1:p) - s*h(j + 1:p, j)
+      end if
+    end do
+    do j = 1, k - 1
+      h(k:p - 1, j) = h(k + 1:p, j)
+    end do
+    do j = k + 1, p
+      h(j - 1:p - 1, j - 1) = h(j:p, j)
+    end do
+  end subroutine chol_delete
+
+  !> Append variable q to the factor L of A(idx, idx) (lower, p = size(idx), in h): its row
+  !! w solves L w = A(idx, q), its pivot is A(q, q) - w'w (returned; its square root taken
+  !! when positive).
+  subroutine chol_append(a, idx, q, h, piv)
+    real(wp), intent(in) :: a(:, :)
+    integer, intent(in) :: idx(:), q
+    real(wp), intent(inout) :: h(:, :)
+    real(wp), intent(out) :: piv
+    real(wp) :: w(size(idx))
+    integer :: p
+    p = size(idx)
+    w = a(idx, q)
+    if (p > 0) call dtrsv('L', 'N', 'N', p, h, size(h, 1), w, 1)
+    piv = a(q, q) - dot_product(w, w)
+    if (.not. piv > 0.0_wp) return
+    h(p + 1, 1:p) = w
+    h(p + 1, p + 1) = sqrt(piv)
+  end subroutine chol_append
+
   !> Work arrays of size n (kept between the steps of one solve).
   subroutine ensure_work(work, n)
     type(newton_work_t), intent(inout) :: work
@@ -233,6 +377,10 @@ contains
     end if
     allocate (work%h(max(1, n), max(1, n)), work%d(n), work%ad(n), work%rhs(max(1, n)), work%free(n))
     allocate (work%held(n), work%rel(n), work%mask(n), source=.false.)
+    if (allocated(work%fac_free)) deallocate (work%fac_free, work%fac_pos)
+    allocate (work%fac_free(n))
+    allocate (work%fac_pos(n), source=0)
+    work%fac_nf = -1
     work%nfree = 0
     work%shifts = 0
     work%started = .false.

@@ -57,7 +57,7 @@ contains
     op%group(1)%rows = [1, 2, 3]
     op%group(1)%sparse = .true.
     count = 0
-    call op%apply([1.0_wp, 2.0_wp, 3.0_wp], corr, count)
+    call op%apply([1.0_wp, 2.0_wp, 3.0_wp], corr, count, 1)
     call report(op%failure%failed() .and. index(op%failure%text(), 'harmonic operator of a group of 3') > 0 &
                 .and. all(corr == 0.0_wp), 'a failed solve of the group operator is recorded, not NaN: '// &
                 op%failure%text())

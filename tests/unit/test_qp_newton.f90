@@ -22,7 +22,8 @@ program test_qp_newton
   use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, mprgp_status_name, MPRGP_CONVERGED, MPRGP_NOT_SPD, &
                    QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
   use smalbe, only: smalbe_solve, smalbe_stats_t
-  use lapack, only: dgesv
+  use qp_newton, only: newton_work_t, chol_delete, chol_append
+  use lapack, only: dgesv, dpotrf
   use strings, only: i2s
   use testing, only: report, test_summary, set_seed, urand, random_spd, random_bounds, enumerate_box, box_projected
   implicit none (type, external)
@@ -34,6 +35,7 @@ program test_qp_newton
   call test_conditioning()
   call test_auto()
   call test_newton_first()
+  call test_kept_factor()
   call test_smalbe()
   call test_indefinite()
   call test_summary()
@@ -302,6 +304,120 @@ contains
                   '), KKT to the rounding level', r, 1.0_wp)
     end do
   end subroutine test_newton_first
+
+  !> Newton work kept between solves (mprgp_t%keep): a solve from the solution's face makes
+  !! one factorization (the face's), and the next solve from there takes it as it is (no
+  !! factorization) to the bits of a solve with fresh work; told that A changed, it factors
+  !! again. A factor that was updated is not carried into the next solve.
+  subroutine test_kept_factor()
+    integer, parameter :: n = 80
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), z(n), w(n), lmin, lmax
+    type(dense_op_t) :: op
+    type(mprgp_t) :: s1, s2, s3
+    type(newton_work_t), target :: kept
+    integer :: i, nf2
+    call random_spd(n, 4.0_wp, a, lmin, lmax)
+    call random_problem(a, b, l, u)
+    call dense_op_init(op, a)
+    s1%opts%rtol = 1.0e-12_wp
+    s1%opts%method = QP_NEWTON
+    s1%keep => kept
+    x = 0.0_wp
+    call s1%solve(op, b, l, x, ub=u)
+    call report(s1%stats%status == MPRGP_CONVERGED .and. s1%stats%n_factor >= 1 .and. &
+                s1%stats%n_factor < s1%stats%n_newton, 'kept work, cold start: converged, '// &
+                i2s(s1%stats%n_factor)//' factorization(s) in '//i2s(s1%stats%n_newton)//' steps (the others updated)')
+    ! the solution nudged inside its face: twice with the kept work, once with fresh work
+    do i = 1, n
+      w(i) = x(i)
+      if (x(i) > l(i) .and. x(i) < u(i)) w(i) = x(i) + 1.0e-3_wp*urand(-1.0_wp, 1.0_wp)*abs(x(i))
+    end do
+    w = min(max(w, l), u)
+    s2%opts = s1%opts
+    s2%keep => kept
+    s2%keep_same_a = .true.
+    y = w
+    call s2%solve(op, b, l, y, ub=u)
+    nf2 = s2%stats%n_factor
+    y = w
+    call s2%solve(op, b, l, y, ub=u)
+    s3%opts = s1%opts
+    z = w
+    call s3%solve(op, b, l, z, ub=u)
+    call report(s2%stats%status == MPRGP_CONVERGED .and. nf2 <= 1 .and. s2%stats%n_factor == 0 .and. &
+                s3%stats%n_factor >= 1, 'warm start on the solution''s face: '//i2s(nf2)//' factorization, '// &
+                'then the kept factor taken ('//i2s(s2%stats%n_factor)//'; fresh work '//i2s(s3%stats%n_factor)//')')
+    call report(all(y == z), 'the kept factor gives the bits of a fresh one')
+    ! told that A changed: a new factor
+    s2%keep_same_a = .false.
+    y = w
+    call s2%solve(op, b, l, y, ub=u)
+    call report(s2%stats%n_factor >= 1 .and. all(y == z), 'keep_same_a = .false.: factored again ('// &
+                i2s(s2%stats%n_factor)//'), the same bits')
+    call test_updated_factor()
+  end subroutine test_kept_factor
+
+  !> Updated factors. chol_delete and chol_append against dpotrf of the reduced and the
+  !! bordered matrix (to 1e-12 relative, a random SPD matrix of condition 1e3); then solves
+  !! whose steps update the factor of the step before (fewer factorizations than steps):
+  !! a cold one, and one whose right-hand side moved (what the Robin iteration does) from
+  !! the last solution; both at the rounding level of the KKT conditions (a wrong update gives
+  !! a wrong direction, a step that misses its face's minimiser and, in the end, a stall).
+  subroutine test_updated_factor()
+    integer, parameter :: n = 240, p = 40
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), x0(n), lmin, lmax, r
+    real(wp) :: h(p, p), ref(p, p), piv, e1, e2
+    type(dense_op_t) :: op
+    type(mprgp_t) :: s1
+    integer :: i, j, k, info, idx(p)
+    ! the update routines alone
+    call random_spd(n, 3.0_wp, a, lmin, lmax)
+    k = 17
+    h = a(1:p, 1:p)
+    call dpotrf('L', p, h, p, info)
+    call chol_delete(h, p, k)
+    idx(1:p - 1) = [(i, i=1, k - 1), (i, i=k + 1, p)]
+    ref(1:p - 1, 1:p - 1) = a(idx(1:p - 1), idx(1:p - 1))
+    call dpotrf('L', p - 1, ref, p, info)
+    e1 = 0.0_wp
+    do j = 1, p - 1
+      e1 = max(e1, maxval(abs(h(j:p - 1, j) - ref(j:p - 1, j))))
+    end do
+    e1 = e1/maxval(abs(ref(1:p - 1, 1:p - 1)))
+    idx(p) = p + 5
+    call chol_append(a, idx(1:p - 1), idx(p), h, piv)
+    ref = a(idx, idx)
+    call dpotrf('L', p, ref, p, info)
+    e2 = 0.0_wp
+    do j = 1, p
+      e2 = max(e2, maxval(abs(h(j:p, j) - ref(j:p, j))))
+    end do
+    e2 = e2/maxval(abs(ref))
+    call report(info == 0 .and. e1 <= 1.0e-12_wp .and. piv > 0.0_wp .and. e2 <= 1.0e-12_wp, &
+                'chol_delete (row 17 of 40) and chol_append: the factors of the reduced and bordered matrix', &
+                max(e1, e2), 1.0e-12_wp)
+    ! solves
+    call random_problem(a, b, l, u)
+    call dense_op_init(op, a)
+    s1%opts%rtol = 1.0e-12_wp
+    s1%opts%method = QP_NEWTON
+    x = 0.0_wp
+    x0 = x
+    call s1%solve(op, b, l, x, ub=u)
+    r = kkt_ratio(a, b, l, u, x, x0, lmax)
+    call report(s1%stats%status == MPRGP_CONVERGED .and. s1%stats%n_factor < s1%stats%n_newton .and. r <= 1.0_wp, &
+                'updated factors, cold start: converged with '//i2s(s1%stats%n_factor)//' factorizations in '// &
+                i2s(s1%stats%n_newton)//' steps, KKT to the rounding level', r, 1.0_wp)
+    do i = 1, n
+      b(i) = b(i) + 1.0e-2_wp*urand(-1.0_wp, 1.0_wp)*maxval(abs(b))
+    end do
+    x0 = x
+    call s1%solve(op, b, l, x, ub=u)
+    r = kkt_ratio(a, b, l, u, x, x0, lmax)
+    call report(s1%stats%status == MPRGP_CONVERGED .and. s1%stats%n_factor < s1%stats%n_newton .and. r <= 1.0_wp, &
+                'updated factors, the right-hand side moved: converged with '//i2s(s1%stats%n_factor)// &
+                ' factorization(s) in '//i2s(s1%stats%n_newton)//' steps, KKT to the rounding level', r, 1.0_wp)
+  end subroutine test_updated_factor
 
   !> SMALBE (an equality row) with the Newton method inside, against the enumeration.
   subroutine test_smalbe()
