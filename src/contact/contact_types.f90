@@ -93,6 +93,10 @@ module contact_types
     !! later solves use it alone; k >= 2: its last MPRGP solve cost more than two Newton steps,
     !! so its next solve starts with the Newton method, within k - 1 steps; 0: MPRGP first
     integer, allocatable :: newton(:)
+    !> (bodies) 1: the body's active-set method holds the factor LAPACK makes of the free block
+    !! of its last forces (the rows strictly inside their bounds), which its next solve may
+    !! take as it is; a resumed run makes it again first (module robin_subproblems)
+    integer, allocatable :: kept(:)
     !> (m, 2 k) per body up to k F_a-orthonormal directions of its solves, in the side layout:
     !! direction j of a body is in column j on its side-1 rows and k + j on its side-2 rows
     real(wp), allocatable :: rw(:, :)          !< [1/sqrt(length force)]
@@ -168,7 +172,7 @@ contains
     integer, intent(in) :: nbody             !< bodies
     integer, intent(in) :: npair             !< pairs
     allocate (st%flam(nbody), st%mu(3, nbody), st%nrw(2, nbody))
-    allocate (st%newton(nbody), source=0)
+    allocate (st%newton(nbody), st%kept(nbody), source=0)
     st%flam = 0.0_wp
     st%mu = 0.0_wp
     st%nrw(1, :) = 0

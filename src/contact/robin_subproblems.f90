@@ -12,7 +12,7 @@ module robin_subproblems
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
                    QP_NEWTON, QP_NEWTON_FIRST
   use smalbe, only: smalbe_solve, smalbe_stats_t
-  use qp_newton, only: newton_work_t
+  use qp_newton, only: newton_work_t, newton_factor, newton_forget, newton_holds
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
   use contact_common, only: gather, scatter, body_threads, partner_slots
@@ -202,9 +202,9 @@ contains
     type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
-    integer :: m, k, ka, r, mm, nfree, changed
+    integer :: m, k, ka, r, mm, nfree, changed, i, info
     logical :: moved
-    real(wp) :: cost
+    real(wp) :: cost, flops
     m = size(rhs)
     mm = size(state%G, 1)
     updates = 0
@@ -290,14 +290,29 @@ contains
       inner%switched = smalbe_stats%switched
       updates = smalbe_stats%updates
     else
+      ! the active-set method's factor from the body's last solve (frictionless: the free
+      ! rows are those of the last forces); a resumed run makes it again, not counted
       inner_solver%keep => subproblems%newton_work(a)
       inner_solver%keep_same_a = .true.
+      if (state%kept(a) == 1 .and. subproblems%newton_work(a)%fac_nf < 0 .and. .not. allocated(ub)) then
+        call newton_factor(subproblems%hessian(a)%a, pack([(i, i=1, m)], lam0 > lb), subproblems%newton_work(a), &
+                           info, flops)
+      end if
       if (allocated(ub)) then
         call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a), ub=ub)
       else
         call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a))
       end if
       inner = inner_solver%stats
+    end if
+    ! the factor is carried into the next solve when it is the one LAPACK makes of the free
+    ! block of these forces (what a resumed run can make again), else dropped
+    if (r == 0) then
+      state%kept(a) = 0
+      if (.not. allocated(ub)) then
+        if (newton_holds(subproblems%newton_work(a), pack([(i, i=1, m)], lam > lb))) state%kept(a) = 1
+      end if
+      if (state%kept(a) == 0) call newton_forget(subproblems%newton_work(a))
     end if
     ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
     if (inner%switched) state%newton(a) = 1

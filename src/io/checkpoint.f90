@@ -63,6 +63,7 @@ module checkpoint
     integer :: depth = 5                       ! Anderson depth of this run
     logical :: has_products = .false., has_search = .false., has_recycle = .false., has_mu = .false.
     logical :: has_newton = .false.
+    logical :: has_kept = .false.
     logical :: has_rows = .false.
     logical, allocatable :: signed(:)    ! rows whose force may be negative (friction's tangential rows)
   end type ckpt_reader_t
@@ -150,6 +151,7 @@ contains
     call write_dset(gid, 'row_state', st%row_state, hs)
     call write_dset(gid, 'nrw', reshape(st%nrw, [size(st%nrw)]), hs)
     call write_dset(gid, 'newton', st%newton, hs)
+    call write_dset(gid, 'kept', st%kept, hs)
     call write_dset(gid, 'rw', st%rw, hs)
     call write_dset(gid, 'raw', st%raw, hs)
     call write_dset(gid, 'mu', st%mu, hs)
@@ -507,6 +509,9 @@ contains
     r%has_newton = exists(r%gid, 'newton', .false.)
     if (r%has_newton) call need(r, r%gid, '/state', 'newton', .false., CLASS_INTEGER, [int(r%nbody, hsize_t)], &
                                 'one flag per body')
+    r%has_kept = exists(r%gid, 'kept', .false.)
+    if (r%has_kept) call need(r, r%gid, '/state', 'kept', .false., CLASS_INTEGER, [int(r%nbody, hsize_t)], &
+                              'one flag per body')
     ! the equality multipliers of floating bodies: absent from older checkpoints
     r%has_mu = exists(r%gid, 'mu', .false.)
     if (r%has_mu) call need(r, r%gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, int(r%nbody, hsize_t)], &
@@ -643,10 +648,15 @@ contains
       st%row_state = -1
     end if
     allocate (st%mu(3, r%nbody), st%nrw(2, r%nbody))
-    allocate (st%newton(r%nbody), source=0)
+    allocate (st%newton(r%nbody), st%kept(r%nbody), source=0)
     if (r%has_newton) then
       call read_dset(r%gid, 'newton', ir, r%hs)
       if (.not. r%hs%failed()) st%newton = ir
+    end if
+    ! the kept factors (absent from older checkpoints: none, made again when needed)
+    if (r%has_kept) then
+      call read_dset(r%gid, 'kept', ir, r%hs)
+      if (.not. r%hs%failed()) st%kept = merge(1, 0, ir /= 0)
     end if
     st%mu = 0.0_wp
     if (r%has_mu) then

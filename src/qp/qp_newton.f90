@@ -42,6 +42,7 @@ module qp_newton
   private
 
   public :: newton_work_t, newton_step, newton_begin, chol_delete, chol_append
+  public :: newton_factor, newton_forget, newton_holds
   public :: NEWTON_FULL, NEWTON_CUT, NEWTON_STILL, NEWTON_NOT_SPD
 
   integer, parameter :: NEWTON_FULL = 0      !< a whole step: x is the minimiser of f on its face
@@ -92,8 +93,8 @@ contains
     type(newton_work_t), intent(inout) :: work
     integer, intent(out) :: outcome
     real(wp), intent(out) :: flops
-    integer :: n, i, nf, info, try, nrel, worst
-    real(wp) :: dad, t, dmax, tau, wmax
+    integer :: n, i, nf, info, nrel, worst
+    real(wp) :: dad, t, wmax
 
     n = size(x)
     flops = 0.0_wp
@@ -190,30 +191,12 @@ contains
           return
         end if
       end if
-      call forget_factor()
-      dmax = 0.0_wp
-      do k = 1, nf
-        dmax = max(dmax, a(work%free(k), work%free(k)))
-      end do
-      tau = 0.0_wp
-      do try = 0, SHIFT_TRIES
-        call gather_block(a, work%free(1:nf), tau, work%h)
-        call dpotrf('L', nf, work%h, n, info)
-        flops = flops + real(nf, wp)**3/3.0_wp
-        if (info == 0) exit
-        tau = merge(1.0e-14_wp*dmax, 100.0_wp*tau, try == 0)
-      end do
+      call newton_factor(a, work%free(1:nf), work, info, flops)
       if (info /= 0) then
         outcome = NEWTON_NOT_SPD
         return
       end if
-      if (tau > 0.0_wp) work%shifts = work%shifts + 1
-      work%factored = work%factored + 1
-      work%fac_nf = nf
-      work%fac_free(1:nf) = work%free(1:nf)
-      work%fac_pos(work%free(1:nf)) = [(k, k=1, nf)]
-      work%fac_tau = tau
-      work%fac_updates = 0
+      if (work%fac_tau > 0.0_wp) work%shifts = work%shifts + 1
       call solve_face()
     end subroutine direction
 
@@ -261,12 +244,6 @@ contains
       ok = .true.
     end function kept_factor
 
-    !> No factor kept.
-    subroutine forget_factor()
-      if (work%fac_nf > 0) work%fac_pos(work%fac_free(1:work%fac_nf)) = 0
-      work%fac_nf = -1
-    end subroutine forget_factor
-
     !> d_F from the factor of A_FF (+ tau I) in h, in the factor's order.
     subroutine solve_face()
       integer :: k
@@ -303,6 +280,61 @@ contains
     end do
   end subroutine gather_block
 
+  !> The factor LAPACK makes of A(idx, idx) (idx ascending, the free set), shifted by tau I
+  !! when it is not numerically positive definite (tau from 1e-14 of its largest diagonal,
+  !! times 100 each try), kept in `work` (info /= 0: no shift helped, none kept); flops grows
+  !! by its cost. Deterministic: the same A and idx give the same bits.
+  subroutine newton_factor(a, idx, work, info, flops)
+    real(wp), intent(in) :: a(:, :)
+    integer, intent(in) :: idx(:)
+    type(newton_work_t), intent(inout) :: work
+    integer, intent(out) :: info
+    real(wp), intent(inout) :: flops
+    integer :: nf, k, try
+    real(wp) :: dmax, tau
+    call ensure_work(work, size(a, 1))
+    call newton_forget(work)
+    nf = size(idx)
+    info = 0
+    if (nf == 0) return
+    dmax = 0.0_wp
+    do k = 1, nf
+      dmax = max(dmax, a(idx(k), idx(k)))
+    end do
+    tau = 0.0_wp
+    do try = 0, SHIFT_TRIES
+      call gather_block(a, idx, tau, work%h)
+      call dpotrf('L', nf, work%h, size(work%h, 1), info)
+      flops = flops + real(nf, wp)**3/3.0_wp
+      if (info == 0) exit
+      tau = merge(1.0e-14_wp*dmax, 100.0_wp*tau, try == 0)
+    end do
+    if (info /= 0) return
+    work%factored = work%factored + 1
+    work%fac_nf = nf
+    work%fac_free(1:nf) = idx
+    work%fac_pos(idx) = [(k, k=1, nf)]
+    work%fac_tau = tau
+    work%fac_updates = 0
+  end subroutine newton_factor
+
+  !> No factor kept.
+  subroutine newton_forget(work)
+    type(newton_work_t), intent(inout) :: work
+    if (work%fac_nf > 0) work%fac_pos(work%fac_free(1:work%fac_nf)) = 0
+    work%fac_nf = -1
+  end subroutine newton_forget
+
+  !> True when `work` holds the factor LAPACK made of A(idx, idx) (idx ascending), not updated.
+  logical function newton_holds(work, idx) result(yes)
+    type(newton_work_t), intent(in) :: work
+    integer, intent(in) :: idx(:)
+    yes = .false.
+    if (work%fac_nf /= size(idx) .or. work%fac_updates /= 0) return
+    if (size(idx) == 0) return
+    yes = all(work%fac_free(1:size(idx)) == idx)
+  end function newton_holds
+
   !> A new solve with `work`: its working set is taken again from the warm start; the
   !! factor stays when `same_a` (the caller's A is the one the factor was made of) and it
   !! was made, not updated: a solve's first factor is then the one LAPACK makes of its first
@@ -316,8 +348,7 @@ contains
     work%same_face = .false.
     work%shifts = 0
     if (same_a .and. work%fac_updates == 0) return
-    if (work%fac_nf > 0) work%fac_pos(work%fac_free(1:work%fac_nf)) = 0
-    work%fac_nf = -1
+    call newton_forget(work)
   end subroutine newton_begin
 
   !> Delete row and column k of the Cholesky factor L (lower, p x p, in h): the rows below

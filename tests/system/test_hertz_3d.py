@@ -11,7 +11,9 @@ contact alone (SMALBE): the contact force is 4 q A to 1e-9 (A the area of the to
 triangles, summed by meshio), a and p0 within 2% and 3% of Hertz for that force. Different
 materials (the sphere's E three times the block's, P half as large again on the same approach):
 a and p0 within 2% and 3.5% of Hertz with both materials' E* on the finer mesh (-1.71%,
-+3.00%), Robin = monolithic to 1e-8 on the coarser.
++3.00%), Robin = monolithic to 1e-8 on the coarser. A run stopped at outer iteration 12
+with a checkpoint that notes a kept active-set factor, resumed: bitwise the uninterrupted run
+(forces, history, product count).
 """
 import os
 import shutil
@@ -77,6 +79,29 @@ try:
         errs[h] = (a_f / a_h - 1, p0_f / p0_h - 1)
         print(f"INFO  hc = {h}: P = {P:.5f}, a {a_f:.5f} / Hertz {a_h:.5f} ({100 * errs[h][0]:+.2f}%), "
               f"p0 {p0_f:.3f} / Hertz {p0_h:.3f} ({100 * errs[h][1]:+.2f}%)")
+    # a restart in the middle: stopped at outer iteration 12 with a checkpoint (the bodies'
+    # active-set factors kept then, which the checkpoint notes and the resumed run makes
+    # again), resumed: the forces, the history and the product count of the uninterrupted run
+    full = os.path.join(work, "r0.01.h5")
+    p, part = solve("0.01", ("&solver max_outer=12 /", "&output checkpoint_every=6 /"), "stop")
+    ck = part + ".ckpt.h5"
+    if check(p.returncode == 2 and os.path.exists(ck), "Hertz 3D: stopped at max_outer = 12, checkpoint written",
+             (p.stdout + p.stderr)[-300:]):
+        with h5py.File(ck, "r") as f:
+            kept = f["/state/kept"][...]
+        check(kept.max() == 1, "Hertz 3D: at the checkpoint a body's active-set factor is kept", f"{kept}")
+        msh = os.path.join(ROOT, "inputs", "gmsh", "sphere_block_h0.01.msh")
+        resumed = os.path.join(work, "resumed.h5")
+        p, _ = run_solver(BIN, DECK, f"&body id=1, mesh='{msh}' /", f"&body id=2, mesh='{msh}' /",
+                          f"&output file='{resumed}' /", "--restart", ck, env=solver_env(2), timeout=300)
+        same = p.returncode == 0 and os.path.exists(resumed) and os.path.exists(full)
+        if same:
+            with h5py.File(full, "r") as a, h5py.File(resumed, "r") as b:
+                diff = [k for k in ("/contact/normal_force", "/history/inner", "/history/residual",
+                                    "/history/criterion") if not np.array_equal(a[k][...], b[k][...])]
+            same = not diff
+        check(same, "Hertz 3D: the resumed run = the uninterrupted one, bitwise (forces, history, products)",
+              (p.stdout + p.stderr)[-300:])
     # force control: the sphere's top loaded by a uniform pressure q instead of pushed down,
     # held along y by the contact alone (the symmetry planes hold the rest: SMALBE); its force
     # is known before the run, P = 4 q pi R^2 / 4, and it is about the pushed run's
