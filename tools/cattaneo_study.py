@@ -253,7 +253,10 @@ def measure(h5, text, mu=None):
                           - (cc / a) * np.sqrt(np.clip(1.0 - x ** 2 / cc ** 2, 0.0, None)))
     inside = np.abs(x) < a
     cs = np.linspace(0.5 * c_th, 1.5 * c_th, 4001)
-    c_fit = cs[int(np.argmin([np.linalg.norm((qs - cm(cc))[inside]) for cc in cs]))]
+    xi, cc = x[inside], cs[:, None]            # cm(cc) on |x| < a for every cc at once, a row each
+    shapes = mu * p0 * (np.sqrt(np.clip(1.0 - xi ** 2 / a ** 2, 0.0, None))
+                        - (cc / a) * np.sqrt(np.clip(1.0 - xi ** 2 / cc ** 2, 0.0, None)))
+    c_fit = cs[int(np.argmin([np.linalg.norm(qs[inside] - row) for row in shapes]))]
     away = inside & (np.abs(np.abs(x) - c_th) > 0.1 * a) & (np.abs(x) < 0.9 * a)
     l2 = float(np.linalg.norm((qs - cm(c_th))[away]) / np.linalg.norm(cm(c_th)[away]))
     err = qs - cm(c_th)                # its parts even and odd in x (the mirror by interpolation)
