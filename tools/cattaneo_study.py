@@ -78,8 +78,10 @@ def deck(n, method):
 """
 
 
-def run(binary, n, mode, method, out, extra=()):
-    """One run; returns (its measured quantities, console text)."""
+def run(binary, n, mode, method, out, extra=(), force_h5=None):
+    """One run; returns its measured quantities (the console text among them). force_h5, mode
+    'displacement': the result file of the force run on this mesh (same method), whose mean top
+    displacement is prescribed, instead of running it again."""
     os.makedirs(out, exist_ok=True)
     path = os.path.join(out, f"cm_{mode}_{method}_{n}.nml")
     with open(path, "w") as f:
@@ -92,6 +94,12 @@ def run(binary, n, mode, method, out, extra=()):
         loads = [f"&boundary body=1, group='top', uy={-D}, stage=1 /",
                  f"&traction body=1, side='top', t0={QFRAC * MU * P / W}, 0.0, stage=2 /"]
         return solve(binary, path, h5, loads, extra)
+    if mode == "displacement" and force_h5 is not None:
+        f = measure(force_h5, "")
+        ux = mean_ux(force_h5, H)
+        r = solve(binary, path, h5, [f"&boundary body=1, group='top', ux={ux!r}, uy={-D} /"], extra)
+        r["Q_force"] = f["Q"]
+        return r
     p = solve(binary, path, h5, [top], None)
     P = p["P"]
     loads = [top, f"&traction body=1, side='top', t0={QFRAC * MU * P / W}, 0.0 /"]
