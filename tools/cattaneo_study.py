@@ -78,8 +78,10 @@ def deck(n, method):
 """
 
 
-def run(binary, n, mode, method, out, extra=()):
-    """One run; returns (its measured quantities, console text)."""
+def run(binary, n, mode, method, out, extra=(), force_h5=None):
+    """One run; returns its measured quantities (the console text among them). force_h5, mode
+    'displacement': the result file of the force run on this mesh (same method), whose mean top
+    displacement is prescribed, instead of running it again."""
     os.makedirs(out, exist_ok=True)
     path = os.path.join(out, f"cm_{mode}_{method}_{n}.nml")
     with open(path, "w") as f:
@@ -92,6 +94,12 @@ def run(binary, n, mode, method, out, extra=()):
         loads = [f"&boundary body=1, group='top', uy={-D}, stage=1 /",
                  f"&traction body=1, side='top', t0={QFRAC * MU * P / W}, 0.0, stage=2 /"]
         return solve(binary, path, h5, loads, extra)
+    if mode == "displacement" and force_h5 is not None:
+        f = measure(force_h5, "")
+        ux = mean_ux(force_h5, H)
+        r = solve(binary, path, h5, [f"&boundary body=1, group='top', ux={ux!r}, uy={-D} /"], extra)
+        r["Q_force"] = f["Q"]
+        return r
     p = solve(binary, path, h5, [top], None)
     P = p["P"]
     loads = [top, f"&traction body=1, side='top', t0={QFRAC * MU * P / W}, 0.0 /"]
@@ -253,7 +261,10 @@ def measure(h5, text, mu=None):
                           - (cc / a) * np.sqrt(np.clip(1.0 - x ** 2 / cc ** 2, 0.0, None)))
     inside = np.abs(x) < a
     cs = np.linspace(0.5 * c_th, 1.5 * c_th, 4001)
-    c_fit = cs[int(np.argmin([np.linalg.norm((qs - cm(cc))[inside]) for cc in cs]))]
+    xi, cc = x[inside], cs[:, None]            # cm(cc) on |x| < a for every cc at once, a row each
+    shapes = mu * p0 * (np.sqrt(np.clip(1.0 - xi ** 2 / a ** 2, 0.0, None))
+                        - (cc / a) * np.sqrt(np.clip(1.0 - xi ** 2 / cc ** 2, 0.0, None)))
+    c_fit = cs[int(np.argmin([np.linalg.norm(qs[inside] - row) for row in shapes]))]
     away = inside & (np.abs(np.abs(x) - c_th) > 0.1 * a) & (np.abs(x) < 0.9 * a)
     l2 = float(np.linalg.norm((qs - cm(c_th))[away]) / np.linalg.norm(cm(c_th)[away]))
     err = qs - cm(c_th)                # its parts even and odd in x (the mirror by interpolation)

@@ -225,18 +225,33 @@ def check_xdmf(stem, tag, nbody, npair):
                                    np.array(f[f"{grp}/normal_displacement_{side}2"])) \
                 and [cb.type for cb in m.cells] == ["line"] and len(m.cells[0].data) == nseg
             check(ok, f"{tag}: meshio reads {name} back to /{grp} ({n} nodes, {nseg} segments)")
+    PARAVIEW.append((stem, tag, nbody + len(lines)))
+
+
+PARAVIEW = []     # (stem, tag, its number of blocks): the files check_paraview has ParaView read
+
+
+def check_paraview():
+    """ParaView's Xdmf3ReaderT reads each collection of PARAVIEW into its number of blocks (the
+    bodies and contact lines), all of them in one pvpython (its start-up takes seconds)."""
     pv = shutil.which("pvpython")
-    if not pv:
-        print(f"SKIP  {tag}: pvpython not found: ParaView's reading of {stem}.xdmf not tested")
+    if not PARAVIEW:
         return
-    script = (f"from paraview import simple as s\nr = s.Xdmf3ReaderT(FileName=[{os.path.abspath(f'{OUT}/{stem}.xdmf')!r}])\n"
-              "r.UpdatePipeline()\nd = s.servermanager.Fetch(r)\nprint('BLOCKS', d.GetNumberOfBlocks())\n")
+    if not pv:
+        for stem, tag, _ in PARAVIEW:
+            print(f"SKIP  {tag}: pvpython not found: ParaView's reading of {stem}.xdmf not tested")
+        return
+    script = "from paraview import simple as s\n" + "".join(
+        f"r = s.Xdmf3ReaderT(FileName=[{os.path.abspath(f'{OUT}/{stem}.xdmf')!r}])\n"
+        f"r.UpdatePipeline()\nd = s.servermanager.Fetch(r)\nprint('BLOCKS', {stem!r}, d.GetNumberOfBlocks())\n"
+        for stem, _, _ in PARAVIEW)
     cmd = [pv, "-c", script] if os.environ.get("DISPLAY") or not shutil.which("xvfb-run") \
         else ["xvfb-run", "-a", pv, "-c", script]
     q = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
-    got = re.findall(r"BLOCKS (\d+)", q.stdout)
-    check(got and int(got[-1]) == nbody + len(lines), f"{tag}: ParaView reads {stem}.xdmf: {nbody + len(lines)} blocks",
-          (q.stdout + q.stderr).strip()[-300:])
+    for stem, tag, blocks in PARAVIEW:
+        got = re.findall(rf"^BLOCKS {re.escape(stem)} (\d+)$", q.stdout, re.M)
+        check(got and int(got[-1]) == blocks, f"{tag}: ParaView reads {stem}.xdmf: {blocks} blocks",
+              f"BLOCKS {got[-1]}" if got else (q.stdout + q.stderr).strip()[-300:])
 
 
 # ---- 3. plot tools ---------------------------------------------------------------------------
@@ -289,6 +304,7 @@ if p.returncode == 0:
     with h5py.File(f"{OUT}/two.h5", "r") as f:
         ncell = f["body1/cells"].shape[0] + f["body2/cells"].shape[0]
     check_plots("two", "2 bodies", 1, [(1, 2)], ncell)
+check_paraview()
 
 # the files of a 3-body result are committed together: a folder at a name only it writes
 if os.path.isfile(f"{OUT}/s3.h5"):
