@@ -10,7 +10,7 @@
 !! mu times its normal load does not (it would slide: no static equilibrium).
 module floating
   use kinds, only: wp
-  use space, only: NDIM, NCOMP, NRIGID, node_dof, dof_node
+  use space, only: NDIM, NCOMP, NRIGID, node_dof, dof_node, dof_comp
   use assembly, only: body_system_t, rigid_motion_name
   use contact_interface, only: interface_t, body_slots, slot_row, slot_side, has_friction, DIR_NORMAL, row_direction
   use config, only: FRICTION_COULOMB, FRICTION_TRESCA
@@ -895,17 +895,18 @@ contains
     end do
   end function free_list
 
-  !> The fixing DOFs in words: 'node 12 uy, node 40 ux', by the nodes' tags (a mesh file's
-  !! node tags; a rectangle's node numbers).
+  !> The fixing DOFs in words: 'node 12 uy, node 40 ux' ('uz' in 3D), by the nodes' tags (a
+  !! mesh file's node tags; a rectangle's node numbers).
   function fixing_list(system, node_tag) result(s)
     type(body_system_t), intent(in) :: system
     integer, intent(in) :: node_tag(:)          !< (nodes) the tag of each node of the body's mesh
     character(len=:), allocatable :: s
+    character(len=*), parameter :: AXES = 'xyz'
     integer :: k
     s = ''
     do k = 1, system%nrig
       if (k > 1) s = s//', '
-      s = s//'node '//i2s(node_tag((system%fixing(k) + 1)/2))//merge(' ux', ' uy', mod(system%fixing(k), 2) == 1)
+      s = s//'node '//i2s(node_tag(dof_node(system%fixing(k))))//' u'//AXES(dof_comp(system%fixing(k)):dof_comp(system%fixing(k)))
     end do
   end function fixing_list
 

@@ -295,6 +295,7 @@ contains
       inner_solver%keep => subproblems%newton_work(a)
       inner_solver%keep_same_a = .true.
       if (state%kept(a) == 1 .and. subproblems%newton_work(a)%fac_nf < 0 .and. .not. allocated(ub)) then
+        flops = 0.0_wp
         call newton_factor(subproblems%hessian(a)%a, pack([(i, i=1, m)], lam0 > lb), subproblems%newton_work(a), &
                            info, flops)
       end if

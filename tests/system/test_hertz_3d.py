@@ -16,6 +16,7 @@ with a checkpoint that notes a kept active-set factor, resumed: bitwise the unin
 (forces, history, product count).
 """
 import os
+import re
 import shutil
 import sys
 import tempfile
@@ -118,6 +119,14 @@ try:
     if check(p.returncode == 0, "Hertz 3D, force control: converged", (p.stdout + p.stderr)[-300:]):
         check("is held only by contact (free: translation along y)" in p.stdout,
               "Hertz 3D, force control: the sphere is held only by contact (SMALBE)")
+        # its fixing DOF, named by node tag and component: a y component (the free motion's),
+        # of a node of the mesh (three components per node, not two)
+        fx = re.search(r"fixing DOFs for its generalized inverse: node (\d+) u([xyz]);", p.stdout)
+        import meshio
+        npts = len(meshio.read(os.path.join(ROOT, "inputs", "gmsh", "sphere_block_h0.01.msh")).points)
+        check(fx is not None and fx.group(2) == "y" and 1 <= int(fx.group(1)) <= npts,
+              "Hertz 3D, force control: the fixing DOF named as a y component of a mesh node",
+              fx.group(0) if fx else p.stdout[-300:])
         P, a_h, p0_h, a_f, p0_f = measure(h5)
         want = 4.0 * q * face_area(os.path.join(ROOT, "inputs", "gmsh", "sphere_block_h0.01.msh"), "sphere_top")
         check(abs(P - want) <= 1e-9 * want, "Hertz 3D, force control: the contact force is the load, 4 q A "
