@@ -317,11 +317,12 @@ contains
     end if
     ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
     if (inner%switched) state%newton(a) = 1
-    ! 'auto' on a body held by its supports: when a solve that MPRGP finished left the body's
-    ! active set as it found it (settled) and cost more than two steps of the Newton method on
-    ! its free set, the next solve starts with the Newton method (from the warm start: one
-    ! step while the set stays), within half that solve's work, then 'auto' from where it
-    ! stopped; a solve that had to fall back returns the body to MPRGP first
+    ! 'auto' on a body held by its supports: when a solve that MPRGP finished changed at most
+    ! a twelfth of the body's free rows between free and bound and cost more than two steps of
+    ! the Newton method with a new factor, the next solve starts with the Newton method (from
+    ! the warm start: one step while the set stays; steps on an updated factor while it moves
+    ! a little), within half that solve's work, then 'auto' from where it stopped; a solve that
+    ! had to fall back returns the body to MPRGP first
     if (solver%inner_solver == INNER_AUTO .and. r == 0 .and. state%newton(a) /= 1 .and. &
         inner%status == MPRGP_CONVERGED .and. (state%newton(a) == 0 .or. inner%fell_back)) then
       state%newton(a) = 0
