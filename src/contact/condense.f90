@@ -16,7 +16,7 @@ module condense
   use mesh, only: mesh_t
   use contact_interface, only: interface_t, body_slots, slot_row, slot_side
   use assembly, only: body_system_t
-  use factorization, only: factor_t, new_factor
+  use factorization, only: factor_t, new_factor, flex_product
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use errors, only: error_t, ERR_MEMORY
@@ -502,32 +502,29 @@ contains
   end subroutine factor_body
 
   !> Form F_a and b_a (and u0 = K_a^-1 f_a, unless the factor is distributed) from the
-  !! factorization: X = (K_a^-1) on the interface DOFs by the factor's interface_inverse,
-  !! F_a = B_a X B_a' (flex_from_x), b_a by one solve (interface_load). Collective with MUMPS
-  !! (flex and b on the host).
+  !! factorization: F_a = B_a (K_a^-1) B_a' on the interface DOFs by the factor's
+  !! rows_flexibility, its rank (flex_finish), b_a by one solve (interface_load). Collective
+  !! with MUMPS (flex and b on the host).
   subroutine condense_body(sys, bc, err)
     type(body_system_t), intent(in) :: sys           !< assembled system of the body
     type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives flex, b, u0
     type(error_t), intent(out) :: err                !< the failure, if any
     real(wp) :: t0
-    integer :: k, st
-    real(wp), allocatable :: x(:, :)
+    integer :: st
     t0 = wtime()
     if (bc%fac%holds_result()) then
       if (allocated(bc%flex)) deallocate (bc%flex)
-      k = size(bc%idx)
-      if (bc%m > 0 .and. k > 0) then
-        ! X = (K^-1) on the interface DOFs, then F = B X B' over the few entries of each row
-        allocate (x(k, k), stat=st)
-        if (st /= 0) then
-          call err%set(ERR_MEMORY, 'out of memory for the interface block of K^-1')
-          return
-        end if
-        call bc%fac%interface_inverse(bc%idx, x, err)
+      allocate (bc%flex(bc%m, bc%m), stat=st)
+      if (st /= 0) then
+        call err%set(ERR_MEMORY, 'out of memory for the interface flexibility')
+        return
+      end if
+      if (bc%m > 0) bc%flex = 0.0_wp
+      if (bc%m > 0 .and. size(bc%idx) > 0) then
+        call bc%fac%rows_flexibility(bc%idx, bc%bptr, bc%bpos, bc%bval, bc%flex, err)
         if (err%failed()) return
       end if
-      if (.not. allocated(x)) allocate (x(0, 0))
-      call flex_from_x(bc, x)
+      call flex_finish(bc)
     end if
     call interface_load(sys, bc, err)
     bc%t_condense = wtime() - t0
@@ -558,64 +555,27 @@ contains
     if (.not. bc%fac%distributed) call move_alloc(u0, bc%u0)
   end subroutine interface_load
 
-  !> F_a = B_a X B_a' from X = (K_a^-1) on the interface DOFs bc%idx (any factorization:
-  !! CHOLMOD's trailing block or MUMPS's inverse Schur complement), then F_a's numerical rank
-  !! and the proximal weight (flex_rank). Two ways by B_a's nnz entries: entry pairs of every
-  !! two rows (nnz^2 products: rows of one or a few entries, a slave's, and every plane
-  !! body's), or, when that would cost over four times as much, Y = X B_a' and then B_a Y
-  !! ((k + m) nnz: a solid master's rows, each over the DOFs of every master node its slave
-  !! node's support meets: 36 entries per row on Hertz's block, a sixth of the time).
+  !> F_a = B_a X B_a' from X = (K_a^-1) on the interface DOFs bc%idx (factorization's
+  !! flex_product), then its numerical rank and proximal weight (flex_finish).
   subroutine flex_from_x(bc, x)
     type(body_condensed_t), intent(inout) :: bc      !< body with its rows; receives flex, rank, prox
     real(wp), intent(in) :: x(:, :)                  !< (k,k) (K_a^-1) on bc%idx [length/force]
-    integer :: i, j, e, f, k, nnz
-    real(wp) :: acc
-    real(wp), allocatable :: y(:, :)
     if (allocated(bc%flex)) deallocate (bc%flex)
     allocate (bc%flex(bc%m, bc%m))
-    if (bc%m > 0) bc%flex = 0.0_wp
-    k = size(bc%idx)
-    nnz = size(bc%bval)
-    if (bc%m > 0 .and. k > 0) then
-      if (nnz <= 4*(k + bc%m)) then
-        do j = 1, bc%m
-          do i = 1, bc%m
-            acc = 0.0_wp
-            do f = bc%bptr(j), bc%bptr(j + 1) - 1
-              do e = bc%bptr(i), bc%bptr(i + 1) - 1
-                acc = acc + (bc%bval(e)*bc%bval(f))*x(bc%bpos(e), bc%bpos(f))
-              end do
-            end do
-            bc%flex(i, j) = acc
-          end do
-        end do
-      else
-        allocate (y(k, bc%m))
-        y = 0.0_wp
-        do j = 1, bc%m
-          do f = bc%bptr(j), bc%bptr(j + 1) - 1
-            y(:, j) = y(:, j) + bc%bval(f)*x(:, bc%bpos(f))
-          end do
-        end do
-        do j = 1, bc%m
-          do i = 1, bc%m
-            acc = 0.0_wp
-            do e = bc%bptr(i), bc%bptr(i + 1) - 1
-              acc = acc + bc%bval(e)*y(bc%bpos(e), j)
-            end do
-            bc%flex(i, j) = acc
-          end do
-        end do
-        ! the same number from either side: F_a symmetric to the last bit
-        bc%flex = 0.5_wp*(bc%flex + transpose(bc%flex))
-      end if
-    end if
+    call flex_product(x, bc%bptr, bc%bpos, bc%bval, bc%flex)
+    call flex_finish(bc)
+  end subroutine flex_from_x
+
+  !> F_a's numerical rank, kernel or range, and proximal weight (flex_rank), unless every row
+  !! selects its own DOF (F_a then positive definite).
+  subroutine flex_finish(bc)
+    type(body_condensed_t), intent(inout) :: bc      !< body with flex; receives rank, prox, kern, rng
     bc%rank = bc%m
     bc%prox = 0.0_wp
     if (allocated(bc%kern)) deallocate (bc%kern)
     if (allocated(bc%rng)) deallocate (bc%rng)
     if (bc%m > 0 .and. .not. selection_rows(bc)) call flex_rank(bc)
-  end subroutine flex_from_x
+  end subroutine flex_finish
 
   !> True when every row of B_a picks one DOF, each a different one (F_a is then a principal
   !! block of K_a^-1 up to signs, positive definite).

@@ -7,6 +7,8 @@
 !!   solve              K u = r in place
 !!   interface_inverse  X = (K^-1) on the interface DOFs (the condensation hook: CHOLMOD's
 !!                      trailing block of L, unit solves for the banded factor, S^-1 for MUMPS)
+!!   rows_flexibility   F = B X B' for sparse rows B on those DOFs (CHOLMOD: from the trailing
+!!                      block without X; the others: X, then flex_product)
 !!   free, summary      release; one line of statistics (`stats` holds the numbers)
 !! Every failure is an `error_t` (module errors): a solve or an inverse without a valid
 !! factorization, a matrix that is not positive definite, a library's status, never a NaN.
@@ -21,12 +23,13 @@ module factorization
   use config, only: factor_cfg_t, FACTOR_BANDED, FACTOR_MUMPS, ORDER_AMD, ORDER_NATURAL, ORDER_ND
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN, ORD_NODES
   use mumps_iface, only: mumps_t, mumps_schur_factor, mumps_solve, mumps_end
-  use errors, only: error_t, ERR_NUMERICAL
+  use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
   use strings, only: body_label
   implicit none (type, external)
   private
 
   public :: factor_t, chol_factor_t, cholmod_factor_t, banded_factor_t, mumps_factor_t, factor_stats_t, new_factor
+  public :: flex_product
 
   !> What a factorization cost and holds.
   type :: factor_stats_t
@@ -58,6 +61,8 @@ module factorization
     procedure(solve_i), deferred :: solve
     !> X = (K^-1)(idx, idx) for the interface DOFs idx (those given to factorize as `last`).
     procedure(inverse_i), deferred :: interface_inverse
+    !> F = B X B' for sparse rows B on the interface DOFs (X as interface_inverse's).
+    procedure :: rows_flexibility => factor_rows_flexibility
     !> Release the factorization.
     procedure(free_i), deferred :: free
     !> One line: method, sizes, times, memory.
@@ -117,6 +122,7 @@ module factorization
     procedure :: factorize => chol_factorize
     procedure :: solve => chol_solve
     procedure :: interface_inverse => chol_inverse
+    procedure :: rows_flexibility => chol_rows_flexibility
     procedure :: free => chol_free
     procedure :: summary => chol_summary
     procedure :: wants_interior_order => chol_wants_interior_order
@@ -257,6 +263,96 @@ contains
     type(error_t), intent(out) :: err             !< the failure, if any
     call self%chol%flexibility(idx, spread(1.0_wp, 1, size(idx)), x, err)
   end subroutine chol_inverse
+
+  !> F = B X B', X = (K^-1)(idx, idx) by interface_inverse, then flex_product. Called where
+  !! the results are (holds_result).
+  subroutine factor_rows_flexibility(self, idx, bptr, bpos, bval, flex, err)
+    class(factor_t), intent(inout) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based interface DOFs (the columns of B)
+    integer, intent(in) :: bptr(:)                !< (m+1) row starts in bpos, bval
+    integer, intent(in) :: bpos(:)                !< columns of B's entries (into idx)
+    real(wp), intent(in) :: bval(:)               !< B's entries
+    real(wp), intent(out) :: flex(:, :)           !< (m,m) B X B'
+    type(error_t), intent(out) :: err             !< the failure, if any
+    real(wp), allocatable :: x(:, :)
+    integer :: st
+    allocate (x(size(idx), size(idx)), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'out of memory for the interface block of K^-1')
+      return
+    end if
+    if (size(idx) > 0) call self%interface_inverse(idx, x, err)
+    if (err%failed()) return
+    call flex_product(x, bptr, bpos, bval, flex)
+  end subroutine factor_rows_flexibility
+
+  !> F = B X B' from CHOLMOD's trailing block (cholesky%chol_row_flexibility), else as
+  !! every factor does (X, then flex_product).
+  subroutine chol_rows_flexibility(self, idx, bptr, bpos, bval, flex, err)
+    class(chol_factor_t), intent(inout) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based interface DOFs (the columns of B)
+    integer, intent(in) :: bptr(:)                !< (m+1) row starts in bpos, bval
+    integer, intent(in) :: bpos(:)                !< columns of B's entries (into idx)
+    real(wp), intent(in) :: bval(:)               !< B's entries
+    real(wp), intent(out) :: flex(:, :)           !< (m,m) B X B'
+    type(error_t), intent(out) :: err             !< the failure, if any
+    logical :: used
+    call self%chol%row_flexibility(idx, bptr, bpos, bval, flex, err, used)
+    if (.not. used) call factor_rows_flexibility(self, idx, bptr, bpos, bval, flex, err)
+  end subroutine chol_rows_flexibility
+
+  !> F = B X B' from X = (K^-1) on the interface DOFs, over B's nnz entries, two ways: entry
+  !! pairs of every two rows (nnz^2 products: rows of one or a few entries, a slave's, and
+  !! every plane body's), or, when that would cost over four times as much, Y = X B' and then
+  !! B Y ((k + m) nnz: a solid master's rows, each over the DOFs of every master node its
+  !! slave node's support meets), symmetrized.
+  subroutine flex_product(x, bptr, bpos, bval, flex)
+    real(wp), intent(in) :: x(:, :)               !< (k,k) (K^-1) on the interface DOFs
+    integer, intent(in) :: bptr(:)                !< (m+1) row starts in bpos, bval
+    integer, intent(in) :: bpos(:)                !< columns of B's entries (into x)
+    real(wp), intent(in) :: bval(:)               !< B's entries
+    real(wp), intent(out) :: flex(:, :)           !< (m,m) B X B'
+    integer :: i, j, e, f, k, m, nnz
+    real(wp) :: acc
+    real(wp), allocatable :: y(:, :)
+    m = size(bptr) - 1
+    k = size(x, 1)
+    nnz = size(bval)
+    if (m > 0) flex = 0.0_wp
+    if (m == 0 .or. k == 0) return
+    if (nnz <= 4*(k + m)) then
+      do j = 1, m
+        do i = 1, m
+          acc = 0.0_wp
+          do f = bptr(j), bptr(j + 1) - 1
+            do e = bptr(i), bptr(i + 1) - 1
+              acc = acc + (bval(e)*bval(f))*x(bpos(e), bpos(f))
+            end do
+          end do
+          flex(i, j) = acc
+        end do
+      end do
+    else
+      allocate (y(k, m))
+      y = 0.0_wp
+      do j = 1, m
+        do f = bptr(j), bptr(j + 1) - 1
+          y(:, j) = y(:, j) + bval(f)*x(:, bpos(f))
+        end do
+      end do
+      do j = 1, m
+        do i = 1, m
+          acc = 0.0_wp
+          do e = bptr(i), bptr(i + 1) - 1
+            acc = acc + bval(e)*y(bpos(e), j)
+          end do
+          flex(i, j) = acc
+        end do
+      end do
+      ! the same number from either side: F symmetric to the last bit
+      flex = 0.5_wp*(flex + transpose(flex))
+    end if
+  end subroutine flex_product
 
   !> Release the factorization.
   subroutine chol_free(self)

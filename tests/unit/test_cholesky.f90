@@ -67,6 +67,8 @@ program test_cholesky
   call check_concurrent(ORD_METIS)
   call check_concurrent(ORD_AMD)
 
+  call check_row_flexibility()
+
   ! ---- 8. the factorization's dense kernels as tiles: the same bits at any thread count ----
   call check_tiles()
 
@@ -596,6 +598,82 @@ contains
     call report(info == ERR_NUMERICAL .and. len_trim(msg) > 0, 'unsorted row indices: ERR_NUMERICAL: '//trim(msg))
     call ch%free()
   end subroutine check_bad_input
+
+  !> F = B (K^-1)_GG B' for sparse rows B from the trailing block (chol_row_flexibility)
+  !! against the dense inverse: 300 rows in random order (three panels), 1-6 entries each on
+  !! 200 interface DOFs, one empty row; bitwise the same whether its panel tasks run on one
+  !! thread or on a team of two; not taken (used false) for a banded factor.
+  subroutine check_row_flexibility()
+    type(csc_t) :: M
+    type(chol_t) :: ch
+    type(error_t) :: err
+    integer, parameter :: K = 40, MI = 200, MR = 300
+    integer, allocatable :: g(:), bptr(:), bpos(:), pick(:)
+    real(wp), allocatable :: bval(:), D(:, :), X(:, :), B(:, :), Fr(:, :), F1(:, :), F2(:, :)
+    real(wp) :: r, anorm, rcond, tol
+    real(wp), allocatable :: work(:)
+    integer, allocatable :: iwork(:)
+    integer :: i, j, e, ne, nr, info, n
+    logical :: used, used2
+    character(len=256) :: msg
+    call laplace2d(K, 0.01_wp, M)
+    n = M%n
+    g = random_subset(n, MI)
+    allocate (bptr(MR + 1), bpos(6*MR), bval(6*MR), B(MR, MI))
+    B = 0.0_wp
+    ne = 0
+    bptr(1) = 1
+    do i = 1, MR
+      call random_number(r)
+      nr = 1 + int(6.0_wp*r)
+      if (i == MR/2) nr = 0
+      pick = random_subset(MI, nr)
+      do e = 1, nr
+        ne = ne + 1
+        bpos(ne) = pick(e)
+        call random_number(r)
+        bval(ne) = r - 0.5_wp
+        B(i, pick(e)) = B(i, pick(e)) + bval(ne)
+      end do
+      bptr(i + 1) = ne + 1
+    end do
+    ! dense reference
+    call to_dense(M, D)
+    anorm = maxval(sum(abs(D), dim=1))
+    call dpotrf('L', n, D, n, info)
+    allocate (work(3*n), iwork(n))
+    call dpocon('L', n, D, n, anorm, rcond, work, iwork, info)
+    call dpotri('L', n, D, n, info)
+    allocate (X(MI, MI))
+    do j = 1, MI
+      do i = 1, MI
+        X(i, j) = D(max(g(i), g(j)), min(g(i), g(j)))
+      end do
+    end do
+    Fr = matmul(B, matmul(X, transpose(B)))
+    tol = max(1.0e-12_wp, 100.0_wp*eps/rcond)
+    allocate (F1(MR, MR), F2(MR, MR))
+    call ch%factor(n, M%colptr, M%rowind, M%val, FACT_CHOLMOD, ORD_METIS, err, last=g)
+    call error_parts(err, info, msg)
+    call report(info == 0 .and. ch%interface_last_ok, 'row flexibility: CHOLMOD factor, interface last '//trim(msg))
+    call ch%row_flexibility(g, bptr, bpos(1:ne), bval(1:ne), F1, err, used)
+    call error_parts(err, info, msg)
+    call report(info == 0 .and. used, 'row flexibility: formed from the trailing block '//trim(msg))
+    call report_le(rel_diff2(F1, Fr), tol, 'row flexibility: B (K^-1)_GG B'' vs the dense inverse')
+    call report(all(F1 == transpose(F1)), 'row flexibility: symmetric to the last bit')
+    call report(all(F1(MR/2, :) == 0.0_wp), 'row flexibility: a row on no DOF gives a zero row')
+    !$omp parallel num_threads(2) default(shared)
+    !$omp single
+    call ch%row_flexibility(g, bptr, bpos(1:ne), bval(1:ne), F2, err, used2)
+    !$omp end single
+    !$omp end parallel
+    call report(used2 .and. all(F2 == F1), 'row flexibility: its panel tasks on two threads give the same bits')
+    call ch%free()
+    call ch%factor(n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, err)
+    call ch%row_flexibility(g, bptr, bpos(1:ne), bval(1:ne), F2, err, used)
+    call report(.not. used .and. .not. err%failed(), 'row flexibility: a banded factor leaves it to the caller')
+    call ch%free()
+  end subroutine check_row_flexibility
 
   !> Two factorizations + flexibilities + solves inside `omp parallel sections`
   !! equal the same computed sequentially.
