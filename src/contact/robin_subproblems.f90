@@ -10,7 +10,7 @@ module robin_subproblems
   use config, only: solver_cfg_t, ACCEL_NONE, INNER_MPRGP, INNER_ACTIVE_SET, INNER_AUTO
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
-                   QP_NEWTON, QP_NEWTON_FIRST
+                   QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use qp_newton, only: newton_work_t, newton_factor, newton_forget, newton_holds
   use condense, only: body_condensed_t
@@ -30,6 +30,8 @@ module robin_subproblems
   integer, parameter :: NEWTON_FIRST_MAX = 64
   !> a Newton step on an updated factor, in products: one product and two triangular solves
   real(wp), parameter :: UPDATED_STEP_COST = 2.0_wp
+  !> QP_POLISH: the tolerance of its MPRGP phase, relative to the body's contact displacement
+  real(wp), parameter :: POLISH_RTOL = 1.0e-4_wp
 
   !> The bodies' subproblems as the outer loop solves them (one entry per body).
   type, public :: subproblems_t
@@ -202,7 +204,7 @@ contains
     type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
-    integer :: m, k, ka, r, mm, nfree, changed, i, info
+    integer :: m, k, ka, r, mm, nfree, changed, i, info, steps
     logical :: moved
     real(wp) :: cost, flops
     m = size(rhs)
@@ -234,7 +236,8 @@ contains
     end if
     inner_solver%opts%max_it = solver%inner_max_it
     inner_solver%opts%method = inner_method(solver%inner_solver, state%newton(a))
-    inner_solver%opts%newton_budget = max(1, state%newton(a) - 1)
+    inner_solver%opts%newton_budget = max(1, state%newton(a) - 1, -state%newton(a))
+    inner_solver%opts%polish_scale = max(1.0_wp, POLISH_RTOL/max(rtol_in, tiny(1.0_wp)))
     inner_solver%opts%lambda_max = subproblems%lmax_hessian(a)
     ! F_a is the same in every iteration and the warm start is the last solution: its
     ! gradient comes from F_a lam_a of the last solve (no initial product)
@@ -317,15 +320,17 @@ contains
     end if
     ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
     if (inner%switched) state%newton(a) = 1
-    ! 'auto' on a body held by its supports: when a solve that MPRGP finished changed at most
-    ! a twelfth of the body's free rows between free and bound and cost more than two steps of
-    ! the Newton method with a new factor, the next solve starts with the Newton method (from
-    ! the warm start: one step while the set stays; steps on an updated factor while it moves
-    ! a little), within half that solve's work, then 'auto' from where it stopped; a solve that
-    ! had to fall back returns the body to MPRGP first
+    ! 'auto' on a body held by its supports: when a solve that MPRGP finished cost more than
+    ! two steps of the Newton method with a new factor, the next solve takes the Newton method
+    ! within half that solve's work: first (from the warm start: one step while the set stays,
+    ! steps on an updated factor while it moves a little) when the solve changed at most a
+    ! twelfth of the body's free rows between free and bound, else after MPRGP to a loose
+    ! tolerance (QP_POLISH: MPRGP finds where the set moved, the Newton method ends on it);
+    ! then 'auto' from where it stopped. A solve that had to fall back returns the body to
+    ! MPRGP first; a polished solve that did not goes on with the Newton method first once
+    ! its set settles
     if (solver%inner_solver == INNER_AUTO .and. r == 0 .and. state%newton(a) /= 1 .and. &
-        inner%status == MPRGP_CONVERGED .and. (state%newton(a) == 0 .or. inner%fell_back)) then
-      state%newton(a) = 0
+        inner%status == MPRGP_CONVERGED .and. (state%newton(a) <= 0 .or. inner%fell_back)) then
       if (allocated(ub)) then
         nfree = count(lam > lb .and. lam < ub)
         changed = count((lam > lb) .neqv. (lam0 > lb)) + count((lam < ub) .neqv. (lam0 < ub))
@@ -333,10 +338,16 @@ contains
         nfree = count(lam > lb)
         changed = count((lam > lb) .neqv. (lam0 > lb))
       end if
-      cost = newton_step_cost(m, nfree)
-      if (12*changed <= nfree .and. .not. inner%fell_back .and. real(inner%n_matvec, wp) > 2.0_wp*cost) &
-        state%newton(a) = 1 + max(2, min(NEWTON_FIRST_MAX, 1 + int((0.5_wp*real(inner%n_matvec, wp) - cost)/ &
-                                                                   UPDATED_STEP_COST)))
+      if (state%newton(a) < 0 .and. .not. inner%fell_back) then
+        if (12*changed <= nfree) state%newton(a) = 1 - state%newton(a)
+      else
+        state%newton(a) = 0
+        cost = newton_step_cost(m, nfree)
+        if (.not. inner%fell_back .and. real(inner%n_matvec, wp) > 2.0_wp*cost) then
+          steps = max(2, min(NEWTON_FIRST_MAX, 1 + int((0.5_wp*real(inner%n_matvec, wp) - cost)/UPDATED_STEP_COST)))
+          state%newton(a) = merge(1 + steps, -steps, 12*changed <= nfree)
+        end if
+      end if
     end if
     grad = inner_solver%g
     call scatter(lam, body%slots, state%lam)
@@ -381,7 +392,8 @@ contains
 
   !> The QP method of a body's solve: the deck's inner_solver, 'auto' resolved by what the
   !! body's earlier solves needed (newton = 1: the Newton method at once; k >= 2: the Newton
-  !! method within k - 1 steps, then MPRGP).
+  !! method within k - 1 steps, then MPRGP; k <= -1: MPRGP to a loose tolerance, then the
+  !! Newton method within -k steps, then MPRGP).
   pure integer function inner_method(choice, newton) result(method)
     integer, intent(in) :: choice    !< INNER_*
     integer, intent(in) :: newton    !< robin_state_t%newton of the body
@@ -396,6 +408,8 @@ contains
         method = QP_NEWTON
       case (2:)
         method = QP_NEWTON_FIRST
+      case (:-1)
+        method = QP_POLISH
       case default
         method = QP_AUTO
       end select

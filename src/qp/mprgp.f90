@@ -43,7 +43,7 @@ module mprgp
   use strings, only: itoa
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
-                           QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
+                           QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
   use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
   use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped, SET_OK, SET_NONFINITE
   implicit none (type, external)
@@ -52,7 +52,7 @@ module mprgp
   public :: lambda_max_estimate, mprgp_status_name, chopped
   public :: mprgp_t, mprgp_opts_t, mprgp_stats_t, constraint_set_t, box_set_t, box_set
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
-  public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
+  public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
 
   !> Safety factor: default alpha_bar = ALPHA_FACTOR / lambda_max (theory: (0, 2/|A|]).
   real(wp), parameter :: ALPHA_FACTOR = 1.9_wp
@@ -175,6 +175,7 @@ contains
     real(wp), intent(inout), optional :: raw(:, :)  !< (n, k) A rw
     integer, intent(inout), optional :: nrw(2)      !< directions held in rw, next slot to fill (ring)
     integer :: method, max_it, budget
+    real(wp) :: tol
 
     self%stats = mprgp_stats_t()
     if (.not. valid_arguments(self, A%n, b, set, x, rw, raw, nrw)) then
@@ -216,6 +217,26 @@ contains
         if (.not. self%fresh) call true_gradient(self, A, b, x)
         call set_p_to_phi(self, set, x)
         call auto_steps()
+      end if
+    case (QP_POLISH)
+      ! MPRGP at the looser tolerance; on its face the Newton method within its budget; what
+      ! is left by MPRGP ('auto') at the real tolerance
+      tol = self%tol
+      self%tol = tol*self%opts%polish_scale
+      call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
+      self%tol = tol
+      if (self%stats%status == MPRGP_CONVERGED) then
+        max_it = self%opts%max_it
+        self%opts%max_it = min(max_it, self%it + self%opts%newton_budget)
+        if (.not. self%fresh) call true_gradient(self, A, b, x)
+        call newton_loop(self, A, b, set, x)
+        self%opts%max_it = max_it
+        if (self%stats%status == MPRGP_MAX_IT .and. self%it < max_it) then
+          self%stats%fell_back = .true.
+          if (.not. self%fresh) call true_gradient(self, A, b, x)
+          call set_p_to_phi(self, set, x)
+          call auto_steps()
+        end if
       end if
     case default
       call mprgp_loop(self, A, b, set, x, rw, raw, nrw)

@@ -9,7 +9,7 @@ module mprgp_options
 
   public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, mprgp_stop_iface
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
-  public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
+  public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
 
   integer, parameter :: MPRGP_CONVERGED = 0  !< |gP| <= max(rtol |b|, atol) at the true gradient
   integer, parameter :: MPRGP_MAX_IT = 1     !< max_it steps done without convergence
@@ -25,6 +25,11 @@ module mprgp_options
   !> the active-set Newton method within a budget of steps (opts%newton_budget), then MPRGP from
   !! where it stopped: for a warm start whose active set is (nearly) the solution's
   integer, parameter :: QP_NEWTON_FIRST = 3
+  !> MPRGP to a tolerance opts%polish_scale times looser, the active-set Newton method from
+  !! there within opts%newton_budget steps, then MPRGP from where it stopped: for a warm
+  !! start whose active set is still moving, where MPRGP finds the new set at low accuracy
+  !! and the Newton method finishes on it exactly
+  integer, parameter :: QP_POLISH = 4
 
   abstract interface
     !> True when the solve must stop now (polled once per step).
@@ -34,12 +39,14 @@ module mprgp_options
 
   !> Options of an MPRGP solve. Tolerances are in the units of b (for contact: a displacement).
   type :: mprgp_opts_t
-    integer :: method = QP_MPRGP     !< QP_AUTO, QP_MPRGP, QP_NEWTON or QP_NEWTON_FIRST
+    integer :: method = QP_MPRGP     !< QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST or QP_POLISH
     !> QP_AUTO: the MPRGP steps allowed before the Newton method takes over (0: the
     !! default budget, about the cost of three factorizations of A: max(100, n/2) steps)
     integer :: auto_budget = 0
-    !> QP_NEWTON_FIRST: the Newton steps allowed before MPRGP takes over
+    !> QP_NEWTON_FIRST, QP_POLISH: the Newton steps allowed before MPRGP takes over
     integer :: newton_budget = 4
+    !> QP_POLISH: MPRGP's first tolerance, as a multiple (>= 1) of rtol and atol
+    real(wp) :: polish_scale = 1.0_wp
     real(wp) :: rtol = 1.0e-8_wp     !< stop when |gP| <= max(rtol*|b|, atol)
     real(wp) :: atol = 0.0_wp        !< absolute floor of the stopping test (units of b)
     !> at max_it, a projected gradient (fresh) within the rounding level of A x,
@@ -78,7 +85,8 @@ module mprgp_options
     integer :: n_newton = 0            !< steps of the active-set Newton method
     integer :: n_factor = 0            !< Cholesky factorizations of a free block (a Newton step on a recurring free set makes none)
     logical :: switched = .false.      !< QP_AUTO: MPRGP used up its budget and the Newton method finished
-    logical :: fell_back = .false.     !< QP_NEWTON_FIRST: the Newton method used up its budget and MPRGP finished
+    !> QP_NEWTON_FIRST, QP_POLISH: the Newton method used up its budget and MPRGP finished
+    logical :: fell_back = .false.
     integer :: n_recycled = 0          !< line searches along s and the stored directions that moved x (no product)
     real(wp) :: gp_norm = 0.0_wp       !< |gP| at the returned x (units of b)
     real(wp) :: b_norm = 0.0_wp        !< |b|
@@ -130,12 +138,16 @@ contains
       why = 'opts%atol is negative: '//trim(rtoa(o%atol))
       return
     end if
-    if (o%method < QP_AUTO .or. o%method > QP_NEWTON_FIRST) then
-      why = 'opts%method is not QP_AUTO, QP_MPRGP, QP_NEWTON or QP_NEWTON_FIRST'
+    if (o%method < QP_AUTO .or. o%method > QP_POLISH) then
+      why = 'opts%method is not QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST or QP_POLISH'
       return
     end if
     if (o%auto_budget < 0) then
       why = 'opts%auto_budget is negative'
+      return
+    end if
+    if (.not. (o%polish_scale >= 1.0_wp .and. ieee_is_finite(o%polish_scale))) then
+      why = 'opts%polish_scale is not a finite number >= 1: '//trim(rtoa(o%polish_scale))
       return
     end if
     if (o%newton_budget < 0) then

@@ -73,6 +73,11 @@ contains
     bad%gamma = 0.0_wp
     call solve_once(op, b, l, x, bad, st)
     call report(st%status == MPRGP_BAD_ARG, 'bad args: gamma = 0 -> bad argument')
+    bad = opts
+    bad%polish_scale = 0.5_wp
+    call solve_once(op, b, l, x, bad, st)
+    call report(st%status == MPRGP_BAD_ARG .and. index(st%message, 'polish_scale') > 0, &
+               'bad args: polish_scale < 1 -> bad argument: "'//trim(st%message)//'"')
     call report(mprgp_status_name(MPRGP_BAD_ARG) == 'bad argument' .and. &
                mprgp_status_name(MPRGP_NOT_SPD) == 'not SPD' .and. &
                mprgp_status_name(MPRGP_NONFINITE) == 'non-finite' .and. &

@@ -13,6 +13,9 @@
 !!    from a cold start its budget runs out and 'auto' finishes from there, to the solution
 !!    of the Newton method alone (and an ill-conditioned problem still switches back to the
 !!    Newton method rather than running MPRGP to its limit);
+!!  - QP_POLISH: MPRGP to a loose tolerance, then the Newton method: the Newton method's
+!!    solution at a fraction of MPRGP's work on an ill-conditioned problem; with a budget that
+!!    runs out, 'auto' finishes from there, to the same solution;
 !!  - SMALBE with an equality row, with the Newton method inside, against the enumeration;
 !!  - an indefinite matrix is reported as not SPD, never as converged.
 !! One line per check: PASS/FAIL, the measured value and its tolerance. Exit 1 on a failure.
@@ -20,7 +23,7 @@ program test_qp_newton
   use kinds, only: wp
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, mprgp_status_name, MPRGP_CONVERGED, MPRGP_NOT_SPD, &
-                   QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST
+                   QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use qp_newton, only: newton_work_t, chol_delete, chol_append
   use lapack, only: dgesv, dpotrf
@@ -35,6 +38,7 @@ program test_qp_newton
   call test_conditioning()
   call test_auto()
   call test_newton_first()
+  call test_polish()
   call test_kept_factor()
   call test_smalbe()
   call test_indefinite()
@@ -304,6 +308,55 @@ contains
                   '), KKT to the rounding level', r, 1.0_wp)
     end do
   end subroutine test_newton_first
+
+  !> QP_POLISH on 150 unknowns at condition 1e6, rtol 1e-12: MPRGP to 1e-4 (polish_scale 1e8)
+  !! and the Newton method from there reach the Newton method's own solution, in fewer products
+  !! than MPRGP alone; MPRGP stopped at once (polish_scale 1e12) with a budget of one Newton
+  !! step falls back to 'auto' and still ends at that solution.
+  subroutine test_polish()
+    integer, parameter :: n = 150
+    real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), z(n), x0(n), lmin, lmax, r, cond
+    type(mprgp_opts_t) :: opts
+    type(mprgp_stats_t) :: st, sn, sm
+    cond = 1.0e6_wp
+    call random_spd(n, log10(cond), a, lmin, lmax)
+    call random_problem(a, b, l, u)
+    opts = mprgp_opts_t()
+    opts%rtol = 1.0e-12_wp
+    opts%max_it = 100000
+    opts%method = QP_NEWTON
+    y = 0.0_wp
+    call solve(a, b, l, u, y, opts, sn)
+    ! MPRGP alone, within 20,000 steps (it needs more)
+    opts%method = QP_MPRGP
+    opts%max_it = 20000
+    z = 0.0_wp
+    call solve(a, b, l, u, z, opts, sm)
+    opts%max_it = 100000
+    opts%method = QP_POLISH
+    opts%polish_scale = 1.0e8_wp
+    opts%newton_budget = 20
+    x = 0.0_wp
+    x0 = min(max(x, l), u)
+    call solve(a, b, l, u, x, opts, st)
+    r = kkt_ratio(a, b, l, u, x, x0, lmax)
+    call report(st%status == MPRGP_CONVERGED .and. .not. st%fell_back .and. st%n_newton >= 1 .and. r <= 1.0_wp, &
+                'polish, cond 1e6: MPRGP to 1e-4, then '//i2s(st%n_newton)//' Newton step(s), KKT to the rounding '// &
+                'level', r, 1.0_wp)
+    call report(maxval(abs(x - y)) <= 1.0e3_wp*cond*eps*maxval(abs(y)), '  ... the Newton method''s solution: '// &
+                'max |x - x_Newton| / max |x_Newton| within 1e3 cond eps', maxval(abs(x - y))/maxval(abs(y)), &
+                1.0e3_wp*cond*eps)
+    call report(10*st%n_matvec < sm%n_matvec, '  ... in '//i2s(st%n_matvec)//' products, under a tenth of '// &
+                'MPRGP alone: '//i2s(sm%n_matvec)//' ('//mprgp_status_name(sm%status)//')')
+    opts%polish_scale = 1.0e12_wp
+    opts%newton_budget = 1
+    x = 0.0_wp
+    call solve(a, b, l, u, x, opts, st)
+    r = kkt_ratio(a, b, l, u, x, x0, lmax)
+    call report(st%status == MPRGP_CONVERGED .and. st%fell_back .and. r <= 1.0_wp .and. &
+                maxval(abs(x - y)) <= 1.0e3_wp*cond*eps*maxval(abs(y)), 'polish, budget 1 from MPRGP''s first '// &
+                'iterates: fell back to auto, the Newton method''s solution, KKT to the rounding level', r, 1.0_wp)
+  end subroutine test_polish
 
   !> Newton work kept between solves (mprgp_t%keep): a solve from the solution's face makes
   !! one factorization (the face's), and the next solve from there takes it as it is (no
