@@ -20,7 +20,7 @@ module condense
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use errors, only: error_t, ERR_MEMORY
-  use lapack, only: dpotrf, dpocon, dpstrf, dsyevr, dsyevd, dgemm, dgeqrf, dorgqr
+  use lapack, only: dpotrf, dpocon, dpstrf, dsyevr, dsyevd, dgemm, dgeqrf, dorgqr, dsytrf
   implicit none (type, external)
   private
 
@@ -662,10 +662,11 @@ contains
     liwork = max(10*bc%m, iwork(1))
     deallocate (work, iwork)
     allocate (work(lwork), iwork(liwork))
-    ! how many eigenvalues lie below NEAR_KERNEL max diag (values only)
-    call dsyevr('N', 'V', 'L', bc%m, f, bc%m, -dmax, NEAR_KERNEL*dmax, 1, 1, 0.0_wp, nnear, ev, z, bc%m, isuppz, &
-                work, lwork, iwork, liwork, lapinfo)
-    if (lapinfo == 0 .and. nnear > k) then
+    ! how many eigenvalues lie below NEAR_KERNEL max diag: the inertia of F_a - NEAR_KERNEL
+    ! max diag I (Sylvester), its negative eigenvalues those of D in L D L' (a quarter of the
+    ! tridiagonal reduction that counting by dsyevr took)
+    nnear = count_below(bc%flex, NEAR_KERNEL*dmax)
+    if (nnear > k) then
       k = nnear
       deallocate (z)
       allocate (z(bc%m, k))
@@ -679,6 +680,50 @@ contains
       bc%kern = z
       bc%rank = bc%m - k
     end if
+
+  contains
+
+    !> The eigenvalues of the symmetric a below tau, by the inertia of a - tau I (LAPACK
+    !! dsytrf: a 1x1 block of D counts when negative, a 2x2 block once when its determinant is
+    !! negative, twice when its determinant is positive and its trace negative); -1 when the
+    !! factorization fails (then no count).
+    integer function count_below(a, tau) result(nneg)
+      real(wp), intent(in) :: a(:, :), tau
+      real(wp), allocatable :: s(:, :), w(:)
+      integer, allocatable :: ipiv(:)
+      integer :: n, j, info, lw
+      real(wp) :: det
+      n = size(a, 1)
+      nneg = -1
+      s = a
+      do j = 1, n
+        s(j, j) = s(j, j) - tau
+      end do
+      allocate (ipiv(n), w(1))
+      call dsytrf('L', n, s, n, ipiv, w, -1, info)
+      lw = max(1, int(w(1)))
+      deallocate (w)
+      allocate (w(lw))
+      call dsytrf('L', n, s, n, ipiv, w, lw, info)
+      if (info < 0) return
+      nneg = 0
+      j = 1
+      do while (j <= n)
+        if (ipiv(j) > 0 .or. j == n) then
+          if (s(j, j) < 0.0_wp) nneg = nneg + 1
+          j = j + 1
+        else
+          det = s(j, j)*s(j + 1, j + 1) - s(j + 1, j)**2
+          if (det < 0.0_wp) then
+            nneg = nneg + 1
+          else if (s(j, j) + s(j + 1, j + 1) < 0.0_wp) then
+            nneg = nneg + 2
+          end if
+          j = j + 2
+        end if
+      end do
+    end function count_below
+
   end subroutine flex_rank
 
   !> F_a = B_a X B_a' from k <= m/2 interface DOFs (a master surface at least twice as

@@ -12,7 +12,7 @@ module lapack
   public :: dsymv, dgemm, dgemv, dsyrk, dtrsm, dtrsv
   public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
   public :: dpbtrf, dpbtrs, dpbsv
-  public :: dgels, dgesv, dsygv, dgesvd, dgeqrf, dorgqr
+  public :: dgels, dgesv, dsygv, dgesvd, dgeqrf, dorgqr, dsytrf
 
   interface
 
@@ -215,6 +215,22 @@ module lapack
       integer, intent(in) :: liwork          !< size of iwork (-1: query)
       integer, intent(out) :: info           !< status
     end subroutine dsyevr
+
+    !> A = L D L' (uplo 'L') of a symmetric matrix by Bunch-Kaufman pivoting: D block diagonal
+    !! with 1x1 and 2x2 blocks (ipiv(k) > 0: a 1x1 block at k; ipiv(k) = ipiv(k+1) < 0: a 2x2
+    !! block at k, k+1). lwork = -1: workspace query. info > 0: D(info, info) is exactly zero.
+    subroutine dsytrf(uplo, n, a, lda, ipiv, work, lwork, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo   !< 'U' or 'L'
+      integer, intent(in) :: n               !< order of A
+      integer, intent(in) :: lda             !< leading dimension of a
+      real(wp), intent(inout) :: a(lda, *)   !< A on entry; D and the multipliers on exit
+      integer, intent(out) :: ipiv(*)        !< (n) the pivots and block structure
+      real(wp), intent(inout) :: work(*)     !< (lwork) workspace
+      integer, intent(in) :: lwork           !< size of work (-1: query)
+      integer, intent(out) :: info           !< status
+    end subroutine dsytrf
 
     !> QR factorization A = Q R of an m x n matrix (Householder): R in the upper triangle,
     !! Q as reflectors below it and in tau (dorgqr forms it).
