@@ -406,19 +406,10 @@ contains
     !> F from the trailing block L_G: (K^-1)_GG = (L_G L_G')^-1 via dpotri.
     subroutine flex_block()
       real(wp), allocatable :: lg(:, :)
-      integer :: ml, lapinfo, a, b, code
-      character(len=512) :: cmsg
+      integer :: ml, lapinfo, a, b
       ml = self%m_last
-      allocate (lg(ml, ml), stat=st)
-      if (st /= 0) then
-        call err%set(ERR_MEMORY, 'Cholesky: out of memory for the trailing block of L.')
-        return
-      end if
-      call cm_trailing_block(self%handle, lg, code, cmsg)
-      if (code /= CM_OK) then
-        call set_cm_error(code, cmsg, err)
-        return
-      end if
+      call trailing_block(self, lg, err)
+      if (err%failed()) return
       call dpotri('L', ml, lg, ml, lapinfo)
       if (lapinfo > 0) then
         write (emsg, '(a,i0,a)') 'Cholesky: trailing block of L is singular (dpotri info ', lapinfo, ').'
@@ -500,8 +491,7 @@ contains
     integer, parameter :: ROW_PANEL = 128
     real(wp), allocatable :: lg(:, :), wt(:, :), fs(:, :)
     integer, allocatable :: pos(:), first(:), order(:), cnt(:), pstart(:), r0(:)
-    integer :: m, ml, i, e, q, np, a, b, nr, na, nb, nc, st, code
-    character(len=512) :: cmsg
+    integer :: m, ml, i, e, q, np, a, b, nr, na, nb, nc, st
 
     used_block = .false.
     m = size(bptr) - 1
@@ -516,16 +506,13 @@ contains
     end do
     if (any(pos(idx) == 0)) return
     used_block = .true.
-    allocate (lg(ml, ml), wt(m, ml), fs(m, m), first(m), order(m), cnt(0:ml + 1), stat=st)
+    allocate (wt(m, ml), fs(m, m), first(m), order(m), cnt(0:ml + 1), stat=st)
     if (st /= 0) then
-      call err%set(ERR_MEMORY, 'Cholesky: out of memory for the trailing block of L and the rows on it.')
+      call err%set(ERR_MEMORY, 'Cholesky: out of memory for the rows on the trailing block of L.')
       return
     end if
-    call cm_trailing_block(self%handle, lg, code, cmsg)
-    if (code /= CM_OK) then
-      call set_cm_error(code, cmsg, err)
-      return
-    end if
+    call trailing_block(self, lg, err)
+    if (err%failed()) return
     ! the rows in the order of their first position in G (stable counting sort; a row on
     ! no DOF goes last, its W row stays zero)
     do i = 1, m
@@ -600,6 +587,23 @@ contains
       end do
     end do
   end subroutine chol_row_flexibility
+
+  !> The trailing block L_G (m_last x m_last, lower triangle) of a CHOLMOD factor whose
+  !! interface DOFs were ordered last. err: ERR_MEMORY, or CHOLMOD's failure.
+  subroutine trailing_block(self, lg, err)
+    type(chol_t), intent(in) :: self
+    real(wp), allocatable, intent(out) :: lg(:, :)
+    type(error_t), intent(inout) :: err
+    integer :: st, code
+    character(len=512) :: cmsg
+    allocate (lg(self%m_last, self%m_last), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'Cholesky: out of memory for the trailing block of L.')
+      return
+    end if
+    call cm_trailing_block(self%handle, lg, code, cmsg)
+    if (code /= CM_OK) call set_cm_error(code, cmsg, err)
+  end subroutine trailing_block
 
   !> One line describing the factorization (method, sizes, times, memory).
   function chol_summary(self) result(line)

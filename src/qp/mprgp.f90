@@ -207,17 +207,7 @@ contains
     case (QP_NEWTON_FIRST)
       ! the Newton method within its budget (a warm start on the solution's face ends in one
       ! step); 'auto' from where it stopped when the active set moved more than that
-      max_it = self%opts%max_it
-      budget = self%opts%newton_budget
-      self%opts%max_it = min(max_it, budget)
-      call newton_loop(self, A, b, set, x)
-      self%opts%max_it = max_it
-      if (self%stats%status == MPRGP_MAX_IT .and. self%it < max_it) then
-        self%stats%fell_back = .true.
-        if (.not. self%fresh) call true_gradient(self, A, b, x)
-        call set_p_to_phi(self, set, x)
-        call auto_steps()
-      end if
+      call newton_then_auto(self%opts%newton_budget)
     case (QP_POLISH)
       ! MPRGP at the looser tolerance; on its face the Newton method within its budget; what
       ! is left by MPRGP ('auto') at the real tolerance
@@ -226,17 +216,8 @@ contains
       call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
       self%tol = tol
       if (self%stats%status == MPRGP_CONVERGED) then
-        max_it = self%opts%max_it
-        self%opts%max_it = min(max_it, self%it + self%opts%newton_budget)
         if (.not. self%fresh) call true_gradient(self, A, b, x)
-        call newton_loop(self, A, b, set, x)
-        self%opts%max_it = max_it
-        if (self%stats%status == MPRGP_MAX_IT .and. self%it < max_it) then
-          self%stats%fell_back = .true.
-          if (.not. self%fresh) call true_gradient(self, A, b, x)
-          call set_p_to_phi(self, set, x)
-          call auto_steps()
-        end if
+        call newton_then_auto(self%it + self%opts%newton_budget)
       end if
     case default
       call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
@@ -252,6 +233,22 @@ contains
     call consume_search(self)
 
   contains
+
+    !> The Newton method up to step `limit`; if it stops there unconverged, 'auto' from where
+    !! it stopped (fell_back).
+    subroutine newton_then_auto(limit)
+      integer, intent(in) :: limit
+      max_it = self%opts%max_it
+      self%opts%max_it = min(max_it, limit)
+      call newton_loop(self, A, b, set, x)
+      self%opts%max_it = max_it
+      if (self%stats%status == MPRGP_MAX_IT .and. self%it < max_it) then
+        self%stats%fell_back = .true.
+        if (.not. self%fresh) call true_gradient(self, A, b, x)
+        call set_p_to_phi(self, set, x)
+        call auto_steps()
+      end if
+    end subroutine newton_then_auto
 
     !> MPRGP within a budget of about three factorizations' work (counted on from the steps
     !! already taken); the Newton method from where it stopped (a conditioning MPRGP pays
