@@ -318,8 +318,12 @@ contains
       end if
       if (state%kept(a) == 0) call newton_forget(subproblems%newton_work(a))
     end if
-    ! F_a does not change: a body whose QP needed the Newton method starts with it from now on
-    if (inner%switched) state%newton(a) = 1
+    ! F_a does not change: a body whose QP needed the Newton method polishes its later solves
+    ! (a frictionless body held by its supports, under 'auto': MPRGP to a loose tolerance, then
+    ! the Newton method, the active-set method first once its set settles) or starts with the
+    ! Newton method from now on (any other)
+    if (inner%switched) state%newton(a) = merge(-NEWTON_FIRST_MAX, 1, r == 0 .and. .not. allocated(ub) .and. &
+                                                solver%inner_solver == INNER_AUTO)
     ! 'auto' on a body held by its supports: when a solve that MPRGP finished cost more than
     ! two steps of the Newton method with a new factor, the next solve takes the Newton method
     ! within half that solve's work: first (from the warm start: one step while the set stays,

@@ -64,8 +64,10 @@ module mprgp
   !! larger problems are solved by MPRGP whatever opts%method says.
   integer, parameter :: NEWTON_MAX_N = 8192
   integer, parameter :: NEWTON_MAX_N_BUILT = 4096
-  !> QP_AUTO's smallest budget of MPRGP steps.
+  !> QP_AUTO's budget of MPRGP steps: max(AUTO_BUDGET_MIN, n/AUTO_BUDGET_DIV), about three
+  !! factorizations of a free block of n/2 unknowns
   integer, parameter :: AUTO_BUDGET_MIN = 100
+  integer, parameter :: AUTO_BUDGET_DIV = 16
   !> Working precision of a Newton solve: |gP| <= NEWTON_FLOOR n eps lambda_max |x|.
   real(wp), parameter :: NEWTON_FLOOR = 10.0_wp
 
@@ -209,13 +211,18 @@ contains
       ! step); 'auto' from where it stopped when the active set moved more than that
       call newton_then_auto(self%opts%newton_budget)
     case (QP_POLISH)
-      ! MPRGP at the looser tolerance; on its face the Newton method within its budget; what
-      ! is left by MPRGP ('auto') at the real tolerance
+      ! MPRGP at the looser tolerance within 'auto''s budget; from there the Newton method
+      ! within its budget; what is left by 'auto' at the real tolerance
       tol = self%tol
       self%tol = tol*self%opts%polish_scale
+      max_it = self%opts%max_it
+      budget = self%opts%auto_budget
+      if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/AUTO_BUDGET_DIV)
+      self%opts%max_it = min(max_it, budget)
       call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
+      self%opts%max_it = max_it
       self%tol = tol
-      if (self%stats%status == MPRGP_CONVERGED) then
+      if (self%stats%status == MPRGP_CONVERGED .or. (self%stats%status == MPRGP_MAX_IT .and. budget < max_it)) then
         if (.not. self%fresh) call true_gradient(self, A, b, x)
         call newton_then_auto(self%it + self%opts%newton_budget)
       end if
@@ -250,13 +257,13 @@ contains
       end if
     end subroutine newton_then_auto
 
-    !> MPRGP within a budget of about three factorizations' work (counted on from the steps
-    !! already taken); the Newton method from where it stopped (a conditioning MPRGP pays
-    !! for, the Newton method does not).
+    !> MPRGP within a budget of about three factorizations of a free block of half the
+    !! unknowns (counted on from the steps already taken); the Newton method from where it
+    !! stopped (a conditioning MPRGP pays for, the Newton method does not).
     subroutine auto_steps()
       max_it = self%opts%max_it
       budget = self%opts%auto_budget
-      if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/2)
+      if (budget == 0) budget = max(AUTO_BUDGET_MIN, self%n/AUTO_BUDGET_DIV)
       budget = self%it + budget
       self%opts%max_it = min(max_it, budget)
       call mprgp_loop(self, A, b, set, x, rw, raw, nrw)

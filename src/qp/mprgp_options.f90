@@ -40,8 +40,9 @@ module mprgp_options
   !> Options of an MPRGP solve. Tolerances are in the units of b (for contact: a displacement).
   type :: mprgp_opts_t
     integer :: method = QP_MPRGP     !< QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST or QP_POLISH
-    !> QP_AUTO: the MPRGP steps allowed before the Newton method takes over (0: the
-    !! default budget, about the cost of three factorizations of A: max(100, n/2) steps)
+    !> QP_AUTO, QP_POLISH: the MPRGP steps allowed before the Newton method takes over (0: the
+    !! default budget, max(100, n/16) steps, about the cost of three factorizations of a free
+    !! block of n/2 unknowns, (n/2)^3/3 flops each, n/48 products of 2 n^2 flops)
     integer :: auto_budget = 0
     !> QP_NEWTON_FIRST, QP_POLISH: the Newton steps allowed before MPRGP takes over
     integer :: newton_budget = 4

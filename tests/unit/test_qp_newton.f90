@@ -311,8 +311,8 @@ contains
 
   !> QP_POLISH on 150 unknowns at condition 1e6, rtol 1e-12: MPRGP to 1e-4 (polish_scale 1e8)
   !! and the Newton method from there reach the Newton method's own solution, in fewer products
-  !! than MPRGP alone; MPRGP stopped at once (polish_scale 1e12) with a budget of one Newton
-  !! step falls back to 'auto' and still ends at that solution.
+  !! than MPRGP alone (its MPRGP phase unbounded); MPRGP stopped at once (polish_scale 1e12)
+  !! with a budget of one Newton step falls back to 'auto' and still ends at that solution.
   subroutine test_polish()
     integer, parameter :: n = 150
     real(wp) :: a(n, n), b(n), l(n), u(n), x(n), y(n), z(n), x0(n), lmin, lmax, r, cond
@@ -336,6 +336,7 @@ contains
     opts%method = QP_POLISH
     opts%polish_scale = 1.0e8_wp
     opts%newton_budget = 20
+    opts%auto_budget = 100000      ! MPRGP's phase to its loose tolerance, whatever it takes
     x = 0.0_wp
     x0 = min(max(x, l), u)
     call solve(a, b, l, u, x, opts, st)
@@ -350,6 +351,7 @@ contains
                 'MPRGP alone: '//i2s(sm%n_matvec)//' ('//mprgp_status_name(sm%status)//')')
     opts%polish_scale = 1.0e12_wp
     opts%newton_budget = 1
+    opts%auto_budget = 0
     x = 0.0_wp
     call solve(a, b, l, u, x, opts, st)
     r = kkt_ratio(a, b, l, u, x, x0, lmax)
