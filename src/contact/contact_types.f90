@@ -91,7 +91,9 @@ module contact_types
     integer, allocatable :: nrw(:, :)          !< (2, bodies) per body: directions held in rw, next slot to fill
     !> (bodies, inner_solver 'auto') 1: the body's QP needed the active-set Newton method, so its
     !! later solves use it alone; k >= 2: its last MPRGP solve cost more than two Newton steps,
-    !! so its next solve starts with the Newton method, within k - 1 steps; 0: MPRGP first
+    !! so its next solve starts with the Newton method, within k - 1 steps; k <= -1: its next
+    !! solve is polished (MPRGP to a loose tolerance, then the Newton method within -k steps);
+    !! 0: MPRGP first
     integer, allocatable :: newton(:)
     !> (bodies) 1: the body's active-set method holds the factor LAPACK makes of the free block
     !! of its last forces (the rows strictly inside their bounds), which its next solve may
