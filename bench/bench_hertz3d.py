@@ -13,7 +13,8 @@ program's `time:` line (factor, condense, iterate, total), the contact phases (c
 iterate) and the whole run as multiples of the factorization, the peak memory, the factor
 memory against the estimate the memory check printed before factoring, and a and p0 of the
 fitted Hertz shape against Hertz for the run's force (tools/hertz3d_study.py's fit). Prints a
-Markdown table and writes results/bench_hertz3d.csv; exit 1 when a run fails (the table first).
+Markdown table and writes results/bench_hertz3d.csv (with the inner products, `inner`, too);
+exit 1 when a run fails (the table first).
 
 The pair's slave is the deck's default (the sphere, whose contact group has the shorter mean
 edge) unless --slave names a body (2: the block, whose flat top gives each row one displacement
@@ -68,6 +69,7 @@ def solve(binary, msh, out, threads, slave=0, method="robin"):
     est = re.findall(r"body \d+ ([0-9.]+) (MiB|GiB)", line("phase: ordering"))
     est_mb = sum(float(v) * (1024.0 if u == "GiB" else 1.0) for v, u in est)
     row = {"exit": r.returncode, "status": res.get("status", "?"), "outer": res.get("outer", "?"),
+           "inner": res.get("inner", "?"),
            "n1": res.get("n1", "?"), "n2": res.get("n2", "?"), "m": res.get("m", "?"), "wall": wall,
            "estimate_mb": est_mb}
     row.update(tim)
@@ -117,7 +119,7 @@ def main():
               f"| {r['total'] / f:.2f} | {r['peak_mb']:.0f} | {r['factor_mb']:.0f} ({r['estimate_mb']:.0f}) "
               f"| {100 * r['ea']:+.2f}% | {100 * r['ep']:+.2f}% |")
     os.makedirs(os.path.dirname(a.csv), exist_ok=True)
-    keys = ["hc", "n1", "n2", "m", "exit", "status", "outer", "factor", "condense", "iterate", "total", "peak_mb",
+    keys = ["hc", "n1", "n2", "m", "exit", "status", "outer", "inner", "factor", "condense", "iterate", "total", "peak_mb",
             "factor_mb", "estimate_mb", "P", "ea", "ep"]
     with open(a.csv, "w", newline="") as f:
         w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
