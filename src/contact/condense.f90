@@ -695,7 +695,7 @@ contains
       real(wp) :: det
       n = size(a, 1)
       nneg = -1
-      s = a
+      allocate (s, source=a)
       do j = 1, n
         s(j, j) = s(j, j) - tau
       end do

@@ -354,7 +354,7 @@ contains
     type(error_t), intent(out) :: err             !< the failure, if any
     logical, intent(in), optional :: use_solves   !< force the solve-based path (default false)
     logical, intent(out), optional :: used_block  !< true if the trailing-block path was used
-    integer :: m, i, j, k, st
+    integer :: m, i, j, st
     integer, allocatable :: pos(:)
     logical :: try_block
     character(len=200) :: emsg
@@ -379,20 +379,9 @@ contains
       end if
     end do
 
-    try_block = self%method == FACT_CHOLMOD .and. self%interface_last_ok .and. self%m_last > 0
-    if (present(use_solves)) try_block = try_block .and. .not. use_solves
-    if (try_block) then
-      allocate (pos(self%n), stat=st)
-      if (st /= 0) then
-        try_block = .false.
-      else
-        pos = 0
-        do k = 1, self%m_last
-          pos(self%last(k)) = k
-        end do
-        try_block = all(pos(idx) > 0)
-      end if
-    end if
+    try_block = .true.
+    if (present(use_solves)) try_block = .not. use_solves
+    if (try_block) try_block = block_holds(self, idx, pos)
 
     if (try_block) then
       call flex_block()
@@ -495,16 +484,9 @@ contains
 
     used_block = .false.
     m = size(bptr) - 1
-    if (self%method /= FACT_CHOLMOD .or. .not. self%interface_last_ok .or. self%m_last <= 0 .or. m <= 0) return
-    if (any(idx < 1 .or. idx > self%n)) return
+    if (m <= 0) return
+    if (.not. block_holds(self, idx, pos)) return
     ml = self%m_last
-    allocate (pos(self%n), stat=st)
-    if (st /= 0) return
-    pos = 0
-    do q = 1, ml
-      pos(self%last(q)) = q
-    end do
-    if (any(pos(idx) == 0)) return
     used_block = .true.
     allocate (wt(m, ml), fs(m, m), first(m), order(m), cnt(0:ml + 1), stat=st)
     if (st /= 0) then
@@ -587,6 +569,26 @@ contains
       end do
     end do
   end subroutine chol_row_flexibility
+
+  !> True when the trailing block of this factor holds (K^-1) on idx: a CHOLMOD factor that
+  !! ordered its `last` DOFs last, every idx among them (and in range); pos(j) is then the
+  !! position of DOF j among them (0: not among them). False also when pos cannot be allocated.
+  logical function block_holds(self, idx, pos) result(ok)
+    class(chol_t), intent(in) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based DOFs
+    integer, allocatable, intent(out) :: pos(:)   !< (n) position of each DOF in `last`
+    integer :: q, st
+    ok = .false.
+    if (self%method /= FACT_CHOLMOD .or. .not. self%interface_last_ok .or. self%m_last <= 0) return
+    if (any(idx < 1 .or. idx > self%n)) return
+    allocate (pos(self%n), stat=st)
+    if (st /= 0) return
+    pos = 0
+    do q = 1, self%m_last
+      pos(self%last(q)) = q
+    end do
+    ok = all(pos(idx) > 0)
+  end function block_holds
 
   !> The trailing block L_G (m_last x m_last, lower triangle) of a CHOLMOD factor whose
   !! interface DOFs were ordered last. err: ERR_MEMORY, or CHOLMOD's failure.
