@@ -20,7 +20,7 @@ module condense
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use errors, only: error_t, ERR_MEMORY
-  use lapack, only: dpotrf, dpocon, dpstrf, dsyevr, dsyevd, dgemm, dgeqrf, dorgqr, dsytrf
+  use lapack, only: dpotrf_tiles, dpocon, dpstrf, dsyevr, dsyevd, dgemm, dgeqrf, dorgqr, dsytrf
   implicit none (type, external)
   private
 
@@ -503,15 +503,19 @@ contains
 
   !> Form F_a and b_a (and u0 = K_a^-1 f_a, unless the factor is distributed) from the
   !! factorization: F_a = B_a (K_a^-1) B_a' on the interface DOFs by the factor's
-  !! rows_flexibility, its rank (flex_finish), b_a by one solve (interface_load). Collective
-  !! with MUMPS (flex and b on the host).
+  !! rows_flexibility, its rank (flex_finish), b_a by one solve (interface_load; an OpenMP
+  !! task beside the flexibility when that only reads the factor). Collective with MUMPS
+  !! (flex and b on the host).
   subroutine condense_body(sys, bc, err)
     type(body_system_t), intent(in) :: sys           !< assembled system of the body
     type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives flex, b, u0
     type(error_t), intent(out) :: err                !< the failure, if any
     real(wp) :: t0
     integer :: st
+    type(error_t) :: err_load
+    logical :: beside
     t0 = wtime()
+    beside = .false.
     if (bc%fac%holds_result()) then
       if (allocated(bc%flex)) deallocate (bc%flex)
       allocate (bc%flex(bc%m, bc%m), stat=st)
@@ -521,12 +525,25 @@ contains
       end if
       if (bc%m > 0) bc%flex = 0.0_wp
       if (bc%m > 0 .and. size(bc%idx) > 0) then
+        ! b_a's solve beside the flexibility when that only reads the factor: a thread the
+        ! body loop leaves idle takes it (else this one, at the wait)
+        beside = bc%fac%flexibility_beside_solve(bc%idx)
+        if (beside) then
+          !$omp task default(shared)
+          call interface_load(sys, bc, err_load)
+          !$omp end task
+        end if
         call bc%fac%rows_flexibility(bc%idx, bc%bptr, bc%bpos, bc%bval, bc%flex, err)
-        if (err%failed()) return
       end if
-      call flex_finish(bc)
+      if (.not. err%failed()) call flex_finish(bc)
+      !$omp taskwait
+      if (err%failed()) return
     end if
-    call interface_load(sys, bc, err)
+    if (beside) then
+      err = err_load
+    else
+      call interface_load(sys, bc, err)
+    end if
     bc%t_condense = wtime() - t0
   end subroutine condense_body
 
@@ -630,7 +647,7 @@ contains
     ! 1 / |F_a^-1|_1, estimated, at least 1e4 times the pivot tolerance below (no estimate is
     ! that far off). Anything else is decided by the pivoted factor, as before.
     f = bc%flex
-    call dpotrf('L', bc%m, f, bc%m, lapinfo)
+    call dpotrf_tiles('L', bc%m, f, bc%m, lapinfo)
     if (lapinfo == 0) then
       anorm = maxval(sum(abs(bc%flex), dim=1))
       call dpocon('L', bc%m, f, bc%m, anorm, rcond, work, piv, lapinfo)

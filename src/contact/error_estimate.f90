@@ -4,7 +4,7 @@
 module error_estimate
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use lapack, only: dsymv, dpotrf, dtrsv, dposv, dsyev
+  use lapack, only: dsymv, dpotrf_tiles, dtrsv, dposv, dsyev
   use contact_interface, only: interface_t, slot_row, row_bounds
   use condense, only: body_condensed_t
   use contact_common, only: scatter, body_threads
@@ -196,12 +196,12 @@ contains
       ok = .not. err%failed()
     else
       self%a = self%h
-      call dpotrf('U', self%m, self%a, self%m, info)
+      call dpotrf_tiles('L', self%m, self%a, self%m, info)
       ok = info == 0
     end if
   end subroutine hessian_factor
 
-  !> x <- H^-1 x (after hessian_factor). Dense: the two triangular solves with U' and U
+  !> x <- H^-1 x (after hessian_factor). Dense: the two triangular solves with L and L'
   !! (dtrsv; dpotrs with one right-hand side goes through dtrsm, three times slower here).
   subroutine hessian_solve(self, x)
     class(hessian_t), intent(inout) :: self
@@ -210,8 +210,8 @@ contains
     if (self%sparse) then
       call self%chol%solve(x, err)
     else
-      call dtrsv('U', 'T', 'N', self%m, self%a, self%m, x, 1)
-      call dtrsv('U', 'N', 'N', self%m, self%a, self%m, x, 1)
+      call dtrsv('L', 'N', 'N', self%m, self%a, self%m, x, 1)
+      call dtrsv('L', 'T', 'N', self%m, self%a, self%m, x, 1)
     end if
   end subroutine hessian_solve
 

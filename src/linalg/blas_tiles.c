@@ -256,3 +256,17 @@ void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *inf
     else
         real_potrf(uplo, n, a, lda, info, 1);
 }
+
+/* A = L L' of one dense matrix outside a factorization, as tiles on the team's idle threads
+ * (the same numbers for any thread count); a small or upper one goes to the real dpotrf. The
+ * calling thread's state (inside a factorization or not, its tile count) is left as it was. */
+void dpotrf_tiles_(const char *uplo, const int *n, double *a, const int *lda, int *info)
+{
+    int was = tiles_on;
+    long run = tiles_run;
+    found();
+    tiles_on = 1;
+    dpotrf_(uplo, n, a, lda, info);
+    tiles_on = was;
+    if (!was) tiles_run = run;
+}

@@ -74,6 +74,7 @@ module cholesky
     generic :: solve => chol_solve_vec, chol_solve_mat
     procedure :: flexibility => chol_flexibility
     procedure :: row_flexibility => chol_row_flexibility
+    procedure :: holds_block => chol_holds_block
     procedure :: summary => chol_summary
     procedure :: free => chol_free
   end type chol_t
@@ -569,6 +570,18 @@ contains
       end do
     end do
   end subroutine chol_row_flexibility
+
+  !> True when row_flexibility on the DOFs idx forms F from the trailing block of L, reading
+  !! the factor and nothing a solve uses: a CHOLMOD factor that ordered every idx last
+  !! (block_holds). A solve of the same factor may then run beside it on another thread (it
+  !! keeps its workspace and CHOLMOD's Common in the handle, which the block's copy does not
+  !! touch).
+  logical function chol_holds_block(self, idx) result(yes)
+    class(chol_t), intent(in) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based DOFs
+    integer, allocatable :: pos(:)
+    yes = block_holds(self, idx, pos)
+  end function chol_holds_block
 
   !> True when the trailing block of this factor holds (K^-1) on idx: a CHOLMOD factor that
   !! ordered its `last` DOFs last, every idx among them (and in range); pos(j) is then the

@@ -63,6 +63,9 @@ module factorization
     procedure(inverse_i), deferred :: interface_inverse
     !> F = B X B' for sparse rows B on the interface DOFs (X as interface_inverse's).
     procedure :: rows_flexibility => factor_rows_flexibility
+    !> True when rows_flexibility on these DOFs reads the factor only, so that a solve may run
+    !! beside it on another thread (default: false, it solves).
+    procedure :: flexibility_beside_solve => factor_flexibility_beside_solve
     !> Release the factorization.
     procedure(free_i), deferred :: free
     !> One line: method, sizes, times, memory.
@@ -123,6 +126,7 @@ module factorization
     procedure :: solve => chol_solve
     procedure :: interface_inverse => chol_inverse
     procedure :: rows_flexibility => chol_rows_flexibility
+    procedure :: flexibility_beside_solve => chol_flexibility_beside_solve
     procedure :: free => chol_free
     procedure :: summary => chol_summary
     procedure :: wants_interior_order => chol_wants_interior_order
@@ -285,6 +289,20 @@ contains
     if (err%failed()) return
     call flex_product(x, bptr, bpos, bval, flex)
   end subroutine factor_rows_flexibility
+
+  !> False: a factor's own rows_flexibility solves with it.
+  logical function factor_flexibility_beside_solve(self, idx) result(yes)
+    class(factor_t), intent(in) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based interface DOFs
+    yes = .false.
+  end function factor_flexibility_beside_solve
+
+  !> True when F comes from CHOLMOD's trailing block (cholesky%holds_block).
+  logical function chol_flexibility_beside_solve(self, idx) result(yes)
+    class(chol_factor_t), intent(in) :: self
+    integer, intent(in) :: idx(:)                 !< 1-based interface DOFs
+    yes = self%chol%holds_block(idx)
+  end function chol_flexibility_beside_solve
 
   !> F = B X B' from CHOLMOD's trailing block (cholesky%chol_row_flexibility), else as
   !! every factor does (X, then flex_product).

@@ -10,7 +10,7 @@ module lapack
   private
 
   public :: dsymv, dgemm, dgemv, dsyrk, dtrsm, dtrsv
-  public :: dpotrf, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
+  public :: dpotrf, dpotrf_tiles, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels, dgesv, dsygv, dgesvd, dgeqrf, dorgqr, dsytrf
 
@@ -115,6 +115,19 @@ module lapack
       integer, intent(out) :: info          !< status (see above)
       real(wp), intent(inout) :: a(lda, *)  !< A on entry, its Cholesky factor on exit
     end subroutine dpotrf
+
+    !> dpotrf whose lower factor of an order above two tiles is made as OpenMP tasks of the
+    !! real routine (src/linalg/blas_tiles.c): idle threads of the team help, and the factor is
+    !! the same for any thread count (it rounds differently from dpotrf's own blocking).
+    subroutine dpotrf_tiles(uplo, n, a, lda, info)
+      import :: wp
+      implicit none
+      character(len=1), intent(in) :: uplo  !< 'U' or 'L' (only 'L' is tiled)
+      integer, intent(in) :: n              !< order of A
+      integer, intent(in) :: lda            !< leading dimension of a, >= max(1, n)
+      integer, intent(out) :: info          !< as dpotrf's
+      real(wp), intent(inout) :: a(lda, *)  !< A on entry, its Cholesky factor on exit
+    end subroutine dpotrf_tiles
 
     !> Cholesky factorization with complete pivoting of a symmetric positive semidefinite A:
     !! P' A P = L L', its numerical rank in `rank` (pivots below tol stop it). info = 1 when

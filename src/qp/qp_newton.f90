@@ -36,7 +36,7 @@
 !! Thread safety: no module variables; each solve has its own work arrays.
 module qp_newton
   use kinds, only: wp
-  use lapack, only: dpotrf, dpotrs, dsymv, dtrsv
+  use lapack, only: dpotrf_tiles, dpotrs, dsymv, dtrsv
   use constraint_set, only: constraint_set_t
   implicit none (type, external)
   private
@@ -304,7 +304,7 @@ contains
     tau = 0.0_wp
     do try = 0, SHIFT_TRIES
       call gather_block(a, idx, tau, work%h)
-      call dpotrf('L', nf, work%h, size(work%h, 1), info)
+      call dpotrf_tiles('L', nf, work%h, size(work%h, 1), info)
       flops = flops + real(nf, wp)**3/3.0_wp
       if (info == 0) exit
       tau = merge(1.0e-14_wp*dmax, 100.0_wp*tau, try == 0)

@@ -10,7 +10,7 @@ program test_cholesky
   use kinds, only: wp
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL
   use banded, only: rcm_order, band_width
-  use lapack, only: dpotrf, dpotri, dposv, dpocon
+  use lapack, only: dpotrf, dpotrf_tiles, dpotri, dposv, dpocon
   use clock, only: wtime
   use testing, only: report, report_le, test_summary, error_parts
   use errors, only: error_t, ERR_NUMERICAL
@@ -71,6 +71,7 @@ program test_cholesky
 
   ! ---- 8. the factorization's dense kernels as tiles: the same bits at any thread count ----
   call check_tiles()
+  call check_potrf_tiles()
 
   ! ---- 9. larger problem: timings ----
   call timing_run()
@@ -609,8 +610,9 @@ contains
     type(error_t) :: err
     integer, parameter :: K = 40, MI = 200, MR = 300
     integer, allocatable :: g(:), bptr(:), bpos(:), pick(:)
-    real(wp), allocatable :: bval(:), D(:, :), X(:, :), B(:, :), Fr(:, :), F1(:, :), F2(:, :)
+    real(wp), allocatable :: bval(:), D(:, :), X(:, :), B(:, :), Fr(:, :), F1(:, :), F2(:, :), u1(:), u2(:)
     real(wp) :: r, anorm, rcond, tol
+    type(error_t) :: err2
     real(wp), allocatable :: work(:)
     integer, allocatable :: iwork(:)
     integer :: i, j, e, ne, nr, info, n
@@ -668,10 +670,30 @@ contains
     !$omp end single
     !$omp end parallel
     call report(used2 .and. all(F2 == F1), 'row flexibility: its panel tasks on two threads give the same bits')
+    ! a solve of the same factor as a task beside it (what condense does): the same bits, both
+    allocate (u1(n))
+    u1 = [(cos(0.3_wp*i), i = 1, n)]
+    u2 = u1
+    call ch%solve(u1, err)
+    call report(ch%holds_block(g) .and. .not. ch%holds_block([g, pack([(i, i = 1, n)], [(all(g /= i), i = 1, n)])]), &
+                'row flexibility: the block holds the interface DOFs, not one DOF more')
+    F2 = 0.0_wp
+    !$omp parallel num_threads(2) default(shared)
+    !$omp single
+    !$omp task default(shared)
+    call ch%solve(u2, err2)
+    !$omp end task
+    call ch%row_flexibility(g, bptr, bpos(1:ne), bval(1:ne), F2, err, used2)
+    !$omp taskwait
+    !$omp end single
+    !$omp end parallel
+    call report(used2 .and. all(F2 == F1) .and. all(u2 == u1) .and. .not. err2%failed(), &
+                'row flexibility: a solve beside it on another thread, both the same bits')
     call ch%free()
     call ch%factor(n, M%colptr, M%rowind, M%val, FACT_BANDED, ORD_NATURAL, err)
     call ch%row_flexibility(g, bptr, bpos(1:ne), bval(1:ne), F2, err, used)
-    call report(.not. used .and. .not. err%failed(), 'row flexibility: a banded factor leaves it to the caller')
+    call report(.not. used .and. .not. err%failed() .and. .not. ch%holds_block(g), &
+                'row flexibility: a banded factor leaves it to the caller')
     call ch%free()
   end subroutine check_row_flexibility
 
@@ -806,6 +828,72 @@ contains
                 'tiled dpotrf: a negative last pivot is reported at its column: '//trim(msg))
     call ch%free()
   end subroutine check_tiles
+
+  !> dpotrf_tiles, a dense Cholesky factor as tiles outside a factorization (the rank test of
+  !! a flexibility, the Newton method's free block): an SPD matrix of order 700 (three tile
+  !! columns) factorized by one thread of a team of 1, 2 and 4 gives the same bits every
+  !! time, L L' = A to rounding and L within rounding of LAPACK's dpotrf; a matrix whose
+  !! leading minor of order 600 is not positive definite reports info = 600, as dpotrf does;
+  !! an upper factor, or one of two tiles or less, is LAPACK's own to the last bit.
+  subroutine check_potrf_tiles()
+    integer, parameter :: N = 700
+    real(wp), allocatable :: a(:, :), l(:, :), l1(:, :), lref(:, :), r(:, :)
+    integer :: t, info, info1, i, j
+    integer, parameter :: teams(3) = [1, 2, 4]
+    character(len=8) :: tname
+    allocate (a(N, N))
+    call random_number(a)
+    a = matmul(transpose(a), a)/real(N, wp)
+    do i = 1, N
+      a(i, i) = a(i, i) + 1.0_wp
+    end do
+    lref = a
+    call dpotrf('L', N, lref, N, info)
+    do t = 1, size(teams)
+      write (tname, '(i0)') teams(t)
+      l = a
+      call omp_set_max_active_levels(merge(0, 1, teams(t) == 1))
+      !$omp parallel num_threads(teams(t)) default(shared)
+      !$omp single
+      call dpotrf_tiles('L', N, l, N, info1)
+      !$omp end single
+      !$omp end parallel
+      do j = 1, N
+        l(1:j - 1, j) = 0.0_wp
+      end do
+      if (t == 1) then
+        l1 = l
+        r = matmul(l, transpose(l)) - a
+        call report(info1 == 0 .and. info == 0, 'dpotrf_tiles: an SPD matrix of order 700 factorized')
+        call report_le(maxval(abs(r))/maxval(abs(a)), 100.0_wp*eps, 'dpotrf_tiles: |L L'' - A| / |A|')
+        do j = 1, N
+          lref(1:j - 1, j) = 0.0_wp
+        end do
+        call report_le(maxval(abs(l - lref))/maxval(abs(lref)), 100.0_wp*eps, 'dpotrf_tiles: L against LAPACK''s dpotrf')
+      else
+        call report(info1 == 0 .and. all(l == l1), 'dpotrf_tiles: a team of '//trim(tname)//' gives the same bits')
+      end if
+    end do
+    call omp_set_max_active_levels(1)
+    ! a minor that is not positive definite: info names its order
+    l = a
+    l(600, 600) = -1.0_wp
+    lref = l
+    call dpotrf_tiles('L', N, l, N, info1)
+    call dpotrf('L', N, lref, N, info)
+    call report(info1 == 600 .and. info == 600, 'dpotrf_tiles: a leading minor of order 600 not positive definite')
+    ! upper, and small: LAPACK's own
+    l = a
+    lref = a
+    call dpotrf_tiles('U', N, l, N, info1)
+    call dpotrf('U', N, lref, N, info)
+    call report(info1 == 0 .and. all(l == lref), 'dpotrf_tiles: an upper factor is dpotrf''s, bit for bit')
+    l = a(1:500, 1:500)
+    lref = l
+    call dpotrf_tiles('L', 500, l, 500, info1)
+    call dpotrf('L', 500, lref, 500, info)
+    call report(info1 == 0 .and. all(l == lref), 'dpotrf_tiles: order 500 (two tiles) is dpotrf''s, bit for bit')
+  end subroutine check_potrf_tiles
 
   !> A larger lattice (200 x 200 cells, ~80k DOFs, 200 interface DOFs): print timings.
   subroutine timing_run()
