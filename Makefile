@@ -66,13 +66,13 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology volume_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
+        cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set tangent_discs mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
-TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box test_gmsh_3d test_frames
+TESTS_F := test_errors test_deck test_mprgp test_mprgp_options test_mprgp_box test_constraint_set test_disc_set test_qp_newton test_cholesky test_factorization test_ordering test_fem test_gmsh test_mortar test_equilibrium test_contact test_files test_h5io test_floating test_digest test_rank_map test_text_scanner test_flex_rank test_result_names test_materials test_elements_3d test_mortar_3d test_box test_gmsh_3d test_frames
 BENCH_F := bench_mprgp bench_ordering bench_ordering_3d bench_assembly_rate
 TEST_BINS  := $(addprefix $(BUILD)/tests/,$(TESTS_F))
 BENCH_BINS := $(addprefix $(BUILD)/bench/,$(BENCH_F))
@@ -187,6 +187,7 @@ $(BUILD)/factorization.o:  $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/config.o $
                            $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/constraint_set.o: $(BUILD)/kinds.o
+$(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/constraint_set.o
 $(BUILD)/qp_newton.o:      $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/constraint_set.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \

@@ -22,16 +22,9 @@
 !! proportioning steps, its line search, the Newton step); a new set may compute all three
 !! the same way.
 !!
-!! A separable per-node disc |(x_2i-1, x_2i)| <= r_i (3D friction) fits as another
-!! extension `disc_set_t` holding r(:): a node is free when its point lies strictly inside
-!! its disc; `project` scales a node outside its disc back onto the circle; with n the
-!! outward normal of a node on its circle, the projected gradient is g where g.n >= 0 (-g
-!! points into the disc) and g - (g.n) n otherwise, the chopped gradient that part on the
-!! circle; the reduced free gradient cuts phi where x - alpha phi leaves the disc; the step
-!! lengths are the smaller root of |x_i + t d_i| = r_i over the nodes, the blocker is a node
-!! and `pin` puts it on its circle; `binding`, `leaving` and `settle` test the normal
-!! components of g and d. The solvers index variables, and a disc acts on pairs of them: the free mask marks both
-!! components of a node alike.
+!! A separable per-node disc |(x_a, x_b)| <= r (3D friction) is the extension `disc_set_t`
+!! of module tangent_discs (a box on the other variables); its faces are curved, so it is not
+!! `linear`.
 module constraint_set
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
@@ -86,6 +79,12 @@ module constraint_set
     procedure(settle_i), deferred :: settle
     !> |gP|.
     procedure :: projected_gradient_norm => set_projected_gradient_norm
+    !> True when the set's faces are flat (a box): a step along a face direction stays on
+    !! the face, which MPRGP's proportioning step and the active-set Newton method rely on.
+    procedure :: linear => set_linear
+    !> d' C d, the second-order change of the cost along the boundary that the curvature of
+    !! its faces adds when x + t d is projected back (0 on flat faces).
+    procedure :: boundary_curvature => set_boundary_curvature
   end type constraint_set_t
 
   abstract interface
@@ -213,6 +212,19 @@ contains
       allocate (box%ub(size(lb)), source=big)
     end if
   end function box_set
+
+  !> True: the faces of a box are flat (a set with curved faces overrides it).
+  logical function set_linear(self) result(yes)
+    class(constraint_set_t), intent(in) :: self
+    yes = .true.
+  end function set_linear
+
+  !> 0: flat faces add no curvature.
+  real(wp) function set_boundary_curvature(self, x, g, d) result(c)
+    class(constraint_set_t), intent(in) :: self
+    real(wp), intent(in) :: x(:), g(:), d(:)   !< iterate, gradient, direction
+    c = 0.0_wp
+  end function set_boundary_curvature
 
   !> |gP| = sqrt(sum gP_i^2), summed in index order.
   real(wp) function set_projected_gradient_norm(self, x, g) result(r)

@@ -193,6 +193,8 @@ contains
     end if
     call start(self, A, b, set, x, rw, raw, nrw)
     method = self%opts%method
+    ! the Newton method's face problems are linear: a set with curved faces (discs) is MPGP's
+    if (.not. set%linear()) method = QP_MPRGP
     if (method /= QP_MPRGP) then
       select type (A)
       type is (dense_op_t)
@@ -299,7 +301,7 @@ contains
       if (proportional(self, A, set, x, betabeta, phitphi, ok)) then
         if (ok) ok = cg_or_expansion_step(self, A, set, x, rw, raw, nrw)
       else if (ok) then
-        ok = proportioning_step(self, A, set, x, betabeta)
+        ok = proportioning_step(self, A, b, set, x, betabeta)
       end if
       if (.not. ok) exit main
     end do main
@@ -792,17 +794,19 @@ contains
 
   !> Exact line search along -beta (the chopped gradient), which releases variables from
   !! the boundary, cut where a released variable reaches the boundary again (in a box: its
-  !! opposite bound). False on a breakdown.
-  logical function proportioning_step(self, A, set, x, betabeta) result(ok)
+  !! opposite bound); on a set with curved faces, the projected step (projected_proportioning).
+  !! False on a breakdown.
+  logical function proportioning_step(self, A, b, set, x, betabeta) result(ok)
     type(mprgp_t), intent(inout) :: self
     class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:)
     class(constraint_set_t), intent(in) :: set
     real(wp), intent(in) :: betabeta
     real(wp), intent(inout) :: x(:)
     real(wp) :: pap, pp, acg
     integer :: i, n, blk
     n = self%n
-    associate (p => self%p, ap => self%ap, gr => self%g, d => self%w, free => self%free)
+    step: associate (p => self%p, ap => self%ap, gr => self%g, d => self%w, free => self%free)
       call set%chopped_gradient(x, gr, p)
       call A%apply(p, ap)
       self%stats%n_matvec = self%stats%n_matvec + 1
@@ -814,22 +818,61 @@ contains
       end do
       ok = check_curvature(self, pap, pp, 'proportioning direction')
       if (.not. ok) return
+      d = -p
+      if (.not. set%linear()) exit step
       ! A variable released from the boundary may reach it again (in a box, one released
       ! from l may reach u first): the step is cut there, so that the recurrence gradient
       ! stays that of x. With lower bounds only, p <= 0 and no upper bound is finite: no
       ! step is cut.
-      d = -p
       call set%max_step(x, d, betabeta / pap, acg, blk)
       call set%move(x, d, acg, free)
       do i = 1, n
         gr(i) = gr(i) - acg * ap(i)
       end do
       call set%pin(x, d, blk)
-    end associate
+    end associate step
+    if (.not. set%linear()) call projected_proportioning(self, A, b, set, x, &
+                                                        betabeta / (pap + set%boundary_curvature(x, self%g, self%w)))
     call set_p_to_phi(self, set, x)
     self%stats%n_prop = self%stats%n_prop + 1
-    self%fresh = .false.
+    self%fresh = self%fresh .and. .not. set%linear()
   end function proportioning_step
+
+  !> The proportioning step on a set with curved faces (MPGP): along d = -beta (in self%w)
+  !! the point slides along a disc's circle and leaves the set to second order, so the step
+  !! is projected, x = P(x + t d), and the gradient computed again. t0 is the exact line
+  !! search of the cost plus the faces' curvature term (the force that presses a point on
+  !! its circle, over the radius: constraint_set%boundary_curvature), the minimiser of the
+  !! second-order model of the cost along the circle; t is halved while the projected step
+  !! does not decrease the cost (f(x') - f(x) = (g + g')'(x' - x) / 2 for a quadratic),
+  !! which a short enough step does (the decrease is first order in t).
+  subroutine projected_proportioning(self, A, b, set, x, t0)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:)
+    class(constraint_set_t), intent(in) :: set
+    real(wp), intent(inout) :: x(:)
+    real(wp), intent(in) :: t0              !< the exact line search's step along d
+    real(wp), allocatable :: x0(:), g0(:)
+    real(wp) :: t, df, noise
+    integer :: retry
+    x0 = x
+    g0 = self%g
+    t = t0
+    do retry = 0, MAX_RETRY
+      x = x0
+      call set%move(x, self%w, t, self%free)
+      call true_gradient(self, A, b, x)
+      ! an increase below its rounding counts as none: that of the two gradients (|A x| +
+      ! |b| each) over the step, and that of the projected point (eps |x|, on a circle of
+      ! radius r against a pressing force s: s r eps, more than the decrease near the end)
+      df = 0.5_wp*dot_product(g0 + self%g, x - x0)
+      noise = 8.0_wp*epsilon(1.0_wp)*(dot_product(abs(self%ax) + abs(b), abs(x - x0)) + &
+                                      dot_product(abs(g0) + abs(self%g), abs(x)))
+      if (df <= noise) exit
+      t = 0.5_wp*t
+    end do
+  end subroutine projected_proportioning
 
   !> Record a failure.
   subroutine fail(self, code, msg)

@@ -1,0 +1,315 @@
+!> Unit tests of the friction set of 3D contact (module tangent_discs: l_n >= 0 on a node's normal
+!! force, |(l_t1, l_t2)| <= r on its two tangential ones) and of MPRGP on it (MPGP):
+!!  - each method against its formula written out here: projection (a point outside its
+!!    disc lands on the circle along its own direction), free set, chopped gradient (zero
+!!    exactly at a KKT point g = -s nu, the tangential part along the circle otherwise),
+!!    projected step and reduced gradient (x - alpha phit = P(x - alpha g)), the feasible
+!!    step (x + t d on the circle, from inside, for either sign of x.d), the cut of a step,
+!!    a disc of radius 0 (a fixed point);
+!!  - the refusal of bad sets (a negative or NaN radius, a pair out of range, a variable in
+!!    two pairs);
+!!  - MPGP: with A = I the minimiser is the projection of b (exact); isotropy, the same
+!!    2 x 2 problem with b turned by 0, 15, 30 and 45 degrees in the plane gives the force on
+!!    the circle along b every time (a box fails this by up to 41%); 30 nodes with a random
+!!    SPD A (condition 1e2): the KKT conditions checked from A x - b, and the minimiser
+!!    against an independent method written here (projected gradient with Nesterov's
+!!    momentum, FISTA, 20000 steps); the active-set Newton method, whose faces are flat,
+!!    is not used on it (the same answer, no Newton step).
+!! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
+program test_disc_set
+  use kinds, only: wp
+  use linop, only: dense_op_t, dense_op_init
+  use constraint_set, only: SET_OK, SET_BAD_ARG, SET_NONFINITE
+  use tangent_discs, only: disc_set_t, disc_set
+  use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP
+  use lapack, only: dposv
+  use testing, only: report, report_le, test_summary, set_seed, urand, random_spd
+  implicit none (type, external)
+
+  real(wp), parameter :: big = huge(1.0_wp), eps = epsilon(1.0_wp), pi = acos(-1.0_wp)
+
+  call set_seed(20261129)
+  call test_pointwise()
+  call test_steps()
+  call test_validate()
+  call test_identity()
+  call test_isotropy()
+  call test_random_qp()
+  call test_summary()
+
+contains
+
+  !> K nodes: variable 3k-2 the normal force (>= 0), 3k-1 and 3k its disc of radius r(k).
+  function node_set(r) result(set)
+    real(wp), intent(in) :: r(:)
+    type(disc_set_t) :: set
+    integer :: k, nk
+    real(wp), allocatable :: lb(:)
+    nk = size(r)
+    allocate (lb(3*nk), source=-big)
+    lb(1:3*nk:3) = 0.0_wp
+    set = disc_set(lb, reshape([(3*k - 1, 3*k, k=1, nk)], [2, nk]), r)
+  end function node_set
+
+  !> Projection, free set, chopped and projected gradients, on four nodes: inside, outside,
+  !! on the circle, and a disc of radius 0.
+  subroutine test_pointwise()
+    type(disc_set_t) :: set
+    real(wp) :: x(12), y(12), g(12), v(12), w(12), nu(2), tg(2)
+    logical :: free(12)
+    set = node_set([1.0_wp, 2.0_wp, 0.5_wp, 0.0_wp])
+    x = [0.3_wp, 0.2_wp, -0.4_wp, -0.1_wp, 3.0_wp, 4.0_wp, 0.0_wp, 0.3_wp, -0.4_wp, 0.2_wp, 0.1_wp, 0.1_wp]
+    y = x
+    call set%project(y)
+    call report(all(y(1:3) == x(1:3)) .and. y(4) == 0.0_wp .and. y(7) == 0.0_wp, &
+                'project: a point inside its disc and a normal force >= 0 stay; a negative normal force goes to 0')
+    call report_le(abs(hypot(y(5), y(6)) - 2.0_wp) + abs(y(5)*x(6) - y(6)*x(5)), 4.0_wp*eps, &
+                   'project: (3, 4) onto the circle of radius 2 along its own direction')
+    call report(y(8) == x(8) .and. y(9) == x(9) .and. all(y(11:12) == 0.0_wp), &
+                'project: a point on its circle stays; a disc of radius 0 is the origin')
+    call set%free_mask(y, free)
+    call report(free(1) .and. free(2) .and. free(3) .and. .not. any(free(5:6)) .and. .not. any(free(8:9)) .and. &
+                .not. any(free(11:12)) .and. .not. free(4) .and. .not. free(7), &
+                'free set: inside free, on a circle (both variables) or at 0 not')
+    ! on the circle of node 3 (radius 0.5, point (0.3, -0.4)): nu = (0.6, -0.8), tangent (0.8, 0.6)
+    nu = [0.6_wp, -0.8_wp]
+    tg = [0.8_wp, 0.6_wp]
+    g = 1.0_wp
+    g(8:9) = -2.5_wp*nu
+    call set%chopped_gradient(y, g, v)
+    call set%projected_gradient(y, g, w)
+    call report(all(v(8:9) == 0.0_wp) .and. all(w(8:9) == 0.0_wp), 'KKT on a circle (g = -s nu, s > 0): beta = gP = 0')
+    g(8:9) = -2.5_wp*nu + 0.7_wp*tg
+    call set%chopped_gradient(y, g, v)
+    call report_le(maxval(abs(v(8:9) - 0.7_wp*tg)), 4.0_wp*eps, 'chopped on a circle: the part along it (g = -s nu + c t)')
+    g(8:9) = 1.5_wp*nu + 0.7_wp*tg
+    call set%chopped_gradient(y, g, v)
+    call report_le(maxval(abs(v(8:9) - g(8:9))), 4.0_wp*eps, 'chopped on a circle: all of g when -g points inside')
+    call set%free_gradient(y, g, v)
+    call report(all(v(1:3) == g(1:3)) .and. all(v(5:6) == 0.0_wp) .and. all(v(8:9) == 0.0_wp) .and. &
+                all(v(11:12) == 0.0_wp), 'free gradient: g inside, 0 on circles and at radius 0')
+    g(11:12) = [3.0_wp, -1.0_wp]
+    call set%projected_gradient(y, g, w)
+    call report(all(w(11:12) == 0.0_wp) .and. all(w(1:3) == g(1:3)) .and. w(4) == min(g(4), 0.0_wp), &
+                'projected gradient: 0 on a disc of radius 0, g inside, the box''s on a normal force')
+    call set%reduced_gradient(y, g, 0.0_wp, v)
+    call report(all(v(2:3) == g(2:3)), 'reduced gradient without a step length: phi')
+  end subroutine test_pointwise
+
+  !> The feasible step from inside a disc, for x.d of either sign, the blocker and `pin`,
+  !! the cut of a step, the step bound, and the projected step against its definition.
+  subroutine test_steps()
+    type(disc_set_t) :: set
+    real(wp) :: x(6), d(6), v(6), phit(6), y(6), g(6), t, t2, s
+    integer :: blk, trial
+    logical :: free(6), cut
+    set = node_set([1.0_wp, 2.0_wp])
+    do trial = 1, 2
+      x = [0.5_wp, 0.6_wp, 0.7_wp, 0.1_wp, 0.0_wp, 0.0_wp]
+      d = 0.0_wp
+      ! outward (x.d > 0) and inward first (x.d < 0): the root on the far side
+      d(2:3) = merge([1.0_wp, 0.5_wp], [-1.0_wp, -0.5_wp], trial == 1)
+      call set%max_step(x, d, 10.0_wp, t, blk)
+      y = x + t*d
+      call report_le(abs(hypot(y(2), y(3)) - 1.0_wp), 4.0_wp*eps, &
+                     'max step: x + t d on the circle (x.d '//merge('> 0', '< 0', trial == 1)//')')
+      call report(blk == 2 .and. t > 0.0_wp, 'max step: the blocker is the disc''s first variable')
+      call set%pin(y, d, blk)
+      call set%free_mask(y, free)
+      call report(.not. free(2) .and. .not. free(3) .and. abs(hypot(y(2), y(3)) - 1.0_wp) <= 2.0_wp*eps, &
+                  'pin: the blocking disc on its circle, not free')
+      t2 = set%step_bound(x, d, 10.0_wp)
+      call report_le(abs(t2 - t), 4.0_wp*eps*t, 'step bound: the same root')
+      t2 = 10.0_wp
+      cut = set%cut_step(x, d, t2, .false.)
+      call report(cut .and. abs(t2 - t) <= 4.0_wp*eps*t, 'cut step: cut to the root')
+      t2 = 0.5_wp*t
+      cut = set%cut_step(x, d, t2, .false.)
+      call report(.not. cut .and. t2 == 0.5_wp*t, 'cut step: a step inside is not cut')
+    end do
+    ! from a point on the circle along its tangent: no feasible step
+    x = [0.0_wp, 0.6_wp, 0.8_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+    d = [0.0_wp, 0.8_wp, -0.6_wp, 0.0_wp, 0.0_wp, 0.0_wp]
+    call set%max_step(x, d, 1.0_wp, t, blk)
+    call report(t <= 4.0_wp*eps .and. blk == 2, 'max step: 0 along the tangent of a point on the circle')
+    ! the projected step and the reduced gradient: x + d = P(x - alpha phi), x - alpha phit = the same
+    x = [0.5_wp, 0.3_wp, 0.1_wp, 0.2_wp, 1.0_wp, -1.0_wp]
+    g = [1.0_wp, -4.0_wp, 2.0_wp, -0.3_wp, 3.0_wp, 3.0_wp]
+    call set%projected_step(x, g, 0.5_wp, v)
+    call set%reduced_gradient(x, g, 0.5_wp, phit)
+    y = x - 0.5_wp*g
+    call set%project(y)
+    call report_le(maxval(abs(x + v - y)), 4.0_wp*eps, 'projected step: x + d = P(x - alpha g) on the free set')
+    call report_le(maxval(abs(x - 0.5_wp*phit - y)), 4.0_wp*eps, 'reduced gradient: x - alpha phit = P(x - alpha g)')
+    call set%move(x, g, -0.5_wp, free)
+    call report_le(maxval(abs(x - y)), 4.0_wp*eps, 'move: P(x + t d)')
+    s = hypot(x(2), x(3))
+    call report(.not. free(2) .and. .not. free(3) .and. abs(s - 1.0_wp) <= 2.0_wp*eps, 'move: lands on the circle, not free')
+  end subroutine test_steps
+
+  !> Bad sets are refused with their reason.
+  subroutine test_validate()
+    type(disc_set_t) :: set
+    integer :: code
+    character(len=:), allocatable :: why
+    real(wp) :: nan
+    set = node_set([1.0_wp, 2.0_wp])
+    call set%validate(6, code, why)
+    call report(code == SET_OK .and. why == '', 'validate: a good set')
+    set = node_set([1.0_wp, -2.0_wp])
+    call set%validate(6, code, why)
+    call report(code == SET_BAD_ARG .and. index(why, 'r(2)') > 0, 'validate: a negative radius: '//why)
+    nan = 0.0_wp
+    nan = nan/nan
+    set = node_set([nan, 2.0_wp])
+    call set%validate(6, code, why)
+    call report(code == SET_NONFINITE .and. index(why, 'r(1)') > 0, 'validate: a NaN radius: '//why)
+    set = disc_set([0.0_wp, 0.0_wp, 0.0_wp], reshape([2, 4], [2, 1]), [1.0_wp])
+    call set%validate(3, code, why)
+    call report(code == SET_BAD_ARG .and. index(why, 'outside') > 0, 'validate: a pair out of range: '//why)
+    set = disc_set([0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], reshape([1, 2, 2, 3], [2, 2]), [1.0_wp, 1.0_wp])
+    call set%validate(4, code, why)
+    call report(code == SET_BAD_ARG .and. index(why, 'variable 2') > 0, 'validate: a variable in two pairs: '//why)
+  end subroutine test_validate
+
+  !> A = I: the minimiser of 1/2|x|^2 - b'x over the set is P(b).
+  subroutine test_identity()
+    integer, parameter :: nk = 20, n = 3*nk
+    type(disc_set_t) :: set
+    type(dense_op_t) :: A
+    type(mprgp_t) :: solver
+    real(wp) :: a0(n, n), b(n), x(n), p(n), r(nk)
+    integer :: i
+    do i = 1, nk
+      r(i) = urand(0.1_wp, 1.0_wp)
+    end do
+    set = node_set(r)
+    a0 = 0.0_wp
+    do i = 1, n
+      a0(i, i) = 1.0_wp
+      b(i) = urand(-2.0_wp, 2.0_wp)
+    end do
+    call dense_op_init(A, a0)
+    p = b
+    call set%project(p)
+    x = 0.0_wp
+    solver%opts%rtol = 1.0e-14_wp
+    call solver%solve_in(A, b, set, x)
+    call report(solver%stats%status == MPRGP_CONVERGED, 'A = I: converged: '//trim(solver%stats%message))
+    call report_le(maxval(abs(x - p)), 1.0e-14_wp, 'A = I: the minimiser is P(b)')
+    call report(count(hypot(p(2:n:3), p(3:n:3)) >= r - 1.0e-12_wp) > 0 .and. count(p(1:n:3) == 0.0_wp) > 0, &
+                'A = I: discs on their circles and normal forces at 0 among them')
+  end subroutine test_identity
+
+  !> One node, A = 3 I on its tangential pair and its normal force free: b = 6 (cos q, sin q)
+  !! pulls it beyond its circle of radius 1, for q = 0, 15, 30, 45 degrees: x on the circle
+  !! along b each time (a box |x_i| <= 1 would give |x| = sqrt(2) at 45 degrees).
+  subroutine test_isotropy()
+    type(disc_set_t) :: set
+    type(dense_op_t) :: A
+    type(mprgp_t) :: solver
+    real(wp) :: a0(3, 3), b(3), x(3), q, worst
+    integer :: j
+    a0 = 0.0_wp
+    a0(1, 1) = 2.0_wp
+    a0(2, 2) = 3.0_wp
+    a0(3, 3) = 3.0_wp
+    call dense_op_init(A, a0)
+    set = node_set([1.0_wp])
+    worst = 0.0_wp
+    do j = 0, 3
+      q = real(15*j, wp)*pi/180.0_wp
+      b = [1.0_wp, 6.0_wp*cos(q), 6.0_wp*sin(q)]
+      x = 0.0_wp
+      solver%opts%rtol = 1.0e-14_wp
+      call solver%solve_in(A, b, set, x)
+      worst = max(worst, abs(x(1) - 0.5_wp), abs(x(2) - cos(q)), abs(x(3) - sin(q)))
+      if (solver%stats%status /= MPRGP_CONVERGED) worst = big
+    end do
+    call report_le(worst, 1.0e-13_wp, 'isotropy: b turned by 0, 15, 30, 45 degrees: x = (cos q, sin q) on the circle')
+  end subroutine test_isotropy
+
+  !> 30 nodes, random SPD A (condition 1e2), b with normal parts of both signs, radii 0.3 to
+  !! 1.5 times the tangential forces of the unconstrained minimiser (some discs end on their
+  !! circles, some inside); rtol 1e-10: MPGP's x against the KKT conditions and
+  !! against FISTA's; the Newton method asked for, MPGP used (no Newton step, the same x).
+  subroutine test_random_qp()
+    integer, parameter :: nk = 30, n = 3*nk
+    type(disc_set_t) :: set
+    type(dense_op_t) :: A
+    type(mprgp_t) :: solver
+    real(wp) :: a0(n, n), b(n), x(n), x2(n), xf(n), y(n), xold(n), g(n), r(nk), lmin, lmax, tk, tk1, s
+    real(wp) :: kkt_n, kkt_t, gscale, nu(2), y2(n, n)
+    integer :: i, k, it, onc, info
+    call random_spd(n, 2.0_wp, a0, lmin, lmax)
+    do k = 1, nk
+      b(3*k - 2) = urand(-1.0_wp, 2.0_wp)*lmax
+      b(3*k - 1) = urand(-1.0_wp, 1.0_wp)*lmax
+      b(3*k) = urand(-1.0_wp, 1.0_wp)*lmax
+    end do
+    ! radii from 0.3 to 1.5 times the tangential force of the unconstrained minimiser: some
+    ! discs end on their circles, some inside
+    xf = b
+    y2 = a0
+    call dposv('L', n, 1, y2, n, xf, n, info)
+    do k = 1, nk
+      r(k) = urand(0.3_wp, 1.5_wp)*hypot(xf(3*k - 1), xf(3*k))
+    end do
+    set = node_set(r)
+    call dense_op_init(A, a0)
+    x = 0.0_wp
+    solver%opts%rtol = 1.0e-10_wp
+    solver%opts%max_it = 100000
+    call solver%solve_in(A, b, set, x)
+    call report(solver%stats%status == MPRGP_CONVERGED, 'random QP: converged: '//trim(solver%stats%message))
+    ! KKT from A x - b, relative to |b|
+    g = matmul(a0, x) - b
+    gscale = norm2(b)
+    kkt_n = 0.0_wp
+    kkt_t = 0.0_wp
+    onc = 0
+    do k = 1, nk
+      i = 3*k - 2
+      if (x(i) > 0.0_wp) then
+        kkt_n = max(kkt_n, abs(g(i)))
+      else if (x(i) == 0.0_wp) then
+        kkt_n = max(kkt_n, -g(i))
+      else
+        kkt_n = big
+      end if
+      s = hypot(x(i + 1), x(i + 2))
+      if (s >= r(k)*(1.0_wp - 1.0e-12_wp)) then
+        onc = onc + 1
+        nu = x(i + 1:i + 2)/s
+        ! g_t = -c nu with c >= 0: no part along the circle, no outward part
+        kkt_t = max(kkt_t, abs(g(i + 1)*nu(2) - g(i + 2)*nu(1)), max(dot_product(g(i + 1:i + 2), nu), 0.0_wp))
+      else
+        kkt_t = max(kkt_t, maxval(abs(g(i + 1:i + 2))))
+      end if
+    end do
+    call report(onc >= 3 .and. onc <= nk - 3, 'random QP: some discs on their circles, some inside')
+    call report_le(kkt_n/gscale, 1.0e-10_wp, 'random QP: KKT of the normal forces (x >= 0, g >= 0, x g = 0)')
+    call report_le(kkt_t/gscale, 1.0e-10_wp, 'random QP: KKT of the discs (g = 0 inside; g = -c nu, c >= 0, on a circle)')
+    ! FISTA with step 1/lmax (lmax is A's largest eigenvalue)
+    xf = 0.0_wp
+    y = xf
+    tk = 1.0_wp
+    do it = 1, 20000
+      xold = xf
+      xf = y - (matmul(a0, y) - b)/lmax
+      call set%project(xf)
+      tk1 = 0.5_wp*(1.0_wp + sqrt(1.0_wp + 4.0_wp*tk*tk))
+      y = xf + ((tk - 1.0_wp)/tk1)*(xf - xold)
+      tk = tk1
+    end do
+    call report_le(norm2(x - xf)/norm2(xf), 1.0e-9_wp, 'random QP: MPGP''s minimiser against FISTA''s (20000 steps)')
+    ! the Newton method asked for: MPGP takes the set
+    x2 = 0.0_wp
+    solver%opts%method = QP_NEWTON
+    call solver%solve_in(A, b, set, x2)
+    call report(solver%stats%status == MPRGP_CONVERGED .and. solver%stats%n_newton == 0 .and. &
+                norm2(x2 - x) <= 1.0e-12_wp*norm2(x), 'random QP: the Newton method asked for, MPGP used (no Newton step)')
+    solver%opts%method = QP_MPRGP
+  end subroutine test_random_qp
+
+end program test_disc_set
