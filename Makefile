@@ -66,7 +66,7 @@ endif
 # Library modules in data-flow order (deck -> mesh -> assembly -> factorization ->
 # condensation -> contact iteration -> output).
 MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology volume_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
-        cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set tangent_discs mprgp_support qp_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
+        cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set tangent_discs mprgp_support qp_newton disc_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
         results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
@@ -190,8 +190,10 @@ $(BUILD)/constraint_set.o: $(BUILD)/kinds.o
 $(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/constraint_set.o
 $(BUILD)/qp_newton.o:      $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/constraint_set.o
+$(BUILD)/disc_newton.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/tangent_discs.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
-                           $(BUILD)/constraint_set.o $(BUILD)/mprgp_support.o $(BUILD)/qp_newton.o
+                           $(BUILD)/constraint_set.o $(BUILD)/mprgp_support.o $(BUILD)/qp_newton.o \
+                           $(BUILD)/tangent_discs.o $(BUILD)/disc_newton.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o $(BUILD)/constraint_set.o
 $(BUILD)/nonneg_lsq.o:     $(BUILD)/cholesky.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o
 $(BUILD)/mortar_chains.o:  $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o

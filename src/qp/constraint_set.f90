@@ -80,7 +80,7 @@ module constraint_set
     !> |gP|.
     procedure :: projected_gradient_norm => set_projected_gradient_norm
     !> True when the set's faces are flat (a box): a step along a face direction stays on
-    !! the face, which MPRGP's proportioning step and the active-set Newton method rely on.
+    !! the face, which MPRGP's proportioning step and qp_newton's active-set method rely on.
     procedure :: linear => set_linear
     !> d' C d, the second-order change of the cost along the boundary that the curvature of
     !! its faces adds when x + t d is projected back (0 on flat faces).

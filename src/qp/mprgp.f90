@@ -33,6 +33,11 @@
 !! u = +huge, so a solve without upper bounds executes the same floating-point operations,
 !! iterate for iterate, with or without ub.
 !!
+!! A set whose faces are curved (`linear` false: the discs of 3D friction, module
+!! tangent_discs) makes this MPGP (Dostal and Kozubek): its proportioning step is projected
+!! and the gradient computed again; QP_NEWTON on it is module disc_newton's method along the
+!! circles, every other method MPGP.
+!!
 !! Thread safety: no module variables, no SAVE, work arrays are local to each call.
 !! Two threads may solve concurrently with two different operators.
 module mprgp
@@ -46,6 +51,8 @@ module mprgp
                            QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
   use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
   use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped, SET_OK, SET_NONFINITE
+  use tangent_discs, only: disc_set_t
+  use disc_newton, only: disc_newton_step, disc_held, DN_STILL, DN_NOT_SPD
   implicit none (type, external)
   private
 
@@ -193,8 +200,9 @@ contains
     end if
     call start(self, A, b, set, x, rw, raw, nrw)
     method = self%opts%method
-    ! the Newton method's face problems are linear: a set with curved faces (discs) is MPGP's
-    if (.not. set%linear()) method = QP_MPRGP
+    ! a set with curved faces (discs): MPGP, or asked for, the Newton method along its circles
+    ! (module disc_newton)
+    if (.not. set%linear() .and. method /= QP_NEWTON) method = QP_MPRGP
     if (method /= QP_MPRGP) then
       select type (A)
       type is (dense_op_t)
@@ -205,7 +213,11 @@ contains
     end if
     select case (method)
     case (QP_NEWTON)
-      call newton_loop(self, A, b, set, x)
+      if (set%linear()) then
+        call newton_loop(self, A, b, set, x)
+      else
+        call disc_newton_loop(self, A, b, set, x, rw, raw, nrw)
+      end if
     case (QP_AUTO)
       call auto_steps()
     case (QP_NEWTON_FIRST)
@@ -408,6 +420,75 @@ contains
     end subroutine newton_steps
 
   end subroutine newton_loop
+
+  !> The Newton method on a set with curved faces (module disc_newton), until the stopping
+  !! test ends the solve: each step on a dense A computes the gradient afresh. Two steps in a
+  !! row that find x at its face's minimiser with nothing to release end it: converged to
+  !! working precision when |gP| is within NEWTON_FLOOR n eps lambda_max |x|, else as failed
+  !! (max_it). An A that is not a dense_op_t, or a set that is not the friction set, is MPGP's.
+  subroutine disc_newton_loop(self, A, b, set, x, rw, raw, nrw)
+    type(mprgp_t), intent(inout) :: self
+    class(linop_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:)
+    class(constraint_set_t), intent(in) :: set
+    real(wp), intent(inout) :: x(:)
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)
+    integer, intent(inout), optional :: nrw(2)
+    logical, allocatable :: held(:)
+    logical :: at_min
+    real(wp) :: betabeta, phitphi, flops, floor
+    integer :: outcome, still
+    character(len=24) :: s1
+    select type (set)
+    type is (disc_set_t)
+      select type (A)
+      type is (dense_op_t)
+        if (.not. self%fresh) call true_gradient(self, A, b, x)
+        allocate (held(self%n))
+        call disc_held(set, x, self%g, held)
+        at_min = .false.
+        still = 0
+        main: do
+          select case (stopping_test(self, A, b, set, x, betabeta, phitphi))
+          case (DONE)
+            exit main
+          case (RETEST)
+            cycle main
+          end select
+          self%it = self%it + 1
+          flops = 0.0_wp
+          call disc_newton_step(A%a, b, set, x, self%g, self%ax, held, at_min, outcome, flops)
+          self%fresh = .true.
+          self%stats%n_newton = self%stats%n_newton + 1
+          if (flops > 2.0_wp*real(self%n, wp)**2*2.5_wp) self%stats%n_factor = self%stats%n_factor + 1
+          self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(self%n, wp)**2)))
+          if (outcome == DN_NOT_SPD) then
+            call fail(self, MPRGP_NOT_SPD, 'the Newton method on the discs met a face matrix that is not '// &
+                      'positive definite at step '//trim(itoa(self%it))//': A is not SPD')
+            exit main
+          end if
+          still = merge(still + 1, 0, outcome == DN_STILL)
+          if (still < 2) cycle main
+          self%stats%gp_norm = set%projected_gradient_norm(x, self%g)
+          if (self%lam_lo <= 0.0_wp) self%lam_lo = maxval(sum(abs(A%a), dim=1))
+          floor = NEWTON_FLOOR*real(self%n, wp)*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)
+          write (s1, '(es10.3)') self%stats%gp_norm
+          if (self%stats%gp_norm <= floor) then
+            self%stats%status = MPRGP_CONVERGED
+            self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
+              ' after '//trim(itoa(self%stats%n_newton))//' Newton steps on the discs'
+          else
+            self%stats%status = MPRGP_MAX_IT
+            self%stats%message = 'not converged: the Newton method on the discs stalls at |gP| = '// &
+              trim(adjustl(s1))
+          end if
+          exit main
+        end do main
+        return
+      end select
+    end select
+    call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
+  end subroutine disc_newton_loop
 
   !> A solve uses its search direction once.
   subroutine consume_search(self)

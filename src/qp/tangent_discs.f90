@@ -19,9 +19,10 @@
 !!                     variable, and `pin` puts that disc on its circle.
 !! The set is not linear (its faces are curved): MPRGP's proportioning step along -beta
 !! leaves a disc to second order, so it is projected and the gradient computed again
-!! (module mprgp), and the active-set Newton method, whose face problems are linear, is not
-!! used with it. `binding`, `leaving` and `settle` still answer for a disc (on its circle,
-!! with the gradient or the direction pointing out of it) so that the set is whole.
+!! (module mprgp), and its active-set Newton method is module disc_newton's (a Newton step
+!! along the circles), not qp_newton's. `binding` (a disc on its circle whose gradient does
+!! not point into it) is disc_newton's working set; `leaving` and `settle` answer for a disc
+!! too, so that the set is whole.
 !!
 !! Thread safety: no module variables.
 module tangent_discs
@@ -31,7 +32,7 @@ module tangent_discs
   implicit none (type, external)
   private
 
-  public :: disc_set_t, disc_set
+  public :: disc_set_t, disc_set, circle_point
 
   real(wp), parameter :: big = huge(1.0_wp)
   !> A point within this relative distance of its circle is on it (a projected point lands
@@ -181,6 +182,21 @@ contains
     real(wp), intent(in) :: xa, xb, r
     on = xa*xa + xb*xb >= (r*(1.0_wp - CIRCLE_RTOL))**2
   end function on_circle
+
+  !> The unit outward normal (na, nb) of a point (xa, xb) of a circle and its distance s from
+  !! the centre ((1, 0) at the centre).
+  pure subroutine circle_point(xa, xb, na, nb, s)
+    real(wp), intent(in) :: xa, xb
+    real(wp), intent(out) :: na, nb, s
+    s = sqrt(xa*xa + xb*xb)
+    if (s > 0.0_wp) then
+      na = xa/s
+      nb = xb/s
+    else
+      na = 1.0_wp
+      nb = 0.0_wp
+    end if
+  end subroutine circle_point
 
   !> (xa, xb) scaled onto the disc of radius r when outside it.
   pure subroutine project_point(xa, xb, r)

@@ -13,8 +13,10 @@
 !!    the circle along b every time (a box fails this by up to 41%); 30 nodes with a random
 !!    SPD A (condition 1e2): the KKT conditions checked from A x - b, and the minimiser
 !!    against an independent method written here (projected gradient with Nesterov's
-!!    momentum, FISTA, 20000 steps); the active-set Newton method, whose faces are flat,
-!!    is not used on it (the same answer, no Newton step).
+!!    momentum, FISTA, 20000 steps);
+!!  - the Newton method along the circles (module disc_newton): the same minimiser as MPGP's
+!!    on that problem, and at condition 1e6 (40 nodes) the KKT conditions to 1e-10 |b|
+!!    within 200 steps.
 !! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
 program test_disc_set
   use kinds, only: wp
@@ -35,6 +37,7 @@ program test_disc_set
   call test_identity()
   call test_isotropy()
   call test_random_qp()
+  call test_newton_hard()
   call test_summary()
 
 contains
@@ -303,13 +306,68 @@ contains
       tk = tk1
     end do
     call report_le(norm2(x - xf)/norm2(xf), 1.0e-9_wp, 'random QP: MPGP''s minimiser against FISTA''s (20000 steps)')
-    ! the Newton method asked for: MPGP takes the set
+    ! the Newton method along the circles (module disc_newton): the same minimiser
     x2 = 0.0_wp
     solver%opts%method = QP_NEWTON
     call solver%solve_in(A, b, set, x2)
-    call report(solver%stats%status == MPRGP_CONVERGED .and. solver%stats%n_newton == 0 .and. &
-                norm2(x2 - x) <= 1.0e-12_wp*norm2(x), 'random QP: the Newton method asked for, MPGP used (no Newton step)')
+    call report(solver%stats%status == MPRGP_CONVERGED .and. solver%stats%n_newton > 0, &
+                'random QP: the Newton method on the discs converged: '//trim(solver%stats%message))
+    call report_le(norm2(x2 - x)/norm2(x), 1.0e-9_wp, 'random QP: the Newton method''s minimiser against MPGP''s')
     solver%opts%method = QP_MPRGP
   end subroutine test_random_qp
+
+  !> The same kind of problem at condition 1e6 (beyond what MPGP's sliding along the circles
+  !! reaches in a test's time): the Newton method on the discs, from 0, within 200 steps, to
+  !! rtol 1e-10, with the KKT conditions checked as above (1e-10 |b|).
+  subroutine test_newton_hard()
+    integer, parameter :: nk = 40, n = 3*nk
+    type(disc_set_t) :: set
+    type(dense_op_t) :: A
+    type(mprgp_t) :: solver
+    real(wp) :: a0(n, n), b(n), x(n), xu(n), y2(n, n), g(n), r(nk), lmin, lmax, s, nu(2), kkt
+    integer :: i, k, info, onc
+    call random_spd(n, 6.0_wp, a0, lmin, lmax)
+    do k = 1, nk
+      b(3*k - 2) = urand(-1.0_wp, 2.0_wp)*lmax
+      b(3*k - 1) = urand(-1.0_wp, 1.0_wp)*lmax
+      b(3*k) = urand(-1.0_wp, 1.0_wp)*lmax
+    end do
+    xu = b
+    y2 = a0
+    call dposv('L', n, 1, y2, n, xu, n, info)
+    do k = 1, nk
+      r(k) = urand(0.3_wp, 1.5_wp)*hypot(xu(3*k - 1), xu(3*k))
+    end do
+    set = node_set(r)
+    call dense_op_init(A, a0)
+    x = 0.0_wp
+    solver%opts%method = QP_NEWTON
+    solver%opts%rtol = 1.0e-10_wp
+    solver%opts%max_it = 200
+    call solver%solve_in(A, b, set, x)
+    call report(solver%stats%status == MPRGP_CONVERGED, 'condition 1e6: the Newton method on the discs: '// &
+                trim(solver%stats%message))
+    g = matmul(a0, x) - b
+    kkt = 0.0_wp
+    onc = 0
+    do k = 1, nk
+      i = 3*k - 2
+      if (x(i) > 0.0_wp) then
+        kkt = max(kkt, abs(g(i)))
+      else
+        kkt = max(kkt, -g(i), merge(big, 0.0_wp, x(i) < 0.0_wp))
+      end if
+      s = hypot(x(i + 1), x(i + 2))
+      if (s >= r(k)*(1.0_wp - 1.0e-12_wp)) then
+        onc = onc + 1
+        nu = x(i + 1:i + 2)/s
+        kkt = max(kkt, abs(g(i + 1)*nu(2) - g(i + 2)*nu(1)), max(dot_product(g(i + 1:i + 2), nu), 0.0_wp))
+      else
+        kkt = max(kkt, maxval(abs(g(i + 1:i + 2))))
+      end if
+    end do
+    call report(onc >= 3 .and. onc <= nk - 3, 'condition 1e6: some discs on their circles, some inside')
+    call report_le(kkt/norm2(b), 1.0e-10_wp, 'condition 1e6: the KKT conditions (normal forces and discs)')
+  end subroutine test_newton_hard
 
 end program test_disc_set
