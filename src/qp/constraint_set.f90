@@ -31,7 +31,7 @@ module constraint_set
   implicit none (type, external)
   private
 
-  public :: constraint_set_t, box_set_t, box_set, chopped
+  public :: constraint_set_t, box_set_t, box_set, chopped, set_projected_gradient_norm
   public :: SET_OK, SET_BAD_ARG, SET_NONFINITE
 
   integer, parameter :: SET_OK = 0         !< the set is valid for n unknowns

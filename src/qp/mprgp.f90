@@ -36,7 +36,8 @@
 !! A set whose faces are curved (`linear` false: the discs of 3D friction, module
 !! tangent_discs) makes this MPGP (Dostal and Kozubek): its proportioning step is projected
 !! and the gradient computed again; QP_NEWTON on it is module disc_newton's method along the
-!! circles, every other method MPGP.
+!! circles, QP_AUTO (and the Newton-first and polished variants, which keep box factors)
+!! MPGP within 'auto''s budget and then that method.
 !!
 !! Thread safety: no module variables, no SAVE, work arrays are local to each call.
 !! Two threads may solve concurrently with two different operators.
@@ -200,9 +201,10 @@ contains
     end if
     call start(self, A, b, set, x, rw, raw, nrw)
     method = self%opts%method
-    ! a set with curved faces (discs): MPGP, or asked for, the Newton method along its circles
-    ! (module disc_newton)
-    if (.not. set%linear() .and. method /= QP_NEWTON) method = QP_MPRGP
+    ! a set with curved faces (discs): MPGP, the Newton method along its circles (module
+    ! disc_newton), or 'auto' between them (its Newton-first and polished variants keep box
+    ! factors: 'auto' there)
+    if (.not. set%linear() .and. method /= QP_NEWTON .and. method /= QP_MPRGP) method = QP_AUTO
     if (method /= QP_MPRGP) then
       select type (A)
       type is (dense_op_t)
@@ -285,7 +287,11 @@ contains
       if (self%stats%status == MPRGP_MAX_IT .and. budget < max_it) then
         self%stats%switched = .true.
         if (.not. self%fresh) call true_gradient(self, A, b, x)
-        call newton_loop(self, A, b, set, x)
+        if (set%linear()) then
+          call newton_loop(self, A, b, set, x)
+        else
+          call disc_newton_loop(self, A, b, set, x, rw, raw, nrw)
+        end if
       end if
     end subroutine auto_steps
 

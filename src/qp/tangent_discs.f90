@@ -28,7 +28,7 @@
 module tangent_discs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
-  use constraint_set, only: constraint_set_t, box_set_t, SET_OK, SET_BAD_ARG, SET_NONFINITE
+  use constraint_set, only: constraint_set_t, box_set_t, set_projected_gradient_norm, SET_OK, SET_BAD_ARG, SET_NONFINITE
   implicit none (type, external)
   private
 
@@ -150,9 +150,16 @@ contains
     end if
     allocate (seen(n), source=0)
     do k = 1, size(self%r)
-      if (.not. ieee_is_finite(self%r(k)) .or. self%r(k) < 0.0_wp) then
+      ! (two tests: an ordered comparison with a NaN would raise the invalid flag)
+      if (.not. ieee_is_finite(self%r(k))) then
         write (buf, '(a,i0,a)') 'r(', k, ') is not a finite radius >= 0'
-        code = merge(SET_NONFINITE, SET_BAD_ARG, .not. ieee_is_finite(self%r(k)))
+        code = SET_NONFINITE
+        message = trim(buf)
+        return
+      end if
+      if (self%r(k) < 0.0_wp) then
+        write (buf, '(a,i0,a)') 'r(', k, ') is not a finite radius >= 0'
+        code = SET_BAD_ARG
         message = trim(buf)
         return
       end if
@@ -327,20 +334,12 @@ contains
     end do
   end subroutine disc_split_gradient
 
-  !> |gP|, summed in index order.
+  !> |gP|, summed in index order (the generic one: the box's one-pass sum knows no discs).
   real(wp) function disc_projected_gradient_norm(self, x, g) result(r)
     class(disc_set_t), intent(in) :: self
     real(wp), intent(in) :: x(:)    !< iterate
     real(wp), intent(in) :: g(:)    !< gradient
-    real(wp), allocatable :: gp(:)
-    integer :: i
-    allocate (gp(size(x)))
-    call self%projected_gradient(x, g, gp)
-    r = 0.0_wp
-    do i = 1, size(x)
-      r = r + gp(i)**2
-    end do
-    r = sqrt(r)
+    r = set_projected_gradient_norm(self, x, g)
   end function disc_projected_gradient_norm
 
   !> beta: the box's on its variables, g - min(nu.g, 0) nu on a disc's circle, 0 inside.

@@ -5,7 +5,9 @@
   - every relative link and image of README.md and doc/*.md points to an existing file;
   - the module graph of doc/developing.md is what tools/module_graph.py derives from src/;
   - doc/developing.md's Layout names every source file of src/ in its own folder and every
-    header of include/, and names no file that is not there;
+    header of include/, and names no file that is not there; every procedure or type it names
+    (a name with an underscore that src/ defines) is defined in the file it is named under, or
+    in the module that qualifies it ("assembly's nodal_stress");
   - no issue numbers in README.md or doc/ (CHANGELOG.md holds the history);
   - doc/geometry.md's "Shipped scenes" names every inputs/*.nml and the Cattaneo-Mindlin study;
   - the effective deck of README.md's annotated run is the one bin/robin_contact prints for
@@ -200,6 +202,80 @@ moved = dev.replace("    blas_tiles.c", "    blas_tile.c", 1).replace("\n    dig
 m2, e2, _, _ = layout_mismatch(moved)
 check("src/linalg/blas_tiles.c" in m2 and "src/linalg/blas_tile.c" in e2 and "src/base/digest.f90" in m2,
       "the layout check finds a renamed file and a file put in the wrong folder", f"{m2} / {e2}")
+
+
+# the procedures and types the Layout names against where src/ defines them
+def layout_entries(text):
+    """{src path: its description} of the Layout block (an entry's continuation lines joined)."""
+    block = text.split("## Layout", 1)[1].split("```", 2)[1] if "## Layout" in text else ""
+    stack, entries, cur = [], {}, None
+    for ln in block.splitlines():
+        m = re.match(r"^( *)(\S+)(\s|$)", ln)
+        if not m:
+            continue
+        indent, name = len(m.group(1)), m.group(2)
+        if re.fullmatch(r"[A-Za-z0-9_]+\.(f90|c)", name) or name.endswith("/"):
+            while stack and stack[-1][0] >= indent:
+                stack.pop()
+            cur = None
+            if name.endswith("/"):
+                stack.append((indent, name[:-1]))
+            elif stack and stack[0][1] == "src":
+                cur = "/".join([d for _, d in stack] + [name])
+                entries[cur] = ln[m.end(2):]
+        elif cur is not None:
+            entries[cur] += " " + ln.strip()
+    return entries
+
+
+DEF_F90 = [re.compile(r"^\s*(?:(?:pure|elemental|recursive|impure|module)\s+)*(?:(?:integer|logical|real|character|"
+                      r"complex|type|class)\b[^!\n]*?\s+)?(?:subroutine|function)\s+(\w+)", re.I | re.M),
+           re.compile(r"^\s*type\s*(?:,[^:!\n]*)?::\s*(\w+)", re.I | re.M),
+           re.compile(r"^\s*procedure\s*(?:\([^)]*\))?\s*(?:,[^:!\n]*)?::\s*(\w+)", re.I | re.M)]
+DEF_C = re.compile(r"^(?:static\s+)?(?:const\s+)?(?:struct\s+)?\w+[\s*]+\**(\w+)\s*\([^;]*$", re.M)
+
+
+def src_definitions(root):
+    """{name: the src files that define it}: Fortran procedures (interface bodies too), types
+    and type-bound names; C functions (a trailing underscore, the Fortran binding, dropped)."""
+    defs = {}
+    for f in glob.glob(os.path.join(root, "src", "**", "*.*"), recursive=True):
+        rel = os.path.relpath(f, root)
+        if not f.endswith((".f90", ".c")):
+            continue
+        text = read(f)
+        for pat in (DEF_F90 if f.endswith(".f90") else [DEF_C]):
+            for name in pat.findall(text):
+                defs.setdefault(name.lower().rstrip("_"), set()).add(rel)
+    return defs
+
+
+def misplaced_names(text, defs):
+    """Names with an underscore in a Layout entry that src/ defines, but not in that entry's
+    file; a name after "<module>'s " or "<module>' " is looked for in that module's file."""
+    stems = {os.path.splitext(os.path.basename(p))[0]: p for ps in defs.values() for p in ps}
+    out = []
+    for path, desc in layout_entries(text).items():
+        for m in re.finditer(r"\b[a-z][a-z0-9]*_[a-z0-9_]*\b", desc):
+            where = defs.get(m.group(0))
+            if not where:
+                continue
+            q = re.search(r"(\w+)'s?\s+$", desc[:m.start()])
+            want = stems.get(q.group(1), path) if q else path
+            if want not in where:
+                out.append(f"{m.group(0)} (under {path}) is defined in {', '.join(sorted(where))}")
+    return sorted(set(out))
+
+
+defs = src_definitions(ROOT)
+bad = misplaced_names(dev, defs)
+check(defs and not bad, "every procedure and type doc/developing.md's Layout names is defined in the file it is named "
+      "under (or in the module it is qualified by)", "; ".join(bad[:4]))
+wrong = dev.replace("(build_interface: two groups per pair", "(two groups per pair", 1).replace(
+    "    condense.f90        a body on its contact rows B_a:", "    condense.f90        a body on its contact rows B_a (build_interface):", 1)
+bad2 = misplaced_names(wrong, defs)
+check(any(b.startswith("build_interface (under src/contact/condense.f90)") for b in bad2),
+      "the name check finds a procedure named under the wrong file", "; ".join(bad2[:2]))
 
 
 # the README's effective deck against the program's

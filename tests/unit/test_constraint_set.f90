@@ -6,6 +6,7 @@
 !! box set against `solve` with lb, ub (the same iterates, bit for bit).
 !! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
 program test_constraint_set
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
   use linop, only: dense_op_t, dense_op_init
   use constraint_set, only: box_set_t, box_set, SET_OK, SET_BAD_ARG, SET_NONFINITE
@@ -241,8 +242,7 @@ contains
     box = box_set([0.0_wp, 0.0_wp], [1.0_wp, -1.0_wp])
     call box%validate(2, code, why)
     call report(code == SET_BAD_ARG .and. index(why, 'empty') > 0, 'box: ub < lb refused ('//why//')')
-    nan = 0.0_wp
-    nan = nan/nan
+    nan = ieee_value(1.0_wp, ieee_quiet_nan)
     box = box_set([0.0_wp, nan])
     call box%validate(2, code, why)
     call report(code == SET_NONFINITE, 'box: NaN bound refused ('//why//')')

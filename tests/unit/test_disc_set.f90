@@ -16,14 +16,16 @@
 !!    momentum, FISTA, 20000 steps);
 !!  - the Newton method along the circles (module disc_newton): the same minimiser as MPGP's
 !!    on that problem, and at condition 1e6 (40 nodes) the KKT conditions to 1e-10 |b|
-!!    within 200 steps.
+!!    within 200 steps; 'auto' (MPGP within its budget, then that method) at condition 1e3:
+!!    switched, MPGP's minimiser at fewer products.
 !! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
 program test_disc_set
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
   use linop, only: dense_op_t, dense_op_init
   use constraint_set, only: SET_OK, SET_BAD_ARG, SET_NONFINITE
   use tangent_discs, only: disc_set_t, disc_set
-  use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP
+  use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP, QP_AUTO
   use lapack, only: dposv
   use testing, only: report, report_le, test_summary, set_seed, urand, random_spd
   implicit none (type, external)
@@ -38,6 +40,7 @@ program test_disc_set
   call test_isotropy()
   call test_random_qp()
   call test_newton_hard()
+  call test_auto()
   call test_summary()
 
 contains
@@ -162,8 +165,7 @@ contains
     set = node_set([1.0_wp, -2.0_wp])
     call set%validate(6, code, why)
     call report(code == SET_BAD_ARG .and. index(why, 'r(2)') > 0, 'validate: a negative radius: '//why)
-    nan = 0.0_wp
-    nan = nan/nan
+    nan = ieee_value(1.0_wp, ieee_quiet_nan)
     set = node_set([nan, 2.0_wp])
     call set%validate(6, code, why)
     call report(code == SET_NONFINITE .and. index(why, 'r(1)') > 0, 'validate: a NaN radius: '//why)
@@ -241,23 +243,9 @@ contains
     type(disc_set_t) :: set
     type(dense_op_t) :: A
     type(mprgp_t) :: solver
-    real(wp) :: a0(n, n), b(n), x(n), x2(n), xf(n), y(n), xold(n), g(n), r(nk), lmin, lmax, tk, tk1, s
-    real(wp) :: kkt_n, kkt_t, gscale, nu(2), y2(n, n)
-    integer :: i, k, it, onc, info
-    call random_spd(n, 2.0_wp, a0, lmin, lmax)
-    do k = 1, nk
-      b(3*k - 2) = urand(-1.0_wp, 2.0_wp)*lmax
-      b(3*k - 1) = urand(-1.0_wp, 1.0_wp)*lmax
-      b(3*k) = urand(-1.0_wp, 1.0_wp)*lmax
-    end do
-    ! radii from 0.3 to 1.5 times the tangential force of the unconstrained minimiser: some
-    ! discs end on their circles, some inside
-    xf = b
-    y2 = a0
-    call dposv('L', n, 1, y2, n, xf, n, info)
-    do k = 1, nk
-      r(k) = urand(0.3_wp, 1.5_wp)*hypot(xf(3*k - 1), xf(3*k))
-    end do
+    real(wp) :: a0(n, n), b(n), x(n), x2(n), xf(n), y(n), xold(n), r(nk), lmax, tk, tk1, kkt
+    integer :: it, onc
+    call random_friction_qp(nk, 2.0_wp, a0, b, r, lmax)
     set = node_set(r)
     call dense_op_init(A, a0)
     x = 0.0_wp
@@ -265,34 +253,10 @@ contains
     solver%opts%max_it = 100000
     call solver%solve_in(A, b, set, x)
     call report(solver%stats%status == MPRGP_CONVERGED, 'random QP: converged: '//trim(solver%stats%message))
-    ! KKT from A x - b, relative to |b|
-    g = matmul(a0, x) - b
-    gscale = norm2(b)
-    kkt_n = 0.0_wp
-    kkt_t = 0.0_wp
-    onc = 0
-    do k = 1, nk
-      i = 3*k - 2
-      if (x(i) > 0.0_wp) then
-        kkt_n = max(kkt_n, abs(g(i)))
-      else if (x(i) == 0.0_wp) then
-        kkt_n = max(kkt_n, -g(i))
-      else
-        kkt_n = big
-      end if
-      s = hypot(x(i + 1), x(i + 2))
-      if (s >= r(k)*(1.0_wp - 1.0e-12_wp)) then
-        onc = onc + 1
-        nu = x(i + 1:i + 2)/s
-        ! g_t = -c nu with c >= 0: no part along the circle, no outward part
-        kkt_t = max(kkt_t, abs(g(i + 1)*nu(2) - g(i + 2)*nu(1)), max(dot_product(g(i + 1:i + 2), nu), 0.0_wp))
-      else
-        kkt_t = max(kkt_t, maxval(abs(g(i + 1:i + 2))))
-      end if
-    end do
+    call kkt_of(a0, b, x, r, kkt, onc)
     call report(onc >= 3 .and. onc <= nk - 3, 'random QP: some discs on their circles, some inside')
-    call report_le(kkt_n/gscale, 1.0e-10_wp, 'random QP: KKT of the normal forces (x >= 0, g >= 0, x g = 0)')
-    call report_le(kkt_t/gscale, 1.0e-10_wp, 'random QP: KKT of the discs (g = 0 inside; g = -c nu, c >= 0, on a circle)')
+    call report_le(kkt/norm2(b), 1.0e-10_wp, 'random QP: KKT (x_n >= 0, g_n >= 0, x_n g_n = 0; g_t = 0 inside a '// &
+                   'disc, g_t = -c nu, c >= 0, on its circle)')
     ! FISTA with step 1/lmax (lmax is A's largest eigenvalue)
     xf = 0.0_wp
     y = xf
@@ -324,20 +288,9 @@ contains
     type(disc_set_t) :: set
     type(dense_op_t) :: A
     type(mprgp_t) :: solver
-    real(wp) :: a0(n, n), b(n), x(n), xu(n), y2(n, n), g(n), r(nk), lmin, lmax, s, nu(2), kkt
-    integer :: i, k, info, onc
-    call random_spd(n, 6.0_wp, a0, lmin, lmax)
-    do k = 1, nk
-      b(3*k - 2) = urand(-1.0_wp, 2.0_wp)*lmax
-      b(3*k - 1) = urand(-1.0_wp, 1.0_wp)*lmax
-      b(3*k) = urand(-1.0_wp, 1.0_wp)*lmax
-    end do
-    xu = b
-    y2 = a0
-    call dposv('L', n, 1, y2, n, xu, n, info)
-    do k = 1, nk
-      r(k) = urand(0.3_wp, 1.5_wp)*hypot(xu(3*k - 1), xu(3*k))
-    end do
+    real(wp) :: a0(n, n), b(n), x(n), r(nk), lmax, kkt
+    integer :: onc
+    call random_friction_qp(nk, 6.0_wp, a0, b, r, lmax)
     set = node_set(r)
     call dense_op_init(A, a0)
     x = 0.0_wp
@@ -347,10 +300,78 @@ contains
     call solver%solve_in(A, b, set, x)
     call report(solver%stats%status == MPRGP_CONVERGED, 'condition 1e6: the Newton method on the discs: '// &
                 trim(solver%stats%message))
+    call kkt_of(a0, b, x, r, kkt, onc)
+    call report(onc >= 3 .and. onc <= nk - 3, 'condition 1e6: some discs on their circles, some inside')
+    call report_le(kkt/norm2(b), 1.0e-10_wp, 'condition 1e6: the KKT conditions (normal forces and discs)')
+  end subroutine test_newton_hard
+
+  !> 'auto' on a disc set, condition 1e3 (30 nodes, rtol 1e-10): MPGP within its budget, then
+  !! the Newton method on the discs: converged, switched, the same minimiser as MPGP's alone
+  !! (1e-9) at fewer products.
+  subroutine test_auto()
+    integer, parameter :: nk = 30, n = 3*nk
+    type(disc_set_t) :: set
+    type(dense_op_t) :: A
+    type(mprgp_t) :: solver
+    real(wp) :: a0(n, n), b(n), x(n), x2(n), r(nk), lmax
+    integer :: nmv
+    character(len=64) :: msg
+    call random_friction_qp(nk, 3.0_wp, a0, b, r, lmax)
+    set = node_set(r)
+    call dense_op_init(A, a0)
+    x = 0.0_wp
+    solver%opts%method = QP_MPRGP
+    solver%opts%rtol = 1.0e-10_wp
+    solver%opts%max_it = 100000
+    call solver%solve_in(A, b, set, x)
+    nmv = solver%stats%n_matvec
+    x2 = 0.0_wp
+    solver%opts%method = QP_AUTO
+    call solver%solve_in(A, b, set, x2)
+    write (msg, '(i0,a,i0,a)') solver%stats%n_matvec, ' products against ', nmv, ' of MPGP alone'
+    call report(solver%stats%status == MPRGP_CONVERGED .and. solver%stats%switched .and. solver%stats%n_matvec < nmv, &
+                'auto on discs, condition 1e3: switched to the Newton method, '//trim(msg))
+    call report_le(norm2(x2 - x)/norm2(x), 1.0e-9_wp, 'auto on discs: the minimiser of MPGP alone')
+  end subroutine test_auto
+
+  !> A random friction QP of nk nodes: A SPD of condition 10^cexp, b with normal parts of
+  !! both signs, radii 0.3 to 1.5 times the tangential forces of the unconstrained minimiser
+  !! (some discs end on their circles, some inside).
+  subroutine random_friction_qp(nk, cexp, a0, b, r, lmax)
+    integer, intent(in) :: nk
+    real(wp), intent(in) :: cexp
+    real(wp), intent(out) :: a0(3*nk, 3*nk), b(3*nk), r(nk), lmax
+    real(wp) :: xu(3*nk), y2(3*nk, 3*nk), lmin
+    integer :: k, info
+    call random_spd(3*nk, cexp, a0, lmin, lmax)
+    do k = 1, nk
+      b(3*k - 2) = urand(-1.0_wp, 2.0_wp)*lmax
+      b(3*k - 1) = urand(-1.0_wp, 1.0_wp)*lmax
+      b(3*k) = urand(-1.0_wp, 1.0_wp)*lmax
+    end do
+    xu = b
+    y2 = a0
+    call dposv('L', 3*nk, 1, y2, 3*nk, xu, 3*nk, info)
+    if (info /= 0) error stop 'random_friction_qp: dposv failed'
+    do k = 1, nk
+      r(k) = urand(0.3_wp, 1.5_wp)*hypot(xu(3*k - 1), xu(3*k))
+    end do
+  end subroutine random_friction_qp
+
+  !> The KKT conditions of x for the node set of radii r, from g = A x - b: max over the
+  !! nodes of |g_n| where x_n > 0, -g_n where x_n = 0 (huge where x_n < 0), |g_t| inside a
+  !! disc, and on a circle g_t's part along it and its outward part (g_t = -c nu, c >= 0);
+  !! onc: the discs on their circles.
+  subroutine kkt_of(a0, b, x, r, kkt, onc)
+    real(wp), intent(in) :: a0(:, :), b(:), x(:), r(:)
+    real(wp), intent(out) :: kkt
+    integer, intent(out) :: onc
+    real(wp) :: g(size(x)), s, nu(2)
+    integer :: i, k
     g = matmul(a0, x) - b
     kkt = 0.0_wp
     onc = 0
-    do k = 1, nk
+    do k = 1, size(r)
       i = 3*k - 2
       if (x(i) > 0.0_wp) then
         kkt = max(kkt, abs(g(i)))
@@ -366,8 +387,6 @@ contains
         kkt = max(kkt, maxval(abs(g(i + 1:i + 2))))
       end if
     end do
-    call report(onc >= 3 .and. onc <= nk - 3, 'condition 1e6: some discs on their circles, some inside')
-    call report_le(kkt/norm2(b), 1.0e-10_wp, 'condition 1e6: the KKT conditions (normal forces and discs)')
-  end subroutine test_newton_hard
+  end subroutine kkt_of
 
 end program test_disc_set
