@@ -30,6 +30,9 @@ module strings
   contains
     procedure :: add => text_buffer_add    !< append a piece
     procedure :: text => text_buffer_text  !< the text so far
+    !> the text so far into an allocatable (what code that two threads may run at once calls:
+    !! no deferred-length function result, see the header)
+    procedure :: get => text_buffer_get
   end type text_buffer_t
 
 contains
@@ -57,6 +60,16 @@ contains
       t = ''
     end if
   end function text_buffer_text
+
+  subroutine text_buffer_get(self, t)
+    class(text_buffer_t), intent(in) :: self
+    character(len=:), allocatable, intent(out) :: t   !< the text so far
+    if (allocated(self%buf)) then
+      t = self%buf(1:self%n)
+    else
+      t = ''
+    end if
+  end subroutine text_buffer_get
 
   !> Disable floating-point halting around a READ (an overflowing literal such as 1e400
   !! would trap in a -ffpe-trap build; it is reported as non-finite instead).

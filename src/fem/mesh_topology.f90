@@ -255,7 +255,7 @@ contains
         n = n + 1
         call list%add(merge(', ', '  ', n > 1)//"'"//file_mesh%phys_name(k)%s//"'")
       end do
-      names = list%text()
+      call list%get(names)
       names = trim(adjustl(names))
     end if
     if (len(region) > 0 .and. group == 0) then
@@ -796,7 +796,7 @@ contains
       mesh%group(ngroup)%nnode = ninner
       mesh%group(ngroup)%node = inner(1:ninner)
     end do
-    mesh%file_groups = names%text()
+    call names%get(mesh%file_groups)
     mesh%file_groups = trim(adjustl(mesh%file_groups))
     mesh%ngroup = ngroup
   end subroutine boundary_groups
@@ -878,7 +878,7 @@ contains
       mesh%group(group)%node = [mesh%group(group)%node, nodes(1:nfound)]
       mesh%group(group)%nnode = size(mesh%group(group)%node)
     end do
-    names = list%text()
+    call list%get(names)
     if (len(names) == 0) return
     if (len(mesh%file_groups) == 0) mesh%file_groups = '(none)'
     mesh%file_groups = mesh%file_groups//'; physical points:'//names

@@ -614,7 +614,7 @@ contains
       mesh%group(ngroup)%nnode = ninner
       mesh%group(ngroup)%node = inner(1:ninner)
     end do
-    mesh%file_groups = names%text()
+    call names%get(mesh%file_groups)
     mesh%file_groups = trim(adjustl(mesh%file_groups))
     mesh%ngroup = ngroup
   end subroutine face_groups
@@ -688,7 +688,7 @@ contains
       mesh%group(g)%node = [mesh%group(g)%node, nodes(1:n)]
       mesh%group(g)%nnode = size(mesh%group(g)%node)
     end do
-    names = list%text()
+    call list%get(names)
     if (len(names) == 0) return
     if (len(mesh%file_groups) == 0) mesh%file_groups = '(none)'
     mesh%file_groups = mesh%file_groups//'; physical curves:'//names
