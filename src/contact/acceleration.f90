@@ -64,8 +64,8 @@ contains
     x = x + state%omega*r
   end subroutine aitken
 
-  !> Anderson mixing of the state's depth (its stored differences, `anderson_history`) with
-  !! mixing parameter delta:
+  !> Anderson mixing of the state's depth (its stored differences, `anderson_history`, at
+  !! most the 2m unknowns) with mixing parameter delta:
   !! x+ = x + delta r - (dX + delta dR) gamma, gamma = argmin |r - dR gamma|.
   subroutine anderson(delta, state, x, r)
     real(wp), intent(in) :: delta
@@ -75,7 +75,9 @@ contains
     real(wp), allocatable :: gam(:), qr(:, :), rhs(:), work(:)
     integer :: n2, k, j, info, lwork, depth
     n2 = size(x)
-    depth = size(state%dX, 2)
+    ! at most n2 differences: more would make the least-squares problem underdetermined
+    ! (and LAPACK's dgels refuses a leading dimension below the columns)
+    depth = min(size(state%dX, 2), n2)
     if (state%nacc > 0) then
       j = mod(state%nacc - 1, depth) + 1
       state%dX(:, j) = x - state%x_prev
