@@ -51,8 +51,9 @@ contains
 
   !> One step from the feasible x with g = A x - b (both updated; ax = A x too). held is the
   !! working set (disc_held at the start of a solve, then carried); at_min: the last step was
-  !! whole (x near its face's minimiser): release first. flops: the step's work.
-  subroutine disc_newton_step(a, b, set, x, g, ax, held, at_min, outcome, flops)
+  !! whole (x near its face's minimiser): release first. flops: the step's work; factored:
+  !! counts the face factorizations.
+  subroutine disc_newton_step(a, b, set, x, g, ax, held, at_min, outcome, flops, factored)
     real(wp), intent(in) :: a(:, :)           !< A (n x n, dense, symmetric)
     real(wp), intent(in) :: b(:)              !< the linear term
     type(disc_set_t), intent(in) :: set       !< the feasible set
@@ -63,6 +64,7 @@ contains
     logical, intent(inout) :: at_min          !< in: release first; out: this step was whole
     integer, intent(out) :: outcome           !< DN_*
     real(wp), intent(inout) :: flops          !< work added (multiply-adds x 2)
+    integer, intent(inout) :: factored        !< factorizations made (one more when this step made one)
     integer, allocatable :: free(:), dk(:)
     real(wp), allocatable :: h(:, :), rhs(:), tau(:, :), curv(:), d(:), dfree(:), x0(:), g0(:)
     logical, allocatable :: rel(:)
@@ -118,6 +120,7 @@ contains
     end do
     call dpotrf_tiles('L', nf + nd, h, nf + nd, info)
     flops = flops + real(nf + nd, wp)**3/3.0_wp
+    factored = factored + 1
     if (info /= 0) then
       outcome = DN_NOT_SPD
       return

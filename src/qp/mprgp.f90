@@ -463,10 +463,9 @@ contains
           end select
           self%it = self%it + 1
           flops = 0.0_wp
-          call disc_newton_step(A%a, b, set, x, self%g, self%ax, held, at_min, outcome, flops)
+          call disc_newton_step(A%a, b, set, x, self%g, self%ax, held, at_min, outcome, flops, self%stats%n_factor)
           self%fresh = .true.
           self%stats%n_newton = self%stats%n_newton + 1
-          if (flops > 2.0_wp*real(self%n, wp)**2*2.5_wp) self%stats%n_factor = self%stats%n_factor + 1
           self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(self%n, wp)**2)))
           if (outcome == DN_NOT_SPD) then
             call fail(self, MPRGP_NOT_SPD, 'the Newton method on the discs met a face matrix that is not '// &

@@ -274,8 +274,10 @@ contains
     x2 = 0.0_wp
     solver%opts%method = QP_NEWTON
     call solver%solve_in(A, b, set, x2)
-    call report(solver%stats%status == MPRGP_CONVERGED .and. solver%stats%n_newton > 0, &
-                'random QP: the Newton method on the discs converged: '//trim(solver%stats%message))
+    call report(solver%stats%status == MPRGP_CONVERGED .and. solver%stats%n_newton > 0 .and. &
+                solver%stats%n_factor > 0 .and. solver%stats%n_factor <= solver%stats%n_newton, &
+                'random QP: the Newton method on the discs converged (a factor per step at most): '// &
+                trim(solver%stats%message))
     call report_le(norm2(x2 - x)/norm2(x), 1.0e-9_wp, 'random QP: the Newton method''s minimiser against MPGP''s')
     solver%opts%method = QP_MPRGP
   end subroutine test_random_qp
