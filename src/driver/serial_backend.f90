@@ -26,6 +26,16 @@ module serial_backend
                  agree_code, report_ranks, finish
   end type serial_backend_t
 
+  abstract interface
+    !> One body's share of a phase; a failure in err.
+    subroutine body_work_i(run, a, err)
+      import :: run_t, error_t
+      type(run_t), intent(inout) :: run   !< the run (body a's parts only are touched)
+      integer, intent(in) :: a            !< the body
+      type(error_t), intent(out) :: err   !< its failure, if any
+    end subroutine body_work_i
+  end interface
+
 contains
 
   !> The whole run against this process's memory (exit 1, nothing allocated yet).
@@ -44,61 +54,21 @@ contains
   subroutine factor(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its systems factorized into its bodies
-    type(error_t), allocatable :: err(:)
-    integer, allocatable :: order(:)
-    integer :: a, k
-    allocate (err(run%nbody))
-    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
-    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
-    do k = 1, run%nbody
-      a = order(k)
-      call factor_body(run%deck%solver%factor, run%contact_line, a, run%meshes(a), run%systems(a), run%bodies(a), &
-                       err(a))
-    end do
-    !$omp end parallel do
-    do a = 1, run%nbody
-      call fail_on(err(a), 'body '//body_label(a)//': factorization failed')
-    end do
+    call each_body(run, factor_one, 'factorization failed')
   end subroutine factor
 
   !> Every body's interface flexibility F_a and b_a, the largest first.
   subroutine condense(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies condensed
-    type(error_t), allocatable :: err(:)
-    integer, allocatable :: order(:)
-    integer :: a, k
-    allocate (err(run%nbody))
-    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
-    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
-    do k = 1, run%nbody
-      a = order(k)
-      call condense_body(run%systems(a), run%bodies(a), err(a))
-    end do
-    !$omp end parallel do
-    do a = 1, run%nbody
-      call fail_on(err(a), 'body '//body_label(a)//': condensation failed')
-    end do
+    call each_body(run, condense_one, 'condensation failed')
   end subroutine condense
 
   !> Every body's b_a for the current step's loads (one solve each), the largest first.
   subroutine condense_load(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its bodies' interface loads
-    type(error_t), allocatable :: err(:)
-    integer, allocatable :: order(:)
-    integer :: a, k
-    allocate (err(run%nbody))
-    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
-    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
-    do k = 1, run%nbody
-      a = order(k)
-      call step_interface_load(run%contact_line, a, run%systems(a), run%bodies(a), err(a))
-    end do
-    !$omp end parallel do
-    do a = 1, run%nbody
-      call fail_on(err(a), 'body '//body_label(a)//': load step condensation failed')
-    end do
+    call each_body(run, load_one, 'load step condensation failed')
   end subroutine condense_load
 
   !> The factors' memory [MiB].
@@ -123,25 +93,7 @@ contains
   subroutine recover(self, run)
     class(serial_backend_t), intent(inout) :: self
     type(run_t), intent(inout) :: run   !< the run: its displacements
-    real(wp), allocatable :: ufree(:)
-    type(error_t), allocatable :: err(:)
-    integer, allocatable :: order(:)
-    integer :: a, k
-    allocate (err(run%nbody))
-    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
-    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(ufree, a)
-    do k = 1, run%nbody
-      a = order(k)
-      allocate (ufree(run%systems(a)%n))
-      call recover_displacement(run%systems(a), run%bodies(a), gather(run%result%lam_body, run%bodies(a)%slots), ufree, &
-                                err(a))
-      if (.not. err(a)%failed()) call expand(run%systems(a), ufree, run%displacement(1:run%systems(a)%ndof, a))
-      deallocate (ufree)
-    end do
-    !$omp end parallel do
-    do a = 1, run%nbody
-      call fail_on(err(a), 'body '//body_label(a)//': displacement recovery failed')
-    end do
+    call each_body(run, recover_one, 'displacement recovery failed')
   end subroutine recover
 
   !> One process decides its exit code alone.
@@ -163,5 +115,67 @@ contains
     call par_finalize()
     call terminate(run%code)
   end subroutine finish
+
+  ! ---- the bodies on the threads ------------------------------------------------------
+
+  !> work(run, a, err(a)) for every body on the run's threads (dynamic schedule, the largest
+  !! body first), then the first failure as the fatal error 'body <a>: <what>: <reason>'.
+  !! The team has all the run's threads even with fewer bodies: a thread without a body
+  !! waits at the loop's barrier, where it runs the tasks the others make (the tiles of a
+  !! factorization, the condensation's panels).
+  subroutine each_body(run, work, what)
+    type(run_t), intent(inout) :: run
+    procedure(body_work_i) :: work
+    character(len=*), intent(in) :: what    !< what failed, for the message
+    type(error_t), allocatable :: err(:)
+    integer, allocatable :: order(:)
+    integer :: a, k
+    allocate (err(run%nbody))
+    order = largest_first([(run%systems(a)%n, a=1, run%nbody)])
+    !$omp parallel do num_threads(run%threads) schedule(dynamic, 1) private(a)
+    do k = 1, run%nbody
+      a = order(k)
+      call work(run, a, err(a))
+    end do
+    !$omp end parallel do
+    do a = 1, run%nbody
+      call fail_on(err(a), 'body '//body_label(a)//': '//what)
+    end do
+  end subroutine each_body
+
+  !> Order and factorize body a.
+  subroutine factor_one(run, a, err)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: a
+    type(error_t), intent(out) :: err
+    call factor_body(run%deck%solver%factor, run%contact_line, a, run%meshes(a), run%systems(a), run%bodies(a), err)
+  end subroutine factor_one
+
+  !> Body a's interface flexibility F_a and b_a.
+  subroutine condense_one(run, a, err)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: a
+    type(error_t), intent(out) :: err
+    call condense_body(run%systems(a), run%bodies(a), err)
+  end subroutine condense_one
+
+  !> Body a's b_a for the current step's loads (one solve).
+  subroutine load_one(run, a, err)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: a
+    type(error_t), intent(out) :: err
+    call step_interface_load(run%contact_line, a, run%systems(a), run%bodies(a), err)
+  end subroutine load_one
+
+  !> Body a's displacement under its own contact forces.
+  subroutine recover_one(run, a, err)
+    type(run_t), intent(inout) :: run
+    integer, intent(in) :: a
+    type(error_t), intent(out) :: err
+    real(wp), allocatable :: ufree(:)
+    allocate (ufree(run%systems(a)%n))
+    call recover_displacement(run%systems(a), run%bodies(a), gather(run%result%lam_body, run%bodies(a)%slots), ufree, err)
+    if (.not. err%failed()) call expand(run%systems(a), ufree, run%displacement(1:run%systems(a)%ndof, a))
+  end subroutine recover_one
 
 end module serial_backend
