@@ -54,11 +54,7 @@ contains
   function text_buffer_text(self) result(t)
     class(text_buffer_t), intent(in) :: self
     character(len=:), allocatable :: t
-    if (allocated(self%buf)) then
-      t = self%buf(1:self%n)
-    else
-      t = ''
-    end if
+    call self%get(t)
   end function text_buffer_text
 
   subroutine text_buffer_get(self, t)

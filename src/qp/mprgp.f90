@@ -340,9 +340,8 @@ contains
     real(wp), intent(inout) :: x(:)
     type(newton_work_t), target :: own
     type(newton_work_t), pointer :: work
-    real(wp) :: betabeta, phitphi, flops, floor
+    real(wp) :: betabeta, phitphi, flops
     integer :: outcome, j, n
-    character(len=24) :: s1
     n = self%n
     if (associated(self%keep)) then
       work => self%keep
@@ -408,19 +407,9 @@ contains
           refined = .true.
           cycle main
         end if
-        if (self%lam_lo <= 0.0_wp) self%lam_lo = maxval(sum(abs(am), dim=1))
-        floor = NEWTON_FLOOR*real(n, wp)*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)
-        write (s1, '(es10.3)') self%stats%gp_norm
-        if (self%stats%gp_norm <= floor) then
-          self%stats%status = MPRGP_CONVERGED
-          self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
-            ' after '//trim(itoa(self%stats%n_newton))//' Newton steps (x solves its face exactly; '// &
-            'the tolerance asked for is below what double precision resolves)'
-        else
-          self%stats%status = MPRGP_MAX_IT
-          self%stats%message = 'not converged: the Newton method stalls at |gP| = '//trim(adjustl(s1))// &
-            ', above the rounding level of A (A nearly singular on the free set)'
-        end if
+        call newton_verdict(self, am, x, ' Newton steps (x solves its face exactly; the tolerance asked for is '// &
+                            'below what double precision resolves)', 'the Newton method', &
+                            ', above the rounding level of A (A nearly singular on the free set)')
         exit main
       end do main
     end subroutine newton_steps
@@ -442,9 +431,8 @@ contains
     integer, intent(inout), optional :: nrw(2)
     logical, allocatable :: held(:)
     logical :: at_min
-    real(wp) :: betabeta, phitphi, flops, floor
+    real(wp) :: betabeta, phitphi, flops
     integer :: outcome, still
-    character(len=24) :: s1
     select type (set)
     type is (disc_set_t)
       select type (A)
@@ -475,18 +463,7 @@ contains
           still = merge(still + 1, 0, outcome == DN_STILL)
           if (still < 2) cycle main
           self%stats%gp_norm = set%projected_gradient_norm(x, self%g)
-          if (self%lam_lo <= 0.0_wp) self%lam_lo = maxval(sum(abs(A%a), dim=1))
-          floor = NEWTON_FLOOR*real(self%n, wp)*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)
-          write (s1, '(es10.3)') self%stats%gp_norm
-          if (self%stats%gp_norm <= floor) then
-            self%stats%status = MPRGP_CONVERGED
-            self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
-              ' after '//trim(itoa(self%stats%n_newton))//' Newton steps on the discs'
-          else
-            self%stats%status = MPRGP_MAX_IT
-            self%stats%message = 'not converged: the Newton method on the discs stalls at |gP| = '// &
-              trim(adjustl(s1))
-          end if
+          call newton_verdict(self, A%a, x, ' Newton steps on the discs', 'the Newton method on the discs', '')
           exit main
         end do main
         return
@@ -494,6 +471,30 @@ contains
     end select
     call mprgp_loop(self, A, b, set, x, rw, raw, nrw)
   end subroutine disc_newton_loop
+
+  !> The end of a Newton method whose x solves its face but whose |gP| (in stats) stays above
+  !! the tolerance: converged to working precision when |gP| is within NEWTON_FLOOR n eps
+  !! lambda_max |x| (a Cholesky solve's backward error), else failed (max_it); the messages
+  !! name the method (`who`) and add `done` after its step count or `why` after |gP|.
+  subroutine newton_verdict(self, am, x, done, who, why)
+    type(mprgp_t), intent(inout) :: self
+    real(wp), intent(in) :: am(:, :)           !< A, dense
+    real(wp), intent(in) :: x(:)
+    character(len=*), intent(in) :: done, who, why
+    real(wp) :: floor
+    character(len=24) :: s1
+    if (self%lam_lo <= 0.0_wp) self%lam_lo = maxval(sum(abs(am), dim=1))
+    floor = NEWTON_FLOOR*real(self%n, wp)*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)
+    write (s1, '(es10.3)') self%stats%gp_norm
+    if (self%stats%gp_norm <= floor) then
+      self%stats%status = MPRGP_CONVERGED
+      self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
+        ' after '//trim(itoa(self%stats%n_newton))//done
+    else
+      self%stats%status = MPRGP_MAX_IT
+      self%stats%message = 'not converged: '//who//' stalls at |gP| = '//trim(adjustl(s1))//why
+    end if
+  end subroutine newton_verdict
 
   !> A solve uses its search direction once.
   subroutine consume_search(self)
@@ -942,8 +943,8 @@ contains
     real(wp), allocatable :: x0(:), g0(:)
     real(wp) :: t, df, noise
     integer :: retry
-    x0 = x
-    g0 = self%g
+    allocate (x0, source=x)
+    allocate (g0, source=self%g)
     t = t0
     do retry = 0, MAX_RETRY
       x = x0
