@@ -211,7 +211,7 @@ $(BUILD)/condense.o:       $(BUILD)/assembly.o $(BUILD)/factorization.o $(BUILD)
 $(BUILD)/floating.o:       $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
                            $(BUILD)/nonneg_lsq.o $(BUILD)/strings.o
-$(BUILD)/contact_types.o:  $(BUILD)/kinds.o
+$(BUILD)/contact_types.o:  $(BUILD)/kinds.o $(BUILD)/space.o
 $(BUILD)/contact_common.o: $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o
 $(BUILD)/friction_view.o:  $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/kinds.o $(BUILD)/space.o
 $(BUILD)/equality_rows.o:  $(BUILD)/condense.o $(BUILD)/contact_interface.o $(BUILD)/kinds.o $(BUILD)/lapack.o \
@@ -225,7 +225,8 @@ $(BUILD)/robin_operators.o: $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/robin_subproblems.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/robin_operators.o \
-                           $(BUILD)/qp_newton.o $(BUILD)/smalbe.o $(BUILD)/sorting.o
+                           $(BUILD)/qp_newton.o $(BUILD)/smalbe.o $(BUILD)/sorting.o $(BUILD)/constraint_set.o \
+                           $(BUILD)/tangent_discs.o
 $(BUILD)/acceleration.o:   $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/lapack.o $(BUILD)/contact_types.o \
                            $(BUILD)/contact_common.o
 $(BUILD)/robin_iteration.o: $(BUILD)/acceleration.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \
@@ -234,18 +235,18 @@ $(BUILD)/robin_iteration.o: $(BUILD)/acceleration.o $(BUILD)/clock.o $(BUILD)/co
 $(BUILD)/monolithic.o:     $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
-                           $(BUILD)/sorting.o $(BUILD)/strings.o
+                           $(BUILD)/sorting.o $(BUILD)/strings.o $(BUILD)/tangent_discs.o
 $(BUILD)/error_estimate.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o \
-                           $(BUILD)/nonneg_lsq.o
+                           $(BUILD)/nonneg_lsq.o $(BUILD)/constraint_set.o $(BUILD)/tangent_discs.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/files.o:          $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
                            $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/friction_view.o \
                            $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
-$(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
+$(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o $(BUILD)/results.o
 # the driver's modules (src/driver): the run's data, its two back-ends, its phases
 $(BUILD)/load_history.o:   $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_interface.o \

@@ -4,7 +4,7 @@
 module contact_common
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, DIR_NORMAL
+  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t
   implicit none (type, external)
@@ -127,20 +127,36 @@ contains
   !! a bound far above every force weighs a stuck node's slip as lam_max, not as the bound,
   !! which would weigh its rounding) and a slip against the force (max(-lam_t slip, 0)) all
   !! count, scaled like the normal ones (the largest normal force lam_max and the
-  !! displacement scale).
+  !! displacement scale). In space a node's two tangential rows count as one disc: its
+  !! force's length against the radius, and the slip's part across the force
+  !! (|lam_t| |slip - (slip.nu) nu|, nu = lam_t / |lam_t|: slip and force must be parallel).
   subroutine frictional_residual(contact_line, uscale, res)
     type(interface_t), intent(in) :: contact_line
     real(wp), intent(in) :: uscale
     type(contact_result_t), intent(inout) :: res
     real(wp), allocatable :: lb(:), ub(:)
-    real(wp) :: lmax, pen, comp
+    integer, allocatable :: pr(:, :)
+    logical, allocatable :: in_disc(:)
+    real(wp) :: lmax, pen, comp, lt(2), sl(2), ln
     integer :: i
-    allocate (lb(contact_line%m), ub(contact_line%m))
+    allocate (lb(contact_line%m), ub(contact_line%m), in_disc(contact_line%m))
     call row_bounds(contact_line, res%lam, lb, ub)
     lmax = maxval(res%lam, mask=contact_line%dir == DIR_NORMAL)
     pen = 0.0_wp
     comp = 0.0_wp
+    pr = disc_rows(contact_line)
+    in_disc = .false.
+    do i = 1, size(pr, 2)
+      in_disc(pr(:, i)) = .true.
+      lt = res%lam(pr(:, i))
+      sl = res%gap(pr(:, i))
+      ln = norm2(lt)
+      comp = max(comp, min(max(ub(pr(1, i)) - ln, 0.0_wp), lmax)*norm2(sl), max(-dot_product(lt, sl), 0.0_wp), &
+                 max(ln - ub(pr(1, i)), 0.0_wp)*uscale)
+      if (ln > 0.0_wp) comp = max(comp, ln*norm2(sl - dot_product(sl, lt/ln)*lt/ln))
+    end do
     do i = 1, contact_line%m
+      if (in_disc(i)) cycle
       if (contact_line%dir(i) == DIR_NORMAL) then
         pen = max(pen, res%gap(i))
         comp = max(comp, max(res%lam(i), 0.0_wp)*abs(res%gap(i)))

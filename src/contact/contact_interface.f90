@@ -62,7 +62,7 @@ module contact_interface
   integer, parameter, public :: DIR_NORMAL = 0    !< a row of the normal gap (force >= 0); dir > 0: a row of the slip
 
   public :: build_interface, contact_resultant, body_slots, pair_rows, slot_row, slot_side, row_bounds, has_friction
-  public :: row_direction, row_directions
+  public :: row_direction, row_directions, disc_rows, disc_positions
 
 contains
 
@@ -142,9 +142,63 @@ contains
     has_friction = any(itf%dir > DIR_NORMAL)
   end function has_friction
 
+  !> The pairs of tangential rows that carry one node's tangential force in space (its tangent
+  !! 1 and tangent 2 rows), whose force is bounded by a disc |(l_t1, l_t2)| <= t (METHOD-3D
+  !! section 3); none in the plane, where a node's one tangential row has an interval.
+  pure function disc_rows(itf) result(pr)
+    type(interface_t), intent(in) :: itf
+    integer, allocatable :: pr(:, :)          !< (2, nodes) the tangent-1 row, the tangent-2 row
+    integer, allocatable :: t2(:)
+    integer :: k, n
+    allocate (pr(2, 0))
+    if (NDIM /= 3 .or. itf%m == 0) return
+    allocate (t2(itf%m))
+    t2 = 0
+    do k = 1, itf%m
+      if (itf%dir(k) == 2) t2(itf%nrow(k)) = k
+    end do
+    n = 0
+    do k = 1, itf%m
+      if (itf%dir(k) == 1) n = n + 1
+    end do
+    deallocate (pr)
+    allocate (pr(2, n))
+    n = 0
+    do k = 1, itf%m
+      if (itf%dir(k) /= 1) cycle
+      n = n + 1
+      pr(:, n) = [k, t2(itf%nrow(k))]
+    end do
+  end function disc_rows
+
+  !> The discs among the rows `rows` (a body's rows, or any subset holding both rows of each
+  !! disc it touches), as positions in `rows`.
+  pure function disc_positions(itf, rows) result(pp)
+    type(interface_t), intent(in) :: itf
+    integer, intent(in) :: rows(:)            !< contact rows, 1..m
+    integer, allocatable :: pp(:, :)          !< (2, discs) positions in rows
+    integer, allocatable :: pr(:, :), pos(:)
+    integer :: i, n
+    pr = disc_rows(itf)
+    allocate (pos(itf%m))
+    pos = 0
+    do i = 1, size(rows)
+      pos(rows(i)) = i
+    end do
+    n = count(pos(pr(1, :)) > 0 .and. pos(pr(2, :)) > 0)
+    allocate (pp(2, n))
+    n = 0
+    do i = 1, size(pr, 2)
+      if (pos(pr(1, i)) == 0 .or. pos(pr(2, i)) == 0) cycle
+      n = n + 1
+      pp(:, n) = pos(pr(:, i))
+    end do
+  end function disc_positions
+
   !> The bounds of the contact forces on the rows: a normal row's force is >= 0 (no upper
   !! bound, +huge); a tangential row's lies in [-t, t] with t = slip_bound x tributary length
-  !! (Tresca) or mu x the node's normal force lam_n (Coulomb; lam_n < 0 counts as 0).
+  !! (Tresca) or mu x the node's normal force lam_n (Coulomb; lam_n < 0 counts as 0). In
+  !! space t is the radius of the node's disc (disc_rows), given on both its rows.
   !! With `start` (no normal force known yet) a Coulomb row is unbounded: the first solve
   !! sticks everywhere, and its normal forces give the first bounds.
   pure subroutine row_bounds(itf, lam_n, lb, ub, start)

@@ -5,6 +5,7 @@
 !! iteration calls.
 module contact_types
   use kinds, only: wp
+  use space, only: NRIGID
   implicit none (type, external)
   private
 
@@ -46,10 +47,12 @@ module contact_types
     !> the natural residual |lam - P(lam - (H lam - c)/L)| / |lam| of the mean force (zero at
     !! the monolithic solution; the bound is 2 kappa times it); -1: not computed
     real(wp) :: natural = -1.0_wp
+    !> why no bound is given, when the bound is not computed for a reason other than its size
+    character(len=200) :: no_bound_reason = ''
     integer :: active = 0                      !< nodes with lam > 0
     !> bodies held only by contact: the amplitudes alpha_a of their rigid motions R_a
     !! (u_a = K_a^+ (f_a - B_a' lam) + R_a alpha_a; alpha_a = -mu_a, the equality multipliers)
-    real(wp), allocatable :: rigid(:, :)       !< (3, bodies) [length] (R_a's columns are dimensionless)
+    real(wp), allocatable :: rigid(:, :)       !< (NRIGID, bodies) [length] (R_a's columns are dimensionless)
     integer :: eq_updates = 0                  !< SMALBE multiplier updates, all solves
     integer :: nhist = 0                       !< entries in the history
     real(wp), allocatable :: h_criterion(:)    !< per outer iteration
@@ -80,7 +83,7 @@ module contact_types
     !! Per body: (bodies) and (3, bodies); on the contact rows: the side layout (m, 2) of
     !! contact_result_t.
     real(wp), allocatable :: flam(:)           !< (bodies) |F_a lam_a| of the last iterate [length]
-    real(wp), allocatable :: mu(:, :)          !< (3, bodies) equality multipliers of floating bodies (SMALBE warm start) [length]
+    real(wp), allocatable :: mu(:, :)          !< (NRIGID, bodies) equality multipliers of floating bodies (SMALBE warm start) [length]
     real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
     real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
     integer :: reuse = 0                       !< 1: flam_v holds F_a lam_a (0: not known, e.g. an older checkpoint)
@@ -173,7 +176,7 @@ contains
     real(wp), intent(in) :: g0(:)            !< initial gap
     integer, intent(in) :: nbody             !< bodies
     integer, intent(in) :: npair             !< pairs
-    allocate (st%flam(nbody), st%mu(3, nbody), st%nrw(2, nbody))
+    allocate (st%flam(nbody), st%mu(NRIGID, nbody), st%nrw(2, nbody))
     allocate (st%newton(nbody), st%kept(nbody), source=0)
     st%flam = 0.0_wp
     st%mu = 0.0_wp
@@ -223,7 +226,7 @@ contains
     type(contact_result_t), intent(inout) :: res
     integer, intent(in) :: m, nh, nbody
     if (allocated(res%rigid)) deallocate (res%rigid)
-    allocate (res%rigid(3, nbody))
+    allocate (res%rigid(NRIGID, nbody))
     res%rigid = 0.0_wp
     if (allocated(res%lam)) deallocate (res%lam, res%lam_body, res%w, res%gap, res%obstacle)
     if (allocated(res%h_criterion)) deallocate (res%h_criterion, res%h_residual, res%h_wall, res%h_inner, res%h_active)

@@ -5,7 +5,9 @@ module error_estimate
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use lapack, only: dsymv, dpotrf_tiles, dtrsv, dposv, dsyev
-  use contact_interface, only: interface_t, slot_row, row_bounds
+  use contact_interface, only: interface_t, slot_row, row_bounds, disc_rows
+  use constraint_set, only: constraint_set_t
+  use tangent_discs, only: friction_set
   use condense, only: body_condensed_t
   use contact_common, only: scatter, body_threads
   use linop, only: csc_op_t
@@ -48,6 +50,7 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)      !< condensed bodies
     type(contact_result_t), intent(inout) :: res         !< lam in; error_bound, kappa out
     type(hessian_t) :: hs
+    class(constraint_set_t), allocatable :: set
     real(wp), allocatable :: g(:), r(:), x(:), y(:), xp(:), yp(:), bs(:, :), lo(:), hi(:)
     real(wp) :: lmax, lmin, nl, perr, lprev, mu, mprev
     integer :: m, i, k, ki, ib
@@ -123,14 +126,25 @@ contains
     ! fixed point reached)
     allocate (lo(m), hi(m))
     call row_bounds(contact_line, res%lam, lo, hi)
-    if (sum(bodies(:)%nrig) > 0) then
+    set = friction_set(lo, hi, disc_rows(contact_line))
+    if (sum(bodies(:)%nrig) > 0 .and. .not. set%linear()) then
+      ! the projection on {discs, G l = e} is not available (project_feasible's dual Newton
+      ! method clips to a box)
+      res%error_bound = huge(1.0_wp)
+      res%no_bound_reason = 'no projection onto the friction discs together with the equilibrium of a body held '// &
+                            'only by contact'
+      return
+    else if (sum(bodies(:)%nrig) > 0) then
       ! floating bodies: the feasible set is {lo <= l <= hi, G l = e}, and the bound holds with the
       ! projection on it (the proof only uses the projection's variational inequality and
       ! the strong convexity of the objective on R^m); the projection's own inaccuracy is added
       call project_feasible(bodies, m, res%lam - g/lmax, lo, hi, y, perr)
       r = res%lam - y
     else
-      r = res%lam - min(max(lo, res%lam - g/lmax), hi)
+      ! the projection onto the box, or onto its discs in space
+      y = res%lam - g/lmax
+      call set%project(y)
+      r = res%lam - y
       perr = 0.0_wp
     end if
     nl = norm2(res%lam)

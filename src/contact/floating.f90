@@ -28,6 +28,9 @@ module floating
   !> A body held by Coulomb friction is on the edge of sliding when its load cannot be
   !! balanced with mu lowered by this fraction
   real(wp), parameter :: EDGE_MARGIN = 1.0e-6_wp
+  !> the sides of the polygon that stands for a node's friction disc in space (cone_columns)
+  integer, parameter :: CONE_SIDES = 64
+  real(wp), parameter :: PI = 3.141592653589793238_wp
 
   !> a free motion counts as held by the contact when at least this fraction of its reach on the
   !! contact (squared) is normal to it (1%: mu >= 1e-4)
@@ -698,56 +701,90 @@ contains
   !! its column (lam_n >= 0); a Coulomb pair's normal row i with its tangential row j gives
   !! g_i + mu g_j and g_i - mu g_j (lam_n (1, +-mu): exactly the cone |lam_t| <= mu lam_n);
   !! a Tresca pair keeps the normal column and gives +g_j and -g_j (the tangential force
-  !! free of the normal one: its bound does not depend on it).
-  function cone_columns(contact_line, rows, g, mu_scale) result(gc)
+  !! free of the normal one: its bound does not depend on it). In space a node's tangential
+  !! force lies in a disc, and its generators are the CONE_SIDES directions
+  !! (cos th_k t1 + sin th_k t2) / cos(pi / CONE_SIDES) of the polygon circumscribing the
+  !! disc: an outer approximation, exact to 1 / cos(pi / CONE_SIDES) - 1 = 1.2e-3 relative
+  !! (a load up to that much beyond the friction limit passes the check, and the solve then
+  !! says it does not converge). With tres (one entry per column of gc): the Tresca
+  !! tangential row whose bound the column shares (its tangent-1 row in space), 0 for none.
+  function cone_columns(contact_line, rows, g, mu_scale, tres) result(gc)
     type(interface_t), intent(in) :: contact_line
     integer, intent(in) :: rows(:)
     type(sparse_cols_t), intent(in) :: g
     real(wp), intent(in), optional :: mu_scale   !< Coulomb's mu times this (default 1)
+    integer, allocatable, intent(out), optional :: tres(:)
     type(sparse_cols_t) :: gc
-    integer, allocatable :: tcol(:), cr(:)
-    real(wp), allocatable :: cv(:)
-    integer :: i, k, p
+    integer, allocatable :: tcol(:, :), cr(:), tr(:)
+    real(wp), allocatable :: cv(:), dir(:, :)
+    integer :: i, k, p, q, nd
     real(wp) :: sc, t
     sc = 1.0_wp
     if (present(mu_scale)) sc = mu_scale
-    allocate (tcol(contact_line%m))
+    ! the directions of a node's tangential force: +-t in the plane, the polygon in space
+    if (NDIM == 2) then
+      dir = reshape([1.0_wp, -1.0_wp], [1, 2])
+    else
+      allocate (dir(2, CONE_SIDES))
+      do q = 1, CONE_SIDES
+        dir(:, q) = [cos(2.0_wp*PI*(q - 1)/CONE_SIDES), sin(2.0_wp*PI*(q - 1)/CONE_SIDES)]/cos(PI/CONE_SIDES)
+      end do
+    end if
+    nd = size(dir, 2)
+    allocate (tcol(NDIM - 1, contact_line%m), tr(0))
     tcol = 0
     do i = 1, size(rows)
-      if (contact_line%dir(rows(i)) > DIR_NORMAL) tcol(contact_line%nrow(rows(i))) = i
+      if (contact_line%dir(rows(i)) > DIR_NORMAL) tcol(contact_line%dir(rows(i)), contact_line%nrow(rows(i))) = i
     end do
-    call gc%init(g%nrow, 2*(g%ptr(g%ncol + 1) - 1))
+    call gc%init(g%nrow, nd*(g%ptr(g%ncol + 1) - 1))
     do i = 1, size(rows)
       k = rows(i)
       p = contact_line%pair_of(k)
-      associate (ri => g%row(g%ptr(i):g%ptr(i + 1) - 1), vi => g%val(g%ptr(i):g%ptr(i + 1) - 1))
-        if (contact_line%dir(k) > DIR_NORMAL) then
-          if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
-          call gc%push(ri, vi)
-          call gc%push(ri, -vi)
-        else if (tcol(k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
-          ! divided by sqrt(1 + (mu)^2): the same cone, columns of one size for any mu
-          t = sc*contact_line%pair_mu(p)
-          call combine(i, tcol(k), t)
-          call gc%push(cr, cv/sqrt(1.0_wp + t*t))
-          call combine(i, tcol(k), -t)
-          call gc%push(cr, cv/sqrt(1.0_wp + t*t))
-        else
-          call gc%push(ri, vi)
-        end if
-      end associate
+      if (contact_line%dir(k) > DIR_NORMAL) then
+        ! a Tresca node's generators at its first tangential row
+        if (contact_line%pair_friction(p) == FRICTION_COULOMB .or. contact_line%dir(k) > 1) cycle
+        do q = 1, nd
+          allocate (cr(0), cv(0))
+          call add_tangents(contact_line%nrow(k), q, 1.0_wp)
+          call gc%push(cr, cv)
+          tr = [tr, k]
+          deallocate (cr, cv)
+        end do
+      else if (tcol(1, k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
+        ! divided by sqrt(1 + (mu |d|)^2): the same cone, columns of one size for any mu
+        t = sc*contact_line%pair_mu(p)
+        do q = 1, nd
+          cr = g%row(g%ptr(i):g%ptr(i + 1) - 1)
+          cv = g%val(g%ptr(i):g%ptr(i + 1) - 1)
+          call add_tangents(k, q, t)
+          call gc%push(cr, cv/sqrt(1.0_wp + (t*norm2(dir(:, q)))**2))
+          tr = [tr, 0]
+        end do
+      else
+        call gc%push(g%row(g%ptr(i):g%ptr(i + 1) - 1), g%val(g%ptr(i):g%ptr(i + 1) - 1))
+        tr = [tr, 0]
+      end if
     end do
+    if (present(tres)) tres = tr
 
   contains
 
-    !> cr, cv: the entries of column a + t column b.
-    subroutine combine(a, b, tt)
-      integer, intent(in) :: a, b
+    !> cr, cv plus tt times direction q of node row n's tangential columns.
+    subroutine add_tangents(n, q, tt)
+      integer, intent(in) :: n, q
+      real(wp), intent(in) :: tt
+      integer :: j
+      do j = 1, NDIM - 1
+        if (tcol(j, n) > 0) call add_column(tcol(j, n), tt*dir(j, q))
+      end do
+    end subroutine add_tangents
+
+    !> cr, cv plus tt times column b.
+    subroutine add_column(b, tt)
+      integer, intent(in) :: b
       real(wp), intent(in) :: tt
       integer :: l, c, n
-      n = g%ptr(a + 1) - g%ptr(a)
-      cr = g%row(g%ptr(a):g%ptr(a + 1) - 1)
-      cv = g%val(g%ptr(a):g%ptr(a + 1) - 1)
+      n = size(cr)
       do l = g%ptr(b), g%ptr(b + 1) - 1
         c = findloc(cr(1:n), g%row(l), 1)
         if (c > 0) then
@@ -757,14 +794,14 @@ contains
           cv = [cv, tt*g%val(l)]
         end if
       end do
-    end subroutine combine
+    end subroutine add_column
 
   end function cone_columns
 
   !> nnls(g, e) over the admissible contact forces of the rows `rows` (g's columns): the
-  !! cone's generators (`cone_columns`), and for a Tresca pair's tangential row j its bound
-  !! too, |lam_j| <= t_j = slip_bound x tributary length: lam_j = t_j (s+ - s-) with
-  !! s+ + s- + slack = 1, one more equation per such row, scaled by |e| so that the
+  !! cone's generators (`cone_columns`), and for a Tresca node its bound too, |lam_t| <= t =
+  !! slip_bound x tributary length: lam_t = t sum_q s_q d_q over the node's generators d_q
+  !! with sum_q s_q + slack = 1, one more equation per such node, scaled by |e| so that the
   !! residual weighs a violated bound like an unbalanced load of |e|. res: the residual.
   subroutine admissible_nnls(contact_line, rows, g, e, res, mu_scale)
     type(interface_t), intent(in) :: contact_line
@@ -774,61 +811,54 @@ contains
     real(wp), intent(out) :: res
     real(wp), intent(in), optional :: mu_scale
     type(sparse_cols_t) :: gc, ga
-    real(wp), allocatable :: ea(:), x(:)
-    integer, allocatable :: tres(:)
-    logical, allocatable :: has_t(:)
-    integer :: i, k, n, nt, r, p
-    real(wp) :: w, t
+    real(wp), allocatable :: ea(:), x(:), tb(:)
+    integer, allocatable :: tres(:), bound_of(:)
+    integer :: c, k, nt, r, p
+    real(wp) :: w
     if (.not. has_friction(contact_line)) then
       allocate (x(g%ncol))
       call nnls(g, e, x, res)
       return
     end if
-    gc = cone_columns(contact_line, rows, g, mu_scale)
-    ! the Tresca rows, in the order cone_columns gave their column pairs
-    tres = pack(rows, [(contact_line%dir(rows(i)) > DIR_NORMAL .and. &
-                        contact_line%pair_friction(contact_line%pair_of(rows(i))) == FRICTION_TRESCA, i=1, size(rows))])
-    nt = size(tres)
+    gc = cone_columns(contact_line, rows, g, mu_scale, tres)
+    nt = 0
+    if (size(tres) > 0) nt = count(tres > 0)
     if (nt == 0) then
       allocate (x(gc%ncol))
       call nnls(gc, e, x, res)
       return
     end if
-    ! the normal rows whose tangential row is among `rows`
-    allocate (has_t(contact_line%m))
-    has_t = .false.
-    do i = 1, size(rows)
-      if (contact_line%dir(rows(i)) > DIR_NORMAL) has_t(contact_line%nrow(rows(i))) = .true.
-    end do
     r = g%nrow
     w = max(norm2(e), tiny(1.0_wp))
+    ! the Tresca nodes in the order of their first generator, each with its bound, no larger
+    ! than 1e3 |e| / |its first generator| (a bound beyond that does not bind a balance of |e|,
+    ! and a slip_bound of 1e20 would only spoil the least squares)
+    allocate (bound_of(contact_line%m), tb(0))
+    bound_of = 0
+    nt = 0
+    do c = 1, gc%ncol
+      k = tres(c)
+      if (k == 0) cycle
+      if (bound_of(k) > 0) cycle
+      nt = nt + 1
+      bound_of(k) = nt
+      p = contact_line%pair_of(k)
+      tb = [tb, min(contact_line%pair_slip(p)*contact_line%trib(k), &
+                    1.0e3_wp*w/max(norm2(gc%val(gc%ptr(c):gc%ptr(c + 1) - 1)), tiny(1.0_wp)))]
+    end do
     allocate (ea(r + nt), x(gc%ncol + nt))
     ea(1:r) = e
     ea(r + 1:) = w
-    call ga%init(r + nt, size(gc%val) + 3*nt)
-    ! gc's columns in order; each Tresca row's column pair (+g, -g) scaled by the bound
-    n = 0
-    k = 0
-    do i = 1, size(rows)
-      p = contact_line%pair_of(rows(i))
-      if (contact_line%dir(rows(i)) > DIR_NORMAL) then
-        if (contact_line%pair_friction(p) == FRICTION_COULOMB) cycle
-        k = k + 1
-        ! the bound, no larger than 1e3 |e| / |g_j| (a bound beyond that does not bind a
-        ! balance of |e|, and a slip_bound of 1e20 would only spoil the least squares)
-        t = contact_line%pair_slip(p)*contact_line%trib(rows(i))
-        t = min(t, 1.0e3_wp*w/max(norm2(gc%val(gc%ptr(n + 1):gc%ptr(n + 2) - 1)), tiny(1.0_wp)))
-        call push_scaled(n + 1, t, k)
-        call push_scaled(n + 2, t, k)
-        n = n + 2
-      else if (contact_line%pair_friction(p) == FRICTION_COULOMB .and. has_t(rows(i))) then
-        call push_scaled(n + 1, 1.0_wp, 0)
-        call push_scaled(n + 2, 1.0_wp, 0)
-        n = n + 2
-      else
-        call push_scaled(n + 1, 1.0_wp, 0)
-        n = n + 1
-      end if
+    call ga%init(r + nt, size(gc%val) + 3*nt + gc%ncol)
+    ! gc's columns in order; each Tresca generator scaled by its node's bound
+    do c = 1, gc%ncol
+      associate (rc => gc%row(gc%ptr(c):gc%ptr(c + 1) - 1), vc => gc%val(gc%ptr(c):gc%ptr(c + 1) - 1))
+        if (tres(c) > 0) then
+          call ga%push([rc, r + bound_of(tres(c))], [vc*tb(bound_of(tres(c))), w])
+        else
+          call ga%push(rc, vc)
+        end if
+      end associate
     end do
     do k = 1, nt
       call ga%push([r + k], [w])
@@ -836,21 +866,6 @@ contains
     ! the method by the rigid rows (the bound rows, one per Tresca node, do not make the
     ! active set method's problem harder to decide, only longer)
     call nnls(ga, ea, x, res, merge(NNLS_ACTIVE_SET, NNLS_INTERIOR, r <= NNLS_DENSE_MAX))
-
-  contains
-
-    !> gc's column c times tt into ga, with w in row r + kb when kb > 0 (its bound's row).
-    subroutine push_scaled(c, tt, kb)
-      integer, intent(in) :: c, kb
-      real(wp), intent(in) :: tt
-      associate (rc => gc%row(gc%ptr(c):gc%ptr(c + 1) - 1), vc => gc%val(gc%ptr(c):gc%ptr(c + 1) - 1))
-        if (kb > 0) then
-          call ga%push([rc, r + kb], [vc*tt, w])
-        else
-          call ga%push(rc, vc)
-        end if
-      end associate
-    end subroutine push_scaled
 
   end subroutine admissible_nnls
 

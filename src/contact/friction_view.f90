@@ -2,9 +2,12 @@
 !! normal rows alone (every dataset and line of a frictionless result keeps its meaning and
 !! its length, one entry per contact node), and beside it, per normal row, the tangential
 !! force of its node, the shear traction, the slip and the node's state (stick, slip, open).
+!! In space a node's tangential force, shear and slip have two components (along the frame's
+!! tangents t1, t2), the force also as a vector, and its state compares the force's length
+!! with the radius of its disc.
 module friction_view
   use kinds, only: wp
-  use space, only: NCOMP
+  use space, only: NCOMP, NDIM
   use contact_interface, only: interface_t, row_bounds, contact_resultant, DIR_NORMAL
   use contact_types, only: contact_result_t
   implicit none (type, external)
@@ -28,11 +31,14 @@ module friction_view
     !! and of all pairs together [force]
     real(wp), allocatable :: resultant(:, :)  !< (NCOMP, npair)
     real(wp), allocatable :: resultant_all(:) !< (NCOMP)
-    real(wp), allocatable :: force(:)         !< tangential force of the node (0: frictionless pair) [force]
-    real(wp), allocatable :: shear(:)         !< force / tributary length [stress]
+    !> (NDIM - 1, nodes) tangential force of the node along each tangent (0: frictionless pair) [force]
+    real(wp), allocatable :: force(:, :)
+    real(wp), allocatable :: force_xyz(:, :)  !< (NDIM, nodes) the tangential force as a vector [force]
+    real(wp), allocatable :: shear(:, :)      !< (NDIM - 1, nodes) force / tributary length [stress]
     real(wp), allocatable :: bound(:)         !< the bound of |force| (Tresca's, or mu x the normal force) [force]
-    real(wp), allocatable :: slip(:)          !< relative tangential displacement along the row's tangent [length]
-    real(wp), allocatable :: slip_increment(:) !< slip less the slip the step started from [length]
+    !> (NDIM - 1, nodes) relative tangential displacement along each tangent [length]
+    real(wp), allocatable :: slip(:, :)
+    real(wp), allocatable :: slip_increment(:, :) !< (NDIM - 1, nodes) slip less the slip the step started from [length]
     integer, allocatable :: state(:)          !< NODE_*
   end type tangential_t
 
@@ -50,9 +56,9 @@ contains
     type(interface_t), intent(out) :: itf_n
     type(contact_result_t), intent(out) :: res_n
     type(tangential_t), intent(out) :: tg
-    integer, allocatable :: keep(:), tan(:)
+    integer, allocatable :: keep(:), tan(:, :)
     real(wp), allocatable :: lb(:), ub(:)
-    integer :: k, p, s, n, e, q, mn
+    integer :: k, p, s, n, e, q, mn, j
     real(wp) :: margin
     keep = pack([(k, k=1, itf%m)], itf%dir == DIR_NORMAL)
     mn = size(keep)
@@ -116,14 +122,16 @@ contains
     end if
     tg%on = any(itf%dir > DIR_NORMAL)
     if (.not. tg%on) return
-    ! the tangential row of each normal row (0: none)
-    allocate (tan(itf%m))
+    ! the tangential rows of each normal row (0: none)
+    allocate (tan(NDIM - 1, itf%m))
     tan = 0
     do k = 1, itf%m
-      if (itf%dir(k) > DIR_NORMAL) tan(itf%nrow(k)) = k
+      if (itf%dir(k) > DIR_NORMAL) tan(itf%dir(k), itf%nrow(k)) = k
     end do
-    allocate (tg%force(mn), tg%shear(mn), tg%bound(mn), tg%slip(mn), tg%slip_increment(mn), tg%state(mn))
+    allocate (tg%force(NDIM - 1, mn), tg%force_xyz(NDIM, mn), tg%shear(NDIM - 1, mn), tg%bound(mn), &
+              tg%slip(NDIM - 1, mn), tg%slip_increment(NDIM - 1, mn), tg%state(mn))
     tg%force = 0.0_wp
+    tg%force_xyz = 0.0_wp
     tg%shear = 0.0_wp
     tg%bound = 0.0_wp
     tg%slip = 0.0_wp
@@ -134,14 +142,18 @@ contains
     call row_bounds(itf, res%lam, lb, ub)
     margin = max(AT_BOUND, 100.0_wp*res%residual)
     do k = 1, mn
-      q = tan(keep(k))
-      if (q == 0) cycle
-      tg%force(k) = res%lam(q)
-      if (itf%trib(q) > 0.0_wp) tg%shear(k) = res%lam(q)/itf%trib(q)
+      if (tan(1, keep(k)) == 0) cycle
+      do j = 1, NDIM - 1
+        q = tan(j, keep(k))
+        tg%force(j, k) = res%lam(q)
+        if (itf%trib(q) > 0.0_wp) tg%shear(j, k) = res%lam(q)/itf%trib(q)
+        tg%slip(j, k) = res%w(q, 1) + res%w(q, 2)
+        tg%slip_increment(j, k) = res%gap(q)
+        tg%force_xyz(:, k) = tg%force_xyz(:, k) + res%lam(q)*itf%frame(:, j + 1, q)
+      end do
+      q = tan(1, keep(k))
       tg%bound(k) = ub(q)
-      tg%slip(k) = res%w(q, 1) + res%w(q, 2)
-      tg%slip_increment(k) = res%gap(q)
-      if (abs(res%lam(q)) >= (1.0_wp - margin)*ub(q) .and. ub(q) > 0.0_wp) then
+      if (norm2(tg%force(:, k)) >= (1.0_wp - margin)*ub(q) .and. ub(q) > 0.0_wp) then
         tg%state(k) = NODE_SLIP
       else if (res%lam(keep(k)) > 0.0_wp) then
         tg%state(k) = NODE_STICK

@@ -13,10 +13,11 @@ module monolithic
   use clock, only: wtime
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_STOPPED, &
                    mprgp_status_name, QP_AUTO, QP_MPRGP, QP_NEWTON
-  use smalbe, only: smalbe_solve, smalbe_stats_t
+  use smalbe, only: smalbe_solve, smalbe_solve_in, smalbe_stats_t
+  use tangent_discs, only: friction_set
   use strings, only: itoa
   use sorting, only: sort_ints
-  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, DIR_NORMAL
+  use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use config, only: FRICTION_COULOMB, INNER_MPRGP, INNER_ACTIVE_SET
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
@@ -159,7 +160,9 @@ contains
         inner_solver%opts%eq_feas = equality%feas
         inner_solver%opts%eq_feas_x = equality%feas_x
         if (friction) then
-          call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer, ub=ub)
+          ! the box of the tangential forces, or in space their discs
+          call smalbe_solve_in(inner_solver, hessian, c, equality%g, equality%e, equality%rho, &
+                               friction_set(lb, ub, disc_rows(contact_line)), lam, mu, outer)
         else
           call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
         end if
@@ -176,7 +179,7 @@ contains
         end do
       else
         if (friction) then
-          call inner_solver%solve(hessian, c, lb, lam, ub=ub)
+          call inner_solver%solve_in(hessian, c, friction_set(lb, ub, disc_rows(contact_line)), lam)
         else
           call inner_solver%solve(hessian, c, lb, lam)
         end if

@@ -9,7 +9,7 @@ module robin_iteration
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use config, only: solver_cfg_t, STOP_RESIDUAL, ACCEL_NONE, ROBIN_HARMONIC
   use clock, only: wtime
-  use contact_interface, only: interface_t, has_friction, row_bounds, DIR_NORMAL
+  use contact_interface, only: interface_t, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
@@ -185,7 +185,7 @@ contains
         end do
         first = .false.
       end if
-      if (has_friction(contact_line)) call update_row_states(subproblems%lb, subproblems%ub, run_state)
+      if (has_friction(contact_line)) call update_row_states(contact_line, subproblems%lb, subproblems%ub, run_state)
       if (m == 0) then
         res%status = STATUS_CONVERGED
         res%outer = it
@@ -262,13 +262,24 @@ contains
   end function bound_state
 
   !> Friction: the rows' bound states of this iterate (both sides of a row: side 1's + 4 x
-  !! side 2's), and whether any changed since the last iterate.
-  subroutine update_row_states(lb, ub, run_state)
-    real(wp), intent(in) :: lb(:), ub(:)               !< (m) this iteration's boxes
+  !! side 2's), and whether any changed since the last iterate. In space both rows of a disc
+  !! have the disc's state: on its circle (BOUND_UPPER) or inside.
+  subroutine update_row_states(itf, lb, ub, run_state)
+    type(interface_t), intent(in) :: itf
+    real(wp), intent(in) :: lb(:), ub(:)               !< (m) this iteration's boxes (a disc's radius in ub)
     type(robin_state_t), intent(inout) :: run_state
-    integer, allocatable :: now(:)
+    integer, allocatable :: now(:), pr(:, :)
+    integer :: k, s, code(2)
     allocate (now(size(lb)))
     now = bound_state(run_state%lam(:, 1), lb, ub) + 4*bound_state(run_state%lam(:, 2), lb, ub)
+    pr = disc_rows(itf)
+    do k = 1, size(pr, 2)
+      do s = 1, 2
+        ! on its circle to the rounding of a projection
+        code(s) = merge(BOUND_UPPER, BOUND_INSIDE, norm2(run_state%lam(pr(:, k), s)) >= (1.0_wp - 1.0e-12_wp)*ub(pr(1, k)))
+      end do
+      now(pr(:, k)) = code(1) + 4*code(2)
+    end do
     run_state%settled = merge(1, 0, all(now == run_state%row_state))
     run_state%row_state = now
   end subroutine update_row_states
@@ -277,13 +288,15 @@ contains
   !! same bound on both sides at their unrelaxed value T(G): while a row is at its bound its
   !! obstacle enters neither body's solution, and relaxing it only slows its way to the
   !! fixed point (at a fixed point G = T(G), so the fixed point is the same). Not for
-  !! `steklov`, whose map needs the relaxation on every row (doc/method.md, "Friction").
+  !! `steklov`, whose map needs the relaxation on every row (doc/method.md, "Friction"), and
+  !! not for a disc in space, whose force on its circle turns with the obstacles.
   subroutine full_step_at_bounds(itf, row_state, g_full, g_new)
     type(interface_t), intent(in) :: itf
     integer, intent(in) :: row_state(:)                !< (m) update_row_states
     real(wp), intent(in) :: g_full(:, :)               !< (m, 2) T(G)
     real(wp), intent(inout) :: g_new(:, :)             !< (m, 2) relaxed obstacles
     integer :: k
+    if (size(disc_rows(itf), 2) > 0) return
     do k = 1, itf%m
       if (itf%dir(k) == DIR_NORMAL) cycle
       if (row_state(k) == BOUND_LOWER*5 .or. row_state(k) == BOUND_UPPER*5) g_new(k, :) = g_full(k, :)

@@ -11,7 +11,9 @@ module robin_subproblems
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
                    QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
-  use smalbe, only: smalbe_solve, smalbe_stats_t
+  use smalbe, only: smalbe_solve, smalbe_solve_in, smalbe_stats_t
+  use constraint_set, only: constraint_set_t
+  use tangent_discs, only: friction_set
   use qp_newton, only: newton_work_t, newton_factor, newton_forget, newton_holds
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
@@ -19,7 +21,7 @@ module robin_subproblems
   use sorting, only: largest_first
   use equality_rows, only: equality_t, equality_init, equality_add_penalty
   use robin_operators, only: robin_operator_t
-  use contact_interface, only: interface_t, slot_row, slot_side
+  use contact_interface, only: interface_t, slot_row, slot_side, disc_positions
   implicit none (type, external)
   private
 
@@ -48,7 +50,15 @@ module robin_subproblems
     !> each body's Newton work from one solve to the next (a body held by its supports: its
     !! Hessian does not change, and a free set that recurs keeps its factor)
     type(newton_work_t), allocatable :: newton_work(:)
+    !> friction in space: each body's discs (its rows' positions of a node's two tangential
+    !! forces, contact_interface's disc_positions); none in the plane
+    type(disc_list_t), allocatable :: discs(:)
   end type subproblems_t
+
+  !> The discs of one body's rows.
+  type :: disc_list_t
+    integer, allocatable :: pos(:, :)     !< (2, discs) positions in the body's rows
+  end type disc_list_t
 
   !> A vector per body.
   type :: vec_t
@@ -80,6 +90,10 @@ contains
     n = size(bodies)
     allocate (subproblems%flexibility(n), subproblems%hessian(n), subproblems%proximal(n), subproblems%equality(n))
     allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n), subproblems%newton_work(n))
+    allocate (subproblems%discs(n))
+    do a = 1, n
+      subproblems%discs(a)%pos = disc_positions(contact_line, slot_row(bodies(a)%slots, contact_line%m))
+    end do
     subproblems%lmax_body = 0.0_wp
     ! largest first: the dynamic schedule then balances the threads
     subproblems%order = largest_first([(bodies(a)%m, a=1, size(bodies))])
@@ -203,6 +217,7 @@ contains
     integer, intent(out) :: updates               !< SMALBE multiplier updates
     type(mprgp_t) :: inner_solver
     type(smalbe_stats_t) :: smalbe_stats
+    class(constraint_set_t), allocatable :: set
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
     integer :: m, k, ka, r, mm, nfree, changed, i, info, steps
     logical :: moved
@@ -215,8 +230,14 @@ contains
       lb = subproblems%lb(slot_row(body%slots, mm))
       ub = subproblems%ub(slot_row(body%slots, mm))
     else
-      allocate (lb(m))
+      allocate (lb(m), ub(0))
       lb = 0.0_wp
+    end if
+    ! the box of the forces, with a disc on each node's tangential pair in space
+    if (size(ub) > 0) then
+      set = friction_set(lb, ub, subproblems%discs(a)%pos)
+    else
+      set = friction_set(lb, [(huge(1.0_wp), i=1, m)], subproblems%discs(a)%pos)
     end if
     rhs = body%b - gather(state%G, body%slots)
     if (subproblems%proximal(a)%n > 0) then
@@ -249,12 +270,10 @@ contains
     ! Coulomb: the box moved with the normal forces; a warm start outside it is projected
     ! and its product is no longer known
     moved = .false.
-    if (allocated(ub)) then
-      moved = any(lam < lb .or. lam > ub)
-      if (moved) then
-        lam = min(max(lam, lb), ub)
-        inner_solver%opts%use_ax = .false.
-      end if
+    if (size(ub) > 0) then
+      call set%project(lam)
+      moved = any(lam /= lam0)
+      if (moved) inner_solver%opts%use_ax = .false.
     end if
     ! Krylov recycling, not with Aitken or Anderson acceleration, whose updates difference
     ! past iterates and so amplify the (smaller but differently placed) inner errors
@@ -280,13 +299,8 @@ contains
         inner_solver%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
         inner_solver%opts%eq_feas_x = merge(max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)* &
                                             sqrt(eq%gg), 0.0_wp, all(eq%e == 0.0_wp))
-        if (allocated(ub)) then
-          call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, lam, state%mu(1:r, a), &
-                            smalbe_stats, rw, raw, state%nrw(:, a), ub=ub)
-        else
-          call smalbe_solve(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, lb, lam, state%mu(1:r, a), &
-                            smalbe_stats, rw, raw, state%nrw(:, a))
-        end if
+        call smalbe_solve_in(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, set, lam, state%mu(1:r, a), &
+                             smalbe_stats, rw, raw, state%nrw(:, a))
       end associate
       inner = smalbe_stats%inner
       inner%n_matvec = smalbe_stats%n_matvec
@@ -297,23 +311,19 @@ contains
       ! rows are those of the last forces); a resumed run makes it again, not counted
       inner_solver%keep => subproblems%newton_work(a)
       inner_solver%keep_same_a = .true.
-      if (state%kept(a) == 1 .and. subproblems%newton_work(a)%fac_nf < 0 .and. .not. allocated(ub)) then
+      if (state%kept(a) == 1 .and. subproblems%newton_work(a)%fac_nf < 0 .and. size(ub) == 0) then
         flops = 0.0_wp
         call newton_factor(subproblems%hessian(a)%a, pack([(i, i=1, m)], lam0 > lb), subproblems%newton_work(a), &
                            info, flops)
       end if
-      if (allocated(ub)) then
-        call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a), ub=ub)
-      else
-        call inner_solver%solve(subproblems%hessian(a), rhs, lb, lam, rw, raw, state%nrw(:, a))
-      end if
+      call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
       inner = inner_solver%stats
     end if
     ! the factor is carried into the next solve when it is the one LAPACK makes of the free
     ! block of these forces (what a resumed run can make again), else dropped
     if (r == 0) then
       state%kept(a) = 0
-      if (.not. allocated(ub)) then
+      if (size(ub) == 0) then
         if (newton_holds(subproblems%newton_work(a), pack([(i, i=1, m)], lam > lb))) state%kept(a) = 1
       end if
       if (state%kept(a) == 0) call newton_forget(subproblems%newton_work(a))
@@ -322,7 +332,7 @@ contains
     ! (a frictionless body held by its supports, under 'auto': MPRGP to a loose tolerance, then
     ! the Newton method, the active-set method first once its set settles) or starts with the
     ! Newton method from now on (any other)
-    if (inner%switched) state%newton(a) = merge(-NEWTON_FIRST_MAX, 1, r == 0 .and. .not. allocated(ub) .and. &
+    if (inner%switched) state%newton(a) = merge(-NEWTON_FIRST_MAX, 1, r == 0 .and. size(ub) == 0 .and. &
                                                 solver%inner_solver == INNER_AUTO)
     ! 'auto' on a body held by its supports: when a solve that MPRGP finished cost more than
     ! two steps of the Newton method with a new factor, the next solve takes the Newton method
@@ -335,7 +345,7 @@ contains
     ! its set settles
     if (solver%inner_solver == INNER_AUTO .and. r == 0 .and. state%newton(a) /= 1 .and. &
         inner%status == MPRGP_CONVERGED .and. (state%newton(a) <= 0 .or. inner%fell_back)) then
-      if (allocated(ub)) then
+      if (size(ub) > 0) then
         nfree = count(lam > lb .and. lam < ub)
         changed = count((lam > lb) .neqv. (lam0 > lb)) + count((lam < ub) .neqv. (lam0 < ub))
       else

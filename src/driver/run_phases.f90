@@ -722,7 +722,7 @@ contains
   function amplitudes(run, a) result(t)
     type(run_t), intent(in) :: run
     integer, intent(in) :: a
-    character(len=64) :: t
+    character(len=128) :: t
     integer :: k
     t = ''
     do k = 1, run%systems(a)%nrig

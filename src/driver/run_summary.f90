@@ -2,7 +2,7 @@
 !! setting to try on standard error) and the closing summary lines on standard output.
 module run_summary
   use kinds, only: wp
-  use space, only: NCOMP, node_dof, dof_comp
+  use space, only: NDIM, NCOMP, node_dof, dof_comp
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
   use config, only: side_axis, MAX_SIDES, solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
@@ -69,6 +69,8 @@ contains
       if (result%outer > 0 .and. result%error_bound < 1.0_wp) then
         line(2) = 'accuracy: |lam - lam_monolithic|/|lam| <= '//sci(result%error_bound)// &
           ' (a posteriori bound, cond('//trim(merge('F1+F2', 'H    ', run%contact_line%npair <= 1))//') ~ '//sci(result%kappa)//')'
+      else if (result%outer > 0 .and. len_trim(result%no_bound_reason) > 0) then
+        line(2) = 'accuracy: no bound ('//trim(result%no_bound_reason)//')'
       else if (result%outer > 0) then
         ! a relative error bound of 1 or more says nothing: say why instead
         line(2) = 'accuracy: no bound (the a posteriori bound is '//sci(result%error_bound)//', cond('// &
@@ -270,16 +272,16 @@ contains
                  ' resultant_on_body'//i2s(itf%pair_body(1, p))//'='
         end if
         if (tg%on) then
-          if (any(tg%state(r(1):r(2)) >= 0)) tail = ' tangential_force_sum='//sci(sum(tg%force(r(1):r(2))), 5)// &
+          ! the sum along the tangent in the plane, the vector sum (x, y, z) in space
+          if (any(tg%state(r(1):r(2)) >= 0)) tail = ' tangential_force_sum='//tangential_sum(r(1), r(2))// &
             ' stick='//i2s(count(tg%state(r(1):r(2)) == NODE_STICK))//' slip='//i2s(count(tg%state(r(1):r(2)) == NODE_SLIP))
           ! Tresca's bound holds whether or not the surfaces touch: a shear across an open gap
           ! is what given friction means, not a force between bodies that touch; say so
           if (itf%pair_friction(p) == FRICTION_TRESCA) then
-            nopen = count(result%lam(r(1):r(2)) <= 0.0_wp .and. tg%force(r(1):r(2)) /= 0.0_wp)
+            nopen = count(result%lam(r(1):r(2)) <= 0.0_wp .and. any(tg%force(:, r(1):r(2)) /= 0.0_wp, dim=1))
             if (nopen > 0) call warn('pair '//i2s(p)//' (Tresca, slip_bound '//sci(itf%pair_slip(p), 4)// &
               '): '//i2s(nopen)//' of its '//i2s(r(2) - r(1) + 1)//' nodes carry a shear force across an open gap '// &
-              '(no normal force; their shear sums to '//sci(sum(pack(tg%force(r(1):r(2)), result%lam(r(1):r(2)) <= &
-              0.0_wp)), 4)//'): Tresca''s bound acts whether or not the surfaces touch; for a shear that needs '// &
+              '(no normal force; their shear sums to '//open_shear(r(1), r(2))//'): Tresca''s bound acts whether or not the surfaces touch; for a shear that needs '// &
               'contact use friction=''coulomb''')
           end if
         end if
@@ -288,6 +290,33 @@ contains
         vec_text(fres, ',', 5)//' normal_force_sum='//sci(ftot, 5)//' active=', active, &
         ' imbalance=', imbalance, ' penetration=', result%penetration, ' complementarity=', result%complementarity, tail
     end do
+
+  contains
+
+    !> The tangential forces of rows i..j summed: a number in the plane, a vector in space.
+    function tangential_sum(i, j) result(t)
+      integer, intent(in) :: i, j
+      character(len=:), allocatable :: t
+      if (NDIM == 2) then
+        t = sci(sum(tg%force(1, i:j)), 5)
+      else
+        t = vec_text(sum(tg%force_xyz(:, i:j), dim=2), ',', 5)
+      end if
+    end function tangential_sum
+
+    !> The tangential forces of the rows i..j without a normal force, summed.
+    function open_shear(i, j) result(t)
+      integer, intent(in) :: i, j
+      character(len=:), allocatable :: t
+      logical :: open(j - i + 1)
+      open = result%lam(i:j) <= 0.0_wp
+      if (NDIM == 2) then
+        t = sci(sum(pack(tg%force(1, i:j), open)), 4)
+      else
+        t = vec_text(sum(tg%force_xyz(:, i:j), dim=2, mask=spread(open, 1, NDIM)), ',', 4)
+      end if
+    end function open_shear
+
   end function pair_lines
 
   !> The `reaction:` line of each supported body (the first MAX_LISTED, then how many more):

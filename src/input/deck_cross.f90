@@ -79,7 +79,7 @@ contains
     call check_loads(d, st)
   end subroutine check_cross
 
-  !> What a 3D deck cannot have yet: friction, a parabolic gap, materials other than isotropic
+  !> What a 3D deck cannot have yet: a parabolic gap, materials other than isotropic
   !! young and poisson, regions; each refusal names the group.
   subroutine check_solid(d, st)
     type(deck_t), intent(in) :: d
@@ -88,9 +88,6 @@ contains
     character(len=:), allocatable :: p
     p = st%path//': '
     do k = 1, d%npair
-      if (d%pair(k)%friction /= FRICTION_NONE) call fatal(EXIT_INPUT, p//st%pair_at(k)%s//': friction='''// &
-        trim(word(FRICTION_CHOICES, d%pair(k)%friction))//''' in a 3D deck: contact between solid bodies is '// &
-        'frictionless for now; give friction=''none''')
       if (d%pair(k)%gap_radius > 0.0_wp) call fatal(EXIT_INPUT, p//st%pair_at(k)%s//': gap_radius = '// &
         r2s(d%pair(k)%gap_radius)//' in a 3D deck: the parabolic gap is a 2D profile; in 3D the gap is '// &
         'the geometry''s')

@@ -331,7 +331,8 @@ contains
     call v%real('gap_center', c%gap_center, unit='[length]', doc='s of the vertex of that parabola')
     call v%enum('friction', c%friction, FRICTION_CHOICES, doc='`''none''` (frictionless), '// &
       '`''tresca''` (the shear traction bounded by `slip_bound`: |t| <= slip_bound) or `''coulomb''` '// &
-      '(|t| <= mu p, p the contact pressure); `mu=0` or `slip_bound=0` is frictionless')
+      '(|t| <= mu p, p the contact pressure); `mu=0` or `slip_bound=0` is frictionless; in a 3D deck t is '// &
+      'the shear vector in the tangent plane and |t| its length')
     call v%real('mu', c%mu, unit='[-]', range='0 <= mu <= 1e4; with `friction=''coulomb''` only', &
       doc='*coulomb only:* the friction coefficient')
     call v%real('slip_bound', c%slip_bound, unit='[stress]', range='0 <= slip_bound <= 1e20; with '// &

@@ -6,6 +6,7 @@
 !! that is not what this deck implies (shapes, ranges, NaN or Inf).
 module checkpoint
   use kinds, only: wp
+  use space, only: NRIGID
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use hdf5, only: hid_t, hsize_t
   use h5io, only: file_open, file_close, group_open, group_close, &
@@ -514,8 +515,8 @@ contains
                               'one flag per body')
     ! the equality multipliers of floating bodies: absent from older checkpoints
     r%has_mu = exists(r%gid, 'mu', .false.)
-    if (r%has_mu) call need(r, r%gid, '/state', 'mu', .false., CLASS_REAL, [3_hsize_t, int(r%nbody, hsize_t)], &
-                          'three multipliers per body')
+    if (r%has_mu) call need(r, r%gid, '/state', 'mu', .false., CLASS_REAL, [int(NRIGID, hsize_t), int(r%nbody, hsize_t)], &
+                          'one multiplier per rigid motion and body')
     if (len_trim(r%msg) > 0) return
     ! the history: five arrays of one length r%nh, it <= r%nh <= max_outer (checked after reading it)
     call need(r, r%hid, '/history', 'criterion', .false., CLASS_REAL, [-1_hsize_t], 'one entry per outer iteration')
@@ -647,7 +648,7 @@ contains
       allocate (st%row_state(m))
       st%row_state = -1
     end if
-    allocate (st%mu(3, r%nbody), st%nrw(2, r%nbody))
+    allocate (st%mu(NRIGID, r%nbody), st%nrw(2, r%nbody))
     allocate (st%newton(r%nbody), st%kept(r%nbody), source=0)
     if (r%has_newton) then
       call read_dset(r%gid, 'newton', ir, r%hs)

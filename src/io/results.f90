@@ -705,6 +705,13 @@ contains
       call write_dset(pid, 's', itf%s(i:j), st, ul)
       w2 = transpose(row_directions(itf, i, j))
       call write_dset(pid, 'normal', w2, st, '1')
+      ! friction in space: the tangents its tangential components are along
+      if (NDIM == 3 .and. itf%pair_friction(q) /= FRICTION_NONE) then
+        w2 = transpose(itf%frame(:, 2, i:j))
+        call write_dset(pid, 'tangent1', w2, st, '1')
+        w2 = transpose(itf%frame(:, 3, i:j))
+        call write_dset(pid, 'tangent2', w2, st, '1')
+      end if
       call write_dset(pid, 'g0', itf%g0(i:j), st, ul)
       call write_dset(pid, tributary_name(), itf%trib(i:j), st, trib_unit)
       call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
@@ -728,7 +735,11 @@ contains
   !> The tangential part of the nodes i..j (friction) in the group gid (or its subgroup
   !! `sub`): tangential_force, shear, tangential_bound (the bound of |tangential_force|), slip,
   !! slip_increment (the slip of the last load step) and state (0 open, 1 stick, 2 slip,
-  !! -1 a node of a frictionless pair; the names in the attribute state_names).
+  !! -1 a node of a frictionless pair; the names in the attribute state_names). In space the
+  !! force, shear and slips are (nodes, 2) arrays of their components along the node's
+  !! tangents t1, t2 (the pair's `tangent1`, `tangent2`, stored as `normal` is), with the
+  !! force also as a vector (tangential_force_xyz, stored as geometry_xyz is) and the shear's
+  !! length (shear_magnitude).
   subroutine write_tangential(gid, tg, i, j, ul, us, uf, st, sub)
     integer(hid_t), intent(in) :: gid
     type(tangential_t), intent(in) :: tg
@@ -737,13 +748,35 @@ contains
     type(error_t), intent(inout) :: st
     character(len=*), intent(in), optional :: sub
     integer(hid_t) :: pid
+    real(wp), allocatable :: a1(:), a2(:, :)
     pid = gid
     if (present(sub)) call group_open(gid, sub, pid, st)
-    call write_dset(pid, 'tangential_force', tg%force(i:j), st, uf)
-    call write_dset(pid, 'shear', tg%shear(i:j), st, us)
+    if (NDIM == 2) then
+      a1 = tg%force(1, i:j)
+      call write_dset(pid, 'tangential_force', a1, st, uf)
+      a1 = tg%shear(1, i:j)
+      call write_dset(pid, 'shear', a1, st, us)
+      a1 = tg%slip(1, i:j)
+      call write_dset(pid, 'slip', a1, st, ul)
+      a1 = tg%slip_increment(1, i:j)
+      call write_dset(pid, 'slip_increment', a1, st, ul)
+    else
+      ! (nodes, component) arrays, as `normal`
+      a2 = transpose(tg%force(:, i:j))
+      call write_dset(pid, 'tangential_force', a2, st, uf)
+      ! (x, y, z) per node, as geometry_xyz (ParaView's vector)
+      a2 = tg%force_xyz(:, i:j)
+      call write_dset(pid, 'tangential_force_xyz', a2, st, uf)
+      a2 = transpose(tg%shear(:, i:j))
+      call write_dset(pid, 'shear', a2, st, us)
+      a1 = norm2(tg%shear(:, i:j), dim=1)
+      call write_dset(pid, 'shear_magnitude', a1, st, us)
+      a2 = transpose(tg%slip(:, i:j))
+      call write_dset(pid, 'slip', a2, st, ul)
+      a2 = transpose(tg%slip_increment(:, i:j))
+      call write_dset(pid, 'slip_increment', a2, st, ul)
+    end if
     call write_dset(pid, 'tangential_bound', tg%bound(i:j), st, uf)
-    call write_dset(pid, 'slip', tg%slip(i:j), st, ul)
-    call write_dset(pid, 'slip_increment', tg%slip_increment(i:j), st, ul)
     call write_dset(pid, 'state', tg%state(i:j), st, '1')
     call write_attr(pid, 'state_names', 'none=-1 open=0 stick=1 slip=2', st)
     if (present(sub)) call group_close(pid, st)
@@ -1142,7 +1175,8 @@ contains
   !! triangles, quadrilaterals or both, contact_cells) with the contact fields at its
   !! nodes; `side` names the columns of the normal displacements ('body': the
   !! normal_displacement_body1/2 of /contact, 'side': normal_displacement_side1/2 of a pair);
-  !! with friction also its shear, tangential force, slip and slip increment.
+  !! with friction also its shear, tangential force, slip and slip increment (in space the
+  !! shear's length, the tangential force as a vector and the node's state).
   function contact_grid_text(name, g, n, cells, side, fg, time, friction) result(t)
     character(len=*), intent(in) :: name, g, side
     character(len=*), intent(in) :: fg     !< file:path of the group of its fields
@@ -1189,10 +1223,15 @@ contains
     do k = 1, size(f)
       t = t//field_text(trim(f(k)), 'Scalar', trim(nn), fg//'/'//trim(f(k)))
     end do
-    if (friction) then
+    if (friction .and. NDIM == 2) then
       do k = 1, size(ft)
         t = t//field_text(trim(ft(k)), 'Scalar', trim(nn), fg//'/'//trim(ft(k)))
       end do
+    else if (friction) then
+      ! in space: the shear's length, the tangential force as a vector, the stick zone
+      t = t//field_text('shear_magnitude', 'Scalar', trim(nn), fg//'/shear_magnitude')
+      t = t//field_text('tangential_force', 'Vector', trim(nn)//' 3', fg//'/tangential_force_xyz')
+      t = t//field_text('state', 'Scalar', trim(nn), fg//'/state', 'Node')
     end if
     t = t//line('      </Grid>')
   end function contact_grid_text
@@ -1207,7 +1246,7 @@ contains
         line('        </Geometry>')
   end function geometry_text
 
-  !> A field of a grid: nodal (default) or per cell (center = 'Cell', integer data).
+  !> A field of a grid: nodal (default), or integer data at `center` ('Cell', or 'Node').
   function field_text(name, kind, dims, path, center) result(t)
     character(len=*), intent(in) :: name, kind, dims, path
     character(len=*), intent(in), optional :: center

@@ -15,7 +15,8 @@
 !! mu <- mu + rho (Gx - e), and M <- beta M when L did not grow by at least
 !! rho/2 |Gx - e|^2. It stops when the projected gradient is below eta and |Gx - e| below
 !! feas. The upper bounds are optional (absent or +huge(1.0_wp): none); the bounds go to
-!! MPRGP as one `box_set_t` (module constraint_set).
+!! MPRGP as one `box_set_t` (module constraint_set), or `smalbe_solve_in` takes any
+!! constraint set (the discs of friction in space).
 !!
 !! On return g = Hx - c + G'mu (the gradient of the Lagrangian at the final multipliers,
 !! which is MPRGP's last gradient), so for contact `G_a - g` is still B_a u_a with the
@@ -26,11 +27,11 @@ module smalbe
   use linop, only: linop_t
   use lapack, only: dposv
   use mprgp, only: mprgp_t, mprgp_opts_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, QP_NEWTON
-  use constraint_set, only: constraint_set_t, box_set_t, box_set
+  use constraint_set, only: constraint_set_t, box_set
   implicit none (type, external)
   private
 
-  public :: smalbe_solve, smalbe_stats_t, SMALBE_MAX_UPDATES
+  public :: smalbe_solve, smalbe_solve_in, smalbe_stats_t, SMALBE_MAX_UPDATES
 
   integer, parameter :: SMALBE_MAX_UPDATES = 200   !< multiplier updates before giving up
   real(wp), parameter :: BETA = 0.2_wp              !< M <- BETA M when L did not grow enough
@@ -70,12 +71,28 @@ contains
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_t%solve)
     integer, intent(inout), optional :: nrw(2)
     real(wp), intent(in), optional :: ub(:)     !< (n) upper bounds (>= lb); +huge(1.0_wp): none
+    call smalbe_solve_in(solver, A, c, gm, e, rho, box_set(lb, ub), x, mu, stats, rw, raw, nrw)
+  end subroutine smalbe_solve
+
+  !> `smalbe_solve` on any constraint set (a box, or discs: module tangent_discs).
+  subroutine smalbe_solve_in(solver, A, c, gm, e, rho, set, x, mu, stats, rw, raw, nrw)
+    type(mprgp_t), intent(inout) :: solver      !< inner solver (options; ax, g as above)
+    class(linop_t), intent(inout) :: A          !< H + rho G'G
+    real(wp), intent(in) :: c(:)                !< (n) linear term
+    real(wp), intent(in) :: gm(:, :)            !< (r, n) equality rows G
+    real(wp), intent(in) :: e(:)                !< (r) right-hand side
+    real(wp), intent(in) :: rho                 !< the penalty folded into A
+    class(constraint_set_t), intent(in) :: set  !< the feasible set
+    real(wp), intent(inout) :: x(:)             !< in: warm start; out: solution
+    real(wp), intent(inout) :: mu(:)            !< (r) in: warm start; out: multipliers
+    type(smalbe_stats_t), intent(out) :: stats
+    real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_t%solve)
+    integer, intent(inout), optional :: nrw(2)
     type(mprgp_opts_t) :: opts
     real(wp), allocatable :: rhs(:), r(:)
     real(wp) :: lag_old, lag_new, rr, m_control, feas
     integer :: n, k
     logical :: have_ax
-    type(box_set_t) :: set
 
     n = size(x)
     allocate (rhs(n), r(size(e)))
@@ -83,7 +100,6 @@ contains
     feas = opts%eq_feas
     m_control = opts%eq_m
     have_ax = opts%use_ax .and. allocated(solver%ax)
-    set = box_set(lb, ub)
     if (have_ax) call multiplier_estimate(gm, e, rho, set, x, c, solver%ax, mu)
     solver%eq_g = gm
     solver%eq_e = e
@@ -138,7 +154,7 @@ contains
     end if
     solver%opts = opts
     deallocate (solver%eq_g, solver%eq_e)
-  end subroutine smalbe_solve
+  end subroutine smalbe_solve_in
 
   !> A better start for the multipliers when the warm start mu is far off: the least-squares
   !! multipliers of the free set, mu_ls = argmin |g0_F + G_F' mu| (g0 = H x - c, no product:

@@ -28,11 +28,12 @@
 module tangent_discs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
-  use constraint_set, only: constraint_set_t, box_set_t, set_projected_gradient_norm, SET_OK, SET_BAD_ARG, SET_NONFINITE
+  use constraint_set, only: constraint_set_t, box_set_t, box_set, set_projected_gradient_norm, SET_OK, SET_BAD_ARG, &
+                            SET_NONFINITE
   implicit none (type, external)
   private
 
-  public :: disc_set_t, disc_set, circle_point
+  public :: disc_set_t, disc_set, circle_point, friction_set
 
   real(wp), parameter :: big = huge(1.0_wp)
   !> A point within this relative distance of its circle is on it (a projected point lands
@@ -100,6 +101,20 @@ contains
       end do
     end do
   end function disc_set
+
+  !> The feasible set of contact forces: the box lb <= x <= ub, or, with discs (pair(:, k) the
+  !! two tangential forces of a node in space), the box on the other variables and the disc of
+  !! radius ub(pair(1, k)) on each pair.
+  function friction_set(lb, ub, pair) result(set)
+    real(wp), intent(in) :: lb(:), ub(:)      !< the bounds (a disc's variables: -r and r)
+    integer, intent(in) :: pair(:, :)         !< (2, nd) the discs' variables; nd = 0: a box
+    class(constraint_set_t), allocatable :: set
+    if (size(pair, 2) > 0) then
+      allocate (set, source=disc_set(lb, pair, ub(pair(1, :)), ub))
+    else
+      allocate (set, source=box_set(lb, ub))
+    end if
+  end function friction_set
 
   !> Not linear: the discs' boundaries are curved.
   logical function disc_linear(self) result(yes)
@@ -187,7 +202,7 @@ contains
   !> |x_k| on or beyond the circle of radius r (to CIRCLE_RTOL).
   pure logical function on_circle(xa, xb, r) result(on)
     real(wp), intent(in) :: xa, xb, r
-    on = xa*xa + xb*xb >= (r*(1.0_wp - CIRCLE_RTOL))**2
+    on = hypot(xa, xb) >= r*(1.0_wp - CIRCLE_RTOL)
   end function on_circle
 
   !> The unit outward normal (na, nb) of a point (xa, xb) of a circle and its distance s from
@@ -244,6 +259,11 @@ contains
   pure real(wp) function root(xa, xb, da, db, r) result(t)
     real(wp), intent(in) :: xa, xb, da, db, r
     real(wp) :: a, bq, c, disc
+    ! no step reaches a circle of radius huge (no bound: Coulomb's first solve)
+    if (r >= big) then
+      t = big
+      return
+    end if
     a = da*da + db*db
     if (a <= 0.0_wp) then
       t = big
@@ -482,7 +502,7 @@ contains
     if (cut .and. whole) return
     do k = 1, size(self%r)
       associate (a => self%pair(1, k), b => self%pair(2, k))
-        if ((x(a) + t*d(a))**2 + (x(b) + t*d(b))**2 > self%r(k)**2) then
+        if (hypot(x(a) + t*d(a), x(b) + t*d(b)) > self%r(k)) then
           cut = .true.
           if (whole) return
           t = max(0.0_wp, min(t, root(x(a), x(b), d(a), d(b), self%r(k))))

@@ -17,7 +17,7 @@ temporary folder). References are exact solutions and the 2D program itself.
     the bodies balance to 1e-12; the 'steklov' and 'constant' operators too (to 1e-8).
 (4) Bad input, exit 1, one message, nothing written: a box's variable in a 2D deck, a body
     with no depth in a 3D deck, plane stress in a 3D deck, uz in a 2D deck, dimension = 4,
-    friction and a parabolic gap in a 3D deck, t1 in a 3D deck, an override that changes the
+    a parabolic gap in a 3D deck, t1 in a 3D deck, an override that changes the
     dimension, a box resting on another held only by contact (nothing holds it along x).
 (6) A cube held only by contact, its six rigid motions free, pressed into a corner of three
     clamped walls by a pressure on its other three faces: each wall's contact resultant is
@@ -184,7 +184,6 @@ try:
         ("stress", "&scene plane='stress' /\n" + boxes, "plane strain, plane stress and axisymmetric bodies"),
         ("uz2d", deck2 + "&boundary body=2, group='bottom', uz=0.0 /\n", "uz = 0.0 in a 2D deck"),
         ("dim4", "&scene dimension=4 /\n" + boxes, "must be 2 (plane or axisymmetric bodies) or 3"),
-        ("friction", boxes + "&contact friction='coulomb', mu=0.3 /\n", "frictionless for now"),
         ("gap", boxes + "&contact gap_radius=2.0 /\n", "the parabolic gap is a 2D profile"),
         ("t1", boxes + "&traction body=1, side='right', t0=0.0, 0.0, 0.0, t1=1.0, 0.0 /\n", "t1 (a traction varying"),
         ("floating6", boxes.replace("top='displacement'", "top='free'").replace(

@@ -8,6 +8,9 @@
 !!    a disc of radius 0 (a fixed point);
 !!  - the refusal of bad sets (a negative or NaN radius, a pair out of range, a variable in
 !!    two pairs);
+!!  - friction_set: a box when there are no pairs (the plane: a tangential force in
+!!    [-t, t]), discs of radius ub(pair(1, k)) otherwise; a disc of radius huge (Coulomb's
+!!    first solve) never binds, and a step towards it is not cut;
 !!  - MPGP: with A = I the minimiser is the projection of b (exact); isotropy, the same
 !!    2 x 2 problem with b turned by 0, 15, 30 and 45 degrees in the plane gives the force on
 !!    the circle along b every time (a box fails this by up to 41%); 30 nodes with a random
@@ -24,7 +27,8 @@ program test_disc_set
   use kinds, only: wp
   use linop, only: dense_op_t, dense_op_init
   use constraint_set, only: SET_OK, SET_BAD_ARG, SET_NONFINITE
-  use tangent_discs, only: disc_set_t, disc_set
+  use tangent_discs, only: disc_set_t, disc_set, friction_set
+  use constraint_set, only: constraint_set_t
   use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP, QP_AUTO
   use lapack, only: dposv
   use testing, only: report, report_le, test_summary, set_seed, urand, random_spd
@@ -36,6 +40,7 @@ program test_disc_set
   call test_pointwise()
   call test_steps()
   call test_validate()
+  call test_friction_set()
   call test_identity()
   call test_isotropy()
   call test_random_qp()
@@ -44,6 +49,31 @@ program test_disc_set
   call test_summary()
 
 contains
+
+  !> friction_set: a box, or discs on the pairs with the radius from ub.
+  subroutine test_friction_set()
+    class(constraint_set_t), allocatable :: set
+    real(wp) :: x(3), t
+    integer :: blocker
+    ! no pairs: the box [lb, ub]; (3, 4) lands on (2, 2) componentwise
+    set = friction_set([0.0_wp, -2.0_wp, -2.0_wp], [big, 2.0_wp, 2.0_wp], reshape([integer ::], [2, 0]))
+    x = [1.0_wp, 3.0_wp, 4.0_wp]
+    call set%project(x)
+    call report(set%linear() .and. all(x == [1.0_wp, 2.0_wp, 2.0_wp]), 'friction_set without pairs: the box', x(3))
+    ! a pair: the disc of radius 2; (3, 4) lands on 2 (3, 4) / 5
+    set = friction_set([0.0_wp, -2.0_wp, -2.0_wp], [big, 2.0_wp, 2.0_wp], reshape([2, 3], [2, 1]))
+    x = [1.0_wp, 3.0_wp, 4.0_wp]
+    call set%project(x)
+    call report_le(maxval(abs(x - [1.0_wp, 1.2_wp, 1.6_wp])), 2.0_wp*eps, 'friction_set with a pair: its disc')
+    call report(.not. set%linear(), 'friction_set with a pair: not linear', 0.0_wp)
+    ! radius huge: nothing binds, no step is cut, no overflow (the checked build traps it)
+    set = friction_set([0.0_wp, -big, -big], [big, big, big], reshape([2, 3], [2, 1]))
+    x = [1.0_wp, 1.0e300_wp, 1.0e300_wp]
+    call set%project(x)
+    call set%max_step(x, [0.0_wp, 1.0e300_wp, 1.0e300_wp], 1.0_wp, t, blocker)
+    call report(all(x == [1.0_wp, 1.0e300_wp, 1.0e300_wp]) .and. t == 1.0_wp .and. blocker == 0, &
+                'friction_set, radius huge: no projection, no cut', t)
+  end subroutine test_friction_set
 
   !> K nodes: variable 3k-2 the normal force (>= 0), 3k-1 and 3k its disc of radius r(k).
   function node_set(r) result(set)
