@@ -326,8 +326,8 @@ contains
         call need(r, kid, path, 'w', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(m))
         call need(r, kid, path, 'gap', .false., CLASS_REAL, [m2], contact_nodes(m))
         call need(r, kid, path, 'obstacle', .false., CLASS_REAL, [m2, 2_hsize_t], contact_nodes(m))
-        call need(r, kid, path, 'rigid', .false., CLASS_REAL, [3_hsize_t, int(nbody, hsize_t)], &
-                  'three amplitudes per body')
+        call need(r, kid, path, 'rigid', .false., CLASS_REAL, [int(NRIGID, hsize_t), int(nbody, hsize_t)], &
+                  'one amplitude per rigid motion and body')
         if (len_trim(r%msg) == 0) then
           associate (d => done(k))
             call read_attr(kid, 'status', d%status, r%hs)

@@ -25,6 +25,13 @@ poisson 0 so that a uniform state is exact with the lower block clamped below).
 (4) Sliding threshold: the block of (2) pushed along 30 degrees by Q = 0.99 mu P sticks (held by
     friction alone, the tangential resultant Q to 1e-9); at Q = 1.01 mu P the run stops with
     exit 1, one message naming the body and the direction it would slide in, nothing written.
+(6) Load history, steel pressed onto aluminium then moved sideways (Coulomb mu = 0.3, partial
+    slip): in two stages against both at once the results differ (path dependence, > 1e-3), each
+    equals the monolithic solution of its own history (1e-6); the slip increment of the second
+    stage is not its slip; stopped at max_outer in the second stage and restarted from its
+    checkpoint, bitwise the uninterrupted run.
+(7) The same scene with one and two threads bitwise; mpirun -np 1, 2, 4 (MUMPS) = the serial
+    run to 1e-10 (both to tol 1e-12; skipped without bin/robin_contact_mpi or mpirun).
 (5) The output of a frictional 3D pair: tangential force in the frame (2 components), as a
     vector, consistent with the tangents written beside it; shear magnitude; stick/slip counts
     and the vector resultant on the contact line; the contact surface's XDMF (read by meshio)
@@ -33,15 +40,20 @@ poisson 0 so that a uniform state is exact with the lower block clamped below).
 import math
 import os
 import re
+import shutil
+import subprocess
 import sys
 import tempfile
 
+import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from test_friction import MONO, Run, check, converged, refused, rel  # noqa: E402
+from test_friction import BIN, MONO, ROOT, Run, check, converged, refused, rel  # noqa: E402
 from solid_decks import THREE_BOXES  # noqa: E402
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+from rc_run import solver_env  # noqa: E402
 
 ROBIN = "&solver robin_operator='harmonic', delta=0.5, stop='residual', tol=1e-11 /"
 P = 1.0e6
@@ -215,12 +227,100 @@ def threshold(tmp):
             refused(r, what, ["body 2", "slide along (8.660E-01, 0.000E+00, 5.000E-01)", "no static equilibrium"])
 
 
+# steel pressed onto aluminium (a Poisson mismatch), then moved sideways a little: partial slip
+PATH_DECK = """&scene title='3D load history', dimension=3 /
+&body id=1, x0=0.0, y0=0.0, z0=0.0, width=1.0, height=0.5, depth=1.0, nx=4, ny=2, nz=4, element='P1',
+      young=7.0e10, poisson=0.33, bottom='clamped' /
+&body id=2, x0=0.0, y0=0.5, z0=0.0, width=1.0, height=0.5, depth=1.0, nx=5, ny=2, nz=5, element='Q1',
+      young=2.1e11, poisson=0.3 /
+&contact bodies=1,2, groups='top','bottom', friction='coulomb', mu=0.3 /
+"""
+PRESS = "&boundary body=2, group='top', uy=-2.0e-6{} /"
+SHIFT = "&boundary body=2, group='top', ux=2.0e-7, uz=1.0e-7{} /"
+TIGHT = "&solver stop='residual', tol=1e-10 /"
+
+
+def both(r):
+    g = pair(r)
+    return np.concatenate([g["normal_force"], g["tangential_force"].ravel()])
+
+
+def load_history(tmp):
+    runs = {}
+    for hist, st in (("two stages", (", stage=1", ", stage=2")), ("at once", ("", ""))):
+        for meth in ("monolithic", "robin"):
+            r = Run(tmp, f"path_{hist[:3]}_{meth}", PATH_DECK, PRESS.format(st[0]), SHIFT.format(st[1]), TIGHT,
+                    f"&solver method='{meth}' /")
+            runs[hist, meth] = r
+            converged(r, f"3D load history {hist} ({meth})")
+    if not all(r.ok for r in runs.values()):
+        return runs
+    d = rel(both(runs["two stages", "monolithic"]), both(runs["at once", "monolithic"]))
+    check(d > 1e-3, "3D load history: P then Q differs from P and Q at once (path dependence)", f"{d:.2e}")
+    for hist in ("two stages", "at once"):
+        e = rel(both(runs[hist, "robin"]), both(runs[hist, "monolithic"]))
+        check(e <= 1e-6, f"3D load history {hist}: Robin = monolithic of the same history (1e-6)", f"{e:.2e}")
+    g = pair(runs["two stages", "monolithic"])
+    check(not np.allclose(g["slip"], g["slip_increment"]), "3D load history: the second stage's slip increment is not "
+          "its slip")
+    # stopped in the second stage, restarted from the checkpoint
+    stem = os.path.join(tmp, "path_restart")
+    deck = os.path.join(tmp, "path_two_robin.nml")
+    over = [PRESS.format(", stage=1"), SHIFT.format(", stage=2"), TIGHT]
+    p1 = subprocess.run([BIN, deck, *over, "&solver max_outer=40 /", f"&output file='{stem}.h5', checkpoint_every=4 /"],
+                        capture_output=True, text=True, env=solver_env(), timeout=600)
+    p2 = subprocess.run([BIN, deck, *over, f"&output file='{stem}.h5', checkpoint_every=4 /", "--restart",
+                         f"{stem}.h5.ckpt.h5"], capture_output=True, text=True, env=solver_env(), timeout=600)
+    ok = p1.returncode == 2 and "step=2 of=2" in p1.stdout and p2.returncode == 0
+    if check(ok, "3D load history: stopped at max_outer in the second stage (exit 2), restarted (exit 0)",
+             f"exit {p1.returncode}, {p2.returncode}: {(p1.stdout + p2.stderr).strip()[-300:]}"):
+        with h5py.File(stem + ".h5", "r") as f:
+            same = all(np.array_equal(np.array(f["contact"]["pair_1"][k]), pair(runs["two stages", "robin"])[k])
+                       for k in ("normal_force", "tangential_force", "slip", "slip_increment"))
+        check(same, "3D load history: the restarted run = the uninterrupted one, bitwise")
+    return runs
+
+
+def threads_and_mpi(tmp):
+    over = [PRESS.format(""), SHIFT.format(""), TIGHT]
+    one = Run(tmp, "threads1", PATH_DECK, *over, threads=1)
+    two = Run(tmp, "threads2", PATH_DECK, *over, threads=2)
+    if converged(one, "3D friction, one thread") and converged(two, "3D friction, two threads"):
+        same = all(np.array_equal(pair(one)[k], pair(two)[k]) for k in ("normal_force", "tangential_force"))
+        check(same and one.res.get("outer") == two.res.get("outer"), "3D friction: one and two threads bitwise")
+    mpi_bin = os.path.abspath(os.environ.get("MPI_BIN", os.path.join(ROOT, "bin/robin_contact_mpi")))
+    if not (os.path.exists(mpi_bin) and shutil.which("mpirun")):
+        print(f"SKIP  {mpi_bin} or mpirun absent: no MPI check")
+        return
+    serial = Run(tmp, "mpi_serial", PATH_DECK, *over, "&solver tol=1e-12 /")
+    if not converged(serial, "3D friction, serial, tol 1e-12"):
+        return
+    env = solver_env(threads=1)
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_mpi_yield_when_idle="1",
+               OMPI_MCA_rmaps_base_oversubscribe="1")
+    deck = os.path.join(tmp, "mpi_serial.nml")
+    for np_ in (1, 2, 4):
+        out = os.path.join(tmp, f"mpi_np{np_}.h5")
+        p = subprocess.run(["mpirun", "--oversubscribe", "-np", str(np_), mpi_bin, deck, *over, "&solver tol=1e-12 /",
+                            "&solver factorization='mumps' /", f"&output file='{out}' /"],
+                           capture_output=True, text=True, env=env, timeout=600)
+        what = f"3D friction, mpirun -np {np_}"
+        if not check(p.returncode == 0 and os.path.exists(out), f"{what}: exit 0", p.stderr.strip()[-300:]):
+            continue
+        with h5py.File(out, "r") as f:
+            e = max(float(np.max(np.abs(np.array(f["contact"]["pair_1"][k]) - pair(serial)[k])) /
+                          np.max(np.abs(pair(serial)[k]))) for k in ("normal_force", "tangential_force"))
+        check(e <= 1e-10, f"{what}: = serial (1e-10)", f"{e:.2e}")
+
+
 def main():
     with tempfile.TemporaryDirectory(prefix="rc_friction3d_") as tmp:
         zero_friction(tmp)
         patch_stick(tmp)
         slide(tmp)
         threshold(tmp)
+        load_history(tmp)
+        threads_and_mpi(tmp)
     print(f"{len(check.failed)} failed")
     return 1 if check.failed else 0
 
