@@ -144,30 +144,30 @@ contains
 
   !> The pairs of tangential rows that carry one node's tangential force in space (its tangent
   !! 1 and tangent 2 rows), whose force is bounded by a disc |(l_t1, l_t2)| <= t (METHOD-3D
-  !! section 3); none in the plane, where a node's one tangential row has an interval.
+  !! section 3); none in the plane, where a node's one tangential row has an interval, as has
+  !! a node on a plane of symmetry in space (symmetry_tangents).
   pure function disc_rows(itf) result(pr)
     type(interface_t), intent(in) :: itf
     integer, allocatable :: pr(:, :)          !< (2, nodes) the tangent-1 row, the tangent-2 row
-    integer, allocatable :: t2(:)
+    integer, allocatable :: t(:, :)
     integer :: k, n
-    allocate (pr(2, 0))
-    if (NDIM /= 3 .or. itf%m == 0) return
-    allocate (t2(itf%m))
-    t2 = 0
+    if (NDIM /= 3 .or. itf%m == 0) then
+      allocate (pr(2, 0))
+      return
+    end if
+    ! each node's tangent-1 and tangent-2 rows (0: none; a node on a plane of symmetry has one)
+    allocate (t(2, itf%m))
+    t = 0
     do k = 1, itf%m
-      if (itf%dir(k) == 2) t2(itf%nrow(k)) = k
+      if (itf%dir(k) > DIR_NORMAL) t(itf%dir(k), itf%nrow(k)) = k
     end do
-    n = 0
-    do k = 1, itf%m
-      if (itf%dir(k) == 1) n = n + 1
-    end do
-    deallocate (pr)
+    n = count(t(1, :) > 0 .and. t(2, :) > 0)
     allocate (pr(2, n))
     n = 0
     do k = 1, itf%m
-      if (itf%dir(k) /= 1) cycle
+      if (t(1, k) == 0 .or. t(2, k) == 0) cycle
       n = n + 1
-      pr(:, n) = [k, t2(itf%nrow(k))]
+      pr(:, n) = t(:, k)
     end do
   end function disc_rows
 
@@ -476,10 +476,10 @@ contains
     type(error_t), intent(out) :: err
     !> slave nodes that carry rows in an earlier pair of the same bodies: none here
     logical, intent(in), optional :: taken(:)
-    integer :: g(2), s, sl, ma, j, e, k, ne, nr
+    integer :: g(2), s, sl, ma, j, e, k, ne, nr, r
     real(wp) :: hmean(2), tol, gmin, ext
-    logical, allocatable :: removable(:)
-    real(wp), allocatable :: gdist(:)
+    logical, allocatable :: removable(:), keep_t(:, :)
+    real(wp), allocatable :: gdist(:), nrm(:, :)
     character(len=300) :: what(2)               ! each side's words for messages
     type(mortar_t) :: mt
     type(error_t) :: why
@@ -585,11 +585,17 @@ contains
       end if
 
       ! a pair with friction (a positive bound) has NDIM - 1 tangential rows per slave node
-      ! after the normal ones: nr = NDIM mt%m rows, else mt%m
+      ! after the normal ones (tangent 1's, then tangent 2's), less those along a direction
+      ! held on both sides (symmetry_tangents)
       itf%pair_friction = [FRICTION_NONE]
       if ((cc%friction == FRICTION_TRESCA .and. cc%slip_bound > 0.0_wp) .or. &
           (cc%friction == FRICTION_COULOMB .and. cc%mu > 0.0_wp)) itf%pair_friction = [cc%friction]
-      nr = merge(NDIM*mt%m, mt%m, itf%pair_friction(1) /= FRICTION_NONE)
+      allocate (keep_t(NDIM - 1, mt%m), nrm(NDIM, mt%m))
+      keep_t = itf%pair_friction(1) /= FRICTION_NONE
+      nrm = mt%normal
+      if (itf%pair_friction(1) /= FRICTION_NONE .and. NDIM == 3) &
+        call symmetry_tangents(sys(cc%bodies(sl)), sys(cc%bodies(ma)), mt, nrm, keep_t)
+      nr = mt%m + count(keep_t)
       itf%m = nr
       allocate (itf%s(nr), itf%xy(NDIM, nr), itf%g0(nr), itf%trib(nr), itf%node(nr, 2), itf%frame(NDIM, NDIM, nr), &
                 itf%dir(nr), itf%nrow(nr))
@@ -597,7 +603,7 @@ contains
       itf%xy(:, 1:mt%m) = ms%xy(:, mt%snode)
     end associate
     do j = 1, mt%m
-      itf%frame(:, :, j) = frame_of(mt%normal(:, j))
+      itf%frame(:, :, j) = frame_of(nrm(:, j))
     end do
     itf%trib(1:mt%m) = mt%d
     itf%node(1:mt%m, sl) = mt%snode
@@ -607,23 +613,26 @@ contains
                                                   (2.0_wp*cc%gap_radius)
     itf%dir(1:mt%m) = DIR_NORMAL
     itf%nrow(1:mt%m) = [(j, j=1, mt%m)]
-    do k = 1, nr/mt%m - 1          ! tangent k's rows: k mt%m + 1 .. (k + 1) mt%m
-      associate (t => [(k*mt%m + j, j=1, mt%m)])
-        itf%s(t) = itf%s(1:mt%m)
-        itf%xy(:, t) = itf%xy(:, 1:mt%m)
-        itf%frame(:, :, t) = itf%frame(:, :, 1:mt%m)
-        itf%trib(t) = mt%d
-        itf%node(t, sl) = mt%snode
-        itf%g0(t) = 0.0_wp
-        itf%dir(t) = k
-        itf%nrow(t) = [(j, j=1, mt%m)]
-      end associate
+    r = mt%m
+    do k = 1, NDIM - 1
+      do j = 1, mt%m
+        if (.not. keep_t(k, j)) cycle
+        r = r + 1
+        itf%s(r) = itf%s(j)
+        itf%xy(:, r) = itf%xy(:, j)
+        itf%frame(:, :, r) = itf%frame(:, :, j)
+        itf%trib(r) = mt%d(j)
+        itf%node(r, sl) = mt%snode(j)
+        itf%g0(r) = 0.0_wp
+        itf%dir(r) = k
+        itf%nrow(r) = j
+      end do
     end do
     ! B_s: + sum_k ws_k d_j.u_k ; B_m: - sum_l wm_l d_j.u_l (every component of each node),
     ! d_j the row's direction (normal, then tangents)
-    ne = (nr/mt%m)*NCOMP*(mt%sptr(mt%m + 1) - 1)
+    ne = NCOMP*sum(mt%sptr(itf%nrow + 1) - mt%sptr(itf%nrow))
     allocate (itf%b(sl)%ptr(nr + 1), itf%b(sl)%dof(ne), itf%b(sl)%val(ne))
-    ne = (nr/mt%m)*NCOMP*(mt%mptr(mt%m + 1) - 1)
+    ne = NCOMP*sum(mt%mptr(itf%nrow + 1) - mt%mptr(itf%nrow))
     allocate (itf%b(ma)%ptr(nr + 1), itf%b(ma)%dof(ne), itf%b(ma)%val(ne))
     call fill_rows(mt%sptr, mt%snod, mt%sval, 1.0_wp, itf%b(sl))
     call fill_rows(mt%mptr, mt%mnod, mt%mval, -1.0_wp, itf%b(ma))
@@ -655,6 +664,43 @@ contains
     end subroutine fill_rows
 
   end subroutine mortar_pair
+
+  !> Friction in space on a plane of symmetry: where a slave node and some master node its row
+  !! reaches have the same displacement component c prescribed (a roller on the plane x_c =
+  !! const in both bodies) and the node's normal lies nearly in that plane (|n_c| < 0.1), the
+  !! contact normal of the symmetric solution is in the plane: n_c is set to 0 (nrm), so that
+  !! one tangent of the node's frame is e_c itself (frame_of), and that tangent's row is
+  !! dropped (keep_t): the symmetric solution has no shear across the plane, and the row's
+  !! force would act on the slave's prescribed DOF and use up the node's friction disc; the
+  !! node keeps a tangential row in the plane, an interval as in 2D.
+  subroutine symmetry_tangents(sys_s, sys_m, mt, nrm, keep_t)
+    type(body_system_t), intent(in) :: sys_s, sys_m   !< the slave's and the master's body
+    type(mortar_t), intent(in) :: mt
+    real(wp), intent(inout) :: nrm(:, :)              !< (NDIM, m) the nodes' normals
+    logical, intent(inout) :: keep_t(:, :)            !< (NDIM - 1, m) the tangential rows kept
+    real(wp) :: f(NDIM, NDIM), e(NDIM)
+    integer :: j, c, k, q
+    logical :: held
+    do j = 1, mt%m
+      do c = 1, NCOMP
+        if (abs(nrm(c, j)) >= 0.1_wp) cycle
+        e = 0.0_wp
+        e(c) = 1.0_wp
+        ! held along e_c at the slave node, and at some master node its row reaches (the
+        ! master's nodes off the plane also carry weights of a node at the plane's edge)
+        held = normal_fixed(sys_s, mt%snode(j), e)
+        if (held) held = any([(abs(mt%mval(q)) > 1.0e-12_wp .and. normal_fixed(sys_m, mt%mnod(q), e), &
+                               q=mt%mptr(j), mt%mptr(j + 1) - 1)])
+        if (.not. held) cycle
+        nrm(c, j) = 0.0_wp
+        nrm(:, j) = nrm(:, j)/norm2(nrm(:, j))
+        f = frame_of(nrm(:, j))
+        do k = 1, NDIM - 1
+          if (abs(abs(f(c, k + 1)) - 1.0_wp) <= 1.0e-12_wp) keep_t(k, j) = .false.
+        end do
+      end do
+    end do
+  end subroutine symmetry_tangents
 
   !> Whether the displacement of node k along nrm is prescribed in the body: every
   !! component that nrm has is a prescribed DOF.

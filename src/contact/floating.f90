@@ -716,8 +716,8 @@ contains
     integer, allocatable, intent(out), optional :: tres(:)
     type(sparse_cols_t) :: gc
     integer, allocatable :: tcol(:, :), cr(:), tr(:)
-    real(wp), allocatable :: cv(:), dir(:, :)
-    integer :: i, k, p, q, nd
+    real(wp), allocatable :: cv(:), dir(:, :), nd_dir(:, :)
+    integer :: i, k, p, q
     real(wp) :: sc, t
     sc = 1.0_wp
     if (present(mu_scale)) sc = mu_scale
@@ -730,34 +730,35 @@ contains
         dir(:, q) = [cos(2.0_wp*PI*(q - 1)/CONE_SIDES), sin(2.0_wp*PI*(q - 1)/CONE_SIDES)]/cos(PI/CONE_SIDES)
       end do
     end if
-    nd = size(dir, 2)
     allocate (tcol(NDIM - 1, contact_line%m), tr(0))
     tcol = 0
     do i = 1, size(rows)
       if (contact_line%dir(rows(i)) > DIR_NORMAL) tcol(contact_line%dir(rows(i)), contact_line%nrow(rows(i))) = i
     end do
-    call gc%init(g%nrow, nd*(g%ptr(g%ncol + 1) - 1))
+    call gc%init(g%nrow, size(dir, 2)*(g%ptr(g%ncol + 1) - 1))
     do i = 1, size(rows)
       k = rows(i)
       p = contact_line%pair_of(k)
       if (contact_line%dir(k) > DIR_NORMAL) then
         ! a Tresca node's generators at its first tangential row
-        if (contact_line%pair_friction(p) == FRICTION_COULOMB .or. contact_line%dir(k) > 1) cycle
-        do q = 1, nd
+        if (contact_line%pair_friction(p) == FRICTION_COULOMB .or. i /= first_tangent(contact_line%nrow(k))) cycle
+        call node_directions(contact_line%nrow(k))
+        do q = 1, size(nd_dir, 2)
           allocate (cr(0), cv(0))
           call add_tangents(contact_line%nrow(k), q, 1.0_wp)
           call gc%push(cr, cv)
           tr = [tr, k]
           deallocate (cr, cv)
         end do
-      else if (tcol(1, k) > 0 .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
+      else if (any(tcol(:, k) > 0) .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
         ! divided by sqrt(1 + (mu |d|)^2): the same cone, columns of one size for any mu
         t = sc*contact_line%pair_mu(p)
-        do q = 1, nd
+        call node_directions(k)
+        do q = 1, size(nd_dir, 2)
           cr = g%row(g%ptr(i):g%ptr(i + 1) - 1)
           cv = g%val(g%ptr(i):g%ptr(i + 1) - 1)
           call add_tangents(k, q, t)
-          call gc%push(cr, cv/sqrt(1.0_wp + (t*norm2(dir(:, q)))**2))
+          call gc%push(cr, cv/sqrt(1.0_wp + (t*norm2(nd_dir(:, q)))**2))
           tr = [tr, 0]
         end do
       else
@@ -769,13 +770,31 @@ contains
 
   contains
 
-    !> cr, cv plus tt times direction q of node row n's tangential columns.
+    !> The position in rows of node row n's first tangential row.
+    integer function first_tangent(n)
+      integer, intent(in) :: n
+      first_tangent = tcol(findloc(tcol(:, n) > 0, .true., 1), n)
+    end function first_tangent
+
+    !> nd_dir: the directions of node row n's tangential force: the polygon when it has two
+    !! tangential rows, +-1 along its one row otherwise (the plane, or a plane of symmetry).
+    subroutine node_directions(n)
+      integer, intent(in) :: n
+      if (count(tcol(:, n) > 0) == NDIM - 1) then
+        nd_dir = dir
+      else
+        nd_dir = 0.0_wp*dir(:, 1:2)
+        nd_dir(findloc(tcol(:, n) > 0, .true., 1), :) = [1.0_wp, -1.0_wp]
+      end if
+    end subroutine node_directions
+
+    !> cr, cv plus tt times direction q (nd_dir) of node row n's tangential columns.
     subroutine add_tangents(n, q, tt)
       integer, intent(in) :: n, q
       real(wp), intent(in) :: tt
       integer :: j
       do j = 1, NDIM - 1
-        if (tcol(j, n) > 0) call add_column(tcol(j, n), tt*dir(j, q))
+        if (tcol(j, n) > 0) call add_column(tcol(j, n), tt*nd_dir(j, q))
       end do
     end subroutine add_tangents
 

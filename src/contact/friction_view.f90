@@ -142,16 +142,17 @@ contains
     call row_bounds(itf, res%lam, lb, ub)
     margin = max(AT_BOUND, 100.0_wp*res%residual)
     do k = 1, mn
-      if (tan(1, keep(k)) == 0) cycle
+      if (all(tan(:, keep(k)) == 0)) cycle
       do j = 1, NDIM - 1
         q = tan(j, keep(k))
+        if (q == 0) cycle      ! a node on a plane of symmetry: no force across it
         tg%force(j, k) = res%lam(q)
         if (itf%trib(q) > 0.0_wp) tg%shear(j, k) = res%lam(q)/itf%trib(q)
         tg%slip(j, k) = res%w(q, 1) + res%w(q, 2)
         tg%slip_increment(j, k) = res%gap(q)
         tg%force_xyz(:, k) = tg%force_xyz(:, k) + res%lam(q)*itf%frame(:, j + 1, q)
       end do
-      q = tan(1, keep(k))
+      q = maxval(tan(:, keep(k)))
       tg%bound(k) = ub(q)
       if (norm2(tg%force(:, k)) >= (1.0_wp - margin)*ub(q) .and. ub(q) > 0.0_wp) then
         tg%state(k) = NODE_SLIP

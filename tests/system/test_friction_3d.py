@@ -32,6 +32,10 @@ poisson 0 so that a uniform state is exact with the lower block clamped below).
     checkpoint, bitwise the uninterrupted run.
 (7) The same scene with one and two threads bitwise; mpirun -np 1, 2, 4 (MUMPS) = the serial
     run to 1e-10 (both to tol 1e-12; skipped without bin/robin_contact_mpi or mpirun).
+(8) inputs/cattaneo_sphere.nml (a sphere pressed on a block then pulled sideways, a half model,
+    on its shipped coarse mesh): Robin = monolithic (1e-6), the harmonic operator without a
+    stall, no shear across the plane of symmetry, the pull held by the contact alone (1e-5),
+    a stick zone inside a slipping ring (tools/cattaneo3d_study.py compares with Mindlin).
 (5) The output of a frictional 3D pair: tangential force in the frame (2 components), as a
     vector, consistent with the tangents written beside it; shear magnitude; stick/slip counts
     and the vector resultant on the contact line; the contact surface's XDMF (read by meshio)
@@ -313,6 +317,39 @@ def threads_and_mpi(tmp):
         check(e <= 1e-10, f"{what}: = serial (1e-10)", f"{e:.2e}")
 
 
+def cattaneo(tmp):
+    """(8) inputs/cattaneo_sphere.nml on its shipped mesh."""
+    deck = os.path.join(ROOT, "inputs", "cattaneo_sphere.nml")
+    robin = Run(tmp, "cm_robin", deck)
+    mono = Run(tmp, "cm_mono", deck, MONO)
+    if not (converged(robin, "Cattaneo-Mindlin sphere (Robin)") and converged(mono, "Cattaneo-Mindlin sphere (monolithic)")):
+        return
+    check("stalled" not in robin.text, "Cattaneo-Mindlin sphere: the harmonic operator does not stall (the plane of "
+          "symmetry's rows dropped)", robin.text[-300:] if "stalled" in robin.text else "")
+    g, gm = pair(robin), pair(mono)
+    e = max(rel(g["normal_force"], gm["normal_force"]), rel(g["tangential_force"], gm["tangential_force"]))
+    check(e <= 1e-6, "Cattaneo-Mindlin sphere: Robin = monolithic (1e-6)", f"{e:.2e}, outer {robin.res.get('outer')}")
+    # the plane z = 0: no shear across it, and those nodes' tangent along z has no row
+    on_plane = np.abs(g["z"]) < 1e-12
+    tz = np.abs(g["tangential_force_xyz"][on_plane, 2])
+    check(np.count_nonzero(on_plane) >= 5 and np.all(tz <= 1e-14 * np.max(np.abs(g["tangential_force_xyz"]))),
+          "Cattaneo-Mindlin sphere: no shear across the plane of symmetry", f"{np.count_nonzero(on_plane)} nodes, "
+          f"largest z shear {np.max(tz) if tz.size else 0:.2e}")
+    # Q (the traction on the top) is held by the contact alone: the contact's resultant on the
+    # sphere along x balances the sphere's load (its reaction line's loads=)
+    qx = g["resultant_on_first_body"][0]
+    m = re.search(r"reaction: body=1 .*?loads=(\S+?),", robin.text)
+    load = float(m.group(1)) if m else float("nan")
+    check(load > 0 and abs(qx + load) <= 1e-5 * load,
+          "Cattaneo-Mindlin sphere: the contact alone holds the pull Q (1e-5, the line's six digits)",
+          f"contact {qx:.9e}, load {load:.9e}")
+    # a stick zone in the middle, ringed by slip
+    r = np.hypot(g["x"], g["z"])
+    stick, slip = g["state"] == 1, g["state"] == 2
+    check(stick.any() and slip.any() and np.median(r[stick]) < np.median(r[slip]),
+          "Cattaneo-Mindlin sphere: a stick zone inside a slipping ring", f"stick {stick.sum()}, slip {slip.sum()}")
+
+
 def main():
     with tempfile.TemporaryDirectory(prefix="rc_friction3d_") as tmp:
         zero_friction(tmp)
@@ -321,6 +358,7 @@ def main():
         threshold(tmp)
         load_history(tmp)
         threads_and_mpi(tmp)
+        cattaneo(tmp)
     print(f"{len(check.failed)} failed")
     return 1 if check.failed else 0
 

@@ -1,0 +1,169 @@
+#!/usr/bin/python3
+"""Cattaneo-Mindlin in 3D: the scene of inputs/cattaneo_sphere.nml (a sphere R = 1 pressed on a
+block of the same material, P, then pulled sideways, Q ~ 0.5 mu P, Coulomb mu = 0.3, a half
+model) with a contact radius a ~ 0.02 R (the top pushed down by --push): a finite sphere's own
+lateral expansion under P makes a shear that Mindlin's half-spaces do not have, of relative
+size about 0.4 (a/R)/mu (measured in 2D: doc/verification.md), so a small a/R. Meshed here with
+gmsh (inputs/gmsh/cattaneo_sphere.geo, hc = --hc within rc = 0.06 of the contact point; three
+meshes, a/h about 6, 8 and 11). Two ways of pulling: 'force' (a traction on the sphere's top,
+0.5 mu P over its area, P from a first run of the normal load alone on the first mesh; the
+sphere held along x by the contact alone) and 'displacement' (the top moved along x by
+--shift instead, its uy held).
+
+Measured from each result (the pair's nodes, r their distance from the y axis):
+  P, Q        2 x the contact's resultant on the sphere along y and x (half model)
+  a           Hertz's contact radius (3 P R / (4 E*))^(1/3), E* = E / (2 (1 - nu^2))
+  c           the stick zone's radius from its area: sqrt(2 A_stick / pi), A_stick the
+              tributary areas of the nodes in state stick (half model: half a disc)
+  c_theory    Mindlin: a (1 - Q / (mu P))^(1/3)
+  shear       the L2 error (tributary-area weighted) of the nodes' shear along x against
+              q(r) = mu p0 sqrt(1 - r^2/a^2) - [r < c] mu p0 (c/a) sqrt(1 - r^2/c^2),
+              p0 = 3 P / (2 pi a^2), over the nodes with r < 0.9 a and |r - c| > 0.15 a
+              (away from the stick edge, where q has a kink, and from the contact's edge),
+              relative to the L2 norm of q there
+and the observed orders of the errors of c and of the shear between successive meshes.
+Prints a Markdown table; with --check, exits 1 unless on the finest mesh |c / c_theory - 1|
+<= 3% and the shear error <= 5% for both ways of pulling.
+
+usage: tools/cattaneo3d_study.py [--bin bin/robin_contact] [--hc 0.0033,0.0025,0.0018] [--method monolithic]
+                                 [--check]
+"""
+import argparse
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+E, NU, R, MU = 1000.0, 0.3, 1.0, 0.3
+DECK = """&scene title = 'Cattaneo-Mindlin: a sphere on a block, half model', dimension = 3 /
+&body id = 1, mesh = '{msh}', region = 'sphere', young = 1000.0, poisson = 0.3 /
+&body id = 2, mesh = '{msh}', region = 'block', young = 1000.0, poisson = 0.3 /
+&boundary body = 1, group = 'sphere_top', uy = {push}, stage = 1 /
+&boundary body = 1, group = 'sphere_z0', uz = 0.0 /
+&boundary body = 2, group = 'block_bottom', ux = 0.0, uy = 0.0, uz = 0.0 /
+&boundary body = 2, group = 'block_z0', uz = 0.0 /
+&contact body1_group = 'sphere_arc', body2_group = 'block_top', friction = 'coulomb', mu = 0.3 /
+&solver method = '{method}' /
+&output file = '{h5}' /
+"""
+
+
+def measure(h5):
+    """P, Q, a, c, c_theory, the shear's relative L2 error of a result file."""
+    with h5py.File(h5, "r") as f:
+        g = f["/contact/pair_1"]
+        x, z = g["x"][()], g["z"][()]
+        area = g["tributary_area"][()]
+        state = g["state"][()]
+        lam = g["normal_force"][()]
+        fx = g["tangential_force_xyz"][()][:, 0]
+        res = g["resultant_on_first_body"][()]
+    P, Q = 2.0 * abs(res[1]), 2.0 * abs(res[0])
+    estar = E / (2.0 * (1.0 - NU * NU))
+    a = (3.0 * P * R / (4.0 * estar)) ** (1.0 / 3.0)
+    p0 = 3.0 * P / (2.0 * math.pi * a * a)
+    c = math.sqrt(2.0 * np.sum(area[state == 1]) / math.pi)
+    ct = a * (1.0 - Q / (MU * P)) ** (1.0 / 3.0)
+    r = np.hypot(x, z)
+    q = np.where(area > 0, fx / np.where(area > 0, area, 1.0), 0.0)
+    q = q * np.sign(np.sum(fx))
+    qt = MU * p0 * np.sqrt(np.clip(1.0 - (r / a) ** 2, 0.0, None))
+    qt -= np.where(r < ct, MU * p0 * (ct / a) * np.sqrt(np.clip(1.0 - (r / ct) ** 2, 0.0, None)), 0.0)
+    w = (r < 0.9 * a) & (np.abs(r - ct) > 0.15 * a)
+    err = math.sqrt(np.sum(area[w] * (q[w] - qt[w]) ** 2) / np.sum(area[w] * qt[w] ** 2))
+    return dict(P=P, Q=Q, a=a, c=c, ct=ct, shear=err, active=int(np.count_nonzero(lam > 0)))
+
+
+def mesh(hc, work, gmsh):
+    out = os.path.join(work, f"cattaneo_sphere_h{hc}.msh")
+    subprocess.run([gmsh, "-3", "-format", "msh41", "-v", "2", "-setnumber", "hc", hc, "-setnumber", "rc", "0.06",
+                    os.path.join(ROOT, "inputs", "gmsh", "cattaneo_sphere.geo"), "-o", out], capture_output=True, check=True)
+    return out
+
+
+def run(binary, work, name, text, *extra):
+    deck = os.path.join(work, name + ".nml")
+    with open(deck, "w") as f:
+        f.write(text + "".join(e + "\n" for e in extra))
+    t0 = time.time()
+    p = subprocess.run([binary, deck], capture_output=True, text=True)
+    return p, time.time() - t0
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "bin", "robin_contact"))
+    ap.add_argument("--hc", default="0.0033,0.0025,0.0018")
+    ap.add_argument("--push", type=float, default=-4.0e-4, help="the top's displacement along y (stage 1)")
+    ap.add_argument("--shift", type=float, default=5.0e-5, help="the top's displacement along x ('displacement')")
+    ap.add_argument("--method", default="monolithic")
+    ap.add_argument("--check", action="store_true")
+    a = ap.parse_args()
+    gmsh = shutil.which("gmsh")
+    if not gmsh:
+        print("cattaneo3d_study: gmsh is needed to mesh the sphere (apt-get install gmsh)")
+        return 1
+    work = tempfile.mkdtemp(prefix="rc_cattaneo3d_")
+    failed = False
+    try:
+        meshes = {hc: mesh(hc, work, gmsh) for hc in a.hc.split(",")}
+        first = next(iter(meshes.values()))
+        h5 = os.path.join(work, "normal.h5")
+        p, _ = run(a.bin, work, "normal", DECK.format(msh=first, push=a.push, method=a.method, h5=h5))
+        if p.returncode != 0:
+            print(f"the normal load alone failed (exit {p.returncode}): {p.stderr.strip()[-300:]}")
+            return 1
+        with h5py.File(h5, "r") as f:
+            p_half = abs(f["/contact/pair_1/resultant_on_first_body"][1])
+        traction = 0.5 * MU * p_half / (math.pi / 2.0)
+        print(f"P (half model, normal load alone, first mesh) = {p_half:.6e}; the pull's traction {traction:.6e}\n")
+        print("| pull | hc | DOFs | contact nodes | Q / (mu P) | a | a / h | c | c (Mindlin) | c error | order "
+              "| shear error | order | outer | wall s | peak MiB |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        for pull in ("force", "displacement"):
+            last = None
+            for hc, msh in meshes.items():
+                h5 = os.path.join(work, f"{pull}_{hc}.h5")
+                text = DECK.format(msh=msh, push=a.push, method=a.method, h5=h5)
+                if pull == "force":
+                    extra = f"&traction body=1, group='sphere_top', t0={traction!r}, 0.0, 0.0, stage=2 /"
+                else:
+                    extra = f"&boundary body=1, group='sphere_top', ux={a.shift!r}, stage=2 /"
+                p, wall = run(a.bin, work, f"{pull}_{hc}", text, extra)
+                if p.returncode != 0:
+                    print(f"| {pull} | {hc} | run failed (exit {p.returncode}): {p.stderr.strip()[-200:]} |")
+                    failed = True
+                    continue
+                res = dict(w.split("=", 1) for w in p.stdout.splitlines()[-1].split()[1:] if "=" in w)
+                peak = next((w.split("=")[1] for w in p.stdout.split() if w.startswith("peak_mb=")), "?")
+                m = measure(h5)
+                ec = m["c"] / m["ct"] - 1.0
+                oc = os_ = ""
+                if last is not None:
+                    lh = math.log(float(last[0]) / float(hc))
+                    if ec != 0 and last[1] != 0:
+                        oc = f"{math.log(abs(last[1] / ec)) / lh:.2f}"
+                    os_ = f"{math.log(last[2] / m['shear']) / lh:.2f}"
+                print(f"| {pull} | {hc} | {res.get('dofs', '?')} | {m['active']} | {m['Q'] / (MU * m['P']):.4f} "
+                      f"| {m['a']:.5f} | {m['a'] / float(hc):.1f} | {m['c']:.5f} | {m['ct']:.5f} | {100 * ec:+.2f}% | {oc} "
+                      f"| {100 * m['shear']:.2f}% | {os_} | {res.get('outer', '?')} | {wall:.1f} | {peak} |", flush=True)
+                last = (hc, ec, m["shear"])
+            if a.check and last is not None and (abs(last[1]) > 0.03 or last[2] > 0.05):
+                print(f"check: {pull}: on the finest mesh c is off by {100 * last[1]:+.2f}% (3% allowed) and the shear "
+                      f"by {100 * last[2]:.2f}% (5% allowed)")
+                failed = True
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return 1 if (a.check and failed) else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
