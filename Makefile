@@ -371,6 +371,13 @@ table1: $(PROG)
 hard: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/hard.py --bin $(PROG)
 
+# Cattaneo-Mindlin in 3D against Mindlin on three meshes gmsh makes (a sphere on a block, a/R
+# about 0.02, a/h about 6, 8 and 11; up to about 220k DOFs): exits 1 unless the finest mesh
+# gives the stick radius within 3% and the ring-averaged shear within 5% (tools/cattaneo3d_study.py)
+.PHONY: cattaneo3d
+cattaneo3d: $(PROG)
+	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) tools/cattaneo3d_study.py --bin $(PROG) --check
+
 bench: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench.py --bin $(PROG)
 	$(PYTHON) bench/plot_bench.py results/bench.csv
@@ -391,14 +398,16 @@ bench-gmsh: $(PROG)
 # Hertz in 3D, a ladder of meshes of inputs/sphere_block.nml's sphere on a block (meshes by
 # gmsh into results/bench_hertz3d/; hc = 0.01, 0.005, 0.0035: up to about 2 x 120k DOFs, a few
 # minutes); HERTZ3D_HC=0.01,0.005,0.0035,0.0028 adds about 2 x 235k DOFs (12 GB)
-# HERTZ3D_SLAVE=2 makes the block the slave, HERTZ3D_METHOD=monolithic solves in one piece
+# HERTZ3D_SLAVE=2 makes the block the slave, HERTZ3D_METHOD=monolithic solves in one piece,
+# HERTZ3D_MU=0.3 gives the pair Coulomb friction
 HERTZ3D_HC ?= 0.01,0.005,0.0035
 HERTZ3D_SLAVE ?= 0
 HERTZ3D_METHOD ?= robin
+HERTZ3D_MU ?= 0
 .PHONY: bench-hertz3d
 bench-hertz3d: $(PROG)
 	OMP_NUM_THREADS=$${OMP_NUM_THREADS:-2} $(PYTHON) bench/bench_hertz3d.py --bin $(PROG) --gmsh $(GMSH) --hc $(HERTZ3D_HC) \
-	  --slave $(HERTZ3D_SLAVE) --method $(HERTZ3D_METHOD)
+	  --slave $(HERTZ3D_SLAVE) --method $(HERTZ3D_METHOD) --mu $(HERTZ3D_MU)
 
 # The MPI binary beside the serial one: the paper's scene at 1024x512 per body,
 # serial CHOLMOD and MUMPS at -np 2, 4, 8 (oversubscribed here), time per phase and the

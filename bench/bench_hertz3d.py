@@ -19,11 +19,13 @@ exit 1 when a run fails (the table first).
 The pair's slave is the deck's default (the sphere, whose contact group has the shorter mean
 edge) unless --slave names a body (2: the block, whose flat top gives each row one displacement
 component per node on both bodies); --method monolithic solves the same discrete problem in
-one piece.
+one piece; --mu gives the pair Coulomb friction (the same meshes and factorizations; the
+interface has three rows per contact node instead of one, less the tangents across the two
+planes of symmetry).
 
 Usage: bench/bench_hertz3d.py [--hc 0.01,0.005,0.0035] [--bin bin/robin_contact] [--gmsh gmsh]
                               [--workdir results/bench_hertz3d] [--threads 2] [--slave 0|1|2]
-                              [--method robin|monolithic]
+                              [--method robin|monolithic] [--mu 0.3]
   --hc 0.01,0.005,0.0035,0.0028   adds a level of about 2 x 235k DOFs (12 GB, several minutes)
 """
 import argparse
@@ -53,12 +55,13 @@ def mesh(gmsh, geo, hc, work):
     return out
 
 
-def solve(binary, msh, out, threads, slave=0, method="robin"):
+def solve(binary, msh, out, threads, slave=0, method="robin", mu=0.0):
     deck = os.path.join(ROOT, "inputs", "sphere_block.nml")
     env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    law = f", friction='coulomb', mu={mu}" if mu > 0 else ""
     cmd = [binary, deck, f"&body id=1, mesh='{msh}' /", f"&body id=2, mesh='{msh}' /",
            f"&solver tol=1e-8, method='{method}' /", f"&output file='{out}' /",
-           f"&contact body1_group='sphere_arc', body2_group='block_top', slave={slave} /"]
+           f"&contact body1_group='sphere_arc', body2_group='block_top', slave={slave}{law} /"]
     t0 = time.time()
     r = subprocess.run(cmd, capture_output=True, text=True, env=env)
     wall = time.time() - t0
@@ -91,6 +94,7 @@ def main():
     ap.add_argument("--csv", default=os.path.join(ROOT, "results", "bench_hertz3d.csv"))
     ap.add_argument("--slave", type=int, default=0, choices=(0, 1, 2))
     ap.add_argument("--method", default="robin", choices=("robin", "monolithic"))
+    ap.add_argument("--mu", type=float, default=0.0, help="Coulomb friction on the pair (0: frictionless)")
     a = ap.parse_args()
     os.makedirs(a.workdir, exist_ok=True)
     geo = os.path.join(ROOT, "inputs", "gmsh", "sphere_block.geo")
@@ -99,14 +103,14 @@ def main():
         t0 = time.time()
         msh = mesh(a.gmsh, geo, hc, a.workdir)
         print(f"hc = {hc}: mesh {os.path.basename(msh)} ({time.time() - t0:.0f} s)", flush=True)
-        row = solve(a.bin, msh, os.path.join(a.workdir, f"r{hc}.h5"), a.threads, a.slave, a.method)
+        row = solve(a.bin, msh, os.path.join(a.workdir, f"r{hc}.h5"), a.threads, a.slave, a.method, a.mu)
         row["hc"] = hc
         rows.append(row)
         print(f"hc = {hc}: exit {row['exit']}, {row.get('total', 0):.1f} s", flush=True)
-    print(f"\nslave: {a.slave or 'the default'}, method: {a.method}")
-    print("\n| hc | DOFs (body 1 + 2) | rows | outer | factor s | condense s | iterate s | total s "
+    print(f"\nslave: {a.slave or 'the default'}, method: {a.method}, mu: {a.mu or 'none (frictionless)'}")
+    print("\n| hc | DOFs (body 1 + 2) | rows | outer | inner | factor s | condense s | iterate s | total s "
           "| contact / factor | total / factor | peak MB | factor MB (estimate) | a error | p0 error |")
-    print("| --- " * 14 + "|")
+    print("| --- " * 15 + "|")
     bad = 0
     for r in rows:
         if r["exit"] != 0:
@@ -114,7 +118,7 @@ def main():
             print(f"| {r['hc']} | {r['n1']} + {r['n2']} | {r['m']} | run failed (exit {r['exit']}, {r['status']}) |")
             continue
         f = r.get("factor", 0.0)
-        print(f"| {r['hc']} | {r['n1']} + {r['n2']} | {r['m']} | {r['outer']} | {f:.1f} | {r['condense']:.1f} "
+        print(f"| {r['hc']} | {r['n1']} + {r['n2']} | {r['m']} | {r['outer']} | {r['inner']} | {f:.1f} | {r['condense']:.1f} "
               f"| {r['iterate']:.1f} | {r['total']:.1f} | {(r['condense'] + r['iterate']) / f:.2f} "
               f"| {r['total'] / f:.2f} | {r['peak_mb']:.0f} | {r['factor_mb']:.0f} ({r['estimate_mb']:.0f}) "
               f"| {100 * r['ea']:+.2f}% | {100 * r['ep']:+.2f}% |")

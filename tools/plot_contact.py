@@ -95,8 +95,11 @@ active zone ends on one side only (a half or quarter model, as inputs/sphere_blo
                          the normal), err_a = |a_fit - a| / a, err_p0 = |max p - p0| / p0,
                          err_L2 weighted by the tributary areas. Several pairs: on --pair K only.
 Printed per surface: its nodes, faces, map axes, centre, symmetry planes, largest pressure and
-active nodes; per line its direction, samples and largest interpolated pressure. No Mindlin
-curve (solid bodies are frictionless).
+active nodes; per line its direction, samples and largest interpolated pressure. With friction
+each surface also gets a map of the shear's length (/contact/.../shear_magnitude) with the stick
+nodes (state 1) marked, and its tangential resultant (x, y, z) and stick and slip counts are
+printed ('plot_contact: NAME: tangential resultant (...), stick n, slip n'). No Mindlin curve
+(tools/cattaneo3d_study.py compares a sphere's with Mindlin's).
 Exit 0 on success, 1 (with a message) on a missing or unreadable file or any other failure.
 Run with /usr/bin/python3 (numpy, h5py and matplotlib come from Debian packages).
 """
@@ -435,6 +438,12 @@ def read_surface(f, g, u, resultant_name, box, centre=None):
              ux=dataset_unit(g["x"], u["length"]), up=dataset_unit(g["pressure"], u["stress"]),
              uf=dataset_unit(g["normal_force"], u["force"]), ug=dataset_unit(g["gap"], u["length"]))
     r["k"], r["ij"], r["c"], r["sym"] = surface_frame(xyz, normal, lam, box, centre)
+    # friction: the shear's length, the state (1 stick, 2 slip), the tangential force vectors
+    if "shear_magnitude" in g:
+        r["shear"] = np.asarray(g["shear_magnitude"][()], dtype=float)
+        r["state"] = np.asarray(g["state"][()], dtype=int)
+        r["tforce"] = np.asarray(g["tangential_force_xyz"][()], dtype=float)
+        r["us"] = dataset_unit(g["shear_magnitude"], u["stress"])
     tris = []
     if "faces" in g:
         for fc in np.asarray(g["faces"][()], dtype=int).reshape(len(g["faces"]), -1):
@@ -588,6 +597,31 @@ def read_run_3d(path, a):
         return out
 
 
+def shear_map(fig, ax, r, tri, fx, lx):
+    """The shear's length on a solid result's contact surface, the stick nodes marked."""
+    fs, ls = si_scale(r["shear"], r["us"])
+    pc = ax.tripcolor(tri, r["shear"] / fs, shading="gouraud", cmap="magma", vmin=0.0,
+                      vmax=max(r["shear"].max(initial=0.0) / fs, 1e-300))
+    fig.colorbar(pc, ax=ax, label=axis_label("shear |t|", ls), shrink=0.85)
+    st = r["state"] == 1
+    i, j = r["ij"]
+    ax.plot(r["xyz"][st, i] / fx, r["xyz"][st, j] / fx, "c.", ms=3.0, label=f"stick ({int(st.sum())} nodes)")
+    finish_map(ax, r, tri, lx, "shear, the stick zone marked")
+
+
+def finish_map(ax, r, tri, lx, what):
+    """A surface map's frame: equal axes over the surface, their labels, the title, the legend."""
+    i, j = r["ij"]
+    ax.set_aspect("equal")
+    ax.set_xlim(tri.x.min(), tri.x.max())
+    ax.set_ylim(tri.y.min(), tri.y.max())
+    ax.set_xlabel(axis_label(AXES[i], lx))
+    ax.set_ylabel(axis_label(AXES[j], lx))
+    ax.set_title(f"{r['name']}: {what}", fontsize=8)
+    ax.legend(fontsize=6, loc="upper right", framealpha=0.6)
+    plain_axis(ax)
+
+
 def main_3d(a):
     """plot_contact.py on solid results (see the docstring's last part)."""
     runs = []
@@ -604,7 +638,13 @@ def main_3d(a):
                 r["label"] = f"{r['pair']}, {r['label']}"
             runs.append(r)
     if a.mindlin:
-        print("plot_contact: no Mindlin curve: solid results are frictionless", file=sys.stderr)
+        print("plot_contact: no Mindlin curve for solid results (tools/cattaneo3d_study.py compares a sphere's "
+              "with Mindlin's)", file=sys.stderr)
+    for r in runs:
+        if "shear" in r:
+            q = np.sum(r["tforce"], axis=0)
+            print(f"plot_contact: {r['name']}: tangential resultant ({', '.join(f'{v:.6g}' for v in q)}), "
+                  f"stick {int(np.sum(r['state'] == 1))}, slip {int(np.sum(r['state'] == 2))}")
     ux, up, ug = runs[0]["ux"], runs[0]["up"], runs[0]["ug"]
     rows = []
     nhertz = 0
@@ -654,8 +694,10 @@ def main_3d(a):
     maps = runs[:4]
     if len(runs) > 4:
         print(f"plot_contact: note: {len(runs)} contact surfaces, the first 4 mapped", file=sys.stderr)
-    fig = plt.figure(figsize=(max(8.0, 4.2 * len(maps)), 11.0), dpi=120)
-    gs = fig.add_gridspec(3, len(maps), height_ratios=[2.4, 2.0, 1.0])
+    shear = any("shear" in r for r in maps)
+    fig = plt.figure(figsize=(max(8.0, 4.2 * len(maps)), 15.0 if shear else 11.0), dpi=120)
+    gs = fig.add_gridspec(4 if shear else 3, len(maps), height_ratios=[2.4, 2.4, 2.0, 1.0] if shear else [2.4, 2.0, 1.0])
+    below = 2 if shear else 1
     fx, lx = si_scale(np.concatenate([r["xyz"].reshape(-1) for r in runs]), ux)
     fp, lp = si_scale(np.concatenate([r["p"] for r in runs] + [[r["h"]["p0"]] for r in runs if r["h"]]), up)
     fg, lg = si_scale(np.concatenate([r["line"]["gap"] for r in runs]), ug)
@@ -680,16 +722,11 @@ def main_3d(a):
             th = np.linspace(0.0, 2.0 * np.pi, 361)
             ax.plot((cx + r["h"]["a"] * np.cos(th)) / fx, (cy + r["h"]["a"] * np.sin(th)) / fx, "w:", lw=1.3,
                     label=f"Hertz a = {format_quantity(r['h']['a'], ux)}")
-        ax.set_aspect("equal")
-        ax.set_xlim(tri.x.min(), tri.x.max())
-        ax.set_ylim(tri.y.min(), tri.y.max())
-        ax.set_xlabel(axis_label(AXES[i], lx))
-        ax.set_ylabel(axis_label(AXES[j], lx))
-        ax.set_title(f"{r['name']}: contact pressure", fontsize=8)
-        ax.legend(fontsize=6, loc="upper right", framealpha=0.6)
-        plain_axis(ax)
-    ax = fig.add_subplot(gs[1, :])
-    axg = fig.add_subplot(gs[2, :], sharex=ax)
+        finish_map(ax, r, tri, lx, "contact pressure")
+        if "shear" in r:
+            shear_map(fig, fig.add_subplot(gs[1, col]), r, tri, fx, lx)
+    ax = fig.add_subplot(gs[below, :])
+    axg = fig.add_subplot(gs[below + 1, :], sharex=ax)
     colours = plt.rcParams["axes.prop_cycle"].by_key().get("color", ["C0"])
     for n, r in enumerate(runs):
         c = colours[n % len(colours)]

@@ -361,21 +361,28 @@ def load_history(tmp):
               "slip and its increment (meshio), the last step's shear = the file's", f"{rd.num_steps} steps")
     except ImportError:
         print("SKIP  meshio absent: the XDMF fields are not read back")
-    # stopped in the second stage, restarted from the checkpoint
+    restart_in_second_stage(tmp, "load history", [press.format(", stage=1"), shear.format(", stage=2"), tight], 18,
+                            "contact", runs["two stages", "robin"].c)
+
+
+def restart_in_second_stage(tmp, what, over, max_outer, group, want):
+    """A two-stage run (the deck tmp/path_two_robin.nml with over) stopped at max_outer in its
+    second stage, restarted from its checkpoint: bitwise want (the uninterrupted run's datasets
+    of `group`)."""
     stem = os.path.join(tmp, "path_restart")
     deck = os.path.join(tmp, "path_two_robin.nml")
-    over = [press.format(", stage=1"), shear.format(", stage=2"), tight]
-    p1 = subprocess.run([BIN, deck, *over, "&solver max_outer=18 /", f"&output file='{stem}.h5', checkpoint_every=4 /"],
+    p1 = subprocess.run([BIN, deck, *over, f"&solver max_outer={max_outer} /",
+                         f"&output file='{stem}.h5', checkpoint_every=4 /"],
                         capture_output=True, text=True, env=solver_env(), timeout=600)
     p2 = subprocess.run([BIN, deck, *over, f"&output file='{stem}.h5', checkpoint_every=4 /", "--restart",
                          f"{stem}.h5.ckpt.h5"], capture_output=True, text=True, env=solver_env(), timeout=600)
     ok = p1.returncode == 2 and "step=2 of=2" in p1.stdout and p2.returncode == 0
-    if check(ok, "load history: stopped at max_outer in the second stage (exit 2), restarted (exit 0)",
+    if check(ok, f"{what}: stopped at max_outer in the second stage (exit 2), restarted (exit 0)",
              f"exit {p1.returncode}, {p2.returncode}: {(p1.stdout + p2.stderr).strip()[-300:]}"):
         with h5py.File(stem + ".h5", "r") as f:
-            same = all(np.array_equal(np.array(f["contact"][k]), runs["two stages", "robin"].c[k])
+            same = all(np.array_equal(np.array(f[group][k]), want[k])
                        for k in ("normal_force", "tangential_force", "slip", "slip_increment"))
-        check(same, "load history: the restarted run = the uninterrupted one, bitwise")
+        check(same, f"{what}: the restarted run = the uninterrupted one, bitwise")
 
 
 def main():

@@ -54,7 +54,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from test_friction import BIN, MONO, ROOT, Run, check, converged, refused, rel  # noqa: E402
+from test_friction import MONO, ROOT, Run, check, converged, refused, rel, restart_in_second_stage  # noqa: E402
 from solid_decks import THREE_BOXES  # noqa: E402
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_run import solver_env  # noqa: E402
@@ -267,21 +267,8 @@ def load_history(tmp):
     g = pair(runs["two stages", "monolithic"])
     check(not np.allclose(g["slip"], g["slip_increment"]), "3D load history: the second stage's slip increment is not "
           "its slip")
-    # stopped in the second stage, restarted from the checkpoint
-    stem = os.path.join(tmp, "path_restart")
-    deck = os.path.join(tmp, "path_two_robin.nml")
-    over = [PRESS.format(", stage=1"), SHIFT.format(", stage=2"), TIGHT]
-    p1 = subprocess.run([BIN, deck, *over, "&solver max_outer=40 /", f"&output file='{stem}.h5', checkpoint_every=4 /"],
-                        capture_output=True, text=True, env=solver_env(), timeout=600)
-    p2 = subprocess.run([BIN, deck, *over, f"&output file='{stem}.h5', checkpoint_every=4 /", "--restart",
-                         f"{stem}.h5.ckpt.h5"], capture_output=True, text=True, env=solver_env(), timeout=600)
-    ok = p1.returncode == 2 and "step=2 of=2" in p1.stdout and p2.returncode == 0
-    if check(ok, "3D load history: stopped at max_outer in the second stage (exit 2), restarted (exit 0)",
-             f"exit {p1.returncode}, {p2.returncode}: {(p1.stdout + p2.stderr).strip()[-300:]}"):
-        with h5py.File(stem + ".h5", "r") as f:
-            same = all(np.array_equal(np.array(f["contact"]["pair_1"][k]), pair(runs["two stages", "robin"])[k])
-                       for k in ("normal_force", "tangential_force", "slip", "slip_increment"))
-        check(same, "3D load history: the restarted run = the uninterrupted one, bitwise")
+    restart_in_second_stage(tmp, "3D load history", [PRESS.format(", stage=1"), SHIFT.format(", stage=2"), TIGHT], 40,
+                            "contact/pair_1", pair(runs["two stages", "robin"]))
     return runs
 
 
