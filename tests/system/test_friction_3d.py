@@ -12,7 +12,8 @@ poisson 0 so that a uniform state is exact with the lower block clamped below).
     and by the shear its sides carry in the uniform state sigma_yy = -p, sigma_xy = tau_x,
     sigma_yz = tau_z (the lower block's sides too); Coulomb mu = 0.5: every node sticks, the
     pressure is p and the shear vector (tau_x, 0, tau_z) at every node to 1e-8, for the
-    monolithic solve and the Robin iteration (harmonic), which equal each other to 1e-8.
+    monolithic solve and the Robin iteration (harmonic; steklov; constant, alpha 2e-12 with
+    Anderson), which equal each other to 1e-8.
 (3) Sliding and isotropy: the upper block's top pressed down and moved along directions
     turned by 0, 15, 30 and 45 degrees about y (a prescribed displacement, on a lower block
     1000 times stiffer), Coulomb mu = 0.3: every node in contact slips (a corner may open:
@@ -54,7 +55,7 @@ import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from test_friction import MONO, ROOT, Run, check, converged, refused, rel, restart_in_second_stage  # noqa: E402
+from test_friction import MONO, ROBIN as ROBIN_2D, ROOT, Run, check, converged, refused, rel, restart_in_second_stage  # noqa: E402,E501
 from solid_decks import THREE_BOXES  # noqa: E402
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_run import solver_env  # noqa: E402
@@ -121,6 +122,8 @@ def patch_stick(tmp):
     deck = stick_deck(tx, tz)
     mono = Run(tmp, "stick_mono", deck, MONO)
     runs = {"monolithic": mono, "harmonic": Run(tmp, "stick_harmonic", deck, ROBIN)}
+    for op in ("steklov", "constant_anderson"):
+        runs[op] = Run(tmp, f"stick_{op}", deck, ROBIN_2D[op])
     for name, r in runs.items():
         what = f"3D stick patch ({name})"
         if not converged(r, what):
