@@ -13,7 +13,7 @@ module robin_iteration
   use condense, only: body_condensed_t
   use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
-                           STATUS_INTERRUPTED
+                           STATUS_INTERRUPTED, BOUND_LOWER, BOUND_UPPER, BOUND_INSIDE
   use contact_common, only: interface_residual, maxabs, all_finite, gather, scatter
   use errors, only: error_t
   use robin_operators, only: robin_operator_t, new_robin_operator, progress_rtol
@@ -24,7 +24,6 @@ module robin_iteration
 
   integer, parameter :: STALL_LIMIT = 25      !< iterations of small increment / large residual before 'diverged'
   integer, parameter :: HISTORY_CHUNK = 256   !< initial history entries (grown by doubling)
-  integer, parameter :: BOUND_LOWER = 1, BOUND_UPPER = 2, BOUND_INSIDE = 3   !< bound_state codes
   integer, parameter :: FLAT_LIMIT = 50       !< iterations without a 1% better residual (stop='residual'), or
                                               !! without a 1% better criterion and residual than in the
                                               !! as many before (a cycle), before 'diverged'

@@ -16,7 +16,7 @@ module robin_subproblems
   use tangent_discs, only: friction_set
   use qp_newton, only: newton_work_t, newton_factor, newton_forget, newton_holds
   use condense, only: body_condensed_t
-  use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size
+  use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size, BOUND_UPPER
   use contact_common, only: gather, scatter, body_threads, partner_slots
   use sorting, only: largest_first
   use equality_rows, only: equality_t, equality_init, equality_add_penalty
@@ -271,6 +271,11 @@ contains
     ! and its product is no longer known
     moved = .false.
     if (size(ub) > 0) then
+      ! in space, a disc whose force was on its last circle starts on its new one (Coulomb's
+      ! radius moved with lam_n): the face it slid on stays its face, and the active-set
+      ! method need not find its slipping discs again one per step
+      if (size(subproblems%discs(a)%pos) > 0) call onto_new_circles(subproblems%discs(a)%pos, &
+                                                                      last_on_circle(state%row_state, body%slots, mm), ub, lam)
       call set%project(lam)
       moved = any(lam /= lam0)
       if (moved) inner_solver%opts%use_ax = .false.
@@ -403,6 +408,42 @@ contains
     end subroutine directions_in
 
   end subroutine solve_body
+
+  !> Whether each of a body's contact forces was at its upper bound in the last iterate (in
+  !! space: its disc's force on its circle), from the rows' states (robin_state_t%row_state,
+  !! checkpointed: a resumed run decides alike).
+  pure function last_on_circle(row_state, slots, m) result(on)
+    integer, intent(in) :: row_state(:)       !< (m) side 1's state + 4 x side 2's (-1: none yet)
+    integer, intent(in) :: slots(:)           !< the body's slots
+    integer, intent(in) :: m                  !< contact rows of all pairs
+    logical :: on(size(slots))
+    integer :: i, code
+    do i = 1, size(slots)
+      code = row_state(slot_row(slots(i), m))
+      if (code < 0) then
+        on(i) = .false.
+      else if (slot_side(slots(i), m) == 1) then
+        on(i) = mod(code, 4) == BOUND_UPPER
+      else
+        on(i) = code/4 == BOUND_UPPER
+      end if
+    end do
+  end function last_on_circle
+
+  !> Each disc k (its variables pos(:, k)) whose force was on its circle in the last iterate
+  !! (was_on) is scaled onto its circle of radius r now: the same direction.
+  pure subroutine onto_new_circles(pos, was_on, r, lam)
+    integer, intent(in) :: pos(:, :)          !< (2, discs) the discs' variables
+    logical, intent(in) :: was_on(:)          !< per variable
+    real(wp), intent(in) :: r(:)              !< the radii now, per variable
+    real(wp), intent(inout) :: lam(:)
+    integer :: k
+    real(wp) :: s
+    do k = 1, size(pos, 2)
+      s = norm2(lam(pos(:, k)))
+      if (s > 0.0_wp .and. was_on(pos(1, k)) .and. r(pos(1, k)) < huge(1.0_wp)) lam(pos(:, k)) = lam(pos(:, k))*(r(pos(1, k))/s)
+    end do
+  end subroutine onto_new_circles
 
   !> The QP method of a body's solve: the deck's inner_solver, 'auto' resolved by what the
   !! body's earlier solves needed (newton = 1: the Newton method at once; k >= 2: the Newton

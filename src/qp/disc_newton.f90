@@ -15,7 +15,9 @@
 !! s_k), exact on a flat face and quadratically convergent on a curved one. The step is cut
 !! where a free variable reaches its bound or a free disc its circle (which then join the
 !! held set), the held discs are projected back onto their circles, and the step is halved
-!! while the cost does not fall (beyond its rounding). Constraints are released, as in
+!! while the cost does not fall (beyond its rounding); a cut step is replaced by the whole step
+!! projected onto the set when that lowers the cost more (all its blockers then join the held
+!! set in one step). Constraints are released, as in
 !! module qp_newton, after a whole step (x near its face's minimiser): a box variable whose
 !! multiplier has the wrong sign, a disc whose gradient points into it (nu.g > 0).
 !!
@@ -66,8 +68,8 @@ contains
     real(wp), intent(inout) :: flops          !< work added (multiply-adds x 2)
     integer, intent(inout) :: factored        !< factorizations made (one more when this step made one)
     integer, allocatable :: free(:), dk(:)
-    real(wp), allocatable :: h(:, :), rhs(:), tau(:, :), curv(:), d(:), dfree(:), x0(:), g0(:)
-    logical, allocatable :: rel(:)
+    real(wp), allocatable :: h(:, :), rhs(:), tau(:, :), curv(:), d(:), dfree(:), x0(:), g0(:), xb(:), axb(:)
+    logical, allocatable :: rel(:), onb(:)
     integer :: n, nf, nd, k, i, j, info, blk, half, q
     real(wp) :: t, tmax, df, noise, s, na, nb
     logical :: cut
@@ -174,6 +176,21 @@ contains
         held(set%pair(:, set%disc(blk))) = .true.
       else
         held(blk) = .true.
+      end if
+      ! the whole step projected onto the set, taken instead when it lowers the cost more:
+      ! every variable and disc it takes beyond its bound joins the held set at once, not one
+      ! per step (a warm start whose face moved by many discs); one more product
+      xb = x0 + d
+      call set%project(xb)
+      allocate (axb(n), onb(n))
+      call dsymv('U', n, 1.0_wp, a, n, xb, 1, 0.0_wp, axb, 1)
+      flops = flops + 2.0_wp*real(n, wp)**2
+      if (0.5_wp*dot_product(xb, axb) - dot_product(b, xb) < 0.5_wp*dot_product(x, ax) - dot_product(b, x)) then
+        x = xb
+        ax = axb
+        g = ax - b
+        call set%free_mask(x, onb)
+        held = held .or. .not. onb
       end if
     end if
     at_min = .not. cut .and. half == 0

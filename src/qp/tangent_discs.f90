@@ -135,7 +135,7 @@ contains
     do k = 1, size(self%r)
       associate (a => self%pair(1, k), b => self%pair(2, k))
         if (self%r(k) <= 0.0_wp .or. .not. on_circle(x(a), x(b), self%r(k))) cycle
-        s = sqrt(x(a)**2 + x(b)**2)
+        s = hypot(x(a), x(b))
         na = x(a)/s
         nb = x(b)/s
         press = max(-(na*g(a) + nb*g(b)), 0.0_wp)
@@ -210,7 +210,7 @@ contains
   pure subroutine circle_point(xa, xb, na, nb, s)
     real(wp), intent(in) :: xa, xb
     real(wp), intent(out) :: na, nb, s
-    s = sqrt(xa*xa + xb*xb)
+    s = hypot(xa, xb)
     if (s > 0.0_wp) then
       na = xa/s
       nb = xb/s
@@ -225,7 +225,7 @@ contains
     real(wp), intent(inout) :: xa, xb
     real(wp), intent(in) :: r
     real(wp) :: s
-    s = sqrt(xa*xa + xb*xb)
+    s = hypot(xa, xb)
     if (s <= r) return
     if (r > 0.0_wp) then
       xa = xa*(r/s)
@@ -241,7 +241,7 @@ contains
     real(wp), intent(in) :: xa, xb, r, ga, gb
     real(wp), intent(out) :: ba, bb
     real(wp) :: s, na, nb, gn
-    s = sqrt(xa*xa + xb*xb)
+    s = hypot(xa, xb)
     if (r <= 0.0_wp .or. s <= 0.0_wp) then
       ba = 0.0_wp
       bb = 0.0_wp
@@ -479,7 +479,7 @@ contains
       return
     end if
     associate (a => self%pair(1, k), b => self%pair(2, k))
-      s = sqrt(x(a)**2 + x(b)**2)
+      s = hypot(x(a), x(b))
       if (s > 0.0_wp .and. self%r(k) > 0.0_wp) then
         x(a) = x(a)*(self%r(k)/s)
         x(b) = x(b)*(self%r(k)/s)

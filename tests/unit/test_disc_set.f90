@@ -52,25 +52,25 @@ contains
 
   !> friction_set: a box, or discs on the pairs with the radius from ub.
   subroutine test_friction_set()
-    class(constraint_set_t), allocatable :: set
+    class(constraint_set_t), allocatable :: box, disc, open
     real(wp) :: x(3), t
     integer :: blocker
     ! no pairs: the box [lb, ub]; (3, 4) lands on (2, 2) componentwise
-    set = friction_set([0.0_wp, -2.0_wp, -2.0_wp], [big, 2.0_wp, 2.0_wp], reshape([integer ::], [2, 0]))
+    box = friction_set([0.0_wp, -2.0_wp, -2.0_wp], [big, 2.0_wp, 2.0_wp], reshape([integer ::], [2, 0]))
     x = [1.0_wp, 3.0_wp, 4.0_wp]
-    call set%project(x)
-    call report(set%linear() .and. all(x == [1.0_wp, 2.0_wp, 2.0_wp]), 'friction_set without pairs: the box', x(3))
+    call box%project(x)
+    call report(box%linear() .and. all(x == [1.0_wp, 2.0_wp, 2.0_wp]), 'friction_set without pairs: the box', x(3))
     ! a pair: the disc of radius 2; (3, 4) lands on 2 (3, 4) / 5
-    set = friction_set([0.0_wp, -2.0_wp, -2.0_wp], [big, 2.0_wp, 2.0_wp], reshape([2, 3], [2, 1]))
+    disc = friction_set([0.0_wp, -2.0_wp, -2.0_wp], [big, 2.0_wp, 2.0_wp], reshape([2, 3], [2, 1]))
     x = [1.0_wp, 3.0_wp, 4.0_wp]
-    call set%project(x)
+    call disc%project(x)
     call report_le(maxval(abs(x - [1.0_wp, 1.2_wp, 1.6_wp])), 2.0_wp*eps, 'friction_set with a pair: its disc')
-    call report(.not. set%linear(), 'friction_set with a pair: not linear', 0.0_wp)
+    call report(.not. disc%linear(), 'friction_set with a pair: not linear', 0.0_wp)
     ! radius huge: nothing binds, no step is cut, no overflow (the checked build traps it)
-    set = friction_set([0.0_wp, -big, -big], [big, big, big], reshape([2, 3], [2, 1]))
+    open = friction_set([0.0_wp, -big, -big], [big, big, big], reshape([2, 3], [2, 1]))
     x = [1.0_wp, 1.0e300_wp, 1.0e300_wp]
-    call set%project(x)
-    call set%max_step(x, [0.0_wp, 1.0e300_wp, 1.0e300_wp], 1.0_wp, t, blocker)
+    call open%project(x)
+    call open%max_step(x, [0.0_wp, 1.0e300_wp, 1.0e300_wp], 1.0_wp, t, blocker)
     call report(all(x == [1.0_wp, 1.0e300_wp, 1.0e300_wp]) .and. t == 1.0_wp .and. blocker == 0, &
                 'friction_set, radius huge: no projection, no cut', t)
   end subroutine test_friction_set
