@@ -77,9 +77,10 @@ def hertz(P):
 
 
 # ---- the .inp ------------------------------------------------------------------------------
-def read_mesh(msh):
+def read_mesh(msh, groups=None):
     """Nodes (n x 3), the tetrahedra of each body {'sphere', 'block'} (0-based node indices,
-    positive volume) and the triangles of each physical surface, from a Gmsh MSH 4.1 file."""
+    positive volume) and the triangles of each physical surface (groups: default this scene's
+    supports and contact groups), from a Gmsh MSH 4.1 file."""
     m = meshio.read(msh)
     sets = m.cell_sets_dict
     tets = {}
@@ -90,7 +91,7 @@ def read_mesh(msh):
         t[vol < 0] = t[vol < 0][:, [0, 2, 1, 3]]
         tets[body] = t
     tris = {}
-    for name in list(SUPPORTS) + [SLAVE, MASTER]:
+    for name in groups or list(SUPPORTS) + [SLAVE, MASTER]:
         tris[name] = m.cells_dict["triangle"][sets[name]["triangle"]].astype(np.int64)
     return m.points, tets, tris
 
