@@ -39,8 +39,8 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from cattaneo3d_study import DECK, E, MU, NU, R, mindlin_shear  # noqa: E402
-from ccx_hertz3d import dat_totals, face_surface, read_mesh, sta_counts, write_lines  # noqa: E402
+from cattaneo3d_study import DECK, E, MU, NU, R, mindlin_shear, ring_error  # noqa: E402
+from ccx_hertz3d import dat_totals, face_surface, frd_fields, read_mesh, sta_counts, write_lines  # noqa: E402
 from rc_run import solver_env  # noqa: E402
 
 GROUPS = ("sphere_top", "sphere_z0", "block_bottom", "block_z0", "sphere_arc", "block_top")
@@ -67,17 +67,8 @@ def measure(xz, area, p, sx, sabs, P, Q):
     c = math.sqrt(2.0 * np.sum(area[stick]) / math.pi)
     r = np.hypot(xz[:, 0], xz[:, 1])
     sx = sx * np.sign(np.sum(sx * area))
-    qt = mindlin_shear(r, a, p0, ct)
-    num = den = 0.0
-    for lo in np.arange(8) * a / 8.0:
-        k = (r >= lo) & (r < lo + a / 8.0)
-        mid = lo + a / 16.0
-        if not k.any() or mid > 0.9 * a or abs(mid - ct) <= 0.15 * a:
-            continue
-        qm, qa = np.sum(sx[k] * area[k]) / np.sum(area[k]), np.sum(qt[k] * area[k]) / np.sum(area[k])
-        num += np.sum(area[k]) * (qm - qa) ** 2
-        den += np.sum(area[k]) * qa ** 2
-    return dict(a=a, c=c, ct=ct, shear=math.sqrt(num / den), active=int(np.count_nonzero(p > 0)), QmuP=Q / (MU * P))
+    shear = ring_error(r, sx * area, area, a, ct, mindlin_shear(r, a, p0, ct))
+    return dict(a=a, c=c, ct=ct, shear=shear, active=int(np.count_nonzero(p > 0)), QmuP=Q / (MU * P))
 
 
 def write_inp(path, points, tets, tris, a):
@@ -111,24 +102,6 @@ def write_inp(path, points, tets, tris, a):
                     "*NODE PRINT, NSET=N_SPHERE_TOP, TOTALS=ONLY\nRF\n*CONTACT FILE\nCSTR\n*END STEP\n")
 
 
-def frd_cstr(frd):
-    """{node id: {CPRESS, CSHEAR1, CSHEAR2}} of the last CONTACT block of an ASCII .frd file."""
-    last, cur, names = {}, None, []
-    with open(frd) as f:
-        for line in f:
-            if line.startswith(" -4"):
-                cur = {} if line.split()[1] == "CONTACT" else None
-                names = []
-            elif cur is not None and line.startswith(" -5"):
-                names.append(line.split()[1])
-            elif cur is not None and line.startswith(" -1"):
-                vals = [float(line[13 + 12 * k:25 + 12 * k]) for k in range(len(names))]
-                cur[int(line[3:13])] = dict(zip(names, vals))
-            elif cur is not None and line.startswith(" -3"):
-                last, cur = cur, None
-    return last
-
-
 def run_ccx(a, msh, work, mesh):
     points, tets, tris = mesh
     job = os.path.join(work, "cm3d")
@@ -143,7 +116,7 @@ def run_ccx(a, msh, work, mesh):
     err = re.search(r"\*ERROR.*", log)
     if p.returncode != 0 or err or not os.path.exists(job + ".frd"):
         return {"status": "failed: " + (err.group(0).strip() if err else f"exit {p.returncode}"), "wall": wall}
-    cs = frd_cstr(job + ".frd")
+    cs = frd_fields(job + ".frd")
     tot = dat_totals(job + ".dat")["N_SPHERE_TOP"]
     ids = np.unique(tris["sphere_arc"])
     area = node_areas(points, tris["sphere_arc"])[ids]

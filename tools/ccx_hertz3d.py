@@ -169,6 +169,12 @@ def dat_totals(dat):
 
 def frd_contact(frd):
     """{node id: CPRESS} of the last CONTACT block of an ASCII .frd file (slave nodes)."""
+    return {n: v["CPRESS"] for n, v in frd_fields(frd).items()}
+
+
+def frd_fields(frd):
+    """{node id: {name: value}} of the last CONTACT block of an ASCII .frd file (slave nodes:
+    CPRESS, CSHEAR1, CSHEAR2 with CSTR)."""
     last, cur, names = {}, None, []
     with open(frd) as f:
         for line in f:
@@ -182,7 +188,7 @@ def frd_contact(frd):
                 cur[int(line[3:13])] = dict(zip(names, vals))
             elif cur is not None and line.startswith(" -3"):
                 last, cur = cur, None
-    return {n: v["CPRESS"] for n, v in last.items()}
+    return last
 
 
 def sta_counts(sta):

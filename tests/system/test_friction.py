@@ -303,19 +303,25 @@ def mpi(tmp):
     serial = Run(tmp, "mpi_serial", stack, *over)
     if not converged(serial, "frictional stack, serial"):
         return
+    mpi_against_serial(tmp, mpi_bin, stack, over, "frictional stack", "contact", serial.c)
+
+
+def mpi_against_serial(tmp, mpi_bin, deck, over, what0, group, want):
+    """mpirun -np 1, 2, 4 of deck with over (MUMPS): the datasets normal_force and
+    tangential_force of `group` equal want's (the serial run's) to 1e-10."""
     env = solver_env(threads=1)
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_mpi_yield_when_idle="1",
                OMPI_MCA_rmaps_base_oversubscribe="1")
     for np_ in (1, 2, 4):
         out = os.path.join(tmp, f"mpi_np{np_}.h5")
-        p = subprocess.run(["mpirun", "--oversubscribe", "-np", str(np_), mpi_bin, stack, *over,
+        p = subprocess.run(["mpirun", "--oversubscribe", "-np", str(np_), mpi_bin, deck, *over,
                             "&solver factorization='mumps' /", f"&output file='{out}' /"],
                            capture_output=True, text=True, env=env, timeout=600)
-        what = f"frictional stack, mpirun -np {np_}"
+        what = f"{what0}, mpirun -np {np_}"
         if not check(p.returncode == 0 and os.path.exists(out), f"{what}: exit 0", p.stderr.strip()[-300:]):
             continue
         with h5py.File(out, "r") as f:
-            e = max(float(np.max(np.abs(np.array(f["contact"][k]) - serial.c[k])) / np.max(np.abs(serial.c[k])))
+            e = max(float(np.max(np.abs(np.array(f[group][k]) - want[k])) / np.max(np.abs(want[k])))
                     for k in ("normal_force", "tangential_force"))
         check(e <= 1e-10, f"{what}: = serial (1e-10)", f"{e:.2e}")
 

@@ -50,15 +50,13 @@ import subprocess
 import sys
 import tempfile
 
-import h5py
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
-from test_friction import MONO, ROBIN as ROBIN_2D, ROOT, Run, check, converged, refused, rel, restart_in_second_stage  # noqa: E402,E501
+from test_friction import (MONO, ROBIN as ROBIN_2D, ROOT, Run, check, converged, mpi_against_serial, refused,  # noqa: E402
+                           rel, restart_in_second_stage)
 from solid_decks import THREE_BOXES  # noqa: E402
-sys.path.insert(0, os.path.join(ROOT, "tools"))
-from rc_run import solver_env  # noqa: E402
 
 ROBIN = "&solver robin_operator='harmonic', delta=0.5, stop='residual', tol=1e-11 /"
 P = 1.0e6
@@ -293,22 +291,8 @@ def threads_and_mpi(tmp):
     serial = Run(tmp, "mpi_serial", PATH_DECK, *over, "&solver tol=1e-12 /")
     if not converged(serial, "3D friction, serial, tol 1e-12"):
         return
-    env = solver_env(threads=1)
-    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_mpi_yield_when_idle="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
-    deck = os.path.join(tmp, "mpi_serial.nml")
-    for np_ in (1, 2, 4):
-        out = os.path.join(tmp, f"mpi_np{np_}.h5")
-        p = subprocess.run(["mpirun", "--oversubscribe", "-np", str(np_), mpi_bin, deck, *over, "&solver tol=1e-12 /",
-                            "&solver factorization='mumps' /", f"&output file='{out}' /"],
-                           capture_output=True, text=True, env=env, timeout=600)
-        what = f"3D friction, mpirun -np {np_}"
-        if not check(p.returncode == 0 and os.path.exists(out), f"{what}: exit 0", p.stderr.strip()[-300:]):
-            continue
-        with h5py.File(out, "r") as f:
-            e = max(float(np.max(np.abs(np.array(f["contact"]["pair_1"][k]) - pair(serial)[k])) /
-                          np.max(np.abs(pair(serial)[k]))) for k in ("normal_force", "tangential_force"))
-        check(e <= 1e-10, f"{what}: = serial (1e-10)", f"{e:.2e}")
+    mpi_against_serial(tmp, mpi_bin, os.path.join(tmp, "mpi_serial.nml"), [*over, "&solver tol=1e-12 /"],
+                       "3D friction", "contact/pair_1", pair(serial))
 
 
 def cattaneo(tmp):
