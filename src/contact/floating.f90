@@ -833,7 +833,7 @@ contains
     real(wp), allocatable :: ea(:), x(:), tb(:)
     integer, allocatable :: tres(:), bound_of(:)
     integer :: c, k, nt, r, p
-    real(wp) :: w
+    real(wp) :: w, t, gn
     if (.not. has_friction(contact_line)) then
       allocate (x(g%ncol))
       call nnls(g, e, x, res)
@@ -862,8 +862,11 @@ contains
       nt = nt + 1
       bound_of(k) = nt
       p = contact_line%pair_of(k)
-      tb = [tb, min(contact_line%pair_slip(p)*contact_line%trib(k), &
-                    1.0e3_wp*w/max(norm2(gc%val(gc%ptr(c):gc%ptr(c + 1) - 1)), tiny(1.0_wp)))]
+      t = contact_line%pair_slip(p)*contact_line%trib(k)
+      gn = norm2(gc%val(gc%ptr(c):gc%ptr(c + 1) - 1))
+      ! (a generator of no length, or one so short that the cap would overflow: no cap)
+      if (gn > 1.0e3_wp*(w/huge(1.0_wp))) t = min(t, 1.0e3_wp*w/gn)
+      tb = [tb, t]
     end do
     allocate (ea(r + nt), x(gc%ncol + nt))
     ea(1:r) = e
