@@ -1016,11 +1016,13 @@ contains
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: c(:, :)
     type(error_t), intent(inout) :: st
-    if (size(c, 1) <= 2) then
-      call write_dset(gid, 'segments', c, st, '1')
+    integer, allocatable :: w(:, :)
+    w = c     ! contiguous, as the writer takes it (a section passed here is not)
+    if (size(w, 1) <= 2) then
+      call write_dset(gid, 'segments', w, st, '1')
     else
-      call write_dset(gid, 'faces', c, st, '1')
-      if (any(c < 0)) call write_dset(gid, 'topology', face_topology(c), st, '1')
+      call write_dset(gid, 'faces', w, st, '1')
+      if (any(w < 0)) call write_dset(gid, 'topology', face_topology(w), st, '1')
     end if
   end subroutine write_contact_cells
 
