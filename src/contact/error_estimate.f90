@@ -59,6 +59,15 @@ contains
     res%error_bound = 0.0_wp
     res%kappa = 1.0_wp
     if (m == 0) return
+    if (sum(bodies(:)%nrig) > 0 .and. size(disc_rows(contact_line), 2) > 0) then
+      ! the projection on {discs, G l = e} is not available (project_feasible's dual Newton
+      ! method clips to a box): no bound, and none of its eigenvalue estimates
+      res%error_bound = huge(1.0_wp)
+      res%kappa = huge(1.0_wp)
+      res%no_bound_reason = 'no projection onto the friction discs together with the equilibrium of a body held '// &
+                            'only by contact'
+      return
+    end if
     allocate (g(m), r(m), x(m), y(m), xp(m), yp(m), bs(m, 2))
     ! H = sum_a E_a' F_a E_a: dense for two bodies in one pair (F_1 + F_2), sparse otherwise
     call hs%init(contact_line, bodies)
@@ -127,14 +136,7 @@ contains
     allocate (lo(m), hi(m))
     call row_bounds(contact_line, res%lam, lo, hi)
     set = friction_set(lo, hi, disc_rows(contact_line))
-    if (sum(bodies(:)%nrig) > 0 .and. .not. set%linear()) then
-      ! the projection on {discs, G l = e} is not available (project_feasible's dual Newton
-      ! method clips to a box)
-      res%error_bound = huge(1.0_wp)
-      res%no_bound_reason = 'no projection onto the friction discs together with the equilibrium of a body held '// &
-                            'only by contact'
-      return
-    else if (sum(bodies(:)%nrig) > 0) then
+    if (sum(bodies(:)%nrig) > 0) then
       ! floating bodies: the feasible set is {lo <= l <= hi, G l = e}, and the bound holds with the
       ! projection on it (the proof only uses the projection's variational inequality and
       ! the strong convexity of the objective on R^m); the projection's own inaccuracy is added

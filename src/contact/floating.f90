@@ -717,7 +717,7 @@ contains
     type(sparse_cols_t) :: gc
     integer, allocatable :: tcol(:, :), cr(:), tr(:)
     real(wp), allocatable :: cv(:), dir(:, :), nd_dir(:, :)
-    integer :: i, k, p, q
+    integer :: i, k, p, q, nc
     real(wp) :: sc, t
     sc = 1.0_wp
     if (present(mu_scale)) sc = mu_scale
@@ -730,7 +730,9 @@ contains
         dir(:, q) = [cos(2.0_wp*PI*(q - 1)/CONE_SIDES), sin(2.0_wp*PI*(q - 1)/CONE_SIDES)]/cos(PI/CONE_SIDES)
       end do
     end if
-    allocate (tcol(NDIM - 1, contact_line%m), tr(0))
+    ! at most size(dir, 2) columns per row: tres's entries filled in place (nc of them)
+    allocate (tcol(NDIM - 1, contact_line%m), tr(size(dir, 2)*size(rows)))
+    nc = 0
     tcol = 0
     do i = 1, size(rows)
       if (contact_line%dir(rows(i)) > DIR_NORMAL) tcol(contact_line%dir(rows(i)), contact_line%nrow(rows(i))) = i
@@ -747,7 +749,8 @@ contains
           allocate (cr(0), cv(0))
           call add_tangents(contact_line%nrow(k), q, 1.0_wp)
           call gc%push(cr, cv)
-          tr = [tr, k]
+          nc = nc + 1
+          tr(nc) = k
           deallocate (cr, cv)
         end do
       else if (any(tcol(:, k) > 0) .and. contact_line%pair_friction(p) == FRICTION_COULOMB) then
@@ -759,14 +762,16 @@ contains
           cv = g%val(g%ptr(i):g%ptr(i + 1) - 1)
           call add_tangents(k, q, t)
           call gc%push(cr, cv/sqrt(1.0_wp + (t*norm2(nd_dir(:, q)))**2))
-          tr = [tr, 0]
+          nc = nc + 1
+          tr(nc) = 0
         end do
       else
         call gc%push(g%row(g%ptr(i):g%ptr(i + 1) - 1), g%val(g%ptr(i):g%ptr(i + 1) - 1))
-        tr = [tr, 0]
+        nc = nc + 1
+        tr(nc) = 0
       end if
     end do
-    if (present(tres)) tres = tr
+    if (present(tres)) tres = tr(1:nc)
 
   contains
 
@@ -852,7 +857,7 @@ contains
     ! the Tresca nodes in the order of their first generator, each with its bound, no larger
     ! than 1e3 |e| / |its first generator| (a bound beyond that does not bind a balance of |e|,
     ! and a slip_bound of 1e20 would only spoil the least squares)
-    allocate (bound_of(contact_line%m), tb(0))
+    allocate (bound_of(contact_line%m), tb(contact_line%m))
     bound_of = 0
     nt = 0
     do c = 1, gc%ncol
@@ -866,7 +871,7 @@ contains
       gn = norm2(gc%val(gc%ptr(c):gc%ptr(c + 1) - 1))
       ! (a generator of no length, or one so short that the cap would overflow: no cap)
       if (gn > 1.0e3_wp*(w/huge(1.0_wp))) t = min(t, 1.0e3_wp*w/gn)
-      tb = [tb, t]
+      tb(nt) = t
     end do
     allocate (ea(r + nt), x(gc%ncol + nt))
     ea(1:r) = e
