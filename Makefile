@@ -190,7 +190,7 @@ $(BUILD)/constraint_set.o: $(BUILD)/kinds.o
 $(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/constraint_set.o
 $(BUILD)/qp_newton.o:      $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/constraint_set.o
-$(BUILD)/disc_newton.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/tangent_discs.o
+$(BUILD)/disc_newton.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/tangent_discs.o $(BUILD)/qp_newton.o
 $(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
                            $(BUILD)/constraint_set.o $(BUILD)/mprgp_support.o $(BUILD)/qp_newton.o \
                            $(BUILD)/tangent_discs.o $(BUILD)/disc_newton.o

@@ -21,24 +21,46 @@
 !! module qp_newton, after a whole step (x near its face's minimiser): a box variable whose
 !! multiplier has the wrong sign, a disc whose gradient points into it (nu.g > 0).
 !!
-!! Each step factors the face's matrix (dense Cholesky, `dpotrf_tiles`) and computes the
-!! gradient afresh (one product with A; the projection makes a recurrence inexact).
+!! The face's matrix is solved through a Cholesky factor of A on the free variables and the
+!! held discs' pairs (disc_factor_t), made once a solve (`dpotrf_tiles`) and then carried
+!! from face to face by row updates (a disc that reaches its circle costs O(p^2), not a
+!! new O(p^3) factor), with the Schur complement on the held discs' tangents, which turn
+!! at every step. Each step computes the gradient afresh (one product with A; the
+!! projection makes a recurrence inexact).
 !!
 !! Thread safety: no module variables; the work arrays are the caller's.
 module disc_newton
   use kinds, only: wp
-  use lapack, only: dpotrf_tiles, dpotrs, dsymv
+  use lapack, only: dpotrf_tiles, dpotrf, dpotrs, dsymv, dtrsv, dgemv, dsyrk
   use tangent_discs, only: disc_set_t, circle_point
+  use qp_newton, only: chol_delete, chol_append
   implicit none (type, external)
   private
 
-  public :: disc_newton_step, disc_held
+  public :: disc_newton_step, disc_held, disc_factor_t, face_solve
   public :: DN_STEP, DN_STILL, DN_NOT_SPD
 
   integer, parameter :: DN_STEP = 0       !< a step was taken
   integer, parameter :: DN_STILL = 1      !< no step: x is its face's minimiser and nothing is released
   integer, parameter :: DN_NOT_SPD = 2    !< the face's matrix is not positive definite (A is not SPD)
   integer, parameter :: MAX_HALVING = 40
+
+  !> The factor the steps of one solve carry: L L' = A(U, U), U the free variables (the
+  !! F part, first) then both variables of each held disc (the P part, in pairs, last).
+  !! A step whose face is a few variables away updates it (rows deleted, inserted at the
+  !! end of the F part, discs appended) instead of factoring the face again; the face's
+  !! matrix Z'AZ + C is then solved through the Schur complement on the held discs'
+  !! tangents (face_solve), O(p nd^2) where a new factor costs O(p^3).
+  type :: disc_factor_t
+    real(wp), allocatable :: h(:, :)     !< (n, n) the factor in its leading p x p block
+    integer, allocatable :: var(:)       !< (n) the variable at each position
+    integer, allocatable :: pos(:)       !< (n) the position of each variable (0: none)
+    integer, allocatable :: pdisc(:)     !< the disc at each pair of the P part
+    integer :: nf = 0                    !< the F part's length
+    integer :: nd = 0                    !< the P part's discs
+    integer :: updates = 0               !< rows changed since the factor was made
+    logical :: valid = .false.           !< h holds a factor
+  end type disc_factor_t
 
 contains
 
@@ -55,7 +77,7 @@ contains
   !! working set (disc_held at the start of a solve, then carried); at_min: the last step was
   !! whole (x near its face's minimiser): release first. flops: the step's work; factored:
   !! counts the face factorizations.
-  subroutine disc_newton_step(a, b, set, x, g, ax, held, at_min, outcome, flops, factored)
+  subroutine disc_newton_step(a, b, set, x, g, ax, held, at_min, outcome, flops, factored, fac)
     real(wp), intent(in) :: a(:, :)           !< A (n x n, dense, symmetric)
     real(wp), intent(in) :: b(:)              !< the linear term
     type(disc_set_t), intent(in) :: set       !< the feasible set
@@ -67,10 +89,11 @@ contains
     integer, intent(out) :: outcome           !< DN_*
     real(wp), intent(inout) :: flops          !< work added (multiply-adds x 2)
     integer, intent(inout) :: factored        !< factorizations made (one more when this step made one)
+    type(disc_factor_t), intent(inout) :: fac !< the factor of the solve's last face (carried)
     integer, allocatable :: free(:), dk(:)
-    real(wp), allocatable :: h(:, :), rhs(:), tau(:, :), curv(:), d(:), dfree(:), x0(:), g0(:), xb(:), axb(:)
+    real(wp), allocatable :: rhs(:), tau(:, :), curv(:), d(:), dfree(:), x0(:), g0(:), xb(:), axb(:)
     logical, allocatable :: rel(:), onb(:)
-    integer :: n, nf, nd, k, i, j, info, blk, half, q
+    integer :: n, nf, nd, k, i, info, blk, half, q
     real(wp) :: t, tmax, df, noise, s, na, nb
     logical :: cut
     n = size(x)
@@ -98,37 +121,12 @@ contains
       tau(:, q) = [-nb, na]
       curv(q) = max(-(na*g(set%pair(1, k)) + nb*g(set%pair(2, k))), 0.0_wp)/set%r(k)
     end do
-    allocate (h(nf + nd, nf + nd), rhs(nf + nd))
-    do j = 1, nf
-      do i = j, nf
-        h(i, j) = a(free(i), free(j))
-      end do
-      do q = 1, nd
-        h(nf + q, j) = tau(1, q)*a(set%pair(1, dk(q)), free(j)) + tau(2, q)*a(set%pair(2, dk(q)), free(j))
-      end do
-      rhs(j) = -g(free(j))
-    end do
-    do q = 1, nd
-      associate (p1 => set%pair(1, dk(q)), p2 => set%pair(2, dk(q)))
-        do i = q, nd
-          associate (r1 => set%pair(1, dk(i)), r2 => set%pair(2, dk(i)))
-            h(nf + i, nf + q) = tau(1, i)*(a(r1, p1)*tau(1, q) + a(r1, p2)*tau(2, q)) + &
-                                tau(2, i)*(a(r2, p1)*tau(1, q) + a(r2, p2)*tau(2, q))
-          end associate
-        end do
-        h(nf + q, nf + q) = h(nf + q, nf + q) + curv(q)
-        rhs(nf + q) = -(tau(1, q)*g(p1) + tau(2, q)*g(p2))
-      end associate
-    end do
-    call dpotrf_tiles('L', nf + nd, h, nf + nd, info)
-    flops = flops + real(nf + nd, wp)**3/3.0_wp
-    factored = factored + 1
+    allocate (rhs(nf + nd))
+    call face_solve(a, set, free, dk, tau, curv, g, fac, rhs, info, flops, factored)
     if (info /= 0) then
       outcome = DN_NOT_SPD
       return
     end if
-    call dpotrs('L', nf + nd, 1, h, nf + nd, rhs, nf + nd, info)
-    flops = flops + 2.0_wp*real(nf + nd, wp)**2
     allocate (d(n), dfree(n))
     d = 0.0_wp
     d(free) = rhs(1:nf)
@@ -195,5 +193,314 @@ contains
     end if
     at_min = .not. cut .and. half == 0
   end subroutine disc_newton_step
+
+  !> The Newton direction on the face (module header): rhs = delta (the free variables in
+  !! the order of `free`, then the held discs' tangential coordinates in the order of dk)
+  !! from (Z'AZ + C) delta = -Z'g. With L = [Lf 0; W' Lp] the factor of A(U, U) (F part
+  !! then P part, bring_to_face) and T the held discs' tangents (2 nd x nd), Z'AZ + C =
+  !! [Lf 0; T'W' K] [Lf' WT; 0 K'] where K K' = S = T'Lp Lp'T + C (nd x nd). info /= 0:
+  !! the face's matrix is not positive definite.
+  subroutine face_solve(a, set, free, dk, tau, curv, g, fac, rhs, info, flops, factored)
+    real(wp), intent(in) :: a(:, :)
+    type(disc_set_t), intent(in) :: set
+    integer, intent(in) :: free(:), dk(:)
+    real(wp), intent(in) :: tau(:, :), curv(:), g(:)
+    type(disc_factor_t), intent(inout) :: fac
+    real(wp), intent(out) :: rhs(:)
+    integer, intent(out) :: info
+    real(wp), intent(inout) :: flops
+    integer, intent(inout) :: factored
+    real(wp), allocatable :: gt(:, :), sm(:, :), zf(:), v(:), tq(:, :)
+    integer, allocatable :: dq(:)
+    integer :: nf, nd, np, ld, i, q, k, j
+    nf = size(free)
+    nd = size(dk)
+    call bring_to_face(a, set, free, dk, fac, info, flops, factored)
+    if (info /= 0) return
+    np = 2*nd
+    ld = size(fac%h, 1)
+    ! the tangents in the P part's order
+    allocate (tq(2, nd), dq(nd))
+    do i = 1, nd
+      dq(i) = (fac%pos(set%pair(1, dk(i))) - nf + 1)/2
+      tq(:, dq(i)) = tau(:, i)
+    end do
+    ! z_F = Lf^-1 r_F, r_F = -g_F (F part's order)
+    allocate (zf(nf), v(np))
+    do i = 1, nf
+      zf(i) = -g(fac%var(i))
+    end do
+    if (nf > 0) call dtrsv('L', 'N', 'N', nf, fac%h, ld, zf, 1)
+    flops = flops + real(nf, wp)**2
+    if (nd > 0) then
+      ! G = Lp' T (np x nd), S = G'G + C
+      allocate (gt(np, nd), sm(nd, nd))
+      do q = 1, nd
+        do i = 1, np
+          j = nf + i
+          gt(i, q) = 0.0_wp
+          if (i <= 2*q - 1) gt(i, q) = fac%h(nf + 2*q - 1, j)*tq(1, q)
+          if (i <= 2*q) gt(i, q) = gt(i, q) + fac%h(nf + 2*q, j)*tq(2, q)
+        end do
+      end do
+      call dsyrk('L', 'T', nd, np, 1.0_wp, gt, np, 0.0_wp, sm, nd)
+      do i = 1, nd
+        sm(dq(i), dq(i)) = sm(dq(i), dq(i)) + curv(i)
+      end do
+      call dpotrf('L', nd, sm, nd, info)
+      flops = flops + real(np, wp)*real(nd, wp)**2 + real(nd, wp)**3/3.0_wp + 4.0_wp*real(np, wp)*nd
+      if (info /= 0) return
+      ! y = r_D - T'W'z_F, delta_D = S^-1 y
+      v = 0.0_wp
+      if (nf > 0) call dgemv('N', np, nf, 1.0_wp, fac%h(nf + 1, 1), ld, zf, 1, 0.0_wp, v, 1)
+      do q = 1, nd
+        k = fac%pdisc(q)
+        rhs(nf + q) = -(tq(1, q)*g(set%pair(1, k)) + tq(2, q)*g(set%pair(2, k))) - &
+                      (tq(1, q)*v(2*q - 1) + tq(2, q)*v(2*q))
+      end do
+      call dpotrs('L', nd, 1, sm, nd, rhs(nf + 1:), nd, info)
+      ! z_F - W T delta_D
+      do q = 1, nd
+        v(2*q - 1:2*q) = tq(:, q)*rhs(nf + q)
+      end do
+      if (nf > 0) call dgemv('T', np, nf, -1.0_wp, fac%h(nf + 1, 1), ld, v, 1, 1.0_wp, zf, 1)
+      flops = flops + 4.0_wp*real(np, wp)*nf + 2.0_wp*real(nd, wp)**2
+    end if
+    if (nf > 0) call dtrsv('L', 'T', 'N', nf, fac%h, ld, zf, 1)
+    flops = flops + real(nf, wp)**2
+    ! back to the caller's orders: F in the order of `free`, the discs in that of dk
+    do i = 1, nf
+      rhs(i) = zf(fac%pos(free(i)))
+    end do
+    if (nd > 0) then
+      v(1:nd) = rhs(nf + 1:nf + nd)
+      do i = 1, nd
+        rhs(nf + i) = v(dq(i))
+      end do
+    end if
+  end subroutine face_solve
+
+  !> fac brought to the face (free, dk): a new factor when it holds none or the face is
+  !! far from its own (over p/12 rows to change at once, or p/2 since it was made, or an
+  !! update that loses positive definiteness); else the rows that left it deleted (the
+  !! last first), the variables that joined F inserted at the end of the F part, the
+  !! discs newly held appended as pairs. info /= 0: A(U, U) is not positive definite.
+  subroutine bring_to_face(a, set, free, dk, fac, info, flops, factored)
+    real(wp), intent(in) :: a(:, :)
+    type(disc_set_t), intent(in) :: set
+    integer, intent(in) :: free(:), dk(:)
+    type(disc_factor_t), intent(inout) :: fac
+    integer, intent(out) :: info
+    real(wp), intent(inout) :: flops
+    integer, intent(inout) :: factored
+    logical, allocatable :: in_f(:), in_d(:), keep(:)
+    integer :: n, p, np, pc, nchange, i, k, q, v
+    real(wp) :: piv
+    n = size(a, 1)
+    info = 0
+    if (.not. allocated(fac%h)) then
+      allocate (fac%h(max(1, n), max(1, n)), fac%var(n), fac%pdisc(0))
+      allocate (fac%pos(n), source=0)
+      fac%valid = .false.
+    end if
+    allocate (in_f(n), in_d(size(set%r)), source=.false.)
+    in_f(free) = .true.
+    in_d(dk) = .true.
+    if (fac%valid) then
+      p = fac%nf + 2*fac%nd
+      allocate (keep(p))
+      do i = 1, fac%nf
+        keep(i) = in_f(fac%var(i))
+      end do
+      do q = 1, fac%nd
+        keep(fac%nf + 2*q - 1:fac%nf + 2*q) = in_d(fac%pdisc(q))
+      end do
+      nchange = count(.not. keep) + count(fac%pos(free) == 0 .or. fac%pos(free) > fac%nf)
+      do i = 1, size(dk)
+        if (fac%pos(set%pair(1, dk(i))) <= fac%nf) nchange = nchange + 2
+      end do
+      if (nchange == 0) return
+      if (12*nchange <= p .and. 2*(fac%updates + nchange) <= p) then
+        call update()
+        if (info == 0) return
+      end if
+    end if
+    call fresh()
+  contains
+
+    subroutine update()
+      integer :: j
+      ! deletions, the last position first (the positions above stay valid)
+      pc = p
+      do j = p, 1, -1
+        if (keep(j)) cycle
+        call chol_delete(fac%h, pc, j)
+        flops = flops + 4.0_wp*real(pc - j, wp)**2
+        fac%pos(fac%var(j)) = 0
+        fac%var(j:pc - 1) = fac%var(j + 1:pc)
+        pc = pc - 1
+        if (j <= fac%nf) then
+          fac%nf = fac%nf - 1
+        else if (mod(j - fac%nf, 2) == 1) then
+          ! the pair's first variable: the disc leaves (its second went first)
+          q = (j - fac%nf + 1)/2
+          fac%pdisc(q:fac%nd - 1) = fac%pdisc(q + 1:fac%nd)
+          fac%nd = fac%nd - 1
+        end if
+      end do
+      np = 2*fac%nd
+      call renumber()
+      ! the variables that joined F, at the end of the F part
+      do i = 1, size(free)
+        v = free(i)
+        if (fac%pos(v) > 0) cycle
+        call chol_insert(a, fac, v, piv, flops)
+        if (.not. piv > 1.0e-8_wp*a(v, v)) then
+          info = 1
+          return
+        end if
+      end do
+      ! the discs newly held, as pairs at the end
+      do i = 1, size(dk)
+        k = dk(i)
+        if (fac%pos(set%pair(1, k)) > 0) cycle
+        do j = 1, 2
+          v = set%pair(j, k)
+          p = fac%nf + 2*fac%nd + j - 1
+          call chol_append(a, fac%var(1:p), v, fac%h, piv)
+          flops = flops + real(p, wp)**2
+          if (.not. piv > 1.0e-8_wp*a(v, v)) then
+            info = 1
+            return
+          end if
+          fac%var(p + 1) = v
+          fac%pos(v) = p + 1
+        end do
+        fac%pdisc = [fac%pdisc(1:fac%nd), k]
+        fac%nd = fac%nd + 1
+      end do
+      fac%updates = fac%updates + nchange
+    end subroutine update
+
+    !> A new factor: F in the order of `free`, then the discs of dk.
+    subroutine fresh()
+      integer :: i2, j2, pp
+      call forget()
+      fac%nf = size(free)
+      fac%nd = size(dk)
+      pp = fac%nf + 2*fac%nd
+      fac%var(1:fac%nf) = free
+      do i2 = 1, fac%nd
+        fac%var(fac%nf + 2*i2 - 1:fac%nf + 2*i2) = set%pair(:, dk(i2))
+      end do
+      fac%pdisc = dk
+      do j2 = 1, pp
+        do i2 = j2, pp
+          fac%h(i2, j2) = a(fac%var(i2), fac%var(j2))
+        end do
+      end do
+      call dpotrf_tiles('L', pp, fac%h, size(fac%h, 1), info)
+      flops = flops + real(pp, wp)**3/3.0_wp
+      factored = factored + 1
+      if (info /= 0) return
+      call renumber()
+      fac%updates = 0
+      fac%valid = .true.
+    end subroutine fresh
+
+    subroutine forget()
+      fac%pos = 0
+      fac%valid = .false.
+      fac%nf = 0
+      fac%nd = 0
+    end subroutine forget
+
+    subroutine renumber()
+      integer :: j
+      do j = 1, fac%nf + 2*fac%nd
+        fac%pos(fac%var(j)) = j
+      end do
+    end subroutine renumber
+
+  end subroutine bring_to_face
+
+  !> Variable v inserted at the end of the F part (position nf + 1) of the factor
+  !! [Lf 0; W' Lp]: its row l solves Lf l = A(F, v), its pivot d = sqrt(A(v,v) - l'l)
+  !! (piv = d^2, nothing changed when not positive), its column below c = (A(P, v) - W'l)/d,
+  !! and Lp becomes the factor of Lp Lp' - c c' (chol_downdate); the P part moves down a
+  !! row. piv is set to 0 when the downdate fails (the face is then factored anew).
+  subroutine chol_insert(a, fac, v, piv, flops)
+    real(wp), intent(in) :: a(:, :)
+    type(disc_factor_t), intent(inout) :: fac
+    integer, intent(in) :: v
+    real(wp), intent(out) :: piv
+    real(wp), intent(inout) :: flops
+    real(wp), allocatable :: l(:), c(:), w(:)
+    integer :: nf, np, ld, j
+    logical :: ok
+    nf = fac%nf
+    np = 2*fac%nd
+    ld = size(fac%h, 1)
+    allocate (l(nf), c(np))
+    l = a(fac%var(1:nf), v)
+    if (nf > 0) call dtrsv('L', 'N', 'N', nf, fac%h, ld, l, 1)
+    piv = a(v, v) - dot_product(l, l)
+    flops = flops + real(nf, wp)**2 + 2.0_wp*real(np, wp)*nf + 4.0_wp*real(np, wp)**2
+    if (.not. piv > 0.0_wp) return
+    if (np > 0) then
+      c = a(fac%var(nf + 1:nf + np), v)
+      if (nf > 0) call dgemv('N', np, nf, -1.0_wp, fac%h(nf + 1, 1), ld, l, 1, 1.0_wp, c, 1)
+      c = c/sqrt(piv)
+      w = c
+      call chol_downdate(fac%h(nf + 1:nf + np, nf + 1:nf + np), w, ok)
+      if (.not. ok) then
+        piv = 0.0_wp
+        return
+      end if
+      ! the P part down a row and a column
+      do j = nf + np, nf + 1, -1
+        fac%h(j + 2:nf + np + 1, j + 1) = fac%h(j + 1:nf + np, j)
+        fac%h(j + 1, j + 1) = fac%h(j, j)
+      end do
+      do j = 1, nf
+        fac%h(nf + 2:nf + np + 1, j) = fac%h(nf + 1:nf + np, j)
+      end do
+      fac%h(nf + 2:nf + np + 1, nf + 1) = c
+    end if
+    fac%h(nf + 1, 1:nf) = l
+    fac%h(nf + 1, nf + 1) = sqrt(piv)
+    fac%var(nf + 2:nf + np + 1) = fac%var(nf + 1:nf + np)
+    fac%var(nf + 1) = v
+    fac%nf = nf + 1
+    do j = nf + 1, nf + np + 1
+      fac%pos(fac%var(j)) = j
+    end do
+  end subroutine chol_insert
+
+  !> L (lower, n x n) becomes the factor of L L' - c c' by hyperbolic plane rotations
+  !! (c is overwritten); ok false (L then undefined) when that is not positive definite
+  !! to working precision.
+  pure subroutine chol_downdate(l, c, ok)
+    real(wp), intent(inout) :: l(:, :)
+    real(wp), intent(inout) :: c(:)
+    logical, intent(out) :: ok
+    integer :: j, n
+    real(wp) :: r2, r, co, si
+    n = size(c)
+    ok = .false.
+    do j = 1, n
+      r2 = (l(j, j) - c(j))*(l(j, j) + c(j))
+      if (.not. r2 > (64.0_wp*epsilon(1.0_wp)*l(j, j))**2) return
+      r = sqrt(r2)
+      co = r/l(j, j)
+      si = c(j)/l(j, j)
+      l(j, j) = r
+      if (j < n) then
+        l(j + 1:n, j) = (l(j + 1:n, j) - si*c(j + 1:n))/co
+        c(j + 1:n) = co*c(j + 1:n) - si*l(j + 1:n, j)
+      end if
+    end do
+    ok = .true.
+  end subroutine chol_downdate
 
 end module disc_newton

@@ -53,7 +53,7 @@ module mprgp
   use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
   use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped, SET_OK, SET_NONFINITE
   use tangent_discs, only: disc_set_t
-  use disc_newton, only: disc_newton_step, disc_held, DN_STILL, DN_NOT_SPD
+  use disc_newton, only: disc_newton_step, disc_held, DN_STILL, DN_NOT_SPD, disc_factor_t
   implicit none (type, external)
   private
 
@@ -433,6 +433,7 @@ contains
     logical :: at_min
     real(wp) :: betabeta, phitphi, flops
     integer :: outcome, still
+    type(disc_factor_t) :: fac
     select type (set)
     type is (disc_set_t)
       select type (A)
@@ -451,7 +452,7 @@ contains
           end select
           self%it = self%it + 1
           flops = 0.0_wp
-          call disc_newton_step(A%a, b, set, x, self%g, self%ax, held, at_min, outcome, flops, self%stats%n_factor)
+          call disc_newton_step(A%a, b, set, x, self%g, self%ax, held, at_min, outcome, flops, self%stats%n_factor, fac)
           self%fresh = .true.
           self%stats%n_newton = self%stats%n_newton + 1
           self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(self%n, wp)**2)))

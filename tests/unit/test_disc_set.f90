@@ -31,6 +31,8 @@ program test_disc_set
   use constraint_set, only: constraint_set_t
   use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP, QP_AUTO
   use lapack, only: dposv
+  use disc_newton, only: disc_factor_t, face_solve
+  use strings, only: itoa
   use testing, only: report, report_le, test_summary, set_seed, urand, random_spd
   implicit none (type, external)
 
@@ -46,6 +48,7 @@ program test_disc_set
   call test_random_qp()
   call test_newton_hard()
   call test_auto()
+  call test_carried_factor()
   call test_summary()
 
 contains
@@ -420,5 +423,108 @@ contains
       end if
     end do
   end subroutine kkt_of
+
+  !> The factor the Newton steps carry (module disc_newton: deleted, inserted and appended
+  !! rows, the Schur complement on the held discs' tangents) against the face's matrix
+  !! Z'AZ + C written out and solved by LAPACK, along 300 faces each a few variables from
+  !! the last (120 variables, 40 nodes, condition 1e4): a variable freed or held, a disc
+  !! held or released, tangents and curvatures new each time; every 25 faces a jump far
+  !! away (a new factor). The direction to 1e-10 relative on every face, and updates made.
+  subroutine test_carried_factor()
+    integer, parameter :: nk = 40, n = 3*nk
+    type(disc_set_t) :: set
+    type(disc_factor_t) :: fac
+    real(wp) :: a0(n, n), g(n), r(nk), lmin, lmax, flops, worst, th
+    logical :: freev(n), heldd(nk)
+    integer, allocatable :: free(:), dk(:)
+    real(wp), allocatable :: tau(:, :), curv(:), d(:), h(:, :), e(:)
+    integer :: step, k, i, q, info, factored, nfresh
+    call random_spd(n, 4.0_wp, a0, lmin, lmax)
+    r = 1.0_wp
+    set = node_set(r)
+    ! a start: normal forces free, a third of the discs held, the rest free
+    freev = .true.
+    heldd = .false.
+    do k = 1, nk, 3
+      heldd(k) = .true.
+    end do
+    worst = 0.0_wp
+    factored = 0
+    do step = 1, 300
+      if (mod(step, 25) == 0) then
+        do k = 1, nk
+          heldd(k) = urand(0.0_wp, 1.0_wp) < 0.4_wp
+          freev(3*k - 2) = urand(0.0_wp, 1.0_wp) < 0.8_wp
+        end do
+      else if (step > 1) then
+        k = 1 + int(urand(0.0_wp, real(nk, wp) - 1.0e-9_wp))
+        select case (mod(step, 3))
+        case (0)
+          freev(3*k - 2) = .not. freev(3*k - 2)
+        case default
+          heldd(k) = .not. heldd(k)
+        end select
+      end if
+      do k = 1, nk
+        freev(3*k - 1:3*k) = .not. heldd(k)
+      end do
+      free = pack([(i, i=1, n)], freev)
+      dk = pack([(k, k=1, nk)], heldd)
+      allocate (tau(2, size(dk)), curv(size(dk)), d(size(free) + size(dk)))
+      do q = 1, size(dk)
+        th = urand(0.0_wp, 2.0_wp*pi)
+        tau(:, q) = [cos(th), sin(th)]
+        curv(q) = urand(0.0_wp, 1.0_wp)
+      end do
+      do i = 1, n
+        g(i) = urand(-1.0_wp, 1.0_wp)
+      end do
+      flops = 0.0_wp
+      call face_solve(a0, set, free, dk, tau, curv, g, fac, d, info, flops, factored)
+      ! the face's matrix written out
+      call face_matrix(a0, set, free, dk, tau, curv, g, h, e)
+      call dposv('L', size(e), 1, h, size(e), e, size(e), info)
+      worst = max(worst, norm2(d - e)/norm2(e))
+      deallocate (tau, curv, d, h, e)
+    end do
+    nfresh = factored
+    call report_le(worst, 1.0e-10_wp, 'carried face factor: the Newton direction on 300 faces against LAPACK on Z''AZ + C')
+    call report(nfresh < 100, 'carried face factor: most faces by updates ('//trim(itoa(nfresh))//' factors for 300 faces)')
+
+  end subroutine test_carried_factor
+
+  !> The Newton face's matrix Z'AZ + C and right-hand side -Z'g written out (module
+  !! disc_newton's header): the free variables, then the held discs' tangents.
+  subroutine face_matrix(a0, set, free, dk, tau, curv, g, h, e)
+    real(wp), intent(in) :: a0(:, :), tau(:, :), curv(:), g(:)
+    type(disc_set_t), intent(in) :: set
+    integer, intent(in) :: free(:), dk(:)
+    real(wp), allocatable, intent(out) :: h(:, :), e(:)
+    integer :: nf, nd, i, j, q
+    nf = size(free)
+    nd = size(dk)
+    allocate (h(nf + nd, nf + nd), e(nf + nd))
+    do j = 1, nf
+      do i = 1, nf
+        h(i, j) = a0(free(i), free(j))
+      end do
+      e(j) = -g(free(j))
+    end do
+    do q = 1, nd
+      associate (p => set%pair(:, dk(q)))
+        do j = 1, nf
+          h(nf + q, j) = tau(1, q)*a0(p(1), free(j)) + tau(2, q)*a0(p(2), free(j))
+          h(j, nf + q) = h(nf + q, j)
+        end do
+        do i = 1, nd
+          associate (s => set%pair(:, dk(i)))
+            h(nf + i, nf + q) = dot_product(tau(:, i), matmul(a0(s, p), tau(:, q)))
+          end associate
+        end do
+        h(nf + q, nf + q) = h(nf + q, nf + q) + curv(q)
+        e(nf + q) = -dot_product(tau(:, q), g(p))
+      end associate
+    end do
+  end subroutine face_matrix
 
 end program test_disc_set
