@@ -19,7 +19,7 @@
 module budget
   use kinds, only: wp
   use space, only: NDIM
-  use config, only: MAX_SIDES, body_stiffness, deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
+  use config, only: MAX_SIDES, MODULUS_MIN, MODULUS_MAX, body_stiffness, deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
   use strings, only: i2s, sci, fmt_real
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
@@ -372,10 +372,10 @@ contains
     ! a stiffness (of the order of young) and a flexibility (of 1/young) whose squares stay finite
     do a = 1, d%nbody
       call body_stiffness(d%body(a), elo, ehi)
-      if (.not. (ehi < LOAD_MAX/MARGIN .and. elo > MARGIN/LOAD_MAX)) then
-        call err%set(ERR_INPUT, 'body '//i2s(a)//': '//modulus(a, merge(ehi, elo, ehi >= LOAD_MAX/MARGIN))// &
+      if (.not. (ehi < MODULUS_MAX .and. elo > MODULUS_MIN)) then
+        call err%set(ERR_INPUT, 'body '//i2s(a)//': '//modulus(a, merge(ehi, elo, ehi >= MODULUS_MAX))// &
               ' is outside ['// &
-              sci(MARGIN/LOAD_MAX)//', '//sci(LOAD_MAX/MARGIN)//'], where its stiffness and flexibility '// &
+              sci(MODULUS_MIN)//', '//sci(MODULUS_MAX)//'], where its stiffness and flexibility '// &
               'stay within double precision; rescale the units')
         return
       end if

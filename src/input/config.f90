@@ -17,6 +17,13 @@ module config
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
   integer, parameter, public :: PATH_LEN = 4096
+  !> The range of an elastic modulus [stress] (young; a &material's moduli and stiffness
+  !! constants): sqrt(huge)/1e6 and its inverse, where a body's stiffness, its flexibility
+  !! and their squares in the solvers' norms stay within double precision with a margin of 1e6
+  !! for the products of assembly (deck_checks refuses a modulus outside before its elastic
+  !! law is computed; budget's check_load_range the stiffness of the laws).
+  real(wp), parameter, public :: MODULUS_MAX = sqrt(huge(1.0_wp))/1.0e6_wp
+  real(wp), parameter, public :: MODULUS_MIN = 1.0e6_wp/sqrt(huge(1.0_wp))
   !> The most load stages a deck may have (`stage=` of a load group, `&solver load_steps`).
   integer, parameter, public :: MAX_STAGES = 16
   !> The most load steps of one stage.

@@ -8,11 +8,11 @@ module deck_checks
   use kinds, only: wp
   use space, only: NDIM, set_dimension
   use errors, only: fatal, EXIT_INPUT
-  use strings, only: i2s, r2s, quote, quoted_list, word
+  use strings, only: i2s, r2s, sci, quote, quoted_list, word
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
-  use config, only: MAX_SIDES, pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, &
+  use config, only: MAX_SIDES, MODULUS_MIN, MODULUS_MAX, pair_oriented, deck_t, body_cfg_t, body_force_cfg_t, material_cfg_t, region_cfg_t, &
                     MAT_ISOTROPIC, MAT_ORTHOTROPIC, MAT_ANISOTROPIC, MAT_KIND_NAMES, UNSET, traction_cfg_t, boundary_cfg_t, contact_cfg_t, solver_cfg_t, output_cfg_t, &
                     side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, BC_DISPLACEMENT, bc_names, &
@@ -497,6 +497,7 @@ contains
     if (c%ny < 1) call bad_value(g, src, 'ny', i2s(c%ny), 'must be >= 1 (cells along y)')
     if (.not. c%young > 0.0_wp) call bad_value(g, src, 'young', r2s(c%young), &
       'must be > 0 (Young''s modulus)')
+    call check_modulus(g, src, 'young', c%young)
     if (c%poisson >= 0.5_wp) call bad_value(g, src, 'poisson', r2s(c%poisson), 'is out of range: '// &
       'it must satisfy -1 < poisson < 0.5; poisson >= 0.5 (an incompressible material) is '// &
       'rejected: this displacement formulation cannot model it')
@@ -653,6 +654,7 @@ contains
     character(len=40), parameter :: LISTS(3) = [character(len=40) :: ISO, ORTHO, ANISO]
     character(len=:), allocatable :: first_name
     integer :: n, k, j, kinds(3), kind
+    real(wp) :: x
     call material_vars(m, v)
     call read_group(g, src, v)
     if (len_trim(m%name) == 0) call bad_value(g, src, 'name', "''", 'is empty: a material needs a name')
@@ -692,11 +694,18 @@ contains
       if (m%poisson == UNSET) call die_at(src, g%line, 'in group &material: isotropic material '// &
         quote(trim(m%name))//' has young but no poisson; give both')
       if (.not. m%young > 0.0_wp) call bad_value(g, src, 'young', r2s(m%young), 'must be > 0 (Young''s modulus)')
+      call check_modulus(g, src, 'young', m%young)
       if (.not. (m%poisson > -1.0_wp .and. m%poisson < 0.5_wp)) call bad_value(g, src, 'poisson', &
         r2s(m%poisson), 'is out of range: it must satisfy -1 < poisson < 0.5')
     end if
     do k = 1, 4
       call positive(trim(word('e1 e2 e3 g12', k)), [m%e1, m%e2, m%e3, m%g12])
+    end do
+    do k = 1, 10               ! a stiffness constant may be 0 or negative, not beyond the range
+      x = constant(m, trim(word(ANISO, k)))
+      if (x /= UNSET .and. .not. abs(x) < MODULUS_MAX) call bad_value(g, src, trim(word(ANISO, k)), r2s(x), &
+        'is beyond '//sci(MODULUS_MAX)//' in magnitude, where a body''s stiffness stays within double '// &
+        'precision; rescale the units')
     end do
     if (.not. m%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(m%density), &
       'must be >= 0 (mass per volume)')
@@ -719,8 +728,22 @@ contains
       real(wp) :: x
       x = vals(k)
       if (x /= UNSET .and. .not. x > 0.0_wp) call bad_value(g, src, name, r2s(x), 'must be > 0 (a modulus)')
+      if (x /= UNSET) call check_modulus(g, src, name, x)
     end subroutine positive
   end subroutine add_material
+
+  !> A modulus [stress] (young, e1, ...) within (MODULUS_MIN, MODULUS_MAX), where a body's
+  !! stiffness and flexibility stay within double precision: checked before the elastic law
+  !! is computed (resolve_materials), which a modulus of 1e308 makes overflow.
+  subroutine check_modulus(g, src, name, x)
+    type(grp_t), intent(in) :: g             !< the group
+    type(src_t), intent(in) :: src           !< where it comes from
+    character(len=*), intent(in) :: name     !< the variable
+    real(wp), intent(in) :: x                !< its value [stress]
+    if (.not. (x > MODULUS_MIN .and. x < MODULUS_MAX)) call bad_value(g, src, name, r2s(x), &
+      'is outside ['//sci(MODULUS_MIN)//', '//sci(MODULUS_MAX)//'], where a body''s stiffness and '// &
+      'flexibility stay within double precision; rescale the units')
+  end subroutine check_modulus
 
   !> How many of the constants `names` material m has.
   integer function count_given(m, names) result(n)
@@ -734,34 +757,39 @@ contains
   integer function first_given(m, names) result(j)
     type(material_cfg_t), intent(in) :: m
     character(len=*), intent(in) :: names
-    real(wp) :: x
     do j = 1, 10
       if (len_trim(word(names, j)) == 0) exit
-      select case (trim(word(names, j)))
-      case ('young'); x = m%young
-      case ('poisson'); x = m%poisson
-      case ('e1'); x = m%e1
-      case ('e2'); x = m%e2
-      case ('e3'); x = m%e3
-      case ('nu12'); x = m%nu12
-      case ('nu13'); x = m%nu13
-      case ('nu23'); x = m%nu23
-      case ('g12'); x = m%g12
-      case ('c11'); x = m%c11
-      case ('c12'); x = m%c12
-      case ('c16'); x = m%c16
-      case ('c22'); x = m%c22
-      case ('c26'); x = m%c26
-      case ('c66'); x = m%c66
-      case ('c13'); x = m%c13
-      case ('c23'); x = m%c23
-      case ('c36'); x = m%c36
-      case default; x = m%c33
-      end select
-      if (x /= UNSET) return
+      if (constant(m, trim(word(names, j))) /= UNSET) return
     end do
     j = 0
   end function first_given
+
+  !> The constant `name` of material m (UNSET: not given).
+  real(wp) function constant(m, name) result(x)
+    type(material_cfg_t), intent(in) :: m
+    character(len=*), intent(in) :: name
+    select case (name)
+    case ('young'); x = m%young
+    case ('poisson'); x = m%poisson
+    case ('e1'); x = m%e1
+    case ('e2'); x = m%e2
+    case ('e3'); x = m%e3
+    case ('nu12'); x = m%nu12
+    case ('nu13'); x = m%nu13
+    case ('nu23'); x = m%nu23
+    case ('g12'); x = m%g12
+    case ('c11'); x = m%c11
+    case ('c12'); x = m%c12
+    case ('c16'); x = m%c16
+    case ('c22'); x = m%c22
+    case ('c26'); x = m%c26
+    case ('c66'); x = m%c66
+    case ('c13'); x = m%c13
+    case ('c23'); x = m%c23
+    case ('c36'); x = m%c36
+    case default; x = m%c33
+    end select
+  end function constant
 
   !> A &region group: a part of a body made of a material of its own (deck), or a change of
   !! the region of that body and name (override).

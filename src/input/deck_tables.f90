@@ -21,6 +21,8 @@ module deck_tables
             solver_vars, output_vars, body_force_vars, material_vars, region_vars
 
   ! the documentation of `stage`, shared by the load groups
+  !> The range of a modulus (config's MODULUS_MIN, MODULUS_MAX; deck_checks' check_modulus)
+  character(len=*), parameter :: MODULUS_RANGE = '> 0; within [7.458e-149, 1.341e148] (double precision)'
   character(len=*), parameter :: STAGE_DOC = &
     'the load stage that applies it: stage s ramps its loads from 0 to their full value over its '// &
     '`&solver load_steps`, the earlier stages'' loads held at full value, the later ones'' at 0 '// &
@@ -134,7 +136,7 @@ contains
       doc='the direction of the material''s axis 1 (orthotropic and anisotropic materials), from x '// &
       'counter-clockwise. Rendered only when not 0')
     if (form == ALL_FORMS .or. len_trim(b%material) == 0) then
-      call v%real('young', b%young, unit='[stress]', range='> 0', doc='Young''s modulus of the '// &
+      call v%real('young', b%young, unit='[stress]', range=MODULUS_RANGE, doc='Young''s modulus of the '// &
         'body''s isotropic material (without `material`)')
       call v%real('poisson', b%poisson, unit='[-]', range='-1 < poisson < 0.5', doc='Poisson''s '// &
         'ratio; 0.5 (an incompressible material) is rejected: this displacement formulation '// &
@@ -237,12 +239,12 @@ contains
     if (present(rendering)) all_vars = .not. rendering
     call v%str('name', m%name, required=.true., doc='the material''s name, by which `&body` and '// &
       '`&region` use it; each name once')
-    call opt('young', m%young, '[stress]', '> 0', 'isotropic: Young''s modulus')
+    call opt('young', m%young, '[stress]', MODULUS_RANGE, 'isotropic: Young''s modulus')
     call opt('poisson', m%poisson, '[-]', '-1 < poisson < 0.5', 'isotropic: Poisson''s ratio')
-    call opt('e1', m%e1, '[stress]', '> 0', 'orthotropic: the modulus along the material''s axis '// &
+    call opt('e1', m%e1, '[stress]', MODULUS_RANGE, 'orthotropic: the modulus along the material''s axis '// &
       '1 (in the plane, at the body''s or region''s `angle` from x)')
-    call opt('e2', m%e2, '[stress]', '> 0', 'orthotropic: the modulus along axis 2 (in the plane)')
-    call opt('e3', m%e3, '[stress]', '> 0', 'orthotropic: the modulus along axis 3 (out of the '// &
+    call opt('e2', m%e2, '[stress]', MODULUS_RANGE, 'orthotropic: the modulus along axis 2 (in the plane)')
+    call opt('e3', m%e3, '[stress]', MODULUS_RANGE, 'orthotropic: the modulus along axis 3 (out of the '// &
       'plane); plane strain only')
     call opt('nu12', m%nu12, '[-]', '', 'orthotropic: the contraction along 2 under a stress '// &
       'along 1 (nu12/e1 = nu21/e2); the Poisson''s ratios must leave the compliance positive '// &
@@ -251,10 +253,10 @@ contains
       'along 1; plane strain only')
     call opt('nu23', m%nu23, '[-]', '', 'orthotropic: the contraction along 3 under a stress '// &
       'along 2; plane strain only')
-    call opt('g12', m%g12, '[stress]', '> 0', 'orthotropic: the in-plane shear modulus')
+    call opt('g12', m%g12, '[stress]', MODULUS_RANGE, 'orthotropic: the in-plane shear modulus')
     call opt('c11', m%c11, '[stress]', '', 'anisotropic: the stiffness in Voigt order 1 = xx, '// &
       '2 = yy, 3 = zz, 6 = xy of the material axes: sxx = c11 exx + c12 eyy + c13 ezz + c16 gxy, '// &
-      '...; it must be positive definite')
+      '...; it must be positive definite, each constant within +-1.341e148 (double precision)')
     call opt('c12', m%c12, '[stress]', '', 'anisotropic: xx-yy')
     call opt('c16', m%c16, '[stress]', '', 'anisotropic: xx-xy; not given: 0')
     call opt('c22', m%c22, '[stress]', '', 'anisotropic: yy-yy')

@@ -160,6 +160,9 @@ try:
     bad("override_density", good, "density", "material = 'steel'", "change the material",
         over=("&body id=1, density=2700.0 /",))
     bad("huge_modulus", good.replace("young=2.0e11, poisson=0.3 /", "young=1.0e300, poisson=0.3 /"),
+        "huge_modulus.nml:2: in group &material: young = 1.0e300 is outside", "rescale the units")
+    # young within its range, the plane-stress stiffness E/(1 - nu^2) beyond it
+    bad("huge_stiffness", good.replace("young=2.0e11, poisson=0.3 /", "young=1.3e148, poisson=0.3 /"),
         "its materials' moduli", "outside", "rescale the units")
     write_bar(os.path.join(work, "bar2.msh"), NX, NY, extra_region=True)
     bad("two_regions", good.replace("bar.msh", "bar2.msh") + "&region body=1, name='strip', material='steel' /\n",

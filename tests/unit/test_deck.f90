@@ -114,17 +114,28 @@ program test_deck
   call delete_file(trim(tmp)//'_my_case.nml')
 
   ! ---- exact round trip of awkward reals -----------------------------------------------------
+  ! young: the largest modulus accepted (the double below MODULUS_MAX); huge(1.0) is refused
+  ! before the elastic law is computed, which it makes overflow (below)
   call write_file(trim(tmp)//'_reals.nml', [character(len=200) :: &
     '&body id=1, x0=-0.1, y0=0.30000000000000004, width=1.2345678901234567e11, height=7e-300,', &
-    '  nx=1, ny=1, left=''clamped'', bottom=''contact'', young=1.7976931348623157e308, poisson=-0.999999 /', &
+    '  nx=1, ny=1, left=''clamped'', bottom=''contact'', young=1.3407807929942594e148, poisson=-0.999999 /', &
     '&body id=2, x0=-0.1, y0=-1.0, width=1.2345678901234567e11, height=1.0, nx=1, ny=1,', &
     '  left=''clamped'', top=''contact'', poisson=0.49999999999999994 /', &
     '&contact gap_radius=123456.7, gap_center=-2.5e-5 /'])
   call read_deck(trim(tmp)//'_reals.nml', none, e)
-  call check(e%body(1)%y0 == 0.30000000000000004_wp .and. e%body(1)%young == huge(1.0_wp) .and. &
-             e%body(2)%poisson == 0.49999999999999994_wp, 'reals: read exactly')
+  call check(e%body(1)%y0 == 0.30000000000000004_wp .and. e%body(1)%young == nearest(MODULUS_MAX, -1.0_wp) &
+             .and. e%body(2)%poisson == 0.49999999999999994_wp, 'reals: read exactly')
   call round_trip(e, 'awkward reals')
   call delete_file(trim(tmp)//'_reals.nml')
+  call refused('young_huge', [character(len=200) :: &
+    '&body id=1, y0=1.0, nx=1, ny=1, left=''clamped'', bottom=''contact'',', &
+    '  young=1.7976931348623157e308, poisson=-0.999999 /', &
+    '&body id=2, nx=1, ny=1, left=''clamped'', top=''contact'' /'], &
+    ':2: in group &body: young = 1.7976931348623157e308 is outside [7.458E-149, 1.341E+148]')
+  call refused('young_max', [character(len=200) :: &
+    '&body id=1, y0=1.0, nx=1, ny=1, left=''clamped'', bottom=''contact'', young=1.3407807929942596e148 /', &
+    '&body id=2, nx=1, ny=1, left=''clamped'', top=''contact'' /'], &
+    ':1: in group &body: young = 1.3407807929942596e148 is outside')
 
   call test_pairs()
 

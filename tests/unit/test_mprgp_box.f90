@@ -579,6 +579,10 @@ contains
         solver%opts%lambda_max = lmax + rho * sum(gm**2)
         solver%opts%eq_m = lmax / sqrt(sum(gm**2))
         solver%opts%eq_feas = 1.0e-14_wp * norm2(e)
+        ! G x - e is computed to about eps sum |G_i x_i| <= eps |G| |x|, which exceeds 1e-14 |e|
+        ! where |e| << |G| |x| (one of these problems: 1.3e-16 against 8e-17): feasible down to
+        ! that rounding, or SMALBE spins to its update limit on rounding alone
+        solver%opts%eq_feas_x = 10.0_wp * sqrt(real(n, wp)) * epsilon(1.0_wp) * norm2(gm)
         call smalbe_solve(solver, op, c, gm, e, rho, l, x, mu, st, ub=u)
       end block
       g = matmul(h, x) - c + mu(1) * gm(1, :)
