@@ -20,7 +20,7 @@ module condense
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use errors, only: error_t, ERR_MEMORY
-  use lapack, only: dpotrf_tiles, dpocon, dpstrf, dsyevr, dsyevd, dgemm, dgeqrf, dorgqr, dsytrf
+  use lapack, only: dpotrf_tiles, dpotrs, dpocon, dpstrf, dsyevr, dsyevd, dsyev, dgemm, dgeqrf, dorgqr, dsytrf
   implicit none (type, external)
   private
 
@@ -28,6 +28,10 @@ module condense
   !! eigenvalues up to this times max diag F_a (flex_rank; the level below which its
   !! condition estimate does not call F_a plainly of full rank either)
   real(wp), parameter :: NEAR_KERNEL = 1.0e-6_wp
+  !> F_a of at least this order gets its (near-)kernel basis by subspace iteration
+  !! (smallest_eigenvectors) instead of LAPACK's tridiagonal reduction (every plane deck's
+  !! F_a is smaller)
+  integer, parameter, public :: SUBSPACE_MIN = 1500
 
   !> One body reduced to the interface.
   type, public :: body_condensed_t
@@ -83,7 +87,7 @@ module condense
     real(wp) :: t_condense = 0.0_wp         !< wall time of F_a and b_a [s]
   end type body_condensed_t
 
-  public :: factor_body, condense_body, interface_load, recover_displacement, apply_bt, apply_b, interface_dofs, &
+  public :: smallest_eigenvectors, factor_body, condense_body, interface_load, recover_displacement, apply_bt, apply_b, interface_dofs, &
             flex_from_x, prescribed_part, to_global, contact_frames, frame_of_normal, rotated_values, rotated_triplets
 
 contains
@@ -622,7 +626,7 @@ contains
     real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :)
     integer, allocatable :: piv(:), isuppz(:), iwork(:)
     integer :: lapinfo, r, lwork, liwork, k, nfound, nnear
-    logical :: halting(size(ieee_usual))
+    logical :: halting(size(ieee_usual)), ok
     real(wp) :: dmax, rcond, anorm
     integer :: i
     dmax = 0.0_wp
@@ -688,9 +692,21 @@ contains
       deallocate (z)
       allocate (z(bc%m, k))
     end if
-    f = bc%flex
-    call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
-                work, lwork, iwork, liwork, lapinfo)
+    lapinfo = 1
+    if (bc%m >= SUBSPACE_MIN) then
+      ! a large F_a: its k smallest eigenvectors by subspace iteration, a fraction of the
+      ! tridiagonal reduction's time (LAPACK's own eigensolver when that does not converge)
+      call smallest_eigenvectors(bc%flex, k, dmax, z, ok)
+      if (ok) then
+        lapinfo = 0
+        nfound = k
+      end if
+    end if
+    if (lapinfo /= 0) then
+      f = bc%flex
+      call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
+                  work, lwork, iwork, liwork, lapinfo)
+    end if
     call ieee_set_halting_mode(ieee_usual, halting)
     ! no eigenvectors (dsyevr failed): robin_operators then uses the other body's F
     if (lapinfo == 0 .and. nfound == k) then
@@ -742,6 +758,88 @@ contains
     end function count_below
 
   end subroutine flex_rank
+
+  !> The eigenvectors of the k smallest eigenvalues of the symmetric positive semidefinite
+  !! f (m x m, both triangles) by subspace iteration with (f + sigma I)^-1, sigma = 1e-10
+  !! dmax (its Cholesky factor, O(m^3/3)), on b = max(2k, k + 32) vectors from a fixed
+  !! start (the same bits every run), orthonormalized after each solve (QR), and the
+  !! Rayleigh-Ritz pairs from the third solve on: done when every one of the k has
+  !! |f z - theta z| <= 1e-12 dmax (the eigenvalues between k and b converge with them,
+  !! at the ratio (lambda_i + sigma) / (lambda_b+1 + sigma) a solve). ok false (z
+  !! undefined) when the factor fails, b reaches m, or 12 solves do not converge.
+  subroutine smallest_eigenvectors(f, k, dmax, z, ok)
+    real(wp), intent(in) :: f(:, :)
+    integer, intent(in) :: k
+    real(wp), intent(in) :: dmax
+    real(wp), allocatable, intent(out) :: z(:, :)
+    logical, intent(out) :: ok
+    integer, parameter :: MAX_SOLVES = 12
+    real(wp), allocatable :: l(:, :), v(:, :), fv(:, :), hs(:, :), ev(:), work(:), tau(:)
+    integer :: m, b, i, j, it, info, lwork
+    real(wp) :: res
+    m = size(f, 1)
+    b = max(2*k, k + 32)
+    ok = .false.
+    if (k < 1 .or. b >= m) return
+    allocate (l(m, m))
+    l = f
+    do i = 1, m
+      l(i, i) = l(i, i) + 1.0e-10_wp*dmax
+    end do
+    call dpotrf_tiles('L', m, l, m, info)
+    if (info /= 0) return
+    allocate (v(m, b), fv(m, b), hs(b, b), ev(b), tau(b), work(1))
+    ! a fixed start of full rank: cos of integer multiples (no random state)
+    do j = 1, b
+      do i = 1, m
+        v(i, j) = cos(real(i, wp)*real(j, wp)*0.7548776662466927_wp + real(j, wp))
+      end do
+    end do
+    call dgeqrf(m, b, v, m, tau, work, -1, info)
+    lwork = max(b, int(work(1)))
+    call dsyev('V', 'L', b, hs, b, ev, work, -1, info)
+    lwork = max(lwork, int(work(1)), 64*b)
+    deallocate (work)
+    allocate (work(lwork))
+    if (.not. orthonormal()) return
+    do it = 1, MAX_SOLVES
+      call dpotrs('L', m, b, l, m, v, m, info)
+      if (info /= 0) return
+      if (.not. orthonormal()) return
+      if (it < 3) cycle
+      ! Rayleigh-Ritz: hs = v' f v, its eigenpairs, z = v y (ascending)
+      call dgemm('N', 'N', m, b, m, 1.0_wp, f, m, v, m, 0.0_wp, fv, m)
+      call dgemm('T', 'N', b, b, m, 1.0_wp, v, m, fv, m, 0.0_wp, hs, b)
+      hs = 0.5_wp*(hs + transpose(hs))
+      call dsyev('V', 'L', b, hs, b, ev, work, lwork, info)
+      if (info /= 0) return
+      if (allocated(z)) deallocate (z)
+      allocate (z(m, k))
+      call dgemm('N', 'N', m, k, b, 1.0_wp, v, m, hs, b, 0.0_wp, z, m)
+      ! residuals |f z_i - theta_i z_i| = |fv y_i - theta_i z_i|
+      res = 0.0_wp
+      do i = 1, k
+        res = max(res, norm2(matmul(fv, hs(:, i)) - ev(i)*z(:, i)))
+      end do
+      if (res <= 1.0e-12_wp*dmax) then
+        ok = .true.
+        return
+      end if
+      v = matmul(v, hs)
+    end do
+
+  contains
+
+    !> v's columns orthonormalized (QR); false when LAPACK fails.
+    logical function orthonormal() result(yes)
+      call dgeqrf(m, b, v, m, tau, work, lwork, info)
+      yes = info == 0
+      if (.not. yes) return
+      call dorgqr(m, b, b, v, m, tau, work, lwork, info)
+      yes = info == 0
+    end function orthonormal
+
+  end subroutine smallest_eigenvectors
 
   !> F_a = B_a X B_a' from k <= m/2 interface DOFs (a master surface at least twice as
   !! coarse as its slave): its rank is at most k and its range lies in that of B_a, so its

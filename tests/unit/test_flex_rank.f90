@@ -19,10 +19,10 @@
 !! eigensolver (LAPACK dsyev), to 1e-12.
 program test_flex_rank
   use kinds, only: wp
-  use condense, only: body_condensed_t, flex_from_x
+  use condense, only: body_condensed_t, flex_from_x, smallest_eigenvectors, SUBSPACE_MIN
   use robin_operators, only: range_proximal
   use lapack, only: dpstrf, dsyev
-  use testing, only: report, report_le, test_summary, identity
+  use testing, only: report, report_le, test_summary, identity, set_seed, urand
   implicit none (type, external)
   integer, parameter :: M = 60
 
@@ -35,6 +35,7 @@ program test_flex_rank
   call dense_rows(30, 20)
   call coarse_rows(40, 12, .false.)
   call coarse_rows(40, 12, .true.)
+  call large_kernel(1600, 30)
   call test_summary()
 
 contains
@@ -187,5 +188,65 @@ contains
     bc%bptr(m + 1) = e + 1
   end subroutine fill
 
+
+  !> An F_a of order m >= SUBSPACE_MIN gets its kernel and near-kernel basis by subspace
+  !! iteration (condense `smallest_eigenvectors`): F = Q D Q' with Q three Householder
+  !! reflections and D 10 zeros, 20 eigenvalues from 1e-12 to 1e-7 and the rest between
+  !! 1e-5 and 1 (a gap of 100 after the 30th): the 30 vectors found, orthonormal (1e-12),
+  !! spanning Q's first 30 columns (|Z - Q30 Q30' Z| <= 1e-6, the residual over the gap).
+  subroutine large_kernel(m, k)
+    integer, intent(in) :: m, k
+    real(wp), allocatable :: f(:, :), d(:), v(:, :), z(:, :), q(:, :), w(:), c(:, :)
+    real(wp) :: vv, vav
+    integer :: i, j, r
+    logical :: ok
+    call set_seed(20261129)
+    allocate (f(m, m), d(m), v(m, 3), q(m, k), w(m))
+    d(1:10) = 0.0_wp
+    do i = 11, 30
+      d(i) = 10.0_wp**(-12.0_wp + 5.0_wp*real(i - 11, wp)/19.0_wp)
+    end do
+    do i = 31, m
+      d(i) = 10.0_wp**(-5.0_wp + 5.0_wp*urand(0.0_wp, 1.0_wp))
+    end do
+    d(m) = 1.0_wp
+    do r = 1, 3
+      do i = 1, m
+        v(i, r) = urand(-1.0_wp, 1.0_wp)
+      end do
+    end do
+    ! F = H3 H2 H1 D H1 H2 H3, Q = H3 H2 H1 (H = I - 2 v v'/v'v)
+    f = 0.0_wp
+    q = 0.0_wp
+    do i = 1, m
+      f(i, i) = d(i)
+    end do
+    do i = 1, k
+      q(i, i) = 1.0_wp
+    end do
+    do r = 1, 3
+      vv = dot_product(v(:, r), v(:, r))
+      w = matmul(f, v(:, r))
+      vav = dot_product(v(:, r), w)
+      do j = 1, m
+        f(:, j) = f(:, j) - (2.0_wp/vv)*(v(:, r)*w(j) + w*v(j, r)) + (4.0_wp*vav/vv**2)*v(:, r)*v(j, r)
+      end do
+      do j = 1, k
+        q(:, j) = q(:, j) - (2.0_wp*dot_product(v(:, r), q(:, j))/vv)*v(:, r)
+      end do
+    end do
+    f = 0.5_wp*(f + transpose(f))
+    call report(m >= SUBSPACE_MIN, 'large F_a: order 1600 takes the subspace iteration')
+    call smallest_eigenvectors(f, k, maxval([(f(i, i), i=1, m)]), z, ok)
+    call report(ok, 'large F_a: the subspace iteration converged')
+    if (.not. ok) return
+    c = matmul(transpose(z), z)
+    do i = 1, k
+      c(i, i) = c(i, i) - 1.0_wp
+    end do
+    call report_le(maxval(abs(c)), 1.0e-12_wp, 'large F_a: the basis orthonormal')
+    call report_le(norm2(z - matmul(q, matmul(transpose(q), z))), 1.0e-6_wp, &
+                   'large F_a: the basis spans the 30 smallest eigenvectors')
+  end subroutine large_kernel
 
 end program test_flex_rank
