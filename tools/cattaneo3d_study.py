@@ -5,7 +5,9 @@ model) with a contact radius a ~ 0.02 R (the top pushed down by --push): a finit
 lateral expansion under P makes a shear that Mindlin's half-spaces do not have, of relative
 size about 0.4 (a/R)/mu (measured in 2D: doc/verification.md), so a small a/R. Meshed here with
 gmsh (inputs/gmsh/cattaneo_sphere.geo, hc = --hc within rc = 0.06 of the contact point; three
-meshes, a/h about 6, 8 and 11). Two ways of pulling: 'force' (a traction on the sphere's top,
+meshes, a/h about 6, 8 and 11; the contact group only the sphere's cap of radius --cap = 0.04,
+twice a, where gmsh meshes the surface in nearly equilateral triangles and the rows are a
+quarter of the whole half sphere's). Two ways of pulling: 'force' (a traction on the sphere's top,
 0.5 mu P over its area, P from a first run of the normal load alone on the first mesh; the
 sphere held along x by the contact alone) and 'displacement' (the top moved along x by
 --shift instead, its uy held).
@@ -33,7 +35,7 @@ Prints a Markdown table; with --check, exits 1 unless on the finest mesh |c (fit
 meshes and result files there; --from DIR measures the result files such a run left there
 (no runs; no DOFs, times or memory).
 
-usage: tools/cattaneo3d_study.py [--bin bin/robin_contact] [--hc 0.0033,0.0025,0.0018] [--method monolithic]
+usage: tools/cattaneo3d_study.py [--bin bin/robin_contact] [--hc 0.0033,0.0025,0.0018] [--cap 0.04] [--method monolithic]
                                  [--check] [--keep DIR | --from DIR]
 """
 import argparse
@@ -138,10 +140,10 @@ def fit_c(r, fx, area, a, p0, rings=16):
     return 0.5 * (lo + hi)
 
 
-def mesh(hc, work, gmsh):
+def mesh(hc, work, gmsh, cap):
     out = os.path.join(work, f"cattaneo_sphere_h{hc}.msh")
     subprocess.run([gmsh, "-3", "-format", "msh41", "-v", "2", "-setnumber", "hc", hc, "-setnumber", "rc", "0.06",
-                    os.path.join(ROOT, "inputs", "gmsh", "cattaneo_sphere.geo"), "-o", out], capture_output=True, check=True)
+                    "-setnumber", "cap", repr(cap), os.path.join(ROOT, "inputs", "gmsh", "cattaneo_sphere.geo"), "-o", out], capture_output=True, check=True)
     return out
 
 
@@ -161,6 +163,8 @@ def main():
     ap.add_argument("--push", type=float, default=-4.0e-4, help="the top's displacement along y (stage 1)")
     ap.add_argument("--shift", type=float, default=5.0e-5, help="the top's displacement along x ('displacement')")
     ap.add_argument("--method", default="monolithic")
+    ap.add_argument("--cap", type=float, default=0.04,
+                    help="the contact group is the sphere's cap of this radius (0: its whole lower half)")
     ap.add_argument("--check", action="store_true")
     ap.add_argument("--keep", default=None, metavar="DIR")
     ap.add_argument("--from", dest="source", default=None, metavar="DIR")
@@ -177,7 +181,7 @@ def main():
         if a.source:
             meshes = {hc: None for hc in a.hc.split(",")}
         else:
-            meshes = {hc: mesh(hc, work, gmsh) for hc in a.hc.split(",")}
+            meshes = {hc: mesh(hc, work, gmsh, a.cap) for hc in a.hc.split(",")}
             traction = normal_load(a, work, next(iter(meshes.values())))
             if traction is None:
                 return 1
