@@ -27,7 +27,7 @@ module contact_types
   !> Outcome of a contact solve, with the outer history.
   type, public :: contact_result_t
     integer :: status = STATUS_NONE            !< STATUS_*
-    character(len=16) :: method = ''           !< robin | monolithic
+    integer :: method = 0                      !< METHOD_ROBIN or METHOD_MONOLITHIC (config); 0: none yet
     character(len=256) :: message = ''         !< why it failed, if it did
     integer :: outer = 0                       !< outer iterations (1 for monolithic)
     integer :: inner = 0                       !< Hessian multiplications, all subproblems (IT_inner)

@@ -7,7 +7,7 @@
 !! normal forces, by repeated box solves until the normal forces settle.
 module monolithic
   use kinds, only: wp
-  use config, only: solver_cfg_t
+  use config, only: solver_cfg_t, METHOD_MONOLITHIC
   use linop, only: linop_t, dense_op_t, dense_op_init, csc_op_t, csc_op_init
   use lapack, only: dsyrk, dpotrf, dtrsm, dtrsv
   use clock, only: wtime
@@ -72,7 +72,7 @@ contains
 
     m = contact_line%m
     t0 = wtime()
-    res%method = 'monolithic'
+    res%method = METHOD_MONOLITHIC
     call alloc_result(res, m, 1, size(bodies))
     allocate (c(m), lb(m), lam(m), bs(m, 2))
     ! c = sum_a E_a' b_a - g0: each row has one body on each side

@@ -7,7 +7,7 @@
 module robin_iteration
   use kinds, only: wp
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use config, only: solver_cfg_t, STOP_RESIDUAL, ACCEL_NONE, ROBIN_HARMONIC
+  use config, only: solver_cfg_t, STOP_RESIDUAL, ACCEL_NONE, ROBIN_HARMONIC, METHOD_ROBIN
   use clock, only: wtime
   use contact_interface, only: interface_t, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use condense, only: body_condensed_t
@@ -97,7 +97,7 @@ contains
         run_state%reuse = 0   ! F_a lam_a is not known for these forces
       end if
     end if
-    res%method = 'robin'
+    res%method = METHOD_ROBIN
 
     robin_op = new_robin_operator(solver%robin_operator)
     call subproblems_init(subproblems, contact_line, bodies, robin_op, run_state, resumed)

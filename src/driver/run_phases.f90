@@ -809,7 +809,7 @@ contains
     character(len=*), intent(in) :: phase          !< the phase just ended
     if (.not. par_any(stop_requested())) return
     run%result%status = STATUS_INTERRUPTED
-    run%result%method = merge('robin     ', 'monolithic', run%deck%solver%method == METHOD_ROBIN)
+    run%result%method = run%deck%solver%method
     run%code = EXIT_INTERRUPTED
     write (error_unit, '(a)') 'robin_contact: interrupted: signal '//i2s(pending_signal())//' during the '// &
       phase//'; stopped before the first outer iteration, so there is no checkpoint and nothing was written'

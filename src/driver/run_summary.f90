@@ -5,13 +5,13 @@ module run_summary
   use space, only: NDIM, NCOMP, node_dof, dof_comp
   use, intrinsic :: iso_fortran_env, only: error_unit, output_unit, int64
   use errors, only: EXIT_OK, EXIT_NOT_CONVERGED, EXIT_NUMERICAL, EXIT_INTERRUPTED, warn
-  use config, only: side_axis, MAX_SIDES, solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names
+  use config, only: side_axis, MAX_SIDES, solver_cfg_t, ROBIN_HARMONIC, FRICTION_TRESCA, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_names, METHOD_MONOLITHIC, METHOD_CHOICES
   use contact_interface, only: interface_t, DIR_NORMAL, contact_resultant
   use contact_types, only: contact_result_t
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED, STATUS_NO_EQUILIBRIUM
   use sysinfo, only: write_stdout_checked
-  use strings, only: sci, fmt_real, i2s
+  use strings, only: sci, fmt_real, i2s, word
   use run_state, only: run_t
   use mesh, only: group_index, group_nodes
   use namelist_vars, only: str_t
@@ -48,7 +48,7 @@ contains
     if (run%result%status == STATUS_CONVERGED .and. len_trim(run%result%message) > 0 .and. run%rank == 0) &
       write (error_unit, '(a)') 'robin_contact: note: '//trim(run%result%message)
     if (run%code == EXIT_NOT_CONVERGED .and. run%result%status /= STATUS_NO_EQUILIBRIUM) write (error_unit, '(a)') &
-      'robin_contact: next: '//next_setting(run%deck%solver, trim(run%result%method) == 'monolithic')
+      'robin_contact: next: '//next_setting(run%deck%solver, run%result%method == METHOD_MONOLITHIC)
     if (run%result%status == STATUS_NO_EQUILIBRIUM) write (error_unit, '(a)') 'robin_contact: next: the steps '// &
       'before it are solved and written; no solver setting gives a step without an equilibrium one: lower its '// &
       'loads, raise mu, or support the body'
@@ -93,7 +93,7 @@ contains
         ' condense=', timing%condense, ' iterate=', timing%iterate, ' output=', timing%output, ' total=', timing%total, &
         ' peak_mb=', timing%peak_rss_mb, ' factor_mb=', timing%factor_mb
       write (line(4), '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', &
-        status_name(result%status), ' method=', trim(result%method), ' outer=', result%outer, ' inner=', result%inner, &
+        status_name(result%status), ' method=', word(METHOD_CHOICES, result%method), ' outer=', result%outer, ' inner=', result%inner, &
         ' n1=', run%systems(1)%n, ' n2=', run%systems(2)%n, ' m=', run%contact_line%m, &
         ' delta=', fmt_real(run%deck%solver%delta, '(f0.6)'), ' residual=', result%residual, &
         ' wall_s=', fmt_real(timing%total, '(f0.3)')

@@ -23,7 +23,7 @@ module results
                    write_text, commit_files, data_open, data_write, data_close
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, element_names, FACTOR_CHOICES, FRICTION_NONE, &
                     XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC, contact_cfg_t, pair_oriented, &
-                    side_names, BC_CONTACT
+                    side_names, BC_CONTACT, METHOD_CHOICES
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof, group_index
   use assembly, only: body_system_t, nodal_stress, support_reactions
@@ -296,7 +296,7 @@ contains
     end if
     ! root attributes
     call write_attr(fid, 'status', status_name(res%status), st)
-    call write_attr(fid, 'method', trim(res%method), st)
+    call write_attr(fid, 'method', word(METHOD_CHOICES, res%method), st)
     call write_attr(fid, 'message', trim(res%message), st)
     call write_attr(fid, 'version', program_version, st)
     call write_attr(fid, 'title', trim(d%title), st)
