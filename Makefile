@@ -185,7 +185,7 @@ $(BUILD)/mumps_iface.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/factorization.o $(BUILD)/element_types.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/factorization.o:  $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/config.o $(BUILD)/cholesky.o $(BUILD)/mumps_iface.o \
                            $(BUILD)/errors.o $(BUILD)/strings.o
-$(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/signals.o
 $(BUILD)/constraint_set.o: $(BUILD)/kinds.o
 $(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/constraint_set.o
@@ -231,11 +231,12 @@ $(BUILD)/acceleration.o:   $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/lapack.o 
                            $(BUILD)/contact_common.o
 $(BUILD)/robin_iteration.o: $(BUILD)/acceleration.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \
                            $(BUILD)/contact_common.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
-                           $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/robin_operators.o $(BUILD)/robin_subproblems.o
+                           $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/robin_operators.o $(BUILD)/robin_subproblems.o \
+                           $(BUILD)/signals.o
 $(BUILD)/monolithic.o:     $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/smalbe.o \
-                           $(BUILD)/sorting.o $(BUILD)/strings.o $(BUILD)/tangent_discs.o
+                           $(BUILD)/sorting.o $(BUILD)/strings.o $(BUILD)/tangent_discs.o $(BUILD)/signals.o
 $(BUILD)/error_estimate.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/contact_common.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o \

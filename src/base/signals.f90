@@ -14,7 +14,14 @@ module signals
     end function rc_signals_pending
   end interface
 
-  public :: signals_install, stop_requested, pending_signal
+  abstract interface
+    !> A stop hook (stop_requested is one): true when the caller must stop at its next
+    !! stopping point (an MPRGP solve: its next step; the contact iteration: the end of the
+    !! outer iteration).
+    logical function stop_iface()
+    end function stop_iface
+  end interface
+  public :: signals_install, stop_requested, pending_signal, stop_iface
 
 contains
 

@@ -138,13 +138,7 @@ module contact_types
     end subroutine checkpointer_save_iface
   end interface
 
-  abstract interface
-    !> True when the run must stop at the end of this outer iteration (a signal came).
-    logical function stop_iface()
-    end function stop_iface
-  end interface
-
-  public :: state_init, alloc_result, grow_history, stop_iface, recycle_size, status_name, anderson_history
+  public :: state_init, alloc_result, grow_history, recycle_size, status_name, anderson_history
 
 contains
 

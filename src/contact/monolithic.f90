@@ -20,7 +20,8 @@ module monolithic
   use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use config, only: FRICTION_COULOMB, INNER_MPRGP, INNER_ACTIVE_SET
   use condense, only: body_condensed_t
-  use contact_types, only: contact_result_t, stop_iface, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
+  use signals, only: stop_iface
+  use contact_types, only: contact_result_t, alloc_result, STATUS_CONVERGED, STATUS_MAX_OUTER, &
                            STATUS_FAILED, STATUS_INTERRUPTED
   use contact_common, only: interface_residual, all_finite, gather, scatter, body_threads
   use equality_rows, only: equality_t, equality_init, equality_add_penalty, stacked_rows, equality_force_scaled

@@ -11,7 +11,8 @@ module robin_iteration
   use clock, only: wtime
   use contact_interface, only: interface_t, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use condense, only: body_condensed_t
-  use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, stop_iface, state_init, alloc_result, &
+  use signals, only: stop_iface
+  use contact_types, only: contact_result_t, robin_state_t, checkpointer_t, state_init, alloc_result, &
                            grow_history, STATUS_CONVERGED, STATUS_MAX_OUTER, STATUS_DIVERGED, STATUS_FAILED, &
                            STATUS_INTERRUPTED, BOUND_LOWER, BOUND_UPPER, BOUND_INSIDE
   use contact_common, only: interface_residual, maxabs, all_finite, gather, scatter

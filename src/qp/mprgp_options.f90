@@ -4,10 +4,11 @@ module mprgp_options
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
   use strings, only: rtoa
+  use signals, only: stop_iface
   implicit none (type, external)
   private
 
-  public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, mprgp_stop_iface
+  public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
   public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
 
@@ -30,12 +31,6 @@ module mprgp_options
   !! start whose active set is still moving, where MPRGP finds the new set at low accuracy
   !! and the Newton method finishes on it exactly
   integer, parameter :: QP_POLISH = 4
-
-  abstract interface
-    !> True when the solve must stop now (polled once per step).
-    logical function mprgp_stop_iface()
-    end function mprgp_stop_iface
-  end interface
 
   !> Options of an MPRGP solve. Tolerances are in the units of b (for contact: a displacement).
   type :: mprgp_opts_t
@@ -71,7 +66,7 @@ module mprgp_options
     !> SMALBE: |eq_g x - eq_e| <= max(eq_feas, eq_feas_x |x|) counts as feasible, so rows whose
     !! right side vanishes (a body pressed only by a deformation) are judged against the size of x
     real(wp) :: eq_feas_x = 0.0_wp   !< (units of eq_e per unit of x)
-    procedure(mprgp_stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
+    procedure(stop_iface), pointer, nopass :: stop => null()  !< polled every step: stop when true
   end type mprgp_opts_t
 
   !> What an MPRGP solve did.
