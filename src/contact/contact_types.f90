@@ -9,12 +9,12 @@ module contact_types
   implicit none (type, external)
   private
 
-  !> How a contact solve ended (contact_result_t%status); `status_name` gives the word the
-  !! results file and the `result:` line print.
   !> A contact row's force against its bound (robin_state_t%row_state: side 1's + 4 x side 2's):
   !! at the lower bound (a normal row's zero force included), at the upper bound (in space: a
   !! disc's force on its circle), or strictly inside
   integer, parameter, public :: BOUND_LOWER = 1, BOUND_UPPER = 2, BOUND_INSIDE = 3
+  !> How a contact solve ended (contact_result_t%status); `status_name` gives the word the
+  !! results file and the `result:` line print.
   integer, parameter, public :: STATUS_NONE = 0         !< not solved (yet)
   integer, parameter, public :: STATUS_CONVERGED = 1    !< the stopping criterion was met
   integer, parameter, public :: STATUS_MAX_OUTER = 2    !< max_outer iterations without convergence
