@@ -279,7 +279,7 @@ $(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkp
                            $(BUILD)/results.o $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
                            $(BUILD)/run_summary.o $(BUILD)/serial_backend.o $(BUILD)/signals.o $(BUILD)/sorting.o \
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
-$(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/deck.o $(BUILD)/results.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
+$(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/deck.o $(BUILD)/config.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
 $(BUILD)/files_shim.o:     include/files_shim.h
 $(BUILD)/robin_contact.o:  $(OBJS)

@@ -14,9 +14,8 @@ program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
   use errors, only: fatal, warn, error_t, fail_on, EXIT_INPUT
-  use config, only: METHOD_ROBIN
+  use config, only: METHOD_ROBIN, program_version
   use deck, only: read_deck, print_deck
-  use results, only: program_version
   use signals, only: signals_install
   use sysinfo, only: peak_rss_mb
   use budget, only: check_load_range

@@ -4,7 +4,7 @@
 module command_line
   use errors, only: fatal, terminate, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL
   use deck, only: deck_usage, deck_reference
-  use results, only: program_version
+  use config, only: program_version
   use sysinfo, only: write_stdout_checked
   use mpi_env, only: par_finalize
   implicit none (type, external)

@@ -14,6 +14,8 @@ module config
   public :: deck_init, pair_oriented, stage_count, stage_steps, body_force_of, body_stiffness
   public :: shape_vertices, side_axis
 
+  !> robin_contact's version (`--version`, the deck echo, the result files)
+  character(len=*), parameter, public :: program_version = '1.0.0'
   !> The longest file path (Linux PATH_MAX, its terminating NUL included); paths in a deck
   !! are held in variables of this length, and a longer one is refused with its length.
   integer, parameter, public :: PATH_LEN = 4096

@@ -23,7 +23,7 @@ module results
                    write_text, commit_files, data_open, data_write, data_close
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, element_names, FACTOR_CHOICES, FRICTION_NONE, &
                     XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC, contact_cfg_t, pair_oriented, &
-                    side_names, BC_CONTACT, METHOD_CHOICES
+                    side_names, BC_CONTACT, METHOD_CHOICES, program_version
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof, group_index
   use assembly, only: body_system_t, nodal_stress, support_reactions
@@ -34,8 +34,6 @@ module results
   use errors, only: error_t, ERR_IO
   implicit none (type, external)
   private
-
-  character(len=*), parameter, public :: program_version = '1.0.0'  !< robin_contact version
 
   !> Wall-time breakdown of a run [s] and memory.
   type, public :: timing_t

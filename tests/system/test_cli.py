@@ -39,9 +39,9 @@ def source(path):
 
 
 # ---- --version: the version string written to results -----------------------------------
-m = re.search(r"program_version\s*=\s*'([^']+)'", source("src/io/results.f90"))
+m = re.search(r"program_version\s*=\s*'([^']+)'", source("src/input/config.f90"))
 version = m.group(1) if m else None
-check(version is not None, "program_version found in src/io/results.f90")
+check(version is not None, "program_version found in src/input/config.f90")
 p = run("--version")
 check(p.returncode == 0, "--version exits 0", f"exit {p.returncode}")
 check(p.stdout == f"robin_contact {version}\n".encode(), "--version prints 'robin_contact <program_version>'",
