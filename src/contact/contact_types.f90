@@ -87,7 +87,7 @@ module contact_types
     !! Per body: (bodies) and (3, bodies); on the contact rows: the side layout (m, 2) of
     !! contact_result_t.
     real(wp), allocatable :: flam(:)           !< (bodies) |F_a lam_a| of the last iterate [length]
-    real(wp), allocatable :: mu(:, :)          !< (NRIGID, bodies) equality multipliers of floating bodies (SMALBE warm start) [length]
+    real(wp), allocatable :: eq_mult(:, :)     !< (NRIGID, bodies) equality multipliers of floating bodies (SMALBE warm start) [length]
     real(wp), allocatable :: G(:, :)           !< (m,2) obstacles [length]
     real(wp), allocatable :: lam(:, :)         !< (m,2) contact forces, warm starts [force]
     integer :: reuse = 0                       !< 1: flam_v holds F_a lam_a (0: not known, e.g. an older checkpoint)
@@ -174,10 +174,10 @@ contains
     real(wp), intent(in) :: g0(:)            !< initial gap
     integer, intent(in) :: nbody             !< bodies
     integer, intent(in) :: npair             !< pairs
-    allocate (st%flam(nbody), st%mu(NRIGID, nbody), st%nrw(2, nbody))
+    allocate (st%flam(nbody), st%eq_mult(NRIGID, nbody), st%nrw(2, nbody))
     allocate (st%newton(nbody), st%kept(nbody), source=0)
     st%flam = 0.0_wp
-    st%mu = 0.0_wp
+    st%eq_mult = 0.0_wp
     st%nrw(1, :) = 0
     st%nrw(2, :) = 1
     allocate (st%G(m, 2), st%lam(m, 2), st%r_prev(2*m), st%x_prev(2*m))

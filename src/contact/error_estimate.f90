@@ -41,7 +41,7 @@ contains
   !> A posteriori bound of the error of res%lam against the monolithic solution lam* of
   !! the same discrete problem: for the strongly convex QP min 1/2 l'Hl - c'l, l >= 0
   !! (H = sum_a E_a' F_a E_a, c = sum_a E_a' b_a - g0) and the natural residual
-  !! r = l - max(0, l - (Hl - c)/L), |l - lam*| <= 2 (L/mu) |r| with L, mu the extreme
+  !! r = l - max(0, l - (Hl - c)/L), |l - lam*| <= 2 (L/rq) |r| with L, rq the extreme
   !! eigenvalues of H (estimated by power and inverse iteration, kappa enlarged by 10%).
   !! Sets res%error_bound (relative to |lam|) and res%kappa. H is dense for two bodies in one
   !! pair, sparse (CHOLMOD) for several pairs.
@@ -52,7 +52,7 @@ contains
     type(hessian_t) :: hs
     class(constraint_set_t), allocatable :: set
     real(wp), allocatable :: g(:), r(:), x(:), y(:), xp(:), yp(:), bs(:, :), lo(:), hi(:)
-    real(wp) :: lmax, lmin, nl, perr, lprev, mu, mprev
+    real(wp) :: lmax, lmin, nl, perr, lprev, rq, mprev
     integer :: m, i, k, ki, ib
     logical :: ok
     m = contact_line%m
@@ -100,16 +100,16 @@ contains
         x(i) = 1.0_wp + 0.5_wp*cos(real(3*i, wp))
       end do
       x = x/norm2(x)
-      mu = 0.0_wp
+      rq = 0.0_wp
       do ki = 1, 60
         y = x
         call hs%solve(y)
         ! x'H^-1 x, an estimate of 1/lambda_min from below: settled when it moves by less
         ! than 1e-6 an iteration
-        mprev = mu
-        mu = dot_product(x, y)
+        mprev = rq
+        rq = dot_product(x, y)
         x = y/norm2(y)
-        if (ki >= 5 .and. abs(mu - mprev) <= 1.0e-6_wp*abs(mu)) exit
+        if (ki >= 5 .and. abs(rq - mprev) <= 1.0e-6_wp*abs(rq)) exit
       end do
     end if
     !$omp end parallel sections

@@ -113,8 +113,8 @@ contains
       end do
       ! 1. every free motion must meet the contact normals: min over motions v of
       ! |G'v|^2 / (v'S v), the part of the motion's reach on the contact that is normal to it
-      ! (generalized eigenproblem G G' v = mu S v), at least HOLD_MIN. A disc on a flat
-      ! surface turning about its centre has normals through the centre: mu is only the
+      ! (generalized eigenproblem G G' v = theta S v), at least HOLD_MIN. A disc on a flat
+      ! surface turning about its centre has normals through the centre: theta is only the
       ! discretisation's error of the normals (1e-6), not a hold
       allocate (gg(r, r), ev(r))
       gg = matmul(bodies(a)%rg, transpose(bodies(a)%rg))
@@ -231,7 +231,7 @@ contains
     integer, allocatable :: root(:), members(:), col(:), rowof(:), ti(:), tj(:), roff(:)
     real(wp), allocatable :: es(:), tv(:), v(:)
     type(sparse_cols_t) :: gs
-    real(wp) :: c(NRIGID), res, hold, mu
+    real(wp) :: c(NRIGID), res, hold, theta
     integer :: a, g, r, nm, ncol, k, i, i0, q, nz
     logical :: held
     character(len=:), allocatable :: names
@@ -285,17 +285,17 @@ contains
       call gs%from_triplets(r, ncol, ti, tj, tv)
       deallocate (ti, tj, tv)
       names = group_names(members)
-      ! every joint motion held (G G' v = mu S v with every mu > hold) exactly when
+      ! every joint motion held (G G' v = theta S v with every theta > hold) exactly when
       ! G G' - hold S is positive definite: one Cholesky factor decides (dense r^3/3 up to
       ! NNLS_DENSE_MAX rows, sparse beyond: a chain's G G' is banded), the eigenproblem or
       ! inverse iteration only names the free motion when there is one. The threshold is
-      ! HOLD_MIN / nm^2: a chain of nm bodies held at one end has its smallest mu near
+      ! HOLD_MIN / nm^2: a chain of nm bodies held at one end has its smallest theta near
       ! 2.5 / nm^2 (held, though weakly: 4e-5 for 249 blocks), while a motion the contact
-      ! normals miss has mu at the normals' discretisation error
+      ! normals miss has theta at the normals' discretisation error
       hold = HOLD_MIN/real(nm, wp)**2
-      call group_held(gs, members, roff, hold, held, mu, v, err)
+      call group_held(gs, members, roff, hold, held, theta, v, err)
       if (err%failed()) return
-      if (.not. held .and. mu <= hold) then
+      if (.not. held .and. theta <= hold) then
         ! the free motion of the group, as its first body's part of it
         c = matmul(systems(members(1))%rig_coef, v(1:bodies(members(1))%nrig))
         if (nm == 2) then
@@ -327,14 +327,14 @@ contains
   contains
 
     !> Whether G G' - hold S is positive definite (S: the members' rreach blocks); when it
-    !! is not, mu and v: the smallest mu of G G' v = mu S v and its motion (dense: LAPACK's
+    !! is not, theta and v: the smallest theta of G G' v = theta S v and its motion (dense: LAPACK's
     !! generalized eigenproblem; sparse: inverse iteration with G G' + hold S).
-    subroutine group_held(gs, members, roff, hold, held, mu, v, err)
+    subroutine group_held(gs, members, roff, hold, held, theta, v, err)
       type(sparse_cols_t), intent(in) :: gs
       integer, intent(in) :: members(:), roff(:)
       real(wp), intent(in) :: hold
       logical, intent(out) :: held
-      real(wp), intent(out) :: mu
+      real(wp), intent(out) :: theta
       real(wp), allocatable, intent(out) :: v(:)
       type(error_t), intent(inout) :: err
       real(wp), allocatable :: gd(:, :), gg(:, :), sr(:, :), ev(:), bv(:), sv(:), gv(:)
@@ -342,7 +342,7 @@ contains
       type(error_t) :: ferr
       integer :: r, k, l, info, it, nb
       r = gs%nrow
-      mu = huge(1.0_wp)
+      theta = huge(1.0_wp)
       if (r <= NNLS_DENSE_MAX) then
         allocate (gd(r, gs%ncol), sr(r, r), ev(r))
         gd = 0.0_wp
@@ -360,7 +360,7 @@ contains
         if (held) return
         call held_motions(gg, sr, r, ev, info)
         held = info /= 0
-        mu = ev(1)
+        theta = ev(1)
         v = gg(:, 1)
         return
       end if
@@ -385,7 +385,7 @@ contains
         call err%set(ERR_NUMERICAL, 'the check of the floating bodies '//group_names(members)//': '//ferr%message)
         return
       end if
-      ! inverse iteration: v <- (G G' + hold S)^-1 S v converges to the smallest mu's motion
+      ! inverse iteration: v <- (G G' + hold S)^-1 S v converges to the smallest theta's motion
       call gm%factor(gs, spread(1.0_wp, 1, gs%ncol), hold*bv, ferr)
       if (ferr%failed()) then
         held = .true.      ! no motion to name (S singular along it): decided by the NNLS below
@@ -403,10 +403,10 @@ contains
       end do
       sv = s_times(v)
       gv = gs%ttimes(v)
-      ! the factor decided (G G' - hold S is not positive definite: some mu is below hold);
+      ! the factor decided (G G' - hold S is not positive definite: some theta is below hold);
       ! the Rayleigh quotient only names the motion, and may sit above hold when the
-      ! smallest mu are clustered
-      mu = min(dot_product(gv, gv)/max(dot_product(v, sv), tiny(1.0_wp)), hold)
+      ! smallest theta are clustered
+      theta = min(dot_product(gv, gv)/max(dot_product(v, sv), tiny(1.0_wp)), hold)
       call gm%free()
 
     end subroutine group_held
@@ -896,15 +896,15 @@ contains
 
   end subroutine admissible_nnls
 
-  !> mu ascending and the eigenvectors (in gg) of G G' v = mu S v (S: rreach): how much of
+  !> theta ascending and the eigenvectors (in gg) of G G' v = theta S v (S: rreach): how much of
   !! each motion's reach on the contact is normal to it. S singular (a motion that does not
-  !! move the contact nodes at all): info /= 0 from dsygv, and then that motion has mu = 0
+  !! move the contact nodes at all): info /= 0 from dsygv, and then that motion has theta = 0
   !! (dsyev of G G' alone decides, with a zero threshold scale).
-  subroutine held_motions(gg, s, r, mu, info)
+  subroutine held_motions(gg, s, r, theta, info)
     real(wp), intent(inout) :: gg(:, :)
     real(wp), intent(in) :: s(:, :)
     integer, intent(in) :: r
-    real(wp), intent(out) :: mu(:)
+    real(wp), intent(out) :: theta(:)
     integer, intent(out) :: info
     real(wp), allocatable :: b(:, :), g0(:, :), work(:)
     real(wp) :: wq(1)
@@ -914,14 +914,14 @@ contains
     b = s(1:r, 1:r)
     ! the workspace LAPACK asks for (a fixed 64 was too small from r = 22 on: dsygv and
     ! dsyev refused it, printed "illegal value" and the group's check was skipped)
-    call dsygv(1, 'V', 'U', r, gg, r, b, r, mu, wq, -1, info)
+    call dsygv(1, 'V', 'U', r, gg, r, b, r, theta, wq, -1, info)
     lwork = max(3*r, int(wq(1)))
     allocate (work(lwork))
-    call dsygv(1, 'V', 'U', r, gg, r, b, r, mu, work, lwork, info)
+    call dsygv(1, 'V', 'U', r, gg, r, b, r, theta, work, lwork, info)
     if (info /= 0) then
       gg(1:r, 1:r) = g0
-      call dsyev('V', 'U', r, gg, r, mu, work, lwork, info)
-      if (info == 0) mu(1) = 0.0_wp
+      call dsyev('V', 'U', r, gg, r, theta, work, lwork, info)
+      if (info == 0) theta(1) = 0.0_wp
     end if
   end subroutine held_motions
 

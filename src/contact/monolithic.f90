@@ -64,7 +64,7 @@ contains
     type(mprgp_stats_t) :: inner
     type(smalbe_stats_t) :: outer
     type(equality_t) :: equality
-    real(wp), allocatable :: c(:), lb(:), ub(:), lam(:), rows(:, :), rhs(:), mu(:), bs(:, :), wa(:), lfac(:, :), ub_new(:)
+    real(wp), allocatable :: c(:), lb(:), ub(:), lam(:), rows(:, :), rhs(:), eq_mult(:), bs(:, :), wa(:), lfac(:, :), ub_new(:)
     integer :: m, a, r, nrig, info, fixed, nfix, nmv
     real(wp) :: t0, lmax, change, change_best
     integer :: fixed_best
@@ -136,8 +136,8 @@ contains
       end select
     end if
     if (equality%r > 0) then
-      allocate (mu(equality%r))
-      mu = 0.0_wp
+      allocate (eq_mult(equality%r))
+      eq_mult = 0.0_wp
     end if
     ! friction: the boxes of the tangential rows; Coulomb repeats the box solve with the
     ! boxes of the last normal forces (warm-started) until they change by less than
@@ -163,19 +163,19 @@ contains
         if (friction) then
           ! the box of the tangential forces, or in space their discs
           call smalbe_solve_in(inner_solver, hessian, c, equality%g, equality%e, equality%rho, &
-                               friction_set(lb, ub, disc_rows(contact_line)), lam, mu, outer)
+                               friction_set(lb, ub, disc_rows(contact_line)), lam, eq_mult, outer)
         else
-          call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, mu, outer)
+          call smalbe_solve(inner_solver, hessian, c, equality%g, equality%e, equality%rho, lb, lam, eq_mult, outer)
         end if
         inner = outer%inner
         inner%n_matvec = outer%n_matvec
         res%eq_updates = res%eq_updates + outer%updates
-        ! multipliers of the orthonormalized rows L^-1 G back to those of G: mu = L^-T mu~
-        if (allocated(lfac)) call dtrsv('L', 'T', 'N', size(mu), lfac, size(mu), mu, 1)
+        ! multipliers of the orthonormalized rows L^-1 G back to those of G: eq_mult = L^-T eq_mult~
+        if (allocated(lfac)) call dtrsv('L', 'T', 'N', size(eq_mult), lfac, size(eq_mult), eq_mult, 1)
         r = 0
         do a = 1, size(bodies)
           if (bodies(a)%nrig == 0) cycle
-          res%rigid(1:bodies(a)%nrig, a) = -mu(r + 1:r + bodies(a)%nrig)
+          res%rigid(1:bodies(a)%nrig, a) = -eq_mult(r + 1:r + bodies(a)%nrig)
           r = r + bodies(a)%nrig
         end do
       else

@@ -320,11 +320,11 @@ contains
       allocate (flam(bodies(a)%m))
       call subproblems%flexibility(a)%apply(gather(run_state%lam, bodies(a)%slots), flam)
       wa = bodies(a)%b - flam
-      if (bodies(a)%nrig > 0) wa = wa - matmul(run_state%mu(1:bodies(a)%nrig, a), bodies(a)%rg)
+      if (bodies(a)%nrig > 0) wa = wa - matmul(run_state%eq_mult(1:bodies(a)%nrig, a), bodies(a)%rg)
       call scatter(wa, bodies(a)%slots, res%w)
       deallocate (flam)
     end do
-    res%rigid = -run_state%mu
+    res%rigid = -run_state%eq_mult
     call interface_residual(contact_line, bodies, res)
     res%obstacle = run_state%G
     res%outer = run_state%it
@@ -347,7 +347,7 @@ contains
     integer :: a
     res%lam_body = run_state%lam
     res%w = w
-    res%rigid = -run_state%mu
+    res%rigid = -run_state%eq_mult
     call interface_residual(contact_line, bodies, res)
     bsum = 0.0_wp
     do a = 1, size(bodies)
@@ -413,7 +413,7 @@ contains
       ! the body's own contact displacement F_a lam_a = b_a - w_a - (its rigid motion)
       wa = gather(w, bodies(a)%slots)
       own = bodies(a)%b - wa
-      if (bodies(a)%nrig > 0) own = own - matmul(run_state%mu(1:bodies(a)%nrig, a), bodies(a)%rg)
+      if (bodies(a)%nrig > 0) own = own - matmul(run_state%eq_mult(1:bodies(a)%nrig, a), bodies(a)%rg)
       wn(a) = norm2(wa)
       on(a) = norm2(own)
       cap = cap + on(a)

@@ -304,7 +304,7 @@ contains
         inner_solver%opts%eq_feas = max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)*norm2(eq%e)
         inner_solver%opts%eq_feas_x = merge(max(rtol_in, 10.0_wp*sqrt(real(m, wp))*epsilon(1.0_wp), FEAS_RTOL_MIN)* &
                                             sqrt(eq%gg), 0.0_wp, all(eq%e == 0.0_wp))
-        call smalbe_solve_in(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, set, lam, state%mu(1:r, a), &
+        call smalbe_solve_in(inner_solver, subproblems%hessian(a), rhs, eq%g, eq%e, eq%rho, set, lam, state%eq_mult(1:r, a), &
                              smalbe_stats, rw, raw, state%nrw(:, a))
       end associate
       inner = smalbe_stats%inner

@@ -155,7 +155,7 @@ contains
     call write_dset(gid, 'kept', st%kept, hs)
     call write_dset(gid, 'rw', st%rw, hs)
     call write_dset(gid, 'raw', st%raw, hs)
-    call write_dset(gid, 'mu', st%mu, hs)
+    call write_dset(gid, 'mu', st%eq_mult, hs)   ! the dataset keeps its name: earlier checkpoints read the same
     call group_close(gid, hs)
     call write_history(fid, res, hs)
     if (self%step > 0) call write_load_history(fid, self%step, self%done, hs)
@@ -648,7 +648,7 @@ contains
       allocate (st%row_state(m))
       st%row_state = -1
     end if
-    allocate (st%mu(NRIGID, r%nbody), st%nrw(2, r%nbody))
+    allocate (st%eq_mult(NRIGID, r%nbody), st%nrw(2, r%nbody))
     allocate (st%newton(r%nbody), st%kept(r%nbody), source=0)
     if (r%has_newton) then
       call read_dset(r%gid, 'newton', ir, r%hs)
@@ -659,10 +659,10 @@ contains
       call read_dset(r%gid, 'kept', ir, r%hs)
       if (.not. r%hs%failed()) st%kept = merge(1, 0, ir /= 0)
     end if
-    st%mu = 0.0_wp
+    st%eq_mult = 0.0_wp
     if (r%has_mu) then
       call read_dset(r%gid, 'mu', rmu, r%hs)
-      if (.not. r%hs%failed()) st%mu = rmu
+      if (.not. r%hs%failed()) st%eq_mult = rmu
     end if
     if (r%has_recycle) then
       call read_dset(r%gid, 'nrw', ir, r%hs)
@@ -718,7 +718,7 @@ contains
     call need_finite(r, 'dataset /state/fsrch', st%fsrch)
     call need_finite(r, 'dataset /state/rw', st%rw)
     call need_finite(r, 'dataset /state/raw', st%raw)
-    call need_finite(r, 'dataset /state/mu', st%mu)
+    call need_finite(r, 'dataset /state/mu', st%eq_mult)
     call need_finite(r, 'attribute res_best of /state', [st%res_best])
     call need_finite(r, 'attribute crit of /state', [st%crit])
     call need_finite(r, 'attribute progress of /state', [st%progress])

@@ -393,7 +393,7 @@ contains
   !> The interior point method on the scaled problem (columns of unit norm, |e| = 1, the
   !! bound x <= XMAX): min 1/2 |s|^2 with G x + s = e, 0 <= x <= XMAX; y = s is the
   !! multiplier of the equality, z >= 0 and u >= 0 those of the bounds, w = XMAX - x. A
-  !! Newton step for the perturbed conditions x z = w u = sigma mu reduces, with
+  !! Newton step for the perturbed conditions x z = w u = sigma duality reduces, with
   !! D = z/x + u/w, to (I + G D^-1 G') dy = rhs: one sparse factor per step, two solves
   !! (predictor and corrector). Stops when |G x - e| (a true upper bound of the minimum,
   !! x >= 0 at every step) is below ZERO_RES, or when the duality gap is below 1e-10 of
@@ -414,7 +414,7 @@ contains
     real(wp), allocatable :: cn(:), e1(:), xs(:), w(:), z(:), u(:), y(:), dinv(:)
     real(wp), allocatable :: rp(:), rd(:), ru(:), rc1(:), rc2(:), dx(:), dy(:), dz(:), dw(:), du(:), q(:)
     integer, allocatable :: live(:)
-    real(wp) :: es, mu, mu_aff, sigma, alpha, resid
+    real(wp) :: es, duality, duality_aff, sigma, alpha, resid
     integer :: r, m, n, j, l, step
 
     ok = .true.
@@ -456,12 +456,12 @@ contains
       rp = rp - y
       rd = -gs%ttimes(y) - z + u
       ru = XMAX - xs - w
-      mu = (dot_product(xs, z) + dot_product(w, u))/real(2*n, wp)
-      if (2*n*mu <= 1.0e-10_wp*resid**2 .and. norm2(rp) <= 1.0e-12_wp .and. maxval(abs(rd)) <= 1.0e-12_wp) exit
+      duality = (dot_product(xs, z) + dot_product(w, u))/real(2*n, wp)
+      if (2*n*duality <= 1.0e-10_wp*resid**2 .and. norm2(rp) <= 1.0e-12_wp .and. maxval(abs(rd)) <= 1.0e-12_wp) exit
       ! complementarity at rounding with the primal residual left (a balance on the edge of
       ! feasibility, x pressed against its bound): an upper bound below SMALL_RES stands,
       ! above it nothing is certified and the active set method decides
-      if (mu <= 1.0e-18_wp) then
+      if (duality <= 1.0e-18_wp) then
         ok = resid <= SMALL_RES
         exit
       end if
@@ -475,11 +475,11 @@ contains
       call direction()
       if (.not. ok) exit
       alpha = max_step()
-      mu_aff = (dot_product(xs + alpha*dx, z + alpha*dz) + dot_product(w + alpha*dw, u + alpha*du))/real(2*n, wp)
-      sigma = min(1.0_wp, (mu_aff/mu)**3)
+      duality_aff = (dot_product(xs + alpha*dx, z + alpha*dz) + dot_product(w + alpha*dw, u + alpha*du))/real(2*n, wp)
+      sigma = min(1.0_wp, (duality_aff/duality)**3)
       ! corrector
-      rc1 = sigma*mu - xs*z - dx*dz
-      rc2 = sigma*mu - w*u - dw*du
+      rc1 = sigma*duality - xs*z - dx*dz
+      rc2 = sigma*duality - w*u - dw*du
       call direction()
       if (.not. ok) exit
       alpha = min(1.0_wp, 0.995_wp*max_step())

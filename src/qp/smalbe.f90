@@ -4,21 +4,21 @@
 !!
 !! with MPRGP (module mprgp) as its inner solver. Z. Dostal, "Optimal Quadratic
 !! Programming Algorithms", Springer 2009, ch. 9; the form used here (doc/method.md,
-!! "Bodies held only by contact"): for a fixed penalty rho and multipliers mu,
+!! "Bodies held only by contact"): for a fixed penalty rho and multipliers mult,
 !!
-!!     L(x, mu, rho) = 1/2 x'Hx - c'x + mu'(Gx - e) + rho/2 |Gx - e|^2
+!!     L(x, mult, rho) = 1/2 x'Hx - c'x + mult'(Gx - e) + rho/2 |Gx - e|^2
 !!
 !! is minimised over the box l <= x <= u by MPRGP with the Hessian A = H + rho G'G (the
 !! caller passes A: its products are the only ones, and since A does not change from one
 !! solve to the next MPRGP's stored directions stay valid) and the linear term
-!! c - G'mu + rho G'e, to a projected gradient below min(M |Gx - e|, eta); then
-!! mu <- mu + rho (Gx - e), and M <- beta M when L did not grow by at least
+!! c - G'mult + rho G'e, to a projected gradient below min(M |Gx - e|, eta); then
+!! mult <- mult + rho (Gx - e), and M <- beta M when L did not grow by at least
 !! rho/2 |Gx - e|^2. It stops when the projected gradient is below eta and |Gx - e| below
 !! feas. The upper bounds are optional (absent or +huge(1.0_wp): none); the bounds go to
 !! MPRGP as one `box_set_t` (module constraint_set), or `smalbe_solve_in` takes any
 !! constraint set (the discs of friction in space).
 !!
-!! On return g = Hx - c + G'mu (the gradient of the Lagrangian at the final multipliers,
+!! On return g = Hx - c + G'mult (the gradient of the Lagrangian at the final multipliers,
 !! which is MPRGP's last gradient), so for contact `G_a - g` is still B_a u_a with the
 !! rigid part of u_a = R_a alpha_a, alpha_a = -mu_a. At the solution g holds the bound
 !! multipliers: g_i >= 0 where x_i = l_i, g_i <= 0 where x_i = u_i, g_i = 0 in between.
@@ -54,10 +54,10 @@ contains
   !! A, use_ax (its ax: A x at the warm start, first solve only), recycle, and SMALBE's
   !! initial M (opts%eq_m > 0) and the |Gx - e| that counts as feasible (opts%eq_feas); its
   !! search direction s, as (if any) serves the first solve. On return solver%g holds
-  !! Hx - c + G'mu and solver%ax A x. mu holds the warm start of the multipliers and returns
+  !! Hx - c + G'mult and solver%ax A x. mult holds the warm start of the multipliers and returns
   !! them. stats%inner%status is MPRGP_CONVERGED only when both the projected gradient and
   !! |Gx - e| met their tolerances.
-  subroutine smalbe_solve(solver, A, c, gm, e, rho, lb, x, mu, stats, rw, raw, nrw, ub)
+  subroutine smalbe_solve(solver, A, c, gm, e, rho, lb, x, mult, stats, rw, raw, nrw, ub)
     type(mprgp_t), intent(inout) :: solver      !< inner solver (options; ax, g as above)
     class(linop_t), intent(inout) :: A          !< H + rho G'G
     real(wp), intent(in) :: c(:)                !< (n) linear term
@@ -66,16 +66,16 @@ contains
     real(wp), intent(in) :: rho                 !< the penalty folded into A
     real(wp), intent(in) :: lb(:)               !< (n) lower bounds
     real(wp), intent(inout) :: x(:)             !< in: warm start; out: solution
-    real(wp), intent(inout) :: mu(:)            !< (r) in: warm start; out: multipliers
+    real(wp), intent(inout) :: mult(:)            !< (r) in: warm start; out: multipliers
     type(smalbe_stats_t), intent(out) :: stats
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_t%solve)
     integer, intent(inout), optional :: nrw(2)
     real(wp), intent(in), optional :: ub(:)     !< (n) upper bounds (>= lb); +huge(1.0_wp): none
-    call smalbe_solve_in(solver, A, c, gm, e, rho, box_set(lb, ub), x, mu, stats, rw, raw, nrw)
+    call smalbe_solve_in(solver, A, c, gm, e, rho, box_set(lb, ub), x, mult, stats, rw, raw, nrw)
   end subroutine smalbe_solve
 
   !> `smalbe_solve` on any constraint set (a box, or discs: module tangent_discs).
-  subroutine smalbe_solve_in(solver, A, c, gm, e, rho, set, x, mu, stats, rw, raw, nrw)
+  subroutine smalbe_solve_in(solver, A, c, gm, e, rho, set, x, mult, stats, rw, raw, nrw)
     type(mprgp_t), intent(inout) :: solver      !< inner solver (options; ax, g as above)
     class(linop_t), intent(inout) :: A          !< H + rho G'G
     real(wp), intent(in) :: c(:)                !< (n) linear term
@@ -84,7 +84,7 @@ contains
     real(wp), intent(in) :: rho                 !< the penalty folded into A
     class(constraint_set_t), intent(in) :: set  !< the feasible set
     real(wp), intent(inout) :: x(:)             !< in: warm start; out: solution
-    real(wp), intent(inout) :: mu(:)            !< (r) in: warm start; out: multipliers
+    real(wp), intent(inout) :: mult(:)            !< (r) in: warm start; out: multipliers
     type(smalbe_stats_t), intent(out) :: stats
     real(wp), intent(inout), optional :: rw(:, :), raw(:, :)  !< stored directions (mprgp_t%solve)
     integer, intent(inout), optional :: nrw(2)
@@ -100,7 +100,7 @@ contains
     feas = opts%eq_feas
     m_control = opts%eq_m
     have_ax = opts%use_ax .and. allocated(solver%ax)
-    if (have_ax) call multiplier_estimate(gm, e, rho, set, x, c, solver%ax, mu)
+    if (have_ax) call multiplier_estimate(gm, e, rho, set, x, c, solver%ax, mult)
     solver%eq_g = gm
     solver%eq_e = e
     lag_old = -huge(1.0_wp)
@@ -116,8 +116,8 @@ contains
       ! floor 10 times higher costs a soft floating body's contrast case its last digits)
       if (opts%lambda_max > 0.0_wp) &
         solver%opts%atol = max(opts%atol, sqrt(real(n, wp))*epsilon(1.0_wp)*opts%lambda_max*norm2(x))
-      ! linear term of L(., mu, rho) with the penalty's part: c - G'mu + rho G'e
-      rhs = c - matmul(mu - rho*e, gm)
+      ! linear term of L(., mult, rho) with the penalty's part: c - G'mult + rho G'e
+      rhs = c - matmul(mult - rho*e, gm)
       feas = max(opts%eq_feas, opts%eq_feas_x*norm2(x))
       solver%opts%eq_feas = feas
       call solver%solve_in(A, rhs, set, x, rw, raw, nrw)
@@ -133,13 +133,13 @@ contains
       rr = norm2(r)
       stats%feas = rr
       ! the new multipliers; MPRGP's gradient is the Lagrangian's gradient at them (also after
-      ! an inner solve that stopped on max_it: g and mu must agree, the caller's B u uses both)
-      mu = mu + rho*r
+      ! an inner solve that stopped on max_it: g and mult must agree, the caller's B u uses both)
+      mult = mult + rho*r
       if (stats%inner%status /= MPRGP_CONVERGED) exit
       ! L(x, mu_new, rho) = 1/2 x'Ax - x'rhs(mu_old) + mu_old'(Gx - e)... written out:
       ! 1/2 x'Hx - c'x + mu_new'(Gx - e) + rho/2 |Gx - e|^2, with x'Hx = x'Ax - rho |Gx|^2
       lag_new = 0.5_wp*(dot_product(x, solver%ax) - rho*sum(matmul(gm, x)**2)) - dot_product(c, x) + &
-                dot_product(mu, r) + 0.5_wp*rho*rr*rr
+                dot_product(mult, r) + 0.5_wp*rho*rr*rr
       stats%updates = k
       feas = max(opts%eq_feas, opts%eq_feas_x*norm2(x))
       if (rr <= feas) exit
@@ -156,16 +156,16 @@ contains
     deallocate (solver%eq_g, solver%eq_e)
   end subroutine smalbe_solve_in
 
-  !> A better start for the multipliers when the warm start mu is far off: the least-squares
-  !! multipliers of the free set, mu_ls = argmin |g0_F + G_F' mu| (g0 = H x - c, no product:
+  !> A better start for the multipliers when the warm start mult is far off: the least-squares
+  !! multipliers of the free set, mu_ls = argmin |g0_F + G_F' mult| (g0 = H x - c, no product:
   !! H x = A x - rho G'G x), over every variable when x has no free one (a floating body that
   !! lost contact: mu_ls is then the rigid shift that brings it back to its obstacle on
   !! average, where the warm start would need of order |shift| / (rho |e|) updates to get).
-  !! mu_ls replaces mu when the Lagrangian's projected gradient at x is smaller with it.
-  subroutine multiplier_estimate(gm, e, rho, set, x, c, ax, mu)
+  !! mu_ls replaces mult when the Lagrangian's projected gradient at x is smaller with it.
+  subroutine multiplier_estimate(gm, e, rho, set, x, c, ax, mult)
     real(wp), intent(in) :: gm(:, :), e(:), rho, x(:), c(:), ax(:)
     class(constraint_set_t), intent(in) :: set
-    real(wp), intent(inout) :: mu(:)
+    real(wp), intent(inout) :: mult(:)
     real(wp), allocatable :: g0(:), gf(:, :), a(:, :), b(:), mls(:)
     logical, allocatable :: free(:)
     integer :: r, i, info
@@ -181,7 +181,7 @@ contains
     call dposv('U', r, 1, a, r, b, r, info)
     if (info /= 0) return
     mls = b
-    if (proj_norm(set, g0 + matmul(mls, gm), x) < proj_norm(set, g0 + matmul(mu, gm), x)) mu = mls
+    if (proj_norm(set, g0 + matmul(mls, gm), x) < proj_norm(set, g0 + matmul(mult, gm), x)) mult = mls
   end subroutine multiplier_estimate
 
   !> Norm of the projected gradient of g at x (norm2 of the vector gP).
