@@ -650,19 +650,26 @@ contains
     ! condition estimate show at half the cost of the pivoted factor: lambda_min(F_a) >=
     ! 1 / |F_a^-1|_1, estimated, at least 1e4 times the pivot tolerance below (no estimate is
     ! that far off). Anything else is decided by the pivoted factor, as before.
-    f = bc%flex
-    call dpotrf_tiles('L', bc%m, f, bc%m, lapinfo)
-    if (lapinfo == 0) then
-      anorm = maxval(sum(abs(bc%flex), dim=1))
-      call dpocon('L', bc%m, f, bc%m, anorm, rcond, work, piv, lapinfo)
-      if (lapinfo == 0 .and. rcond*anorm >= 1.0e-6_wp*dmax) then
-        bc%rank = bc%m
-        return
+    if (bc%m >= SUBSPACE_MIN .and. size(bc%idx) < bc%m) then
+      ! more rows than DOFs (a 3D frictional master: three rows a slave node): singular by
+      ! its shape, of rank at most its DOFs; the inertia count below decides the kernel
+      ! (neither the plain nor the pivoted factor is needed to know that)
+      r = size(bc%idx)
+    else
+      f = bc%flex
+      call dpotrf_tiles('L', bc%m, f, bc%m, lapinfo)
+      if (lapinfo == 0) then
+        anorm = maxval(sum(abs(bc%flex), dim=1))
+        call dpocon('L', bc%m, f, bc%m, anorm, rcond, work, piv, lapinfo)
+        if (lapinfo == 0 .and. rcond*anorm >= 1.0e-6_wp*dmax) then
+          bc%rank = bc%m
+          return
+        end if
       end if
+      f = bc%flex
+      call dpstrf('L', bc%m, f, bc%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)
+      if (lapinfo < 0) return
     end if
-    f = bc%flex
-    call dpstrf('L', bc%m, f, bc%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)
-    if (lapinfo < 0) return
     bc%rank = r
     if (r == bc%m) return
     bc%prox = 1.0e-2_wp*dmax

@@ -21,7 +21,7 @@ program test_flex_rank
   use kinds, only: wp
   use condense, only: body_condensed_t, flex_from_x, smallest_eigenvectors, SUBSPACE_MIN
   use robin_operators, only: range_proximal
-  use lapack, only: dpstrf, dsyev
+  use lapack, only: dpstrf, dsyev, dsyevd
   use testing, only: report, report_le, test_summary, identity, set_seed, urand
   implicit none (type, external)
   integer, parameter :: M = 60
@@ -36,6 +36,7 @@ program test_flex_rank
   call coarse_rows(40, 12, .false.)
   call coarse_rows(40, 12, .true.)
   call large_kernel(1600, 30)
+  call tall_rows(1600, 1590)
   call test_summary()
 
 contains
@@ -248,5 +249,52 @@ contains
     call report_le(norm2(z - matmul(q, matmul(transpose(q), z))), 1.0e-6_wp, &
                    'large F_a: the basis spans the 30 smallest eigenvectors')
   end subroutine large_kernel
+
+  !> More rows than DOFs at order m >= SUBSPACE_MIN (a 3D frictional master): F_a = B B'
+  !! (X = I), row i on DOFs mod(i - 1, k) + 1 (coefficient 1) and mod(7 i, k) + 1 (1/2),
+  !! singular by its shape; flex_from_x decides its kernel without a factor: the rank is m
+  !! minus the eigenvalues below NEAR_KERNEL = 1e-6 of the largest diagonal entry that a
+  !! dense symmetric eigensolver (LAPACK dsyevd) counts on the same F_a, the kernel basis
+  !! orthonormal and |F_a z| <= 1e-6 max diag on each vector.
+  subroutine tall_rows(m, k)
+    integer, intent(in) :: m, k
+    type(body_condensed_t) :: bc
+    real(wp), allocatable :: x(:, :), f(:, :), ev(:), work(:), c(:, :)
+    integer, allocatable :: iwork(:)
+    integer :: i, info, nref
+    real(wp) :: dmax
+    allocate (x(k, k), source=0.0_wp)
+    do i = 1, k
+      x(i, i) = 1.0_wp
+    end do
+    bc%m = m
+    allocate (bc%idx(k), bc%bptr(m + 1), bc%bpos(2*m), bc%bval(2*m))
+    bc%idx = [(i, i=1, k)]
+    do i = 1, m
+      bc%bptr(i) = 2*i - 1
+      bc%bpos(2*i - 1:2*i) = [modulo(i - 1, k) + 1, modulo(7*i, k) + 1]
+      bc%bval(2*i - 1:2*i) = [1.0_wp, 0.5_wp]
+    end do
+    bc%bptr(m + 1) = 2*m + 1
+    call flex_from_x(bc, x)
+    f = bc%flex
+    dmax = maxval([(f(i, i), i=1, m)])
+    allocate (ev(m), work(1 + 6*m + 2*m*m), iwork(3 + 5*m))
+    call dsyevd('N', 'L', m, f, m, ev, work, size(work), iwork, size(iwork), info)
+    nref = count(ev <= 1.0e-6_wp*dmax)
+    call report(info == 0 .and. nref >= m - k, 'more rows than DOFs, order 1600: the reference eigenvalues')
+    call report(bc%rank == m - nref, 'more rows than DOFs: the rank is m less the eigenvalues below 1e-6 max diag', &
+                real(bc%rank, wp), real(m - nref, wp))
+    call report(allocated(bc%kern) .and. bc%prox > 0.0_wp, 'more rows than DOFs: a kernel basis, a proximal weight')
+    if (.not. allocated(bc%kern)) return
+    call report(size(bc%kern, 2) == nref, 'more rows than DOFs: the basis has m - rank vectors')
+    c = matmul(transpose(bc%kern), bc%kern)
+    do i = 1, size(c, 1)
+      c(i, i) = c(i, i) - 1.0_wp
+    end do
+    call report_le(maxval(abs(c)), 1.0e-12_wp, 'more rows than DOFs: the basis orthonormal')
+    call report_le(maxval(norm2(matmul(bc%flex, bc%kern), dim=1))/dmax, 1.0e-6_wp, &
+                   'more rows than DOFs: |F_a z| <= 1e-6 max diag on the basis')
+  end subroutine tall_rows
 
 end program test_flex_rank
