@@ -156,7 +156,7 @@ $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/
 $(BUILD)/deck.o:           $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/namelist_input.o $(BUILD)/config.o \
                            $(BUILD)/deck_checks.o $(BUILD)/deck_cross.o $(BUILD)/deck_render.o
 $(BUILD)/budget.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/config.o $(BUILD)/space.o
-$(BUILD)/mesh.o:           $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o
+$(BUILD)/mesh.o:           $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/errors.o
 $(BUILD)/mesh_topology.o:  $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/errors.o $(BUILD)/config.o $(BUILD)/strings.o $(BUILD)/int_hash.o $(BUILD)/mesh.o
 $(BUILD)/volume_topology.o: $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/int_hash.o \
                            $(BUILD)/sorting.o $(BUILD)/mesh.o $(BUILD)/mesh_topology.o

@@ -164,14 +164,9 @@ contains
         if (len_trim(deck%body(a)%mesh) > 0) then
           call msh_read(trim(deck%body(a)%mesh), trim(deck%body(a)%region), a, run%meshes(a), err(a), run%mesh_hex(a))
         else if (NDIM == 3) then
-          block
-            integer :: info
-            character(len=256) :: bmsg
-            call box_build(run%meshes(a), deck%body(a), kuhn_tets, info, bmsg)
-            if (info /= 0) err(a) = error_t(ERR_INPUT, trim(bmsg))
-          end block
+          call box_build(run%meshes(a), deck%body(a), kuhn_tets, err(a))
         else
-          call mesh_build(run%meshes(a), deck%body(a))
+          call mesh_build(run%meshes(a), deck%body(a), err(a))
         end if
       end do
       !$omp end parallel do

@@ -29,6 +29,7 @@ module mesh
   use kinds, only: wp
   use space, only: node_dof, dof_node, dof_comp
   use strings, only: i2s
+  use errors, only: error_t, ERR_INPUT
   use config, only: body_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, ELEM_HEX8, ELEM_TET4, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, &
                     SIDE_TOP, MAX_SIDES, side_names, shape_vertices
   implicit none (type, external)
@@ -253,31 +254,27 @@ contains
   !> Build the structured mesh of a body (its rectangle, nx x ny grid cells and element).
   !! On a bad body (nx or ny < 1, non-positive extent, unknown element) the mesh is left
   !! empty (nnode = 0) and, if present, `info` is non-zero with a sentence in `msg`.
-  subroutine mesh_build(mesh, body, info, msg)
+  subroutine mesh_build(mesh, body, err)
     type(mesh_t), intent(out) :: mesh                  !< the mesh built
     type(body_cfg_t), intent(in) :: body               !< geometry, grid and element of the body
-    integer, intent(out), optional :: info             !< 0 on success
-    character(len=*), intent(out), optional :: msg     !< error sentence when info /= 0
-    integer :: i, j, c, n00, n10, n01, n11, stat
-    character(len=256) :: err
+    type(error_t), intent(out) :: err                  !< a grid the rectangle cannot have (ERR_INPUT)
+    integer :: i, j, c, n00, n10, n01, n11
+    character(len=256) :: why
 
-    stat = 0
-    err = ''
+    why = ''
     if (body%nx < 1 .or. body%ny < 1) then
-      stat = 1
-      write (err, '(a,i0,a,i0,a,i0,a)') 'body ', body%id, ': the grid needs nx, ny >= 1 (got ', &
+      write (why, '(a,i0,a,i0,a,i0,a)') 'body ', body%id, ': the grid needs nx, ny >= 1 (got ', &
         body%nx, ' x ', body%ny, ')'
     else if (.not. (body%width > 0.0_wp .and. body%height > 0.0_wp)) then
-      stat = 2
-      write (err, '(a,i0,a,es12.4,a,es12.4,a)') 'body ', body%id, &
+      write (why, '(a,i0,a,es12.4,a,es12.4,a)') 'body ', body%id, &
         ': width and height must be positive (got ', body%width, ', ', body%height, ')'
     else if (body%element /= ELEM_Q1 .and. body%element /= ELEM_P1) then
-      stat = 3
-      write (err, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', body%element
+      write (why, '(a,i0,a,i0)') 'body ', body%id, ': unknown element code ', body%element
     end if
-    if (present(info)) info = stat
-    if (present(msg)) msg = err
-    if (stat /= 0) return
+    if (len_trim(why) > 0) then
+      call err%set(ERR_INPUT, trim(why))
+      return
+    end if
 
     mesh%element = body%element
     mesh%nx = body%nx
@@ -345,7 +342,7 @@ contains
   !! 'bottom', 'top', 'front' (z = z0), 'back' (z = z0 + depth), their faces oriented outward:
   !! quadrilaterals, or each grid face cut along its diagonal from its lowest to its highest
   !! grid corner into two triangles (the tetrahedra's faces). info /= 0 with msg on a bad grid.
-  subroutine box_build(mesh, body, tets, info, msg)
+  subroutine box_build(mesh, body, tets, err)
     type(mesh_t), intent(out) :: mesh                  !< the mesh built
     type(body_cfg_t), intent(in) :: body               !< the box's geometry, grid and element
     !> the six tetrahedra of a grid cell's eight vertices (elements_3d's kuhn_tets, passed in
@@ -356,24 +353,18 @@ contains
         integer, intent(out) :: t(4, 6)
       end subroutine tets
     end interface
-    integer, intent(out) :: info                       !< 0 on success
-    character(len=*), intent(out) :: msg               !< the error sentence when info /= 0
+    type(error_t), intent(out) :: err                  !< a grid the box cannot have (ERR_INPUT)
     integer :: i, j, k, c, v(8), t(4, 6)
 
-    info = 0
-    msg = ''
     if (body%nx < 1 .or. body%ny < 1 .or. body%nz < 1) then
-      info = 1
-      msg = 'body '//i2s(body%id)//': the grid needs nx, ny, nz >= 1 (got '//i2s(body%nx)//' x '// &
-            i2s(body%ny)//' x '//i2s(body%nz)//')'
+      call err%set(ERR_INPUT, 'body '//i2s(body%id)//': the grid needs nx, ny, nz >= 1 (got '//i2s(body%nx)// &
+                   ' x '//i2s(body%ny)//' x '//i2s(body%nz)//')')
       return
     else if (.not. (body%width > 0.0_wp .and. body%height > 0.0_wp .and. body%depth > 0.0_wp)) then
-      info = 2
-      msg = 'body '//i2s(body%id)//': width, height and depth must be positive'
+      call err%set(ERR_INPUT, 'body '//i2s(body%id)//': width, height and depth must be positive')
       return
     else if (body%element /= ELEM_Q1 .and. body%element /= ELEM_P1) then
-      info = 3
-      msg = 'body '//i2s(body%id)//': unknown element code '//i2s(body%element)
+      call err%set(ERR_INPUT, 'body '//i2s(body%id)//': unknown element code '//i2s(body%element))
       return
     end if
     mesh%element = merge(ELEM_HEX8, ELEM_TET4, body%element == ELEM_Q1)

@@ -6,9 +6,9 @@ program test_box
   use kinds, only: wp
   use space, only: set_dimension
   use config, only: body_cfg_t, ELEM_Q1, ELEM_P1, ELEM_HEX8, ELEM_TET4, MAX_SIDES, UNSET, side_axis
-  use mesh, only: mesh_t, box_build
-  use elements_3d, only: kuhn_tets, face_area_normal, tet4_gradients, hex8_gradients
-  use testing, only: report, report_le, test_summary
+  use mesh, only: mesh_t
+  use elements_3d, only: face_area_normal, tet4_gradients, hex8_gradients
+  use testing, only: box_mesh_parts, report, report_le, test_summary
   implicit none (type, external)
 
   call set_dimension(3)
@@ -42,7 +42,7 @@ contains
     b%ny = 3
     b%nz = 2
     b%element = element
-    call box_build(m, b, kuhn_tets, info, msg)
+    call box_mesh_parts(m, b, info, msg)
     call report(info == 0, what//': built ('//trim(msg)//')')
     if (info /= 0) return
     call report(m%nnode == 5*4*3 .and. m%ncell == 4*3*2*merge(1, 6, element == ELEM_Q1) .and. &
@@ -143,11 +143,11 @@ contains
     b%id = 7
     b%depth = 1.0_wp
     b%nz = 0
-    call box_build(m, b, kuhn_tets, info, msg)
+    call box_mesh_parts(m, b, info, msg)
     call report(info /= 0 .and. index(msg, 'body 7') > 0 .and. index(msg, 'nz') > 0, 'nz = 0 refused ('//trim(msg)//')')
     b%nz = 2
     b%depth = UNSET
-    call box_build(m, b, kuhn_tets, info, msg)
+    call box_mesh_parts(m, b, info, msg)
     call report(info /= 0 .and. index(msg, 'depth') > 0, 'depth not positive refused ('//trim(msg)//')')
   end subroutine test_bad_grid
 

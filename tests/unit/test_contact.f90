@@ -7,7 +7,7 @@ program test_contact
   use kinds, only: wp
   use config, only: deck_t
   use deck, only: read_deck
-  use mesh, only: mesh_t, mesh_build
+  use mesh, only: mesh_t
   use assembly, only: body_system_t, assemble_body, expand, residual_full
   use contact_interface, only: interface_t, build_interface
   use condense, only: body_condensed_t, factor_body, condense_body, recover_displacement, apply_b, apply_bt, to_global
@@ -17,7 +17,7 @@ program test_contact
   use robin_operators, only: harmonic_operator_t
   use monolithic, only: solve_monolithic
   use error_estimate, only: error_bound
-  use testing, only: report, test_summary, error_parts
+  use testing, only: grid_mesh, report, test_summary, error_parts
   use errors, only: error_t
   implicit none (type, external)
   character(len=4096) :: none(0)
@@ -107,7 +107,7 @@ contains
     if (size(over) > 0) tag = trim(tag)//' '//trim(over(1))
     write (*, '(a)') '--- '//trim(tag)
     do a = 1, 2
-      call mesh_build(msh(a), d%body(a))
+      call grid_mesh(msh(a), d%body(a))
       call assemble_body(msh(a), d%body(a), d%plane_strain, d%traction, d%ntraction, systems(a), err)
       call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed: '//trim(msg)

@@ -7,9 +7,9 @@ program test_equilibrium
   use kinds, only: wp
   use config, only: body_cfg_t, traction_cfg_t, ELEM_Q1, ELEM_P1, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, BC_FREE, BC_CLAMPED, BC_CONTACT
-  use mesh, only: mesh_t, mesh_build
+  use mesh, only: mesh_t
   use assembly, only: body_system_t, assemble_body, residual_full
-  use testing, only: report, test_summary, solve_full, error_parts
+  use testing, only: grid_mesh, grid_mesh_parts, report, test_summary, solve_full, error_parts
   use errors, only: error_t
   implicit none (type, external)
 
@@ -67,7 +67,7 @@ contains
     integer :: info
     type(error_t) :: err
     character(len=256) :: msg
-    call mesh_build(m, body, info, msg)
+    call grid_mesh_parts(m, body, info, msg)
     if (info == 0) then
       call assemble_body(m, body, plane_strain, tr, size(tr), sys, err)
       call error_parts(err, info, msg)
@@ -157,7 +157,7 @@ contains
     character(len=64) :: what
     do i = 1, 4
       call seed_body(ELEM_Q1, nxs(i), nys(i), .false., body, tr)
-      call mesh_build(m, body)
+      call grid_mesh(m, body)
       call assemble_body(m, body, .true., tr, 2, sys, err)
       call error_parts(err, info, msg)
       write (what, '(a,i0,a,i0,a,i0,a)') 'seed mesh ', nxs(i), 'x', nys(i), ': n = ', nexp(i), ' free DOFs'

@@ -6,12 +6,12 @@ program test_errors
   use errors, only: error_t, exit_code, fail_on, ERR_NONE, ERR_INPUT, ERR_NUMERICAL, ERR_IO, ERR_MEMORY, &
                     EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL
   use config, only: body_cfg_t, traction_cfg_t, deck_t, deck_init, SIDE_LEFT, BC_CLAMPED
-  use mesh, only: mesh_t, mesh_build
+  use mesh, only: mesh_t
   use assembly, only: assemble_body, body_system_t
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_AMD, ORD_NATURAL
   use mortar, only: mortar_t, mortar_build
   use budget, only: check_load_range
-  use testing, only: report, test_summary
+  use testing, only: grid_mesh, report, test_summary
   implicit none (type, external)
 
   call test_categories()
@@ -62,7 +62,7 @@ contains
     body%nx = 3
     body%ny = 2
     body%bc(SIDE_LEFT) = BC_CLAMPED
-    call mesh_build(m, body)
+    call grid_mesh(m, body)
     tr(1)%body = 1
     tr(1)%group = 'no_such_group'
     tr(1)%origin = '&traction 1'

@@ -52,12 +52,12 @@ program test_fem
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, element_names, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT
-  use mesh, only: mesh_t, mesh_build, side_nodes
+  use mesh, only: mesh_t, side_nodes
   use assembly, only: body_system_t, assemble_body, expand, residual_full, nodal_stress, csc_matvec, &
                       body_force_fn, cell_triplets
   use test_fem_manufactured, only: ms_u, ms_force, ms_lame_lambda, ms_lame_mu
   use elements, only: MAX_NVERT, MAX_NDOF, element_stiffness, q1_gradients, element_shape_integrals
-  use testing, only: report, test_summary, solve_full, error_parts
+  use testing, only: grid_mesh, grid_mesh_parts, report, test_summary, solve_full, error_parts
   use errors, only: error_t
   implicit none (type, external)
 
@@ -177,7 +177,7 @@ contains
     tr%body = 1
     tr%side = SIDE_TOP
     tr%t0(1:2) = [0.3_wp, -1.0_wp]
-    call mesh_build(m, body)
+    call grid_mesh(m, body)
   end subroutine loaded_rect
 
   !> Deterministic pseudo-random number in [-0.5, 0.5) for integer pair (i, j).
@@ -695,7 +695,7 @@ contains
     e = body%young
     nu = body%poisson
 
-    call mesh_build(m, body)
+    call grid_mesh(m, body)
     call distort_interior(m, 0.3_wp)
     allocate (u_ex(2*m%nnode))
     do k = 1, m%nnode
@@ -848,7 +848,7 @@ contains
     do lev = 1, nlev
       body%nx = 2**(lev + 1)
       body%ny = 2**(lev + 1)
-      call mesh_build(m, body)
+      call grid_mesh(m, body)
       allocate (up(2*m%nnode))
       do k = 1, m%nnode
         call ms_u(m%xy(1, k), m%xy(2, k), ue, ge)
@@ -892,7 +892,7 @@ contains
 
     body = rect_body(2, 0.5_wp, 1.0_wp, 2.0_wp, 1.2_wp, 7, 5, element)
     body%bc = BC_FREE
-    call mesh_build(m, body)
+    call grid_mesh(m, body)
     allocate (onside(m%nnode))
     do kase = 1, 2
       do side = 1, 4
@@ -982,9 +982,9 @@ contains
     t_mm(1)%t1 = t_si(1)%t1*1.0e-9_wp
     t_mm(2)%t0 = t_si(2)%t0*1.0e-6_wp
 
-    call mesh_build(m, b_si)
+    call grid_mesh(m, b_si)
     call solve_body(m, b_si, plane_strain, t_si, 2, sys, u_si)
-    call mesh_build(m, b_mm)
+    call grid_mesh(m, b_mm)
     call solve_body(m, b_mm, plane_strain, t_mm, 2, sys, u_mm)
     scale = maxval(abs(u_mm))
     err = maxval(abs(u_mm - 1.0e3_wp*u_si))
@@ -1009,7 +1009,7 @@ contains
     body%nx = 3
     body%ny = 2
     body%bc(SIDE_LEFT) = BC_CLAMPED
-    call mesh_build(m, body)
+    call grid_mesh(m, body)
     tr(1)%body = 1
     tr(1)%side = 7
     call assemble_body(m, body, .true., tr, 1, sys, err)
@@ -1041,9 +1041,9 @@ contains
     write (*, '(a,a)') '      message: ', trim(msg)
     call report(info /= 0, 'errors: an inverted cell gives info /= 0', real(info, wp), 0.0_wp)
     body%nx = 0
-    call mesh_build(m, body, info, msg)
+    call grid_mesh_parts(m, body, info, msg)
     call report(info /= 0 .and. m%nnode == 0, &
-                'errors: mesh_build with nx = 0 gives info /= 0', real(info, wp), 0.0_wp)
+                'errors: mesh_build with nx = 0 gives an input error', real(info, wp), 0.0_wp)
     call assemble_body(m, body, .true., tr, 1, sys, err)
     call error_parts(err, info, msg)
     call report(info /= 0, 'errors: assemble_body on an empty mesh gives info /= 0', real(info, wp), 0.0_wp)

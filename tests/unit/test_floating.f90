@@ -16,7 +16,7 @@ program test_floating
   use kinds, only: wp
   use config, only: body_cfg_t, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, BC_FREE, BC_CLAMPED, BC_ROLLER
-  use mesh, only: mesh_t, mesh_build, group_index, group_nodes
+  use mesh, only: mesh_t, group_index, group_nodes
   use gmsh_msh, only: msh_read
   use errors, only: error_t
   use assembly, only: body_system_t, assemble_body, residual_full, rigid_motion_name
@@ -26,7 +26,7 @@ program test_floating
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use nonneg_lsq, only: nnls, sparse_cols_t, NNLS_ACTIVE_SET, NNLS_INTERIOR
   use lapack, only: dgesv, dsyev
-  use testing, only: report, report_le, test_summary, set_seed, error_parts
+  use testing, only: grid_mesh_parts, report, report_le, test_summary, set_seed, error_parts
   use errors, only: error_t
   implicit none (type, external)
 
@@ -298,7 +298,7 @@ contains
       bnd(1)%origin = 'test'
       if (group == 'bottom') rot_at = [0.7_wp, 0.0_wp]   ! ux = 0 on y = 0: rotations about points of it
     end if
-    call mesh_build(msh, body, info, msg)
+    call grid_mesh_parts(msh, body, info, msg)
     if (info == 0) then
       call assemble_body(msh, body, .true., notr, 0, system, err, boundaries=bnd, contact_groups=[contact])
       call error_parts(err, info, msg)

@@ -15,10 +15,10 @@ program test_materials
   use kinds, only: wp
   use config, only: body_cfg_t, traction_cfg_t, material_cfg_t, elastic_law_t, ELEM_Q1, ELEM_P1, &
                     BC_DISPLACEMENT, MAT_ORTHOTROPIC, MAT_ANISOTROPIC, MAT_ISOTROPIC, UNSET
-  use mesh, only: mesh_t, mesh_build
+  use mesh, only: mesh_t
   use assembly, only: body_system_t, assemble_body, nodal_stress, lame_parameters
   use material_laws, only: material_law, symmetric_eigenvalues
-  use testing, only: report, test_summary, solve_full, error_parts
+  use testing, only: grid_mesh, report, test_summary, solve_full, error_parts
   use errors, only: error_t
   implicit none (type, external)
 
@@ -172,7 +172,7 @@ contains
     allocate (body%law(1))
     call material_law(m, angle, plane_strain, body%law(1), msg)
     call report(len(msg) == 0, trim(what)//': material_law accepts the material')
-    call mesh_build(msh, body)
+    call grid_mesh(msh, body)
     h = 0.3_wp*body%width/body%nx                 ! distort the interior nodes
     do k = 1, msh%nnode
       if (abs(msh%xy(1, k) - body%x0) > 1e-9_wp .and. abs(msh%xy(1, k) - body%x0 - body%width) > 1e-9_wp .and. &

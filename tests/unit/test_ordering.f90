@@ -23,7 +23,7 @@ program test_ordering
                     SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, &
                     BC_FREE, BC_CLAMPED, BC_ROLLER, BC_CONTACT, factor_cfg_t
   use space, only: set_dimension, node_dof, dof_node
-  use mesh, only: mesh_t, mesh_build, node_id
+  use mesh, only: mesh_t, node_id
   use assembly, only: body_system_t, assemble_body, csc_matvec
   use supports, only: number_free_dofs
   use ordering, only: grid_dissection, coordinate_bisection, ND_LEAF_NODES, node_dissection, node_groups
@@ -34,7 +34,7 @@ program test_ordering
   use factorization, only: cholmod_factor_t, factor_t, new_factor
   use clock, only: wtime
   use strings, only: body_label
-  use testing, only: report, report_le, test_summary, rectangle_body, structured_body, general_body, &
+  use testing, only: grid_mesh, report, report_le, test_summary, rectangle_body, structured_body, general_body, &
                      side_free_dofs, order_body, factor_ordered, error_parts, box_system
   use errors, only: error_t, ERR_NUMERICAL
   implicit none (type, external)
@@ -355,7 +355,7 @@ contains
     tr(2)%side = SIDE_BOTTOM
     tr(2)%t0(1:2) = [5.0e5_wp, 1.0e6_wp]
     do a = 1, 2
-      call mesh_build(msh(a), d%body(a))
+      call grid_mesh(msh(a), d%body(a))
       call assemble_body(msh(a), d%body(a), .true., tr, 2, sys(a), err)
       call error_parts(err, info, msg)
       if (info /= 0) error stop 'assembly failed: '//trim(msg)

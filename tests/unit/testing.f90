@@ -31,7 +31,7 @@ module testing
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered, box_system
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
   public :: random_bounds, enumerate_box, box_projected, identity
-  public :: error_parts
+  public :: error_parts, grid_mesh, grid_mesh_parts, box_mesh_parts
 
 contains
 
@@ -208,7 +208,7 @@ contains
     character(len=256) :: msg
     type(error_t) :: err
     tr(1) = top_traction(b)
-    call mesh_build(msh, b, info, msg)
+    call grid_mesh_parts(msh, b, info, msg)
     if (info /= 0) error stop 'structured_body: mesh_build failed: '//trim(msg)
     call assemble_body(msh, b, .true., tr, 1, sys, err)
     if (err%failed()) error stop 'structured_body: assemble_body failed: '//err%text()
@@ -270,7 +270,7 @@ contains
     tr(1)%body = 1
     tr(1)%side = SIDE_TOP
     tr(1)%t0 = [0.0_wp, -1.0e6_wp, 0.0_wp]
-    call box_build(msh, b, kuhn_tets, info, msg)
+    call box_mesh_parts(msh, b, info, msg)
     if (info /= 0) error stop 'box_system: box_build failed: '//trim(msg)
     call assemble_body(msh, b, .true., tr, 1, sys, err)
     if (err%failed()) error stop 'box_system: assemble_body failed: '//err%text()
@@ -326,7 +326,7 @@ contains
     type(error_t) :: err
 
     tr(1) = top_traction(b)
-    call mesh_build(grid, b, info, msg)
+    call grid_mesh_parts(grid, b, info, msg)
     if (info /= 0) error stop 'general_body: mesh_build failed: '//trim(msg)
     nn = grid%nnode
 
@@ -556,6 +556,37 @@ contains
     info = err%category
     msg = err%text()
   end subroutine error_parts
+
+  !> mesh_build of a grid the test knows to be valid: stops the test program when it fails.
+  subroutine grid_mesh(m, body)
+    type(mesh_t), intent(out) :: m
+    type(body_cfg_t), intent(in) :: body
+    type(error_t) :: err
+    call mesh_build(m, body, err)
+    if (err%failed()) error stop 'grid_mesh: mesh_build failed: '//err%text()
+  end subroutine grid_mesh
+
+  !> mesh_build with its outcome as (category, message): info 0 on success.
+  subroutine grid_mesh_parts(m, body, info, msg)
+    type(mesh_t), intent(out) :: m
+    type(body_cfg_t), intent(in) :: body
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    type(error_t) :: err
+    call mesh_build(m, body, err)
+    call error_parts(err, info, msg)
+  end subroutine grid_mesh_parts
+
+  !> box_build (Kuhn's tetrahedra) with its outcome as (category, message): info 0 on success.
+  subroutine box_mesh_parts(m, body, info, msg)
+    type(mesh_t), intent(out) :: m
+    type(body_cfg_t), intent(in) :: body
+    integer, intent(out) :: info
+    character(len=*), intent(out) :: msg
+    type(error_t) :: err
+    call box_build(m, body, kuhn_tets, err)
+    call error_parts(err, info, msg)
+  end subroutine box_mesh_parts
 
 
   ! ---- bound-constrained QPs: random bounds, the solution by enumeration, the projected gradient
