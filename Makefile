@@ -167,7 +167,7 @@ $(BUILD)/elements.o:       $(BUILD)/kinds.o $(BUILD)/config.o
 $(BUILD)/elements_3d.o:    $(BUILD)/kinds.o
 $(BUILD)/element_types.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/elements.o $(BUILD)/elements_3d.o $(BUILD)/space.o
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
-$(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o
+$(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/body_system.o:    $(BUILD)/kinds.o
 $(BUILD)/supports.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o $(BUILD)/strings.o
 $(BUILD)/stiffness_pattern.o: $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o

@@ -9,6 +9,8 @@
 module linop
   use kinds, only: wp
   use lapack, only: dsymv
+  use errors, only: error_t, ERR_INPUT
+  use strings, only: i2s
   implicit none (type, external)
   private
 
@@ -55,14 +57,14 @@ module linop
 contains
 
   !> Make `op` a dense operator holding a copy of the square matrix `a`.
-  !! `info` (optional): 0 on success, 1 if `a` is not square (op%n is then 0).
-  subroutine dense_op_init(op, a, info)
+  !! `err` (optional): a matrix that is not square (op%n is then 0).
+  subroutine dense_op_init(op, a, err)
     type(dense_op_t), intent(out) :: op      !< the operator to set up
     real(wp), intent(in) :: a(:,:)           !< symmetric matrix, full storage
-    integer, intent(out), optional :: info   !< 0 ok, 1 not square
-    if (present(info)) info = 0
+    type(error_t), intent(out), optional :: err   !< a matrix that is not square
     if (size(a, 1) /= size(a, 2)) then
-      if (present(info)) info = 1
+      if (present(err)) call err%set(ERR_INPUT, 'dense operator: the matrix is '//i2s(size(a, 1))//' x '// &
+                                     i2s(size(a, 2))//', not square')
       op%n = 0
       allocate (op%a(0, 0))
       return
@@ -91,15 +93,15 @@ contains
   end subroutine dense_apply
 
   !> Make `op` a CSC operator holding copies of the arrays (0-based indices).
-  !! `info` (optional): 0 on success, 1 bad n or colptr, 2 row index out of range
-  !! (op%n is then 0 and the operator is empty).
-  subroutine csc_op_init(op, n, colptr, rowind, val, info)
+  !! `err` (optional): bad n or colptr, or a row index out of range (op%n is then 0 and the
+  !! operator is empty).
+  subroutine csc_op_init(op, n, colptr, rowind, val, err)
     type(csc_op_t), intent(out) :: op       !< the operator to set up
     integer, intent(in) :: n                !< matrix size
     integer, intent(in) :: colptr(:)        !< size n+1, 0-based, nondecreasing
     integer, intent(in) :: rowind(:)        !< 0-based row indices
     real(wp), intent(in) :: val(:)          !< values
-    integer, intent(out), optional :: info  !< 0 ok, 1 bad structure, 2 index out of range
+    type(error_t), intent(out), optional :: err   !< a bad structure or an index out of range
     integer :: j, nnz, ierr
     ierr = 0
     if (n < 0 .or. size(colptr) /= n + 1) then
@@ -118,8 +120,14 @@ contains
         end if
       end if
     end if
-    if (present(info)) info = ierr
     if (ierr /= 0) then
+      if (present(err)) then
+        if (ierr == 1) then
+          call err%set(ERR_INPUT, 'sparse operator: bad n or column pointers')
+        else
+          call err%set(ERR_INPUT, 'sparse operator: a row index out of range')
+        end if
+      end if
       op%n = 0
       allocate (op%colptr(1), op%rowind(0), op%val(0))
       op%colptr = 0

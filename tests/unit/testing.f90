@@ -141,7 +141,8 @@ contains
     real(wp), intent(in) :: scale_a                   !< factor applied to A
     integer, allocatable :: cp(:), ri(:)
     real(wp), allocatable :: v(:)
-    integer :: j, k, info
+    integer :: j, k
+    type(error_t) :: err
     real(wp) :: h2
     h2 = real(n + 1, wp)**2
     allocate (cp(n + 1), ri(3 * n), v(3 * n))
@@ -157,8 +158,8 @@ contains
       end if
       cp(j + 1) = k
     end do
-    call csc_op_init(op, n, cp, ri, v, info)
-    if (info /= 0) error stop 'csc_op_init failed'
+    call csc_op_init(op, n, cp, ri, v, err)
+    if (err%failed()) error stop 'csc_op_init failed: '//err%text()
     allocate (b(n), l(n))
     b = -15.0_wp
     l = -1.0_wp
