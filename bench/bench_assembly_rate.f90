@@ -46,7 +46,7 @@ program bench_assembly_rate
       call msh_read_shared(trim(d%body(1)%mesh), [(d%body(a)%region, a=1, d%nbody)], [(a, a=1, d%nbody)], m, e, 1)
     else
       do a = 1, d%nbody
-        call mesh_build(m(a), d%body(a))
+        call mesh_build(m(a), d%body(a), e(a))
       end do
     end if
     call cpu_time(t(2))
