@@ -2,10 +2,17 @@
 !! form for decks, fixed forms for messages and summary lines), namelist string literals,
 !! blank-separated word lists, and the floating-point guard around READs of numbers.
 !!
-!! Thread safety: `itoa` and `rtoa` return fixed-length results for use inside code that
-!! runs on two threads (MPRGP): deferred-length character results built into
-!! concatenations were seen to corrupt memory when two threads ran the same statement
-!! (gfortran 12, AddressSanitizer). The deferred-length helpers are for serial code.
+!! Numbers to text, one function a format: `i2s` (an integer), `roundtrip` (the shortest
+!! text that reads back to a real: deck values), `sci` (scientific notation with a chosen
+!! number of digits: measured values), `fixed` (fixed-point with a leading 0: sizes, times).
+!!
+!! Thread safety: gfortran 12 keeps the length of a deferred-length character function
+!! result in a static variable of the call site, which two threads at the same statement
+!! share (a wrong length, memory corrupted: seen in MPRGP under AddressSanitizer and in the
+!! mesh reader). `i2s` and `sci` declare their result's length from their arguments, which
+!! the caller computes into a local, so code that two threads run at once may call them;
+!! `roundtrip`, `fixed`, `quote`, `word` and the others return deferred-length results and
+!! are for serial code.
 module strings
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: ieee_exceptions, only: ieee_usual, ieee_get_halting_mode, &
@@ -15,7 +22,7 @@ module strings
   private
 
   public :: fpstate_t, fp_read_begin, fp_read_end, lower, is_ident, is_letter, first_nonblank
-  public :: i2s, r2s, itoa, rtoa, sci, fmt_real, quote, quoted_list, next_word, index_of, word, body_label
+  public :: i2s, roundtrip, sci, fixed, quote, quoted_list, next_word, index_of, word, body_label
 
   !> Saved floating-point halting modes and flags.
   type :: fpstate_t
@@ -34,6 +41,12 @@ module strings
     !! no deferred-length function result, see the header)
     procedure :: get => text_buffer_get
   end type text_buffer_t
+
+  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308):
+  !! `sci(x)` with 3 digits after the point, `sci(x, digits)` with `digits`.
+  interface sci
+    module procedure sci_3, sci_digits
+  end interface sci
 
 contains
 
@@ -109,13 +122,30 @@ contains
     first_nonblank = max(1, verify(s, ' '))
   end function first_nonblank
 
-  pure function i2s(i) result(s)
-    integer, intent(in) :: i
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(i0)') i
-    s = trim(buf)
+  !> An integer as text, as short as it goes ('42', '-7'); its length is i2s_len(k), not
+  !! deferred (code that two threads run may call it, see the header).
+  pure function i2s(k) result(s)
+    integer, intent(in) :: k   !< the integer
+    character(len=i2s_len(k)) :: s
+    write (s, '(i0)') k
   end function i2s
+
+  !> The length of i2s(k): its digits and a minus sign (counted on -|k|, which never overflows).
+  pure integer function i2s_len(k)
+    integer, intent(in) :: k
+    integer :: m
+    if (k < 0) then
+      i2s_len = 2
+      m = k
+    else
+      i2s_len = 1
+      m = -k
+    end if
+    do while (m <= -10)
+      m = m / 10
+      i2s_len = i2s_len + 1
+    end do
+  end function i2s_len
 
   !> The label of body a in messages and names: '1', '2'.
   pure function body_label(a) result(s)
@@ -165,8 +195,10 @@ contains
     end do
   end function quoted_list
 
-  !> Shortest text that reads back to exactly x (decimal form for moderate exponents).
-  function r2s(x) result(s)
+  !> The shortest text that reads back to exactly x: decimal form for exponents -3 to 5
+  !! (0.001, 210000.0), else one digit before the point and an exponent (2.1e11); what the
+  !! effective deck and messages about deck values print.
+  function roundtrip(x) result(s)
     real(wp), intent(in) :: x
     character(len=:), allocatable :: s
     character(len=48) :: buf
@@ -229,7 +261,7 @@ contains
       end if
     end if
     if (neg) s = '-'//s
-  end function r2s
+  end function roundtrip
 
   !> Find the next blank-separated word at or after p: on return table(p:q) (q < p if none).
   subroutine next_word(table, p, q)
@@ -282,45 +314,42 @@ contains
     end do
   end function word
 
-  !> Integer to text, fixed length (thread-safe; use with trim).
-  function itoa(k) result(s)
-    integer, intent(in) :: k
-    character(len=24) :: s
-    write (s, '(i0)') k
-  end function itoa
+  !> sci(x): 3 digits after the point.
+  pure function sci_3(x) result(t)
+    real(wp), intent(in) :: x   !< the value
+    character(len=len_trim(sci_text(x, 3))) :: t
+    t = sci_text(x, 3)
+  end function sci_3
 
-  !> Real to text as es12.4, fixed length, left-adjusted (thread-safe; use with trim).
-  function rtoa(v) result(s)
-    real(wp), intent(in) :: v
-    character(len=24) :: s
-    write (s, '(es12.4)') v
-    s = adjustl(s)
-  end function rtoa
+  !> sci(x, digits): `digits` digits after the point.
+  pure function sci_digits(x, digits) result(t)
+    real(wp), intent(in) :: x        !< the value
+    integer, intent(in) :: digits    !< digits after the point
+    character(len=len_trim(sci_text(x, digits))) :: t
+    t = sci_text(x, digits)
+  end function sci_digits
 
-  !> Scientific notation with a 2- or 3-digit exponent as needed (1.234E-09, 1.798E+308),
-  !! with `digits` digits after the point (default 3).
-  function sci(x, digits) result(t)
+  !> sci's text, left-adjusted in a fixed-length buffer (its length is sci's result length).
+  pure function sci_text(x, digits) result(buf)
     real(wp), intent(in) :: x
-    integer, intent(in), optional :: digits
-    character(len=:), allocatable :: t
-    character(len=32) :: buf, fmt
-    integer :: d
-    d = 3
-    if (present(digits)) d = digits
+    integer, intent(in) :: digits
+    character(len=32) :: buf
+    character(len=32) :: fmt
     if (abs(x) >= 1.0e100_wp .or. (abs(x) < 1.0e-99_wp .and. x /= 0.0_wp)) then
-      write (fmt, '(a,i0,a,i0,a)') '(es', d + 8, '.', d, 'e3)'
+      write (fmt, '(a,i0,a,i0,a)') '(es', digits + 8, '.', digits, 'e3)'
     else
-      write (fmt, '(a,i0,a,i0,a)') '(es', d + 7, '.', d, ')'
+      write (fmt, '(a,i0,a,i0,a)') '(es', digits + 7, '.', digits, ')'
     end if
     write (buf, fmt) x
-    t = trim(adjustl(buf))
-  end function sci
+    buf = adjustl(buf)
+  end function sci_text
 
-  !> A fixed-point number in format `fmt` with a leading 0 (0.95, 0.012); trailing zeros
-  !! are dropped except for the format '(f0.3)' (times keep their three decimals).
-  function fmt_real(x, fmt) result(s)
-    real(wp), intent(in) :: x
-    character(len=*), intent(in) :: fmt
+  !> Fixed-point text in format `fmt` ('(f0.2)', ...) with a leading 0 (0.95, 0.012);
+  !! trailing zeros are dropped except for the format '(f0.3)' (times keep their three
+  !! decimals).
+  function fixed(x, fmt) result(s)
+    real(wp), intent(in) :: x            !< the value
+    character(len=*), intent(in) :: fmt  !< an F edit descriptor in parentheses
     character(len=:), allocatable :: s
     character(len=40) :: buf
     write (buf, fmt) x
@@ -332,6 +361,6 @@ contains
       if (s(len(s):len(s)) == '.') s = s(1:len(s) - 1)
     end if
     if (s(1:1) == '.') s = '0'//s
-  end function fmt_real
+  end function fixed
 
 end module strings

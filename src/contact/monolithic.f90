@@ -15,7 +15,7 @@ module monolithic
                    mprgp_status_name, QP_AUTO, QP_MPRGP, QP_NEWTON
   use smalbe, only: smalbe_solve, smalbe_solve_in, smalbe_stats_t
   use tangent_discs, only: friction_set
-  use strings, only: itoa
+  use strings, only: i2s
   use sorting, only: sort_ints
   use contact_interface, only: interface_t, slot_row, slot_side, has_friction, row_bounds, disc_rows, DIR_NORMAL
   use config, only: FRICTION_COULOMB, INNER_MPRGP, INNER_ACTIVE_SET
@@ -192,7 +192,7 @@ contains
       res%inner = nmv
       if (inner%status == MPRGP_STOPPED) then
         res%status = STATUS_INTERRUPTED
-        res%message = 'monolithic MPRGP stopped by a signal after '//trim(itoa(inner%n_cg + inner%n_exp + inner%n_prop))// &
+        res%message = 'monolithic MPRGP stopped by a signal after '//i2s(inner%n_cg + inner%n_exp + inner%n_prop)// &
                       ' steps (no checkpoint: the monolithic solve is one step)'
       else if (inner%status /= MPRGP_CONVERGED) then
         res%status = merge(STATUS_MAX_OUTER, STATUS_FAILED, inner%status == MPRGP_MAX_IT)

@@ -16,7 +16,7 @@ module run_state
   use contact_types, only: contact_result_t, robin_state_t
   use results, only: timing_t, step_result_t
   use load_history, only: load_step_t, step_history_t
-  use strings, only: fmt_real
+  use strings, only: fixed
   use clock, only: wtime
   use mpi_env, only: par_built, par_init, par_finalize, par_rank, par_size, par_abort
   implicit none (type, external)
@@ -111,7 +111,7 @@ contains
   subroutine phase(run, what)
     type(run_t), intent(in) :: run        !< the run (its start time)
     character(len=*), intent(in) :: what  !< the phase
-    write (output_unit, '(a)') 'phase: '//trim(what)//' (at '//fmt_real(wtime() - run%t_start, '(f0.1)')//' s)'
+    write (output_unit, '(a)') 'phase: '//trim(what)//' (at '//fixed(wtime() - run%t_start, '(f0.1)')//' s)'
     flush (output_unit)
   end subroutine phase
 

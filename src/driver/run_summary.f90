@@ -11,7 +11,7 @@ module run_summary
   use friction_view, only: tangential_t, split_friction, NODE_STICK, NODE_SLIP
   use contact_types, only: status_name, STATUS_CONVERGED, STATUS_FAILED, STATUS_INTERRUPTED, STATUS_NO_EQUILIBRIUM
   use sysinfo, only: write_stdout_checked
-  use strings, only: sci, fmt_real, i2s, word
+  use strings, only: sci, fixed, i2s, word
   use run_state, only: run_t
   use mesh, only: group_index, group_nodes
   use namelist_vars, only: str_t
@@ -95,8 +95,8 @@ contains
       write (line(4), '(a,a,a,a,a,i0,a,i0,a,i0,a,i0,a,i0,a,a,a,es8.2,a,a)') 'result: status=', &
         status_name(result%status), ' method=', word(METHOD_CHOICES, result%method), ' outer=', result%outer, ' inner=', result%inner, &
         ' n1=', run%systems(1)%n, ' n2=', run%systems(2)%n, ' m=', run%contact_line%m, &
-        ' delta=', fmt_real(run%deck%solver%delta, '(f0.6)'), ' residual=', result%residual, &
-        ' wall_s=', fmt_real(timing%total, '(f0.3)')
+        ' delta=', fixed(run%deck%solver%delta, '(f0.6)'), ' residual=', result%residual, &
+        ' wall_s=', fixed(timing%total, '(f0.3)')
       line(4) = trim(line(4))//' bodies='//i2s(run%nbody)//' pairs='//i2s(run%contact_line%npair)// &
                 ' dofs='//total_dofs(run)
       ! one contact line per pair; the output line sits before the time line when a result
@@ -138,7 +138,7 @@ contains
       if (allocated(run%contact_line%dir)) ftot = sum(run%result%lam, mask=run%contact_line%dir == DIR_NORMAL)
     end if
     t = 'step: step='//i2s(k)//' of='//i2s(size(run%plan))//' stage='//i2s(run%plan(k)%stage)// &
-        ' load_factor='//fmt_real(run%plan(k)%factor, '(f0.6)')//' outer='//i2s(run%result%outer)// &
+        ' load_factor='//fixed(run%plan(k)%factor, '(f0.6)')//' outer='//i2s(run%result%outer)// &
         ' status='//status_name(run%result%status)//' normal_force_sum='//sci(ftot, 5)
     np = run%contact_line%npair
     if (np > 1 .and. allocated(run%contact_line%pair_ptr)) then

@@ -20,7 +20,7 @@ module budget
   use kinds, only: wp
   use space, only: NDIM
   use config, only: MAX_SIDES, MODULUS_MIN, MODULUS_MAX, body_stiffness, deck_t, body_cfg_t, factor_cfg_t, ELEM_Q1, FACTOR_BANDED, ORDER_NATURAL
-  use strings, only: i2s, sci, fmt_real
+  use strings, only: i2s, sci, fixed
   use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
@@ -176,7 +176,7 @@ contains
       mb = body_memory_mb(d%body(a), d%solver%factor, nm, nf)
       if (nm > INDEX_MAX .or. nf > INDEX_MAX) then
         call err%set(ERR_INPUT, 'body '//i2s(a)//' (nx = '//i2s(d%body(a)%nx)//', ny = '// &
-              i2s(d%body(a)%ny)//') needs about '//fmt_real(nm/1.0e9_wp, '(f0.2)')//'e9 matrix and '//fmt_real(nf/1.0e9_wp, '(f0.2)')// &
+              i2s(d%body(a)%ny)//') needs about '//fixed(nm/1.0e9_wp, '(f0.2)')//'e9 matrix and '//fixed(nf/1.0e9_wp, '(f0.2)')// &
               'e9 factor entries, beyond the 2^31 (2.1e9) that the 32-bit indices of this build hold; '// &
               'use fewer cells')
         return
@@ -184,18 +184,18 @@ contains
     end do
     est = run_memory_mb(d)
     if (limit_mb > 0.0_wp .and. est > limit_mb .and. d%nbody == 2) then
-      call err%set(ERR_INPUT, 'the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
-            ' GiB (body 1: '//fmt_real(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
-            ' GiB, body 2: '//fmt_real(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
+      call err%set(ERR_INPUT, 'the run needs about '//fixed(est/1024.0_wp, '(f0.2)')// &
+            ' GiB (body 1: '//fixed(body_memory_mb(d%body(1), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
+            ' GiB, body 2: '//fixed(body_memory_mb(d%body(2), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
-            fmt_real(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
+            fixed(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
             'use fewer cells or a machine with more memory'//solid_remedy())
     else if (limit_mb > 0.0_wp .and. est > limit_mb) then
-      call err%set(ERR_INPUT, 'the run needs about '//fmt_real(est/1024.0_wp, '(f0.2)')// &
+      call err%set(ERR_INPUT, 'the run needs about '//fixed(est/1024.0_wp, '(f0.2)')// &
             ' GiB for its '//i2s(d%nbody)//' bodies (the largest, body '//i2s(big)//': '// &
-            fmt_real(body_memory_mb(d%body(big), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
+            fixed(body_memory_mb(d%body(big), d%solver%factor, nm, nf)/1024.0_wp, '(f0.2)')// &
             ' GiB: meshes, matrices and Cholesky factors) but this process may use only '// &
-            fmt_real(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
+            fixed(limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ulimit -v); '// &
             'use fewer cells or a machine with more memory'//solid_remedy())
     end if
   end subroutine check_budget
@@ -316,16 +316,16 @@ contains
     end do
     x = rank_memory_mb(d, ranks, rank, fs)
     what = 'with factorization=''mumps'' on '//i2s(ranks)//' rank(s) ('//map_text(d%nbody, ranks, host, group)// &
-           ') a rank needs about '//fmt_real(rank_mb/1024.0_wp, '(f0.2)')//' GiB (rank '//i2s(rank)// &
-           ': its share of the MUMPS factor '//fmt_real(fs/1024.0_wp, '(f0.2)')//' GiB, the meshes and loads of '// &
+           ') a rank needs about '//fixed(rank_mb/1024.0_wp, '(f0.2)')//' GiB (rank '//i2s(rank)// &
+           ': its share of the MUMPS factor '//fixed(fs/1024.0_wp, '(f0.2)')//' GiB, the meshes and loads of '// &
            'every body and its element entries the rest)'
     if (process_limit_mb > 0.0_wp .and. rank_mb > process_limit_mb) then
       call err%set(ERR_INPUT, ''//what//' but a process may use only '// &
-            fmt_real(process_limit_mb/1024.0_wp, '(f0.2)')//' GiB (ulimit -v); use more ranks per body or fewer cells')
+            fixed(process_limit_mb/1024.0_wp, '(f0.2)')//' GiB (ulimit -v); use more ranks per body or fewer cells')
     else if (node_limit_mb > 0.0_wp .and. node_mb > node_limit_mb) then
       call err%set(ERR_INPUT, ''//what//', and the '//i2s(node_ranks)//' rank(s) on its node about '// &
-            fmt_real(node_mb/1024.0_wp, '(f0.2)')//' GiB together, but that node may use only '// &
-            fmt_real(node_limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ROBIN_MEMORY_LIMIT_MB); '// &
+            fixed(node_mb/1024.0_wp, '(f0.2)')//' GiB together, but that node may use only '// &
+            fixed(node_limit_mb/1024.0_wp, '(f0.2)')//' GiB (available memory, cgroup or ROBIN_MEMORY_LIMIT_MB); '// &
             'spread the ranks over more nodes (fewer per node), use more ranks per body, or fewer cells')
     end if
   end subroutine check_budget_ranks

@@ -8,7 +8,7 @@ module deck_checks
   use kinds, only: wp
   use space, only: NDIM, set_dimension
   use errors, only: fatal, EXIT_INPUT
-  use strings, only: i2s, r2s, sci, quote, quoted_list, word
+  use strings, only: i2s, roundtrip, sci, quote, quoted_list, word
   use namelist_vars, only: str_t, vars_t
   use namelist_input, only: src_t, grp_t, read_group, find_asg, find_int, die_at, bad_value
 
@@ -338,17 +338,17 @@ contains
     integer, intent(in) :: form, nbody
     integer :: k
     character(len=:), allocatable :: shown
-    if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', r2s(c%gap_radius), &
+    if (c%gap_radius < 0.0_wp) call bad_value(g, src, 'gap_radius', roundtrip(c%gap_radius), &
       'must be >= 0 (0: no initial gap; R > 0: g0(x) = (x - gap_center)^2/(2R))')
-    if (c%mu < 0.0_wp .or. c%mu > MU_MAX) call bad_value(g, src, 'mu', r2s(c%mu), 'must be >= 0 and <= 1e4 '// &
+    if (c%mu < 0.0_wp .or. c%mu > MU_MAX) call bad_value(g, src, 'mu', roundtrip(c%mu), 'must be >= 0 and <= 1e4 '// &
       '(the Coulomb friction coefficient: no pair of materials has more than about 10; a pair that must not slip '// &
       'sticks with any mu its load needs, and a larger one only spoils the conditioning)')
-    if (c%slip_bound < 0.0_wp .or. c%slip_bound > SLIP_MAX) call bad_value(g, src, 'slip_bound', r2s(c%slip_bound), &
+    if (c%slip_bound < 0.0_wp .or. c%slip_bound > SLIP_MAX) call bad_value(g, src, 'slip_bound', roundtrip(c%slip_bound), &
       'must be >= 0 and <= 1e20 (Tresca''s bound of the shear traction, in the deck''s stress unit)')
-    if (c%mu /= 0.0_wp .and. c%friction /= FRICTION_COULOMB) call bad_value(g, src, 'mu', r2s(c%mu), &
+    if (c%mu /= 0.0_wp .and. c%friction /= FRICTION_COULOMB) call bad_value(g, src, 'mu', roundtrip(c%mu), &
       'is the Coulomb coefficient: give it with friction=''coulomb''')
     if (c%slip_bound /= 0.0_wp .and. c%friction /= FRICTION_TRESCA) call bad_value(g, src, 'slip_bound', &
-      r2s(c%slip_bound), 'is Tresca''s bound: give it with friction=''tresca''')
+      roundtrip(c%slip_bound), 'is Tresca''s bound: give it with friction=''tresca''')
     if (c%interference_stage < 0 .or. c%interference_stage > MAX_STAGES) call bad_value(g, src, &
       'interference_stage', i2s(c%interference_stage), 'must be >= 0 and <= '//i2s(MAX_STAGES)// &
       ' (0: the whole interference at once; s: ramped over stage s''s load steps)')
@@ -385,24 +385,24 @@ contains
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     type(solver_cfg_t), intent(inout) :: s
-    if (s%alpha < 0.0_wp) call bad_value(g, src, 'alpha', r2s(s%alpha), 'must be >= 0')
+    if (s%alpha < 0.0_wp) call bad_value(g, src, 'alpha', roundtrip(s%alpha), 'must be >= 0')
     if (s%robin_operator == ROBIN_CONSTANT .and. .not. s%alpha > 0.0_wp) call bad_value(g, src, &
-      'alpha', r2s(s%alpha), 'must be > 0 when robin_operator=''constant''')
+      'alpha', roundtrip(s%alpha), 'must be > 0 when robin_operator=''constant''')
     if (.not. (s%delta > 0.0_wp .and. s%delta <= 1.0_wp)) call bad_value(g, src, 'delta', &
-      r2s(s%delta), 'is out of range: the relaxation must satisfy 0 < delta <= 1')
-    if (.not. s%tol > 0.0_wp) call bad_value(g, src, 'tol', r2s(s%tol), 'must be > 0')
+      roundtrip(s%delta), 'is out of range: the relaxation must satisfy 0 < delta <= 1')
+    if (.not. s%tol > 0.0_wp) call bad_value(g, src, 'tol', roundtrip(s%tol), 'must be > 0')
     if (s%max_outer < 1) call bad_value(g, src, 'max_outer', i2s(s%max_outer), 'must be >= 1')
-    if (.not. s%inner_factor > 0.0_wp) call bad_value(g, src, 'inner_factor', r2s(s%inner_factor), &
+    if (.not. s%inner_factor > 0.0_wp) call bad_value(g, src, 'inner_factor', roundtrip(s%inner_factor), &
       'must be > 0')
     if (.not. (s%inner_rtol_min > 0.0_wp .and. s%inner_rtol_min < 1.0_wp)) call bad_value(g, src, &
-      'inner_rtol_min', r2s(s%inner_rtol_min), 'must satisfy 0 < inner_rtol_min < 1')
+      'inner_rtol_min', roundtrip(s%inner_rtol_min), 'must satisfy 0 < inner_rtol_min < 1')
     if (.not. (s%inner_rtol_max > 0.0_wp .and. s%inner_rtol_max < 1.0_wp)) call bad_value(g, src, &
-      'inner_rtol_max', r2s(s%inner_rtol_max), 'must satisfy 0 < inner_rtol_max < 1')
+      'inner_rtol_max', roundtrip(s%inner_rtol_max), 'must satisfy 0 < inner_rtol_max < 1')
     if (s%inner_rtol_max < s%inner_rtol_min) call bad_value(g, src, 'inner_rtol_max', &
-      r2s(s%inner_rtol_max), 'must be >= inner_rtol_min = '//r2s(s%inner_rtol_min))
+      roundtrip(s%inner_rtol_max), 'must be >= inner_rtol_min = '//roundtrip(s%inner_rtol_min))
     if (s%inner_max_it < 1) call bad_value(g, src, 'inner_max_it', i2s(s%inner_max_it), 'must be >= 1')
     if (.not. (s%monolithic_rtol > 0.0_wp .and. s%monolithic_rtol < 1.0_wp)) call bad_value(g, src, &
-      'monolithic_rtol', r2s(s%monolithic_rtol), 'must satisfy 0 < monolithic_rtol < 1')
+      'monolithic_rtol', roundtrip(s%monolithic_rtol), 'must satisfy 0 < monolithic_rtol < 1')
     if (any(s%load_steps < 1 .and. s%load_steps /= STEPS_UNSET)) call bad_value(g, src, 'load_steps', &
       i2s(minval(s%load_steps, mask=s%load_steps /= STEPS_UNSET)), 'must be >= 1 (steps per stage)')
     ! every step's result is kept for the result file: a bound well above any ramp's need
@@ -491,19 +491,19 @@ contains
     call body_vars(c, v, ALL_FORMS)
     call read_group(g, src, v)
     if (len_trim(c%mesh) > 0 .and. find_asg(g, 'mesh') > 0) call mesh_body(g, src, c, st%path)
-    if (.not. c%width > 0.0_wp) call bad_value(g, src, 'width', r2s(c%width), 'must be > 0')
-    if (.not. c%height > 0.0_wp) call bad_value(g, src, 'height', r2s(c%height), 'must be > 0')
+    if (.not. c%width > 0.0_wp) call bad_value(g, src, 'width', roundtrip(c%width), 'must be > 0')
+    if (.not. c%height > 0.0_wp) call bad_value(g, src, 'height', roundtrip(c%height), 'must be > 0')
     if (c%nx < 1) call bad_value(g, src, 'nx', i2s(c%nx), 'must be >= 1 (cells along x)')
     if (c%ny < 1) call bad_value(g, src, 'ny', i2s(c%ny), 'must be >= 1 (cells along y)')
-    if (.not. c%young > 0.0_wp) call bad_value(g, src, 'young', r2s(c%young), &
+    if (.not. c%young > 0.0_wp) call bad_value(g, src, 'young', roundtrip(c%young), &
       'must be > 0 (Young''s modulus)')
     call check_modulus(g, src, 'young', c%young)
-    if (c%poisson >= 0.5_wp) call bad_value(g, src, 'poisson', r2s(c%poisson), 'is out of range: '// &
+    if (c%poisson >= 0.5_wp) call bad_value(g, src, 'poisson', roundtrip(c%poisson), 'is out of range: '// &
       'it must satisfy -1 < poisson < 0.5; poisson >= 0.5 (an incompressible material) is '// &
       'rejected: this displacement formulation cannot model it')
-    if (c%poisson <= -1.0_wp) call bad_value(g, src, 'poisson', r2s(c%poisson), 'is out of range: '// &
+    if (c%poisson <= -1.0_wp) call bad_value(g, src, 'poisson', roundtrip(c%poisson), 'is out of range: '// &
       'it must satisfy -1 < poisson < 0.5')
-    if (.not. c%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(c%density), &
+    if (.not. c%density >= 0.0_wp) call bad_value(g, src, 'density', roundtrip(c%density), &
       'must be >= 0 (mass per volume)')
     if (find_asg(g, 'material') > 0 .and. len_trim(c%material) > 0) then
       do s = 1, 3
@@ -523,13 +523,13 @@ contains
           quote(trim(c%material))//', ... /''), or give material='''' with young and poisson')
       end do
     end if
-    if (.not. abs(c%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', r2s(c%angle), &
+    if (.not. abs(c%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', roundtrip(c%angle), &
       'is out of range: an angle in degrees, at most 3600 in magnitude')
     c%id = b0%id
     do s = 1, MAX_SIDES
       if (c%bc(s) /= BC_DISPLACEMENT) c%u_side(:, s) = 0.0_wp
     end do
-    if (find_asg(g, 'depth') > 0 .and. .not. c%depth > 0.0_wp) call bad_value(g, src, 'depth', r2s(c%depth), &
+    if (find_asg(g, 'depth') > 0 .and. .not. c%depth > 0.0_wp) call bad_value(g, src, 'depth', roundtrip(c%depth), &
       'must be > 0')
     if (c%nz < 1) call bad_value(g, src, 'nz', i2s(c%nz), 'must be >= 1 (cells along z)')
     do s = 1, 5
@@ -693,21 +693,21 @@ contains
         quote(trim(m%name))//' has poisson but no young; give both')
       if (m%poisson == UNSET) call die_at(src, g%line, 'in group &material: isotropic material '// &
         quote(trim(m%name))//' has young but no poisson; give both')
-      if (.not. m%young > 0.0_wp) call bad_value(g, src, 'young', r2s(m%young), 'must be > 0 (Young''s modulus)')
+      if (.not. m%young > 0.0_wp) call bad_value(g, src, 'young', roundtrip(m%young), 'must be > 0 (Young''s modulus)')
       call check_modulus(g, src, 'young', m%young)
       if (.not. (m%poisson > -1.0_wp .and. m%poisson < 0.5_wp)) call bad_value(g, src, 'poisson', &
-        r2s(m%poisson), 'is out of range: it must satisfy -1 < poisson < 0.5')
+        roundtrip(m%poisson), 'is out of range: it must satisfy -1 < poisson < 0.5')
     end if
     do k = 1, 4
       call positive(trim(word('e1 e2 e3 g12', k)), [m%e1, m%e2, m%e3, m%g12])
     end do
     do k = 1, 10               ! a stiffness constant may be 0 or negative, not beyond the range
       x = constant(m, trim(word(ANISO, k)))
-      if (x /= UNSET .and. .not. abs(x) < MODULUS_MAX) call bad_value(g, src, trim(word(ANISO, k)), r2s(x), &
+      if (x /= UNSET .and. .not. abs(x) < MODULUS_MAX) call bad_value(g, src, trim(word(ANISO, k)), roundtrip(x), &
         'is beyond '//sci(MODULUS_MAX)//' in magnitude, where a body''s stiffness stays within double '// &
         'precision; rescale the units')
     end do
-    if (.not. m%density >= 0.0_wp) call bad_value(g, src, 'density', r2s(m%density), &
+    if (.not. m%density >= 0.0_wp) call bad_value(g, src, 'density', roundtrip(m%density), &
       'must be >= 0 (mass per volume)')
     if (n == 0) then
       if (.not. allocated(d%material)) allocate (d%material(4))
@@ -727,7 +727,7 @@ contains
       real(wp), intent(in) :: vals(4)
       real(wp) :: x
       x = vals(k)
-      if (x /= UNSET .and. .not. x > 0.0_wp) call bad_value(g, src, name, r2s(x), 'must be > 0 (a modulus)')
+      if (x /= UNSET .and. .not. x > 0.0_wp) call bad_value(g, src, name, roundtrip(x), 'must be > 0 (a modulus)')
       if (x /= UNSET) call check_modulus(g, src, name, x)
     end subroutine positive
   end subroutine add_material
@@ -740,7 +740,7 @@ contains
     type(src_t), intent(in) :: src           !< where it comes from
     character(len=*), intent(in) :: name     !< the variable
     real(wp), intent(in) :: x                !< its value [stress]
-    if (.not. (x > MODULUS_MIN .and. x < MODULUS_MAX)) call bad_value(g, src, name, r2s(x), &
+    if (.not. (x > MODULUS_MIN .and. x < MODULUS_MAX)) call bad_value(g, src, name, roundtrip(x), &
       'is outside ['//sci(MODULUS_MIN)//', '//sci(MODULUS_MAX)//'], where a body''s stiffness and '// &
       'flexibility stay within double precision; rescale the units')
   end subroutine check_modulus
@@ -810,7 +810,7 @@ contains
       'of the body''s mesh file')
     if (len_trim(r%material) == 0) call bad_value(g, src, 'material', "''", 'is empty: a region is '// &
       'made of a &material, named here')
-    if (.not. abs(r%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', r2s(r%angle), &
+    if (.not. abs(r%angle) <= 3600.0_wp) call bad_value(g, src, 'angle', roundtrip(r%angle), &
       'is out of range: an angle in degrees, at most 3600 in magnitude')
     n = 0
     do k = 1, d%nregion
@@ -854,7 +854,7 @@ contains
       'group=''NAME'', a physical curve of the body''s mesh (a rectangle has ''left'', ''right'', '// &
       '''bottom'', ''top'')')
     if (find_asg(g, 'uz') > 0 .and. NDIM == 2) call die_at(src, g%line, 'in group &boundary: uz = '// &
-      r2s(t%uz)//' in a 2D deck: a plane body has no z displacement (a 3D deck: &scene dimension=3)')
+      roundtrip(t%uz)//' in a 2D deck: a plane body has no z displacement (a 3D deck: &scene dimension=3)')
     if (find_asg(g, 'ux') == 0 .and. find_asg(g, 'uy') == 0 .and. find_asg(g, 'uz') == 0) call die_at(src, g%line, &
       'in group &boundary: neither ux nor uy'//trim(merge(' nor uz', '       ', NDIM == 3))//' is given; give '// &
       'the components to prescribe (ux=0.0 for a roller on a vertical wall, ux=0.0, uy=0.0 to clamp)')

@@ -6,7 +6,7 @@
 module deck_cross
   use kinds, only: wp
   use errors, only: fatal, warn, EXIT_INPUT
-  use strings, only: i2s, r2s, word
+  use strings, only: i2s, roundtrip, word
   use sorting, only: merge_sort_by_keys
   use config, only: MAX_SIDES, FRICTION_NONE, FRICTION_CHOICES, deck_t, body_cfg_t, elastic_law_t, MAT_KIND_NAMES, SIDE_LEFT, SIDE_RIGHT, SIDE_BOTTOM, SIDE_TOP, side_names, BC_CLAMPED, &
                     BC_CONTACT, BC_DISPLACEMENT, bc_names, STEPS_UNSET, stage_count
@@ -89,7 +89,7 @@ contains
     p = st%path//': '
     do k = 1, d%npair
       if (d%pair(k)%gap_radius > 0.0_wp) call fatal(EXIT_INPUT, p//st%pair_at(k)%s//': gap_radius = '// &
-        r2s(d%pair(k)%gap_radius)//' in a 3D deck: the parabolic gap is a 2D profile; in 3D the gap is '// &
+        roundtrip(d%pair(k)%gap_radius)//' in a 3D deck: the parabolic gap is a 2D profile; in 3D the gap is '// &
         'the geometry''s')
     end do
     do k = 1, d%nbody
@@ -166,11 +166,11 @@ contains
           if (f%body /= 0 .and. f%body /= b) cycle
           if (maxval(d%body(b)%law%density) > 0.0_wp) cycle
           if (len_trim(d%body(b)%material) > 0) call fatal(EXIT_INPUT, st%path//': the '//trim(f%origin)// &
-            ' gives gravity = '//r2s(f%gravity(1))//', '//r2s(f%gravity(2))//' on '//on//', but body '// &
+            ' gives gravity = '//roundtrip(f%gravity(1))//', '//roundtrip(f%gravity(2))//' on '//on//', but body '// &
             i2s(b)//' ('//st%body_at(b)%s//') is of material '''//trim(d%body(b)%material)//''', whose '// &
             'density = 0: give the &material density= (mass per volume), or a force per volume with force=')
           call fatal(EXIT_INPUT, st%path//': the '//trim(f%origin)//' gives gravity = '// &
-            r2s(f%gravity(1))//', '//r2s(f%gravity(2))//' on '//on//', but body '//i2s(b)//' ('//st%body_at(b)%s//') has density = 0: give it '// &
+            roundtrip(f%gravity(1))//', '//roundtrip(f%gravity(2))//' on '//on//', but body '//i2s(b)//' ('//st%body_at(b)%s//') has density = 0: give it '// &
             'density= (mass per volume), or a force per volume with force=')
         end do
       end associate
@@ -404,7 +404,7 @@ contains
       do b = 1, d%nbody
         if (len_trim(d%body(b)%mesh) > 0) cycle
         if (d%body(b)%x0 < 0.0_wp) call fatal(EXIT_INPUT, st%path//': body '//i2s(b)//' ('// &
-          st%body_at(b)%s//'): x0 = '//r2s(d%body(b)%x0)//' is below the axis: with plane = '// &
+          st%body_at(b)%s//'): x0 = '//roundtrip(d%body(b)%x0)//' is below the axis: with plane = '// &
           '''axisymmetric'' x is the radius, x0 >= 0')
       end do
     end if

@@ -5,7 +5,7 @@
 !! and the allowed range). The reader (`namelist_input`) checks assignments against it.
 module namelist_vars
   use kinds, only: wp
-  use strings, only: i2s, r2s, quote, word
+  use strings, only: i2s, roundtrip, quote, word
   implicit none (type, external)
   private
 
@@ -277,10 +277,10 @@ contains
           end if
         case (T_REAL)
           if (v%nval == 1) then
-            item = v%name//'='//r2s(v%rs)
+            item = v%name//'='//roundtrip(v%rs)
           else
-            item = v%name//'='//r2s(v%rv(1))//', '//r2s(v%rv(2))
-            if (v%nval == 3) item = item//', '//r2s(v%rv(3))
+            item = v%name//'='//roundtrip(v%rv(1))//', '//roundtrip(v%rv(2))
+            if (v%nval == 3) item = item//', '//roundtrip(v%rv(3))
           end if
         case (T_STR)
           if (v%nval == 1) then
@@ -334,14 +334,14 @@ contains
         case (T_REAL)
           if (v%nval == 1) then
             typ = 'real'
-            def = '`'//r2s(v%rs)//'`'
+            def = '`'//roundtrip(v%rs)//'`'
             if (v%rs == -huge(1.0_wp)) def = 'not given'
           else
             typ = 'real pair (x, y)'
-            def = '`'//r2s(v%rv(1))//', '//r2s(v%rv(2))//'`'
+            def = '`'//roundtrip(v%rv(1))//', '//roundtrip(v%rv(2))//'`'
             if (v%nval == 3) then
               typ = 'real vector (x, y, z)'
-              def = '`'//r2s(v%rv(1))//', '//r2s(v%rv(2))//', '//r2s(v%rv(3))//'`'
+              def = '`'//roundtrip(v%rv(1))//', '//roundtrip(v%rv(2))//', '//roundtrip(v%rv(3))//'`'
             end if
           end if
         case (T_STR)

@@ -46,7 +46,7 @@ module mprgp
   use kinds, only: wp
   use linop, only: linop_t, dense_op_t
   use qp_newton, only: newton_work_t, newton_step, newton_begin, NEWTON_FULL, NEWTON_STILL, NEWTON_NOT_SPD
-  use strings, only: itoa
+  use strings, only: i2s
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
                            QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
@@ -392,7 +392,7 @@ contains
         self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(n, wp)**2)))
         if (outcome == NEWTON_NOT_SPD) then
           call fail(self, MPRGP_NOT_SPD, 'the active-set Newton method met a curvature <= 0 at step '// &
-                    trim(itoa(self%it))//': A is not SPD')
+                    i2s(self%it)//': A is not SPD')
           exit main
         end if
         if (.not. (outcome == NEWTON_STILL .or. (outcome == NEWTON_FULL .and. work%same_face))) then
@@ -458,7 +458,7 @@ contains
           self%stats%n_matvec = self%stats%n_matvec + max(1, nint(flops/(2.0_wp*real(self%n, wp)**2)))
           if (outcome == DN_NOT_SPD) then
             call fail(self, MPRGP_NOT_SPD, 'the Newton method on the discs met a face matrix that is not '// &
-                      'positive definite at step '//trim(itoa(self%it))//': A is not SPD')
+                      'positive definite at step '//i2s(self%it)//': A is not SPD')
             exit main
           end if
           still = merge(still + 1, 0, outcome == DN_STILL)
@@ -490,7 +490,7 @@ contains
     if (self%stats%gp_norm <= floor) then
       self%stats%status = MPRGP_CONVERGED
       self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))// &
-        ' after '//trim(itoa(self%stats%n_newton))//done
+        ' after '//i2s(self%stats%n_newton)//done
     else
       self%stats%status = MPRGP_MAX_IT
       self%stats%message = 'not converged: '//who//' stalls at |gP| = '//trim(adjustl(s1))//why
@@ -582,11 +582,11 @@ contains
     if (.not. valid_options(self)) return
     do i = 1, n
       if (.not. ieee_is_finite(b(i))) then
-        call fail(self, MPRGP_NONFINITE, 'b('//trim(itoa(i))//') is not finite')
+        call fail(self, MPRGP_NONFINITE, 'b('//i2s(i)//') is not finite')
         return
       end if
       if (.not. ieee_is_finite(x(i))) then
-        call fail(self, MPRGP_NONFINITE, 'initial x('//trim(itoa(i))//') is not finite')
+        call fail(self, MPRGP_NONFINITE, 'initial x('//i2s(i)//') is not finite')
         return
       end if
     end do
@@ -682,7 +682,7 @@ contains
     self%stats%gp_norm = sqrt(gp2)
     if (.not. ieee_is_finite(gp2)) then
       call fail(self, MPRGP_NONFINITE, 'the projected gradient became non-finite after '// &
-                trim(itoa(self%it))//' steps')
+                i2s(self%it)//' steps')
       return
     end if
 
@@ -707,7 +707,7 @@ contains
         write (s1, '(es10.3)') self%stats%gp_norm
         write (s2, '(es10.3)') tol_now
         self%stats%message = 'converged: |gP| = '//trim(adjustl(s1))//' <= '//trim(adjustl(s2))// &
-                             ' after '//trim(itoa(self%it))//' steps, '//trim(itoa(self%stats%n_matvec))// &
+                             ' after '//i2s(self%it)//' steps, '//i2s(self%stats%n_matvec)// &
                              ' products with A'
         return
       end if
@@ -727,7 +727,7 @@ contains
         if (self%stats%gp_norm <= 10.0_wp*sqrt(real(n, wp))*epsilon(1.0_wp)*self%lam_lo*max(norm2(x), self%xscale0)) then
           self%stats%status = MPRGP_CONVERGED
           self%stats%message = 'converged to working precision: |gP| = '//trim(adjustl(s1))//' after '// &
-            trim(itoa(self%it))//' steps (the tolerance asked for is below what double precision resolves)'
+            i2s(self%it)//' steps (the tolerance asked for is below what double precision resolves)'
           return
         end if
       end if
@@ -735,13 +735,13 @@ contains
       write (s1, '(es10.3)') self%stats%gp_norm
       write (s2, '(es10.3)') tol_now
       self%stats%message = 'not converged: |gP| = '//trim(adjustl(s1))//' > '//trim(adjustl(s2))// &
-                           ' after max_it = '//trim(itoa(self%opts%max_it))//' steps'
+                           ' after max_it = '//i2s(self%opts%max_it)//' steps'
       return
     end if
     if (associated(self%opts%stop)) then
       if (self%opts%stop()) then
         self%stats%status = MPRGP_STOPPED
-        self%stats%message = 'stopped on request after '//trim(itoa(self%it))//' steps'
+        self%stats%message = 'stopped on request after '//i2s(self%it)//' steps'
         return
       end if
     end if
@@ -1033,7 +1033,7 @@ contains
     ok = .false.
     if (.not. (ieee_is_finite(dad_) .and. ieee_is_finite(dd_))) then
       call fail(self, MPRGP_NONFINITE, 'non-finite curvature along the '//what//' after '// &
-                trim(itoa(self%it))//' steps')
+                i2s(self%it)//' steps')
       return
     end if
     if (dad_ <= 0.0_wp .and. dd_ <= tiny(1.0_wp)) then
@@ -1048,7 +1048,7 @@ contains
     if (dad_ <= 0.0_wp) then
       write (s1, '(es10.3)') dad_
       call fail(self, MPRGP_NOT_SPD, 'p''Ap = '//trim(adjustl(s1))//' <= 0 along the '//what// &
-                ' at step '//trim(itoa(self%it))//': A is not SPD')
+                ' at step '//i2s(self%it)//': A is not SPD')
       return
     end if
     ok = .true.

@@ -3,7 +3,7 @@
 module mprgp_options
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
-  use strings, only: rtoa
+  use strings, only: sci
   use signals, only: stop_iface
   implicit none (type, external)
   private
@@ -124,14 +124,14 @@ contains
       why = 'opts%rtol is not finite'
       return
     else if (o%rtol < 0.0_wp) then
-      why = 'opts%rtol is negative: '//trim(rtoa(o%rtol))
+      why = 'opts%rtol is negative: '//sci(o%rtol, 4)
       return
     end if
     if (.not. ieee_is_finite(o%atol)) then
       why = 'opts%atol is not finite'
       return
     else if (o%atol < 0.0_wp) then
-      why = 'opts%atol is negative: '//trim(rtoa(o%atol))
+      why = 'opts%atol is negative: '//sci(o%atol, 4)
       return
     end if
     if (o%method < QP_AUTO .or. o%method > QP_POLISH) then
@@ -143,7 +143,7 @@ contains
       return
     end if
     if (.not. (o%polish_scale >= 1.0_wp .and. ieee_is_finite(o%polish_scale))) then
-      why = 'opts%polish_scale is not a finite number >= 1: '//trim(rtoa(o%polish_scale))
+      why = 'opts%polish_scale is not a finite number >= 1: '//sci(o%polish_scale, 4)
       return
     end if
     if (o%newton_budget < 0) then
@@ -158,7 +158,7 @@ contains
       why = 'opts%gamma is not finite'
       return
     else if (o%gamma <= 0.0_wp) then
-      why = 'opts%gamma must be positive: '//trim(rtoa(o%gamma))
+      why = 'opts%gamma must be positive: '//sci(o%gamma, 4)
       return
     end if
     if (.not. (ieee_is_finite(o%alpha_bar) .and. ieee_is_finite(o%lambda_max))) then

@@ -32,7 +32,7 @@ program test_disc_set
   use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP, QP_AUTO
   use lapack, only: dposv
   use disc_newton, only: disc_factor_t, face_solve
-  use strings, only: itoa
+  use strings, only: i2s
   use testing, only: report, report_le, test_summary, set_seed, urand, random_spd
   implicit none (type, external)
 
@@ -489,7 +489,7 @@ contains
     end do
     nfresh = factored
     call report_le(worst, 1.0e-10_wp, 'carried face factor: the Newton direction on 300 faces against LAPACK on Z''AZ + C')
-    call report(nfresh < 100, 'carried face factor: most faces by updates ('//trim(itoa(nfresh))//' factors for 300 faces)')
+    call report(nfresh < 100, 'carried face factor: most faces by updates ('//i2s(nfresh)//' factors for 300 faces)')
 
   end subroutine test_carried_factor
 

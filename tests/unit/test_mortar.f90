@@ -5,6 +5,7 @@
 !! the contract's consistency diagnostic, the dispatch by dimension, and the node frames.
 program test_mortar
   use kinds, only: wp
+  use strings, only: i2s, fixed
   use mortar, only: mortar_t, mortar_build, mortar_consistency
   use space, only: frame_of
   use testing, only: report, report_le, test_summary, error_parts
@@ -287,21 +288,21 @@ contains
     integer :: lev
     do lev = 1, 2
       call curved_case(r, 12 * lev, err(lev), hmax(lev), e_n, e_pu, e_ws, e_end)
-      call report_le(e_n, tol, 'curved n = '//itoa(12 * lev)//': interior normals radial (x - c)/R')
-      call report_le(e_end, tol, 'curved n = '//itoa(12 * lev)//': end normals = their edge''s normal')
-      call report_le(e_pu, tol, 'curved n = '//itoa(12 * lev)//': partition of unity')
-      call report_le(e_ws, tol, 'curved n = '//itoa(12 * lev)//': slave weight 1')
+      call report_le(e_n, tol, 'curved n = '//i2s(12 * lev)//': interior normals radial (x - c)/R')
+      call report_le(e_end, tol, 'curved n = '//i2s(12 * lev)//': end normals = their edge''s normal')
+      call report_le(e_pu, tol, 'curved n = '//i2s(12 * lev)//': partition of unity')
+      call report_le(e_ws, tol, 'curved n = '//i2s(12 * lev)//': slave weight 1')
       ! The error is O(h^2/R): the dual average of the normal distance d(s) is
       ! d(s_j) - d'' h^2/12 + ... with d'' ~ 1/R, and the chord lies inside the circle by
       ! up to h^2/(8R), which adds about + h^2/(12R) to the average. The two cancel for
       ! uniform spacing; with this spacing (+-25% perturbed) the error measured is about
       ! h^2/150R. Tolerance h^2/(20R): the vertical gap instead of the normal distance, or
       ! a first-order error, would exceed it.
-      call report_le(err(lev), hmax(lev)**2 / (20.0_wp * r), 'curved n = '//itoa(12 * lev)// &
+      call report_le(err(lev), hmax(lev)**2 / (20.0_wp * r), 'curved n = '//i2s(12 * lev)// &
                      ': |g0 - normal distance to y = 0| <= h^2/(20R)')
     end do
     call report(err(2) <= err(1) / 3.0_wp, 'curved: g0 error falls at second order (ratio '// &
-                rtoa(err(1) / err(2))//' >= 3 on halving h)')
+                fixed(err(1) / err(2), '(f0.2)')//' >= 3 on halving h)')
   end subroutine test_curved
 
   !> One polygon of the curved test: n segments on the circle of radius r.
@@ -330,8 +331,8 @@ contains
     do k = 1, 9
       em(:, k) = [k + 1, k]          ! right to left: the master body below
     end do
-    call build_ok(xs, es, [(.false., k = 1, n + 1)], xm, em, mt, 'curved n = '//itoa(n))
-    call report(mt%m == n + 1, 'curved n = '//itoa(n)//': every slave node has a row')
+    call build_ok(xs, es, [(.false., k = 1, n + 1)], xm, em, mt, 'curved n = '//i2s(n))
+    call report(mt%m == n + 1, 'curved n = '//i2s(n)//': every slave node has a row')
     hm = 0.0_wp
     do k = 1, n
       hm = max(hm, norm2(xs(:, k + 1) - xs(:, k)))
@@ -460,8 +461,8 @@ contains
       allocate (rem(size(xs, 2)))
       rem = .false.
       rem(rnode) = .true.
-      call build_ok(xs, es, rem, xm, em, mt, 'removal of node '//itoa(rnode))
-      call report(mt%m == ns .and. .not. any(mt%snode == rnode), 'removal of node '//itoa(rnode)//': no row for it')
+      call build_ok(xs, es, rem, xm, em, mt, 'removal of node '//i2s(rnode))
+      call report(mt%m == ns .and. .not. any(mt%snode == rnode), 'removal of node '//i2s(rnode)//': no row for it')
       nb = [rnode - 1, rnode + 1]                 ! slave neighbours (ids k+1 at us(k))
       ok = 0
       e_inv = 0.0_wp; e_g = 0.0_wp; e_d = 0.0_wp
@@ -482,20 +483,20 @@ contains
                         - [0.0_wp, h * slave_sum(mt, j)]))
         e_d = max(e_d, abs(mt%d(j) - ts(k - 1)))
       end do
-      call report(ok == 0, 'removal of node '//itoa(rnode)//': own weight 1 first; neighbours carry it with '// &
-                  'weight (L/2)/D_jj, other rows do not (code '//itoa(ok)//')')
-      call report_le(e_inv, tol, 'removal of node '//itoa(rnode)//': sum of slave weights = sum of master weights')
-      call report_le(e_g, tol, 'removal of node '//itoa(rnode)//': g0 = h * (sum of weights) = the row at u = 0')
-      call report_le(e_d, tol, 'removal of node '//itoa(rnode)//': D_jj unchanged (int N_j)')
+      call report(ok == 0, 'removal of node '//i2s(rnode)//': own weight 1 first; neighbours carry it with '// &
+                  'weight (L/2)/D_jj, other rows do not (code '//i2s(ok)//')')
+      call report_le(e_inv, tol, 'removal of node '//i2s(rnode)//': sum of slave weights = sum of master weights')
+      call report_le(e_g, tol, 'removal of node '//i2s(rnode)//': g0 = h * (sum of weights) = the row at u = 0')
+      call report_le(e_d, tol, 'removal of node '//i2s(rnode)//': D_jj unchanged (int N_j)')
       ! Uniform pressure p: lam_j = p D_jj gives both bodies their consistent nodal forces,
       ! the removed node's share included (it comes through the neighbours' extra entries).
       lam = p * mt%d
       f_m = side_forces(mt%mptr, mt%mnod, mt%mval, lam, nm + 2)
       f_s = side_forces(mt%sptr, mt%snod, mt%sval, lam, size(xs, 2))
       call report_le(maxval([(abs(p * tm(k) - f_m(nm + 2 - k)), k = 0, nm)]) / p, tol, &
-                     'removal of node '//itoa(rnode)//': uniform pressure reaches the master exactly (patch test)')
+                     'removal of node '//i2s(rnode)//': uniform pressure reaches the master exactly (patch test)')
       call report_le(maxval([(abs(p * ts(k) - f_s(k + 1)), k = 0, ns)]) / p, tol, &
-                     'removal of node '//itoa(rnode)//': and the slave, removed node included')
+                     'removal of node '//i2s(rnode)//': and the slave, removed node included')
       deallocate (rem)
     end do
   end subroutine test_removal
@@ -514,7 +515,7 @@ contains
     um = positions(4, -0.13_wp, 1.03_wp, 0.5_wp, 9)   ! master on [-0.13, 1.03]
     call two_lines(us, um, h, 0.0_wp, [0.0_wp, 0.0_wp], xs, es, xm, em)
     call build_ok(xs, es, [(.false., k = 1, size(xs, 2))], xm, em, mt, 'slave longer')
-    call report(mt%m == 6, 'slave longer: rows for the 6 slave nodes under the master only (got '//itoa(mt%m)//')')
+    call report(mt%m == 6, 'slave longer: rows for the 6 slave nodes under the master only (got '//i2s(mt%m)//')')
     xmax = -1.0_wp
     e_inv = 0.0_wp; e_g = 0.0_wp
     jend = 0
@@ -755,7 +756,7 @@ contains
       call mortar_build(xs, es, r, xm, em_, mt, err)
       call error_parts(err, info, msg)
     end if
-    call report(info == ERR_INPUT .and. index(msg, word) > 0, 'bad input, '//what//': category = '//itoa(info)//', "'// &
+    call report(info == ERR_INPUT .and. index(msg, word) > 0, 'bad input, '//what//': category = '//i2s(info)//', "'// &
                 trim(msg)//'"')
   end subroutine expect_bad
 
@@ -804,21 +805,5 @@ contains
     write (*, '(a,f8.3,a)') 'INFO  mortar_build, 100k slave x 130k master segments: ', &
       real(t1 - t0, wp) / real(rate, wp), ' s'
   end subroutine test_timing
-
-  function itoa(k) result(s)
-    integer, intent(in) :: k
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(i0)') k
-    s = trim(buf)
-  end function itoa
-
-  function rtoa(x) result(s)
-    real(wp), intent(in) :: x
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(f0.2)') x
-    s = trim(buf)
-  end function rtoa
 
 end program test_mortar

@@ -16,6 +16,7 @@
 !!  - bad input, each message naming side, face or node; the build time at 100k x 130k faces.
 program test_mortar_3d
   use kinds, only: wp
+  use strings, only: i2s, fixed
   use mortar, only: mortar_t, mortar_build, mortar_consistency
   use testing, only: report, report_le, test_summary, error_parts
   use errors, only: error_t, ERR_INPUT
@@ -461,8 +462,8 @@ contains
     end do
     hasrow = .false.
     hasrow(mt%snode) = .true.
-    call report(all(hasrow .eqv. under), 'rim: rows exactly at the '//itoa(count(under))//' slave nodes over the master '// &
-                '(got '//itoa(mt%m)//'; the nearest node '//rtoa(dmin)//' from the master''s edge)')
+    call report(all(hasrow .eqv. under), 'rim: rows exactly at the '//i2s(count(under))//' slave nodes over the master '// &
+                '(got '//i2s(mt%m)//'; the nearest node '//fixed(dmin, '(f0.3)')//' from the master''s edge)')
     e_inv = 0.0_wp; e_g = 0.0_wp
     do j = 1, mt%m
       e_inv = max(e_inv, abs(slave_sum(mt, j) - master_sum(mt, j)))
@@ -471,8 +472,8 @@ contains
     call report_le(e_inv, tol, 'rim: sum of slave weights = sum of master weights on every row')
     call report_le(e_g, tol, 'rim: g0 = h * (sum of weights) on every row')
     call mortar_consistency(mt, e_pu, nfull)
-    call report(nfull > 0 .and. nfull < mt%m, 'rim: '//itoa(nfull)//' interior rows fully covered and unmodified, '// &
-                itoa(mt%m - nfull)//' rim rows modified')
+    call report(nfull > 0 .and. nfull < mt%m, 'rim: '//i2s(nfull)//' interior rows fully covered and unmodified, '// &
+                i2s(mt%m - nfull)//' rim rows modified')
     call report_le(e_pu, tol, 'rim: partition of unity on the interior rows')
     tm = tributary(m)
     fm = side_forces(mt%mptr, mt%mnod, mt%mval, p * mt%d, size(m%x, 2))
@@ -555,7 +556,7 @@ contains
       call cap_case(8 * 2**(lev - 1), err(lev), erim(lev), e_pu(lev), hmax(lev))
       ! warped faces: D_jj by 3x3 Gauss, M by the 7-point rule with the surface/plane ratio
       ! (not polynomial): equal to quadrature accuracy, measured 1e-13 at n = 8
-      call report_le(e_pu(lev), 1.0e-11_wp, 'curved n = '//itoa(8 * 2**(lev - 1))// &
+      call report_le(e_pu(lev), 1.0e-11_wp, 'curved n = '//i2s(8 * 2**(lev - 1))// &
                      ': partition of unity, slave weight 1 (master covers the cap; warped faces, bound 1e-11)')
       write (*, '(a,i0,a,es10.3,a,es10.3,a,es10.3)') 'INFO  curved n = ', 8 * 2**(lev - 1), ': h = ', hmax(lev), &
         ', max |g0/sw - exact normal distance| interior ', err(lev), ', rim ', erim(lev)
@@ -563,7 +564,7 @@ contains
     rate1 = log(err(1) / err(2)) / log(hmax(1) / hmax(2))
     rate2 = log(err(2) / err(3)) / log(hmax(2) / hmax(3))
     call report(rate1 > 1.7_wp .and. rate2 > 1.7_wp, 'curved: g0 error at the interior nodes falls at second order '// &
-                '(observed orders '//rtoa(rate1)//', '//rtoa(rate2)//' > 1.7)')
+                '(observed orders '//fixed(rate1, '(f0.3)')//', '//fixed(rate2, '(f0.3)')//' > 1.7)')
     call report_le(err(3), hmax(3)**2, 'curved n = 32: max |g0/sw - exact normal distance| <= h^2/R')
   end subroutine test_curved
 
@@ -589,8 +590,8 @@ contains
     call place(s, eye, [0.0_wp, 0.0_wp, 0.0_wp])
     m = sheet(positions(7, -0.5_wp, 0.5_wp, 0.4_wp, 31), positions(6, -0.5_wp, 0.5_wp, 0.4_wp, 32), 0.0_wp, 0.0_wp, &
               3, .true., 0.0_wp, 33, eye, [0.0_wp, 0.0_wp, 0.0_wp])
-    call build_ok(s, [(.false., k = 1, size(s%x, 2))], m, mt, 'curved n = '//itoa(n))
-    call report(mt%m == size(s%x, 2), 'curved n = '//itoa(n)//': every slave node has a row')
+    call build_ok(s, [(.false., k = 1, size(s%x, 2))], m, mt, 'curved n = '//i2s(n))
+    call report(mt%m == size(s%x, 2), 'curved n = '//i2s(n)//': every slave node has a row')
     hm = 0.0_wp
     do k = 1, size(s%f, 2)
       do i = 1, 4
@@ -644,7 +645,7 @@ contains
     fs = s%f
     fs(:, 4) = [fs(1, 4), fs(2, 4), fs(2, 4), fs(4, 4)]
     call expect_bad(s%x, fs, rem, m%x, m%f, 'slave face repeating a node', &
-                    ['slave face 4', 'repeats node', itoa(700 + fs(2, 4)) // '         '], tags)
+                    ['slave face 4', 'repeats node', i2s(700 + fs(2, 4)) // '         '], tags)
     fm = m%f
     fm(2, 5) = fm(1, 5)
     call expect_bad(s%x, s%f, rem, m%x, fm, 'master face repeating a node', ['master face 5', 'repeats node '])
@@ -693,7 +694,7 @@ contains
     do k = 1, size(words)
       ok = ok .and. index(msg, trim(words(k))) > 0
     end do
-    call report(ok, 'bad input, '//what//': category = '//itoa(info)//', "'//trim(msg)//'"')
+    call report(ok, 'bad input, '//what//': category = '//i2s(info)//', "'//trim(msg)//'"')
   end subroutine expect_bad
 
   !> 316 x 316 slave quadrilaterals (a gently curved cylinder of radius 1e4) against
@@ -720,8 +721,8 @@ contains
     call mortar_build(s%x, s%f, [(.false., k = 1, size(s%x, 2))], m%x, m%f(1:3, :), mt, err)
     call system_clock(t1)
     call error_parts(err, info, msg)
-    call report(info == 0 .and. mt%m == size(s%x, 2), 'timing case: '//itoa(size(s%f, 2))//' slave quadrilaterals x '// &
-                itoa(size(m%f, 2))//' master triangles built, a row per slave node')
+    call report(info == 0 .and. mt%m == size(s%x, 2), 'timing case: '//i2s(size(s%f, 2))//' slave quadrilaterals x '// &
+                i2s(size(m%f, 2))//' master triangles built, a row per slave node')
     e_pu = 0.0_wp
     do k = 1, mt%m
       e_pu = max(e_pu, abs(master_sum(mt, k) - 1.0_wp))
@@ -731,23 +732,5 @@ contains
     write (*, '(a,f8.3,a)') 'INFO  mortar_build, 100k slave quadrilaterals x 130k master triangles: ', &
       real(t1 - t0, wp) / real(rate, wp), ' s'
   end subroutine test_timing
-
-  !> An integer as text.
-  function itoa(k) result(s)
-    integer, intent(in) :: k                      !< the integer
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(i0)') k
-    s = trim(buf)
-  end function itoa
-
-  !> A real as text, 3 decimals.
-  function rtoa(x) result(s)
-    real(wp), intent(in) :: x                     !< the value
-    character(len=:), allocatable :: s
-    character(len=24) :: buf
-    write (buf, '(f0.3)') x
-    s = trim(buf)
-  end function rtoa
 
 end program test_mortar_3d

@@ -11,7 +11,7 @@ program test_mprgp_options
   use mprgp, only: mprgp_t, lambda_max_estimate, mprgp_status_name, mprgp_opts_t, mprgp_stats_t, &
                    MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, &
                    MPRGP_STOPPED
-  use strings, only: i2s, fmt_real
+  use strings, only: i2s, fixed
   use testing, only: report, test_summary, obstacle_problem, set_seed, urand, random_spd, spd_from_eigs, &
                      solve_once
   implicit none (type, external)
@@ -191,8 +191,8 @@ contains
     call report(st1%alpha_bar < 19.0_wp / lam_true .and. st2%alpha_bar < 20.0_wp / lam_true .and. &
                st1%alpha_bar * st1%lambda_max <= 2.0_wp .and. st2%alpha_bar * st2%lambda_max <= 2.0_wp, &
                'alpha guard ('//name//'): bad alpha_bar cut to alpha_bar*lambda_max = '// &
-               fmt_real(st1%alpha_bar * lam_true, '(f0.3)')//', '// &
-               fmt_real(st2%alpha_bar * lam_true, '(f0.3)')//'; products '// &
+               fixed(st1%alpha_bar * lam_true, '(f0.3)')//', '// &
+               fixed(st2%alpha_bar * lam_true, '(f0.3)')//'; products '// &
                i2s(st1%n_matvec)//', '//i2s(st2%n_matvec)//' vs '//i2s(st0%n_matvec))
   end subroutine guard_case
 
