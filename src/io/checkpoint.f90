@@ -3,7 +3,11 @@
 !! far, written atomically to `<result file>.ckpt.h5`. A restart resumes bitwise
 !! identically and refuses a checkpoint made from a different deck, from a mesh file
 !! whose content has changed since (FNV-1a 64 hash of its bytes), or holding anything
-!! that is not what this deck implies (shapes, ranges, NaN or Inf).
+!! that is not what this deck implies (shapes, ranges, NaN or Inf). The file is written
+!! in HDF5's latest format, whose metadata carry checksums: a file corrupted in its
+!! structure is refused as unreadable, not parsed (HDF5's parser of the default format
+!! crashed on some; tests/unit/test_checkpoint.f90). Values corrupted into other finite
+!! values within range are not detected.
 module checkpoint
   use kinds, only: wp
   use space, only: NRIGID
@@ -116,7 +120,7 @@ contains
     if (.not. allocated(self%file)) return
     call ensure_parent_dir(self%file)
     tmp = temp_name(self%file)
-    call file_open(tmp, fid, hs, create=.true.)
+    call file_open(tmp, fid, hs, create=.true., checksums=.true.)
     call write_dset(fid, 'key', self%key, hs)
     if (allocated(self%meshes)) then
       if (len(self%meshes) > 0) call write_dset(fid, 'mesh_files', self%meshes, hs)

@@ -32,7 +32,8 @@ module h5io
                   h5awrite_f, h5aread_f, h5tcopy_f, h5tset_size_f, h5tget_size_f, h5tclose_f, &
                   haddr_t, h5pcreate_f, h5pset_alloc_time_f, h5pset_fill_time_f, h5pset_obj_track_times_f, &
                   h5dget_offset_f, H5P_DATASET_CREATE_F, H5P_GROUP_CREATE_F, H5D_ALLOC_TIME_EARLY_F, &
-                  H5D_FILL_TIME_NEVER_F
+                  H5D_FILL_TIME_NEVER_F, H5P_FILE_ACCESS_F, h5pset_libver_bounds_f, H5F_LIBVER_LATEST_F, &
+                  H5P_DEFAULT_F, h5pclose_f
   implicit none (type, external)
   private
 
@@ -70,23 +71,42 @@ contains
 
   !> Open the HDF5 file `path` for reading, or create (truncate) it for writing when
   !! `create` is present and true; fid = -1 on failure.
-  subroutine file_open(path, fid, st, create)
+  subroutine file_open(path, fid, st, create, checksums)
     character(len=*), intent(in) :: path        !< file path
     integer(hid_t), intent(out) :: fid          !< the open file
     type(error_t), intent(inout) :: st      !< status
     logical, intent(in), optional :: create     !< create the file (default: read it)
+    !> create it in the latest file format, whose metadata (superblock, object headers, heaps,
+    !! B-trees) carry checksums that HDF5 verifies on reading: a file corrupted there fails
+    !! to open or to read, where the default format's parser can crash (SIGSEGV) on it
+    !! (HDF5 1.10 readers; the checkpoint; default .false.)
+    logical, intent(in), optional :: checksums
     logical :: new
-    integer :: e
+    integer :: e, ec
+    integer(hid_t) :: fapl
     fid = -1
     new = .false.
     if (present(create)) new = create
     call library_init(st)
     if (st%failed()) return
+    fapl = H5P_DEFAULT_F
+    if (new .and. present(checksums)) then
+      if (checksums) then
+        call h5pcreate_f(H5P_FILE_ACCESS_F, fapl, e)
+        if (e == 0) call h5pset_libver_bounds_f(fapl, H5F_LIBVER_LATEST_F, H5F_LIBVER_LATEST_F, e)
+        if (e /= 0) then
+          if (fapl /= H5P_DEFAULT_F) call h5pclose_f(fapl, ec)
+          call fail(st, 'failed to make the file access properties of '//path)
+          return
+        end if
+      end if
+    end if
     if (new) then
-      call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, e)
+      call h5fcreate_f(path, H5F_ACC_TRUNC_F, fid, e, access_prp=fapl)
     else
       call h5fopen_f(path, H5F_ACC_RDONLY_F, fid, e)
     end if
+    if (fapl /= H5P_DEFAULT_F) call h5pclose_f(fapl, ec)
     if (e /= 0) then
       fid = -1
       call fail(st, merge('failed to create ', 'failed to open   ', new)//path)
