@@ -31,10 +31,12 @@ program test_checkpoint
   use files, only: temp_name
   use errors, only: error_t, ERR_INPUT, ERR_IO
   use strings, only: i2s
-  use testing, only: report, test_summary, write_file, set_seed, urand
+  use testing, only: report, test_summary, write_file, set_seed, urand, file_bytes
   implicit none (type, external)
 
-  character(len=*), parameter :: dir = 'build/test-checkpoint'
+  !> the test's files: beside its own executable (a release and a checked build's make check
+  !! may run at once)
+  character(len=:), allocatable :: dir
   character(len=*), parameter :: KEY = 'deck inputs/x.nml: bodies 2, pairs 1, rows 7 (a made-up fingerprint)'
   character(len=*), parameter :: MESHES = '0123456789abcdef  /data/meshes/block.msh'
   integer, parameter :: m = 7, nbody = 2, depth = 5, maxout = 40, nh = 5
@@ -47,6 +49,8 @@ program test_checkpoint
   integer :: rc
 
   call set_dimension(2)
+  call get_command_argument(0, arg)
+  dir = trim(arg)//'_files'
   ! `test_checkpoint --sweep FILE`: read corrupted copies of FILE (a child process: a crash
   ! ends it, not the test)
   if (command_argument_count() >= 2) then
@@ -179,20 +183,6 @@ contains
                  all(a%kept == b%kept)
   end function states_equal
 
-  !> The whole file as bytes ('' when it cannot be read).
-  function file_bytes(path) result(b)
-    character(len=*), intent(in) :: path
-    character(len=:), allocatable :: b
-    integer :: u, n, ios
-    b = ''
-    open (newunit=u, file=path, access='stream', form='unformatted', status='old', action='read', iostat=ios)
-    if (ios /= 0) return
-    inquire (unit=u, size=n)
-    deallocate (b)
-    allocate (character(len=n) :: b)
-    if (n > 0) read (u, iostat=ios) b
-    close (u)
-  end function file_bytes
 
   !> Write bytes to path (replacing it).
   subroutine put_bytes(path, b)

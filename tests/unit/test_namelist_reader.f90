@@ -32,7 +32,7 @@ program test_namelist_reader
   use namelist_input, only: src_t, grp_t, text_source, load_file, parse_source, read_group, find_asg, find_int, &
                             unknown_group
   use strings, only: i2s
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, file_bytes
   implicit none (type, external)
 
   character(len=*), parameter :: NL = achar(10)
@@ -346,7 +346,7 @@ contains
       call put_text(bad_path(k), text)
       out = bad_path(k)//'.out'
       call execute_command_line(trim(self)//' --bad '//i2s(k)//' > '//out//' 2>&1', exitstat=r)
-      msg = text_of(out)
+      msg = file_bytes(out)
       ok = r == 1 .and. index(msg, 'robin_contact: error: '//bad_path(k)) == 1
       ! every piece of the expected text in the message
       do while (len(expect) > 0)
@@ -370,19 +370,6 @@ contains
     close (u)
   end subroutine put_text
 
-  function text_of(path) result(s)
-    character(len=*), intent(in) :: path
-    character(len=:), allocatable :: s
-    integer :: u, nb, ios
-    s = ''
-    open (newunit=u, file=path, access='stream', form='unformatted', status='old', action='read', iostat=ios)
-    if (ios /= 0) return
-    inquire (unit=u, size=nb)
-    deallocate (s)
-    allocate (character(len=nb) :: s)
-    if (nb > 0) read (u, iostat=ios) s
-    close (u)
-  end function text_of
 
 
 end program test_namelist_reader

@@ -31,7 +31,7 @@ module testing
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered, box_system
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
   public :: random_bounds, enumerate_box, box_projected, identity
-  public :: error_parts, grid_mesh, grid_mesh_parts, box_mesh_parts
+  public :: error_parts, grid_mesh, grid_mesh_parts, box_mesh_parts, file_bytes
 
 contains
 
@@ -81,6 +81,21 @@ contains
     end do
     close (u)
   end subroutine write_file
+
+  !> The whole file as bytes ('' when it cannot be read).
+  function file_bytes(path) result(b)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: b
+    integer :: u, n, ios
+    b = ''
+    open (newunit=u, file=path, access='stream', form='unformatted', status='old', action='read', iostat=ios)
+    if (ios /= 0) return
+    inquire (unit=u, size=n)
+    deallocate (b)
+    allocate (character(len=n) :: b)
+    if (n > 0) read (u, iostat=ios) b
+    close (u)
+  end function file_bytes
 
   !> Solve K u = f on the free DOFs with LAPACK's banded Cholesky (natural order);
   !! stops the test program if the matrix is not positive definite.
