@@ -34,8 +34,9 @@ program test_checkpoint
   use testing, only: report, test_summary, write_file, set_seed, urand, file_bytes
   implicit none (type, external)
 
-  !> the test's files: beside its own executable (a release and a checked build's make check
-  !! may run at once)
+  !> the test's files: in its own build folder, beside the folder of the test programs (a
+  !! release and a checked build's make check may run at once; a name starting test_ in that
+  !! folder would be taken for a test)
   character(len=:), allocatable :: dir
   character(len=*), parameter :: KEY = 'deck inputs/x.nml: bodies 2, pairs 1, rows 7 (a made-up fingerprint)'
   character(len=*), parameter :: MESHES = '0123456789abcdef  /data/meshes/block.msh'
@@ -50,7 +51,7 @@ program test_checkpoint
 
   call set_dimension(2)
   call get_command_argument(0, arg)
-  dir = trim(arg)//'_files'
+  dir = arg(1:index(arg, '/', back=.true.))//'../test-checkpoint'
   ! `test_checkpoint --sweep FILE`: read corrupted copies of FILE (a child process: a crash
   ! ends it, not the test)
   if (command_argument_count() >= 2) then
