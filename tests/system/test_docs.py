@@ -8,6 +8,9 @@
     header of include/, and names no file that is not there; every procedure or type it names
     (a name with an underscore that src/ defines) is defined in the file it is named under, or
     in the module that qualifies it ("assembly's nodal_stress");
+  - doc/developing.md's extension guides ("How to extend" and the "Adding ..." sections) name
+    files that exist, quote no underscored name the code does not have, and define each
+    `module::name` they quote in that module's file;
   - no issue numbers in README.md or doc/ (CHANGELOG.md holds the history);
   - doc/geometry.md's "Shipped scenes" names every inputs/*.nml and the Cattaneo-Mindlin study;
   - the effective deck of README.md's annotated run is the one bin/robin_contact prints for
@@ -277,6 +280,58 @@ bad2 = misplaced_names(wrong, defs)
 check(any(b.startswith("build_interface (under src/contact/condense.f90)") for b in bad2),
       "the name check finds a procedure named under the wrong file", "; ".join(bad2[:2]))
 
+
+
+# the extension guides (How to extend, Adding ...): the files they name exist, the names they
+# quote occur in the code, and a qualified name module::name is defined in that module's file
+def guide_text(text):
+    """doc/developing.md from '## How to extend' to the end (the extension guides)."""
+    return text.split("## How to extend", 1)[1] if "## How to extend" in text else ""
+
+
+def code_words(root):
+    """Every identifier of src/, tests/, tools/, the Makefile and include/ (a set)."""
+    words = set()
+    files = glob.glob(os.path.join(root, "src", "**", "*.*"), recursive=True)
+    for sub in ("tests", "tools", "include"):
+        files += glob.glob(os.path.join(root, sub, "**", "*.*"), recursive=True)
+    for f in files + [os.path.join(root, "Makefile")]:
+        if os.path.basename(f) == "test_docs.py":     # this test's own made-up names
+            continue
+        if f.endswith((".f90", ".c", ".h", ".py", ".sh")) or f.endswith("Makefile"):
+            words.update(re.findall(r"[A-Za-z_][A-Za-z0-9_]*", read(f)))
+        words.add(os.path.splitext(os.path.basename(f))[0])     # a test or module by its file's name
+    return words
+
+
+def guide_mismatch(text, defs, words):
+    """What the guides quote that is not in the tree: paths, underscored names, module::name."""
+    out = []
+    stems = {os.path.splitext(os.path.basename(p))[0]: p for ps in defs.values() for p in ps}
+    for q in re.findall(r"`([^`\n]+)`", guide_text(text)):
+        for tok in q.split():
+            tok = tok.strip("(),;.")
+            if re.fullmatch(r"(src|tests|tools|include|doc|inputs|bench)/[\w./-]+", tok):
+                if "test_x." not in tok and not os.path.exists(os.path.join(ROOT, tok)):
+                    out.append(f"no file {tok}")
+            elif "::" in tok and re.fullmatch(r"\w+::\w+", tok):
+                mod, name = tok.split("::")
+                if stems.get(mod) not in defs.get(name.lower(), set()):
+                    out.append(f"{name} is not defined in module {mod}")
+            elif re.fullmatch(r"[A-Za-z][A-Za-z0-9]*_[A-Za-z0-9_]*", tok) and tok not in words:
+                out.append(f"{tok} occurs nowhere in the code")
+    return sorted(set(out))
+
+
+words = code_words(ROOT)
+gbad = guide_mismatch(dev, defs, words)
+check(guide_text(dev) and not gbad, "doc/developing.md's extension guides name files that exist and names the code has",
+      "; ".join(gbad[:4]))
+gwrong = dev.replace("`new_robin_operator`", "`new_robin_op`").replace(
+    "`tests/unit/test_qp_newton.f90`", "`tests/unit/test_newton.f90`", 1)
+gbad2 = guide_mismatch(gwrong, defs, words)
+check("new_robin_op occurs nowhere in the code" in gbad2 and "no file tests/unit/test_newton.f90" in gbad2,
+      "the guide check finds a renamed procedure and a missing file", "; ".join(gbad2[:4]))
 
 # the README's effective deck against the program's
 def echo_of(text):
