@@ -177,7 +177,7 @@ $(BUILD)/assembly.o:       $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $
                            $(BUILD)/supports.o $(BUILD)/stiffness_pattern.o $(BUILD)/rigid_modes.o $(BUILD)/strings.o \
                            $(BUILD)/material_laws.o
 $(BUILD)/ordering.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/cholmod_iface.o
-$(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o
+$(BUILD)/cholmod_iface.o:  $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/banded.o:         $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/clock.o $(BUILD)/sorting.o $(BUILD)/lapack.o
 $(BUILD)/cholesky.o:       $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/cholmod_iface.o $(BUILD)/banded.o \
                            $(BUILD)/ordering.o $(BUILD)/clock.o

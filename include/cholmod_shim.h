@@ -15,22 +15,30 @@
 extern "C" {
 #endif
 
-/* status codes (match module cholesky's info values) */
+/* status codes (module cholmod_iface turns them into an error_t) */
 #define CHSH_OK             0
 #define CHSH_NOT_POSDEF     1
 #define CHSH_OUT_OF_MEMORY  2
 #define CHSH_FAILURE        3
 
-/* fill-reducing orderings (match module cholesky's ORD_* values) */
+/* fill-reducing orderings: module cholmod_iface's ORD_* values (its cm_create checks
+ * them and the status codes against its own through chsh_codes) */
 #define CHSH_ORD_METIS      1
 #define CHSH_ORD_AMD        2
 #define CHSH_ORD_NATURAL    3
 #define CHSH_ORD_GIVEN      4   /* interior order given by the caller */
-/* (5 is module cholesky's ORD_NODES: it computes the interior order itself, METIS on the
- * node graph through chsh_metis_order, and hands it over as CHSH_ORD_GIVEN) */
+/* (5 is module cholmod_iface's ORD_NODES: module cholesky computes the interior order
+ * itself, METIS on the node graph through chsh_metis_order, and hands it over as
+ * CHSH_ORD_GIVEN) */
 #define CHSH_ORD_AUTO       6   /* CHOLMOD's own choice (nmethods = 0); no DOFs last */
 
 typedef struct chsh_factor chsh_factor;   /* opaque */
+
+/* The codes above, in the order CHSH_OK, CHSH_NOT_POSDEF, CHSH_OUT_OF_MEMORY, CHSH_FAILURE,
+ * CHSH_ORD_METIS, CHSH_ORD_AMD, CHSH_ORD_NATURAL, CHSH_ORD_GIVEN, CHSH_ORD_AUTO, into
+ * codes[0 .. ncodes-1] (at most those nine; the rest is set to -1): module cholmod_iface
+ * compares them with its own constants, the one place where the two are checked equal. */
+void chsh_codes(int *codes, int ncodes);
 
 /* Statistics of the last analysis/factorization of a handle. */
 typedef struct chsh_stats {

@@ -16,9 +16,8 @@ module cholesky
   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_int
   use kinds, only: wp, ip, i8
   use cholmod_iface, only: cm_stats_t, cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, &
-                           cm_get_stats, cm_release_workspace, cm_free, CM_ORD_METIS, &
-                           CM_ORD_AMD, CM_ORD_NATURAL, CM_ORD_GIVEN, CM_ORD_AUTO, CM_OK, CM_OUT_OF_MEMORY, &
-                           CM_NOT_POSDEF
+                           cm_get_stats, cm_release_workspace, cm_free, ORD_METIS, ORD_AMD, ORD_NATURAL, &
+                           ORD_GIVEN, ORD_NODES, ORD_AUTO
   use banded, only: band_t
   use lapack, only: dpotri, dtrsm, dsyrk, dgemm
   use ordering, only: node_dissection
@@ -30,15 +29,8 @@ module cholesky
   integer, parameter, public :: FACT_CHOLMOD = 1   !< CHOLMOD supernodal LL'
   integer, parameter, public :: FACT_BANDED = 2    !< RCM + LAPACK band Cholesky
 
-  integer, parameter, public :: ORD_METIS = 1      !< METIS nested dissection (CHOLMOD)
-  integer, parameter, public :: ORD_AMD = 2        !< AMD, or CAMD when an interface is given
-  integer, parameter, public :: ORD_NATURAL = 3    !< natural order (interface last if given)
-  integer, parameter, public :: ORD_GIVEN = 4      !< caller's interior order (interior_perm), interface last
-  !> METIS on the node graph (ordering%node_dissection: a solid body's nodes, from the pattern), interface last
-  integer, parameter, public :: ORD_NODES = 5
-  !> CHOLMOD's own analysis (its default strategy: AMD, and METIS too when AMD fills much; the
-  !! better kept), nothing last: a reference for benchmarks
-  integer, parameter, public :: ORD_AUTO = 6
+  ! the fill-reducing orderings (FACT_CHOLMOD), defined in cholmod_iface and handed on
+  public :: ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN, ORD_NODES, ORD_AUTO
 
   !> One factorization of one symmetric positive definite matrix K (n x n).
   type, public :: chol_t
@@ -105,8 +97,7 @@ contains
     real(wp) :: t_order
     type(cm_stats_t) :: st
     character(len=200) :: emsg
-    character(len=512) :: cmsg
-    integer :: code
+    logical :: not_posdef
 
     call self%free()
 
@@ -228,11 +219,8 @@ contains
     call cm_init()    ! BLAS single-threaded, for the banded path too
     select case (method)
     case (FACT_CHOLMOD)
-      call cm_create(self%handle, code, cmsg)
-      if (code /= CM_OK) then
-        call set_cm_error(code, cmsg, err)
-        return
-      end if
+      call cm_create(self%handle, err)
+      if (err%failed()) return
       allocate (last0(self%m_last))
       last0 = int(self%last - 1, c_int)
       if (ordering == ORD_GIVEN .or. ordering == ORD_NODES) then
@@ -244,11 +232,11 @@ contains
           allocate (inter0(size(interior_perm)))
           inter0 = int(interior_perm - 1, c_int)
         end if
-        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, code, cmsg, &
-                          interior0=inter0)
+        call cm_factorize(self%handle, n, colptr, rowind, val, ORD_GIVEN, last0, err, interior0=inter0, &
+                          not_posdef=not_posdef)
         deallocate (inter0)
       else
-        call cm_factorize(self%handle, n, colptr, rowind, val, cm_ordering(ordering), last0, code, cmsg)
+        call cm_factorize(self%handle, n, colptr, rowind, val, ordering, last0, err, not_posdef=not_posdef)
       end if
       st = cm_get_stats(self%handle)
       self%t_analyze = st%t_analyze + t_order
@@ -261,9 +249,8 @@ contains
       self%tiles = int(st%tiles, i8)
       self%mem_bytes = int(st%mem_peak, i8)
       self%interface_last_ok = (st%last_ok == 1 .and. self%m_last > 0)
-      if (code /= CM_OK) then
-        self%not_posdef = code == CM_NOT_POSDEF
-        call set_cm_error(code, cmsg, err)
+      if (err%failed()) then
+        self%not_posdef = not_posdef
         call cm_free(self%handle)
         return
       end if
@@ -282,35 +269,6 @@ contains
 
   end subroutine chol_factor
 
-  !> The error for a CHOLMOD shim status: out of memory, or any other failure.
-  subroutine set_cm_error(code, text, err)
-    integer, intent(in) :: code              !< CM_* status, not CM_OK
-    character(len=*), intent(in) :: text     !< the shim's sentence
-    type(error_t), intent(inout) :: err      !< receives the error
-    if (code == CM_OUT_OF_MEMORY) then
-      call err%set(ERR_MEMORY, text)
-    else
-      call err%set(ERR_NUMERICAL, text)
-    end if
-  end subroutine set_cm_error
-
-  !> Map ORD_* to the shim's codes.
-  pure integer function cm_ordering(ordering)
-    integer, intent(in) :: ordering
-    select case (ordering)
-    case (ORD_METIS)
-      cm_ordering = CM_ORD_METIS
-    case (ORD_AMD)
-      cm_ordering = CM_ORD_AMD
-    case (ORD_GIVEN, ORD_NODES)
-      cm_ordering = CM_ORD_GIVEN
-    case (ORD_AUTO)
-      cm_ordering = CM_ORD_AUTO
-    case default
-      cm_ordering = CM_ORD_NATURAL
-    end select
-  end function cm_ordering
-
   !> Solve K x = b in place (one right-hand side). err: ERR_MEMORY or ERR_NUMERICAL.
   subroutine chol_solve_vec(self, b, err)
     class(chol_t), intent(in) :: self
@@ -327,7 +285,6 @@ contains
     real(wp), intent(inout), contiguous :: b(:, :)   !< right-hand sides in, solutions out (n x nrhs)
     type(error_t), intent(out) :: err                !< the failure, if any
     character(len=512) :: emsg
-    integer :: code
     if (self%method == 0) then
       call err%set(ERR_NUMERICAL, 'Cholesky: solve called without a valid factorization.')
     else if (size(b, 1) /= self%n) then
@@ -335,8 +292,7 @@ contains
         ' differs from the matrix order ', self%n, '.'
       call err%set(ERR_NUMERICAL, emsg)
     else if (self%method == FACT_CHOLMOD) then
-      call cm_solve(self%handle, b, code, emsg)
-      if (code /= CM_OK) call set_cm_error(code, emsg, err)
+      call cm_solve(self%handle, b, err)
     else
       call self%band%solve(b, err)
     end if
@@ -609,15 +565,13 @@ contains
     type(chol_t), intent(in) :: self
     real(wp), allocatable, intent(out) :: lg(:, :)
     type(error_t), intent(inout) :: err
-    integer :: st, code
-    character(len=512) :: cmsg
+    integer :: st
     allocate (lg(self%m_last, self%m_last), stat=st)
     if (st /= 0) then
       call err%set(ERR_MEMORY, 'Cholesky: out of memory for the trailing block of L.')
       return
     end if
-    call cm_trailing_block(self%handle, lg, code, cmsg)
-    if (code /= CM_OK) call set_cm_error(code, cmsg, err)
+    call cm_trailing_block(self%handle, lg, err)
   end subroutine trailing_block
 
   !> One line describing the factorization (method, sizes, times, memory).

@@ -2,24 +2,37 @@
 !! `bind(c)` interfaces and thin typed wrappers around an opaque handle.
 !! One handle holds one factorization with its own CHOLMOD workspace, so two
 !! threads may use two different handles at once (never one handle from two
-!! threads). Nothing of CHOLMOD's own types is visible here.
+!! threads). Nothing of CHOLMOD's own types is visible here; the shim's status
+!! becomes an `error_t` here (out of memory or too large: ERR_MEMORY, else
+!! ERR_NUMERICAL, with the shim's sentence).
+!!
+!! The fill-reducing orderings `ORD_*` are defined here, once, for every module that
+!! factorizes (module cholesky hands them on): the shim takes the same numbers
+!! (`CHSH_ORD_*`), which `cm_create` checks.
 module cholmod_iface
   use, intrinsic :: iso_c_binding, only: c_ptr, c_null_ptr, c_associated, c_int, &
                                          c_double, c_char, c_null_char
   use kinds, only: wp
+  use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
   implicit none (type, external)
   private
 
-  integer, parameter, public :: CM_OK = 0             !< success
-  integer, parameter, public :: CM_NOT_POSDEF = 1     !< matrix not positive definite
-  integer, parameter, public :: CM_OUT_OF_MEMORY = 2  !< out of memory / too large
-  integer, parameter, public :: CM_FAILURE = 3        !< any other failure
+  ! the shim's status codes (CHSH_*), turned into an error_t here
+  integer, parameter :: CM_OK = 0             ! success
+  integer, parameter :: CM_NOT_POSDEF = 1     ! matrix not positive definite
+  integer, parameter :: CM_OUT_OF_MEMORY = 2  ! out of memory / too large
+  integer, parameter :: CM_FAILURE = 3        ! any other failure
 
-  integer, parameter, public :: CM_ORD_METIS = 1      !< METIS nested dissection
-  integer, parameter, public :: CM_ORD_AMD = 2        !< (constrained) approximate minimum degree
-  integer, parameter, public :: CM_ORD_NATURAL = 3    !< natural order (interface last if given)
-  integer, parameter, public :: CM_ORD_GIVEN = 4      !< interior order given by the caller, interface last
-  integer, parameter, public :: CM_ORD_AUTO = 6       !< CHOLMOD's own choice (AMD, METIS if AMD fills much), nothing last
+  integer, parameter, public :: ORD_METIS = 1      !< METIS nested dissection (CHOLMOD)
+  integer, parameter, public :: ORD_AMD = 2        !< AMD, or CAMD when an interface is given
+  integer, parameter, public :: ORD_NATURAL = 3    !< natural order (interface last if given)
+  integer, parameter, public :: ORD_GIVEN = 4      !< caller's interior order (interior_perm), interface last
+  !> METIS on the node graph (ordering%node_dissection: a solid body's nodes, from the pattern),
+  !! interface last; module cholesky computes that order and hands it to the shim as ORD_GIVEN
+  integer, parameter, public :: ORD_NODES = 5
+  !> CHOLMOD's own analysis (its default strategy: AMD, and METIS too when AMD fills much; the
+  !! better kept), nothing last: a reference for benchmarks
+  integer, parameter, public :: ORD_AUTO = 6
 
   integer, parameter :: MSG_LEN = 512
 
@@ -45,7 +58,16 @@ module cholmod_iface
   public :: cm_init, cm_create, cm_factorize, cm_solve, cm_trailing_block, cm_get_stats, &
             cm_release_workspace, cm_free, cm_metis_order
 
+  !> the number of codes chsh_codes gives
+  integer, parameter :: NCODES = 9
+
   interface
+    subroutine chsh_codes(codes, ncodes) bind(c, name='chsh_codes')
+      import :: c_int
+      integer(c_int), intent(out) :: codes(*)
+      integer(c_int), value :: ncodes
+    end subroutine chsh_codes
+
     function chsh_create(h, msg, msglen) bind(c, name='chsh_create') result(code)
       import :: c_ptr, c_int, c_char
       type(c_ptr), intent(out) :: h
@@ -125,21 +147,26 @@ module cholmod_iface
 
 contains
 
-  !> Convert a NUL-terminated C buffer into a Fortran string.
-  pure function c_to_f(buf) result(s)
-    character(kind=c_char), intent(in) :: buf(:)
-    character(len=:), allocatable :: s
-    integer :: k, l
-    l = 0
-    do k = 1, size(buf)
+  !> The error for a shim status that is not CM_OK: the shim's sentence (NUL-terminated in
+  !! buf) with ERR_MEMORY for out of memory (or too large), else ERR_NUMERICAL. Copies into a
+  !! fixed-length text (no deferred-length function result: two threads call this at once).
+  subroutine set_error(code, buf, err)
+    integer, intent(in) :: code                      !< CM_* status, not CM_OK
+    character(kind=c_char), intent(in) :: buf(:)     !< the shim's sentence
+    type(error_t), intent(inout) :: err              !< receives the error
+    character(len=MSG_LEN) :: text
+    integer :: k
+    text = ''
+    do k = 1, min(size(buf), MSG_LEN)
       if (buf(k) == c_null_char) exit
-      l = k
+      text(k:k) = buf(k)
     end do
-    allocate (character(len=l) :: s)
-    do k = 1, l
-      s(k:k) = buf(k)
-    end do
-  end function c_to_f
+    if (code == CM_OUT_OF_MEMORY) then
+      call err%set(ERR_MEMORY, text)
+    else
+      call err%set(ERR_NUMERICAL, text)
+    end if
+  end subroutine set_error
 
   !> Hold OpenBLAS to one thread (once per process; safe to call repeatedly and
   !! from several threads). Parallelism is over the bodies, with OpenMP.
@@ -147,98 +174,106 @@ contains
     call chsh_init()
   end subroutine cm_init
 
-  !> Create an empty handle (idempotent: an existing handle is kept).
-  subroutine cm_create(h, info, msg)
+  !> Create an empty handle (idempotent: an existing handle is kept). First checks that the
+  !! shim's status and ordering codes are this module's (the one place they are compared).
+  !! err: ERR_MEMORY, or ERR_NUMERICAL (CHOLMOD's failure, or codes that differ).
+  subroutine cm_create(h, err)
     type(c_ptr), intent(inout) :: h          !< handle (c_null_ptr on entry for a new one)
-    integer, intent(out) :: info             !< CM_* code
-    character(len=*), intent(out) :: msg     !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err        !< the failure, if any
     character(kind=c_char) :: buf(MSG_LEN)
-    msg = ''
-    info = CM_OK
+    integer(c_int) :: codes(NCODES)
+    integer :: code
+    call chsh_codes(codes, int(NCODES, c_int))
+    if (any(codes /= [CM_OK, CM_NOT_POSDEF, CM_OUT_OF_MEMORY, CM_FAILURE, &
+                      ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN, ORD_AUTO])) then
+      call err%set(ERR_NUMERICAL, 'CHOLMOD shim: its status or ordering codes (include/cholmod_shim.h) '// &
+                   'differ from module cholmod_iface''s.')
+      return
+    end if
     if (c_associated(h)) return
-    info = chsh_create(h, buf, MSG_LEN)
-    if (info /= CM_OK) msg = c_to_f(buf)
+    code = chsh_create(h, buf, MSG_LEN)
+    if (code /= CM_OK) call set_error(code, buf, err)
   end subroutine cm_create
 
   !> Analyze and factorize a symmetric positive definite matrix (full symmetric CSC,
   !! 0-based, rows sorted). `last0` (0-based, may be empty) lists DOFs to order last.
-  !! With CM_ORD_GIVEN, `interior0` (0-based, size n - size(last0)) is the order of
-  !! all the other DOFs; it is required then and ignored otherwise. Module cholesky
+  !! With ORD_GIVEN, `interior0` (0-based, size n - size(last0)) is the order of
+  !! all the other DOFs; it is required then and ignored otherwise (ORD_NODES is module
+  !! cholesky's: it hands its node order over as ORD_GIVEN). Module cholesky
   !! checks the arguments (with the user-facing messages); the shim checks again that
   !! the interior order is given and is a permutation of the other DOFs.
-  subroutine cm_factorize(h, n, colptr, rowind, val, ordering, last0, info, msg, interior0)
+  !! err: ERR_NUMERICAL (not positive definite, bad arguments, CHOLMOD failure) or ERR_MEMORY.
+  subroutine cm_factorize(h, n, colptr, rowind, val, ordering, last0, err, interior0, not_posdef)
     type(c_ptr), intent(in) :: h                  !< handle from cm_create
     integer, intent(in) :: n                      !< matrix order
     integer(c_int), intent(in) :: colptr(:)       !< column pointers, size n+1, 0-based
     integer(c_int), intent(in) :: rowind(:)       !< row indices, 0-based
     real(wp), intent(in) :: val(:)                !< values
-    integer, intent(in) :: ordering               !< CM_ORD_*
+    integer, intent(in) :: ordering               !< ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN or ORD_AUTO
     integer(c_int), intent(in) :: last0(:)        !< DOFs to order last, 0-based, in order
-    integer, intent(out) :: info                  !< CM_* code
-    character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
-    integer(c_int), intent(in), optional :: interior0(:)  !< interior order, 0-based (CM_ORD_GIVEN)
+    type(error_t), intent(out) :: err             !< the failure, if any
+    integer(c_int), intent(in), optional :: interior0(:)  !< interior order, 0-based (ORD_GIVEN)
+    !> true when the failure is a pivot <= 0 (the matrix is not positive definite)
+    logical, intent(out), optional :: not_posdef
     character(kind=c_char) :: buf(MSG_LEN)
-    msg = ''
-    if (ordering == CM_ORD_GIVEN) then
-      info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
+    integer :: code
+    if (ordering == ORD_GIVEN) then
+      code = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
                             int(size(last0), c_int), last0, interior0, buf, MSG_LEN)
     else
-      info = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
+      code = chsh_factorize(h, int(n, c_int), colptr, rowind, val, int(ordering, c_int), &
                             int(size(last0), c_int), last0, msg=buf, msglen=MSG_LEN)
     end if
-    if (info /= CM_OK) msg = c_to_f(buf)
+    if (present(not_posdef)) not_posdef = code == CM_NOT_POSDEF
+    if (code /= CM_OK) call set_error(code, buf, err)
   end subroutine cm_factorize
 
   !> METIS nested dissection (postordered) of the graph of a symmetric pattern: n vertices,
   !! CSC 0-based with rows sorted in each column, the strictly upper triangle read; perm0(k)
   !! is the vertex (0-based) placed k-th, checked to be a permutation. Serialized with every
-  !! other METIS call of the process; needs no handle.
-  subroutine cm_metis_order(n, colptr, rowind, perm0, info, msg)
+  !! other METIS call of the process; needs no handle. err: ERR_MEMORY or ERR_NUMERICAL.
+  subroutine cm_metis_order(n, colptr, rowind, perm0, err)
     integer, intent(in) :: n                      !< vertices
     integer(c_int), intent(in) :: colptr(:)       !< column pointers, size n+1, 0-based
     integer(c_int), intent(in) :: rowind(:)       !< row indices, 0-based (size >= 1)
     integer(c_int), intent(out) :: perm0(:)       !< (n) the order, 0-based
-    integer, intent(out) :: info                  !< CM_* code
-    character(len=*), intent(out) :: msg          !< one sentence on failure, else blank
+    type(error_t), intent(out) :: err             !< the failure, if any
     character(kind=c_char) :: buf(MSG_LEN)
-    msg = ''
+    integer :: code
     if (size(colptr) < n + 1 .or. size(perm0) < n .or. size(rowind) < 1) then
-      info = CM_FAILURE
-      msg = 'cm_metis_order: the graph''s arrays are shorter than its size.'
+      call err%set(ERR_NUMERICAL, 'cm_metis_order: the graph''s arrays are shorter than its size.')
       return
     end if
-    info = chsh_metis_order(int(n, c_int), colptr, rowind, perm0, buf, MSG_LEN)
-    if (info /= CM_OK) msg = c_to_f(buf)
+    code = chsh_metis_order(int(n, c_int), colptr, rowind, perm0, buf, MSG_LEN)
+    if (code /= CM_OK) call set_error(code, buf, err)
   end subroutine cm_metis_order
 
-  !> Solve K X = B in place for the columns of `b` (n x nrhs).
-  subroutine cm_solve(h, b, info, msg)
+  !> Solve K X = B in place for the columns of `b` (n x nrhs). err: ERR_MEMORY or ERR_NUMERICAL.
+  subroutine cm_solve(h, b, err)
     type(c_ptr), intent(in) :: h                        !< factorized handle
     real(wp), contiguous, intent(inout) :: b(:, :)      !< right-hand sides in, solutions out
-    integer, intent(out) :: info                        !< CM_* code
-    character(len=*), intent(out) :: msg                !< one sentence on failure
+    type(error_t), intent(out) :: err                   !< the failure, if any
     character(kind=c_char) :: buf(MSG_LEN)
-    msg = ''
-    info = chsh_solve(h, int(size(b, 2), c_int), b, int(max(1, size(b, 1)), c_int), buf, MSG_LEN)
-    if (info /= CM_OK) msg = c_to_f(buf)
+    integer :: code
+    code = chsh_solve(h, int(size(b, 2), c_int), b, int(max(1, size(b, 1)), c_int), buf, MSG_LEN)
+    if (code /= CM_OK) call set_error(code, buf, err)
   end subroutine cm_solve
 
   !> Copy the trailing m x m diagonal block of the Cholesky factor L (lower triangle).
-  subroutine cm_trailing_block(h, lg, info, msg)
+  !! err: ERR_MEMORY or ERR_NUMERICAL.
+  subroutine cm_trailing_block(h, lg, err)
     type(c_ptr), intent(in) :: h                        !< factorized handle
     real(wp), contiguous, intent(out) :: lg(:, :)       !< m x m block, zeros above the diagonal
-    integer, intent(out) :: info                        !< CM_* code
-    character(len=*), intent(out) :: msg                !< one sentence on failure
+    type(error_t), intent(out) :: err                   !< the failure, if any
     character(kind=c_char) :: buf(MSG_LEN)
-    msg = ''
+    integer :: code
     if (size(lg, 1) /= size(lg, 2)) then
-      info = CM_FAILURE
-      msg = 'cm_trailing_block: the output block is not square.'
+      call err%set(ERR_NUMERICAL, 'cm_trailing_block: the output block is not square.')
       return
     end if
-    info = chsh_trailing_block(h, int(size(lg, 1), c_int), lg, int(max(1, size(lg, 1)), c_int), &
+    code = chsh_trailing_block(h, int(size(lg, 1), c_int), lg, int(max(1, size(lg, 1)), c_int), &
                                buf, MSG_LEN)
-    if (info /= CM_OK) msg = c_to_f(buf)
+    if (code /= CM_OK) call set_error(code, buf, err)
   end subroutine cm_trailing_block
 
   !> Statistics of the handle's last factorization (zeros for a null handle).

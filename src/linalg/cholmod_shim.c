@@ -77,6 +77,16 @@ void chsh_init(void)
     bt_init();
 }
 
+void chsh_codes(int *codes, int ncodes)
+{
+    static const int all[] = {CHSH_OK, CHSH_NOT_POSDEF, CHSH_OUT_OF_MEMORY, CHSH_FAILURE,
+                              CHSH_ORD_METIS, CHSH_ORD_AMD, CHSH_ORD_NATURAL, CHSH_ORD_GIVEN,
+                              CHSH_ORD_AUTO};
+    int k;
+    for (k = 0; k < ncodes; k++)
+        codes[k] = k < (int) (sizeof all / sizeof all[0]) ? all[k] : -1;
+}
+
 static void set_msg(char *msg, int msglen, const char *fmt, ...)
 {
     va_list ap;

@@ -159,6 +159,10 @@ contains
   !> The factor the deck's setting names, not yet factorized: CHOLMOD with its ordering
   !! (ordering='nd': in the plane the caller's interior order, a solid body's by METIS on its
   !! node graph; the interface last), banded, or MUMPS over the group `comm` (default: 0).
+  !! The one place where the deck's choices (config's FACTOR_* and ORDER_*) become linalg's
+  !! codes (cholesky's FACT_*, cholmod_iface's ORD_*): the deck's lists are what a user may
+  !! write, linalg's what a factorization can do (MUMPS is no chol_t; 'nd' is ORD_GIVEN or
+  !! ORD_NODES by the dimension), and config, upstream of linalg, cannot use linalg's.
   subroutine new_factor(fc, body, fac, comm)
     type(factor_cfg_t), intent(in) :: fc                  !< factorization and ordering
     integer, intent(in) :: body                           !< the body, for messages

@@ -37,7 +37,7 @@ module mumps_iface
     real(wp) :: rank_factor_mb = 0.0_wp       !< this rank's share of them (INFO(9)) [MiB]
   end type mumps_t
 
-  public :: mumps_schur_factor, mumps_solve, mumps_end, mumps_error_text
+  public :: mumps_schur_factor, mumps_solve, mumps_end
 
 contains
 
@@ -239,7 +239,8 @@ contains
     mt%alive = .false.
   end subroutine mumps_end
 
-  !> A sentence for a MUMPS error code (INFOG(1) < 0, INFOG(2) its detail).
+  !> A sentence for a MUMPS error code (INFOG(1) < 0, INFOG(2) its detail): MUMPS's status
+  !! translated where it is called (the errors of this module's procedures).
   function mumps_error_text(info1, info2, body) result(s)
     integer, intent(in) :: info1, info2, body
     character(len=:), allocatable :: s

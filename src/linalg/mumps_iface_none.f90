@@ -21,7 +21,7 @@ module mumps_iface
     real(wp) :: rank_factor_mb = 0.0_wp       !< this rank's share of them [MiB]
   end type mumps_t
 
-  public :: mumps_schur_factor, mumps_solve, mumps_end, mumps_error_text
+  public :: mumps_schur_factor, mumps_solve, mumps_end
 
   character(len=*), parameter :: NONE = 'this binary is built without MUMPS: run bin/robin_contact_mpi under mpirun'
 
@@ -52,12 +52,5 @@ contains
     type(mumps_t), intent(inout) :: mt
     mt%k = 0
   end subroutine mumps_end
-
-  !> A sentence for a MUMPS error code.
-  function mumps_error_text(info1, info2, body) result(s)
-    integer, intent(in) :: info1, info2, body
-    character(len=:), allocatable :: s
-    s = NONE//repeat(' ', 0*(info1 + info2 + body))
-  end function mumps_error_text
 
 end module mumps_iface

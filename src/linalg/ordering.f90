@@ -39,7 +39,7 @@ module ordering
   use kinds, only: wp, i8
   use space, only: NCOMP, node_dof
   use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
-  use cholmod_iface, only: cm_metis_order, CM_OK, CM_OUT_OF_MEMORY
+  use cholmod_iface, only: cm_metis_order
   implicit none (type, external)
   private
 
@@ -48,11 +48,6 @@ module ordering
   !> Boxes with fewer nodes than this are ordered naturally (no further dissection); the
   !! factor's size depends little on it (within 12% from 4 to 64 on 512 x 256 Q1 cells).
   integer, parameter, public :: ND_LEAF_NODES = 16
-
-  ! internal status of an ordering; the exported procedures return an error_t
-  integer, parameter :: ND_OK = 0            !< success
-  integer, parameter :: ND_BAD_SYSTEM = 1    !< mesh and system do not match
-  integer, parameter :: ND_BAD_LAST = 2      !< an entry of `last` is out of range or repeated
 
   !> Unstructured meshes: node sets with fewer nodes than this are not bisected further.
   integer, parameter, public :: RCB_LEAF_NODES = 16
@@ -94,23 +89,22 @@ contains
     integer, allocatable, intent(out) :: perm(:)      !< the interior ordering, 1-based free DOFs
     type(error_t), intent(out) :: err                 !< ERR_NUMERICAL with one sentence (perm empty)
     type(order_t) :: order
-    integer :: nx1, info
+    integer :: nx1
     character(len=200) :: emsg
 
-    emsg = ''
     if (nx < 1 .or. ny < 1 .or. size(free_of) /= 2*(nx + 1)*(ny + 1)) then
       write (emsg, '(a,i0,a,i0,a,i0,a)') 'nested dissection: the system (', size(free_of), &
         ' DOFs) does not belong to a ', nx, ' x ', ny, ' cell mesh.'
-      info = ND_BAD_SYSTEM
+      call err%set(ERR_NUMERICAL, emsg)
     else
-      call start_order(n, last, order, info, emsg)
+      call start_order(n, last, order, err)
     end if
-    if (info == ND_OK) then
+    if (.not. err%failed()) then
       nx1 = nx + 1
       call dissect(0, nx, 0, ny)
-      call finish_order(order, info, emsg)
+      call finish_order(order, err)
     end if
-    call hand_over(order, info, emsg, perm, err)
+    call hand_over(order, err, perm)
 
   contains
 
@@ -172,23 +166,26 @@ contains
     type(error_t), intent(out) :: err                 !< ERR_NUMERICAL with one sentence (perm empty)
     type(order_t) :: order
     type(node_graph_t) :: graph
-    integer :: n, stamp, info
+    integer :: n, stamp
     character(len=200) :: emsg
 
     emsg = ''
     n = size(dof_of)
-    info = ND_BAD_SYSTEM
-    if (general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg)) call start_order(n, last, order, info, emsg)
-    if (info == ND_OK) then
+    if (general_arrays_ok(xy, free_of, dof_of, colptr, rowind, emsg)) then
+      call start_order(n, last, order, err)
+    else
+      call err%set(ERR_NUMERICAL, emsg)
+    end if
+    if (.not. err%failed()) then
       if (build_node_graph(xy, free_of, dof_of, colptr, rowind, n, order%skip, graph, emsg)) then
         stamp = 0
         call bisect(1, size(graph%sorted, 1))
-        call finish_order(order, info, emsg)
+        call finish_order(order, err)
       else
-        info = ND_BAD_SYSTEM
+        call err%set(ERR_NUMERICAL, emsg)
       end if
     end if
-    call hand_over(order, info, emsg, perm, err)
+    call hand_over(order, err, perm)
 
   contains
 
@@ -365,24 +362,17 @@ contains
     type(error_t), intent(out) :: err                 !< the failure (perm empty), if any
     type(order_t) :: order
     integer, allocatable :: group_of(:), members(:), gptr(:), gp(:), gi(:), gorder(:), mark(:)
-    integer :: n, ng, g, h, k, p, q, info, cm_info, st, pass
-    character(len=200) :: emsg
-    character(len=512) :: cmsg
+    integer :: n, ng, g, h, k, p, q, st, pass
 
-    emsg = ''
     n = size(colptr) - 1
-    info = ND_BAD_SYSTEM
     if (n < 0) then
-      emsg = 'node ordering: no column pointers.'
+      call err%set(ERR_NUMERICAL, 'node ordering: no column pointers.')
     else
-      call start_order(n, last, order, info, emsg)
+      call start_order(n, last, order, err)
     end if
-    if (info == ND_OK) then
-      call node_groups(colptr, rowind, order%skip, group_of, members, gptr, ng, emsg)
-      if (ng < 0) info = ND_BAD_SYSTEM
-    end if
-    if (info /= ND_OK) then
-      call hand_over(order, info, emsg, perm, err)
+    if (.not. err%failed()) call node_groups(colptr, rowind, order%skip, group_of, members, gptr, ng, err)
+    if (err%failed()) then
+      call hand_over(order, err, perm)
       return
     end if
 
@@ -420,10 +410,9 @@ contains
       return
     end if
 
-    call cm_metis_order(ng, gp, gi, gorder, cm_info, cmsg)
-    if (cm_info /= CM_OK) then
+    call cm_metis_order(ng, gp, gi, gorder, err)
+    if (err%failed()) then
       allocate (perm(0))
-      call err%set(merge(ERR_MEMORY, ERR_NUMERICAL, cm_info == CM_OUT_OF_MEMORY), trim(cmsg))
       return
     end if
     do k = 1, ng
@@ -433,16 +422,16 @@ contains
         if (order%pos <= size(order%perm)) order%perm(order%pos) = members(p)
       end do
     end do
-    call finish_order(order, info, emsg)
-    call hand_over(order, info, emsg, perm, err)
+    call finish_order(order, err)
+    call hand_over(order, err, perm)
   end subroutine node_dissection
 
   !> The nodes of a stiffness pattern (see the module header): the free DOFs not skipped, in
   !! increasing order (members), split into runs (node g: members(gptr(g) : gptr(g+1) - 1)) of
   !! DOFs whose columns, and those of every DOF between them (skipped ones too), are
   !! identical, spanning at most NCOMP consecutive DOFs; group_of(j) is DOF j's node, 0 for a
-  !! skipped one. ng = -1 and a sentence in emsg on a pattern out of range.
-  subroutine node_groups(colptr, rowind, skip, group_of, members, gptr, ng, emsg)
+  !! skipped one. On a pattern out of range ERR_NUMERICAL with a sentence, ng = -1.
+  subroutine node_groups(colptr, rowind, skip, group_of, members, gptr, ng, err)
     integer, intent(in) :: colptr(:)                  !< (n+1) 0-based CSC column pointers
     integer, intent(in) :: rowind(:)                  !< 0-based row indices, sorted in each column
     logical, intent(in) :: skip(:)                    !< (n) the DOFs left out (ordered last)
@@ -450,31 +439,34 @@ contains
     integer, allocatable, intent(out) :: members(:)   !< the DOFs not skipped, in increasing order
     integer, allocatable, intent(out) :: gptr(:)      !< (ng+1) node g's DOFs in members
     integer, intent(out) :: ng                        !< the number of nodes, -1 on a bad pattern
-    character(len=*), intent(inout) :: emsg           !< the failure, if any
+    type(error_t), intent(out) :: err                 !< the failure, if any
     integer :: n, j, i, prev, first, nm, q
     logical :: join
+    character(len=200) :: emsg
 
     n = size(colptr) - 1
     ng = -1
     if (n < 0 .or. size(skip) < n) then
       allocate (group_of(0), members(0), gptr(1))
-      emsg = 'node ordering: no column pointers, or fewer skip flags than DOFs.'
+      call err%set(ERR_NUMERICAL, 'node ordering: no column pointers, or fewer skip flags than DOFs.')
       return
     end if
     allocate (group_of(n), members(count(.not. skip(1:n))), gptr(n + 1))
     if (colptr(1) /= 0 .or. colptr(n + 1) > size(rowind)) then
-      emsg = 'node ordering: the column pointers do not start at 0 or exceed the row indices.'
+      call err%set(ERR_NUMERICAL, 'node ordering: the column pointers do not start at 0 or exceed the row indices.')
       return
     end if
     do j = 1, n
       if (colptr(j + 1) < colptr(j)) then
         write (emsg, '(a,i0,a)') 'node ordering: the column pointers decrease at column ', j, '.'
+        call err%set(ERR_NUMERICAL, emsg)
         return
       end if
       do q = colptr(j) + 1, colptr(j + 1)
         if (rowind(q) < 0 .or. rowind(q) >= n) then
           write (emsg, '(a,i0,a,i0,a)') 'node ordering: row index ', rowind(q), ' of column ', j, &
             ' is out of range.'
+          call err%set(ERR_NUMERICAL, emsg)
           return
         end if
       end do
@@ -518,25 +510,24 @@ contains
 
   end subroutine node_groups
 
-  !> Check `last` (in 1..n, no repeats: else ND_BAD_LAST with a sentence) and start an
+  !> Check `last` (in 1..n, no repeats: else ERR_NUMERICAL with a sentence) and start an
   !! empty order of n - size(last) DOFs.
-  subroutine start_order(n, last, order, info, emsg)
+  subroutine start_order(n, last, order, err)
     integer, intent(in) :: n, last(:)
     type(order_t), intent(out) :: order
-    integer, intent(out) :: info
-    character(len=*), intent(inout) :: emsg
+    type(error_t), intent(out) :: err
+    character(len=200) :: emsg
     integer :: k
-    info = ND_OK
     allocate (order%skip(max(n, 0)))
     order%skip = .false.
     do k = 1, size(last)
       if (last(k) < 1 .or. last(k) > n) then
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is out of range.'
-        info = ND_BAD_LAST
+        call err%set(ERR_NUMERICAL, emsg)
         return
       else if (order%skip(last(k))) then
         write (emsg, '(a,i0,a,i0,a)') 'nested dissection: interface DOF ', last(k), ' (entry ', k, ') is repeated.'
-        info = ND_BAD_LAST
+        call err%set(ERR_NUMERICAL, emsg)
         return
       end if
       order%skip(last(k)) = .true.
@@ -544,30 +535,27 @@ contains
     allocate (order%perm(n - size(last)))
   end subroutine start_order
 
-  !> Every DOF placed exactly once, else free_of is not a bijection onto 1..n: ND_BAD_SYSTEM.
-  subroutine finish_order(order, info, emsg)
+  !> Every DOF placed exactly once, else free_of is not a bijection onto 1..n: ERR_NUMERICAL.
+  subroutine finish_order(order, err)
     type(order_t), intent(in) :: order
-    integer, intent(inout) :: info
-    character(len=*), intent(inout) :: emsg
+    type(error_t), intent(inout) :: err
+    character(len=200) :: emsg
     if (order%bad_map .or. order%pos /= size(order%perm)) then
       write (emsg, '(a,i0,a,i0,a)') 'nested dissection: ordered ', order%pos, ' DOFs but expected ', size(order%perm), &
         ' (inconsistent free-DOF map).'
-      info = ND_BAD_SYSTEM
+      call err%set(ERR_NUMERICAL, emsg)
     end if
   end subroutine finish_order
 
-  !> The result: the order, or on failure an empty perm and the sentence in err.
-  subroutine hand_over(order, info, emsg, perm, err)
+  !> The result: the order, or on failure (err set) an empty perm.
+  subroutine hand_over(order, err, perm)
     type(order_t), intent(inout) :: order
-    integer, intent(in) :: info
-    character(len=*), intent(in) :: emsg
+    type(error_t), intent(in) :: err
     integer, allocatable, intent(out) :: perm(:)
-    type(error_t), intent(out) :: err
-    if (info == ND_OK) then
-      call move_alloc(order%perm, perm)
-    else
+    if (err%failed()) then
       allocate (perm(0))
-      call err%set(ERR_NUMERICAL, emsg)
+    else
+      call move_alloc(order%perm, perm)
     end if
   end subroutine hand_over
 

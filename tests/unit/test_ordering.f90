@@ -564,7 +564,6 @@ contains
     logical :: ok
     type(error_t) :: err
     character(len=256) :: msg
-    character(len=200) :: emsg
     character(len=96) :: tag
 
     call box_system(nx, ny, nz, elem, bcs, msh, sys, last)
@@ -587,14 +586,13 @@ contains
                 name//': (the same check fails on the reversed order)')
 
     ! the nodes of the pattern are the mesh's nodes with a DOF not last
-    emsg = ''
-    call node_groups(sys%colptr, sys%rowind, is_last, group_of, members, gptr, ng, emsg)
+    call node_groups(sys%colptr, sys%rowind, is_last, group_of, members, gptr, ng, err)
     allocate (has_inner(msh%nnode), node_of_group(max(ng, 1)))
     has_inner = .false.
     do k = 1, sys%n
       if (.not. is_last(k)) has_inner(dof_node(sys%dof_of(k))) = .true.
     end do
-    ok = ng == count(has_inner)
+    ok = .not. err%failed() .and. ng == count(has_inner)
     do g = 1, max(ng, 0)
       node_of_group(g) = dof_node(sys%dof_of(members(gptr(g))))
       do p = gptr(g), gptr(g + 1) - 1
