@@ -136,7 +136,7 @@ $(BUILD)/errors.o:
 $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
 $(BUILD)/digest.o:         $(BUILD)/errors.o
-$(BUILD)/int_hash.o:       $(BUILD)/kinds.o
+$(BUILD)/int_hash.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
