@@ -136,7 +136,7 @@ $(BUILD)/errors.o:
 $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
 $(BUILD)/digest.o:         $(BUILD)/errors.o
-$(BUILD)/int_hash.o:       $(BUILD)/kinds.o
+$(BUILD)/int_hash.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
@@ -169,7 +169,7 @@ $(BUILD)/element_types.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/elements.
 $(BUILD)/lapack.o:         $(BUILD)/kinds.o
 $(BUILD)/linop.o:          $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/body_system.o:    $(BUILD)/kinds.o
-$(BUILD)/supports.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o $(BUILD)/strings.o
+$(BUILD)/supports.o:       $(BUILD)/space.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o $(BUILD)/strings.o $(BUILD)/errors.o
 $(BUILD)/stiffness_pattern.o: $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/body_system.o
 $(BUILD)/rigid_modes.o:    $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/lapack.o $(BUILD)/body_system.o
 $(BUILD)/assembly.o:       $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/mesh.o $(BUILD)/elements_3d.o \

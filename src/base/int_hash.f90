@@ -3,6 +3,8 @@
 !! caller in its own arrays indexed by the slot (0..mask).
 module int_hash
   use kinds, only: i8
+  use errors, only: error_t, ERR_MEMORY
+  use strings, only: i2s
   implicit none (type, external)
   private
 
@@ -18,18 +20,23 @@ module int_hash
 
 contains
 
-  !> An empty table with room for n keys (capacity at least 2n, at least 16).
-  subroutine hash_init(h, n, stat)
+  !> An empty table with room for n keys (capacity at least 2n, at least 16). err
+  !! (ERR_MEMORY) when the table cannot be allocated (the caller names what it was for).
+  subroutine hash_init(h, n, err)
     type(int_hash_t), intent(out) :: h   !< the table
     integer, intent(in) :: n             !< keys to hold
-    integer, intent(out) :: stat         !< the allocation's status (0: success)
+    type(error_t), intent(out) :: err    !< ERR_MEMORY: no room for the table
     integer(i8) :: capacity
+    integer :: st
     capacity = 16
     do while (capacity < 2_i8*n)
       capacity = 2*capacity
     end do
-    allocate (h%key(0:capacity - 1), stat=stat)
-    if (stat /= 0) return
+    allocate (h%key(0:capacity - 1), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for a hash table of '//i2s(n)//' keys')
+      return
+    end if
     h%key = HASH_EMPTY
     h%mask = capacity - 1
   end subroutine hash_init

@@ -284,41 +284,43 @@ contains
     scanner%pos = stop_at + len(marker)
   end subroutine skip_past
 
-  !> A decimal integer with an optional sign, in the default integer range.
-  pure subroutine parse_int(t, v, ok)
-    character(len=*), intent(in) :: t
-    integer, intent(out) :: v
-    logical, intent(out) :: ok
+  !> A decimal integer with an optional sign, in the default integer range. A token that
+  !! is not one is an answer (valid false), not a failure: the caller names the token.
+  pure subroutine parse_int(t, v, valid)
+    character(len=*), intent(in) :: t   !< the token
+    integer, intent(out) :: v           !< its value (0 when not valid)
+    logical, intent(out) :: valid       !< t is such an integer
     integer :: i, i0, d
     integer(i8) :: m
     v = 0
     i0 = 1
     if (t(1:1) == '-' .or. t(1:1) == '+') i0 = 2
-    ok = len(t) >= i0 .and. len(t) - i0 < 18
-    if (.not. ok) return
+    valid = len(t) >= i0 .and. len(t) - i0 < 18
+    if (.not. valid) return
     m = 0
     do i = i0, len(t)
       d = iachar(t(i:i)) - iachar('0')
       if (d < 0 .or. d > 9) then
-        ok = .false.
+        valid = .false.
         return
       end if
       m = 10*m + d
     end do
     if (t(1:1) == '-') m = -m
-    ok = abs(m) <= huge(v)
-    if (ok) v = int(m)
+    valid = abs(m) <= huge(v)
+    if (valid) v = int(m)
   end subroutine parse_int
 
   !> A decimal real: an optional sign, digits with an optional fraction (one digit at least)
   !! and an optional exponent (e, E, d or D). Exact (correctly rounded): with a mantissa below
   !! 2**53 and a power of ten up to 22 by one multiplication or division of two exact
   !! doubles; with up to 17 significant digits and a power of ten from -21 to 20 by
-  !! nearest_quotient; other forms (18+ digits, large exponents) by a formatted READ.
-  subroutine parse_real(t, v, ok)
-    character(len=*), intent(in) :: t
-    real(wp), intent(out) :: v
-    logical, intent(out) :: ok
+  !! nearest_quotient; other forms (18+ digits, large exponents) by a formatted READ. A
+  !! token that is not a finite real is an answer (valid false), not a failure.
+  subroutine parse_real(t, v, valid)
+    character(len=*), intent(in) :: t   !< the token
+    real(wp), intent(out) :: v          !< its value
+    logical, intent(out) :: valid       !< t is a finite real
     integer :: i, d, nsig, e10, ex, esign
     integer(i8) :: m
     logical :: digits, neg
@@ -333,13 +335,13 @@ contains
     nsig = 0
     e10 = 0
     digits = .false.
-    ok = .true.
+    valid = .true.
     do while (i <= len(t))                       ! integer part
       d = iachar(t(i:i)) - iachar('0')
       if (d < 0 .or. d > 9) exit
       digits = .true.
       if (nsig >= 18) then
-        ok = .false.
+        valid = .false.
       else
         m = 10*m + d
         if (m > 0) nsig = nsig + 1
@@ -354,7 +356,7 @@ contains
           if (d < 0 .or. d > 9) exit
           digits = .true.
           if (nsig >= 18) then
-            ok = .false.
+            valid = .false.
           else
             m = 10*m + d
             if (m > 0) nsig = nsig + 1
@@ -385,29 +387,29 @@ contains
     end if
     ! the form: digits, and nothing after the exponent ('+', '.', '1-2' are no numbers)
     if (.not. (digits .and. i > len(t))) then
-      ok = .false.
+      valid = .false.
       return
     end if
-    if (ok .and. m == 0) then
+    if (valid .and. m == 0) then
       v = 0.0_wp
-    else if (ok .and. m <= 2_i8**53 .and. abs(e10) <= 22) then
+    else if (valid .and. m <= 2_i8**53 .and. abs(e10) <= 22) then
       v = real(m, wp)
       if (e10 >= 0) then
         v = v*p10(e10)
       else
         v = v/p10(-e10)
       end if
-    else if (ok .and. e10 >= -21 .and. e10 <= 20) then
+    else if (valid .and. e10 >= -21 .and. e10 <= 20) then
       v = nearest_quotient(int(m, i16)*10_i16**max(e10, 0), 10_i16**max(-e10, 0))
     else
       ! Rare forms (18+ digits, large exponents): a formatted READ, only of number
       ! characters (a list-directed READ would take '/' or ',' as separators).
-      ok = len(t) <= 64 .and. verify(t, '0123456789+-.eEdD') == 0
-      if (.not. ok) return
+      valid = len(t) <= 64 .and. verify(t, '0123456789+-.eEdD') == 0
+      if (.not. valid) return
       call fp_read_begin(fp)
       read (t, '(f64.0)', iostat=ios) v
       call fp_read_end(fp)
-      ok = ios == 0 .and. abs(v) <= huge(v)
+      valid = ios == 0 .and. abs(v) <= huge(v)
       return
     end if
     if (neg) v = -v

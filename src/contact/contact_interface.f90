@@ -336,7 +336,8 @@ contains
     type(error_t), intent(out) :: err             !< ERR_INPUT naming both groups and a shared edge
     type(int_hash_t) :: h
     integer, allocatable :: owner(:), nend(:)
-    integer :: a, p, s, g, e, slot, n1, n2, n3, ne, stat, q, t
+    integer :: a, p, s, g, e, slot, n1, n2, n3, ne, q, t
+    type(error_t) :: mem
     integer(i8) :: key
     logical :: keyed
 
@@ -362,8 +363,8 @@ contains
             if (g > 0) ne = ne + m%group(g)%nedge
           end do
         end do
-        call hash_init(h, ne, stat)
-        if (stat /= 0) then
+        call hash_init(h, ne, mem)
+        if (mem%failed()) then
           call err%set(ERR_INPUT, 'body '//i2s(a)//': not enough memory to compare its contact groups'' '// &
                        i2s(ne)//' edges')
           return

@@ -124,8 +124,6 @@ contains
     type(elastic_law_t), allocatable :: laws(:)
     type(element_slot_t) :: elems(NSHAPE)
     logical :: with_k
-    integer :: info
-    character(len=512) :: msg
 
     with_k = .true.
     if (present(matrix)) with_k = matrix
@@ -151,11 +149,8 @@ contains
 
     call prescribed_dofs(mesh, body, prescribed, sys, u_prescribed)
     if (present(boundaries)) then
-      call group_conditions(mesh, body%id, boundaries, prescribed, sys, info, msg)
-      if (info /= 0) then
-        call err%set(ERR_INPUT, msg)
-        return
-      end if
+      call group_conditions(mesh, body%id, boundaries, prescribed, sys, err)
+      if (err%failed()) return
     end if
     if (mesh%axisymmetric) then
       call axis_conditions(mesh, prescribed, sys, err)

@@ -270,7 +270,8 @@ contains
   subroutine read_physical_names(scanner, file_mesh)
     type(scanner_t), intent(inout) :: scanner
     type(file_mesh_t), intent(inout) :: file_mesh
-    integer :: n, k, dim, tag, st
+    integer :: n, k, dim, tag
+    type(error_t) :: err
     integer(i8) :: q
     ! a name takes at least 7 characters: '1 2 ""' and a line end
     n = read_count(scanner, 'the number of physical names', 7, 'physical names')
@@ -303,8 +304,8 @@ contains
         call scan_fail(scanner, 'a physical name must be in double quotes on one line')
         return
       end if
-      call add_physical(file_mesh, dim, tag, scanner%text(scanner%pos + 1:scanner%pos + q - 1), st)
-      if (st /= 0) then
+      call add_physical(file_mesh, dim, tag, scanner%text(scanner%pos + 1:scanner%pos + q - 1), err)
+      if (err%failed()) then
         call scan_fail(scanner, 'not enough memory for '//i2s(k)//' physical groups', SCAN_OTHER_FAILURE)
         return
       end if
@@ -324,6 +325,7 @@ contains
     character(len=*), parameter :: KIND(0:3) = ['points  ', 'curves  ', 'surfaces', 'volumes ']
     integer :: nents(0:3), dim, k, j, nb, tag, np, bound, st, nkeep
     integer(i8) :: need
+    type(error_t) :: err
     real(wp) :: r
     integer, allocatable :: phys(:)
     do dim = 0, 3
@@ -377,9 +379,9 @@ contains
           call move_alloc(phys, file_mesh%ent(file_mesh%nent)%phys)
           do j = 1, np        ! physical groups without a name are named by their tag
             call add_physical(file_mesh, dim, file_mesh%ent(file_mesh%nent)%phys(j), &
-                              i2s(file_mesh%ent(file_mesh%nent)%phys(j)), st)
-            if (st /= 0) then
-              call scan_fail(scanner, 'not enough memory for the physical groups', SCAN_OTHER_FAILURE)
+                              i2s(file_mesh%ent(file_mesh%nent)%phys(j)), err)
+            if (err%failed()) then
+              call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
               return
             end if
           end do
@@ -388,9 +390,9 @@ contains
         end if
       end do
     end do
-    call index_entities(file_mesh, st)
-    if (st /= 0) then
-      call scan_fail(scanner, 'not enough memory for the entities', SCAN_OTHER_FAILURE)
+    call index_entities(file_mesh, err)
+    if (err%failed()) then
+      call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
       return
     end if
     call expect(scanner, '$EndEntities')
@@ -405,6 +407,7 @@ contains
     integer, parameter :: NODE_BYTES = 8, BLOCK_BYTES = 8
     integer :: nblock, ntotal, b, edim, etag, param, nb, k, j, st, slot, first, tag, tag_lo, tag_hi
     real(wp) :: z, r
+    type(error_t) :: err
 
     nblock = read_count(scanner, 'the number of node blocks', BLOCK_BYTES, 'node blocks')
     ntotal = read_count(scanner, 'the number of nodes', NODE_BYTES, 'nodes')
@@ -419,9 +422,9 @@ contains
       by_tag%hi = tag_hi
       if (st == 0) allocate (by_tag%node_of_tag(tag_lo:tag_hi), source=0, stat=st)
     else
-      if (st == 0) call index_to_hash(by_tag, file_mesh%node_tag, 0, ntotal, st)
+      if (st == 0) call index_to_hash(by_tag, file_mesh%node_tag, 0, ntotal, err)
     end if
-    if (st /= 0) then
+    if (st /= 0 .or. err%failed()) then
       call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
       return
     end if
@@ -446,9 +449,9 @@ contains
         end if
         tag = file_mesh%node_tag(k)
         if (by_tag%direct .and. (tag < by_tag%lo .or. tag > by_tag%hi)) then
-          call index_to_hash(by_tag, file_mesh%node_tag, k - 1, ntotal, st)
-          if (st /= 0) then
-            call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
+          call index_to_hash(by_tag, file_mesh%node_tag, k - 1, ntotal, err)
+          if (err%failed()) then
+            call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
             return
           end if
         end if
@@ -611,7 +614,8 @@ contains
     ! the fewest characters of an element (a point: tag and node) and of a block's header
     integer, parameter :: ELEMENT_BYTES = 4, BLOCK_BYTES = 8
     character(len=*), parameter :: WHAT(0:3) = ['a point      ', 'a line       ', 'a surface    ', 'a volume     ']
-    integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, st, t, dim, nodes(8)
+    integer :: nblock, ntotal, b, edim, etag, etype, nb, k, j, nv, tag, ntg, ent, t, dim, nodes(8)
+    type(error_t) :: err
 
     nblock = read_count(scanner, 'the number of element blocks', BLOCK_BYTES, 'element blocks')
     ntotal = read_count(scanner, 'the number of elements', ELEMENT_BYTES, 'elements')
@@ -667,16 +671,16 @@ contains
       ent = entity_index(file_mesh, edim, etag)
       select case (etype)
       case (4, 5)
-        call grow(file_mesh%cell_tag, file_mesh%cell_entity, file_mesh%ncell, nb, ntotal, st, file_mesh%cell_node)
+        call grow(file_mesh%cell_tag, file_mesh%cell_entity, file_mesh%ncell, nb, ntotal, err, file_mesh%cell_node)
       case (2, 3)
-        call grow(file_mesh%face_tag, file_mesh%face_entity, file_mesh%nface, nb, ntotal, st, file_mesh%face_node)
+        call grow(file_mesh%face_tag, file_mesh%face_entity, file_mesh%nface, nb, ntotal, err, file_mesh%face_node)
       case (1)
-        call grow(file_mesh%line_tag, file_mesh%line_entity, file_mesh%nline, nb, ntotal, st, file_mesh%line_node)
+        call grow(file_mesh%line_tag, file_mesh%line_entity, file_mesh%nline, nb, ntotal, err, file_mesh%line_node)
       case default
-        call grow(file_mesh%point_node, file_mesh%point_entity, file_mesh%npoint, nb, ntotal, st)
+        call grow(file_mesh%point_node, file_mesh%point_entity, file_mesh%npoint, nb, ntotal, err)
       end select
-      if (st /= 0) then
-        call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
+      if (err%failed()) then
+        call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
         return
       end if
       do k = 1, nb
@@ -732,26 +736,32 @@ contains
 
   !> Room for `nb` more items after the `used` ones of one kind's arrays (a and e, and the
   !! columns of `nodes` if present): the capacity doubled, at least used + nb, at most
-  !! `cap_max` (the elements announced). stat /= 0: out of memory.
-  subroutine grow(a, e, used, nb, cap_max, stat, nodes)
+  !! `cap_max` (the elements announced). err (ERR_MEMORY, naming the cap_max elements): out
+  !! of memory.
+  subroutine grow(a, e, used, nb, cap_max, err, nodes)
     integer, allocatable, intent(inout) :: a(:), e(:)
     integer, intent(in) :: used, nb, cap_max
-    integer, intent(out) :: stat
+    type(error_t), intent(out) :: err
     integer, allocatable, intent(inout), optional :: nodes(:, :)
     integer, allocatable :: a2(:), e2(:), n2(:, :)
-    integer :: cap
-    stat = 0
+    integer :: cap, st
     if (used + nb <= size(a)) return
     cap = int(min(int(cap_max, i8), max(int(used, i8) + nb, 2_i8*size(a))))
-    allocate (a2(cap), e2(cap), stat=stat)
-    if (stat /= 0) return
+    allocate (a2(cap), e2(cap), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for '//i2s(cap_max)//' elements')
+      return
+    end if
     a2(1:used) = a(1:used)
     e2(1:used) = e(1:used)
     call move_alloc(a2, a)
     call move_alloc(e2, e)
     if (present(nodes)) then
-      allocate (n2(size(nodes, 1), cap), stat=stat)
-      if (stat /= 0) return
+      allocate (n2(size(nodes, 1), cap), stat=st)
+      if (st /= 0) then
+        call err%set(ERR_MEMORY, 'not enough memory for '//i2s(cap_max)//' elements')
+        return
+      end if
       n2(:, 1:used) = nodes(:, 1:used)
       call move_alloc(n2, nodes)
     end if
@@ -772,17 +782,22 @@ contains
   end function node_of
 
   !> Move the index to a hash table sized for ntotal tags, holding the nnode tags read so far.
-  subroutine index_to_hash(by_tag, node_tag, nnode, ntotal, stat)
+  !! err (ERR_MEMORY, naming the ntotal nodes): out of memory.
+  subroutine index_to_hash(by_tag, node_tag, nnode, ntotal, err)
     type(node_index_t), intent(inout) :: by_tag
     integer, intent(in) :: node_tag(:)
     integer, intent(in) :: nnode, ntotal
-    integer, intent(out) :: stat
-    integer :: k, slot
+    type(error_t), intent(out) :: err
+    integer :: k, slot, st
     by_tag%direct = .false.
     if (allocated(by_tag%node_of_tag)) deallocate (by_tag%node_of_tag)
-    call hash_init(by_tag%hash, ntotal, stat)
-    if (stat == 0) allocate (by_tag%node_of_slot(0:by_tag%hash%mask), stat=stat)
-    if (stat /= 0) return
+    st = 0
+    call hash_init(by_tag%hash, ntotal, err)
+    if (.not. err%failed()) allocate (by_tag%node_of_slot(0:by_tag%hash%mask), stat=st)
+    if (err%failed() .or. st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for '//i2s(ntotal)//' nodes')
+      return
+    end if
     do k = 1, nnode
       slot = hash_slot(by_tag%hash, int(node_tag(k), i8))
       by_tag%hash%key(slot) = node_tag(k)

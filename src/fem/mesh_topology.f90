@@ -87,28 +87,34 @@ contains
   end function group_key
 
   !> Add a physical group (dim, tag), dim 0..3, named `name` unless it is there already
-  !! (looked up through a hash table, so many groups cost linear time). stat /= 0: out of
-  !! memory.
-  subroutine add_physical(file_mesh, dim, tag, name, stat)
+  !! (looked up through a hash table, so many groups cost linear time). err (ERR_MEMORY):
+  !! out of memory.
+  subroutine add_physical(file_mesh, dim, tag, name, err)
     type(file_mesh_t), intent(inout) :: file_mesh
     integer, intent(in) :: dim, tag
     character(len=*), intent(in) :: name
-    integer, intent(out) :: stat
+    type(error_t), intent(out) :: err     !< ERR_MEMORY: no room for the groups
     integer, allocatable :: idim(:), itag(:)
     type(name_t), allocatable :: nm(:)
-    integer :: k, slot
+    integer :: k, slot, st
     integer(i8) :: key
-    stat = 0
+    st = 0
     if (.not. allocated(file_mesh%phys_dim)) &
-      allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), stat=stat)
-    if (stat /= 0) return
+      allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for the physical groups')
+      return
+    end if
     if (2_i8*(file_mesh%nphys + 1) > file_mesh%phys_hash%mask + 1) then   ! keep the table at most half full
-      call hash_init(file_mesh%phys_hash, 2*(file_mesh%nphys + 1), stat)
-      if (stat == 0) then
+      call hash_init(file_mesh%phys_hash, 2*(file_mesh%nphys + 1), err)
+      if (.not. err%failed()) then
         if (allocated(file_mesh%phys_of_slot)) deallocate (file_mesh%phys_of_slot)
-        allocate (file_mesh%phys_of_slot(0:file_mesh%phys_hash%mask), stat=stat)
+        allocate (file_mesh%phys_of_slot(0:file_mesh%phys_hash%mask), stat=st)
       end if
-      if (stat /= 0) return
+      if (err%failed() .or. st /= 0) then
+        call err%set(ERR_MEMORY, 'not enough memory for the physical groups')
+        return
+      end if
       do k = 1, file_mesh%nphys
         key = group_key(file_mesh%phys_dim(k), file_mesh%phys_tag(k))
         slot = hash_slot(file_mesh%phys_hash, key)
@@ -120,8 +126,11 @@ contains
     slot = hash_slot(file_mesh%phys_hash, key)
     if (file_mesh%phys_hash%key(slot) == key) return
     if (file_mesh%nphys == size(file_mesh%phys_dim)) then
-      allocate (idim(2*file_mesh%nphys), itag(2*file_mesh%nphys), nm(2*file_mesh%nphys), stat=stat)
-      if (stat /= 0) return
+      allocate (idim(2*file_mesh%nphys), itag(2*file_mesh%nphys), nm(2*file_mesh%nphys), stat=st)
+      if (st /= 0) then
+        call err%set(ERR_MEMORY, 'not enough memory for the physical groups')
+        return
+      end if
       idim(1:file_mesh%nphys) = file_mesh%phys_dim
       itag(1:file_mesh%nphys) = file_mesh%phys_tag
       do k = 1, file_mesh%nphys
@@ -140,15 +149,19 @@ contains
   end subroutine add_physical
 
   !> Hash the entities (dim 0..2; 3D: 0..3) for entity_index; of two with the same dimension and tag
-  !! the first is found. stat /= 0: out of memory.
-  subroutine index_entities(file_mesh, stat)
+  !! the first is found. err (ERR_MEMORY): out of memory.
+  subroutine index_entities(file_mesh, err)
     type(file_mesh_t), intent(inout) :: file_mesh
-    integer, intent(out) :: stat
-    integer :: k, slot
+    type(error_t), intent(out) :: err     !< ERR_MEMORY: no room for the index
+    integer :: k, slot, st
     integer(i8) :: key
-    call hash_init(file_mesh%ent_hash, file_mesh%nent, stat)
-    if (stat == 0) allocate (file_mesh%ent_of_slot(0:file_mesh%ent_hash%mask), stat=stat)
-    if (stat /= 0) return
+    st = 0
+    call hash_init(file_mesh%ent_hash, file_mesh%nent, err)
+    if (.not. err%failed()) allocate (file_mesh%ent_of_slot(0:file_mesh%ent_hash%mask), stat=st)
+    if (err%failed() .or. st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for the entities')
+      return
+    end if
     do k = 1, file_mesh%nent
       key = group_key(file_mesh%ent(k)%dim, file_mesh%ent(k)%tag)
       slot = hash_slot(file_mesh%ent_hash, key)
@@ -177,22 +190,22 @@ contains
   !! once for all the bodies of the file. Out of memory: left absent.
   subroutine index_groups(file_mesh)
     type(file_mesh_t), intent(inout) :: file_mesh
-    integer :: st
+    type(error_t) :: err
     call bucket_items(file_mesh%cell_entity(1:file_mesh%ncell), 0, file_mesh%nent, file_mesh%ent_cell_first, &
-                      file_mesh%ent_cells, st)
-    if (st /= 0) then
+                      file_mesh%ent_cells, err)
+    if (err%failed()) then
       if (allocated(file_mesh%ent_cell_first)) deallocate (file_mesh%ent_cell_first)
       if (allocated(file_mesh%ent_cells)) deallocate (file_mesh%ent_cells)
     end if
     call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), &
-                       file_mesh%point_first, file_mesh%point_members, st)
-    if (st /= 0) then
+                       file_mesh%point_first, file_mesh%point_members, err)
+    if (err%failed()) then
       if (allocated(file_mesh%point_first)) deallocate (file_mesh%point_first)
       if (allocated(file_mesh%point_members)) deallocate (file_mesh%point_members)
     end if
     call bucket_items(file_mesh%line_node(1, 1:file_mesh%nline), 1, file_mesh%nnode, file_mesh%node_line_first, &
-                      file_mesh%node_lines, st)
-    if (st /= 0) then
+                      file_mesh%node_lines, err)
+    if (err%failed()) then
       if (allocated(file_mesh%node_line_first)) deallocate (file_mesh%node_line_first)
       if (allocated(file_mesh%node_lines)) deallocate (file_mesh%node_lines)
     end if
@@ -200,14 +213,18 @@ contains
 
   !> Items 1..size(key) bucketed by their key in [lo, hi] (a counting sort, items in
   !! increasing order within a bucket): bucket k holds members(first(k):first(k+1)-1).
-  subroutine bucket_items(key, lo, hi, first, members, stat)
+  !! err (ERR_MEMORY): out of memory.
+  subroutine bucket_items(key, lo, hi, first, members, err)
     integer, intent(in) :: key(:), lo, hi
     integer, allocatable, intent(out) :: first(:), members(:)
-    integer, intent(out) :: stat
+    type(error_t), intent(out) :: err
     integer, allocatable :: fill(:)
-    integer :: i, k
-    allocate (first(lo:hi + 1), members(size(key)), fill(lo:hi), stat=stat)
-    if (stat /= 0) return
+    integer :: i, k, st
+    allocate (first(lo:hi + 1), members(size(key)), fill(lo:hi), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory to bucket '//i2s(size(key))//' items')
+      return
+    end if
     fill = 0
     do i = 1, size(key)
       fill(key(i)) = fill(key(i)) + 1
@@ -667,6 +684,7 @@ contains
     integer :: c, i, nv, a, b, slot, st, phys, line, nedge, ngroup, ninner, m, j, ncand, k
     integer(i8) :: key, key_base
     type(text_buffer_t) :: names
+    type(error_t) :: mem
 
     ! the candidate lines, in file order: those starting at a node of the body when it is a
     ! small part of the file (node_lines), else all
@@ -692,14 +710,15 @@ contains
     end if
 
     ! the body's line edges, keyed by their two nodes (line_slot = -1: not a body edge)
-    call hash_init(edge_hash, ncand, st)
-    if (st == 0) allocate (line_slot(ncand), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
-                           edge_local(0:edge_hash%mask), edges(2, ncand), cells(ncand), &
-                           inner(2*ncand), marked(mesh%nnode), on_line(mesh%nnode), &
-                           seen_group(0:edge_hash%mask), &
-                           seen_line(0:edge_hash%mask), stat=st)
-    if (st == 0) call group_members(file_mesh, 1, file_mesh%line_entity(cand), first, members, st)
-    if (st /= 0) then
+    st = 0
+    call hash_init(edge_hash, ncand, mem)
+    if (.not. mem%failed()) allocate (line_slot(ncand), edge_count(0:edge_hash%mask), edge_cell(0:edge_hash%mask), &
+                                      edge_local(0:edge_hash%mask), edges(2, ncand), cells(ncand), &
+                                      inner(2*ncand), marked(mesh%nnode), on_line(mesh%nnode), &
+                                      seen_group(0:edge_hash%mask), &
+                                      seen_line(0:edge_hash%mask), stat=st)
+    if (st == 0 .and. .not. mem%failed()) call group_members(file_mesh, 1, file_mesh%line_entity(cand), first, members, mem)
+    if (st /= 0 .or. mem%failed()) then
       call err%set(ERR_MEMORY, 'not enough memory for the boundary edges')
       return
     end if
@@ -816,6 +835,7 @@ contains
     integer, allocatable, target :: own_first(:), own_members(:)
     integer, pointer :: first(:), members(:)
     integer :: phys, point, n, nfound, group, c, i, m, st
+    type(error_t) :: mem
     real(wp) :: tol
     character(len=:), allocatable :: names
     type(text_buffer_t) :: list
@@ -825,7 +845,8 @@ contains
       first => file_mesh%point_first
       members => file_mesh%point_members
     else if (st == 0) then
-      call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), own_first, own_members, st)
+      call group_members(file_mesh, 0, file_mesh%point_entity(1:file_mesh%npoint), own_first, own_members, mem)
+      if (mem%failed()) st = 1
       first => own_first
       members => own_members
     end if
@@ -917,15 +938,19 @@ contains
   !> The items (lines or points, by their entities `item_entity`, 0: none) of every physical
   !! group of dimension `dim`: those of group p are members(first(p):first(p + 1) - 1), in
   !! file order, each once. One pass over the items, so many groups cost linear time.
-  subroutine group_members(file_mesh, dim, item_entity, first, members, stat)
+  !! err (ERR_MEMORY): out of memory.
+  subroutine group_members(file_mesh, dim, item_entity, first, members, err)
     type(file_mesh_t), intent(in) :: file_mesh
     integer, intent(in) :: dim, item_entity(:)
     integer, allocatable, intent(out) :: first(:), members(:)
-    integer, intent(out) :: stat
+    type(error_t), intent(out) :: err     !< ERR_MEMORY: no room for the lists
     integer, allocatable :: fill(:), last_item(:)
-    integer :: pass, item, j, p
-    allocate (first(file_mesh%nphys + 1), fill(file_mesh%nphys), last_item(file_mesh%nphys), stat=stat)
-    if (stat /= 0) return
+    integer :: pass, item, j, p, st
+    allocate (first(file_mesh%nphys + 1), fill(file_mesh%nphys), last_item(file_mesh%nphys), stat=st)
+    if (st /= 0) then
+      call err%set(ERR_MEMORY, 'not enough memory for the members of '//i2s(file_mesh%nphys)//' physical groups')
+      return
+    end if
     fill = 0
     do pass = 1, 2            ! count, then place
       last_item = 0
@@ -947,8 +972,11 @@ contains
         do p = 1, file_mesh%nphys
           first(p + 1) = first(p) + fill(p)
         end do
-        allocate (members(first(file_mesh%nphys + 1) - 1), stat=stat)
-        if (stat /= 0) return
+        allocate (members(first(file_mesh%nphys + 1) - 1), stat=st)
+        if (st /= 0) then
+          call err%set(ERR_MEMORY, 'not enough memory for the members of '//i2s(file_mesh%nphys)//' physical groups')
+          return
+        end if
         fill = 0
       end if
     end do

@@ -8,6 +8,7 @@ module supports
   use config, only: body_cfg_t, boundary_cfg_t, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_axis
   use mesh, only: mesh_t, side_nodes, group_index, group_names, group_nodes
   use body_system, only: body_system_t
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
@@ -71,28 +72,25 @@ contains
   end subroutine prescribed_dofs
 
   !> The &boundary conditions of this body: the components given are prescribed on every
-  !! node of the group (a later condition overrides an earlier value). info = 1 when the
-  !! group is not one of the body's.
-  subroutine group_conditions(mesh, body_id, boundaries, prescribed, sys, info, msg)
+  !! node of the group (a later condition overrides an earlier value). err (ERR_INPUT) when
+  !! the group is not one of the body's, naming the body, where the deck gave the condition,
+  !! the group and the groups there are.
+  subroutine group_conditions(mesh, body_id, boundaries, prescribed, sys, err)
     type(mesh_t), intent(in) :: mesh                   !< the body's mesh
     integer, intent(in) :: body_id                     !< the body (conditions of the other are skipped)
     type(boundary_cfg_t), intent(in) :: boundaries(:)  !< the deck's &boundary conditions
     logical, intent(inout) :: prescribed(:)            !< (ndof) whether each DOF is prescribed
     type(body_system_t), intent(inout) :: sys          !< its u_fixed gets the values
-    integer, intent(out) :: info                       !< 0, or 1 on an unknown group
-    character(len=*), intent(out) :: msg               !< the failure, naming the condition
+    type(error_t), intent(out) :: err                  !< ERR_INPUT: an unknown group
     integer :: i, g, k, cc, dof
     integer, allocatable :: nodes(:)
 
-    info = 0
-    msg = ''
     do i = 1, size(boundaries)
       if (boundaries(i)%body /= body_id) cycle
       g = group_index(mesh, boundaries(i)%group)
       if (g == 0) then
-        info = 1
-        msg = 'body '//body_label(body_id)//': '//trim(boundaries(i)%origin)//': '// &
-              unknown_group(mesh, boundaries(i)%group)
+        call err%set(ERR_INPUT, 'body '//body_label(body_id)//': '//trim(boundaries(i)%origin)//': '// &
+                     unknown_group(mesh, boundaries(i)%group))
         return
       end if
       call group_nodes(mesh, g, nodes)

@@ -533,21 +533,23 @@ contains
     logical, allocatable :: marked(:)
     type(int_hash_t) :: seen
     integer :: phys, m, face, nv, v(4), w(4), nw, i, a, c, f, st, nedge, ninner, ngroup, nmax, nvf, seen_slot, key4(4)
+    type(error_t) :: mem
     integer(i8) :: s, key
     type(text_buffer_t) :: names
 
     allocate (mesh%group(count(file_mesh%phys_dim(1:file_mesh%nphys) <= 2)))
-    call group_members(file_mesh, 2, file_mesh%face_entity(1:file_mesh%nface), first, members, st)
+    st = 0
+    call group_members(file_mesh, 2, file_mesh%face_entity(1:file_mesh%nface), first, members, mem)
     nmax = 0
-    if (st == 0) then
+    if (.not. mem%failed()) then
       do phys = 1, file_mesh%nphys
         nmax = max(nmax, first(phys + 1) - first(phys))
       end do
       allocate (edges(4, nmax), cells(nmax), inner(mesh%nnode), marked(mesh%nnode), stat=st)
     end if
-    if (st == 0) call hash_init(seen, size(members), st)
-    if (st == 0) allocate (seen_face(0:seen%mask), stat=st)
-    if (st /= 0) then
+    if (st == 0 .and. .not. mem%failed()) call hash_init(seen, size(members), mem)
+    if (st == 0 .and. .not. mem%failed()) allocate (seen_face(0:seen%mask), stat=st)
+    if (st /= 0 .or. mem%failed()) then
       call err%set(ERR_MEMORY, 'not enough memory for the boundary faces')
       return
     end if
@@ -646,12 +648,14 @@ contains
     integer, allocatable :: first(:), members(:), nodes(:)
     logical, allocatable :: taken(:)
     integer :: phys, m, line, i, a, b, n, g, j, st
+    type(error_t) :: mem
     character(len=:), allocatable :: names
     type(text_buffer_t) :: list
 
-    call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, st)
-    if (st == 0) allocate (nodes(mesh%nnode), taken(mesh%nnode), stat=st)
-    if (st /= 0) then
+    st = 0
+    call group_members(file_mesh, 1, file_mesh%line_entity(1:file_mesh%nline), first, members, mem)
+    if (.not. mem%failed()) allocate (nodes(mesh%nnode), taken(mesh%nnode), stat=st)
+    if (st /= 0 .or. mem%failed()) then
       call err%set(ERR_MEMORY, 'not enough memory for the physical curves')
       return
     end if

@@ -114,7 +114,7 @@ contains
     type(robin_state_t), intent(in) :: st       !< outer state after iteration st%it
     type(contact_result_t), intent(in) :: res   !< history so far
     integer(hid_t) :: fid, gid
-    type(error_t) :: hs
+    type(error_t) :: hs, moved
     character(len=:), allocatable :: tmp
     logical :: ok
     if (.not. allocated(self%file)) return
@@ -166,7 +166,8 @@ contains
     call file_close(fid, hs)
     ok = .not. hs%failed()
     if (ok) then
-      call atomic_rename(tmp, self%file, ok)
+      call atomic_rename(tmp, self%file, moved)
+      ok = .not. moved%failed()
       if (.not. ok) call hs%set(ERR_IO, 'failed to rename '//tmp//' to it')
     end if
     if (.not. ok) then

@@ -10,7 +10,7 @@
 !! old files or all the new ones.
 module files
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_long_long, c_long
-  use errors, only: error_t, ERR_INPUT
+  use errors, only: error_t, ERR_INPUT, ERR_IO
   use strings, only: i2s
   implicit none (type, external)
   private
@@ -285,12 +285,13 @@ contains
     end do
   end subroutine ensure_parent_dir
 
-  !> rename(2): atomic within one file system; replaces `new`. ok = .false. on failure.
-  subroutine atomic_rename(old, new, ok)
+  !> rename(2): atomic within one file system; replaces `new`. err (ERR_IO) on failure.
+  subroutine atomic_rename(old, new, err)
     character(len=*), intent(in) :: old   !< temporary name
     character(len=*), intent(in) :: new   !< final name
-    logical, intent(out) :: ok            !< success
-    ok = c_rename(trim(old)//c_null_char, trim(new)//c_null_char) == 0
+    type(error_t), intent(out) :: err     !< ERR_IO: the rename failed, naming both
+    if (c_rename(trim(old)//c_null_char, trim(new)//c_null_char) /= 0) &
+      call err%set(ERR_IO, 'cannot rename '//trim(old)//' to '//trim(new))
   end subroutine atomic_rename
 
   !> True when `path` names something that exists and is not a regular file (after
@@ -317,24 +318,24 @@ contains
   !! (2) the files already at the final names are kept aside (a hard link, or a rename
   !! where links are not supported); (3) the renames; (4) the kept files are removed.
   !! When a step fails, what this call renamed into place is undone, the kept files are
-  !! put back, the temporary files are removed, ok = .false. and msg says what failed.
+  !! put back, the temporary files are removed, and err (ERR_IO) says what failed.
   !! With `stale_prefix`, once all are renamed and still under the lock, the numbered files
   !! `<stale_prefix(i)><k><stale_suffix>` for k = stale_first(i), stale_first(i) + 1, ...
   !! up to the first that does not exist (an earlier, larger set's own files, which the
   !! new set lacks) are removed; `removed` counts them. A failed commit removes none.
-  subroutine commit_files(tmp, final, ok, msg, stale_prefix, stale_first, stale_suffix, removed)
+  subroutine commit_files(tmp, final, err, stale_prefix, stale_first, stale_suffix, removed)
     character(len=*), intent(in) :: tmp(:)                 !< complete files, temporary names
     character(len=*), intent(in) :: final(:)               !< their final names
-    logical, intent(out) :: ok                             !< all renamed
-    character(len=:), allocatable, intent(out) :: msg      !< what failed
+    type(error_t), intent(out) :: err                      !< ERR_IO: what failed (none renamed)
     character(len=*), intent(in), optional :: stale_prefix(:)   !< numbered names of an earlier set: the part before k
     integer, intent(in), optional :: stale_first(:)        !< the first k each prefix's new set lacks
     character(len=*), intent(in), optional :: stale_suffix !< the part after k
     integer, intent(out), optional :: removed              !< stale files removed
     character(len=len(final) + 160) :: bak(size(final))
     integer :: kept(size(final)), k, j, fd, kind
-    character(len=:), allocatable :: dir, stale
-    logical :: done
+    character(len=:), allocatable :: dir, stale, msg
+    logical :: ok
+    type(error_t) :: step
 
     ok = .false.
     msg = ''
@@ -376,8 +377,8 @@ contains
     end do
     ! 3. the renames
     do k = 1, size(final)
-      call atomic_rename(tmp(k), final(k), done)
-      if (.not. done) then
+      call atomic_rename(tmp(k), final(k), step)
+      if (step%failed()) then
         msg = 'cannot rename '//trim(tmp(k))//' to '//trim(final(k))//restore(1, k - 1, .true.)// &
               restore(k, size(final), .false.)
         call finish()
@@ -415,6 +416,7 @@ contains
       character(len=:), allocatable :: note
       integer :: i
       logical :: back
+      type(error_t) :: moved
       note = ''
       do i = k1, k2
         back = .true.
@@ -423,12 +425,14 @@ contains
           if (renamed) call remove_file(final(i))
         case (KEPT_LINK)
           if (renamed) then
-            call atomic_rename(bak(i), final(i), back)
+            call atomic_rename(bak(i), final(i), moved)
+            back = .not. moved%failed()
           else
             call remove_file(bak(i))
           end if
         case (KEPT_MOVED)
-          call atomic_rename(bak(i), final(i), back)
+          call atomic_rename(bak(i), final(i), moved)
+          back = .not. moved%failed()
         end select
         if (.not. back) note = note//'; the earlier '//trim(final(i))//' could not be put back: it is '//trim(bak(i))
         kept(i) = KEPT_NONE
@@ -441,81 +445,88 @@ contains
         do j = 1, size(tmp)
           call remove_file(tmp(j))
         end do
+        call err%set(ERR_IO, msg)
       end if
       call rc_unlock_dir(fd)
     end subroutine finish
 
   end subroutine commit_files
 
-  !> Write `text` as the whole content of `path` (replaced). ok = .false. when the file
+  !> Write `text` as the whole content of `path` (replaced). err (ERR_IO) when the file
   !! cannot be created, written or closed (a full disk shows at the latest on close).
-  subroutine write_text(path, text, ok)
+  subroutine write_text(path, text, err)
     character(len=*), intent(in) :: path   !< file to write
     character(len=*), intent(in) :: text   !< its content, lines ended by new-line characters
-    logical, intent(out) :: ok             !< success
-    integer :: u, ios
+    type(error_t), intent(out) :: err      !< ERR_IO: the file could not be written, naming it
+    integer :: u, ios, ios_close
     open (newunit=u, file=path, status='replace', access='stream', form='unformatted', &
           action='write', iostat=ios)
-    ok = ios == 0
-    if (.not. ok) return
+    if (ios /= 0) then
+      call err%set(ERR_IO, 'cannot create '//trim(path))
+      return
+    end if
     write (u, iostat=ios) text
-    ok = ios == 0
-    close (u, iostat=ios)
-    ok = ok .and. ios == 0
+    close (u, iostat=ios_close)
+    if (ios /= 0 .or. ios_close /= 0) call err%set(ERR_IO, 'cannot write '//trim(path))
   end subroutine write_text
 
   !> Open the existing file `path` for writing at given offsets (`data_write`), without
-  !! truncating it; fd = -1 and why says so, with the system's reason, on failure.
-  subroutine data_open(path, fd, why)
-    character(len=*), intent(in) :: path                  !< the file
-    integer, intent(out) :: fd                            !< its descriptor, -1 on failure
-    character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
+  !! truncating it; fd = -1 and err (ERR_IO, naming the file, with the system's reason) on
+  !! failure.
+  subroutine data_open(path, fd, err)
+    character(len=*), intent(in) :: path      !< the file
+    integer, intent(out) :: fd                !< its descriptor, -1 on failure
+    type(error_t), intent(out) :: err         !< ERR_IO: the file cannot be opened
     fd = rc_open_data(trim(path)//c_null_char)
-    why = ''
     if (fd < 0) then
-      why = 'cannot open it to write its data: '//error_text(int(-fd, c_int))
+      call set_system_error(err, trim(path)//': cannot open it to write its data: ', int(-fd, c_int))
       fd = -1
     end if
   end subroutine data_open
 
-  !> Write n bytes from buf at byte offset `offset` of the file fd (thread-safe: pwrite(2));
-  !! why = '' or the system's reason of a failure.
-  subroutine data_write(fd, buf, n, offset, why)
+  !> Write n bytes from buf at byte offset `offset` of the file fd (thread-safe: pwrite(2),
+  !! and no function with a deferred-length result); err (ERR_IO) on failure, its message
+  !! the system's reason alone (the caller names what it was writing).
+  subroutine data_write(fd, buf, n, offset, err)
     integer, intent(in) :: fd                             !< from data_open
     type(c_ptr), intent(in) :: buf                        !< the bytes
     integer(c_long_long), intent(in) :: n, offset         !< their number, where they go
-    character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
+    type(error_t), intent(out) :: err                     !< ERR_IO: the system's reason
     integer(c_int) :: e
-    why = ''
     if (n <= 0) return
     e = rc_write_at(int(fd, c_int), buf, n, offset)
-    if (e /= 0) why = error_text(e)
+    if (e /= 0) call set_system_error(err, '', e)
   end subroutine data_write
 
-  !> Close a file of data_open (nothing for fd < 0); why = '' or the system's reason of a
-  !! failure (a full disk may show only here).
-  subroutine data_close(fd, why)
+  !> Close a file of data_open (nothing for fd < 0); err (ERR_IO) on failure (a full disk
+  !! may show only here), its message the system's reason alone (the caller names the file).
+  subroutine data_close(fd, err)
     integer, intent(inout) :: fd                          !< the descriptor; -1 on return
-    character(len=:), allocatable, intent(out) :: why     !< '' or the reason of a failure
+    type(error_t), intent(out) :: err                     !< ERR_IO: the system's reason
     integer(c_int) :: e
-    why = ''
     if (fd < 0) return
     e = rc_close_data(int(fd, c_int))
     fd = -1
-    if (e /= 0) why = error_text(e)
+    if (e /= 0) call set_system_error(err, '', e)
   end subroutine data_close
 
-  !> The system's text of the errno value e.
-  function error_text(e) result(t)
+  !> err = ERR_IO with `prefix` and the system's text of the errno value e. Builds the text
+  !! in a local of explicit length (no deferred-length function result): data_write runs
+  !! on several threads at once.
+  subroutine set_system_error(err, prefix, e)
+    type(error_t), intent(inout) :: err
+    character(len=*), intent(in) :: prefix
     integer(c_int), intent(in) :: e
-    character(len=:), allocatable :: t
     character(kind=c_char) :: buf(160)
+    character(len=len(prefix) + size(buf)) :: text
     integer :: n, i
     n = rc_error_text(e, buf, int(size(buf), c_int))
-    allocate (character(len=max(n, 0)) :: t)
+    n = min(max(n, 0), size(buf))
+    text(1:len(prefix)) = prefix
     do i = 1, n
-      t(i:i) = buf(i)
+      text(len(prefix) + i:len(prefix) + i) = buf(i)
     end do
-  end function error_text
+    call err%set(ERR_IO, text(1:len(prefix) + n))
+  end subroutine set_system_error
 
 end module files

@@ -106,8 +106,8 @@ contains
     real(wp), allocatable :: times(:)
     character(len=len_trim(file) + 160), allocatable :: tmp(:)
     character(len=len_trim(file) + 16) :: stale_pre(2)
-    character(len=:), allocatable :: why, h5, id
-    type(error_t) :: st
+    character(len=:), allocatable :: h5, id
+    type(error_t) :: st, commit
     integer :: k, nb, np, nf, nt, nstale
     integer :: nbf, npf   ! the bodies and pairs with an XDMF file of their own
     logical :: ok, per_body
@@ -167,9 +167,9 @@ contains
     ! companions of an earlier result with more bodies or pairs, which this one lacks
     stale_pre(1) = replace_suffix(trim(file), '.h5', '_body')
     stale_pre(2) = replace_suffix(trim(file), '.h5', '_contact')
-    call commit_files(tmp(nf:1:-1), name(nf:1:-1), ok, why, stale_pre, [nbf + 1, merge(npf + 1, 1, npf > 1)], '.xdmf', &
+    call commit_files(tmp(nf:1:-1), name(nf:1:-1), commit, stale_pre, [nbf + 1, merge(npf + 1, 1, npf > 1)], '.xdmf', &
                       nstale)
-    if (.not. ok) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//why)
+    if (commit%failed()) call err%set(ERR_IO, 'cannot write '//trim(file)//': '//commit%message)
     if (present(stale)) stale = nstale
 
   contains
@@ -180,20 +180,24 @@ contains
     subroutine write_companions(done)
       logical, intent(out) :: done   !< all written
       integer :: a, q
+      type(error_t) :: werr
       if (np == 1) then
-        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, surf, id, times), done)
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, surf, id, times), werr)
       else
-        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, surf, id, times), done)
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, surf, id, times), werr)
       end if
       do a = 1, nbf
-        if (done) call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, surf, id, times), done)
+        if (.not. werr%failed()) &
+          call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, surf, id, times), werr)
       end do
-      if (done) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, itf, surf, id, times), done)
+      if (.not. werr%failed()) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, itf, surf, id, times), werr)
       if (npf > 1) then
         do q = 1, npf
-          if (done) call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, itf, surf, id, times), done)
+          if (.not. werr%failed()) &
+            call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, itf, surf, id, times), werr)
         end do
       end if
+      done = .not. werr%failed()
     end subroutine write_companions
 
     subroutine remove_temps()
@@ -275,7 +279,8 @@ contains
     integer :: a, k, fd
     real(wp), allocatable :: pres(:), w2(:, :)
     type(error_t), allocatable :: body_err(:)
-    character(len=:), allocatable :: ul, us, uf, why, trib_unit
+    type(error_t) :: closing
+    character(len=:), allocatable :: ul, us, uf, trib_unit
     character(len=3) :: comp(6)
 
     comp(1:NSTRESS) = stress_names()
@@ -288,10 +293,7 @@ contains
     allocate (body_err(size(msh)))
     fd = -1
     call file_open(path, fid, st, create=.true.)
-    if (.not. st%failed()) then
-      call data_open(path, fd, why)
-      if (fd < 0) call st%set(ERR_IO, trim(path)//': '//why)
-    end if
+    if (.not. st%failed()) call data_open(path, fd, st)
     ! root attributes
     call write_attr(fid, 'status', status_name(res%status), st)
     call write_attr(fid, 'method', word(METHOD_CHOICES, res%method), st)
@@ -420,8 +422,9 @@ contains
     call file_close(fid, st)
     ! the bodies' data written (the HDF5 file is closed: no object overlaps their storage)
     !$omp taskwait
-    call data_close(fd, why)
-    if (len(why) > 0 .and. .not. st%failed()) call st%set(ERR_IO, trim(path)//': failed to close the file: '//why)
+    call data_close(fd, closing)
+    if (closing%failed() .and. .not. st%failed()) &
+      call st%set(ERR_IO, trim(path)//': failed to close the file: '//closing%message)
     ! a body's failure (fields not finite, data not written) first, the bodies in order
     do a = size(msh), 1, -1
       if (body_err(a)%failed()) st = body_err(a)
@@ -514,10 +517,10 @@ contains
       integer(c_long_long), intent(in) :: n
       character(len=*), intent(in) :: name
       integer, intent(in) :: k
-      character(len=:), allocatable :: why
+      type(error_t) :: werr
       if (err%failed()) return
-      call data_write(fd, buf, n, int(off(k), c_long_long), why)
-      if (len(why) > 0) call err%set(ERR_IO, 'failed to write dataset /body'//i2s(a)//'/'//name//': '//why)
+      call data_write(fd, buf, n, int(off(k), c_long_long), werr)
+      if (werr%failed()) call err%set(ERR_IO, 'failed to write dataset /body'//i2s(a)//'/'//name//': '//werr%message)
     end subroutine write_data
 
   end subroutine body_data

@@ -4,15 +4,21 @@
 !! left in any case).
 program test_files
   use files, only: temp_name, run_id, commit_files, write_text, remove_file, dir_name
+  use errors, only: error_t, ERR_IO
   use testing, only: report, test_summary
   implicit none (type, external)
-  character(len=*), parameter :: dir = 'build/test-files'
-  character(len=64) :: fin(3)
-  character(len=160) :: tmp(3)
-  character(len=:), allocatable :: msg, t1, t2
-  logical :: ok
+  character(len=:), allocatable :: dir
+  character(len=4096) :: arg
+  character(len=512) :: fin(3)
+  character(len=640) :: tmp(3)
+  character(len=:), allocatable :: t1, t2
+  type(error_t) :: err
   integer :: k, rc
 
+  ! the files in build/<kind>/test-files (beside the folder of this program): a release
+  ! and a checked make check running at once share none
+  call get_command_argument(0, arg)
+  dir = arg(1:index(arg, '/', back=.true.))//'../test-files'
   call execute_command_line('rm -rf '//dir//' && mkdir -p '//dir, exitstat=rc)
   do k = 1, 3
     write (fin(k), '(a,i0,a)') dir//'/f', k, '.txt'
@@ -30,32 +36,33 @@ program test_files
 
   ! ---- 1. new files, nothing there before ----------------------------------------------
   call make_temps('new1')
-  call commit_files(tmp, fin, ok, msg)
-  call report(ok .and. all_are('new1') .and. clean(), 'commit into free names: all renamed, nothing left over')
+  call commit_files(tmp, fin, err)
+  call report(.not. err%failed() .and. all_are('new1') .and. clean(), 'commit into free names: all renamed, nothing left over')
 
   ! ---- 2. replace earlier files --------------------------------------------------------
   call make_temps('new2')
-  call commit_files(tmp, fin, ok, msg)
-  call report(ok .and. all_are('new2') .and. clean(), 'commit over earlier files: all replaced, none kept aside')
+  call commit_files(tmp, fin, err)
+  call report(.not. err%failed() .and. all_are('new2') .and. clean(), 'commit over earlier files: all replaced, none kept aside')
 
   ! ---- 3. a final name is a folder: nothing replaced --------------------------------------
   call make_temps('new3')
   call remove_file(fin(2))
   call execute_command_line('mkdir '//trim(fin(2)), exitstat=rc)
-  call commit_files(tmp, fin, ok, msg)
-  call report(.not. ok .and. index(msg, trim(fin(2))//' is a folder') > 0 .and. index(msg, 'nothing was replaced') > 0, &
-              'a folder at a final name: failure naming it ('//msg//')')
+  call commit_files(tmp, fin, err)
+  call report(err%category == ERR_IO .and. index(err%text(), trim(fin(2))//' is a folder') > 0 .and. &
+              index(err%text(), 'nothing was replaced') > 0, 'a folder at a final name: failure naming it ('//err%text()//')')
   call report(content(fin(1)) == 'new2' .and. content(fin(3)) == 'new2' .and. clean(), &
               'a folder at a final name: the other files unchanged, no temporary left')
   call execute_command_line('rmdir '//trim(fin(2)), exitstat=rc)
 
   ! ---- 4. the third rename fails (its temporary file is missing): roll back -------------
   call make_temps('new4')
-  call write_text(fin(2), 'new2', ok)
+  call write_text(fin(2), 'new2', err)
+  call report(.not. err%failed(), 'write_text')
   call remove_file(tmp(3))
-  call commit_files(tmp, fin, ok, msg)
-  call report(.not. ok .and. index(msg, 'cannot rename') > 0 .and. index(msg, 'put back') > 0, &
-              'a rename failing half-way: failure ('//msg//')')
+  call commit_files(tmp, fin, err)
+  call report(err%category == ERR_IO .and. index(err%text(), 'cannot rename') > 0 .and. index(err%text(), 'put back') > 0, &
+              'a rename failing half-way: failure ('//err%text()//')')
   call report(all_are('new2') .and. clean(), &
               'a rename failing half-way: the earlier files are all back, no temporary or kept file left')
 
@@ -63,11 +70,11 @@ program test_files
   call remove_file(fin(1))
   call make_temps('new5')
   call remove_file(tmp(3))
-  call commit_files(tmp, fin, ok, msg)
+  call commit_files(tmp, fin, err)
   block
     logical :: there
     inquire (file=fin(1), exist=there)
-    call report(.not. ok .and. .not. there .and. content(fin(2)) == 'new2' .and. content(fin(3)) == 'new2' &
+    call report(err%failed() .and. .not. there .and. content(fin(2)) == 'new2' .and. content(fin(3)) == 'new2' &
                 .and. clean(), 'a rename failing half-way: a name that was free is free again')
   end block
 
@@ -78,7 +85,7 @@ contains
   subroutine make_temps(text)
     character(len=*), intent(in) :: text
     integer :: j
-    logical :: w
+    type(error_t) :: w
     do j = 1, 3
       tmp(j) = temp_name(fin(j))
       call write_text(tmp(j), text, w)

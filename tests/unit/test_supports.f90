@@ -7,8 +7,8 @@
 !!    sides' constraints, the later side in SIDE_* order wins a component both prescribe);
 !!    u_prescribed replaces every prescribed value (stage 1 where it was 0);
 !!  - group_conditions: &boundary conditions on named groups, the later overriding the
-!!    earlier, another body's skipped, a zero value at stage 0; an unknown group is info = 1
-!!    with a message naming the body, where the deck gave it, the group and the groups there are;
+!!    earlier, another body's skipped, a zero value at stage 0; an unknown group is an
+!!    ERR_INPUT error naming the body, where the deck gave it, the group and the groups there are;
 !!  - number_free_dofs: the DOFs left free numbered 1..n in increasing order, dof_of its
 !!    inverse;
 !!  - reactions against the exact solution of uniaxial tension (ux = eps x prescribed on the
@@ -33,7 +33,7 @@ program test_supports
   use body_system, only: body_system_t
   use supports, only: prescribed_dofs, group_conditions, number_free_dofs
   use assembly, only: assemble_body, expand, support_reactions
-  use errors, only: error_t
+  use errors, only: error_t, ERR_INPUT
   use testing, only: report, report_le, test_summary, band_solve, grid_mesh_parts, box_mesh_parts
   implicit none (type, external)
 
@@ -161,6 +161,7 @@ contains
     real(wp) :: x, y
     integer :: k, info, dx, dy
     character(len=300) :: msg
+    type(error_t) :: err
     b = rectangle(2.0_wp, 1.0_wp, 4, 2, ELEM_Q1)
     b%bc(SIDE_RIGHT) = BC_DISPLACEMENT
     b%u_side(1:2, SIDE_RIGHT) = [0.01_wp, -0.02_wp]
@@ -183,8 +184,8 @@ contains
     bd(4)%group = 'top'
     bd(4)%fix(1:2) = [.false., .true.]
     bd(4)%stage = 5
-    call group_conditions(msh, 1, bd, pre, sys, info, msg)
-    ok = info == 0
+    call group_conditions(msh, 1, bd, pre, sys, err)
+    ok = .not. err%failed()
     do k = 1, msh%nnode
       x = msh%xy(1, k)
       y = msh%xy(2, k)
@@ -212,10 +213,11 @@ contains
     ! an unknown group
     bd(1)%group = 'nope'
     bd(1)%origin = 'line 12'
-    call group_conditions(msh, 1, bd(1:1), pre, sys, info, msg)
-    call report(info == 1 .and. index(msg, 'body 1: line 12: group ''nope'' has no edge on the boundary of this body') == 1 &
-                .and. index(msg, 'its groups are ''left'', ''right'', ''bottom'', ''top''') > 0, &
-                'group_conditions: an unknown group named with the body, the deck line and the groups: '//trim(msg))
+    call group_conditions(msh, 1, bd(1:1), pre, sys, err)
+    call report(err%category == ERR_INPUT .and. &
+                index(err%text(), 'body 1: line 12: group ''nope'' has no edge on the boundary of this body') == 1 &
+                .and. index(err%text(), 'its groups are ''left'', ''right'', ''bottom'', ''top''') > 0, &
+                'group_conditions: an unknown group named with the body, the deck line and the groups: '//err%text())
   end subroutine test_groups
 
   ! ---- reactions ----------------------------------------------------------------------------------
