@@ -137,7 +137,7 @@ $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
 $(BUILD)/digest.o:         $(BUILD)/errors.o
 $(BUILD)/int_hash.o:       $(BUILD)/kinds.o
-$(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
