@@ -13,7 +13,8 @@
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use errors, only: warn, error_t, fail_on, ERR_INPUT
+  use errors, only: warn, error_t, ERR_INPUT
+  use fatal_errors, only: fail_on
   use config, only: METHOD_ROBIN, program_version
   use deck, only: read_deck, print_deck
   use signals, only: signals_install
