@@ -49,6 +49,15 @@ module deck_checks
     type(str_t), allocatable :: box_var(:)
   end type state_t
 
+  !> Room for item `n` of a list the deck adds to group by group (pairs, tractions, body forces,
+  !! materials, regions, boundaries, and their origins): allocated at 4 on first use, doubled
+  !! when full, so that a deck of many groups is read in linear time. One specific per item
+  !! type, each the same three steps (`capacity` is the rule).
+  interface grow
+    module procedure grow_pairs, grow_strs, grow_tractions, grow_body_forces, grow_materials, grow_regions, &
+      grow_boundaries
+  end interface grow
+
 contains
 
   !> A group that appears at most once (&scene, &solver, &output): read into its
@@ -154,8 +163,6 @@ contains
     type(state_t), intent(inout) :: st
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(contact_cfg_t), target :: c
-    type(contact_cfg_t), allocatable :: tmp(:)
-    type(str_t), allocatable :: wtmp(:)
     type(vars_t) :: v
     integer :: form, n
     logical :: named, legacy
@@ -198,15 +205,9 @@ contains
     if (err%failed()) return
     call check_contact(g, src, c, form, d%nbody, err)
     if (err%failed()) return
-    n = d%npair
-    if (n == size(d%pair)) then   ! grow geometrically: many pairs stay linear
-      allocate (tmp(2*n), wtmp(2*n))
-      tmp(1:n) = d%pair(1:n)
-      wtmp(1:n) = st%pair_at(1:n)
-      call move_alloc(tmp, d%pair)
-      call move_alloc(wtmp, st%pair_at)
-    end if
-    n = n + 1
+    n = d%npair + 1
+    call grow(d%pair, n)
+    call grow(st%pair_at, n)
     d%npair = n
     d%pair(n) = c
     d%pairs_named = form == PAIR_FORM
@@ -752,8 +753,6 @@ contains
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(load_in_t), target :: t
     type(vars_t) :: v
-    type(traction_cfg_t), allocatable :: tmp(:)
-    type(str_t), allocatable :: wtmp(:)
     integer :: n
 
     call traction_vars(t, v, ALL_FORMS)
@@ -763,15 +762,9 @@ contains
     if (err%failed()) return
     call check_stage(g, src, t%stage, err)
     if (err%failed()) return
-    n = d%ntraction
-    if (n == size(d%traction)) then   ! grow geometrically: many tractions stay linear
-      allocate (tmp(max(4, 2*n)), wtmp(max(4, 2*n)))
-      tmp(1:n) = d%traction(1:n)
-      wtmp(1:n) = st%trac_at(1:n)
-      call move_alloc(tmp, d%traction)
-      call move_alloc(wtmp, st%trac_at)
-    end if
-    n = n + 1
+    n = d%ntraction + 1
+    call grow(d%traction, n)
+    call grow(st%trac_at, n)
     d%ntraction = n
     d%traction(n)%body = t%body
     d%traction(n)%side = t%side
@@ -838,7 +831,6 @@ contains
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(body_force_cfg_t), target :: f
     type(vars_t) :: v
-    type(body_force_cfg_t), allocatable :: tmp(:)
     integer :: n
     call body_force_vars(f, v)
     call read_group(g, src, v, err)
@@ -850,14 +842,8 @@ contains
     end if
     call check_stage(g, src, f%stage, err)
     if (err%failed()) return
-    if (.not. allocated(d%body_force)) allocate (d%body_force(4))
-    n = d%nbody_force
-    if (n == size(d%body_force)) then
-      allocate (tmp(2*n))
-      tmp(1:n) = d%body_force(1:n)
-      call move_alloc(tmp, d%body_force)
-    end if
-    n = n + 1
+    n = d%nbody_force + 1
+    call grow(d%body_force, n)
     d%nbody_force = n
     f%origin = '&body_force at '//origin
     d%body_force(n) = f
@@ -874,7 +860,6 @@ contains
     logical, intent(in) :: override
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(material_cfg_t), target :: m
-    type(material_cfg_t), allocatable :: tmp(:)
     type(vars_t) :: v
     character(len=*), parameter :: ISO = 'young poisson', &
       ORTHO = 'e1 e2 e3 nu12 nu13 nu23 g12', ANISO = 'c11 c12 c16 c22 c26 c66 c13 c23 c36 c33'
@@ -969,13 +954,8 @@ contains
       return
     end if
     if (n == 0) then
-      if (.not. allocated(d%material)) allocate (d%material(4))
       n = d%nmaterial + 1
-      if (n > size(d%material)) then
-        allocate (tmp(2*size(d%material)))
-        tmp(1:n - 1) = d%material(1:n - 1)
-        call move_alloc(tmp, d%material)
-      end if
+      call grow(d%material, n)
       d%nmaterial = n
       m%origin = '&material at '//origin
     end if
@@ -1070,7 +1050,6 @@ contains
     logical, intent(in) :: override
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(region_cfg_t), target :: r
-    type(region_cfg_t), allocatable :: tmp(:)
     type(vars_t) :: v
     integer :: n, k
     call region_vars(r, v)
@@ -1103,13 +1082,8 @@ contains
       return
     end if
     if (n == 0) then
-      if (.not. allocated(d%region)) allocate (d%region(4))
       n = d%nregion + 1
-      if (n > size(d%region)) then
-        allocate (tmp(2*size(d%region)))
-        tmp(1:n - 1) = d%region(1:n - 1)
-        call move_alloc(tmp, d%region)
-      end if
+      call grow(d%region, n)
       d%nregion = n
     end if
     r%origin = '&region at '//origin
@@ -1125,7 +1099,6 @@ contains
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(load_in_t), target :: t
     type(vars_t) :: v
-    type(boundary_cfg_t), allocatable :: tmp(:)
     integer :: n
 
     call boundary_vars(t, v, ALL_FORMS)
@@ -1158,13 +1131,8 @@ contains
         'the components to prescribe (ux=0.0 for a roller on a vertical wall, ux=0.0, uy=0.0 to clamp)', err)
       return
     end if
-    n = d%nboundary
-    if (n == size(d%boundary)) then
-      allocate (tmp(max(4, 2*n)))
-      tmp(1:n) = d%boundary(1:n)
-      call move_alloc(tmp, d%boundary)
-    end if
-    n = n + 1
+    n = d%nboundary + 1
+    call grow(d%boundary, n)
     d%nboundary = n
     d%boundary(n)%body = t%body
     d%boundary(n)%group = t%group
@@ -1383,5 +1351,90 @@ contains
     end if
     call set_dimension(d%dimension)
   end subroutine resolve_dimension
+
+  ! ---- growing lists (generic grow) --------------------------------------------------------
+
+  !> The size of a list that must hold `n` items and holds `have`: at least 4, doubled.
+  pure integer function capacity(n, have)
+    integer, intent(in) :: n, have
+    capacity = max(4, 2*have, n)
+  end function capacity
+
+  subroutine grow_pairs(list, n)
+    type(contact_cfg_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(contact_cfg_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_pairs
+
+  subroutine grow_strs(list, n)
+    type(str_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(str_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_strs
+
+  subroutine grow_tractions(list, n)
+    type(traction_cfg_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(traction_cfg_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_tractions
+
+  subroutine grow_body_forces(list, n)
+    type(body_force_cfg_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(body_force_cfg_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_body_forces
+
+  subroutine grow_materials(list, n)
+    type(material_cfg_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(material_cfg_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_materials
+
+  subroutine grow_regions(list, n)
+    type(region_cfg_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(region_cfg_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_regions
+
+  subroutine grow_boundaries(list, n)
+    type(boundary_cfg_t), allocatable, intent(inout) :: list(:)
+    integer, intent(in) :: n
+    type(boundary_cfg_t), allocatable :: tmp(:)
+    if (.not. allocated(list)) allocate (list(0))
+    if (n <= size(list)) return
+    allocate (tmp(capacity(n, size(list))))
+    tmp(1:size(list)) = list
+    call move_alloc(tmp, list)
+  end subroutine grow_boundaries
 
 end module deck_checks
