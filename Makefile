@@ -68,7 +68,7 @@ endif
 MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology volume_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set tangent_discs mprgp_support qp_newton disc_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
         robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
-        results checkpoint load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
+        results checkpoint fatal_errors load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
 
@@ -137,7 +137,7 @@ $(BUILD)/clock.o:          $(BUILD)/kinds.o
 $(BUILD)/strings.o:        $(BUILD)/kinds.o
 $(BUILD)/digest.o:         $(BUILD)/errors.o
 $(BUILD)/int_hash.o:       $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
-$(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/strings.o
+$(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
@@ -249,23 +249,24 @@ $(BUILD)/results.o:        $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/config.
                            $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o $(BUILD)/results.o
-# the driver's modules (src/driver): the run's data, its two back-ends, its phases
+# the driver's modules (src/driver): the route to an exit on error, the run's data, its two back-ends, its phases
+$(BUILD)/fatal_errors.o:   $(BUILD)/errors.o
 $(BUILD)/load_history.o:   $(BUILD)/assembly.o $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_interface.o \
                            $(BUILD)/errors.o $(BUILD)/floating.o $(BUILD)/kinds.o
 $(BUILD)/run_state.o:      $(BUILD)/assembly.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \
-                           $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/deck.o $(BUILD)/errors.o \
+                           $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/deck.o $(BUILD)/fatal_errors.o \
                            $(BUILD)/kinds.o $(BUILD)/load_history.o $(BUILD)/mesh.o $(BUILD)/mpi_env.o $(BUILD)/results.o \
                            $(BUILD)/strings.o
 $(BUILD)/run_backend.o:    $(BUILD)/config.o $(BUILD)/run_state.o
 # a back-end implements every phase of the interface: not every phase needs every argument
 $(BUILD)/serial_backend.o $(BUILD)/mpi_backend.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/serial_backend.o: $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense.o $(BUILD)/config.o \
-                           $(BUILD)/contact_common.o $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/load_history.o \
-                           $(BUILD)/mpi_env.o $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/sorting.o \
+                           $(BUILD)/contact_common.o $(BUILD)/errors.o $(BUILD)/fatal_errors.o $(BUILD)/kinds.o \
+                           $(BUILD)/load_history.o $(BUILD)/mpi_env.o $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/sorting.o \
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/mpi_backend.o:    $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/condense.o $(BUILD)/factorization.o \
                            $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
-                           $(BUILD)/floating.o $(BUILD)/kinds.o $(BUILD)/mpi_env.o \
+                           $(BUILD)/fatal_errors.o $(BUILD)/floating.o $(BUILD)/kinds.o $(BUILD)/mpi_env.o \
                            $(BUILD)/run_backend.o $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_summary.o:    $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/space.o \
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/errors.o \
@@ -273,13 +274,14 @@ $(BUILD)/run_summary.o:    $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/contac
                            $(BUILD)/run_state.o $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkpoint.o $(BUILD)/cholmod_iface.o $(BUILD)/elements_3d.o $(BUILD)/space.o \
                            $(BUILD)/clock.o $(BUILD)/config.o $(BUILD)/contact_common.o $(BUILD)/contact_interface.o \
-                           $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/files.o \
+                           $(BUILD)/contact_types.o $(BUILD)/error_estimate.o $(BUILD)/errors.o $(BUILD)/fatal_errors.o \
+                           $(BUILD)/files.o \
                            $(BUILD)/floating.o $(BUILD)/gmsh_msh.o $(BUILD)/kinds.o $(BUILD)/load_history.o \
                            $(BUILD)/mesh.o $(BUILD)/monolithic.o $(BUILD)/mpi_backend.o $(BUILD)/mpi_env.o \
                            $(BUILD)/results.o $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
                            $(BUILD)/run_summary.o $(BUILD)/serial_backend.o $(BUILD)/signals.o $(BUILD)/sorting.o \
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
-$(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/deck.o $(BUILD)/config.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
+$(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/fatal_errors.o $(BUILD)/deck.o $(BUILD)/config.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o
 $(BUILD)/sysinfo_shim.o:   include/sysinfo_shim.h
 $(BUILD)/files_shim.o:     include/files_shim.h
 $(BUILD)/robin_contact.o:  $(OBJS)

@@ -23,6 +23,7 @@ program bench_assembly_rate
   type(mesh_t), allocatable :: m(:)
   type(body_system_t), allocatable :: s(:)
   type(error_t), allocatable :: e(:)
+  type(error_t) :: e1
   real(wp) :: w(3), best_w(2)
   real :: t(3), best_t(2)
   integer :: a, rep, nrep, ndof, stat
@@ -35,7 +36,8 @@ program bench_assembly_rate
   nrep = 3
   call get_environment_variable('BENCH_REPEAT', arg)
   if (len_trim(arg) > 0) read (arg, *, iostat=stat) nrep
-  call read_deck(trim(path), overrides, d)
+  call read_deck(trim(path), overrides, d, e1)
+  if (e1%failed()) error stop 'bad deck: '//e1%message
   best_t = huge(1.0)
   best_w = huge(1.0_wp)
   do rep = 1, max(1, nrep)

@@ -13,7 +13,8 @@
 program robin_contact
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use errors, only: fatal, warn, error_t, fail_on, EXIT_INPUT
+  use errors, only: warn, error_t, ERR_INPUT
+  use fatal_errors, only: fail_on
   use config, only: METHOD_ROBIN, program_version
   use deck, only: read_deck, print_deck
   use signals, only: signals_install
@@ -40,10 +41,11 @@ program robin_contact
   ! ---- the deck, and a deck that cannot fit this machine refused before anything is allocated
   call start_ranks(run)
   call parse_arguments(run%rank, deck_path, overrides, run%restart_file)
-  call read_deck(deck_path, overrides, run%deck)
+  call read_deck(deck_path, overrides, run%deck, err)
+  call fail_on(err)   ! read_deck's messages name their source (the deck and line, or the override)
   call choose_backend(run, backend)
-  if (len(run%restart_file) > 0 .and. run%deck%solver%method /= METHOD_ROBIN) call fatal(EXIT_INPUT, &
-    'deck '//trim(run%deck%source)//': --restart applies to method=''robin'' only')
+  if (len(run%restart_file) > 0 .and. run%deck%solver%method /= METHOD_ROBIN) &
+    call fail_on(error_t(ERR_INPUT, '--restart applies to method=''robin'' only'), 'deck '//trim(run%deck%source))
   if (.not. signals_install()) call warn('cannot install the SIGTERM/SIGINT handlers')
   call backend%check_memory(run, run%deck)
   call check_load_range(run%deck, err)

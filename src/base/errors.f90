@@ -1,14 +1,10 @@
-!> Exit codes and the single route for fatal errors.
-!! Every fatal error goes through `fatal`, which calls the procedure pointer
-!! `fatal_handler`; the default prints one sentence to stderr and exits with the
-!! code, without a Fortran runtime message or backtrace. Tests may point the
-!! handler elsewhere.
-!!
-!! Below the driver, a procedure that can fail returns an `error_t` (its category
-!! and one sentence); the driver turns the category into the exit code in one
-!! place, `exit_code`, and adds the deck's name. See doc/developing.md.
+!> Exit codes and errors: `error_t` (a category and one sentence), which every procedure
+!! below the driver that can fail returns, and `exit_code`, the one place where a category
+!! becomes an exit code; `warn` prints a warning line. The driver alone ends a run on an
+!! error (module fatal_errors: fail_on, which adds the deck's name, and fatal). See
+!! doc/developing.md, "How errors travel".
 module errors
-  use, intrinsic :: iso_fortran_env, only: error_unit, output_unit
+  use, intrinsic :: iso_fortran_env, only: error_unit
   implicit none (type, external)
   private
 
@@ -39,56 +35,15 @@ module errors
     procedure :: text => error_text
   end type error_t
 
-  abstract interface
-    !> A fatal-error handler: receives the exit code and the message.
-    subroutine fatal_handler_iface(code, msg)
-      integer, intent(in) :: code
-      character(len=*), intent(in) :: msg
-    end subroutine fatal_handler_iface
-  end interface
-
-  !> Where fatal errors go (default: print and exit).
-  procedure(fatal_handler_iface), pointer, public :: fatal_handler => default_handler
-
-  public :: fatal, terminate, warn, fatal_handler_iface, exit_code, fail_on
+  public :: warn, exit_code
 
 contains
-
-  !> Report a fatal error with its exit code and one sentence naming the culprit.
-  subroutine fatal(code, msg)
-    integer, intent(in) :: code           !< one of the EXIT_* codes
-    character(len=*), intent(in) :: msg   !< what went wrong, naming the input, body and value
-    call fatal_handler(code, msg)
-    ! A handler that returns is not allowed to continue the computation.
-    call terminate(code)
-  end subroutine fatal
 
   !> Print a warning line to stderr (the run continues).
   subroutine warn(msg)
     character(len=*), intent(in) :: msg  !< warning text
     write (error_unit, '(a)') 'robin_contact: warning: '//trim(msg)
   end subroutine warn
-
-  !> Flush the standard units and exit with `code`, silently.
-  subroutine terminate(code)
-    integer, intent(in) :: code  !< process exit status
-    flush (output_unit)
-    flush (error_unit)
-    select case (code)
-    case (0)
-      stop 0, quiet=.true.
-    case (1)
-      stop 1, quiet=.true.
-    case (2)
-      stop 2, quiet=.true.
-    case (3)
-      stop 3, quiet=.true.
-    case (4)
-      stop 4, quiet=.true.
-    case default
-      stop 3, quiet=.true.
-    end select
-  end subroutine terminate
 
   !> The exit code of an error's category: the one place where categories meet exit codes.
   pure integer function exit_code(err)
@@ -102,19 +57,6 @@ contains
       exit_code = EXIT_NUMERICAL
     end select
   end function exit_code
-
-  !> Stop the run with `err`'s exit code when it holds an error; `context` (the deck, say)
-  !! is put in front of the message.
-  subroutine fail_on(err, context)
-    type(error_t), intent(in) :: err              !< the error, possibly none
-    character(len=*), intent(in), optional :: context  !< prefix such as "deck inputs/x.nml"
-    if (.not. err%failed()) return
-    if (present(context)) then
-      call fatal(exit_code(err), trim(context)//': '//err%text())
-    else
-      call fatal(exit_code(err), err%text())
-    end if
-  end subroutine fail_on
 
   !> True when the error holds a failure.
   elemental logical function error_failed(self)
@@ -148,12 +90,5 @@ contains
       text = ''
     end if
   end function error_text
-
-  subroutine default_handler(code, msg)
-    integer, intent(in) :: code
-    character(len=*), intent(in) :: msg
-    write (error_unit, '(a)') 'robin_contact: error: '//trim(msg)
-    call terminate(code)
-  end subroutine default_handler
 
 end module errors

@@ -1,20 +1,20 @@
 !> A text scanner over a whole file held in memory: blank-separated tokens, integers and
 !! reals converted by hand (a list-directed READ costs about 1.7 us a number, several
 !! seconds for the millions of numbers of a large mesh file), the current line for
-!! messages, and the first error met (code, line, sentence). After an error every read
-!! returns at once (0 for a number), so a reader checks the status only where it must
-!! stop.
+!! messages, and the first error met (an error_t: ERR_INPUT or ERR_MEMORY and its sentence,
+!! with its line). After an error every read returns at once (0 for a number), so a reader
+!! checks `scanner%err%failed()` only where it must stop. The end of the text is no error: a
+!! token starting past the end (s > scanner%n) says so, and the reader that expected one
+!! more reports it (bad_token, expect).
 module text_scanner
   use kinds, only: wp, i8
+  use errors, only: error_t, ERR_NONE, ERR_INPUT, ERR_MEMORY
   use strings, only: i2s, fpstate_t, fp_read_begin, fp_read_end
   implicit none (type, external)
   private
 
   public :: scanner_load, scan_fail, next_token, bad_token, get_int, get_real, read_count, bytes_left, &
             expect, skip_past, parse_int, parse_real
-
-  integer, parameter, public :: SCAN_BAD_INPUT = 1       !< info: the text is not what was expected
-  integer, parameter, public :: SCAN_OTHER_FAILURE = 3   !< info: anything else (memory)
 
   integer, parameter :: i16 = selected_int_kind(38)   ! 128-bit integers (nearest_quotient)
 
@@ -31,9 +31,8 @@ module text_scanner
     integer :: line = 1                       !< the line of pos
     character(len=:), allocatable :: path     !< the file
     character(len=:), allocatable :: section  !< the part being read, for messages
-    integer :: info = 0                       !< first error: code (0: none)
+    type(error_t) :: err                      !< the first error: ERR_INPUT (bad text) or ERR_MEMORY, its sentence
     integer :: err_line = 0                   !< its line (0: none)
-    character(len=:), allocatable :: err      !< its text
   end type scanner_t
 
 contains
@@ -41,19 +40,20 @@ contains
   ! ---- errors ---------------------------------------------------------------------------
 
   !> Record an error (the first one only) at the current line, or with no line (at_line false).
-  subroutine scan_fail(scanner, text, code, at_line)
+  subroutine scan_fail(scanner, text, category, at_line)
     type(scanner_t), intent(inout) :: scanner
-    character(len=*), intent(in) :: text
-    integer, intent(in), optional :: code
-    logical, intent(in), optional :: at_line
-    if (scanner%info /= 0) return
-    scanner%info = SCAN_BAD_INPUT
-    if (present(code)) scanner%info = code
+    character(len=*), intent(in) :: text               !< what is wrong (the reader adds file and line)
+    integer, intent(in), optional :: category          !< ERR_INPUT (default) or ERR_MEMORY
+    logical, intent(in), optional :: at_line           !< .false.: the error has no line
+    if (scanner%err%category /= ERR_NONE) return
+    ! the components set directly (no trim): readers of several bodies run this on threads
+    scanner%err%category = ERR_INPUT
+    if (present(category)) scanner%err%category = category
     scanner%err_line = scanner%line
     if (present(at_line)) then
       if (.not. at_line) scanner%err_line = 0
     end if
-    scanner%err = text
+    scanner%err%message = text
   end subroutine scan_fail
 
   ! ---- the text -------------------------------------------------------------------------
@@ -84,7 +84,7 @@ contains
     if (st /= 0) then
       close (u)
       call scan_fail(scanner, 'needs '//i2s(int(size_bytes/2**20))//' MB of memory to be read', &
-                SCAN_OTHER_FAILURE, .false.)
+                ERR_MEMORY, .false.)
       return
     end if
     read (u, iostat=ios, iomsg=iom) scanner%text
@@ -156,7 +156,7 @@ contains
     integer :: code, d
     logical :: ok
     v = 0
-    if (scanner%info /= 0) return
+    if (scanner%err%category /= ERR_NONE) return
     pos = skip_blanks(scanner, scanner%pos)
     scanner%pos = pos
     m = 0
@@ -189,7 +189,7 @@ contains
     integer(i8) :: s, e
     logical :: ok
     v = 0.0_wp
-    if (scanner%info /= 0) return
+    if (scanner%err%category /= ERR_NONE) return
     call next_token(scanner, s, e)
     ok = s <= e
     if (ok) call parse_real(scanner%text(s:e), v, ok)
@@ -209,7 +209,7 @@ contains
     integer(i8) :: s, e
     logical :: ok
     v = 0
-    if (scanner%info /= 0) return
+    if (scanner%err%category /= ERR_NONE) return
     call next_token(scanner, s, e)
     ok = s <= e
     if (ok) call parse_int(scanner%text(s:e), v, ok)
@@ -255,7 +255,7 @@ contains
     type(scanner_t), intent(inout) :: scanner
     character(len=*), intent(in) :: word
     integer(i8) :: s, e
-    if (scanner%info /= 0) return
+    if (scanner%err%category /= ERR_NONE) return
     call next_token(scanner, s, e)
     if (s > scanner%n) then
       call scan_fail(scanner, 'the file ends before '//word//' (truncated file?)')

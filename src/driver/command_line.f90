@@ -2,7 +2,8 @@
 !! `--deck-reference` (anywhere) print to standard output and exit 0 without a deck; any
 !! other argument that starts with '-' is an unknown option (exit 1).
 module command_line
-  use errors, only: fatal, terminate, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL
+  use errors, only: EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL
+  use fatal_errors, only: fatal, terminate
   use deck, only: deck_usage, deck_reference
   use config, only: program_version
   use sysinfo, only: write_stdout_checked

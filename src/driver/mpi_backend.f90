@@ -7,7 +7,8 @@
 module mpi_backend
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use errors, only: fatal, terminate, error_t, exit_code, EXIT_INPUT
+  use errors, only: error_t, exit_code, EXIT_INPUT
+  use fatal_errors, only: fatal, terminate
   use config, only: deck_t
   use assembly, only: expand, cell_triplets
   use contact_types, only: STATUS_FAILED

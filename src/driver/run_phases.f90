@@ -6,7 +6,8 @@ module run_phases
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
-  use errors, only: error_t, fail_on, fatal, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
+  use errors, only: error_t, warn, EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL, EXIT_INTERRUPTED, ERR_INPUT
+  use fatal_errors, only: fail_on, fatal
   use config, only: METHOD_ROBIN, METHOD_MONOLITHIC, FACTOR_MUMPS, FACTOR_CHOICES, deck_t, body_force_of, stage_count, body_stiffness, &
                     solver_cfg_t, ROBIN_HARMONIC, ROBIN_STEKLOV, ELEM_Q1, ELEM_P1, ELEM_HEX8
   use space, only: NDIM

@@ -6,7 +6,7 @@
 module run_state
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
-  use errors, only: fatal_handler, terminate
+  use fatal_errors, only: fatal_handler, terminate
   use config, only: deck_t, output_cfg_t
   use deck, only: deck_text
   use mesh, only: mesh_t

@@ -3,7 +3,8 @@
 !! (condense::factor_body, each body's factorization%factor_t).
 module serial_backend
   use kinds, only: wp
-  use errors, only: terminate, error_t, fail_on
+  use errors, only: error_t
+  use fatal_errors, only: terminate, fail_on
   use config, only: deck_t
   use assembly, only: expand
   use condense, only: factor_body, condense_body, recover_displacement

@@ -29,7 +29,7 @@ module gmsh_msh
   use digest, only: text_digest
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use text_scanner, only: scanner_t, scanner_load, scan_fail, next_token, get_int, get_real, read_count, &
-                          expect, skip_past, bytes_left, SCAN_OTHER_FAILURE
+                          expect, skip_past, bytes_left
   use mesh, only: mesh_t
   use mesh_topology, only: file_mesh_t, body_from_file, add_physical, index_entities, entity_index, index_groups
   use volume_topology, only: body_from_volumes
@@ -80,10 +80,10 @@ contains
     call scanner_load(scanner, path)
     if (present(hex)) then
       hex = ''
-      if (scanner%info == 0) hex = text_digest(scanner%text)
+      if (.not. scanner%err%failed()) hex = text_digest(scanner%text)
     end if
-    if (scanner%info == 0) call parse(scanner, file_mesh)
-    if (scanner%info == 0) call build(scanner, file_mesh, trim(region), mesh)
+    if (.not. scanner%err%failed()) call parse(scanner, file_mesh)
+    if (.not. scanner%err%failed()) call build(scanner, file_mesh, trim(region), mesh)
     if (allocated(scanner%text)) deallocate (scanner%text)
     call outcome(scanner, path, body_id, mesh, err)
   end subroutine msh_read
@@ -108,14 +108,14 @@ contains
     n = size(region)
     allocate (file_mesh%phys_dim(8), file_mesh%phys_tag(8), file_mesh%phys_name(8), body_scanner(n))
     call scanner_load(scanner, path)
-    loaded = scanner%info == 0
+    loaded = .not. scanner%err%failed()
     if (present(hex)) hex = ''
     ! the content hash (which a checkpoint records) of the same bytes, beside the parse
     ! (which changes the scanner's position and status, never its text)
     !$omp parallel sections num_threads(min(2, nthr)) if (loaded .and. present(hex))
     !$omp section
     if (loaded) call parse(scanner, file_mesh)
-    if (scanner%info == 0) call index_groups(file_mesh)     ! once for all the bodies
+    if (.not. scanner%err%failed()) call index_groups(file_mesh)     ! once for all the bodies
     !$omp section
     if (loaded .and. present(hex)) hex = text_digest(scanner%text)
     !$omp end parallel sections
@@ -125,7 +125,7 @@ contains
     end do
     !$omp parallel do num_threads(nthr) schedule(dynamic, 1)
     do a = 1, n
-      if (body_scanner(a)%info == 0) call build(body_scanner(a), file_mesh, trim(region(a)), mesh(a))
+      if (.not. body_scanner(a)%err%failed()) call build(body_scanner(a), file_mesh, trim(region(a)), mesh(a))
     end do
     !$omp end parallel do
     do a = 1, n
@@ -142,11 +142,11 @@ contains
     type(mesh_t), intent(inout) :: mesh
     type(error_t), intent(out) :: err
     character(len=:), allocatable :: msg
-    if (scanner%info == 0) return
+    if (.not. scanner%err%failed()) return
     msg = 'body '//i2s(body_id)//": mesh file '"//path//"'"
     if (scanner%err_line > 0) msg = msg//', line '//i2s(scanner%err_line)
-    msg = msg//': '//scanner%err//'.'
-    call err%set(merge(ERR_MEMORY, ERR_INPUT, scanner%info == SCAN_OTHER_FAILURE), msg)
+    msg = msg//': '//scanner%err%message//'.'
+    call err%set(scanner%err%category, msg)
     mesh%nnode = 0
     mesh%ncell = 0
   end subroutine outcome
@@ -169,7 +169,7 @@ contains
     ! static variable of its call site, which two threads running this line share (the
     ! reason came out empty in about 2% of two-thread runs with two failing bodies)
     if (.not. allocated(err%message)) err%message = 'cannot be built'
-    call scan_fail(scanner, err%message, merge(SCAN_OTHER_FAILURE, 1, err%category == ERR_MEMORY), .false.)
+    call scan_fail(scanner, err%message, merge(ERR_MEMORY, ERR_INPUT, err%category == ERR_MEMORY), .false.)
   end subroutine build
 
   ! ---- parsing ----------------------------------------------------------------------------
@@ -229,7 +229,7 @@ contains
           call skip_past(scanner, '$End'//tok(2:))
         end if
       end select
-      if (scanner%info /= 0) return
+      if (scanner%err%failed()) return
     end do
     if (.not. has_format) then
       call scan_fail(scanner, 'is empty: no $MeshFormat section')
@@ -256,7 +256,7 @@ contains
       return
     end if
     file_type = get_int(scanner, 'the file type')
-    if (scanner%info == 0 .and. file_type /= 0) then
+    if (.not. scanner%err%failed() .and. file_type /= 0) then
       call scan_fail(scanner, 'is a binary MSH file, and only ASCII is read; write it without -bin '// &
                 '(Mesh.Binary = 0)')
       return
@@ -275,11 +275,11 @@ contains
     integer(i8) :: q
     ! a name takes at least 7 characters: '1 2 ""' and a line end
     n = read_count(scanner, 'the number of physical names', 7, 'physical names')
-    if (scanner%info /= 0) return
+    if (scanner%err%failed()) return
     do k = 1, n
       dim = get_int(scanner, 'a physical dimension')
       tag = get_int(scanner, 'a physical tag')
-      if (scanner%info /= 0) return
+      if (scanner%err%failed()) return
       if (dim < 0 .or. dim > 3) then
         call scan_fail(scanner, 'physical group '//i2s(tag)//' has dimension '//i2s(dim)//', not 0, 1, 2 or 3')
         return
@@ -306,7 +306,7 @@ contains
       end if
       call add_physical(file_mesh, dim, tag, scanner%text(scanner%pos + 1:scanner%pos + q - 1), err)
       if (err%failed()) then
-        call scan_fail(scanner, 'not enough memory for '//i2s(k)//' physical groups', SCAN_OTHER_FAILURE)
+        call scan_fail(scanner, 'not enough memory for '//i2s(k)//' physical groups', ERR_MEMORY)
         return
       end if
       scanner%pos = scanner%pos + q + 1
@@ -332,7 +332,7 @@ contains
       nents(dim) = read_count(scanner, 'the number of '//trim(KIND(dim)), merge(POINT_BYTES, OTHER_BYTES, dim == 0), &
                               trim(KIND(dim)))
     end do
-    if (scanner%info /= 0) return
+    if (scanner%err%failed()) return
     need = POINT_BYTES*int(nents(0), i8) + OTHER_BYTES*(int(nents(1), i8) + nents(2) + nents(3))
     if (need > bytes_left(scanner)) then
       call scan_fail(scanner, '$Entities announces '//i2s(nents(0))//' points, '//i2s(nents(1))//' curves, '// &
@@ -344,7 +344,7 @@ contains
     if (NDIM == 3) nkeep = nkeep + nents(3)     ! the volumes are read, and kept in a 3D run
     allocate (file_mesh%ent(nkeep), stat=st)
     if (st /= 0) then
-      call scan_fail(scanner, 'not enough memory for '//i2s(nkeep)//' entities', SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, 'not enough memory for '//i2s(nkeep)//' entities', ERR_MEMORY)
       return
     end if
     do dim = 0, 3
@@ -355,10 +355,10 @@ contains
         end do
         np = read_count(scanner, 'the number of physical tags', 2, &
                         'physical tags for '//KIND(dim)(1:len_trim(KIND(dim)) - 1)//' '//i2s(tag))
-        if (scanner%info /= 0) return
+        if (scanner%err%failed()) return
         allocate (phys(np), stat=st)
         if (st /= 0) then
-          call scan_fail(scanner, 'not enough memory for '//i2s(np)//' physical tags', SCAN_OTHER_FAILURE)
+          call scan_fail(scanner, 'not enough memory for '//i2s(np)//' physical tags', ERR_MEMORY)
           return
         end if
         do j = 1, np     ! negative when the entity is reversed in the group
@@ -371,7 +371,7 @@ contains
             bound = get_int(scanner, 'a bounding entity tag')
           end do
         end if
-        if (scanner%info /= 0) return
+        if (scanner%err%failed()) return
         if (dim <= 2 .or. NDIM == 3) then
           file_mesh%nent = file_mesh%nent + 1
           file_mesh%ent(file_mesh%nent)%dim = dim
@@ -381,7 +381,7 @@ contains
             call add_physical(file_mesh, dim, file_mesh%ent(file_mesh%nent)%phys(j), &
                               i2s(file_mesh%ent(file_mesh%nent)%phys(j)), err)
             if (err%failed()) then
-              call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
+              call scan_fail(scanner, err%message, ERR_MEMORY)
               return
             end if
           end do
@@ -392,7 +392,7 @@ contains
     end do
     call index_entities(file_mesh, err)
     if (err%failed()) then
-      call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, err%message, ERR_MEMORY)
       return
     end if
     call expect(scanner, '$EndEntities')
@@ -413,7 +413,7 @@ contains
     ntotal = read_count(scanner, 'the number of nodes', NODE_BYTES, 'nodes')
     tag_lo = get_int(scanner, 'the smallest node tag')
     tag_hi = get_int(scanner, 'the largest node tag')
-    if (scanner%info /= 0) return
+    if (scanner%err%failed()) return
     allocate (file_mesh%node_tag(ntotal), file_mesh%node_xy(merge(3, 2, NDIM == 3), ntotal), stat=st)
     by_tag%direct = tag_lo >= 1 .and. tag_hi >= tag_lo .and. &
                     int(tag_hi, i8) - tag_lo + 1 <= DIRECT_SPAN*(int(ntotal, i8) + 1)
@@ -425,7 +425,7 @@ contains
       if (st == 0) call index_to_hash(by_tag, file_mesh%node_tag, 0, ntotal, err)
     end if
     if (st /= 0 .or. err%failed()) then
-      call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' nodes', ERR_MEMORY)
       return
     end if
     file_mesh%nnode = 0
@@ -434,7 +434,7 @@ contains
       etag = get_int(scanner, 'an entity tag')
       param = get_int(scanner, 'the parametric flag')
       nb = read_count(scanner, 'the number of nodes in the block', NODE_BYTES, 'nodes in a block')
-      if (scanner%info /= 0) return
+      if (scanner%err%failed()) return
       if (int(file_mesh%nnode, i8) + nb > ntotal) then
         call scan_fail(scanner, 'the node blocks hold more nodes than the '//i2s(ntotal)//' announced')
         return
@@ -442,7 +442,7 @@ contains
       first = file_mesh%nnode
       do k = first + 1, first + nb
         file_mesh%node_tag(k) = get_int(scanner, 'a node tag')
-        if (scanner%info /= 0) return
+        if (scanner%err%failed()) return
         if (file_mesh%node_tag(k) < 1) then
           call scan_fail(scanner, 'node tag '//i2s(file_mesh%node_tag(k))//' in $Nodes: tags must be >= 1')
           return
@@ -451,7 +451,7 @@ contains
         if (by_tag%direct .and. (tag < by_tag%lo .or. tag > by_tag%hi)) then
           call index_to_hash(by_tag, file_mesh%node_tag, k - 1, ntotal, err)
           if (err%failed()) then
-            call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
+            call scan_fail(scanner, err%message, ERR_MEMORY)
             return
           end if
         end if
@@ -476,7 +476,7 @@ contains
             r = get_real(scanner, 'a parametric coordinate')
           end do
         end if
-        if (scanner%info /= 0) return
+        if (scanner%err%failed()) return
         if (NDIM == 3) then
           file_mesh%node_xy(3, k) = z
         else if (z /= 0.0_wp) then
@@ -509,13 +509,13 @@ contains
     ntotal = read_count(scanner, 'the number of elements', ELEMENT_BYTES, 'elements')
     k = get_int(scanner, 'the smallest element tag')
     k = get_int(scanner, 'the largest element tag')
-    if (scanner%info /= 0) return
+    if (scanner%err%failed()) return
     ! sized for the worst case; the lines are a small part of a 2D mesh but bounded by ntotal too
     allocate (file_mesh%cell_tag(ntotal), file_mesh%cell_entity(ntotal), file_mesh%cell_node(4, ntotal), &
               file_mesh%line_tag(ntotal), file_mesh%line_entity(ntotal), file_mesh%line_node(2, ntotal), &
               file_mesh%point_entity(ntotal), file_mesh%point_node(ntotal), stat=st)
     if (st /= 0) then
-      call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', SCAN_OTHER_FAILURE)
+      call scan_fail(scanner, 'not enough memory for '//i2s(ntotal)//' elements', ERR_MEMORY)
       return
     end if
     t = 0
@@ -537,7 +537,7 @@ contains
       end select
       ! an element takes at least its tag and nodes, each a digit and a separator
       nb = read_count(scanner, 'the number of elements in the block', 2*(nv + 1), 'elements in a block')
-      if (scanner%info /= 0) return
+      if (scanner%err%failed()) return
       if (int(t, i8) + nb > ntotal) then
         call scan_fail(scanner, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
         return
@@ -555,7 +555,7 @@ contains
       ent = entity_index(file_mesh, edim, etag)
       do k = 1, nb
         tag = get_int(scanner, 'an element tag')
-        if (scanner%info /= 0) return
+        if (scanner%err%failed()) return
         if (tag < 1) then
           call scan_fail(scanner, 'element tag '//i2s(tag)//' in $Elements: tags must be >= 1')
           return
@@ -575,7 +575,7 @@ contains
         end if
         do j = 1, nv
           ntg = get_int(scanner, 'a node tag')
-          if (scanner%info /= 0) return
+          if (scanner%err%failed()) return
           if (ntg < 1) then
             call scan_fail(scanner, 'element '//i2s(tag)//' refers to node tag '//i2s(ntg)//': tags must be >= 1')
             return
@@ -621,7 +621,7 @@ contains
     ntotal = read_count(scanner, 'the number of elements', ELEMENT_BYTES, 'elements')
     k = get_int(scanner, 'the smallest element tag')
     k = get_int(scanner, 'the largest element tag')
-    if (scanner%info /= 0) return
+    if (scanner%err%failed()) return
     allocate (file_mesh%cell_tag(0), file_mesh%cell_entity(0), file_mesh%cell_node(8, 0), &
               file_mesh%face_tag(0), file_mesh%face_entity(0), file_mesh%face_node(4, 0), &
               file_mesh%line_tag(0), file_mesh%line_entity(0), file_mesh%line_node(2, 0), &
@@ -653,7 +653,7 @@ contains
       end select
       ! an element takes at least its tag and nodes, each a digit and a separator
       nb = read_count(scanner, 'the number of elements in the block', 2*(nv + 1), 'elements in a block')
-      if (scanner%info /= 0) return
+      if (scanner%err%failed()) return
       if (int(t, i8) + nb > ntotal) then
         call scan_fail(scanner, 'the element blocks hold more elements than the '//i2s(ntotal)//' announced')
         return
@@ -680,12 +680,12 @@ contains
         call grow(file_mesh%point_node, file_mesh%point_entity, file_mesh%npoint, nb, ntotal, err)
       end select
       if (err%failed()) then
-        call scan_fail(scanner, err%message, SCAN_OTHER_FAILURE)
+        call scan_fail(scanner, err%message, ERR_MEMORY)
         return
       end if
       do k = 1, nb
         tag = get_int(scanner, 'an element tag')
-        if (scanner%info /= 0) return
+        if (scanner%err%failed()) return
         if (tag < 1) then
           call scan_fail(scanner, 'element tag '//i2s(tag)//' in $Elements: tags must be >= 1')
           return
@@ -693,7 +693,7 @@ contains
         nodes = 0
         do j = 1, nv
           ntg = get_int(scanner, 'a node tag')
-          if (scanner%info /= 0) return
+          if (scanner%err%failed()) return
           if (ntg < 1) then
             call scan_fail(scanner, 'element '//i2s(tag)//' refers to node tag '//i2s(ntg)//': tags must be >= 1')
             return

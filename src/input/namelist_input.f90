@@ -11,7 +11,7 @@
 module namelist_input
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
-  use errors, only: fatal, EXIT_INPUT
+  use errors, only: error_t, ERR_INPUT
   use strings, only: fpstate_t, fp_read_begin, fp_read_end, lower, is_ident, is_letter, first_nonblank, &
                      i2s, quote, quoted_list, index_of, text_buffer_t
   use namelist_vars, only: str_t, vars_t, T_INT, T_REAL, T_STR, T_ENUM, var_index, var_list
@@ -55,30 +55,42 @@ contains
   ! ============================================================================================
 
   !> Read a deck file (a regular file, or a stream such as a pipe or /dev/stdin) as lines.
-  subroutine load_file(path, src)
+  subroutine load_file(path, src, err)
     character(len=*), intent(in) :: path   !< file path
     type(src_t), intent(out) :: src        !< its lines
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     logical :: exists
     integer :: u, ios, n
     character(len=512) :: msg
     character(len=:), allocatable :: text
 
     inquire (file=path, exist=exists)
-    if (.not. exists) call fatal(EXIT_INPUT, 'cannot open the deck file '''//path// &
-      ''': no such file')
+    if (.not. exists) then
+      call err%set(ERR_INPUT, 'cannot open the deck file '''//path// &
+        ''': no such file')
+      return
+    end if
     open (newunit=u, file=path, access='stream', form='unformatted', status='old', &
           action='read', iostat=ios, iomsg=msg)
-    if (ios /= 0) call fatal(EXIT_INPUT, 'cannot open the deck file '''//path//''': '//trim(msg))
+    if (ios /= 0) then
+      call err%set(ERR_INPUT, 'cannot open the deck file '''//path//''': '//trim(msg))
+      return
+    end if
     inquire (unit=u, size=n)
     if (n <= 0) then
       ! a stream (pipe) has no size (-1, or 0 for some): read it record by record
       close (u)
-      call read_stream(path, text)
+      call read_stream(path, text, err)
+      if (err%failed()) return
     else
       allocate (character(len=n) :: text)
       if (n > 0) then
         read (u, iostat=ios, iomsg=msg) text
-        if (ios /= 0) call fatal(EXIT_INPUT, 'cannot read the deck file '''//path//''': '//trim(msg))
+        if (ios /= 0) then
+          call err%set(ERR_INPUT, 'cannot read the deck file '''//path//''': '//trim(msg))
+          close (u)
+          return
+        end if
       end if
       close (u)
     end if
@@ -88,21 +100,28 @@ contains
   end subroutine load_file
 
   !> The whole text of a sequential file of unknown size (pipe), lines joined by LF.
-  subroutine read_stream(path, text)
+  subroutine read_stream(path, text, err)
     character(len=*), intent(in) :: path
     character(len=:), allocatable, intent(out) :: text
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     character(len=4096) :: chunk
     type(text_buffer_t) :: tb
     integer :: u, ios, nread
     character(len=512) :: msg
     open (newunit=u, file=path, access='sequential', form='formatted', status='old', &
           action='read', iostat=ios, iomsg=msg)
-    if (ios /= 0) call fatal(EXIT_INPUT, 'cannot open the deck file '''//path//''': '//trim(msg))
+    if (ios /= 0) then
+      call err%set(ERR_INPUT, 'cannot open the deck file '''//path//''': '//trim(msg))
+      return
+    end if
     do
       read (u, '(a)', advance='no', size=nread, iostat=ios, iomsg=msg) chunk
       if (is_iostat_end(ios)) exit
-      if (ios /= 0 .and. .not. is_iostat_eor(ios)) &
-        call fatal(EXIT_INPUT, 'cannot read the deck file '''//path//''': '//trim(msg))
+      if (ios /= 0 .and. .not. is_iostat_eor(ios)) then
+        call err%set(ERR_INPUT, 'cannot read the deck file '''//path//''': '//trim(msg))
+        close (u)
+        return
+      end if
       call tb%add(chunk(1:nread))
       if (is_iostat_eor(ios)) call tb%add(NL)
     end do
@@ -148,10 +167,11 @@ contains
 
   !> Strip comments, join the lines into one buffer (with the line of every character),
   !! split it into groups and each group into assignments.
-  subroutine parse_source(src, groups, gs)
+  subroutine parse_source(src, groups, gs, err)
     type(src_t), intent(in) :: src                  !< the text
     character(len=*), intent(in) :: groups          !< the known group names (for messages)
     type(grp_t), allocatable, intent(out) :: gs(:)  !< its groups, in order
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     type(str_t), allocatable :: clean(:)
     character(len=:), allocatable :: buf, gname
     integer, allocatable :: lineof(:)
@@ -163,8 +183,11 @@ contains
     n = 0
     do i = 1, size(src%lines)
       call strip_comment(src%lines(i)%s, clean(i)%s, bad)
-      if (bad > 0) call die_at(src, i, 'unterminated character string: the quote at column '// &
-        i2s(bad)//' is not closed on this line')
+      if (bad > 0) then
+        call die_at(src, i, 'unterminated character string: the quote at column '// &
+          i2s(bad)//' is not closed on this line', err)
+        return
+      end if
       n = n + len(clean(i)%s) + 1
     end do
     allocate (character(len=n) :: buf)
@@ -193,11 +216,13 @@ contains
         end do
         if (ng == 0) then
           call die_at(src, lineof(p), 'syntax error: unexpected text '''//buf(p:q)// &
-            ''' outside a namelist group; a group looks like &name var=value, ... /')
+            ''' outside a namelist group; a group looks like &name var=value, ... /', err)
+          return
         else
           call die_at(src, lineof(p), 'syntax error: unexpected text '''//buf(p:q)// &
             ''' after the ''/'' that closes group &'//gs(ng)%name//' (line '// &
-            i2s(gs(ng)%line)//'); a group looks like &name var=value, ... /')
+            i2s(gs(ng)%line)//'); a group looks like &name var=value, ... /', err)
+          return
         end if
       end if
       q = p + 1
@@ -206,10 +231,16 @@ contains
         q = q + 1
       end do
       gname = lower(buf(p + 1:q - 1))
-      if (len(gname) == 0) call die_at(src, lineof(p), 'syntax error: ''&'' must be followed '// &
-        'by a group name (one of '//quoted_list(groups, '&')//')')
-      if (.not. is_letter(gname(1:1))) call die_at(src, lineof(p), 'syntax error: ''&'// &
-        gname//''' is not a group name')
+      if (len(gname) == 0) then
+        call die_at(src, lineof(p), 'syntax error: ''&'' must be followed '// &
+          'by a group name (one of '//quoted_list(groups, '&')//')', err)
+        return
+      end if
+      if (.not. is_letter(gname(1:1))) then
+        call die_at(src, lineof(p), 'syntax error: ''&'// &
+          gname//''' is not a group name', err)
+        return
+      end if
       ! Find the closing '/', outside quotes.
       r = q
       quote_ch = ' '
@@ -224,12 +255,16 @@ contains
         else if (ch == '&') then
           call die_at(src, lineof(r), 'syntax error: group &'//gname//' (line '// &
             i2s(lineof(p))//') is not closed with ''/'' before the next ''&'' on line '// &
-            i2s(lineof(r)))
+            i2s(lineof(r)), err)
+          return
         end if
         r = r + 1
       end do
-      if (r > n) call die_at(src, lineof(p), 'syntax error: group &'//gname// &
-        ' is not closed: a group ends with ''/''')
+      if (r > n) then
+        call die_at(src, lineof(p), 'syntax error: group &'//gname// &
+          ' is not closed: a group ends with ''/''', err)
+        return
+      end if
       if (ng == size(gs)) then   ! grow geometrically: many groups stay linear
         allocate (tmp(max(8, 2*ng)))
         tmp(1:ng) = gs(1:ng)
@@ -239,7 +274,8 @@ contains
       gs(ng)%name = gname
       gs(ng)%text = buf(p:r)
       gs(ng)%line = lineof(p)
-      call split_assignments(src, gs(ng), buf(q:r - 1), lineof(q:r - 1))
+      call split_assignments(src, gs(ng), buf(q:r - 1), lineof(q:r - 1), err)
+      if (err%failed()) return
       p = r + 1
     end do
     gs = gs(1:ng)
@@ -275,11 +311,12 @@ contains
   end subroutine strip_comment
 
   !> Split the inside of a group (after its name, before '/') into assignments.
-  subroutine split_assignments(src, g, body, lineof)
+  subroutine split_assignments(src, g, body, lineof, err)
     type(src_t), intent(in) :: src
     type(grp_t), intent(inout) :: g
     character(len=*), intent(in) :: body
     integer, intent(in) :: lineof(:)
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     integer, allocatable :: eqs(:), nstart(:)
     integer :: i, j, k, e, ne, jp, ios
     character :: q
@@ -299,9 +336,12 @@ contains
     end do
     ne = size(eqs)
     if (ne == 0) then
-      if (len_trim(body) > 0) call die_at(src, lineof(first_nonblank(body)), &
-        'syntax error in group &'//g%name//': expected name=value, found '''// &
-        trim(adjustl(body))//'''')
+      if (len_trim(body) > 0) then
+        call die_at(src, lineof(first_nonblank(body)), &
+          'syntax error in group &'//g%name//': expected name=value, found '''// &
+          trim(adjustl(body))//'''', err)
+        return
+      end if
       g%nasg = 0
       allocate (g%a(0))
       return
@@ -318,13 +358,18 @@ contains
       if (j >= 1) then
         if (body(j:j) == ')') then
           jp = index(body(1:j), '(', back=.true.)
-          if (jp == 0) call die_at(src, lineof(j), 'syntax error in group &'//g%name// &
-            ': unbalanced '')'' before ''=''')
+          if (jp == 0) then
+            call die_at(src, lineof(j), 'syntax error in group &'//g%name// &
+              ': unbalanced '')'' before ''=''', err)
+            return
+          end if
           read (body(jp + 1:j - 1), *, iostat=ios) g%a(k)%sub
           if (ios /= 0 .or. g%a(k)%sub < 1 .or. verify(trim(adjustl(body(jp + 1:j - 1))), &
-                                                           '0123456789') /= 0) &
+                                                           '0123456789') /= 0) then
             call die_at(src, lineof(j), 'in group &'//g%name//': bad subscript ('// &
-            body(jp + 1:j - 1)//'); only a single index such as t0(2) is accepted')
+              body(jp + 1:j - 1)//'); only a single index such as t0(2) is accepted', err)
+            return
+          end if
           j = jp - 1
           do while (j >= 1)
             if (body(j:j) /= ' ') exit
@@ -337,21 +382,33 @@ contains
         if (.not. is_ident(body(j:j))) exit
         j = j - 1
       end do
-      if (j + 1 > e) call die_at(src, lineof(eqs(k)), 'syntax error in group &'//g%name// &
-        ': misplaced ''='' (no variable name before it)')
-      if (.not. is_letter(body(j + 1:j + 1))) call die_at(src, lineof(j + 1), &
-        'syntax error in group &'//g%name//': '''//body(j + 1:e)//''' is not a variable name')
+      if (j + 1 > e) then
+        call die_at(src, lineof(eqs(k)), 'syntax error in group &'//g%name// &
+          ': misplaced ''='' (no variable name before it)', err)
+        return
+      end if
+      if (.not. is_letter(body(j + 1:j + 1))) then
+        call die_at(src, lineof(j + 1), &
+          'syntax error in group &'//g%name//': '''//body(j + 1:e)//''' is not a variable name', err)
+        return
+      end if
       if (j >= 1) then
-        if (body(j:j) /= ' ' .and. body(j:j) /= ',') call die_at(src, lineof(j + 1), &
-          'syntax error in group &'//g%name//': '''//body(j:e)//''' is not a variable name')
+        if (body(j:j) /= ' ' .and. body(j:j) /= ',') then
+          call die_at(src, lineof(j + 1), &
+            'syntax error in group &'//g%name//': '''//body(j:e)//''' is not a variable name', err)
+          return
+        end if
       end if
       nstart(k) = j + 1
       g%a(k)%name = lower(body(j + 1:e))
       g%a(k)%line = lineof(j + 1)
     end do
-    if (len_trim(body(1:nstart(1) - 1)) > 0) call die_at(src, lineof(first_nonblank(body)), &
-      'syntax error in group &'//g%name//': expected name=value, found '''// &
-      trim(adjustl(body(1:nstart(1) - 1)))//'''')
+    if (len_trim(body(1:nstart(1) - 1)) > 0) then
+      call die_at(src, lineof(first_nonblank(body)), &
+        'syntax error in group &'//g%name//': expected name=value, found '''// &
+        trim(adjustl(body(1:nstart(1) - 1)))//'''', err)
+      return
+    end if
     do k = 1, ne
       if (k < ne) then
         v = trim(adjustl(body(eqs(k) + 1:nstart(k + 1) - 1)))
@@ -372,10 +429,11 @@ contains
   !> Read every assignment of `g` into its variable of `vars`, checking the name (known,
   !! given once), the subscript, the number and type of values, enumeration spellings and
   !! string lengths. Null values leave a variable unchanged; `n*value` repeats a value.
-  subroutine read_group(g, src, vars)
+  subroutine read_group(g, src, vars, err)
     type(grp_t), intent(in) :: g        !< the group
     type(src_t), intent(in) :: src      !< where it comes from (for messages)
     type(vars_t), intent(inout) :: vars !< its variables, bound to their storage
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     integer :: k, j, i, nitem, rep, ios, pos, m, code, kk
     type(str_t), allocatable :: items(:)
     character(len=:), allocatable :: tok, head, txt
@@ -385,20 +443,31 @@ contains
     do k = 1, g%nasg
       associate (a => g%a(k))
         j = var_index(vars, a%name)
-        if (j == 0) call die_at(src, a%line, 'in group &'//g%name//': unknown variable '''// &
-          a%name//'''; the variables of &'//g%name//' are '//var_list(vars))
+        if (j == 0) then
+          call die_at(src, a%line, 'in group &'//g%name//': unknown variable '''// &
+            a%name//'''; the variables of &'//g%name//' are '//var_list(vars), err)
+          return
+        end if
         do kk = 1, k - 1
-          if (g%a(kk)%name == a%name .and. (g%a(kk)%sub == a%sub .or. g%a(kk)%sub == 0 .or. a%sub == 0)) &
+          if (g%a(kk)%name == a%name .and. (g%a(kk)%sub == a%sub .or. g%a(kk)%sub == 0 .or. a%sub == 0)) then
             call die_at(src, a%line, 'in group &'//g%name//': '//a%name//' is given twice in this '// &
-            'group (also at line '//i2s(g%a(kk)%line)//'); give each variable once')
+              'group (also at line '//i2s(g%a(kk)%line)//'); give each variable once', err)
+            return
+          end if
         end do
         associate (v => vars%v(j))
           head = 'in group &'//g%name//': '//a%name//' = '//a%value
           if (a%sub > 0) then
-            if (v%nval == 1) call die_at(src, a%line, 'in group &'//g%name//': '//a%name// &
-              ' is a single value and takes no subscript')
-            if (a%sub > v%nval) call die_at(src, a%line, 'in group &'//g%name//': subscript '// &
-              i2s(a%sub)//' of '//a%name//' is out of range (1 to '//i2s(v%nval)//')')
+            if (v%nval == 1) then
+              call die_at(src, a%line, 'in group &'//g%name//': '//a%name// &
+                ' is a single value and takes no subscript', err)
+              return
+            end if
+            if (a%sub > v%nval) then
+              call die_at(src, a%line, 'in group &'//g%name//': subscript '// &
+                i2s(a%sub)//' of '//a%name//' is out of range (1 to '//i2s(v%nval)//')', err)
+              return
+            end if
           end if
           call split_items(a%value, items)
           ! count the values first: too many is an error whatever they are
@@ -411,19 +480,25 @@ contains
           end do
           if (nitem > merge(1, v%nval, a%sub > 0)) then
             if (v%nval == 1 .or. a%sub > 0) then
-              call die_at(src, a%line, head//': too many values ('//a%name//' takes one value)')
+              call die_at(src, a%line, head//': too many values ('//a%name//' takes one value)', err)
+              return
             else if (v%typ == T_REAL) then
               call die_at(src, a%line, head//': too many values ('//a%name//' takes '// &
-                i2s(v%nval)//': the '//trim(merge('x and y   ', 'x, y and z', v%nval == 2))//' components)')
+                i2s(v%nval)//': the '//trim(merge('x and y   ', 'x, y and z', v%nval == 2))//' components)', err)
+              return
             else
               call die_at(src, a%line, head//': too many values ('//a%name//' takes '// &
-                i2s(v%nval)//')')
+                i2s(v%nval)//')', err)
+              return
             end if
           end if
           pos = max(a%sub, 1)
           do i = 1, size(items)
             call repeat_count(items(i)%s, rep, tok)
-            if (rep < 0) call die_at(src, a%line, head//': bad repeat count in '''//items(i)%s//'''')
+            if (rep < 0) then
+              call die_at(src, a%line, head//': bad repeat count in '''//items(i)%s//'''', err)
+              return
+            end if
             if (len(tok) == 0) then   ! null value: leaves the variable unchanged
               pos = pos + rep
               cycle
@@ -431,10 +506,15 @@ contains
             select case (v%typ)
             case (T_INT)
               if (verify(tok, '+-0123456789') /= 0 .or. verify(tok(2:), '0123456789') /= 0 .or. &
-                  verify(tok, '+-') == 0) call die_at(src, a%line, head// &
-                ': expected an integer, e.g. '//a%name//'=24, found '//tok)
+                  verify(tok, '+-') == 0) then
+                call die_at(src, a%line, head//': expected an integer, e.g. '//a%name//'=24, found '//tok, err)
+                return
+              end if
               read (tok, *, iostat=ios) m
-              if (ios /= 0) call die_at(src, a%line, head//': the integer '//tok//' is out of range')
+              if (ios /= 0) then
+                call die_at(src, a%line, head//': the integer '//tok//' is out of range', err)
+                return
+              end if
               if (v%nval == 1) then
                 v%ip = m
               else
@@ -446,34 +526,49 @@ contains
               call fp_read_end(fps)
               if (ios /= 0 .or. scan(tok, '''"/(),;') > 0 .or. verify(tok(1:1), '+-.0123456789') /= 0) then
                 if (verify(lower(tok), '+-nafity') == 0 .and. ios == 0) then
-                  call die_at(src, a%line, head//': '//tok//' is not a finite real number')
+                  call die_at(src, a%line, head//': '//tok//' is not a finite real number', err)
+                  return
                 end if
                 call die_at(src, a%line, head//': expected a real number, e.g. '// &
-                  a%name//'=1.5e6, found '//tok)
+                  a%name//'=1.5e6, found '//tok, err)
+                return
               end if
-              if (.not. ieee_is_finite(x)) call die_at(src, a%line, head//': '//tok// &
-                ' is not a finite real number')
+              if (.not. ieee_is_finite(x)) then
+                call die_at(src, a%line, head//': '//tok// &
+                  ' is not a finite real number', err)
+                return
+              end if
               if (v%nval == 1) then
                 v%rs = x
               else
                 v%rv(pos:pos + rep - 1) = x
               end if
             case default   ! T_STR, T_ENUM
-              if (.not. is_quoted(tok)) call die_at(src, a%line, head// &
-                ': expected a quoted character string, e.g. '//a%name//'=''...'', found '//tok)
+              if (.not. is_quoted(tok)) then
+                call die_at(src, a%line, head// &
+                  ': expected a quoted character string, e.g. '//a%name//'=''...'', found '//tok, err)
+                return
+              end if
               txt = unquote(tok)
               if (v%typ == T_STR .and. v%nval > 1) then
-                if (len_trim(txt) > len(v%sv(pos)%p)) call die_at(src, a%line, head//': '''//txt// &
-                  ''' is too long (at most '//i2s(len(v%sv(pos)%p))//' characters)')
+                if (len_trim(txt) > len(v%sv(pos)%p)) then
+                  call die_at(src, a%line, head//': '''//txt// &
+                    ''' is too long (at most '//i2s(len(v%sv(pos)%p))//' characters)', err)
+                  return
+                end if
                 do m = pos, pos + rep - 1
                   v%sv(m)%p = txt
                 end do
               else if (v%typ == T_STR) then
-                if (len_trim(txt) > len(v%sp)) call die_at(src, a%line, head//': is too long (at most '// &
-                  i2s(len(v%sp))//' characters)')
+                if (len_trim(txt) > len(v%sp)) then
+                  call die_at(src, a%line, head//': is too long (at most '// &
+                    i2s(len(v%sp))//' characters)', err)
+                  return
+                end if
                 v%sp = txt
               else
-                call check_enum(g, src, a%name, txt, v%choices, code)
+                call check_enum(g, src, a%name, txt, v%choices, code, err)
+                if (err%failed()) return
                 v%ip = v%base + code - 1
               end if
             end select
@@ -615,11 +710,13 @@ contains
   ! Errors
   ! ============================================================================================
 
-  !> Fatal error at a line of a source, with the line echoed.
-  subroutine die_at(src, line, msg)
+  !> Bad input at a line of a source, with the line echoed: `err` holds ERR_INPUT and the
+  !! message, which starts with the source's label (and the line, in a file).
+  subroutine die_at(src, line, msg, err)
     type(src_t), intent(in) :: src
     integer, intent(in) :: line
     character(len=*), intent(in) :: msg
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     character(len=:), allocatable :: m
     character(len=6) :: num
     integer :: i
@@ -636,47 +733,51 @@ contains
         m = m//src%lines(i)%s//' '
       end do
     end if
-    call fatal(EXIT_INPUT, m)
+    call err%set(ERR_INPUT, m)
   end subroutine die_at
 
-  !> Fatal error on the value of one variable of a group (at the line where it is set).
-  subroutine bad_value(g, src, name, shown, why)
+  !> Bad input: the value of one variable of a group (at the line where it is set).
+  subroutine bad_value(g, src, name, shown, why, err)
     type(grp_t), intent(in) :: g
     type(src_t), intent(in) :: src
     character(len=*), intent(in) :: name   ! variable
     character(len=*), intent(in) :: shown  ! its value, used when it is not set in this group
     character(len=*), intent(in) :: why
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     integer :: k
     k = find_asg(g, name)
     if (k > 0) then
       call die_at(src, g%a(k)%line, 'in group &'//g%name//': '//name//' = '//g%a(k)%value// &
-        ' '//why)
+        ' '//why, err)
     else
       call die_at(src, g%line, 'in group &'//g%name//': '//name//' = '//shown// &
-        ' (not set in this group) '//why)
+        ' (not set in this group) '//why, err)
     end if
   end subroutine bad_value
 
-  !> An enumeration: `value` must be one of the blank-separated `allowed` (any case).
   !> An enumeration: `value` must be one of the blank-separated `allowed` (any case);
   !! `k` is its position in the list.
-  subroutine check_enum(g, src, name, value, allowed, k)
+  subroutine check_enum(g, src, name, value, allowed, k, err)
     type(grp_t), intent(in) :: g                         !< the group
     type(src_t), intent(in) :: src                       !< where it comes from
     character(len=*), intent(in) :: name, value, allowed !< variable, its value, the choices
     integer, intent(out) :: k                            !< position of the value in `allowed`
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     k = index_of(allowed, trim(adjustl(value)))
-    if (k == 0) call bad_value(g, src, name, quote(trim(value)), 'is not allowed; the allowed '// &
-      'values are '//quoted_list(allowed, ''))
+    if (k == 0) then
+      call bad_value(g, src, name, quote(trim(value)), 'is not allowed; the allowed '// &
+        'values are '//quoted_list(allowed, ''), err)
+    end if
   end subroutine check_enum
 
-  !> Fatal error: a group that is not one of `groups` (blank-separated).
-  subroutine unknown_group(g, src, groups)
+  !> Bad input: a group that is not one of `groups` (blank-separated).
+  subroutine unknown_group(g, src, groups, err)
     type(grp_t), intent(in) :: g                !< the group
     type(src_t), intent(in) :: src              !< where it comes from
     character(len=*), intent(in) :: groups      !< the known group names
+    type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     call die_at(src, g%line, 'unknown group &'//g%name//'; the groups are '// &
-      quoted_list(groups, '&'))
+      quoted_list(groups, '&'), err)
   end subroutine unknown_group
 
 end module namelist_input

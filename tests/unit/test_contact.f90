@@ -102,7 +102,8 @@ contains
 
     allocate (ov(size(over)))
     ov = over
-    call read_deck(path, ov, d)
+    call read_deck(path, ov, d, err)
+    if (err%failed()) error stop 'bad deck: '//err%message
     tag = trim(path)
     if (size(over) > 0) tag = trim(tag)//' '//trim(over(1))
     write (*, '(a)') '--- '//trim(tag)

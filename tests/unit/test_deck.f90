@@ -2,13 +2,14 @@
 !! (print_deck output read back gives identical values), override precedence and
 !! semantics, defaults, a few namelist forms (case, repeat counts, quotes, comments), and
 !! the Markdown reference table of a group (cells, required, forms, escaping); the contact
-!! pairs in both forms and their bad input. A fatal error ends the process: a bad deck is
-!! read by this program run again as `test_deck --read DECK`, its exit code and message
-!! checked (tests/system/test_bad_input.sh runs the whole program on more).
+!! pairs in both forms and their bad input. A bad deck is read in this process: read_deck
+!! returns ERR_INPUT (exit code 1) and a message that names the deck file first and holds the
+!! expected text (tests/system/test_bad_input.sh runs the whole program on more).
 program test_deck
   use kinds, only: wp
   use config
   use deck, only: read_deck, print_deck, deck_text
+  use errors, only: error_t, exit_code, ERR_INPUT, EXIT_INPUT
   use namelist_vars, only: vars_t, str_t, reference_table, render_group
   use testing, only: report, test_summary, write_file
   implicit none (type, external)
@@ -19,23 +20,12 @@ program test_deck
   character(len=:), allocatable :: t1, t2
   character(len=*), parameter :: NL = achar(10)
   real(wp) :: r
-  character(len=4096) :: arg
-
-  ! `test_deck --read DECK`: read one deck and stop (the bad-input cases below)
-  if (command_argument_count() >= 2) then
-    call get_command_argument(1, arg)
-    if (arg == '--read') then
-      call get_command_argument(2, arg)
-      call read_deck(trim(arg), none, d)
-      stop 0
-    end if
-  end if
 
   call random_number(r)
   write (tmp, '(a,i0)') '/tmp/test_deck_', int(r * 1.0e9_wp)
 
   ! ---- the default deck (the seed's scene) ---------------------------------------------
-  call read_deck('inputs/default.nml', none, d)
+  call read_good('inputs/default.nml', none, d)
   call check(d%body(1)%id == 1 .and. d%body(2)%id == 2, 'default: body ids 1 and 2')
   call check(d%body(1)%nx == 24 .and. d%body(1)%ny == 16 .and. d%body(2)%nx == 24 .and. &
              d%body(2)%ny == 16, 'default: 24x16 cells per body')
@@ -71,7 +61,7 @@ program test_deck
   ov(4) = '&traction body=2, side=''bottom'', t0=0.0, 1.0e5 /'
   ov(5) = '&displacement body=2, side=''right'', u=0.0, -1.0e-4 /  &scene plane=''stress'' /'
   ov(6) = '&body id=1, element=''p1'' /'
-  call read_deck('inputs/default.nml', ov, e)
+  call read_good('inputs/default.nml', ov, e)
   call check(e%solver%delta == 0.7_wp, 'override: later override wins (delta = 0.7)')
   call check(e%solver%robin_operator == ROBIN_CONSTANT .and. e%solver%alpha == 2.5e-12_wp, &
              'override: robin_operator and alpha')
@@ -98,7 +88,7 @@ program test_deck
     '&scene title=''a!b, it''''s "quoted" / here'' /  ! comment with a quote '' and a /', &
     '&traction body=1, side=''top'', t0=2*-1.0e6 /', &
     '&traction body=1, side=''top'', t0(2)=5.0, t1=, 3.0 /'])
-  call read_deck(trim(tmp)//'_my_case.nml', none, e)
+  call read_good(trim(tmp)//'_my_case.nml', none, e)
   call check(e%output%file == 'results/'//trim(tmp(6:))//'_my_case.h5', &
              'defaults: output file results/<deck basename>.h5 ('//trim(e%output%file)//')')
   call check(e%body(1)%width == 1.0_wp .and. e%body(1)%poisson == 0.3_wp .and. &
@@ -122,7 +112,7 @@ program test_deck
     '&body id=2, x0=-0.1, y0=-1.0, width=1.2345678901234567e11, height=1.0, nx=1, ny=1,', &
     '  left=''clamped'', top=''contact'', poisson=0.49999999999999994 /', &
     '&contact gap_radius=123456.7, gap_center=-2.5e-5 /'])
-  call read_deck(trim(tmp)//'_reals.nml', none, e)
+  call read_good(trim(tmp)//'_reals.nml', none, e)
   call check(e%body(1)%y0 == 0.30000000000000004_wp .and. e%body(1)%young == nearest(MODULUS_MAX, -1.0_wp) &
              .and. e%body(2)%poisson == 0.49999999999999994_wp, 'reals: read exactly')
   call round_trip(e, 'awkward reals')
@@ -230,7 +220,7 @@ contains
       '&body id=1, y0=1.0, nx=2, ny=2, left=''clamped'' /', &
       '&body id=2, y0=0.0, nx=2, ny=2, bottom=''clamped'' /', T1, &
       '&contact body1_group=''bottom'', body2_group=''top'', slave=2, gap_radius=4.0 /'])
-    call read_deck(trim(tmp)//'_two.nml', none, p)
+    call read_good(trim(tmp)//'_two.nml', none, p)
     call check(p%npair == 1 .and. all(p%pair(1)%bodies == [1, 2]) .and. &
                p%pair(1)%body_group(1) == 'bottom' .and. p%pair(1)%body_group(2) == 'top' .and. &
                p%pair(1)%slave == 2 .and. p%pair(1)%gap_radius == 4.0_wp .and. .not. p%pairs_named, &
@@ -239,11 +229,11 @@ contains
                'pairs: the two-body form is rendered in the two-body form')
     call round_trip(p, 'two-body form')
     o(1) = '&contact body2_group=''top'', gap_radius=1.0 /'
-    call read_deck(trim(tmp)//'_two.nml', o(1:1), p)
+    call read_good(trim(tmp)//'_two.nml', o(1:1), p)
     call check(p%pair(1)%gap_radius == 1.0_wp .and. p%pair(1)%slave == 2, &
                'pairs: an override in the two-body form changes the pair (1, 2)')
     o(1) = '&contact bodies=2,1, groups=''top'',''rim'', slave=1 /'
-    call read_deck(trim(tmp)//'_two.nml', o(1:1), p)
+    call read_good(trim(tmp)//'_two.nml', o(1:1), p)
     call check(all(p%pair(1)%bodies == [1, 2]) .and. p%pair(1)%body_group(1) == 'rim' .and. &
                p%pair(1)%body_group(2) == 'top' .and. p%pair(1)%slave == 1 .and. .not. p%pairs_named, &
                'pairs: an override naming the pair (2, 1) of a two-body deck keeps body 1''s group first')
@@ -252,7 +242,7 @@ contains
     ! the pair form, bodies out of order and a pair given as (3, 2)
     call write_file(trim(tmp)//'_stack.nml', [character(len=120) :: B3, B1, B2, T1, P12, &
       '&contact bodies=3,2, groups=''top'',''bottom'', slave=2, gap_radius=2.5, gap_center=0.5 /'])
-    call read_deck(trim(tmp)//'_stack.nml', none, p)
+    call read_good(trim(tmp)//'_stack.nml', none, p)
     call check(p%nbody == 3 .and. p%npair == 2 .and. p%pairs_named, 'pairs: three bodies, two named pairs')
     call check(p%body(1)%y0 == 2.0_wp .and. p%body(3)%y0 == 0.0_wp .and. p%body(3)%id == 3 .and. &
                p%body(3)%bc(SIDE_BOTTOM) == BC_CLAMPED, 'pairs: bodies stored by id, whatever their order')
@@ -268,12 +258,12 @@ contains
     call round_trip(p, 'pair form')
     o(1) = '&contact bodies=2,3, groups=''bottom'',''top'', slave=3 /'
     o(2) = '&body id=3, young=1e9 /'
-    call read_deck(trim(tmp)//'_stack.nml', o, p)
+    call read_good(trim(tmp)//'_stack.nml', o, p)
     call check(all(p%pair(2)%bodies == [2, 3]) .and. p%pair(2)%body_group(1) == 'bottom' .and. &
                p%pair(2)%slave == 3 .and. p%pair(2)%gap_radius == 2.5_wp .and. p%body(3)%young == 1.0e9_wp, &
                'pairs: an override names its pair by its bodies, in either order')
     o(1) = '&contact bodies=3,2, slave=3 /'
-    call read_deck(trim(tmp)//'_stack.nml', o(1:1), p)
+    call read_good(trim(tmp)//'_stack.nml', o(1:1), p)
     call check(all(p%pair(2)%bodies == [3, 2]) .and. p%pair(2)%body_group(1) == 'top' .and. &
                p%pair(2)%slave == 3, 'pairs: an override in the deck''s order keeps the groups')
     call delete_file(trim(tmp)//'_stack.nml')
@@ -313,30 +303,36 @@ contains
       'the &contact at line 3 names group ''rim'' of body 2, a rectangle')
   end subroutine test_pairs
 
-  !> The deck of `lines` read by `test_deck --read`: exit code 1 and `expect` in its message.
+  !> read_deck on a good deck: a failure is a failed check (with its message).
+  subroutine read_good(path, overrides, out)
+    character(len=*), intent(in) :: path, overrides(:)
+    type(deck_t), intent(out) :: out
+    type(error_t) :: err
+    call read_deck(path, overrides, out, err)
+    if (err%failed()) call check(.false., 'read_deck '//path//' (refused: '//err%message//')')
+  end subroutine read_good
+
+  !> The deck of `lines` refused by read_deck: ERR_INPUT (exit code 1), the message starting
+  !! with the deck's path (with `expect` right after it when `expect` starts with its line
+  !! ':N:') and holding `expect`.
   subroutine refused(name, lines, expect)
     character(len=*), intent(in) :: name, lines(:), expect
-    character(len=4096) :: self
-    character(len=:), allocatable :: f, out, msg
-    integer :: rc, u, ios
-    character(len=1000) :: line
+    character(len=:), allocatable :: f, msg
+    type(deck_t) :: p
+    type(error_t) :: err
+    logical :: ok
     f = trim(tmp)//'_bad_'//name//'.nml'
-    out = trim(tmp)//'_bad_'//name//'.out'
     call write_file(f, lines)
-    call get_command_argument(0, self)
-    call execute_command_line(trim(self)//' --read '//f//' > '//out//' 2>&1', exitstat=rc)
-    msg = ''
-    open (newunit=u, file=out, status='old', action='read', iostat=ios)
-    do while (ios == 0)
-      read (u, '(a)', iostat=ios) line
-      if (ios == 0) msg = msg//trim(line)//NL
-    end do
-    close (u, status='delete')
-    if (rc == 1 .and. index(msg, expect) > 0) then
-      call check(.true., 'bad deck '''//name//''': exit 1 and "'//expect//'"')
+    call read_deck(f, none, p, err)
+    msg = err%text()
+    ok = err%category == ERR_INPUT .and. exit_code(err) == EXIT_INPUT .and. index(msg, f) == 1 .and. &
+         index(msg, expect) > 0
+    if (expect(1:1) == ':') ok = ok .and. index(msg, f//expect) == 1
+    if (ok) then
+      call check(.true., 'bad deck '''//name//''': ERR_INPUT and "'//expect//'"')
     else
-      call check(.false., 'bad deck '''//name//''': exit 1 and "'//expect//'" (exit '// &
-                 achar(48 + min(max(rc, 0), 9))//': '//msg//')')
+      call check(.false., 'bad deck '''//name//''': ERR_INPUT and "'//expect//'" (category '// &
+                 achar(48 + min(max(err%category, 0), 9))//': '//msg//')')
     end if
     call delete_file(f)
   end subroutine refused
@@ -352,7 +348,7 @@ contains
     open (newunit=u, file=f, status='replace', action='write')
     call print_deck(a, u)
     close (u)
-    call read_deck(f, none, b)
+    call read_good(f, none, b)
     call compare(a, b, diff)
     call check(len(diff) == 0, 'round trip of the '//what//': identical values'//diff)
     call check(after_first_line(a%effective) == after_first_line(b%effective), &

@@ -1,9 +1,11 @@
 !> The error convention below the driver (module errors): the exit code of each category,
 !! the error_t methods, and one real failing call per stage, each returning its category
-!! and a message naming the culprit.
+!! and a message naming the culprit; the driver's half (module fatal_errors): fail_on
+!! returns when there is no error.
 program test_errors
   use kinds, only: wp, ip
-  use errors, only: error_t, exit_code, fail_on, ERR_NONE, ERR_INPUT, ERR_NUMERICAL, ERR_IO, ERR_MEMORY, &
+  use fatal_errors, only: fail_on
+  use errors, only: error_t, exit_code, ERR_NONE, ERR_INPUT, ERR_NUMERICAL, ERR_IO, ERR_MEMORY, &
                     EXIT_OK, EXIT_INPUT, EXIT_NUMERICAL
   use config, only: body_cfg_t, traction_cfg_t, deck_t, deck_init, SIDE_LEFT, BC_CLAMPED
   use mesh, only: mesh_t

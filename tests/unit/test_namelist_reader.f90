@@ -15,15 +15,17 @@
 !!  - strings: doubled quotes inside quotes of either kind, the other quote kind inside,
 !!    `!`, `/`, `=`, `&` and `,` inside quotes, a string pair, a choice in any case;
 !!  - find_asg and find_int;
-!!  - malformed input: 27 texts, each read from a file by this program run again as
-!!    `test_namelist_reader --bad K` (a fatal error ends a process): exit code 1 and the
-!!    message naming the file and line, the group and the variable (an unknown variable, a
+!!  - malformed input: 27 texts, each read from a file in this process as a deck reads its
+!!    groups: ERR_INPUT (exit code 1) and the message starting with the file's path, naming
+!!    the line, the group and the variable (an unknown variable, a
 !!    real for an integer, a string for a real, a real with a kind suffix, NaN, 1e999, too
 !!    many values, a variable given twice, subscripts out of range, on a scalar and not an
 !!    integer, a choice not allowed, a string too long, unquoted, unterminated, a group not
 !!    closed, closed by the next group, text outside a group and after one, a bad repeat
 !!    count, an integer out of range, a misplaced `=`, a name starting with a digit, a value
 !!    without a name, an unknown group, a string in an integer list), with the line echoed.
+!! The files are written under build/<kind>/test-namelist (beside the folder of this
+!! program), so that a release and a checked build's tests running at once do not share them.
 !! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
 program test_namelist_reader
   use, intrinsic :: iso_fortran_env, only: int64
@@ -31,12 +33,13 @@ program test_namelist_reader
   use namelist_vars, only: vars_t
   use namelist_input, only: src_t, grp_t, text_source, load_file, parse_source, read_group, find_asg, find_int, &
                             unknown_group
+  use errors, only: error_t, exit_code, ERR_INPUT, EXIT_INPUT
   use strings, only: i2s
-  use testing, only: report, test_summary, file_bytes
+  use testing, only: report, test_summary
   implicit none (type, external)
 
   character(len=*), parameter :: NL = achar(10)
-  character(len=*), parameter :: dir = 'build/test-namelist'
+  character(len=:), allocatable :: dir   ! build/<kind>/test-namelist
   character(len=*), parameter :: GROUPS = 'part other'
   integer, parameter :: NBAD = 27
 
@@ -47,19 +50,12 @@ program test_namelist_reader
   character(len=8), target :: names(2)
   type(vars_t) :: t
   character(len=4096) :: arg
-  integer :: k, rc
+  integer :: rc
 
   call part_table(t)
-  ! `test_namelist_reader --bad K`: read malformed text K from a file and stop
-  if (command_argument_count() >= 2) then
-    call get_command_argument(1, arg)
-    if (arg == '--bad') then
-      call get_command_argument(2, arg)
-      read (arg, *) k
-      call read_bad(k)
-      stop 0
-    end if
-  end if
+  ! beside the folder of this program (build/<kind>/tests/)
+  call get_command_argument(0, arg)
+  dir = arg(1:index(arg, '/', back=.true.))//'../test-namelist'
   call execute_command_line('rm -rf '//dir//' && mkdir -p '//dir, exitstat=rc)
 
   call test_layout()
@@ -103,11 +99,14 @@ contains
     character(len=*), intent(in) :: text
     type(grp_t), allocatable :: gs(:)
     type(src_t) :: src
+    type(error_t) :: err
     call defaults()
     call text_source(text, 'test text', src)
-    call parse_source(src, GROUPS, gs)
+    call parse_source(src, GROUPS, gs, err)
+    if (err%failed()) error stop 'read_one: '//err%message
     if (size(gs) /= 1) error stop 'read_one: not one group'
-    call read_group(gs(1), src, t)
+    call read_group(gs(1), src, t, err)
+    if (err%failed()) error stop 'read_one: '//err%message
   end subroutine read_one
 
   !> The 64-bit patterns of two reals are equal.
@@ -124,6 +123,7 @@ contains
     character(len=:), allocatable :: text
     integer :: val
     logical :: found
+    type(error_t) :: err
     text = '! a deck of two parts'//NL// &
            '&part n = 3,          ! a comment after a value'//NL// &
            achar(9)//'x = 1.5e3'//achar(9)//'! the group goes on, a tab before it'//NL// &
@@ -133,8 +133,8 @@ contains
            '&part'//NL// &
            '/'
     call text_source(text, 'test text', src)
-    call parse_source(src, GROUPS, gs)
-    call report(size(gs) == 4, 'layout: four groups (two on one line, one over two lines)')
+    call parse_source(src, GROUPS, gs, err)
+    call report(.not. err%failed() .and. size(gs) == 4, 'layout: four groups (two on one line, one over two lines)')
     if (size(gs) /= 4) return
     call report(gs(1)%name == 'part' .and. gs(2)%name == 'part' .and. gs(3)%name == 'other' .and. &
                 gs(4)%name == 'part' .and. all([gs%line] == [2, 6, 6, 7]), &
@@ -144,14 +144,14 @@ contains
     call report(all([gs(1)%a%line] == [2, 3, 5]) .and. gs(2)%a(3)%name == 'ids' .and. gs(2)%a(3)%value == '1 2', &
                 'layout: each assignment at the line of its name (comment lines skipped), its value as written')
     call defaults()
-    call read_group(gs(1), src, t)
-    call report(n == 3 .and. same(x, 1.5e3_wp) .and. name == 'tab'//achar(9)//'kept!', &
+    call read_group(gs(1), src, t, err)
+    call report(.not. err%failed() .and. n == 3 .and. same(x, 1.5e3_wp) .and. name == 'tab'//achar(9)//'kept!', &
                 'layout: comments and the line ends (CR) dropped, a tab and a ! inside quotes kept')
-    call read_group(gs(2), src, t)
-    call report(n == -7 .and. same(x, 0.5_wp) .and. all(ids == [1, 2]) .and. name == 'tab'//achar(9)//'kept!', &
+    call read_group(gs(2), src, t, err)
+    call report(.not. err%failed() .and. n == -7 .and. same(x, 0.5_wp) .and. all(ids == [1, 2]) .and. name == 'tab'//achar(9)//'kept!', &
                 'layout: a second &part (upper case, with and without commas) sets only what it gives')
-    call read_group(gs(4), src, t)
-    call report(n == -7, 'layout: an empty group changes nothing')
+    call read_group(gs(4), src, t, err)
+    call report(.not. err%failed() .and. n == -7, 'layout: an empty group changes nothing')
     call find_int(gs(2), 'n', val, found)
     call report(find_asg(gs(1), 'x') == 2 .and. find_asg(gs(1), 'v') == 0 .and. found .and. val == -7, &
                 'find_asg, find_int: the assignment of a name, an integer''s value')
@@ -310,20 +310,25 @@ contains
     end select
   end subroutine bad_case
 
-  !> The child: read malformed text k from its file as a deck reads a group (unknown groups
-  !! refused); returning means it was accepted.
-  subroutine read_bad(k)
+  !> Read malformed text k from its file as a deck reads its groups (unknown groups
+  !! refused); `err` holds the refusal.
+  subroutine read_bad(k, err)
     integer, intent(in) :: k
-    character(len=:), allocatable :: text, expect
+    type(error_t), intent(out) :: err
     type(src_t) :: src
     type(grp_t), allocatable :: gs(:)
     integer :: i
-    call bad_case(k, text, expect)
-    call load_file(bad_path(k), src)
-    call parse_source(src, GROUPS, gs)
+    call load_file(bad_path(k), src, err)
+    if (err%failed()) return
+    call parse_source(src, GROUPS, gs, err)
+    if (err%failed()) return
     do i = 1, size(gs)
-      if (gs(i)%name /= 'part' .and. gs(i)%name /= 'other') call unknown_group(gs(i), src, GROUPS)
-      if (gs(i)%name == 'part') call read_group(gs(i), src, t)
+      if (gs(i)%name /= 'part' .and. gs(i)%name /= 'other') then
+        call unknown_group(gs(i), src, GROUPS, err)
+        return
+      end if
+      if (gs(i)%name == 'part') call read_group(gs(i), src, t, err)
+      if (err%failed()) return
     end do
   end subroutine read_bad
 
@@ -336,18 +341,16 @@ contains
   end function bad_path
 
   subroutine test_bad()
-    character(len=:), allocatable :: text, expect, out, msg, piece
-    character(len=4096) :: self
-    integer :: k, r, p
+    character(len=:), allocatable :: text, expect, msg, piece
+    integer :: k, p
     logical :: ok
-    call get_command_argument(0, self)
+    type(error_t) :: err
     do k = 1, NBAD
       call bad_case(k, text, expect)
       call put_text(bad_path(k), text)
-      out = bad_path(k)//'.out'
-      call execute_command_line(trim(self)//' --bad '//i2s(k)//' > '//out//' 2>&1', exitstat=r)
-      msg = file_bytes(out)
-      ok = r == 1 .and. index(msg, 'robin_contact: error: '//bad_path(k)) == 1
+      call read_bad(k, err)
+      msg = err%text()
+      ok = err%category == ERR_INPUT .and. exit_code(err) == EXIT_INPUT .and. index(msg, bad_path(k)) == 1
       ! every piece of the expected text in the message
       do while (len(expect) > 0)
         p = index(expect, '|')
@@ -358,7 +361,7 @@ contains
         expect = expect(min(p + 1, len(expect) + 1):)
       end do
       if (index(msg, NL) > 0) msg = msg(1:index(msg, NL) - 1)
-      call report(ok, 'malformed '//i2s(k)//': exit 1, '//trim(msg(min(len(msg), 23):)))
+      call report(ok, 'malformed '//i2s(k)//': ERR_INPUT, '//trim(msg(min(len(msg), len(bad_path(k)) + 1):)))
     end do
   end subroutine test_bad
 

@@ -8,6 +8,7 @@ program test_text_scanner
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: int64
   use text_scanner, only: parse_real, parse_int, get_int, scanner_t
+  use errors, only: ERR_INPUT
   use testing, only: report, test_summary
   implicit none (type, external)
   character(len=40) :: t
@@ -73,11 +74,11 @@ contains
     do k = 1, size(good)
       v = get_int(sc, 'a number')
       call parse_int(trim(good(k)), ref, ok)
-      if (.not. ok .or. v /= ref .or. sc%info /= 0) nbad = nbad + 1
+      if (.not. ok .or. v /= ref .or. sc%err%failed()) nbad = nbad + 1
     end do
     call report(nbad == 0 .and. sc%line == 3, 'get_int = parse_int on 7 tokens over 3 lines', real(nbad, wp))
     v = get_int(sc, 'a number')
-    call report(sc%info /= 0 .and. index(sc%err, 'the file ends inside $Test') > 0, &
+    call report(sc%err%category == ERR_INPUT .and. index(sc%err%message, 'the file ends inside $Test') > 0, &
                 'get_int at the end of the text: the file ends inside the section')
     nbad = 0
     do k = 1, size(bad)
@@ -87,7 +88,7 @@ contains
       sc%section = '$Test'
       v = get_int(sc, 'a number')
       call parse_int(trim(bad(k)), ref, ok)
-      if (ok .or. sc%info == 0 .or. v /= 0 .or. index(sc%err, "found '"//trim(bad(k))//"'") == 0) nbad = nbad + 1
+      if (ok .or. sc%err%category /= ERR_INPUT .or. v /= 0 .or. index(sc%err%message, "found '"//trim(bad(k))//"'") == 0) nbad = nbad + 1
     end do
     call report(nbad == 0, 'get_int refuses what parse_int refuses, naming the token (5 tokens)', real(nbad, wp))
   end subroutine test_get_int
