@@ -626,7 +626,7 @@ contains
     real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :)
     integer, allocatable :: piv(:), isuppz(:), iwork(:)
     integer :: lapinfo, r, lwork, liwork, k, nfound, nnear
-    logical :: halting(size(ieee_usual)), ok
+    logical :: halting(size(ieee_usual)), converged
     real(wp) :: dmax, rcond, anorm
     integer :: i
     dmax = 0.0_wp
@@ -703,8 +703,8 @@ contains
     if (bc%m >= SUBSPACE_MIN) then
       ! a large F_a: its k smallest eigenvectors by subspace iteration, a fraction of the
       ! tridiagonal reduction's time (LAPACK's own eigensolver when that does not converge)
-      call smallest_eigenvectors(bc%flex, k, dmax, z, ok)
-      if (ok) then
+      call smallest_eigenvectors(bc%flex, k, dmax, z, converged)
+      if (converged) then
         lapinfo = 0
         nfound = k
       end if
@@ -772,21 +772,22 @@ contains
   !! start (the same bits every run), orthonormalized after each solve (QR), and the
   !! Rayleigh-Ritz pairs from the third solve on: done when every one of the k has
   !! |f z - theta z| <= 1e-12 dmax (the eigenvalues between k and b converge with them,
-  !! at the ratio (lambda_i + sigma) / (lambda_b+1 + sigma) a solve). ok false (z
-  !! undefined) when the factor fails, b reaches m, or 12 solves do not converge.
-  subroutine smallest_eigenvectors(f, k, dmax, z, ok)
+  !! at the ratio (lambda_i + sigma) / (lambda_b+1 + sigma) a solve). converged
+  !! false (z undefined; the caller falls back to LAPACK's eigensolver) when the factor
+  !! fails, b reaches m, or 12 solves do not converge.
+  subroutine smallest_eigenvectors(f, k, dmax, z, converged)
     real(wp), intent(in) :: f(:, :)
     integer, intent(in) :: k
     real(wp), intent(in) :: dmax
     real(wp), allocatable, intent(out) :: z(:, :)
-    logical, intent(out) :: ok
+    logical, intent(out) :: converged   !< the k vectors found (else z undefined)
     integer, parameter :: MAX_SOLVES = 12
     real(wp), allocatable :: l(:, :), v(:, :), fv(:, :), hs(:, :), ev(:), work(:), tau(:)
     integer :: m, b, i, j, it, info, lwork
     real(wp) :: res
     m = size(f, 1)
     b = max(2*k, k + 32)
-    ok = .false.
+    converged = .false.
     if (k < 1 .or. b >= m) return
     allocate (l(m, m))
     l = f
@@ -829,7 +830,7 @@ contains
         res = max(res, norm2(matmul(fv, hs(:, i)) - ev(i)*z(:, i)))
       end do
       if (res <= 1.0e-12_wp*dmax) then
-        ok = .true.
+        converged = .true.
         return
       end if
       v = matmul(v, hs)

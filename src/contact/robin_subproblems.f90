@@ -219,8 +219,8 @@ contains
     type(smalbe_stats_t) :: smalbe_stats
     class(constraint_set_t), allocatable :: set
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
-    integer :: m, k, ka, r, mm, nfree, changed, i, info, steps
-    logical :: moved
+    integer :: m, k, ka, r, mm, nfree, changed, i, steps
+    logical :: moved, definite
     real(wp) :: cost, flops
     m = size(rhs)
     mm = size(state%G, 1)
@@ -319,7 +319,7 @@ contains
       if (state%kept(a) == 1 .and. subproblems%newton_work(a)%fac_nf < 0 .and. size(ub) == 0) then
         flops = 0.0_wp
         call newton_factor(subproblems%hessian(a)%a, pack([(i, i=1, m)], lam0 > lb), subproblems%newton_work(a), &
-                           info, flops)
+                           definite, flops)
       end if
       call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
       inner = inner_solver%stats

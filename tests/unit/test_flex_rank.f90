@@ -200,7 +200,7 @@ contains
     real(wp), allocatable :: f(:, :), d(:), v(:, :), z(:, :), q(:, :), w(:), c(:, :)
     real(wp) :: vv, vav
     integer :: i, j, r
-    logical :: ok
+    logical :: converged
     call set_seed(20261129)
     allocate (f(m, m), d(m), v(m, 3), q(m, k), w(m))
     d(1:10) = 0.0_wp
@@ -238,9 +238,9 @@ contains
     end do
     f = 0.5_wp*(f + transpose(f))
     call report(m >= SUBSPACE_MIN, 'large F_a: order 1600 takes the subspace iteration')
-    call smallest_eigenvectors(f, k, maxval([(f(i, i), i=1, m)]), z, ok)
-    call report(ok, 'large F_a: the subspace iteration converged')
-    if (.not. ok) return
+    call smallest_eigenvectors(f, k, maxval([(f(i, i), i=1, m)]), z, converged)
+    call report(converged, 'large F_a: the subspace iteration converged')
+    if (.not. converged) return
     c = matmul(transpose(z), z)
     do i = 1, k
       c(i, i) = c(i, i) - 1.0_wp
