@@ -185,13 +185,13 @@ $(BUILD)/mumps_iface.o:    $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/strings.o
 $(BUILD)/factorization.o $(BUILD)/element_types.o: FFLAGS += -Wno-unused-dummy-argument
 $(BUILD)/factorization.o:  $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/config.o $(BUILD)/cholesky.o $(BUILD)/mumps_iface.o \
                            $(BUILD)/errors.o $(BUILD)/strings.o
-$(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/signals.o
+$(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/signals.o $(BUILD)/errors.o
 $(BUILD)/constraint_set.o: $(BUILD)/kinds.o
 $(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/constraint_set.o
 $(BUILD)/qp_newton.o:      $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/constraint_set.o
 $(BUILD)/disc_newton.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/tangent_discs.o $(BUILD)/qp_newton.o
-$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
+$(BUILD)/mprgp.o:          $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/errors.o $(BUILD)/linop.o $(BUILD)/mprgp_options.o \
                            $(BUILD)/constraint_set.o $(BUILD)/mprgp_support.o $(BUILD)/qp_newton.o \
                            $(BUILD)/tangent_discs.o $(BUILD)/disc_newton.o
 $(BUILD)/smalbe.o:         $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/lapack.o $(BUILD)/mprgp.o $(BUILD)/constraint_set.o

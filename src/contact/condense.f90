@@ -96,33 +96,33 @@ contains
   !! order of `body_slots`): the DOFs it touches with a non-zero coefficient, in the order
   !! the rows first touch them (these are ordered last in the factorization), the rows over
   !! their positions, and the constant part on prescribed DOFs.
-  subroutine interface_dofs(itf, a, sys, bc)
+  subroutine interface_dofs(itf, a, sys, cbody)
     type(interface_t), intent(in) :: itf             !< the contact rows of all pairs
     integer, intent(in) :: a                         !< body number
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
-    type(body_condensed_t), intent(inout) :: bc      !< receives m, n, slots, idx and the rows on it
+    type(body_condensed_t), intent(inout) :: cbody   !< receives m, n, slots, idx and the rows on it
     integer :: i, e, p, k, ne, row, side, total
     integer, allocatable :: pos_of(:), idx(:)
 
-    bc%slots = body_slots(itf, a)
-    bc%m = size(bc%slots)
-    bc%n = sys%n
-    if (allocated(bc%idx)) deallocate (bc%idx)
-    if (allocated(bc%bptr)) deallocate (bc%bptr, bc%bpos, bc%bval, bc%bfix)
+    cbody%slots = body_slots(itf, a)
+    cbody%m = size(cbody%slots)
+    cbody%n = sys%n
+    if (allocated(cbody%idx)) deallocate (cbody%idx)
+    if (allocated(cbody%bptr)) deallocate (cbody%bptr, cbody%bpos, cbody%bval, cbody%bfix)
     total = 0
-    do i = 1, bc%m
-      row = slot_row(bc%slots(i), itf%m)
-      side = slot_side(bc%slots(i), itf%m)
+    do i = 1, cbody%m
+      row = slot_row(cbody%slots(i), itf%m)
+      side = slot_side(cbody%slots(i), itf%m)
       total = total + itf%b(side)%ptr(row + 1) - itf%b(side)%ptr(row)
     end do
-    allocate (pos_of(sys%n), idx(total), bc%bptr(bc%m + 1), bc%bpos(total), bc%bval(total), bc%bfix(bc%m))
+    allocate (pos_of(sys%n), idx(total), cbody%bptr(cbody%m + 1), cbody%bpos(total), cbody%bval(total), cbody%bfix(cbody%m))
     pos_of = 0
     k = 0
     ne = 0
-    bc%bptr(1) = 1
-    do i = 1, bc%m
-      row = slot_row(bc%slots(i), itf%m)
-      side = slot_side(bc%slots(i), itf%m)
+    cbody%bptr(1) = 1
+    do i = 1, cbody%m
+      row = slot_row(cbody%slots(i), itf%m)
+      side = slot_side(cbody%slots(i), itf%m)
       associate (b => itf%b(side))
         do e = b%ptr(row), b%ptr(row + 1) - 1
           if (b%val(e) == 0.0_wp) cycle
@@ -134,15 +134,15 @@ contains
             pos_of(p) = k
           end if
           ne = ne + 1
-          bc%bpos(ne) = pos_of(p)
-          bc%bval(ne) = b%val(e)
+          cbody%bpos(ne) = pos_of(p)
+          cbody%bval(ne) = b%val(e)
         end do
       end associate
-      bc%bptr(i + 1) = ne + 1
+      cbody%bptr(i + 1) = ne + 1
     end do
-    bc%idx = idx(1:k)
-    call prescribed_part(itf, sys, bc)
-    call contact_frames(sys, bc)
+    cbody%idx = idx(1:k)
+    call prescribed_part(itf, sys, cbody)
+    call contact_frames(sys, cbody)
   end subroutine interface_dofs
 
   !> The contact frames: a row whose entries on free DOFs all lie on one node, on two or more
@@ -154,30 +154,30 @@ contains
   !! whose columns of K_a do not share one pattern keep the global frame. The factor then
   !! orders one DOF per such row last instead of NCOMP, and the dense trailing block and its
   !! inverse shrink by NCOMP^3 (doc/method.md, "Contact frames").
-  subroutine contact_frames(sys, bc)
+  subroutine contact_frames(sys, cbody)
     type(body_system_t), intent(in) :: sys           !< the body's DOF map and pattern
-    type(body_condensed_t), intent(inout) :: bc      !< its rows on the free DOFs; gets the frames
+    type(body_condensed_t), intent(inout) :: cbody   !< its rows on the free DOFs; gets the frames
     integer, allocatable :: rot_of(:), nidx(:), pos_of(:), nbpos(:), nbptr(:)
     real(wp), allocatable :: nbval(:), rtmp(:, :, :)
     integer, allocatable :: dtmp(:, :)
     integer :: i, e, p, nd, node, c, k, ne, nr, j, p1, q
     real(wp) :: v(NCOMP), w(NCOMP), vn
     logical :: one
-    bc%nrot = 0
-    if (allocated(bc%rot)) deallocate (bc%rot, bc%rot_dof)
-    if (bc%m == 0) return
-    allocate (rot_of(sys%n), dtmp(NCOMP, bc%m), rtmp(NCOMP, NCOMP, bc%m))
+    cbody%nrot = 0
+    if (allocated(cbody%rot)) deallocate (cbody%rot, cbody%rot_dof)
+    if (cbody%m == 0) return
+    allocate (rot_of(sys%n), dtmp(NCOMP, cbody%m), rtmp(NCOMP, NCOMP, cbody%m))
     rot_of = 0
     nr = 0
-    do i = 1, bc%m
-      if (bc%bptr(i + 1) - bc%bptr(i) < 2) cycle
-      node = dof_node(sys%dof_of(bc%idx(bc%bpos(bc%bptr(i)))))
+    do i = 1, cbody%m
+      if (cbody%bptr(i + 1) - cbody%bptr(i) < 2) cycle
+      node = dof_node(sys%dof_of(cbody%idx(cbody%bpos(cbody%bptr(i)))))
       one = .true.
       v = 0.0_wp
-      do e = bc%bptr(i), bc%bptr(i + 1) - 1
-        nd = sys%dof_of(bc%idx(bc%bpos(e)))
+      do e = cbody%bptr(i), cbody%bptr(i + 1) - 1
+        nd = sys%dof_of(cbody%idx(cbody%bpos(e)))
         if (dof_node(nd) /= node) one = .false.
-        if (one) v(dof_comp(nd)) = v(dof_comp(nd)) + bc%bval(e)
+        if (one) v(dof_comp(nd)) = v(dof_comp(nd)) + cbody%bval(e)
       end do
       if (.not. one) cycle
       p1 = sys%free_of(node_dof(node, 1))
@@ -194,24 +194,24 @@ contains
     if (nr == 0) return
     ! B_a T: each row's entries on a rotated node become R' v, the defining row's exactly
     ! (|v|, 0, ...); components below 1e-13 |v| are rounding of an orthogonal frame
-    allocate (nidx(sys%n), pos_of(sys%n), nbpos(size(bc%bval) + NCOMP*bc%m), nbval(size(bc%bval) + NCOMP*bc%m), &
-              nbptr(bc%m + 1))
+    allocate (nidx(sys%n), pos_of(sys%n), nbpos(size(cbody%bval) + NCOMP*cbody%m), nbval(size(cbody%bval) + NCOMP*cbody%m), &
+              nbptr(cbody%m + 1))
     pos_of = 0
     k = 0
     ne = 0
     nbptr(1) = 1
-    do i = 1, bc%m
-      do e = bc%bptr(i), bc%bptr(i + 1) - 1
-        p = bc%idx(bc%bpos(e))
+    do i = 1, cbody%m
+      do e = cbody%bptr(i), cbody%bptr(i + 1) - 1
+        p = cbody%idx(cbody%bpos(e))
         j = rot_of(p)
         if (j == 0) then
-          call put(p, bc%bval(e))
+          call put(p, cbody%bval(e))
           cycle
         end if
-        if (p /= bc%idx(bc%bpos(first_on(i, j)))) cycle     ! the node's entries, once
+        if (p /= cbody%idx(cbody%bpos(first_on(i, j)))) cycle     ! the node's entries, once
         v = 0.0_wp
-        do q = bc%bptr(i), bc%bptr(i + 1) - 1
-          if (rot_of(bc%idx(bc%bpos(q))) == j) v(bc%idx(bc%bpos(q)) - dtmp(1, j) + 1) = bc%bval(q)
+        do q = cbody%bptr(i), cbody%bptr(i + 1) - 1
+          if (rot_of(cbody%idx(cbody%bpos(q))) == j) v(cbody%idx(cbody%bpos(q)) - dtmp(1, j) + 1) = cbody%bval(q)
         end do
         w = matmul(transpose(rtmp(:, :, j)), v)
         vn = norm2(v)
@@ -222,13 +222,13 @@ contains
       end do
       nbptr(i + 1) = ne + 1
     end do
-    bc%nrot = nr
-    bc%rot_dof = dtmp(:, 1:nr)
-    bc%rot = rtmp(:, :, 1:nr)
-    bc%idx = nidx(1:k)
-    bc%bptr = nbptr
-    bc%bpos = nbpos(1:ne)
-    bc%bval = nbval(1:ne)
+    cbody%nrot = nr
+    cbody%rot_dof = dtmp(:, 1:nr)
+    cbody%rot = rtmp(:, :, 1:nr)
+    cbody%idx = nidx(1:k)
+    cbody%bptr = nbptr
+    cbody%bpos = nbpos(1:ne)
+    cbody%bval = nbval(1:ne)
 
   contains
 
@@ -249,8 +249,8 @@ contains
     !> The first entry of row i on rotated node j.
     integer function first_on(i, j) result(ef)
       integer, intent(in) :: i, j
-      do ef = bc%bptr(i), bc%bptr(i + 1) - 1
-        if (rot_of(bc%idx(bc%bpos(ef))) == j) return
+      do ef = cbody%bptr(i), cbody%bptr(i + 1) - 1
+        if (rot_of(cbody%idx(cbody%bpos(ef))) == j) return
       end do
     end function first_on
 
@@ -299,19 +299,19 @@ contains
   end function frame_of_normal
 
   !> v = T v~ (to the global frame) or, with inverse, v~ = T' v: the rotated nodes' triples.
-  pure subroutine to_global(bc, v, inverse)
-    type(body_condensed_t), intent(in) :: bc         !< the body's frames
+  pure subroutine to_global(cbody, v, inverse)
+    type(body_condensed_t), intent(in) :: cbody      !< the body's frames
     real(wp), intent(inout) :: v(:)                  !< (n) a vector of free DOFs
     logical, intent(in), optional :: inverse
     integer :: j
     logical :: inv
     inv = .false.
     if (present(inverse)) inv = inverse
-    do j = 1, bc%nrot
+    do j = 1, cbody%nrot
       if (inv) then
-        v(bc%rot_dof(:, j)) = matmul(transpose(bc%rot(:, :, j)), v(bc%rot_dof(:, j)))
+        v(cbody%rot_dof(:, j)) = matmul(transpose(cbody%rot(:, :, j)), v(cbody%rot_dof(:, j)))
       else
-        v(bc%rot_dof(:, j)) = matmul(bc%rot(:, :, j), v(bc%rot_dof(:, j)))
+        v(cbody%rot_dof(:, j)) = matmul(cbody%rot(:, :, j), v(cbody%rot_dof(:, j)))
       end if
     end do
   end subroutine to_global
@@ -319,9 +319,9 @@ contains
   !> T'K_a T in CSC (the pattern of K_a: a rotated node's columns share one pattern and its
   !! DOFs are consecutive rows): first the columns of each rotated node (K R), then in every
   !! column the rotated nodes' rows (R' (K R)).
-  subroutine rotated_values(sys, bc, val)
+  subroutine rotated_values(sys, cbody, val)
     type(body_system_t), intent(in) :: sys
-    type(body_condensed_t), intent(in) :: bc
+    type(body_condensed_t), intent(in) :: cbody
     real(wp), allocatable, intent(out) :: val(:)
     integer, allocatable :: rot_row(:)
     integer :: j, c, l, q, q0, len
@@ -329,17 +329,17 @@ contains
     val = sys%val
     allocate (rot_row(sys%n))
     rot_row = 0
-    do j = 1, bc%nrot
-      rot_row(bc%rot_dof(1, j)) = j
-      q0 = sys%colptr(bc%rot_dof(1, j))
-      len = sys%colptr(bc%rot_dof(1, j) + 1) - q0
+    do j = 1, cbody%nrot
+      rot_row(cbody%rot_dof(1, j)) = j
+      q0 = sys%colptr(cbody%rot_dof(1, j))
+      len = sys%colptr(cbody%rot_dof(1, j) + 1) - q0
       allocate (cols(len, NCOMP))
       do c = 1, NCOMP
-        cols(:, c) = val(sys%colptr(bc%rot_dof(c, j)) + 1:sys%colptr(bc%rot_dof(c, j)) + len)
+        cols(:, c) = val(sys%colptr(cbody%rot_dof(c, j)) + 1:sys%colptr(cbody%rot_dof(c, j)) + len)
       end do
-      cols = matmul(cols, bc%rot(:, :, j))
+      cols = matmul(cols, cbody%rot(:, :, j))
       do c = 1, NCOMP
-        val(sys%colptr(bc%rot_dof(c, j)) + 1:sys%colptr(bc%rot_dof(c, j)) + len) = cols(:, c)
+        val(sys%colptr(cbody%rot_dof(c, j)) + 1:sys%colptr(cbody%rot_dof(c, j)) + len) = cols(:, c)
       end do
       deallocate (cols)
     end do
@@ -348,7 +348,7 @@ contains
       do while (q <= sys%colptr(l + 1))
         j = rot_row(sys%rowind(q) + 1)
         if (j > 0) then
-          val(q:q + NCOMP - 1) = matmul(transpose(bc%rot(:, :, j)), val(q:q + NCOMP - 1))
+          val(q:q + NCOMP - 1) = matmul(transpose(cbody%rot(:, :, j)), val(q:q + NCOMP - 1))
           q = q + NCOMP
         else
           q = q + 1
@@ -360,8 +360,8 @@ contains
   !> T'K_a T as triplets of its lower triangle, from K_a's (lower triangle, duplicates to be
   !! summed): an entry on a rotated node is taken with its mirror, spread over the frames of
   !! its row's and its column's nodes, and kept where it falls on or below the diagonal.
-  subroutine rotated_triplets(bc, n, irn, jcn, kval, ri, rj, rv)
-    type(body_condensed_t), intent(in) :: bc
+  subroutine rotated_triplets(cbody, n, irn, jcn, kval, ri, rj, rv)
+    type(body_condensed_t), intent(in) :: cbody
     integer, intent(in) :: n, irn(:), jcn(:)
     real(wp), intent(in) :: kval(:)
     integer, allocatable, intent(out) :: ri(:), rj(:)
@@ -370,8 +370,8 @@ contains
     integer :: e, q, a, b, ja, jb, ca, cb, na, nb, side, r0, c0, i1, j1
     allocate (rot_of(n))
     rot_of = 0
-    do ja = 1, bc%nrot
-      rot_of(bc%rot_dof(:, ja)) = ja
+    do ja = 1, cbody%nrot
+      rot_of(cbody%rot_dof(:, ja)) = ja
     end do
     q = 0
     do e = 1, size(irn)
@@ -400,22 +400,22 @@ contains
         nb = merge(NCOMP, 1, jb > 0)
         do a = 1, na
           r0 = i1
-          if (ja > 0) r0 = bc%rot_dof(a, ja)
+          if (ja > 0) r0 = cbody%rot_dof(a, ja)
           do b = 1, nb
             c0 = j1
-            if (jb > 0) c0 = bc%rot_dof(b, jb)
+            if (jb > 0) c0 = cbody%rot_dof(b, jb)
             if (r0 < c0) cycle
             q = q + 1
             ri(q) = r0
             rj(q) = c0
             rv(q) = kval(e)
             if (ja > 0) then
-              ca = i1 - bc%rot_dof(1, ja) + 1
-              rv(q) = rv(q)*bc%rot(ca, a, ja)
+              ca = i1 - cbody%rot_dof(1, ja) + 1
+              rv(q) = rv(q)*cbody%rot(ca, a, ja)
             end if
             if (jb > 0) then
-              cb = j1 - bc%rot_dof(1, jb) + 1
-              rv(q) = rv(q)*bc%rot(cb, b, jb)
+              cb = j1 - cbody%rot_dof(1, jb) + 1
+              rv(q) = rv(q)*cbody%rot(cb, b, jb)
             end if
           end do
         end do
@@ -426,22 +426,22 @@ contains
     rv = rv(1:q)
   end subroutine rotated_triplets
 
-  !> B_a's part on the prescribed DOFs, B_a,d u_d (bc%bfix), for the body's current
+  !> B_a's part on the prescribed DOFs, B_a,d u_d (cbody%bfix), for the body's current
   !! u_fixed (a load step changes it): each row's entries on prescribed DOFs, in row order.
-  subroutine prescribed_part(itf, sys, bc)
-    type(interface_t), intent(in) :: itf          !< the contact rows of all pairs
-    type(body_system_t), intent(in) :: sys        !< the body's DOF map and u_fixed
-    type(body_condensed_t), intent(inout) :: bc   !< its rows (slots); gets bfix
+  subroutine prescribed_part(itf, sys, cbody)
+    type(interface_t), intent(in) :: itf           !< the contact rows of all pairs
+    type(body_system_t), intent(in) :: sys         !< the body's DOF map and u_fixed
+    type(body_condensed_t), intent(inout) :: cbody !< its rows (slots); gets bfix
     integer :: i, e, row, side
-    do i = 1, bc%m
-      row = slot_row(bc%slots(i), itf%m)
-      side = slot_side(bc%slots(i), itf%m)
-      bc%bfix(i) = 0.0_wp
+    do i = 1, cbody%m
+      row = slot_row(cbody%slots(i), itf%m)
+      side = slot_side(cbody%slots(i), itf%m)
+      cbody%bfix(i) = 0.0_wp
       associate (b => itf%b(side))
         do e = b%ptr(row), b%ptr(row + 1) - 1
           if (b%val(e) == 0.0_wp) cycle
           if (sys%free_of(b%dof(e)) /= 0) cycle
-          bc%bfix(i) = bc%bfix(i) + b%val(e)*sys%u_fixed(b%dof(e))
+          cbody%bfix(i) = cbody%bfix(i) + b%val(e)*sys%u_fixed(b%dof(e))
         end do
       end associate
     end do
@@ -452,13 +452,13 @@ contains
   !! geometric nested dissection of the body's grid (module ordering); its time is part of
   !! t_factor. With MUMPS (collective over `comm`) each rank gives its share of K_a's cells
   !! as triplets irn, jcn, kval (assembly%cell_triplets); the others give the whole K_a (sys).
-  subroutine factor_body(fc, itf, a, msh, sys, bc, err, comm, irn, jcn, kval)
+  subroutine factor_body(fc, itf, a, msh, sys, cbody, err, comm, irn, jcn, kval)
     type(factor_cfg_t), intent(in) :: fc             !< factorization and ordering
     type(interface_t), intent(in) :: itf             !< the contact rows of all pairs
     integer, intent(in) :: a                         !< body number
     type(mesh_t), intent(in) :: msh                  !< mesh of body a
     type(body_system_t), intent(in) :: sys           !< assembled system of body a
-    type(body_condensed_t), intent(inout) :: bc      !< receives the factorization
+    type(body_condensed_t), intent(inout) :: cbody   !< receives the factorization
     type(error_t), intent(out) :: err                !< the failure (see the factor's factorize), if any
     integer, intent(in), optional :: comm            !< MUMPS: the body's group of ranks
     integer, intent(in), optional :: irn(:), jcn(:)  !< MUMPS: this rank's entries of K_a, 1-based
@@ -468,41 +468,41 @@ contains
     real(wp) :: t0
 
     t0 = wtime()
-    call interface_dofs(itf, a, sys, bc)
-    if (allocated(bc%fac)) then
-      call bc%fac%free()
-      deallocate (bc%fac)
+    call interface_dofs(itf, a, sys, cbody)
+    if (allocated(cbody%fac)) then
+      call cbody%fac%free()
+      deallocate (cbody%fac)
     end if
-    call new_factor(fc, a, bc%fac, comm)
-    if (bc%nrot > 0 .and. .not. present(irn)) call rotated_values(sys, bc, kr)
+    call new_factor(fc, a, cbody%fac, comm)
+    if (cbody%nrot > 0 .and. .not. present(irn)) call rotated_values(sys, cbody, kr)
     if (present(irn)) then
-      if (bc%nrot > 0) then
-        call rotated_triplets(bc, sys%n, irn, jcn, kval, ri, rj, rv)
-        call bc%fac%factorize(sys%n, bc%idx, err, irn=ri, jcn=rj, tval=rv)
+      if (cbody%nrot > 0) then
+        call rotated_triplets(cbody, sys%n, irn, jcn, kval, ri, rj, rv)
+        call cbody%fac%factorize(sys%n, cbody%idx, err, irn=ri, jcn=rj, tval=rv)
       else
-        call bc%fac%factorize(sys%n, bc%idx, err, irn=irn, jcn=jcn, tval=kval)
+        call cbody%fac%factorize(sys%n, cbody%idx, err, irn=irn, jcn=jcn, tval=kval)
       end if
-    else if (bc%fac%wants_interior_order()) then
+    else if (cbody%fac%wants_interior_order()) then
       if (msh%structured) then
-        call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, bc%idx, perm, err)
+        call grid_dissection(msh%nx, msh%ny, sys%free_of, sys%n, cbody%idx, perm, err)
       else
-        call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, bc%idx, perm, err)
+        call coordinate_bisection(msh%xy, sys%free_of, sys%dof_of, sys%colptr, sys%rowind, cbody%idx, perm, err)
       end if
       if (err%failed()) then
-        bc%t_factor = wtime() - t0
+        cbody%t_factor = wtime() - t0
         return
       end if
-      if (bc%nrot > 0) then
-        call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, kr, interior_perm=perm)
+      if (cbody%nrot > 0) then
+        call cbody%fac%factorize(sys%n, cbody%idx, err, sys%colptr, sys%rowind, kr, interior_perm=perm)
       else
-        call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val, interior_perm=perm)
+        call cbody%fac%factorize(sys%n, cbody%idx, err, sys%colptr, sys%rowind, sys%val, interior_perm=perm)
       end if
-    else if (bc%nrot > 0) then
-      call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, kr)
+    else if (cbody%nrot > 0) then
+      call cbody%fac%factorize(sys%n, cbody%idx, err, sys%colptr, sys%rowind, kr)
     else
-      call bc%fac%factorize(sys%n, bc%idx, err, sys%colptr, sys%rowind, sys%val)
+      call cbody%fac%factorize(sys%n, cbody%idx, err, sys%colptr, sys%rowind, sys%val)
     end if
-    bc%t_factor = wtime() - t0
+    cbody%t_factor = wtime() - t0
   end subroutine factor_body
 
   !> Form F_a and b_a (and u0 = K_a^-1 f_a, unless the factor is distributed) from the
@@ -510,9 +510,9 @@ contains
   !! rows_flexibility, its rank (flex_finish), b_a by one solve (interface_load; an OpenMP
   !! task beside the flexibility when that only reads the factor). Collective with MUMPS
   !! (flex and b on the host).
-  subroutine condense_body(sys, bc, err)
+  subroutine condense_body(sys, cbody, err)
     type(body_system_t), intent(in) :: sys           !< assembled system of the body
-    type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives flex, b, u0
+    type(body_condensed_t), intent(inout) :: cbody   !< factorized body; receives flex, b, u0
     type(error_t), intent(out) :: err                !< the failure, if any
     real(wp) :: t0
     integer :: st
@@ -520,89 +520,89 @@ contains
     logical :: beside
     t0 = wtime()
     beside = .false.
-    if (bc%fac%holds_result()) then
-      if (allocated(bc%flex)) deallocate (bc%flex)
-      allocate (bc%flex(bc%m, bc%m), stat=st)
+    if (cbody%fac%holds_result()) then
+      if (allocated(cbody%flex)) deallocate (cbody%flex)
+      allocate (cbody%flex(cbody%m, cbody%m), stat=st)
       if (st /= 0) then
         call err%set(ERR_MEMORY, 'out of memory for the interface flexibility')
         return
       end if
-      if (bc%m > 0) bc%flex = 0.0_wp
-      if (bc%m > 0 .and. size(bc%idx) > 0) then
+      if (cbody%m > 0) cbody%flex = 0.0_wp
+      if (cbody%m > 0 .and. size(cbody%idx) > 0) then
         ! b_a's solve beside the flexibility when that only reads the factor: a thread the
         ! body loop leaves idle takes it (else this one, at the wait)
-        beside = bc%fac%flexibility_beside_solve(bc%idx)
+        beside = cbody%fac%flexibility_beside_solve(cbody%idx)
         if (beside) then
           !$omp task default(shared)
-          call interface_load(sys, bc, err_load)
+          call interface_load(sys, cbody, err_load)
           !$omp end task
         end if
-        call bc%fac%rows_flexibility(bc%idx, bc%bptr, bc%bpos, bc%bval, bc%flex, err)
+        call cbody%fac%rows_flexibility(cbody%idx, cbody%bptr, cbody%bpos, cbody%bval, cbody%flex, err)
       end if
-      if (.not. err%failed()) call flex_finish(bc)
+      if (.not. err%failed()) call flex_finish(cbody)
       !$omp taskwait
       if (err%failed()) return
     end if
     if (beside) then
       err = err_load
     else
-      call interface_load(sys, bc, err)
+      call interface_load(sys, cbody, err)
     end if
-    bc%t_condense = wtime() - t0
+    cbody%t_condense = wtime() - t0
   end subroutine condense_body
 
   !> b_a = B_a K_a^-1 f_a + B_a,d u_d for the body's current loads (one solve, collective
   !! with MUMPS; b on the host), keeping u0 = K_a^-1 f_a unless the factor is distributed.
   !! B_a,d u_d (bfix) is the caller's (interface_dofs, prescribed_part).
-  subroutine interface_load(sys, bc, err)
+  subroutine interface_load(sys, cbody, err)
     type(body_system_t), intent(in) :: sys           !< the body's loads
-    type(body_condensed_t), intent(inout) :: bc      !< factorized body; receives b (and u0)
+    type(body_condensed_t), intent(inout) :: cbody   !< factorized body; receives b (and u0)
     type(error_t), intent(out) :: err                !< the solve's failure, if any
     real(wp), allocatable :: u0(:)
-    if (.not. allocated(bc%b)) allocate (bc%b(bc%m))
-    if (size(bc%b) /= bc%m) then
-      deallocate (bc%b)
-      allocate (bc%b(bc%m))
+    if (.not. allocated(cbody%b)) allocate (cbody%b(cbody%m))
+    if (size(cbody%b) /= cbody%m) then
+      deallocate (cbody%b)
+      allocate (cbody%b(cbody%m))
     end if
-    if (bc%fac%holds_result()) then
+    if (cbody%fac%holds_result()) then
       u0 = sys%f
-      call to_global(bc, u0, inverse=.true.)
+      call to_global(cbody, u0, inverse=.true.)
     else
       allocate (u0(0))
     end if
-    call bc%fac%solve(u0, err)
+    call cbody%fac%solve(u0, err)
     if (err%failed()) return
-    if (bc%fac%holds_result()) call apply_b(bc, u0, bc%b)
-    if (.not. bc%fac%distributed) call move_alloc(u0, bc%u0)
+    if (cbody%fac%holds_result()) call apply_b(cbody, u0, cbody%b)
+    if (.not. cbody%fac%distributed) call move_alloc(u0, cbody%u0)
   end subroutine interface_load
 
-  !> F_a = B_a X B_a' from X = (K_a^-1) on the interface DOFs bc%idx (factorization's
+  !> F_a = B_a X B_a' from X = (K_a^-1) on the interface DOFs cbody%idx (factorization's
   !! flex_product), then its numerical rank and proximal weight (flex_finish).
-  subroutine flex_from_x(bc, x)
-    type(body_condensed_t), intent(inout) :: bc      !< body with its rows; receives flex, rank, prox
-    real(wp), intent(in) :: x(:, :)                  !< (k,k) (K_a^-1) on bc%idx [length/force]
-    if (allocated(bc%flex)) deallocate (bc%flex)
-    allocate (bc%flex(bc%m, bc%m))
-    call flex_product(x, bc%bptr, bc%bpos, bc%bval, bc%flex)
-    call flex_finish(bc)
+  subroutine flex_from_x(cbody, x)
+    type(body_condensed_t), intent(inout) :: cbody   !< body with its rows; receives flex, rank, prox
+    real(wp), intent(in) :: x(:, :)                  !< (k,k) (K_a^-1) on cbody%idx [length/force]
+    if (allocated(cbody%flex)) deallocate (cbody%flex)
+    allocate (cbody%flex(cbody%m, cbody%m))
+    call flex_product(x, cbody%bptr, cbody%bpos, cbody%bval, cbody%flex)
+    call flex_finish(cbody)
   end subroutine flex_from_x
 
   !> F_a's numerical rank, kernel or range, and proximal weight (flex_rank), unless every row
   !! selects its own DOF (F_a then positive definite).
-  subroutine flex_finish(bc)
-    type(body_condensed_t), intent(inout) :: bc      !< body with flex; receives rank, prox, kern, rng
-    bc%rank = bc%m
-    bc%prox = 0.0_wp
-    if (allocated(bc%kern)) deallocate (bc%kern)
-    if (allocated(bc%rng)) deallocate (bc%rng)
-    if (bc%m > 0 .and. .not. selection_rows(bc)) call flex_rank(bc)
+  subroutine flex_finish(cbody)
+    type(body_condensed_t), intent(inout) :: cbody   !< body with flex; receives rank, prox, kern, rng
+    cbody%rank = cbody%m
+    cbody%prox = 0.0_wp
+    if (allocated(cbody%kern)) deallocate (cbody%kern)
+    if (allocated(cbody%rng)) deallocate (cbody%rng)
+    if (cbody%m > 0 .and. .not. selection_rows(cbody)) call flex_rank(cbody)
   end subroutine flex_finish
 
   !> True when every row of B_a picks one DOF, each a different one (F_a is then a principal
   !! block of K_a^-1 up to signs, positive definite).
-  pure logical function selection_rows(bc)
-    type(body_condensed_t), intent(in) :: bc
-    selection_rows = size(bc%idx) == bc%m .and. size(bc%bpos) == bc%m
+  pure logical function selection_rows(cbody)
+    type(body_condensed_t), intent(in) :: cbody
+    selection_rows = size(cbody%idx) == cbody%m .and. size(cbody%bpos) == cbody%m
   end function selection_rows
 
   !> The numerical rank of F_a by Cholesky with complete pivoting (pivots below
@@ -621,104 +621,104 @@ contains
   !! 100 tol and pinning costs outer iterations (it converges at the relaxation's rate).
   !! F_a = 0 (all its contact DOFs prescribed): rank 0, no `kern` (the proximal term is then
   !! the other body's F).
-  subroutine flex_rank(bc)
-    type(body_condensed_t), intent(inout) :: bc
+  subroutine flex_rank(cbody)
+    type(body_condensed_t), intent(inout) :: cbody
     real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :)
     integer, allocatable :: piv(:), isuppz(:), iwork(:)
     integer :: lapinfo, r, lwork, liwork, k, nfound, nnear
-    logical :: halting(size(ieee_usual)), ok
+    logical :: halting(size(ieee_usual)), converged
     real(wp) :: dmax, rcond, anorm
     integer :: i
     dmax = 0.0_wp
-    do i = 1, bc%m
-      dmax = max(dmax, bc%flex(i, i))
+    do i = 1, cbody%m
+      dmax = max(dmax, cbody%flex(i, i))
     end do
     if (.not. dmax > 0.0_wp) then
       ! every contact DOF of the body is prescribed (a foundation drawn as a body): F_a = 0,
       ! its kernel is everything, and the proximal term alone (the other body's F) carries
       ! its subproblem: the other body then solves the obstacle problem against it
-      bc%rank = 0
-      bc%prox = 1.0_wp
+      cbody%rank = 0
+      cbody%prox = 1.0_wp
       return
     end if
-    if (2*size(bc%idx) <= bc%m) then
-      call low_rank_range(bc, dmax)
+    if (2*size(cbody%idx) <= cbody%m) then
+      call low_rank_range(cbody, dmax)
       return
     end if
-    allocate (f(bc%m, bc%m), work(3*bc%m), piv(bc%m))
+    allocate (f(cbody%m, cbody%m), work(3*cbody%m), piv(cbody%m))
     ! The usual F_a is plainly of full rank, which the blocked Cholesky factor and LAPACK's
     ! condition estimate show at half the cost of the pivoted factor: lambda_min(F_a) >=
     ! 1 / |F_a^-1|_1, estimated, at least 1e4 times the pivot tolerance below (no estimate is
     ! that far off). Anything else is decided by the pivoted factor, as before.
-    if (bc%m >= SUBSPACE_MIN .and. size(bc%idx) < bc%m) then
+    if (cbody%m >= SUBSPACE_MIN .and. size(cbody%idx) < cbody%m) then
       ! more rows than DOFs (a 3D frictional master: three rows a slave node): singular by
       ! its shape, of rank at most its DOFs; the inertia count below decides the kernel
       ! (neither the plain nor the pivoted factor is needed to know that)
-      r = size(bc%idx)
+      r = size(cbody%idx)
     else
-      f = bc%flex
-      call dpotrf_tiles('L', bc%m, f, bc%m, lapinfo)
+      f = cbody%flex
+      call dpotrf_tiles('L', cbody%m, f, cbody%m, lapinfo)
       if (lapinfo == 0) then
-        anorm = maxval(sum(abs(bc%flex), dim=1))
-        call dpocon('L', bc%m, f, bc%m, anorm, rcond, work, piv, lapinfo)
+        anorm = maxval(sum(abs(cbody%flex), dim=1))
+        call dpocon('L', cbody%m, f, cbody%m, anorm, rcond, work, piv, lapinfo)
         if (lapinfo == 0 .and. rcond*anorm >= 1.0e-6_wp*dmax) then
-          bc%rank = bc%m
+          cbody%rank = cbody%m
           return
         end if
       end if
-      f = bc%flex
-      call dpstrf('L', bc%m, f, bc%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)
+      f = cbody%flex
+      call dpstrf('L', cbody%m, f, cbody%m, piv, r, 1.0e-10_wp*dmax, work, lapinfo)
       if (lapinfo < 0) return
     end if
-    bc%rank = r
-    if (r == bc%m) return
-    bc%prox = 1.0e-2_wp*dmax
+    cbody%rank = r
+    if (r == cbody%m) return
+    cbody%prox = 1.0e-2_wp*dmax
     ! the eigenvectors of the m - r smallest eigenvalues only (the tridiagonal reduction is
     ! the O(m^3) part: a tenth of the time of all m eigenvectors)
-    f = bc%flex
-    k = bc%m - r
-    allocate (ev(bc%m), isuppz(2*bc%m), iwork(1))
-    allocate (z(bc%m, k))
+    f = cbody%flex
+    k = cbody%m - r
+    allocate (ev(cbody%m), isuppz(2*cbody%m), iwork(1))
+    allocate (z(cbody%m, k))
     ! dsyevr starts by testing that IEEE infinities and NaNs are safe, by making some
     ! (LAPACK's ILAENV/IEEECK, the workspace query too): no floating-point trap while it runs
     ! (the checked build sets them)
     call ieee_get_halting_mode(ieee_usual, halting)
     call ieee_set_halting_mode(ieee_usual, .false.)
-    call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
+    call dsyevr('V', 'I', 'L', cbody%m, f, cbody%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, cbody%m, isuppz, &
                 work, -1, iwork, -1, lapinfo)
-    lwork = max(26*bc%m, int(work(1)))
-    liwork = max(10*bc%m, iwork(1))
+    lwork = max(26*cbody%m, int(work(1)))
+    liwork = max(10*cbody%m, iwork(1))
     deallocate (work, iwork)
     allocate (work(lwork), iwork(liwork))
     ! how many eigenvalues lie below NEAR_KERNEL max diag: the inertia of F_a - NEAR_KERNEL
     ! max diag I (Sylvester), its negative eigenvalues those of D in L D L' (a quarter of the
     ! tridiagonal reduction that counting by dsyevr took)
-    nnear = count_below(bc%flex, NEAR_KERNEL*dmax)
+    nnear = count_below(cbody%flex, NEAR_KERNEL*dmax)
     if (nnear > k) then
       k = nnear
       deallocate (z)
-      allocate (z(bc%m, k))
+      allocate (z(cbody%m, k))
     end if
     lapinfo = 1
-    if (bc%m >= SUBSPACE_MIN) then
+    if (cbody%m >= SUBSPACE_MIN) then
       ! a large F_a: its k smallest eigenvectors by subspace iteration, a fraction of the
       ! tridiagonal reduction's time (LAPACK's own eigensolver when that does not converge)
-      call smallest_eigenvectors(bc%flex, k, dmax, z, ok)
-      if (ok) then
+      call smallest_eigenvectors(cbody%flex, k, dmax, z, converged)
+      if (converged) then
         lapinfo = 0
         nfound = k
       end if
     end if
     if (lapinfo /= 0) then
-      f = bc%flex
-      call dsyevr('V', 'I', 'L', bc%m, f, bc%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, bc%m, isuppz, &
+      f = cbody%flex
+      call dsyevr('V', 'I', 'L', cbody%m, f, cbody%m, 0.0_wp, 0.0_wp, 1, k, 0.0_wp, nfound, ev, z, cbody%m, isuppz, &
                   work, lwork, iwork, liwork, lapinfo)
     end if
     call ieee_set_halting_mode(ieee_usual, halting)
     ! no eigenvectors (dsyevr failed): robin_operators then uses the other body's F
     if (lapinfo == 0 .and. nfound == k) then
-      bc%kern = z
-      bc%rank = bc%m - k
+      cbody%kern = z
+      cbody%rank = cbody%m - k
     end if
 
   contains
@@ -772,21 +772,22 @@ contains
   !! start (the same bits every run), orthonormalized after each solve (QR), and the
   !! Rayleigh-Ritz pairs from the third solve on: done when every one of the k has
   !! |f z - theta z| <= 1e-12 dmax (the eigenvalues between k and b converge with them,
-  !! at the ratio (lambda_i + sigma) / (lambda_b+1 + sigma) a solve). ok false (z
-  !! undefined) when the factor fails, b reaches m, or 12 solves do not converge.
-  subroutine smallest_eigenvectors(f, k, dmax, z, ok)
+  !! at the ratio (lambda_i + sigma) / (lambda_b+1 + sigma) a solve). converged
+  !! false (z undefined; the caller falls back to LAPACK's eigensolver) when the factor
+  !! fails, b reaches m, or 12 solves do not converge.
+  subroutine smallest_eigenvectors(f, k, dmax, z, converged)
     real(wp), intent(in) :: f(:, :)
     integer, intent(in) :: k
     real(wp), intent(in) :: dmax
     real(wp), allocatable, intent(out) :: z(:, :)
-    logical, intent(out) :: ok
+    logical, intent(out) :: converged   !< the k vectors found (else z undefined)
     integer, parameter :: MAX_SOLVES = 12
     real(wp), allocatable :: l(:, :), v(:, :), fv(:, :), hs(:, :), ev(:), work(:), tau(:)
     integer :: m, b, i, j, it, info, lwork
     real(wp) :: res
     m = size(f, 1)
     b = max(2*k, k + 32)
-    ok = .false.
+    converged = .false.
     if (k < 1 .or. b >= m) return
     allocate (l(m, m))
     l = f
@@ -829,7 +830,7 @@ contains
         res = max(res, norm2(matmul(fv, hs(:, i)) - ev(i)*z(:, i)))
       end do
       if (res <= 1.0e-12_wp*dmax) then
-        ok = .true.
+        converged = .true.
         return
       end if
       v = matmul(v, hs)
@@ -856,22 +857,22 @@ contains
   !! is Q times the eigenvectors of the eigenvalues above NEAR_KERNEL max diag; every other
   !! direction is kernel, as in flex_rank. LAPACK failing: rank k, no basis (robin_operators
   !! then uses the other body's F).
-  subroutine low_rank_range(bc, dmax)
-    type(body_condensed_t), intent(inout) :: bc
+  subroutine low_rank_range(cbody, dmax)
+    type(body_condensed_t), intent(inout) :: cbody
     real(wp), intent(in) :: dmax                   !< max diag F_a (> 0)
     real(wp), allocatable :: q(:, :), fq(:, :), s(:, :), ev(:), work(:), tau(:)
     integer, allocatable :: iwork(:)
     integer :: m, k, i, e, r, lapinfo, lwork, liwork
     logical :: halting(size(ieee_usual))
-    m = bc%m
-    k = size(bc%idx)
-    bc%prox = 1.0e-2_wp*dmax
-    bc%rank = k
+    m = cbody%m
+    k = size(cbody%idx)
+    cbody%prox = 1.0e-2_wp*dmax
+    cbody%rank = k
     allocate (q(m, k), tau(k), work(1), fq(m, k), s(k, k), ev(k), iwork(1))
     q = 0.0_wp
     do i = 1, m
-      do e = bc%bptr(i), bc%bptr(i + 1) - 1
-        q(i, bc%bpos(e)) = q(i, bc%bpos(e)) + bc%bval(e)
+      do e = cbody%bptr(i), cbody%bptr(i + 1) - 1
+        q(i, cbody%bpos(e)) = q(i, cbody%bpos(e)) + cbody%bval(e)
       end do
     end do
     call dgeqrf(m, k, q, m, tau, work, -1, lapinfo)
@@ -882,7 +883,7 @@ contains
     if (lapinfo /= 0) return
     call dorgqr(m, k, k, q, m, tau, work, lwork, lapinfo)
     if (lapinfo /= 0) return
-    call dgemm('N', 'N', m, k, m, 1.0_wp, bc%flex, m, q, m, 0.0_wp, fq, m)
+    call dgemm('N', 'N', m, k, m, 1.0_wp, cbody%flex, m, q, m, 0.0_wp, fq, m)
     call dgemm('T', 'N', k, k, m, 1.0_wp, q, m, fq, m, 0.0_wp, s, k)
     s = 0.5_wp*(s + transpose(s))
     ! no floating-point trap in LAPACK's IEEE tests (as in flex_rank)
@@ -898,37 +899,37 @@ contains
     if (lapinfo /= 0) return
     ! ascending: the last r eigenvalues are above the near-kernel level
     r = count(ev > NEAR_KERNEL*dmax)
-    allocate (bc%rng(m, r))
-    if (r > 0) call dgemm('N', 'N', m, r, k, 1.0_wp, q, m, s(:, k - r + 1:), k, 0.0_wp, bc%rng, m)
-    bc%rank = r
+    allocate (cbody%rng(m, r))
+    if (r > 0) call dgemm('N', 'N', m, r, k, 1.0_wp, q, m, s(:, k - r + 1:), k, 0.0_wp, cbody%rng, m)
+    cbody%rank = r
   end subroutine low_rank_range
 
   !> w(m) = B_a u: the rows on the free displacements u (n, in the body's contact frames:
   !! `to_global` with inverse turns a global one into them) plus the part on prescribed DOFs.
-  subroutine apply_b(bc, u, w)
-    type(body_condensed_t), intent(in) :: bc         !< condensed body
+  subroutine apply_b(cbody, u, w)
+    type(body_condensed_t), intent(in) :: cbody      !< condensed body
     real(wp), intent(in) :: u(:)                     !< (n) free displacements [length]
     real(wp), intent(out) :: w(:)                    !< (m) B_a u [length]
     integer :: i, e
-    do i = 1, bc%m
+    do i = 1, cbody%m
       w(i) = 0.0_wp
-      do e = bc%bptr(i), bc%bptr(i + 1) - 1
-        w(i) = w(i) + bc%bval(e)*u(bc%idx(bc%bpos(e)))
+      do e = cbody%bptr(i), cbody%bptr(i + 1) - 1
+        w(i) = w(i) + cbody%bval(e)*u(cbody%idx(cbody%bpos(e)))
       end do
-      w(i) = w(i) + bc%bfix(i)
+      w(i) = w(i) + cbody%bfix(i)
     end do
   end subroutine apply_b
 
   !> r(n) = B_a' lam: scatter the interface forces onto the normal DOFs (in the body's
   !! contact frames: `to_global` turns r into the global frame).
-  subroutine apply_bt(bc, lam, r)
-    type(body_condensed_t), intent(in) :: bc         !< condensed body
+  subroutine apply_bt(cbody, lam, r)
+    type(body_condensed_t), intent(in) :: cbody      !< condensed body
     real(wp), intent(in) :: lam(:)                   !< (m) interface forces [force]
     real(wp), intent(inout) :: r(:)                  !< (n) r += B_a' lam
     integer :: i, e
-    do i = 1, bc%m
-      do e = bc%bptr(i), bc%bptr(i + 1) - 1
-        r(bc%idx(bc%bpos(e))) = r(bc%idx(bc%bpos(e))) + bc%bval(e)*lam(i)
+    do i = 1, cbody%m
+      do e = cbody%bptr(i), cbody%bptr(i + 1) - 1
+        r(cbody%idx(cbody%bpos(e))) = r(cbody%idx(cbody%bpos(e))) + cbody%bval(e)*lam(i)
       end do
     end do
   end subroutine apply_bt
@@ -937,35 +938,35 @@ contains
   !! contact forces lam, by one solve: u0 - K_a^-1 B_a' lam when condensation kept u0, else
   !! K_a^-1 (f_a - B_a' lam) (a distributed factor: collective, u_free on the host).
   !! err: the solve failed (u_free is then not set).
-  subroutine recover_displacement(sys, bc, lam, u_free, err)
+  subroutine recover_displacement(sys, cbody, lam, u_free, err)
     type(body_system_t), intent(in) :: sys           !< assembled system
-    type(body_condensed_t), intent(inout) :: bc      !< factorized body
+    type(body_condensed_t), intent(inout) :: cbody   !< factorized body
     real(wp), intent(in) :: lam(:)                   !< (m) contact force on this body [force]
     real(wp), intent(inout) :: u_free(:)             !< (n) displacement at free DOFs [length] (host)
     type(error_t), intent(out) :: err                !< the failure, if any
     real(wp), allocatable :: r(:)
-    if (allocated(bc%u0)) then
+    if (allocated(cbody%u0)) then
       allocate (r(sys%n))
       r = 0.0_wp
-      call apply_bt(bc, lam, r)
-      call bc%fac%solve(r, err)
+      call apply_bt(cbody, lam, r)
+      call cbody%fac%solve(r, err)
       if (err%failed()) return
-      u_free = bc%u0 - r
-      call to_global(bc, u_free)
+      u_free = cbody%u0 - r
+      call to_global(cbody, u_free)
     else
-      if (bc%fac%holds_result()) then
+      if (cbody%fac%holds_result()) then
         r = sys%f
-        call to_global(bc, r, inverse=.true.)
+        call to_global(cbody, r, inverse=.true.)
         r = -r
-        call apply_bt(bc, lam, r)
+        call apply_bt(cbody, lam, r)
         r = -r
       else
         allocate (r(0))
       end if
-      call bc%fac%solve(r, err)
-      if (bc%fac%holds_result() .and. .not. err%failed()) then
+      call cbody%fac%solve(r, err)
+      if (cbody%fac%holds_result() .and. .not. err%failed()) then
         u_free = r
-        call to_global(bc, u_free)
+        call to_global(cbody, u_free)
       end if
     end if
   end subroutine recover_displacement

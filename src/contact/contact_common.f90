@@ -53,17 +53,17 @@ contains
     end do
   end function partner_slots
 
-  !> The positions in body's own vectors of the rows of pair p (contiguous: a body's rows
+  !> The positions in cbody's own vectors of the rows of pair p (contiguous: a body's rows
   !! go pair by pair), as first and last (last < first: the body is not in the pair).
-  pure function pair_positions(body, contact_line, p) result(r)
-    type(body_condensed_t), intent(in) :: body
+  pure function pair_positions(cbody, contact_line, p) result(r)
+    type(body_condensed_t), intent(in) :: cbody
     type(interface_t), intent(in) :: contact_line
     integer, intent(in) :: p                !< pair
     integer :: r(2)
     integer :: k, row
     r = [1, 0]
-    do k = 1, body%m
-      row = slot_row(body%slots(k), contact_line%m)
+    do k = 1, cbody%m
+      row = slot_row(cbody%slots(k), contact_line%m)
       if (contact_line%pair_of(row) /= p) cycle
       if (r(2) < r(1)) r(1) = k
       r(2) = k

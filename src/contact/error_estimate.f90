@@ -54,7 +54,7 @@ contains
     real(wp), allocatable :: g(:), r(:), x(:), y(:), xp(:), yp(:), bs(:, :), lo(:), hi(:)
     real(wp) :: lmax, lmin, nl, perr, lprev, rq, mprev
     integer :: m, i, k, ki, ib
-    logical :: ok
+    logical :: definite
     m = contact_line%m
     res%error_bound = 0.0_wp
     res%kappa = 1.0_wp
@@ -94,8 +94,8 @@ contains
       if (k >= 5 .and. abs(lmax - lprev) <= 1.0e-6_wp*lmax) exit
     end do
     !$omp section
-    call hs%factor(ok)
-    if (ok) then
+    call hs%factor(definite)
+    if (definite) then
       do i = 1, m
         x(i) = 1.0_wp + 0.5_wp*cos(real(3*i, wp))
       end do
@@ -113,7 +113,7 @@ contains
       end do
     end if
     !$omp end parallel sections
-    if (.not. ok .or. .not. lmax > 0.0_wp) then
+    if (.not. definite .or. .not. lmax > 0.0_wp) then
       res%error_bound = huge(1.0_wp)
       res%kappa = huge(1.0_wp)
       return
@@ -201,19 +201,20 @@ contains
     end if
   end subroutine hessian_apply
 
-  !> The Cholesky factor of H; ok false when H is not positive definite.
-  subroutine hessian_factor(self, ok)
+  !> The Cholesky factor of H; definite false when H is not positive definite (then there
+  !! is no inverse iteration and no bound).
+  subroutine hessian_factor(self, definite)
     class(hessian_t), intent(inout) :: self
-    logical, intent(out) :: ok
+    logical, intent(out) :: definite
     integer :: info
     type(error_t) :: err
     if (self%sparse) then
       call self%chol%factor(self%m, self%hc%colptr, self%hc%rowind, self%hc%val, FACT_CHOLMOD, ORD_AMD, err)
-      ok = .not. err%failed()
+      definite = .not. err%failed()
     else
       self%a = self%h
       call dpotrf_tiles('L', self%m, self%a, self%m, info)
-      ok = info == 0
+      definite = info == 0
     end if
   end subroutine hessian_factor
 

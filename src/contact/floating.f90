@@ -38,34 +38,34 @@ module floating
 
 contains
 
-  !> body%rg = R_a' B_a' (row k: B_a applied to kernel vector k, from the interface's rows
-  !! over global DOFs; B_a never touches a fixing DOF) and body%re = R_a' f_a (the applied
+  !> cbody%rg = R_a' B_a' (row k: B_a applied to kernel vector k, from the interface's rows
+  !! over global DOFs; B_a never touches a fixing DOF) and cbody%re = R_a' f_a (the applied
   !! load along each free motion: the lifting of prescribed displacements has no part
   !! along R_a, since K R_a = 0). Needs no factorization: the checks run before it.
-  subroutine rigid_rows(contact_line, a, system, body)
+  subroutine rigid_rows(contact_line, a, system, cbody)
     type(interface_t), intent(in) :: contact_line   !< contact rows of all pairs
     integer, intent(in) :: a                        !< the body
     type(body_system_t), intent(in) :: system       !< its system
-    type(body_condensed_t), intent(inout) :: body   !< receives slots, nrig, rg, re, rreach
+    type(body_condensed_t), intent(inout) :: cbody  !< receives slots, nrig, rg, re, rreach
     integer :: k, i, e, row, side, m
     integer :: l, nd, c
     real(wp) :: dotkl
-    body%slots = body_slots(contact_line, a)
-    m = size(body%slots)
-    body%m = m
-    body%nrig = system%nrig
-    if (allocated(body%rg)) deallocate (body%rg, body%re)
-    if (allocated(body%rreach)) deallocate (body%rreach)
-    allocate (body%rg(system%nrig, m), body%re(system%nrig), body%rreach(system%nrig, system%nrig))
-    body%rreach = 0.0_wp
+    cbody%slots = body_slots(contact_line, a)
+    m = size(cbody%slots)
+    cbody%m = m
+    cbody%nrig = system%nrig
+    if (allocated(cbody%rg)) deallocate (cbody%rg, cbody%re)
+    if (allocated(cbody%rreach)) deallocate (cbody%rreach)
+    allocate (cbody%rg(system%nrig, m), cbody%re(system%nrig), cbody%rreach(system%nrig, system%nrig))
+    cbody%rreach = 0.0_wp
     do k = 1, system%nrig
       do i = 1, m
-        row = slot_row(body%slots(i), contact_line%m)
-        side = slot_side(body%slots(i), contact_line%m)
-        body%rg(k, i) = 0.0_wp
+        row = slot_row(cbody%slots(i), contact_line%m)
+        side = slot_side(cbody%slots(i), contact_line%m)
+        cbody%rg(k, i) = 0.0_wp
         associate (b => contact_line%b(side))
           do e = b%ptr(row), b%ptr(row + 1) - 1
-            body%rg(k, i) = body%rg(k, i) + b%val(e)*system%rig(b%dof(e), k)
+            cbody%rg(k, i) = cbody%rg(k, i) + b%val(e)*system%rig(b%dof(e), k)
             ! the motions' vectors at the entry's node, against the coefficient's weight
             nd = dof_node(b%dof(e))
             do l = 1, system%nrig
@@ -73,16 +73,16 @@ contains
               do c = 1, NCOMP
                 dotkl = dotkl + system%rig(node_dof(nd, c), k)*system%rig(node_dof(nd, c), l)
               end do
-              body%rreach(k, l) = body%rreach(k, l) + b%val(e)**2*dotkl
+              cbody%rreach(k, l) = cbody%rreach(k, l) + b%val(e)**2*dotkl
             end do
           end do
         end associate
       end do
-      body%re(k) = dot_product(system%rig(:, k), system%f_applied)
+      cbody%re(k) = dot_product(system%rig(:, k), system%f_applied)
     end do
     ! a load with no part along the free motions (to rounding) has none: e = 0 exactly, the
     ! sign that only a deformation can press the body into the contact (check_pressed)
-    if (.not. norm2(body%re) > 1.0e-12_wp*max(sum(abs(system%f_applied)), tiny(1.0_wp))) body%re = 0.0_wp
+    if (.not. norm2(cbody%re) > 1.0e-12_wp*max(sum(abs(system%f_applied)), tiny(1.0_wp))) cbody%re = 0.0_wp
   end subroutine rigid_rows
 
   !> Can the contact hold the floating bodies? err = ERR_INPUT with the sentence when a
@@ -251,11 +251,11 @@ contains
       allocate (roff(nm + 1))
       roff(1) = 0
       do k = 1, nm
-        associate (bd => bodies(members(k)))
-          roff(k + 1) = roff(k) + bd%nrig
-          nz = nz + bd%nrig*bd%m
-          do i = 1, bd%m
-            i0 = slot_row(bd%slots(i), contact_line%m)
+        associate (cbody => bodies(members(k)))
+          roff(k + 1) = roff(k) + cbody%nrig
+          nz = nz + cbody%nrig*cbody%m
+          do i = 1, cbody%m
+            i0 = slot_row(cbody%slots(i), contact_line%m)
             if (col(i0) == 0) then
               ncol = ncol + 1
               col(i0) = ncol
@@ -269,17 +269,17 @@ contains
       allocate (ti(nz), tj(nz), tv(nz), es(r))
       nz = 0
       do k = 1, nm
-        associate (bd => bodies(members(k)))
-          do i = 1, bd%m
-            i0 = slot_row(bd%slots(i), contact_line%m)
-            do q = 1, bd%nrig
+        associate (cbody => bodies(members(k)))
+          do i = 1, cbody%m
+            i0 = slot_row(cbody%slots(i), contact_line%m)
+            do q = 1, cbody%nrig
               nz = nz + 1
               ti(nz) = roff(k) + q
               tj(nz) = col(i0)
-              tv(nz) = bd%rg(q, i)
+              tv(nz) = cbody%rg(q, i)
             end do
           end do
-          es(roff(k) + 1:roff(k + 1)) = bd%re
+          es(roff(k) + 1:roff(k + 1)) = cbody%re
         end associate
       end do
       call gs%from_triplets(r, ncol, ti, tj, tv)

@@ -307,20 +307,20 @@ contains
   !! G_a sees as balanced: a floating body's F_a depends on its fixing DOFs by terms in G_a'
   !! (rigid motions), its response to a self-equilibrated force does not
   !! (doc/method.md, "Bodies held only by contact").
-  function projected_flex(body) result(pf)
-    type(body_condensed_t), intent(in) :: body
+  function projected_flex(cbody) result(pf)
+    type(body_condensed_t), intent(in) :: cbody
     real(wp), allocatable :: pf(:, :), q(:, :), gg(:, :), y(:, :)
     integer :: m, r, info
-    m = body%m
-    r = body%nrig
+    m = cbody%m
+    r = cbody%nrig
     allocate (pf(m, m), q(r, m), gg(r, r), y(m, m))
     ! q = (G G')^-1 G, so that P x = x - G' (q x)
-    gg = matmul(body%rg, transpose(body%rg))
-    q = body%rg
+    gg = matmul(cbody%rg, transpose(cbody%rg))
+    q = cbody%rg
     call dposv('U', r, m, gg, r, q, r, info)
     ! y = P F = F - G' (q F);  pf = y P = y - (y q') G
-    y = body%flex - matmul(transpose(body%rg), matmul(q, body%flex))
-    pf = y - matmul(matmul(y, transpose(q)), body%rg)
+    y = cbody%flex - matmul(transpose(cbody%rg), matmul(q, cbody%flex))
+    pf = y - matmul(matmul(y, transpose(q)), cbody%rg)
     pf = 0.5_wp*(pf + transpose(pf))
   end function projected_flex
 

@@ -202,10 +202,10 @@ contains
   !! last force with its known product F_a lam_a, optionally a first line search along the
   !! last change of lam_a, and the Krylov recycling of its stored directions; its vectors
   !! are taken out of the side-layout state and put back.
-  subroutine solve_body(subproblems, solver, body, a, rtol_in, search, lam_other, state, rhs, grad, inner, updates)
+  subroutine solve_body(subproblems, solver, cbody, a, rtol_in, search, lam_other, state, rhs, grad, inner, updates)
     type(subproblems_t), target, intent(inout) :: subproblems
     type(solver_cfg_t), intent(in) :: solver
-    type(body_condensed_t), intent(in) :: body
+    type(body_condensed_t), intent(in) :: cbody
     integer, intent(in) :: a
     real(wp), intent(in) :: rtol_in
     logical, intent(in) :: search                 !< line search along the last change of lam_a first
@@ -219,16 +219,16 @@ contains
     type(smalbe_stats_t) :: smalbe_stats
     class(constraint_set_t), allocatable :: set
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
-    integer :: m, k, ka, r, mm, nfree, changed, i, info, steps
-    logical :: moved
+    integer :: m, k, ka, r, mm, nfree, changed, i, steps
+    logical :: moved, definite
     real(wp) :: cost, flops
     m = size(rhs)
     mm = size(state%G, 1)
     updates = 0
     if (m == 0) return
     if (allocated(subproblems%lb)) then
-      lb = subproblems%lb(slot_row(body%slots, mm))
-      ub = subproblems%ub(slot_row(body%slots, mm))
+      lb = subproblems%lb(slot_row(cbody%slots, mm))
+      ub = subproblems%ub(slot_row(cbody%slots, mm))
     else
       allocate (lb(m), ub(0))
       lb = 0.0_wp
@@ -239,7 +239,7 @@ contains
     else
       set = friction_set(lb, [(huge(1.0_wp), i=1, m)], subproblems%discs(a)%pos)
     end if
-    rhs = body%b - gather(state%G, body%slots)
+    rhs = cbody%b - gather(state%G, cbody%slots)
     if (subproblems%proximal(a)%n > 0) then
       ! a singular body is pinned to its partners' last forces
       call subproblems%proximal(a)%apply(lam_other, grad)
@@ -263,8 +263,8 @@ contains
     ! F_a is the same in every iteration and the warm start is the last solution: its
     ! gradient comes from F_a lam_a of the last solve (no initial product)
     inner_solver%opts%use_ax = state%reuse == 1
-    inner_solver%ax = gather(state%flam_v, body%slots)
-    lam0 = gather(state%lam, body%slots)
+    inner_solver%ax = gather(state%flam_v, cbody%slots)
+    lam0 = gather(state%lam, cbody%slots)
     lam = lam0
     flam0 = inner_solver%ax
     ! Coulomb: the box moved with the normal forces; a warm start outside it is projected
@@ -275,7 +275,7 @@ contains
       ! radius moved with lam_n): the face it slid on stays its face, and the active-set
       ! method need not find its slipping discs again one per step
       if (size(subproblems%discs(a)%pos) > 0) call onto_new_circles(subproblems%discs(a)%pos, &
-                                                                      last_on_circle(state%row_state, body%slots, mm), ub, lam)
+                                                                      last_on_circle(state%row_state, cbody%slots, mm), ub, lam)
       call set%project(lam)
       moved = any(lam /= lam0)
       if (moved) inner_solver%opts%use_ax = .false.
@@ -284,8 +284,8 @@ contains
     ! past iterates and so amplify the (smaller but differently placed) inner errors
     inner_solver%opts%recycle = solver%acceleration == ACCEL_NONE
     if (search .and. .not. moved) then
-      inner_solver%s = gather(state%srch, body%slots)
-      inner_solver%as = gather(state%fsrch, body%slots)
+      inner_solver%s = gather(state%srch, cbody%slots)
+      inner_solver%as = gather(state%fsrch, cbody%slots)
     end if
     ! the body's stored directions: column j on its side-1 rows, k + j on its side-2 rows;
     ! none without recycling (they are only stored then, never used: a quarter of the time)
@@ -319,7 +319,7 @@ contains
       if (state%kept(a) == 1 .and. subproblems%newton_work(a)%fac_nf < 0 .and. size(ub) == 0) then
         flops = 0.0_wp
         call newton_factor(subproblems%hessian(a)%a, pack([(i, i=1, m)], lam0 > lb), subproblems%newton_work(a), &
-                           info, flops)
+                           definite, flops)
       end if
       call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
       inner = inner_solver%stats
@@ -369,10 +369,10 @@ contains
       end if
     end if
     grad = inner_solver%g
-    call scatter(lam, body%slots, state%lam)
-    call scatter(inner_solver%ax, body%slots, state%flam_v)
-    call scatter(lam - lam0, body%slots, state%srch)
-    call scatter(inner_solver%ax - flam0, body%slots, state%fsrch)
+    call scatter(lam, cbody%slots, state%lam)
+    call scatter(inner_solver%ax, cbody%slots, state%flam_v)
+    call scatter(lam - lam0, cbody%slots, state%srch)
+    call scatter(inner_solver%ax - flam0, cbody%slots, state%fsrch)
     call directions_in(rw, state%rw)
     call directions_in(raw, state%raw)
 
@@ -384,8 +384,8 @@ contains
       real(wp), intent(in) :: all(:, :)
       real(wp), intent(out) :: mine(:, :)
       integer :: i, j, row(m), off(m)
-      row = slot_row(body%slots, mm)
-      off = (slot_side(body%slots, mm) - 1)*k
+      row = slot_row(cbody%slots, mm)
+      off = (slot_side(cbody%slots, mm) - 1)*k
       do j = 1, ka
         do i = 1, m
           mine(i, j) = all(row(i), off(i) + j)
@@ -398,8 +398,8 @@ contains
       real(wp), intent(in) :: mine(:, :)
       real(wp), intent(inout) :: all(:, :)
       integer :: i, j, row(m), off(m)
-      row = slot_row(body%slots, mm)
-      off = (slot_side(body%slots, mm) - 1)*k
+      row = slot_row(cbody%slots, mm)
+      off = (slot_side(cbody%slots, mm) - 1)*k
       do j = 1, ka
         do i = 1, m
           all(row(i), off(i) + j) = mine(i, j)

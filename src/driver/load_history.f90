@@ -82,16 +82,16 @@ contains
   !> The body's interface load for its current loads, on its factor (on one rank: CHOLMOD or banded):
   !! u0 = K_a^-1 f_a and b_a = B_a u0 + B_a,d u_d; for a body held only by contact its
   !! load along the free motions too (floating%rigid_rows). One solve, no factorization.
-  subroutine step_interface_load(itf, a, sys, bc, err)
-    type(interface_t), intent(in) :: itf          !< the contact rows of all pairs
-    integer, intent(in) :: a                      !< the body
-    type(body_system_t), intent(in) :: sys        !< its loads of the step
-    type(body_condensed_t), intent(inout) :: bc   !< its factor; gets bfix, u0, b (and re)
-    type(error_t), intent(out) :: err             !< the solve's failure, if any
-    call prescribed_part(itf, sys, bc)
-    call interface_load(sys, bc, err)
+  subroutine step_interface_load(itf, a, sys, cbody, err)
+    type(interface_t), intent(in) :: itf           !< the contact rows of all pairs
+    integer, intent(in) :: a                       !< the body
+    type(body_system_t), intent(in) :: sys         !< its loads of the step
+    type(body_condensed_t), intent(inout) :: cbody !< its factor; gets bfix, u0, b (and re)
+    type(error_t), intent(out) :: err              !< the solve's failure, if any
+    call prescribed_part(itf, sys, cbody)
+    call interface_load(sys, cbody, err)
     if (err%failed()) return
-    if (sys%nrig > 0) call rigid_rows(itf, a, sys, bc)
+    if (sys%nrig > 0) call rigid_rows(itf, a, sys, cbody)
   end subroutine step_interface_load
 
 end module load_history

@@ -155,30 +155,30 @@ contains
     real(wp) :: rv(5)
     real(wp), allocatable :: max_rank_mb(:)
     do b = 1, run%nbody
-      associate (body => run%bodies(b), fac => run%bodies(b)%fac)
-        m = body%m
+      associate (cbody => run%bodies(b), fac => run%bodies(b)%fac)
+        m = cbody%m
         if (.not. (self%mine(b) .and. fac%holds_result())) then
-          if (allocated(body%flex)) deallocate (body%flex)
-          allocate (body%flex(m, m))
+          if (allocated(cbody%flex)) deallocate (cbody%flex)
+          allocate (cbody%flex(m, m))
         end if
-        if (.not. allocated(body%b)) allocate (body%b(m))
-        call par_bcast_reals(body%flex, m*m, self%host(b))
-        call par_bcast_reals(body%b, m, self%host(b))
-        rv = [body%prox, fac%stats%mem_bytes, fac%stats%max_rank_mb, fac%stats%factor_mb, fac%stats%tiles]
+        if (.not. allocated(cbody%b)) allocate (cbody%b(m))
+        call par_bcast_reals(cbody%flex, m*m, self%host(b))
+        call par_bcast_reals(cbody%b, m, self%host(b))
+        rv = [cbody%prox, fac%stats%mem_bytes, fac%stats%max_rank_mb, fac%stats%factor_mb, fac%stats%tiles]
         call par_bcast_reals(rv, 5, self%host(b))
-        body%prox = rv(1)
+        cbody%prox = rv(1)
         fac%stats%mem_bytes = rv(2)
         fac%stats%max_rank_mb = rv(3)
         fac%stats%factor_mb = rv(4)
         fac%stats%tiles = rv(5)
-        iv(1) = body%rank
+        iv(1) = cbody%rank
         call par_bcast_ints(iv, 1, self%host(b))
-        body%rank = iv(1)
+        cbody%rank = iv(1)
         ! the kernel basis of a singular F_a (flex_rank), or the basis of its range when that
         ! is the smaller part (condense `low_rank_range`), which the harmonic operator's
         ! proximal term needs on rank 0 as much as on the body's host
-        call share_basis(body%kern, .not. (self%mine(b) .and. fac%holds_result()), m, self%host(b))
-        call share_basis(body%rng, .not. (self%mine(b) .and. fac%holds_result()), m, self%host(b))
+        call share_basis(cbody%kern, .not. (self%mine(b) .and. fac%holds_result()), m, self%host(b))
+        call share_basis(cbody%rng, .not. (self%mine(b) .and. fac%holds_result()), m, self%host(b))
       end associate
       call self%err(b)%clear()
     end do

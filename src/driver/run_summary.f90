@@ -340,15 +340,15 @@ contains
     if (.not. allocated(run%bodies)) return
     nsup = 0
     do a = 1, run%nbody
-      associate (sy => run%systems(a), bd => run%bodies(a), r => run%reaction(1:run%systems(a)%ndof, a))
+      associate (sy => run%systems(a), cbody => run%bodies(a), r => run%reaction(1:run%systems(a)%ndof, a))
         if (count(sy%free_of == 0) <= sy%nrig) cycle    ! no support: held only by contact (its fixing DOFs)
-        if (.not. allocated(bd%bptr)) cycle
+        if (.not. allocated(cbody%bptr)) cycle
         nsup = nsup + 1
         if (nsup > MAX_LISTED) cycle
         allocate (c(sy%n))
         c = 0.0_wp
-        call apply_bt(bd, gather(run%result%lam_body, bd%slots), c)
-        call to_global(bd, c)
+        call apply_bt(cbody, gather(run%result%lam_body, cbody%slots), c)
+        call to_global(cbody, c)
         cc = 0.0_wp
         do p = 1, sy%n
           cc(dof_comp(sy%dof_of(p))) = cc(dof_comp(sy%dof_of(p))) - c(p)

@@ -93,9 +93,9 @@ contains
     integer, allocatable :: free(:), dk(:)
     real(wp), allocatable :: rhs(:), tau(:, :), curv(:), d(:), dfree(:), x0(:), g0(:), xb(:), axb(:)
     logical, allocatable :: rel(:), onb(:)
-    integer :: n, nf, nd, k, i, info, blk, half, q
+    integer :: n, nf, nd, k, i, blk, half, q
     real(wp) :: t, tmax, df, noise, s, na, nb
-    logical :: cut
+    logical :: cut, definite
     n = size(x)
     outcome = DN_STEP
     ! 1. releases at a face's minimiser
@@ -122,8 +122,8 @@ contains
       curv(q) = max(-(na*g(set%pair(1, k)) + nb*g(set%pair(2, k))), 0.0_wp)/set%r(k)
     end do
     allocate (rhs(nf + nd))
-    call face_solve(a, set, free, dk, tau, curv, g, fac, rhs, info, flops, factored)
-    if (info /= 0) then
+    call face_solve(a, set, free, dk, tau, curv, g, fac, rhs, definite, flops, factored)
+    if (.not. definite) then
       outcome = DN_NOT_SPD
       return
     end if
@@ -198,21 +198,23 @@ contains
   !! the order of `free`, then the held discs' tangential coordinates in the order of dk)
   !! from (Z'AZ + C) delta = -Z'g. With L = [Lf 0; W' Lp] the factor of A(U, U) (F part
   !! then P part, bring_to_face) and T the held discs' tangents (2 nd x nd), Z'AZ + C =
-  !! [Lf 0; T'W' K] [Lf' WT; 0 K'] where K K' = S = T'Lp Lp'T + C (nd x nd). info /= 0:
-  !! the face's matrix is not positive definite.
-  subroutine face_solve(a, set, free, dk, tau, curv, g, fac, rhs, info, flops, factored)
+  !! [Lf 0; T'W' K] [Lf' WT; 0 K'] where K K' = S = T'Lp Lp'T + C (nd x nd). definite
+  !! false (rhs undefined): the face's matrix is not positive definite, an outcome of the
+  !! step (DN_NOT_SPD), not a failure.
+  subroutine face_solve(a, set, free, dk, tau, curv, g, fac, rhs, definite, flops, factored)
     real(wp), intent(in) :: a(:, :)
     type(disc_set_t), intent(in) :: set
     integer, intent(in) :: free(:), dk(:)
     real(wp), intent(in) :: tau(:, :), curv(:), g(:)
     type(disc_factor_t), intent(inout) :: fac
     real(wp), intent(out) :: rhs(:)
-    integer, intent(out) :: info
+    logical, intent(out) :: definite
     real(wp), intent(inout) :: flops
     integer, intent(inout) :: factored
     real(wp), allocatable :: gt(:, :), sm(:, :), zf(:), v(:), tq(:, :)
     integer, allocatable :: dq(:)
-    integer :: nf, nd, np, ld, i, q, k, j
+    integer :: nf, nd, np, ld, i, q, k, j, info
+    definite = .false.
     nf = size(free)
     nd = size(dk)
     call bring_to_face(a, set, free, dk, fac, info, flops, factored)
@@ -278,6 +280,7 @@ contains
         rhs(nf + i) = v(dq(i))
       end do
     end if
+    definite = .true.
   end subroutine face_solve
 
   !> fac brought to the face (free, dk): a new factor when it holds none or the face is

@@ -47,7 +47,8 @@ module mprgp
   use linop, only: linop_t, dense_op_t
   use qp_newton, only: newton_work_t, newton_step, newton_begin, NEWTON_FULL, NEWTON_STILL, NEWTON_NOT_SPD
   use strings, only: i2s
-  use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error, MPRGP_CONVERGED, &
+  use errors, only: error_t
+  use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, check_options, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
                            QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
   use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
@@ -600,10 +601,10 @@ contains
   !> The options are finite and in range (else a bad-argument failure).
   logical function valid_options(self) result(ok)
     type(mprgp_t), intent(inout) :: self
-    character(len=:), allocatable :: why
-    why = options_error(self%opts)
-    ok = len(why) == 0
-    if (.not. ok) call fail(self, MPRGP_BAD_ARG, why)
+    type(error_t) :: err
+    call check_options(self%opts, err)
+    ok = .not. err%failed()
+    if (.not. ok) call fail(self, MPRGP_BAD_ARG, err%message)
   end function valid_options
 
   !> Project the warm start, take its gradient (from ax with opts%use_ax), and unless it

@@ -5,10 +5,11 @@ module mprgp_options
   use kinds, only: wp
   use strings, only: sci
   use signals, only: stop_iface
+  use errors, only: error_t, ERR_INPUT
   implicit none (type, external)
   private
 
-  public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, options_error
+  public :: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, check_options
   public :: MPRGP_CONVERGED, MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED
   public :: QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
 
@@ -115,60 +116,61 @@ contains
     end select
   end function mprgp_status_name
 
-  !> Why the options cannot be used: '' when they are finite and in range.
-  function options_error(o) result(why)
+  !> Why the options cannot be used, in err (ERR_INPUT and one sentence naming the option);
+  !! no error when they are finite and in range. No deferred-length result: a solve checks
+  !! its options on a body loop's thread (doc/developing.md, Conventions).
+  subroutine check_options(o, err)
     type(mprgp_opts_t), intent(in) :: o   !< options
-    character(len=:), allocatable :: why
-    why = ''
+    type(error_t), intent(out) :: err     !< the first option out of range
     if (.not. ieee_is_finite(o%rtol)) then
-      why = 'opts%rtol is not finite'
+      call err%set(ERR_INPUT, 'opts%rtol is not finite')
       return
     else if (o%rtol < 0.0_wp) then
-      why = 'opts%rtol is negative: '//sci(o%rtol, 4)
+      call err%set(ERR_INPUT, 'opts%rtol is negative: '//sci(o%rtol, 4))
       return
     end if
     if (.not. ieee_is_finite(o%atol)) then
-      why = 'opts%atol is not finite'
+      call err%set(ERR_INPUT, 'opts%atol is not finite')
       return
     else if (o%atol < 0.0_wp) then
-      why = 'opts%atol is negative: '//sci(o%atol, 4)
+      call err%set(ERR_INPUT, 'opts%atol is negative: '//sci(o%atol, 4))
       return
     end if
     if (o%method < QP_AUTO .or. o%method > QP_POLISH) then
-      why = 'opts%method is not QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST or QP_POLISH'
+      call err%set(ERR_INPUT, 'opts%method is not QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST or QP_POLISH')
       return
     end if
     if (o%auto_budget < 0) then
-      why = 'opts%auto_budget is negative'
+      call err%set(ERR_INPUT, 'opts%auto_budget is negative')
       return
     end if
     if (.not. (o%polish_scale >= 1.0_wp .and. ieee_is_finite(o%polish_scale))) then
-      why = 'opts%polish_scale is not a finite number >= 1: '//sci(o%polish_scale, 4)
+      call err%set(ERR_INPUT, 'opts%polish_scale is not a finite number >= 1: '//sci(o%polish_scale, 4))
       return
     end if
     if (o%newton_budget < 0) then
-      why = 'opts%newton_budget is negative'
+      call err%set(ERR_INPUT, 'opts%newton_budget is negative')
       return
     end if
     if (o%max_it < 0) then
-      why = 'opts%max_it is negative'
+      call err%set(ERR_INPUT, 'opts%max_it is negative')
       return
     end if
     if (.not. ieee_is_finite(o%gamma)) then
-      why = 'opts%gamma is not finite'
+      call err%set(ERR_INPUT, 'opts%gamma is not finite')
       return
     else if (o%gamma <= 0.0_wp) then
-      why = 'opts%gamma must be positive: '//sci(o%gamma, 4)
+      call err%set(ERR_INPUT, 'opts%gamma must be positive: '//sci(o%gamma, 4))
       return
     end if
     if (.not. (ieee_is_finite(o%alpha_bar) .and. ieee_is_finite(o%lambda_max))) then
-      why = 'opts%alpha_bar or opts%lambda_max is not finite'
+      call err%set(ERR_INPUT, 'opts%alpha_bar or opts%lambda_max is not finite')
       return
     end if
     if (o%alpha_bar <= 0.0_wp .and. o%lambda_max <= 0.0_wp .and. o%power_its < 1) then
-      why = 'opts%power_its must be >= 1 when neither alpha_bar nor lambda_max is given'
+      call err%set(ERR_INPUT, 'opts%power_its must be >= 1 when neither alpha_bar nor lambda_max is given')
       return
     end if
-  end function options_error
+  end subroutine check_options
 
 end module mprgp_options

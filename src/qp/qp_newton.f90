@@ -94,6 +94,7 @@ contains
     integer, intent(out) :: outcome
     real(wp), intent(out) :: flops
     integer :: n, i, nf, info, nrel, worst
+    logical :: definite
     real(wp) :: dad, t, wmax
 
     n = size(x)
@@ -191,8 +192,8 @@ contains
           return
         end if
       end if
-      call newton_factor(a, work%free(1:nf), work, info, flops)
-      if (info /= 0) then
+      call newton_factor(a, work%free(1:nf), work, definite, flops)
+      if (.not. definite) then
         outcome = NEWTON_NOT_SPD
         return
       end if
@@ -282,20 +283,21 @@ contains
 
   !> The factor LAPACK makes of A(idx, idx) (idx ascending, the free set), shifted by tau I
   !! when it is not numerically positive definite (tau from 1e-14 of its largest diagonal,
-  !! times 100 each try), kept in `work` (info /= 0: no shift helped, none kept); flops grows
-  !! by its cost. Deterministic: the same A and idx give the same bits.
-  subroutine newton_factor(a, idx, work, info, flops)
+  !! times 100 each try), kept in `work` (definite false: no shift helped, none kept, an
+  !! outcome of the step, NEWTON_NOT_SPD, not a failure); flops grows by its cost.
+  !! Deterministic: the same A and idx give the same bits.
+  subroutine newton_factor(a, idx, work, definite, flops)
     real(wp), intent(in) :: a(:, :)
     integer, intent(in) :: idx(:)
     type(newton_work_t), intent(inout) :: work
-    integer, intent(out) :: info
+    logical, intent(out) :: definite
     real(wp), intent(inout) :: flops
-    integer :: nf, k, try
+    integer :: nf, k, try, info
     real(wp) :: dmax, tau
     call ensure_work(work, size(a, 1))
     call newton_forget(work)
     nf = size(idx)
-    info = 0
+    definite = .true.
     if (nf == 0) return
     dmax = 0.0_wp
     do k = 1, nf
@@ -309,7 +311,8 @@ contains
       if (info == 0) exit
       tau = merge(1.0e-14_wp*dmax, 100.0_wp*tau, try == 0)
     end do
-    if (info /= 0) return
+    definite = info == 0
+    if (.not. definite) return
     work%factored = work%factored + 1
     work%fac_nf = nf
     work%fac_free(1:nf) = idx

@@ -133,25 +133,25 @@ contains
   !! leaves u_free as it was (it used to come back as NaN).
   subroutine test_recover_failure()
     type(factor_cfg_t) :: fc
-    type(body_condensed_t) :: bc
+    type(body_condensed_t) :: cbody
     type(body_system_t) :: sys
     type(error_t) :: err
     real(wp) :: ufree(3)
     fc%factorization = FACTOR_CHOLMOD
     fc%ordering = ORDER_AMD
-    call new_factor(fc, 1, bc%fac)
-    call bc%fac%factorize(3, [integer ::], err, colptr, rowind, bad)
+    call new_factor(fc, 1, cbody%fac)
+    call cbody%fac%factorize(3, [integer ::], err, colptr, rowind, bad)
     call report(err%failed(), 'recover: the body''s factorization failed')
     sys%n = 3
     sys%f = [1.0_wp, 1.0_wp, 1.0_wp]
-    bc%m = 0
-    bc%idx = [integer ::]
-    bc%bptr = [1]
-    bc%bpos = [integer ::]
-    bc%bval = [real(wp) ::]
-    bc%u0 = [0.0_wp, 0.0_wp, 0.0_wp]
+    cbody%m = 0
+    cbody%idx = [integer ::]
+    cbody%bptr = [1]
+    cbody%bpos = [integer ::]
+    cbody%bval = [real(wp) ::]
+    cbody%u0 = [0.0_wp, 0.0_wp, 0.0_wp]
     ufree = 7.0_wp
-    call recover_displacement(sys, bc, [real(wp) ::], ufree, err)
+    call recover_displacement(sys, cbody, [real(wp) ::], ufree, err)
     call report(err%failed() .and. all(ufree == 7.0_wp), &
                 'recover: a failed solve is an error_t, u_free untouched, no NaN ('//err%text()//')')
   end subroutine test_recover_failure

@@ -48,7 +48,7 @@ contains
     real(wp), intent(in) :: eps         !< the twin row's second coefficient differs by eps
     logical, intent(in) :: twin         !< rows 10 and 11 on the same DOFs
     logical, intent(in) :: empty        !< row 20 has zero coefficients
-    type(body_condensed_t) :: bc
+    type(body_condensed_t) :: cbody
     real(wp) :: x(M, M), g(M, M), f(M, M), work(2*M), r(M)
     integer :: i, e, piv(M), rank_ref, info
     ! X = G G' + I, G with entries in [-1/2, 1/2] from a fixed seed
@@ -59,97 +59,97 @@ contains
     do i = 1, M
       x(i, i) = x(i, i) + 1.0_wp
     end do
-    bc%m = M
-    allocate (bc%idx(M), bc%bptr(M + 1), bc%bpos(2*M), bc%bval(2*M))
-    bc%idx = [(i, i=1, M)]
+    cbody%m = M
+    allocate (cbody%idx(M), cbody%bptr(M + 1), cbody%bpos(2*M), cbody%bval(2*M))
+    cbody%idx = [(i, i=1, M)]
     e = 0
     do i = 1, M
-      bc%bptr(i) = e + 1
-      bc%bpos(e + 1) = i
-      bc%bpos(e + 2) = modulo(i, M) + 1
-      bc%bval(e + 1) = 1.0_wp
-      bc%bval(e + 2) = 0.25_wp
+      cbody%bptr(i) = e + 1
+      cbody%bpos(e + 1) = i
+      cbody%bpos(e + 2) = modulo(i, M) + 1
+      cbody%bval(e + 1) = 1.0_wp
+      cbody%bval(e + 2) = 0.25_wp
       e = e + 2
     end do
-    bc%bptr(M + 1) = e + 1
+    cbody%bptr(M + 1) = e + 1
     if (twin) then   ! row 11 on row 10's DOFs
-      bc%bpos(21:22) = bc%bpos(19:20)
-      bc%bval(22) = bc%bval(20) + eps
+      cbody%bpos(21:22) = cbody%bpos(19:20)
+      cbody%bval(22) = cbody%bval(20) + eps
     end if
-    if (empty) bc%bval(39:40) = 0.0_wp
-    call flex_from_x(bc, x)
-    f = bc%flex
-    call dpstrf('L', M, f, M, piv, rank_ref, 1.0e-10_wp*maxval([(bc%flex(i, i), i=1, M)]), work, info)
+    if (empty) cbody%bval(39:40) = 0.0_wp
+    call flex_from_x(cbody, x)
+    f = cbody%flex
+    call dpstrf('L', M, f, M, piv, rank_ref, 1.0e-10_wp*maxval([(cbody%flex(i, i), i=1, M)]), work, info)
     if (present(near)) rank_ref = rank_ref - near
-    call report(info >= 0 .and. bc%rank == rank_ref, what//': the rank of the pivoted Cholesky factor'// &
+    call report(info >= 0 .and. cbody%rank == rank_ref, what//': the rank of the pivoted Cholesky factor'// &
                 trim(merge(' less the near-kernel', '                     ', present(near))), &
-                real(bc%rank, wp), real(rank_ref, wp))
-    call report(bc%rank == expected, what//': the expected rank', real(bc%rank, wp), real(expected, wp))
-    if (bc%rank < M) then
-      call report(allocated(bc%kern) .and. bc%prox > 0.0_wp, what//': a kernel basis and a proximal weight')
-      if (allocated(bc%kern)) then
-        r = matmul(bc%flex, bc%kern(:, 1))
-        call report_le(norm2(r)/maxval(abs(bc%flex)), 1.0e-10_wp, what//': F_a z = 0 on the kernel')
+                real(cbody%rank, wp), real(rank_ref, wp))
+    call report(cbody%rank == expected, what//': the expected rank', real(cbody%rank, wp), real(expected, wp))
+    if (cbody%rank < M) then
+      call report(allocated(cbody%kern) .and. cbody%prox > 0.0_wp, what//': a kernel basis and a proximal weight')
+      if (allocated(cbody%kern)) then
+        r = matmul(cbody%flex, cbody%kern(:, 1))
+        call report_le(norm2(r)/maxval(abs(cbody%flex)), 1.0e-10_wp, what//': F_a z = 0 on the kernel')
         if (present(near)) then
-          r = matmul(bc%flex, bc%kern(:, size(bc%kern, 2)))
-          call report_le(norm2(r)/maxval(abs(bc%flex)), 1.0e-6_wp, what//': |F_a z| <= 1e-6 |F_a| on the near-kernel')
-          call report(size(bc%kern, 2) == M - expected, what//': the basis spans kernel and near-kernel')
+          r = matmul(cbody%flex, cbody%kern(:, size(cbody%kern, 2)))
+          call report_le(norm2(r)/maxval(abs(cbody%flex)), 1.0e-6_wp, what//': |F_a z| <= 1e-6 |F_a| on the near-kernel')
+          call report(size(cbody%kern, 2) == M - expected, what//': the basis spans kernel and near-kernel')
         end if
-        call report_le(abs(norm2(bc%kern(:, 1)) - 1.0_wp), 1.0e-12_wp, what//': |z| = 1')
+        call report_le(abs(norm2(cbody%kern(:, 1)) - 1.0_wp), 1.0e-12_wp, what//': |z| = 1')
       end if
     else
-      call report(.not. allocated(bc%kern) .and. bc%prox == 0.0_wp, what//': no kernel, no proximal weight')
+      call report(.not. allocated(cbody%kern) .and. cbody%prox == 0.0_wp, what//': no kernel, no proximal weight')
     end if
   end subroutine case
 
   !> m rows over all k DOFs (nnz = m k > 4 (k + m)): F_a against B X B' formed densely.
   subroutine dense_rows(m, k)
     integer, intent(in) :: m, k
-    type(body_condensed_t) :: bc
+    type(body_condensed_t) :: cbody
     real(wp) :: x(k, k), b(m, k), ref(m, m)
-    call fill(m, k, .false., bc, x, b)
-    call flex_from_x(bc, x)
+    call fill(m, k, .false., cbody, x, b)
+    call flex_from_x(cbody, x)
     ref = matmul(b, matmul(x, transpose(b)))
-    call report_le(maxval(abs(bc%flex - ref))/maxval(abs(ref)), 1.0e-13_wp, &
+    call report_le(maxval(abs(cbody%flex - ref))/maxval(abs(ref)), 1.0e-13_wp, &
                    'rows of many entries: F_a = B X B'' (formed densely)')
-    call report(bc%rank == min(m, k) .or. (k < m .and. bc%rank == k), 'rows of many entries: rank min(m, k)', &
-                real(bc%rank, wp), real(min(m, k), wp))
+    call report(cbody%rank == min(m, k) .or. (k < m .and. cbody%rank == k), 'rows of many entries: rank min(m, k)', &
+                real(cbody%rank, wp), real(min(m, k), wp))
   end subroutine dense_rows
 
   !> m rows over k <= m/2 DOFs: rank(B), the range basis, and the proximal term on it.
   subroutine coarse_rows(m, k, dependent)
     integer, intent(in) :: m, k
     logical, intent(in) :: dependent     !< B's last column the sum of its first two
-    type(body_condensed_t) :: bc
+    type(body_condensed_t) :: cbody
     real(wp) :: x(k, k), b(m, k), qq(m, m), fo(m, m), p(m, m), pref(m, m), z(m, m), ev(m), work(4*m*m)
     real(wp) :: floor
     integer :: i, r, info, nk
     character(len=40) :: what
     what = merge('coarse rows, a dependent column', 'coarse rows                    ', dependent)
-    call fill(m, k, dependent, bc, x, b)
-    call flex_from_x(bc, x)
+    call fill(m, k, dependent, cbody, x, b)
+    call flex_from_x(cbody, x)
     r = merge(k - 1, k, dependent)
-    call report(bc%rank == r, trim(what)//': the rank of B', real(bc%rank, wp), real(r, wp))
-    call report(allocated(bc%rng) .and. .not. allocated(bc%kern) .and. bc%prox > 0.0_wp, &
+    call report(cbody%rank == r, trim(what)//': the rank of B', real(cbody%rank, wp), real(r, wp))
+    call report(allocated(cbody%rng) .and. .not. allocated(cbody%kern) .and. cbody%prox > 0.0_wp, &
                 trim(what)//': a range basis, no kernel basis, a proximal weight')
-    if (.not. allocated(bc%rng)) return
-    call report(size(bc%rng, 2) == r, trim(what)//': the range basis has rank columns')
-    qq = matmul(bc%rng, transpose(bc%rng))
-    call report_le(maxval(abs(matmul(transpose(bc%rng), bc%rng) - identity(r))), 1.0e-12_wp, &
+    if (.not. allocated(cbody%rng)) return
+    call report(size(cbody%rng, 2) == r, trim(what)//': the range basis has rank columns')
+    qq = matmul(cbody%rng, transpose(cbody%rng))
+    call report_le(maxval(abs(matmul(transpose(cbody%rng), cbody%rng) - identity(r))), 1.0e-12_wp, &
                    trim(what)//': Q''Q = I')
-    call report_le(maxval(abs(matmul(qq, matmul(bc%flex, qq)) - bc%flex))/maxval(abs(bc%flex)), 1.0e-12_wp, &
+    call report_le(maxval(abs(matmul(qq, matmul(cbody%flex, qq)) - cbody%flex))/maxval(abs(cbody%flex)), 1.0e-12_wp, &
                    trim(what)//': F_a = QQ'' F_a QQ''')
     ! the partner's flexibility: any SPD matrix; the reference kernel: the eigenvectors of
     ! F_a's m - r smallest eigenvalues (dsyev, all of them)
     call random_number(fo)
     fo = matmul(fo, transpose(fo)) + identity(m)
-    z = bc%flex
+    z = cbody%flex
     call dsyev('V', 'L', m, z, m, ev, work, size(work), info)
     nk = m - r
     floor = 1.0e-10_wp*maxval([(fo(i, i), i=1, m)])
     pref = matmul(z(:, 1:nk), matmul(matmul(transpose(z(:, 1:nk)), matmul(fo, z(:, 1:nk))) + floor*identity(nk), &
                                      transpose(z(:, 1:nk))))
-    call range_proximal(bc%rng, fo, p)
+    call range_proximal(cbody%rng, fo, p)
     call report(info == 0, trim(what)//': dsyev of the reference')
     call report_le(maxval(abs(p - pref))/maxval(abs(pref)), 1.0e-12_wp, &
                    trim(what)//': range_proximal = Z (Z''F_o Z + floor I) Z''')
@@ -157,10 +157,10 @@ contains
 
   !> Rows over k DOFs, each on every DOF (coefficients in [-1/2, 1/2] plus 1 on DOF i mod k),
   !! X = G G' + I; b the dense B.
-  subroutine fill(m, k, dependent, bc, x, b)
+  subroutine fill(m, k, dependent, cbody, x, b)
     integer, intent(in) :: m, k
     logical, intent(in) :: dependent
-    type(body_condensed_t), intent(out) :: bc
+    type(body_condensed_t), intent(out) :: cbody
     real(wp), intent(out) :: x(k, k), b(m, k)
     real(wp) :: g(k, k)
     integer :: i, j, e
@@ -174,19 +174,19 @@ contains
       b(i, modulo(i - 1, k) + 1) = b(i, modulo(i - 1, k) + 1) + 1.0_wp
     end do
     if (dependent) b(:, k) = b(:, 1) + b(:, 2)
-    bc%m = m
-    allocate (bc%idx(k), bc%bptr(m + 1), bc%bpos(m*k), bc%bval(m*k))
-    bc%idx = [(i, i=1, k)]
+    cbody%m = m
+    allocate (cbody%idx(k), cbody%bptr(m + 1), cbody%bpos(m*k), cbody%bval(m*k))
+    cbody%idx = [(i, i=1, k)]
     e = 0
     do i = 1, m
-      bc%bptr(i) = e + 1
+      cbody%bptr(i) = e + 1
       do j = 1, k
         e = e + 1
-        bc%bpos(e) = j
-        bc%bval(e) = b(i, j)
+        cbody%bpos(e) = j
+        cbody%bval(e) = b(i, j)
       end do
     end do
-    bc%bptr(m + 1) = e + 1
+    cbody%bptr(m + 1) = e + 1
   end subroutine fill
 
 
@@ -200,7 +200,7 @@ contains
     real(wp), allocatable :: f(:, :), d(:), v(:, :), z(:, :), q(:, :), w(:), c(:, :)
     real(wp) :: vv, vav
     integer :: i, j, r
-    logical :: ok
+    logical :: converged
     call set_seed(20261129)
     allocate (f(m, m), d(m), v(m, 3), q(m, k), w(m))
     d(1:10) = 0.0_wp
@@ -238,9 +238,9 @@ contains
     end do
     f = 0.5_wp*(f + transpose(f))
     call report(m >= SUBSPACE_MIN, 'large F_a: order 1600 takes the subspace iteration')
-    call smallest_eigenvectors(f, k, maxval([(f(i, i), i=1, m)]), z, ok)
-    call report(ok, 'large F_a: the subspace iteration converged')
-    if (.not. ok) return
+    call smallest_eigenvectors(f, k, maxval([(f(i, i), i=1, m)]), z, converged)
+    call report(converged, 'large F_a: the subspace iteration converged')
+    if (.not. converged) return
     c = matmul(transpose(z), z)
     do i = 1, k
       c(i, i) = c(i, i) - 1.0_wp
@@ -258,7 +258,7 @@ contains
   !! orthonormal and |F_a z| <= 1e-6 max diag on each vector.
   subroutine tall_rows(m, k)
     integer, intent(in) :: m, k
-    type(body_condensed_t) :: bc
+    type(body_condensed_t) :: cbody
     real(wp), allocatable :: x(:, :), f(:, :), ev(:), work(:), c(:, :)
     integer, allocatable :: iwork(:)
     integer :: i, info, nref
@@ -267,33 +267,33 @@ contains
     do i = 1, k
       x(i, i) = 1.0_wp
     end do
-    bc%m = m
-    allocate (bc%idx(k), bc%bptr(m + 1), bc%bpos(2*m), bc%bval(2*m))
-    bc%idx = [(i, i=1, k)]
+    cbody%m = m
+    allocate (cbody%idx(k), cbody%bptr(m + 1), cbody%bpos(2*m), cbody%bval(2*m))
+    cbody%idx = [(i, i=1, k)]
     do i = 1, m
-      bc%bptr(i) = 2*i - 1
-      bc%bpos(2*i - 1:2*i) = [modulo(i - 1, k) + 1, modulo(7*i, k) + 1]
-      bc%bval(2*i - 1:2*i) = [1.0_wp, 0.5_wp]
+      cbody%bptr(i) = 2*i - 1
+      cbody%bpos(2*i - 1:2*i) = [modulo(i - 1, k) + 1, modulo(7*i, k) + 1]
+      cbody%bval(2*i - 1:2*i) = [1.0_wp, 0.5_wp]
     end do
-    bc%bptr(m + 1) = 2*m + 1
-    call flex_from_x(bc, x)
-    f = bc%flex
+    cbody%bptr(m + 1) = 2*m + 1
+    call flex_from_x(cbody, x)
+    f = cbody%flex
     dmax = maxval([(f(i, i), i=1, m)])
     allocate (ev(m), work(1 + 6*m + 2*m*m), iwork(3 + 5*m))
     call dsyevd('N', 'L', m, f, m, ev, work, size(work), iwork, size(iwork), info)
     nref = count(ev <= 1.0e-6_wp*dmax)
     call report(info == 0 .and. nref >= m - k, 'more rows than DOFs, order 1600: the reference eigenvalues')
-    call report(bc%rank == m - nref, 'more rows than DOFs: the rank is m less the eigenvalues below 1e-6 max diag', &
-                real(bc%rank, wp), real(m - nref, wp))
-    call report(allocated(bc%kern) .and. bc%prox > 0.0_wp, 'more rows than DOFs: a kernel basis, a proximal weight')
-    if (.not. allocated(bc%kern)) return
-    call report(size(bc%kern, 2) == nref, 'more rows than DOFs: the basis has m - rank vectors')
-    c = matmul(transpose(bc%kern), bc%kern)
+    call report(cbody%rank == m - nref, 'more rows than DOFs: the rank is m less the eigenvalues below 1e-6 max diag', &
+                real(cbody%rank, wp), real(m - nref, wp))
+    call report(allocated(cbody%kern) .and. cbody%prox > 0.0_wp, 'more rows than DOFs: a kernel basis, a proximal weight')
+    if (.not. allocated(cbody%kern)) return
+    call report(size(cbody%kern, 2) == nref, 'more rows than DOFs: the basis has m - rank vectors')
+    c = matmul(transpose(cbody%kern), cbody%kern)
     do i = 1, size(c, 1)
       c(i, i) = c(i, i) - 1.0_wp
     end do
     call report_le(maxval(abs(c)), 1.0e-12_wp, 'more rows than DOFs: the basis orthonormal')
-    call report_le(maxval(norm2(matmul(bc%flex, bc%kern), dim=1))/dmax, 1.0e-6_wp, &
+    call report_le(maxval(norm2(matmul(cbody%flex, cbody%kern), dim=1))/dmax, 1.0e-6_wp, &
                    'more rows than DOFs: |F_a z| <= 1e-6 max diag on the basis')
   end subroutine tall_rows
 

@@ -21,7 +21,7 @@ program test_frames
   implicit none (type, external)
   integer, parameter :: NNODE = 4
   type(body_system_t) :: sys
-  type(body_condensed_t) :: bc
+  type(body_condensed_t) :: cbody
   real(wp), allocatable :: k(:, :), b(:, :), t(:, :), kt(:, :), bt(:, :), kv(:), v(:), w(:), lo(:, :), rv(:)
   integer, allocatable :: irn(:), jcn(:), ri(:), rj(:)
   real(wp) :: n1(3), lmin, lmax, r2(2, 2), r3(3, 3), err
@@ -62,15 +62,15 @@ program test_frames
   b(2, fr(3, 1):fr(3, 2)) = [0.3_wp, 0.7_wp]
   b(3, fr(2, 2)) = 1.1_wp
   b(4, fr(4, 2):fr(4, 3)) = [0.6_wp, -0.8_wp]
-  bc%m = 4
-  bc%n = n
-  call rows_in(b, bc)
-  call contact_frames(sys, bc)
-  call report(bc%nrot == 1, 'one node gets a frame (the one under row 1 alone), not the nodes of a '// &
-              'two-node row, of a one-component row, or with a prescribed component', real(bc%nrot, wp))
-  if (bc%nrot /= 1) call test_summary()
-  call report(all(bc%rot_dof(:, 1) == [fr(1, 1), fr(1, 2), fr(1, 3)]), 'the frame is node 1''s')
-  r3 = bc%rot(:, :, 1)
+  cbody%m = 4
+  cbody%n = n
+  call rows_in(b, cbody)
+  call contact_frames(sys, cbody)
+  call report(cbody%nrot == 1, 'one node gets a frame (the one under row 1 alone), not the nodes of a '// &
+              'two-node row, of a one-component row, or with a prescribed component', real(cbody%nrot, wp))
+  if (cbody%nrot /= 1) call test_summary()
+  call report(all(cbody%rot_dof(:, 1) == [fr(1, 1), fr(1, 2), fr(1, 3)]), 'the frame is node 1''s')
+  r3 = cbody%rot(:, :, 1)
   call report_le(maxval(abs(matmul(transpose(r3), r3) - identity(3))), 1.0e-15_wp, 'R''R = I (space)')
   call report_le(maxval(abs(r3(:, 1) - n1)), 1.0e-15_wp, 'R''s first column is the row''s direction n')
   r2 = frame_of_normal([0.6_wp, -0.8_wp])
@@ -82,11 +82,11 @@ program test_frames
   t(fr(1, 1):fr(1, 3), fr(1, 1):fr(1, 3)) = r3
   bt = matmul(b, t)
   kt = matmul(transpose(t), matmul(k, t))
-  err = maxval(abs(rows_out(bc) - bt))
+  err = maxval(abs(rows_out(cbody) - bt))
   call report_le(err, 1.0e-14_wp, 'the rewritten rows are B T')
-  call report(bc%bptr(2) - bc%bptr(1) == 1 .and. bc%bval(bc%bptr(1)) == norm2(0.37_wp*n1), &
+  call report(cbody%bptr(2) - cbody%bptr(1) == 1 .and. cbody%bval(cbody%bptr(1)) == norm2(0.37_wp*n1), &
               'the defining row touches one DOF, with |D n| exactly')
-  call rotated_values(sys, bc, kv)
+  call rotated_values(sys, cbody, kv)
   err = 0.0_wp
   do j = 1, n
     err = max(err, maxval(abs(kv(sys%colptr(j) + 1:sys%colptr(j + 1)) - kt(:, j))))
@@ -101,7 +101,7 @@ program test_frames
       rv = [rv, 0.25_wp*k(i, j), 0.75_wp*k(i, j)]
     end do
   end do
-  call rotated_triplets(bc, n, irn, jcn, rv, ri, rj, kv)
+  call rotated_triplets(cbody, n, irn, jcn, rv, ri, rj, kv)
   allocate (lo(n, n))
   lo = 0.0_wp
   do e = 1, size(ri)
@@ -118,9 +118,9 @@ program test_frames
   call report_le(err/maxval(abs(k)), 1.0e-13_wp, 'T''K T from the lower-triangle triplets (summed)')
   v = [(urand(-1.0_wp, 1.0_wp), i=1, n)]
   w = v
-  call to_global(bc, w)
+  call to_global(cbody, w)
   call report_le(maxval(abs(w - matmul(t, v))), 1.0e-15_wp, 'to_global is T v')
-  call to_global(bc, w, inverse=.true.)
+  call to_global(cbody, w, inverse=.true.)
   call report_le(maxval(abs(w - v)), 1.0e-15_wp, 'and its inverse T''')
   call test_summary()
 
@@ -133,41 +133,41 @@ contains
   end function fr
 
   !> The condensed body's rows from a dense B (its non-zero entries, idx in first-touch order).
-  subroutine rows_in(bd, c)
+  subroutine rows_in(bd, cbody)
     real(wp), intent(in) :: bd(:, :)
-    type(body_condensed_t), intent(inout) :: c
+    type(body_condensed_t), intent(inout) :: cbody
     integer :: ii, jj, kk, ne
     integer, allocatable :: pos(:)
-    allocate (pos(size(bd, 2)), c%idx(0), c%bptr(size(bd, 1) + 1), c%bpos(0), c%bval(0))
+    allocate (pos(size(bd, 2)), cbody%idx(0), cbody%bptr(size(bd, 1) + 1), cbody%bpos(0), cbody%bval(0))
     pos = 0
     kk = 0
     ne = 0
-    c%bptr(1) = 1
+    cbody%bptr(1) = 1
     do ii = 1, size(bd, 1)
       do jj = 1, size(bd, 2)
         if (bd(ii, jj) == 0.0_wp) cycle
         if (pos(jj) == 0) then
           kk = kk + 1
-          c%idx = [c%idx, jj]
+          cbody%idx = [cbody%idx, jj]
           pos(jj) = kk
         end if
         ne = ne + 1
-        c%bpos = [c%bpos, pos(jj)]
-        c%bval = [c%bval, bd(ii, jj)]
+        cbody%bpos = [cbody%bpos, pos(jj)]
+        cbody%bval = [cbody%bval, bd(ii, jj)]
       end do
-      c%bptr(ii + 1) = ne + 1
+      cbody%bptr(ii + 1) = ne + 1
     end do
   end subroutine rows_in
 
   !> The dense B of a condensed body's rows.
-  function rows_out(c) result(bd)
-    type(body_condensed_t), intent(in) :: c
-    real(wp) :: bd(c%m, c%n)
+  function rows_out(cbody) result(bd)
+    type(body_condensed_t), intent(in) :: cbody
+    real(wp) :: bd(cbody%m, cbody%n)
     integer :: ii, ee
     bd = 0.0_wp
-    do ii = 1, c%m
-      do ee = c%bptr(ii), c%bptr(ii + 1) - 1
-        bd(ii, c%idx(c%bpos(ee))) = bd(ii, c%idx(c%bpos(ee))) + c%bval(ee)
+    do ii = 1, cbody%m
+      do ee = cbody%bptr(ii), cbody%bptr(ii + 1) - 1
+        bd(ii, cbody%idx(cbody%bpos(ee))) = bd(ii, cbody%idx(cbody%bpos(ee))) + cbody%bval(ee)
       end do
     end do
   end function rows_out

@@ -334,7 +334,7 @@ contains
     type(mesh_t) :: msh(2)
     type(body_system_t) :: sys(2)
     type(interface_t) :: itf
-    type(body_condensed_t) :: bc(2, 2)
+    type(body_condensed_t) :: cbody(2, 2)
     type(traction_cfg_t) :: tr(2)
     character(len=5), parameter :: ords(2) = ['metis', 'nd   ']
     integer, parameter :: ord_codes(2) = [ORDER_METIS, ORDER_ND]
@@ -367,22 +367,22 @@ contains
     do o = 1, 2
       d%solver%factor%ordering = ord_codes(o)
       do a = 1, 2
-        call factor_body(d%solver%factor, itf, a, msh(a), sys(a), bc(a, o), err)
+        call factor_body(d%solver%factor, itf, a, msh(a), sys(a), cbody(a, o), err)
         call error_parts(err, info, msg)
-        call report(info == 0 .and. interface_last(bc(a, o)), &
+        call report(info == 0 .and. interface_last(cbody(a, o)), &
                     'factor_body ordering='''//trim(ords(o))//''', body '//body_label(a)//': ok, interface last '//trim(msg))
         if (info /= 0) return
-        call condense_body(sys(a), bc(a, o), err)
+        call condense_body(sys(a), cbody(a, o), err)
         call error_parts(err, info, msg)
         if (info /= 0) error stop 'condense_body failed: '//trim(msg)
       end do
     end do
     do a = 1, 2
-      dflex = norm2(bc(a, 2)%flex - bc(a, 1)%flex)/max(norm2(bc(a, 1)%flex), tiny(1.0_wp))
-      db = norm2(bc(a, 2)%b - bc(a, 1)%b)/max(norm2(bc(a, 1)%b), tiny(1.0_wp))
+      dflex = norm2(cbody(a, 2)%flex - cbody(a, 1)%flex)/max(norm2(cbody(a, 1)%flex), tiny(1.0_wp))
+      db = norm2(cbody(a, 2)%b - cbody(a, 1)%b)/max(norm2(cbody(a, 1)%b), tiny(1.0_wp))
       call report_le(max(dflex, db), FLEX_TOL, 'body '//body_label(a)//': F_a and b_a with ''nd'' = with ''metis''')
-      call bc(a, 1)%fac%free()
-      call bc(a, 2)%fac%free()
+      call cbody(a, 1)%fac%free()
+      call cbody(a, 2)%fac%free()
     end do
   end subroutine check_condense
 
@@ -721,10 +721,10 @@ contains
   end subroutine check_nodes_bad
 
   !> The body's CHOLMOD factor has the interface DOFs last in its permutation.
-  logical function interface_last(bc)
-    type(body_condensed_t), intent(in) :: bc
+  logical function interface_last(cbody)
+    type(body_condensed_t), intent(in) :: cbody
     interface_last = .false.
-    select type (f => bc%fac)
+    select type (f => cbody%fac)
     type is (cholmod_factor_t)
       interface_last = f%chol%interface_last_ok
     end select

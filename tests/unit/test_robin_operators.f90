@@ -110,19 +110,19 @@ contains
 
   !> Body a of interface itf condensed to the flexibility f (supported: nrig = 0, no
   !! equilibrium rows, rank m).
-  subroutine condensed(itf, a, f, body)
+  subroutine condensed(itf, a, f, cbody)
     type(interface_t), intent(in) :: itf
     integer, intent(in) :: a
     real(wp), intent(in) :: f(:, :)
-    type(body_condensed_t), intent(out) :: body
-    body%slots = body_slots(itf, a)
-    body%m = size(body%slots)
-    body%flex = f
-    body%rank = body%m
-    body%nrig = 0
-    allocate (body%rg(0, body%m), body%re(0))   ! as floating's rigid_rows leaves a supported body
-    allocate (body%b(body%m))
-    body%b = 0.0_wp
+    type(body_condensed_t), intent(out) :: cbody
+    cbody%slots = body_slots(itf, a)
+    cbody%m = size(cbody%slots)
+    cbody%flex = f
+    cbody%rank = cbody%m
+    cbody%nrig = 0
+    allocate (cbody%rg(0, cbody%m), cbody%re(0))   ! as floating's rigid_rows leaves a supported body
+    allocate (cbody%b(cbody%m))
+    cbody%b = 0.0_wp
   end subroutine condensed
 
   !> The operators of the bodies' flexibilities (what the subproblems hand the Robin operator).
