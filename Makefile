@@ -141,7 +141,7 @@ $(BUILD)/text_scanner.o:   $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/sorting.o:
 $(BUILD)/sysinfo.o:        $(BUILD)/kinds.o
 $(BUILD)/signals.o:
-$(BUILD)/mpi_env.o:        $(BUILD)/kinds.o
+$(BUILD)/mpi_env.o:        $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/space.o:          $(BUILD)/kinds.o
 $(BUILD)/config.o:         $(BUILD)/kinds.o $(BUILD)/space.o
 $(BUILD)/namelist_vars.o:  $(BUILD)/kinds.o $(BUILD)/strings.o

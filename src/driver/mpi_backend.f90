@@ -7,8 +7,8 @@
 module mpi_backend
   use kinds, only: wp
   use, intrinsic :: iso_fortran_env, only: output_unit
-  use errors, only: error_t, exit_code, EXIT_INPUT
-  use fatal_errors, only: fatal, terminate
+  use errors, only: error_t, EXIT_INPUT
+  use fatal_errors, only: fatal, terminate, fail_on
   use config, only: deck_t
   use assembly, only: expand, cell_triplets
   use contact_types, only: STATUS_FAILED
@@ -51,18 +51,15 @@ contains
     type(run_t), intent(in) :: run          !< the run: its rank and ranks
     type(deck_t), intent(in) :: the_deck    !< the deck to size
     real(wp) :: est, node_est
-    integer :: st, node_ranks
+    integer :: node_ranks
     type(error_t) :: err
-    character(len=1024) :: m1
     est = rank_memory_mb(the_deck, run%ranks, run%rank)
     call par_node_sum(est, node_est, node_ranks)
     call check_budget_ranks(the_deck, run%ranks, run%rank, est, node_est, node_ranks, node_memory_limit_mb(), &
                             process_memory_limit_mb(), err)
-    st = exit_code(err)
-    m1 = ''
-    if (err%failed()) m1 = 'deck '//trim(the_deck%source)//': '//err%text()
-    call par_agree(st, m1)
-    if (st /= 0) call fatal(st, trim(m1))
+    if (err%failed()) call err%set(err%category, 'deck '//trim(the_deck%source)//': '//err%text())
+    call par_agree(err)
+    call fail_on(err)
   end subroutine check_memory
 
   !> Map the bodies to the ranks and split the ranks into their groups, then each rank
@@ -329,18 +326,14 @@ contains
   subroutine agree_fatal(self, what)
     class(mpi_backend_t), intent(inout) :: self
     character(len=*), intent(in) :: what
-    integer :: st, b
-    character(len=512) :: m1
-    st = 0
-    m1 = ''
+    integer :: b
+    type(error_t) :: err
     do b = size(self%err), 1, -1
-      if (self%err(b)%failed()) then
-        st = exit_code(self%err(b))
-        m1 = 'body '//body_label(b)//': '//what//': '//self%err(b)%text()
-      end if
+      if (self%err(b)%failed()) &
+        call err%set(self%err(b)%category, 'body '//body_label(b)//': '//what//': '//self%err(b)%text())
     end do
-    call par_agree(st, m1)
-    if (st /= 0) call fatal(st, trim(m1))
+    call par_agree(err)
+    call fail_on(err)
   end subroutine agree_fatal
 
   !> End the run with its code on every rank: the MUMPS instances freed, MPI finalized.

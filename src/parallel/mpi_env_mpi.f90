@@ -4,6 +4,7 @@
 !! mpi_env_serial.f90 instead, with the same API.
 module mpi_env
   use kinds, only: wp
+  use errors, only: error_t, exit_code
   use mpi
   implicit none (type, external)
   private
@@ -81,16 +82,23 @@ contains
     call MPI_Bcast(s, len(s), MPI_CHARACTER, root, MPI_COMM_WORLD, ierr)
   end subroutine par_bcast_str
 
-  !> Agree on a status: every rank ends with the largest info of all ranks and the message
-  !! of the lowest rank that has it (collective over the world).
-  subroutine par_agree(info, msg)
-    integer, intent(inout) :: info         !< in: this rank's status; out: the world's
-    character(len=*), intent(inout) :: msg  !< in: this rank's message; out: the chosen one
-    integer :: pair(2), best(2), ierr
-    pair = [info, par_rank()]
+  !> Agree on an error: every rank ends with the error of the lowest rank whose error has the
+  !! largest exit code (none when no rank failed; collective over the world).
+  subroutine par_agree(err)
+    type(error_t), intent(inout) :: err   !< in: this rank's error; out: the world's (see above)
+    integer :: pair(2), best(2), head(2), ierr
+    character(len=:), allocatable :: text
+    pair = [exit_code(err), par_rank()]
     call MPI_Allreduce(pair, best, 1, MPI_2INTEGER, MPI_MAXLOC, MPI_COMM_WORLD, ierr)
-    info = best(1)
-    if (info /= 0) call MPI_Bcast(msg, len(msg), MPI_CHARACTER, best(2), MPI_COMM_WORLD, ierr)
+    if (best(1) == 0) return
+    ! the chosen rank's category and message, whatever this rank held
+    head = 0
+    if (par_rank() == best(2)) head = [err%category, len(err%text())]
+    call MPI_Bcast(head, 2, MPI_INTEGER, best(2), MPI_COMM_WORLD, ierr)
+    allocate (character(len=head(2)) :: text)
+    if (par_rank() == best(2)) text = err%text()
+    call MPI_Bcast(text, head(2), MPI_CHARACTER, best(2), MPI_COMM_WORLD, ierr)
+    call err%set(head(1), text)
   end subroutine par_agree
 
   !> The largest x over the ranks and the lowest world rank that has it (collective).

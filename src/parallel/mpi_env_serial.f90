@@ -3,6 +3,7 @@
 !! calls one set of routines whichever binary it is.
 module mpi_env
   use kinds, only: wp
+  use errors, only: error_t
   implicit none (type, external)
   private
 
@@ -64,11 +65,10 @@ contains
     if (root < 0) s = s
   end subroutine par_bcast_str
 
-  !> Agree on a status across ranks (one rank: unchanged).
-  subroutine par_agree(info, msg)
-    integer, intent(inout) :: info
-    character(len=*), intent(inout) :: msg
-    if (info < -huge(info)) msg = ''
+  !> Agree on an error across ranks (one rank: unchanged).
+  subroutine par_agree(err)
+    type(error_t), intent(inout) :: err   !< this rank's error, which is the world's
+    if (.false.) call err%clear()
   end subroutine par_agree
 
   !> The largest x over the ranks and the rank that has it (one rank: x, 0).
