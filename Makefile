@@ -248,7 +248,7 @@ $(BUILD)/files.o:          $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
 $(BUILD)/results.o:        $(BUILD)/space.o $(BUILD)/body_system.o $(BUILD)/config.o $(BUILD)/contact_interface.o \
                            $(BUILD)/contact_types.o $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o \
-                           $(BUILD)/friction_view.o $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
+                           $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
                            $(BUILD)/post_process.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o $(BUILD)/results.o

@@ -10,7 +10,7 @@
 !! fields live only while they are written (bodies may be asked for on several threads at once).
 module post_process
   use kinds, only: wp
-  use space, only: NCOMP, NSTRESS, dof_node
+  use space, only: NDIM, NCOMP, NSTRESS, dof_node
   use config, only: deck_t
   use mesh, only: mesh_t
   use body_system, only: body_system_t
@@ -34,6 +34,10 @@ module post_process
     type(contact_result_t) :: res             !< the solution on the normal rows (split_friction)
     type(tangential_t) :: tg                  !< the tangential part of each node (friction)
     real(wp), allocatable :: pressure(:)      !< (m) normal force / tributary length of each row [stress]
+    integer, allocatable :: active(:)         !< (m) 1 where the row carries a normal force, else 0
+    !> (m) in space with friction: the length of each node's shear (tg%shear) [stress]
+    real(wp), allocatable :: shear_magnitude(:)
+    real(wp) :: normal_force_sum = 0.0_wp     !< the sum of the rows' normal forces [force]
   end type contact_fields_t
 
   !> A load step's solution, as the driver keeps it.
@@ -84,8 +88,7 @@ contains
     f%rf => rf
     allocate (f%step(0))
     call split_friction(itf_all, res_all, f%itf, f%last%res, f%last%tg)
-    allocate (f%last%pressure(f%itf%m))
-    call row_pressure(f%itf, f%last%res, f%last%pressure)
+    call row_fields(f%itf, f%last)
   end subroutine prepare_fields
 
   !> Append a load step (its stage, load factor, contact solution and displacements, pointed
@@ -117,8 +120,7 @@ contains
     type(interface_t) :: itf
     call split_friction(f%itf_all, f%step(k)%res, itf, cf%res, cf%tg)
     if (.not. allocated(cf%res%lam)) return
-    allocate (cf%pressure(itf%m))
-    call row_pressure(itf, cf%res, cf%pressure)
+    call row_fields(itf, cf)
   end subroutine step_contact
 
   !> Body a's fields in load step k (k = 0: the last result): its nodal stresses and von Mises
@@ -162,18 +164,22 @@ contains
     end associate
   end subroutine body_fields
 
-  !> The contact pressure of each row: its normal force over its tributary length (0 where
-  !! that is 0).
-  subroutine row_pressure(itf, res, pres)
+  !> The fields of each row of cf's solution (cf%res, cf%tg): its contact pressure, its normal
+  !! force over its tributary length (0 where that is 0); whether it is active; in space
+  !! with friction its shear's length; and the sum of the normal forces.
+  subroutine row_fields(itf, cf)
     type(interface_t), intent(in) :: itf              !< the normal rows
-    type(contact_result_t), intent(in) :: res         !< the solution on them
-    real(wp), intent(out) :: pres(:)                  !< (m) [stress]
+    type(contact_fields_t), intent(inout) :: cf
+    allocate (cf%pressure(itf%m))
     where (itf%trib > 0.0_wp)
-      pres = res%lam/itf%trib
+      cf%pressure = cf%res%lam/itf%trib
     elsewhere
-      pres = 0.0_wp
+      cf%pressure = 0.0_wp
     end where
-  end subroutine row_pressure
+    cf%active = merge(1, 0, cf%res%lam > 0.0_wp)
+    if (cf%tg%on .and. NDIM == 3) cf%shear_magnitude = norm2(cf%tg%shear, dim=1)
+    cf%normal_force_sum = sum(cf%res%lam)
+  end subroutine row_fields
 
   !> The contact pressure as a nodal field of body a (0 off its contact lines): where it is
   !! a pair's slave the rows' pressures; on the master the mean of the pressures of the rows that reach a

@@ -33,7 +33,6 @@ module results
   use body_system, only: body_system_t
   use contact_interface, only: interface_t, pair_rows, row_directions
   use contact_types, only: contact_result_t, status_name
-  use friction_view, only: tangential_t
   use post_process, only: result_fields_t, contact_fields_t, body_fields_t
   use floating, only: free_list
   use errors, only: error_t, ERR_IO
@@ -149,9 +148,9 @@ contains
     call write_companions(ok)
     !$omp end task
     if (size(times) > 0) then
-      call write_h5(tmp(1), d, msh, sys, fields, surf, u, tm, id, st, steps)
+      call write_h5(tmp(1), d, msh, sys, fields, fields%itf, surf, fields%last%res, u, tm, id, st, steps)
     else
-      call write_h5(tmp(1), d, msh, sys, fields, surf, u, tm, id, st)
+      call write_h5(tmp(1), d, msh, sys, fields, fields%itf, surf, fields%last%res, u, tm, id, st)
     end if
     !$omp end single
     !$omp end parallel
@@ -255,13 +254,15 @@ contains
   !> The HDF5 result file `path`, whole; st records the first failure. The large datasets of
   !! each body are created with their storage reserved, and a task per body (`body_data`)
   !! takes their data from `fields` and writes them there; all tasks end before this returns.
-  subroutine write_h5(path, d, msh, sys, fields, surf, u, tm, run_id, st, steps)
+  subroutine write_h5(path, d, msh, sys, fields, itf, surf, res, u, tm, run_id, st, steps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
     type(body_system_t), intent(in) :: sys(:)
-    type(result_fields_t), intent(in) :: fields        !< the normal rows, the contact and body fields
+    type(result_fields_t), intent(in) :: fields        !< the contact and body fields
+    type(interface_t), intent(in) :: itf               !< the normal rows (fields%itf)
     type(faces_t), intent(in) :: surf(:)               !< (npair) the contact surfaces (in space)
+    type(contact_result_t), intent(in) :: res          !< the solution on them (fields%last%res)
     real(wp), intent(in) :: u(:, :)
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
@@ -285,8 +286,6 @@ contains
     trib_unit = tributary_unit(d, ul)
     allocate (body_err(size(msh)))
     fd = -1
-    ! the last result's normal rows, its solution on them, the tangential part, the rows' pressures
-    associate (itf => fields%itf, res => fields%last%res, tg => fields%last%tg, pres => fields%last%pressure)
     call file_open(path, fid, st, create=.true.)
     if (.not. st%failed()) then
       call data_open(path, fd, why)
@@ -359,13 +358,13 @@ contains
     deallocate (w2)
     call write_dset(gid, 'g0', itf%g0, st, ul)
     call write_dset(gid, tributary_name(), itf%trib, st, trib_unit)
-    call contact_solution(gid, res, tg, pres, ul, us, uf, st)
+    call contact_solution(gid, fields%last, ul, us, uf, st)
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments (in
     ! space: the contact surfaces' faces)
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
     call write_contact_cells(gid, contact_cells(itf, surf, 1, itf%npair), st)
     do k = 1, itf%npair
-      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, trib_unit, st, cells=contact_cells(itf, surf, k, k))
+      call write_pair(gid, k, itf, fields%last, ul, us, uf, trib_unit, st, cells=contact_cells(itf, surf, k, k))
     end do
     call group_close(gid, st)
     call write_history(fid, res, st)
@@ -415,7 +414,6 @@ contains
         !$omp end task
       end if
     end do
-    end associate
     if (present(steps)) call write_steps(fid, d, msh, sys, fields, steps, ul, us, uf, st)
     call file_close(fid, st)
     ! the bodies' data written (the HDF5 file is closed: no object overlaps their storage)
@@ -554,24 +552,23 @@ contains
     do k = 1, size(steps)
       ! one entry per contact node, the tangential part beside it (as the last result)
       call fields%step_contact(k, cf)
-      associate (itf => fields%itf, res => cf%res, tg => cf%tg)
       call group_open(sid, 'step_'//i2s(k), kid, st, create=.true.)
       call write_attr(kid, 'stage', steps(k)%stage, st)
       call write_attr(kid, 'load_factor', steps(k)%load_factor, st)
       call write_attr(kid, 'time', step_time(steps(k)), st)
-      call write_attr(kid, 'outer', res%outer, st)
-      call write_attr(kid, 'inner', res%inner, st)
-      call write_attr(kid, 'status', status_name(res%status), st)
-      call write_attr(kid, 'residual', res%residual, st)
-      if (.not. allocated(res%lam)) then
+      call write_attr(kid, 'outer', cf%res%outer, st)
+      call write_attr(kid, 'inner', cf%res%inner, st)
+      call write_attr(kid, 'status', status_name(cf%res%status), st)
+      call write_attr(kid, 'residual', cf%res%residual, st)
+      if (.not. allocated(cf%res%lam)) then
         call group_close(kid, st)
         cycle
       end if
-      call write_attr(kid, 'normal_force_sum', sum(res%lam), st)
+      call write_attr(kid, 'normal_force_sum', cf%normal_force_sum, st)
       call group_open(kid, 'contact', gid, st, create=.true.)
-      call contact_solution(gid, res, tg, cf%pressure, ul, us, uf, st)
-      do q = 1, itf%npair
-        call write_pair(gid, q, itf, res, tg, cf%pressure, ul, us, uf, tributary_unit(d, ul), st)
+      call contact_solution(gid, cf, ul, us, uf, st)
+      do q = 1, fields%itf%npair
+        call write_pair(gid, q, fields%itf, cf, ul, us, uf, tributary_unit(d, ul), st)
       end do
       call group_close(gid, st)
       do a = 1, size(msh)
@@ -596,11 +593,10 @@ contains
         rr = file_order(msh(a), bf%reaction)
         call write_dset(gid, 'reaction', transpose(rr), st, uf)
         call write_dset(gid, 'reaction_xyz', pad3(rr), st, uf)
-        if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
+        if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', cf%res%rigid(1:sys(a)%nrig, a), st, ul)
         call group_close(gid, st)
       end do
       call group_close(kid, st)
-      end associate
     end do
     call group_close(sid, st)
 
@@ -609,26 +605,24 @@ contains
   !> The contact solution of all rows into the group gid (/contact, or a load step's):
   !! forces of both sides, their resultant on body 1, pressure, gap, active flags, normal
   !! displacements, obstacles and, with friction, the tangential part.
-  subroutine contact_solution(gid, res, tg, pres, ul, us, uf, st)
+  subroutine contact_solution(gid, cf, ul, us, uf, st)
     integer(hid_t), intent(in) :: gid
-    type(contact_result_t), intent(in) :: res
-    type(tangential_t), intent(in) :: tg
-    real(wp), intent(in), contiguous :: pres(:)   !< (m) pressure of each row [stress]
+    type(contact_fields_t), intent(in) :: cf    !< the solution's contact fields
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     type(error_t), intent(inout) :: st
-    call write_dset(gid, 'normal_force', res%lam, st, uf)
-    call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
-    call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
+    call write_dset(gid, 'normal_force', cf%res%lam, st, uf)
+    call write_dset(gid, 'normal_force_body1', cf%res%lam_body(:, 1), st, uf)
+    call write_dset(gid, 'normal_force_body2', cf%res%lam_body(:, 2), st, uf)
     ! the contact forces' resultant on body 1 (x, y): what balances its load
-    call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
-    call write_dset(gid, 'pressure', pres, st, us)
-    call write_dset(gid, 'gap', res%gap, st, ul)
-    call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
-    call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
-    call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
-    call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
-    call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
-    if (tg%on) call write_tangential(gid, tg, 1, size(pres), ul, us, uf, st)
+    call write_dset(gid, 'resultant_body1', cf%tg%resultant_all, st, uf)
+    call write_dset(gid, 'pressure', cf%pressure, st, us)
+    call write_dset(gid, 'gap', cf%res%gap, st, ul)
+    call write_dset(gid, 'active', cf%active, st, '1')
+    call write_dset(gid, 'normal_displacement_body1', cf%res%w(:, 1), st, ul)
+    call write_dset(gid, 'normal_displacement_body2', cf%res%w(:, 2), st, ul)
+    call write_dset(gid, 'obstacle_body1', cf%res%obstacle(:, 1), st, ul)
+    call write_dset(gid, 'obstacle_body2', cf%res%obstacle(:, 2), st, ul)
+    if (cf%tg%on) call write_tangential(gid, cf, 1, size(cf%pressure), ul, us, uf, st)
   end subroutine contact_solution
 
   !> The group pair_<q> of the contact group gid: pair q's rows alone, its solution (forces
@@ -637,13 +631,11 @@ contains
   !! `cells` (contact_cells), the ids of its bodies (side 1, side 2), its slave body and its
   !! line (coordinates, normals, g0, tributary lengths, segments or faces 0-based within the
   !! pair).
-  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, trib_unit, st, cells)
+  subroutine write_pair(gid, q, itf, cf, ul, us, uf, trib_unit, st, cells)
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
-    type(contact_result_t), intent(in) :: res
-    type(tangential_t), intent(in) :: tg
-    real(wp), intent(in), contiguous :: pres(:)  !< (m) pressure of each row [stress]
+    type(contact_fields_t), intent(in) :: cf    !< the solution's contact fields (all rows)
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     character(len=*), intent(in) :: trib_unit   !< of the tributary lengths (tributary_unit)
     type(error_t), intent(inout) :: st
@@ -680,17 +672,17 @@ contains
       call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
       call write_contact_cells(pid, cells, st)
     end if
-    call write_dset(pid, 'normal_force', res%lam(i:j), st, uf)
-    call write_dset(pid, 'normal_force_side1', res%lam_body(i:j, 1), st, uf)
-    call write_dset(pid, 'normal_force_side2', res%lam_body(i:j, 2), st, uf)
-    call write_dset(pid, 'resultant_on_first_body', tg%resultant(:, q), st, uf)
-    call write_dset(pid, 'pressure', pres(i:j), st, us)
-    call write_dset(pid, 'gap', res%gap(i:j), st, ul)
-    call write_dset(pid, 'active', merge(1, 0, res%lam(i:j) > 0.0_wp), st, '1')
-    call write_dset(pid, 'normal_displacement_side1', res%w(i:j, 1), st, ul)
-    call write_dset(pid, 'normal_displacement_side2', res%w(i:j, 2), st, ul)
-    if (tg%on) then
-      if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(pid, tg, i, j, ul, us, uf, st)
+    call write_dset(pid, 'normal_force', cf%res%lam(i:j), st, uf)
+    call write_dset(pid, 'normal_force_side1', cf%res%lam_body(i:j, 1), st, uf)
+    call write_dset(pid, 'normal_force_side2', cf%res%lam_body(i:j, 2), st, uf)
+    call write_dset(pid, 'resultant_on_first_body', cf%tg%resultant(:, q), st, uf)
+    call write_dset(pid, 'pressure', cf%pressure(i:j), st, us)
+    call write_dset(pid, 'gap', cf%res%gap(i:j), st, ul)
+    call write_dset(pid, 'active', cf%active(i:j), st, '1')
+    call write_dset(pid, 'normal_displacement_side1', cf%res%w(i:j, 1), st, ul)
+    call write_dset(pid, 'normal_displacement_side2', cf%res%w(i:j, 2), st, ul)
+    if (cf%tg%on) then
+      if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(pid, cf, i, j, ul, us, uf, st)
     end if
     call group_close(pid, st)
   end subroutine write_pair
@@ -703,9 +695,9 @@ contains
   !! tangents t1, t2 (the pair's `tangent1`, `tangent2`, stored as `normal` is), with the
   !! force also as a vector (tangential_force_xyz, stored as geometry_xyz is) and the shear's
   !! length (shear_magnitude).
-  subroutine write_tangential(gid, tg, i, j, ul, us, uf, st, sub)
+  subroutine write_tangential(gid, cf, i, j, ul, us, uf, st, sub)
     integer(hid_t), intent(in) :: gid
-    type(tangential_t), intent(in) :: tg
+    type(contact_fields_t), intent(in) :: cf    !< the solution's contact fields (its tangential part)
     integer, intent(in) :: i, j
     character(len=*), intent(in) :: ul, us, uf
     type(error_t), intent(inout) :: st
@@ -715,32 +707,32 @@ contains
     pid = gid
     if (present(sub)) call group_open(gid, sub, pid, st)
     if (NDIM == 2) then
-      a1 = tg%force(1, i:j)
+      a1 = cf%tg%force(1, i:j)
       call write_dset(pid, 'tangential_force', a1, st, uf)
-      a1 = tg%shear(1, i:j)
+      a1 = cf%tg%shear(1, i:j)
       call write_dset(pid, 'shear', a1, st, us)
-      a1 = tg%slip(1, i:j)
+      a1 = cf%tg%slip(1, i:j)
       call write_dset(pid, 'slip', a1, st, ul)
-      a1 = tg%slip_increment(1, i:j)
+      a1 = cf%tg%slip_increment(1, i:j)
       call write_dset(pid, 'slip_increment', a1, st, ul)
     else
       ! (nodes, component) arrays, as `normal`
-      a2 = transpose(tg%force(:, i:j))
+      a2 = transpose(cf%tg%force(:, i:j))
       call write_dset(pid, 'tangential_force', a2, st, uf)
       ! (x, y, z) per node, as geometry_xyz (ParaView's vector)
-      a2 = tg%force_xyz(:, i:j)
+      a2 = cf%tg%force_xyz(:, i:j)
       call write_dset(pid, 'tangential_force_xyz', a2, st, uf)
-      a2 = transpose(tg%shear(:, i:j))
+      a2 = transpose(cf%tg%shear(:, i:j))
       call write_dset(pid, 'shear', a2, st, us)
-      a1 = norm2(tg%shear(:, i:j), dim=1)
+      a1 = cf%shear_magnitude(i:j)
       call write_dset(pid, 'shear_magnitude', a1, st, us)
-      a2 = transpose(tg%slip(:, i:j))
+      a2 = transpose(cf%tg%slip(:, i:j))
       call write_dset(pid, 'slip', a2, st, ul)
-      a2 = transpose(tg%slip_increment(:, i:j))
+      a2 = transpose(cf%tg%slip_increment(:, i:j))
       call write_dset(pid, 'slip_increment', a2, st, ul)
     end if
-    call write_dset(pid, 'tangential_bound', tg%bound(i:j), st, uf)
-    call write_dset(pid, 'state', tg%state(i:j), st, '1')
+    call write_dset(pid, 'tangential_bound', cf%tg%bound(i:j), st, uf)
+    call write_dset(pid, 'state', cf%tg%state(i:j), st, '1')
     call write_attr(pid, 'state_names', 'none=-1 open=0 stick=1 slip=2', st)
     if (present(sub)) call group_close(pid, st)
   end subroutine write_tangential
