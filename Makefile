@@ -67,7 +67,7 @@ endif
 # condensation -> contact iteration -> output).
 MODS := kinds space errors clock strings digest int_hash text_scanner sorting sysinfo signals mpi_env config material_laws namelist_vars namelist_input deck_tables deck_checks deck_cross deck_render deck budget mesh mesh_topology volume_topology gmsh_msh elements elements_3d element_types lapack linop body_system supports stiffness_pattern rigid_modes assembly \
         cholmod_iface ordering banded cholesky mumps_iface factorization mprgp_options constraint_set tangent_discs mprgp_support qp_newton disc_newton mprgp smalbe nonneg_lsq mortar_chains mortar_rows mortar_segments mortar_surfaces mortar contact_interface condense contact_types contact_common friction_view floating equality_rows \
-        robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate h5io files history_io \
+        robin_operators robin_subproblems acceleration robin_iteration monolithic error_estimate post_process h5io files history_io \
         results checkpoint fatal_errors load_history run_state run_backend serial_backend mpi_backend run_summary run_phases command_line
 OBJS := $(addprefix $(BUILD)/,$(addsuffix .o,$(MODS))) $(BUILD)/cholmod_shim.o $(BUILD)/blas_tiles.o $(BUILD)/sighdl.o \
         $(BUILD)/sysinfo_shim.o $(BUILD)/files_shim.o
@@ -241,12 +241,15 @@ $(BUILD)/error_estimate.o: $(BUILD)/cholesky.o $(BUILD)/condense.o $(BUILD)/cont
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/errors.o $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/linop.o $(BUILD)/monolithic.o \
                            $(BUILD)/nonneg_lsq.o $(BUILD)/constraint_set.o $(BUILD)/tangent_discs.o
+$(BUILD)/post_process.o:   $(BUILD)/assembly.o $(BUILD)/body_system.o $(BUILD)/config.o $(BUILD)/contact_interface.o \
+                           $(BUILD)/contact_types.o $(BUILD)/friction_view.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/space.o
 $(BUILD)/h5io.o:           $(BUILD)/kinds.o $(BUILD)/errors.o
 $(BUILD)/files.o:          $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/history_io.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/contact_types.o $(BUILD)/h5io.o
-$(BUILD)/results.o:        $(BUILD)/space.o $(BUILD)/assembly.o $(BUILD)/config.o $(BUILD)/contact_interface.o $(BUILD)/contact_types.o \
-                           $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o $(BUILD)/friction_view.o \
-                           $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o $(BUILD)/strings.o
+$(BUILD)/results.o:        $(BUILD)/space.o $(BUILD)/body_system.o $(BUILD)/config.o $(BUILD)/contact_interface.o \
+                           $(BUILD)/contact_types.o $(BUILD)/errors.o $(BUILD)/files.o $(BUILD)/floating.o \
+                           $(BUILD)/h5io.o $(BUILD)/history_io.o $(BUILD)/kinds.o $(BUILD)/mesh.o \
+                           $(BUILD)/post_process.o $(BUILD)/strings.o
 $(BUILD)/checkpoint.o:     $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/digest.o $(BUILD)/contact_types.o $(BUILD)/h5io.o \
                            $(BUILD)/files.o $(BUILD)/history_io.o $(BUILD)/results.o
 # the driver's modules (src/driver): the route to an exit on error, the run's data, its two back-ends, its phases
@@ -278,7 +281,7 @@ $(BUILD)/run_phases.o:     $(BUILD)/assembly.o $(BUILD)/budget.o $(BUILD)/checkp
                            $(BUILD)/files.o \
                            $(BUILD)/floating.o $(BUILD)/gmsh_msh.o $(BUILD)/kinds.o $(BUILD)/load_history.o \
                            $(BUILD)/mesh.o $(BUILD)/monolithic.o $(BUILD)/mpi_backend.o $(BUILD)/mpi_env.o \
-                           $(BUILD)/results.o $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
+                           $(BUILD)/post_process.o $(BUILD)/results.o $(BUILD)/robin_iteration.o $(BUILD)/run_backend.o $(BUILD)/run_state.o \
                            $(BUILD)/run_summary.o $(BUILD)/serial_backend.o $(BUILD)/signals.o $(BUILD)/sorting.o \
                            $(BUILD)/strings.o $(BUILD)/sysinfo.o
 $(BUILD)/command_line.o:   $(BUILD)/errors.o $(BUILD)/fatal_errors.o $(BUILD)/deck.o $(BUILD)/config.o $(BUILD)/sysinfo.o $(BUILD)/mpi_env.o

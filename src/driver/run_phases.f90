@@ -24,6 +24,7 @@ module run_phases
   use floating, only: rigid_rows, check_held, check_pressed, free_list, fixing_list, friction_edge
   use contact_common, only: gather
   use results, only: write_results, result_files, per_body_files
+  use post_process, only: result_fields_t, prepare_fields, add_step
   use checkpoint, only: h5_checkpointer_t, checkpoint_read, checkpoint_read_steps, checkpoint_file, mesh_identity
   use files, only: remove_file, special_file, check_new_files
   use signals, only: stop_requested, pending_signal
@@ -773,20 +774,29 @@ contains
   !! checkpoint; a run that stopped keeps it. An earlier result at this path stays until
   !! this one replaces it whole; a run that fails leaves it untouched.
   subroutine write_output(run)
-    type(run_t), intent(inout) :: run   !< the run: whether its result was written
+    type(run_t), intent(inout), target :: run   !< the run: whether its result was written
     type(error_t) :: err
-    integer :: stale
+    type(result_fields_t) :: fields
+    integer :: stale, k
     if (run%code == EXIT_NUMERICAL .or. run%rank /= 0) return
     call support_forces(run)
     run%timing%peak_rss_mb = peak_rss_mb()
     run%timing%total = wtime() - run%t_start
     stale = 0
+    ! the fields the file shows: the contact ones now, each body's as the writer writes it
+    call prepare_fields(fields, run%deck, run%meshes, run%systems, run%contact_line, run%result, run%displacement, &
+                        run%reaction)
     if (size(run%plan) > 1) then   ! every load step's result too
-      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%reaction, run%timing, err, run%steps, threads=run%threads, stale=stale)
+      if (allocated(run%steps)) then
+        do k = 1, size(run%steps)
+          call add_step(fields, run%steps(k)%stage, run%steps(k)%load_factor, run%steps(k)%res, run%steps(k)%u)
+        end do
+      end if
+      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, fields, run%displacement, &
+                         run%timing, err, run%steps, threads=run%threads, stale=stale)
     else
-      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, run%contact_line, run%result, &
-                         run%displacement, run%reaction, run%timing, err, threads=run%threads, stale=stale)
+      call write_results(run%deck%output%file, run%deck, run%meshes, run%systems, fields, run%displacement, &
+                         run%timing, err, threads=run%threads, stale=stale)
     end if
     run%written = .not. err%failed()
     call fail_on(err, 'output')

@@ -7,6 +7,10 @@
 !! through its rows; in space a surface, the faces of the slave's contact group whose every
 !! node carries a row (`faces`).
 !!
+!! The fields come computed (post_process's result_fields_t: the contact rows' view, their
+!! pressures and tangential part, each body's stresses, contact pressure and reactions);
+!! this module orders, names and writes them.
+!!
 !! Every numeric dataset has a string attribute `units` (the deck's unit names: length,
 !! stress, force/length for the nodal contact force in 2D, '1' for pure numbers and
 !! counts, 's' for wall times); the root has `unit_length`, `unit_force`, `unit_stress`.
@@ -14,7 +18,7 @@ module results
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_c_binding, only: c_loc, c_long_long
   use kinds, only: wp
-  use space, only: NDIM, NCOMP, NSTRESS, dof_node
+  use space, only: NDIM, NCOMP, NSTRESS
   use hdf5, only: hid_t, hsize_t, haddr_t
   use h5io, only: file_open, file_close, group_open, group_close, write_dset, write_attr, write_attr_list, &
                   reserve_dset
@@ -26,10 +30,10 @@ module results
                     side_names, BC_CONTACT, METHOD_CHOICES, program_version
   use strings, only: word, body_label, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof, group_index
-  use assembly, only: body_system_t, nodal_stress, support_reactions
+  use body_system, only: body_system_t
   use contact_interface, only: interface_t, pair_rows, row_directions
   use contact_types, only: contact_result_t, status_name
-  use friction_view, only: tangential_t, split_friction
+  use post_process, only: result_fields_t, contact_fields_t, body_fields_t
   use floating, only: free_list
   use errors, only: error_t, ERR_IO
   implicit none (type, external)
@@ -83,20 +87,21 @@ contains
   !! last) only when all are complete. Otherwise err (ERR_IO, naming the file and what
   !! failed); then the files of an earlier result at these names are as they were, and no
   !! temporary file is left. The HDF5 library is called from one thread; with two, the
-  !! other writes the companions and, body by body, computes the fields of each body
-  !! (its stresses) and writes their data into the storage the first has reserved.
-  subroutine write_results(file, d, msh, sys, itf_all, res_all, u, rf, tm, err, steps, threads, stale)
+  !! other writes the companions and, body by body, takes the fields of each body from
+  !! `fields` (post_process's body_fields) and writes their data into the storage the first
+  !! has reserved.
+  subroutine write_results(file, d, msh, sys, fields, u, tm, err, steps, threads, stale)
     character(len=*), intent(in) :: file               !< result path (.h5)
     type(deck_t), intent(in) :: d                      !< the effective deck
     type(mesh_t), intent(in) :: msh(:)                 !< meshes
     type(body_system_t), intent(in) :: sys(:)          !< systems (DOF maps)
-    type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs
-    type(contact_result_t), intent(in) :: res_all      !< contact solution
+    !> the fields to write (post_process's prepare_fields, with the load steps add_step's)
+    type(result_fields_t), intent(in) :: fields
     real(wp), intent(in) :: u(:, :)                    !< (maxndof, bodies) full displacements
-    real(wp), intent(in) :: rf(:, :)                   !< (maxndof, bodies) the supports' forces (support_reactions)
     type(timing_t), intent(in) :: tm                   !< timing breakdown
     type(error_t), intent(out) :: err                  !< the failure, if any
-    !> the load steps' results (several steps: /steps, and the XDMF files a time series)
+    !> the load steps' results (several steps: /steps, and the XDMF files a time series;
+    !! fields%step(k) the fields of steps(k))
     type(step_result_t), intent(in), optional :: steps(:)
     integer, intent(in), optional :: threads           !< threads to write with (default 1)
     !> the files of an earlier result at this name that this one lacks, removed once it is
@@ -111,17 +116,13 @@ contains
     integer :: k, nb, np, nf, nt, nstale
     integer :: nbf, npf   ! the bodies and pairs with an XDMF file of their own
     logical :: ok, per_body
-    type(interface_t) :: itf
-    type(contact_result_t) :: res
-    type(tangential_t) :: tg
     type(faces_t), allocatable :: surf(:)
 
-    ! the file shows one entry per contact node: the normal rows, with friction the
-    ! tangential part of each node beside them
-    call split_friction(itf_all, res_all, itf, res, tg)
-    call contact_surfaces(d, msh, itf, surf)
+    ! the file shows one entry per contact node: the normal rows (fields%itf), with friction
+    ! the tangential part of each node beside them
+    call contact_surfaces(d, msh, fields%itf, surf)
     nb = size(msh)
-    np = itf%npair
+    np = fields%itf%npair
     call ensure_parent_dir(file)
     per_body = per_body_files(d%output%xdmf, nb, np)
     nbf = merge(nb, 0, per_body)
@@ -147,9 +148,9 @@ contains
     call write_companions(ok)
     !$omp end task
     if (size(times) > 0) then
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, surf, res, tg, u, rf, tm, id, st, steps)
+      call write_h5(tmp(1), d, msh, sys, fields, fields%itf, surf, fields%last%res, u, tm, id, st, steps)
     else
-      call write_h5(tmp(1), d, msh, sys, itf_all, itf, surf, res, tg, u, rf, tm, id, st)
+      call write_h5(tmp(1), d, msh, sys, fields, fields%itf, surf, fields%last%res, u, tm, id, st)
     end if
     !$omp end single
     !$omp end parallel
@@ -182,19 +183,19 @@ contains
       integer :: a, q
       type(error_t) :: werr
       if (np == 1) then
-        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, itf, surf, id, times), werr)
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [0], h5, msh, fields%itf, surf, id, times), werr)
       else
-        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, itf, surf, id, times), werr)
+        call write_text(tmp(2), xdmf_text([(a, a=1, nb)], [(q, q=1, np)], h5, msh, fields%itf, surf, id, times), werr)
       end if
       do a = 1, nbf
         if (.not. werr%failed()) &
-          call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, itf, surf, id, times), werr)
+          call write_text(tmp(2 + a), xdmf_text([a], [integer ::], h5, msh, fields%itf, surf, id, times), werr)
       end do
-      if (.not. werr%failed()) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, itf, surf, id, times), werr)
+      if (.not. werr%failed()) call write_text(tmp(3 + nbf), xdmf_text([integer ::], [0], h5, msh, fields%itf, surf, id, times), werr)
       if (npf > 1) then
         do q = 1, npf
           if (.not. werr%failed()) &
-            call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, itf, surf, id, times), werr)
+            call write_text(tmp(3 + nbf + q), xdmf_text([integer ::], [q], h5, msh, fields%itf, surf, id, times), werr)
         end do
       end if
       done = .not. werr%failed()
@@ -256,19 +257,17 @@ contains
 
   !> The HDF5 result file `path`, whole; st records the first failure. The large datasets of
   !! each body are created with their storage reserved, and a task per body (`body_data`)
-  !! computes and writes their data there; all tasks end before this returns.
-  subroutine write_h5(path, d, msh, sys, itf_all, itf, surf, res, tg, u, rf, tm, run_id, st, steps)
+  !! takes their data from `fields` and writes them there; all tasks end before this returns.
+  subroutine write_h5(path, d, msh, sys, fields, itf, surf, res, u, tm, run_id, st, steps)
     character(len=*), intent(in) :: path
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
     type(body_system_t), intent(in) :: sys(:)
-    type(interface_t), intent(in) :: itf_all           !< contact rows of all pairs (normal and tangential)
-    type(interface_t), intent(in) :: itf               !< its normal rows (split_friction)
+    type(result_fields_t), intent(in) :: fields        !< the contact and body fields
+    type(interface_t), intent(in) :: itf               !< the normal rows (fields%itf)
     type(faces_t), intent(in) :: surf(:)               !< (npair) the contact surfaces (in space)
-    type(contact_result_t), intent(in) :: res
-    type(tangential_t), intent(in) :: tg               !< the tangential part (friction), per node
+    type(contact_result_t), intent(in) :: res          !< the solution on them (fields%last%res)
     real(wp), intent(in) :: u(:, :)
-    real(wp), intent(in) :: rf(:, :)                   !< (maxndof, bodies) the supports' forces
     type(timing_t), intent(in) :: tm
     character(len=*), intent(in) :: run_id
     type(error_t), intent(inout) :: st
@@ -277,7 +276,7 @@ contains
     integer(haddr_t) :: off(BD_COUNT)
     integer(hsize_t) :: nn, nc
     integer :: a, k, fd
-    real(wp), allocatable :: pres(:), w2(:, :)
+    real(wp), allocatable :: w2(:, :)
     type(error_t), allocatable :: body_err(:)
     type(error_t) :: closing
     character(len=:), allocatable :: ul, us, uf, trib_unit
@@ -361,14 +360,13 @@ contains
     deallocate (w2)
     call write_dset(gid, 'g0', itf%g0, st, ul)
     call write_dset(gid, tributary_name(), itf%trib, st, trib_unit)
-    allocate (pres(itf%m))
-    call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
+    call contact_solution(gid, fields%last, ul, us, uf, st)
     ! the contact line as a grid of its own (XDMF): points padded with z = 0, segments (in
     ! space: the contact surfaces' faces)
     call write_dset(gid, 'geometry_xyz', pad3(itf%xy), st, ul)
     call write_contact_cells(gid, contact_cells(itf, surf, 1, itf%npair), st)
     do k = 1, itf%npair
-      call write_pair(gid, k, itf, res, tg, pres, ul, us, uf, trib_unit, st, cells=contact_cells(itf, surf, k, k))
+      call write_pair(gid, k, itf, fields%last, ul, us, uf, trib_unit, st, cells=contact_cells(itf, surf, k, k))
     end do
     call group_close(gid, st)
     call write_history(fid, res, st)
@@ -413,12 +411,12 @@ contains
       call reserve_dset(gid, 'reaction_xyz', [3_hsize_t, nn], .false., off(BD_REACTION_XYZ), st, uf)
       call group_close(gid, st)
       if (.not. st%failed()) then
-        !$omp task firstprivate(a, off) shared(msh, d, u, rf, sys, itf, pres, body_err, fd)
-        call body_data(fd, off, a, msh(a), d, u(1:sys(a)%ndof, a), rf(1:sys(a)%ndof, a), itf, pres, body_err(a))
+        !$omp task firstprivate(a, off) shared(msh, u, sys, fields, body_err, fd)
+        call body_data(fd, off, a, msh(a), u(1:sys(a)%ndof, a), fields, body_err(a))
         !$omp end task
       end if
     end do
-    if (present(steps)) call write_steps(fid, d, msh, sys, itf_all, steps, ul, us, uf, st)
+    if (present(steps)) call write_steps(fid, d, msh, sys, fields, steps, ul, us, uf, st)
     call file_close(fid, st)
     ! the bodies' data written (the HDF5 file is closed: no object overlaps their storage)
     !$omp taskwait
@@ -434,30 +432,27 @@ contains
   !> Body a's fields in the file's node and cell order, each written at its reserved offset
   !! off(BD_*) of the file fd: coordinates and displacement (nnode, 2), both padded with z = 0
   !! (3, nnode), the cells (0-based), for a mixed mesh its XDMF topology, the body id per
-  !! cell, the nodal stresses (nnode, 4) and each component, von Mises and the contact
-  !! pressure, the supports' reactions (nnode, 2) and padded (3, nnode). Fields that are not
-  !! finite are a failure, never written.
-  subroutine body_data(fd, off, a, msh, d, ua, ra, itf, pres, err)
+  !! cell, and from fields%body_fields the nodal stresses (nnode, 4) and each component, von
+  !! Mises and the contact pressure, the supports' reactions (nnode, 2) and padded (3, nnode).
+  !! Fields that are not finite are a failure, never written.
+  subroutine body_data(fd, off, a, msh, ua, fields, err)
     integer, intent(in) :: fd                       !< the result file (data_open)
     integer(haddr_t), intent(in) :: off(:)          !< (BD_COUNT) where each dataset's data go
     integer, intent(in) :: a                        !< the body
     type(mesh_t), intent(in) :: msh                 !< its mesh
-    type(deck_t), intent(in) :: d                   !< the deck (its material, plane strain)
     real(wp), intent(in) :: ua(:)                   !< (ndof) its displacement
-    real(wp), intent(in) :: ra(:)                   !< (ndof) the supports' forces on it
-    type(interface_t), intent(in) :: itf            !< the contact rows (normal)
-    real(wp), intent(in) :: pres(:)                 !< (m) pressure of each row [stress]
+    type(result_fields_t), intent(in) :: fields     !< its fields (body_fields)
     type(error_t), intent(inout) :: err             !< the first failure
-    real(wp), allocatable, target :: sigma(:, :), vm(:), w2(:, :), w3(:, :), sigt(:, :), p(:), uf(:, :)
+    real(wp), allocatable, target :: vm(:), w2(:, :), w3(:, :), sigt(:, :), uf(:, :)
     integer, allocatable, target :: iv(:), iw(:, :)
+    type(body_fields_t) :: bf
     character(len=3) :: comp(6)
     integer :: k, nn
     comp(1:NSTRESS) = stress_names()
     nn = msh%nnode
-    allocate (sigma(NSTRESS, nn), vm(nn), p(nn))
-    call nodal_stress(msh, d%body(a), d%plane_strain, ua, sigma, vm)
-    vm = file_order(msh, vm)
-    if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm)))) then
+    call fields%body_fields(0, a, fields%last%pressure, bf)
+    vm = file_order(msh, bf%von_mises)
+    if (.not. (all(ieee_is_finite(bf%stress)) .and. all(ieee_is_finite(vm)))) then
       call err%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
       return
     end if
@@ -480,16 +475,19 @@ contains
     end if
     iv = spread(a, 1, msh%ncell)
     call put_int(iv, 'body_id', BD_BODY_ID)
-    sigt = transpose(file_order(msh, sigma))
+    sigt = transpose(file_order(msh, bf%stress))
+    deallocate (bf%stress)       ! each field freed once written: a large body's are large
     call put(sigt, 'stress', BD_STRESS)
     do k = 1, NSTRESS
       call put(sigt(:, k), comp(k), BD_SXX + k - 1)
     end do
     call put(vm, 'von_mises', BD_VON_MISES)
-    call nodal_pressure(itf, a, pres, p)
-    vm = file_order(msh, p)
+    deallocate (sigt, bf%von_mises)
+    vm = file_order(msh, bf%pressure)
+    deallocate (bf%pressure)
     call put(vm, 'contact_pressure', BD_PRESSURE)
-    uf = file_order(msh, reshape(ra, [NCOMP, nn]))
+    uf = file_order(msh, bf%reaction)
+    deallocate (bf%reaction)
     w2 = transpose(uf)
     call put(w2, 'reaction', BD_REACTION)
     w3 = pad3(uf)
@@ -535,21 +533,20 @@ contains
   !> /steps/step_<k> for every load step k: its stage, load factor, time, counts and status
   !! (attributes), its contact arrays (contact, contact/pair_<q>) and each body's
   !! displacement and stresses (body<a>), the datasets named as the last result's.
-  subroutine write_steps(fid, d, msh, sys, itf_all, steps, ul, us, uf, st)
+  subroutine write_steps(fid, d, msh, sys, fields, steps, ul, us, uf, st)
     integer(hid_t), intent(in) :: fid
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
     type(body_system_t), intent(in) :: sys(:)
-    type(interface_t), intent(in) :: itf_all    !< contact rows of all pairs (normal and tangential)
+    type(result_fields_t), intent(in) :: fields   !< the normal rows; the steps' fields (fields%step(k): steps(k))
     type(step_result_t), intent(in) :: steps(:)
     character(len=*), intent(in) :: ul, us, uf
     type(error_t), intent(inout) :: st
     integer(hid_t) :: sid, kid, gid
     integer :: k, a, q, nn, c
-    real(wp), allocatable :: pres(:), sigma(:, :), vm(:), sigt(:, :), pnode(:), disp(:, :)
-    type(interface_t) :: itf
-    type(contact_result_t) :: res
-    type(tangential_t) :: tg
+    real(wp), allocatable :: sigt(:, :), disp(:, :), rr(:, :)
+    type(contact_fields_t) :: cf
+    type(body_fields_t) :: bf
     character(len=3) :: comp(6)
     comp(1:NSTRESS) = stress_names()
     call group_open(fid, 'steps', sid, st, create=.true.)
@@ -557,25 +554,24 @@ contains
     call write_attr(sid, 'time', 'cumulative load factor: stage - 1 + load_factor', st)
     do k = 1, size(steps)
       ! one entry per contact node, the tangential part beside it (as the last result)
-      call split_friction(itf_all, steps(k)%res, itf, res, tg)
+      call fields%step_contact(k, cf)
       call group_open(sid, 'step_'//i2s(k), kid, st, create=.true.)
       call write_attr(kid, 'stage', steps(k)%stage, st)
       call write_attr(kid, 'load_factor', steps(k)%load_factor, st)
       call write_attr(kid, 'time', step_time(steps(k)), st)
-      call write_attr(kid, 'outer', res%outer, st)
-      call write_attr(kid, 'inner', res%inner, st)
-      call write_attr(kid, 'status', status_name(res%status), st)
-      call write_attr(kid, 'residual', res%residual, st)
-      if (.not. allocated(res%lam)) then
+      call write_attr(kid, 'outer', cf%res%outer, st)
+      call write_attr(kid, 'inner', cf%res%inner, st)
+      call write_attr(kid, 'status', status_name(cf%res%status), st)
+      call write_attr(kid, 'residual', cf%res%residual, st)
+      if (.not. allocated(cf%res%lam)) then
         call group_close(kid, st)
         cycle
       end if
-      call write_attr(kid, 'normal_force_sum', sum(res%lam), st)
-      allocate (pres(itf%m))
+      call write_attr(kid, 'normal_force_sum', cf%normal_force_sum, st)
       call group_open(kid, 'contact', gid, st, create=.true.)
-      call contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
-      do q = 1, itf%npair
-        call write_pair(gid, q, itf, res, tg, pres, ul, us, uf, tributary_unit(d, ul), st)
+      call contact_solution(gid, cf, ul, us, uf, st)
+      do q = 1, fields%itf%npair
+        call write_pair(gid, q, fields%itf, cf, ul, us, uf, tributary_unit(d, ul), st)
       end do
       call group_close(gid, st)
       do a = 1, size(msh)
@@ -585,88 +581,51 @@ contains
           disp = transpose(file_order(msh(a), reshape(ua, [NCOMP, nn])))   ! a contiguous copy (see write_h5)
           call write_dset(gid, 'displacement', disp, st, ul)
           call write_dset(gid, 'displacement_xyz', pad3(file_order(msh(a), reshape(ua, [NCOMP, nn]))), st, ul)
-          allocate (sigma(NSTRESS, nn), vm(nn), pnode(nn))
-          call nodal_stress(msh(a), d%body(a), d%plane_strain, ua, sigma, vm)
         end associate
-        if (.not. (all(ieee_is_finite(sigma)) .and. all(ieee_is_finite(vm))) .and. .not. st%failed()) &
+        call fields%body_fields(k, a, cf%pressure, bf)
+        if (.not. (all(ieee_is_finite(bf%stress)) .and. all(ieee_is_finite(bf%von_mises))) .and. .not. st%failed()) &
           call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' in load step '//i2s(k)// &
                       ' are not finite: beyond double precision, rescale the units')
-        sigt = transpose(file_order(msh(a), sigma))
+        sigt = transpose(file_order(msh(a), bf%stress))
         call write_dset(gid, 'stress', sigt, st, us)
         do c = 1, NSTRESS
           call write_dset(gid, comp(c), sigt(:, c), st, us)
         end do
-        call write_dset(gid, 'von_mises', file_order(msh(a), vm), st, us)
-        call nodal_pressure(itf, a, pres, pnode)
-        call write_dset(gid, 'contact_pressure', file_order(msh(a), pnode), st, us)
-        call step_reactions(a, steps(k))
-        if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', res%rigid(1:sys(a)%nrig, a), st, ul)
-        deallocate (sigma, vm, pnode)
+        call write_dset(gid, 'von_mises', file_order(msh(a), bf%von_mises), st, us)
+        call write_dset(gid, 'contact_pressure', file_order(msh(a), bf%pressure), st, us)
+        rr = file_order(msh(a), bf%reaction)
+        call write_dset(gid, 'reaction', transpose(rr), st, uf)
+        call write_dset(gid, 'reaction_xyz', pad3(rr), st, uf)
+        if (sys(a)%nrig > 0) call write_dset(gid, 'rigid_amplitude', cf%res%rigid(1:sys(a)%nrig, a), st, ul)
         call group_close(gid, st)
       end do
-      deallocate (pres)
       call group_close(kid, st)
     end do
     call group_close(sid, st)
 
-  contains
-
-    !> Body a's reactions in step sk: its applied loads those of the step (the earlier stages
-    !! whole, its own stage times its load factor).
-    subroutine step_reactions(a, sk)
-      integer, intent(in) :: a
-      type(step_result_t), intent(in) :: sk
-      real(wp), allocatable :: fa(:), rf(:), rr(:, :)
-      integer :: s
-      associate (sy => sys(a))
-        allocate (fa(sy%ndof), rf(sy%ndof))
-        if (allocated(sy%fa_stage)) then
-          fa = 0.0_wp
-          do s = 1, sk%stage - 1
-            fa = fa + sy%fa_stage(:, s)
-          end do
-          fa = fa + sk%load_factor*sy%fa_stage(:, sk%stage)
-        else
-          fa = sk%load_factor*sy%f_applied
-        end if
-        call support_reactions(msh(a), d%body(a), d%plane_strain, sy, sk%u(1:sy%ndof, a), fa, rf)
-        rr = file_order(msh(a), reshape(rf, [NCOMP, msh(a)%nnode]))
-        call write_dset(gid, 'reaction', transpose(rr), st, uf)
-        call write_dset(gid, 'reaction_xyz', pad3(rr), st, uf)
-      end associate
-    end subroutine step_reactions
-
   end subroutine write_steps
 
   !> The contact solution of all rows into the group gid (/contact, or a load step's):
-  !! forces of both sides, their resultant on body 1, pressure (returned in pres), gap,
-  !! active flags, normal displacements, obstacles and, with friction, the tangential part.
-  subroutine contact_solution(gid, itf, res, tg, ul, us, uf, st, pres)
+  !! forces of both sides, their resultant on body 1, pressure, gap, active flags, normal
+  !! displacements, obstacles and, with friction, the tangential part.
+  subroutine contact_solution(gid, cf, ul, us, uf, st)
     integer(hid_t), intent(in) :: gid
-    type(interface_t), intent(in) :: itf
-    type(contact_result_t), intent(in) :: res
-    type(tangential_t), intent(in) :: tg
+    type(contact_fields_t), intent(in) :: cf    !< the solution's contact fields
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     type(error_t), intent(inout) :: st
-    real(wp), intent(out), contiguous :: pres(:)   !< (m) pressure of each row [stress]
-    call write_dset(gid, 'normal_force', res%lam, st, uf)
-    call write_dset(gid, 'normal_force_body1', res%lam_body(:, 1), st, uf)
-    call write_dset(gid, 'normal_force_body2', res%lam_body(:, 2), st, uf)
+    call write_dset(gid, 'normal_force', cf%res%lam, st, uf)
+    call write_dset(gid, 'normal_force_body1', cf%res%lam_body(:, 1), st, uf)
+    call write_dset(gid, 'normal_force_body2', cf%res%lam_body(:, 2), st, uf)
     ! the contact forces' resultant on body 1 (x, y): what balances its load
-    call write_dset(gid, 'resultant_body1', tg%resultant_all, st, uf)
-    where (itf%trib > 0.0_wp)
-      pres = res%lam/itf%trib
-    elsewhere
-      pres = 0.0_wp
-    end where
-    call write_dset(gid, 'pressure', pres, st, us)
-    call write_dset(gid, 'gap', res%gap, st, ul)
-    call write_dset(gid, 'active', merge(1, 0, res%lam > 0.0_wp), st, '1')
-    call write_dset(gid, 'normal_displacement_body1', res%w(:, 1), st, ul)
-    call write_dset(gid, 'normal_displacement_body2', res%w(:, 2), st, ul)
-    call write_dset(gid, 'obstacle_body1', res%obstacle(:, 1), st, ul)
-    call write_dset(gid, 'obstacle_body2', res%obstacle(:, 2), st, ul)
-    if (tg%on) call write_tangential(gid, tg, 1, itf%m, ul, us, uf, st)
+    call write_dset(gid, 'resultant_body1', cf%tg%resultant_all, st, uf)
+    call write_dset(gid, 'pressure', cf%pressure, st, us)
+    call write_dset(gid, 'gap', cf%res%gap, st, ul)
+    call write_dset(gid, 'active', cf%active, st, '1')
+    call write_dset(gid, 'normal_displacement_body1', cf%res%w(:, 1), st, ul)
+    call write_dset(gid, 'normal_displacement_body2', cf%res%w(:, 2), st, ul)
+    call write_dset(gid, 'obstacle_body1', cf%res%obstacle(:, 1), st, ul)
+    call write_dset(gid, 'obstacle_body2', cf%res%obstacle(:, 2), st, ul)
+    if (cf%tg%on) call write_tangential(gid, cf, 1, size(cf%pressure), ul, us, uf, st)
   end subroutine contact_solution
 
   !> The group pair_<q> of the contact group gid: pair q's rows alone, its solution (forces
@@ -675,13 +634,11 @@ contains
   !! `cells` (contact_cells), the ids of its bodies (side 1, side 2), its slave body and its
   !! line (coordinates, normals, g0, tributary lengths, segments or faces 0-based within the
   !! pair).
-  subroutine write_pair(gid, q, itf, res, tg, pres, ul, us, uf, trib_unit, st, cells)
+  subroutine write_pair(gid, q, itf, cf, ul, us, uf, trib_unit, st, cells)
     integer(hid_t), intent(in) :: gid
     integer, intent(in) :: q
     type(interface_t), intent(in) :: itf
-    type(contact_result_t), intent(in) :: res
-    type(tangential_t), intent(in) :: tg
-    real(wp), intent(in), contiguous :: pres(:)  !< (m) pressure of each row [stress]
+    type(contact_fields_t), intent(in) :: cf    !< the solution's contact fields (all rows)
     character(len=*), intent(in) :: ul, us, uf  !< units: length, stress, force/length
     character(len=*), intent(in) :: trib_unit   !< of the tributary lengths (tributary_unit)
     type(error_t), intent(inout) :: st
@@ -718,17 +675,17 @@ contains
       call write_dset(pid, 'geometry_xyz', pad3(itf%xy(:, i:j)), st, ul)
       call write_contact_cells(pid, cells, st)
     end if
-    call write_dset(pid, 'normal_force', res%lam(i:j), st, uf)
-    call write_dset(pid, 'normal_force_side1', res%lam_body(i:j, 1), st, uf)
-    call write_dset(pid, 'normal_force_side2', res%lam_body(i:j, 2), st, uf)
-    call write_dset(pid, 'resultant_on_first_body', tg%resultant(:, q), st, uf)
-    call write_dset(pid, 'pressure', pres(i:j), st, us)
-    call write_dset(pid, 'gap', res%gap(i:j), st, ul)
-    call write_dset(pid, 'active', merge(1, 0, res%lam(i:j) > 0.0_wp), st, '1')
-    call write_dset(pid, 'normal_displacement_side1', res%w(i:j, 1), st, ul)
-    call write_dset(pid, 'normal_displacement_side2', res%w(i:j, 2), st, ul)
-    if (tg%on) then
-      if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(pid, tg, i, j, ul, us, uf, st)
+    call write_dset(pid, 'normal_force', cf%res%lam(i:j), st, uf)
+    call write_dset(pid, 'normal_force_side1', cf%res%lam_body(i:j, 1), st, uf)
+    call write_dset(pid, 'normal_force_side2', cf%res%lam_body(i:j, 2), st, uf)
+    call write_dset(pid, 'resultant_on_first_body', cf%tg%resultant(:, q), st, uf)
+    call write_dset(pid, 'pressure', cf%pressure(i:j), st, us)
+    call write_dset(pid, 'gap', cf%res%gap(i:j), st, ul)
+    call write_dset(pid, 'active', cf%active(i:j), st, '1')
+    call write_dset(pid, 'normal_displacement_side1', cf%res%w(i:j, 1), st, ul)
+    call write_dset(pid, 'normal_displacement_side2', cf%res%w(i:j, 2), st, ul)
+    if (cf%tg%on) then
+      if (itf%pair_friction(q) /= FRICTION_NONE) call write_tangential(pid, cf, i, j, ul, us, uf, st)
     end if
     call group_close(pid, st)
   end subroutine write_pair
@@ -741,9 +698,9 @@ contains
   !! tangents t1, t2 (the pair's `tangent1`, `tangent2`, stored as `normal` is), with the
   !! force also as a vector (tangential_force_xyz, stored as geometry_xyz is) and the shear's
   !! length (shear_magnitude).
-  subroutine write_tangential(gid, tg, i, j, ul, us, uf, st, sub)
+  subroutine write_tangential(gid, cf, i, j, ul, us, uf, st, sub)
     integer(hid_t), intent(in) :: gid
-    type(tangential_t), intent(in) :: tg
+    type(contact_fields_t), intent(in) :: cf    !< the solution's contact fields (its tangential part)
     integer, intent(in) :: i, j
     character(len=*), intent(in) :: ul, us, uf
     type(error_t), intent(inout) :: st
@@ -753,83 +710,35 @@ contains
     pid = gid
     if (present(sub)) call group_open(gid, sub, pid, st)
     if (NDIM == 2) then
-      a1 = tg%force(1, i:j)
+      a1 = cf%tg%force(1, i:j)
       call write_dset(pid, 'tangential_force', a1, st, uf)
-      a1 = tg%shear(1, i:j)
+      a1 = cf%tg%shear(1, i:j)
       call write_dset(pid, 'shear', a1, st, us)
-      a1 = tg%slip(1, i:j)
+      a1 = cf%tg%slip(1, i:j)
       call write_dset(pid, 'slip', a1, st, ul)
-      a1 = tg%slip_increment(1, i:j)
+      a1 = cf%tg%slip_increment(1, i:j)
       call write_dset(pid, 'slip_increment', a1, st, ul)
     else
       ! (nodes, component) arrays, as `normal`
-      a2 = transpose(tg%force(:, i:j))
+      a2 = transpose(cf%tg%force(:, i:j))
       call write_dset(pid, 'tangential_force', a2, st, uf)
       ! (x, y, z) per node, as geometry_xyz (ParaView's vector)
-      a2 = tg%force_xyz(:, i:j)
+      a2 = cf%tg%force_xyz(:, i:j)
       call write_dset(pid, 'tangential_force_xyz', a2, st, uf)
-      a2 = transpose(tg%shear(:, i:j))
+      a2 = transpose(cf%tg%shear(:, i:j))
       call write_dset(pid, 'shear', a2, st, us)
-      a1 = norm2(tg%shear(:, i:j), dim=1)
+      a1 = cf%shear_magnitude(i:j)
       call write_dset(pid, 'shear_magnitude', a1, st, us)
-      a2 = transpose(tg%slip(:, i:j))
+      a2 = transpose(cf%tg%slip(:, i:j))
       call write_dset(pid, 'slip', a2, st, ul)
-      a2 = transpose(tg%slip_increment(:, i:j))
+      a2 = transpose(cf%tg%slip_increment(:, i:j))
       call write_dset(pid, 'slip_increment', a2, st, ul)
     end if
-    call write_dset(pid, 'tangential_bound', tg%bound(i:j), st, uf)
-    call write_dset(pid, 'state', tg%state(i:j), st, '1')
+    call write_dset(pid, 'tangential_bound', cf%tg%bound(i:j), st, uf)
+    call write_dset(pid, 'state', cf%tg%state(i:j), st, '1')
     call write_attr(pid, 'state_names', 'none=-1 open=0 stick=1 slip=2', st)
     if (present(sub)) call group_close(pid, st)
   end subroutine write_tangential
-
-  !> The contact pressure as a nodal field of body a (0 off its contact lines): where it is
-  !! a pair's slave the rows' pressures; on the master the mean of the pressures of the rows that reach a
-  !! node, weighted by their mortar weight times tributary length (a uniform pressure stays
-  !! uniform, and matching lines give the slave's values).
-  subroutine nodal_pressure(itf, a, pres, p)
-    type(interface_t), intent(in) :: itf
-    integer, intent(in) :: a                  !< body
-    real(wp), intent(in) :: pres(:)           !< (m) pressure of each row [stress]
-    real(wp), intent(out) :: p(:)             !< (nnode) nodal field [stress]
-    real(wp), allocatable :: den(:), ps(:)
-    logical, allocatable :: on_slave(:)
-    integer :: k, e, i, q, sd
-    real(wp) :: w
-    allocate (den(size(p)), ps(size(p)), on_slave(size(p)))
-    p = 0.0_wp
-    den = 0.0_wp
-    on_slave = .false.
-    do q = 1, itf%npair
-      do sd = 1, 2
-        if (itf%pair_body(sd, q) /= a) cycle
-        if (sd == itf%pair_slave(q)) then
-          do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 1
-            ps(itf%node(k, sd)) = pres(k)
-            on_slave(itf%node(k, sd)) = .true.
-          end do
-          cycle
-        end if
-        do k = itf%pair_ptr(q), itf%pair_ptr(q + 1) - 1
-          ! a node's entries (x, y, z) are adjacent: weight |w n| = w
-          do e = itf%b(sd)%ptr(k), itf%b(sd)%ptr(k + 1) - NCOMP, NCOMP
-            i = dof_node(itf%b(sd)%dof(e))
-            if (NCOMP == 2) then
-              w = hypot(itf%b(sd)%val(e), itf%b(sd)%val(e + 1))
-            else
-              w = norm2(itf%b(sd)%val(e:e + NCOMP - 1))
-            end if
-            if (w <= 1.0e-12_wp) cycle             ! a rounding-level weight of a matching line
-            w = w*itf%trib(k)
-            p(i) = p(i) + w*pres(k)
-            den(i) = den(i) + w
-          end do
-        end do
-      end do
-    end do
-    where (den > 0.0_wp) p = p/den
-    where (on_slave) p = ps
-  end subroutine nodal_pressure
 
   !> The XDMF 'Mixed' topology of a mesh: per cell its type (4 triangle, 5 quadrilateral,
   !! 6 tetrahedron, 9 hexahedron) and its 0-based vertices, in the file's order.
@@ -877,8 +786,8 @@ contains
     if (size(v, 1) < 3) p(3, :) = 0.0_wp
   end function pad3
 
-  !> The names of the stress components, in the order of nodal_stress: in the plane sxx,
-  !! syy, sxy, szz; in space sxx, syy, szz, syz, sxz, sxy.
+  !> The names of the stress components, in the order of body_fields_t's stress: in the
+  !! plane sxx, syy, sxy, szz; in space sxx, syy, szz, syz, sxz, sxy.
   function stress_names() result(c)
     character(len=3), allocatable :: c(:)
     if (NDIM == 3) then
@@ -934,7 +843,7 @@ contains
   subroutine contact_surfaces(d, msh, itf, surf)
     type(deck_t), intent(in) :: d
     type(mesh_t), intent(in) :: msh(:)
-    type(interface_t), intent(in) :: itf            !< the normal rows (split_friction)
+    type(interface_t), intent(in) :: itf            !< the normal rows (result_fields_t's itf)
     type(faces_t), allocatable, intent(out) :: surf(:)
     type(contact_cfg_t) :: cc
     integer, allocatable :: rowof(:), f(:, :)
