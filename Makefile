@@ -149,7 +149,7 @@ $(BUILD)/namelist_input.o: $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/deck_tables.o:    $(BUILD)/kinds.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/space.o
 $(BUILD)/deck_checks.o:    $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/errors.o $(BUILD)/space.o \
                            $(BUILD)/namelist_input.o $(BUILD)/config.o $(BUILD)/deck_tables.o
-$(BUILD)/material_laws.o:  $(BUILD)/kinds.o $(BUILD)/config.o
+$(BUILD)/material_laws.o:  $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/errors.o
 $(BUILD)/deck_cross.o:     $(BUILD)/kinds.o $(BUILD)/errors.o $(BUILD)/strings.o $(BUILD)/sorting.o $(BUILD)/config.o $(BUILD)/deck_checks.o \
                            $(BUILD)/material_laws.o
 $(BUILD)/deck_render.o:    $(BUILD)/strings.o $(BUILD)/namelist_vars.o $(BUILD)/config.o $(BUILD)/deck_tables.o
@@ -186,8 +186,8 @@ $(BUILD)/factorization.o $(BUILD)/element_types.o: FFLAGS += -Wno-unused-dummy-a
 $(BUILD)/factorization.o:  $(BUILD)/kinds.o $(BUILD)/space.o $(BUILD)/config.o $(BUILD)/cholesky.o $(BUILD)/mumps_iface.o \
                            $(BUILD)/errors.o $(BUILD)/strings.o
 $(BUILD)/mprgp_options.o:  $(BUILD)/kinds.o $(BUILD)/strings.o $(BUILD)/signals.o $(BUILD)/errors.o
-$(BUILD)/constraint_set.o: $(BUILD)/kinds.o
-$(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o
+$(BUILD)/constraint_set.o: $(BUILD)/kinds.o $(BUILD)/errors.o
+$(BUILD)/tangent_discs.o:  $(BUILD)/kinds.o $(BUILD)/constraint_set.o $(BUILD)/errors.o
 $(BUILD)/mprgp_support.o:  $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/constraint_set.o
 $(BUILD)/qp_newton.o:      $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/constraint_set.o
 $(BUILD)/disc_newton.o:    $(BUILD)/kinds.o $(BUILD)/lapack.o $(BUILD)/tangent_discs.o $(BUILD)/qp_newton.o

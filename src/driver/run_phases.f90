@@ -188,10 +188,10 @@ contains
       end do
       do a = 1, deck%nbody   ! each cell's material, from the deck's regions
         block
-          character(len=:), allocatable :: msg
+          type(error_t) :: lerr
           integer :: bad, i, n
-          call assign_cell_laws(run%meshes(a), deck%body(a), msg, bad)
-          if (len(msg) == 0) cycle
+          call assign_cell_laws(run%meshes(a), deck%body(a), lerr, bad)
+          if (.not. lerr%failed()) cycle
           n = 1
           do i = 1, deck%nregion     ! law bad is the (bad-1)-th region of body a
             if (deck%region(i)%body /= a) cycle
@@ -199,7 +199,7 @@ contains
             if (n == bad) exit
           end do
           call fail_on(error_t(ERR_INPUT, 'the '//trim(deck%region(i)%origin)//" (body "//i2s(a)//", name = '"// &
-            trim(deck%region(i)%name)//"'): mesh file '"//trim(deck%body(a)%mesh)//"': "//msg), &
+            trim(deck%region(i)%name)//"'): mesh file '"//trim(deck%body(a)%mesh)//"': "//lerr%message), &
             'deck '//trim(deck%source))
         end block
       end do

@@ -118,17 +118,17 @@ contains
 
   !> The elastic law of each cell (mesh%cell_law) from the body's laws (body_cfg_t%law: 1 the
   !! body's own, then one per region, named by its physical surface): unallocated when the
-  !! body has one law. msg = '' on success; else a region that is no physical surface of the
-  !! body's cells, or a cell in two regions of different laws (stiffness or density).
-  subroutine assign_cell_laws(mesh, body, msg, bad)
+  !! body has one law. ERR_INPUT (and the law's index in `failing_law`, for the caller to
+  !! name the deck's region) for a region that is no physical surface of the body's cells, or
+  !! a cell in two regions of different laws (stiffness or density).
+  subroutine assign_cell_laws(mesh, body, err, failing_law)
     type(mesh_t), intent(inout) :: mesh               !< the body's mesh
     type(body_cfg_t), intent(in) :: body              !< its laws
-    character(len=:), allocatable, intent(out) :: msg !< '' or why not
-    integer, intent(out) :: bad                       !< the law that fails (its region's), 0: none
+    type(error_t), intent(out) :: err                 !< ERR_INPUT: why not
+    integer, intent(out) :: failing_law               !< the law that fails (its region's), 0: none
     integer :: k, r, j, c
     character(len=:), allocatable :: names
-    msg = ''
-    bad = 0
+    failing_law = 0
     if (allocated(mesh%cell_law)) deallocate (mesh%cell_law)
     if (.not. allocated(body%law)) return
     if (size(body%law) < 2) return
@@ -139,10 +139,10 @@ contains
       do j = 1, mesh%nregion
         if (mesh%region(j)%name == trim(body%law(k)%region)) r = j
       end do
-      bad = k
       if (r == 0 .and. trim(body%law(k)%region) == trim(body%region)) then
-        msg = "'"//trim(body%law(k)%region)//"' is the body's own physical surface: a region is "// &
-              'another physical surface holding some of its cells'
+        call err%set(ERR_INPUT, "'"//trim(body%law(k)%region)//"' is the body's own physical surface: a "// &
+                     'region is another physical surface holding some of its cells')
+        failing_law = k
         return
       else if (r == 0) then
         names = ''
@@ -150,12 +150,13 @@ contains
           names = names//merge(', ', '  ', j > 1)//"'"//mesh%region(j)%name//"'"
         end do
         if (mesh%nregion == 0) then
-          msg = "the body's cells are in no physical surface '"//trim(body%law(k)%region)// &
-                "' (they are in no physical surface but the body's own)"
+          call err%set(ERR_INPUT, "the body's cells are in no physical surface '"//trim(body%law(k)%region)// &
+                       "' (they are in no physical surface but the body's own)")
         else
-          msg = "the body's cells are in no physical surface '"//trim(body%law(k)%region)// &
-                "' (the physical surfaces holding its cells: "//trim(adjustl(names))//')'
+          call err%set(ERR_INPUT, "the body's cells are in no physical surface '"//trim(body%law(k)%region)// &
+                       "' (the physical surfaces holding its cells: "//trim(adjustl(names))//')')
         end if
+        failing_law = k
         return
       end if
       do j = 1, size(mesh%region(r)%cell)
@@ -163,16 +164,16 @@ contains
         if (mesh%cell_law(c) /= 1) then
           if (any(body%law(mesh%cell_law(c))%d /= body%law(k)%d) .or. &
               body%law(mesh%cell_law(c))%density /= body%law(k)%density) then
-            msg = 'cell '//i2s(mesh%cell_tag(c))//" is in region '"//trim(body%law(mesh%cell_law(c))%region)// &
-                  "' and in region '"//trim(body%law(k)%region)//"', of different materials: a cell "// &
-                  'is of one material'
+            call err%set(ERR_INPUT, 'cell '//i2s(mesh%cell_tag(c))//" is in region '"// &
+                         trim(body%law(mesh%cell_law(c))%region)//"' and in region '"//trim(body%law(k)%region)// &
+                         "', of different materials: a cell is of one material")
+            failing_law = k
             return
           end if
         end if
         mesh%cell_law(c) = k
       end do
     end do
-    bad = 0
   end subroutine assign_cell_laws
 
   !> Id of grid node (i,j), i = 0..nx, j = 0..ny.

@@ -426,17 +426,17 @@ contains
     type(state_t), intent(in) :: st
     type(error_t), intent(out) :: err   !< ERR_INPUT and the message on bad input
     integer :: b, k, i, n
-    character(len=:), allocatable :: msg
+    type(error_t) :: lerr   ! a material's law (refused in the first loop, known good after it)
 
     do k = 1, d%nmaterial     ! every material, used or not, is one the scene's model can use
       block
         type(elastic_law_t) :: law
-        call material_law(d%material(k), 0.0_wp, d%plane_strain, law, msg, d%axisymmetric)
-        if (len(msg) > 0) then
+        call material_law(d%material(k), 0.0_wp, d%plane_strain, law, lerr, d%axisymmetric)
+        if (lerr%failed()) then
           call err%set(ERR_INPUT, st%path//': the '//trim(d%material(k)%origin)// &
             ' (material '''//trim(d%material(k)%name)//''', '//trim(word(MAT_KIND_NAMES, d%material(k)%kind))// &
             ', in '//trim(merge('axisymmetric', merge('plane strain', 'plane stress', d%plane_strain), &
-            d%axisymmetric))//'): '//msg)
+            d%axisymmetric))//'): '//lerr%message)
           return
         end if
       end block
@@ -458,7 +458,7 @@ contains
             trim(d%body(b)%material)//''' names no &material ('//material_names(d)//')')
           return
         end if
-        call material_law(d%material(k), d%body(b)%angle, d%plane_strain, d%body(b)%law(1), msg, d%axisymmetric)
+        call material_law(d%material(k), d%body(b)%angle, d%plane_strain, d%body(b)%law(1), lerr, d%axisymmetric)
       end if
       n = 1
       do i = 1, d%nregion
@@ -477,7 +477,7 @@ contains
           return
         end if
         d%body(b)%law(n)%region = d%region(i)%name
-        call material_law(d%material(k), d%region(i)%angle, d%plane_strain, d%body(b)%law(n), msg, d%axisymmetric)
+        call material_law(d%material(k), d%region(i)%angle, d%plane_strain, d%body(b)%law(n), lerr, d%axisymmetric)
       end do
     end do
     call check_body_forces(d, st, err)

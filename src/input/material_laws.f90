@@ -24,6 +24,7 @@
 !! and the energy e_material' D e_material = e_xy' (T' D T) e_xy gives d = T' D T.
 module material_laws
   use kinds, only: wp
+  use errors, only: error_t, ERR_INPUT
   use config, only: material_cfg_t, elastic_law_t, MAT_ISOTROPIC, MAT_ORTHOTROPIC, MAT_ANISOTROPIC, UNSET
   implicit none (type, external)
   private
@@ -61,21 +62,21 @@ contains
   end subroutine isotropic_law
 
   !> The law of material m, its axis 1 at `angle` degrees from x, in plane strain or plane
-  !! stress. msg = '' on success; else why not: a constant the model needs and m lacks
-  !! (named), or a tensor that is not positive definite (its eigenvalues named).
-  subroutine material_law(m, angle, plane_strain, law, msg, axisymmetric)
+  !! stress. On bad input err says why: a constant the model needs and m lacks (named), or a
+  !! tensor that is not positive definite (its eigenvalues named).
+  subroutine material_law(m, angle, plane_strain, law, err, axisymmetric)
     type(material_cfg_t), intent(in) :: m          !< the material (its kind known)
     real(wp), intent(in) :: angle                  !< axis 1 from x [degrees]
     logical, intent(in) :: plane_strain            !< plane strain (else plane stress)
     !> a body of revolution: the hoop strain is not 0, so the whole 4x4 (c33 too) is needed
     logical, intent(in), optional :: axisymmetric
     type(elastic_law_t), intent(inout) :: law      !< the law (region kept)
-    character(len=:), allocatable, intent(out) :: msg
+    type(error_t), intent(out) :: err              !< ERR_INPUT: what the material lacks, or a law not positive definite
+    character(len=:), allocatable :: msg
     real(wp) :: s4(4, 4), c4(4, 4), c3(3, 3), ev(4)
     integer :: n
     logical :: axi
 
-    msg = ''
     axi = .false.
     if (present(axisymmetric)) axi = axisymmetric
     law%density = m%density
@@ -85,7 +86,10 @@ contains
       return
     case (MAT_ORTHOTROPIC)
       msg = missing(m, plane_strain, axi)
-      if (len(msg) > 0) return
+      if (len(msg) > 0) then
+        call err%set(ERR_INPUT, msg)
+        return
+      end if
       s4 = 0.0_wp
       s4(1, 1) = 1.0_wp/m%e1
       s4(2, 2) = 1.0_wp/m%e2
@@ -106,13 +110,17 @@ contains
         msg = 'its compliance is not positive definite: its smallest eigenvalue is '// &
               num(ev(1))//' [1/stress] (eigenvalues '//nums(ev(1:n))//'); the Poisson''s ratios '// &
               'are too large for the moduli (each nu_ij^2 < E_i/E_j, and the determinant > 0)'
+        call err%set(ERR_INPUT, msg)
         return
       end if
       c4 = 0.0_wp
       call invert(s4(1:n, 1:n), c4(1:n, 1:n))
     case (MAT_ANISOTROPIC)
       msg = missing(m, plane_strain, axi)
-      if (len(msg) > 0) return
+      if (len(msg) > 0) then
+        call err%set(ERR_INPUT, msg)
+        return
+      end if
       c3 = reshape([m%c11, m%c12, value_or_zero(m%c16), m%c12, m%c22, value_or_zero(m%c26), &
                     value_or_zero(m%c16), value_or_zero(m%c26), m%c66], [3, 3])
       c4 = 0.0_wp
@@ -130,6 +138,7 @@ contains
       if (.not. ev(1) > 0.0_wp) then
         msg = 'its stiffness is not positive definite: its smallest eigenvalue is '//num(ev(1))// &
               ' [stress] (eigenvalues '//nums(ev(1:n))//')'
+        call err%set(ERR_INPUT, msg)
         return
       end if
       if (.not. plane_strain .and. n == 4) then     ! plane stress: szz = 0 condenses ezz out

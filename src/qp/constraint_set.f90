@@ -28,22 +28,19 @@
 module constraint_set
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   implicit none (type, external)
   private
 
   public :: constraint_set_t, box_set_t, box_set, chopped, set_projected_gradient_norm
-  public :: SET_OK, SET_BAD_ARG, SET_NONFINITE
-
-  integer, parameter :: SET_OK = 0         !< the set is valid for n unknowns
-  integer, parameter :: SET_BAD_ARG = 1    !< wrong sizes or an empty set
-  integer, parameter :: SET_NONFINITE = 2  !< a non-finite datum
 
   real(wp), parameter :: big = huge(1.0_wp)
 
   !> A closed convex feasible set of R^n, with what the QP solvers need of it.
   type, abstract :: constraint_set_t
   contains
-    !> Check the set's data for n unknowns: SET_OK, or SET_BAD_ARG / SET_NONFINITE and why.
+    !> Check the set's data for n unknowns: ERR_INPUT (wrong sizes, an empty set) or
+    !! ERR_NUMERICAL (a non-finite datum) and why.
     procedure(validate_i), deferred :: validate
     !> x = P(x), the Euclidean projection onto the set.
     procedure(project_i), deferred :: project
@@ -88,12 +85,11 @@ module constraint_set
   end type constraint_set_t
 
   abstract interface
-    subroutine validate_i(self, n, code, message)
-      import :: constraint_set_t
+    subroutine validate_i(self, n, err)
+      import :: constraint_set_t, error_t
       class(constraint_set_t), intent(in) :: self
       integer, intent(in) :: n
-      integer, intent(out) :: code
-      character(len=:), allocatable, intent(out) :: message
+      type(error_t), intent(out) :: err
     end subroutine validate_i
     subroutine project_i(self, x)
       import :: constraint_set_t, wp
@@ -258,39 +254,32 @@ contains
   end function chopped
 
   !> Sizes n, finite bounds (-huge / +huge for none), lb <= ub.
-  subroutine box_validate(self, n, code, message)
+  subroutine box_validate(self, n, err)
     class(box_set_t), intent(in) :: self
-    integer, intent(in) :: n                                !< unknowns
-    integer, intent(out) :: code                            !< SET_*
-    character(len=:), allocatable, intent(out) :: message   !< why not SET_OK ('' else)
+    integer, intent(in) :: n                !< unknowns
+    type(error_t), intent(out) :: err       !< ERR_INPUT or ERR_NUMERICAL and why
     character(len=80) :: buf
     integer :: i
-    code = SET_OK
-    message = ''
     if (size(self%lb) /= n .or. size(self%ub) /= n) then
       write (buf, '(a,i0,a,i0,a,i0)') 'size mismatch: A%n = ', n, ', size(lb) = ', size(self%lb), &
         ', size(ub) = ', size(self%ub)
-      code = SET_BAD_ARG
-      message = trim(buf)
+      call err%set(ERR_INPUT, trim(buf))
       return
     end if
     do i = 1, n
       if (.not. ieee_is_finite(self%lb(i))) then
         write (buf, '(i0)') i
-        code = SET_NONFINITE
-        message = 'lb('//trim(buf)//') is not finite (use -huge(1.0_wp) for no bound)'
+        call err%set(ERR_NUMERICAL, 'lb('//trim(buf)//') is not finite (use -huge(1.0_wp) for no bound)')
         return
       end if
       if (.not. ieee_is_finite(self%ub(i))) then
         write (buf, '(i0)') i
-        code = SET_NONFINITE
-        message = 'ub('//trim(buf)//') is not finite (use huge(1.0_wp) for no bound)'
+        call err%set(ERR_NUMERICAL, 'ub('//trim(buf)//') is not finite (use huge(1.0_wp) for no bound)')
         return
       end if
       if (self%ub(i) < self%lb(i)) then
         write (buf, '(i0)') i
-        code = SET_BAD_ARG
-        message = 'ub('//trim(buf)//') < lb('//trim(buf)//'): the box is empty'
+        call err%set(ERR_INPUT, 'ub('//trim(buf)//') < lb('//trim(buf)//'): the box is empty')
         return
       end if
     end do

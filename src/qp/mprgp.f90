@@ -47,12 +47,12 @@ module mprgp
   use linop, only: linop_t, dense_op_t
   use qp_newton, only: newton_work_t, newton_step, newton_begin, NEWTON_FULL, NEWTON_STILL, NEWTON_NOT_SPD
   use strings, only: i2s
-  use errors, only: error_t
+  use errors, only: error_t, ERR_NUMERICAL
   use mprgp_options, only: mprgp_opts_t, mprgp_stats_t, mprgp_status_name, check_options, MPRGP_CONVERGED, &
                            MPRGP_MAX_IT, MPRGP_NONFINITE, MPRGP_NOT_SPD, MPRGP_BAD_ARG, MPRGP_STOPPED, &
                            QP_AUTO, QP_MPRGP, QP_NEWTON, QP_NEWTON_FIRST, QP_POLISH
   use mprgp_support, only: lambda_max_estimate, power_iteration, line_search, recycled_subspace, store_direction
-  use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped, SET_OK, SET_NONFINITE
+  use constraint_set, only: constraint_set_t, box_set_t, box_set, chopped
   use tangent_discs, only: disc_set_t
   use disc_newton, only: disc_newton_step, disc_held, DN_STILL, DN_NOT_SPD, disc_factor_t
   implicit none (type, external)
@@ -514,8 +514,8 @@ contains
     class(constraint_set_t), intent(in) :: set
     real(wp), intent(in), optional :: rw(:, :), raw(:, :)
     integer, intent(in), optional :: nrw(2)
-    integer :: i, code
-    character(len=:), allocatable :: why
+    integer :: i
+    type(error_t) :: verr
     ok = .false.
     self%n = n
     if (n < 0) then
@@ -532,9 +532,9 @@ contains
       self%stats%status = MPRGP_BAD_ARG
       return
     end if
-    call set%validate(n, code, why)
-    if (code /= SET_OK) then
-      call fail(self, merge(MPRGP_NONFINITE, MPRGP_BAD_ARG, code == SET_NONFINITE), why)
+    call set%validate(n, verr)
+    if (verr%failed()) then
+      call fail(self, merge(MPRGP_NONFINITE, MPRGP_BAD_ARG, verr%category == ERR_NUMERICAL), verr%message)
       return
     end if
     if (self%opts%use_ax) then

@@ -28,8 +28,8 @@
 module tangent_discs
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use kinds, only: wp
-  use constraint_set, only: constraint_set_t, box_set_t, box_set, set_projected_gradient_norm, SET_OK, SET_BAD_ARG, &
-                            SET_NONFINITE
+  use constraint_set, only: constraint_set_t, box_set_t, box_set, set_projected_gradient_norm
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   implicit none (type, external)
   private
 
@@ -147,20 +147,18 @@ contains
 
   !> The box's checks, then: one radius per pair, radii finite and >= 0, pairs of two
   !! different variables in 1..n, no variable in two pairs.
-  subroutine disc_validate(self, n, code, message)
+  subroutine disc_validate(self, n, err)
     class(disc_set_t), intent(in) :: self
-    integer, intent(in) :: n                                !< unknowns
-    integer, intent(out) :: code                            !< SET_*
-    character(len=:), allocatable, intent(out) :: message   !< why not SET_OK ('' else)
+    integer, intent(in) :: n                !< unknowns
+    type(error_t), intent(out) :: err       !< ERR_INPUT or ERR_NUMERICAL and why
     character(len=120) :: buf
     integer :: k, j, i
     integer, allocatable :: seen(:)
-    call self%box_set_t%validate(n, code, message)
-    if (code /= SET_OK) return
+    call self%box_set_t%validate(n, err)
+    if (err%failed()) return
     if (size(self%r) /= size(self%pair, 2) .or. size(self%disc) /= n) then
       write (buf, '(a,i0,a,i0)') 'size mismatch: ', size(self%pair, 2), ' pairs, radii ', size(self%r)
-      code = SET_BAD_ARG
-      message = trim(buf)
+      call err%set(ERR_INPUT, trim(buf))
       return
     end if
     allocate (seen(n), source=0)
@@ -168,28 +166,24 @@ contains
       ! (two tests: an ordered comparison with a NaN would raise the invalid flag)
       if (.not. ieee_is_finite(self%r(k))) then
         write (buf, '(a,i0,a)') 'r(', k, ') is not a finite radius >= 0'
-        code = SET_NONFINITE
-        message = trim(buf)
+        call err%set(ERR_NUMERICAL, trim(buf))
         return
       end if
       if (self%r(k) < 0.0_wp) then
         write (buf, '(a,i0,a)') 'r(', k, ') is not a finite radius >= 0'
-        code = SET_BAD_ARG
-        message = trim(buf)
+        call err%set(ERR_INPUT, trim(buf))
         return
       end if
       do j = 1, 2
         i = self%pair(j, k)
         if (i < 1 .or. i > n) then
           write (buf, '(a,i0,a,i0,a,i0)') 'pair ', k, ' names variable ', i, ' outside 1..', n
-          code = SET_BAD_ARG
-          message = trim(buf)
+          call err%set(ERR_INPUT, trim(buf))
           return
         end if
         if (seen(i) /= 0) then
           write (buf, '(a,i0,a,i0,a,i0)') 'variable ', i, ' is in pair ', seen(i), ' and in pair ', k
-          code = SET_BAD_ARG
-          message = trim(buf)
+          call err%set(ERR_INPUT, trim(buf))
           return
         end if
         seen(i) = k

@@ -5,9 +5,9 @@ errors travel").
   - `fatal` (the exit with a message) is called only under src/driver/: every other module
     reports a failure through `type(error_t), intent(out) :: err`;
   - no procedure a module exports (in its `public` list, bound to a public type, or the
-    interface of a deferred binding) has an integer or logical status out-argument named
-    info, stat, istat, ierr, ok or why, LAPACK's own wrappers (src/linalg/lapack.f90) and the
-    driver excepted;
+    interface of a deferred binding) has a status out-argument (integer, logical or text)
+    named info, stat, istat, ierr, ok, why, msg, emsg or message, LAPACK's own wrappers
+    (src/linalg/lapack.f90) and the driver excepted;
   - no NaN is made in src/ (a failure is an error_t, never a NaN in the result);
   - `stop` only in the driver, in errors.f90's exit and in the serial MPI stand-in's abort.
 Each check is also run on a made-up source that must make it fail.
@@ -22,7 +22,7 @@ sys.path.insert(0, os.path.join(ROOT, "tools"))
 from rc_checks import Checks  # noqa: E402
 
 check = Checks()
-STATUS = {"info", "stat", "istat", "ierr", "ok", "why"}
+STATUS = {"info", "stat", "istat", "ierr", "ok", "why", "msg", "emsg", "message"}
 EXEMPT = {"src/linalg/lapack.f90"}           # LAPACK's own interfaces keep LAPACK's INFO
 STOP_ALLOWED = {"src/base/errors.f90", "src/parallel/mpi_env_serial.f90"}
 
@@ -107,7 +107,7 @@ def exported_status_args(text):
         if END.match(s):
             if depth == 1 and (name in exported or not default_private):
                 for d in decls:
-                    if re.search(r"intent\s*\(\s*(in)?out\s*\)", d) and re.match(r"^(integer|logical)\b", d):
+                    if re.search(r"intent\s*\(\s*(in)?out\s*\)", d) and re.match(r"^(integer|logical|character)\b", d):
                         for v in re.findall(r"(\w+)\s*(?:\([^)]*\))?\s*(?:=[^,]*)?(?:,|$)", d.split("::", 1)[-1]):
                             if v in STATUS and v in args:
                                 out.append((name, v))
@@ -140,7 +140,7 @@ for f in below:
     if f in EXEMPT:
         continue
     bad += [f"{f}: {p}({a})" for p, a in exported_status_args(open(os.path.join(ROOT, f)).read())]
-check(not bad, "no exported procedure below the driver has an info/stat/ok/why out-argument "
+check(not bad, "no exported procedure below the driver has an info/stat/ok/why/msg out-argument "
       "(LAPACK's wrappers excepted)", "; ".join(bad[:8]) + (f" (+{len(bad) - 8} more)" if len(bad) > 8 else ""))
 made_up = """module m
   implicit none (type, external)
@@ -171,8 +171,9 @@ contains
 end module m
 """
 found = sorted(exported_status_args(made_up))
-check(found == [("bad_one", "info"), ("t_run", "ok")],
-      "the status check finds a public procedure's info and a bound procedure's ok, and not a private helper's",
+check(found == [("bad_one", "info"), ("t_run", "ok"), ("t_run", "why")],
+      "the status check finds a public procedure's info and a bound procedure's ok and why, and not a private "
+      "helper's",
       str(found))
 
 nan = [f for f in files if re.search(r"ieee_quiet_nan|ieee_signaling_nan", open(os.path.join(ROOT, f)).read(), re.I)]

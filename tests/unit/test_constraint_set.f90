@@ -8,8 +8,9 @@
 program test_constraint_set
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   use linop, only: dense_op_t, dense_op_init
-  use constraint_set, only: box_set_t, box_set, SET_OK, SET_BAD_ARG, SET_NONFINITE
+  use constraint_set, only: box_set_t, box_set
   use mprgp, only: mprgp_t, MPRGP_CONVERGED
   use testing, only: report, test_summary, set_seed, urand, random_spd
   implicit none (type, external)
@@ -231,21 +232,20 @@ contains
   !> Wrong sizes, NaN and an empty box are refused, a valid box accepted.
   subroutine test_validate()
     type(box_set_t) :: box
-    integer :: code
-    character(len=:), allocatable :: why
+    type(error_t) :: verr
     real(wp) :: nan
     box = box_set([0.0_wp, 0.0_wp], [1.0_wp, 1.0_wp])
-    call box%validate(2, code, why)
-    call report(code == SET_OK .and. len(why) == 0, 'box: a valid box is accepted')
-    call box%validate(3, code, why)
-    call report(code == SET_BAD_ARG, 'box: wrong size refused ('//why//')')
+    call box%validate(2, verr)
+    call report(.not. verr%failed() .and. len(verr%text()) == 0, 'box: a valid box is accepted')
+    call box%validate(3, verr)
+    call report(verr%category == ERR_INPUT, 'box: wrong size refused ('//verr%text()//')')
     box = box_set([0.0_wp, 0.0_wp], [1.0_wp, -1.0_wp])
-    call box%validate(2, code, why)
-    call report(code == SET_BAD_ARG .and. index(why, 'empty') > 0, 'box: ub < lb refused ('//why//')')
+    call box%validate(2, verr)
+    call report(verr%category == ERR_INPUT .and. index(verr%text(), 'empty') > 0, 'box: ub < lb refused ('//verr%text()//')')
     nan = ieee_value(1.0_wp, ieee_quiet_nan)
     box = box_set([0.0_wp, nan])
-    call box%validate(2, code, why)
-    call report(code == SET_NONFINITE, 'box: NaN bound refused ('//why//')')
+    call box%validate(2, verr)
+    call report(verr%category == ERR_NUMERICAL, 'box: NaN bound refused ('//verr%text()//')')
     box = box_set([0.0_wp, 0.0_wp])
     call report(all(box%ub == big), 'box: without ub, ub = +huge')
   end subroutine test_validate

@@ -25,8 +25,8 @@
 program test_disc_set
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use kinds, only: wp
+  use errors, only: error_t, ERR_INPUT, ERR_NUMERICAL
   use linop, only: dense_op_t, dense_op_init
-  use constraint_set, only: SET_OK, SET_BAD_ARG, SET_NONFINITE
   use tangent_discs, only: disc_set_t, disc_set, friction_set
   use constraint_set, only: constraint_set_t
   use mprgp, only: mprgp_t, MPRGP_CONVERGED, QP_NEWTON, QP_MPRGP, QP_AUTO
@@ -189,25 +189,24 @@ contains
   !> Bad sets are refused with their reason.
   subroutine test_validate()
     type(disc_set_t) :: set
-    integer :: code
-    character(len=:), allocatable :: why
+    type(error_t) :: verr
     real(wp) :: nan
     set = node_set([1.0_wp, 2.0_wp])
-    call set%validate(6, code, why)
-    call report(code == SET_OK .and. why == '', 'validate: a good set')
+    call set%validate(6, verr)
+    call report(.not. verr%failed() .and. verr%text() == '', 'validate: a good set')
     set = node_set([1.0_wp, -2.0_wp])
-    call set%validate(6, code, why)
-    call report(code == SET_BAD_ARG .and. index(why, 'r(2)') > 0, 'validate: a negative radius: '//why)
+    call set%validate(6, verr)
+    call report(verr%category == ERR_INPUT .and. index(verr%text(), 'r(2)') > 0, 'validate: a negative radius: '//verr%text())
     nan = ieee_value(1.0_wp, ieee_quiet_nan)
     set = node_set([nan, 2.0_wp])
-    call set%validate(6, code, why)
-    call report(code == SET_NONFINITE .and. index(why, 'r(1)') > 0, 'validate: a NaN radius: '//why)
+    call set%validate(6, verr)
+    call report(verr%category == ERR_NUMERICAL .and. index(verr%text(), 'r(1)') > 0, 'validate: a NaN radius: '//verr%text())
     set = disc_set([0.0_wp, 0.0_wp, 0.0_wp], reshape([2, 4], [2, 1]), [1.0_wp])
-    call set%validate(3, code, why)
-    call report(code == SET_BAD_ARG .and. index(why, 'outside') > 0, 'validate: a pair out of range: '//why)
+    call set%validate(3, verr)
+    call report(verr%category == ERR_INPUT .and. index(verr%text(), 'outside') > 0, 'validate: a pair out of range: '//verr%text())
     set = disc_set([0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], reshape([1, 2, 2, 3], [2, 2]), [1.0_wp, 1.0_wp])
-    call set%validate(4, code, why)
-    call report(code == SET_BAD_ARG .and. index(why, 'variable 2') > 0, 'validate: a variable in two pairs: '//why)
+    call set%validate(4, verr)
+    call report(verr%category == ERR_INPUT .and. index(verr%text(), 'variable 2') > 0, 'validate: a variable in two pairs: '//verr%text())
   end subroutine test_validate
 
   !> A = I: the minimiser of 1/2|x|^2 - b'x over the set is P(b).

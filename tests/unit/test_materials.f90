@@ -148,7 +148,7 @@ contains
     type(error_t) :: err
     real(wp), allocatable :: up(:), u(:), sigma(:, :), vm(:)
     real(wp) :: s(3), e(3), szz, worst, sworst, umax, h
-    character(len=:), allocatable :: msg
+    type(error_t) :: merr
     character(len=80) :: what
     character(len=256) :: emsg
     integer :: k, info
@@ -170,8 +170,8 @@ contains
     body%element = element
     body%bc = BC_DISPLACEMENT
     allocate (body%law(1))
-    call material_law(m, angle, plane_strain, body%law(1), msg)
-    call report(len(msg) == 0, trim(what)//': material_law accepts the material')
+    call material_law(m, angle, plane_strain, body%law(1), merr)
+    call report(.not. merr%failed(), trim(what)//': material_law accepts the material')
     call grid_mesh(msh, body)
     h = 0.3_wp*body%width/body%nx                 ! distort the interior nodes
     do k = 1, msh%nnode
@@ -210,7 +210,7 @@ contains
     type(material_cfg_t) :: m
     type(elastic_law_t) :: law
     type(body_cfg_t) :: b
-    character(len=:), allocatable :: msg
+    type(error_t) :: merr
     real(wp) :: la, mu
     integer :: ip
     m%kind = MAT_ISOTROPIC
@@ -219,7 +219,7 @@ contains
     b%young = m%young
     b%poisson = m%poisson
     do ip = 1, 2
-      call material_law(m, 30.0_wp, ip == 1, law, msg)
+      call material_law(m, 30.0_wp, ip == 1, law, merr)
       call lame_parameters(b, ip == 1, la, mu)
       call report(law%isotropic .and. law%lame_lambda == la .and. law%lame_mu == mu .and. &
                   law%d(1, 1) == la + 2*mu .and. law%d(3, 3) == mu, &
@@ -230,9 +230,9 @@ contains
 
   subroutine turn_swaps()
     type(elastic_law_t) :: l0, l90
-    character(len=:), allocatable :: msg
-    call material_law(ortho(), 0.0_wp, .true., l0, msg)
-    call material_law(ortho(), 90.0_wp, .true., l90, msg)
+    type(error_t) :: merr
+    call material_law(ortho(), 0.0_wp, .true., l0, merr)
+    call material_law(ortho(), 90.0_wp, .true., l90, merr)
     call report(abs(l90%d(1, 1) - l0%d(2, 2)) <= 1e-12_wp*l0%d(1, 1) .and. &
                 abs(l90%d(2, 2) - l0%d(1, 1)) <= 1e-12_wp*l0%d(1, 1) .and. &
                 abs(l90%d(4, 1) - l0%d(4, 2)) <= 1e-12_wp*l0%d(1, 1) .and. abs(l90%d(1, 3)) <= 1e-12_wp*l0%d(1, 1), &
@@ -259,23 +259,23 @@ contains
   subroutine bad_materials()
     type(material_cfg_t) :: m
     type(elastic_law_t) :: law
-    character(len=:), allocatable :: msg
+    type(error_t) :: merr
     m = ortho()
     m%nu12 = 4.0_wp          ! nu12^2 = 16 > E1/E2 = 14
-    call material_law(m, 0.0_wp, .false., law, msg)
-    call report(index(msg, 'not positive definite') > 0 .and. index(msg, 'eigenvalue') > 0, &
+    call material_law(m, 0.0_wp, .false., law, merr)
+    call report(index(merr%text(), 'not positive definite') > 0 .and. index(merr%text(), 'eigenvalue') > 0, &
                 'orthotropic nu12 = 4 with E1/E2 = 14: refused, its compliance''s eigenvalue named')
     m = ortho()
     m%e3 = UNSET
-    call material_law(m, 0.0_wp, .true., law, msg)
-    call report(index(msg, 'plane strain') > 0 .and. index(msg, 'e3') > 0, &
+    call material_law(m, 0.0_wp, .true., law, merr)
+    call report(index(merr%text(), 'plane strain') > 0 .and. index(merr%text(), 'e3') > 0, &
                 'orthotropic without e3 in plane strain: refused, e3 named')
-    call material_law(m, 0.0_wp, .false., law, msg)
-    call report(len(msg) == 0, 'orthotropic without e3 in plane stress: accepted (not needed)')
+    call material_law(m, 0.0_wp, .false., law, merr)
+    call report(.not. merr%failed(), 'orthotropic without e3 in plane stress: accepted (not needed)')
     m = aniso()
     m%c12 = 300.0_wp          ! c12^2 > c11 c22
-    call material_law(m, 0.0_wp, .true., law, msg)
-    call report(index(msg, 'stiffness is not positive definite') > 0 .and. index(msg, '-') > 0, &
+    call material_law(m, 0.0_wp, .true., law, merr)
+    call report(index(merr%text(), 'stiffness is not positive definite') > 0 .and. index(merr%text(), '-') > 0, &
                 'anisotropic c12 = 300 > sqrt(c11 c22): refused, the negative eigenvalue named')
   end subroutine bad_materials
 
