@@ -22,7 +22,7 @@ module strings
   private
 
   public :: fpstate_t, fp_read_begin, fp_read_end, lower, is_ident, is_letter, first_nonblank
-  public :: i2s, roundtrip, sci, fixed, quote, quoted_list, next_word, index_of, word, body_label
+  public :: i2s, roundtrip, sci, fixed, quote, quoted_list, next_word, index_of, word
 
   !> Saved floating-point halting modes and flags.
   type :: fpstate_t
@@ -146,13 +146,6 @@ contains
       i2s_len = i2s_len + 1
     end do
   end function i2s_len
-
-  !> The label of body a in messages and names: '1', '2'.
-  pure function body_label(a) result(s)
-    integer, intent(in) :: a   !< the body's number
-    character(len=:), allocatable :: s
-    s = i2s(a)
-  end function body_label
 
   !> A character value as a namelist string literal (quotes doubled).
   pure function quote(s) result(r)

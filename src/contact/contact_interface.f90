@@ -22,7 +22,7 @@ module contact_interface
   use strings, only: i2s, sci
   use int_hash, only: int_hash_t, hash_init, hash_slot, HASH_EMPTY
   use assembly, only: body_system_t
-  use errors, only: error_t, ERR_INPUT
+  use errors, only: error_t, ERR_INPUT, ERR_MEMORY
   implicit none (type, external)
   private
 
@@ -333,7 +333,7 @@ contains
     type(contact_cfg_t), intent(in) :: pairs(:)   !< the pairs, oriented, rectangle sides resolved
     logical, intent(in) :: named                  !< the deck names its pairs (messages)
     type(mesh_t), intent(in) :: msh(:)            !< meshes of all bodies
-    type(error_t), intent(out) :: err             !< ERR_INPUT naming both groups and a shared edge
+    type(error_t), intent(out) :: err             !< ERR_INPUT naming both groups and a shared edge (ERR_MEMORY: no room to compare)
     type(int_hash_t) :: h
     integer, allocatable :: owner(:), nend(:)
     integer :: a, p, s, g, e, slot, n1, n2, n3, ne, q, t
@@ -365,7 +365,7 @@ contains
         end do
         call hash_init(h, ne, mem)
         if (mem%failed()) then
-          call err%set(ERR_INPUT, 'body '//i2s(a)//': not enough memory to compare its contact groups'' '// &
+          call err%set(ERR_MEMORY, 'body '//i2s(a)//': not enough memory to compare its contact groups'' '// &
                        i2s(ne)//' edges')
           return
         end if
@@ -484,6 +484,7 @@ contains
     character(len=300) :: what(2)               ! each side's words for messages
     type(mortar_t) :: mt
     type(error_t) :: why
+    character(len=:), allocatable :: gtext      ! a sentence about a group (built by a subroutine: threads)
 
     do s = 1, 2
       if (named) then
@@ -497,20 +498,22 @@ contains
         g(s) = group_index(m, cc%body_group(s))
         if (g(s) == 0) then
           if (named) then
+            call group_names(m, gtext)
             call err%set(ERR_INPUT, trim(what(s))//' has no group '''//trim(cc%body_group(s))//''' with edges on '// &
-                         'its boundary; its groups are '//group_names(m))
+                         'its boundary; its groups are '//gtext)
           else
+            call group_names(m, gtext)
             call err%set(ERR_INPUT, trim(what(s))//' has no such group with edges on its boundary; its groups are '// &
-                         group_names(m))
+                         gtext)
           end if
           return
         end if
         if (nodes_only(m, g(s))) then
+          call nodes_only_refusal(m, g(s), 'contact needs', gtext)
           if (named) then
-            call err%set(ERR_INPUT, trim(what(s))//': group '''//trim(cc%body_group(s))//''': '// &
-                         nodes_only_refusal(m, g(s), 'contact needs'))
+            call err%set(ERR_INPUT, trim(what(s))//': group '''//trim(cc%body_group(s))//''': '//gtext)
           else
-            call err%set(ERR_INPUT, trim(what(s))//': '//nodes_only_refusal(m, g(s), 'contact needs'))
+            call err%set(ERR_INPUT, trim(what(s))//': '//gtext)
           end if
           return
         end if

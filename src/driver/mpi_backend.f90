@@ -14,7 +14,7 @@ module mpi_backend
   use contact_types, only: STATUS_FAILED
   use sysinfo, only: peak_rss_mb, node_memory_limit_mb, process_memory_limit_mb
   use budget, only: rank_memory_mb, check_budget_ranks, body_rank_map
-  use strings, only: i2s, body_label
+  use strings, only: i2s
   use mpi_env, only: par_finalize, par_split, par_bcast_reals, par_bcast_ints, par_agree, par_max_real, &
                      par_sum_real, par_node_sum
   use factorization, only: new_factor
@@ -104,7 +104,7 @@ contains
     self%group_rank = merge(run%rank - self%host, 0, self%mine)
     do a = 1, nb
       if (self%group_size(a) > run%meshes(a)%ncell) call fatal(EXIT_INPUT, 'deck '//trim(run%deck%source)// &
-        ': '//i2s(self%group_size(a))//' ranks for body '//body_label(a)//', which has '// &
+        ': '//i2s(self%group_size(a))//' ranks for body '//i2s(a)//', which has '// &
         i2s(run%meshes(a)%ncell)//' cells: use fewer ranks (at most one per cell of each body)')
     end do
     color = run%rank
@@ -330,7 +330,7 @@ contains
     type(error_t) :: err
     do b = size(self%err), 1, -1
       if (self%err(b)%failed()) &
-        call err%set(self%err(b)%category, 'body '//body_label(b)//': '//what//': '//self%err(b)%text())
+        call err%set(self%err(b)%category, 'body '//i2s(b)//': '//what//': '//self%err(b)%text())
     end do
     call par_agree(err)
     call fail_on(err)

@@ -30,7 +30,7 @@ module run_phases
   use signals, only: stop_requested, pending_signal
   use sysinfo, only: peak_rss_mb
   use budget, only: body_memory_mb
-  use strings, only: sci, i2s, word, body_label
+  use strings, only: sci, i2s, word
   use sorting, only: largest_first
   use omp_lib, only: omp_get_max_threads, omp_set_max_active_levels, omp_set_num_threads
   use clock, only: wtime
@@ -297,7 +297,7 @@ contains
     end if
     do a = 1, run%nbody
       associate (system => run%systems(a))
-        if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//body_label(a)//' is held only by '// &
+        if (system%nrig > 0) write (output_unit, '(a)') 'floating: body '//i2s(a)//' is held only by '// &
           'contact (free: '//free_list(system)//'); fixing DOFs for its generalized inverse: '//fixing_list(system, run%meshes(a)%node_tag)// &
           '; kernel check |K R|/(|K| |R|) = '//sci(system%rig_residual)
       end associate
@@ -406,8 +406,8 @@ contains
         ! a body whose contact DOFs are all prescribed does not move on the contact: the
         ! problem is the other body's obstacle problem, one QP, which is also the Robin
         ! iteration's fixed point (doc/method.md, "A body rigid on the contact")
-        write (output_unit, '(a)') 'robin: body '//body_label(rigid)//' does not move on the contact (every '// &
-          'contact DOF prescribed): the contact problem is body '//body_label(3 - rigid)// &
+        write (output_unit, '(a)') 'robin: body '//i2s(rigid)//' does not move on the contact (every '// &
+          'contact DOF prescribed): the contact problem is body '//i2s(3 - rigid)// &
           '''s obstacle problem, solved as one QP (method monolithic)'
         call solve_monolithic(deck%solver, contact_line, bodies, result, stop_requested)
       else
@@ -444,7 +444,7 @@ contains
             scale = norm2(e)
             ratio = '|G lam - e|/|e| = '
           end if
-          write (output_unit, '(a)') 'equilibrium: body '//body_label(a)//' '//ratio// &
+          write (output_unit, '(a)') 'equilibrium: body '//i2s(a)//' '//ratio// &
             sci(norm2(matmul(g, own) - e)/scale)//' (its own force), '// &
             sci(norm2(matmul(g, mean) - e)/scale)//' (mean force); rigid motion '// &
             'amplitudes '//trim(amplitudes(run, a))//'; SMALBE multiplier updates '// &

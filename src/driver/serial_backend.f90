@@ -16,7 +16,7 @@ module serial_backend
   use run_state, only: run_t
   use run_backend, only: backend_t
   use load_history, only: step_interface_load
-  use strings, only: body_label
+  use strings, only: i2s
   implicit none (type, external)
   private
 
@@ -140,7 +140,7 @@ contains
     end do
     !$omp end parallel do
     do a = 1, run%nbody
-      call fail_on(err(a), 'body '//body_label(a)//': '//what)
+      call fail_on(err(a), 'body '//i2s(a)//': '//what)
     end do
   end subroutine each_body
 

@@ -16,7 +16,7 @@ module assembly
   use kinds, only: wp
   use space, only: NDIM, NCOMP, node_dof
   use, intrinsic :: iso_fortran_env, only: int16
-  use strings, only: body_label, sci
+  use strings, only: i2s, sci
   use sorting, only: sort_by_key
   use config, only: body_cfg_t, elastic_law_t, body_stiffness, traction_cfg_t, boundary_cfg_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, NSHAPE, &
                     SIDE_LEFT, SIDE_RIGHT, SIDE_TOP, side_names, BC_FREE, BC_DISPLACEMENT
@@ -134,14 +134,14 @@ contains
     laws = body_laws(body, plane_strain)
     if (allocated(mesh%cell_law)) then
       if (maxval(mesh%cell_law) > size(laws)) then
-        call err%set(ERR_NUMERICAL, 'body '//body_label(body%id)//': internal error, a cell''s law is '// &
+        call err%set(ERR_NUMERICAL, 'body '//i2s(body%id)//': internal error, a cell''s law is '// &
                      'beyond the body''s laws')
         return
       end if
     end if
     if (present(body_load)) then
       if (size(body_load, 3) /= size(laws)) then
-        call err%set(ERR_NUMERICAL, 'body '//body_label(body%id)//': internal error, body forces for '// &
+        call err%set(ERR_NUMERICAL, 'body '//i2s(body%id)//': internal error, body forces for '// &
                      'another number of laws')
         return
       end if
@@ -328,7 +328,7 @@ contains
     do k = 1, mesh%nnode
       if (abs(mesh%xy(1, k)) > tol) cycle
       if (prescribed(node_dof(k, 1)) .and. sys%u_fixed(node_dof(k, 1)) /= 0.0_wp) then
-        call err%set(ERR_INPUT, 'body '//body_label(sys%id)//': node '//body_label(mesh%node_tag(k))// &
+        call err%set(ERR_INPUT, 'body '//i2s(sys%id)//': node '//i2s(mesh%node_tag(k))// &
                      ' lies on the axis (x = 0), where ur = 0, but a support prescribes ux = '// &
                      sci(sys%u_fixed(node_dof(k, 1)))//' there; a body of revolution''s axis cannot move off it')
         return
@@ -388,6 +388,7 @@ contains
     !> (2, laws) constant body force per volume in the cells of each law [force/length^3]
     real(wp), intent(in), optional :: body_load(:, :)
     integer :: t, g
+    character(len=:), allocatable :: why
 
     allocate (sys%f(sys%n), sys%f_applied(sys%ndof))
     sys%f = 0.0_wp
@@ -397,13 +398,13 @@ contains
       if (len_trim(tractions(t)%group) > 0) then
         g = group_index(mesh, tractions(t)%group)
         if (g == 0) then
-          call err%set(ERR_INPUT, 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
-                unknown_group(mesh, tractions(t)%group))
+          call unknown_group(mesh, tractions(t)%group, why)
+          call err%set(ERR_INPUT, 'body '//i2s(body_id)//': '//trim(tractions(t)%origin)//': '//why)
           return
         end if
         if (nodes_only(mesh, g)) then
-          call err%set(ERR_INPUT, 'body '//body_label(body_id)//': '//trim(tractions(t)%origin)//': '// &
-                nodes_only_refusal(mesh, g, 'a traction needs'))
+          call nodes_only_refusal(mesh, g, 'a traction needs', why)
+          call err%set(ERR_INPUT, 'body '//i2s(body_id)//': '//trim(tractions(t)%origin)//': '//why)
           return
         end if
         if (NDIM == 3) then

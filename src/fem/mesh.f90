@@ -559,10 +559,11 @@ contains
   !> The names of the body's groups, quoted and comma-separated, a physical point's
   !! followed by ' (point)', a curve's inside the body by ' (inside the body)' (a volume
   !! mesh's other groups of nodes only, a physical curve or a surface inside the body, by
-  !! ' (nodes only)') (for messages).
-  function group_names(mesh) result(s)
+  !! ' (nodes only)') (for messages). A subroutine, not a function: messages are built on
+  !! threads (doc/developing.md, Conventions).
+  subroutine group_names(mesh, s)
     type(mesh_t), intent(in) :: mesh
-    character(len=:), allocatable :: s
+    character(len=:), allocatable, intent(out) :: s
     integer :: g
     s = ''
     do g = 1, mesh%ngroup
@@ -577,7 +578,7 @@ contains
       end if
     end do
     if (mesh%ngroup == 0) s = '(none)'
-  end function group_names
+  end subroutine group_names
 
   !> The distinct nodes of group g (those of its edges and its single nodes), in
   !! increasing node id.
@@ -609,11 +610,11 @@ contains
   !> The sentence refusing group g (nodes_only) where boundary edges are needed: `use` is
   !! what needs them, with its verb, e.g. 'a traction needs' or 'contact needs'. In space
   !! (a volume mesh) what is needed is a surface with faces on the boundary.
-  function nodes_only_refusal(mesh, g, use) result(s)
+  subroutine nodes_only_refusal(mesh, g, use, s)
     type(mesh_t), intent(in) :: mesh        !< the body's mesh
     integer, intent(in) :: g                !< a group without edges (nodes_only)
     character(len=*), intent(in) :: use     !< what needs a curve, with its verb
-    character(len=:), allocatable :: s
+    character(len=:), allocatable, intent(out) :: s   !< the sentence
     if (size(mesh%xy, 1) == 3) then
       if (mesh%group(g)%point) then
         s = "group '"//mesh%group(g)%name//"' is a physical point: "//use//' a surface'
@@ -633,7 +634,7 @@ contains
     end if
     s = s//' (a physical curve with edges on the boundary of the body); a group of nodes can '// &
         'only prescribe displacements (&boundary)'
-  end function nodes_only_refusal
+  end subroutine nodes_only_refusal
 
   !> The nodes on one side of the mesh, ordered by increasing s (x on bottom/top,
   !! y on left/right), corners included. An unknown side gives an empty list.

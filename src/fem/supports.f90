@@ -4,7 +4,7 @@
 module supports
   use kinds, only: wp
   use space, only: NDIM, NCOMP, node_dof
-  use strings, only: body_label
+  use strings, only: i2s
   use config, only: body_cfg_t, boundary_cfg_t, BC_CLAMPED, BC_ROLLER, BC_DISPLACEMENT, side_axis
   use mesh, only: mesh_t, side_nodes, group_index, group_names, group_nodes
   use body_system, only: body_system_t
@@ -84,13 +84,14 @@ contains
     type(error_t), intent(out) :: err                  !< ERR_INPUT: an unknown group
     integer :: i, g, k, cc, dof
     integer, allocatable :: nodes(:)
+    character(len=:), allocatable :: why
 
     do i = 1, size(boundaries)
       if (boundaries(i)%body /= body_id) cycle
       g = group_index(mesh, boundaries(i)%group)
       if (g == 0) then
-        call err%set(ERR_INPUT, 'body '//body_label(body_id)//': '//trim(boundaries(i)%origin)//': '// &
-                     unknown_group(mesh, boundaries(i)%group))
+        call unknown_group(mesh, boundaries(i)%group, why)
+        call err%set(ERR_INPUT, 'body '//i2s(body_id)//': '//trim(boundaries(i)%origin)//': '//why)
         return
       end if
       call group_nodes(mesh, g, nodes)
@@ -108,29 +109,32 @@ contains
 
   !> The sentence for a group name the body's mesh does not have (in space: no face, and
   !! the physical surfaces of its volume mesh's file).
-  function unknown_group(mesh, name) result(s)
+  subroutine unknown_group(mesh, name, s)
     type(mesh_t), intent(in) :: mesh      !< the body's mesh
     character(len=*), intent(in) :: name  !< the group name it lacks
-    character(len=:), allocatable :: s, src
+    character(len=:), allocatable, intent(out) :: s   !< the sentence
+    character(len=:), allocatable :: src, names
     src = 'the rectangle'
     if (mesh%box) src = 'the box'
     if (allocated(mesh%source)) then
       if (len(mesh%source) > 0) src = mesh%source
     end if
     if (NDIM == 3) then
+      call group_names(mesh, names)
       s = 'group '''//trim(name)//''' has no face on the boundary of this body ('//src// &
-          '); its groups are '//group_names(mesh)
+          '); its groups are '//names
       if (allocated(mesh%file_groups) .and. .not. mesh%box) then
         if (len_trim(mesh%file_groups) > 0) s = s//' (physical surfaces of the file: '//trim(mesh%file_groups)//')'
       end if
       return
     end if
+    call group_names(mesh, names)
     s = 'group '''//trim(name)//''' has no edge on the boundary of this body ('//src// &
-        '); its groups are '//group_names(mesh)
+        '); its groups are '//names
     if (allocated(mesh%file_groups) .and. .not. mesh%structured) then
       if (len_trim(mesh%file_groups) > 0) s = s//' (physical curves of the file: '//trim(mesh%file_groups)//')'
     end if
-  end function unknown_group
+  end subroutine unknown_group
 
   !> Number the DOFs that are not prescribed 1..n in increasing global order
   !! (sys%n, sys%free_of, sys%dof_of).

@@ -28,7 +28,7 @@ module results
   use config, only: deck_t, ELEM_Q1, ELEM_P1, ELEM_MIXED, ELEM_HEX8, ELEM_TET4, element_names, FACTOR_CHOICES, FRICTION_NONE, &
                     XDMF_PER_BODY, XDMF_COLLECTION, XDMF_PER_BODY_MAX, MAT_ISOTROPIC, contact_cfg_t, pair_oriented, &
                     side_names, BC_CONTACT, METHOD_CHOICES, program_version
-  use strings, only: word, body_label, i2s, text_buffer_t
+  use strings, only: word, i2s, text_buffer_t
   use mesh, only: mesh_t, file_order, file_cells, file_dof, group_index
   use body_system, only: body_system_t
   use contact_interface, only: interface_t, pair_rows, row_directions
@@ -214,7 +214,7 @@ contains
   pure function body_group_name(a) result(g)
     integer, intent(in) :: a   !< the body
     character(len=:), allocatable :: g
-    g = 'body'//body_label(a)
+    g = 'body'//i2s(a)
   end function body_group_name
 
   !> Whether a result of nb bodies and np pairs has one XDMF file per body and per pair
@@ -245,7 +245,7 @@ contains
     name(1) = file
     name(2) = replace_suffix(file, '.h5', '.xdmf')
     do k = 1, nb
-      name(2 + k) = replace_suffix(file, '.h5', '_body'//body_label(k)//'.xdmf')
+      name(2 + k) = replace_suffix(file, '.h5', '_body'//i2s(k)//'.xdmf')
     end do
     name(3 + nb) = replace_suffix(file, '.h5', '_contact.xdmf')
     if (np > 1) then
@@ -453,7 +453,7 @@ contains
     call fields%body_fields(0, a, fields%last%pressure, bf)
     vm = file_order(msh, bf%von_mises)
     if (.not. (all(ieee_is_finite(bf%stress)) .and. all(ieee_is_finite(vm)))) then
-      call err%set(ERR_IO, 'the stresses of body '//body_label(a)//' are not finite: beyond double precision, rescale the units')
+      call err%set(ERR_IO, 'the stresses of body '//i2s(a)//' are not finite: beyond double precision, rescale the units')
       return
     end if
     uf = file_order(msh, reshape(ua, [NCOMP, nn]))
@@ -584,7 +584,7 @@ contains
         end associate
         call fields%body_fields(k, a, cf%pressure, bf)
         if (.not. (all(ieee_is_finite(bf%stress)) .and. all(ieee_is_finite(bf%von_mises))) .and. .not. st%failed()) &
-          call st%set(ERR_IO, 'the stresses of body '//body_label(a)//' in load step '//i2s(k)// &
+          call st%set(ERR_IO, 'the stresses of body '//i2s(a)//' in load step '//i2s(k)// &
                       ' are not finite: beyond double precision, rescale the units')
         sigt = transpose(file_order(msh(a), bf%stress))
         call write_dset(gid, 'stress', sigt, st, us)
@@ -1057,9 +1057,9 @@ contains
     write (nn, '(i0)') msh%nnode
     write (nc, '(i0)') msh%ncell
     write (nv, '(i0)') msh%nvert
-    g = h5//':/body'//body_label(a)
-    fg = h5//':'//fields//'/body'//body_label(a)
-    t = line('      <Grid Name="body'//body_label(a)//'" GridType="Uniform">')//time
+    g = h5//':/body'//i2s(a)
+    fg = h5//':'//fields//'/body'//i2s(a)
+    t = line('      <Grid Name="body'//i2s(a)//'" GridType="Uniform">')//time
     t = t//line('        <Topology TopologyType="'//trim(topo)//'" NumberOfElements="'//trim(nc)//'">')
     if (msh%element == ELEM_MIXED) then
       write (nv, '(i0)') topology_size(msh)

@@ -24,7 +24,7 @@ module factorization
   use cholesky, only: chol_t, FACT_CHOLMOD, FACT_BANDED, ORD_METIS, ORD_AMD, ORD_NATURAL, ORD_GIVEN, ORD_NODES
   use mumps_iface, only: mumps_t, mumps_schur_factor, mumps_solve, mumps_end
   use errors, only: error_t, ERR_NUMERICAL, ERR_MEMORY
-  use strings, only: body_label
+  use strings, only: i2s
   implicit none (type, external)
   private
 
@@ -163,9 +163,9 @@ contains
   !! codes (cholesky's FACT_*, cholmod_iface's ORD_*): the deck's lists are what a user may
   !! write, linalg's what a factorization can do (MUMPS is no chol_t; 'nd' is ORD_GIVEN or
   !! ORD_NODES by the dimension), and config, upstream of linalg, cannot use linalg's.
-  subroutine new_factor(fc, body, fac, comm)
+  subroutine new_factor(fc, body_id, fac, comm)
     type(factor_cfg_t), intent(in) :: fc                  !< factorization and ordering
-    integer, intent(in) :: body                           !< the body, for messages
+    integer, intent(in) :: body_id                        !< the body's number, for messages
     class(factor_t), allocatable, intent(out) :: fac      !< the new factor
     integer, intent(in), optional :: comm                 !< MUMPS: the body's group of ranks
     select case (fc%factorization)
@@ -199,7 +199,7 @@ contains
         end select
       end select
     end select
-    fac%body = body
+    fac%body = body_id
   end subroutine new_factor
 
   !> A factor on one rank holds its results (a distributed one overrides this).
@@ -407,7 +407,7 @@ contains
     real(wp), intent(in), optional :: tval(:)             !< their values [stress]
     self%n = 0
     if (.not. (present(irn) .and. present(jcn) .and. present(tval))) then
-      call err%set(ERR_NUMERICAL, 'MUMPS: the factorization of body '//body_label(self%body)// &
+      call err%set(ERR_NUMERICAL, 'MUMPS: the factorization of body '//i2s(self%body)// &
                    ' needs its share of the stiffness as triplets.')
       return
     end if
@@ -431,7 +431,7 @@ contains
     type(error_t), intent(out) :: err             !< the failure, if any
     if (self%n <= 0) then
       call err%set(ERR_NUMERICAL, 'MUMPS: solve called without a valid factorization of body '// &
-                   body_label(self%body)//'.')
+                   i2s(self%body)//'.')
       return
     end if
     call mumps_solve(self%mt, b, self%body, err)
@@ -446,7 +446,7 @@ contains
     type(error_t), intent(out) :: err             !< the failure, if any
     character(len=120) :: emsg
     if (self%n <= 0 .or. .not. allocated(self%mt%x)) then
-      call err%set(ERR_NUMERICAL, 'MUMPS: the interface inverse of body '//body_label(self%body)// &
+      call err%set(ERR_NUMERICAL, 'MUMPS: the interface inverse of body '//i2s(self%body)// &
                    ' was asked for without a valid factorization.')
       return
     end if

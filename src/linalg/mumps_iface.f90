@@ -10,7 +10,7 @@
 !! compiles mumps_iface_none.f90 (same API, every call an error) instead.
 module mumps_iface
   use kinds, only: wp
-  use strings, only: body_label
+  use strings, only: i2s
   use lapack, only: dpotrf, dpotri
   use mpi, only: MPI_Bcast, MPI_INTEGER
   use errors, only: error_t, ERR_NUMERICAL
@@ -155,7 +155,7 @@ contains
 
     subroutine fail(what)
       character(len=*), intent(in) :: what
-      call err%set(ERR_NUMERICAL, 'MUMPS '//what//' of body '//body_label(body)//' failed: '// &
+      call err%set(ERR_NUMERICAL, 'MUMPS '//what//' of body '//i2s(body)//' failed: '// &
                    trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body)))
     end subroutine fail
 
@@ -219,7 +219,7 @@ contains
     end if
   contains
     subroutine fail()
-      call err%set(ERR_NUMERICAL, 'MUMPS solve with body '//body_label(body)//' failed: '// &
+      call err%set(ERR_NUMERICAL, 'MUMPS solve with body '//i2s(body)//' failed: '// &
                    trim(mumps_error_text(mt%id%INFOG(1), mt%id%INFOG(2), body)))
       if (associated(mt%id%RHS)) deallocate (mt%id%RHS)
       if (associated(mt%id%REDRHS)) deallocate (mt%id%REDRHS)
@@ -248,7 +248,7 @@ contains
     write (c, '(a,i0,a,i0,a)') '(INFO(1) = ', info1, ', INFO(2) = ', info2, ')'
     select case (info1)
     case (-10)
-      s = 'the stiffness of body '//body_label(body)//' is singular (not held against rigid motion?) '//trim(c)
+      s = 'the stiffness of body '//i2s(body)//' is singular (not held against rigid motion?) '//trim(c)
     case (-19)
       s = 'the working memory cap per rank (ROBIN_MUMPS_MAX_MB, ICNTL(23)) is too small for the factor '//trim(c)
     case (-9, -8, -14, -15, -17, -20)
@@ -258,7 +258,7 @@ contains
     case (-5, -7)
       s = 'out of memory in the MUMPS analysis: use more ranks per body or a coarser mesh '//trim(c)
     case (-6)
-      s = 'the stiffness of body '//body_label(body)//' is structurally singular '//trim(c)
+      s = 'the stiffness of body '//i2s(body)//' is structurally singular '//trim(c)
     case default
       s = 'MUMPS error '//trim(c)//' (see the MUMPS user guide, section "Error diagnostics")'
     end select

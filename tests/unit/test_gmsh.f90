@@ -650,7 +650,7 @@ contains
       call report(nodes_only(a, g) .and. a%group(g)%point .and. a%group(g)%nedge == 0 .and. size(nodes) == 1, &
                   "'corner': one node, no edge")
       if (size(nodes) == 1) call report(a%node_tag(nodes(1)) == 3, "'corner' is the node of tag 3 (shared with the cells)")
-      s = nodes_only_refusal(a, g, 'a traction needs')
+      call nodes_only_refusal(a, g, 'a traction needs', s)
       call report(index(s, "group 'corner' is a physical point: a traction needs a curve") > 0, &
                   'a point group is refused for a traction: '//s)
     end if
@@ -666,7 +666,7 @@ contains
       call report(nodes_only(a, g) .and. .not. a%group(g)%point .and. size(nodes) == 2, &
                   "'diag': the nodes of an inside curve, no edge")
       if (size(nodes) == 2) call report(all(a%node_tag(nodes) == [1, 3]), "'diag': nodes of tags 1 and 3")
-      s = nodes_only_refusal(a, g, 'contact needs')
+      call nodes_only_refusal(a, g, 'contact needs', s)
       call report(index(s, "group 'diag' is a curve inside the body") > 0, 'an inside curve is refused for contact: '//s)
     end if
     g = group_index(a, 'base')
@@ -677,7 +677,7 @@ contains
                   "'base': its edge, and the point 'base' on its node")
       if (size(nodes) == 2) call report(all(a%node_tag(nodes) == [1, 2]), "'base': nodes of tags 1 and 2")
     end if
-    s = group_names(a)
+    call group_names(a, s)
     call report(index(s, "'corner' (point)") > 0 .and. index(s, "'diag' (inside the body)") > 0, &
                 'group_names marks points and inside curves: '//s)
     call report(index(a%file_groups, 'physical points: corner free_pt both base') > 0, &

@@ -693,7 +693,7 @@ contains
       call report(nodes_only(m, g) .and. .not. m%group(g)%point .and. size(nodes) == 3, &
                   "'mid': the three nodes of an inner face, no face")
       if (size(nodes) == 3) call report(all(sorted(m%node_tag(nodes)) == [1, 2, 14]), "'mid': nodes 1, 2, 14")
-      s = nodes_only_refusal(m, g, 'contact needs')
+      call nodes_only_refusal(m, g, 'contact needs', s)
       call report(index(s, "'mid' has no face on the boundary") > 0 .and. index(s, 'a surface on the boundary') > 0, &
                   'an inner surface is refused for contact: '//s)
     end if
@@ -710,7 +710,7 @@ contains
       call group_nodes(m, g, nodes)
       call report(m%group(g)%point .and. size(nodes) == 1, "'corner': one node")
       if (size(nodes) == 1) call report(m%node_tag(nodes(1)) == 27, "'corner': node 27")
-      s = nodes_only_refusal(m, g, 'a traction needs')
+      call nodes_only_refusal(m, g, 'a traction needs', s)
       call report(index(s, "'corner' is a physical point: a traction needs a surface") > 0, &
                   'a point is refused for a traction: '//s)
     end if

@@ -33,7 +33,7 @@ program test_ordering
   use condense, only: body_condensed_t, factor_body, condense_body
   use factorization, only: cholmod_factor_t, factor_t, new_factor
   use clock, only: wtime
-  use strings, only: body_label
+  use strings, only: i2s
   use testing, only: grid_mesh, report, report_le, test_summary, rectangle_body, structured_body, general_body, &
                      side_free_dofs, order_body, factor_ordered, error_parts, box_system
   use errors, only: error_t, ERR_NUMERICAL
@@ -370,7 +370,7 @@ contains
         call factor_body(d%solver%factor, itf, a, msh(a), sys(a), cbody(a, o), err)
         call error_parts(err, info, msg)
         call report(info == 0 .and. interface_last(cbody(a, o)), &
-                    'factor_body ordering='''//trim(ords(o))//''', body '//body_label(a)//': ok, interface last '//trim(msg))
+                    'factor_body ordering='''//trim(ords(o))//''', body '//i2s(a)//': ok, interface last '//trim(msg))
         if (info /= 0) return
         call condense_body(sys(a), cbody(a, o), err)
         call error_parts(err, info, msg)
@@ -380,7 +380,7 @@ contains
     do a = 1, 2
       dflex = norm2(cbody(a, 2)%flex - cbody(a, 1)%flex)/max(norm2(cbody(a, 1)%flex), tiny(1.0_wp))
       db = norm2(cbody(a, 2)%b - cbody(a, 1)%b)/max(norm2(cbody(a, 1)%b), tiny(1.0_wp))
-      call report_le(max(dflex, db), FLEX_TOL, 'body '//body_label(a)//': F_a and b_a with ''nd'' = with ''metis''')
+      call report_le(max(dflex, db), FLEX_TOL, 'body '//i2s(a)//': F_a and b_a with ''nd'' = with ''metis''')
       call cbody(a, 1)%fac%free()
       call cbody(a, 2)%fac%free()
     end do
