@@ -55,6 +55,7 @@ contains
     real(wp) :: lmax, lmin, nl, perr, lprev, rq, mprev
     integer :: m, i, k, ki, ib
     logical :: definite
+    type(error_t) :: serr     ! a solve with the factor of H
     m = contact_line%m
     res%error_bound = 0.0_wp
     res%kappa = 1.0_wp
@@ -103,7 +104,11 @@ contains
       rq = 0.0_wp
       do ki = 1, 60
         y = x
-        call hs%solve(y)
+        call hs%solve(y, serr)
+        if (serr%failed()) then     ! no estimate of lambda_min: no bound
+          definite = .false.
+          exit
+        end if
         ! x'H^-1 x, an estimate of 1/lambda_min from below: settled when it moves by less
         ! than 1e-6 an iteration
         mprev = rq
@@ -220,10 +225,10 @@ contains
 
   !> x <- H^-1 x (after hessian_factor). Dense: the two triangular solves with L and L'
   !! (dtrsv; dpotrs with one right-hand side goes through dtrsm, three times slower here).
-  subroutine hessian_solve(self, x)
+  subroutine hessian_solve(self, x, err)
     class(hessian_t), intent(inout) :: self
     real(wp), intent(inout), contiguous :: x(:)
-    type(error_t) :: err
+    type(error_t), intent(out) :: err     !< CHOLMOD's solve failed (then: no bound)
     if (self%sparse) then
       call self%chol%solve(x, err)
     else

@@ -51,13 +51,16 @@ contains
     type(run_t), intent(in) :: run          !< the run: its rank and ranks
     type(deck_t), intent(in) :: the_deck    !< the deck to size
     real(wp) :: est, node_est
-    integer :: node_ranks
+    integer :: node_ranks, cat
     type(error_t) :: err
     est = rank_memory_mb(the_deck, run%ranks, run%rank)
     call par_node_sum(est, node_est, node_ranks)
     call check_budget_ranks(the_deck, run%ranks, run%rank, est, node_est, node_ranks, node_memory_limit_mb(), &
                             process_memory_limit_mb(), err)
-    if (err%failed()) call err%set(err%category, 'deck '//trim(the_deck%source)//': '//err%text())
+    if (err%failed()) then
+      cat = err%category     ! not err%category itself: set writes it
+      call err%set(cat, 'deck '//trim(the_deck%source)//': '//err%text())
+    end if
     call par_agree(err)
     call fail_on(err)
   end subroutine check_memory

@@ -16,12 +16,16 @@ module mpi_env
 
 contains
 
-  !> Start MPI (once).
+  !> Start MPI (once). MPI's own failures are fatal (MPI_ERRORS_ARE_FATAL on the world, which
+  !! the groups split from it inherit): a failed collective aborts every rank, which is all a
+  !! translation into an error_t could do midway through one; so the `ierr` of the calls
+  !! here is never other than MPI_SUCCESS when they return.
   subroutine par_init()
     integer :: ierr
     logical :: up
     call MPI_Initialized(up, ierr)
     if (.not. up) call MPI_Init(ierr)
+    call MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_ARE_FATAL, ierr)
   end subroutine par_init
 
   !> End MPI (every rank calls it, collectively).

@@ -261,6 +261,7 @@ contains
                       (tq(1, q)*v(2*q - 1) + tq(2, q)*v(2*q))
       end do
       call dpotrs('L', nd, 1, sm, nd, rhs(nf + 1:), nd, info)
+      if (info /= 0) return
       ! z_F - W T delta_D
       do q = 1, nd
         v(2*q - 1:2*q) = tq(:, q)*rhs(nf + q)

@@ -31,7 +31,7 @@ program test_checkpoint
   use files, only: temp_name
   use errors, only: error_t, ERR_INPUT, ERR_IO
   use strings, only: i2s
-  use testing, only: report, test_summary, write_file, set_seed, urand, file_bytes
+  use testing, only: report, test_summary, write_file, set_seed, urand, file_bytes, scratch_path, fresh_folder
   implicit none (type, external)
 
   !> the test's files: in its own build folder, beside the folder of the test programs (a
@@ -47,11 +47,9 @@ program test_checkpoint
   type(step_result_t), target :: done(2)
   character(len=:), allocatable :: file
   character(len=4096) :: arg
-  integer :: rc
 
   call set_dimension(2)
-  call get_command_argument(0, arg)
-  dir = arg(1:index(arg, '/', back=.true.))//'../test-checkpoint'
+  dir = scratch_path('test-checkpoint')
   ! `test_checkpoint --sweep FILE`: read corrupted copies of FILE (a child process: a crash
   ! ends it, not the test)
   if (command_argument_count() >= 2) then
@@ -63,7 +61,7 @@ program test_checkpoint
     end if
   end if
   call set_seed(4242)
-  call execute_command_line('rm -rf '//dir//' && mkdir -p '//dir, exitstat=rc)
+  call fresh_folder(dir)
   file = checkpoint_file(dir//'/run.h5')
   call report(file == dir//'/run.h5.ckpt.h5', 'checkpoint_file: <result file>.ckpt.h5')
 

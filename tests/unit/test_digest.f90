@@ -4,14 +4,13 @@ program test_digest
   use digest, only: file_digest, text_digest
   use, intrinsic :: iso_fortran_env, only: int8
   use errors, only: error_t
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, scratch_path, fresh_folder
   implicit none (type, external)
   character(len=:), allocatable :: dir
-  character(len=4096) :: arg
   character(len=16) :: h1, h2
   character(len=3000) :: big
   type(error_t) :: err
-  integer :: u, rc, i
+  integer :: u, i
 
   ! published FNV-1a 64 vectors (http://www.isthe.com/chongo/src/fnv/test_fnv.c)
   call report(text_digest('') == 'cbf29ce484222325', 'FNV-1a 64 of "" (got '//text_digest('')//')')
@@ -22,9 +21,8 @@ program test_digest
 
   ! the files in build/<kind>/test-digest (beside the folder of this program): a release
   ! and a checked make check running at once share none
-  call get_command_argument(0, arg)
-  dir = arg(1:index(arg, '/', back=.true.))//'../test-digest'
-  call execute_command_line('rm -rf '//dir//' && mkdir -p '//dir, exitstat=rc)
+  dir = scratch_path('test-digest')
+  call fresh_folder(dir)
   do i = 1, len(big)
     big(i:i) = achar(32 + mod(7*i, 90))
   end do

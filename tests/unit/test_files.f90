@@ -5,10 +5,9 @@
 program test_files
   use files, only: temp_name, run_id, commit_files, write_text, remove_file, dir_name
   use errors, only: error_t, ERR_IO
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, scratch_path, fresh_folder
   implicit none (type, external)
   character(len=:), allocatable :: dir
-  character(len=4096) :: arg
   character(len=512) :: fin(3)
   character(len=640) :: tmp(3)
   character(len=:), allocatable :: t1, t2
@@ -17,9 +16,8 @@ program test_files
 
   ! the files in build/<kind>/test-files (beside the folder of this program): a release
   ! and a checked make check running at once share none
-  call get_command_argument(0, arg)
-  dir = arg(1:index(arg, '/', back=.true.))//'../test-files'
-  call execute_command_line('rm -rf '//dir//' && mkdir -p '//dir, exitstat=rc)
+  dir = scratch_path('test-files')
+  call fresh_folder(dir)
   do k = 1, 3
     write (fin(k), '(a,i0,a)') dir//'/f', k, '.txt'
   end do

@@ -11,10 +11,9 @@ program test_h5io
                   CLASS_REAL, CLASS_INTEGER, CLASS_VSTRING
   use files, only: data_open, data_write, data_close
   use errors, only: error_t, ERR_IO
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, scratch_path
   implicit none (type, external)
   character(len=:), allocatable :: path
-  character(len=4096) :: arg
   real(wp), target :: a(3, 4)
   integer, target :: ids(5)
   real(wp), allocatable :: a2(:, :)
@@ -27,8 +26,7 @@ program test_h5io
 
   ! the file build/<kind>/test-h5io.h5 (beside the folder of this program): a release and a
   ! checked make check running at once share none
-  call get_command_argument(0, arg)
-  path = arg(1:index(arg, '/', back=.true.))//'../test-h5io.h5'
+  path = scratch_path('test-h5io.h5')
   do j = 1, 4
     do i = 1, 3
       a(i, j) = real(10*i + j, wp) + 0.125_wp

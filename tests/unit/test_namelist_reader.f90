@@ -35,7 +35,7 @@ program test_namelist_reader
                             unknown_group
   use errors, only: error_t, exit_code, ERR_INPUT, EXIT_INPUT
   use strings, only: i2s
-  use testing, only: report, test_summary
+  use testing, only: report, test_summary, scratch_path, fresh_folder
   implicit none (type, external)
 
   character(len=*), parameter :: NL = achar(10)
@@ -49,14 +49,11 @@ program test_namelist_reader
   character(len=16), target :: name
   character(len=8), target :: names(2)
   type(vars_t) :: t
-  character(len=4096) :: arg
-  integer :: rc
 
   call part_table(t)
   ! beside the folder of this program (build/<kind>/tests/)
-  call get_command_argument(0, arg)
-  dir = arg(1:index(arg, '/', back=.true.))//'../test-namelist'
-  call execute_command_line('rm -rf '//dir//' && mkdir -p '//dir, exitstat=rc)
+  dir = scratch_path('test-namelist')
+  call fresh_folder(dir)
 
   call test_layout()
   call test_reals()

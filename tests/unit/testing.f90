@@ -31,7 +31,7 @@ module testing
   public :: rectangle_body, structured_body, general_body, side_free_dofs, order_body, factor_ordered, box_system
   public :: set_seed, urand, random_spd, spd_from_eigs, solve_once
   public :: random_bounds, enumerate_box, box_projected, identity
-  public :: error_parts, grid_mesh, grid_mesh_parts, box_mesh_parts, file_bytes
+  public :: error_parts, grid_mesh, grid_mesh_parts, box_mesh_parts, file_bytes, scratch_path, fresh_folder
 
 contains
 
@@ -81,6 +81,32 @@ contains
     end do
     close (u)
   end subroutine write_file
+
+  !> A path for a test's files beside the folder of the running test program
+  !! (build/<kind>/name for build/<kind>/tests/test_x), so that a release and a checked
+  !! `make check` running at once share none; `name` in the current folder when the program
+  !! was started without a path.
+  function scratch_path(name) result(path)
+    character(len=*), intent(in) :: name   !< a file or folder name, e.g. 'test-files'
+    character(len=:), allocatable :: path
+    character(len=4096) :: arg
+    integer :: k
+    call get_command_argument(0, arg)
+    k = index(arg, '/', back=.true.)
+    if (k == 0) then
+      path = name
+    else
+      path = arg(1:k)//'../'//name
+    end if
+  end function scratch_path
+
+  !> Remove the folder `dir` with what it holds, and make it anew (empty).
+  subroutine fresh_folder(dir)
+    character(len=*), intent(in) :: dir   !< the folder (from scratch_path)
+    integer :: rc
+    call execute_command_line("rm -rf '"//dir//"' && mkdir -p '"//dir//"'", exitstat=rc)
+    if (rc /= 0) error stop 'fresh_folder: cannot make '//dir
+  end subroutine fresh_folder
 
   !> The whole file as bytes ('' when it cannot be read).
   function file_bytes(path) result(b)
