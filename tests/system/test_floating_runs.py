@@ -38,6 +38,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "..", "tools"))
 from rc_checks import Checks  # noqa: E402
 from rc_results import rel_err, text_attr  # noqa: E402
+from plane_decks import PAPER_ROLLER  # noqa: E402
 from rc_run import result_fields, run_solver, solver_env  # noqa: E402
 from hertz_study import hertz_fit  # noqa: E402
 
@@ -57,16 +58,7 @@ R_DISC = 1.0
 
 ROLLER = os.path.join(OUT, "paper_roller.nml")
 with open(ROLLER, "w") as f:
-    f.write("""! the paper's scene, body 1 on a roller (ux = 0 on its left side): held vertically only by contact
-&body id=1, x0=0.0, y0=1.0, width=3.0, height=1.0, nx=24, ny=16, young=2.1e11, poisson=0.277 /
-&body id=2, x0=0.0, y0=0.0, width=3.0, height=1.0, nx=24, ny=16, young=2.1e11, poisson=0.277 /
-&boundary body=1, group='left', ux=0.0 /
-&boundary body=2, group='left', ux=0.0, uy=0.0 /
-&traction body=1, side='top', t0=0.0, -3.0e6, t1=0.0, -1.0e6 /
-&traction body=1, side='right', t0=0.0, 2.0e6 /
-&contact body1_group='bottom', body2_group='top' /
-&solver robin_operator='harmonic', delta=0.5, tol=1e-10 /
-""")
+    f.write(PAPER_ROLLER)
 # the same, ux = 0 on body 1's top instead: free are the vertical translation and a rotation
 # about a point of the top line (two equilibrium rows: force and moment)
 ROLLER_TOP = os.path.join(OUT, "paper_roller_top.nml")

@@ -26,6 +26,7 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools"))
 from rc_checks import Checks  # noqa: E402
 from rc_run import result_fields, solver_env  # noqa: E402
+from plane_decks import PAPER_ROLLER  # noqa: E402
 
 BIN = os.path.abspath(os.environ.get("BIN", "bin/robin_contact"))
 OUT = os.path.abspath(os.path.join(os.environ.get("BUILD", "build/release"), "test-out", "restart_trust"))
@@ -38,15 +39,7 @@ os.makedirs(OUT)
 # contact, so its checkpoint carries SMALBE multipliers /state/mu; about 25 outer iterations
 ROLLER = os.path.join(OUT, "roller.nml")
 with open(ROLLER, "w") as f:
-    f.write("""&body id=1, x0=0.0, y0=1.0, width=3.0, height=1.0, nx=24, ny=16, young=2.1e11, poisson=0.277 /
-&body id=2, x0=0.0, y0=0.0, width=3.0, height=1.0, nx=24, ny=16, young=2.1e11, poisson=0.277 /
-&boundary body=1, group='left', ux=0.0 /
-&boundary body=2, group='left', ux=0.0, uy=0.0 /
-&traction body=1, side='top', t0=0.0, -3.0e6, t1=0.0, -1.0e6 /
-&traction body=1, side='right', t0=0.0, 2.0e6 /
-&contact body1_group='bottom', body2_group='top' /
-&solver robin_operator='harmonic', delta=0.5, tol=1e-10 /
-""")
+    f.write(PAPER_ROLLER)
 
 
 def out(name):
