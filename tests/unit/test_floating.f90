@@ -26,7 +26,7 @@ program test_floating
   use smalbe, only: smalbe_solve, smalbe_stats_t
   use nonneg_lsq, only: nnls, sparse_cols_t, NNLS_ACTIVE_SET, NNLS_INTERIOR
   use lapack, only: dgesv, dsyev
-  use testing, only: grid_mesh_parts, report, report_le, test_summary, set_seed, error_parts
+  use testing, only: grid_mesh_parts, report, report_le, test_summary, set_seed, error_parts, spd_from_eigs
   use errors, only: error_t
   implicit none (type, external)
 
@@ -339,25 +339,16 @@ contains
   end subroutine disc_case
 
   ! ---------------------------------------------------------------------------------------
-  !> A random SPD matrix with eigenvalues in [1, kappa].
+  !> A random SPD matrix with eigenvalues in [1, kappa] (1 among them), by testing's
+  !! spd_from_eigs.
   subroutine random_spd(h, kappa)
     real(wp), intent(out) :: h(:, :)
     real(wp), intent(in) :: kappa
-    real(wp), allocatable :: q(:, :), d(:)
-    integer :: n, j, k
-    n = size(h, 1)
-    allocate (q(n, n), d(n))
-    call uniform(q, -1.0_wp, 1.0_wp)
-    do j = 1, n   ! orthonormal columns
-      do k = 1, j - 1
-        q(:, j) = q(:, j) - dot_product(q(:, k), q(:, j))*q(:, k)
-      end do
-      q(:, j) = q(:, j)/norm2(q(:, j))
-    end do
+    real(wp), allocatable :: d(:)
+    allocate (d(size(h, 1)))
     call uniform(d, 1.0_wp, kappa)
     d(1) = 1.0_wp
-    h = matmul(q*spread(d, 1, n), transpose(q))
-    h = 0.5_wp*(h + transpose(h))
+    call spd_from_eigs(size(h, 1), d, h)
   end subroutine random_spd
 
   !> The QP min 1/2 x'Hx - c'x, x >= l, Gx = e by enumerating the free sets F: solve
@@ -432,7 +423,10 @@ contains
     solver%opts%rtol = 1.0e-14_wp
     solver%opts%lambda_max = lmax + rho*ev(r)
     solver%opts%eq_m = lmax/sqrt(ev(r))           ! SMALBE's initial M
-    solver%opts%eq_feas = 1.0e-14_wp*norm2(e)     ! |Gx - e| that counts as feasible
+    ! |Gx - e| that counts as feasible: 1e-14 of |e| or of |G| |x|, whichever is larger (a
+    ! small e from terms of G x that cancel is not known better than the terms' rounding)
+    solver%opts%eq_feas = 1.0e-14_wp*norm2(e)
+    solver%opts%eq_feas_x = 1.0e-14_wp*sqrt(ev(r))
     x = max(l, 0.0_wp)
     mu = 0.0_wp
     call smalbe_solve(solver, op, c, gm, e, rho, l, x, mu, st)
