@@ -53,7 +53,16 @@ module robin_subproblems
     !> friction in space: each body's discs (its rows' positions of a node's two tangential
     !! forces, contact_interface's disc_positions); none in the plane
     type(disc_list_t), allocatable :: discs(:)
+    !> friction in space: each body's Hessian on the rows its last Newton solve left free to
+    !! move (not held at 0 by a disc of radius 0: Coulomb on a node without normal force)
+    type(reduced_t), allocatable :: reduced(:)
   end type subproblems_t
+
+  !> A body's Hessian on some of its rows.
+  type :: reduced_t
+    integer, allocatable :: rows(:)       !< the rows (increasing); not allocated: none yet
+    type(dense_op_t) :: op                !< the Hessian on them
+  end type reduced_t
 
   !> The discs of one body's rows.
   type :: disc_list_t
@@ -90,7 +99,7 @@ contains
     n = size(bodies)
     allocate (subproblems%flexibility(n), subproblems%hessian(n), subproblems%proximal(n), subproblems%equality(n))
     allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n), subproblems%newton_work(n))
-    allocate (subproblems%discs(n))
+    allocate (subproblems%discs(n), subproblems%reduced(n))
     do a = 1, n
       subproblems%discs(a)%pos = disc_positions(contact_line, slot_row(bodies(a)%slots, contact_line%m))
     end do
@@ -257,6 +266,17 @@ contains
     end if
     inner_solver%opts%max_it = solver%inner_max_it
     inner_solver%opts%method = inner_method(solver%inner_solver, state%newton(a))
+    ! friction in space under 'auto', a body held by its supports: the Newton method on the
+    ! discs once the body has forces, on the rows not held at 0 (solve_reduced). From a warm
+    ! start its steps move a few discs at a time on row updates of one factor a solve, where
+    ! MPGP's expansions along the circles took hundreds of products a solve while the stick
+    ! and slip sets still moved (doc/performance.md, the 3D Hertz pair with friction). The
+    ! first solve (no forces yet; Coulomb's first bounds are unbounded, every row free) by
+    ! 'auto' as before.
+    if (solver%inner_solver == INNER_AUTO .and. size(subproblems%discs(a)%pos) > 0 .and. &
+        subproblems%equality(a)%r == 0) then
+      if (any(gather(state%lam, cbody%slots) /= 0.0_wp)) inner_solver%opts%method = QP_NEWTON
+    end if
     inner_solver%opts%newton_budget = max(1, state%newton(a) - 1, -state%newton(a))
     inner_solver%opts%polish_scale = max(1.0_wp, POLISH_RTOL/max(rtol_in, tiny(1.0_wp)))
     inner_solver%opts%lambda_max = subproblems%lmax_hessian(a)
@@ -321,7 +341,11 @@ contains
         call newton_factor(subproblems%hessian(a)%a, pack([(i, i=1, m)], lam0 > lb), subproblems%newton_work(a), &
                            definite, flops)
       end if
-      call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
+      if (inner_solver%opts%method == QP_NEWTON .and. size(subproblems%discs(a)%pos) > 0 .and. size(ub) > 0) then
+        call solve_reduced()
+      else
+        call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
+      end if
       inner = inner_solver%stats
     end if
     ! the factor is carried into the next solve when it is the one LAPACK makes of the free
@@ -377,6 +401,68 @@ contains
     call directions_in(raw, state%raw)
 
   contains
+
+    !> The Newton method on the discs without the rows a disc of radius 0 holds at 0 (both
+    !! its forces; Coulomb on a node without normal force: most of a large candidate
+    !! surface), whose columns add nothing to a product and whose rows need no gradient
+    !! until the end: on p of the m rows a product costs (p/m)^2 of one on all, and so does
+    !! every step's work outside the face's factor. The reduced Hessian is kept while the
+    !! rows stay (a copy of F_a's entries: the same values on a resumed run). A x on every
+    !! row at the end from the columns of the nonzero forces. inner%n_matvec counts
+    !! products on all m rows.
+    subroutine solve_reduced()
+      integer, allocatable :: idx(:), map(:), pr(:, :)
+      real(wp), allocatable :: xr(:), axf(:)
+      class(constraint_set_t), allocatable :: rset
+      integer :: p, j, q
+      idx = pack([(i, i=1, m)], .not. (lb == 0.0_wp .and. ub == 0.0_wp))
+      p = size(idx)
+      if (16*p > 15*m) then
+        call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
+        return
+      end if
+      associate (red => subproblems%reduced(a))
+        if (allocated(red%rows)) then
+          if (size(red%rows) /= p) deallocate (red%rows)
+        end if
+        if (allocated(red%rows)) then
+          if (any(red%rows /= idx)) deallocate (red%rows)
+        end if
+        if (.not. allocated(red%rows)) then
+          red%rows = idx
+          call dense_op_init(red%op, subproblems%hessian(a)%a(idx, idx))
+        end if
+      end associate
+      allocate (map(m), source=0)
+      map(idx) = [(j, j=1, p)]
+      ! a disc's two rows share their bound: kept or left out together
+      associate (pos => subproblems%discs(a)%pos)
+        pr = reshape([(map(pos(:, q)), q=1, size(pos, 2))], [2, size(pos, 2)])
+        pr = pr(:, pack([(q, q=1, size(pos, 2))], pr(1, :) > 0))
+      end associate
+      rset = friction_set(lb(idx), ub(idx), pr)
+      xr = lam(idx)
+      if (inner_solver%opts%use_ax) inner_solver%ax = inner_solver%ax(idx)
+      if (allocated(inner_solver%s)) then
+        if (all(inner_solver%s(pack([(i, i=1, m)], map == 0)) == 0.0_wp)) then
+          inner_solver%s = inner_solver%s(idx)
+          inner_solver%as = inner_solver%as(idx)
+        else
+          deallocate (inner_solver%s, inner_solver%as)
+        end if
+      end if
+      call inner_solver%solve_in(subproblems%reduced(a)%op, rhs(idx), rset, xr)
+      lam = 0.0_wp
+      lam(idx) = xr
+      allocate (axf(m), source=0.0_wp)
+      do j = 1, p
+        if (xr(j) /= 0.0_wp) axf = axf + subproblems%hessian(a)%a(:, idx(j))*xr(j)
+      end do
+      inner_solver%ax = axf
+      inner_solver%g = axf - rhs
+      inner_solver%stats%n_matvec = nint(real(inner_solver%stats%n_matvec, wp)*(real(p, wp)/real(m, wp))**2 + &
+                                         real(count(xr /= 0.0_wp), wp)/real(m, wp))
+    end subroutine solve_reduced
 
     !> The body's directions out of the side layout (column by column: each a contiguous
     !! column of `all` read at the body's rows).
