@@ -20,7 +20,9 @@ module condense
   use ordering, only: grid_dissection, coordinate_bisection
   use clock, only: wtime
   use errors, only: error_t, ERR_MEMORY
-  use lapack, only: dpotrf_tiles, dpotrs, dpocon, dpstrf, dsyevr, dsyevd, dsyev, dgemm, dgeqrf, dorgqr, dsytrf
+  use lapack, only: dpotrf_tiles, dpotrs, dpocon, dpstrf, dsyevr, dsyevd, dsyev, dgemm, dgeqrf, dorgqr, dsytrf, &
+                    tiles_begin, tiles_end
+  use iso_c_binding, only: c_long
   implicit none (type, external)
   private
 
@@ -623,9 +625,9 @@ contains
   !! the other body's F).
   subroutine flex_rank(cbody)
     type(body_condensed_t), intent(inout) :: cbody
-    real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :)
+    real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :), lsh(:, :)
     integer, allocatable :: piv(:), isuppz(:), iwork(:)
-    integer :: lapinfo, r, lwork, liwork, k, nfound, nnear
+    integer :: lapinfo, r, lwork, liwork, k, nfound, nnear, shinfo
     logical :: halting(size(ieee_usual)), converged
     real(wp) :: dmax, rcond, anorm
     integer :: i
@@ -693,7 +695,18 @@ contains
     ! how many eigenvalues lie below NEAR_KERNEL max diag: the inertia of F_a - NEAR_KERNEL
     ! max diag I (Sylvester), its negative eigenvalues those of D in L D L' (a quarter of the
     ! tridiagonal reduction that counting by dsyevr took)
-    nnear = count_below(cbody%flex, NEAR_KERNEL*dmax)
+    if (cbody%m >= SUBSPACE_MIN) then
+      ! the count and the shifted factor of the subspace iteration below need only F_a: two
+      ! tasks (a thread the body loop leaves idle takes one)
+      !$omp taskgroup
+      !$omp task default(shared)
+      nnear = count_below(cbody%flex, NEAR_KERNEL*dmax)
+      !$omp end task
+      call shifted_factor(cbody%flex, dmax, lsh, shinfo)
+      !$omp end taskgroup
+    else
+      nnear = count_below(cbody%flex, NEAR_KERNEL*dmax)
+    end if
     if (nnear > k) then
       k = nnear
       deallocate (z)
@@ -703,7 +716,8 @@ contains
     if (cbody%m >= SUBSPACE_MIN) then
       ! a large F_a: its k smallest eigenvectors by subspace iteration, a fraction of the
       ! tridiagonal reduction's time (LAPACK's own eigensolver when that does not converge)
-      call smallest_eigenvectors(cbody%flex, k, dmax, z, converged)
+      converged = .false.
+      if (shinfo == 0) call smallest_eigenvectors(cbody%flex, k, dmax, z, converged, lsh)
       if (converged) then
         lapinfo = 0
         nfound = k
@@ -775,27 +789,28 @@ contains
   !! at the ratio (lambda_i + sigma) / (lambda_b+1 + sigma) a solve). converged
   !! false (z undefined; the caller falls back to LAPACK's eigensolver) when the factor
   !! fails, b reaches m, or 12 solves do not converge.
-  subroutine smallest_eigenvectors(f, k, dmax, z, converged)
+  subroutine smallest_eigenvectors(f, k, dmax, z, converged, lsh)
     real(wp), intent(in) :: f(:, :)
     integer, intent(in) :: k
     real(wp), intent(in) :: dmax
     real(wp), allocatable, intent(out) :: z(:, :)
     logical, intent(out) :: converged   !< the k vectors found (else z undefined)
+    real(wp), intent(in), optional :: lsh(:, :)   !< shifted_factor's factor (else made here)
     integer, parameter :: MAX_SOLVES = 12
     real(wp), allocatable :: l(:, :), v(:, :), fv(:, :), hs(:, :), ev(:), work(:), tau(:)
-    integer :: m, b, i, j, it, info, lwork
+    integer :: m, b, i, j, it, info, lwork, h, info2
+    integer(c_long) :: ntiles
     real(wp) :: res
     m = size(f, 1)
     b = max(2*k, k + 32)
     converged = .false.
     if (k < 1 .or. b >= m) return
-    allocate (l(m, m))
-    l = f
-    do i = 1, m
-      l(i, i) = l(i, i) + 1.0e-10_wp*dmax
-    end do
-    call dpotrf_tiles('L', m, l, m, info)
-    if (info /= 0) return
+    if (present(lsh)) then
+      l = lsh
+    else
+      call shifted_factor(f, dmax, l, info)
+      if (info /= 0) return
+    end if
     allocate (v(m, b), fv(m, b), hs(b, b), ev(b), tau(b), work(1))
     ! a fixed start of full rank: cos of integer multiples (no random state)
     do j = 1, b
@@ -811,12 +826,21 @@ contains
     allocate (work(lwork))
     if (.not. orthonormal()) return
     do it = 1, MAX_SOLVES
-      call dpotrs('L', m, b, l, m, v, m, info)
-      if (info /= 0) return
+      ! the columns in two halves, two tasks (the same numbers for any thread count)
+      h = b/2
+      !$omp taskgroup
+      !$omp task default(shared)
+      call dpotrs('L', m, h, l, m, v, m, info2)
+      !$omp end task
+      call dpotrs('L', m, b - h, l, m, v(1, h + 1), m, info)
+      !$omp end taskgroup
+      if (info /= 0 .or. info2 /= 0) return
       if (.not. orthonormal()) return
       if (it < 3) cycle
       ! Rayleigh-Ritz: hs = v' f v, its eigenpairs, z = v y (ascending)
+      call tiles_begin()
       call dgemm('N', 'N', m, b, m, 1.0_wp, f, m, v, m, 0.0_wp, fv, m)
+      ntiles = tiles_end()
       call dgemm('T', 'N', b, b, m, 1.0_wp, v, m, fv, m, 0.0_wp, hs, b)
       hs = 0.5_wp*(hs + transpose(hs))
       call dsyev('V', 'L', b, hs, b, ev, work, lwork, info)
@@ -848,6 +872,23 @@ contains
     end function orthonormal
 
   end subroutine smallest_eigenvectors
+
+  !> The Cholesky factor (lower) of f + 1e-10 dmax I, the shift of smallest_eigenvectors'
+  !! inverse iteration; info /= 0: none.
+  subroutine shifted_factor(f, dmax, l, info)
+    real(wp), intent(in) :: f(:, :)
+    real(wp), intent(in) :: dmax
+    real(wp), allocatable, intent(out) :: l(:, :)
+    integer, intent(out) :: info
+    integer :: i, m
+    m = size(f, 1)
+    allocate (l(m, m))
+    l = f
+    do i = 1, m
+      l(i, i) = l(i, i) + 1.0e-10_wp*dmax
+    end do
+    call dpotrf_tiles('L', m, l, m, info)
+  end subroutine shifted_factor
 
   !> F_a = B_a X B_a' from k <= m/2 interface DOFs (a master surface at least twice as
   !! coarse as its slave): its rank is at most k and its range lies in that of B_a, so its

@@ -11,9 +11,10 @@
 module robin_operators
   use kinds, only: wp, ip
   use config, only: solver_cfg_t, ROBIN_CONSTANT, ROBIN_HARMONIC
-  use linop, only: dense_op_t, dense_op_init, dense_op_take
+  use linop, only: dense_op_t, dense_op_init, dense_op_take, symmetrize
   use cholesky, only: chol_t, FACT_CHOLMOD, ORD_AMD
-  use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk, dsymv, dtrsv
+  use lapack, only: dgemm, dposv, dgesv, dsyevd, dgesvd, dpotrf, dpotri, dpocon, dtrsm, dsyrk, dsymv, dtrsv, tiles_begin, tiles_end
+  use iso_c_binding, only: c_long
   use mprgp, only: lambda_max_estimate
   use contact_interface, only: interface_t, has_friction, slot_row, slot_side, DIR_NORMAL
   use condense, only: body_condensed_t
@@ -782,37 +783,73 @@ contains
     type(body_condensed_t), intent(in) :: bodies(:)
     integer, intent(in) :: a
     real(wp), intent(out) :: p(:, :)
-    real(wp), allocatable :: zf(:, :), zr(:, :), r(:, :), fo(:, :)
-    real(wp) :: floor
-    integer :: i, k, m
-    fo = partner_flex(contact_line, bodies, a)
-    if (allocated(bodies(a)%rng)) then
-      call range_proximal(bodies(a)%rng, fo, p)
-      return
+    integer :: o
+    ! one partner on all of a's rows in their order (two bodies): its F as it is, no copy
+    o = whole_partner(contact_line, bodies, a)
+    if (o > 0) then
+      call pin(bodies(o)%flex)
+    else
+      call pin(partner_flex(contact_line, bodies, a))
     end if
-    if (.not. allocated(bodies(a)%kern)) then
-      p = fo
-      return
-    end if
-    m = bodies(a)%m
-    k = size(bodies(a)%kern, 2)
-    allocate (zf(k, m), zr(m, k), r(k, k))
-    ! R = Z' F_o Z (k x k), F_o the partners' flexibilities, floored so that F_a + Pi_a is
-    ! definite even if F_o is nearly singular on ker F_a
-    call dgemm('T', 'N', k, m, m, 1.0_wp, bodies(a)%kern, m, fo, m, 0.0_wp, zf, k)
-    call dgemm('N', 'N', k, k, m, 1.0_wp, zf, k, bodies(a)%kern, m, 0.0_wp, r, k)
-    r = 0.5_wp*(r + transpose(r))
-    floor = 0.0_wp
-    do i = 1, m
-      floor = max(floor, 1.0e-10_wp*fo(i, i))
-    end do
-    do i = 1, k
-      r(i, i) = r(i, i) + floor
-    end do
-    call dgemm('N', 'N', m, k, k, 1.0_wp, bodies(a)%kern, m, r, k, 0.0_wp, zr, m)
-    call dgemm('N', 'T', m, m, k, 1.0_wp, zr, m, bodies(a)%kern, m, 0.0_wp, p, m)
-    p = 0.5_wp*(p + transpose(p))
+
+  contains
+
+    subroutine pin(fo)
+      real(wp), intent(in) :: fo(:, :)        !< the partners' flexibilities on a's rows
+      real(wp), allocatable :: zf(:, :), zr(:, :), r(:, :)
+      real(wp) :: floor
+      integer :: i, k, m
+      if (allocated(bodies(a)%rng)) then
+        call range_proximal(bodies(a)%rng, fo, p)
+        return
+      end if
+      if (.not. allocated(bodies(a)%kern)) then
+        p = fo
+        return
+      end if
+      m = bodies(a)%m
+      k = size(bodies(a)%kern, 2)
+      allocate (zf(k, m), zr(m, k), r(k, k))
+      ! R = Z' F_o Z (k x k), F_o the partners' flexibilities, floored so that F_a + Pi_a is
+      ! definite even if F_o is nearly singular on ker F_a
+      call dgemm('T', 'N', k, m, m, 1.0_wp, bodies(a)%kern, m, fo, m, 0.0_wp, zf, k)
+      call dgemm('N', 'N', k, k, m, 1.0_wp, zf, k, bodies(a)%kern, m, 0.0_wp, r, k)
+      r = 0.5_wp*(r + transpose(r))
+      floor = 0.0_wp
+      do i = 1, m
+        floor = max(floor, 1.0e-10_wp*fo(i, i))
+      end do
+      do i = 1, k
+        r(i, i) = r(i, i) + floor
+      end do
+      call dgemm('N', 'N', m, k, k, 1.0_wp, bodies(a)%kern, m, r, k, 0.0_wp, zr, m)
+      call dgemm('N', 'T', m, m, k, 1.0_wp, zr, m, bodies(a)%kern, m, 0.0_wp, p, m)
+      call symmetrize(p)
+    end subroutine pin
+
   end subroutine kernel_proximal
+
+  !> The body whose F is the partners' flexibility of body a as it is (partner_flex without
+  !! a copy): a's only pair's other body, when that pair holds all the rows of both in the
+  !! same order; 0 otherwise.
+  integer function whole_partner(contact_line, bodies, a) result(o)
+    type(interface_t), intent(in) :: contact_line
+    type(body_condensed_t), intent(in) :: bodies(:)
+    integer, intent(in) :: a
+    integer :: q, n, ra(2), ro(2), b
+    o = 0
+    n = 0
+    do q = 1, contact_line%npair
+      if (all(contact_line%pair_body(:, q) /= a)) cycle
+      n = n + 1
+      b = sum(contact_line%pair_body(:, q)) - a
+      ra = pair_positions(bodies(a), contact_line, q)
+      ro = pair_positions(bodies(b), contact_line, q)
+      if (n == 1 .and. b /= a .and. all(ra == [1, bodies(a)%m]) .and. all(ro == [1, bodies(b)%m]) .and. &
+          bodies(b)%m == bodies(a)%m) o = b
+    end do
+    if (n /= 1) o = 0
+  end function whole_partner
 
   !> kernel_proximal's Z R Z' from the range basis Q of F_a instead (Z Z' = I - Q Q', the
   !! kernel the larger part): P = (I - QQ') F_o (I - QQ') + floor (I - QQ'), as
@@ -843,7 +880,7 @@ contains
       call dgemm('N', 'T', m, m, r, -1.0_wp, q, m, c, m, 1.0_wp, p, m)
       call dgemm('N', 'T', m, m, r, -floor, q, m, q, m, 1.0_wp, p, m)
     end if
-    p = 0.5_wp*(p + transpose(p))
+    call symmetrize(p)
   end subroutine range_proximal
 
   !> S = 2 F_1 (F_1 + F_2)^-1 F_2 = 2 (F_1^-1 + F_2^-1)^-1 (symmetric positive definite).
@@ -862,16 +899,21 @@ contains
     real(wp), allocatable :: sk(:, :)
     integer, allocatable :: idx(:)
     integer :: k, i, m, kinfo(0:1)
+    integer(c_long) :: ntiles
     m = size(f1, 1)
     allocate (s(m, m))
     s = 0.0_wp
     kinfo = 0
     ! the two kinds' blocks (0: normal, 1: tangential) on the two threads (disjoint parts of s)
-    !$omp parallel do num_threads(body_threads()) schedule(static, 1) private(k, idx, sk) if (m > 256)
+    !$omp parallel do num_threads(body_threads()) schedule(static, 1) private(k, idx, sk, ntiles) if (m > 256)
     do k = 0, 1
       idx = pack([(i, i=1, m)], tangential .eqv. (k == 1))
       if (size(idx) == 0) cycle
+      ! as tiles: the thread of the smaller kind (the normal rows, a third of the tangential
+      ! ones) helps with the larger once it is done
+      call tiles_begin()
       call harmonic_lean(f1(idx, idx), f2(idx, idx), sk, kinfo(k))
+      ntiles = tiles_end()
       if (kinfo(k) == 0) s(idx, idx) = sk
     end do
     !$omp end parallel do

@@ -7,6 +7,8 @@
 !! bounds are built once, before the outer loop.
 module robin_subproblems
   use kinds, only: wp
+  use lapack, only: tiles_begin, tiles_end
+  use iso_c_binding, only: c_long
   use config, only: solver_cfg_t, ACCEL_NONE, INNER_MPRGP, INNER_ACTIVE_SET, INNER_AUTO
   use linop, only: dense_op_t, dense_op_init
   use mprgp, only: mprgp_t, mprgp_stats_t, MPRGP_CONVERGED, MPRGP_MAX_IT, mprgp_status_name, QP_AUTO, QP_MPRGP, &
@@ -96,6 +98,7 @@ contains
     real(wp), allocatable :: p(:, :)
     integer, allocatable :: nmv(:)
     integer :: a, k, n, m
+    integer(c_long) :: ntiles
     n = size(bodies)
     allocate (subproblems%flexibility(n), subproblems%hessian(n), subproblems%proximal(n), subproblems%equality(n))
     allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n), subproblems%newton_work(n))
@@ -109,7 +112,7 @@ contains
     nmv = 0
     ! every body's part on the threads: F_a, its bound, its Hessian (a copy of F_a, the
     ! proximal term, the penalty of its equilibrium rows)
-    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a, m, p) if (contact_line%m > 64)
+    !$omp parallel do num_threads(body_threads()) schedule(dynamic, 1) private(a, m, p, ntiles) if (contact_line%m > 64)
     do k = 1, n
       a = subproblems%order(k)
       m = bodies(a)%m
@@ -121,7 +124,10 @@ contains
       subproblems%proximal(a)%n = 0
       if (bodies(a)%prox > 0.0_wp) then
         allocate (p(m, m))
+        ! as tiles: a body without one (its copies done) lends its thread
+        call tiles_begin()
         call robin_op%proximal_term(contact_line, bodies, a, p)
+        ntiles = tiles_end()
         call dense_op_init(subproblems%proximal(a), p)
         subproblems%hessian(a)%a = subproblems%hessian(a)%a + p
         ! lambda_max(F_a + Pi_a) <= lambda_max(F_a) + |Pi_a|_inf

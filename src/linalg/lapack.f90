@@ -6,6 +6,7 @@
 !! OpenBLAS to one thread so that two OpenMP threads may call them at once.
 module lapack
   use kinds, only: wp
+  use iso_c_binding, only: c_long
   implicit none (type, external)
   private
 
@@ -13,6 +14,7 @@ module lapack
   public :: dpotrf, dpotrf_tiles, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels, dgesv, dsygv, dgesvd, dgeqrf, dorgqr, dsytrf
+  public :: tiles_begin, tiles_end
 
   interface
 
@@ -115,6 +117,19 @@ module lapack
       integer, intent(out) :: info          !< status (see above)
       real(wp), intent(inout) :: a(lda, *)  !< A on entry, its Cholesky factor on exit
     end subroutine dpotrf
+
+    !> From here on the calling thread's large dgemm, dsyrk, dtrsm and dpotrf (lower) calls
+    !! run as tiles, OpenMP tasks of the real routine that idle threads of the team take
+    !! (src/linalg/blas_tiles.c): the results are the same for any thread count (and round
+    !! differently from the routines' own blocking). Until tiles_end.
+    subroutine tiles_begin() bind(c, name='bt_begin')
+    end subroutine tiles_begin
+
+    !> Back to plain calls on the calling thread; the tiles its calls made since tiles_begin.
+    function tiles_end() result(n) bind(c, name='bt_end')
+      import :: c_long
+      integer(c_long) :: n
+    end function tiles_end
 
     !> dpotrf whose lower factor of an order above two tiles is made as OpenMP tasks of the
     !! real routine (src/linalg/blas_tiles.c): idle threads of the team help, and the factor is

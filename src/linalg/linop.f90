@@ -14,7 +14,7 @@ module linop
   implicit none (type, external)
   private
 
-  public :: linop_t, dense_op_t, csc_op_t, dense_op_init, dense_op_take, csc_op_init
+  public :: linop_t, dense_op_t, csc_op_t, dense_op_init, dense_op_take, csc_op_init, symmetrize
 
   !> An abstract symmetric linear operator of size `n`.
   type, abstract :: linop_t
@@ -72,6 +72,27 @@ contains
     op%n = size(a, 1)
     allocate (op%a(op%n, op%n), source=a)
   end subroutine dense_op_init
+
+  !> a = (a + a')/2 in place, block by block (a large matrix's transpose in one sweep
+  !! reads it a row at a time across memory): every entry the number 0.5 (a + a') gives.
+  subroutine symmetrize(a)
+    real(wp), intent(inout) :: a(:, :)      !< square
+    integer, parameter :: BLK = 64
+    integer :: n, ib, jb, i, j
+    real(wp) :: v
+    n = size(a, 1)
+    do jb = 1, n, BLK
+      do ib = jb, n, BLK
+        do j = jb, min(jb + BLK - 1, n)
+          do i = max(ib, j + 1), min(ib + BLK - 1, n)
+            v = 0.5_wp*(a(i, j) + a(j, i))
+            a(i, j) = v
+            a(j, i) = v
+          end do
+        end do
+      end do
+    end do
+  end subroutine symmetrize
 
   !> Make `op` a dense operator of the square matrix `a`, taking its storage (no copy;
   !! `a` is deallocated on return).
