@@ -226,7 +226,7 @@ $(BUILD)/robin_subproblems.o: $(BUILD)/condense.o $(BUILD)/config.o $(BUILD)/con
                            $(BUILD)/contact_interface.o $(BUILD)/contact_types.o $(BUILD)/equality_rows.o \
                            $(BUILD)/kinds.o $(BUILD)/linop.o $(BUILD)/mprgp.o $(BUILD)/robin_operators.o \
                            $(BUILD)/qp_newton.o $(BUILD)/smalbe.o $(BUILD)/sorting.o $(BUILD)/constraint_set.o \
-                           $(BUILD)/tangent_discs.o $(BUILD)/lapack.o
+                           $(BUILD)/tangent_discs.o $(BUILD)/lapack.o $(BUILD)/disc_newton.o
 $(BUILD)/acceleration.o:   $(BUILD)/kinds.o $(BUILD)/config.o $(BUILD)/lapack.o $(BUILD)/contact_types.o \
                            $(BUILD)/contact_common.o
 $(BUILD)/robin_iteration.o: $(BUILD)/acceleration.o $(BUILD)/clock.o $(BUILD)/condense.o $(BUILD)/config.o \

@@ -17,8 +17,9 @@ module robin_subproblems
   use constraint_set, only: constraint_set_t
   use tangent_discs, only: friction_set
   use qp_newton, only: newton_work_t, newton_factor, newton_forget, newton_holds
+  use disc_newton, only: disc_factor_t
   use condense, only: body_condensed_t
-  use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size, BOUND_UPPER
+  use contact_types, only: contact_result_t, robin_state_t, STATUS_FAILED, recycle_size, BOUND_UPPER, BOUND_LOWER
   use contact_common, only: gather, scatter, body_threads, partner_slots
   use sorting, only: largest_first
   use equality_rows, only: equality_t, equality_init, equality_add_penalty
@@ -58,6 +59,11 @@ module robin_subproblems
     !> friction in space: each body's Hessian on the rows its last Newton solve left free to
     !! move (not held at 0 by a disc of radius 0: Coulomb on a node without normal force)
     type(reduced_t), allocatable :: reduced(:)
+    !> friction in space: each body's factor of the Newton method on its discs, carried from
+    !! one solve to the next while its Hessian (reduced) stays; a solve takes it only as a
+    !! new factorization would make it (disc_newton's disc_factor_t%carried), so the solves
+    !! do bit for bit what they would without it, and a resumed run, which has none yet, too
+    type(disc_factor_t), allocatable :: disc_work(:)
   end type subproblems_t
 
   !> A body's Hessian on some of its rows.
@@ -102,7 +108,7 @@ contains
     n = size(bodies)
     allocate (subproblems%flexibility(n), subproblems%hessian(n), subproblems%proximal(n), subproblems%equality(n))
     allocate (subproblems%lmax_body(n), subproblems%lmax_hessian(n), nmv(n), subproblems%newton_work(n))
-    allocate (subproblems%discs(n), subproblems%reduced(n))
+    allocate (subproblems%discs(n), subproblems%reduced(n), subproblems%disc_work(n))
     do a = 1, n
       subproblems%discs(a)%pos = disc_positions(contact_line, slot_row(bodies(a)%slots, contact_line%m))
     end do
@@ -300,8 +306,12 @@ contains
       ! in space, a disc whose force was on its last circle starts on its new one (Coulomb's
       ! radius moved with lam_n): the face it slid on stays its face, and the active-set
       ! method need not find its slipping discs again one per step
-      if (size(subproblems%discs(a)%pos) > 0) call onto_new_circles(subproblems%discs(a)%pos, &
-                                                                      last_on_circle(state%row_state, cbody%slots, mm), ub, lam)
+      ! (and a tangential force alone on its node, a box, on its last bound starts on its new
+      ! one: a node on a plane of symmetry)
+      if (size(subproblems%discs(a)%pos) > 0) then
+        call onto_new_circles(subproblems%discs(a)%pos, last_on_circle(state%row_state, cbody%slots, mm), ub, lam)
+        call onto_new_bounds(subproblems%discs(a)%pos, last_bound(state%row_state, cbody%slots, mm), lb, ub, lam)
+      end if
       call set%project(lam)
       moved = any(lam /= lam0)
       if (moved) inner_solver%opts%use_ax = .false.
@@ -415,7 +425,10 @@ contains
     !! every step's work outside the face's factor. The reduced Hessian is kept while the
     !! rows stay (a copy of F_a's entries: the same values on a resumed run). A x on every
     !! row at the end from the columns of the nonzero forces. inner%n_matvec counts
-    !! products on all m rows.
+    !! products on all m rows. The solve starts from the face of the warm start (the last
+    !! answer, its forces on their new circles and bounds: hold_boundary), whose factor the
+    !! last solve left (disc_work): once the stick and slip sets settle, a solve is one
+    !! Newton step on a factor it does not make.
     subroutine solve_reduced()
       integer, allocatable :: idx(:), map(:), pr(:, :)
       real(wp), allocatable :: xr(:), axf(:)
@@ -423,6 +436,10 @@ contains
       integer :: p, j, q
       idx = pack([(i, i=1, m)], .not. (lb == 0.0_wp .and. ub == 0.0_wp))
       p = size(idx)
+      ! hardly any row held at 0: all rows (a factor carried from a reduced solve has another
+      ! size, and the solve drops it)
+      inner_solver%keep_disc => subproblems%disc_work(a)
+      inner_solver%hold_boundary = .true.
       if (16*p > 15*m) then
         call inner_solver%solve_in(subproblems%hessian(a), rhs, set, lam, rw, raw, state%nrw(:, a))
         return
@@ -437,6 +454,8 @@ contains
         if (.not. allocated(red%rows)) then
           red%rows = idx
           call dense_op_init(red%op, subproblems%hessian(a)%a(idx, idx))
+          ! another Hessian: the carried factor's positions mean other rows
+          subproblems%disc_work(a)%valid = .false.
         end if
       end associate
       allocate (map(m), source=0)
@@ -521,6 +540,47 @@ contains
       end if
     end do
   end function last_on_circle
+
+  !> Each contact row's bound state in the last iterate on the body's side (BOUND_*; 0: not
+  !! known yet), from robin_state_t%row_state.
+  pure function last_bound(row_state, slots, m) result(code)
+    integer, intent(in) :: row_state(:)       !< (m) side 1's state + 4 x side 2's (-1: none yet)
+    integer, intent(in) :: slots(:)           !< the body's slots
+    integer, intent(in) :: m                  !< contact rows of all pairs
+    integer :: code(size(slots))
+    integer :: i, c
+    do i = 1, size(slots)
+      c = row_state(slot_row(slots(i), m))
+      if (c < 0) then
+        code(i) = 0
+      else if (slot_side(slots(i), m) == 1) then
+        code(i) = mod(c, 4)
+      else
+        code(i) = c/4
+      end if
+    end do
+  end function last_bound
+
+  !> Each bounded row outside the discs (pos) whose force was on a bound in the last iterate
+  !! (code) is put on that bound now (Coulomb's bound moved with lam_n).
+  pure subroutine onto_new_bounds(pos, code, lb, ub, lam)
+    integer, intent(in) :: pos(:, :)          !< (2, discs) the discs' variables
+    integer, intent(in) :: code(:)            !< per variable: BOUND_* of the last iterate (0: not known)
+    real(wp), intent(in) :: lb(:), ub(:)      !< the bounds now
+    real(wp), intent(inout) :: lam(:)
+    logical :: in_disc(size(lam))
+    integer :: i
+    in_disc = .false.
+    in_disc(pack(pos, .true.)) = .true.
+    do i = 1, size(lam)
+      if (in_disc(i) .or. .not. (ub(i) < huge(1.0_wp) .and. lb(i) > -huge(1.0_wp))) cycle
+      if (code(i) == BOUND_UPPER) then
+        lam(i) = ub(i)
+      else if (code(i) == BOUND_LOWER) then
+        lam(i) = lb(i)
+      end if
+    end do
+  end subroutine onto_new_bounds
 
   !> Each disc k (its variables pos(:, k)) whose force was on its circle in the last iterate
   !! (was_on) is scaled onto its circle of radius r now: the same direction.

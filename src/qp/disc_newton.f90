@@ -25,8 +25,12 @@
 !! held discs' pairs (disc_factor_t), made once a solve (`dpotrf_tiles`) and then carried
 !! from face to face by row updates (a disc that reaches its circle costs O(p^2), not a
 !! new O(p^3) factor), with the Schur complement on the held discs' tangents, which turn
-!! at every step. Each step computes the gradient afresh (one product with A; the
-!! projection makes a recurrence inexact).
+!! at every step. A caller that solves nearby problems with the same A (the Robin
+!! iteration's solves of a body) may carry the factor from one solve to the next: a solve
+!! takes it only when it is what a new factorization of its first face makes, bit for bit
+!! (disc_factor_t%carried). Blockers within a negligible part of a step (TINY_STEP: on
+!! their bounds but for rounding) are held all at once. Each step computes the gradient
+!! afresh (one product with A; the projection makes a recurrence inexact).
 !!
 !! Thread safety: no module variables; the work arrays are the caller's.
 module disc_newton
@@ -44,6 +48,8 @@ module disc_newton
   integer, parameter :: DN_STILL = 1      !< no step: x is its face's minimiser and nothing is released
   integer, parameter :: DN_NOT_SPD = 2    !< the face's matrix is not positive definite (A is not SPD)
   integer, parameter :: MAX_HALVING = 40
+  !> a step cut at most this part of its length is a blocker on its bound but for rounding
+  real(wp), parameter :: TINY_STEP = 1.0e-6_wp
 
   !> The factor the steps of one solve carry: L L' = A(U, U), U the free variables (the
   !! F part, first) then both variables of each held disc (the P part, in pairs, last).
@@ -60,6 +66,12 @@ module disc_newton
     integer :: nd = 0                    !< the P part's discs
     integer :: updates = 0               !< rows changed since the factor was made
     logical :: valid = .false.           !< h holds a factor
+    !> the factor comes from an earlier solve with the same A (set at a solve's start): its
+    !! first step takes it only when it is a new factor (no updates since it was made) of
+    !! exactly that step's face, and then it is bit for bit what factoring the face makes
+    !! (the order of a new factor is the face's; fresh); otherwise it is made anew. So the
+    !! solve does what it would do without it, on a resumed run as on the uninterrupted one
+    logical :: carried = .false.
   end type disc_factor_t
 
 contains
@@ -142,6 +154,28 @@ contains
     ! 3. the feasible step of the free variables (the held discs turn, they are not cut)
     call set%max_step(x, dfree, 1.0_wp, tmax, blk)
     tmax = max(tmax, 0.0_wp)
+    ! blockers within a negligible part of the step (variables on a bound but for rounding: a
+    ! warm start's leftovers) are all held at once and pinned there, and the next step is the
+    ! Newton step of that face; not a step of length ~0 for each of them
+    if (blk /= 0 .and. tmax <= TINY_STEP) then
+      do while (blk /= 0 .and. tmax <= TINY_STEP)
+        call set%pin(x, dfree, blk)
+        if (set%disc(blk) > 0) then
+          held(set%pair(:, set%disc(blk))) = .true.
+          dfree(set%pair(:, set%disc(blk))) = 0.0_wp
+        else
+          held(blk) = .true.
+          dfree(blk) = 0.0_wp
+        end if
+        call set%max_step(x, dfree, 1.0_wp, tmax, blk)
+        tmax = max(tmax, 0.0_wp)
+      end do
+      call dsymv('U', n, 1.0_wp, a, n, x, 1, 0.0_wp, ax, 1)
+      g = ax - b
+      flops = flops + 2.0_wp*real(n, wp)**2
+      at_min = .false.
+      return
+    end if
     t = tmax
     x0 = x
     g0 = g
@@ -300,13 +334,23 @@ contains
     logical, allocatable :: in_f(:), in_d(:), keep(:)
     integer :: n, p, np, pc, nchange, i, k, q, v
     real(wp) :: piv
+    logical :: was_carried
     n = size(a, 1)
     info = 0
+    ! a factor of a problem of another size holds nothing of this one
+    if (allocated(fac%h)) then
+      if (size(fac%h, 1) /= max(1, n) .or. size(fac%pos) /= n) then
+        deallocate (fac%h, fac%var, fac%pos, fac%pdisc)
+        fac%valid = .false.
+      end if
+    end if
     if (.not. allocated(fac%h)) then
       allocate (fac%h(max(1, n), max(1, n)), fac%var(n), fac%pdisc(0))
       allocate (fac%pos(n), source=0)
       fac%valid = .false.
     end if
+    was_carried = fac%carried
+    fac%carried = .false.
     allocate (in_f(n), in_d(size(set%r)), source=.false.)
     in_f(free) = .true.
     in_d(dk) = .true.
@@ -323,8 +367,8 @@ contains
       do i = 1, size(dk)
         if (fac%pos(set%pair(1, dk(i))) <= fac%nf) nchange = nchange + 2
       end do
-      if (nchange == 0) return
-      if (12*nchange <= p .and. 2*(fac%updates + nchange) <= p) then
+      if (nchange == 0 .and. .not. (was_carried .and. fac%updates > 0)) return
+      if (.not. was_carried .and. 12*nchange <= p .and. 2*(fac%updates + nchange) <= p) then
         call update()
         if (info == 0) return
       end if
@@ -389,6 +433,7 @@ contains
     !> A new factor: F in the order of `free`, then the discs of dk.
     subroutine fresh()
       integer :: i2, j2, pp
+      real(wp), allocatable :: t(:, :)
       call forget()
       fac%nf = size(free)
       fac%nd = size(dk)
@@ -398,15 +443,21 @@ contains
         fac%var(fac%nf + 2*i2 - 1:fac%nf + 2*i2) = set%pair(:, dk(i2))
       end do
       fac%pdisc = dk
+      ! in a pp x pp array of its own: the factor's bits depend on A on the face alone, not
+      ! on the size of the problem (h's leading dimension)
+      allocate (t(pp, pp))
       do j2 = 1, pp
         do i2 = j2, pp
-          fac%h(i2, j2) = a(fac%var(i2), fac%var(j2))
+          t(i2, j2) = a(fac%var(i2), fac%var(j2))
         end do
       end do
-      call dpotrf_tiles('L', pp, fac%h, size(fac%h, 1), info)
+      call dpotrf_tiles('L', pp, t, pp, info)
       flops = flops + real(pp, wp)**3/3.0_wp
       factored = factored + 1
       if (info /= 0) return
+      do j2 = 1, pp
+        fac%h(j2:pp, j2) = t(j2:pp, j2)
+      end do
       call renumber()
       fac%updates = 0
       fac%valid = .true.

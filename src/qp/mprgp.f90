@@ -101,6 +101,15 @@ module mprgp
     !! taken again while the free set recurs); `keep_same_a`: A is the one of its last solve
     type(newton_work_t), pointer :: keep => null()
     logical :: keep_same_a = .false.
+    !> the caller's factor of the Newton method on the discs, carried from one solve to the
+    !! next with the same A (the caller drops it when A changes): a solve takes it only as
+    !! a new factorization would make it (disc_factor_t%carried)
+    type(disc_factor_t), pointer :: keep_disc => null()
+    !> the Newton method on the discs starts from the face of x: every variable on its bound
+    !! and every disc on its circle held (a warm start from the last solve's answer: its
+    !! face, whose factor keep_disc may hold), releasing only at the face's minimiser; else
+    !! from the binding ones (on the boundary with the gradient pointing out)
+    logical :: hold_boundary = .false.
     ! the iteration's state
     integer, private :: n = 0              ! unknowns
     integer, private :: it = 0             ! steps taken
@@ -434,14 +443,25 @@ contains
     logical :: at_min
     real(wp) :: betabeta, phitphi, flops
     integer :: outcome, still
-    type(disc_factor_t) :: fac
+    type(disc_factor_t), target :: own
+    type(disc_factor_t), pointer :: fac
+    fac => own
+    if (associated(self%keep_disc)) then
+      fac => self%keep_disc
+      fac%carried = .true.
+    end if
     select type (set)
     type is (disc_set_t)
       select type (A)
       type is (dense_op_t)
         if (.not. self%fresh) call true_gradient(self, A, b, x)
         allocate (held(self%n))
-        call disc_held(set, x, self%g, held)
+        if (self%hold_boundary) then
+          call set%free_mask(x, held)
+          held = .not. held
+        else
+          call disc_held(set, x, self%g, held)
+        end if
         at_min = .false.
         still = 0
         main: do

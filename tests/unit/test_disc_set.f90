@@ -20,7 +20,12 @@
 !!  - the Newton method along the circles (module disc_newton): the same minimiser as MPGP's
 !!    on that problem, and at condition 1e6 (40 nodes) the KKT conditions to 1e-10 |b|
 !!    within 200 steps; 'auto' (MPGP within its budget, then that method) at condition 1e3:
-!!    switched, MPGP's minimiser at fewer products.
+!!    switched, MPGP's minimiser at fewer products;
+!!  - a sequence of nearby problems (the same A, b and radii moved a little each time, as the
+!!    Robin iteration's solves of a body), each from the last answer: started from its face
+!!    with the factor carried from solve to solve, bit for bit the answers of the same
+!!    starts with a new factor each solve, with fewer factorizations, and the minimisers of
+!!    the default start (the binding set) to 1e-9 with the KKT conditions to 1e-10 |b|.
 !! One line per check: PASS/FAIL. Exits with status 1 if any check failed.
 program test_disc_set
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
@@ -49,6 +54,7 @@ program test_disc_set
   call test_newton_hard()
   call test_auto()
   call test_carried_factor()
+  call test_warm_sequence()
   call test_summary()
 
 contains
@@ -367,6 +373,97 @@ contains
                 'auto on discs, condition 1e3: switched to the Newton method, '//trim(msg))
     call report_le(norm2(x2 - x)/norm2(x), 1.0e-9_wp, 'auto on discs: the minimiser of MPGP alone')
   end subroutine test_auto
+
+  !> Eight nearby problems (30 nodes, condition 1e2; b and the radii moved by up to 1% and 2%
+  !! each time), each from the last answer projected onto its set, solved three ways by the
+  !! Newton method on the discs: (a) from the binding set (the default); (b) from the face of
+  !! the start (hold_boundary) with the factor carried (keep_disc); (c) as (b) with a new
+  !! factor each solve. (b) = (c) bit for bit with fewer factorizations; (b) = (a) to 1e-9
+  !! and the KKT conditions to 1e-10 |b|.
+  subroutine test_warm_sequence()
+    integer, parameter :: nk = 30, n = 3*nk, nseq = 8
+    type(disc_set_t) :: set
+    type(dense_op_t) :: A
+    type(mprgp_t) :: sa, sb, sc
+    type(disc_factor_t), target :: carried
+    real(wp) :: a0(n, n), b0(n), b(n), r0(nk), r(nk), rprev(nk), lmax, xa(n), xb(n), xc(n), kkt, worst_a, worst_k
+    integer :: k, j, fb, fc
+    logical :: same
+    call random_friction_qp(nk, 2.0_wp, a0, b0, r0, lmax)
+    call dense_op_init(A, a0)
+    xa = 0.0_wp
+    xb = 0.0_wp
+    xc = 0.0_wp
+    same = .true.
+    fb = 0
+    fc = 0
+    worst_a = 0.0_wp
+    worst_k = 0.0_wp
+    do k = 1, nseq
+      do j = 1, n
+        b(j) = b0(j)*(1.0_wp + 1.0e-4_wp*sin(real(7*j + 3*k, wp)))
+      end do
+      do j = 1, nk
+        r(j) = r0(j)*(1.0_wp + 2.0e-4_wp*cos(real(5*j + k, wp)))
+      end do
+      set = node_set(r)
+      ! a force on its last circle onto its new one (as the Robin iteration does)
+      if (k > 1) then
+        call onto_circles(xa, rprev, r)
+        call onto_circles(xb, rprev, r)
+        call onto_circles(xc, rprev, r)
+      end if
+      call set%project(xa)
+      call set%project(xb)
+      call set%project(xc)
+      rprev = r
+      call warm_solve(sa, A, b, set, xa, .false., .false., carried)
+      call warm_solve(sb, A, b, set, xb, .true., .true., carried)
+      fb = fb + sb%stats%n_factor
+      call warm_solve(sc, A, b, set, xc, .true., .false., carried)
+      fc = fc + sc%stats%n_factor
+      same = same .and. all(xb == xc) .and. sb%stats%status == MPRGP_CONVERGED .and. sc%stats%status == MPRGP_CONVERGED
+      worst_a = max(worst_a, norm2(xb - xa)/norm2(xa))
+      call kkt_of(a0, b, xb, r, kkt, j)
+      worst_k = max(worst_k, kkt/norm2(b))
+    end do
+    call report(same, 'warm sequence: the factor carried from solve to solve = a new one each solve, bit for bit')
+    call report(fb < fc, 'warm sequence: carried, '//i2s(fb)//' factorizations against '//i2s(fc))
+    call report_le(worst_a, 1.0e-9_wp, 'warm sequence: started from the face = from the binding set')
+    call report_le(worst_k, 1.0e-10_wp, 'warm sequence: KKT conditions of every answer')
+
+  end subroutine test_warm_sequence
+
+  !> Each node's tangential force on its circle of radius rprev (but for rounding) put on its
+  !! circle of radius r, the same direction (as the Robin iteration does between solves).
+  subroutine onto_circles(x, rprev, r)
+    real(wp), intent(inout) :: x(:)
+    real(wp), intent(in) :: rprev(:), r(:)
+    integer :: q
+    real(wp) :: h
+    do q = 1, size(r)
+      h = hypot(x(3*q - 1), x(3*q))
+      if (h > 0.0_wp .and. h >= rprev(q)*(1.0_wp - 1.0e-14_wp)) x(3*q - 1:3*q) = x(3*q - 1:3*q)*(r(q)/h)
+    end do
+  end subroutine onto_circles
+
+  !> One solve of test_warm_sequence by the Newton method on the discs, from the face of x
+  !! (face) or the binding set, with the factor `carried` from the last solve (carry).
+  subroutine warm_solve(s, A, b, set, x, face, carry, carried)
+    type(mprgp_t), intent(inout) :: s
+    type(dense_op_t), intent(inout) :: A
+    real(wp), intent(in) :: b(:)
+    type(disc_set_t), intent(in) :: set
+    real(wp), intent(inout) :: x(:)
+    logical, intent(in) :: face, carry
+    type(disc_factor_t), target, intent(inout) :: carried
+    s%opts%method = QP_NEWTON
+    s%opts%rtol = 1.0e-11_wp
+    s%opts%max_it = 1000
+    s%hold_boundary = face
+    if (carry) s%keep_disc => carried
+    call s%solve_in(A, b, set, x)
+  end subroutine warm_solve
 
   !> A random friction QP of nk nodes: A SPD of condition 10^cexp, b with normal parts of
   !! both signs, radii 0.3 to 1.5 times the tangential forces of the unconstrained minimiser
