@@ -241,6 +241,7 @@ contains
     class(constraint_set_t), allocatable :: set
     real(wp), allocatable :: lb(:), ub(:), lam(:), lam0(:), flam0(:), rw(:, :), raw(:, :)
     integer :: m, k, ka, r, mm, nfree, changed, i, steps
+    integer, allocatable :: last(:)
     logical :: moved, definite
     real(wp) :: cost, flops
     m = size(rhs)
@@ -309,8 +310,9 @@ contains
       ! (and a tangential force alone on its node, a box, on its last bound starts on its new
       ! one: a node on a plane of symmetry)
       if (size(subproblems%discs(a)%pos) > 0) then
-        call onto_new_circles(subproblems%discs(a)%pos, last_on_circle(state%row_state, cbody%slots, mm), ub, lam)
-        call onto_new_bounds(subproblems%discs(a)%pos, last_bound(state%row_state, cbody%slots, mm), lb, ub, lam)
+        last = last_bound(state%row_state, cbody%slots, mm)
+        call onto_new_circles(subproblems%discs(a)%pos, last == BOUND_UPPER, ub, lam)
+        call onto_new_bounds(subproblems%discs(a)%pos, last, lb, ub, lam)
       end if
       call set%project(lam)
       moved = any(lam /= lam0)
@@ -520,29 +522,9 @@ contains
 
   end subroutine solve_body
 
-  !> Whether each of a body's contact forces was at its upper bound in the last iterate (in
-  !! space: its disc's force on its circle), from the rows' states (robin_state_t%row_state,
-  !! checkpointed: a resumed run decides alike).
-  pure function last_on_circle(row_state, slots, m) result(on)
-    integer, intent(in) :: row_state(:)       !< (m) side 1's state + 4 x side 2's (-1: none yet)
-    integer, intent(in) :: slots(:)           !< the body's slots
-    integer, intent(in) :: m                  !< contact rows of all pairs
-    logical :: on(size(slots))
-    integer :: i, code
-    do i = 1, size(slots)
-      code = row_state(slot_row(slots(i), m))
-      if (code < 0) then
-        on(i) = .false.
-      else if (slot_side(slots(i), m) == 1) then
-        on(i) = mod(code, 4) == BOUND_UPPER
-      else
-        on(i) = code/4 == BOUND_UPPER
-      end if
-    end do
-  end function last_on_circle
-
   !> Each contact row's bound state in the last iterate on the body's side (BOUND_*; 0: not
-  !! known yet), from robin_state_t%row_state.
+  !! known yet; in space BOUND_UPPER for a disc's force on its circle), from the rows' states
+  !! (robin_state_t%row_state, checkpointed: a resumed run decides alike).
   pure function last_bound(row_state, slots, m) result(code)
     integer, intent(in) :: row_state(:)       !< (m) side 1's state + 4 x side 2's (-1: none yet)
     integer, intent(in) :: slots(:)           !< the body's slots
