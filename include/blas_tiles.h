@@ -9,6 +9,10 @@ void bt_init(void);
 void bt_begin(void);
 /* Back to plain calls; returns the tiles this thread's calls made since bt_begin. */
 long bt_end(void);
+/* A task's body on this thread with plain calls (the thread may be inside a tiled call,
+ * taking the task at its taskwait): the state before, for bt_resume. */
+int bt_pause(void);
+void bt_resume(int was);
 /* dpotrf as tiles (lower, n > 2 TILE) wherever it is called, the caller's state unchanged
  * (Fortran: lapack's dpotrf_tiles). */
 void dpotrf_tiles_(const char *uplo, const int *n, double *a, const int *lda, int *info);

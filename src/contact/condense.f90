@@ -21,8 +21,8 @@ module condense
   use clock, only: wtime
   use errors, only: error_t, ERR_MEMORY
   use lapack, only: dpotrf_tiles, dpotrs, dpocon, dpstrf, dsyevr, dsyevd, dsyev, dgemm, dgeqrf, dorgqr, dsytrf, &
-                    tiles_begin, tiles_end
-  use iso_c_binding, only: c_long
+                    tiles_begin, tiles_end, tiles_pause, tiles_resume
+  use iso_c_binding, only: c_long, c_int
   implicit none (type, external)
   private
 
@@ -520,6 +520,7 @@ contains
     integer :: st
     type(error_t) :: err_load
     logical :: beside
+    integer(c_int) :: tiles
     t0 = wtime()
     beside = .false.
     if (cbody%fac%holds_result()) then
@@ -535,8 +536,10 @@ contains
         ! body loop leaves idle takes it (else this one, at the wait)
         beside = cbody%fac%flexibility_beside_solve(cbody%idx)
         if (beside) then
-          !$omp task default(shared)
+          !$omp task default(shared) private(tiles)
+          tiles = tiles_pause()
           call interface_load(sys, cbody, err_load)
+          call tiles_resume(tiles)
           !$omp end task
         end if
         call cbody%fac%rows_flexibility(cbody%idx, cbody%bptr, cbody%bpos, cbody%bval, cbody%flex, err)
@@ -628,6 +631,8 @@ contains
     real(wp), allocatable :: f(:, :), work(:), ev(:), z(:, :), lsh(:, :)
     integer, allocatable :: piv(:), isuppz(:), iwork(:)
     integer :: lapinfo, r, lwork, liwork, k, nfound, nnear, shinfo
+    integer(c_int) :: tiles
+    logical :: sub
     logical :: halting(size(ieee_usual)), converged
     real(wp) :: dmax, rcond, anorm
     integer :: i
@@ -692,15 +697,20 @@ contains
     liwork = max(10*cbody%m, iwork(1))
     deallocate (work, iwork)
     allocate (work(lwork), iwork(liwork))
+    deallocate (f)   ! (made again for dsyevr below, if it is needed)
+    ! the subspace iteration's block of 2k vectors (at least k + 32) fits (smallest_eigenvectors)
+    sub = cbody%m >= SUBSPACE_MIN .and. max(2*k, k + 32) < cbody%m
     ! how many eigenvalues lie below NEAR_KERNEL max diag: the inertia of F_a - NEAR_KERNEL
     ! max diag I (Sylvester), its negative eigenvalues those of D in L D L' (a quarter of the
     ! tridiagonal reduction that counting by dsyevr took)
-    if (cbody%m >= SUBSPACE_MIN) then
+    if (sub) then
       ! the count and the shifted factor of the subspace iteration below need only F_a: two
       ! tasks (a thread the body loop leaves idle takes one)
       !$omp taskgroup
-      !$omp task default(shared)
+      !$omp task default(shared) private(tiles)
+      tiles = tiles_pause()
       nnear = count_below(cbody%flex, NEAR_KERNEL*dmax)
+      call tiles_resume(tiles)
       !$omp end task
       call shifted_factor(cbody%flex, dmax, lsh, shinfo)
       !$omp end taskgroup
@@ -713,7 +723,7 @@ contains
       allocate (z(cbody%m, k))
     end if
     lapinfo = 1
-    if (cbody%m >= SUBSPACE_MIN) then
+    if (sub) then
       ! a large F_a: its k smallest eigenvectors by subspace iteration, a fraction of the
       ! tridiagonal reduction's time (LAPACK's own eigensolver when that does not converge)
       converged = .false.
@@ -795,18 +805,19 @@ contains
     real(wp), intent(in) :: dmax
     real(wp), allocatable, intent(out) :: z(:, :)
     logical, intent(out) :: converged   !< the k vectors found (else z undefined)
-    real(wp), intent(in), optional :: lsh(:, :)   !< shifted_factor's factor (else made here)
+    real(wp), allocatable, intent(inout), optional :: lsh(:, :)   !< shifted_factor's factor, taken (else made here)
     integer, parameter :: MAX_SOLVES = 12
     real(wp), allocatable :: l(:, :), v(:, :), fv(:, :), hs(:, :), ev(:), work(:), tau(:)
     integer :: m, b, i, j, it, info, lwork, h, info2
     integer(c_long) :: ntiles
+    integer(c_int) :: tiles
     real(wp) :: res
     m = size(f, 1)
     b = max(2*k, k + 32)
     converged = .false.
     if (k < 1 .or. b >= m) return
     if (present(lsh)) then
-      l = lsh
+      call move_alloc(lsh, l)
     else
       call shifted_factor(f, dmax, l, info)
       if (info /= 0) return
@@ -829,8 +840,10 @@ contains
       ! the columns in two halves, two tasks (the same numbers for any thread count)
       h = b/2
       !$omp taskgroup
-      !$omp task default(shared)
+      !$omp task default(shared) private(tiles)
+      tiles = tiles_pause()
       call dpotrs('L', m, h, l, m, v, m, info2)
+      call tiles_resume(tiles)
       !$omp end task
       call dpotrs('L', m, b - h, l, m, v(1, h + 1), m, info)
       !$omp end taskgroup

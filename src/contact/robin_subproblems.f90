@@ -543,8 +543,9 @@ contains
     end do
   end function last_bound
 
-  !> Each bounded row outside the discs (pos) whose force was on a bound in the last iterate
-  !! (code) is put on that bound now (Coulomb's bound moved with lam_n).
+  !> Each bounded row outside the discs (pos) whose force was on a nonzero bound in the last
+  !! iterate (code, and the force's sign) is put on that bound now (Coulomb's bound moved
+  !! with lam_n).
   pure subroutine onto_new_bounds(pos, code, lb, ub, lam)
     integer, intent(in) :: pos(:, :)          !< (2, discs) the discs' variables
     integer, intent(in) :: code(:)            !< per variable: BOUND_* of the last iterate (0: not known)
@@ -556,9 +557,10 @@ contains
     in_disc(pack(pos, .true.)) = .true.
     do i = 1, size(lam)
       if (in_disc(i) .or. .not. (ub(i) < huge(1.0_wp) .and. lb(i) > -huge(1.0_wp))) cycle
-      if (code(i) == BOUND_UPPER) then
+      ! (a zero force counts as on its bound where the bound was 0: no side to keep)
+      if (code(i) == BOUND_UPPER .and. lam(i) > 0.0_wp) then
         lam(i) = ub(i)
-      else if (code(i) == BOUND_LOWER) then
+      else if (code(i) == BOUND_LOWER .and. lam(i) < 0.0_wp) then
         lam(i) = lb(i)
       end if
     end do

@@ -99,6 +99,18 @@ long bt_end(void)
     return tiles_run;
 }
 
+int bt_pause(void)
+{
+    int was = tiles_on;
+    tiles_on = 0;
+    return was;
+}
+
+void bt_resume(int was)
+{
+    tiles_on = was;
+}
+
 static int is_n(const char *t)
 {
     return *t == 'N' || *t == 'n';

@@ -6,7 +6,7 @@
 !! OpenBLAS to one thread so that two OpenMP threads may call them at once.
 module lapack
   use kinds, only: wp
-  use iso_c_binding, only: c_long
+  use iso_c_binding, only: c_long, c_int
   implicit none (type, external)
   private
 
@@ -14,7 +14,7 @@ module lapack
   public :: dpotrf, dpotrf_tiles, dpotrs, dpotri, dposv, dpocon, dpstrf, dsyev, dsyevd, dsyevr
   public :: dpbtrf, dpbtrs, dpbsv
   public :: dgels, dgesv, dsygv, dgesvd, dgeqrf, dorgqr, dsytrf
-  public :: tiles_begin, tiles_end
+  public :: tiles_begin, tiles_end, tiles_pause, tiles_resume
 
   interface
 
@@ -130,6 +130,20 @@ module lapack
       import :: c_long
       integer(c_long) :: n
     end function tiles_end
+
+    !> The calling thread's calls plain until tiles_resume (an OpenMP task's body: the thread
+    !! that runs it may be inside a tiled call, taking the task at its wait, and the task's
+    !! numbers must not depend on that); the state before.
+    function tiles_pause() result(was) bind(c, name='bt_pause')
+      import :: c_int
+      integer(c_int) :: was
+    end function tiles_pause
+
+    !> The state tiles_pause returned, back.
+    subroutine tiles_resume(was) bind(c, name='bt_resume')
+      import :: c_int
+      integer(c_int), value :: was
+    end subroutine tiles_resume
 
     !> dpotrf whose lower factor of an order above two tiles is made as OpenMP tasks of the
     !! real routine (src/linalg/blas_tiles.c): idle threads of the team help, and the factor is

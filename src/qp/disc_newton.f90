@@ -367,7 +367,12 @@ contains
       do i = 1, size(dk)
         if (fac%pos(set%pair(1, dk(i))) <= fac%nf) nchange = nchange + 2
       end do
-      if (nchange == 0 .and. .not. (was_carried .and. fac%updates > 0)) return
+      if (nchange == 0 .and. .not. (was_carried .and. fac%updates > 0)) then
+        ! a carried factor taken is counted as made: the work reported does not depend on
+        ! it (a resumed run, which makes it, reports the same)
+        if (was_carried) flops = flops + real(p, wp)**3/3.0_wp
+        return
+      end if
       if (.not. was_carried .and. 12*nchange <= p .and. 2*(fac%updates + nchange) <= p) then
         call update()
         if (info == 0) return

@@ -371,10 +371,12 @@ def load_history(tmp):
                             "contact", runs["two stages", "robin"].c)
 
 
-def restart_in_second_stage(tmp, what, over, max_outer, group, want):
+def restart_in_second_stage(tmp, what, over, max_outer, group, want, want_file=None):
     """A two-stage run (the deck tmp/path_two_robin.nml with over) stopped at max_outer in its
     second stage, restarted from its checkpoint: bitwise want (the uninterrupted run's datasets
-    of `group`)."""
+    of `group`); with want_file (the uninterrupted run's result) also its history (criterion,
+    residual, inner products) and its inner count, which the work a resumed run does again
+    (factors it had carried) must not change."""
     stem = os.path.join(tmp, "path_restart")
     deck = os.path.join(tmp, "path_two_robin.nml")
     p1 = subprocess.run([BIN, deck, *over, f"&solver max_outer={max_outer} /",
@@ -389,6 +391,14 @@ def restart_in_second_stage(tmp, what, over, max_outer, group, want):
             same = all(np.array_equal(np.array(f[group][k]), want[k])
                        for k in ("normal_force", "tangential_force", "slip", "slip_increment"))
         check(same, f"{what}: the restarted run = the uninterrupted one, bitwise")
+        if want_file:
+            with h5py.File(stem + ".h5", "r") as f, h5py.File(want_file, "r") as g:
+                same = all(np.array_equal(np.array(f["history"][k]), np.array(g["history"][k]))
+                           for k in ("criterion", "residual", "inner")) and \
+                    f.attrs["inner_iterations"] == g.attrs["inner_iterations"]
+                got = (int(f.attrs["inner_iterations"]), int(g.attrs["inner_iterations"]))
+            check(same, f"{what}: the restarted run's history and inner products = the uninterrupted one's",
+                  f"inner {got[0]} and {got[1]}")
 
 
 def main():

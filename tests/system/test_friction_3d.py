@@ -273,7 +273,7 @@ def load_history(tmp):
     check(not np.allclose(g["slip"], g["slip_increment"]), "3D load history: the second stage's slip increment is not "
           "its slip")
     restart_in_second_stage(tmp, "3D load history", [PRESS.format(", stage=1"), SHIFT.format(", stage=2"), TIGHT], 40,
-                            "contact/pair_1", pair(runs["two stages", "robin"]))
+                            "contact/pair_1", pair(runs["two stages", "robin"]), runs["two stages", "robin"].h5)
     return runs
 
 
