@@ -406,7 +406,9 @@ contains
       '`''auto''`: MPRGP within about the work of three factorizations, then the active-set method '// &
       'from where MPRGP stopped, and for the rest of the run on that body; a body held by its '// &
       'supports whose last solve cost MPRGP more than two active-set steps starts its next solve '// &
-      'with the active-set method (one step when its contact set stays), MPRGP after a budget')
+      'with the active-set method (one step when its contact set stays), MPRGP after a budget; '// &
+      'with friction between solid bodies, a body held by its supports takes the active-set '// &
+      'method along the circles from its second solve on, from the face of its last forces')
     call v%int('inner_max_it', s%inner_max_it, range='>= 1', doc='inner iteration limit per '// &
       'subproblem (MPRGP and Newton steps)')
     call v%real('monolithic_rtol', s%monolithic_rtol, unit='[-]', range='0 < monolithic_rtol < 1', &
