@@ -322,7 +322,7 @@ contains
     ! y = P F = F - G' (q F);  pf = y P = y - (y q') G
     y = cbody%flex - matmul(transpose(cbody%rg), matmul(q, cbody%flex))
     pf = y - matmul(matmul(y, transpose(q)), cbody%rg)
-    pf = 0.5_wp*(pf + transpose(pf))
+    call symmetrize(pf)
   end function projected_flex
 
   ! ---- constant --------------------------------------------------------------------------
@@ -814,7 +814,7 @@ contains
       ! definite even if F_o is nearly singular on ker F_a
       call dgemm('T', 'N', k, m, m, 1.0_wp, bodies(a)%kern, m, fo, m, 0.0_wp, zf, k)
       call dgemm('N', 'N', k, k, m, 1.0_wp, zf, k, bodies(a)%kern, m, 0.0_wp, r, k)
-      r = 0.5_wp*(r + transpose(r))
+      call symmetrize(r)
       floor = 0.0_wp
       do i = 1, m
         floor = max(floor, 1.0e-10_wp*fo(i, i))
@@ -1031,7 +1031,7 @@ contains
     end do
     if (blk(1)%nrig > 0 .and. blk(2)%nrig > 0) then
       a = q(:, :, 1) + q(:, :, 2)
-      a = 0.5_wp*(a + transpose(a))
+      call symmetrize(a)
       s = 0.0_wp
       do i = 1, m
         s(i, i) = 2.0_wp
@@ -1048,7 +1048,7 @@ contains
       s = 2.0_wp*blk(o)%f
       call dgesv(m, m, a, m, ipiv, s, m, info)
     end if
-    s = 0.5_wp*(s + transpose(s))
+    call symmetrize(s)
   end subroutine harmonic_floating
 
   !> The harmonic operator of a pair of two bodies (in no other pair) with a floating body
@@ -1108,7 +1108,7 @@ contains
       nz = size(z, 2)
       y = mm('N', 'N', f, z)
       c = mm('T', 'N', z, y)
-      c = 0.5_wp*(c + transpose(c))
+      call symmetrize(c)
     end if
     allocate (ev(nz), work(1), iwork(1), k(m, m))
     k = 0.0_wp
@@ -1217,12 +1217,12 @@ contains
     t = k
     x = mm('N', 'N', t, v)
     t = mm('T', 'N', v, x)
-    t = 0.5_wp*(t + transpose(t))
+    call symmetrize(t)
     x = transpose(v)
     call dposv('U', nv, m, t, nv, x, nv, info)
     if (info /= 0) return
     s = 2.0_wp*mm('N', 'N', v, x)
-    s = 0.5_wp*(s + transpose(s))
+    call symmetrize(s)
   end subroutine assembly_flex
 
   !> C = op(A) op(B) (op: 'N' as it is, 'T' transposed) by BLAS: the dense blocks of a
@@ -1311,7 +1311,7 @@ contains
     call dposv('U', r, m, gg, r, t, r, info)
     if (info /= 0) return
     finv = finv - matmul(y, t)
-    finv = 0.5_wp*(finv + transpose(finv))
+    call symmetrize(finv)
   end subroutine project_rows_out
 
 end module robin_operators
